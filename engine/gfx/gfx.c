@@ -1,0 +1,309 @@
+/* Textures, framebuffers, draws, the frame block, meshes, timers, readback. */
+#include "gfx/gfx.h"
+
+#include <epoxy/gl.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- formats ----------------------------------------------------------- */
+static const struct {
+  const char *name;
+  GLenum internal;
+  int bytes;
+} formats[LM_FORMAT_COUNT] = {
+    [LM_FORMAT_RGBA8] = {"rgba8", GL_RGBA8, 4},
+    [LM_FORMAT_RGBA16F] = {"rgba16f", GL_RGBA16F, 8},
+    [LM_FORMAT_RGBA32F] = {"rgba32f", GL_RGBA32F, 16},
+    [LM_FORMAT_R16F] = {"r16f", GL_R16F, 2},
+    [LM_FORMAT_R32F] = {"r32f", GL_R32F, 4},
+    [LM_FORMAT_RG16F] = {"rg16f", GL_RG16F, 4},
+    [LM_FORMAT_RG32F] = {"rg32f", GL_RG32F, 8},
+    [LM_FORMAT_DEPTH32F] = {"depth32f", GL_DEPTH_COMPONENT32F, 4},
+};
+
+const char *lm_format_name(lm_format f) {
+  return f > LM_FORMAT_NONE && f < LM_FORMAT_COUNT ? formats[f].name : "none";
+}
+
+lm_format lm_format_parse(const char *name) {
+  for (int f = 1; f < LM_FORMAT_COUNT; f++)
+    if (!strcmp(formats[f].name, name)) return (lm_format)f;
+  return LM_FORMAT_NONE;
+}
+
+bool lm_format_is_depth(lm_format f) { return f == LM_FORMAT_DEPTH32F; }
+int lm_format_bytes(lm_format f) { return f > 0 && f < LM_FORMAT_COUNT ? formats[f].bytes : 0; }
+
+const char *lm_format_list(void) {
+  return "rgba8, rgba16f, rgba32f, r16f, r32f, rg16f, rg32f, depth32f";
+}
+
+/* ---- textures ---------------------------------------------------------- */
+int lm_texture_max_size(void) {
+  GLint n = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &n);
+  return n;
+}
+
+static int mip_levels(int w, int h) {
+  int levels = 1;
+  while ((w | h) > 1) w >>= 1, h >>= 1, levels++;
+  return levels;
+}
+
+bool lm_texture_create(lm_texture *tex, const lm_texture_desc *d, const char *label, lm_error *err) {
+  int max = lm_texture_max_size();
+  if (d->width < 1 || d->height < 1 || d->width > max || d->height > max) {
+    lm_error_set(err, "target '%s': size %dx%d is outside 1x1 .. %dx%d", label, d->width, d->height,
+                 max, max);
+    return false;
+  }
+  if (d->format <= LM_FORMAT_NONE || d->format >= LM_FORMAT_COUNT) {
+    lm_error_set(err, "target '%s': no format", label);
+    return false;
+  }
+  while (glGetError() != GL_NO_ERROR) {}
+  GLuint id;
+  glCreateTextures(GL_TEXTURE_2D, 1, &id);
+  glTextureStorage2D(id, d->mips ? mip_levels(d->width, d->height) : 1, formats[d->format].internal,
+                     d->width, d->height);
+  if (glGetError() == GL_OUT_OF_MEMORY) {
+    glDeleteTextures(1, &id);
+    lm_error_set(err, "target '%s': out of GPU memory for %dx%d %s (%.1f MiB)", label, d->width,
+                 d->height, formats[d->format].name,
+                 (double)d->width * d->height * formats[d->format].bytes / 1048576.0);
+    return false;
+  }
+  GLenum min = d->mips ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR;
+  if (lm_format_is_depth(d->format)) min = GL_NEAREST;
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, min);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, lm_format_is_depth(d->format) ? GL_NEAREST : GL_LINEAR);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  if (label) glObjectLabel(GL_TEXTURE, id, -1, label);
+  tex->id = id;
+  return true;
+}
+
+void lm_texture_destroy(lm_texture *tex) {
+  if (!tex->id) return;
+  lm_framebuffers_forget(*tex);
+  glDeleteTextures(1, &tex->id);
+  tex->id = 0;
+}
+
+void lm_texture_generate_mips(lm_texture tex) { glGenerateTextureMipmap(tex.id); }
+
+void lm_texture_clear(lm_texture tex) {
+  GLint internal = 0;
+  glGetTextureLevelParameteriv(tex.id, 0, GL_TEXTURE_INTERNAL_FORMAT, &internal);
+  static const float zero[4] = {0, 0, 0, 0};
+  glClearTexImage(tex.id, 0, internal == GL_DEPTH_COMPONENT32F ? GL_DEPTH_COMPONENT : GL_RGBA, GL_FLOAT,
+                  zero);
+}
+
+/* ---- framebuffers: cached by attachment set ---------------------------- */
+typedef struct fbo_entry {
+  lm_attachments att;
+  GLuint fbo;
+} fbo_entry;
+static fbo_entry *fbos;
+static int fbo_count, fbo_cap;
+
+static bool same_attachments(const lm_attachments *a, const lm_attachments *b) {
+  if (a->color_count != b->color_count || a->depth.id != b->depth.id) return false;
+  for (int i = 0; i < a->color_count; i++)
+    if (a->color[i].id != b->color[i].id) return false;
+  return true;
+}
+
+bool lm_attachments_bind(const lm_attachments *att, lm_error *err) {
+  fbo_entry *e = NULL;
+  for (int i = 0; i < fbo_count && !e; i++)
+    if (same_attachments(&fbos[i].att, att)) e = &fbos[i];
+  if (!e) {
+    GLuint fbo;
+    glCreateFramebuffers(1, &fbo);
+    GLenum bufs[LM_MAX_COLOR_OUTPUTS];
+    for (int i = 0; i < att->color_count; i++) {
+      glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0 + i, att->color[i].id, 0);
+      bufs[i] = GL_COLOR_ATTACHMENT0 + i;
+    }
+    if (att->depth.id) glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, att->depth.id, 0);
+    glNamedFramebufferDrawBuffers(fbo, att->color_count, bufs);
+    GLenum status = glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+      glDeleteFramebuffers(1, &fbo);
+      lm_error_set(err, "framebuffer incomplete (0x%x)", status);
+      return false;
+    }
+    e = LM_PUSH(fbos, fbo_count, fbo_cap);
+    e->att = *att;
+    e->fbo = fbo;
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
+  glViewport(0, 0, att->width, att->height);
+  return true;
+}
+
+void lm_framebuffers_forget(lm_texture tex) {
+  for (int i = 0; i < fbo_count;) {
+    bool uses = fbos[i].att.depth.id == tex.id;
+    for (int c = 0; c < fbos[i].att.color_count; c++) uses |= fbos[i].att.color[c].id == tex.id;
+    if (uses) {
+      glDeleteFramebuffers(1, &fbos[i].fbo);
+      fbos[i] = fbos[--fbo_count];
+    } else {
+      i++;
+    }
+  }
+}
+
+void lm_clear(int color_count, const float rgba[4], bool clear_depth, float depth) {
+  for (int i = 0; i < color_count; i++) glClearBufferfv(GL_COLOR, i, rgba);
+  if (clear_depth) {
+    glDepthMask(GL_TRUE);
+    glClearBufferfv(GL_DEPTH, 0, &depth);
+  }
+}
+
+static GLuint empty_vao;
+void lm_draw_fullscreen(void) {
+  if (!empty_vao) glCreateVertexArrays(1, &empty_vao);
+  glBindVertexArray(empty_vao);
+  glDrawArrays(GL_TRIANGLES, 0, 3); /* one triangle covering the viewport */
+}
+
+void lm_set_scene_state(bool on) {
+  if (on) {
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+  } else {
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+  }
+}
+
+/* ---- frame block and light buffer -------------------------------------- */
+static GLuint frame_ubo, light_ssbo;
+static GLsizeiptr light_ssbo_size;
+
+void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, int light_count) {
+  if (!frame_ubo) {
+    glCreateBuffers(1, &frame_ubo);
+    glNamedBufferData(frame_ubo, sizeof *frame, NULL, GL_DYNAMIC_DRAW);
+  }
+  glNamedBufferSubData(frame_ubo, 0, sizeof *frame, frame);
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, frame_ubo);
+  /* An empty SSBO binding is an error in some drivers: keep one element. */
+  GLsizeiptr need = (GLsizeiptr)sizeof(lm_light_data) * (light_count > 0 ? light_count : 1);
+  if (need > light_ssbo_size) {
+    if (light_ssbo) glDeleteBuffers(1, &light_ssbo);
+    glCreateBuffers(1, &light_ssbo);
+    glNamedBufferData(light_ssbo, need, NULL, GL_DYNAMIC_DRAW);
+    light_ssbo_size = need;
+  }
+  if (light_count > 0) glNamedBufferSubData(light_ssbo, 0, need, lights);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, light_ssbo);
+}
+
+/* ---- meshes ------------------------------------------------------------ */
+void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const uint32_t *indices,
+                    int index_count) {
+  glCreateVertexArrays(1, &m->vao);
+  glCreateBuffers(1, &m->vbo);
+  glCreateBuffers(1, &m->ibo);
+  glNamedBufferData(m->vbo, (GLsizeiptr)vertex_count * 8 * sizeof(float), vertices, GL_STATIC_DRAW);
+  glNamedBufferData(m->ibo, (GLsizeiptr)index_count * sizeof(uint32_t), indices, GL_STATIC_DRAW);
+  glVertexArrayVertexBuffer(m->vao, 0, m->vbo, 0, 8 * sizeof(float));
+  glVertexArrayElementBuffer(m->vao, m->ibo);
+  static const int sizes[3] = {3, 3, 2}, offsets[3] = {0, 3, 6};
+  for (int a = 0; a < 3; a++) {
+    glEnableVertexArrayAttrib(m->vao, a);
+    glVertexArrayAttribFormat(m->vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a] * sizeof(float));
+    glVertexArrayAttribBinding(m->vao, a, 0);
+  }
+  m->index_count = index_count;
+}
+
+void lm_mesh_destroy(lm_mesh *m) {
+  if (m->vao) glDeleteVertexArrays(1, &m->vao);
+  if (m->vbo) glDeleteBuffers(1, &m->vbo);
+  if (m->ibo) glDeleteBuffers(1, &m->ibo);
+  *m = (lm_mesh){0};
+}
+
+void lm_mesh_draw(const lm_mesh *m) {
+  glBindVertexArray(m->vao);
+  glDrawElements(GL_TRIANGLES, m->index_count, GL_UNSIGNED_INT, NULL);
+}
+
+/* ---- timers ------------------------------------------------------------ */
+lm_clock lm_clock_choose(lm_clock wanted) {
+  if (wanted != LM_CLOCK_AUTO) return wanted;
+  const char *r = lm_gl_renderer();
+  /* llvmpipe's GL_TIME_ELAPSED results were seen to be nonsense. */
+  if (!r || strstr(r, "llvmpipe") || strstr(r, "softpipe") || strstr(r, "SVGA3D")) return LM_CLOCK_CPU;
+  return LM_CLOCK_GPU;
+}
+
+const char *lm_clock_name(lm_clock c) {
+  return c == LM_CLOCK_GPU ? "gpu (GL_TIME_ELAPSED queries)" : "cpu (glFinish + CLOCK_MONOTONIC)";
+}
+
+void lm_timer_begin(lm_timer *t, lm_clock clock) {
+  t->clock = clock;
+  t->ms = -1;
+  if (clock == LM_CLOCK_GPU) {
+    if (!t->query) glCreateQueries(GL_TIME_ELAPSED, 1, &t->query);
+    glBeginQuery(GL_TIME_ELAPSED, t->query);
+  } else {
+    glFinish();
+    t->start_ms = lm_now_ms();
+  }
+}
+
+void lm_timer_end(lm_timer *t) {
+  if (t->clock == LM_CLOCK_GPU) {
+    glEndQuery(GL_TIME_ELAPSED);
+  } else {
+    glFinish();
+    t->ms = lm_now_ms() - t->start_ms;
+  }
+}
+
+double lm_timer_read(lm_timer *t) {
+  if (t->clock == LM_CLOCK_GPU && t->query && t->ms < 0) {
+    GLuint64 ns = 0;
+    glGetQueryObjectui64v(t->query, GL_QUERY_RESULT, &ns);
+    t->ms = (double)ns * 1e-6;
+  }
+  return t->ms;
+}
+
+void lm_timer_destroy(lm_timer *t) {
+  if (t->query) glDeleteQueries(1, &t->query);
+  t->query = 0;
+}
+
+void lm_finish(void) { glFinish(); }
+
+/* ---- readback ---------------------------------------------------------- */
+void lm_texture_read(lm_texture tex, int width, int height, bool floats, void *out) {
+  size_t texel = floats ? 16 : 4, row = (size_t)width * texel;
+  size_t size = row * (size_t)height;
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(tex.id, 0, GL_RGBA, floats ? GL_FLOAT : GL_UNSIGNED_BYTE, (GLsizei)size, out);
+  /* GL's first row is the bottom one; images want the top one first. */
+  unsigned char *p = out, *tmp = lm_alloc(row);
+  for (int y = 0; y < height / 2; y++) {
+    unsigned char *a = p + (size_t)y * row, *b = p + (size_t)(height - 1 - y) * row;
+    memcpy(tmp, a, row);
+    memcpy(a, b, row);
+    memcpy(b, tmp, row);
+  }
+  free(tmp);
+}

@@ -1,0 +1,177 @@
+/* gfx: the only module that speaks OpenGL and EGL. A thin layer of handles
+ * over GL 4.5 core: context, textures, framebuffers, programs with reflection,
+ * meshes, timers and readback. Callers never see a GL name. */
+#ifndef LIMN_GFX_H
+#define LIMN_GFX_H
+
+#include "core/core.h"
+
+/* ---- context ----------------------------------------------------------- */
+typedef struct lm_context_desc {
+  /* "auto" (default: EGL device platform with a hardware device, else Mesa's
+   * surfaceless platform), "device" or "surfaceless". */
+  const char *platform;
+  bool debug; /* GL debug output to the log */
+} lm_context_desc;
+
+/* A headless OpenGL 4.5 core context, current on this thread. */
+bool lm_context_create_headless(const lm_context_desc *desc, lm_error *err);
+/* For a context somebody else made current (a GLFW window): load and check GL. */
+bool lm_context_adopt_current(lm_error *err);
+void lm_context_destroy(void);
+const char *lm_gl_renderer(void);
+const char *lm_gl_version(void);
+const char *lm_context_platform(void); /* "egl-device", "egl-surfaceless", "window" */
+
+/* ---- formats ----------------------------------------------------------- */
+typedef enum lm_format {
+  LM_FORMAT_NONE,
+  LM_FORMAT_RGBA8,
+  LM_FORMAT_RGBA16F,
+  LM_FORMAT_RGBA32F,
+  LM_FORMAT_R16F,
+  LM_FORMAT_R32F,
+  LM_FORMAT_RG16F,
+  LM_FORMAT_RG32F,
+  LM_FORMAT_DEPTH32F,
+  LM_FORMAT_COUNT
+} lm_format;
+const char *lm_format_name(lm_format f);
+lm_format lm_format_parse(const char *name); /* LM_FORMAT_NONE when unknown */
+bool lm_format_is_depth(lm_format f);
+int lm_format_bytes(lm_format f); /* bytes per texel */
+/* Every format name, comma separated, for error messages. */
+const char *lm_format_list(void);
+
+/* ---- textures ---------------------------------------------------------- */
+typedef struct lm_texture { uint32_t id; } lm_texture;
+typedef struct lm_texture_desc {
+  lm_format format;
+  int width, height;
+  bool mips;
+} lm_texture_desc;
+/* Refuses sizes over the GL limit with a message naming `label` and the size. */
+bool lm_texture_create(lm_texture *tex, const lm_texture_desc *desc, const char *label, lm_error *err);
+void lm_texture_destroy(lm_texture *tex);
+void lm_texture_generate_mips(lm_texture tex);
+void lm_texture_clear(lm_texture tex); /* zero every texel of level 0 */
+int lm_texture_max_size(void);
+
+/* ---- framebuffers and passes ------------------------------------------ */
+#define LM_MAX_COLOR_OUTPUTS 8
+typedef struct lm_attachments {
+  lm_texture color[LM_MAX_COLOR_OUTPUTS];
+  int color_count;
+  lm_texture depth; /* id 0: none */
+  int width, height;
+} lm_attachments;
+/* Binds (a cached) framebuffer for these attachments and sets the viewport. */
+bool lm_attachments_bind(const lm_attachments *att, lm_error *err);
+void lm_clear(int color_count, const float rgba[4], bool clear_depth, float depth);
+void lm_draw_fullscreen(void);
+/* Depth test and face culling for scene passes; off for full-screen ones. */
+void lm_set_scene_state(bool on);
+/* Framebuffers cache by attachment set; drop entries that name this texture. */
+void lm_framebuffers_forget(lm_texture tex);
+
+/* ---- shader sources (pure text, no GL; testable on its own) ------------ */
+/* A shader file with its #includes expanded. Each file gets a source-string
+ * number used in #line directives, so compiler logs map back to file:line. */
+typedef struct lm_shader_source {
+  lm_buf text;
+  char **files; /* files[i] is source string i */
+  int file_count, file_cap;
+} lm_shader_source;
+/* `defines` is "NAME=VALUE;NAME2" (may be NULL). Include paths resolve
+ * against the including file's directory, then `include_dir`. */
+bool lm_shader_source_load(lm_shader_source *src, const char *path, const char *include_dir,
+                           const char *defines, lm_error *err);
+void lm_shader_source_free(lm_shader_source *src);
+/* Rewrites a compiler log ("0:12(3): error ..." or "0(12) : error ...")
+ * into "file:line: error ..." lines. */
+void lm_shader_map_log(const lm_shader_source *src, const char *log, lm_buf *out);
+
+/* ---- programs ---------------------------------------------------------- */
+typedef enum lm_uniform_type {
+  LM_UNIFORM_FLOAT, LM_UNIFORM_VEC2, LM_UNIFORM_VEC3, LM_UNIFORM_VEC4,
+  LM_UNIFORM_INT, LM_UNIFORM_IVEC2, LM_UNIFORM_IVEC3, LM_UNIFORM_IVEC4,
+  LM_UNIFORM_BOOL, LM_UNIFORM_MAT3, LM_UNIFORM_MAT4,
+  LM_UNIFORM_SAMPLER, LM_UNIFORM_SAMPLER_SHADOW, LM_UNIFORM_OTHER
+} lm_uniform_type;
+const char *lm_uniform_type_name(lm_uniform_type t);
+int lm_uniform_type_components(lm_uniform_type t); /* 1..16, 0 for samplers */
+
+typedef struct lm_uniform {
+  char name[64];
+  lm_uniform_type type;
+  int location; /* -1: declared in the source but not active */
+  int unit;     /* texture unit, for samplers */
+} lm_uniform;
+
+typedef struct lm_program {
+  uint32_t id;
+  char label[256]; /* "shaders/direct.frag [DEFINE=1]" */
+  lm_uniform *uniforms; /* every uniform declared in the sources */
+  int uniform_count, uniform_cap;
+  int output_count; /* fragment outputs */
+} lm_program;
+
+/* Compiles and links (cached by files and defines). Paths are relative to
+ * the shader directory. Errors name the original file:line. */
+lm_program *lm_program_get(const char *vert, const char *frag, const char *defines, lm_error *err);
+const lm_uniform *lm_program_uniform(const lm_program *p, const char *name);
+void lm_program_use(const lm_program *p);
+void lm_program_set(const lm_program *p, const lm_uniform *u, const float *values);
+void lm_program_set_int(const lm_program *p, const lm_uniform *u, const int *values);
+void lm_program_bind_texture(const lm_uniform *u, lm_texture tex);
+/* Forget every compiled program (shader files changed). */
+void lm_programs_clear(void);
+int lm_program_count(void);
+/* The directory shader paths are relative to: <root>/shaders. */
+const char *lm_shader_dir(void);
+
+/* ---- per-frame engine data (std140 block LimnFrame, binding 0) --------- */
+typedef struct lm_frame_data {
+  float view[16], proj[16], view_proj[16], inv_view[16];
+  float camera_pos[4];
+  float frustum_o[4], frustum_u[4], frustum_v[4]; /* rays to the far plane */
+  float clip[4];        /* near, far, 1/far, tan(fov_y/2) */
+  float output_size[4]; /* w, h, 1/w, 1/h */
+  float time[4];        /* seconds, frame index */
+  int32_t counts[4];    /* lights */
+} lm_frame_data;
+typedef struct lm_light_data {
+  float position[4];  /* xyz, w = type: 0 point, 1 spot, 2 directional */
+  float direction[4]; /* xyz (unit, from the light), w = cos(outer cone) */
+  float color[4];     /* rgb * power, w = radius (point/spot attenuation) */
+  float params[4];    /* x = cos(inner cone) */
+} lm_light_data;
+void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, int light_count);
+
+/* ---- meshes ------------------------------------------------------------ */
+typedef struct lm_mesh { uint32_t vao, vbo, ibo; int index_count; } lm_mesh;
+/* Interleaved position(3) normal(3) uv(2) floats; 32-bit indices. */
+void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const uint32_t *indices,
+                    int index_count);
+void lm_mesh_destroy(lm_mesh *m);
+void lm_mesh_draw(const lm_mesh *m);
+
+/* ---- timers ------------------------------------------------------------ */
+typedef enum lm_clock { LM_CLOCK_AUTO, LM_CLOCK_GPU, LM_CLOCK_CPU } lm_clock;
+/* GPU queries unless the renderer is a software one whose queries are not
+ * trustworthy (llvmpipe, softpipe): then glFinish plus CLOCK_MONOTONIC. */
+lm_clock lm_clock_choose(lm_clock wanted);
+const char *lm_clock_name(lm_clock c);
+typedef struct lm_timer { lm_clock clock; uint32_t query; double start_ms, ms; } lm_timer;
+void lm_timer_begin(lm_timer *t, lm_clock clock);
+void lm_timer_end(lm_timer *t);
+/* Milliseconds; waits for a GPU query's result. */
+double lm_timer_read(lm_timer *t);
+void lm_timer_destroy(lm_timer *t);
+void lm_finish(void);
+
+/* ---- readback ---------------------------------------------------------- */
+/* RGBA rows, top row first. `floats` selects float32 or uint8 output. */
+void lm_texture_read(lm_texture tex, int width, int height, bool floats, void *out);
+
+#endif

@@ -1,0 +1,319 @@
+/* Frame graph recording and compiling: everything here is plain data, so
+ * validation, culling and the texture plan are testable without GL. */
+#include "graph/graph_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void lm_target_size(const lm_target_desc *d, int out_w, int out_h, int *w, int *h) {
+  if (d->width > 0 && d->height > 0) {
+    *w = d->width;
+    *h = d->height;
+    return;
+  }
+  double s = d->scale > 0 && isfinite(d->scale) ? d->scale : 1.0;
+  double fw = floor(out_w * s), fh = floor(out_h * s);
+  *w = fw < 1 ? 1 : fw > 1e6 ? 1000000 : (int)fw;
+  *h = fh < 1 ? 1 : fh > 1e6 ? 1000000 : (int)fh;
+}
+
+lm_graph *lm_graph_create(void) { return lm_alloc(sizeof(lm_graph)); }
+
+void lm_graph_destroy(lm_graph *g) {
+  if (!g) return;
+  for (int i = 0; i < g->persistent_count; i++) {
+    lm_texture_destroy(&g->targets[i].texture);
+    free((char *)g->targets[i].desc.name);
+  }
+  for (int i = 0; i < g->pool_count; i++) lm_texture_destroy(&g->pool[i].texture);
+  for (int i = 0; i < g->timer_count; i++) lm_timer_destroy(&g->timers[i]);
+  lm_arena_reset(&g->arena);
+  free(g->targets);
+  free(g->passes);
+  free(g->outputs);
+  free(g->slots);
+  free(g->pool);
+  free(g->timers);
+  free(g);
+}
+
+void lm_graph_begin(lm_graph *g, int width, int height) {
+  g->width = width > 0 ? width : 1;
+  g->height = height > 0 ? height : 1;
+  lm_arena_reset(&g->arena);
+  g->target_count = g->persistent_count; /* persistent targets come first */
+  g->pass_count = 0;
+  g->output_count = 0;
+  g->slot_count = 0;
+  g->compiled = false;
+}
+
+void lm_graph_output_size(const lm_graph *g, int *width, int *height) {
+  *width = g->width;
+  *height = g->height;
+}
+
+int lm_graph_find_target(const lm_graph *g, const char *name) {
+  for (int i = 0; i < g->target_count; i++)
+    if (!strcmp(g->targets[i].desc.name, name)) return i;
+  return -1;
+}
+
+int lm_graph_add_target(lm_graph *g, const lm_target_desc *d, lm_error *err) {
+  if (!d->name || !d->name[0]) {
+    lm_error_set(err, "a target needs a name");
+    return -1;
+  }
+  if (d->format <= LM_FORMAT_NONE || d->format >= LM_FORMAT_COUNT) {
+    lm_error_set(err, "target '%s': no format (one of %s)", d->name, lm_format_list());
+    return -1;
+  }
+  if ((d->width > 0) != (d->height > 0) || d->width < 0 || d->height < 0 || d->scale < 0 ||
+      !isfinite(d->scale)) {
+    lm_error_set(err, "target '%s': give a positive size {w, h} or a positive scale", d->name);
+    return -1;
+  }
+  if (lm_graph_find_target(g, d->name) >= 0) {
+    lm_error_set(err, "target '%s' is declared twice", d->name);
+    return -1;
+  }
+  if (d->persistent && g->target_count != g->persistent_count) {
+    lm_error_set(err, "target '%s': persistent targets are declared before any frame target "
+                 "(in OnCreate)", d->name);
+    return -1;
+  }
+  graph_target *t = LM_PUSH(g->targets, g->target_count, g->target_cap);
+  *t = (graph_target){.desc = *d, .slot = -1};
+  t->desc.name = d->persistent ? lm_strdup(d->name) : lm_arena_strdup(&g->arena, d->name);
+  if (d->persistent) g->persistent_count++;
+  return g->target_count - 1;
+}
+
+static const char *arena_str(lm_graph *g, const char *s) {
+  return s ? lm_arena_strdup(&g->arena, s) : NULL;
+}
+
+int lm_graph_add_pass(lm_graph *g, const lm_pass_desc *d, lm_error *err) {
+  const char *name = d->name ? d->name : "?";
+  const char *where = d->where ? d->where : "?";
+  if (!d->shader || !d->shader[0]) {
+    lm_error_set(err, "%s: pass '%s': no %s", where, name,
+                 d->kind == LM_PASS_SCENE ? "technique" : "shader");
+    return -1;
+  }
+  if (d->output_count > LM_MAX_COLOR_OUTPUTS || d->input_count > LM_MAX_PASS_INPUTS ||
+      d->param_count > LM_MAX_PASS_PARAMS) {
+    lm_error_set(err, "%s: pass '%s': too many outputs, inputs or parameters (at most %d, %d, %d)",
+                 where, name, LM_MAX_COLOR_OUTPUTS, LM_MAX_PASS_INPUTS, LM_MAX_PASS_PARAMS);
+    return -1;
+  }
+  for (int i = 0; i < d->output_count; i++) {
+    if (d->outputs[i] < 0 || d->outputs[i] >= g->target_count) {
+      lm_error_set(err, "%s: pass '%s': output %d is not a target of this frame", where, name, i + 1);
+      return -1;
+    }
+  }
+  for (int i = 0; i < d->input_count; i++) {
+    if (d->inputs[i].target < 0 || d->inputs[i].target >= g->target_count) {
+      lm_error_set(err, "%s: pass '%s': input '%s' is not a target of this frame", where, name,
+                   d->inputs[i].name);
+      return -1;
+    }
+  }
+  if (d->depth >= g->target_count) {
+    lm_error_set(err, "%s: pass '%s': depth is not a target of this frame", where, name);
+    return -1;
+  }
+  graph_pass *p = LM_PUSH(g->passes, g->pass_count, g->pass_cap);
+  *p = (graph_pass){.desc = *d, .ms = -1};
+  lm_pass_desc *c = &p->desc;
+  c->name = arena_str(g, name);
+  c->where = arena_str(g, where);
+  c->shader = arena_str(g, d->shader);
+  c->defines = arena_str(g, d->defines ? d->defines : "");
+  lm_pass_input *in = lm_arena_alloc(&g->arena, sizeof *in * (size_t)(d->input_count + 1));
+  for (int i = 0; i < d->input_count; i++)
+    in[i] = (lm_pass_input){arena_str(g, d->inputs[i].name), d->inputs[i].target};
+  c->inputs = in;
+  lm_pass_param *pa = lm_arena_alloc(&g->arena, sizeof *pa * (size_t)(d->param_count + 1));
+  for (int i = 0; i < d->param_count; i++) {
+    pa[i] = d->params[i];
+    pa[i].name = arena_str(g, d->params[i].name);
+  }
+  c->params = pa;
+  int *out = lm_arena_alloc(&g->arena, sizeof *out * (size_t)(d->output_count + 1));
+  memcpy(out, d->outputs, sizeof *out * (size_t)d->output_count);
+  c->outputs = out;
+  return g->pass_count - 1;
+}
+
+void lm_graph_mark_output(lm_graph *g, int target) {
+  if (target >= 0 && target < g->target_count) *LM_PUSH(g->outputs, g->output_count, g->output_cap) = target;
+}
+
+static bool pass_writes(const lm_pass_desc *d, int t) {
+  for (int i = 0; i < d->output_count; i++)
+    if (d->outputs[i] == t) return true;
+  return d->depth == t && t >= 0;
+}
+
+/* The last pass before `before` that writes t, or -1. */
+static int last_writer(const lm_graph *g, int t, int before) {
+  for (int i = before - 1; i >= 0; i--)
+    if (pass_writes(&g->passes[i].desc, t)) return i;
+  return -1;
+}
+
+static bool validate_pass(lm_graph *g, int pi, lm_error *err) {
+  const lm_pass_desc *d = &g->passes[pi].desc;
+  const char *where = d->where, *name = d->name;
+  if (d->output_count == 0 && d->depth < 0) {
+    lm_error_set(err, "%s: pass '%s' writes no target (give it out = target)", where, name);
+    return false;
+  }
+  int w = -1, h = -1;
+  for (int i = 0; i < d->output_count + 1; i++) {
+    int t = i < d->output_count ? d->outputs[i] : d->depth;
+    if (t < 0) continue;
+    const graph_target *gt = &g->targets[t];
+    bool depth_slot = i == d->output_count;
+    if (lm_format_is_depth(gt->desc.format) != depth_slot) {
+      lm_error_set(err, "%s: pass '%s': target '%s' (%s) cannot be a %s output", where, name,
+                   gt->desc.name, lm_format_name(gt->desc.format), depth_slot ? "depth" : "colour");
+      return false;
+    }
+    if (w >= 0 && (gt->width != w || gt->height != h)) {
+      lm_error_set(err, "%s: pass '%s': its outputs differ in size (%dx%d and '%s' %dx%d)", where,
+                   name, w, h, gt->desc.name, gt->width, gt->height);
+      return false;
+    }
+    w = gt->width, h = gt->height;
+  }
+  if (d->kind == LM_PASS_FULLSCREEN && d->depth >= 0) {
+    lm_error_set(err, "%s: pass '%s': full-screen passes take no depth target", where, name);
+    return false;
+  }
+  for (int i = 0; i < d->input_count; i++) {
+    int t = d->inputs[i].target;
+    const graph_target *gt = &g->targets[t];
+    if (pass_writes(d, t)) {
+      lm_error_set(err, "%s: pass '%s' reads and writes target '%s' (a feedback loop; write to "
+                   "another target)", where, name, gt->desc.name);
+      return false;
+    }
+    if (!gt->desc.persistent && last_writer(g, t, pi) < 0) {
+      lm_error_set(err, "%s: pass '%s' reads target '%s' that no pass writes before it", where,
+                   name, gt->desc.name);
+      return false;
+    }
+  }
+  return true;
+}
+
+/* Marks pass pi and everything it depends on as needed. */
+static void keep(lm_graph *g, int pi, bool *needed) {
+  if (pi < 0 || needed[pi]) return;
+  needed[pi] = true;
+  const lm_pass_desc *d = &g->passes[pi].desc;
+  for (int i = 0; i < d->input_count; i++) keep(g, last_writer(g, d->inputs[i].target, pi), needed);
+  /* A scene pass that does not clear draws over what an earlier pass left. */
+  if (d->kind == LM_PASS_SCENE && !d->clear) {
+    for (int i = 0; i < d->output_count; i++) keep(g, last_writer(g, d->outputs[i], pi), needed);
+    if (d->depth >= 0) keep(g, last_writer(g, d->depth, pi), needed);
+  }
+}
+
+static void touch(graph_target *t, int pi) {
+  if (!t->used) t->first = pi;
+  t->used = true;
+  t->last = pi;
+}
+
+/* Transient targets whose lifetimes do not overlap share a slot (texture). */
+static void plan_slots(lm_graph *g) {
+  g->slot_count = 0;
+  for (int pi = 0; pi < g->pass_count; pi++) {
+    if (g->passes[pi].culled) continue;
+    for (int t = g->persistent_count; t < g->target_count; t++) {
+      graph_target *gt = &g->targets[t];
+      if (!gt->used || gt->first != pi) continue;
+      lm_texture_desc want = {gt->desc.format, gt->width, gt->height, gt->desc.mips};
+      int found = -1;
+      for (int s = 0; s < g->slot_count && found < 0; s++)
+        if (!memcmp(&g->slots[s].desc, &want, sizeof want) && g->slots[s].free_after < pi) found = s;
+      if (found < 0) {
+        graph_slot *s = LM_PUSH(g->slots, g->slot_count, g->slot_cap);
+        s->desc = want;
+        found = g->slot_count - 1;
+      }
+      g->slots[found].free_after = gt->last;
+      gt->slot = found;
+    }
+  }
+}
+
+bool lm_graph_compile(lm_graph *g, lm_error *err) {
+  for (int t = 0; t < g->target_count; t++) {
+    graph_target *gt = &g->targets[t];
+    lm_target_size(&gt->desc, g->width, g->height, &gt->width, &gt->height);
+    gt->used = false;
+    gt->slot = -1;
+    gt->first = gt->last = -1;
+  }
+  for (int pi = 0; pi < g->pass_count; pi++)
+    if (!validate_pass(g, pi, err)) return false;
+  if (g->output_count == 0) {
+    lm_error_set(err, "the frame presents nothing (call present(target) in OnRender)");
+    return false;
+  }
+  bool *needed = lm_alloc(sizeof(bool) * (size_t)(g->pass_count + 1));
+  for (int i = 0; i < g->output_count; i++) {
+    int writer = last_writer(g, g->outputs[i], g->pass_count);
+    if (writer < 0 && !g->targets[g->outputs[i]].desc.persistent) {
+      lm_error_set(err, "target '%s' is presented but no pass writes it",
+                   g->targets[g->outputs[i]].desc.name);
+      free(needed);
+      return false;
+    }
+    keep(g, writer, needed);
+  }
+  for (int pi = 0; pi < g->pass_count; pi++) {
+    graph_pass *p = &g->passes[pi];
+    p->culled = !needed[pi];
+    p->ms = -1;
+    if (p->culled) {
+      lm_log(LM_LOG_INFO, "left out: pass '%s' (%s): nothing presented reads what it writes",
+             p->desc.name, p->desc.where);
+      continue;
+    }
+    for (int i = 0; i < p->desc.input_count; i++) touch(&g->targets[p->desc.inputs[i].target], pi);
+    for (int i = 0; i < p->desc.output_count; i++) touch(&g->targets[p->desc.outputs[i]], pi);
+    if (p->desc.depth >= 0) touch(&g->targets[p->desc.depth], pi);
+  }
+  free(needed);
+  for (int t = 0; t < g->target_count; t++)
+    if (!g->targets[t].used)
+      lm_log(LM_LOG_DEBUG, "left out: target '%s' (no pass that runs uses it)", g->targets[t].desc.name);
+  plan_slots(g);
+  g->compiled = true;
+  return true;
+}
+
+int lm_graph_pass_count(const lm_graph *g) { return g->pass_count; }
+
+lm_graph_pass_info lm_graph_pass(const lm_graph *g, int i) {
+  const graph_pass *p = &g->passes[i];
+  return (lm_graph_pass_info){p->desc.name, p->desc.where, p->desc.shader, p->desc.kind, p->culled,
+                              p->ms};
+}
+
+int lm_graph_target_count(const lm_graph *g) { return g->target_count; }
+
+lm_graph_target_info lm_graph_target(const lm_graph *g, int i) {
+  const graph_target *t = &g->targets[i];
+  return (lm_graph_target_info){t->desc.name, t->desc.format, t->width, t->height,
+                                t->desc.persistent, t->used, t->slot, t->texture};
+}
+
+int lm_graph_slot_count(const lm_graph *g) { return g->slot_count; }

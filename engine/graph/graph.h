@@ -1,0 +1,115 @@
+/* graph: the frame graph. A frame is recorded as targets and passes (what
+ * each pass reads and writes); compiling validates the recording, leaves out
+ * every pass whose results do not reach an output, and plans which transient
+ * targets share a texture; executing allocates from a pool kept across
+ * frames, runs and times each pass. */
+#ifndef LIMN_GRAPH_H
+#define LIMN_GRAPH_H
+
+#include "gfx/gfx.h"
+
+typedef struct lm_graph lm_graph;
+
+/* ---- recording --------------------------------------------------------- */
+typedef struct lm_target_desc {
+  const char *name;
+  lm_format format;
+  float scale;       /* size as a scale of the output (0 means 1) ... */
+  int width, height; /* ... or absolute, when both are > 0 */
+  bool mips;
+  bool persistent;   /* keeps its texture and contents across frames */
+} lm_target_desc;
+
+/* A target's size for an output of out_w x out_h: never below 1x1. */
+void lm_target_size(const lm_target_desc *d, int out_w, int out_h, int *w, int *h);
+
+typedef enum lm_pass_kind { LM_PASS_FULLSCREEN, LM_PASS_SCENE } lm_pass_kind;
+
+typedef struct lm_pass_input {
+  const char *name; /* sampler uniform */
+  int target;
+} lm_pass_input;
+
+typedef enum lm_param_kind { LM_PARAM_NUMBER, LM_PARAM_BOOL } lm_param_kind;
+typedef struct lm_pass_param {
+  const char *name; /* uniform */
+  lm_param_kind kind;
+  int count;        /* 1 .. 16 numbers */
+  double v[16];
+} lm_pass_param;
+
+#define LM_MAX_PASS_INPUTS 16
+#define LM_MAX_PASS_PARAMS 64
+
+typedef struct lm_pass_desc {
+  lm_pass_kind kind;
+  const char *name;
+  const char *where;   /* where it was recorded ("scripts/pp.lua:12"), for messages */
+  const char *shader;  /* full-screen: fragment shader file; scene: material technique */
+  const char *defines; /* "NAME=VALUE;NAME2" */
+  const lm_pass_input *inputs;
+  int input_count;
+  const lm_pass_param *params;
+  int param_count;
+  const int *outputs; /* colour targets */
+  int output_count;
+  int depth;          /* depth target, or -1 */
+  bool clear;         /* full-screen passes always cover every pixel */
+  float clear_color[4];
+} lm_pass_desc;
+
+lm_graph *lm_graph_create(void);
+void lm_graph_destroy(lm_graph *g);
+/* Starts recording a frame for an output of width x height. Transient
+ * targets and passes of the last frame are forgotten; persistent ones stay. */
+void lm_graph_begin(lm_graph *g, int width, int height);
+void lm_graph_output_size(const lm_graph *g, int *width, int *height);
+/* Returns the target's handle, or -1 with a message. */
+int lm_graph_add_target(lm_graph *g, const lm_target_desc *d, lm_error *err);
+/* Copies the description. Returns the pass index, or -1 with a message. */
+int lm_graph_add_pass(lm_graph *g, const lm_pass_desc *d, lm_error *err);
+/* Marks a target as a result of the frame: what reaches it is kept. */
+void lm_graph_mark_output(lm_graph *g, int target);
+
+/* ---- compiling (no GL) ------------------------------------------------- */
+/* Validates (reads with no writer, feedback loops, formats, sizes), culls
+ * and plans texture sharing. Logs "left out: ..." for each culled pass. */
+bool lm_graph_compile(lm_graph *g, lm_error *err);
+
+typedef struct lm_graph_pass_info {
+  const char *name, *where, *shader;
+  lm_pass_kind kind;
+  bool culled;
+  double ms;        /* last execution, -1 when not run */
+} lm_graph_pass_info;
+int lm_graph_pass_count(const lm_graph *g);
+lm_graph_pass_info lm_graph_pass(const lm_graph *g, int i);
+
+typedef struct lm_graph_target_info {
+  const char *name;
+  lm_format format;
+  int width, height;
+  bool persistent, used;
+  int slot;         /* shared texture slot (transient, used targets), else -1 */
+  lm_texture texture; /* after execution */
+} lm_graph_target_info;
+int lm_graph_target_count(const lm_graph *g);
+lm_graph_target_info lm_graph_target(const lm_graph *g, int i);
+int lm_graph_find_target(const lm_graph *g, const char *name);
+/* Distinct texture slots the plan needs for transient targets. */
+int lm_graph_slot_count(const lm_graph *g);
+
+/* ---- executing --------------------------------------------------------- */
+typedef struct lm_graph_exec_desc {
+  lm_clock clock;
+  /* Draws the scene for a scene pass with the pass's program bound. */
+  void (*draw_scene)(void *user, const char *technique, const lm_program *p);
+  /* Uniforms the scene sets on each draw (not bindable from a script). */
+  bool (*scene_owns_uniform)(const char *name);
+  void *user;
+} lm_graph_exec_desc;
+bool lm_graph_execute(lm_graph *g, const lm_graph_exec_desc *x, lm_error *err);
+/* Pooled textures alive now, and their bytes. */
+void lm_graph_pool_stats(const lm_graph *g, int *textures, double *bytes);
+
+#endif

@@ -1,0 +1,241 @@
+/* Frame graph execution: textures from the pool, programs and their
+ * bindings checked against the recording, each pass run and timed. */
+#include "graph/graph_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { POOL_IDLE_FRAMES = 3 }; /* a pooled texture unused this long is freed */
+
+static bool pool_take(lm_graph *g, const lm_texture_desc *want, const char *label, lm_texture *out,
+                      lm_error *err) {
+  for (int i = 0; i < g->pool_count; i++) {
+    pool_texture *p = &g->pool[i];
+    if (!p->taken && !memcmp(&p->desc, want, sizeof *want)) {
+      p->taken = true;
+      *out = p->texture;
+      return true;
+    }
+  }
+  lm_texture tex;
+  if (!lm_texture_create(&tex, want, label, err)) return false;
+  pool_texture *p = LM_PUSH(g->pool, g->pool_count, g->pool_cap);
+  *p = (pool_texture){*want, tex, 0, true};
+  *out = tex;
+  return true;
+}
+
+static void pool_end_frame(lm_graph *g) {
+  for (int i = 0; i < g->pool_count;) {
+    pool_texture *p = &g->pool[i];
+    p->idle_frames = p->taken ? 0 : p->idle_frames + 1;
+    p->taken = false;
+    if (p->idle_frames > POOL_IDLE_FRAMES) {
+      lm_texture_destroy(&p->texture);
+      g->pool[i] = g->pool[--g->pool_count];
+    } else {
+      i++;
+    }
+  }
+}
+
+void lm_graph_pool_stats(const lm_graph *g, int *textures, double *bytes) {
+  double b = 0;
+  for (int i = 0; i < g->pool_count; i++)
+    b += (double)g->pool[i].desc.width * g->pool[i].desc.height * lm_format_bytes(g->pool[i].desc.format);
+  for (int i = 0; i < g->persistent_count; i++)
+    if (g->targets[i].texture.id)
+      b += (double)g->targets[i].width * g->targets[i].height * lm_format_bytes(g->targets[i].desc.format);
+  *textures = g->pool_count + g->persistent_count;
+  *bytes = b;
+}
+
+static bool allocate(lm_graph *g, lm_error *err) {
+  lm_texture *slot_tex = lm_alloc(sizeof *slot_tex * (size_t)(g->slot_count + 1));
+  bool ok = true;
+  for (int s = 0; s < g->slot_count && ok; s++) {
+    const char *label = "transient target";
+    for (int t = g->persistent_count; t < g->target_count; t++)
+      if (g->targets[t].slot == s) {
+        label = g->targets[t].desc.name; /* the first holder names it in errors */
+        break;
+      }
+    ok = pool_take(g, &g->slots[s].desc, label, &slot_tex[s], err);
+  }
+  for (int t = 0; t < g->target_count && ok; t++) {
+    graph_target *gt = &g->targets[t];
+    if (!gt->desc.persistent) {
+      gt->texture = gt->slot >= 0 ? slot_tex[gt->slot] : (lm_texture){0};
+      continue;
+    }
+    /* Persistent textures are made once and remade only when the size changes. */
+    if (!gt->used || (gt->texture.id && gt->alloc_w == gt->width && gt->alloc_h == gt->height))
+      continue;
+    lm_texture_destroy(&gt->texture);
+    lm_texture_desc want = {gt->desc.format, gt->width, gt->height, gt->desc.mips};
+    ok = lm_texture_create(&gt->texture, &want, gt->desc.name, err);
+    if (ok) lm_texture_clear(gt->texture);
+    gt->alloc_w = gt->width;
+    gt->alloc_h = gt->height;
+  }
+  free(slot_tex);
+  return ok;
+}
+
+static bool is_sampler(lm_uniform_type t) {
+  return t == LM_UNIFORM_SAMPLER || t == LM_UNIFORM_SAMPLER_SHADOW;
+}
+
+static bool is_integer(lm_uniform_type t) {
+  return t == LM_UNIFORM_INT || t == LM_UNIFORM_IVEC2 || t == LM_UNIFORM_IVEC3 || t == LM_UNIFORM_IVEC4;
+}
+
+/* Checks the recorded inputs and parameters against the program's uniforms. */
+static bool check_bindings(const lm_graph *g, const lm_pass_desc *d, const lm_program *p,
+                           const lm_graph_exec_desc *x, lm_error *err) {
+  const char *where = d->where, *name = d->name;
+  for (int i = 0; i < d->input_count; i++) {
+    const lm_uniform *u = lm_program_uniform(p, d->inputs[i].name);
+    const graph_target *t = &g->targets[d->inputs[i].target];
+    if (!u || !is_sampler(u->type)) {
+      lm_error_set(err, "%s: pass '%s': input '%s': %s declares no sampler of that name", where,
+                   name, d->inputs[i].name, p->label);
+      return false;
+    }
+    if (u->type == LM_UNIFORM_SAMPLER_SHADOW && !lm_format_is_depth(t->desc.format)) {
+      lm_error_set(err, "%s: pass '%s': input '%s': a shadow sampler cannot take target '%s' (%s)",
+                   where, name, d->inputs[i].name, t->desc.name, lm_format_name(t->desc.format));
+      return false;
+    }
+  }
+  for (int i = 0; i < p->uniform_count; i++) {
+    const lm_uniform *u = &p->uniforms[i];
+    if (!is_sampler(u->type) || u->location < 0) continue;
+    bool bound = false;
+    for (int k = 0; k < d->input_count && !bound; k++) bound = !strcmp(d->inputs[k].name, u->name);
+    if (!bound) {
+      lm_error_set(err, "%s: pass '%s': %s samples '%s' but the pass gives no input of that name",
+                   where, name, p->label, u->name);
+      return false;
+    }
+  }
+  for (int i = 0; i < d->param_count; i++) {
+    const lm_pass_param *pa = &d->params[i];
+    const lm_uniform *u = lm_program_uniform(p, pa->name);
+    if (!u || (d->kind == LM_PASS_SCENE && x->scene_owns_uniform && x->scene_owns_uniform(pa->name))) {
+      lm_error_set(err, "%s: pass '%s': parameter '%s': %s %s", where, name, pa->name, p->label,
+                   u ? "sets this uniform from the scene's materials" : "declares no uniform of that name");
+      return false;
+    }
+    int want = lm_uniform_type_components(u->type);
+    bool type_ok = false;
+    if (u->type == LM_UNIFORM_BOOL) {
+      type_ok = pa->kind == LM_PARAM_BOOL;
+    } else if (want > 0 && pa->kind == LM_PARAM_NUMBER && pa->count == want) {
+      type_ok = true;
+      for (int c = 0; c < pa->count && is_integer(u->type); c++)
+        type_ok &= pa->v[c] == floor(pa->v[c]) && fabs(pa->v[c]) < 2147483648.0;
+    }
+    if (!type_ok) {
+      lm_error_set(err, "%s: pass '%s': parameter '%s': the shader's uniform is a %s; the pass gives %s",
+                   where, name, pa->name, lm_uniform_type_name(u->type),
+                   pa->kind == LM_PARAM_BOOL ? "a boolean"
+                   : pa->count == 1          ? "one number"
+                                             : "a list of numbers");
+      return false;
+    }
+  }
+  if (d->output_count != p->output_count && d->output_count > 0) {
+    lm_error_set(err, "%s: pass '%s': %s writes %d output%s but the pass gives %d target%s", where,
+                 name, p->label, p->output_count, p->output_count == 1 ? "" : "s", d->output_count,
+                 d->output_count == 1 ? "" : "s");
+    return false;
+  }
+  return true;
+}
+
+static void apply_params(const lm_pass_desc *d, const lm_program *p) {
+  for (int i = 0; i < d->param_count; i++) {
+    const lm_pass_param *pa = &d->params[i];
+    const lm_uniform *u = lm_program_uniform(p, pa->name);
+    if (u->type == LM_UNIFORM_BOOL || is_integer(u->type)) {
+      int v[4] = {0};
+      for (int c = 0; c < pa->count && c < 4; c++) v[c] = (int)pa->v[c];
+      lm_program_set_int(p, u, v);
+    } else {
+      float v[16];
+      for (int c = 0; c < pa->count; c++) v[c] = (float)pa->v[c];
+      lm_program_set(p, u, v);
+    }
+  }
+}
+
+static lm_program *pass_program(const lm_pass_desc *d, lm_error *err) {
+  lm_program *p;
+  if (d->kind == LM_PASS_SCENE) {
+    char vert[256], frag[256];
+    snprintf(vert, sizeof vert, "%s.vert", d->shader);
+    snprintf(frag, sizeof frag, "%s.frag", d->shader);
+    p = lm_program_get(vert, frag, d->defines, err);
+  } else {
+    p = lm_program_get("fullscreen.vert", d->shader, d->defines, err);
+  }
+  if (!p) lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
+  return p;
+}
+
+static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_graph_exec_desc *x,
+                     lm_error *err) {
+  const lm_pass_desc *d = &gp->desc;
+  lm_program *p = pass_program(d, err);
+  if (!p || !check_bindings(g, d, p, x, err)) return false;
+  lm_attachments att = {.color_count = d->output_count};
+  for (int i = 0; i < d->output_count; i++) {
+    const graph_target *t = &g->targets[d->outputs[i]];
+    att.color[i] = t->texture;
+    att.width = t->width, att.height = t->height;
+  }
+  if (d->depth >= 0) {
+    att.depth = g->targets[d->depth].texture;
+    att.width = g->targets[d->depth].width, att.height = g->targets[d->depth].height;
+  }
+  if (!lm_attachments_bind(&att, err)) {
+    lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
+    return false;
+  }
+  lm_program_use(p);
+  for (int i = 0; i < d->input_count; i++)
+    lm_program_bind_texture(lm_program_uniform(p, d->inputs[i].name), g->targets[d->inputs[i].target].texture);
+  apply_params(d, p);
+  lm_timer_begin(timer, x->clock);
+  if (d->kind == LM_PASS_SCENE) {
+    lm_set_scene_state(true);
+    if (d->clear) lm_clear(d->output_count, d->clear_color, d->depth >= 0, 1.0f);
+    if (x->draw_scene) x->draw_scene(x->user, d->shader, p);
+    lm_set_scene_state(false);
+  } else {
+    lm_draw_fullscreen();
+  }
+  lm_timer_end(timer);
+  for (int i = 0; i < d->output_count; i++)
+    if (g->targets[d->outputs[i]].desc.mips) lm_texture_generate_mips(att.color[i]);
+  return true;
+}
+
+bool lm_graph_execute(lm_graph *g, const lm_graph_exec_desc *x, lm_error *err) {
+  if (!g->compiled) {
+    lm_error_set(err, "the frame graph was not compiled");
+    return false;
+  }
+  bool ok = allocate(g, err);
+  g->timers = lm_grow(g->timers, &g->timer_cap, g->pass_count, sizeof *g->timers);
+  if (g->timer_count < g->pass_count) g->timer_count = g->pass_count;
+  for (int pi = 0; pi < g->pass_count && ok; pi++)
+    if (!g->passes[pi].culled) ok = run_pass(g, &g->passes[pi], &g->timers[pi], x, err);
+  for (int pi = 0; pi < g->pass_count && ok; pi++)
+    if (!g->passes[pi].culled) g->passes[pi].ms = lm_timer_read(&g->timers[pi]);
+  pool_end_frame(g);
+  return ok;
+}

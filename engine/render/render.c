@@ -1,0 +1,105 @@
+#include "render/render.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+enum { MAX_LIGHTS = 256 };
+
+struct lm_renderer {
+  lm_renderer_desc desc;
+  lm_graph *graph;
+  lm_clock clock;
+  int output_srgb, output_linear;
+  int frame;
+  double record_ms, compile_ms;
+};
+
+lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
+  if (!lm_scene_upload(desc->scene, err)) return NULL;
+  lm_renderer *r = lm_alloc(sizeof *r);
+  r->desc = *desc;
+  r->graph = lm_graph_create();
+  r->clock = lm_clock_choose(desc->clock);
+  return r;
+}
+
+void lm_renderer_destroy(lm_renderer *r) {
+  if (!r) return;
+  lm_graph_destroy(r->graph);
+  free(r);
+}
+
+lm_graph *lm_renderer_graph(lm_renderer *r) { return r->graph; }
+lm_clock lm_renderer_clock(const lm_renderer *r) { return r->clock; }
+
+void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compile_ms) {
+  *record_ms = r->record_ms;
+  *compile_ms = r->compile_ms;
+}
+
+static void draw_scene(void *user, const char *technique, const lm_program *p) {
+  (void)technique;
+  lm_scene_draw(((lm_renderer *)user)->desc.scene, p);
+}
+
+/* The engine's last pass: sanitize and encode what the script presented. */
+static bool add_output_stage(lm_renderer *r, int presented, lm_error *err) {
+  lm_graph *g = r->graph;
+  r->output_srgb = lm_graph_add_target(g, &(lm_target_desc){.name = "output.srgb",
+                                                            .format = LM_FORMAT_RGBA8}, err);
+  r->output_linear = -1;
+  if (r->desc.linear_output)
+    r->output_linear = lm_graph_add_target(g, &(lm_target_desc){.name = "output.linear",
+                                                                .format = LM_FORMAT_RGBA32F}, err);
+  if (r->output_srgb < 0 || (r->desc.linear_output && r->output_linear < 0)) return false;
+  int outputs[2] = {r->output_srgb, r->output_linear};
+  lm_pass_input input = {"src", presented};
+  lm_pass_desc d = {.kind = LM_PASS_FULLSCREEN, .name = "output", .where = "engine output stage",
+                    .shader = "output.frag", .defines = r->desc.linear_output ? "LINEAR_OUTPUT" : "",
+                    .inputs = &input, .input_count = 1, .outputs = outputs,
+                    .output_count = r->desc.linear_output ? 2 : 1, .depth = -1};
+  if (lm_graph_add_pass(g, &d, err) < 0) return false;
+  lm_graph_mark_output(g, r->output_srgb);
+  if (r->output_linear >= 0) lm_graph_mark_output(g, r->output_linear);
+  return true;
+}
+
+bool lm_renderer_frame(lm_renderer *r, lm_error *err) {
+  lm_graph *g = r->graph;
+  lm_graph_begin(g, r->desc.width, r->desc.height);
+  double t0 = lm_cpu_ms();
+  int presented = -1;
+  if (!lm_pipeline_record(r->desc.pipeline, g, &presented, err)) return false;
+  double t1 = lm_cpu_ms();
+  if (!add_output_stage(r, presented, err) || !lm_graph_compile(g, err)) return false;
+  r->record_ms = t1 - t0;
+  r->compile_ms = lm_cpu_ms() - t1;
+
+  lm_frame_data frame;
+  lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, &frame);
+  frame.time[1] = (float)r->frame++;
+  lm_light_data lights[MAX_LIGHTS];
+  int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
+  frame.counts[0] = n;
+  lm_frame_upload(&frame, lights, n);
+  lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene,
+                          .scene_owns_uniform = lm_scene_owns_uniform, .user = r};
+  return lm_graph_execute(g, &x, err);
+}
+
+bool lm_renderer_read(lm_renderer *r, bool linear, void *rgb, lm_error *err) {
+  int id = linear ? r->output_linear : r->output_srgb;
+  if (id < 0) {
+    lm_error_set(err, "no %s output was kept for this frame", linear ? "linear" : "sRGB");
+    return false;
+  }
+  lm_graph_target_info t = lm_graph_target(r->graph, id);
+  size_t texel = linear ? 16 : 4, px = (size_t)t.width * t.height;
+  unsigned char *rgba = lm_alloc(px * texel);
+  lm_texture_read(t.texture, t.width, t.height, linear, rgba);
+  size_t comp = linear ? 4 : 1;
+  for (size_t i = 0; i < px; i++) /* drop alpha */
+    memcpy((unsigned char *)rgb + i * 3 * comp, rgba + i * 4 * comp, 3 * comp);
+  free(rgba);
+  return true;
+}

@@ -1,0 +1,32 @@
+/* render: one frame of a scene through a pipeline script. Records the frame
+ * (OnRender), appends the engine's output stage (which never lets a NaN or
+ * Inf through and encodes sRGB), compiles and executes the frame graph. */
+#ifndef LIMN_RENDER_H
+#define LIMN_RENDER_H
+
+#include "scene/scene.h"
+#include "script/script.h"
+
+typedef struct lm_renderer lm_renderer;
+
+typedef struct lm_renderer_desc {
+  lm_scene *scene;        /* borrowed */
+  lm_pipeline *pipeline;  /* borrowed */
+  int width, height;
+  int camera;             /* index into the scene's cameras */
+  lm_clock clock;         /* LM_CLOCK_AUTO picks */
+  bool linear_output;     /* also keep a float copy of the output (for EXR) */
+} lm_renderer_desc;
+
+lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err);
+void lm_renderer_destroy(lm_renderer *r);
+bool lm_renderer_frame(lm_renderer *r, lm_error *err);
+lm_graph *lm_renderer_graph(lm_renderer *r);
+lm_clock lm_renderer_clock(const lm_renderer *r);
+/* CPU milliseconds of the last frame spent in Lua (OnRender) and in compiling the graph. */
+void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compile_ms);
+/* The last frame's output, top row first: RGB 8-bit sRGB, or RGB float linear
+ * (needs linear_output). */
+bool lm_renderer_read(lm_renderer *r, bool linear, void *rgb, lm_error *err);
+
+#endif

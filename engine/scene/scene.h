@@ -1,0 +1,102 @@
+/* scene: the scene graph (nodes with local/world transforms), meshes,
+ * materials, lights and cameras, and the built-in scenes. */
+#ifndef LIMN_SCENE_H
+#define LIMN_SCENE_H
+
+#include "gfx/gfx.h"
+
+#define LM_NAME_MAX 64
+
+/* Phong material of seed 000 plus the reflectance rho that ISR reads. */
+typedef struct lm_material {
+  char name[LM_NAME_MAX];
+  float color[3];  /* diffuse albedo, linear */
+  float rho;       /* reflectance, the G-buffer's "radiation mask" */
+  float ka, kd, ks, shininess;
+} lm_material;
+
+typedef enum lm_light_type { LM_LIGHT_POINT, LM_LIGHT_SPOT, LM_LIGHT_DIRECTIONAL } lm_light_type;
+
+/* Position and direction come from the node (lights shine along the node's -Z).
+ * Point and spot lights fade as saturate(1 - (d / radius)^2) (seed 000, eq 16). */
+typedef struct lm_light {
+  char name[LM_NAME_MAX];
+  lm_light_type type;
+  float color[3];
+  float power;
+  float radius;
+  float inner_cone, outer_cone; /* spot half-angles, radians */
+  bool casts_shadows;
+  int node;
+} lm_light;
+
+/* Looks along the node's -Z with +Y up, as in glTF. */
+typedef struct lm_camera {
+  char name[LM_NAME_MAX];
+  float fov_y; /* radians */
+  float znear, zfar;
+  int node;
+} lm_camera;
+
+typedef struct lm_scene_mesh {
+  char name[LM_NAME_MAX];
+  float *vertices; /* position(3) normal(3) uv(2) */
+  int vertex_count;
+  uint32_t *indices;
+  int index_count;
+  lm_mesh gpu;
+} lm_scene_mesh;
+
+typedef struct lm_node {
+  char name[LM_NAME_MAX];
+  int parent;            /* -1: root */
+  float local[16];       /* column-major */
+  float world[16];       /* by lm_scene_update */
+  int mesh, material;    /* -1: none */
+} lm_node;
+
+typedef struct lm_scene {
+  char name[LM_NAME_MAX];
+  lm_node *nodes;
+  int node_count, node_cap;
+  lm_scene_mesh *meshes;
+  int mesh_count, mesh_cap;
+  lm_material *materials;
+  int material_count, material_cap;
+  lm_light *lights;
+  int light_count, light_cap;
+  lm_camera *cameras;
+  int camera_count, camera_cap;
+  bool uploaded;
+} lm_scene;
+
+lm_scene *lm_scene_create(const char *name);
+void lm_scene_destroy(lm_scene *s);
+int lm_scene_add_material(lm_scene *s, const lm_material *m);
+/* Copies the arrays. */
+int lm_scene_add_mesh(lm_scene *s, const char *name, const float *vertices, int vertex_count,
+                      const uint32_t *indices, int index_count);
+int lm_scene_add_node(lm_scene *s, const char *name, int parent, const float local[16], int mesh,
+                      int material);
+int lm_scene_add_light(lm_scene *s, const lm_light *l);
+int lm_scene_add_camera(lm_scene *s, const lm_camera *c);
+/* World transforms from local ones (parents come before children). */
+void lm_scene_update(lm_scene *s);
+
+/* A scene built in code: "cornell". NULL with a message listing the names. */
+lm_scene *lm_scene_builtin(const char *name, lm_error *err);
+const char *lm_scene_builtin_list(void);
+
+/* ---- rendering (needs a GL context) ------------------------------------ */
+bool lm_scene_upload(lm_scene *s, lm_error *err);
+/* Frame block for camera `cam` at an output of width x height. */
+void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_frame_data *out);
+/* Fills up to `max` lights; returns how many. */
+int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max);
+/* Draws every mesh node with `p`, setting model, normal_matrix and the
+ * material uniforms (material_color, material_rho, material_k). */
+void lm_scene_draw(const lm_scene *s, const lm_program *p);
+/* Uniforms a scene draw sets itself; scripts may not bind them. */
+bool lm_scene_owns_uniform(const char *name);
+
+#endif

@@ -1,0 +1,42 @@
+/* script: Lua pipeline scripts. A script defines OnCreate() (once: declares
+ * persistent targets) and OnRender(tech) (each frame: records passes into the
+ * frame graph; it never touches GL). Scripts run in a sandbox: no io, no os
+ * beyond clocks, no C modules, `require` only from the script's folder and
+ * <root>/scripts, and an instruction budget per call. */
+#ifndef LIMN_SCRIPT_H
+#define LIMN_SCRIPT_H
+
+#include "graph/graph.h"
+
+typedef struct lm_pipeline lm_pipeline;
+
+typedef struct lm_pipeline_desc {
+  const char *path;           /* the pipeline script */
+  long instruction_budget;    /* per OnCreate/OnRender call; 0: 100 million */
+} lm_pipeline_desc;
+
+/* Runs the script's top level and reads its Techniques and Options tables. */
+lm_pipeline *lm_pipeline_load(const lm_pipeline_desc *desc, lm_error *err);
+void lm_pipeline_destroy(lm_pipeline *p);
+
+/* Techniques the script lists in `Techniques`; the first is the default. */
+int lm_pipeline_technique_count(const lm_pipeline *p);
+const char *lm_pipeline_technique_name(const lm_pipeline *p, int i);
+bool lm_pipeline_set_technique(lm_pipeline *p, const char *name, lm_error *err);
+const char *lm_pipeline_technique(const lm_pipeline *p);
+
+/* Sets an option of the script's `Options` table by dotted name ("dof.focus"),
+ * the value parsed by the default's type. Unknown names are an error that
+ * lists the known ones. */
+bool lm_pipeline_set_option(lm_pipeline *p, const char *name, const char *value, lm_error *err);
+/* "name=default" lines of every option. */
+void lm_pipeline_list_options(const lm_pipeline *p, lm_buf *out);
+
+/* Records one frame into g (lm_graph_begin already called): OnCreate the
+ * first time, then OnRender(tech). *presented gets the target passed to
+ * present(). Errors carry script:line and a traceback on later lines. */
+bool lm_pipeline_record(lm_pipeline *p, lm_graph *g, int *presented, lm_error *err);
+/* True once OnCreate has run. */
+bool lm_pipeline_created(const lm_pipeline *p);
+
+#endif

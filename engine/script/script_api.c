@@ -1,0 +1,379 @@
+/* What pipeline scripts call: target{}, scene{}, pass{}, present(),
+ * output_size(). Each validates its table and names the field at fault. */
+#include "script/script_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TARGET_META "limn.target"
+
+typedef struct target_handle {
+  int id;
+  unsigned frame; /* 0: persistent (OnCreate) */
+  char name[64];
+} target_handle;
+
+static lm_pipeline *recording(lua_State *L, const char *fn) {
+  lm_pipeline *p = lm_script_pipeline(L);
+  if (!p->graph) luaL_error(L, "%s() is called from OnCreate or OnRender only", fn);
+  return p;
+}
+
+/* Every key of the table at idx must be in `known` (NULL-terminated). */
+static void check_fields(lua_State *L, int idx, const char *what, const char *const *known) {
+  lua_pushnil(L);
+  while (lua_next(L, idx)) {
+    lua_pop(L, 1);
+    if (lua_type(L, -1) == LUA_TNUMBER && lua_tointeger(L, -1) == 1) continue; /* the name */
+    const char *k = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : NULL;
+    bool ok = false;
+    for (const char *const *f = known; k && *f && !ok; f++) ok = !strcmp(k, *f);
+    if (!ok) {
+      lm_buf list = {0};
+      for (const char *const *f = known; *f; f++) lm_buf_printf(&list, "%s%s", f == known ? "" : ", ", *f);
+      lua_pushfstring(L, "%s: unknown field '%s' (known: %s)", what,
+                      k ? k : luaL_typename(L, -1), list.data);
+      lm_buf_free(&list);
+      luaL_where(L, 1);
+      lua_insert(L, -2);
+      lua_concat(L, 2);
+      lua_error(L);
+    }
+  }
+}
+
+static const char *opt_string(lua_State *L, int idx, const char *field, const char *what) {
+  lua_getfield(L, idx, field);
+  const char *s = NULL;
+  if (lua_type(L, -1) == LUA_TSTRING)
+    s = lua_tostring(L, -1);
+  else if (!lua_isnil(L, -1))
+    luaL_error(L, "%s: field '%s' must be a string, not a %s", what, field, luaL_typename(L, -1));
+  lua_pop(L, 1); /* the string stays alive in the table */
+  return s;
+}
+
+static target_handle *to_target(lua_State *L, int idx, const char *what) {
+  lm_pipeline *p = lm_script_pipeline(L);
+  target_handle *t = luaL_testudata(L, idx, TARGET_META);
+  if (!t) luaL_error(L, "%s: expected a target (from target{...}), got a %s", what, luaL_typename(L, idx));
+  if (t->frame && t->frame != p->frame)
+    luaL_error(L, "%s: target '%s' belongs to an earlier frame (declare frame targets in OnRender, "
+               "lasting ones in OnCreate)", what, t->name);
+  return t;
+}
+
+/* ---- target{ name = , format = , scale = | size = {w, h}, mips = } ---- */
+static int l_target(lua_State *L) {
+  lm_pipeline *p = recording(L, "target");
+  luaL_checktype(L, 1, LUA_TTABLE);
+  static const char *const fields[] = {"name", "format", "scale", "size", "mips", NULL};
+  check_fields(L, 1, "target", fields);
+  lm_target_desc d = {.scale = 1.0f, .persistent = p->in_create};
+  lua_rawgeti(L, 1, 1);
+  d.name = lua_tostring(L, -1);
+  lua_pop(L, 1);
+  if (!d.name) d.name = opt_string(L, 1, "name", "target");
+  if (!d.name) return luaL_error(L, "target: give it a name: target{ \"lit\", format = \"rgba16f\" }");
+  char what[128];
+  snprintf(what, sizeof what, "target '%s'", d.name);
+  const char *format = opt_string(L, 1, "format", what);
+  if (!format) return luaL_error(L, "%s: field 'format' is missing (one of %s)", what, lm_format_list());
+  d.format = lm_format_parse(format);
+  if (d.format == LM_FORMAT_NONE)
+    return luaL_error(L, "%s: unknown format '%s' (one of %s)", what, format, lm_format_list());
+  lua_getfield(L, 1, "scale");
+  if (!lua_isnil(L, -1)) {
+    double s = lua_tonumber(L, -1);
+    if (!lua_isnumber(L, -1) || !(s > 0) || s > 16 || !isfinite(s))
+      return luaL_error(L, "%s: scale must be a number in (0, 16]", what);
+    d.scale = (float)s;
+  }
+  lua_getfield(L, 1, "size");
+  if (!lua_isnil(L, -1)) {
+    if (!lua_istable(L, -1)) return luaL_error(L, "%s: size must be {width, height}", what);
+    lua_rawgeti(L, -1, 1);
+    lua_rawgeti(L, -2, 2);
+    lua_Integer w = lua_tointeger(L, -2), h = lua_tointeger(L, -1);
+    if (w < 1 || h < 1 || w > 65536 || h > 65536)
+      return luaL_error(L, "%s: size must be two whole numbers in 1 .. 65536", what);
+    d.width = (int)w, d.height = (int)h;
+    lua_pop(L, 2);
+  }
+  lua_getfield(L, 1, "mips");
+  d.mips = lua_toboolean(L, -1);
+  lua_pop(L, 2);
+  lm_error err;
+  int id = lm_graph_add_target(p->graph, &d, &err);
+  if (id < 0) return luaL_error(L, "%s", err.msg);
+  target_handle *t = lua_newuserdatauv(L, sizeof *t, 0);
+  t->id = id;
+  t->frame = p->in_create ? 0 : p->frame;
+  snprintf(t->name, sizeof t->name, "%s", d.name);
+  luaL_setmetatable(L, TARGET_META);
+  return 1;
+}
+
+static int l_target_tostring(lua_State *L) {
+  target_handle *t = luaL_checkudata(L, 1, TARGET_META);
+  lua_pushfstring(L, "target '%s'", t->name);
+  return 1;
+}
+
+static int l_target_index(lua_State *L) {
+  target_handle *t = luaL_checkudata(L, 1, TARGET_META);
+  const char *k = luaL_checkstring(L, 2);
+  if (!strcmp(k, "name")) {
+    lua_pushstring(L, t->name);
+    return 1;
+  }
+  return luaL_error(L, "target '%s' has no field '%s' (it has: name)", t->name, k);
+}
+
+/* ---- shared pass fields ----------------------------------------------- */
+typedef struct pass_builder {
+  lm_pass_desc desc;
+  lm_pass_input inputs[LM_MAX_PASS_INPUTS];
+  lm_pass_param params[LM_MAX_PASS_PARAMS];
+  int outputs[LM_MAX_COLOR_OUTPUTS];
+  char where[256], defines[1024];
+  char what[160];
+} pass_builder;
+
+static void read_outputs(lua_State *L, int idx, pass_builder *b) {
+  lua_getfield(L, idx, "out");
+  if (luaL_testudata(L, -1, TARGET_META)) {
+    b->outputs[b->desc.output_count++] = to_target(L, -1, b->what)->id;
+  } else if (lua_istable(L, -1)) {
+    int n = (int)lua_rawlen(L, -1);
+    if (n > LM_MAX_COLOR_OUTPUTS) luaL_error(L, "%s: at most %d outputs", b->what, LM_MAX_COLOR_OUTPUTS);
+    for (int i = 1; i <= n; i++) {
+      lua_rawgeti(L, -1, i);
+      b->outputs[b->desc.output_count++] = to_target(L, -1, b->what)->id;
+      lua_pop(L, 1);
+    }
+  } else if (!lua_isnil(L, -1)) {
+    luaL_error(L, "%s: field 'out' must be a target or a list of targets", b->what);
+  }
+  lua_pop(L, 1);
+}
+
+static void read_inputs(lua_State *L, int idx, pass_builder *b) {
+  lua_getfield(L, idx, "inputs");
+  if (lua_isnil(L, -1)) {
+    lua_pop(L, 1);
+    return;
+  }
+  if (!lua_istable(L, -1)) luaL_error(L, "%s: field 'inputs' must be a table { sampler = target }", b->what);
+  lua_pushnil(L);
+  while (lua_next(L, -2)) {
+    if (lua_type(L, -2) != LUA_TSTRING) luaL_error(L, "%s: inputs are named: { sampler = target }", b->what);
+    if (b->desc.input_count >= LM_MAX_PASS_INPUTS) luaL_error(L, "%s: at most %d inputs", b->what, LM_MAX_PASS_INPUTS);
+    char what[256];
+    snprintf(what, sizeof what, "%s: input '%s'", b->what, lua_tostring(L, -2));
+    lm_pass_input *in = &b->inputs[b->desc.input_count++];
+    in->name = lua_tostring(L, -2); /* the key stays alive in the table */
+    in->target = to_target(L, -1, what)->id;
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+}
+
+static void read_params(lua_State *L, int idx, pass_builder *b) {
+  lua_getfield(L, idx, "params");
+  if (lua_isnil(L, -1)) {
+    lua_pop(L, 1);
+    return;
+  }
+  if (!lua_istable(L, -1)) luaL_error(L, "%s: field 'params' must be a table { uniform = value }", b->what);
+  lua_pushnil(L);
+  while (lua_next(L, -2)) {
+    if (lua_type(L, -2) != LUA_TSTRING) luaL_error(L, "%s: params are named: { uniform = value }", b->what);
+    const char *name = lua_tostring(L, -2);
+    if (b->desc.param_count >= LM_MAX_PASS_PARAMS) luaL_error(L, "%s: at most %d params", b->what, LM_MAX_PASS_PARAMS);
+    lm_pass_param *pa = &b->params[b->desc.param_count++];
+    pa->name = name;
+    if (lua_isboolean(L, -1)) {
+      pa->kind = LM_PARAM_BOOL;
+      pa->count = 1;
+      pa->v[0] = lua_toboolean(L, -1);
+    } else if (lua_type(L, -1) == LUA_TNUMBER) {
+      pa->count = 1;
+      pa->v[0] = lua_tonumber(L, -1);
+    } else if (lua_istable(L, -1)) {
+      int n = (int)lua_rawlen(L, -1);
+      if (n < 1 || n > 16) luaL_error(L, "%s: parameter '%s': a list of 1 to 16 numbers", b->what, name);
+      for (int i = 1; i <= n; i++) {
+        lua_rawgeti(L, -1, i);
+        if (lua_type(L, -1) != LUA_TNUMBER)
+          luaL_error(L, "%s: parameter '%s': element %d is a %s, not a number", b->what, name, i,
+                     luaL_typename(L, -1));
+        pa->v[pa->count++] = lua_tonumber(L, -1);
+        lua_pop(L, 1);
+      }
+    } else {
+      luaL_error(L, "%s: parameter '%s': a number, boolean or list of numbers, not a %s", b->what,
+                 name, luaL_typename(L, -1));
+    }
+    for (int i = 0; i < pa->count; i++)
+      if (!isfinite(pa->v[i])) luaL_error(L, "%s: parameter '%s' is not finite", b->what, name);
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+}
+
+static int compare_strings(const void *a, const void *b) { return strcmp(a, b); }
+
+/* defines = { NAME = value | true }: sorted, so one variant has one cache key. */
+static void read_defines(lua_State *L, int idx, pass_builder *b) {
+  lua_getfield(L, idx, "defines");
+  if (lua_isnil(L, -1)) {
+    lua_pop(L, 1);
+    return;
+  }
+  if (!lua_istable(L, -1)) luaL_error(L, "%s: field 'defines' must be a table { NAME = value }", b->what);
+  char entries[32][96];
+  int n = 0;
+  lua_pushnil(L);
+  while (lua_next(L, -2)) {
+    if (lua_type(L, -2) != LUA_TSTRING || n == 32)
+      luaL_error(L, "%s: defines are named (at most 32): { NAME = value }", b->what);
+    const char *name = lua_tostring(L, -2);
+    int type = lua_type(L, -1);
+    if (type == LUA_TBOOLEAN) {
+      if (lua_toboolean(L, -1)) snprintf(entries[n++], sizeof entries[0], "%s", name);
+    } else if (type == LUA_TNUMBER || type == LUA_TSTRING) {
+      lua_pushvalue(L, -1); /* tostring on a copy: lua_next needs the key untouched */
+      snprintf(entries[n++], sizeof entries[0], "%s=%s", name, lua_tostring(L, -1));
+      lua_pop(L, 1);
+    } else {
+      luaL_error(L, "%s: define '%s' must be a number, string or boolean", b->what, name);
+    }
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  qsort(entries, (size_t)n, sizeof entries[0], compare_strings);
+  for (int i = 0; i < n; i++) {
+    size_t len = strlen(b->defines);
+    snprintf(b->defines + len, sizeof b->defines - len, "%s%s", i ? ";" : "", entries[i]);
+  }
+  b->desc.defines = b->defines;
+}
+
+static void begin_pass(lua_State *L, pass_builder *b, lm_pass_kind kind, const char *fn) {
+  memset(b, 0, sizeof *b);
+  luaL_checktype(L, 1, LUA_TTABLE);
+  b->desc.kind = kind;
+  b->desc.inputs = b->inputs;
+  b->desc.params = b->params;
+  b->desc.outputs = b->outputs;
+  b->desc.depth = -1;
+  luaL_where(L, 1);
+  snprintf(b->where, sizeof b->where, "%s", lua_tostring(L, -1));
+  lua_pop(L, 1);
+  size_t n = strlen(b->where);
+  while (n > 0 && (b->where[n - 1] == ' ' || b->where[n - 1] == ':')) b->where[--n] = '\0';
+  b->desc.where = b->where;
+  lua_rawgeti(L, 1, 1);
+  b->desc.name = lua_tostring(L, -1);
+  lua_pop(L, 1);
+  if (!b->desc.name) luaL_error(L, "%s: give the pass a name first: %s{ \"name\", ... }", fn, fn);
+  snprintf(b->what, sizeof b->what, "pass '%s'", b->desc.name);
+}
+
+static void add_pass(lua_State *L, lm_pipeline *p, pass_builder *b) {
+  lm_error err;
+  if (lm_graph_add_pass(p->graph, &b->desc, &err) < 0) luaL_error(L, "%s", err.msg);
+}
+
+/* scene{ "name", technique = "std", out = {...}, depth = T, clear = bool | {r,g,b,a}, ... } */
+static int l_scene(lua_State *L) {
+  lm_pipeline *p = recording(L, "scene");
+  if (p->in_create) return luaL_error(L, "scene() records a pass: call it from OnRender");
+  pass_builder b;
+  int top = lua_gettop(L);
+  begin_pass(L, &b, LM_PASS_SCENE, "scene");
+  static const char *const fields[] = {"technique", "out", "depth", "clear", "params", "defines", NULL};
+  check_fields(L, 1, b.what, fields);
+  b.desc.shader = opt_string(L, 1, "technique", b.what);
+  if (!b.desc.shader) b.desc.shader = "std";
+  read_outputs(L, 1, &b);
+  lua_getfield(L, 1, "depth");
+  if (!lua_isnil(L, -1)) b.desc.depth = to_target(L, -1, b.what)->id;
+  lua_pop(L, 1);
+  lua_getfield(L, 1, "clear");
+  b.desc.clear = true;
+  if (lua_isboolean(L, -1)) {
+    b.desc.clear = lua_toboolean(L, -1);
+  } else if (lua_istable(L, -1)) {
+    for (int i = 0; i < 4; i++) {
+      lua_rawgeti(L, -1, i + 1);
+      b.desc.clear_color[i] = (float)luaL_optnumber(L, -1, 0);
+      lua_pop(L, 1);
+    }
+  } else if (!lua_isnil(L, -1)) {
+    return luaL_error(L, "%s: clear must be true, false or {r, g, b, a}", b.what);
+  }
+  lua_pop(L, 1);
+  read_params(L, 1, &b);
+  read_defines(L, 1, &b);
+  add_pass(L, p, &b);
+  lua_settop(L, top);
+  return 0;
+}
+
+/* pass{ "name", shader = "x.frag", inputs = {...}, params = {...}, out = T | {...}, defines = {...} }
+ * returns its first output, so passes chain. */
+static int l_pass(lua_State *L) {
+  lm_pipeline *p = recording(L, "pass");
+  if (p->in_create) return luaL_error(L, "pass() records a pass: call it from OnRender");
+  pass_builder b;
+  int top = lua_gettop(L);
+  begin_pass(L, &b, LM_PASS_FULLSCREEN, "pass");
+  static const char *const fields[] = {"shader", "inputs", "params", "out", "defines", NULL};
+  check_fields(L, 1, b.what, fields);
+  b.desc.shader = opt_string(L, 1, "shader", b.what);
+  if (!b.desc.shader) return luaL_error(L, "%s: field 'shader' is missing (a file in shaders/)", b.what);
+  read_outputs(L, 1, &b);
+  if (b.desc.output_count == 0) return luaL_error(L, "%s: field 'out' is missing", b.what);
+  read_inputs(L, 1, &b);
+  read_params(L, 1, &b);
+  read_defines(L, 1, &b);
+  add_pass(L, p, &b);
+  lua_settop(L, top);
+  lua_getfield(L, 1, "out");
+  if (lua_istable(L, -1)) lua_rawgeti(L, -1, 1);
+  return 1;
+}
+
+static int l_present(lua_State *L) {
+  lm_pipeline *p = recording(L, "present");
+  if (p->in_create) return luaL_error(L, "present() is called from OnRender");
+  p->presented = to_target(L, 1, "present")->id;
+  return 0;
+}
+
+static int l_output_size(lua_State *L) {
+  lm_pipeline *p = recording(L, "output_size");
+  int w, h;
+  lm_graph_output_size(p->graph, &w, &h);
+  lua_pushinteger(L, w);
+  lua_pushinteger(L, h);
+  return 2;
+}
+
+void lm_script_open_api(lua_State *L) {
+  luaL_newmetatable(L, TARGET_META);
+  lua_pushcfunction(L, l_target_tostring);
+  lua_setfield(L, -2, "__tostring");
+  lua_pushcfunction(L, l_target_index);
+  lua_setfield(L, -2, "__index");
+  lua_pop(L, 1);
+  static const luaL_Reg api[] = {{"target", l_target}, {"scene", l_scene}, {"pass", l_pass},
+                                 {"present", l_present}, {"output_size", l_output_size}, {NULL, NULL}};
+  lua_pushglobaltable(L);
+  luaL_setfuncs(L, api, 0);
+  lua_pop(L, 1);
+}

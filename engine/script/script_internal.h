@@ -1,0 +1,29 @@
+/* Shared by script.c (state, sandbox, options) and script_api.c (the
+ * functions scripts call to record a frame). */
+#ifndef LIMN_SCRIPT_INTERNAL_H
+#define LIMN_SCRIPT_INTERNAL_H
+
+#include "script/script.h"
+
+#include <lauxlib.h>
+#include <lua.h>
+
+struct lm_pipeline {
+  lua_State *L;
+  char path[1024], dir[1024];
+  char technique[64];
+  long budget, executed;
+  /* while recording */
+  lm_graph *graph;
+  unsigned frame;     /* serial of the frame being recorded; 0 inside OnCreate */
+  bool in_create, created;
+  int presented;
+  int options_ref;    /* registry: the Options table with overrides applied */
+};
+
+/* Registers target, scene, pass, present, output_size in the global table. */
+void lm_script_open_api(lua_State *L);
+/* The pipeline that owns L. */
+lm_pipeline *lm_script_pipeline(lua_State *L);
+
+#endif

@@ -1,0 +1,25 @@
+-- The default pipeline. Techniques follow the seed viewer's modes; the first
+-- one listed is the default. Options are what `limn capture --set` can change.
+local gbuffer = require "gbuffer"
+
+Techniques = { "dl" }
+
+Options = {
+  ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
+  background = 0.0,        -- radiance where no geometry is
+}
+
+local function grey(x) return { x, x, x } end
+
+-- Direct light alone (the seed's F5 mode).
+local function direct(G, tech)
+  local lit = target{ "lit", format = "rgba16f" }
+  return pass{ "direct", shader = "direct.frag", inputs = gbuffer.inputs(G),
+               params = { ambient = grey(tech.ambient), background = grey(tech.background) },
+               out = lit }
+end
+
+function OnRender(tech)
+  local G = gbuffer.render(gbuffer.targets())
+  present(direct(G, tech))
+end

@@ -1,0 +1,52 @@
+// Engine data every shader may read, and guarded math helpers.
+#ifndef LIMN_COMMON_GLSL
+#define LIMN_COMMON_GLSL
+
+layout(std140, binding = 0) uniform LimnFrame {
+  mat4 view, proj, view_proj, inv_view;
+  vec4 camera_pos;
+  vec4 frustum_o, frustum_u, frustum_v; // rays from the eye to the far plane
+  vec4 clip;        // near, far, 1/far, tan(fov_y / 2)
+  vec4 output_size; // w, h, 1/w, 1/h
+  vec4 time;        // seconds, frame index
+  ivec4 counts;     // x: lights
+} frame;
+
+struct Light {
+  vec4 position;  // xyz, w: 0 point, 1 spot, 2 directional
+  vec4 direction; // xyz unit (from the light), w: cos(outer cone)
+  vec4 color;     // rgb * power, w: radius
+  vec4 params;    // x: cos(inner cone)
+};
+layout(std430, binding = 1) readonly buffer LimnLights { Light lights[]; };
+
+const float PI = 3.14159265358979;
+const float EPS = 1e-6;
+
+float saturate(float x) { return clamp(x, 0.0, 1.0); }
+vec3 saturate(vec3 x) { return clamp(x, 0.0, 1.0); }
+
+// normalize() of a zero vector is NaN; this returns `fallback` instead.
+vec3 safe_normalize(vec3 v, vec3 fallback) {
+  float len2 = dot(v, v);
+  return len2 > 1e-24 ? v * inversesqrt(len2) : fallback;
+}
+
+float safe_div(float a, float b) { return a / (abs(b) > 1e-20 ? b : (b < 0.0 ? -1e-20 : 1e-20)); }
+
+// Seed 000 eq 17.
+float luminance(vec3 c) { return dot(c, vec3(0.27, 0.67, 0.06)); }
+
+// World position from linear depth / far and the far-plane rays (seed 000, eq 23-24).
+vec3 position_from_depth(vec2 uv, float depth01) {
+  vec3 ray = frame.frustum_o.xyz + frame.frustum_u.xyz * uv.x + frame.frustum_v.xyz * uv.y;
+  return frame.camera_pos.xyz + ray * depth01;
+}
+
+// Replaces NaN and Inf by zero, negatives by zero.
+vec3 finite_or_zero(vec3 c) {
+  bvec3 bad = bvec3(isnan(c.x) || isinf(c.x), isnan(c.y) || isinf(c.y), isnan(c.z) || isinf(c.z));
+  return max(mix(c, vec3(0.0), bad), vec3(0.0));
+}
+
+#endif

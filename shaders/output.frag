@@ -1,0 +1,25 @@
+// The engine's output stage: no NaN, Inf or negative value leaves it, in any
+// mode; out_srgb is sRGB-encoded for 8-bit files and displays.
+#include "common.glsl"
+
+in vec2 uv;
+uniform sampler2D src;
+
+layout(location = 0) out vec4 out_srgb;
+#ifdef LINEAR_OUTPUT
+layout(location = 1) out vec4 out_linear;
+#endif
+
+vec3 srgb_encode(vec3 c) {
+  c = saturate(c);
+  vec3 lo = c * 12.92, hi = 1.055 * pow(max(c, vec3(1e-8)), vec3(1.0 / 2.4)) - 0.055;
+  return mix(lo, hi, step(vec3(0.0031308), c));
+}
+
+void main() {
+  vec3 c = finite_or_zero(texture(src, uv).rgb);
+  out_srgb = vec4(srgb_encode(c), 1.0);
+#ifdef LINEAR_OUTPUT
+  out_linear = vec4(c, 1.0);
+#endif
+}

@@ -1,0 +1,26 @@
+// G-buffer as seed 000 (lines 1229-1259), plus the Phong factors:
+//   clr = albedo, rho     nrm = world normal, shininess
+//   dpt = linear depth / far    mat = k_a, k_d, k_s, coverage (1 = geometry)
+#include "common.glsl"
+
+in vec3 world_normal;
+in float view_depth;
+in vec2 tex_uv;
+
+uniform vec3 material_color;
+uniform float material_rho;
+uniform vec4 material_k; // k_a, k_d, k_s, shininess
+
+layout(location = 0) out vec4 out_clr;
+layout(location = 1) out vec4 out_nrm;
+layout(location = 2) out float out_dpt;
+layout(location = 3) out vec4 out_mat;
+
+void main() {
+  vec3 n = safe_normalize(world_normal, vec3(0.0, 1.0, 0.0));
+  if (!gl_FrontFacing) n = -n; // two-sided: a wall seen from behind still lights
+  out_clr = vec4(saturate(material_color), saturate(material_rho));
+  out_nrm = vec4(n, max(material_k.w, 0.0));
+  out_dpt = max(view_depth, 0.0) * frame.clip.z;
+  out_mat = vec4(saturate(material_k.xyz), 1.0);
+}

@@ -1,0 +1,21 @@
+// The "std" material technique: geometry into the G-buffer.
+#include "common.glsl"
+
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+
+uniform mat4 model;
+uniform mat3 normal_matrix;
+
+out vec3 world_normal;
+out float view_depth;
+out vec2 tex_uv;
+
+void main() {
+  vec4 world = model * vec4(in_position, 1.0);
+  world_normal = normal_matrix * in_normal;
+  view_depth = -(frame.view * world).z; // OpenGL looks down -z
+  tex_uv = in_uv;
+  gl_Position = frame.view_proj * world;
+}

@@ -1,0 +1,323 @@
+/* limn capture: render headless and write images, printing per-pass times. */
+#define _GNU_SOURCE
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "image/image.h"
+#include "render/render.h"
+#include "tools.h"
+
+static const char capture_usage[] =
+    "usage: limn capture [options]\n"
+    "\n"
+    "Renders a scene through a pipeline script without a window and writes the\n"
+    "last frame. PNG gets 8-bit sRGB; EXR gets linear float RGB. Each file is\n"
+    "written under a temporary name and renamed, so a failed run leaves none.\n"
+    "\n"
+    "options:\n"
+    "  --scene NAME         built-in scene (default cornell; built in: %s)\n"
+    "  --script FILE        pipeline script (default scripts/pp.lua)\n"
+    "  --tech NAME          technique of the script (default: the first it lists)\n"
+    "  --set NAME=VALUE     set a technique option the script declares in Options\n"
+    "                       (repeatable; dotted names reach nested options)\n"
+    "  --size WxH           output size (default 256x192)\n"
+    "  --frames N           frames to render (default 1); times are medians\n"
+    "  --camera N           camera index of the scene (default 0)\n"
+    "  --output FILE        image to write, .png or .exr (repeatable)\n"
+    "  --clock auto|gpu|cpu how passes are timed (default auto: GL timer queries,\n"
+    "                       or glFinish + a CPU clock on software renderers)\n"
+    "  --egl auto|device|surfaceless   EGL platform (default auto)\n"
+    "  --list-options       print the script's techniques and options, and exit\n"
+    "  --quiet              no times, errors only\n"
+    "  --verbose            debug messages (targets left out, GL messages)\n"
+    "  --help               this text\n";
+
+typedef struct capture_args {
+  const char *scene, *script, *tech, *egl;
+  const char *outputs[16];
+  int output_count;
+  const char *sets[64];
+  int set_count;
+  int width, height, frames, camera;
+  lm_clock clock;
+  bool list_options, quiet, verbose;
+} capture_args;
+
+static int usage_error(const char *fmt, const char *arg) {
+  fprintf(stderr, "limn capture: ");
+  fprintf(stderr, fmt, arg);
+  fprintf(stderr, "\n(see limn capture --help)\n");
+  return 2;
+}
+
+static bool parse_int(const char *s, int lo, int hi, int *out) {
+  char *end;
+  long v = strtol(s, &end, 10);
+  if (end == s || *end || v < lo || v > hi) return false;
+  *out = (int)v;
+  return true;
+}
+
+static bool parse_size(const char *s, int *w, int *h) {
+  char buf[64];
+  snprintf(buf, sizeof buf, "%s", s);
+  char *x = strchr(buf, 'x');
+  if (!x) return false;
+  *x = '\0';
+  return parse_int(buf, 1, 65536, w) && parse_int(x + 1, 1, 65536, h);
+}
+
+static bool known_extension(const char *path, bool *linear) {
+  const char *dot = strrchr(path, '.');
+  if (!dot || strchr(dot, '/')) return false;
+  *linear = !strcasecmp(dot, ".exr") || !strcasecmp(dot, ".hdr");
+  return *linear || !strcasecmp(dot, ".png") || !strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".tif");
+}
+
+/* Returns 0 to go on, else the exit code. */
+static int parse_args(int argc, char **argv, capture_args *a) {
+  *a = (capture_args){.scene = "cornell", .script = NULL, .egl = "auto", .width = 256,
+                      .height = 192, .frames = 1};
+  static const struct option opts[] = {
+      {"scene", required_argument, 0, 's'},  {"script", required_argument, 0, 'p'},
+      {"tech", required_argument, 0, 't'},   {"set", required_argument, 0, 'D'},
+      {"size", required_argument, 0, 'z'},   {"frames", required_argument, 0, 'n'},
+      {"camera", required_argument, 0, 'c'}, {"output", required_argument, 0, 'o'},
+      {"clock", required_argument, 0, 'k'},  {"egl", required_argument, 0, 'e'},
+      {"list-options", no_argument, 0, 'l'}, {"quiet", no_argument, 0, 'q'},
+      {"verbose", no_argument, 0, 'v'},      {"help", no_argument, 0, 'h'},
+      {0, 0, 0, 0}};
+  opterr = 0;
+  optind = 1;
+  int c;
+  while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
+    switch (c) {
+    case 's': a->scene = optarg; break;
+    case 'p': a->script = optarg; break;
+    case 't': a->tech = optarg; break;
+    case 'D':
+      if (!strchr(optarg, '=') || optarg[0] == '=') return usage_error("--set wants NAME=VALUE, not '%s'", optarg);
+      if (a->set_count == 64) return usage_error("%s", "at most 64 --set flags");
+      a->sets[a->set_count++] = optarg;
+      break;
+    case 'z':
+      if (!parse_size(optarg, &a->width, &a->height))
+        return usage_error("--size wants WxH with both in 1..65536, not '%s'", optarg);
+      break;
+    case 'n':
+      if (!parse_int(optarg, 1, 100000, &a->frames)) return usage_error("--frames wants 1..100000, not '%s'", optarg);
+      break;
+    case 'c':
+      if (!parse_int(optarg, 0, 1 << 20, &a->camera)) return usage_error("--camera wants an index, not '%s'", optarg);
+      break;
+    case 'o': {
+      bool linear;
+      if (!known_extension(optarg, &linear))
+        return usage_error("--output '%s': use a .png, .exr, .jpg, .tif or .hdr file", optarg);
+      if (a->output_count == 16) return usage_error("%s", "at most 16 --output flags");
+      a->outputs[a->output_count++] = optarg;
+      break;
+    }
+    case 'k':
+      if (!strcmp(optarg, "auto")) a->clock = LM_CLOCK_AUTO;
+      else if (!strcmp(optarg, "gpu")) a->clock = LM_CLOCK_GPU;
+      else if (!strcmp(optarg, "cpu")) a->clock = LM_CLOCK_CPU;
+      else return usage_error("--clock wants auto, gpu or cpu, not '%s'", optarg);
+      break;
+    case 'e':
+      if (strcmp(optarg, "auto") && strcmp(optarg, "device") && strcmp(optarg, "surfaceless"))
+        return usage_error("--egl wants auto, device or surfaceless, not '%s'", optarg);
+      a->egl = optarg;
+      break;
+    case 'l': a->list_options = true; break;
+    case 'q': a->quiet = true; break;
+    case 'v': a->verbose = true; break;
+    case 'h': printf(capture_usage, lm_scene_builtin_list()); return -1;
+    case ':': return usage_error("%s needs a value", argv[optind - 1]);
+    default: return usage_error("unknown flag '%s'", argv[optind - 1]);
+    }
+  }
+  if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
+  return 0;
+}
+
+/* A relative script path that does not exist here is looked up under the root. */
+static void resolve_script(const char *given, char *out, size_t cap) {
+  if (!given) {
+    snprintf(out, cap, "%s/scripts/pp.lua", lm_root_dir());
+  } else if (given[0] != '/' && !lm_file_exists(given)) {
+    snprintf(out, cap, "%s/%s", lm_root_dir(), given);
+    if (!lm_file_exists(out)) snprintf(out, cap, "%s", given);
+  } else {
+    snprintf(out, cap, "%s", given);
+  }
+}
+
+typedef struct pass_times {
+  const char *name, *kind;
+  double *ms;
+  int count;
+} pass_times;
+
+static int compare_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static double median(double *v, int n) {
+  if (n == 0) return 0;
+  qsort(v, (size_t)n, sizeof *v, compare_double);
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static void print_times(pass_times *t, int n, int frames, lm_clock clock) {
+  printf("pass times (median of %d frame%s; clock: %s)\n", frames, frames == 1 ? "" : "s",
+         lm_clock_name(clock));
+  double total = 0;
+  for (int i = 0; i < n; i++) {
+    double m = median(t[i].ms, t[i].count);
+    total += m;
+    printf("  %-24s %-10s %9.3f ms\n", t[i].name, t[i].kind, m);
+  }
+  printf("  %-24s %-10s %9.3f ms\n", "total", "", total);
+}
+
+static void collect_times(lm_graph *g, pass_times **times, int *count, int frames) {
+  for (int i = 0; i < lm_graph_pass_count(g); i++) {
+    lm_graph_pass_info p = lm_graph_pass(g, i);
+    if (p.culled || p.ms < 0) continue;
+    pass_times *t = NULL;
+    for (int k = 0; k < *count && !t; k++)
+      if (!strcmp((*times)[k].name, p.name)) t = &(*times)[k];
+    if (!t) {
+      *times = lm_realloc(*times, sizeof **times * (size_t)(*count + 1));
+      t = &(*times)[(*count)++];
+      *t = (pass_times){lm_strdup(p.name), p.kind == LM_PASS_SCENE ? "scene" : "fullscreen",
+                        lm_alloc(sizeof(double) * (size_t)frames), 0};
+    }
+    if (t->count < frames) t->ms[t->count++] = p.ms;
+  }
+}
+
+static bool write_outputs(lm_renderer *r, const capture_args *a, lm_error *err) {
+  size_t px = (size_t)a->width * a->height;
+  unsigned char *srgb = NULL;
+  float *linear = NULL;
+  bool ok = true;
+  for (int i = 0; i < a->output_count && ok; i++) {
+    bool want_linear = false;
+    known_extension(a->outputs[i], &want_linear);
+    if (want_linear && !linear) {
+      linear = lm_alloc(px * 3 * sizeof(float));
+      ok = lm_renderer_read(r, true, linear, err);
+    } else if (!want_linear && !srgb) {
+      srgb = lm_alloc(px * 3);
+      ok = lm_renderer_read(r, false, srgb, err);
+    }
+    if (ok)
+      ok = lm_image_write(a->outputs[i], a->width, a->height, 3, want_linear,
+                          want_linear ? (void *)linear : (void *)srgb, err);
+    if (ok && !a->quiet) lm_info("wrote %s", a->outputs[i]);
+  }
+  free(srgb);
+  free(linear);
+  return ok;
+}
+
+int limn_capture(int argc, char **argv) {
+  capture_args a;
+  int rc = parse_args(argc, argv, &a);
+  if (rc) return rc < 0 ? 0 : rc;
+  if (a.verbose) lm_log_set_level(LM_LOG_DEBUG);
+  if (a.quiet) lm_log_set_level(LM_LOG_WARN);
+
+  char script[2048];
+  resolve_script(a.script, script, sizeof script);
+  lm_error err;
+  lm_pipeline *pipeline = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, &err);
+  if (!pipeline) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    return 1;
+  }
+  rc = 0;
+  if (a.tech && !lm_pipeline_set_technique(pipeline, a.tech, &err)) rc = 2;
+  for (int i = 0; i < a.set_count && !rc; i++) {
+    char name[256];
+    const char *eq = strchr(a.sets[i], '=');
+    snprintf(name, sizeof name, "%.*s", (int)(eq - a.sets[i]), a.sets[i]);
+    if (!lm_pipeline_set_option(pipeline, name, eq + 1, &err)) rc = 2;
+  }
+  if (rc) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    lm_pipeline_destroy(pipeline);
+    return rc;
+  }
+  if (a.list_options) {
+    lm_buf b = {0};
+    printf("techniques:");
+    for (int i = 0; i < lm_pipeline_technique_count(pipeline); i++)
+      printf(" %s", lm_pipeline_technique_name(pipeline, i));
+    lm_pipeline_list_options(pipeline, &b);
+    printf("\noptions: %s\n", b.data ? b.data : "none");
+    lm_buf_free(&b);
+    lm_pipeline_destroy(pipeline);
+    return 0;
+  }
+
+  lm_scene *scene = lm_scene_builtin(a.scene, &err);
+  if (!scene) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    lm_pipeline_destroy(pipeline);
+    return 2;
+  }
+  if (a.camera > 0 && a.camera >= scene->camera_count) {
+    lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a.camera, a.scene, scene->camera_count);
+    lm_scene_destroy(scene);
+    lm_pipeline_destroy(pipeline);
+    return 2;
+  }
+  if (!lm_context_create_headless(&(lm_context_desc){.platform = a.egl, .debug = a.verbose}, &err)) {
+    lm_log(LM_LOG_ERROR, "no OpenGL context: %s", err.msg);
+    lm_scene_destroy(scene);
+    lm_pipeline_destroy(pipeline);
+    return 1;
+  }
+  bool any_linear = false;
+  for (int i = 0; i < a.output_count; i++) {
+    bool l;
+    known_extension(a.outputs[i], &l);
+    any_linear |= l;
+  }
+  lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = pipeline,
+                                                          .width = a.width, .height = a.height,
+                                                          .camera = a.camera, .clock = a.clock,
+                                                          .linear_output = any_linear}, &err);
+  bool ok = r != NULL;
+  pass_times *times = NULL;
+  int time_count = 0;
+  if (ok && !a.quiet)
+    lm_info("renderer: %s (%s, %s); scene %s; script %s; technique %s; %dx%d", lm_gl_renderer(),
+            lm_gl_version(), lm_context_platform(), a.scene, script, lm_pipeline_technique(pipeline),
+            a.width, a.height);
+  for (int f = 0; f < a.frames && ok; f++) {
+    ok = lm_renderer_frame(r, &err);
+    if (ok) collect_times(lm_renderer_graph(r), &times, &time_count, a.frames);
+  }
+  if (ok) ok = write_outputs(r, &a, &err);
+  if (ok && !a.quiet) print_times(times, time_count, a.frames, lm_renderer_clock(r));
+  if (!ok) lm_log(LM_LOG_ERROR, "%s", err.msg);
+  for (int i = 0; i < time_count; i++) {
+    free((char *)times[i].name);
+    free(times[i].ms);
+  }
+  free(times);
+  lm_renderer_destroy(r);
+  lm_programs_clear();
+  lm_scene_destroy(scene);
+  lm_context_destroy();
+  lm_pipeline_destroy(pipeline);
+  return ok ? 0 : 1;
+}

@@ -1,0 +1,32 @@
+/* limn: the command-line front end. */
+#include <stdio.h>
+#include <string.h>
+
+#include "tools.h"
+
+static const char usage[] =
+    "usage: limn <command> [options]\n"
+    "\n"
+    "Limn renders scenes through Lua pipeline scripts (scripts/pp.lua).\n"
+    "\n"
+    "commands:\n"
+    "  capture   render headless (EGL, no window) to PNG or EXR and print per-pass times\n"
+    "  help      this text; `limn <command> --help` describes a command's flags\n"
+    "\n"
+    "example:\n"
+    "  limn capture --scene cornell --script scripts/pp.lua --tech dl --size 256x192 --output out.png\n";
+
+int main(int argc, char **argv) {
+  if (argc < 2) {
+    fputs(usage, stderr);
+    return 2;
+  }
+  const char *cmd = argv[1];
+  if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
+    fputs(usage, stdout);
+    return 0;
+  }
+  if (!strcmp(cmd, "capture")) return limn_capture(argc - 1, argv + 1);
+  fprintf(stderr, "limn: unknown command '%s'\n\n%s", cmd, usage);
+  return 2;
+}
