@@ -1,14 +1,18 @@
 /* GLSL source assembly: #include expansion with #line directives so that a
  * compiler message points at the original file and line. Pure text, no GL. */
+#define _XOPEN_SOURCE 700 /* realpath */
 #include "gfx/gfx.h"
 
 #include <ctype.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+/* A path relative to the engine root when it lies under it. */
 static const char *display_name(const char *path) {
-  const char *root = lm_root_dir();
+  char root[PATH_MAX];
+  if (!realpath(lm_root_dir(), root)) snprintf(root, sizeof root, "%s", lm_root_dir());
   size_t n = strlen(root);
   if (!strncmp(path, root, n) && path[n] == '/') return path + n + 1;
   return path;
@@ -70,8 +74,10 @@ static bool is_version_line(const char *line, int len) {
   return len - i >= 8 && !strncmp(line + i, "#version", 8);
 }
 
-static bool expand(lm_shader_source *src, const char *path, const char *include_dir, int depth,
+static bool expand(lm_shader_source *src, const char *given, const char *include_dir, int depth,
                    lm_error *err) {
+  char path[PATH_MAX]; /* canonical, so "lib/../a.glsl" and "a.glsl" are one file */
+  if (!realpath(given, path)) snprintf(path, sizeof path, "%s", given);
   if (depth > 32) {
     lm_error_set(err, "%s: includes nest deeper than 32 levels", display_name(path));
     return false;

@@ -54,7 +54,8 @@ static bool add_output_stage(lm_renderer *r, int presented, lm_error *err) {
   if (r->output_srgb < 0 || (r->desc.linear_output && r->output_linear < 0)) return false;
   int outputs[2] = {r->output_srgb, r->output_linear};
   lm_pass_input input = {"src", presented};
-  lm_pass_desc d = {.kind = LM_PASS_FULLSCREEN, .name = "output", .where = "engine output stage",
+  lm_pass_desc d = {.kind = LM_PASS_FULLSCREEN, .name = "output",
+                    .where = lm_pipeline_present_where(r->desc.pipeline),
                     .shader = "output.frag", .defines = r->desc.linear_output ? "LINEAR_OUTPUT" : "",
                     .inputs = &input, .input_count = 1, .outputs = outputs,
                     .output_count = r->desc.linear_output ? 2 : 1, .depth = -1};

@@ -24,8 +24,12 @@ static void budget_hook(lua_State *L, lua_Debug *ar) {
   (void)ar;
   lm_pipeline *p = lm_script_pipeline(L);
   p->executed += 1000;
-  if (p->executed > p->budget)
-    luaL_error(L, "instruction budget of %ld exceeded (an endless loop?)", p->budget);
+  if (p->executed > p->budget) {
+    luaL_where(L, 0); /* inside a hook, level 0 is the Lua function that runs */
+    lua_pushfstring(L, "instruction budget of %I exceeded (an endless loop?)", (lua_Integer)p->budget);
+    lua_concat(L, 2);
+    lua_error(L);
+  }
 }
 
 static int l_print(lua_State *L) {
@@ -381,6 +385,8 @@ void lm_pipeline_destroy(lm_pipeline *p) {
 }
 
 bool lm_pipeline_created(const lm_pipeline *p) { return p->created; }
+
+const char *lm_pipeline_present_where(const lm_pipeline *p) { return p->present_where; }
 
 bool lm_pipeline_record(lm_pipeline *p, lm_graph *g, int *presented, lm_error *err) {
   static unsigned serial;

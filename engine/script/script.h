@@ -36,6 +36,8 @@ void lm_pipeline_list_options(const lm_pipeline *p, lm_buf *out);
  * first time, then OnRender(tech). *presented gets the target passed to
  * present(). Errors carry script:line and a traceback on later lines. */
 bool lm_pipeline_record(lm_pipeline *p, lm_graph *g, int *presented, lm_error *err);
+/* Where the last frame called present() ("scripts/pp.lua:30"). */
+const char *lm_pipeline_present_where(const lm_pipeline *p);
 /* True once OnCreate has run. */
 bool lm_pipeline_created(const lm_pipeline *p);
 

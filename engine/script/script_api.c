@@ -352,6 +352,11 @@ static int l_present(lua_State *L) {
   lm_pipeline *p = recording(L, "present");
   if (p->in_create) return luaL_error(L, "present() is called from OnRender");
   p->presented = to_target(L, 1, "present")->id;
+  luaL_where(L, 1);
+  snprintf(p->present_where, sizeof p->present_where, "%s", lua_tostring(L, -1));
+  p->present_where[strcspn(p->present_where, " ")] = '\0';
+  size_t n = strlen(p->present_where);
+  if (n > 0 && p->present_where[n - 1] == ':') p->present_where[n - 1] = '\0';
   return 0;
 }
 

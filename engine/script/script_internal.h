@@ -18,6 +18,7 @@ struct lm_pipeline {
   unsigned frame;     /* serial of the frame being recorded; 0 inside OnCreate */
   bool in_create, created;
   int presented;
+  char present_where[256];
   int options_ref;    /* registry: the Options table with overrides applied */
 };
 

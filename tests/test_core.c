@@ -1,0 +1,96 @@
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/core.h"
+
+static void buf_appends_and_formats(void **state) {
+  (void)state;
+  lm_buf b = {0};
+  lm_buf_append(&b, "abc", -1);
+  lm_buf_append(&b, "defgh", 2);
+  lm_buf_printf(&b, "-%d-%s", 42, "x");
+  assert_string_equal(b.data, "abcde-42-x");
+  assert_int_equal(b.len, 10);
+  for (int i = 0; i < 1000; i++) lm_buf_append(&b, "0123456789", 10);
+  assert_int_equal(b.len, 10010);
+  assert_int_equal((int)strlen(b.data), 10010);
+  lm_buf_free(&b);
+  assert_null(b.data);
+}
+
+static void grow_zeroes_new_slots(void **state) {
+  (void)state;
+  int *items = NULL, count = 0, cap = 0;
+  for (int i = 0; i < 100; i++) assert_int_equal(*LM_PUSH(items, count, cap), 0), items[i] = i;
+  assert_int_equal(count, 100);
+  assert_true(cap >= 100);
+  for (int i = 0; i < 100; i++) assert_int_equal(items[i], i);
+  free(items);
+}
+
+static void arena_allocations_are_zeroed_and_aligned(void **state) {
+  (void)state;
+  lm_arena a = {0};
+  for (int i = 1; i < 2000; i++) {
+    unsigned char *p = lm_arena_alloc(&a, (size_t)i);
+    assert_int_equal((uintptr_t)p % 16, 0);
+    for (int k = 0; k < i; k++) assert_int_equal(p[k], 0);
+    memset(p, 0xab, (size_t)i);
+  }
+  char *s = lm_arena_strdup(&a, "hello");
+  assert_string_equal(s, "hello");
+  lm_arena_reset(&a);
+  assert_null(a.head);
+}
+
+static void hash_is_fnv1a(void **state) {
+  (void)state;
+  /* Published FNV-1a 64 test vectors. */
+  assert_true(lm_hash("", 0, LM_HASH_SEED) == 0xcbf29ce484222325ull);
+  assert_true(lm_hash("a", 1, LM_HASH_SEED) == 0xaf63dc4c8601ec8cull);
+  assert_true(lm_hash("foobar", 6, LM_HASH_SEED) == 0x85944171f73967e8ull);
+}
+
+static void errors_prefix(void **state) {
+  (void)state;
+  lm_error e;
+  lm_error_set(&e, "reads target '%s'", "x");
+  lm_error_prefix(&e, "%s:%d", "pp.lua", 12);
+  assert_string_equal(e.msg, "pp.lua:12: reads target 'x'");
+}
+
+static void files_read_and_dirname(void **state) {
+  (void)state;
+  lm_error err;
+  assert_null(lm_read_file("/nonexistent/file", NULL, &err));
+  assert_non_null(strstr(err.msg, "/nonexistent/file"));
+  size_t len = 0;
+  char *text = lm_read_file(LIMN_TEST_DIR "/test_core.c", &len, &err);
+  assert_non_null(text);
+  assert_true(len > 100 && strlen(text) == len);
+  free(text);
+  char dir[64];
+  lm_dirname("a/b/c.lua", dir, sizeof dir);
+  assert_string_equal(dir, "a/b");
+  lm_dirname("c.lua", dir, sizeof dir);
+  assert_string_equal(dir, ".");
+  lm_dirname("/c.lua", dir, sizeof dir);
+  assert_string_equal(dir, "/");
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(buf_appends_and_formats),
+      cmocka_unit_test(grow_zeroes_new_slots),
+      cmocka_unit_test(arena_allocations_are_zeroed_and_aligned),
+      cmocka_unit_test(hash_is_fnv1a),
+      cmocka_unit_test(errors_prefix),
+      cmocka_unit_test(files_read_and_dirname),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

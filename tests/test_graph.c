@@ -1,0 +1,230 @@
+/* Frame graph validation, culling and texture planning: no GL needed. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <string.h>
+
+#include "graph/graph.h"
+
+static int target(lm_graph *g, const char *name, lm_format f, float scale) {
+  lm_error err;
+  int t = lm_graph_add_target(g, &(lm_target_desc){.name = name, .format = f, .scale = scale}, &err);
+  assert_true(t >= 0);
+  return t;
+}
+
+/* A full-screen pass reading `in` (or none when < 0) and writing `out`. */
+static int fs(lm_graph *g, const char *name, int in, int out) {
+  lm_error err;
+  lm_pass_input input = {"src", in};
+  lm_pass_desc d = {.kind = LM_PASS_FULLSCREEN, .name = name, .where = "test.lua:1",
+                    .shader = "x.frag", .inputs = &input, .input_count = in >= 0,
+                    .outputs = &out, .output_count = 1, .depth = -1};
+  int p = lm_graph_add_pass(g, &d, &err);
+  assert_true(p >= 0);
+  return p;
+}
+
+static void target_sizes_follow_output_and_never_vanish(void **state) {
+  (void)state;
+  int w, h;
+  lm_target_size(&(lm_target_desc){.scale = 0.5f}, 256, 192, &w, &h);
+  assert_int_equal(w, 128), assert_int_equal(h, 96);
+  lm_target_size(&(lm_target_desc){.scale = 0}, 256, 192, &w, &h); /* 0 means 1 */
+  assert_int_equal(w, 256), assert_int_equal(h, 192);
+  lm_target_size(&(lm_target_desc){.scale = 0.25f}, 1, 1, &w, &h);
+  assert_int_equal(w, 1), assert_int_equal(h, 1);
+  lm_target_size(&(lm_target_desc){.scale = 1e-9f}, 8192, 8192, &w, &h);
+  assert_int_equal(w, 1), assert_int_equal(h, 1);
+  lm_target_size(&(lm_target_desc){.width = 512, .height = 64, .scale = 0.5f}, 256, 192, &w, &h);
+  assert_int_equal(w, 512), assert_int_equal(h, 64);
+  lm_target_size(&(lm_target_desc){.scale = 1.0f / 3.0f}, 100, 7, &w, &h);
+  assert_int_equal(w, 33), assert_int_equal(h, 2);
+}
+
+static void bad_targets_are_refused(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_graph_begin(g, 64, 64);
+  lm_error err;
+  assert_int_equal(lm_graph_add_target(g, &(lm_target_desc){.name = "a"}, &err), -1);
+  assert_non_null(strstr(err.msg, "target 'a': no format"));
+  target(g, "a", LM_FORMAT_RGBA8, 1);
+  assert_int_equal(lm_graph_add_target(g, &(lm_target_desc){.name = "a", .format = LM_FORMAT_R32F}, &err), -1);
+  assert_non_null(strstr(err.msg, "declared twice"));
+  assert_int_equal(lm_graph_add_target(g, &(lm_target_desc){.name = "b", .format = LM_FORMAT_R32F,
+                                                             .width = 4}, &err), -1);
+  assert_non_null(strstr(err.msg, "target 'b'"));
+  lm_graph_destroy(g);
+}
+
+static void unread_passes_are_left_out(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_graph_begin(g, 64, 48);
+  int a = target(g, "a", LM_FORMAT_RGBA16F, 1), b = target(g, "b", LM_FORMAT_RGBA16F, 0.5f);
+  int unused = target(g, "unused", LM_FORMAT_RGBA16F, 1), out = target(g, "out", LM_FORMAT_RGBA8, 1);
+  fs(g, "make_a", -1, a);
+  fs(g, "make_unused", a, unused); /* nobody reads it */
+  fs(g, "make_b", a, b);
+  fs(g, "final", b, out);
+  lm_graph_mark_output(g, out);
+  lm_error err;
+  assert_true(lm_graph_compile(g, &err));
+  assert_false(lm_graph_pass(g, 0).culled);
+  assert_true(lm_graph_pass(g, 1).culled);
+  assert_false(lm_graph_pass(g, 2).culled);
+  assert_false(lm_graph_pass(g, 3).culled);
+  assert_false(lm_graph_target(g, unused).used);
+  assert_int_equal(lm_graph_target(g, b).width, 32);
+  assert_int_equal(lm_graph_target(g, b).height, 24);
+  lm_graph_destroy(g);
+}
+
+static void reading_an_unwritten_target_names_the_pass(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_graph_begin(g, 64, 48);
+  int a = target(g, "never_written", LM_FORMAT_RGBA8, 1), out = target(g, "out", LM_FORMAT_RGBA8, 1);
+  fs(g, "light", a, out);
+  lm_graph_mark_output(g, out);
+  lm_error err;
+  assert_false(lm_graph_compile(g, &err));
+  assert_string_equal(err.msg, "test.lua:1: pass 'light' reads target 'never_written' that no pass writes before it");
+  lm_graph_destroy(g);
+}
+
+static void feedback_loops_are_refused(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_graph_begin(g, 64, 48);
+  int a = target(g, "a", LM_FORMAT_RGBA8, 1);
+  fs(g, "first", -1, a);
+  fs(g, "loop", a, a);
+  lm_graph_mark_output(g, a);
+  lm_error err;
+  assert_false(lm_graph_compile(g, &err));
+  assert_non_null(strstr(err.msg, "pass 'loop' reads and writes target 'a'"));
+  lm_graph_destroy(g);
+}
+
+static void formats_and_sizes_are_checked(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_graph_begin(g, 64, 48);
+  int depth = target(g, "depth", LM_FORMAT_DEPTH32F, 1);
+  fs(g, "depth_as_colour", -1, depth);
+  lm_graph_mark_output(g, depth);
+  lm_error err;
+  assert_false(lm_graph_compile(g, &err));
+  assert_non_null(strstr(err.msg, "target 'depth' (depth32f) cannot be a colour output"));
+
+  lm_graph_begin(g, 64, 48);
+  int full = target(g, "full", LM_FORMAT_RGBA8, 1), half = target(g, "half", LM_FORMAT_RGBA8, 0.5f);
+  int outs[2] = {full, half};
+  lm_pass_desc d = {.kind = LM_PASS_SCENE, .name = "mrt", .where = "t.lua:3", .shader = "std",
+                    .outputs = outs, .output_count = 2, .depth = -1, .clear = true};
+  assert_true(lm_graph_add_pass(g, &d, &err) >= 0);
+  lm_graph_mark_output(g, full);
+  assert_false(lm_graph_compile(g, &err));
+  assert_non_null(strstr(err.msg, "its outputs differ in size"));
+
+  lm_graph_begin(g, 64, 48);
+  assert_false(lm_graph_compile(g, &err));
+  assert_non_null(strstr(err.msg, "presents nothing"));
+  lm_graph_destroy(g);
+}
+
+static void scene_passes_without_clear_keep_the_earlier_writer(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_graph_begin(g, 32, 32);
+  int c = target(g, "c", LM_FORMAT_RGBA8, 1);
+  lm_error err;
+  lm_pass_desc d = {.kind = LM_PASS_SCENE, .name = "opaque", .where = "t.lua:1", .shader = "std",
+                    .outputs = &c, .output_count = 1, .depth = -1, .clear = true};
+  assert_int_equal(lm_graph_add_pass(g, &d, &err), 0);
+  d.name = "overlay";
+  d.clear = false;
+  assert_int_equal(lm_graph_add_pass(g, &d, &err), 1);
+  lm_graph_mark_output(g, c);
+  assert_true(lm_graph_compile(g, &err));
+  assert_false(lm_graph_pass(g, 0).culled);
+  assert_false(lm_graph_pass(g, 1).culled);
+  /* Clearing makes the earlier pass dead. */
+  lm_graph_begin(g, 32, 32);
+  c = target(g, "c", LM_FORMAT_RGBA8, 1);
+  d.outputs = &c;
+  d.clear = true;
+  d.name = "opaque";
+  lm_graph_add_pass(g, &d, &err);
+  d.name = "redraw";
+  lm_graph_add_pass(g, &d, &err);
+  lm_graph_mark_output(g, c);
+  assert_true(lm_graph_compile(g, &err));
+  assert_true(lm_graph_pass(g, 0).culled);
+  assert_false(lm_graph_pass(g, 1).culled);
+  lm_graph_destroy(g);
+}
+
+static void disjoint_lifetimes_share_a_texture(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_graph_begin(g, 64, 48);
+  /* a -> b -> c -> out, all alike: a is dead once b is made, so c can reuse a's texture. */
+  int a = target(g, "a", LM_FORMAT_RGBA16F, 1), b = target(g, "b", LM_FORMAT_RGBA16F, 1);
+  int c = target(g, "c", LM_FORMAT_RGBA16F, 1), out = target(g, "out", LM_FORMAT_RGBA16F, 1);
+  fs(g, "pa", -1, a);
+  fs(g, "pb", a, b);
+  fs(g, "pc", b, c);
+  fs(g, "pout", c, out);
+  lm_graph_mark_output(g, out);
+  lm_error err;
+  assert_true(lm_graph_compile(g, &err));
+  assert_int_equal(lm_graph_slot_count(g), 2);
+  assert_int_equal(lm_graph_target(g, a).slot, lm_graph_target(g, c).slot);
+  assert_int_not_equal(lm_graph_target(g, a).slot, lm_graph_target(g, b).slot);
+  assert_int_not_equal(lm_graph_target(g, c).slot, lm_graph_target(g, out).slot);
+  lm_graph_destroy(g);
+}
+
+static void persistent_targets_outlive_frames(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_graph_begin(g, 64, 48);
+  lm_error err;
+  int hist = lm_graph_add_target(g, &(lm_target_desc){.name = "history", .format = LM_FORMAT_R32F,
+                                                      .width = 1, .height = 1, .persistent = true}, &err);
+  assert_int_equal(hist, 0);
+  int out = target(g, "out", LM_FORMAT_RGBA8, 1);
+  fs(g, "use_history", hist, out); /* reading last frame's contents is allowed */
+  lm_graph_mark_output(g, out);
+  assert_true(lm_graph_compile(g, &err));
+  lm_graph_begin(g, 64, 48);
+  assert_int_equal(lm_graph_find_target(g, "history"), 0);
+  assert_int_equal(lm_graph_find_target(g, "out"), -1);
+  assert_int_equal(lm_graph_add_target(g, &(lm_target_desc){.name = "late", .format = LM_FORMAT_R32F,
+                                                            .persistent = true}, &err), 1);
+  target(g, "x", LM_FORMAT_R32F, 1);
+  assert_int_equal(lm_graph_add_target(g, &(lm_target_desc){.name = "later", .format = LM_FORMAT_R32F,
+                                                            .persistent = true}, &err), -1);
+  assert_non_null(strstr(err.msg, "in OnCreate"));
+  lm_graph_destroy(g);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(target_sizes_follow_output_and_never_vanish),
+      cmocka_unit_test(bad_targets_are_refused),
+      cmocka_unit_test(unread_passes_are_left_out),
+      cmocka_unit_test(reading_an_unwritten_target_names_the_pass),
+      cmocka_unit_test(feedback_loops_are_refused),
+      cmocka_unit_test(formats_and_sizes_are_checked),
+      cmocka_unit_test(scene_passes_without_clear_keep_the_earlier_writer),
+      cmocka_unit_test(disjoint_lifetimes_share_a_texture),
+      cmocka_unit_test(persistent_targets_outlive_frames),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
