@@ -15,6 +15,15 @@ typedef struct target_handle {
   char name[64];
 } target_handle;
 
+/* "script.lua:12" of the Lua code that called the running C function. */
+static void caller_where(lua_State *L, char *out, size_t cap) {
+  luaL_where(L, 1);
+  snprintf(out, cap, "%s", lua_tostring(L, -1));
+  lua_pop(L, 1);
+  size_t n = strlen(out);
+  while (n > 0 && (out[n - 1] == ' ' || out[n - 1] == ':')) out[--n] = '\0';
+}
+
 static lm_pipeline *recording(lua_State *L, const char *fn) {
   lm_pipeline *p = lm_script_pipeline(L);
   if (!p->graph) luaL_error(L, "%s() is called from OnCreate or OnRender only", fn);
@@ -270,11 +279,7 @@ static void begin_pass(lua_State *L, pass_builder *b, lm_pass_kind kind, const c
   b->desc.params = b->params;
   b->desc.outputs = b->outputs;
   b->desc.depth = -1;
-  luaL_where(L, 1);
-  snprintf(b->where, sizeof b->where, "%s", lua_tostring(L, -1));
-  lua_pop(L, 1);
-  size_t n = strlen(b->where);
-  while (n > 0 && (b->where[n - 1] == ' ' || b->where[n - 1] == ':')) b->where[--n] = '\0';
+  caller_where(L, b->where, sizeof b->where);
   b->desc.where = b->where;
   lua_rawgeti(L, 1, 1);
   b->desc.name = lua_tostring(L, -1);
@@ -352,11 +357,7 @@ static int l_present(lua_State *L) {
   lm_pipeline *p = recording(L, "present");
   if (p->in_create) return luaL_error(L, "present() is called from OnRender");
   p->presented = to_target(L, 1, "present")->id;
-  luaL_where(L, 1);
-  snprintf(p->present_where, sizeof p->present_where, "%s", lua_tostring(L, -1));
-  p->present_where[strcspn(p->present_where, " ")] = '\0';
-  size_t n = strlen(p->present_where);
-  if (n > 0 && p->present_where[n - 1] == ':') p->present_where[n - 1] = '\0';
+  caller_where(L, p->present_where, sizeof p->present_where);
   return 0;
 }
 
