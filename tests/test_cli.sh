@@ -1,1 +1,114 @@
-exit 0
+#!/usr/bin/env bash
+# The limn command as a user meets it: help, bad flags (exit 2), broken
+# scripts (exit 1 with script:line or the pass), and whole files or none.
+set -u
+limn=$1
+root=$2
+tmp=$(mktemp -d /tmp/limn-cli-XXXXXX)
+trap 'rm -rf "$tmp"' EXIT
+passed=0 failed=0
+
+check() { # check NAME CONDITION...
+  local name=$1; shift
+  if "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $name"; fi
+}
+run() { # run EXPECTED_RC ARGS... : output in $tmp/out, $tmp/err, rc in $rc
+  local want=$1; shift
+  "$limn" "$@" >"$tmp/out" 2>"$tmp/err"; rc=$?
+  [ "$rc" -eq "$want" ] || { echo "  '$*' exited $rc, wanted $want"; sed 's/^/  | /' "$tmp/err" | head -5; return 1; }
+}
+err_has() { grep -qF -- "$1" "$tmp/err" || { echo "  stderr lacks '$1':"; sed 's/^/  | /' "$tmp/err" | head -5; return 1; }; }
+out_has() { grep -qF -- "$1" "$tmp/out" || { echo "  stdout lacks '$1'"; return 1; }; }
+first_error_has() { grep -m1 'error:' "$tmp/err" | grep -qF -- "$1" || { echo "  first error line lacks '$1':"; sed 's/^/  | /' "$tmp/err" | head -3; return 1; }; }
+no_files() { [ -z "$(ls -A "$tmp/img")" ] || { echo "  left files: $(ls "$tmp/img")"; return 1; }; }
+mkdir -p "$tmp/img"
+
+# help and usage
+check "no command" run 2
+check "help" run 0 --help
+check "help lists capture" out_has "capture"
+check "capture help" run 0 capture --help
+for flag in --scene --script --tech --set --size --frames --camera --output --clock --egl --list-options; do
+  check "capture help names $flag" out_has "$flag"
+done
+check "unknown command" run 2 frobnicate
+check "unknown flag" run 2 capture --bogus
+check "unknown flag message" err_has "unknown flag '--bogus'"
+check "bad size" run 2 capture --size 0x5
+check "bad size message" err_has "--size wants WxH"
+check "missing value" run 2 capture --size
+check "bad output type" run 2 capture --output "$tmp/img/x.bmp"
+check "bad frames" run 2 capture --frames -3
+check "bad set" run 2 capture --set novalue
+check "unknown option" run 2 capture --set nope=1
+check "unknown option lists known" err_has "known: ambient="
+check "unknown technique" run 2 capture --tech nope
+check "unknown technique lists known" err_has "known: dl"
+check "unknown scene" run 2 capture --scene nope
+check "bad option value" run 2 capture --set ambient=bright
+check "list options" run 0 capture --list-options
+check "list options shows techniques" out_has "techniques: dl"
+
+# a good capture: both files, per-pass times with the clock named
+check "capture" run 0 capture --scene cornell --script scripts/pp.lua --tech dl --size 64x48 --frames 2 \
+  --set ambient=0.05 --output "$tmp/img/a.png" --output "$tmp/img/a.exr"
+check "png written" test -s "$tmp/img/a.png"
+check "png is a png" bash -c "head -c 4 '$tmp/img/a.png' | od -c | grep -q 'P   N   G'"
+check "exr written" test -s "$tmp/img/a.exr"
+check "exr is an exr" bash -c "head -c 4 '$tmp/img/a.exr' | od -An -tx1 | grep -q '76 2f 31 01'"
+check "times name the clock" out_has "clock: "
+check "times list the gbuffer pass" out_has "gbuffer"
+check "times list the direct pass" out_has "direct"
+check "times are medians of 2" out_has "median of 2 frames"
+rm -f "$tmp/img/"*
+
+# broken scripts: exit 1, a first line naming script:line or the pass, no image
+cat >"$tmp/syntax.lua" <<'LUA'
+Techniques = { "dl" }
+function OnRender(tech)
+  local x = = 2
+end
+LUA
+check "syntax error" run 1 capture --script "$tmp/syntax.lua" --output "$tmp/img/s.png"
+check "syntax error names line" first_error_has "syntax.lua:3:"
+check "syntax error leaves no file" no_files
+
+cat >"$tmp/runtime.lua" <<'LUA'
+Techniques = { "dl" }
+function OnRender(tech)
+  local t = nil
+  present(t.lit)
+end
+LUA
+check "runtime error" run 1 capture --script "$tmp/runtime.lua" --output "$tmp/img/r.png"
+check "runtime error names line" first_error_has "runtime.lua:4: attempt to index a nil value"
+check "runtime error has a traceback" err_has "stack traceback"
+check "runtime error leaves no file" no_files
+
+cat >"$tmp/shader.lua" <<'LUA'
+Techniques = { "dl" }
+function OnRender(tech)
+  local t = target{ "t", format = "rgba8" }
+  present(pass{ "glow", shader = "no_such_shader.frag", out = t })
+end
+LUA
+check "unknown shader" run 1 capture --script "$tmp/shader.lua" --output "$tmp/img/u.png"
+check "unknown shader names the pass" first_error_has "shader.lua:4: pass 'glow'"
+check "unknown shader names the file" first_error_has "no_such_shader.frag"
+check "unknown shader leaves no file" no_files
+
+cat >"$tmp/nowriter.lua" <<'LUA'
+Techniques = { "dl" }
+function OnRender(tech)
+  local G = require("gbuffer").targets()
+  local lit = target{ "lit", format = "rgba16f" }
+  pass{ "direct", shader = "direct.frag", inputs = require("gbuffer").inputs(G), out = lit }
+  present(lit)
+end
+LUA
+check "read without writer" run 1 capture --script "$tmp/nowriter.lua" --output "$tmp/img/n.png"
+check "read without writer names pass and line" first_error_has "nowriter.lua:5: pass 'direct' reads target 'gbuffer.clr' that no pass writes before it"
+check "read without writer leaves no file" no_files
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]

@@ -241,7 +241,7 @@ static void plan_slots(lm_graph *g) {
       lm_texture_desc want = {gt->desc.format, gt->width, gt->height, gt->desc.mips};
       int found = -1;
       for (int s = 0; s < g->slot_count && found < 0; s++)
-        if (!memcmp(&g->slots[s].desc, &want, sizeof want) && g->slots[s].free_after < pi) found = s;
+        if (lm_texture_desc_equal(&g->slots[s].desc, &want) && g->slots[s].free_after < pi) found = s;
       if (found < 0) {
         graph_slot *s = LM_PUSH(g->slots, g->slot_count, g->slot_cap);
         s->desc = want;

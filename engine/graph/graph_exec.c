@@ -13,7 +13,7 @@ static bool pool_take(lm_graph *g, const lm_texture_desc *want, const char *labe
                       lm_error *err) {
   for (int i = 0; i < g->pool_count; i++) {
     pool_texture *p = &g->pool[i];
-    if (!p->taken && !memcmp(&p->desc, want, sizeof *want)) {
+    if (!p->taken && lm_texture_desc_equal(&p->desc, want)) {
       p->taken = true;
       *out = p->texture;
       return true;

@@ -33,6 +33,11 @@ typedef struct graph_slot {
   int free_after; /* last pass index of its current holder */
 } graph_slot;
 
+/* Field by field: padding bytes make memcmp unreliable. */
+static inline bool lm_texture_desc_equal(const lm_texture_desc *a, const lm_texture_desc *b) {
+  return a->format == b->format && a->width == b->width && a->height == b->height && a->mips == b->mips;
+}
+
 struct lm_graph {
   int width, height;
   lm_arena arena;

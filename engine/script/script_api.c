@@ -169,6 +169,10 @@ static void read_outputs(lua_State *L, int idx, pass_builder *b) {
   lua_pop(L, 1);
 }
 
+static int compare_inputs(const void *a, const void *b) {
+  return strcmp(((const lm_pass_input *)a)->name, ((const lm_pass_input *)b)->name);
+}
+
 static void read_inputs(lua_State *L, int idx, pass_builder *b) {
   lua_getfield(L, idx, "inputs");
   if (lua_isnil(L, -1)) {
@@ -188,6 +192,12 @@ static void read_inputs(lua_State *L, int idx, pass_builder *b) {
     lua_pop(L, 1);
   }
   lua_pop(L, 1);
+  /* Table order varies from run to run; messages and bindings should not. */
+  qsort(b->inputs, (size_t)b->desc.input_count, sizeof *b->inputs, compare_inputs);
+}
+
+static int compare_params(const void *a, const void *b) {
+  return strcmp(((const lm_pass_param *)a)->name, ((const lm_pass_param *)b)->name);
 }
 
 static void read_params(lua_State *L, int idx, pass_builder *b) {
@@ -231,6 +241,7 @@ static void read_params(lua_State *L, int idx, pass_builder *b) {
     lua_pop(L, 1);
   }
   lua_pop(L, 1);
+  qsort(b->params, (size_t)b->desc.param_count, sizeof *b->params, compare_params);
 }
 
 static int compare_strings(const void *a, const void *b) { return strcmp(a, b); }
