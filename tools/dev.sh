@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# One entry point for a fresh Debian 12 checkout:
+#   tools/dev.sh run    install what is missing, build, capture the default scene
+#   tools/dev.sh test   install what is missing, build, run the whole test suite
+#   tools/dev.sh build  install what is missing and build
+# BUILD_DIR (default build) and CMAKE_ARGS pass through to CMake.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+# Debian packages the build, the tests and the main job need.
+packages=(
+  build-essential cmake pkg-config git
+  liblua5.4-dev libcglm-dev libopenimageio-dev libepoxy-dev
+  libegl-dev libegl-mesa0 libgl1-mesa-dri libcmocka-dev
+)
+
+deps() {
+  local missing=()
+  for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  local cmd="apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends ${missing[*]}"
+  if [ "$(id -u)" -ne 0 ]; then
+    echo "limn: missing Debian packages: ${missing[*]}" >&2
+    echo "limn: install them as root, then run this again:" >&2
+    echo "  sudo sh -c '$cmd'" >&2
+    exit 1
+  fi
+  echo "limn: installing ${missing[*]}" >&2
+  sh -c "$cmd" >&2
+}
+
+build() {
+  local dir=${BUILD_DIR:-build}
+  # shellcheck disable=SC2086
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo ${CMAKE_ARGS:-} >/dev/null
+  cmake --build "$dir" -j "$(nproc)"
+}
+
+case "${1:-run}" in
+  deps) deps ;;
+  build) deps; build ;;
+  run)
+    deps; build
+    mkdir -p out
+    "${BUILD_DIR:-build}/limn" capture --scene cornell --script scripts/pp.lua --tech dl --size 256x192 \
+      --frames 5 --output out/cornell.png --output out/cornell.exr
+    ;;
+  test)
+    deps; build
+    ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure
+    ;;
+  *) echo "usage: tools/dev.sh run|test|build|deps" >&2; exit 2 ;;
+esac
