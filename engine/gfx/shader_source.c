@@ -137,6 +137,7 @@ bool lm_shader_source_load(lm_shader_source *src, const char *path, const char *
   lm_buf_append(&src->text, "#version 450 core\n", -1);
   if (!append_defines(&src->text, defines, err)) {
     lm_error_prefix(err, "%s", display_name(path));
+    lm_shader_source_free(src);
     return false;
   }
   if (!expand(src, path, include_dir, 0, err)) {
