@@ -45,19 +45,19 @@ local function checked(o)
   for k in pairs(o) do
     if isr.defaults[k] == nil then error("isr." .. tostring(k) .. " is not an ISR option", 3) end
   end
-  local function need(ok, msg)
-    if not ok then error(msg, 4) end
+  local function need(ok, msg, v)
+    if not ok then error(string.format("%s (got %s)", msg, tostring(v)), 4) end
   end
-  need(whole(c.samples, 1, 256), "isr.samples must be a whole number in 1..256")
-  need(within(c.radius, 0, math.huge) and c.radius > 0 and c.radius < math.huge,
-       "isr.radius must be a positive finite number (world units)")
-  need(c.coarse == 1 or c.coarse == 2 or c.coarse == 4, "isr.coarse must be 1, 2 or 4")
-  need(whole(c.blur, 0, 32), "isr.blur must be a whole number in 0..32")
-  need(within(c.k_isr, 0, 1), "isr.k_isr must be in 0..1")
-  need(within(c.k_ssao, 0, 1), "isr.k_ssao must be in 0..1")
-  need(c.sender == "albedo" or c.sender == "lit", 'isr.sender must be "albedo" or "lit"')
-  need(whole(c.bounces, 1, 4), "isr.bounces must be a whole number in 1..4")
-  need(views[c.view], 'isr.view must be "lit", "indirect" or "ao"')
+  need(whole(c.samples, 1, 256), "isr.samples must be a whole number in 1..256", c.samples)
+  need(within(c.radius, 0, math.huge) and c.radius > 0 and c.radius < math.huge, -- not NaN, 0 or Inf
+       "isr.radius must be a positive finite number (world units)", c.radius)
+  need(c.coarse == 1 or c.coarse == 2 or c.coarse == 4, "isr.coarse must be 1, 2 or 4", c.coarse)
+  need(whole(c.blur, 0, 32), "isr.blur must be a whole number in 0..32", c.blur)
+  need(within(c.k_isr, 0, 1), "isr.k_isr must be in 0..1", c.k_isr)
+  need(within(c.k_ssao, 0, 1), "isr.k_ssao must be in 0..1", c.k_ssao)
+  need(c.sender == "albedo" or c.sender == "lit", 'isr.sender must be "albedo" or "lit"', c.sender)
+  need(whole(c.bounces, 1, 4), "isr.bounces must be a whole number in 1..4", c.bounces)
+  need(views[c.view], 'isr.view must be "lit", "indirect" or "ao"', c.view)
   return c
 end
 

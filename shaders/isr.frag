@@ -73,7 +73,8 @@ void main() {
     float r_x = r_uv * world_per_uv * x.depth01, r_x2 = r_x * r_x;
     // Eq 25 with eq 6, F = cos cos A / (pi d^2). Adding A_X to d^2 keeps F
     // finite as d -> 0 and caps a sample's solid angle at 2 pi / N.
-    float area = 0.5 * r_x2;
+    float tilt = max(abs(dot(x.n, safe_normalize(frame.camera_pos.xyz - x.p, x.n))), 0.1);
+    float area = 0.5 * r_x2 / tilt;
     float form_factor = cos_p * cos_x * area / (PI * (d2 + area));
     vec3 radiance = texelFetch(sender, q, 0).rgb;
 #ifdef BOUNCE
@@ -86,5 +87,5 @@ void main() {
   }
   float weight = 2.0 * PI / float(n);
   // Occlusion is normalized by pi, the cosine-weighted hemisphere.
-  isr = vec4(finite_or_zero(weight * gathered), 1.0 - saturate(weight * occlusion / PI));
+  isr = vec4(weight * gathered, 1.0 - saturate(weight * occlusion / PI));
 }
