@@ -101,8 +101,9 @@ function isr.render(G, o, light)
   end
   if o.blur > 0 then
     for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
-      E = pass{ "isr.blur_" .. axis[1], shader = "blur.frag", inputs = { src = E, mask = C.mat },
-                params = { axis = axis[2], radius = o.blur }, defines = { MASK = true },
+      E = pass{ "isr.blur_" .. axis[1], shader = "blur.frag",
+                inputs = { src = E, mask = C.mat, depth = C.dpt },
+                params = { axis = axis[2], radius = o.blur }, defines = { MASK = true, DEPTH = true },
                 out = coarse_target("isr.blur_" .. axis[1], f) }
     end
   end

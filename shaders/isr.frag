@@ -19,9 +19,12 @@
 // depth is R_X (world units). Eq 25 weighs each sample by 2 pi / N, so the
 // patch area in its form factor (eq 6) is A_X = R_X^2 / 2: then
 // (2 pi / N) A_X = pi R_X^2 / N, X's share of the disc, and the sum is the
-// discrete radiosity gather. Eq 26's occluder radius is r = R_X: with the
-// 2 pi / N weight each sample then occludes X's share of solid angle, at
-// most 2 pi / N.
+// discrete radiosity gather. The seed derives A_X from depth alone; here it
+// is also divided by the cosine between X's normal and the ray to the eye
+// (at least 0.1), the area a pixel covers on a tilted surface: without it a
+// wall seen edge-on, which few samples reach, gives almost nothing.
+// Eq 26's occluder radius is r = R_X: with the 2 pi / N weight each sample
+// then occludes X's share of solid angle, at most 2 pi / N.
 #include "gbuffer.glsl"
 
 in vec2 uv;
