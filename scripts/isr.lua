@@ -4,9 +4,11 @@
 --   2. sender radiance L_X: the coarse albedo (the seed) or its direct light
 --   3. the ISR step: indirect light and ambient occlusion (isr.frag, eq 25-26),
 --      repeated for more bounces with the last bounce added to L_X
---   4. a separable Gaussian blur of the coarse result (blur.frag)
+--   4. a separable Gaussian blur of the coarse result that skips background
+--      and does not cross depth edges (blur.frag)
 --   5. direct light, bilateral upsampling and the composite (isr_light.frag,
 --      eq 27-29)
+-- Sample pattern: a golden-angle (Vogel) spiral turned per pixel; see isr.frag.
 local gbuffer = require "gbuffer"
 
 local isr = {}
