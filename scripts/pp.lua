@@ -1,13 +1,17 @@
 -- The default pipeline. Techniques follow the seed viewer's modes; the first
 -- one listed is the default. Options are what `limn capture --set` can change.
 local gbuffer = require "gbuffer"
+local isr = require "isr"
 
-Techniques = { "dl" }
+-- dl: direct light alone (the seed's F5); isr: image-space radiosity (F3).
+Techniques = { "dl", "isr" }
 
 Options = {
   ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
   background = 0.0,        -- radiance where no geometry is
+  isr = {},                -- see isr.defaults in scripts/isr.lua
 }
+for k, v in pairs(isr.defaults) do Options.isr[k] = v end
 
 local function grey(x) return { x, x, x } end
 
@@ -21,5 +25,9 @@ end
 
 function OnRender(tech)
   local G = gbuffer.render(gbuffer.targets())
-  present(direct(G, tech))
+  if tech.name == "isr" then
+    present(isr.render(G, tech.isr, { ambient = grey(tech.ambient), background = grey(tech.background) }))
+  else
+    present(direct(G, tech))
+  end
 end

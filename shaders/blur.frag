@@ -1,0 +1,61 @@
+// Separable Gaussian blur, one axis a pass (seed 000, Listing 3 step 4).
+// With MASK, texels whose mask.a < 0.5 (background) neither give nor take:
+// indirect light does not bleed into the sky and back. With DEPTH, a tap
+// whose linear depth is off the centre's plane by more than a few percent
+// weighs less, so the blur does not carry light across silhouettes (the
+// halos the seed names as a weakness, lines 2592-2688). The plane's slope
+// is the smaller one-sided difference, which does not straddle an edge, so
+// a floor seen at a grazing angle still blurs along its length.
+#include "common.glsl"
+
+in vec2 uv;
+uniform sampler2D src;
+#ifdef MASK
+uniform sampler2D mask;
+#endif
+#ifdef DEPTH
+uniform sampler2D depth;
+const float DEPTH_TOLERANCE = 0.05; // relative depth difference of weight 1/e
+#endif
+uniform ivec2 axis = ivec2(1, 0); // (1, 0) horizontal, (0, 1) vertical
+uniform int radius = 4;           // taps each side; sigma = radius / 2
+
+out vec4 dst;
+
+float weight_at(ivec2 q, float z, float expected) {
+  float w = 1.0;
+#ifdef MASK
+  w *= step(0.5, texelFetch(mask, q, 0).a);
+#endif
+#ifdef DEPTH
+  float dz = (texelFetch(depth, q, 0).r - expected) / (max(z, 1e-12) * DEPTH_TOLERANCE);
+  w *= exp(-dz * dz);
+#endif
+  return w;
+}
+
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy), last = textureSize(src, 0) - 1;
+  vec4 centre = texelFetch(src, p, 0);
+  float z = 0.0, slope = 0.0;
+#ifdef DEPTH
+  z = texelFetch(depth, p, 0).r;
+  float ahead = texelFetch(depth, clamp(p + axis, ivec2(0), last), 0).r - z;
+  float behind = z - texelFetch(depth, clamp(p - axis, ivec2(0), last), 0).r;
+  slope = abs(ahead) < abs(behind) ? ahead : behind;
+#endif
+  if (weight_at(p, z, z) == 0.0 || radius < 1) {
+    dst = centre;
+    return;
+  }
+  float sigma = 0.5 * float(radius), inv2s2 = 0.5 / (sigma * sigma);
+  vec4 sum = vec4(0.0);
+  float wsum = 0.0;
+  for (int i = -radius; i <= radius; i++) {
+    ivec2 q = clamp(p + axis * i, ivec2(0), last);
+    float w = exp(-float(i * i) * inv2s2) * weight_at(q, z, z + float(i) * slope);
+    sum += w * texelFetch(src, q, 0);
+    wsum += w;
+  }
+  dst = wsum > 0.0 ? sum / wsum : centre; // the centre tap has weight 1
+}

@@ -1,0 +1,48 @@
+// Reading the G-buffer that std.frag writes (seed 000, lines 1229-1259): one
+// decoder for every lighting pass, so that they agree on what a channel means.
+#ifndef LIMN_GBUFFER_GLSL
+#define LIMN_GBUFFER_GLSL
+#include "lighting.glsl"
+
+struct Surface {
+  vec3 albedo;     // clr.rgb
+  float rho;       // clr.a: reflectance, the seed's "radiation mask"
+  vec3 n;          // nrm.xyz, unit even where the buffer holds zero
+  float shininess; // nrm.w
+  float depth01;   // dpt: linear depth / far
+  vec3 k;          // mat.xyz: k_a, k_d, k_s
+  bool covered;    // mat.a >= 0.5: geometry, not background
+  vec3 p;          // world position (eq 23-24)
+};
+
+Surface gbuffer_decode(vec4 c, vec4 nn, float d, vec4 m, vec2 uv) {
+  Surface s;
+  s.albedo = c.rgb;
+  s.rho = c.a;
+  s.n = safe_normalize(nn.xyz, vec3(0.0, 1.0, 0.0));
+  s.shininess = nn.w;
+  s.depth01 = max(d, 0.0);
+  s.k = m.xyz;
+  s.covered = m.a >= 0.5;
+  s.p = position_from_depth(uv, s.depth01);
+  return s;
+}
+
+// Filtered read at uv (exact at texel centres).
+Surface gbuffer_read(sampler2D clr, sampler2D nrm, sampler2D dpt, sampler2D mat, vec2 uv) {
+  return gbuffer_decode(texture(clr, uv), texture(nrm, uv), texture(dpt, uv).r, texture(mat, uv), uv);
+}
+
+// Unfiltered read of texel q (blending depths across an edge would invent points).
+Surface gbuffer_fetch(sampler2D clr, sampler2D nrm, sampler2D dpt, sampler2D mat, ivec2 q) {
+  vec2 uv = (vec2(q) + 0.5) / vec2(textureSize(dpt, 0));
+  return gbuffer_decode(texelFetch(clr, q, 0), texelFetch(nrm, q, 0), texelFetch(dpt, q, 0).r,
+                        texelFetch(mat, q, 0), uv);
+}
+
+// Direct light leaving a covered surface toward the eye (Phong, lighting.glsl).
+vec3 direct_light(Surface s, vec3 ambient) {
+  vec3 v = safe_normalize(frame.camera_pos.xyz - s.p, s.n);
+  return phong(s.albedo, s.k, s.shininess, s.n, v, s.p, ambient);
+}
+#endif
