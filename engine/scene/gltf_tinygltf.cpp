@@ -199,13 +199,15 @@ bool read_indices(Loader &L, const char *where, int index, size_t vertex_count,
                   std::vector<uint32_t> &out) {
   char what[160];
   snprintf(what, sizeof what, "%s: indices", where);
+  // The type first: a float index buffer is a clearer mistake than its length.
+  bool exists = index >= 0 && (size_t)index < L.m.accessors.size();
+  int type = exists ? L.m.accessors[index].componentType : 0;
+  if (exists && type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+      type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+    return fail(L, "%s: accessor %d has component type %d; indices are unsigned byte, short or int",
+                what, index, type);
   View v;
   if (!accessor_view(L, what, index, 1, &v)) return false;
-  if (v.type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-      v.type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-      v.type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
-    return fail(L, "%s: accessor %d has component type %d; indices are unsigned byte, short or int",
-                what, index, v.type);
   out.resize(v.count);
   for (size_t i = 0; i < v.count; i++) {
     double x = view_get(v, i, 0);
@@ -631,10 +633,40 @@ bool keep_image_undecoded(tinygltf::Image *, const int, std::string *, std::stri
   return true;
 }
 
-// Trims tinygltf's message to its first line for ours.
+// tinygltf's message, first line only, with any data URI it quotes (a whole
+// buffer in base64) cut to its head.
 std::string first_line(const std::string &s) {
   std::string t = s.substr(0, s.find('\n'));
+  for (size_t at = t.find("data:"); at != std::string::npos; at = t.find("data:", at + 1)) {
+    size_t end = t.find_first_of(" '\"", at);
+    if (end == std::string::npos) end = t.size();
+    if (end - at > 48) t.replace(at + 40, end - at - 40, "...");
+  }
   return t.empty() ? "not a glTF file" : t;
+}
+
+// tinygltf refuses a primitive whose indices accessor does not exist before
+// we see the model, with a message that names no mesh: find the primitive in
+// the JSON ourselves. `json` is the text tinygltf parsed (the GLB's chunk 0).
+std::string locate_bad_indices(const unsigned char *text, size_t len) {
+  using nlohmann::json;
+  json doc = json::parse(text, text + len, nullptr, false);
+  if (!doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array()) return "";
+  size_t accessors = doc.contains("accessors") && doc["accessors"].is_array() ? doc["accessors"].size() : 0;
+  const json &meshes = doc["meshes"];
+  for (size_t mi = 0; mi < meshes.size(); mi++) {
+    if (!meshes[mi].is_object() || !meshes[mi].contains("primitives")) continue;
+    const json &prims = meshes[mi]["primitives"];
+    for (size_t pi = 0; prims.is_array() && pi < prims.size(); pi++) {
+      if (!prims[pi].is_object() || !prims[pi].contains("indices")) continue;
+      const json &ix = prims[pi]["indices"];
+      if (ix.is_number_integer() && ix.get<long long>() >= (long long)accessors)
+        return "mesh " + std::to_string(mi) + " primitive " + std::to_string(pi) +
+               ": indices: accessor " + std::to_string(ix.get<long long>()) +
+               " does not exist (the file has " + std::to_string(accessors) + ")";
+    }
+  }
+  return "";
 }
 
 bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
@@ -662,8 +694,18 @@ bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
                 : gltf.LoadASCIIFromString(model, &why, &warn, (const char *)bytes.data(),
                                            (unsigned)len, dir);
   if (!warn.empty()) lm_debug("%s: tinygltf: %s", path, first_line(warn).c_str());
-  if (!ok) lm_error_set(err, "%s: %s", path, first_line(why).c_str());
-  return ok;
+  // Some of tinygltf's checks (a baseColorFactor of 2 numbers) report into
+  // `why` and carry on with a default: a wrong file all the same.
+  if (ok && why.empty()) return true;
+  std::string what = first_line(why);
+  if (what.find("primitive indices accessor out of bounds") != std::string::npos) {
+    uint32_t json_len = (uint32_t)len; // GLB: tinygltf got this far, so chunk 0 is whole
+    if (glb) memcpy(&json_len, bytes.data() + 12, 4);
+    std::string where = locate_bad_indices(bytes.data() + (glb ? 20 : 0), json_len);
+    if (!where.empty()) what = where;
+  }
+  lm_error_set(err, "%s: %s", path, what.c_str());
+  return false;
 }
 
 // Fills `s` from the parsed model; false (message in L.err) on bad input.
