@@ -465,6 +465,19 @@ static void malformed_files_name_the_element(void **state) {
   EXPECT("rotation.gltf", "\"mesh\":0}", "\"mesh\":0,\"rotation\":[0,0,0,0]}",
          "node 0: rotation is not a usable quaternion");
   EXPECT("matrix.gltf", "\"mesh\":0}", "\"mesh\":0,\"matrix\":[1,0,0]}", "node 0: matrix needs 16");
+  EXPECT("overflow.gltf", "\"mesh\":0}", "\"mesh\":0,\"scale\":[1e5,1,1],\"children\":[1]},{\"scale\":[1e5,1,1]}",
+         "node 1: world transform reaches 1e+10");
+  EXPECT("flat_cam.gltf", "\"mesh\":0}",
+         "\"mesh\":0,\"scale\":[0,1,1],\"children\":[1]},{\"name\":\"eye\",\"camera\":0}],"
+         "\"cameras\":[{\"name\":\"c\",\"type\":\"perspective\",\"perspective\":{\"yfov\":1,\"znear\":1}}",
+         "camera 'c' on node 'eye'", "cannot be inverted");
+  EXPECT("bad_cam.gltf", "\"mesh\":0}",
+         "\"mesh\":0,\"camera\":0}],\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":4,\"znear\":1}}",
+         "camera 0: want 0 < yfov < pi");
+  EXPECT("bad_light.gltf", "\"mesh\":0}",
+         "\"mesh\":0,\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
+         "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"spot\",\"spot\":{\"innerConeAngle\":0.9,\"outerConeAngle\":0.5}}]}},\"extras\":[0",
+         "light 0: spot cone angles");
   EXPECT("color.gltf", "[0.5,0.25,1,1]", "[0.5,0.25]", "baseColorFactor");
   EXPECT("metal.gltf", "\"metallicFactor\":0", "\"metallicFactor\":1e999", "");
 }
@@ -571,6 +584,7 @@ static void assert_sane(const lm_scene *s) {
   }
   for (int i = 0; i < s->node_count; i++) {
     assert_true(s->nodes[i].parent < i);
+    for (int k = 0; k < 16; k++) assert_true(isfinite(s->nodes[i].world[k]));
     assert_true(s->nodes[i].mesh < s->mesh_count);
     assert_true(s->nodes[i].material < s->material_count);
   }

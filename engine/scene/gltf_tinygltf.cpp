@@ -539,6 +539,30 @@ bool load_nodes(Loader &L) {
   return true;
 }
 
+// Finite transforms can still multiply past float range down a hierarchy; and
+// a camera's world transform must invert, since its view matrix is the inverse.
+bool check_world(Loader &L) {
+  for (size_t ni = 0; ni < L.nodes.size(); ni++) {
+    if (L.nodes[ni] < 0) continue;
+    const float *w = L.s->nodes[L.nodes[ni]].world;
+    for (int k = 0; k < 16; k++)
+      if (!std::isfinite(w[k]) || std::fabs(w[k]) > LM_GLTF_MAX_COORD)
+        return fail(L, "node %zu: world transform reaches %g (more than %g): scales or "
+                    "translations too large", ni, (double)w[k], (double)LM_GLTF_MAX_COORD);
+  }
+  for (int ci = 0; ci < L.s->camera_count; ci++) {
+    const float *w = L.s->nodes[L.s->cameras[ci].node].world;
+    double det = (double)w[0] * ((double)w[5] * w[10] - (double)w[9] * w[6]) -
+                 (double)w[4] * ((double)w[1] * w[10] - (double)w[9] * w[2]) +
+                 (double)w[8] * ((double)w[1] * w[6] - (double)w[5] * w[2]);
+    if (!(std::fabs(det) > 1e-24))
+      return fail(L, "camera '%s' on node '%s': its world transform has (near) zero scale and "
+                  "cannot be inverted into a view", L.s->cameras[ci].name,
+                  L.s->nodes[L.s->cameras[ci].node].name);
+  }
+  return true;
+}
+
 // ---- defaults --------------------------------------------------------------
 
 // World-space bounds of every mesh node's vertices; a unit box when none.
@@ -716,6 +740,7 @@ bool convert(const char *path, const tinygltf::Model &model, lm_scene *s, lm_err
   L.nodes.assign(model.nodes.size(), -1);
   if (!load_nodes(L)) return false;
   lm_scene_update(s);
+  if (!check_world(L)) return false;
   add_defaults(s, L.unset_radius);
   return true;
 }
