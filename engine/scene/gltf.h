@@ -6,7 +6,9 @@
  * What comes over, and how:
  * - Nodes of the file's default scene (scene 0 when it names none; every
  *   root node when it has no scenes), parents before children. A node's
- *   local transform is its matrix, or T * R * S.
+ *   local transform is its matrix, or T * R * S. Every world transform must
+ *   stay within LM_GLTF_MAX_COORD, and a camera's must be invertible (no
+ *   zero scale), or the file is refused.
  * - Each mesh primitive becomes its own lm mesh: a node whose mesh has one
  *   primitive holds it itself; a node whose mesh has several gets one child
  *   node per primitive ("<node>.<i>", identity transform), so that each node
