@@ -406,6 +406,30 @@ static void zero_area_triangles_keep_finite_normals(void **state) {
   lm_scene_destroy(s);
 }
 
+/* A .bin next to the .gltf, found from the file's directory, not the cwd. */
+static void external_buffer_resolves_next_to_the_file(void **state) {
+  (void)state;
+  write_bytes("ext.bin", tri_pos, sizeof tri_pos);
+  const char *json =
+      "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],"
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+      "\"buffers\":[{\"uri\":\"ext.bin\",\"byteLength\":%d}],"
+      "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}";
+  char text[1024];
+  snprintf(text, sizeof text, json, 36);
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(write_bytes("ext.gltf", text, strlen(text)), &err);
+  if (!s) fail_msg("%s", err.msg);
+  assert_int_equal(s->meshes[0].vertex_count, 3);
+  assert_float_equal(s->meshes[0].vertices[8], 1.0, 0);
+  lm_scene_destroy(s);
+  snprintf(text, sizeof text, json, 40); /* the file is shorter than promised */
+  const char *path = write_bytes("ext_short.gltf", text, strlen(text));
+  assert_null(lm_scene_load_gltf(path, &err));
+  if (!strstr(err.msg, path) || !strstr(err.msg, "ext.bin")) fail_msg("%s", err.msg);
+}
+
 /* ---- bad input ---------------------------------------------------------- */
 
 /* Loads a triangle file whose JSON has `from` replaced by `to`; expects an
@@ -704,6 +728,7 @@ int main(void) {
       cmocka_unit_test(lights_and_cameras_come_over),
       cmocka_unit_test(glb_loads_like_gltf),
       cmocka_unit_test(zero_area_triangles_keep_finite_normals),
+      cmocka_unit_test(external_buffer_resolves_next_to_the_file),
       cmocka_unit_test(malformed_files_name_the_element),
       cmocka_unit_test(bad_vertex_values_are_refused),
       cmocka_unit_test(truncated_and_missing_files_are_refused),
