@@ -227,21 +227,22 @@ void compute_normals(std::vector<float> &verts, const std::vector<uint32_t> &idx
   size_t n = verts.size() / 8;
   std::vector<double> acc(n * 3, 0.0);
   for (size_t t = 0; t + 2 < idx.size(); t += 3) {
-    const float *a = &verts[idx[t] * 8], *b = &verts[idx[t + 1] * 8], *c = &verts[idx[t + 2] * 8];
+    const float *a = &verts[(size_t)idx[t] * 8], *b = &verts[(size_t)idx[t + 1] * 8],
+                *c = &verts[(size_t)idx[t + 2] * 8];
     double e1[3], e2[3];
     for (int k = 0; k < 3; k++) e1[k] = (double)b[k] - a[k], e2[k] = (double)c[k] - a[k];
     double cr[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
                     e1[0] * e2[1] - e1[1] * e2[0]};
     for (int j = 0; j < 3; j++)
-      for (int k = 0; k < 3; k++) acc[idx[t + j] * 3 + k] += cr[k];
+      for (int k = 0; k < 3; k++) acc[(size_t)idx[t + j] * 3 + k] += cr[k];
   }
   for (size_t i = 0; i < n; i++) {
     double *a = &acc[i * 3];
     double len = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     float *o = &verts[i * 8 + 3];
-    if (len > 0 && std::isfinite(len)) { // only zero-area triangles here: +Z, never NaN
+    if (len > 0 && std::isfinite(len)) {
       for (int k = 0; k < 3; k++) o[k] = (float)(a[k] / len);
-    } else {
+    } else { // only zero-area triangles (or none) here: +Z, never NaN
       o[0] = 0, o[1] = 0, o[2] = 1;
     }
   }
@@ -274,7 +275,7 @@ int load_primitive(Loader &L, int mi, int pi) {
   if (pos == p.attributes.end()) return fail(L, "%s: no POSITION attribute", where), -1;
   char what[160];
   snprintf(what, sizeof what, "%s: POSITION", where);
-  View v;
+  View v; // POSITION's count first: every other attribute must match it
   if (!accessor_view(L, what, pos->second, 3, &v)) return -1;
   size_t count = v.count;
   std::vector<float> verts;
@@ -297,9 +298,11 @@ int load_primitive(Loader &L, int mi, int pi) {
   if (has_normals) normalize_normals(verts);
   else compute_normals(verts, idx);
 
-  char name[LM_NAME_MAX];
-  if (mesh.primitives.size() == 1) snprintf(name, sizeof name, "%s", mesh.name.empty() ? where : mesh.name.c_str());
-  else snprintf(name, sizeof name, "%s.%d", mesh.name.empty() ? "mesh" : mesh.name.c_str(), pi);
+  char base[LM_NAME_MAX], name[LM_NAME_MAX];
+  if (mesh.name.empty()) snprintf(base, sizeof base, "mesh%d", mi);
+  else snprintf(base, sizeof base, "%s", mesh.name.c_str());
+  if (mesh.primitives.size() == 1) snprintf(name, sizeof name, "%s", base);
+  else snprintf(name, sizeof name, "%s.%d", base, pi);
   return lm_scene_add_mesh(L.s, name, verts.data(), (int)count, idx.data(), (int)idx.size());
 }
 
