@@ -8,6 +8,7 @@
 
 #include "image/image.h"
 #include "render/render.h"
+#include "scene/gltf.h"
 #include "tools.h"
 
 static const char capture_usage[] =
@@ -18,7 +19,8 @@ static const char capture_usage[] =
     "written under a temporary name and renamed, so a failed run leaves none.\n"
     "\n"
     "options:\n"
-    "  --scene NAME         built-in scene (default cornell; built in: %s)\n"
+    "  --scene NAME|FILE    built-in scene, or a .gltf/.glb file (default cornell;\n"
+    "                       built in: %s)\n"
     "  --script FILE        pipeline script (default scripts/pp.lua)\n"
     "  --tech NAME          technique of the script (default: the first it lists)\n"
     "  --set NAME=VALUE     set a technique option the script declares in Options\n"
@@ -267,7 +269,7 @@ int limn_capture(int argc, char **argv) {
     return 0;
   }
 
-  lm_scene *scene = lm_scene_builtin(a.scene, &err);
+  lm_scene *scene = lm_scene_load(a.scene, &err);
   if (!scene) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     lm_pipeline_destroy(pipeline);

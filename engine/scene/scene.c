@@ -66,13 +66,20 @@ int lm_scene_add_camera(lm_scene *s, const lm_camera *c) {
   return s->camera_count - 1;
 }
 
+/* The node's matrices are plain float[16] at any alignment; cglm's SIMD
+ * product loads aligned, so it works on aligned copies. */
 void lm_scene_update(lm_scene *s) {
   for (int i = 0; i < s->node_count; i++) {
     lm_node *n = &s->nodes[i];
-    if (n->parent >= 0 && n->parent < i)
-      glm_mat4_mul((vec4 *)s->nodes[n->parent].world, (vec4 *)n->local, (vec4 *)n->world);
-    else
+    if (n->parent >= 0 && n->parent < i) {
+      mat4 parent, local, world;
+      memcpy(parent, s->nodes[n->parent].world, sizeof parent);
+      memcpy(local, n->local, sizeof local);
+      glm_mat4_mul(parent, local, world);
+      memcpy(n->world, world, sizeof n->world);
+    } else {
       memcpy(n->world, n->local, sizeof n->world);
+    }
   }
 }
 

@@ -1,0 +1,78 @@
+/* gltf: glTF 2.0 scenes (.gltf with external or data-URI buffers, and .glb)
+ * read into an lm_scene. The reading itself is tinygltf's, behind the C++
+ * bridge gltf_tinygltf.cpp; every index, offset, length and count it hands
+ * over is checked again here before a byte is read.
+ *
+ * What comes over, and how:
+ * - Nodes of the file's default scene (scene 0 when it names none; every
+ *   root node when it has no scenes), parents before children. A node's
+ *   local transform is its matrix, or T * R * S. Every world transform must
+ *   stay within LM_GLTF_MAX_COORD, and a camera's must be invertible (no
+ *   zero scale), or the file is refused.
+ * - Each mesh primitive becomes its own lm mesh: a node whose mesh has one
+ *   primitive holds it itself; a node whose mesh has several gets one child
+ *   node per primitive ("<node>.<i>", identity transform), so that each node
+ *   keeps one material. Nodes sharing a mesh share its lm meshes.
+ * - Triangles only (mode 4, indexed by u8/u16/u32 or not indexed); points,
+ *   lines, strips and fans are skipped with a warning. Normals absent from
+ *   the file are computed, area-weighted; a vertex that only touches
+ *   zero-area triangles gets +Z. UVs (TEXCOORD_0) are optional (0 when
+ *   absent). Coordinates must be finite and within LM_GLTF_MAX_COORD.
+ *   Sparse accessors, skins and morph targets are not supported.
+ * - Materials, metallic-roughness to Phong (emissive and textures ignored):
+ *     color     = baseColorFactor.rgb, clamped to [0, 1]
+ *     kd        = 1 - metallic               (metals have no diffuse part)
+ *     ks        = mix(0.04, max(color), metallic)   (F0 of glass-like
+ *                 dielectrics, the base color's for metals)
+ *     shininess = 2 / roughness^4 - 2, clamped to [1, 1024] (the Blinn-Phong
+ *                 exponent whose lobe matches GGX of alpha = roughness^2)
+ *     ka        = 1; rho = max(color) * kd   (what diffuse bounce returns)
+ *   A primitive without a material gets material -1, the engine's default.
+ * - Perspective cameras: yfov, znear, zfar; the aspect ratio is the output's.
+ *   An infinite far plane (zfar absent) becomes LM_GLTF_INFINITE_ZFAR, or
+ *   10 * znear when that is larger.
+ *   Orthographic cameras are skipped with a warning.
+ * - KHR_lights_punctual point, spot and directional lights, one lm light per
+ *   node that names one. The engine's lighting is unitless, so
+ *   power = intensity (candela for point and spot, lux for directional) as a
+ *   plain multiplier on color. radius = range; an absent range (infinite in
+ *   glTF) becomes twice the diagonal of the scene's bounds (at least 1).
+ *   Spot cone angles carry over as the inner and outer half-angles.
+ * - With no light in the scene: "default_light", directional, white, power
+ *   1, shining down along normalize(-0.3, -1, -0.5) from above the bounds.
+ * - With no camera: "default_camera", 45 degrees vertical field of view,
+ *   looking at the centre of the bounds from +Z and 20 degrees above, far
+ *   enough that the bounding sphere fits.
+ * Textures are not decoded: lm_material has no texture slots yet, and a bad
+ * texture should not fail a scene that never reads it. The bridge installs
+ * its own image loader (no stb_image) that keeps images undecoded; external
+ * image files are not opened at all. */
+#ifndef LIMN_GLTF_H
+#define LIMN_GLTF_H
+
+/* The bridge is C++: it needs the scene API with C linkage too. */
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#include "scene/scene.h"
+
+#define LM_GLTF_MAX_COORD 1e9f      /* largest |coordinate| a vertex may have */
+#define LM_GLTF_INFINITE_ZFAR 1000.0f /* zfar of a camera with an infinite far plane */
+#define LM_GLTF_MAX_ELEMENTS (1 << 26) /* most vertices or indices per primitive */
+
+/* Reads a .gltf or .glb file (told apart by the GLB magic, not the name).
+ * NULL on any error, with a message naming the file and the element
+ * ("scene.glb: mesh 0 primitive 1: index 7 is 12, past the 8 vertices").
+ * The scene's world transforms are up to date; nothing is uploaded. */
+lm_scene *lm_scene_load_gltf(const char *path, lm_error *err);
+
+/* True when `name` ends in .gltf or .glb (any case): a file, not a built-in. */
+bool lm_scene_is_gltf_name(const char *name);
+/* A glTF file when lm_scene_is_gltf_name(name), else a built-in scene. */
+lm_scene *lm_scene_load(const char *name, lm_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

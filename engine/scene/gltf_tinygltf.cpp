@@ -1,0 +1,777 @@
+// Bridge to tinygltf; the engine sees only scene/gltf.h. tinygltf parses the
+// JSON and resolves buffers; this file turns its Model into an lm_scene and
+// trusts none of its numbers: every index is range-checked and every
+// accessor's bytes are proven to lie inside their buffer before one is read.
+#define TINYGLTF_IMPLEMENTATION
+#define TINYGLTF_NO_STB_IMAGE       // images go through our loader, not stb
+#define TINYGLTF_NO_STB_IMAGE_WRITE // we never write glTF
+#define TINYGLTF_NO_EXTERNAL_IMAGE  // nor open image files nobody reads
+#include <tiny_gltf.h>
+
+#include "scene/gltf.h"
+
+#include <strings.h>
+
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct Loader {
+  const char *path;
+  const tinygltf::Model &m;
+  lm_scene *s;
+  lm_error *err;
+  std::vector<std::vector<int>> meshes; // [mesh][primitive] -> lm mesh; -1 not yet, -2 skipped
+  std::vector<int> materials;           // [material] -> lm material; -1 not yet
+  std::vector<int> nodes;               // [node] -> lm node; -1 not in the scene
+  std::vector<int> unset_radius;        // lm lights whose range was absent
+};
+
+// Every failure goes through here: "path: what".
+__attribute__((format(printf, 2, 3))) bool fail(Loader &L, const char *fmt, ...) {
+  char what[1536];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(what, sizeof what, fmt, ap);
+  va_end(ap);
+  lm_error_set(L.err, "%s: %s", L.path, what);
+  return false;
+}
+
+bool finite_all(const std::vector<double> &v) {
+  for (double x : v)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+
+float clamp01(double x) { return (float)(x < 0 ? 0 : x > 1 ? 1 : x); }
+
+// ---- accessors -------------------------------------------------------------
+
+int component_size(int type) {
+  switch (type) {
+  case TINYGLTF_COMPONENT_TYPE_BYTE:
+  case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+  case TINYGLTF_COMPONENT_TYPE_SHORT:
+  case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+  case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+  case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+  default: return 0;
+  }
+}
+
+int component_count(int type) {
+  switch (type) {
+  case TINYGLTF_TYPE_SCALAR: return 1;
+  case TINYGLTF_TYPE_VEC2: return 2;
+  case TINYGLTF_TYPE_VEC3: return 3;
+  case TINYGLTF_TYPE_VEC4: return 4;
+  default: return 0; // matrices: never a vertex attribute we read
+  }
+}
+
+// An accessor proven readable: element i's components start at base + i * stride.
+struct View {
+  const unsigned char *base; // NULL: no bufferView, every value 0 (glTF's rule)
+  size_t stride, count;
+  int type, ncomp;
+  bool normalized;
+};
+
+// Checks accessor `index` (for `what`, e.g. "mesh 0 primitive 1: POSITION")
+// down to the buffer's last byte.
+bool accessor_view(Loader &L, const char *what, int index, int ncomp, View *v) {
+  const tinygltf::Model &m = L.m;
+  if (index < 0 || (size_t)index >= m.accessors.size())
+    return fail(L, "%s: accessor %d does not exist (the file has %zu)", what, index,
+                m.accessors.size());
+  const tinygltf::Accessor &a = m.accessors[index];
+  if (a.sparse.isSparse) return fail(L, "%s: accessor %d is sparse (not supported)", what, index);
+  if (component_count(a.type) != ncomp)
+    return fail(L, "%s: accessor %d has %d components per element, want %d", what, index,
+                component_count(a.type), ncomp);
+  int csize = component_size(a.componentType);
+  if (!csize)
+    return fail(L, "%s: accessor %d has component type %d, not a glTF one", what, index,
+                a.componentType);
+  if (a.count == 0) return fail(L, "%s: accessor %d is empty", what, index);
+  if (a.count > (size_t)LM_GLTF_MAX_ELEMENTS)
+    return fail(L, "%s: accessor %d has %zu elements, more than %d", what, index, a.count,
+                LM_GLTF_MAX_ELEMENTS);
+  size_t elem = (size_t)csize * (size_t)ncomp;
+  *v = View{nullptr, elem, a.count, a.componentType, ncomp, a.normalized};
+  if (a.bufferView < 0) return true;
+
+  if ((size_t)a.bufferView >= m.bufferViews.size())
+    return fail(L, "%s: accessor %d: bufferView %d does not exist (the file has %zu)", what, index,
+                a.bufferView, m.bufferViews.size());
+  const tinygltf::BufferView &bv = m.bufferViews[a.bufferView];
+  if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size())
+    return fail(L, "%s: accessor %d: bufferView %d: buffer %d does not exist (the file has %zu)",
+                what, index, a.bufferView, bv.buffer, m.buffers.size());
+  size_t size = m.buffers[bv.buffer].data.size();
+  if (bv.byteOffset > size || bv.byteLength > size - bv.byteOffset)
+    return fail(L, "%s: accessor %d: bufferView %d (%zu bytes from %zu) runs past the end of "
+                "buffer %d (%zu bytes)", what, index, a.bufferView, bv.byteLength, bv.byteOffset,
+                bv.buffer, size);
+  size_t stride = bv.byteStride ? bv.byteStride : elem;
+  if (stride < elem || stride % (size_t)csize)
+    return fail(L, "%s: accessor %d: bufferView %d has byteStride %zu, which does not fit "
+                "%zu-byte elements", what, index, a.bufferView, bv.byteStride, elem);
+  // The last element ends at byteOffset + stride * (count - 1) + elem; divide, never overflow.
+  size_t room = bv.byteLength;
+  if (a.byteOffset > room || room - a.byteOffset < elem ||
+      (a.count - 1) > (room - a.byteOffset - elem) / stride)
+    return fail(L, "%s: accessor %d: %zu elements of %zu bytes (stride %zu) from byteOffset %zu "
+                "run past the end of bufferView %d (%zu bytes)", what, index, a.count, elem,
+                stride, a.byteOffset, a.bufferView, room);
+  v->base = m.buffers[bv.buffer].data.data() + bv.byteOffset + a.byteOffset;
+  v->stride = stride;
+  return true;
+}
+
+// Component c of element i as a double (normalized integers to [0, 1] or [-1, 1]).
+double view_get(const View &v, size_t i, int c) {
+  if (!v.base) return 0;
+  const unsigned char *p = v.base + i * v.stride + (size_t)c * (size_t)component_size(v.type);
+  switch (v.type) {
+  case TINYGLTF_COMPONENT_TYPE_BYTE: {
+    int8_t x;
+    memcpy(&x, p, 1);
+    return v.normalized ? std::fmax(x / 127.0, -1.0) : x;
+  }
+  case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return v.normalized ? p[0] / 255.0 : p[0];
+  case TINYGLTF_COMPONENT_TYPE_SHORT: {
+    int16_t x;
+    memcpy(&x, p, 2);
+    return v.normalized ? std::fmax(x / 32767.0, -1.0) : x;
+  }
+  case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+    uint16_t x;
+    memcpy(&x, p, 2);
+    return v.normalized ? x / 65535.0 : x;
+  }
+  case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+    uint32_t x;
+    memcpy(&x, p, 4);
+    return x;
+  }
+  default: {
+    float x;
+    memcpy(&x, p, 4);
+    return x;
+  }
+  }
+}
+
+// Copies attribute `name` of the primitive into slots [at, at + ncomp) of the
+// 8-float vertices; false when absent (*present = false) or bad (error set).
+bool read_attribute(Loader &L, const char *where, const tinygltf::Primitive &p, const char *name,
+                    int ncomp, int at, std::vector<float> &verts, size_t count, bool *present) {
+  auto it = p.attributes.find(name);
+  *present = it != p.attributes.end();
+  if (!*present) return true;
+  char what[160];
+  snprintf(what, sizeof what, "%s: %s", where, name);
+  View v;
+  if (!accessor_view(L, what, it->second, ncomp, &v)) return false;
+  if (v.count != count)
+    return fail(L, "%s: accessor %d has %zu elements, but POSITION has %zu", what, it->second,
+                v.count, count);
+  verts.resize(count * 8);
+  for (size_t i = 0; i < count; i++)
+    for (int c = 0; c < ncomp; c++) {
+      double x = view_get(v, i, c);
+      if (!std::isfinite(x) || std::fabs(x) > LM_GLTF_MAX_COORD)
+        return fail(L, "%s: accessor %d: element %zu has a non-finite or huge value (%g)", what,
+                    it->second, i, x);
+      verts[i * 8 + at + c] = (float)x;
+    }
+  return true;
+}
+
+bool read_indices(Loader &L, const char *where, int index, size_t vertex_count,
+                  std::vector<uint32_t> &out) {
+  char what[160];
+  snprintf(what, sizeof what, "%s: indices", where);
+  // The type first: a float index buffer is a clearer mistake than its length.
+  bool exists = index >= 0 && (size_t)index < L.m.accessors.size();
+  int type = exists ? L.m.accessors[index].componentType : 0;
+  if (exists && type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+      type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+    return fail(L, "%s: accessor %d has component type %d; indices are unsigned byte, short or int",
+                what, index, type);
+  View v;
+  if (!accessor_view(L, what, index, 1, &v)) return false;
+  out.resize(v.count);
+  for (size_t i = 0; i < v.count; i++) {
+    double x = view_get(v, i, 0);
+    if (x >= (double)vertex_count)
+      return fail(L, "%s: index %zu is %.0f, past the %zu vertices", what, i, x, vertex_count);
+    out[i] = (uint32_t)x;
+  }
+  return true;
+}
+
+// ---- primitives ------------------------------------------------------------
+
+// Area-weighted vertex normals: the cross product of two edges is twice the
+// triangle's area long, so summing unnormalized ones weights by area. Doubles
+// keep coordinates up to LM_GLTF_MAX_COORD from overflowing.
+void compute_normals(std::vector<float> &verts, const std::vector<uint32_t> &idx) {
+  size_t n = verts.size() / 8;
+  std::vector<double> acc(n * 3, 0.0);
+  for (size_t t = 0; t + 2 < idx.size(); t += 3) {
+    const float *a = &verts[(size_t)idx[t] * 8], *b = &verts[(size_t)idx[t + 1] * 8],
+                *c = &verts[(size_t)idx[t + 2] * 8];
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; k++) e1[k] = (double)b[k] - a[k], e2[k] = (double)c[k] - a[k];
+    double cr[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                    e1[0] * e2[1] - e1[1] * e2[0]};
+    for (int j = 0; j < 3; j++)
+      for (int k = 0; k < 3; k++) acc[(size_t)idx[t + j] * 3 + k] += cr[k];
+  }
+  for (size_t i = 0; i < n; i++) {
+    double *a = &acc[i * 3];
+    double len = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    float *o = &verts[i * 8 + 3];
+    if (len > 0 && std::isfinite(len)) {
+      for (int k = 0; k < 3; k++) o[k] = (float)(a[k] / len);
+    } else { // only zero-area triangles (or none) here: +Z, never NaN
+      o[0] = 0, o[1] = 0, o[2] = 1;
+    }
+  }
+}
+
+// Normals from the file are normalized too; a zero one gets +Z.
+void normalize_normals(std::vector<float> &verts) {
+  for (size_t i = 0; i < verts.size(); i += 8) {
+    float *o = &verts[i + 3];
+    double len = std::sqrt((double)o[0] * o[0] + (double)o[1] * o[1] + (double)o[2] * o[2]);
+    if (len > 0) {
+      for (int k = 0; k < 3; k++) o[k] = (float)(o[k] / len);
+    } else {
+      o[0] = 0, o[1] = 0, o[2] = 1;
+    }
+  }
+}
+
+// lm mesh of primitive pi of mesh mi; -2 when skipped, -1 on error.
+int load_primitive(Loader &L, int mi, int pi) {
+  const tinygltf::Mesh &mesh = L.m.meshes[mi];
+  const tinygltf::Primitive &p = mesh.primitives[pi];
+  char where[64];
+  snprintf(where, sizeof where, "mesh %d primitive %d", mi, pi);
+  if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES) {
+    lm_warn("%s: %s: mode %d is not triangles; skipped", L.path, where, p.mode);
+    return -2;
+  }
+  auto pos = p.attributes.find("POSITION");
+  if (pos == p.attributes.end()) return fail(L, "%s: no POSITION attribute", where), -1;
+  char what[160];
+  snprintf(what, sizeof what, "%s: POSITION", where);
+  View v; // POSITION's count first: every other attribute must match it
+  if (!accessor_view(L, what, pos->second, 3, &v)) return -1;
+  size_t count = v.count;
+  std::vector<float> verts;
+  bool present, has_normals;
+  if (!read_attribute(L, where, p, "POSITION", 3, 0, verts, count, &present) ||
+      !read_attribute(L, where, p, "NORMAL", 3, 3, verts, count, &has_normals) ||
+      !read_attribute(L, where, p, "TEXCOORD_0", 2, 6, verts, count, &present))
+    return -1;
+
+  std::vector<uint32_t> idx;
+  if (p.indices >= 0) {
+    if (!read_indices(L, where, p.indices, count, idx)) return -1;
+  } else {
+    idx.resize(count);
+    for (size_t i = 0; i < count; i++) idx[i] = (uint32_t)i;
+  }
+  if (idx.size() % 3)
+    return fail(L, "%s: %zu %s, not a multiple of 3 (triangles)", where, idx.size(),
+                p.indices >= 0 ? "indices" : "vertices"), -1;
+  if (has_normals) normalize_normals(verts);
+  else compute_normals(verts, idx);
+
+  char base[LM_NAME_MAX], name[LM_NAME_MAX];
+  if (mesh.name.empty()) snprintf(base, sizeof base, "mesh%d", mi);
+  else snprintf(base, sizeof base, "%s", mesh.name.c_str());
+  if (mesh.primitives.size() == 1) snprintf(name, sizeof name, "%s", base);
+  else snprintf(name, sizeof name, "%s.%d", base, pi);
+  return lm_scene_add_mesh(L.s, name, verts.data(), (int)count, idx.data(), (int)idx.size());
+}
+
+// ---- materials -------------------------------------------------------------
+
+// lm material of glTF material `index`, converted on first use; -1 on error.
+int material_for(Loader &L, const char *where, int index) {
+  if (index < 0) return -1;
+  if ((size_t)index >= L.m.materials.size())
+    return fail(L, "%s: material %d does not exist (the file has %zu)", where, index,
+                L.m.materials.size()), -1;
+  if (L.materials[index] >= 0) return L.materials[index];
+  const tinygltf::Material &gm = L.m.materials[index];
+  const tinygltf::PbrMetallicRoughness &pbr = gm.pbrMetallicRoughness;
+  if (pbr.baseColorFactor.size() != 4 || !finite_all(pbr.baseColorFactor) ||
+      !std::isfinite(pbr.metallicFactor) || !std::isfinite(pbr.roughnessFactor))
+    return fail(L, "material %d: baseColorFactor needs 4 finite numbers, metallicFactor and "
+                "roughnessFactor finite ones", index), -1;
+  lm_material m = {};
+  snprintf(m.name, sizeof m.name, "%s", gm.name.empty() ? "material" : gm.name.c_str());
+  float maxc = 0;
+  for (int c = 0; c < 3; c++) {
+    m.color[c] = clamp01(pbr.baseColorFactor[c]);
+    maxc = std::fmax(maxc, m.color[c]);
+  }
+  float metal = clamp01(pbr.metallicFactor), rough = clamp01(pbr.roughnessFactor);
+  m.ka = 1.0f;
+  m.kd = 1.0f - metal;
+  m.ks = 0.04f + (maxc - 0.04f) * metal;
+  double r4 = (double)rough * rough * rough * rough;
+  double shin = r4 > 0 ? 2.0 / r4 - 2.0 : 1024.0;
+  m.shininess = (float)(shin < 1 ? 1 : shin > 1024 ? 1024 : shin);
+  m.rho = maxc * m.kd;
+  return L.materials[index] = lm_scene_add_material(L.s, &m);
+}
+
+// ---- nodes -----------------------------------------------------------------
+
+// Column-major T * R * S, or the node's matrix.
+bool local_transform(Loader &L, int ni, const tinygltf::Node &n, float out[16]) {
+  if (!n.matrix.empty()) {
+    if (n.matrix.size() != 16 || !finite_all(n.matrix))
+      return fail(L, "node %d: matrix needs 16 finite numbers", ni);
+    for (int i = 0; i < 16; i++) out[i] = (float)n.matrix[i];
+    return true;
+  }
+  double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+  if ((!n.translation.empty() && n.translation.size() != 3) ||
+      (!n.rotation.empty() && n.rotation.size() != 4) || (!n.scale.empty() && n.scale.size() != 3) ||
+      !finite_all(n.translation) || !finite_all(n.rotation) || !finite_all(n.scale))
+    return fail(L, "node %d: translation, rotation and scale need 3, 4 and 3 finite numbers", ni);
+  for (size_t i = 0; i < n.translation.size(); i++) t[i] = n.translation[i];
+  for (size_t i = 0; i < n.scale.size(); i++) s[i] = n.scale[i];
+  if (!n.rotation.empty()) {
+    double len = std::sqrt(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] +
+                           n.rotation[2] * n.rotation[2] + n.rotation[3] * n.rotation[3]);
+    if (!(len > 1e-12) || !std::isfinite(len))
+      return fail(L, "node %d: rotation is not a usable quaternion", ni);
+    for (int i = 0; i < 4; i++) q[i] = n.rotation[i] / len;
+  }
+  double x = q[0], y = q[1], z = q[2], w = q[3];
+  double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),
+                 2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
+                 2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y)};
+  for (int c = 0; c < 3; c++) {
+    for (int k = 0; k < 3; k++) out[c * 4 + k] = (float)(r[c * 3 + k] * s[c]);
+    out[c * 4 + 3] = 0;
+  }
+  for (int k = 0; k < 3; k++) out[12 + k] = (float)t[k];
+  out[15] = 1;
+  return true;
+}
+
+bool add_camera(Loader &L, int ni, int ci, int node) {
+  if (ci < 0 || (size_t)ci >= L.m.cameras.size())
+    return fail(L, "node %d: camera %d does not exist (the file has %zu)", ni, ci, L.m.cameras.size());
+  const tinygltf::Camera &c = L.m.cameras[ci];
+  if (c.type != "perspective") {
+    lm_warn("%s: camera %d: type '%s' is not supported (perspective only); skipped", L.path, ci,
+            c.type.c_str());
+    return true;
+  }
+  const tinygltf::PerspectiveCamera &p = c.perspective;
+  if (!(p.yfov > 0 && p.yfov < M_PI) || !(p.znear > 0 && p.znear < 1e30) ||
+      !(p.zfar == 0 || (p.zfar > p.znear && p.zfar < 1e30)))
+    return fail(L, "camera %d: want 0 < yfov < pi, znear > 0 and zfar > znear (or absent); "
+                "got %g, %g, %g", ci, p.yfov, p.znear, p.zfar);
+  lm_camera cam = {};
+  snprintf(cam.name, sizeof cam.name, "%s", c.name.empty() ? "camera" : c.name.c_str());
+  cam.fov_y = (float)p.yfov;
+  cam.znear = (float)p.znear;
+  cam.zfar = p.zfar > 0 ? (float)p.zfar : std::fmax(LM_GLTF_INFINITE_ZFAR, 10.0f * cam.znear);
+  cam.node = node;
+  lm_scene_add_camera(L.s, &cam);
+  return true;
+}
+
+// The node's KHR_lights_punctual light index, -1 when none; -2 when malformed.
+int node_light(const tinygltf::Node &n) {
+  auto it = n.extensions.find("KHR_lights_punctual");
+  if (it == n.extensions.end()) return -1;
+  const tinygltf::Value &ext = it->second;
+  if (!ext.IsObject() || !ext.Has("light") || !ext.Get("light").IsNumber()) return -2;
+  double d = ext.Get("light").GetNumberAsDouble();
+  return d >= 0 && d < 1e9 && d == std::floor(d) ? (int)d : -2;
+}
+
+bool add_light(Loader &L, int ni, int li, int node) {
+  if (li < 0 || (size_t)li >= L.m.lights.size())
+    return fail(L, "node %d: KHR_lights_punctual light %d does not exist (the file has %zu)", ni,
+                li, L.m.lights.size());
+  const tinygltf::Light &gl = L.m.lights[li];
+  lm_light l = {};
+  snprintf(l.name, sizeof l.name, "%s", gl.name.empty() ? "light" : gl.name.c_str());
+  if (gl.type == "point") l.type = LM_LIGHT_POINT;
+  else if (gl.type == "spot") l.type = LM_LIGHT_SPOT;
+  else if (gl.type == "directional") l.type = LM_LIGHT_DIRECTIONAL;
+  else return fail(L, "light %d: type '%s' is none of point, spot, directional", li, gl.type.c_str());
+  if ((!gl.color.empty() && gl.color.size() != 3) || !finite_all(gl.color))
+    return fail(L, "light %d: color needs 3 finite numbers", li);
+  if (!(gl.intensity >= 0 && gl.intensity < 1e30) || !(gl.range >= 0 && gl.range < 1e30))
+    return fail(L, "light %d: intensity and range must be finite and not negative", li);
+  double inner = gl.spot.innerConeAngle, outer = gl.spot.outerConeAngle;
+  if (l.type == LM_LIGHT_SPOT && !(inner >= 0 && inner < outer && outer <= M_PI / 2))
+    return fail(L, "light %d: spot cone angles need 0 <= inner < outer <= pi/2; got %g, %g", li,
+                inner, outer);
+  for (int c = 0; c < 3; c++) l.color[c] = gl.color.empty() ? 1.0f : (float)gl.color[c];
+  l.power = (float)gl.intensity;
+  l.radius = (float)gl.range;
+  l.inner_cone = l.type == LM_LIGHT_SPOT ? (float)inner : 0.0f;
+  l.outer_cone = l.type == LM_LIGHT_SPOT ? (float)outer : (float)(M_PI / 2);
+  l.casts_shadows = true;
+  l.node = node;
+  int id = lm_scene_add_light(L.s, &l);
+  if (gl.range <= 0) L.unset_radius.push_back(id);
+  return true;
+}
+
+// The node's mesh: on the node itself when it has one primitive, else one
+// child per primitive.
+bool add_mesh(Loader &L, int ni, int mi, int lm_node) {
+  if (mi < 0 || (size_t)mi >= L.m.meshes.size())
+    return fail(L, "node %d: mesh %d does not exist (the file has %zu)", ni, mi, L.m.meshes.size());
+  const tinygltf::Mesh &mesh = L.m.meshes[mi];
+  std::vector<int> &cache = L.meshes[mi];
+  if (cache.empty()) {
+    for (size_t pi = 0; pi < mesh.primitives.size(); pi++) {
+      int id = load_primitive(L, mi, (int)pi);
+      if (id == -1) return false;
+      cache.push_back(id);
+    }
+  }
+  static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  for (size_t pi = 0; pi < mesh.primitives.size(); pi++) {
+    if (cache[pi] < 0) continue;
+    char where[64];
+    snprintf(where, sizeof where, "mesh %d primitive %zu", mi, pi);
+    int mat = material_for(L, where, mesh.primitives[pi].material);
+    if (mat == -1 && mesh.primitives[pi].material >= 0) return false;
+    if (mesh.primitives.size() == 1) {
+      L.s->nodes[lm_node].mesh = cache[pi];
+      L.s->nodes[lm_node].material = mat;
+    } else {
+      char name[LM_NAME_MAX];
+      snprintf(name, sizeof name, "%s.%zu", L.s->nodes[lm_node].name, pi);
+      lm_scene_add_node(L.s, name, lm_node, identity, cache[pi], mat);
+    }
+  }
+  return true;
+}
+
+bool add_node(Loader &L, int ni, int parent, int *out) {
+  const tinygltf::Node &n = L.m.nodes[ni];
+  float local[16];
+  if (!local_transform(L, ni, n, local)) return false;
+  char name[LM_NAME_MAX];
+  if (n.name.empty()) snprintf(name, sizeof name, "node%d", ni);
+  else snprintf(name, sizeof name, "%s", n.name.c_str());
+  int id = *out = lm_scene_add_node(L.s, name, parent, local, -1, -1);
+  L.nodes[ni] = id;
+  if (n.mesh >= 0 && !add_mesh(L, ni, n.mesh, id)) return false;
+  if (n.camera >= 0 && !add_camera(L, ni, n.camera, id)) return false;
+  int li = node_light(n);
+  if (li == -2) return fail(L, "node %d: KHR_lights_punctual wants {\"light\": index}", ni);
+  if (li >= 0 && !add_light(L, ni, li, id)) return false;
+  return true;
+}
+
+// The scene's root nodes: the default scene's, scene 0's, or every node no
+// other node names as a child.
+bool root_nodes(Loader &L, std::vector<int> &roots) {
+  const tinygltf::Model &m = L.m;
+  if (m.scenes.empty()) {
+    std::vector<char> child(m.nodes.size(), 0);
+    for (const tinygltf::Node &n : m.nodes)
+      for (int c : n.children)
+        if (c >= 0 && (size_t)c < child.size()) child[c] = 1;
+    for (size_t i = 0; i < m.nodes.size(); i++)
+      if (!child[i]) roots.push_back((int)i);
+    return true;
+  }
+  int si = m.defaultScene < 0 ? 0 : m.defaultScene;
+  if ((size_t)si >= m.scenes.size())
+    return fail(L, "scene %d does not exist (the file has %zu)", si, m.scenes.size());
+  for (int r : m.scenes[si].nodes) {
+    if (r < 0 || (size_t)r >= m.nodes.size())
+      return fail(L, "scene %d: node %d does not exist (the file has %zu)", si, r, m.nodes.size());
+    roots.push_back(r);
+  }
+  return true;
+}
+
+// Depth first with an explicit stack (a deep file cannot overflow ours),
+// parents before children as lm_scene_update wants. A node met twice is a
+// cycle or a child of two parents: glTF allows neither.
+bool load_nodes(Loader &L) {
+  std::vector<int> roots;
+  if (!root_nodes(L, roots)) return false;
+  std::vector<std::pair<int, int>> stack; // (glTF node, lm parent)
+  for (size_t i = roots.size(); i-- > 0;) stack.push_back({roots[i], -1});
+  while (!stack.empty()) {
+    auto [ni, parent] = stack.back();
+    stack.pop_back();
+    if (L.nodes[ni] >= 0)
+      return fail(L, "node %d is reached twice (a cycle, or a child of two parents)", ni);
+    int id;
+    if (!add_node(L, ni, parent, &id)) return false;
+    const std::vector<int> &children = L.m.nodes[ni].children;
+    for (size_t i = children.size(); i-- > 0;) {
+      int c = children[i];
+      if (c < 0 || (size_t)c >= L.m.nodes.size())
+        return fail(L, "node %d: child %d does not exist (the file has %zu)", ni, c,
+                    L.m.nodes.size());
+      stack.push_back({c, id});
+    }
+  }
+  return true;
+}
+
+// Finite transforms can still multiply past float range down a hierarchy; and
+// a camera's world transform must invert, since its view matrix is the inverse.
+bool check_world(Loader &L) {
+  for (size_t ni = 0; ni < L.nodes.size(); ni++) {
+    if (L.nodes[ni] < 0) continue;
+    const float *w = L.s->nodes[L.nodes[ni]].world;
+    for (int k = 0; k < 16; k++)
+      if (!std::isfinite(w[k]) || std::fabs(w[k]) > LM_GLTF_MAX_COORD)
+        return fail(L, "node %zu: world transform reaches %g (more than %g): scales or "
+                    "translations too large", ni, (double)w[k], (double)LM_GLTF_MAX_COORD);
+  }
+  for (int ci = 0; ci < L.s->camera_count; ci++) {
+    const float *w = L.s->nodes[L.s->cameras[ci].node].world;
+    double det = (double)w[0] * ((double)w[5] * w[10] - (double)w[9] * w[6]) -
+                 (double)w[4] * ((double)w[1] * w[10] - (double)w[9] * w[2]) +
+                 (double)w[8] * ((double)w[1] * w[6] - (double)w[5] * w[2]);
+    if (!(std::fabs(det) > 1e-24))
+      return fail(L, "camera '%s' on node '%s': its world transform has (near) zero scale and "
+                  "cannot be inverted into a view", L.s->cameras[ci].name,
+                  L.s->nodes[L.s->cameras[ci].node].name);
+  }
+  return true;
+}
+
+// ---- defaults --------------------------------------------------------------
+
+// World-space bounds of every mesh node's vertices; a unit box when none.
+void scene_bounds(const lm_scene *s, double lo[3], double hi[3]) {
+  bool any = false;
+  for (int k = 0; k < 3; k++) lo[k] = INFINITY, hi[k] = -INFINITY;
+  for (int i = 0; i < s->node_count; i++) {
+    const lm_node *n = &s->nodes[i];
+    if (n->mesh < 0) continue;
+    const lm_scene_mesh *m = &s->meshes[n->mesh];
+    const float *w = n->world;
+    for (int v = 0; v < m->vertex_count; v++) {
+      const float *p = m->vertices + v * 8;
+      for (int k = 0; k < 3; k++) {
+        double x = (double)w[k] * p[0] + (double)w[4 + k] * p[1] + (double)w[8 + k] * p[2] + w[12 + k];
+        if (!std::isfinite(x)) continue; // a degenerate transform: leave this one out
+        lo[k] = std::fmin(lo[k], x), hi[k] = std::fmax(hi[k], x);
+        any = true;
+      }
+    }
+  }
+  for (int k = 0; k < 3 && any; k++)
+    if (!(lo[k] <= hi[k])) any = false;
+  if (!any)
+    for (int k = 0; k < 3; k++) lo[k] = -0.5, hi[k] = 0.5;
+}
+
+// A node at `eye` whose -Z points along `dir` (+Y up, unless dir is vertical).
+void look_along(const double eye[3], const double dir[3], float out[16]) {
+  double len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+  double z[3] = {-dir[0] / len, -dir[1] / len, -dir[2] / len};
+  double up[3] = {0, 1, 0};
+  if (std::fabs(z[1]) > 0.999) up[1] = 0, up[2] = 1;
+  double x[3] = {up[1] * z[2] - up[2] * z[1], up[2] * z[0] - up[0] * z[2], up[0] * z[1] - up[1] * z[0]};
+  double xl = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+  for (int k = 0; k < 3; k++) x[k] /= xl;
+  double y[3] = {z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]};
+  for (int k = 0; k < 3; k++) {
+    out[k] = (float)x[k], out[4 + k] = (float)y[k], out[8 + k] = (float)z[k];
+    out[12 + k] = (float)eye[k];
+  }
+  out[3] = out[7] = out[11] = 0, out[15] = 1;
+}
+
+void add_defaults(lm_scene *s, const std::vector<int> &unset_radius) {
+  double lo[3], hi[3], c[3], diag = 0;
+  scene_bounds(s, lo, hi);
+  for (int k = 0; k < 3; k++) c[k] = 0.5 * (lo[k] + hi[k]), diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+  diag = std::fmax(std::sqrt(diag), 1e-3);
+  for (int id : unset_radius) s->lights[id].radius = (float)std::fmax(2 * diag, 1.0);
+
+  float m[16];
+  if (s->light_count == 0) {
+    double dir[3] = {-0.3, -1.0, -0.5}, eye[3];
+    for (int k = 0; k < 3; k++) eye[k] = c[k] - dir[k] * diag;
+    look_along(eye, dir, m);
+    lm_light l = {};
+    snprintf(l.name, sizeof l.name, "default_light");
+    l.type = LM_LIGHT_DIRECTIONAL;
+    l.color[0] = l.color[1] = l.color[2] = 1;
+    l.power = 1;
+    l.radius = (float)std::fmax(2 * diag, 1.0);
+    l.outer_cone = (float)(M_PI / 2);
+    l.casts_shadows = true;
+    l.node = lm_scene_add_node(s, "default_light", -1, m, -1, -1);
+    lm_scene_add_light(s, &l);
+  }
+  if (s->camera_count == 0) {
+    const double fov = M_PI / 4, pitch = 20 * M_PI / 180, r = diag / 2;
+    double d = r / std::sin(fov / 2), eye[3], dir[3];
+    double back[3] = {0, std::sin(pitch), std::cos(pitch)};
+    for (int k = 0; k < 3; k++) eye[k] = c[k] + back[k] * d, dir[k] = -back[k];
+    look_along(eye, dir, m);
+    lm_camera cam = {};
+    snprintf(cam.name, sizeof cam.name, "default_camera");
+    cam.fov_y = (float)fov;
+    cam.znear = (float)std::fmax(0.5 * (d - r), 1e-3 * d);
+    cam.zfar = (float)(2 * (d + r));
+    cam.node = lm_scene_add_node(s, "default_camera", -1, m, -1, -1);
+    lm_scene_add_camera(s, &cam);
+  }
+  lm_scene_update(s);
+}
+
+// ---- parsing ---------------------------------------------------------------
+
+// lm_material has no texture slots yet: keep every image undecoded, so that
+// no stb_image runs and a broken texture cannot fail the scene. When textures
+// arrive, this is where OpenImageIO (engine/image) decodes `bytes`.
+bool keep_image_undecoded(tinygltf::Image *, const int, std::string *, std::string *, int, int,
+                          const unsigned char *, int, void *) {
+  return true;
+}
+
+// tinygltf's message, first line only, with any data URI it quotes (a whole
+// buffer in base64) cut to its head.
+std::string first_line(const std::string &s) {
+  std::string t = s.substr(0, s.find('\n'));
+  for (size_t at = t.find("data:"); at != std::string::npos; at = t.find("data:", at + 1)) {
+    size_t end = t.find_first_of(" '\"", at);
+    if (end == std::string::npos) end = t.size();
+    if (end - at > 48) t.replace(at + 40, end - at - 40, "...");
+  }
+  return t.empty() ? "not a glTF file" : t;
+}
+
+// tinygltf refuses a primitive whose indices accessor does not exist before
+// we see the model, with a message that names no mesh: find the primitive in
+// the JSON ourselves. `json` is the text tinygltf parsed (the GLB's chunk 0).
+std::string locate_bad_indices(const unsigned char *text, size_t len) {
+  using nlohmann::json;
+  json doc = json::parse(text, text + len, nullptr, false);
+  if (!doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array()) return "";
+  size_t accessors = doc.contains("accessors") && doc["accessors"].is_array() ? doc["accessors"].size() : 0;
+  const json &meshes = doc["meshes"];
+  for (size_t mi = 0; mi < meshes.size(); mi++) {
+    if (!meshes[mi].is_object() || !meshes[mi].contains("primitives")) continue;
+    const json &prims = meshes[mi]["primitives"];
+    for (size_t pi = 0; prims.is_array() && pi < prims.size(); pi++) {
+      if (!prims[pi].is_object() || !prims[pi].contains("indices")) continue;
+      const json &ix = prims[pi]["indices"];
+      if (ix.is_number_integer() && ix.get<long long>() >= (long long)accessors)
+        return "mesh " + std::to_string(mi) + " primitive " + std::to_string(pi) +
+               ": indices: accessor " + std::to_string(ix.get<long long>()) +
+               " does not exist (the file has " + std::to_string(accessors) + ")";
+    }
+  }
+  return "";
+}
+
+bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
+  size_t len;
+  char *data = lm_read_file(path, &len, err);
+  if (!data) return false;
+  if (len > 0x7fffff00u) {
+    free(data);
+    lm_error_set(err, "%s: larger than 2 GiB", path);
+    return false;
+  }
+  // tinygltf 2.7.0 checks a GLB's BIN chunk length without its 8-byte header
+  // and can read that far past the end: hand it zero padding to read.
+  std::vector<unsigned char> bytes(len + 16, 0);
+  memcpy(bytes.data(), data, len);
+  free(data);
+  char dir[4096];
+  lm_dirname(path, dir, sizeof dir);
+
+  tinygltf::TinyGLTF gltf;
+  gltf.SetImageLoader(keep_image_undecoded, nullptr);
+  std::string why, warn;
+  bool glb = len >= 4 && !memcmp(bytes.data(), "glTF", 4);
+  bool ok = glb ? gltf.LoadBinaryFromMemory(model, &why, &warn, bytes.data(), (unsigned)len, dir)
+                : gltf.LoadASCIIFromString(model, &why, &warn, (const char *)bytes.data(),
+                                           (unsigned)len, dir);
+  if (!warn.empty()) lm_debug("%s: tinygltf: %s", path, first_line(warn).c_str());
+  // Some of tinygltf's checks (a baseColorFactor of 2 numbers) report into
+  // `why` and carry on with a default: a wrong file all the same.
+  if (ok && why.empty()) return true;
+  std::string what = first_line(why);
+  if (what.find("primitive indices accessor out of bounds") != std::string::npos) {
+    uint32_t json_len = (uint32_t)len; // GLB: tinygltf got this far, so chunk 0 is whole
+    if (glb) memcpy(&json_len, bytes.data() + 12, 4);
+    std::string where = locate_bad_indices(bytes.data() + (glb ? 20 : 0), json_len);
+    if (!where.empty()) what = where;
+  }
+  lm_error_set(err, "%s: %s", path, what.c_str());
+  return false;
+}
+
+// Fills `s` from the parsed model; false (message in L.err) on bad input.
+bool convert(const char *path, const tinygltf::Model &model, lm_scene *s, lm_error *err) {
+  Loader L{path, model, s, err, {}, {}, {}, {}};
+  L.meshes.resize(model.meshes.size());
+  L.materials.assign(model.materials.size(), -1);
+  L.nodes.assign(model.nodes.size(), -1);
+  if (!load_nodes(L)) return false;
+  lm_scene_update(s);
+  if (!check_world(L)) return false;
+  add_defaults(s, L.unset_radius);
+  return true;
+}
+
+} // namespace
+
+extern "C" lm_scene *lm_scene_load_gltf(const char *path, lm_error *err) {
+  lm_scene *s = nullptr;
+  try {
+    tinygltf::Model model;
+    if (!parse(path, &model, err)) return nullptr;
+    const char *base = strrchr(path, '/');
+    s = lm_scene_create(base ? base + 1 : path);
+    if (convert(path, model, s, err)) return s;
+  } catch (const std::exception &e) { // tinygltf throws on some malformed input
+    lm_error_set(err, "%s: malformed glTF (%s)", path, e.what());
+  } catch (...) {
+    lm_error_set(err, "%s: malformed glTF", path);
+  }
+  lm_scene_destroy(s);
+  return nullptr;
+}
+
+extern "C" bool lm_scene_is_gltf_name(const char *name) {
+  const char *dot = strrchr(name, '.');
+  return dot && !strchr(dot, '/') && (!strcasecmp(dot, ".gltf") || !strcasecmp(dot, ".glb"));
+}
+
+extern "C" lm_scene *lm_scene_load(const char *name, lm_error *err) {
+  return lm_scene_is_gltf_name(name) ? lm_scene_load_gltf(name, err) : lm_scene_builtin(name, err);
+}

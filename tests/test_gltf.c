@@ -1,0 +1,739 @@
+/* glTF loading: small files written by the test itself (JSON with base64
+ * data URIs, and GLB), what they load into, the malformed ones each refused
+ * with a message naming the file and the element, and a mutation loop that
+ * must never crash. No GL needed. */
+#define _DEFAULT_SOURCE /* mkdtemp */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene/gltf.h"
+
+static char tmp_dir[64];
+
+/* ---- writing files ------------------------------------------------------ */
+
+/* Binary data of a file under construction; each piece 4-byte aligned. */
+typedef struct blob {
+  unsigned char data[4096];
+  size_t len;
+} blob;
+
+static size_t blob_add(blob *b, const void *p, size_t n) {
+  b->len = (b->len + 3) & ~(size_t)3;
+  size_t at = b->len;
+  assert_true(at + n <= sizeof b->data);
+  memcpy(b->data + at, p, n);
+  b->len += n;
+  return at;
+}
+
+static char *base64(const unsigned char *p, size_t n) {
+  static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  char *out = malloc(4 * ((n + 2) / 3) + 1), *o = out;
+  for (size_t i = 0; i < n; i += 3) {
+    uint32_t v = (uint32_t)p[i] << 16 | (i + 1 < n ? (uint32_t)p[i + 1] << 8 : 0) |
+                 (i + 2 < n ? p[i + 2] : 0);
+    *o++ = tab[v >> 18 & 63];
+    *o++ = tab[v >> 12 & 63];
+    *o++ = i + 1 < n ? tab[v >> 6 & 63] : '=';
+    *o++ = i + 2 < n ? tab[v & 63] : '=';
+  }
+  *o = '\0';
+  return out;
+}
+
+static const char *path_of(const char *name) {
+  static char path[8][256];
+  static int next;
+  char *p = path[next++ % 8];
+  snprintf(p, 256, "%s/%s", tmp_dir, name);
+  return p;
+}
+
+static const char *write_bytes(const char *name, const void *data, size_t len) {
+  const char *path = path_of(name);
+  FILE *f = fopen(path, "wb");
+  assert_non_null(f);
+  assert_int_equal(fwrite(data, 1, len, f), len);
+  fclose(f);
+  return path;
+}
+
+/* Writes `json` with its one "%s" replaced by `b` as a data URI, and
+ * "%zu" (if any, after it) by the blob's length. */
+static const char *write_gltf(const char *name, const char *json, const blob *b) {
+  char *b64 = base64(b->data, b->len);
+  size_t cap = strlen(json) + strlen(b64) + 128;
+  char *text = malloc(cap), uri[64];
+  snprintf(uri, sizeof uri, "data:application/octet-stream;base64,");
+  char *full = malloc(strlen(uri) + strlen(b64) + 1);
+  strcpy(full, uri), strcat(full, b64);
+  snprintf(text, cap, json, full, b->len);
+  const char *path = write_bytes(name, text, strlen(text));
+  free(b64), free(full), free(text);
+  return path;
+}
+
+/* GLB bytes of `json` (its buffer 0 without a uri) and `b` as the BIN chunk. */
+static size_t make_glb(const char *json, const blob *b, unsigned char *out, size_t cap) {
+  size_t jlen = (strlen(json) + 3) & ~(size_t)3, blen = (b->len + 3) & ~(size_t)3;
+  size_t total = 12 + 8 + jlen + 8 + blen;
+  assert_true(total <= cap);
+  memset(out, 0, total);
+  uint32_t head[3] = {0x46546C67, 2, (uint32_t)total}, jhead[2] = {(uint32_t)jlen, 0x4E4F534A},
+           bhead[2] = {(uint32_t)blen, 0x004E4942};
+  memcpy(out, head, 12);
+  memcpy(out + 12, jhead, 8);
+  memset(out + 20, ' ', jlen);
+  memcpy(out + 20, json, strlen(json));
+  memcpy(out + 20 + jlen, bhead, 8);
+  memcpy(out + 28 + jlen, b->data, b->len);
+  return total;
+}
+
+/* ---- the files ---------------------------------------------------------- */
+
+static const float tri_pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+
+/* One triangle; indices of component type `ctype` (0: not indexed). */
+static const char *write_triangle(const char *name, int ctype) {
+  blob b = {0};
+  blob_add(&b, tri_pos, sizeof tri_pos);
+  size_t isize = ctype == 5121 ? 1 : ctype == 5123 ? 2 : 4, ioff = 0;
+  unsigned char idx[12] = {0};
+  for (int i = 0; i < 3; i++) {
+    uint32_t v = (uint32_t)i;
+    memcpy(idx + i * isize, &v, isize); /* little-endian */
+  }
+  if (ctype) ioff = blob_add(&b, idx, 3 * isize);
+  char json[2048];
+  snprintf(json, sizeof json,
+           "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+           "\"nodes\":[{\"name\":\"tri\",\"mesh\":0}],"
+           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}%s,\"material\":0}]}],"
+           "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.25,1,1],"
+           "\"metallicFactor\":0,\"roughnessFactor\":0.5}}],"
+           "\"buffers\":[{\"uri\":\"%%s\",\"byteLength\":%%zu}],"
+           "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36}"
+           ",{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}],"
+           "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}"
+           ",{\"bufferView\":1,\"componentType\":%d,\"count\":3,\"type\":\"SCALAR\"}]}",
+           ctype ? ",\"indices\":1" : "", ioff, 3 * isize, ctype ? ctype : 5125);
+  return write_gltf(name, json, &b);
+}
+
+static void assert_triangle(const lm_scene *s) {
+  assert_int_equal(s->mesh_count, 1);
+  const lm_scene_mesh *m = &s->meshes[0];
+  assert_int_equal(m->vertex_count, 3);
+  assert_int_equal(m->index_count, 3);
+  for (int i = 0; i < 3; i++) {
+    assert_int_equal(m->indices[i], i);
+    const float *v = m->vertices + i * 8;
+    for (int k = 0; k < 3; k++) assert_float_equal(v[k], tri_pos[i * 3 + k], 0);
+    assert_float_equal(v[3], 0, 1e-6), assert_float_equal(v[4], 0, 1e-6);
+    assert_float_equal(v[5], 1, 1e-6); /* computed: counter-clockwise in XY faces +Z */
+    assert_float_equal(v[6], 0, 0), assert_float_equal(v[7], 0, 0);
+  }
+  assert_string_equal(s->nodes[0].name, "tri");
+  assert_int_equal(s->nodes[0].mesh, 0);
+  assert_int_equal(s->material_count, 1);
+  assert_int_equal(s->nodes[0].material, 0);
+  const lm_material *mat = &s->materials[0];
+  assert_float_equal(mat->color[0], 0.5, 1e-6);
+  assert_float_equal(mat->color[1], 0.25, 1e-6);
+  assert_float_equal(mat->color[2], 1.0, 1e-6);
+  assert_float_equal(mat->kd, 1.0, 1e-6);        /* not metallic */
+  assert_float_equal(mat->ks, 0.04, 1e-6);       /* dielectric F0 */
+  assert_float_equal(mat->shininess, 30.0, 1e-3); /* 2 / 0.5^4 - 2 */
+  assert_float_equal(mat->rho, 1.0, 1e-6);
+}
+
+/* The default camera looks at the bounds' centre; the default light shines down. */
+static void assert_defaults(const lm_scene *s, const float centre[3]) {
+  assert_int_equal(s->light_count, 1);
+  assert_string_equal(s->lights[0].name, "default_light");
+  assert_int_equal(s->lights[0].type, LM_LIGHT_DIRECTIONAL);
+  const float *lw = s->nodes[s->lights[0].node].world;
+  assert_true(-lw[9] < -0.5f); /* -Z points down */
+  assert_int_equal(s->camera_count, 1);
+  assert_string_equal(s->cameras[0].name, "default_camera");
+  const float *w = s->nodes[s->cameras[0].node].world;
+  float to[3], len = 0, dot = 0;
+  for (int k = 0; k < 3; k++) to[k] = centre[k] - w[12 + k], len += to[k] * to[k];
+  len = sqrtf(len);
+  for (int k = 0; k < 3; k++) dot += -w[8 + k] * to[k] / len;
+  assert_float_equal(dot, 1.0, 1e-4);
+  assert_true(s->cameras[0].znear > 0 && s->cameras[0].znear < len);
+  assert_true(s->cameras[0].zfar > len);
+}
+
+static void triangle_loads_with_every_index_type(void **state) {
+  (void)state;
+  static const int types[] = {5121, 5123, 5125, 0};
+  for (int i = 0; i < 4; i++) {
+    char name[32];
+    snprintf(name, sizeof name, "tri%d.gltf", types[i]);
+    lm_error err = {""};
+    lm_scene *s = lm_scene_load_gltf(write_triangle(name, types[i]), &err);
+    if (!s) fail_msg("%s", err.msg);
+    assert_triangle(s);
+    assert_defaults(s, (float[3]){0.5f, 0.5f, 0});
+    lm_scene_destroy(s);
+  }
+}
+
+static const char two_prims_json[] =
+    "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0,1]}],"
+    "\"nodes\":[{\"name\":\"two\",\"mesh\":0},{\"name\":\"again\",\"mesh\":0,\"translation\":[5,0,0]}],"
+    "\"meshes\":[{\"name\":\"pair\",\"primitives\":["
+    "{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2},\"indices\":3,\"material\":0},"
+    "{\"attributes\":{\"POSITION\":0},\"indices\":4,\"material\":1}]}],"
+    "\"materials\":[{\"name\":\"metal\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.8,0.6,0.2,1]}},"
+    "{\"name\":\"plastic\",\"pbrMetallicRoughness\":{\"metallicFactor\":0,\"roughnessFactor\":1}}],"
+    "\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}],"
+    "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+    "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":96,\"byteLength\":32},"
+    "{\"buffer\":0,\"byteOffset\":128,\"byteLength\":6},{\"buffer\":0,\"byteOffset\":136,\"byteLength\":6}],"
+    "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+    "{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+    "{\"bufferView\":2,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+    "{\"bufferView\":3,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"},"
+    "{\"bufferView\":4,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}";
+
+static blob two_prims_blob(void) {
+  blob b = {0};
+  static const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  static const float nrm[12] = {0, 0, 2, 0, 0, 2, 0, 0, 2, 0, 0, 2}; /* not unit: normalized */
+  static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+  static const uint16_t i0[4] = {0, 1, 2, 0}, i1[4] = {0, 2, 3, 0};
+  blob_add(&b, pos, 48), blob_add(&b, nrm, 48), blob_add(&b, uv, 32);
+  blob_add(&b, i0, 8), blob_add(&b, i1, 8);
+  return b;
+}
+
+static void two_primitives_become_two_meshes_and_children(void **state) {
+  (void)state;
+  blob b = two_prims_blob();
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(write_gltf("two.gltf", two_prims_json, &b), &err);
+  if (!s) fail_msg("%s", err.msg);
+  assert_int_equal(s->mesh_count, 2); /* the second node shares them */
+  assert_int_equal(s->meshes[0].vertex_count, 4);
+  assert_int_equal(s->meshes[1].vertex_count, 4);
+  assert_int_equal(s->meshes[0].index_count, 3);
+  assert_string_equal(s->meshes[0].name, "pair.0");
+  /* two, two.0, two.1, again, again.0, again.1, default light and camera */
+  assert_int_equal(s->node_count, 8);
+  const char *names[] = {"two", "two.0", "two.1", "again", "again.0", "again.1"};
+  const int parents[] = {-1, 0, 0, -1, 3, 3}, meshes[] = {-1, 0, 1, -1, 0, 1};
+  for (int i = 0; i < 6; i++) {
+    assert_string_equal(s->nodes[i].name, names[i]);
+    assert_int_equal(s->nodes[i].parent, parents[i]);
+    assert_int_equal(s->nodes[i].mesh, meshes[i]);
+  }
+  assert_int_equal(s->nodes[1].material, 0);
+  assert_int_equal(s->nodes[2].material, 1);
+  assert_int_equal(s->nodes[5].material, 1);
+  assert_float_equal(s->nodes[4].world[12], 5.0, 0); /* children follow their parent */
+  assert_int_equal(s->material_count, 2);
+  const lm_material *metal = &s->materials[0], *plastic = &s->materials[1];
+  assert_string_equal(metal->name, "metal");
+  assert_float_equal(metal->kd, 0.0, 1e-6);  /* glTF's default metallic is 1 */
+  assert_float_equal(metal->ks, 0.8, 1e-6);  /* F0 from the base color */
+  assert_float_equal(metal->shininess, 1.0, 0); /* roughness 1 */
+  assert_float_equal(metal->rho, 0.0, 1e-6);
+  assert_float_equal(plastic->color[0], 1.0, 0); /* default base color */
+  assert_float_equal(plastic->kd, 1.0, 1e-6);
+  const float *v = s->meshes[0].vertices + 2 * 8;
+  assert_float_equal(v[5], 1.0, 1e-6); /* the file's normal, normalized */
+  assert_float_equal(v[6], 1.0, 0), assert_float_equal(v[7], 1.0, 0);
+  lm_scene_destroy(s);
+}
+
+static void hierarchy_composes_rotated_parents(void **state) {
+  (void)state;
+  blob b = {0};
+  blob_add(&b, tri_pos, sizeof tri_pos);
+  const char *json =
+      "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0, 3]}],"
+      "\"nodes\":[{\"name\":\"parent\",\"translation\":[1,0,0],"
+      "\"rotation\":[0,0,0.7071067811865476,0.7071067811865476],\"children\":[1]},"
+      "{\"name\":\"child\",\"translation\":[1,0,0],\"children\":[2]},"
+      "{\"name\":\"leaf\",\"mesh\":0,\"scale\":[2,2,2]},"
+      "{\"name\":\"m\",\"matrix\":[2,0,0,0, 0,3,0,0, 0,0,4,0, 7,8,9,1]}],"
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+      "\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}],"
+      "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}";
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(write_gltf("tree.gltf", json, &b), &err);
+  if (!s) fail_msg("%s", err.msg);
+  assert_string_equal(s->nodes[2].name, "leaf");
+  assert_int_equal(s->nodes[1].parent, 0), assert_int_equal(s->nodes[2].parent, 1);
+  assert_int_equal(s->nodes[2].material, -1); /* no material: the engine's default */
+  /* The parent turns +X into +Y: the child sits at (1,0,0) + (0,1,0). */
+  const float *w = s->nodes[1].world;
+  assert_float_equal(w[12], 1, 1e-6), assert_float_equal(w[13], 1, 1e-6);
+  assert_float_equal(w[14], 0, 1e-6);
+  /* Leaf vertex (1,0,0) scaled by 2 and rotated: (1,1,0) + (0,2,0). */
+  const float *l = s->nodes[2].world;
+  float x = l[0] * 1 + l[12], y = l[1] * 1 + l[13];
+  assert_float_equal(x, 1, 1e-5), assert_float_equal(y, 3, 1e-5);
+  const float *m = s->nodes[3].world;
+  assert_float_equal(m[0], 2, 0), assert_float_equal(m[5], 3, 0), assert_float_equal(m[10], 4, 0);
+  assert_float_equal(m[12], 7, 0), assert_float_equal(m[13], 8, 0), assert_float_equal(m[14], 9, 0);
+  lm_scene_destroy(s);
+}
+
+static const char lights_json[] =
+    "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\"],"
+    "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":["
+    "{\"name\":\"spot\",\"type\":\"spot\",\"color\":[1,0.5,0.25],\"intensity\":5,\"range\":10,"
+    "\"spot\":{\"innerConeAngle\":0.2,\"outerConeAngle\":0.6}},"
+    "{\"name\":\"bulb\",\"type\":\"point\",\"intensity\":2},"
+    "{\"name\":\"sun\",\"type\":\"directional\"}]}},"
+    "\"scenes\":[{\"nodes\":[0,1,2,3,4,5]}],"
+    "\"nodes\":[{\"name\":\"tri\",\"mesh\":0},"
+    "{\"name\":\"spot_node\",\"translation\":[0,4,0],"
+    "\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}},"
+    "{\"name\":\"bulb_node\",\"extensions\":{\"KHR_lights_punctual\":{\"light\":1}}},"
+    "{\"name\":\"sun_node\",\"extensions\":{\"KHR_lights_punctual\":{\"light\":2}}},"
+    "{\"name\":\"cam_node\",\"translation\":[0,0,5],\"camera\":0},"
+    "{\"name\":\"far_node\",\"camera\":1}],"
+    "\"cameras\":[{\"name\":\"main\",\"type\":\"perspective\",\"perspective\":"
+    "{\"yfov\":0.7,\"znear\":0.05,\"zfar\":50,\"aspectRatio\":1.5}},"
+    "{\"type\":\"perspective\",\"perspective\":{\"yfov\":1.0,\"znear\":0.1}}],"
+    "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+    "\"buffers\":[{%s\"byteLength\":%zu}],"
+    "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+    "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}";
+
+static void assert_lights_and_cameras(const lm_scene *s) {
+  assert_int_equal(s->light_count, 3);
+  const lm_light *spot = &s->lights[0], *bulb = &s->lights[1], *sun = &s->lights[2];
+  assert_string_equal(spot->name, "spot");
+  assert_int_equal(spot->type, LM_LIGHT_SPOT);
+  assert_float_equal(spot->color[1], 0.5, 1e-6);
+  assert_float_equal(spot->power, 5, 0);
+  assert_float_equal(spot->radius, 10, 0);
+  assert_float_equal(spot->inner_cone, 0.2, 1e-6);
+  assert_float_equal(spot->outer_cone, 0.6, 1e-6);
+  assert_string_equal(s->nodes[spot->node].name, "spot_node");
+  assert_float_equal(s->nodes[spot->node].world[13], 4, 0);
+  assert_int_equal(bulb->type, LM_LIGHT_POINT);
+  assert_float_equal(bulb->color[0], 1, 0); /* default white */
+  assert_float_equal(bulb->power, 2, 0);
+  /* No range: twice the bounds' diagonal, the triangle's sqrt(2), at least 1. */
+  assert_float_equal(bulb->radius, 2 * sqrtf(2), 1e-5);
+  assert_int_equal(sun->type, LM_LIGHT_DIRECTIONAL);
+  assert_float_equal(sun->power, 1, 0);
+  assert_int_equal(s->camera_count, 2);
+  assert_string_equal(s->cameras[0].name, "main");
+  assert_float_equal(s->cameras[0].fov_y, 0.7, 1e-6);
+  assert_float_equal(s->cameras[0].znear, 0.05, 1e-6);
+  assert_float_equal(s->cameras[0].zfar, 50, 0);
+  assert_string_equal(s->nodes[s->cameras[0].node].name, "cam_node");
+  assert_float_equal(s->cameras[1].zfar, LM_GLTF_INFINITE_ZFAR, 0);
+}
+
+static void lights_and_cameras_come_over(void **state) {
+  (void)state;
+  blob b = {0};
+  blob_add(&b, tri_pos, sizeof tri_pos);
+  char json[4096];
+  snprintf(json, sizeof json, lights_json, "\"uri\":\"%s\",", (size_t)36);
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(write_gltf("lights.gltf", json, &b), &err);
+  if (!s) fail_msg("%s", err.msg);
+  assert_lights_and_cameras(s);
+  lm_scene_destroy(s);
+}
+
+static void glb_loads_like_gltf(void **state) {
+  (void)state;
+  blob b = {0};
+  blob_add(&b, tri_pos, sizeof tri_pos);
+  char json[4096];
+  snprintf(json, sizeof json, lights_json, "", (size_t)36);
+  unsigned char glb[8192];
+  size_t n = make_glb(json, &b, glb, sizeof glb);
+  lm_error err = {""};
+  /* Told apart by the magic, so even a misnamed file loads. */
+  const char *names[] = {"lights.glb", "lights_glb.gltf"};
+  for (int i = 0; i < 2; i++) {
+    lm_scene *s = lm_scene_load_gltf(write_bytes(names[i], glb, n), &err);
+    if (!s) fail_msg("%s", err.msg);
+    assert_lights_and_cameras(s);
+    assert_int_equal(s->meshes[0].vertex_count, 3);
+    lm_scene_destroy(s);
+  }
+}
+
+static void zero_area_triangles_keep_finite_normals(void **state) {
+  (void)state;
+  blob b = {0};
+  /* A good triangle, and two degenerate ones: collinear, and all one point. */
+  static const float pos[27] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1, 1, 2, 2, 2,
+                                3, 3, 3, 3, 3, 3, 3, 3, 3};
+  blob_add(&b, pos, sizeof pos);
+  const char *json =
+      "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],"
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+      "\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}],"
+      "\"bufferViews\":[{\"buffer\":0,\"byteLength\":108}],"
+      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":9,\"type\":\"VEC3\"}]}";
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(write_gltf("flat.gltf", json, &b), &err);
+  if (!s) fail_msg("%s", err.msg);
+  const lm_scene_mesh *m = &s->meshes[0];
+  assert_int_equal(m->vertex_count, 9);
+  assert_int_equal(m->index_count, 9); /* degenerate triangles are kept */
+  for (int i = 0; i < 9; i++) {
+    const float *n = m->vertices + i * 8 + 3;
+    for (int k = 0; k < 3; k++) assert_true(isfinite(n[k]));
+    assert_float_equal(n[0] * n[0] + n[1] * n[1] + n[2] * n[2], 1.0, 1e-5);
+  }
+  assert_float_equal(m->vertices[3 * 8 + 5], 1.0, 0); /* fallback +Z */
+  assert_string_equal(s->nodes[0].name, "node0");
+  lm_scene_destroy(s);
+}
+
+/* A .bin next to the .gltf, found from the file's directory, not the cwd. */
+static void external_buffer_resolves_next_to_the_file(void **state) {
+  (void)state;
+  write_bytes("ext.bin", tri_pos, sizeof tri_pos);
+  const char *json =
+      "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],"
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+      "\"buffers\":[{\"uri\":\"ext.bin\",\"byteLength\":%d}],"
+      "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}";
+  char text[1024];
+  snprintf(text, sizeof text, json, 36);
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(write_bytes("ext.gltf", text, strlen(text)), &err);
+  if (!s) fail_msg("%s", err.msg);
+  assert_int_equal(s->meshes[0].vertex_count, 3);
+  assert_float_equal(s->meshes[0].vertices[8], 1.0, 0);
+  lm_scene_destroy(s);
+  snprintf(text, sizeof text, json, 40); /* the file is shorter than promised */
+  const char *path = write_bytes("ext_short.gltf", text, strlen(text));
+  assert_null(lm_scene_load_gltf(path, &err));
+  if (!strstr(err.msg, path) || !strstr(err.msg, "ext.bin")) fail_msg("%s", err.msg);
+}
+
+/* ---- bad input ---------------------------------------------------------- */
+
+/* Loads a triangle file whose JSON has `from` replaced by `to`; expects an
+ * error with the file's path and every one of `want` (NULL-terminated). */
+static void expect_error(const char *name, const char *from, const char *to, const char *want[]) {
+  const char *path = write_triangle(name, 5123);
+  FILE *f = fopen(path, "rb");
+  char text[4096];
+  size_t n = fread(text, 1, sizeof text - 1, f);
+  fclose(f);
+  text[n] = '\0';
+  char *at = strstr(text, from), out[4096];
+  if (!at) fail_msg("test bug: '%s' not in %s", from, text);
+  snprintf(out, sizeof out, "%.*s%s%s", (int)(at - text), text, to, at + strlen(from));
+  write_bytes(name, out, strlen(out));
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(path, &err);
+  if (s) fail_msg("%s: loaded, but %s -> %s should fail", name, from, to);
+  if (getenv("LIMN_TEST_VERBOSE")) print_message("%s\n", err.msg);
+  if (!strstr(err.msg, path)) fail_msg("message without the path: %s", err.msg);
+  for (int i = 0; want[i]; i++)
+    if (!strstr(err.msg, want[i])) fail_msg("message without '%s': %s", want[i], err.msg);
+}
+
+#define EXPECT(name, from, to, ...) expect_error(name, from, to, (const char *[]){__VA_ARGS__, NULL})
+
+static void malformed_files_name_the_element(void **state) {
+  (void)state;
+  EXPECT("bad_json.gltf", "\"scene\":0,", "\"scene\":0,,", "");
+  EXPECT("no_key.gltf", "\"meshes\"", "", "");
+  EXPECT("no_buffer.gltf", "data:application/octet-stream;base64,", "missing_", "missing_");
+  EXPECT("short_buffer.gltf", "\"byteLength\":42", "\"byteLength\":30", "");
+  EXPECT("index_range.gltf", "\"indices\":1", "\"indices\":7",
+         "mesh 0 primitive 0: indices: accessor 7 does not exist");
+  EXPECT("count.gltf", "\"count\":3,\"type\":\"VEC3\"", "\"count\":4,\"type\":\"VEC3\"",
+         "mesh 0 primitive 0: POSITION: accessor 0", "run past the end of bufferView 0");
+  EXPECT("view.gltf", "\"byteOffset\":0,\"byteLength\":36", "\"byteOffset\":0,\"byteLength\":400",
+         "mesh 0 primitive 0: POSITION: accessor 0: bufferView 0", "runs past the end of buffer 0");
+  EXPECT("view_off.gltf", "\"byteOffset\":0,\"byteLength\":36",
+         "\"byteOffset\":18446744073709551615,\"byteLength\":36", "");
+  EXPECT("stride.gltf", "\"byteOffset\":0,\"byteLength\":36", "\"byteOffset\":0,\"byteLength\":36,\"byteStride\":8",
+         "mesh 0 primitive 0: POSITION: accessor 0: bufferView 0 has byteStride 8");
+  EXPECT("type.gltf", "\"type\":\"VEC3\"", "\"type\":\"VEC2\"",
+         "mesh 0 primitive 0: POSITION: accessor 0 has 2 components per element, want 3");
+  EXPECT("ctype.gltf", "\"componentType\":5123", "\"componentType\":5126",
+         "mesh 0 primitive 0: indices: accessor 1 has component type 5126");
+  EXPECT("material.gltf", "\"material\":0", "\"material\":3",
+         "mesh 0 primitive 0: material 3 does not exist");
+  EXPECT("mesh.gltf", "\"mesh\":0", "\"mesh\":2", "node 0: mesh 2 does not exist");
+  EXPECT("child.gltf", "\"mesh\":0}", "\"mesh\":0,\"children\":[9]}", "node 0: child 9 does not exist");
+  EXPECT("cycle.gltf", "\"mesh\":0}", "\"mesh\":0,\"children\":[0]}", "node 0 is reached twice");
+  EXPECT("scene.gltf", "\"nodes\":[0]}", "\"nodes\":[4]}", "scene 0: node 4 does not exist");
+  EXPECT("no_pos.gltf", "\"POSITION\"", "\"COLOR_0\"", "mesh 0 primitive 0: no POSITION attribute");
+  EXPECT("camera.gltf", "\"mesh\":0}", "\"mesh\":0,\"camera\":0}", "node 0: camera 0 does not exist");
+  EXPECT("light.gltf", "\"mesh\":0}", "\"mesh\":0,\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}",
+         "node 0: KHR_lights_punctual light 0 does not exist");
+  EXPECT("rotation.gltf", "\"mesh\":0}", "\"mesh\":0,\"rotation\":[0,0,0,0]}",
+         "node 0: rotation is not a usable quaternion");
+  EXPECT("matrix.gltf", "\"mesh\":0}", "\"mesh\":0,\"matrix\":[1,0,0]}", "node 0: matrix needs 16");
+  EXPECT("overflow.gltf", "\"mesh\":0}", "\"mesh\":0,\"scale\":[1e5,1,1],\"children\":[1]},{\"scale\":[1e5,1,1]}",
+         "node 1: world transform reaches 1e+10");
+  EXPECT("flat_cam.gltf", "\"mesh\":0}",
+         "\"mesh\":0,\"scale\":[0,1,1],\"children\":[1]},{\"name\":\"eye\",\"camera\":0}],"
+         "\"cameras\":[{\"name\":\"c\",\"type\":\"perspective\",\"perspective\":{\"yfov\":1,\"znear\":1}}",
+         "camera 'c' on node 'eye'", "cannot be inverted");
+  EXPECT("bad_cam.gltf", "\"mesh\":0}",
+         "\"mesh\":0,\"camera\":0}],\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":4,\"znear\":1}}",
+         "camera 0: want 0 < yfov < pi");
+  EXPECT("bad_light.gltf", "\"mesh\":0}",
+         "\"mesh\":0,\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
+         "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"spot\",\"spot\":{\"innerConeAngle\":0.9,\"outerConeAngle\":0.5}}]}},\"extras\":[0",
+         "light 0: spot cone angles");
+  EXPECT("color.gltf", "[0.5,0.25,1,1]", "[0.5,0.25]", "baseColorFactor");
+  EXPECT("metal.gltf", "\"metallicFactor\":0", "\"metallicFactor\":1e999", "");
+}
+
+/* Vertex data a JSON edit cannot reach: written into the buffer itself. */
+static void bad_vertex_values_are_refused(void **state) {
+  (void)state;
+  static const float bad[] = {NAN, INFINITY, 1e30f, -2e9f};
+  for (int i = 0; i < 4; i++) {
+    blob b = {0};
+    float pos[9];
+    memcpy(pos, tri_pos, sizeof pos);
+    pos[4] = bad[i];
+    blob_add(&b, pos, sizeof pos);
+    static const uint16_t idx[4] = {0, 1, 2, 0};
+    blob_add(&b, idx, 8);
+    const char *json =
+        "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+        "\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}],"
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+        "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}";
+    lm_error err = {""};
+    const char *path = write_gltf("nan.gltf", json, &b);
+    assert_null(lm_scene_load_gltf(path, &err));
+    assert_non_null(strstr(err.msg, path));
+    if (!strstr(err.msg, "mesh 0 primitive 0: POSITION: accessor 0: element 1 has a non-finite or huge value"))
+      fail_msg("%s", err.msg);
+  }
+  /* An index past the vertices, in the buffer. */
+  blob b = {0};
+  blob_add(&b, tri_pos, sizeof tri_pos);
+  static const uint16_t idx[4] = {0, 1, 3, 0};
+  blob_add(&b, idx, 8);
+  const char *json =
+      "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],"
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+      "\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}],"
+      "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
+      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+      "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}";
+  lm_error err = {""};
+  assert_null(lm_scene_load_gltf(write_gltf("index.gltf", json, &b), &err));
+  if (!strstr(err.msg, "mesh 0 primitive 0: indices: index 2 is 3, past the 3 vertices"))
+    fail_msg("%s", err.msg);
+}
+
+static void truncated_and_missing_files_are_refused(void **state) {
+  (void)state;
+  blob b = two_prims_blob();
+  char json[4096];
+  /* GLB wants buffer 0 without a uri: drop it from the JSON text. */
+  snprintf(json, sizeof json, "%s", two_prims_json);
+  char *uri = strstr(json, "\"uri\":\"%s\",");
+  memmove(uri, uri + 11, strlen(uri + 11) + 1);
+  char glb_json[4096];
+  snprintf(glb_json, sizeof glb_json, json, b.len);
+  unsigned char glb[8192];
+  size_t n = make_glb(glb_json, &b, glb, sizeof glb);
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(write_bytes("two.glb", glb, n), &err);
+  if (!s) fail_msg("%s", err.msg);
+  assert_int_equal(s->mesh_count, 2);
+  lm_scene_destroy(s);
+  for (size_t cut = 0; cut < n; cut += n / 16 + 1) {
+    const char *path = write_bytes("cut.glb", glb, cut);
+    assert_null(lm_scene_load_gltf(path, &err));
+    if (!strstr(err.msg, path)) fail_msg("%s", err.msg);
+  }
+  /* The same for a .gltf cut short. */
+  const char *path = write_triangle("cut.gltf", 5123);
+  FILE *f = fopen(path, "rb");
+  char text[4096];
+  size_t len = fread(text, 1, sizeof text, f);
+  fclose(f);
+  for (size_t cut = 0; cut < len; cut += len / 16 + 1) {
+    write_bytes("cut.gltf", text, cut);
+    assert_null(lm_scene_load_gltf(path, &err));
+    if (!strstr(err.msg, path)) fail_msg("%s", err.msg);
+  }
+  const char *missing = path_of("nothing_here.gltf");
+  assert_null(lm_scene_load_gltf(missing, &err));
+  assert_non_null(strstr(err.msg, missing));
+  assert_null(lm_scene_load_gltf(tmp_dir, &err)); /* a directory */
+  assert_non_null(strstr(err.msg, tmp_dir));
+}
+
+/* ---- mutations ---------------------------------------------------------- */
+
+static uint32_t rng_state = 12345;
+static uint32_t rng(void) {
+  rng_state = rng_state * 1664525u + 1013904223u;
+  return rng_state >> 8;
+}
+
+/* Whatever loads must be usable: finite vertices, indices in range, world
+ * transforms for every node, lights and cameras on real nodes. */
+static void assert_sane(const lm_scene *s) {
+  for (int i = 0; i < s->mesh_count; i++) {
+    const lm_scene_mesh *m = &s->meshes[i];
+    for (int v = 0; v < m->vertex_count * 8; v++) assert_true(isfinite(m->vertices[v]));
+    for (int k = 0; k < m->index_count; k++) assert_true(m->indices[k] < (uint32_t)m->vertex_count);
+  }
+  for (int i = 0; i < s->node_count; i++) {
+    assert_true(s->nodes[i].parent < i);
+    for (int k = 0; k < 16; k++) assert_true(isfinite(s->nodes[i].world[k]));
+    assert_true(s->nodes[i].mesh < s->mesh_count);
+    assert_true(s->nodes[i].material < s->material_count);
+  }
+  assert_true(s->light_count >= 1 && s->camera_count >= 1);
+  for (int i = 0; i < s->light_count; i++)
+    assert_true(s->lights[i].node >= 0 && s->lights[i].node < s->node_count);
+  for (int i = 0; i < s->camera_count; i++) {
+    assert_true(s->cameras[i].node >= 0 && s->cameras[i].node < s->node_count);
+    assert_true(s->cameras[i].znear > 0 && s->cameras[i].zfar > s->cameras[i].znear);
+  }
+}
+
+/* Two seeds: the two-primitive mesh, and the lights and cameras file. */
+static size_t seed_glb(int which, unsigned char *glb, size_t cap, size_t *json_end) {
+  blob b = {0};
+  char json[4096], text[4096];
+  if (which == 0) {
+    b = two_prims_blob();
+    snprintf(json, sizeof json, "%s", two_prims_json);
+    char *uri = strstr(json, "\"uri\":\"%s\",");
+    memmove(uri, uri + 11, strlen(uri + 11) + 1);
+    snprintf(text, sizeof text, json, b.len);
+  } else {
+    blob_add(&b, tri_pos, sizeof tri_pos);
+    snprintf(text, sizeof text, lights_json, "", (size_t)36);
+  }
+  *json_end = 20 + ((strlen(text) + 3) & ~(size_t)3);
+  return make_glb(text, &b, glb, cap);
+}
+
+static void mutated_glb_never_crashes(void **state) {
+  (void)state;
+  lm_log_level level = lm_log_get_level();
+  lm_log_set_level(LM_LOG_ERROR); /* skipped primitives warn */
+  unsigned char glb[2][8192], mutant[8192];
+  size_t lens[2], ends[2];
+  for (int i = 0; i < 2; i++) lens[i] = seed_glb(i, glb[i], sizeof glb[i], &ends[i]);
+  /* LIMN_GLTF_MUTATIONS=N runs a longer soak (as under ASan). */
+  const char *env = getenv("LIMN_GLTF_MUTATIONS");
+  int loaded = 0, iters = env && atoi(env) > 0 ? atoi(env) : 600;
+  for (int iter = 0; iter < iters; iter++) {
+    size_t n = lens[iter % 2], json_end = ends[iter % 2];
+    memcpy(mutant, glb[iter % 2], n);
+    size_t len = n;
+    int edits = 1 + (int)(rng() % 3);
+    for (int e = 0; e < edits; e++) {
+      uint32_t r = rng();
+      size_t at = rng() % len;
+      switch (r % 5) {
+      case 0: mutant[at] ^= (unsigned char)(1u << (rng() % 8)); break; /* flip a bit */
+      case 1: mutant[at] = (unsigned char)rng(); break;                 /* any byte */
+      case 2: len = at + 1; break;                                      /* truncate */
+      default: {
+        /* A digit of the JSON for another: still JSON, other indices and sizes. */
+        size_t j = 20 + rng() % (json_end - 20);
+        for (size_t k = 0; k < 64 && j + k < json_end; k++)
+          if (mutant[j + k] >= '0' && mutant[j + k] <= '9') {
+            mutant[j + k] = (unsigned char)('0' + rng() % 10);
+            break;
+          }
+      }
+      }
+    }
+    lm_error err = {""};
+    const char *path = write_bytes("mutant.glb", mutant, len);
+    lm_scene *s = lm_scene_load_gltf(path, &err);
+    if (s) {
+      assert_sane(s);
+      lm_scene_destroy(s);
+      loaded++;
+    } else if (!strstr(err.msg, path)) {
+      fail_msg("iteration %d: message without the path: %s", iter, err.msg);
+    }
+  }
+  print_message("mutations: %d of %d still loaded\n", loaded, iters);
+  assert_true(loaded > 0 && loaded < iters); /* the loop explored both sides */
+  lm_log_set_level(level);
+}
+
+static void names_pick_files_or_builtins(void **state) {
+  (void)state;
+  assert_true(lm_scene_is_gltf_name("a/b.gltf"));
+  assert_true(lm_scene_is_gltf_name("B.GLB"));
+  assert_false(lm_scene_is_gltf_name("cornell"));
+  assert_false(lm_scene_is_gltf_name("dir.gltf/cornell"));
+  lm_error err;
+  lm_scene *s = lm_scene_load("cornell", &err);
+  assert_non_null(s);
+  lm_scene_destroy(s);
+  assert_null(lm_scene_load("nope", &err));
+  assert_non_null(strstr(err.msg, "unknown scene 'nope'"));
+  const char *path = write_triangle("by_name.glTF", 5125);
+  s = lm_scene_load(path, &err);
+  assert_non_null(s);
+  assert_triangle(s);
+  lm_scene_destroy(s);
+}
+
+static int setup(void **state) {
+  (void)state;
+  snprintf(tmp_dir, sizeof tmp_dir, "/tmp/limn_gltf_XXXXXX");
+  return mkdtemp(tmp_dir) ? 0 : -1;
+}
+
+static int teardown(void **state) {
+  (void)state;
+  char cmd[128];
+  snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmp_dir);
+  return system(cmd) == 0 ? 0 : -1;
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(triangle_loads_with_every_index_type),
+      cmocka_unit_test(two_primitives_become_two_meshes_and_children),
+      cmocka_unit_test(hierarchy_composes_rotated_parents),
+      cmocka_unit_test(lights_and_cameras_come_over),
+      cmocka_unit_test(glb_loads_like_gltf),
+      cmocka_unit_test(zero_area_triangles_keep_finite_normals),
+      cmocka_unit_test(external_buffer_resolves_next_to_the_file),
+      cmocka_unit_test(malformed_files_name_the_element),
+      cmocka_unit_test(bad_vertex_values_are_refused),
+      cmocka_unit_test(truncated_and_missing_files_are_refused),
+      cmocka_unit_test(mutated_glb_never_crashes),
+      cmocka_unit_test(names_pick_files_or_builtins),
+  };
+  return cmocka_run_group_tests(tests, setup, teardown);
+}
