@@ -152,7 +152,7 @@ static void cornell_box_has_light_and_colour_where_it_must(void **state) {
   free_result(&fr);
 }
 
-/* Golden image: tools/regen-golden.sh rewrites tests/golden/cornell_dl.png. */
+/* Golden image: tools/regen-golden.sh rewrites data/golden/cornell_dl.png. */
 static void cornell_box_matches_the_golden_image(void **state) {
   (void)state;
   frame_result fr = render(pp_lua, "dl", 1);
@@ -160,7 +160,7 @@ static void cornell_box_matches_the_golden_image(void **state) {
   lm_image golden;
   lm_error err;
   char path[1200];
-  snprintf(path, sizeof path, "%s/golden/cornell_dl.png", LIMN_TEST_DIR);
+  snprintf(path, sizeof path, "%s/data/golden/cornell_dl.png", real_root);
   if (!lm_image_read(path, &golden, &err)) fail_msg("%s", err.msg);
   assert_int_equal(golden.width, W);
   assert_int_equal(golden.height, H);

@@ -6,5 +6,5 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$here/build}
 "$build/limn" capture --scene cornell --script "$here/scripts/pp.lua" --tech dl --size 256x192 \
-  --quiet --output "$here/tests/golden/cornell_dl.png"
-echo "wrote tests/golden/cornell_dl.png"
+  --quiet --output "$here/data/golden/cornell_dl.png"
+echo "wrote data/golden/cornell_dl.png"

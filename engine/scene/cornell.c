@@ -99,7 +99,8 @@ static lm_scene *cornell(void) {
 
   glm_translate_make(m, (vec3){0.0f, 1.0f, 3.4f});
   int cam_node = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
-  lm_scene_add_camera(s, &(lm_camera){"front", glm_rad(45.0f), 0.1f, 20.0f, cam_node});
+  lm_scene_add_camera(s, &(lm_camera){.name = "front", .fov_y = glm_rad(45.0f), .znear = 0.1f, .zfar = 20.0f,
+                                      .node = cam_node});
   lm_scene_update(s);
   return s;
 }

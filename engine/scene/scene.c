@@ -115,7 +115,12 @@ void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_f
   memset(out, 0, sizeof *out);
   lm_camera c = {.fov_y = glm_rad(45.0f), .znear = 0.1f, .zfar = 100.0f, .node = -1};
   if (cam >= 0 && cam < s->camera_count) c = s->cameras[cam];
-  float aspect = (float)width / (float)(height > 0 ? height : 1);
+  /* Keep the projection invertible whatever a scene file says. */
+  c.fov_y = isfinite(c.fov_y) ? glm_clamp(c.fov_y, 1e-4f, GLM_PIf - 1e-3f) : glm_rad(45.0f);
+  c.znear = isfinite(c.znear) && c.znear > 1e-6f ? c.znear : 1e-6f;
+  c.zfar = isfinite(c.zfar) && c.zfar > c.znear * 1.001f ? c.zfar : c.znear * 1.001f;
+  float aspect = c.aspect > 0 && isfinite(c.aspect) ? c.aspect
+                                                   : (float)(width > 0 ? width : 1) / (float)(height > 0 ? height : 1);
   mat4 world = GLM_MAT4_IDENTITY_INIT, view, proj, vp, inv_view;
   if (c.node >= 0) memcpy(world, s->nodes[c.node].world, sizeof world);
   glm_mat4_inv(world, view);

@@ -33,9 +33,10 @@ typedef struct lm_light {
 /* Looks along the node's -Z with +Y up, as in glTF. */
 typedef struct lm_camera {
   char name[LM_NAME_MAX];
-  float fov_y; /* radians */
+  float fov_y; /* radians, vertical */
   float znear, zfar;
   int node;
+  float aspect; /* width / height; 0: the output's */
 } lm_camera;
 
 typedef struct lm_scene_mesh {
