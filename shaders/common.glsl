@@ -10,13 +10,14 @@ layout(std140, binding = 0) uniform LimnFrame {
   vec4 output_size; // w, h, 1/w, 1/h
   vec4 time;        // seconds, frame index
   ivec4 counts;     // x: lights
+  mat4 prev_view_proj; // last frame's, for reprojection and motion blur
 } frame;
 
 struct Light {
   vec4 position;  // xyz, w: 0 point, 1 spot, 2 directional
   vec4 direction; // xyz unit (from the light), w: cos(outer cone)
   vec4 color;     // rgb * power, w: radius
-  vec4 params;    // x: cos(inner cone)
+  vec4 params;    // x: cos(inner cone), y: falloff (0 seed window, 1 none, 2 inverse square)
 };
 layout(std430, binding = 1) readonly buffer LimnLights { Light lights[]; };
 

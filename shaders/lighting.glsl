@@ -1,5 +1,6 @@
 // Direct light: Phong (seed 000, lines 2753-2767) with the seed's point light
-// fall-off saturate(1 - (d / r)^2) (eq 16), spot cones and directional lights.
+// fall-off saturate(1 - (d / r)^2) (eq 16) or none or 1/d^2 (the falloffs
+// POV-Ray can match), spot cones and directional lights.
 #ifndef LIMN_LIGHTING_GLSL
 #define LIMN_LIGHTING_GLSL
 #include "common.glsl"
@@ -15,8 +16,16 @@ vec3 light_incident(int i, vec3 p, out vec3 l) {
   vec3 to_light = li.position.xyz - p;
   float d = length(to_light);
   l = d > 1e-12 ? to_light / d : vec3(0.0, 1.0, 0.0);
-  float radius = max(li.color.w, 1e-12);
-  float fall = saturate(1.0 - (d / radius) * (d / radius));
+  float fall;
+  int mode = int(li.params.y + 0.5);
+  if (mode == 1) { // none: POV-Ray's default point light
+    fall = 1.0;
+  } else if (mode == 2) { // inverse square, finite at the light itself
+    fall = 1.0 / max(d * d, 1e-8);
+  } else { // the seed's window (eq 16), zero beyond the radius
+    float radius = max(li.color.w, 1e-12);
+    fall = saturate(1.0 - (d / radius) * (d / radius));
+  }
   if (type == 1) {
     float cos_angle = dot(-l, li.direction.xyz);
     float inner = li.params.x, outer = li.direction.w;

@@ -139,12 +139,13 @@ typedef struct lm_frame_data {
   float output_size[4]; /* w, h, 1/w, 1/h */
   float time[4];        /* seconds, frame index */
   int32_t counts[4];    /* lights */
+  float prev_view_proj[16]; /* the previous frame's (this frame's on the first) */
 } lm_frame_data;
 typedef struct lm_light_data {
   float position[4];  /* xyz, w = type: 0 point, 1 spot, 2 directional */
   float direction[4]; /* xyz (unit, from the light), w = cos(outer cone) */
   float color[4];     /* rgb * power, w = radius (point/spot attenuation) */
-  float params[4];    /* x = cos(inner cone) */
+  float params[4];    /* x = cos(inner cone), y = falloff (lm_falloff) */
 } lm_light_data;
 void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, int light_count);
 

@@ -11,6 +11,7 @@ struct lm_renderer {
   lm_clock clock;
   int output_srgb, output_linear;
   int frame;
+  float prev_view_proj[16];
   double record_ms, compile_ms;
 };
 
@@ -78,6 +79,8 @@ bool lm_renderer_frame(lm_renderer *r, lm_error *err) {
 
   lm_frame_data frame;
   lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, &frame);
+  memcpy(frame.prev_view_proj, r->frame ? r->prev_view_proj : frame.view_proj, sizeof frame.prev_view_proj);
+  memcpy(r->prev_view_proj, frame.view_proj, sizeof r->prev_view_proj);
   frame.time[1] = (float)r->frame++;
   lm_light_data lights[MAX_LIGHTS];
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);

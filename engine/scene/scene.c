@@ -174,6 +174,7 @@ int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max) {
     for (int c = 0; c < 3; c++) d->color[c] = l->color[c] * l->power;
     d->color[3] = l->radius;
     d->params[0] = cosf(l->inner_cone);
+    d->params[1] = (float)l->falloff;
   }
   return n;
 }

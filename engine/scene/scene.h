@@ -17,8 +17,14 @@ typedef struct lm_material {
 
 typedef enum lm_light_type { LM_LIGHT_POINT, LM_LIGHT_SPOT, LM_LIGHT_DIRECTIONAL } lm_light_type;
 
-/* Position and direction come from the node (lights shine along the node's -Z).
- * Point and spot lights fade as saturate(1 - (d / radius)^2) (seed 000, eq 16). */
+/* How point and spot lights fade with distance d. */
+typedef enum lm_falloff {
+  LM_FALLOFF_WINDOW,         /* saturate(1 - (d / radius)^2), seed 000 eq 16 (the default) */
+  LM_FALLOFF_NONE,           /* constant: POV-Ray's default light */
+  LM_FALLOFF_INVERSE_SQUARE, /* 1 / d^2: physical, and POV-Ray's fade_power 2 */
+} lm_falloff;
+
+/* Position and direction come from the node (lights shine along the node's -Z). */
 typedef struct lm_light {
   char name[LM_NAME_MAX];
   lm_light_type type;
@@ -26,6 +32,7 @@ typedef struct lm_light {
   float power;
   float radius;
   float inner_cone, outer_cone; /* spot half-angles, radians */
+  lm_falloff falloff;
   bool casts_shadows;
   int node;
 } lm_light;
