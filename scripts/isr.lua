@@ -10,6 +10,7 @@
 --      eq 27-29)
 -- Sample pattern: a golden-angle (Vogel) spiral turned per pixel; see isr.frag.
 local gbuffer = require "gbuffer"
+local shadow = require "shadow"
 
 local isr = {}
 
@@ -82,14 +83,16 @@ local function coarse_target(name, f)
 end
 
 -- Records ISR lighting of G with options o (see isr.defaults) and light =
--- { ambient = {r, g, b}, background = {r, g, b} }. Returns the lit target.
+-- { ambient = {r, g, b}, background = {r, g, b}, shadows = atlas or nil }.
+-- Returns the lit target.
 function isr.render(G, o, light)
   o = checked(o)
   local f = o.coarse
   local C = coarse_gbuffer(G, f)
   local sender = C.clr
   if o.sender == "lit" then
-    sender = pass{ "isr.sender", shader = "direct.frag", inputs = gbuffer.inputs(C),
+    local inputs, defines = shadow.bind(light.shadows, gbuffer.inputs(C), {})
+    sender = pass{ "isr.sender", shader = "direct.frag", inputs = inputs, defines = defines,
                    params = { ambient = light.ambient, background = light.background },
                    out = coarse_target("isr.sender", f) }
   end
@@ -109,9 +112,9 @@ function isr.render(G, o, light)
                 out = coarse_target("isr.blur_" .. axis[1], f) }
     end
   end
-  return pass{ "isr.light", shader = "isr_light.frag",
-               inputs = { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat,
-                          isr = E, coarse_dpt = C.dpt, coarse_mat = C.mat },
+  local inputs, defines = shadow.bind(light.shadows, { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat,
+                                                       isr = E, coarse_dpt = C.dpt, coarse_mat = C.mat }, {})
+  return pass{ "isr.light", shader = "isr_light.frag", inputs = inputs, defines = defines,
                params = { ambient = light.ambient, background = light.background,
                           k_isr = o.k_isr, k_ssao = o.k_ssao, view = views[o.view] },
                out = target{ "lit", format = "rgba16f" } }

@@ -43,11 +43,11 @@ check "bad set" run 2 capture --set novalue
 check "unknown option" run 2 capture --set nope=1
 check "unknown option lists known" err_has "known: ambient="
 check "unknown technique" run 2 capture --tech nope
-check "unknown technique lists known" err_has "known: dl"
+check "unknown technique lists known" err_has "known: isr+esm, isr, dl+esm, dl"
 check "unknown scene" run 2 capture --scene nope
 check "bad option value" run 2 capture --set ambient=bright
 check "list options" run 0 capture --list-options
-check "list options shows techniques" out_has "techniques: dl"
+check "list options shows techniques" out_has "techniques: isr+esm isr dl+esm dl"
 
 # a good capture: both files, per-pass times with the clock named
 check "capture" run 0 capture --scene cornell --script scripts/pp.lua --tech dl --size 64x48 --frames 2 \

@@ -258,6 +258,7 @@ static void textures_are_pooled_across_frames(void **state) {
   (void)state;
   lm_error err;
   lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = pp_lua}, &err);
+  assert_true(lm_pipeline_set_technique(p, "dl", &err));
   lm_scene *scene = lm_scene_builtin("cornell", &err);
   lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = p, .width = 64,
                                                           .height = 48}, &err);

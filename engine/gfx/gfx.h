@@ -69,6 +69,9 @@ typedef struct lm_attachments {
 bool lm_attachments_bind(const lm_attachments *att, lm_error *err);
 void lm_clear(int color_count, const float rgba[4], bool clear_depth, float depth);
 void lm_draw_fullscreen(void);
+void lm_set_viewport(int x, int y, int width, int height);
+/* Uploads a shader storage block to `binding` (grows its buffer as needed). */
+void lm_storage_upload(int binding, const void *data, size_t bytes);
 /* Depth test and face culling for scene passes; off for full-screen ones. */
 void lm_set_scene_state(bool on);
 /* Framebuffers cache by attachment set; drop entries that name this texture. */

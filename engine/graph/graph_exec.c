@@ -124,9 +124,11 @@ static bool check_bindings(const lm_graph *g, const lm_pass_desc *d, const lm_pr
   for (int i = 0; i < d->param_count; i++) {
     const lm_pass_param *pa = &d->params[i];
     const lm_uniform *u = lm_program_uniform(p, pa->name);
-    if (!u || (d->kind == LM_PASS_SCENE && x->scene_owns_uniform && x->scene_owns_uniform(pa->name))) {
+    bool engine_owned = !strcmp(pa->name, "pass_view_proj") || !strcmp(pa->name, "pass_depth") ||
+                        (d->kind == LM_PASS_SCENE && x->scene_owns_uniform && x->scene_owns_uniform(pa->name));
+    if (!u || engine_owned) {
       lm_error_set(err, "%s: pass '%s': parameter '%s': %s %s", where, name, pa->name, p->label,
-                   u ? "sets this uniform from the scene's materials" : "declares no uniform of that name");
+                   u ? "has this uniform set by the engine" : "declares no uniform of that name");
       return false;
     }
     int want = lm_uniform_type_components(u->type);
@@ -213,7 +215,16 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
   if (d->kind == LM_PASS_SCENE) {
     lm_set_scene_state(true);
     if (d->clear) lm_clear(d->output_count, d->clear_color, d->depth >= 0, 1.0f);
-    if (x->draw_scene) x->draw_scene(x->user, d->shader, p);
+    if (d->view_count == 0 && x->draw_scene) x->draw_scene(x->user, d->shader, p, NULL);
+    const lm_uniform *u_vp = lm_program_uniform(p, "pass_view_proj");
+    const lm_uniform *u_depth = lm_program_uniform(p, "pass_depth");
+    for (int v = 0; v < d->view_count; v++) {
+      const lm_pass_view *view = &d->views[v];
+      lm_set_viewport(view->x, view->y, view->width, view->height);
+      if (u_vp) lm_program_set(p, u_vp, view->view_proj);
+      if (u_depth) lm_program_set(p, u_depth, view->depth);
+      if (x->draw_scene) x->draw_scene(x->user, d->shader, p, view);
+    }
     lm_set_scene_state(false);
   } else {
     lm_draw_fullscreen();

@@ -1,6 +1,7 @@
 #include "scene/scene.h"
 
 #include <cglm/cglm.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -42,6 +43,14 @@ int lm_scene_add_mesh(lm_scene *s, const char *name, const float *vertices, int 
                       sizeof(uint32_t) * (size_t)index_count);
   m->vertex_count = vertex_count;
   m->index_count = index_count;
+  glm_vec3_fill(m->bounds_min, FLT_MAX);
+  glm_vec3_fill(m->bounds_max, -FLT_MAX);
+  for (int i = 0; i < vertex_count; i++) {
+    const float *p = vertices + (size_t)i * 8;
+    if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
+    glm_vec3_minv(m->bounds_min, (float *)p, m->bounds_min);
+    glm_vec3_maxv(m->bounds_max, (float *)p, m->bounds_max);
+  }
   return s->mesh_count - 1;
 }
 
@@ -81,6 +90,33 @@ void lm_scene_update(lm_scene *s) {
       memcpy(n->world, n->local, sizeof n->world);
     }
   }
+}
+
+bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]) {
+  glm_vec3_fill(min, FLT_MAX);
+  glm_vec3_fill(max, -FLT_MAX);
+  for (int i = 0; i < s->node_count; i++) {
+    const lm_node *n = &s->nodes[i];
+    if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
+    const lm_scene_mesh *m = &s->meshes[n->mesh];
+    if (m->bounds_min[0] > m->bounds_max[0]) continue;
+    mat4 w;
+    memcpy(w, n->world, sizeof w);
+    for (int c = 0; c < 8; c++) {
+      vec4 p = {c & 1 ? m->bounds_max[0] : m->bounds_min[0], c & 2 ? m->bounds_max[1] : m->bounds_min[1],
+                c & 4 ? m->bounds_max[2] : m->bounds_min[2], 1}, q;
+      glm_mat4_mulv(w, p, q);
+      if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) continue;
+      glm_vec3_minv(min, q, min);
+      glm_vec3_maxv(max, q, max);
+    }
+  }
+  if (min[0] > max[0]) {
+    glm_vec3_fill(min, -1);
+    glm_vec3_fill(max, 1);
+    return false;
+  }
+  return true;
 }
 
 bool lm_scene_upload(lm_scene *s, lm_error *err) {

@@ -52,6 +52,7 @@ typedef struct lm_scene_mesh {
   int vertex_count;
   uint32_t *indices;
   int index_count;
+  float bounds_min[3], bounds_max[3]; /* local space, finite positions only */
   lm_mesh gpu;
 } lm_scene_mesh;
 
@@ -90,6 +91,8 @@ int lm_scene_add_light(lm_scene *s, const lm_light *l);
 int lm_scene_add_camera(lm_scene *s, const lm_camera *c);
 /* World transforms from local ones (parents come before children). */
 void lm_scene_update(lm_scene *s);
+/* World-space box around every mesh node; false (and a unit box) when empty. */
+bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]);
 
 /* A scene built in code: "cornell". NULL with a message listing the names. */
 lm_scene *lm_scene_builtin(const char *name, lm_error *err);

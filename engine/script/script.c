@@ -386,6 +386,13 @@ void lm_pipeline_destroy(lm_pipeline *p) {
 
 bool lm_pipeline_created(const lm_pipeline *p) { return p->created; }
 
+void lm_pipeline_set_scene(lm_pipeline *p, const lm_scene *scene, const lm_frame_data *camera,
+                           lm_shadow_plan *shadows) {
+  p->scene = scene;
+  p->camera = camera;
+  p->shadows = shadows;
+}
+
 const char *lm_pipeline_present_where(const lm_pipeline *p) { return p->present_where; }
 
 bool lm_pipeline_record(lm_pipeline *p, lm_graph *g, int *presented, lm_error *err) {
