@@ -11,5 +11,5 @@ void main() {
   if (pass_depth.w > 0.0) // perspective: distance from the light / range
     depth01 = saturate(length(world_pos - pass_depth.xyz) * pass_depth.w);
   else                    // orthographic: window depth is already linear
-    depth01 = gl_FragCoord.z;
+    depth01 = saturate(gl_FragCoord.z); // casters before the near plane are clamped onto it
 }

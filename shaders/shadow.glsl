@@ -46,13 +46,18 @@ float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
   vec2 f = texel - vec2(base);
   float bias = s.params.y;
   int technique = s.info.w;
+  // Filters reach `spread` texels away, where a tilted receiver is deeper:
+  // scale the bias by the tilt (tan of the light's angle, capped).
+  float spread = technique == 1 ? 1.5 : technique == 2 ? s.params.w : 0.0;
+  float c = saturate(ndl), tan_tilt = min(sqrt(max(1.0 - c * c, 0.0)) / max(c, 0.1), 10.0);
+  bias *= 1.0 + spread * tan_tilt;
   if (technique == 0) {
     // ESM with the seed's 4-tap bilinear combination (seed 000, Listing 8):
     // the depth difference is clamped at 0 and scaled by n.l, then exp(-c d).
-    float c = s.params.x, scale = saturate(ndl);
+    float k = s.params.x, scale = saturate(ndl);
     vec4 z = vec4(shadow_texel(base, lo, hi), shadow_texel(base + ivec2(1, 0), lo, hi),
                   shadow_texel(base + ivec2(0, 1), lo, hi), shadow_texel(base + ivec2(1, 1), lo, hi));
-    vec4 vis = exp(-c * max(vec4(r) - z - bias, 0.0) * scale);
+    vec4 vis = exp(-k * max(vec4(r) - z - bias, 0.0) * scale);
     return mix(mix(vis.x, vis.y, f.x), mix(vis.z, vis.w, f.x), f.y);
   }
   if (technique == 1) { // PCF 3x3

@@ -196,7 +196,11 @@ void lm_storage_upload(int binding, const void *data, size_t bytes) {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)binding, storage[binding].buffer);
 }
 
-void lm_set_scene_state(bool on) {
+void lm_set_scene_state(bool on, bool depth_clamp) {
+  if (on && depth_clamp)
+    glEnable(GL_DEPTH_CLAMP);
+  else
+    glDisable(GL_DEPTH_CLAMP);
   if (on) {
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);

@@ -72,8 +72,9 @@ void lm_draw_fullscreen(void);
 void lm_set_viewport(int x, int y, int width, int height);
 /* Uploads a shader storage block to `binding` (grows its buffer as needed). */
 void lm_storage_upload(int binding, const void *data, size_t bytes);
-/* Depth test and face culling for scene passes; off for full-screen ones. */
-void lm_set_scene_state(bool on);
+/* Depth test and face culling for scene passes; off for full-screen ones.
+ * depth_clamp keeps geometry in front of the near plane (shadow casters). */
+void lm_set_scene_state(bool on, bool depth_clamp);
 /* Framebuffers cache by attachment set; drop entries that name this texture. */
 void lm_framebuffers_forget(lm_texture tex);
 

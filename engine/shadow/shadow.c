@@ -52,18 +52,6 @@ static void slice_corners(const lm_frame_data *cam, float z0, float z1, vec3 out
   }
 }
 
-/* Depth range of the scene's bounds along the light view's -z, so that
- * casters outside a cascade's slice still land in its map. */
-static void scene_depth_range(const float bmin[3], const float bmax[3], mat4 view, float *zn, float *zf) {
-  *zn = FLT_MAX, *zf = -FLT_MAX;
-  for (int c = 0; c < 8; c++) {
-    vec4 p = {c & 1 ? bmax[0] : bmin[0], c & 2 ? bmax[1] : bmin[1], c & 4 ? bmax[2] : bmin[2], 1}, q;
-    glm_mat4_mulv(view, p, q);
-    *zn = fminf(*zn, -q[2]);
-    *zf = fmaxf(*zf, -q[2]);
-  }
-}
-
 /* Practical split scheme: a lambda blend of logarithmic and uniform splits. */
 static float split_depth(float n, float f, int i, int count, float lambda) {
   float t = (float)i / (float)count;
@@ -71,13 +59,11 @@ static float split_depth(float n, float f, int i, int count, float lambda) {
   return lambda * lg + (1.0f - lambda) * un;
 }
 
-static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
+static void plan_cascades(lm_shadow_plan *plan, const lm_frame_data *cam,
                           const lm_light_data *light, lm_shadow_light_data *out) {
   const lm_shadow_settings *st = &plan->settings;
   vec3 dir;
   glm_vec3_normalize_to((float *)light->direction, dir);
-  float bmin[3], bmax[3];
-  lm_scene_bounds(s, bmin, bmax);
   float n = cam->clip[0], f = cam->clip[1];
   float reach = st->distance > 0 ? fminf(st->distance, f) : f;
   if (reach <= n) reach = n * 1.001f;
@@ -91,19 +77,23 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_fram
     vec3 corners[8], center = {0, 0, 0};
     slice_corners(cam, z0, z1, corners);
     for (int c = 0; c < 8; c++) glm_vec3_muladds(corners[c], 1.0f / 8.0f, center);
+    float l, r, b, t, extent = 0;
+    for (int c = 0; c < 8; c++) extent = fmaxf(extent, glm_vec3_distance(corners[c], center));
+    extent = ceilf(extent * 16.0f) / 16.0f + 1e-3f;
+    /* The eye sits on a plane across the light snapped to steps of extent/16,
+     * so a small camera move changes no stored depth. */
+    float step = extent / 16.0f, along = glm_vec3_dot(center, dir);
+    float behind = along - floorf(along / step) * step; /* in [0, step) */
     vec3 up, eye;
     up_for(dir, up);
-    glm_vec3_sub(center, dir, eye);
+    glm_vec3_copy(center, eye);
+    glm_vec3_muladds(dir, -(behind + 1.0f), eye);
     mat4 view, proj, vp;
     glm_lookat(eye, center, up, view);
-    float l, r, b, t;
     if (st->stabilize) {
       /* A sphere around the slice does not change as the camera turns
        * (seed 003); rounding its radius keeps float noise from resizing it. */
-      float radius = 0;
-      for (int c = 0; c < 8; c++) radius = fmaxf(radius, glm_vec3_distance(corners[c], center));
-      radius = ceilf(radius * 16.0f) / 16.0f;
-      l = b = -radius, r = t = radius;
+      l = b = -extent, r = t = extent;
     } else {
       l = b = FLT_MAX, r = t = -FLT_MAX;
       for (int c = 0; c < 8; c++) {
@@ -112,9 +102,10 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_fram
         l = fminf(l, q[0]), r = fmaxf(r, q[0]), b = fminf(b, q[1]), t = fmaxf(t, q[1]);
       }
     }
-    float zn, zf;
-    scene_depth_range(bmin, bmax, view, &zn, &zf);
-    zn -= 0.01f * (zf - zn) + 1e-3f, zf += 0.01f * (zf - zn) + 1e-3f;
+    /* Depth spans the slice's sphere only, so ESM's c acts on a short range
+     * (no light leaks across a big scene); casters nearer the light than the
+     * near plane are clamped onto it by depth clamping in the shadow pass. */
+    float zn = 1.0f - extent, zf = 1.0f + step + extent; /* holds the sphere whatever `behind` is */
     glm_ortho(l, r, b, t, zn, zf, proj);
     glm_mat4_mul(proj, view, vp);
     if (st->stabilize) {
@@ -167,7 +158,7 @@ static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
   out->params[3] = plan->settings.radius;
   if (!l->casts_shadows) return;
   if (l->type == LM_LIGHT_DIRECTIONAL) {
-    plan_cascades(plan, s, cam, ld, out);
+    plan_cascades(plan, cam, ld, out);
     return;
   }
   vec3 pos = {ld->position[0], ld->position[1], ld->position[2]};
