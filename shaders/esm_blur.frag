@@ -18,17 +18,21 @@ void main() {
   ivec2 lo = ivec2(floor(vec2(p) / tile) * tile);
   ivec2 hi = min(lo + ivec2(tile) - 1, size - 1);
   int r = clamp(radius, 0, 32);
-  float sigma = max(float(r) * 0.5, 0.5);
-  float z0 = 0.0;
-  for (int i = -r; i <= r; i++)
-    z0 = max(z0, texelFetch(src, clamp(p + ivec2(direction) * i, lo, hi), 0).r);
-  float k = max(c, 1e-3), sum = 0.0;
+  float inv_two_sigma2 = 1.0 / (2.0 * max(float(r) * 0.5, 0.5) * max(float(r) * 0.5, 0.5));
+  float k = max(c, 1e-3);
+  // One pass of a running log-sum-exp: z0 is the largest depth so far and
+  // sum is scaled to it, so no exponent is ever positive.
+  float z0 = texelFetch(src, p, 0).r, sum = 0.0, norm = 0.0;
   for (int i = -r; i <= r; i++) {
+    float w = exp(-float(i * i) * inv_two_sigma2);
     float z = texelFetch(src, clamp(p + ivec2(direction) * i, lo, hi), 0).r;
-    sum += exp(-0.5 * float(i * i) / (sigma * sigma)) * exp(k * (z - z0));
+    if (z > z0) {
+      sum *= exp(k * (z0 - z));
+      z0 = z;
+    }
+    sum += w * exp(k * (z - z0));
+    norm += w;
   }
-  float norm = 0.0;
-  for (int i = -r; i <= r; i++) norm += exp(-0.5 * float(i * i) / (sigma * sigma));
-  // sum includes z0's own tap, so sum / norm > 0 and the log is finite.
+  // sum holds at least the largest tap's own weight, so the log is finite.
   blurred = z0 + log(max(sum / norm, 1e-30)) / k;
 }
