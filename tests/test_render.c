@@ -66,6 +66,8 @@ typedef struct frame_result {
   char pass_names[512];  /* passes that ran, space separated */
 } frame_result;
 
+static bool check_finite; /* render() with the NaN/Inf check */
+
 static frame_result render(const char *script, const char *tech, int frames) {
   frame_result fr = {0};
   lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, &fr.err);
@@ -78,7 +80,8 @@ static frame_result render(const char *script, const char *tech, int frames) {
     return fr;
   }
   lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = p, .width = W,
-                                                          .height = H, .linear_output = true}, &fr.err);
+                                                          .height = H, .linear_output = true,
+                                                          .check_finite = check_finite}, &fr.err);
   assert_non_null(r);
   fr.ok = true;
   for (int f = 0; f < frames && fr.ok; f++) fr.ok = lm_renderer_frame(r, &fr.err);
@@ -252,6 +255,13 @@ static void no_nan_or_inf_leaves_the_output_stage(void **state) {
   for (int i = 0; i < W * H * 3; i++)
     if (!isfinite(fr.linear[i]) || fr.linear[i] < 0) fail_msg("value %g at pixel %d", fr.linear[i], i / 3);
   free_result(&fr);
+  /* The debug check names the pass, the target and the first bad pixel. */
+  check_finite = true;
+  fr = render(path, NULL, 1);
+  check_finite = false;
+  assert_false(fr.ok);
+  if (!strstr(fr.err.msg, "poison.lua:3: pass 'poison' wrote NaN to target 'p' at pixel (0, 0)"))
+    fail_msg("%s", fr.err.msg);
 }
 
 static void textures_are_pooled_across_frames(void **state) {

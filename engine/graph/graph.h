@@ -119,6 +119,9 @@ typedef struct lm_graph_exec_desc {
   /* Uniforms the scene sets on each draw (not bindable from a script). */
   bool (*scene_owns_uniform)(const char *name);
   void *user;
+  /* Debug: read back every float output after its pass and fail at the first
+   * NaN or Inf, naming the pass, the target and the pixel. Slow. */
+  bool check_finite;
 } lm_graph_exec_desc;
 bool lm_graph_execute(lm_graph *g, const lm_graph_exec_desc *x, lm_error *err);
 /* Pooled textures alive now, and their bytes. */

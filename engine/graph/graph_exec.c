@@ -188,6 +188,32 @@ static lm_program *pass_program(const lm_pass_desc *d, lm_error *err) {
   return p;
 }
 
+static bool is_float_format(lm_format f) {
+  return f == LM_FORMAT_RGBA16F || f == LM_FORMAT_RGBA32F || f == LM_FORMAT_R16F ||
+         f == LM_FORMAT_R32F || f == LM_FORMAT_RG16F || f == LM_FORMAT_RG32F;
+}
+
+/* The first non-finite texel of a pass's float outputs, as an error. */
+static bool check_outputs_finite(const lm_graph *g, const lm_pass_desc *d, lm_error *err) {
+  for (int i = 0; i < d->output_count; i++) {
+    const graph_target *t = &g->targets[d->outputs[i]];
+    if (!is_float_format(t->desc.format)) continue;
+    float *px = lm_alloc(sizeof(float) * 4 * (size_t)t->width * (size_t)t->height);
+    lm_texture_read(t->texture, t->width, t->height, true, px);
+    for (size_t k = 0; k < (size_t)t->width * t->height * 4; k++) {
+      if (isfinite(px[k])) continue;
+      size_t texel = k / 4;
+      lm_error_set(err, "%s: pass '%s' wrote %s to target '%s' at pixel (%zu, %zu) (channel %zu, rows from the top)",
+                   d->where, d->name, isnan(px[k]) ? "NaN" : "Inf", t->desc.name, texel % (size_t)t->width,
+                   texel / (size_t)t->width, k % 4);
+      free(px);
+      return false;
+    }
+    free(px);
+  }
+  return true;
+}
+
 static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_graph_exec_desc *x,
                      lm_error *err) {
   const lm_pass_desc *d = &gp->desc;
@@ -232,7 +258,7 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
   lm_timer_end(timer);
   for (int i = 0; i < d->output_count; i++)
     if (g->targets[d->outputs[i]].desc.mips) lm_texture_generate_mips(att.color[i]);
-  return true;
+  return !x->check_finite || check_outputs_finite(g, d, err);
 }
 
 bool lm_graph_execute(lm_graph *g, const lm_graph_exec_desc *x, lm_error *err) {

@@ -93,7 +93,8 @@ bool lm_renderer_frame(lm_renderer *r, lm_error *err) {
   lm_frame_upload(frame, lights, n);
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
   lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene,
-                          .scene_owns_uniform = lm_scene_owns_uniform, .user = r};
+                          .scene_owns_uniform = lm_scene_owns_uniform, .user = r,
+                          .check_finite = r->desc.check_finite};
   return lm_graph_execute(g, &x, err);
 }
 
