@@ -13,76 +13,48 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/render.h"
+#include "gl_test.h"
 
 enum { W = 256, H = 192 };
 
 static lm_scene *scene;
 
 static int setup(void **state) {
-  (void)state;
   lm_error err;
-  if (!lm_context_create_headless(&(lm_context_desc){0}, &err)) {
-    fprintf(stderr, "no OpenGL context: %s\n", err.msg);
-    return -1;
-  }
   scene = lm_scene_builtin("cornell", &err);
-  return scene ? 0 : -1;
+  return scene ? gl_test_setup(state) : -1;
 }
 
 static int teardown(void **state) {
-  (void)state;
-  lm_programs_clear();
   lm_scene_destroy(scene);
-  lm_context_destroy();
-  return 0;
+  return gl_test_teardown(state);
 }
 
 typedef struct image {
-  float rgb[W * H * 3];  /* the output stage's linear copy */
-  float lit[W * H * 4];  /* the script's presented target, before the output stage sanitizes */
-  bool isr_pass, culled_isr_pass; /* a pass named isr.* was recorded / left out */
+  gl_result r;
+  float *lit; /* the script's presented target, before the output stage sanitizes */
+  const float *rgb;
 } image;
 
 /* Renders one frame of pp.lua with technique `tech` and "name=value" options
  * (NULL-terminated). Returns false with the message in err. */
 static bool render(const char *tech, const char *const *sets, image *out, lm_error *err) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/scripts/pp.lua", lm_root_dir());
-  lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = path}, err);
-  assert_non_null(p);
-  assert_true(lm_pipeline_set_technique(p, tech, err));
-  for (; sets && *sets; sets++) {
-    char name[64];
-    const char *eq = strchr(*sets, '=');
-    snprintf(name, sizeof name, "%.*s", (int)(eq - *sets), *sets);
-    if (!lm_pipeline_set_option(p, name, eq + 1, err)) fail_msg("%s", err->msg);
-  }
-  lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = p, .width = W,
-                                                          .height = H, .linear_output = true}, err);
-  assert_non_null(r);
-  bool ok = lm_renderer_frame(r, err);
-  if (ok) {
-    assert_true(lm_renderer_read(r, true, out->rgb, err));
-    lm_graph *g = lm_renderer_graph(r);
-    lm_graph_target_info lit = lm_graph_target(g, lm_graph_find_target(g, "lit"));
-    assert_int_equal(lit.width, W);
-    lm_texture_read(lit.texture, W, H, true, out->lit);
-    out->isr_pass = out->culled_isr_pass = false;
-    for (int i = 0; i < lm_graph_pass_count(g); i++) {
-      lm_graph_pass_info pi = lm_graph_pass(g, i);
-      if (strncmp(pi.name, "isr.", 4)) continue;
-      out->isr_pass = true;
-      out->culled_isr_pass |= pi.culled;
-    }
-  }
-  lm_renderer_destroy(r);
-  lm_pipeline_destroy(p);
-  return ok;
+  out->r = gl_render(&(gl_run){.scene = scene, .tech = tech, .sets = sets, .width = W, .height = H});
+  *err = out->r.err;
+  out->rgb = out->r.rgb;
+  int w, h;
+  out->lit = out->r.ok ? gl_read_target(&out->r, "lit", &w, &h) : NULL;
+  return out->r.ok;
+}
+
+static void image_free(image *im) {
+  gl_result_free(&im->r);
+  free(im->lit);
+  free(im);
 }
 
 static image *render_ok(const char *tech, const char *const *sets) {
-  image *im = malloc(sizeof *im);
+  image *im = calloc(1, sizeof *im);
   assert_non_null(im);
   lm_error err;
   if (!render(tech, sets, im, &err)) fail_msg("%s: %s", tech, err.msg);
@@ -128,8 +100,8 @@ static void indirect_light_bleeds_wall_colour(void **state) {
                 red_dl, red_isr, green_dl, green_isr);
   assert_true(red_isr > red_dl * 1.01);
   assert_true(green_isr > green_dl * 1.02);
-  free(dl);
-  free(isr);
+  image_free(dl);
+  image_free(isr);
 }
 
 /* With k_ISR = 0 and k_SSAO = 1, eq 29 is direct light times accessibility,
@@ -149,8 +121,8 @@ static void occlusion_darkens_inside_corners(void **state) {
   print_message("accessibility: corner %.3f, open wall %.3f\n", corner, open);
   assert_true(open > 0.9 && open <= 1.0 + 1e-4); /* occlusion only darkens */
   assert_true(corner < open - 0.1);
-  free(dl);
-  free(ao);
+  image_free(dl);
+  image_free(ao);
 }
 
 /* The seed's mean error, sum(|dR| + |dG| + |dB|) / (3 w h), between the
@@ -166,8 +138,8 @@ static void coarse_and_full_size_agree(void **state) {
   double mean_error = sum / (3.0 * W * H);
   print_message("mean error coarse 1 vs 2: %.5f\n", mean_error);
   assert_true(mean_error < 0.01);
-  free(a);
-  free(b);
+  image_free(a);
+  image_free(b);
 }
 
 static bool all_finite(const image *im) {
@@ -188,13 +160,13 @@ static void extreme_parameters_stay_finite(void **state) {
       {"isr.k_isr=1", "isr.k_ssao=1", "isr.sender=lit", "isr.bounces=4", NULL},
       {"isr.radius=1e-30", "isr.coarse=1", "isr.sender=lit", "isr.bounces=2", NULL},
   };
-  image *im = malloc(sizeof *im);
   for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+    image *im = calloc(1, sizeof *im);
     lm_error err;
     if (!render("isr", cases[c], im, &err)) fail_msg("case %zu: %s", c, err.msg);
     if (!all_finite(im)) fail_msg("case %zu (%s ...): a NaN, Inf or negative value", c, cases[c][0]);
+    image_free(im);
   }
-  free(im);
 }
 
 /* Out-of-range options stop the frame with the option's name. */
@@ -211,29 +183,30 @@ static void bad_options_name_themselves(void **state) {
       {"isr.sender=sun", "isr.sender must be \"albedo\" or \"lit\" (got sun)"},
       {"isr.bounces=5", "isr.bounces must be"},
   };
-  image *im = malloc(sizeof *im);
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+    image *im = calloc(1, sizeof *im);
     const char *sets[] = {cases[i].set, NULL};
     lm_error err;
     if (render("isr", sets, im, &err)) fail_msg("%s: rendered", cases[i].set);
     if (!strstr(err.msg, cases[i].expect) || !strstr(err.msg, "pp.lua:"))
       fail_msg("%s: '%s'", cases[i].set, err.msg);
+    image_free(im);
   }
-  free(im);
 }
 
 static void dl_records_no_isr_pass(void **state) {
   (void)state;
   image *dl = render_ok("dl", NULL), *isr = render_ok("isr", NULL);
-  assert_false(dl->isr_pass);
-  assert_true(isr->isr_pass);
-  assert_false(isr->culled_isr_pass); /* every ISR pass reaches the output */
-  free(dl);
-  free(isr);
+  assert_false(gl_has_pass(&dl->r, "isr."));
+  assert_true(gl_has_pass(&isr->r, "isr."));
+  lm_graph *g = lm_renderer_graph(isr->r.renderer);
+  for (int i = 0; i < lm_graph_pass_count(g); i++) /* every ISR pass reaches the output */
+    assert_false(lm_graph_pass(g, i).culled);
+  image_free(dl);
+  image_free(isr);
 }
 
 int main(void) {
-  lm_log_set_level(LM_LOG_WARN);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(indirect_light_bleeds_wall_colour),
       cmocka_unit_test(occlusion_darkens_inside_corners),
