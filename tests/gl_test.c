@@ -24,7 +24,8 @@ int gl_test_teardown(void **state) {
 }
 
 static bool read_output(gl_result *r) {
-  return lm_renderer_read(r->renderer, true, r->rgb, &r->err);
+  return lm_renderer_read(r->renderer, true, r->rgb, &r->err) &&
+         lm_renderer_read(r->renderer, false, r->srgb, &r->err);
 }
 
 gl_result gl_render(const gl_run *run) {
@@ -42,9 +43,11 @@ gl_result gl_render(const gl_run *run) {
   }
   r.renderer = lm_renderer_create(&(lm_renderer_desc){.scene = run->scene, .pipeline = r.pipeline,
                                                       .width = r.width, .height = r.height,
-                                                      .linear_output = true}, &r.err);
+                                                      .linear_output = true,
+                                                      .check_finite = run->check_finite}, &r.err);
   if (!r.renderer) return r;
   r.rgb = malloc(sizeof(float) * 3 * (size_t)r.width * (size_t)r.height);
+  r.srgb = malloc(3 * (size_t)r.width * (size_t)r.height);
   r.ok = true;
   for (int f = 0; f < (run->frames ? run->frames : 1) && r.ok; f++) r.ok = lm_renderer_frame(r.renderer, &r.err);
   if (r.ok) r.ok = read_output(&r);
@@ -60,7 +63,18 @@ void gl_result_free(gl_result *r) {
   lm_renderer_destroy(r->renderer);
   lm_pipeline_destroy(r->pipeline);
   free(r->rgb);
+  free(r->srgb);
   *r = (gl_result){0};
+}
+
+void gl_pass_names(const gl_result *r, char *out, size_t cap) {
+  lm_graph *g = lm_renderer_graph(r->renderer);
+  out[0] = '\0';
+  for (int i = 0; i < lm_graph_pass_count(g); i++) {
+    if (lm_graph_pass(g, i).culled) continue;
+    size_t n = strlen(out);
+    snprintf(out + n, cap - n, "%s ", lm_graph_pass(g, i).name);
+  }
 }
 
 bool gl_has_pass(const gl_result *r, const char *prefix) {

@@ -12,6 +12,7 @@ typedef struct gl_run {
   const char *const *sets;  /* "name=value" options, NULL-terminated (may be NULL) */
   int width, height;        /* 0: 256 x 192 */
   int frames;               /* 0: 1 */
+  bool check_finite;        /* the renderer's NaN/Inf attribution */
 } gl_run;
 
 typedef struct gl_result {
@@ -19,6 +20,7 @@ typedef struct gl_result {
   lm_error err;
   int width, height;
   float *rgb;               /* the output stage's linear RGB, rows top first */
+  unsigned char *srgb;      /* and its 8-bit sRGB encoding */
   lm_pipeline *pipeline;
   lm_renderer *renderer;    /* still open: lm_renderer_graph() shows the last frame */
 } gl_result;
@@ -30,6 +32,8 @@ gl_result gl_render(const gl_run *run);
 /* Renders one more frame with the same pipeline (after moving a camera, say). */
 bool gl_render_again(gl_result *r);
 void gl_result_free(gl_result *r);
+/* The passes of the last frame that ran, space separated, into out. */
+void gl_pass_names(const gl_result *r, char *out, size_t cap);
 /* Was a pass whose name starts with `prefix` recorded (culled or not)? */
 bool gl_has_pass(const gl_result *r, const char *prefix);
 /* Mean linear RGB over x0..x1, y0..y1 (rows from the top). */
