@@ -9,6 +9,9 @@
 --             the bounce from L_dir (BOUNCE); full size only (it computes
 --             intensities, which do not survive subsampling, seed line 979);
 --             applied as L_dir + L_ind
+-- Shadows: the merged variant takes them from `lit` (give it a shadowed
+-- direct pass: one line in the pipeline); the two-step one relights, and
+-- light_visibility() in ssdo.frag is where a light's shadow factor goes.
 -- Sampling: halton.glsl (bases 5, 2, 3, a per-pixel rotation). With
 -- `adaptive`, a 1/16-size edge map (ssdo_edges.frag) picks 10, 20 or 30
 -- samples a pixel and `samples` is not used.

@@ -123,6 +123,8 @@ typedef struct image {
   float rgb[W * H * 3];  /* the output stage's linear copy */
   float lit[W * H * 4];  /* the presented target, before the output stage sanitizes */
   bool gi_pass, culled_gi_pass; /* a pass named ssdo.* or ssao.* was recorded / left out */
+  float edges[(W / 16) * (H / 16) * 4]; /* target ssdo.edges, when recorded */
+  bool has_edges;
 } image;
 
 /* Renders one frame of `script` (relative to the scratch root) with
@@ -153,6 +155,14 @@ static bool render_script(const char *script, const char *tech, const char *pres
     lm_graph_target_info lit = lm_graph_target(g, t);
     assert_int_equal(lit.width, W);
     lm_texture_read(lit.texture, W, H, true, out->lit);
+    int e = lm_graph_find_target(g, "ssdo.edges");
+    out->has_edges = e >= 0 && lm_graph_target(g, e).used;
+    if (out->has_edges) {
+      lm_graph_target_info ei = lm_graph_target(g, e);
+      assert_int_equal(ei.width, W / 16);
+      assert_int_equal(ei.height, H / 16);
+      lm_texture_read(ei.texture, ei.width, ei.height, true, out->edges);
+    }
     out->gi_pass = out->culled_gi_pass = false;
     for (int i = 0; i < lm_graph_pass_count(g); i++) {
       lm_graph_pass_info pi = lm_graph_pass(g, i);
@@ -356,6 +366,38 @@ static void variants_agree_under_white_light(void **state) {
   free(b);
 }
 
+/* The adaptive count's edge map (1/16 a side) gives 10 samples on open
+ * planes and 30 where the boxes stand on the floor, nothing but 10, 20 and
+ * 30; and the adaptive image still darkens contacts. (At 256 x 192 a texel
+ * looks 12 pixels each way, so most of the box's texels touch an edge.) */
+static void adaptive_counts_follow_edges(void **state) {
+  (void)state;
+  static const char *const adaptive[] = {"ssdo.adaptive=true", "ssdo.bounce=0", NULL};
+  image *dl = render_ok("dl", NULL), *im = render_ok("ssdo", adaptive);
+  assert_true(im->has_edges);
+  int counts[4] = {0};
+  for (int i = 0; i < (W / 16) * (H / 16); i++) {
+    float v = im->edges[i * 4];
+    if (v != 10 && v != 20 && v != 30) fail_msg("edge map texel %d holds %g", i, v);
+    counts[(int)v / 10]++;
+  }
+  /* The texel over the open back wall (0.6, 1.5, -1) and the one over the
+   * short box's contact with the floor (0.675, 0, 0.40); rows top first. */
+  int col, row;
+  project(0.6f, 1.5f, -1.0f, &col, &row);
+  float wall = im->edges[(row / 16 * (W / 16) + col / 16) * 4];
+  project(0.675f, 0.0f, 0.40f, &col, &row);
+  float contact = im->edges[(row / 16 * (W / 16) + col / 16) * 4];
+  double r = 0.5 * (ratio_at(im, dl, 0.675f, 0.0f, 0.40f) + ratio_at(im, dl, -0.25f, 0.0f, -0.025f));
+  print_message("edge map: %d x 10, %d x 20, %d x 30 samples; open wall %g, contact %g; contact ratio %.3f\n",
+                counts[1], counts[2], counts[3], wall, contact, r);
+  assert_true(wall == 10 && contact == 30);
+  assert_true(counts[1] > 0 && counts[3] > 0);
+  assert_true(r < 0.9);
+  free(dl);
+  free(im);
+}
+
 static bool all_finite(const image *im) {
   for (int i = 0; i < W * H * 4; i++)
     if (!isfinite(im->lit[i]) || im->lit[i] < 0) return false;
@@ -455,6 +497,7 @@ int main(void) {
       cmocka_unit_test(filters_do_not_cross_a_depth_step),
       cmocka_unit_test(reduced_resolution_close_to_full),
       cmocka_unit_test(variants_agree_under_white_light),
+      cmocka_unit_test(adaptive_counts_follow_edges),
       cmocka_unit_test(extreme_parameters_stay_finite),
       cmocka_unit_test(bad_options_name_themselves),
       cmocka_unit_test(dl_records_no_gi_pass),
