@@ -270,9 +270,9 @@ static void bounce_tints_floor_by_red_wall(void **state) {
   double r_dl = d[0] / d[1], r_s = a[0] / a[1], r_s4 = b[0] / b[1], r_t = c[0] / c[1];
   print_message("red/green on the floor by the red wall: dl %.4f, ssdo %.4f, bounce=4 %.4f, two_step %.4f\n",
                 r_dl, r_s, r_s4, r_t);
-  assert_true(r_s > r_dl * 1.01);
-  assert_true(r_s4 > r_s * 1.02);
-  assert_true(r_t > r_dl * 1.01);
+  assert_true(r_s > r_dl * 1.008); /* measured +1.2% */
+  assert_true(r_s4 > r_dl * 1.04); /* +5.0% */
+  assert_true(r_t > r_dl * 1.008); /* +1.1% */
   free(dl);
   free(s);
   free(s4);
@@ -341,6 +341,31 @@ static void reduced_resolution_close_to_full(void **state) {
     assert_true(e < cases[i].limit);
     free(a);
     free(b);
+  }
+}
+
+/* The per-pixel rotation against banding: at 10 samples, with the default
+ * blur, the rotated pattern (interleave 4) lands nearer the converged image
+ * (300 samples) than the raw pattern, whose repeated contours the blur
+ * cannot remove. Both for SSAO and SSDO. */
+static void rotation_beats_raw_pattern(void **state) {
+  (void)state;
+  static const char *const tech[] = {"ssao", "ssdo"};
+  static const char *const sets[2][3][4] = {
+      {{"ssao.samples=300", NULL}, {"ssao.samples=10", "ssao.interleave=1", NULL},
+       {"ssao.samples=10", "ssao.interleave=4", NULL}},
+      {{"ssdo.samples=300", "ssdo.bounce=0", NULL}, {"ssdo.samples=10", "ssdo.interleave=1", "ssdo.bounce=0", NULL},
+       {"ssdo.samples=10", "ssdo.interleave=4", "ssdo.bounce=0", NULL}},
+  };
+  for (int t = 0; t < 2; t++) {
+    image *ref = render_ok(tech[t], sets[t][0]), *raw = render_ok(tech[t], sets[t][1]),
+          *rot = render_ok(tech[t], sets[t][2]);
+    double e_raw = mean_error(raw, ref), e_rot = mean_error(rot, ref);
+    print_message("%s, 10 samples against 300: mean error raw pattern %.5f, rotated %.5f\n", tech[t], e_raw, e_rot);
+    assert_true(e_rot < 0.6 * e_raw); /* measured 0.23 to 0.32 */
+    free(ref);
+    free(raw);
+    free(rot);
   }
 }
 
@@ -496,6 +521,7 @@ int main(void) {
       cmocka_unit_test(bounce_tints_floor_by_red_wall),
       cmocka_unit_test(filters_do_not_cross_a_depth_step),
       cmocka_unit_test(reduced_resolution_close_to_full),
+      cmocka_unit_test(rotation_beats_raw_pattern),
       cmocka_unit_test(variants_agree_under_white_light),
       cmocka_unit_test(adaptive_counts_follow_edges),
       cmocka_unit_test(extreme_parameters_stay_finite),
