@@ -2,7 +2,9 @@
 // 1235-1287): three radical-inverse sequences, base 5 for the azimuth, base
 // 2 for the elevation and base 3 for the step length along the direction.
 // Bases 2 and 5 repeat their split of the hemisphere every 10 samples
-// (seed lines 803-805), so the modules accept counts in multiples of 10 only.
+// (seed lines 803-805), so the modules accept counts in multiples of 10 only
+// (ssdo.lua and ssao.lua refuse others with an error naming the option; a
+// shader handed one anyway rounds it down to a multiple of 10, at least 10).
 //
 // Where the sequence is made: here, in the shader. The seed kept it in a
 // texture, one fetch per sample; a uniform array cannot be bound by a pass.
