@@ -3,19 +3,26 @@
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local shadow = require "shadow"
+local ssdo = require "ssdo"
+local ssao = require "ssao"
 
 -- The seed's viewer modes: isr+esm (F2, the default), isr (F3), dl+esm (F4),
--- dl (F5). "+esm" turns shadows on; shadow.technique picks their filter.
-Techniques = { "isr+esm", "isr", "dl+esm", "dl" }
+-- dl (F5); then screen-space directional and ambient occlusion (seed 001).
+-- "+esm" turns shadows on; shadow.technique picks their filter.
+Techniques = { "isr+esm", "isr", "dl+esm", "dl", "ssdo+esm", "ssdo", "ssao+esm", "ssao" }
 
 Options = {
   ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
   background = 0.0,        -- radiance where no geometry is
   isr = {},                -- see isr.defaults in scripts/isr.lua
   shadow = {},             -- see shadow.defaults in scripts/shadow.lua
+  ssdo = {},               -- see ssdo.defaults in scripts/ssdo.lua
+  ssao = {},               -- see ssao.defaults in scripts/ssao.lua
 }
 for k, v in pairs(isr.defaults) do Options.isr[k] = v end
 for k, v in pairs(shadow.defaults) do Options.shadow[k] = v end
+for k, v in pairs(ssdo.defaults) do Options.ssdo[k] = v end
+for k, v in pairs(ssao.defaults) do Options.ssao[k] = v end
 
 local function grey(x) return { x, x, x } end
 
@@ -28,12 +35,20 @@ local function direct(G, tech, shadows)
 end
 
 function OnRender(tech)
+  local lighting = tech.name:match("^[^+]*")
   local shadows = tech.name:find("+esm", 1, true) and shadow.render(tech.shadow) or nil
   if shadows and tech.shadow.debug then return present(shadow.debug(shadows)) end
+  if shadows and lighting == "ssdo" and tech.ssdo.variant ~= "merged" then
+    error('ssdo+esm needs ssdo.variant = "merged" (the two-step variant relights without shadows)')
+  end
   local G = gbuffer.render(gbuffer.targets())
-  if tech.name:sub(1, 3) == "isr" then
+  if lighting == "isr" then
     present(isr.render(G, tech.isr, { ambient = grey(tech.ambient), background = grey(tech.background),
                                       shadows = shadows }))
+  elseif lighting == "ssdo" then
+    present(ssdo.render(G, direct(G, tech, shadows), tech.ssdo, { ambient = grey(tech.ambient) }))
+  elseif lighting == "ssao" then
+    present(ssao.render(G, direct(G, tech, shadows), tech.ssao))
   else
     present(direct(G, tech, shadows))
   end
