@@ -10,7 +10,7 @@ uniform float strength = 1.0;
 out vec4 dst;
 
 void main() {
-  vec3 c = hdr_clamp(texture(src, uv).rgb, HALF_MAX);
+  vec3 c = hdr_clamp(texelFetch(src, ivec2(gl_FragCoord.xy), 0).rgb, HALF_MAX); // same size: exact
   vec3 b = hdr_clamp(texture(bloom, uv).rgb, HALF_MAX);
   dst = vec4(hdr_clamp(c + max(strength, 0.0) * b, HALF_MAX), 1.0);
 }

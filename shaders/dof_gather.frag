@@ -29,13 +29,14 @@ void main() {
   float wsum = 1.0;
   int n = clamp(samples, 1, 256);
   for (int i = 0; i < n; i++) {
-    vec2 off = vogel_disc(i, n) * rmax;
-    ivec2 q = clamp(p + ivec2(round(off)), ivec2(0), last);
+    ivec2 off = ivec2(round(vogel_disc(i, n) * rmax));
+    ivec2 q = clamp(p + off, ivec2(0), last);
     if (q == p) continue;
     vec2 cq = texelFetch(coc, q, 0).rg;
     float reach = abs(cq.x);
     if (cq.y > cp.y) reach = min(reach, abs(cp.x)); // behind p: no wider than p's own blur
-    float w = saturate(reach - length(off) + 1.0);
+    // A circle under half a pixel stays in its pixel: a sharp tap gives nothing.
+    float w = saturate(reach - length(vec2(off)) + 0.5);
     sum += w * hdr_clamp(texelFetch(src, q, 0).rgb, HALF_MAX);
     wsum += w;
   }

@@ -17,7 +17,7 @@ uniform float exposure = 0.0;  // bias in stops
 out vec4 dst;
 
 void main() {
-  vec3 c = hdr_clamp(texture(src, uv).rgb, 1e30);
+  vec3 c = hdr_clamp(texelFetch(src, ivec2(gl_FragCoord.xy), 0).rgb, 1e30);
   float avg = max(texelFetch(adapted, ivec2(0), 0).r, 1e-30);
   avg = isnan(avg) || isinf(avg) ? 1.0 : avg;
   float a = key;

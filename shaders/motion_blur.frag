@@ -14,7 +14,7 @@ uniform int samples = 12;        // 1..64
 out vec4 dst;
 
 void main() {
-  vec3 centre = hdr_clamp(texture(src, uv).rgb, HALF_MAX);
+  vec3 centre = hdr_clamp(texelFetch(src, ivec2(gl_FragCoord.xy), 0).rgb, HALF_MAX);
   float d = texture(dpt, uv).r;
   // The background has no depth: take the far plane, so that turning the
   // camera blurs it too.
