@@ -361,6 +361,40 @@ static void depth_of_field_keeps_the_focus_plane_sharp(void **state) {
   }
 }
 
+/* The tall box's top edge against the back wall (1 behind it), found in the
+ * sharp image by scanning up its middle column. Focused on the box, the
+ * blurred wall beside the edge keeps its own colour (the sharp box does not
+ * bleed onto it) and the box stays sharp; focused on the wall, the blurred
+ * box spreads over the sharp wall beside it. */
+static void depth_of_field_orders_foreground_and_background(void **state) {
+  (void)state;
+  static const char *const sharp[] = {NULL};
+  static const char *const on_box[] = {"dof=true", "dof.focus=3.46", "dof.range=1", "dof.max_radius=8", NULL};
+  static const char *const on_wall[] = {"dof=true", "dof.focus=4.4", "dof.range=1", "dof.max_radius=8", NULL};
+  float *s = render_once(pp_lua, "dl", sharp), *b = render_once(pp_lua, "dl", on_box);
+  float *w = render_once(pp_lua, "dl", on_wall);
+  int col, row;
+  project(-0.35f, 0.6f, -0.05f, &col, &row);
+  int edge = row; /* the last box row: the next one jumps by over 15% */
+  while (edge < H - 1 && fabsf(at(s, col, edge + 1)[1] - at(s, col, edge)[1]) < 0.15f * at(s, col, edge)[1]) edge++;
+  assert_true(edge < H - 10);
+  float box = at(s, col, edge)[1], wall = at(s, col, edge + 1)[1];
+  print_message("edge at row %d: box %.4f wall %.4f | wall by the edge: sharp %.4f, box focused %.4f, wall "
+                "focused %.4f | box by the edge: sharp %.4f, box focused %.4f\n", edge, box, wall,
+                at(s, col, edge + 3)[1], at(b, col, edge + 3)[1], at(w, col, edge + 3)[1], at(s, col, edge - 2)[1],
+                at(b, col, edge - 2)[1]);
+  assert_true(fabsf(wall - box) > 0.3f * box);
+  float gap = wall - box;
+  /* box focused: the wall 3 pixels above the edge moves < 10% of the way to the box */
+  assert_true(fabsf(at(b, col, edge + 3)[1] - at(s, col, edge + 3)[1]) < 0.1f * fabsf(gap));
+  assert_true(fabsf(at(b, col, edge - 2)[1] - at(s, col, edge - 2)[1]) < 0.05f * fabsf(gap));
+  /* wall focused: the blurred box reaches 3 pixels over the wall, > 20% of the way */
+  assert_true(fabsf(at(w, col, edge + 3)[1] - at(s, col, edge + 3)[1]) > 0.2f * fabsf(gap));
+  free(s);
+  free(b);
+  free(w);
+}
+
 /* ---- motion blur ------------------------------------------------------- */
 /* A still camera leaves the image as it was; a camera moving sideways blurs
  * along x: the horizontal gradient energy drops to under half, and by more
@@ -556,6 +590,7 @@ int main(void) {
       cmocka_unit_test(adaptation_converges_to_the_key_at_its_rate),
       cmocka_unit_test(bloom_spreads_one_bright_pixel_and_nothing_else),
       cmocka_unit_test(depth_of_field_keeps_the_focus_plane_sharp),
+      cmocka_unit_test(depth_of_field_orders_foreground_and_background),
       cmocka_unit_test(motion_blur_follows_the_camera),
       cmocka_unit_test(every_effect_renders_finite_with_dl_and_isr),
       cmocka_unit_test(degenerate_settings_stay_finite),
