@@ -5,6 +5,7 @@ local isr = require "isr"
 local shadow = require "shadow"
 local ssdo = require "ssdo"
 local ssao = require "ssao"
+local post = require "post"
 
 -- The seed's viewer modes: isr+esm (F2, the default), isr (F3), dl+esm (F4),
 -- dl (F5); then screen-space directional and ambient occlusion (seed 001).
@@ -23,6 +24,11 @@ for k, v in pairs(isr.defaults) do Options.isr[k] = v end
 for k, v in pairs(shadow.defaults) do Options.shadow[k] = v end
 for k, v in pairs(ssdo.defaults) do Options.ssdo[k] = v end
 for k, v in pairs(ssao.defaults) do Options.ssao[k] = v end
+-- Post effects, each off by default (the seed viewer's F6 bloom, F7 dof, F8
+-- glass, F9 radial_blur, F11 sepia, F12 tiles; and hdr, motion_blur): a
+-- table per effect, `--set bloom=true` turns one on (bloom.enabled), and
+-- `--set dof.focus=3.5` sets a parameter. See scripts/post.lua.
+for name, d in pairs(post.defaults()) do Options[name] = d end
 
 local function grey(x) return { x, x, x } end
 
@@ -34,6 +40,10 @@ local function direct(G, tech, shadows)
                out = target{ "lit", format = "rgba16f" } }
 end
 
+function OnCreate()
+  post.create()
+end
+
 function OnRender(tech)
   local lighting = tech.name:match("^[^+]*")
   local shadows = tech.name:find("+esm", 1, true) and shadow.render(tech.shadow) or nil
@@ -42,14 +52,16 @@ function OnRender(tech)
     error('ssdo+esm needs ssdo.variant = "merged" (the two-step variant relights without shadows)')
   end
   local G = gbuffer.render(gbuffer.targets())
+  local lit
   if lighting == "isr" then
-    present(isr.render(G, tech.isr, { ambient = grey(tech.ambient), background = grey(tech.background),
-                                      shadows = shadows }))
+    lit = isr.render(G, tech.isr, { ambient = grey(tech.ambient), background = grey(tech.background),
+                                    shadows = shadows })
   elseif lighting == "ssdo" then
-    present(ssdo.render(G, direct(G, tech, shadows), tech.ssdo, { ambient = grey(tech.ambient) }))
+    lit = ssdo.render(G, direct(G, tech, shadows), tech.ssdo, { ambient = grey(tech.ambient) })
   elseif lighting == "ssao" then
-    present(ssao.render(G, direct(G, tech, shadows), tech.ssao))
+    lit = ssao.render(G, direct(G, tech, shadows), tech.ssao)
   else
-    present(direct(G, tech, shadows))
+    lit = direct(G, tech, shadows)
   end
+  present(post.render(lit, tech, G))
 end

@@ -62,6 +62,17 @@ check "times list the direct pass" out_has "direct"
 check "times are medians of 2" out_has "median of 2 frames"
 rm -f "$tmp/img/"*
 
+# effects: `--set bloom=true` turns on bloom.enabled; dotted names set parameters
+check "effects capture" run 0 capture --scene cornell --script scripts/pp.lua --tech dl --size 64x48 \
+  --set bloom=true --set hdr=true --set dof=on --set dof.focus=3.5 --set dof.mode=lens --output "$tmp/img/e.png"
+check "effects run their passes" out_has "hdr.tonemap"
+check "effects list dof" out_has "dof.gather"
+rm -f "$tmp/img/"*
+check "bad effect value" run 1 capture --size 64x48 --set dof.mode=pinhole --output "$tmp/img/f.png"
+check "bad effect value names it" first_error_has "dof.mode must be one of range, lens (got pinhole)"
+check "bad effect value leaves no file" no_files
+rm -f "$tmp/img/"*
+
 # broken scripts: exit 1, a first line naming script:line or the pass, no image
 cat >"$tmp/syntax.lua" <<'LUA'
 Techniques = { "dl" }

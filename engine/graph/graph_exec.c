@@ -43,12 +43,16 @@ static void pool_end_frame(lm_graph *g) {
 
 void lm_graph_pool_stats(const lm_graph *g, int *textures, double *bytes) {
   double b = 0;
+  int n = g->pool_count;
   for (int i = 0; i < g->pool_count; i++)
     b += (double)g->pool[i].desc.width * g->pool[i].desc.height * lm_format_bytes(g->pool[i].desc.format);
+  /* A persistent target no pass has used yet holds no texture. */
   for (int i = 0; i < g->persistent_count; i++)
-    if (g->targets[i].texture.id)
+    if (g->targets[i].texture.id) {
       b += (double)g->targets[i].width * g->targets[i].height * lm_format_bytes(g->targets[i].desc.format);
-  *textures = g->pool_count + g->persistent_count;
+      n++;
+    }
+  *textures = n;
   *bytes = b;
 }
 

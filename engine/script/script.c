@@ -237,6 +237,16 @@ bool lm_pipeline_set_option(lm_pipeline *p, const char *name, const char *value,
       rest = dot + 1;
       continue;
     }
+    /* "bloom=true" on a table with a boolean `enabled` sets bloom.enabled. */
+    if (!dot && lua_istable(L, -1)) {
+      lua_getfield(L, -1, "enabled");
+      bool has_switch = lua_isboolean(L, -1);
+      lua_pop(L, 1);
+      if (has_switch) {
+        rest = "enabled";
+        continue;
+      }
+    }
     if (dot || lua_isnil(L, -1) || lua_istable(L, -1)) break;
     int type = lua_type(L, -1);
     lua_pop(L, 1);
