@@ -205,6 +205,7 @@ static void no_nan_or_inf_leaves_the_output_stage(void **state) {
   assert_false(fr.ok);
   if (!strstr(fr.err.msg, "poison.lua:3: pass 'poison' wrote NaN to target 'p' at pixel (0, 0)"))
     fail_msg("%s", fr.err.msg);
+  gl_result_free(&fr);
 }
 
 static void textures_are_pooled_across_frames(void **state) {
