@@ -91,7 +91,12 @@ int lm_scene_add_camera(lm_scene *s, const lm_camera *c);
 /* World transforms from local ones (parents come before children). */
 void lm_scene_update(lm_scene *s);
 
-/* A scene built in code: "cornell". NULL with a message listing the names. */
+/* The node's material, or the engine's default one (material -1 or out of range). */
+const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n);
+
+/* A scene built in code: "cornell", or "cornell_pov" (the box lit only by
+ * lights POV-Ray matches exactly, engine/scene/pov.h). NULL with a message
+ * listing the names. */
 lm_scene *lm_scene_builtin(const char *name, lm_error *err);
 const char *lm_scene_builtin_list(void);
 
