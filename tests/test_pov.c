@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
+#include <cglm/cglm.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -156,6 +157,14 @@ static void unmatched_spots_and_materials_are_named(void **state) {
   assert_false(lm_pov_export(s, &d, &out, &warn, &err));
   assert_non_null(strstr(err.msg, "light 'spot': spot cone of 90 degrees"));
   lm_buf_free(&out);
+  /* the engine sees only cosines: a negative angle is its size */
+  s->lights[2].inner_cone = -0.1f;
+  s->lights[2].outer_cone = -0.3f;
+  assert_true(lm_pov_export(s, &d, &out, &warn, &err));
+  char want[128];
+  snprintf(want, sizeof want, "radius %.9g\n  falloff %.9g\n", glm_deg(0.1f), glm_deg(0.3f));
+  assert_non_null(strstr(out.data, want));
+  lm_buf_free(&out);
   s->lights[2].outer_cone = 0.3f;
   s->lights[2].casts_shadows = false;
   assert_false(lm_pov_export(s, &d, &out, &warn, &err));
@@ -189,6 +198,10 @@ static void bad_views_are_refused(void **state) {
   assert_false(lm_pov_export(s, &d, &out, NULL, &err));
   assert_non_null(strstr(err.msg, "pretrace_end"));
   d.rad.pretrace_end = 0.01;
+  s->lights[0].power = INFINITY;
+  assert_false(lm_pov_export(s, &d, &out, NULL, &err));
+  assert_string_equal(err.msg, "light 'ceiling_light': a coordinate or colour is not finite (Inf or NaN)");
+  s->lights[0].power = 2.4f;
   s->meshes[0].indices[2] = 99;
   assert_false(lm_pov_export(s, &d, &out, NULL, &err));
   assert_non_null(strstr(err.msg, "node 'floor': mesh 'floor': index 2 is 99, past its 4 vertices"));

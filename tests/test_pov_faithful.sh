@@ -26,8 +26,11 @@ cat "$tmp/m.json"
 num() { grep -o "\"$1\": [-0-9.e+]*" "$tmp/m.json" | awk '{print $2}'; }
 mean=$(num mean_error) pearson=$(num pearson)
 echo "engine dl against POV-Ray (no radiosity, no shadows) at $size: mean error $mean, Pearson $pearson"
-# Measured 0.00195 (the image's mean value is about 0.5; the error sits on
-# a few silhouette pixels and in the 8-bit albedo of the G-buffer).
+# Measured 0.00195 (the image's mean value is about 0.5). Nearly all of it is
+# 54 pixels whose centres lie exactly on the edges where the left wall meets
+# ceiling and floor (the box is symmetric and the view 4:3): a tie that GL's
+# rasterizer gives to the ceiling and POV-Ray to the wall. Elsewhere the two
+# agree to about 0.1% (the G-buffer's 8-bit albedo, 16-bit float light).
 awk -v m="$mean" 'BEGIN { exit !(m < 0.005) }' || fail "mean error $mean is not below 0.005"
 awk -v p="$pearson" 'BEGIN { exit !(p > 0.999) }' || fail "Pearson $pearson is not above 0.999"
 

@@ -78,5 +78,17 @@ check "compare png with exr diff" run 0 compare "$tmp/a.png" "$tmp/b.png" --diff
 check "table names eq 19" out_has "mean error (eq 19)"
 check "diff exr written" test -s "$tmp/d.exr"
 
+# bench: two sizes, one frame each; the clock named, a fit per pass
+check "bench help" run 0 bench --help
+check "bench bad sizes" run 2 bench --sizes 32x24,big
+check "bench bad sizes message" err_has "--sizes wants WxH"
+check "bench json" run 0 bench --sizes 32x24,64x48 --frames 1 --warmup 0 --json
+check "bench names the clock" out_has '"clock": "'
+check "bench has overhead" out_has '"overhead_ms": '
+check "bench fits the direct pass" out_has '{"name": "direct", "ms": ['
+check "bench fit per pixel" out_has '"ns_per_pixel": '
+check "bench table" run 0 bench --sizes 32x24,64x48 --frames 1 --warmup 0
+check "bench table names the fit" out_has "fit: a ms + b ns/pixel"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -37,3 +37,14 @@ bool limn_parse_on_off(const char *s, bool *out) {
   else return false;
   return true;
 }
+
+void limn_json_string(const char *s) {
+  putchar('"');
+  for (; *s; s++) {
+    unsigned char ch = (unsigned char)*s;
+    if (ch == '"' || ch == '\\') printf("\\%c", ch);
+    else if (ch < 0x20) printf("\\u%04x", ch);
+    else putchar(ch);
+  }
+  putchar('"');
+}

@@ -90,25 +90,13 @@ static int parse_args(int argc, char **argv, compare_args *a) {
   return 0;
 }
 
-/* A JSON string (paths may hold quotes or backslashes). */
-static void json_string(const char *s) {
-  putchar('"');
-  for (; *s; s++) {
-    unsigned char ch = (unsigned char)*s;
-    if (ch == '"' || ch == '\\') printf("\\%c", ch);
-    else if (ch < 0x20) printf("\\u%04x", ch);
-    else putchar(ch);
-  }
-  putchar('"');
-}
-
 static void print_json(const compare_args *a, const lm_metrics *m, double scale) {
   printf("{\"a\": ");
-  json_string(a->a);
+  limn_json_string(a->a);
   printf(", \"b\": ");
-  json_string(a->b);
+  limn_json_string(a->b);
   printf(", \"ref\": ");
-  if (a->ref) json_string(a->ref);
+  if (a->ref) limn_json_string(a->ref);
   else printf("null");
   printf(", \"width\": %d, \"height\": %d, \"channels\": %d", m->width, m->height, m->channels);
   printf(", \"mean_error\": %.9g, \"max_error\": %.9g, \"rmse\": %.9g", m->mean_error, m->max_error, m->rmse);
@@ -119,7 +107,7 @@ static void print_json(const compare_args *a, const lm_metrics *m, double scale)
   else printf(", \"closer\": null, \"ties\": null");
   if (a->diff) {
     printf(", \"diff\": ");
-    json_string(a->diff);
+    limn_json_string(a->diff);
     printf(", \"diff_scale\": %.9g", scale);
   }
   printf("}\n");

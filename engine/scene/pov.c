@@ -30,6 +30,7 @@ typedef struct pov_ctx {
   const lm_pov_desc *desc;
   lm_buf *out, *warnings;
   lm_error *err;
+  char nonfinite[160]; /* the first element that wrote Inf or NaN (POV-Ray cannot parse them) */
 } pov_ctx;
 
 /* Something the engine does that POV-Ray cannot: refused when strict, else a warning. */
@@ -48,7 +49,12 @@ static bool mismatch(pov_ctx *c, const char *fmt, ...) {
   return true;
 }
 
-static void put_vec(lm_buf *b, const double v[3]) { lm_buf_printf(b, "<%.9g, %.9g, %.9g>", v[0], v[1], v[2]); }
+/* `what` names the element in the error should a number not be finite. */
+static void put_vec(pov_ctx *c, const double v[3], const char *what) {
+  if (!c->nonfinite[0] && !(isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2])))
+    snprintf(c->nonfinite, sizeof c->nonfinite, "%s", what);
+  lm_buf_printf(c->out, "<%.9g, %.9g, %.9g>", v[0], v[1], v[2]);
+}
 
 static double clamp01(double x) { return x > 0 ? (x < 1 ? x : 1) : 0; } /* NaN -> 0 */
 
@@ -123,14 +129,16 @@ static void write_camera(pov_ctx *c, const lm_scene *s) {
     up[i] = f.frustum_v[i];
   }
   const char *name = c->desc->camera < s->camera_count ? s->cameras[c->desc->camera].name : "default";
+  char what[128];
+  snprintf(what, sizeof what, "camera '%s'", name);
   lm_buf_printf(c->out, "// camera '%s'\ncamera {\n  perspective\n  location ", name);
-  put_vec(c->out, loc);
+  put_vec(c, loc, what);
   lm_buf_printf(c->out, "\n  direction ");
-  put_vec(c->out, dir);
+  put_vec(c, dir, what);
   lm_buf_printf(c->out, "\n  right ");
-  put_vec(c->out, right);
+  put_vec(c, right, what);
   lm_buf_printf(c->out, "\n  up ");
-  put_vec(c->out, up);
+  put_vec(c, up, what);
   lm_buf_printf(c->out, "\n}\n\n");
 }
 
@@ -160,6 +168,8 @@ static bool write_light(pov_ctx *c, const lm_light *l, const lm_light_data *ld, 
       return false;
     }
   }
+  char what[128];
+  snprintf(what, sizeof what, "light '%s'", l->name);
   lm_buf_printf(b, "// light '%s'\nlight_source {\n  ", l->name);
   if (type == LM_LIGHT_DIRECTIONAL) {
     /* A parallel light's shadow rays end at the plane through its location:
@@ -169,34 +179,34 @@ static bool write_light(pov_ctx *c, const lm_light *l, const lm_light_data *ld, 
       loc[i] = center[i] - dir[i] * (2.0 * radius + 1.0);
       at[i] = loc[i] + dir[i];
     }
-    put_vec(b, loc);
+    put_vec(c, loc, what);
     lm_buf_printf(b, "\n  color rgb ");
-    put_vec(b, col);
+    put_vec(c, col, what);
     lm_buf_printf(b, "\n  parallel\n  point_at ");
-    put_vec(b, at);
+    put_vec(c, at, what);
   } else {
-    put_vec(b, pos);
+    put_vec(c, pos, what);
     lm_buf_printf(b, "\n  color rgb ");
-    put_vec(b, col);
+    put_vec(c, col, what);
     if (type == LM_LIGHT_SPOT) {
       /* POV-Ray: pow(cos, tightness) * cubic_spline(cos falloff, cos radius, cos),
        * the spline being smoothstep; tightness 0 leaves the smoothstep alone.
        * It only holds for cones under 90 degrees (POV-Ray drops cos <= 0 and
        * the spline when cos radius <= 0). */
-      double inner = l->inner_cone, outer = l->outer_cone;
-      if (!(outer > 0 && outer < GLM_PI_2) &&
+      /* The engine only sees the cosines, so a negative angle acts as its size. */
+      double inner = fabs(l->inner_cone), outer = fabs(l->outer_cone);
+      if (!(outer < GLM_PI_2) &&
           !mismatch(c, "light '%s': spot cone of %.6g degrees: POV-Ray's spotlight only matches cones "
-                       "under 90 degrees", l->name, glm_deg(outer)))
+                       "under 90 degrees", l->name, glm_deg((float)outer)))
         return false;
-      if (!(inner >= 0)) inner = 0;
       /* inner >= outer: the engine's smoothstep spans 1e-4 in cosine, a hard
        * edge at the outer cone, which is what radius = falloff gives. */
       if (inner > outer) inner = outer;
       double at[3];
       for (int i = 0; i < 3; i++) at[i] = pos[i] + dir[i];
       lm_buf_printf(b, "\n  spotlight\n  radius %.9g\n  falloff %.9g\n  tightness 0\n  point_at ",
-                    glm_deg(inner), glm_deg(outer));
-      put_vec(b, at);
+                    glm_deg((float)inner), glm_deg((float)outer));
+      put_vec(c, at, what);
     }
     if (fade) lm_buf_printf(b, "\n  fade_distance %.9g\n  fade_power 2", LM_POV_FADE_DISTANCE);
   }
@@ -261,12 +271,13 @@ static bool write_mesh_node(pov_ctx *c, const lm_scene *s, const lm_node *n) {
     tri += keep[t];
   }
   if (tri > 0) {
-    char id[64];
+    char id[64], what[160];
+    snprintf(what, sizeof what, "node '%s'", n->name);
     material_id(s, n, id, sizeof id);
     lm_buf_printf(b, "// node '%s', mesh '%s'\nmesh2 {\n  vertex_vectors {\n    %d", n->name, m->name, m->vertex_count);
     for (int v = 0; v < m->vertex_count; v++) {
       lm_buf_printf(b, ",\n    ");
-      put_vec(b, wp + v * 3);
+      put_vec(c, wp + v * 3, what);
     }
     lm_buf_printf(b, "\n  }\n  normal_vectors {\n    %d", m->vertex_count);
     for (int v = 0; v < m->vertex_count; v++) {
@@ -283,7 +294,7 @@ static bool write_mesh_node(pov_ctx *c, const lm_scene *s, const lm_node *n) {
         wn[0] = 0, wn[1] = 1, wn[2] = 0;
       }
       lm_buf_printf(b, ",\n    ");
-      put_vec(b, wn);
+      put_vec(c, wn, what);
     }
     lm_buf_printf(b, "\n  }\n  face_indices {\n    %d", tri);
     for (int t = 0; t < total; t++)
@@ -298,7 +309,7 @@ static bool write_mesh_node(pov_ctx *c, const lm_scene *s, const lm_node *n) {
 
 bool lm_pov_export(const lm_scene *s, const lm_pov_desc *desc, lm_buf *out, lm_buf *warnings,
                    lm_error *err) {
-  pov_ctx c = {desc, out, warnings, err};
+  pov_ctx c = {.desc = desc, .out = out, .warnings = warnings, .err = err};
   if (desc->width < 1 || desc->height < 1) {
     lm_error_set(err, "output size %dx%d: both must be at least 1", desc->width, desc->height);
     return false;
@@ -339,6 +350,10 @@ bool lm_pov_export(const lm_scene *s, const lm_pov_desc *desc, lm_buf *out, lm_b
   for (int i = 0; i < s->node_count && ok; i++) {
     const lm_node *nd = &s->nodes[i];
     if (nd->mesh >= 0 && nd->mesh < s->mesh_count) ok = write_mesh_node(&c, s, nd);
+  }
+  if (ok && c.nonfinite[0]) {
+    lm_error_set(err, "%s: a coordinate or colour is not finite (Inf or NaN)", c.nonfinite);
+    ok = false;
   }
   return ok;
 }

@@ -78,7 +78,8 @@ typedef struct lm_pov_desc {
 /* Appends the SDL for the view to `out`. Warnings (one per line, naming the
  * light or material) go to `warnings` (may be NULL). False with a message
  * when strict and something cannot match, or the view is unusable (a bad
- * camera index or size, an index past a mesh's vertices). */
+ * camera index or size, an index past a mesh's vertices, a coordinate or
+ * colour that is Inf or NaN). */
 bool lm_pov_export(const lm_scene *s, const lm_pov_desc *desc, lm_buf *out, lm_buf *warnings,
                    lm_error *err);
 
