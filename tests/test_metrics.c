@@ -130,6 +130,17 @@ static void mismatched_images_are_refused_by_name(void **state) {
   assert_string_equal(err.msg, "channel counts differ: a.exr has 3, c.png has 1");
   assert_false(lm_metrics_check(&a, "a.exr", &e, "e.exr", &err));
   assert_string_equal(err.msg, "e.exr: empty image");
+  float bad[12] = {0};
+  bad[3 * 3 + 1] = NAN; /* pixel (1, 1), green */
+  lm_image n = img(2, 2, 3, bad);
+  assert_false(lm_metrics_check(&a, "a.exr", &n, "n.exr", &err));
+  assert_string_equal(err.msg, "n.exr: pixel (1, 1) channel 1 is not finite (NaN or Inf)");
+  bad[3 * 3 + 1] = 0;
+  bad[3] = INFINITY;
+  assert_false(lm_metrics_check(&n, "n.exr", &a, "a.exr", &err));
+  assert_string_equal(err.msg, "n.exr: pixel (1, 0) channel 0 is not finite (NaN or Inf)");
+  bad[3] = 0;
+  assert_true(lm_metrics_check(&n, "n.exr", &a, "a.exr", &err));
 }
 
 /* The heat map's ramp: 0 black, half the scale red, the scale and beyond white. */

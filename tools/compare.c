@@ -38,7 +38,8 @@ static const char compare_usage[] =
     "  --help            this text\n"
     "\n"
     "exit codes: 0 compared, 1 the difference image could not be written,\n"
-    "2 bad usage, an unreadable file, or images that differ in size or channels.\n";
+    "2 bad usage, an unreadable file, images that differ in size or channels, or a\n"
+    "NaN or Inf among the values (named by pixel and channel).\n";
 
 typedef struct compare_args {
   const char *a, *b, *ref, *diff;

@@ -6,6 +6,7 @@
 #include <string.h>
 
 static int compared_channels(const lm_image *img) { return img->channels < 3 ? img->channels : 3; }
+static bool finite_values(const lm_image *img, const char *name, lm_error *err);
 
 bool lm_metrics_check(const lm_image *a, const char *a_name, const lm_image *b, const char *b_name,
                       lm_error *err) {
@@ -27,6 +28,20 @@ bool lm_metrics_check(const lm_image *a, const char *a_name, const lm_image *b, 
                  b->channels);
     return false;
   }
+  return finite_values(a, a_name, err) && finite_values(b, b_name, err);
+}
+
+/* False with a message naming the first value that is NaN or Inf. */
+static bool finite_values(const lm_image *img, const char *name, lm_error *err) {
+  int nc = compared_channels(img);
+  size_t px = (size_t)img->width * img->height;
+  for (size_t i = 0; i < px; i++)
+    for (int k = 0; k < nc; k++)
+      if (!isfinite(img->pixels[i * (size_t)img->channels + (size_t)k])) {
+        lm_error_set(err, "%s: pixel (%d, %d) channel %d is not finite (NaN or Inf)", name,
+                     (int)(i % (size_t)img->width), (int)(i / (size_t)img->width), k);
+        return false;
+      }
   return true;
 }
 

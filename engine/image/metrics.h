@@ -48,8 +48,9 @@ typedef struct lm_metrics {
 #define LM_SSIM_K1 0.01
 #define LM_SSIM_K2 0.03
 
-/* False with a message when the images differ in size or channel count, or
- * are empty. `a_name` and `b_name` name them in the message. */
+/* False with a message when the images differ in size or channel count, are
+ * empty, or hold a NaN or Inf among their compared values (no metric of
+ * them would mean anything). `a_name` and `b_name` name them in the message. */
 bool lm_metrics_check(const lm_image *a, const char *a_name, const lm_image *b, const char *b_name,
                       lm_error *err);
 /* Every metric but closer/ties (set to -1). The images must pass lm_metrics_check. */
