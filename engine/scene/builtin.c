@@ -57,9 +57,13 @@ static void trs(vec3 t, float yaw_deg, vec3 scale, mat4 out) {
 }
 
 /* The classic box: interior x in [-1, 1], y in [0, 2], z in [-1, 1], open
- * toward +z; red wall at -x, green at +x, a point light under the ceiling. */
-static lm_scene *cornell(void) {
-  lm_scene *s = lm_scene_create("cornell");
+ * toward +z; red wall at -x, green at +x, a point light under the ceiling.
+ * pov: the same box lit only as POV-Ray can light it too (limn export-pov
+ * matches it exactly): an inverse-square point light under the ceiling, a
+ * dim parallel light through the open side and a spot (no falloff) on the
+ * tall box, so that every light model the export claims is exercised. */
+static lm_scene *cornell(bool pov) {
+  lm_scene *s = lm_scene_create(pov ? "cornell_pov" : "cornell");
   lm_material white = {"white", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.0f, 1.0f};
   lm_material red = {"red", {0.63f, 0.065f, 0.05f}, 0.63f, 1.0f, 1.0f, 0.0f, 1.0f};
   lm_material green = {"green", {0.14f, 0.45f, 0.091f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f};
@@ -94,9 +98,27 @@ static lm_scene *cornell(void) {
   glm_rotate_x(m, glm_rad(-90.0f), m); /* shine down (-Z of the node) */
   int light_node = lm_scene_add_node(s, "light", -1, (float *)m, -1, -1);
   lm_scene_add_light(s, &(lm_light){.name = "ceiling_light", .type = LM_LIGHT_POINT,
-                                     .color = {1.0f, 0.95f, 0.85f}, .power = 1.6f, .radius = 4.0f,
-                                     .inner_cone = glm_rad(30), .outer_cone = glm_rad(45),
+                                     .color = {1.0f, 0.95f, 0.85f}, .power = pov ? 2.4f : 1.6f,
+                                     .radius = 4.0f, .inner_cone = glm_rad(30), .outer_cone = glm_rad(45),
+                                     .falloff = pov ? LM_FALLOFF_INVERSE_SQUARE : LM_FALLOFF_WINDOW,
                                      .casts_shadows = true, .node = light_node});
+  if (pov) {
+    /* Parallel light from the open side, above and to the right, shining down into the box. */
+    glm_mat4_identity(m);
+    glm_rotate_y(m, glm_rad(20.0f), m);
+    glm_rotate_x(m, glm_rad(-35.0f), m);
+    int sun = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
+    lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL,
+                                       .color = {0.6f, 0.7f, 1.0f}, .power = 0.25f,
+                                       .casts_shadows = true, .node = sun});
+    /* Spot from the front right corner onto the tall box. */
+    glm_lookat((vec3){0.8f, 1.7f, 0.9f}, (vec3){-0.35f, 0.8f, -0.35f}, (vec3){0, 1, 0}, m);
+    glm_mat4_inv(m, m); /* lookat gives the view; the node holds its inverse */
+    int spot = lm_scene_add_node(s, "spot", -1, (float *)m, -1, -1);
+    lm_scene_add_light(s, &(lm_light){.name = "spot", .type = LM_LIGHT_SPOT, .color = {1.0f, 0.9f, 0.6f},
+                                       .power = 0.5f, .inner_cone = glm_rad(8), .outer_cone = glm_rad(16),
+                                       .falloff = LM_FALLOFF_NONE, .casts_shadows = true, .node = spot});
+  }
 
   glm_translate_make(m, (vec3){0.0f, 1.0f, 3.4f});
   int cam_node = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
@@ -140,10 +162,11 @@ static lm_scene *field(void) {
   return s;
 }
 
-const char *lm_scene_builtin_list(void) { return "cornell, field"; }
+const char *lm_scene_builtin_list(void) { return "cornell, cornell_pov, field"; }
 
 lm_scene *lm_scene_builtin(const char *name, lm_error *err) {
-  if (!strcmp(name, "cornell")) return cornell();
+  if (!strcmp(name, "cornell")) return cornell(false);
+  if (!strcmp(name, "cornell_pov")) return cornell(true);
   if (!strcmp(name, "field")) return field();
   lm_error_set(err, "unknown scene '%s' (built in: %s)", name, lm_scene_builtin_list());
   return NULL;

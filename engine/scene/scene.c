@@ -224,18 +224,21 @@ bool lm_scene_owns_uniform(const char *name) {
   return false;
 }
 
+const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n) {
+  static const lm_material fallback = {"default", {0.8f, 0.8f, 0.8f}, 0.8f, 0.1f, 0.9f, 0.0f, 16.0f};
+  return n->material >= 0 && n->material < s->material_count ? &s->materials[n->material] : &fallback;
+}
+
 void lm_scene_draw(const lm_scene *s, const lm_program *p) {
   const lm_uniform *u_model = lm_program_uniform(p, "model");
   const lm_uniform *u_normal = lm_program_uniform(p, "normal_matrix");
   const lm_uniform *u_color = lm_program_uniform(p, "material_color");
   const lm_uniform *u_rho = lm_program_uniform(p, "material_rho");
   const lm_uniform *u_k = lm_program_uniform(p, "material_k");
-  static const lm_material fallback = {"default", {0.8f, 0.8f, 0.8f}, 0.8f, 0.1f, 0.9f, 0.0f, 16.0f};
   for (int i = 0; i < s->node_count; i++) {
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
-    const lm_material *m = n->material >= 0 && n->material < s->material_count
-                               ? &s->materials[n->material] : &fallback;
+    const lm_material *m = lm_scene_node_material(s, n);
     mat4 model, inv;
     mat3 normal;
     memcpy(model, n->world, sizeof model);

@@ -94,7 +94,12 @@ void lm_scene_update(lm_scene *s);
 /* World-space box around every mesh node; false (and a unit box) when empty. */
 bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]);
 
-/* A scene built in code: "cornell". NULL with a message listing the names. */
+/* The node's material, or the engine's default one (material -1 or out of range). */
+const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n);
+
+/* A scene built in code: "cornell", or "cornell_pov" (the box lit only by
+ * lights POV-Ray matches exactly, engine/scene/pov.h). NULL with a message
+ * listing the names. */
 lm_scene *lm_scene_builtin(const char *name, lm_error *err);
 const char *lm_scene_builtin_list(void);
 
