@@ -82,7 +82,7 @@ check "diff exr written" test -s "$tmp/d.exr"
 check "bench help" run 0 bench --help
 check "bench bad sizes" run 2 bench --sizes 32x24,big
 check "bench bad sizes message" err_has "--sizes wants WxH"
-check "bench json" run 0 bench --sizes 32x24,64x48 --frames 1 --warmup 0 --json
+check "bench json" run 0 bench --tech dl --sizes 32x24,64x48 --frames 1 --warmup 0 --json
 check "bench names the clock" out_has '"clock": "'
 check "bench has overhead" out_has '"overhead_ms": '
 check "bench fits the direct pass" out_has '{"name": "direct", "ms": ['
