@@ -196,8 +196,8 @@ void lm_storage_upload(int binding, const void *data, size_t bytes) {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)binding, storage[binding].buffer);
 }
 
-void lm_set_scene_state(bool on, bool depth_clamp) {
-  if (on && depth_clamp)
+void lm_set_scene_state(bool on, bool shadow_caster) {
+  if (on && shadow_caster)
     glEnable(GL_DEPTH_CLAMP);
   else
     glDisable(GL_DEPTH_CLAMP);
@@ -205,8 +205,12 @@ void lm_set_scene_state(bool on, bool depth_clamp) {
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
-    glEnable(GL_CULL_FACE);
-    glCullFace(GL_BACK);
+    if (shadow_caster) {
+      glDisable(GL_CULL_FACE);
+    } else {
+      glEnable(GL_CULL_FACE);
+      glCullFace(GL_BACK);
+    }
   } else {
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);

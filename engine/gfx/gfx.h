@@ -72,9 +72,10 @@ void lm_draw_fullscreen(void);
 void lm_set_viewport(int x, int y, int width, int height);
 /* Uploads a shader storage block to `binding` (grows its buffer as needed). */
 void lm_storage_upload(int binding, const void *data, size_t bytes);
-/* Depth test and face culling for scene passes; off for full-screen ones.
- * depth_clamp keeps geometry in front of the near plane (shadow casters). */
-void lm_set_scene_state(bool on, bool depth_clamp);
+/* Depth test and back-face culling for scene passes; off for full-screen
+ * ones. Shadow casters draw both faces (a light inside a closed mesh sees
+ * its back faces) and clamp depth (casters before the near plane count). */
+void lm_set_scene_state(bool on, bool shadow_caster);
 /* Framebuffers cache by attachment set; drop entries that name this texture. */
 void lm_framebuffers_forget(lm_texture tex);
 

@@ -243,7 +243,7 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
   apply_params(d, p);
   lm_timer_begin(timer, x->clock);
   if (d->kind == LM_PASS_SCENE) {
-    lm_set_scene_state(true, d->view_count > 0); /* tiles clamp depth: casters before the near plane count */
+    lm_set_scene_state(true, d->view_count > 0); /* tiles are shadow maps */
     if (d->clear) lm_clear(d->output_count, d->clear_color, d->depth >= 0, 1.0f);
     if (d->view_count == 0 && x->draw_scene) x->draw_scene(x->user, d->shader, p, NULL);
     const lm_uniform *u_vp = lm_program_uniform(p, "pass_view_proj");
