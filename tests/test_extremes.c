@@ -160,6 +160,25 @@ static void degenerate_and_nan_geometry(void **state) {
   }
 }
 
+/* A target larger than the GL limit is refused, naming it and its size. */
+static void oversize_targets_are_refused(void **state) {
+  (void)state;
+  const char *path = "/tmp/limn-extremes-huge.lua";
+  FILE *f = fopen(path, "w");
+  assert_non_null(f);
+  fputs("Techniques = { 'x' }\nfunction OnRender()\n"
+        "  local t = target{ 'huge', format = 'r32f', size = { 65536, 65536 } }\n"
+        "  scene{ 'fill', technique = 'shadow', out = t }\n  present(t)\nend\n", f);
+  fclose(f);
+  lm_scene *s = builtin("cornell");
+  gl_result r = gl_render(&(gl_run){.scene = s, .script = path, .width = 8, .height = 8});
+  assert_false(r.ok);
+  if (!strstr(r.err.msg, "target 'huge': size 65536x65536 is outside 1x1 ..")) fail_msg("%s", r.err.msg);
+  gl_result_free(&r);
+  remove(path);
+  lm_scene_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(hdr_radiance_from_1e_8_to_1e6),
@@ -168,6 +187,7 @@ int main(void) {
       cmocka_unit_test(outputs_of_1x1_and_8192x8192),
       cmocka_unit_test(zero_lights_and_64_lights),
       cmocka_unit_test(degenerate_and_nan_geometry),
+      cmocka_unit_test(oversize_targets_are_refused),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }
