@@ -1,5 +1,7 @@
 /* Shared by the GL tests: a headless context and frames of a pipeline script
- * over a scene, kept open so a test can look at any target afterwards. */
+ * over a scene, kept open so a test can look at any target afterwards; where
+ * the Cornell box's camera sees a world point; a scratch engine root for
+ * test shaders and scripts. */
 #ifndef LIMN_GL_TEST_H
 #define LIMN_GL_TEST_H
 
@@ -7,7 +9,7 @@
 
 typedef struct gl_run {
   lm_scene *scene;          /* borrowed */
-  const char *script;       /* NULL: <root>/scripts/pp.lua */
+  const char *script;       /* NULL: scripts/pp.lua; a relative path is under the root (LIMN_ROOT) */
   const char *tech;         /* NULL: the script's default */
   const char *const *sets;  /* "name=value" options, NULL-terminated (may be NULL) */
   int width, height;        /* 0: 256 x 192 */
@@ -29,6 +31,8 @@ typedef struct gl_result {
 int gl_test_setup(void **state);
 int gl_test_teardown(void **state);
 gl_result gl_render(const gl_run *run);
+/* Sets a "name=value" option for the next frame; false with the message in r->err. */
+bool gl_set(gl_result *r, const char *assignment);
 /* Renders one more frame with the same pipeline (after moving a camera, say). */
 bool gl_render_again(gl_result *r);
 void gl_result_free(gl_result *r);
@@ -36,12 +40,36 @@ void gl_result_free(gl_result *r);
 void gl_pass_names(const gl_result *r, char *out, size_t cap);
 /* Was a pass whose name starts with `prefix` recorded (culled or not)? */
 bool gl_has_pass(const gl_result *r, const char *prefix);
+/* How many passes whose names start with `prefix` ("": any) were recorded and culled. */
+int gl_culled(const gl_result *r, const char *prefix);
 /* Mean linear RGB over x0..x1, y0..y1 (rows from the top). */
 void gl_region(const gl_result *r, int x0, int y0, int x1, int y1, float out[3]);
 float gl_luminance(const float rgb[3]);
 /* Every value finite and not negative. */
 bool gl_all_finite(const gl_result *r);
-/* A target of the last frame as RGBA floats, rows top first (caller frees). */
+/* A used target of the last frame as RGBA floats, rows top first (caller
+ * frees); NULL when the frame has none of that name. */
 float *gl_read_target(gl_result *r, const char *name, int *width, int *height);
+/* Does that target hold only finite values that are not negative? (It is
+ * read before the output stage, which would hide a NaN.) */
+bool gl_target_finite(gl_result *r, const char *name);
+
+/* The pixel of world point (x, y, z) for the camera of the built-in Cornell
+ * box (cornell.c: eye (0, 1, 3.4) looking down -z, fov_y 45 degrees) in a
+ * width x height image, rows from the top. */
+void gl_project(int width, int height, float x, float y, float z, int *col, int *row);
+/* Mean linear RGB of the (2 radius + 1)^2 pixels around a world point of the box. */
+void gl_mean_around(const gl_result *r, float x, float y, float z, int radius, float out[3]);
+
+/* A scratch engine root in /tmp: the real shaders linked in one by one (so
+ * a test can add its own) and scripts/ linked whole. LIMN_ROOT points at it
+ * from then on. Returns 0, or -1 (for a cmocka setup). */
+int gl_scratch_create(void);
+/* The scratch root's path ("" before gl_scratch_create). */
+const char *gl_scratch_root(void);
+/* Writes text to the file `rel` under the scratch root; false when it cannot. */
+bool gl_write_file(const char *rel, const char *text);
+/* Removes the scratch root. Returns 0, or -1. */
+int gl_scratch_remove(void);
 
 #endif
