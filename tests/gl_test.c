@@ -1,15 +1,43 @@
 #define _POSIX_C_SOURCE 200809L
-#include "gl_test.h"
-
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "gl_test.h"
+
+static lm_scene *cornell;
+static char scratch[256];
+
+static bool scratch_create(void) {
+  char real_root[1024], cmd[4096];
+  snprintf(real_root, sizeof real_root, "%s", lm_root_dir());
+  snprintf(scratch, sizeof scratch, "/tmp/limn-test-XXXXXX");
+  if (!mkdtemp(scratch)) return false;
+  snprintf(cmd, sizeof cmd, "mkdir -p %s/shaders && ln -s %s/shaders/* %s/shaders/ && ln -s %s/scripts %s/scripts",
+           scratch, real_root, scratch, real_root, scratch);
+  if (system(cmd) != 0) return false;
+  setenv("LIMN_ROOT", scratch, 1);
+  return true;
+}
+
 int gl_test_setup(void **state) {
   (void)state;
   lm_log_set_level(LM_LOG_WARN);
   lm_error err;
+  if (!scratch_create()) {
+    fprintf(stderr, "no scratch root in /tmp\n");
+    return -1;
+  }
+  if (!(cornell = lm_scene_builtin("cornell", &err))) {
+    fprintf(stderr, "%s\n", err.msg);
+    return -1;
+  }
   if (!lm_context_create_headless(&(lm_context_desc){0}, &err)) {
     fprintf(stderr, "no OpenGL context: %s\n", err.msg);
     return -1;
@@ -19,9 +47,24 @@ int gl_test_setup(void **state) {
 
 int gl_test_teardown(void **state) {
   (void)state;
+  lm_scene_destroy(cornell); /* its GL buffers go before the context */
+  cornell = NULL;
   lm_programs_clear();
   lm_context_destroy();
-  return 0;
+  char cmd[300];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", scratch);
+  return system(cmd) == 0 ? 0 : -1;
+}
+
+lm_scene *gl_cornell(void) { return cornell; }
+
+bool gl_write_file(const char *rel, const char *text) {
+  char path[512];
+  snprintf(path, sizeof path, "%s/%s", scratch, rel);
+  FILE *f = fopen(path, "w");
+  if (!f) return false;
+  bool ok = fputs(text, f) >= 0;
+  return fclose(f) == 0 && ok;
 }
 
 static bool read_output(gl_result *r) {
@@ -51,9 +94,9 @@ gl_result gl_render(const gl_run *run) {
   if (run->tech && !lm_pipeline_set_technique(r.pipeline, run->tech, &r.err)) return r;
   for (const char *const *s = run->sets; s && *s; s++)
     if (!gl_set(&r, *s)) return r;
-  r.renderer = lm_renderer_create(&(lm_renderer_desc){.scene = run->scene, .pipeline = r.pipeline,
-                                                      .width = r.width, .height = r.height,
-                                                      .linear_output = true,
+  r.renderer = lm_renderer_create(&(lm_renderer_desc){.scene = run->scene ? run->scene : cornell,
+                                                      .pipeline = r.pipeline, .width = r.width,
+                                                      .height = r.height, .linear_output = true,
                                                       .check_finite = run->check_finite}, &r.err);
   if (!r.renderer) return r;
   r.rgb = malloc(sizeof(float) * 3 * (size_t)r.width * (size_t)r.height);
@@ -156,36 +199,13 @@ void gl_mean_around(const gl_result *r, float x, float y, float z, int radius, f
   gl_region(r, col - radius, row - radius, col + radius, row + radius, out);
 }
 
-/* ---- the scratch root ---------------------------------------------------- */
-static char scratch[256];
-
-int gl_scratch_create(void) {
-  char real_root[1024], cmd[4096];
-  snprintf(real_root, sizeof real_root, "%s", lm_root_dir());
-  snprintf(scratch, sizeof scratch, "/tmp/limn-test-XXXXXX");
-  if (!mkdtemp(scratch)) return -1;
-  snprintf(cmd, sizeof cmd, "mkdir -p %s/shaders && ln -s %s/shaders/* %s/shaders/ && ln -s %s/scripts %s/scripts",
-           scratch, real_root, scratch, real_root, scratch);
-  if (system(cmd) != 0) return -1;
-  setenv("LIMN_ROOT", scratch, 1);
-  return 0;
-}
-
-const char *gl_scratch_root(void) { return scratch; }
-
-bool gl_write_file(const char *rel, const char *text) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/%s", scratch, rel);
-  FILE *f = fopen(path, "w");
-  if (!f) return false;
-  bool ok = fputs(text, f) >= 0;
-  return fclose(f) == 0 && ok;
-}
-
-int gl_scratch_remove(void) {
-  if (!scratch[0]) return 0;
-  char cmd[300];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", scratch);
-  scratch[0] = '\0';
-  return system(cmd) == 0 ? 0 : -1;
+void gl_assert_bad_options(const gl_bad_option *cases, size_t n, const char *where) {
+  for (size_t i = 0; i < n; i++) {
+    const char *sets[] = {cases[i].set, NULL};
+    gl_result r = gl_render(&(gl_run){.tech = cases[i].tech, .sets = sets});
+    if (r.ok) fail_msg("%s: rendered", cases[i].set);
+    if (!strstr(r.err.msg, cases[i].expect) || !strstr(r.err.msg, where))
+      fail_msg("%s: '%s'", cases[i].set, r.err.msg);
+    gl_result_free(&r);
+  }
 }

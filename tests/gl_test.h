@@ -1,14 +1,14 @@
-/* Shared by the GL tests: a headless context and frames of a pipeline script
- * over a scene, kept open so a test can look at any target afterwards; where
- * the Cornell box's camera sees a world point; a scratch engine root for
- * test shaders and scripts. */
+/* Shared by the GL tests: a headless context, the built-in Cornell box and a
+ * scratch engine root for test shaders and scripts; frames of a pipeline
+ * script over a scene, kept open so a test can look at any target
+ * afterwards; where the box's camera sees a world point; option errors. */
 #ifndef LIMN_GL_TEST_H
 #define LIMN_GL_TEST_H
 
 #include "render/render.h"
 
 typedef struct gl_run {
-  lm_scene *scene;          /* borrowed */
+  lm_scene *scene;          /* borrowed; NULL: gl_cornell() */
   const char *script;       /* NULL: scripts/pp.lua; a relative path is under the root (LIMN_ROOT) */
   const char *tech;         /* NULL: the script's default */
   const char *const *sets;  /* "name=value" options, NULL-terminated (may be NULL) */
@@ -27,9 +27,16 @@ typedef struct gl_result {
   lm_renderer *renderer;    /* still open: lm_renderer_graph() shows the last frame */
 } gl_result;
 
-/* Makes the context (fails the test run when there is none). */
+/* Makes the context (fails the test run when there is none), the Cornell
+ * box and a scratch engine root in /tmp: the real shaders linked in one by
+ * one (so a test can add its own) and scripts/ linked whole; LIMN_ROOT
+ * points at it from then on. A cmocka group setup; teardown undoes it. */
 int gl_test_setup(void **state);
 int gl_test_teardown(void **state);
+/* The built-in Cornell box (a test that changes it puts it back). */
+lm_scene *gl_cornell(void);
+/* Writes text to the file `rel` under the scratch root; false when it cannot. */
+bool gl_write_file(const char *rel, const char *text);
 gl_result gl_render(const gl_run *run);
 /* Sets a "name=value" option for the next frame; false with the message in r->err. */
 bool gl_set(gl_result *r, const char *assignment);
@@ -61,15 +68,13 @@ void gl_project(int width, int height, float x, float y, float z, int *col, int 
 /* Mean linear RGB of the (2 radius + 1)^2 pixels around a world point of the box. */
 void gl_mean_around(const gl_result *r, float x, float y, float z, int radius, float out[3]);
 
-/* A scratch engine root in /tmp: the real shaders linked in one by one (so
- * a test can add its own) and scripts/ linked whole. LIMN_ROOT points at it
- * from then on. Returns 0, or -1 (for a cmocka setup). */
-int gl_scratch_create(void);
-/* The scratch root's path ("" before gl_scratch_create). */
-const char *gl_scratch_root(void);
-/* Writes text to the file `rel` under the scratch root; false when it cannot. */
-bool gl_write_file(const char *rel, const char *text);
-/* Removes the scratch root. Returns 0, or -1. */
-int gl_scratch_remove(void);
+/* An option that must stop the frame: `set` alone with technique `tech` of
+ * pp.lua fails with a message holding `expect`. */
+typedef struct gl_bad_option {
+  const char *tech, *set, *expect;
+} gl_bad_option;
+/* Fails the test unless each case fails so and its message also holds
+ * `where` (the line to blame, "pp.lua:" say). */
+void gl_assert_bad_options(const gl_bad_option *cases, size_t n, const char *where);
 
 #endif

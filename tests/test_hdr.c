@@ -22,7 +22,6 @@ enum { W = 256, H = 192 };
 
 /* Scripts, relative to the scratch root. */
 static const char image_lua[] = "image.lua", pp_lua[] = "scripts/pp.lua";
-static lm_scene *cornell;
 
 /* A grey test image: PATTERN 0 is three bands of rows (bottom lo, middle
  * mid, top hi, 64 rows each at 256x192), PATTERN 1 is `fill` everywhere;
@@ -59,26 +58,15 @@ static const char *image_script =
     "end\n";
 
 static int setup(void **state) {
-  if (gl_scratch_create() != 0 || !gl_write_file("shaders/test_image.frag", image_frag) ||
-      !gl_write_file("image.lua", image_script))
-    return -1;
-  lm_error err;
-  cornell = lm_scene_builtin("cornell", &err);
-  return cornell ? gl_test_setup(state) : -1;
-}
-
-static int teardown(void **state) {
-  lm_scene_destroy(cornell);
-  gl_test_teardown(state);
-  return gl_scratch_remove();
+  if (gl_test_setup(state) != 0) return -1;
+  return gl_write_file("shaders/test_image.frag", image_frag) && gl_write_file("image.lua", image_script) ? 0 : -1;
 }
 
 /* ---- running a pipeline ------------------------------------------------ */
 /* The first frame of `script` with technique `tech` (NULL: the default) and
  * "name=value" options; the test fails when it does not render. */
 static gl_result start(const char *script, const char *tech, const char *const *sets) {
-  gl_result r = gl_render(&(gl_run){.scene = cornell, .script = script, .tech = tech, .sets = sets,
-                                    .width = W, .height = H});
+  gl_result r = gl_render(&(gl_run){.script = script, .tech = tech, .sets = sets, .width = W, .height = H});
   if (!r.ok) fail_msg("%s", r.err.msg);
   return r;
 }
@@ -350,6 +338,7 @@ static void motion_blur_follows_the_camera(void **state) {
   free(blurred_still);
   free(still);
   float *img[2];
+  lm_scene *cornell = gl_cornell();
   int cam = cornell->cameras[0].node;
   float x0 = cornell->nodes[cam].local[12];
   for (int k = 0; k < 2; k++) {
@@ -487,24 +476,14 @@ static void an_effect_off_records_no_pass(void **state) {
 /* Bad values stop the frame with the option's name and what it must be. */
 static void bad_options_name_themselves(void **state) {
   (void)state;
-  static const struct {
-    const char *set, *expect;
-  } cases[] = {
-      {"dof.mode=pinhole", "dof.mode must be one of range, lens (got pinhole)"},
-      {"bloom.radius=2.5", "bloom.radius must be a whole number in 0..32 (got 2.5)"},
-      {"hdr.white=0", "hdr.white must be a number in (0, 1e+06] (got 0)"},
-      {"sepia.strength=2", "sepia.strength must be a finite number in 0..1 (got 2)"},
-      {"bloom.downsample=3", "bloom.downsample must be one of 1, 2, 4 (got 3)"},
+  static const gl_bad_option cases[] = {
+      {"dl", "dof.mode=pinhole", "dof.mode must be one of range, lens (got pinhole)"},
+      {"dl", "bloom.radius=2.5", "bloom.radius must be a whole number in 0..32 (got 2.5)"},
+      {"dl", "hdr.white=0", "hdr.white must be a number in (0, 1e+06] (got 0)"},
+      {"dl", "sepia.strength=2", "sepia.strength must be a finite number in 0..1 (got 2)"},
+      {"dl", "bloom.downsample=3", "bloom.downsample must be one of 1, 2, 4 (got 3)"},
   };
-  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
-    const char *sets[] = {cases[i].set, NULL};
-    gl_result r = gl_render(&(gl_run){.scene = cornell, .script = pp_lua, .tech = "dl", .sets = sets,
-                                      .width = W, .height = H});
-    if (r.ok) fail_msg("%s: rendered", cases[i].set);
-    if (!strstr(r.err.msg, cases[i].expect) || !strstr(r.err.msg, ".lua:"))
-      fail_msg("%s: '%s'", cases[i].set, r.err.msg);
-    gl_result_free(&r);
-  }
+  gl_assert_bad_options(cases, sizeof cases / sizeof *cases, ".lua:");
   gl_result r = start(pp_lua, "dl", NULL);
   assert_false(gl_set(&r, "bloom.nope=1"));
   assert_non_null(strstr(r.err.msg, "bloom.threshold"));
@@ -525,5 +504,5 @@ int main(void) {
       cmocka_unit_test(an_effect_off_records_no_pass),
       cmocka_unit_test(bad_options_name_themselves),
   };
-  return cmocka_run_group_tests(tests, setup, teardown);
+  return cmocka_run_group_tests(tests, setup, gl_test_teardown);
 }

@@ -17,23 +17,10 @@
 
 enum { W = 256, H = 192 };
 
-static lm_scene *scene;
-
-static int setup(void **state) {
-  lm_error err;
-  scene = lm_scene_builtin("cornell", &err);
-  return scene ? gl_test_setup(state) : -1;
-}
-
-static int teardown(void **state) {
-  lm_scene_destroy(scene);
-  return gl_test_teardown(state);
-}
-
 /* Renders one frame of pp.lua with technique `tech` and "name=value" options
  * (NULL-terminated); r.ok false with the message in r.err. */
 static gl_result render(const char *tech, const char *const *sets) {
-  return gl_render(&(gl_run){.scene = scene, .tech = tech, .sets = sets, .width = W, .height = H});
+  return gl_render(&(gl_run){.tech = tech, .sets = sets, .width = W, .height = H});
 }
 
 static gl_result render_ok(const char *tech, const char *const *sets) {
@@ -127,25 +114,16 @@ static void extreme_parameters_stay_finite(void **state) {
 /* Out-of-range options stop the frame with the option's name. */
 static void bad_options_name_themselves(void **state) {
   (void)state;
-  static const struct {
-    const char *set, *expect;
-  } cases[] = {
-      {"isr.samples=0", "isr.samples must be a whole number in 1..256 (got 0)"},
-      {"isr.samples=2.5", "isr.samples must be"},
-      {"isr.coarse=3", "isr.coarse must be one of 1, 2, 4"},
-      {"isr.radius=0", "isr.radius must be a positive"},
-      {"isr.k_ssao=-1", "isr.k_ssao must be a finite number in 0..1"},
-      {"isr.sender=sun", "isr.sender must be one of albedo, lit (got sun)"},
-      {"isr.bounces=5", "isr.bounces must be"},
+  static const gl_bad_option cases[] = {
+      {"isr", "isr.samples=0", "isr.samples must be a whole number in 1..256 (got 0)"},
+      {"isr", "isr.samples=2.5", "isr.samples must be"},
+      {"isr", "isr.coarse=3", "isr.coarse must be one of 1, 2, 4"},
+      {"isr", "isr.radius=0", "isr.radius must be a positive"},
+      {"isr", "isr.k_ssao=-1", "isr.k_ssao must be a finite number in 0..1"},
+      {"isr", "isr.sender=sun", "isr.sender must be one of albedo, lit (got sun)"},
+      {"isr", "isr.bounces=5", "isr.bounces must be"},
   };
-  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
-    const char *sets[] = {cases[i].set, NULL};
-    gl_result r = render("isr", sets);
-    if (r.ok) fail_msg("%s: rendered", cases[i].set);
-    if (!strstr(r.err.msg, cases[i].expect) || !strstr(r.err.msg, "pp.lua:"))
-      fail_msg("%s: '%s'", cases[i].set, r.err.msg);
-    gl_result_free(&r);
-  }
+  gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
 }
 
 static void dl_records_no_isr_pass(void **state) {
@@ -167,5 +145,5 @@ int main(void) {
       cmocka_unit_test(bad_options_name_themselves),
       cmocka_unit_test(dl_records_no_isr_pass),
   };
-  return cmocka_run_group_tests(tests, setup, teardown);
+  return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

@@ -17,28 +17,17 @@
 
 enum { W = 256, H = 192 };
 
-static char real_root[1024];
-static lm_scene *cornell;
+static char real_root[1024]; /* the tree's, before the scratch root takes over */
 static bool check_finite; /* render() with the NaN/Inf check */
 
-/* A scratch engine root (the real shaders and scripts linked in) for test files. */
 static int setup(void **state) {
   snprintf(real_root, sizeof real_root, "%s", lm_root_dir());
-  if (gl_scratch_create() != 0) return -1;
-  lm_error err;
-  cornell = lm_scene_builtin("cornell", &err);
-  return cornell ? gl_test_setup(state) : -1;
-}
-
-static int teardown(void **state) {
-  lm_scene_destroy(cornell);
-  gl_test_teardown(state);
-  return gl_scratch_remove();
+  return gl_test_setup(state);
 }
 
 
 static gl_result render(const char *script, const char *tech, int frames) {
-  return gl_render(&(gl_run){.scene = cornell, .script = script, .tech = tech, .frames = frames,
+  return gl_render(&(gl_run){.script = script, .tech = tech, .frames = frames,
                              .width = W, .height = H, .check_finite = check_finite});
 }
 
@@ -183,6 +172,7 @@ static void no_nan_or_inf_leaves_the_output_stage(void **state) {
   assert_false(fr.ok);
   if (!strstr(fr.err.msg, "poison.lua:3: pass 'poison' wrote NaN to target 'p' at pixel (0, 0)"))
     fail_msg("%s", fr.err.msg);
+  gl_result_free(&fr);
 }
 
 static void textures_are_pooled_across_frames(void **state) {
@@ -219,5 +209,5 @@ int main(void) {
       cmocka_unit_test(no_nan_or_inf_leaves_the_output_stage),
       cmocka_unit_test(textures_are_pooled_across_frames),
   };
-  return cmocka_run_group_tests(tests, setup, teardown);
+  return cmocka_run_group_tests(tests, setup, gl_test_teardown);
 }

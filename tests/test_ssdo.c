@@ -20,8 +20,6 @@
 
 enum { W = 256, H = 192 };
 
-static lm_scene *scene;
-
 /* The synthetic step: left of column EDGE at depth 0.2 (of far), right at
  * 0.4, normals toward the eye, and a signal of 0.2 left and 0.8 right with
  * +-0.1 of hash noise. With COARSE it writes only the signal, for a pass at
@@ -75,27 +73,17 @@ static const char step_lua[] =
     "  end\n"
     "end\n";
 
-/* A scratch engine root with the step's shader and script. */
+/* The step's shader and script in the scratch root. */
 static int setup(void **state) {
-  if (gl_scratch_create() != 0 || !gl_write_file("shaders/step.frag", step_frag) ||
-      !gl_write_file("step.lua", step_lua))
-    return -1;
-  lm_error err;
-  scene = lm_scene_builtin("cornell", &err);
-  return scene ? gl_test_setup(state) : -1;
-}
-
-static int teardown(void **state) {
-  lm_scene_destroy(scene);
-  gl_test_teardown(state);
-  return gl_scratch_remove();
+  if (gl_test_setup(state) != 0) return -1;
+  return gl_write_file("shaders/step.frag", step_frag) && gl_write_file("step.lua", step_lua) ? 0 : -1;
 }
 
 /* Renders one frame of `script` (relative to the scratch root) with
  * technique `tech` and "name=value" options (NULL-terminated); r.ok false
  * with the message in r.err. */
 static gl_result render_script(const char *script, const char *tech, const char *const *sets) {
-  return gl_render(&(gl_run){.scene = scene, .script = script, .tech = tech, .sets = sets, .width = W, .height = H});
+  return gl_render(&(gl_run){.script = script, .tech = tech, .sets = sets, .width = W, .height = H});
 }
 
 static gl_result render(const char *tech, const char *const *sets) {
@@ -278,6 +266,7 @@ static void rotation_beats_raw_pattern(void **state) {
  * the merged variant should match the original two-step one. */
 static void variants_agree_under_white_light(void **state) {
   (void)state;
+  lm_scene *scene = gl_cornell();
   float saved[3];
   memcpy(saved, scene->lights[0].color, sizeof saved);
   scene->lights[0].color[0] = scene->lights[0].color[1] = scene->lights[0].color[2] = 1.0f;
@@ -368,9 +357,7 @@ static void extreme_parameters_stay_finite(void **state) {
  * pipeline's line. */
 static void bad_options_name_themselves(void **state) {
   (void)state;
-  static const struct {
-    const char *tech, *set, *expect;
-  } cases[] = {
+  static const gl_bad_option cases[] = {
       {"ssdo", "ssdo.samples=25", "ssdo.samples must be a multiple of 10 in 10..300 (got 25)"},
       {"ssdo", "ssdo.samples=0", "ssdo.samples must be"},
       {"ssdo", "ssdo.variant=three", "ssdo.variant must be one of merged, two_step (got three)"},
@@ -384,14 +371,7 @@ static void bad_options_name_themselves(void **state) {
       {"ssao", "ssao.tolerance=-1", "ssao.tolerance must be a finite number in"},
       {"ssao", "ssao.samples=15", "ssao.samples must be a multiple of 10"},
   };
-  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
-    const char *sets[] = {cases[i].set, NULL};
-    gl_result r = render(cases[i].tech, sets);
-    if (r.ok) fail_msg("%s: rendered", cases[i].set);
-    if (!strstr(r.err.msg, cases[i].expect) || !strstr(r.err.msg, "pp.lua:"))
-      fail_msg("%s: '%s'", cases[i].set, r.err.msg);
-    gl_result_free(&r);
-  }
+  gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
   /* Two options that only conflict together. */
   const char *both[] = {"ssdo.variant=two_step", "ssdo.resolution=2", NULL};
   gl_result r = render("ssdo", both);
@@ -432,5 +412,5 @@ int main(void) {
       cmocka_unit_test(bad_options_name_themselves),
       cmocka_unit_test(dl_records_no_gi_pass),
   };
-  return cmocka_run_group_tests(tests, setup, teardown);
+  return cmocka_run_group_tests(tests, setup, gl_test_teardown);
 }
