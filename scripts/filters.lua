@@ -7,8 +7,8 @@
 --   filters.upsample 3 x 3 joint bilateral upsampling (upsample.frag) from
 --                    1/2 or 1/4 of the output to full size
 -- Both take one target or a pair (filtered with the same weights through
--- two outputs) and return as many.
-local check = require "check"
+-- two outputs) and return as many. filters.smooth does both for an effect.
+local options = require "options"
 
 local filters = {}
 
@@ -20,15 +20,18 @@ filters.defaults = {
   sigma_normal = 0.2,   -- 1 - cos(angle) between normals of sigma, > 0
 }
 
--- Checks the filter fields of an effect's checked options c; errors name
--- "<prefix>.<field>" and blame `level` (counted from the caller).
-function filters.check(c, prefix, level)
-  local l = level + 1
-  check.need(check.whole(c.blur, 1, 65) and c.blur % 2 == 1,
-             prefix .. ".blur must be an odd whole number in 1..65 (the kernel's side)", c.blur, l)
-  for _, k in ipairs{ "sigma_space", "sigma_depth", "sigma_normal" } do
-    check.need(check.within(c[k], 1e-6, 1e6), prefix .. "." .. k .. " must be in 1e-6..1e6", c[k], l)
-  end
+local rules = {
+  blur = options.odd(1, 65),
+  sigma_space = options.number(1e-6, 1e6),
+  sigma_depth = options.number(1e-6, 1e6),
+  sigma_normal = options.number(1e-6, 1e6),
+}
+
+-- Adds the filter options to an effect's defaults and their rules to its
+-- rules (for options.check).
+function filters.expose(defaults, effect_rules)
+  for k, v in pairs(filters.defaults) do defaults[k] = v end
+  for k, r in pairs(rules) do effect_rules[k] = r end
 end
 
 local function list_of(src)
@@ -70,6 +73,17 @@ function filters.upsample(src, G, o)
         params = { factor = o.factor, sigma_depth = o.sigma_depth, sigma_normal = o.sigma_normal },
         defines = { PAIR = #list == 2 }, out = outs }
   return table.unpack(outs)
+end
+
+-- Blurs src (a target or {a, b}) at 1/factor of G's size and brings it to
+-- full size, with the filter fields of an effect's checked options o.
+-- Passes and targets are named "<prefix>.blur_x" ... and "<prefix>.upsample".
+function filters.smooth(src, G, o, prefix, format, factor)
+  local fo = { name = prefix .. ".blur", format = format, factor = factor, blur = o.blur,
+               sigma_space = o.sigma_space, sigma_depth = o.sigma_depth, sigma_normal = o.sigma_normal }
+  local blurred = { filters.blur(src, G, fo) }
+  fo.name = prefix .. ".upsample"
+  return filters.upsample(blurred, G, fo)
 end
 
 return filters

@@ -1,11 +1,13 @@
 -- Checking an effect's options against its defaults and rules, shared by the
--- effect modules (bloom.lua, dof.lua, hdr.lua ...). Errors name the option
--- ("dof.focus must be ...") and point at the code that called the effect.
+-- effect modules (isr.lua, ssdo.lua, bloom.lua, dof.lua ...). Errors name the
+-- option ("dof.focus must be ...") and point at the code that called the effect.
 local options = {}
 
 local function finite(v) return type(v) == "number" and v == v and v > -math.huge and v < math.huge end
 
--- Rules: each returns nil when v is fine, else what v must be.
+-- Rules: each returns nil when v is fine, else what v must be. A rule gets
+-- the option's value v and all the checked options c, for rules that join
+-- two options (see ssdo.lua's resolution).
 function options.number(lo, hi) -- lo <= v <= hi, finite
   return function(v)
     if not (finite(v) and v >= lo and v <= hi) then
@@ -14,18 +16,31 @@ function options.number(lo, hi) -- lo <= v <= hi, finite
   end
 end
 
-function options.positive(hi) -- 0 < v <= hi
-  hi = hi or 1e30
+function options.positive(hi) -- 0 < v <= hi, finite; no bound without hi
   return function(v)
-    if not (finite(v) and v > 0 and v <= hi) then return string.format("a number in (0, %g]", hi) end
+    if not (finite(v) and v > 0 and v <= (hi or math.huge)) then
+      return hi and string.format("a number in (0, %g]", hi) or "a positive finite number"
+    end
   end
 end
 
+local function whole(v, lo, hi) return finite(v) and v == math.floor(v) and v >= lo and v <= hi end
+
 function options.whole(lo, hi)
   return function(v)
-    if not (finite(v) and v == math.floor(v) and v >= lo and v <= hi) then
-      return string.format("a whole number in %d..%d", lo, hi)
-    end
+    if not whole(v, lo, hi) then return string.format("a whole number in %d..%d", lo, hi) end
+  end
+end
+
+function options.multiple(m, lo, hi) -- a whole multiple of m in lo..hi
+  return function(v)
+    if not (whole(v, lo, hi) and v % m == 0) then return string.format("a multiple of %d in %d..%d", m, lo, hi) end
+  end
+end
+
+function options.odd(lo, hi)
+  return function(v)
+    if not (whole(v, lo, hi) and v % 2 == 1) then return string.format("an odd whole number in %d..%d", lo, hi) end
   end
 end
 
@@ -42,8 +57,9 @@ function options.one_of(...)
 end
 
 -- A copy of `defaults` with the fields of `o` over it, checked by `rules`
--- (field -> rule; every default needs one). `name` prefixes messages; `level`
--- is how many calls up the effect's caller is (1: whoever called check).
+-- (field -> a rule, or a list of rules tried in order; a field without one is
+-- checked by what it is passed to). `name` prefixes messages; `level` is how
+-- many calls up the effect's caller is (1: whoever called check).
 function options.check(name, defaults, o, rules, level)
   level = (level or 1) + 1
   o = o or {}
@@ -64,8 +80,11 @@ function options.check(name, defaults, o, rules, level)
   for k in pairs(rules) do keys[#keys + 1] = k end
   table.sort(keys) -- the same option is reported first every run
   for _, k in ipairs(keys) do
-    local want = rules[k](c[k])
-    if want then error(string.format("%s.%s must be %s (got %s)", name, k, want, tostring(c[k])), level) end
+    local list = type(rules[k]) == "table" and rules[k] or { rules[k] }
+    for _, rule in ipairs(list) do
+      local want = rule(c[k], c)
+      if want then error(string.format("%s.%s must be %s (got %s)", name, k, want, tostring(c[k])), level) end
+    end
   end
   return c
 end

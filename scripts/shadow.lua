@@ -3,6 +3,8 @@
 -- cube faces for a point light, all in one atlas); this module records the
 -- passes: depth from each light, then for ESM a separable blur in log space.
 -- Lighting shaders read the atlas through shaders/shadow.glsl.
+local options = require "options"
+
 local shadow = {}
 
 -- The options a pipeline exposes (pp.lua's Options.shadow), with defaults.
@@ -22,15 +24,13 @@ shadow.defaults = {
   debug = false,      -- present the shadow atlas instead of the image
 }
 
-local techniques = { esm = true, pcf = true, poisson = true, hard = true }
+-- shadow_plan{} checks the rest (engine/script/script_api.c).
+local rules = { technique = options.one_of("esm", "pcf", "poisson", "hard") }
 
 -- Records the shadow passes. Returns the atlas a lighting pass reads as
 -- `shadow_atlas`, or nil when no light casts shadows (nothing is recorded).
 function shadow.render(o)
-  o = o or {}
-  if o.technique ~= nil and not techniques[o.technique] then
-    error("shadow.technique must be esm, pcf, poisson or hard (got " .. tostring(o.technique) .. ")", 2)
-  end
+  o = options.check("shadow", shadow.defaults, o, rules, 2)
   local settings = {}
   for k, v in pairs(o) do
     if k ~= "debug" then settings[k] = v end

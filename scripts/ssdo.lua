@@ -17,7 +17,7 @@
 -- samples a pixel and `samples` is not used.
 local gbuffer = require "gbuffer"
 local filters = require "filters"
-local check = require "check"
+local options = require "options"
 
 local ssdo = {}
 
@@ -31,34 +31,29 @@ ssdo.defaults = {
   resolution = 1,      -- computed at 1/resolution a side: 1, 2 or 4 (merged only)
   interleave = 4,      -- per-pixel rotation tile side: 1 (none), 2 or 4
 }
-for k, v in pairs(filters.defaults) do ssdo.defaults[k] = v end
 
-local function checked(o)
-  local c = check.options(o, ssdo.defaults, "ssdo", 3)
-  local L = 3
-  check.need(c.variant == "merged" or c.variant == "two_step",
-             'ssdo.variant must be "merged" or "two_step"', c.variant, L)
-  check.need(check.whole(c.samples, 10, 300) and c.samples % 10 == 0,
-             "ssdo.samples must be a multiple of 10 in 10..300", c.samples, L)
-  check.need(type(c.adaptive) == "boolean", "ssdo.adaptive must be true or false", c.adaptive, L)
-  check.need(check.within(c.r_max, 1e-6, 1e6), "ssdo.r_max must be in 1e-6..1e6 (world units)", c.r_max, L)
-  check.need(check.within(c.bounce, 0, 100), "ssdo.bounce must be in 0..100", c.bounce, L)
-  check.need(check.within(c.lobe, 1, 64), "ssdo.lobe must be in 1..64", c.lobe, L)
-  check.need(c.resolution == 1 or c.resolution == 2 or c.resolution == 4,
-             "ssdo.resolution must be 1, 2 or 4", c.resolution, L)
-  check.need(c.variant == "merged" or c.resolution == 1,
-             'ssdo.resolution must be 1 with variant "two_step" (it computes intensities)', c.resolution, L)
-  check.need(c.interleave == 1 or c.interleave == 2 or c.interleave == 4,
-             "ssdo.interleave must be 1, 2 or 4", c.interleave, L)
-  filters.check(c, "ssdo", L)
-  return c
-end
+local rules = {
+  variant = options.one_of("merged", "two_step"),
+  samples = options.multiple(10, 10, 300),
+  adaptive = options.boolean,
+  r_max = options.number(1e-6, 1e6),
+  bounce = options.number(0, 100),
+  lobe = options.number(1, 64),
+  resolution = {
+    options.one_of(1, 2, 4),
+    function(v, c) -- the two-step variant computes intensities, which do not survive subsampling
+      if c.variant == "two_step" and v ~= 1 then return '1 with variant "two_step" (it computes intensities)' end
+    end,
+  },
+  interleave = options.one_of(1, 2, 4),
+}
+filters.expose(ssdo.defaults, rules)
 
 -- Records SSDO for G lit by `lit` with options o (see ssdo.defaults) and
 -- light = { ambient = {r, g, b} } (the two-step variant relights ambient).
 -- Returns the result, a full-size rgba16f target "ssdo.lit".
 function ssdo.render(G, lit, o, light)
-  o = checked(o)
+  o = options.check("ssdo", ssdo.defaults, o, rules, 2)
   local f, merged = o.resolution, o.variant == "merged"
   local edges
   if o.adaptive then
@@ -88,11 +83,7 @@ function ssdo.render(G, lit, o, light)
               defines = { BOUNCE = true, ADAPTIVE = o.adaptive },
               out = target{ "ssdo.indirect", format = "rgba16f" } }
   end
-  local fo = { name = "ssdo.blur", format = "rgba16f", factor = f, blur = o.blur, sigma_space = o.sigma_space,
-               sigma_depth = o.sigma_depth, sigma_normal = o.sigma_normal }
-  a, b = filters.blur({ a, b }, G, fo)
-  fo.name = "ssdo.upsample"
-  a, b = filters.upsample({ a, b }, G, fo)
+  a, b = filters.smooth({ a, b }, G, o, "ssdo", "rgba16f", f)
   return pass{ "ssdo.apply", shader = "gi_apply.frag", inputs = { lit = lit, mat = G.mat, a = a, b = b },
                defines = { MERGED = merged, TWO_STEP = not merged },
                out = target{ "ssdo.lit", format = "rgba16f" } }

@@ -16,21 +16,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/render.h"
+#include "gl_test.h"
 
 enum { W = 256, H = 192 };
 
-static char root[256], image_lua[512], pp_lua[512];
-static lm_scene *cornell;
-
-static void write_file(const char *rel, const char *text) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/%s", root, rel);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  fputs(text, f);
-  fclose(f);
-}
+/* Scripts, relative to the scratch root. */
+static const char image_lua[] = "image.lua", pp_lua[] = "scripts/pp.lua";
 
 /* A grey test image: PATTERN 0 is three bands of rows (bottom lo, middle
  * mid, top hi, 64 rows each at 256x192), PATTERN 1 is `fill` everywhere;
@@ -67,90 +58,33 @@ static const char *image_script =
     "end\n";
 
 static int setup(void **state) {
-  (void)state;
-  char real_root[1024];
-  snprintf(real_root, sizeof real_root, "%s", lm_root_dir());
-  snprintf(root, sizeof root, "/tmp/limn-hdr-XXXXXX");
-  if (!mkdtemp(root)) return -1;
-  char cmd[4096];
-  snprintf(cmd, sizeof cmd, "mkdir -p %s/shaders && ln -s %s/shaders/* %s/shaders/ && ln -s %s/scripts %s/scripts",
-           root, real_root, root, real_root, root);
-  if (system(cmd) != 0) return -1;
-  setenv("LIMN_ROOT", root, 1);
-  write_file("shaders/test_image.frag", image_frag);
-  write_file("image.lua", image_script);
-  snprintf(image_lua, sizeof image_lua, "%s/image.lua", root);
-  snprintf(pp_lua, sizeof pp_lua, "%s/scripts/pp.lua", root);
-  lm_log_set_level(LM_LOG_WARN);
-  lm_error err;
-  if (!lm_context_create_headless(&(lm_context_desc){0}, &err)) {
-    fprintf(stderr, "no GL context: %s\n", err.msg);
-    return -1;
-  }
-  cornell = lm_scene_builtin("cornell", &err);
-  return cornell ? 0 : -1;
-}
-
-static int teardown(void **state) {
-  (void)state;
-  lm_programs_clear();
-  lm_scene_destroy(cornell);
-  lm_context_destroy();
-  char cmd[300];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", root);
-  return system(cmd);
+  if (gl_test_setup(state) != 0) return -1;
+  return gl_write_file("shaders/test_image.frag", image_frag) && gl_write_file("image.lua", image_script) ? 0 : -1;
 }
 
 /* ---- running a pipeline ------------------------------------------------ */
-typedef struct run {
-  lm_pipeline *pipeline;
-  lm_renderer *renderer;
-  float *out; /* W*H*3, the output stage's linear copy, top row first */
-} run;
-
-static void set(run *r, const char *assignment) {
-  char name[128];
-  const char *eq = strchr(assignment, '=');
-  assert_non_null(eq);
-  snprintf(name, sizeof name, "%.*s", (int)(eq - assignment), assignment);
-  lm_error err;
-  if (!lm_pipeline_set_option(r->pipeline, name, eq + 1, &err)) fail_msg("%s", err.msg);
-}
-
-static run start(const char *script, const char *tech, const char *const *sets) {
-  run r = {0};
-  lm_error err;
-  r.pipeline = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, &err);
-  if (!r.pipeline) fail_msg("%s", err.msg);
-  if (tech && !lm_pipeline_set_technique(r.pipeline, tech, &err)) fail_msg("%s", err.msg);
-  for (; sets && *sets; sets++) set(&r, *sets);
-  r.renderer = lm_renderer_create(&(lm_renderer_desc){.scene = cornell, .pipeline = r.pipeline, .width = W,
-                                                      .height = H, .linear_output = true}, &err);
-  assert_non_null(r.renderer);
-  r.out = malloc(sizeof(float) * W * H * 3);
-  assert_non_null(r.out);
+/* The first frame of `script` with technique `tech` (NULL: the default) and
+ * "name=value" options; the test fails when it does not render. */
+static gl_result start(const char *script, const char *tech, const char *const *sets) {
+  gl_result r = gl_render(&(gl_run){.script = script, .tech = tech, .sets = sets, .width = W, .height = H});
+  if (!r.ok) fail_msg("%s", r.err.msg);
   return r;
 }
 
-static void frame(run *r) {
-  lm_error err;
-  if (!lm_renderer_frame(r->renderer, &err)) fail_msg("%s", err.msg);
-  assert_true(lm_renderer_read(r->renderer, true, r->out, &err));
+static void set(gl_result *r, const char *assignment) {
+  if (!gl_set(r, assignment)) fail_msg("%s", r->err.msg);
 }
 
-static void stop(run *r) {
-  lm_renderer_destroy(r->renderer);
-  lm_pipeline_destroy(r->pipeline);
-  free(r->out);
+static void frame(gl_result *r) {
+  if (!gl_render_again(r)) fail_msg("%s", r->err.msg);
 }
 
-/* One frame; returns the linear output (the caller frees it). */
+/* One frame; returns the linear output, W*H*3 top row first (the caller frees it). */
 static float *render_once(const char *script, const char *tech, const char *const *sets) {
-  run r = start(script, tech, sets);
-  frame(&r);
-  float *out = r.out;
-  r.out = NULL;
-  stop(&r);
+  gl_result r = start(script, tech, sets);
+  float *out = r.rgb;
+  r.rgb = NULL;
+  gl_result_free(&r);
   return out;
 }
 
@@ -245,11 +179,10 @@ static void adaptation_converges_to_the_key_at_its_rate(void **state) {
   (void)state;
   const double rate = 0.25;
   const char *sets[] = {"hdr=true", "hdr.white=1e6", "hdr.rate=0.25", NULL};
-  run r = start(image_lua, NULL, sets);
+  gl_result r = start(image_lua, NULL, sets);
   double v[3] = {0.25, 1, 4};
   double a = log_average(v, 1e-4); /* the first frame takes its average as is */
-  frame(&r);
-  float ld = at(r.out, 128, 96)[0];
+  float ld = at(r.rgb, 128, 96)[0];
   assert_true(fabs(ld / (1 - ld) / (0.18 * 1 / a) - 1) < 0.01);
   set(&r, "image.gain=8");
   for (int i = 0; i < 3; i++) v[i] *= 8;
@@ -257,7 +190,7 @@ static void adaptation_converges_to_the_key_at_its_rate(void **state) {
   for (int n = 1; n <= 16; n++) {
     a += (target - a) * rate;
     frame(&r);
-    ld = at(r.out, 128, 96)[0];
+    ld = at(r.rgb, 128, 96)[0];
     double l = ld / (1 - ld), want = 0.18 * 8 / a, gap = fabs(l - 0.18);
     if (n <= 4 || n == 16) print_message("frame %d: L %.5f expected %.5f (key 0.18)\n", n + 1, l, want);
     assert_true(fabs(l / want - 1) < 0.01);
@@ -265,7 +198,7 @@ static void adaptation_converges_to_the_key_at_its_rate(void **state) {
     last_gap = gap;
   }
   assert_true(last_gap < 0.01 * 0.18 * 2); /* 0.75^16 of the first gap */
-  stop(&r);
+  gl_result_free(&r);
 }
 
 /* ---- bloom ------------------------------------------------------------- */
@@ -305,12 +238,10 @@ static void bloom_spreads_one_bright_pixel_and_nothing_else(void **state) {
 }
 
 /* ---- depth of field ---------------------------------------------------- */
-/* Pixel of a world point for the box's camera (cornell.c: eye (0, 1, 3.4)
- * looking down -z, fov_y 45 degrees), from the bottom. */
+/* Pixel of a world point of the box, the row from the bottom as at() counts. */
 static void project(float x, float y, float z, int *col, int *row) {
-  float depth = 3.4f - z, t = tanf(0.5f * 45.0f * 3.14159265f / 180.0f), aspect = (float)W / H;
-  *col = (int)((x / (depth * t * aspect) + 1) * 0.5f * W);
-  *row = (int)(((y - 1) / (depth * t) + 1) * 0.5f * H);
+  gl_project(W, H, x, y, z, col, row);
+  *row = H - 1 - *row;
 }
 
 /* Sum of squared luminance differences between neighbours in a (2r+1)^2
@@ -407,19 +338,19 @@ static void motion_blur_follows_the_camera(void **state) {
   free(blurred_still);
   free(still);
   float *img[2];
+  lm_scene *cornell = gl_cornell();
   int cam = cornell->cameras[0].node;
   float x0 = cornell->nodes[cam].local[12];
   for (int k = 0; k < 2; k++) {
-    run r = start(pp_lua, "dl", k ? on : off);
-    frame(&r);
+    gl_result r = start(pp_lua, "dl", k ? on : off);
     cornell->nodes[cam].local[12] = x0 + 0.1f; /* 0.1 to the right between frames */
     lm_scene_update(cornell);
     frame(&r);
     cornell->nodes[cam].local[12] = x0;
     lm_scene_update(cornell);
-    img[k] = r.out;
-    r.out = NULL;
-    stop(&r);
+    img[k] = r.rgb;
+    r.rgb = NULL;
+    gl_result_free(&r);
   }
   double gx[2] = {0}, gy[2] = {0};
   for (int k = 0; k < 2; k++)
@@ -469,15 +400,14 @@ static void every_effect_renders_finite_with_dl_and_isr(void **state) {
         snprintf(on[k], sizeof on[k], "%s=true", effects[k]);
         if (k == e || e == EFFECTS) sets[n++] = on[k];
       }
-      run r = start(pp_lua, techs[t], sets);
-      frame(&r);
+      gl_result r = start(pp_lua, techs[t], sets);
       char what[96];
       snprintf(what, sizeof what, "%s with %s", techs[t], e == EFFECTS ? "every effect" : effects[e]);
       assert_targets_finite(lm_renderer_graph(r.renderer), what);
       double mean = 0;
-      for (int i = 0; i < W * H * 3; i++) mean += r.out[i];
+      for (int i = 0; i < W * H * 3; i++) mean += r.rgb[i];
       if (!(mean / (W * H * 3) > 0.02)) fail_msg("%s: a black image", what);
-      stop(&r);
+      gl_result_free(&r);
     }
   }
 }
@@ -501,27 +431,15 @@ static void degenerate_settings_stay_finite(void **state) {
       {"motion_blur=true", "motion_blur.strength=0", "motion_blur.max_length=0", "sepia=true", "sepia.strength=0", NULL},
   };
   for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
-    run r = start(pp_lua, "dl", cases[c]);
-    frame(&r);
+    gl_result r = start(pp_lua, "dl", cases[c]);
     char what[64];
     snprintf(what, sizeof what, "case %zu (%s ...)", c, cases[c][1]);
     assert_targets_finite(lm_renderer_graph(r.renderer), what);
-    stop(&r);
+    gl_result_free(&r);
   }
 }
 
 /* ---- the frame graph --------------------------------------------------- */
-static void pass_names(lm_graph *g, char *out, size_t cap, bool *culled) {
-  out[0] = '\0';
-  *culled = false;
-  for (int i = 0; i < lm_graph_pass_count(g); i++) {
-    lm_graph_pass_info p = lm_graph_pass(g, i);
-    *culled |= p.culled;
-    size_t n = strlen(out);
-    snprintf(out + n, cap - n, "%s ", p.name);
-  }
-}
-
 /* Off (the default) records no pass of the effect; on records exactly its
  * passes, and none of them is left out. */
 static void an_effect_off_records_no_pass(void **state) {
@@ -530,57 +448,46 @@ static void an_effect_off_records_no_pass(void **state) {
       "motion_blur ", "dof.coc dof.gather ", "bloom.bright bloom.blur_x bloom.blur_y bloom.add ",
       "hdr.reduce1 hdr.reduce2 hdr.reduce3 hdr.adapt hdr.tonemap ", "radial_blur ", "glass ", "tiles ", "sepia "};
   char names[1024], want[1024];
-  bool culled;
-  run r = start(pp_lua, "dl", NULL);
-  frame(&r);
-  pass_names(lm_renderer_graph(r.renderer), names, sizeof names, &culled);
+  gl_result r = start(pp_lua, "dl", NULL);
+  gl_pass_names(&r, names, sizeof names);
   assert_string_equal(names, "gbuffer direct output ");
-  stop(&r);
+  assert_int_equal(gl_culled(&r, ""), 0);
+  gl_result_free(&r);
   for (int e = 0; e < EFFECTS; e++) {
     char on[64];
     snprintf(on, sizeof on, "%s=true", effects[e]);
     const char *sets[] = {on, NULL};
     r = start(pp_lua, "dl", sets);
-    frame(&r);
-    pass_names(lm_renderer_graph(r.renderer), names, sizeof names, &culled);
+    gl_pass_names(&r, names, sizeof names);
     snprintf(want, sizeof want, "gbuffer direct %soutput ", passes[e]);
     assert_string_equal(names, want);
-    assert_false(culled);
+    assert_int_equal(gl_culled(&r, ""), 0);
     char off[64];
     snprintf(off, sizeof off, "%s.enabled=false", effects[e]);
     set(&r, off);
     frame(&r);
-    pass_names(lm_renderer_graph(r.renderer), names, sizeof names, &culled);
+    gl_pass_names(&r, names, sizeof names);
     assert_string_equal(names, "gbuffer direct output ");
-    stop(&r);
+    assert_int_equal(gl_culled(&r, ""), 0);
+    gl_result_free(&r);
   }
 }
 
 /* Bad values stop the frame with the option's name and what it must be. */
 static void bad_options_name_themselves(void **state) {
   (void)state;
-  static const struct {
-    const char *set, *expect;
-  } cases[] = {
-      {"dof.mode=pinhole", "dof.mode must be one of range, lens (got pinhole)"},
-      {"bloom.radius=2.5", "bloom.radius must be a whole number in 0..32 (got 2.5)"},
-      {"hdr.white=0", "hdr.white must be a number in (0, 1e+06] (got 0)"},
-      {"sepia.strength=2", "sepia.strength must be a finite number in 0..1 (got 2)"},
-      {"bloom.downsample=3", "bloom.downsample must be one of 1, 2, 4 (got 3)"},
+  static const gl_bad_option cases[] = {
+      {"dl", "dof.mode=pinhole", "dof.mode must be one of range, lens (got pinhole)"},
+      {"dl", "bloom.radius=2.5", "bloom.radius must be a whole number in 0..32 (got 2.5)"},
+      {"dl", "hdr.white=0", "hdr.white must be a number in (0, 1e+06] (got 0)"},
+      {"dl", "sepia.strength=2", "sepia.strength must be a finite number in 0..1 (got 2)"},
+      {"dl", "bloom.downsample=3", "bloom.downsample must be one of 1, 2, 4 (got 3)"},
   };
-  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
-    const char *sets[] = {cases[i].set, NULL};
-    run r = start(pp_lua, "dl", sets);
-    lm_error err;
-    if (lm_renderer_frame(r.renderer, &err)) fail_msg("%s: rendered", cases[i].set);
-    if (!strstr(err.msg, cases[i].expect) || !strstr(err.msg, ".lua:")) fail_msg("%s: '%s'", cases[i].set, err.msg);
-    stop(&r);
-  }
-  lm_error err;
-  run r = start(pp_lua, "dl", NULL);
-  assert_false(lm_pipeline_set_option(r.pipeline, "bloom.nope", "1", &err));
-  assert_non_null(strstr(err.msg, "bloom.threshold"));
-  stop(&r);
+  gl_assert_bad_options(cases, sizeof cases / sizeof *cases, ".lua:");
+  gl_result r = start(pp_lua, "dl", NULL);
+  assert_false(gl_set(&r, "bloom.nope=1"));
+  assert_non_null(strstr(r.err.msg, "bloom.threshold"));
+  gl_result_free(&r);
 }
 
 int main(void) {
@@ -597,5 +504,5 @@ int main(void) {
       cmocka_unit_test(an_effect_off_records_no_pass),
       cmocka_unit_test(bad_options_name_themselves),
   };
-  return cmocka_run_group_tests(tests, setup, teardown);
+  return cmocka_run_group_tests(tests, setup, gl_test_teardown);
 }

@@ -11,53 +11,23 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "gl_test.h"
 #include "image/image.h"
 
 enum { W = 256, H = 192 };
 
-static char root[256], real_root[1024];
-static lm_scene *cornell;
+static char real_root[1024]; /* the tree's, before the scratch root takes over */
 static bool check_finite; /* render() with the NaN/Inf check */
 
-static void write_file(const char *rel, const char *text) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/%s", root, rel);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  fputs(text, f);
-  fclose(f);
-}
-
-/* A scratch engine root: the real shaders and scripts linked in, plus test files. */
 static int setup(void **state) {
-  (void)state;
   snprintf(real_root, sizeof real_root, "%s", lm_root_dir());
-  snprintf(root, sizeof root, "/tmp/limn-render-XXXXXX");
-  if (!mkdtemp(root)) return -1;
-  char cmd[4096];
-  snprintf(cmd, sizeof cmd, "mkdir -p %s/shaders && ln -s %s/shaders/* %s/shaders/ && ln -s %s/scripts %s/scripts",
-           root, real_root, root, real_root, root);
-  if (system(cmd) != 0) return -1;
-  setenv("LIMN_ROOT", root, 1);
-  lm_error err;
-  cornell = lm_scene_builtin("cornell", &err);
-  return cornell ? gl_test_setup(state) : -1;
-}
-
-static int teardown(void **state) {
-  lm_scene_destroy(cornell);
-  gl_test_teardown(state);
-  char cmd[300];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", root);
-  return system(cmd);
+  return gl_test_setup(state);
 }
 
 
 static gl_result render(const char *script, const char *tech, int frames) {
-  return gl_render(&(gl_run){.scene = cornell, .script = script, .tech = tech, .frames = frames,
+  return gl_render(&(gl_run){.script = script, .tech = tech, .frames = frames,
                              .width = W, .height = H, .check_finite = check_finite});
 }
 
@@ -129,10 +99,11 @@ static void cornell_box_matches_the_golden_image(void **state) {
 
 static void shader_errors_name_the_original_file_and_line(void **state) {
   (void)state;
-  write_file("shaders/broken.frag", "#include \"common.glsl\"\nin vec2 uv;\nout vec4 o;\n\nvoid main() {\n"
-                                    "  o = vec4(no_such_thing);\n}\n");
-  write_file("shaders/bad_include.glsl", "float helper() {\n  return undefined_value;\n}\n");
-  write_file("shaders/uses_bad.frag", "#include \"bad_include.glsl\"\nout vec4 o;\nvoid main() { o = vec4(helper()); }\n");
+  assert_true(gl_write_file("shaders/broken.frag", "#include \"common.glsl\"\nin vec2 uv;\nout vec4 o;\n\n"
+                                                   "void main() {\n  o = vec4(no_such_thing);\n}\n"));
+  assert_true(gl_write_file("shaders/bad_include.glsl", "float helper() {\n  return undefined_value;\n}\n"));
+  assert_true(gl_write_file("shaders/uses_bad.frag",
+                            "#include \"bad_include.glsl\"\nout vec4 o;\nvoid main() { o = vec4(helper()); }\n"));
   lm_error err;
   assert_null(lm_program_get("fullscreen.vert", "broken.frag", NULL, &err));
   if (!strstr(err.msg, "shaders/broken.frag:6:")) fail_msg("%s", err.msg);
@@ -150,10 +121,8 @@ static gl_result direct_with(const char *fields) {
            "function OnRender(tech)\n  local G = gbuffer.render(gbuffer.targets())\n"
            "  local lit = target{ 'lit', format = 'rgba16f' }\n"
            "  pass{ 'direct', shader = 'direct.frag', out = lit, %s }\n  present(lit)\nend\n", fields);
-  write_file("bindings.lua", text);
-  char path[512];
-  snprintf(path, sizeof path, "%s/bindings.lua", root);
-  return render(path, NULL, 1);
+  assert_true(gl_write_file("bindings.lua", text));
+  return render("bindings.lua", NULL, 1);
 }
 
 static void wrong_uniforms_and_inputs_name_the_pass_and_parameter(void **state) {
@@ -186,21 +155,19 @@ static void wrong_uniforms_and_inputs_name_the_pass_and_parameter(void **state) 
 
 static void no_nan_or_inf_leaves_the_output_stage(void **state) {
   (void)state;
-  write_file("shaders/poison.frag", "in vec2 uv;\nuniform float zero = 0.0;\nout vec4 o;\n"
-                                    "void main() {\n  float z = zero;\n"
-                                    "  o = uv.x < 0.33 ? vec4(z / z) : uv.x < 0.66 ? vec4(1.0 / z) : vec4(-1.0 / z);\n}\n");
-  write_file("poison.lua", "Techniques = { 'x' }\nfunction OnRender()\n"
-                           "  present(pass{ 'poison', shader = 'poison.frag', out = target{ 'p', format = 'rgba32f' } })\nend\n");
-  char path[512];
-  snprintf(path, sizeof path, "%s/poison.lua", root);
-  gl_result fr = render(path, NULL, 1);
+  assert_true(gl_write_file("shaders/poison.frag",
+                            "in vec2 uv;\nuniform float zero = 0.0;\nout vec4 o;\nvoid main() {\n  float z = zero;\n"
+                            "  o = uv.x < 0.33 ? vec4(z / z) : uv.x < 0.66 ? vec4(1.0 / z) : vec4(-1.0 / z);\n}\n"));
+  assert_true(gl_write_file("poison.lua", "Techniques = { 'x' }\nfunction OnRender()\n  present(pass{ 'poison', "
+                                          "shader = 'poison.frag', out = target{ 'p', format = 'rgba32f' } })\nend\n"));
+  gl_result fr = render("poison.lua", NULL, 1);
   if (!fr.ok) fail_msg("%s", fr.err.msg);
   for (int i = 0; i < W * H * 3; i++)
     if (!isfinite(fr.rgb[i]) || fr.rgb[i] < 0) fail_msg("value %g at pixel %d", fr.rgb[i], i / 3);
   gl_result_free(&fr);
   /* The debug check names the pass, the target and the first bad pixel. */
   check_finite = true;
-  fr = render(path, NULL, 1);
+  fr = render("poison.lua", NULL, 1);
   check_finite = false;
   assert_false(fr.ok);
   if (!strstr(fr.err.msg, "poison.lua:3: pass 'poison' wrote NaN to target 'p' at pixel (0, 0)"))
@@ -242,5 +209,5 @@ int main(void) {
       cmocka_unit_test(no_nan_or_inf_leaves_the_output_stage),
       cmocka_unit_test(textures_are_pooled_across_frames),
   };
-  return cmocka_run_group_tests(tests, setup, teardown);
+  return cmocka_run_group_tests(tests, setup, gl_test_teardown);
 }

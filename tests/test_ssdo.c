@@ -15,23 +15,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
-#include "render/render.h"
+#include "gl_test.h"
 
 enum { W = 256, H = 192 };
-
-static lm_scene *scene;
-static char root[256], real_root[1024];
-
-static void write_file(const char *rel, const char *text) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/%s", root, rel);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  fputs(text, f);
-  fclose(f);
-}
 
 /* The synthetic step: left of column EDGE at depth 0.2 (of far), right at
  * 0.4, normals toward the eye, and a signal of 0.2 left and 0.8 right with
@@ -86,139 +73,40 @@ static const char step_lua[] =
     "  end\n"
     "end\n";
 
-/* A scratch engine root: the real shaders and scripts linked in, plus the
- * step's shader and script. */
+/* The step's shader and script in the scratch root. */
 static int setup(void **state) {
-  (void)state;
-  snprintf(real_root, sizeof real_root, "%s", lm_root_dir());
-  snprintf(root, sizeof root, "/tmp/limn-ssdo-XXXXXX");
-  if (!mkdtemp(root)) return -1;
-  char cmd[4096];
-  snprintf(cmd, sizeof cmd, "mkdir -p %s/shaders && ln -s %s/shaders/* %s/shaders/ && ln -s %s/scripts %s/scripts",
-           root, real_root, root, real_root, root);
-  if (system(cmd) != 0) return -1;
-  setenv("LIMN_ROOT", root, 1);
-  write_file("shaders/step.frag", step_frag);
-  write_file("step.lua", step_lua);
-  lm_error err;
-  if (!lm_context_create_headless(&(lm_context_desc){0}, &err)) {
-    fprintf(stderr, "no OpenGL context: %s\n", err.msg);
-    return -1;
-  }
-  scene = lm_scene_builtin("cornell", &err);
-  return scene ? 0 : -1;
+  if (gl_test_setup(state) != 0) return -1;
+  return gl_write_file("shaders/step.frag", step_frag) && gl_write_file("step.lua", step_lua) ? 0 : -1;
 }
-
-static int teardown(void **state) {
-  (void)state;
-  lm_programs_clear();
-  lm_scene_destroy(scene);
-  lm_context_destroy();
-  char cmd[300];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", root);
-  return system(cmd);
-}
-
-typedef struct image {
-  float rgb[W * H * 3];  /* the output stage's linear copy */
-  float lit[W * H * 4];  /* the presented target, before the output stage sanitizes */
-  bool gi_pass, culled_gi_pass; /* a pass named ssdo.* or ssao.* was recorded / left out */
-  float edges[(W / 16) * (H / 16) * 4]; /* target ssdo.edges, when recorded */
-  bool has_edges;
-} image;
 
 /* Renders one frame of `script` (relative to the scratch root) with
- * technique `tech` and "name=value" options (NULL-terminated); `presented`
- * names the target the script presents. False with the message in err. */
-static bool render_script(const char *script, const char *tech, const char *presented,
-                          const char *const *sets, image *out, lm_error *err) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/%s", root, script);
-  lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = path}, err);
-  assert_non_null(p);
-  assert_true(lm_pipeline_set_technique(p, tech, err));
-  for (; sets && *sets; sets++) {
-    char name[64];
-    const char *eq = strchr(*sets, '=');
-    snprintf(name, sizeof name, "%.*s", (int)(eq - *sets), *sets);
-    if (!lm_pipeline_set_option(p, name, eq + 1, err)) fail_msg("%s", err->msg);
-  }
-  lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = p, .width = W,
-                                                          .height = H, .linear_output = true}, err);
-  assert_non_null(r);
-  bool ok = lm_renderer_frame(r, err);
-  if (ok) {
-    assert_true(lm_renderer_read(r, true, out->rgb, err));
-    lm_graph *g = lm_renderer_graph(r);
-    int t = lm_graph_find_target(g, presented);
-    assert_true(t >= 0);
-    lm_graph_target_info lit = lm_graph_target(g, t);
-    assert_int_equal(lit.width, W);
-    lm_texture_read(lit.texture, W, H, true, out->lit);
-    int e = lm_graph_find_target(g, "ssdo.edges");
-    out->has_edges = e >= 0 && lm_graph_target(g, e).used;
-    if (out->has_edges) {
-      lm_graph_target_info ei = lm_graph_target(g, e);
-      assert_int_equal(ei.width, W / 16);
-      assert_int_equal(ei.height, H / 16);
-      lm_texture_read(ei.texture, ei.width, ei.height, true, out->edges);
-    }
-    out->gi_pass = out->culled_gi_pass = false;
-    for (int i = 0; i < lm_graph_pass_count(g); i++) {
-      lm_graph_pass_info pi = lm_graph_pass(g, i);
-      if (strncmp(pi.name, "ssdo.", 5) && strncmp(pi.name, "ssao.", 5)) continue;
-      out->gi_pass = true;
-      out->culled_gi_pass |= pi.culled;
-    }
-  }
-  lm_renderer_destroy(r);
-  lm_pipeline_destroy(p);
-  return ok;
+ * technique `tech` and "name=value" options (NULL-terminated); r.ok false
+ * with the message in r.err. */
+static gl_result render_script(const char *script, const char *tech, const char *const *sets) {
+  return gl_render(&(gl_run){.script = script, .tech = tech, .sets = sets, .width = W, .height = H});
 }
 
+static gl_result render(const char *tech, const char *const *sets) {
+  return render_script("scripts/pp.lua", tech, sets);
+}
+
+static gl_result render_ok(const char *tech, const char *const *sets) {
+  gl_result r = render(tech, sets);
+  if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
+  return r;
+}
+
+/* The target a technique of pp.lua presents. */
 static const char *presented_by(const char *tech) {
   return !strcmp(tech, "ssdo") ? "ssdo.lit" : !strcmp(tech, "ssao") ? "ssao.lit" : "lit";
 }
 
-static bool render(const char *tech, const char *const *sets, image *out, lm_error *err) {
-  return render_script("scripts/pp.lua", tech, presented_by(tech), sets, out, err);
-}
-
-static image *render_ok(const char *tech, const char *const *sets) {
-  image *im = malloc(sizeof *im);
-  assert_non_null(im);
-  lm_error err;
-  if (!render(tech, sets, im, &err)) fail_msg("%s: %s", tech, err.msg);
-  return im;
-}
-
-/* Pixel of a world point for the box's camera (cornell.c: eye (0, 1, 3.4)
- * looking down -z, fov_y 45 degrees), top row first. */
-static void project(float x, float y, float z, int *col, int *row) {
-  float depth = 3.4f - z, t = tanf(0.5f * 45.0f * 3.14159265f / 180.0f), aspect = (float)W / H;
-  *col = (int)((x / (depth * t * aspect) + 1) * 0.5f * W);
-  *row = (int)((1 - (y - 1) / (depth * t)) * 0.5f * H);
-}
-
-/* Mean colour of the (2r+1)^2 pixels around a world point. */
-static void mean_around(const image *im, float x, float y, float z, int r, double out[3]) {
-  int c0, r0;
-  project(x, y, z, &c0, &r0);
-  out[0] = out[1] = out[2] = 0;
-  for (int row = r0 - r; row <= r0 + r; row++)
-    for (int col = c0 - r; col <= c0 + r; col++)
-      for (int k = 0; k < 3; k++) out[k] += im->rgb[(row * W + col) * 3 + k];
-  for (int k = 0; k < 3; k++) out[k] /= (2 * r + 1) * (2 * r + 1);
-}
-
-static double lum(const double c[3]) { return 0.27 * c[0] + 0.67 * c[1] + 0.06 * c[2]; }
-
 /* Ratio of a technique's luminance to direct light's around a world point. */
-static double ratio_at(const image *a, const image *dl, float x, float y, float z) {
-  double ca[3], cd[3];
-  mean_around(a, x, y, z, 2, ca);
-  mean_around(dl, x, y, z, 2, cd);
-  return lum(ca) / fmax(lum(cd), 1e-9);
+static double ratio_at(const gl_result *a, const gl_result *dl, float x, float y, float z) {
+  float ca[3], cd[3];
+  gl_mean_around(a, x, y, z, 2, ca);
+  gl_mean_around(dl, x, y, z, 2, cd);
+  return gl_luminance(ca) / fmax(gl_luminance(cd), 1e-9);
 }
 
 /* The floor just beside the boxes (cornell.c: the short one's right face,
@@ -232,25 +120,25 @@ static void contact_darkens_open_planes_stay(void **state) {
   (void)state;
   static const char *const two_step[] = {"ssdo.variant=two_step", NULL};
   static const char *const no_bounce[] = {"ssdo.bounce=0", NULL};
-  image *dl = render_ok("dl", NULL);
+  gl_result dl = render_ok("dl", NULL);
   struct {
     const char *tech;
     const char *const *sets;
     double contact_max;
   } cases[] = {{"ssdo", no_bounce, 0.9}, {"ssdo", two_step, 0.9}, {"ssao", NULL, 0.9}};
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
-    image *im = render_ok(cases[i].tech, cases[i].sets);
-    double contact = 0.5 * (ratio_at(im, dl, 0.675f, 0.0f, 0.40f) + ratio_at(im, dl, -0.25f, 0.0f, -0.025f));
-    double wall = ratio_at(im, dl, 0.3f, 1.45f, -1.0f);
-    double floor_ = ratio_at(im, dl, -0.5f, 0.0f, 0.65f);
+    gl_result im = render_ok(cases[i].tech, cases[i].sets);
+    double contact = 0.5 * (ratio_at(&im, &dl, 0.675f, 0.0f, 0.40f) + ratio_at(&im, &dl, -0.25f, 0.0f, -0.025f));
+    double wall = ratio_at(&im, &dl, 0.3f, 1.45f, -1.0f);
+    double floor_ = ratio_at(&im, &dl, -0.5f, 0.0f, 0.65f);
     print_message("%s %s: contact %.3f, open back wall %.4f, open floor %.4f\n", cases[i].tech,
                   cases[i].sets ? cases[i].sets[0] : "", contact, wall, floor_);
     assert_true(contact < cases[i].contact_max);
     assert_true(fabs(wall - 1) < 0.03);
     assert_true(fabs(floor_ - 1) < 0.03);
-    free(im);
+    gl_result_free(&im);
   }
-  free(dl);
+  gl_result_free(&dl);
 }
 
 /* The bounce carries the red wall's colour onto the floor beside it: the
@@ -260,23 +148,24 @@ static void bounce_tints_floor_by_red_wall(void **state) {
   (void)state;
   static const char *const strong[] = {"ssdo.bounce=4", NULL};
   static const char *const two_step[] = {"ssdo.variant=two_step", NULL};
-  image *dl = render_ok("dl", NULL), *s = render_ok("ssdo", NULL), *s4 = render_ok("ssdo", strong),
-        *t = render_ok("ssdo", two_step);
-  double d[3], a[3], b[3], c[3];
-  mean_around(dl, -0.9f, 0.0f, 0.3f, 2, d);
-  mean_around(s, -0.9f, 0.0f, 0.3f, 2, a);
-  mean_around(s4, -0.9f, 0.0f, 0.3f, 2, b);
-  mean_around(t, -0.9f, 0.0f, 0.3f, 2, c);
-  double r_dl = d[0] / d[1], r_s = a[0] / a[1], r_s4 = b[0] / b[1], r_t = c[0] / c[1];
+  gl_result dl = render_ok("dl", NULL), s = render_ok("ssdo", NULL), s4 = render_ok("ssdo", strong),
+            t = render_ok("ssdo", two_step);
+  float d[3], a[3], b[3], c[3];
+  gl_mean_around(&dl, -0.9f, 0.0f, 0.3f, 2, d);
+  gl_mean_around(&s, -0.9f, 0.0f, 0.3f, 2, a);
+  gl_mean_around(&s4, -0.9f, 0.0f, 0.3f, 2, b);
+  gl_mean_around(&t, -0.9f, 0.0f, 0.3f, 2, c);
+  double r_dl = (double)d[0] / d[1], r_s = (double)a[0] / a[1], r_s4 = (double)b[0] / b[1],
+         r_t = (double)c[0] / c[1];
   print_message("red/green on the floor by the red wall: dl %.4f, ssdo %.4f, bounce=4 %.4f, two_step %.4f\n",
                 r_dl, r_s, r_s4, r_t);
   assert_true(r_s > r_dl * 1.008); /* measured +1.2% */
   assert_true(r_s4 > r_dl * 1.04); /* +5.0% */
   assert_true(r_t > r_dl * 1.008); /* +1.1% */
-  free(dl);
-  free(s);
-  free(s4);
-  free(t);
+  gl_result_free(&dl);
+  gl_result_free(&s);
+  gl_result_free(&s4);
+  gl_result_free(&t);
 }
 
 /* The step image through the blur and the upsampler: every pixel keeps its
@@ -285,18 +174,21 @@ static void bounce_tints_floor_by_red_wall(void **state) {
  * term does cross the edge (so the test can fail). */
 static void filters_do_not_cross_a_depth_step(void **state) {
   (void)state;
-  image *im = malloc(sizeof *im);
-  lm_error err;
   const char *const techs[] = {"blur", "upsample", "blur_flat"};
   const char *const outputs[] = {"blur_x", "up", "blur_x"};
   for (int t = 0; t < 3; t++) {
-    if (!render_script("step.lua", techs[t], outputs[t], NULL, im, &err)) fail_msg("%s: %s", techs[t], err.msg);
+    gl_result r = render_script("step.lua", techs[t], NULL);
+    if (!r.ok) fail_msg("%s: %s", techs[t], r.err.msg);
+    int w, h;
+    float *out = gl_read_target(&r, outputs[t], &w, &h);
+    assert_non_null(out);
+    assert_int_equal(w, W);
     float worst_left = 0, worst_right = 1;
     double sum = 0, sum2 = 0;
     int n = 0;
     for (int y = 0; y < H; y++)
       for (int x = 0; x < W; x++) {
-        float v = im->lit[(y * W + x) * 4];
+        float v = out[(y * W + x) * 4];
         if (x < 101) worst_left = fmaxf(worst_left, v);
         else worst_right = fminf(worst_right, v);
         if (x >= 150 && x < 250) sum += v, sum2 += (double)v * v, n++;
@@ -310,11 +202,12 @@ static void filters_do_not_cross_a_depth_step(void **state) {
     } else {
       assert_true(worst_left > 0.35f || worst_right < 0.65f);
     }
+    free(out);
+    gl_result_free(&r);
   }
-  free(im);
 }
 
-static double mean_error(const image *a, const image *b) {
+static double mean_error(const gl_result *a, const gl_result *b) {
   double sum = 0;
   for (int i = 0; i < W * H * 3; i++) sum += fabs(a->rgb[i] - b->rgb[i]);
   return sum / (3.0 * W * H);
@@ -334,13 +227,13 @@ static void reduced_resolution_close_to_full(void **state) {
   };
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
     const char *full[] = {cases[i].full, NULL}, *reduced[] = {cases[i].reduced, NULL};
-    image *a = render_ok(cases[i].tech, full), *b = render_ok(cases[i].tech, reduced);
-    double e = mean_error(a, b);
+    gl_result a = render_ok(cases[i].tech, full), b = render_ok(cases[i].tech, reduced);
+    double e = mean_error(&a, &b);
     print_message("%s: mean error %s vs %s: %.5f (limit %.3f)\n", cases[i].tech, cases[i].reduced,
                   cases[i].full, e, cases[i].limit);
     assert_true(e < cases[i].limit);
-    free(a);
-    free(b);
+    gl_result_free(&a);
+    gl_result_free(&b);
   }
 }
 
@@ -358,14 +251,14 @@ static void rotation_beats_raw_pattern(void **state) {
        {"ssdo.samples=10", "ssdo.interleave=4", "ssdo.bounce=0", NULL}},
   };
   for (int t = 0; t < 2; t++) {
-    image *ref = render_ok(tech[t], sets[t][0]), *raw = render_ok(tech[t], sets[t][1]),
-          *rot = render_ok(tech[t], sets[t][2]);
-    double e_raw = mean_error(raw, ref), e_rot = mean_error(rot, ref);
+    gl_result ref = render_ok(tech[t], sets[t][0]), raw = render_ok(tech[t], sets[t][1]),
+              rot = render_ok(tech[t], sets[t][2]);
+    double e_raw = mean_error(&raw, &ref), e_rot = mean_error(&rot, &ref);
     print_message("%s, 10 samples against 300: mean error raw pattern %.5f, rotated %.5f\n", tech[t], e_raw, e_rot);
     assert_true(e_rot < 0.6 * e_raw); /* measured 0.23 to 0.32 */
-    free(ref);
-    free(raw);
-    free(rot);
+    gl_result_free(&ref);
+    gl_result_free(&raw);
+    gl_result_free(&rot);
   }
 }
 
@@ -373,22 +266,24 @@ static void rotation_beats_raw_pattern(void **state) {
  * the merged variant should match the original two-step one. */
 static void variants_agree_under_white_light(void **state) {
   (void)state;
+  lm_scene *scene = gl_cornell();
   float saved[3];
   memcpy(saved, scene->lights[0].color, sizeof saved);
   scene->lights[0].color[0] = scene->lights[0].color[1] = scene->lights[0].color[2] = 1.0f;
   static const char *const merged[] = {"ssdo.variant=merged", "ssdo.samples=30", NULL};
   static const char *const two_step[] = {"ssdo.variant=two_step", "ssdo.samples=30", NULL};
-  image *a = render_ok("ssdo", merged), *b = render_ok("ssdo", two_step);
+  gl_result a = render_ok("ssdo", merged), b = render_ok("ssdo", two_step);
   memcpy(scene->lights[0].color, saved, sizeof saved);
-  double e = mean_error(a, b);
-  double ca[3], cb[3];
-  mean_around(a, 0.675f, 0.0f, 0.40f, 2, ca);
-  mean_around(b, 0.675f, 0.0f, 0.40f, 2, cb);
-  print_message("merged vs two_step: mean error %.5f; contact luminance %.4f vs %.4f\n", e, lum(ca), lum(cb));
+  double e = mean_error(&a, &b);
+  float ca[3], cb[3];
+  gl_mean_around(&a, 0.675f, 0.0f, 0.40f, 2, ca);
+  gl_mean_around(&b, 0.675f, 0.0f, 0.40f, 2, cb);
+  double la = gl_luminance(ca), lb = gl_luminance(cb);
+  print_message("merged vs two_step: mean error %.5f; contact luminance %.4f vs %.4f\n", e, la, lb);
   assert_true(e < 0.02);
-  assert_true(fabs(lum(ca) - lum(cb)) < 0.25 * lum(cb));
-  free(a);
-  free(b);
+  assert_true(fabs(la - lb) < 0.25 * lb);
+  gl_result_free(&a);
+  gl_result_free(&b);
 }
 
 /* The adaptive count's edge map (1/16 a side) gives 10 samples on open
@@ -398,35 +293,34 @@ static void variants_agree_under_white_light(void **state) {
 static void adaptive_counts_follow_edges(void **state) {
   (void)state;
   static const char *const adaptive[] = {"ssdo.adaptive=true", "ssdo.bounce=0", NULL};
-  image *dl = render_ok("dl", NULL), *im = render_ok("ssdo", adaptive);
-  assert_true(im->has_edges);
+  gl_result dl = render_ok("dl", NULL), im = render_ok("ssdo", adaptive);
+  int w, h;
+  float *edges = gl_read_target(&im, "ssdo.edges", &w, &h);
+  assert_non_null(edges);
+  assert_int_equal(w, W / 16);
+  assert_int_equal(h, H / 16);
   int counts[4] = {0};
   for (int i = 0; i < (W / 16) * (H / 16); i++) {
-    float v = im->edges[i * 4];
+    float v = edges[i * 4];
     if (v != 10 && v != 20 && v != 30) fail_msg("edge map texel %d holds %g", i, v);
     counts[(int)v / 10]++;
   }
   /* The texel over the open back wall (0.6, 1.5, -1) and the one over the
    * short box's contact with the floor (0.675, 0, 0.40); rows top first. */
   int col, row;
-  project(0.6f, 1.5f, -1.0f, &col, &row);
-  float wall = im->edges[(row / 16 * (W / 16) + col / 16) * 4];
-  project(0.675f, 0.0f, 0.40f, &col, &row);
-  float contact = im->edges[(row / 16 * (W / 16) + col / 16) * 4];
-  double r = 0.5 * (ratio_at(im, dl, 0.675f, 0.0f, 0.40f) + ratio_at(im, dl, -0.25f, 0.0f, -0.025f));
+  gl_project(W, H, 0.6f, 1.5f, -1.0f, &col, &row);
+  float wall = edges[(row / 16 * (W / 16) + col / 16) * 4];
+  gl_project(W, H, 0.675f, 0.0f, 0.40f, &col, &row);
+  float contact = edges[(row / 16 * (W / 16) + col / 16) * 4];
+  double r = 0.5 * (ratio_at(&im, &dl, 0.675f, 0.0f, 0.40f) + ratio_at(&im, &dl, -0.25f, 0.0f, -0.025f));
   print_message("edge map: %d x 10, %d x 20, %d x 30 samples; open wall %g, contact %g; contact ratio %.3f\n",
                 counts[1], counts[2], counts[3], wall, contact, r);
   assert_true(wall == 10 && contact == 30);
   assert_true(counts[1] > 0 && counts[3] > 0);
   assert_true(r < 0.9);
-  free(dl);
-  free(im);
-}
-
-static bool all_finite(const image *im) {
-  for (int i = 0; i < W * H * 4; i++)
-    if (!isfinite(im->lit[i]) || im->lit[i] < 0) return false;
-  return true;
+  free(edges);
+  gl_result_free(&dl);
+  gl_result_free(&im);
 }
 
 /* Extremes of every option give finite, non-negative light before the output
@@ -450,49 +344,40 @@ static void extreme_parameters_stay_finite(void **state) {
       {"ssao", {"ssao.strength=0", "ssao.bias=0.1", "ssao.resolution=2", "ssao.sigma_space=1e-6",
                 "ssao.sigma_depth=1e-6", "ssao.sigma_normal=1e-6", NULL}},
   };
-  image *im = malloc(sizeof *im);
   for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
-    lm_error err;
-    if (!render(cases[c].tech, cases[c].sets, im, &err)) fail_msg("case %zu: %s", c, err.msg);
-    if (!all_finite(im)) fail_msg("case %zu (%s ...): a NaN, Inf or negative value", c, cases[c].sets[0]);
+    gl_result r = render(cases[c].tech, cases[c].sets);
+    if (!r.ok) fail_msg("case %zu: %s", c, r.err.msg);
+    if (!gl_target_finite(&r, presented_by(cases[c].tech)))
+      fail_msg("case %zu (%s ...): a NaN, Inf or negative value", c, cases[c].sets[0]);
+    gl_result_free(&r);
   }
-  free(im);
 }
 
 /* Out-of-range options stop the frame with the option's name and the
  * pipeline's line. */
 static void bad_options_name_themselves(void **state) {
   (void)state;
-  static const struct {
-    const char *tech, *set, *expect;
-  } cases[] = {
+  static const gl_bad_option cases[] = {
       {"ssdo", "ssdo.samples=25", "ssdo.samples must be a multiple of 10 in 10..300 (got 25)"},
       {"ssdo", "ssdo.samples=0", "ssdo.samples must be"},
-      {"ssdo", "ssdo.variant=three", "ssdo.variant must be \"merged\" or \"two_step\" (got three)"},
-      {"ssdo", "ssdo.r_max=0", "ssdo.r_max must be in"},
-      {"ssdo", "ssdo.bounce=-1", "ssdo.bounce must be in 0..100"},
-      {"ssdo", "ssdo.resolution=3", "ssdo.resolution must be 1, 2 or 4"},
+      {"ssdo", "ssdo.variant=three", "ssdo.variant must be one of merged, two_step (got three)"},
+      {"ssdo", "ssdo.r_max=0", "ssdo.r_max must be a finite number in"},
+      {"ssdo", "ssdo.bounce=-1", "ssdo.bounce must be a finite number in 0..100"},
+      {"ssdo", "ssdo.resolution=3", "ssdo.resolution must be one of 1, 2, 4"},
       {"ssdo", "ssdo.blur=10", "ssdo.blur must be an odd whole number"},
-      {"ssdo", "ssdo.sigma_depth=0", "ssdo.sigma_depth must be in"},
-      {"ssdo", "ssdo.interleave=3", "ssdo.interleave must be 1, 2 or 4"},
-      {"ssao", "ssao.strength=2", "ssao.strength must be in 0..1 (got 2)"},
-      {"ssao", "ssao.tolerance=-1", "ssao.tolerance must be in"},
+      {"ssdo", "ssdo.sigma_depth=0", "ssdo.sigma_depth must be a finite number in"},
+      {"ssdo", "ssdo.interleave=3", "ssdo.interleave must be one of 1, 2, 4"},
+      {"ssao", "ssao.strength=2", "ssao.strength must be a finite number in 0..1 (got 2)"},
+      {"ssao", "ssao.tolerance=-1", "ssao.tolerance must be a finite number in"},
       {"ssao", "ssao.samples=15", "ssao.samples must be a multiple of 10"},
   };
-  image *im = malloc(sizeof *im);
-  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
-    const char *sets[] = {cases[i].set, NULL};
-    lm_error err;
-    if (render(cases[i].tech, sets, im, &err)) fail_msg("%s: rendered", cases[i].set);
-    if (!strstr(err.msg, cases[i].expect) || !strstr(err.msg, "pp.lua:"))
-      fail_msg("%s: '%s'", cases[i].set, err.msg);
-  }
+  gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
   /* Two options that only conflict together. */
   const char *both[] = {"ssdo.variant=two_step", "ssdo.resolution=2", NULL};
-  lm_error err;
-  assert_false(render("ssdo", both, im, &err));
-  if (!strstr(err.msg, "ssdo.resolution must be 1 with variant \"two_step\"")) fail_msg("'%s'", err.msg);
-  free(im);
+  gl_result r = render("ssdo", both);
+  assert_false(r.ok);
+  if (!strstr(r.err.msg, "ssdo.resolution must be 1 with variant \"two_step\"")) fail_msg("'%s'", r.err.msg);
+  gl_result_free(&r);
 }
 
 /* dl records no SSDO or SSAO pass; each technique's passes all reach the
@@ -501,21 +386,20 @@ static void dl_records_no_gi_pass(void **state) {
   (void)state;
   static const char *const adaptive[] = {"ssdo.adaptive=true", "ssdo.resolution=2", NULL};
   static const char *const two_step[] = {"ssdo.variant=two_step", NULL};
-  image *dl = render_ok("dl", NULL);
-  assert_false(dl->gi_pass);
+  gl_result dl = render_ok("dl", NULL);
+  assert_false(gl_has_pass(&dl, "ssdo.") || gl_has_pass(&dl, "ssao."));
   const char *techs[] = {"ssdo", "ssdo", "ssdo", "ssao"};
   const char *const *sets[] = {NULL, adaptive, two_step, NULL};
   for (int i = 0; i < 4; i++) {
-    image *im = render_ok(techs[i], sets[i]);
-    assert_true(im->gi_pass);
-    assert_false(im->culled_gi_pass);
-    free(im);
+    gl_result im = render_ok(techs[i], sets[i]);
+    assert_true(gl_has_pass(&im, "ssdo.") || gl_has_pass(&im, "ssao."));
+    assert_int_equal(gl_culled(&im, "ssdo.") + gl_culled(&im, "ssao."), 0);
+    gl_result_free(&im);
   }
-  free(dl);
+  gl_result_free(&dl);
 }
 
 int main(void) {
-  lm_log_set_level(LM_LOG_WARN);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(contact_darkens_open_planes_stay),
       cmocka_unit_test(bounce_tints_floor_by_red_wall),
@@ -528,5 +412,5 @@ int main(void) {
       cmocka_unit_test(bad_options_name_themselves),
       cmocka_unit_test(dl_records_no_gi_pass),
   };
-  return cmocka_run_group_tests(tests, setup, teardown);
+  return cmocka_run_group_tests(tests, setup, gl_test_teardown);
 }
