@@ -113,6 +113,7 @@ static bool check_bindings(const lm_graph *g, const lm_pass_desc *d, const lm_pr
   for (int i = 0; i < p->uniform_count; i++) {
     const lm_uniform *u = &p->uniforms[i];
     if (!is_sampler(u->type) || u->location < 0) continue;
+    if (d->kind == LM_PASS_SCENE && x->scene_owns_uniform && x->scene_owns_uniform(u->name)) continue;
     bool bound = false;
     for (int k = 0; k < d->input_count && !bound; k++) bound = !strcmp(d->inputs[k].name, u->name);
     if (!bound) {
@@ -172,13 +173,14 @@ static void apply_params(const lm_pass_desc *d, const lm_program *p) {
   }
 }
 
-static lm_program *pass_program(const lm_pass_desc *d, lm_error *err) {
+static lm_program *pass_program(const lm_pass_desc *d, const char *extra, lm_error *err) {
   lm_program *p;
   if (d->kind == LM_PASS_SCENE) {
-    char vert[256], frag[256];
+    char vert[256], frag[256], defines[1200];
     snprintf(vert, sizeof vert, "%s.vert", d->shader);
     snprintf(frag, sizeof frag, "%s.frag", d->shader);
-    p = lm_program_get(vert, frag, d->defines, err);
+    snprintf(defines, sizeof defines, "%s%s%s", d->defines, d->defines[0] && extra[0] ? ";" : "", extra);
+    p = lm_program_get(vert, frag, defines, err);
   } else {
     p = lm_program_get("fullscreen.vert", d->shader, d->defines, err);
   }
@@ -186,10 +188,33 @@ static lm_program *pass_program(const lm_pass_desc *d, lm_error *err) {
   return p;
 }
 
+/* Binds p with the pass's inputs and parameters. */
+static void bind_pass(const lm_graph *g, const lm_pass_desc *d, const lm_program *p) {
+  lm_program_use(p);
+  for (int i = 0; i < d->input_count; i++)
+    lm_program_bind_texture(lm_program_uniform(p, d->inputs[i].name), g->targets[d->inputs[i].target].texture);
+  apply_params(d, p);
+}
+
+/* What lm_scene_pass_variant needs beyond the public fields. */
+typedef struct scene_pass_ctx {
+  lm_scene_pass pub; /* first: the callback's pointer is this struct's */
+  const lm_graph_exec_desc *x;
+} scene_pass_ctx;
+
+const lm_program *lm_scene_pass_variant(const lm_scene_pass *sp, const char *defines, lm_error *err) {
+  const scene_pass_ctx *c = (const scene_pass_ctx *)sp;
+  const lm_pass_desc *d = sp->desc;
+  lm_program *p = pass_program(d, defines ? defines : "", err);
+  if (!p || !check_bindings(sp->graph, d, p, c->x, err)) return NULL;
+  bind_pass(sp->graph, d, p);
+  return p;
+}
+
 static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_graph_exec_desc *x,
                      lm_error *err) {
   const lm_pass_desc *d = &gp->desc;
-  lm_program *p = pass_program(d, err);
+  lm_program *p = pass_program(d, "", err);
   if (!p || !check_bindings(g, d, p, x, err)) return false;
   lm_attachments att = {.color_count = d->output_count};
   for (int i = 0; i < d->output_count; i++) {
@@ -205,23 +230,23 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
     lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
     return false;
   }
-  lm_program_use(p);
-  for (int i = 0; i < d->input_count; i++)
-    lm_program_bind_texture(lm_program_uniform(p, d->inputs[i].name), g->targets[d->inputs[i].target].texture);
-  apply_params(d, p);
+  bind_pass(g, d, p);
   lm_timer_begin(timer, x->clock);
+  bool ok = true;
   if (d->kind == LM_PASS_SCENE) {
     lm_set_scene_state(true);
     if (d->clear) lm_clear(d->output_count, d->clear_color, d->depth >= 0, 1.0f);
-    if (x->draw_scene) x->draw_scene(x->user, d->shader, p);
+    scene_pass_ctx c = {{d, p, g}, x};
+    if (x->draw_scene) ok = x->draw_scene(x->user, &c.pub, err);
     lm_set_scene_state(false);
+    if (!ok) lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
   } else {
     lm_draw_fullscreen();
   }
   lm_timer_end(timer);
   for (int i = 0; i < d->output_count; i++)
     if (g->targets[d->outputs[i]].desc.mips) lm_texture_generate_mips(att.color[i]);
-  return true;
+  return ok;
 }
 
 bool lm_graph_execute(lm_graph *g, const lm_graph_exec_desc *x, lm_error *err) {

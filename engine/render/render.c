@@ -13,6 +13,8 @@ struct lm_renderer {
   int frame;
   float prev_view_proj[16];
   double record_ms, compile_ms;
+  lm_frame_data frame_data;   /* this frame's camera, for culling */
+  lm_scene_draw_stats stats;  /* this frame's scene draws */
 };
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
@@ -38,10 +40,34 @@ void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compi
   *compile_ms = r->compile_ms;
 }
 
-static void draw_scene(void *user, const char *technique, const lm_program *p) {
-  (void)technique;
-  lm_scene_draw(((lm_renderer *)user)->desc.scene, p);
+static const lm_program *scene_variant(void *ctx, const char *defines, lm_error *err) {
+  return lm_scene_pass_variant(ctx, defines, err);
 }
+
+static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
+  lm_renderer *r = user;
+  enum { MAX_PARAMS = 256 };
+  lm_material_param params[MAX_PARAMS];
+  int n = sp->desc->material_param_count < MAX_PARAMS ? sp->desc->material_param_count : MAX_PARAMS;
+  for (int i = 0; i < n; i++) {
+    const lm_pass_material_param *q = &sp->desc->material_params[i];
+    params[i] = (lm_material_param){q->material, q->name, q->count, {q->v[0], q->v[1], q->v[2], q->v[3]}};
+  }
+  if (!lm_scene_check_params(r->desc.scene, params, n, err)) return false;
+  lm_scene_draw_desc d = {.program = sp->program, .variant = scene_variant, .ctx = (void *)sp,
+                          .view_proj = r->desc.no_culling ? NULL : r->frame_data.view_proj,
+                          .params = params, .param_count = n};
+  return lm_scene_draw(r->desc.scene, &d, &r->stats, err);
+}
+
+void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height) {
+  r->desc.camera = camera;
+  r->desc.width = width;
+  r->desc.height = height;
+  r->frame = 0; /* a new view has no previous frame to reproject from */
+}
+
+lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r) { return r->stats; }
 
 /* The engine's last pass: sanitize and encode what the script presented. */
 static bool add_output_stage(lm_renderer *r, int presented, lm_error *err) {
@@ -79,6 +105,8 @@ bool lm_renderer_frame(lm_renderer *r, lm_error *err) {
 
   lm_frame_data frame;
   lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, &frame);
+  r->frame_data = frame;
+  r->stats = (lm_scene_draw_stats){0};
   memcpy(frame.prev_view_proj, r->frame ? r->prev_view_proj : frame.view_proj, sizeof frame.prev_view_proj);
   memcpy(r->prev_view_proj, frame.view_proj, sizeof r->prev_view_proj);
   frame.time[1] = (float)r->frame++;

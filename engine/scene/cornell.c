@@ -59,10 +59,10 @@ static void trs(vec3 t, float yaw_deg, vec3 scale, mat4 out) {
  * toward +z; red wall at -x, green at +x, a point light under the ceiling. */
 static lm_scene *cornell(void) {
   lm_scene *s = lm_scene_create("cornell");
-  lm_material white = {"white", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.0f, 1.0f};
-  lm_material red = {"red", {0.63f, 0.065f, 0.05f}, 0.63f, 1.0f, 1.0f, 0.0f, 1.0f};
-  lm_material green = {"green", {0.14f, 0.45f, 0.091f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f};
-  lm_material box = {"box", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.15f, 24.0f};
+  lm_material white = {"white", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.0f, 1.0f, 0};
+  lm_material red = {"red", {0.63f, 0.065f, 0.05f}, 0.63f, 1.0f, 1.0f, 0.0f, 1.0f, 0};
+  lm_material green = {"green", {0.14f, 0.45f, 0.091f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f, 0};
+  lm_material box = {"box", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.15f, 24.0f, 0};
   int m_white = lm_scene_add_material(s, &white), m_red = lm_scene_add_material(s, &red);
   int m_green = lm_scene_add_material(s, &green), m_box = lm_scene_add_material(s, &box);
 

@@ -13,7 +13,16 @@ typedef struct lm_material {
   float color[3];  /* diffuse albedo, linear */
   float rho;       /* reflectance, the G-buffer's "radiation mask" */
   float ka, kd, ks, shininess;
+  int base_color_texture; /* 1 + index into the scene's textures; 0: none */
 } lm_material;
+
+/* A material's image: RGBA8 texels (sRGB-encoded colour), rows top first. */
+typedef struct lm_scene_texture {
+  char name[LM_NAME_MAX];
+  int width, height;
+  unsigned char *rgba;
+  lm_texture gpu;
+} lm_scene_texture;
 
 typedef enum lm_light_type { LM_LIGHT_POINT, LM_LIGHT_SPOT, LM_LIGHT_DIRECTIONAL } lm_light_type;
 
@@ -52,6 +61,7 @@ typedef struct lm_scene_mesh {
   int vertex_count;
   uint32_t *indices;
   int index_count;
+  float bounds[2][3]; /* min, max of the positions (for culling) */
   lm_mesh gpu;
 } lm_scene_mesh;
 
@@ -75,6 +85,8 @@ typedef struct lm_scene {
   int light_count, light_cap;
   lm_camera *cameras;
   int camera_count, camera_cap;
+  lm_scene_texture *textures;
+  int texture_count, texture_cap;
   bool uploaded;
 } lm_scene;
 
@@ -87,6 +99,10 @@ int lm_scene_add_mesh(lm_scene *s, const char *name, const float *vertices, int 
 int lm_scene_add_node(lm_scene *s, const char *name, int parent, const float local[16], int mesh,
                       int material);
 int lm_scene_add_light(lm_scene *s, const lm_light *l);
+/* Takes ownership of `rgba` (malloc'd). Returns the texture's index. */
+int lm_scene_add_texture(lm_scene *s, const char *name, int width, int height, unsigned char *rgba);
+/* Index of the material called `name`, or -1. */
+int lm_scene_find_material(const lm_scene *s, const char *name);
 int lm_scene_add_camera(lm_scene *s, const lm_camera *c);
 /* World transforms from local ones (parents come before children). */
 void lm_scene_update(lm_scene *s);
@@ -101,9 +117,40 @@ bool lm_scene_upload(lm_scene *s, lm_error *err);
 void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_frame_data *out);
 /* Fills up to `max` lights; returns how many. */
 int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max);
-/* Draws every mesh node with `p`, setting model, normal_matrix and the
- * material uniforms (material_color, material_rho, material_k). */
-void lm_scene_draw(const lm_scene *s, const lm_program *p);
+/* A parameter override: material `material`'s parameter `name` ("color",
+ * "rho", "ka", "kd", "ks", "shininess") takes `values` for one draw. */
+typedef struct lm_material_param {
+  const char *material, *name;
+  int count;
+  float v[4];
+} lm_material_param;
+/* Checks overrides against the scene: an unknown material or parameter, or
+ * the wrong count of numbers, is a message naming it. */
+bool lm_scene_check_params(const lm_scene *s, const lm_material_param *params, int count, lm_error *err);
+/* Names of the parameters a material has, for messages. */
+const char *lm_material_param_list(void);
+
+typedef struct lm_scene_draw_desc {
+  const lm_program *program; /* bound: the technique's program */
+  /* The technique's program with `defines` added ("BASE_COLOR_TEXTURE" for a
+   * textured material), bound and ready; NULL with a message. NULL: every
+   * material draws with `program` and without its texture. */
+  const lm_program *(*variant)(void *ctx, const char *defines, lm_error *err);
+  void *ctx;
+  const float *view_proj; /* column-major: nodes wholly outside are culled; NULL: none are */
+  const lm_material_param *params; /* overrides (checked by lm_scene_check_params) */
+  int param_count;
+} lm_scene_draw_desc;
+typedef struct lm_scene_draw_stats {
+  int drawn, culled; /* mesh nodes drawn, and left out by the frustum test */
+  long triangles;    /* triangles drawn */
+} lm_scene_draw_stats;
+/* Draws every mesh node whose bounds reach into the frustum, setting model,
+ * normal_matrix, the material uniforms (material_color, material_rho,
+ * material_k) and base_color_tex. Adds to *stats (may be NULL). */
+bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err);
+/* True when the world-space box lo..hi lies wholly outside one clip plane of view_proj. */
+bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const float hi[3]);
 /* Uniforms a scene draw sets itself; scripts may not bind them. */
 bool lm_scene_owns_uniform(const char *name);
 
