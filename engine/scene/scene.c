@@ -126,6 +126,47 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
   return true;
 }
 
+bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err) {
+  bool same = s->node_count == from->node_count;
+  for (int i = 0; i < s->node_count && same; i++) same = s->nodes[i].mesh == from->nodes[i].mesh;
+  if (!same) {
+    lm_error_set(err, "scene '%s': the file's nodes changed (%d now, %d before): reload the whole scene",
+                 s->name, from->node_count, s->node_count);
+    return false;
+  }
+  lm_scene_texture *textures = lm_alloc(sizeof *textures * (size_t)(from->texture_count + 1));
+  for (int i = 0; i < from->texture_count; i++) {
+    const lm_scene_texture *t = &from->textures[i];
+    size_t bytes = (size_t)t->width * t->height * 4;
+    textures[i] = (lm_scene_texture){.width = t->width, .height = t->height,
+                                     .rgba = memcpy(lm_alloc(bytes), t->rgba, bytes)};
+    memcpy(textures[i].name, t->name, sizeof t->name);
+    if (s->uploaded && !lm_texture_upload_rgba8(&textures[i].gpu, t->width, t->height, t->rgba, true, t->name, err)) {
+      for (int k = 0; k <= i; k++) {
+        if (k < i) lm_texture_destroy(&textures[k].gpu);
+        free(textures[k].rgba);
+      }
+      free(textures);
+      return false;
+    }
+  }
+  for (int i = 0; i < s->texture_count; i++) {
+    if (s->uploaded) lm_texture_destroy(&s->textures[i].gpu);
+    free(s->textures[i].rgba);
+  }
+  free(s->textures);
+  s->textures = textures;
+  s->texture_count = from->texture_count;
+  s->texture_cap = from->texture_count + 1;
+  free(s->materials);
+  s->materials = memcpy(lm_alloc(sizeof *s->materials * (size_t)(from->material_count + 1)), from->materials,
+                        sizeof *s->materials * (size_t)from->material_count);
+  s->material_count = from->material_count;
+  s->material_cap = from->material_count + 1;
+  for (int i = 0; i < s->node_count; i++) s->nodes[i].material = from->nodes[i].material;
+  return true;
+}
+
 static void node_position(const lm_scene *s, int node, vec3 out) {
   const float *w = s->nodes[node].world;
   out[0] = w[12], out[1] = w[13], out[2] = w[14];

@@ -111,6 +111,14 @@ void lm_scene_update(lm_scene *s);
 lm_scene *lm_scene_builtin(const char *name, lm_error *err);
 const char *lm_scene_builtin_list(void);
 
+/* Takes the materials and textures of `from` (the same scene file read
+ * again after an artist changed it) for `s`, leaving geometry, lights and
+ * cameras alone: the viewer's reload. Both must have the same nodes (count
+ * and meshes), else a message and `s` unchanged. Textures are uploaded when
+ * `s` was. `from` keeps its own copies. Shaders reload separately through
+ * lm_programs_clear. */
+bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err);
+
 /* ---- rendering (needs a GL context) ------------------------------------ */
 bool lm_scene_upload(lm_scene *s, lm_error *err);
 /* Frame block for camera `cam` at an output of width x height. */
