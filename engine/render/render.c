@@ -60,6 +60,13 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   return lm_scene_draw(r->desc.scene, &d, &r->stats, err);
 }
 
+bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
+  if (!lm_scene_upload(scene, err)) return false;
+  r->desc.scene = scene;
+  r->frame = 0;
+  return true;
+}
+
 void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height) {
   r->desc.camera = camera;
   r->desc.width = width;

@@ -26,6 +26,8 @@ lm_graph *lm_renderer_graph(lm_renderer *r);
 /* Another camera and output size for the next frames (a capture job's next
  * view): the pipeline, its persistent targets and the texture pool stay. */
 void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height);
+/* Another scene (uploaded now if it was not) for the next frames. */
+bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err);
 /* The last frame's scene draws: nodes drawn and culled, triangles. */
 lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r);
 lm_clock lm_renderer_clock(const lm_renderer *r);

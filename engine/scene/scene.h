@@ -107,6 +107,13 @@ int lm_scene_add_camera(lm_scene *s, const lm_camera *c);
 /* World transforms from local ones (parents come before children). */
 void lm_scene_update(lm_scene *s);
 
+/* Reads a camera list (engine/scene/camlist.c: one view per line, "name
+ * eye_x eye_y eye_z target_x target_y target_z fov_y_degrees [near far]",
+ * '#' comments) and adds a camera per view. Returns the index of the first
+ * camera added and the count in *count; -1 with "file:line: ..." and the
+ * scene unchanged. Without near and far, far covers the whole scene. */
+int lm_scene_add_camera_list(lm_scene *s, const char *path, int *count, lm_error *err);
+
 /* A scene built in code: "cornell". NULL with a message listing the names. */
 lm_scene *lm_scene_builtin(const char *name, lm_error *err);
 const char *lm_scene_builtin_list(void);
