@@ -535,11 +535,11 @@ static unsigned char *planks(int size) {
   unsigned char *p = malloc((size_t)size * size * 3);
   int rows = 8;
   float tone[8];
-  for (int i = 0; i < rows; i++) tone[i] = 0.75f + 0.5f * rnd();
+  for (int i = 0; i < rows; i++) tone[i] = 0.5f + 0.8f * rnd();
   for (int y = 0; y < size; y++)
     for (int x = 0; x < size; x++) {
       int row = y * rows / size;
-      float seam = (y % (size / rows)) == 0 ? 0.35f : 1.0f;
+      float seam = (y % (size / rows)) < 2 ? 0.3f : 1.0f;
       float grain = 0.85f + 0.15f * sinf((float)x * 0.9f + (float)row * 3.0f + sinf((float)y * 0.7f) * 2.0f);
       float k = tone[row] * seam * grain;
       unsigned char *o = p + ((size_t)y * size + x) * 3;
@@ -549,17 +549,18 @@ static unsigned char *planks(int size) {
   return p;
 }
 
-/* Bricks: red with light mortar lines. */
+/* Blocks: large red bricks of varying tone with light mortar lines (bold
+ * enough to survive a 96x72 capture). */
 static unsigned char *bricks(int size) {
   unsigned char *p = malloc((size_t)size * size * 3);
-  int bh = size / 8, bw = size / 4;
+  int bh = size / 4, bw = size / 2;
   for (int y = 0; y < size; y++)
     for (int x = 0; x < size; x++) {
       int row = y / bh, xo = (x + (row % 2) * bw / 2) % size;
-      bool mortar = y % bh < 2 || xo % bw < 2;
+      bool mortar = y % bh < 4 || xo % bw < 4;
       unsigned char *o = p + ((size_t)y * size + x) * 3;
-      float v = 0.85f + 0.15f * (float)(((xo / bw) * 7 + row * 13) % 5) / 4.0f;
-      if (mortar) o[0] = 200, o[1] = 195, o[2] = 185;
+      float v = 0.55f + 0.45f * (float)(((xo / bw) * 7 + row * 13) % 5) / 4.0f;
+      if (mortar) o[0] = 210, o[1] = 205, o[2] = 195;
       else o[0] = (unsigned char)(170 * v), o[1] = (unsigned char)(60 * v), o[2] = (unsigned char)(40 * v);
     }
   return p;
@@ -676,7 +677,7 @@ static void office(const char *dir) {
                   add_material(&d, "book_cream", 0.85f, 0.8f, 0.6f, 0, 0.8f, -1)};
   mesh m = {0};
   float W = 3, D = 3, H = 2.6f; /* room x in [-W, W], z in [-D, D] */
-  quad(&m, (float[]){-W, 0, D}, (float[]){2 * W, 0, 0}, (float[]){0, 0, -2 * D}, 6, 6);
+  quad(&m, (float[]){-W, 0, D}, (float[]){2 * W, 0, 0}, (float[]){0, 0, -2 * D}, 2, 2);
   mesh_node(&d, "floor", -1, add_mesh1(&d, "floor", &m, floor), 0, 0, 0, 0, 1);
   quad(&m, (float[]){-W, H, -D}, (float[]){2 * W, 0, 0}, (float[]){0, 0, 2 * D}, 1, 1);
   quad(&m, (float[]){-W, 0, -D}, (float[]){2 * W, 0, 0}, (float[]){0, H, 0}, 1, 1);
@@ -753,9 +754,9 @@ static void garage(const char *dir) {
   quad(&m, (float[]){-W, 0, 0}, (float[]){2 * W, 0, 0}, (float[]){0, 0, -L}, 1, 1);
   quad(&m, (float[]){-W, H, -L}, (float[]){2 * W, 0, 0}, (float[]){0, 0, L}, 1, 1);
   mesh_node(&d, "slabs", -1, add_mesh1(&d, "slabs", &m, concrete), 0, 0, 0, 0, 1);
-  quad(&m, (float[]){-W, 0, 0}, (float[]){0, 0, -L}, (float[]){0, H, 0}, 10, 1.5f);
-  quad(&m, (float[]){W, 0, -L}, (float[]){0, 0, L}, (float[]){0, H, 0}, 10, 1.5f);
-  quad(&m, (float[]){-W, 0, -L}, (float[]){2 * W, 0, 0}, (float[]){0, H, 0}, 4, 1.5f);
+  quad(&m, (float[]){-W, 0, 0}, (float[]){0, 0, -L}, (float[]){0, H, 0}, 10, 1);
+  quad(&m, (float[]){W, 0, -L}, (float[]){0, 0, L}, (float[]){0, H, 0}, 10, 1);
+  quad(&m, (float[]){-W, 0, -L}, (float[]){2 * W, 0, 0}, (float[]){0, H, 0}, 4, 1);
   mesh_node(&d, "walls", -1, add_mesh1(&d, "walls", &m, brick), 0, 0, 0, 0, 1);
   for (int i = 0; i < 8; i++) box(&m, 0, 0.002f, -1.25f - 2.5f * (float)i, 0.05f, 0.002f, 0.6f);
   mesh_node(&d, "stripes", -1, add_mesh1(&d, "stripes", &m, stripe), 0, 0, 0, 0, 1);
