@@ -19,6 +19,7 @@
  * image, so a killed job leaves it consistent with the files on disk. */
 #define _GNU_SOURCE
 #include <dirent.h>
+#include <glob.h>
 #include <lauxlib.h>
 #include <lua.h>
 #include <stdio.h>
@@ -226,7 +227,9 @@ static bool read_job(job *j, const char *path, lm_error *err) {
   if (!text) return false;
   j->hash = lm_hash(text, len, LM_HASH_SEED);
   lua_State *L = luaL_newstate();
-  bool ok = luaL_loadbufferx(L, text, len, path, "t") == LUA_OK;
+  char chunk[1100];
+  snprintf(chunk, sizeof chunk, "@%s", path); /* messages say "job.lua:3:" */
+  bool ok = luaL_loadbufferx(L, text, len, chunk, "t") == LUA_OK;
   free(text);
   if (ok) {
     lua_newtable(L); /* an empty environment: data, no functions */
@@ -368,6 +371,19 @@ static bool make_parent(const char *file, lm_error *err) {
     if (!c) break;
   }
   return true;
+}
+
+/* A killed run can leave its temporary files (lm_image_write's
+ * "<stem>.tmp-<pid><ext>"): remove those of this output. */
+static void remove_stale_temps(const char *output) {
+  char pattern[1200];
+  const char *dot = strrchr(output, '.'), *slash = strrchr(output, '/');
+  if (!dot || (slash && dot < slash)) return;
+  snprintf(pattern, sizeof pattern, "%.*s.tmp-*%s", (int)(dot - output), output, dot);
+  glob_t g;
+  if (glob(pattern, GLOB_NOSORT, NULL, &g) == 0)
+    for (size_t i = 0; i < g.gl_pathc; i++) remove(g.gl_pathv[i]);
+  globfree(&g);
 }
 
 /* ---- hashes -------------------------------------------------------------- */
@@ -632,6 +648,7 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     const view *v = &views[i];
     const job_scene *s = &j->scenes[v->scene];
     char what[1200];
+    remove_stale_temps(v->output);
     if (!a->force && lm_file_exists(v->output)) {
       skipped++;
       snprintf(what, sizeof what, "%s: exists, skipped", v->output);
