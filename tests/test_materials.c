@@ -247,6 +247,73 @@ static void bad_textures_name_material_texture_and_image(void **state) {
   }
 }
 
+/* ---- the test scenes, mutated --------------------------------------------- */
+static uint32_t rng_state = 777;
+static uint32_t rng(void) {
+  rng_state = rng_state * 1664525u + 1013904223u;
+  return rng_state >> 8;
+}
+
+/* Mutations of data/scenes files, aimed at the JSON's numbers and at the
+ * embedded PNG: whatever loads is consistent, whatever fails names the file. */
+static void mutated_scene_files_never_crash(void **state) {
+  (void)state;
+  static const char *const seeds[] = {"primitives", "cornell"};
+  const char *env = getenv("LIMN_GLTF_MUTATIONS");
+  int iters = env && atoi(env) > 0 ? atoi(env) : 300, loaded = 0;
+  for (int iter = 0; iter < iters; iter++) {
+    char path[1024], out[512];
+    scene_path(seeds[iter % 2], path, sizeof path);
+    size_t len;
+    lm_error err;
+    unsigned char *b = (unsigned char *)lm_read_file(path, &len, &err);
+    assert_non_null(b);
+    uint32_t json_len;
+    memcpy(&json_len, b + 12, 4);
+    size_t json_end = 20 + json_len, png = 0;
+    for (size_t i = json_end; i + 4 < len && !png; i++)
+      if (!memcmp(b + i, "\x89PNG", 4)) png = i;
+    int edits = 1 + (int)(rng() % 3);
+    for (int e = 0; e < edits; e++) {
+      switch (rng() % 4) {
+      case 0: { /* a digit of the JSON for another */
+        size_t j = 20 + rng() % json_len;
+        for (size_t k = 0; k < 64 && j + k < json_end; k++)
+          if (b[j + k] >= '0' && b[j + k] <= '9') {
+            b[j + k] = (unsigned char)('0' + rng() % 10);
+            break;
+          }
+        break;
+      }
+      case 1: /* a byte of the image (or of the buffer when there is none) */
+        b[png ? png + rng() % 800 : json_end + rng() % (len - json_end)] = (unsigned char)rng();
+        break;
+      case 2: b[rng() % len] ^= (unsigned char)(1u << (rng() % 8)); break;
+      default: len = json_end + rng() % (len - json_end); break; /* cut the buffer short */
+      }
+    }
+    snprintf(out, sizeof out, "%s/mutant.glb", tmp);
+    FILE *f = fopen(out, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(b, 1, len, f), len);
+    fclose(f);
+    free(b);
+    lm_scene *s = lm_scene_load_gltf(out, &err);
+    if (s) {
+      loaded++;
+      for (int i = 0; i < s->material_count; i++)
+        assert_true(s->materials[i].base_color_texture >= 0 && s->materials[i].base_color_texture <= s->texture_count);
+      for (int i = 0; i < s->texture_count; i++)
+        assert_true(s->textures[i].width > 0 && s->textures[i].height > 0 && s->textures[i].rgba);
+      lm_scene_destroy(s);
+    } else if (!strstr(err.msg, "mutant.glb")) {
+      fail_msg("iteration %d: message without the path: %s", iter, err.msg);
+    }
+  }
+  printf("scene mutations: %d of %d still loaded\n", loaded, iters);
+  assert_true(loaded > 0 && loaded < iters);
+}
+
 static int setup(void **state) {
   (void)state;
   snprintf(tmp, sizeof tmp, "/tmp/limn-materials-XXXXXX");
@@ -277,6 +344,7 @@ int main(void) {
       cmocka_unit_test(scripts_override_materials_by_name),
       cmocka_unit_test(materials_reload_without_a_restart),
       cmocka_unit_test(bad_textures_name_material_texture_and_image),
+      cmocka_unit_test(mutated_scene_files_never_crash),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }
