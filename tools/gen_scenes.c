@@ -20,6 +20,7 @@ typedef struct buf {
 } buf;
 
 static void put(buf *b, const void *p, size_t n) {
+  if (n == 0) return;
   if (b->len + n > b->cap) {
     b->cap = (b->len + n) * 2 + 256;
     b->data = realloc(b->data, b->cap);

@@ -90,12 +90,29 @@ static std::unique_ptr<ImageInput> open_memory(const void *data, size_t size, co
   return nullptr;
 }
 
+// A PNG's chunks must all lie inside the bytes and end in IEND. OpenImageIO
+// (2.4) leaks when libpng runs off the end of a memory stream, and a cut
+// file deserves its own message anyway.
+static bool png_whole(const unsigned char *b, size_t size, const char *name, lm_error *err) {
+  static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', 13, 10, 26, 10};
+  if (size < 8 || memcmp(b, sig, 8)) return true; /* not a PNG: not ours to judge */
+  for (size_t at = 8; at + 12 <= size;) {
+    size_t len = (size_t)b[at] << 24 | (size_t)b[at + 1] << 16 | (size_t)b[at + 2] << 8 | b[at + 3];
+    if (len > size - at - 12) break;
+    if (!memcmp(b + at + 4, "IEND", 4)) return true;
+    at += 12 + len;
+  }
+  lm_error_set(err, "%s: PNG cut short or damaged (%zu bytes, no whole chunk sequence ending in IEND)", name, size);
+  return false;
+}
+
 static bool read_memory(const void *data, size_t size, const char *name, TypeDesc type, int *w, int *h,
                         int *channels, std::vector<unsigned char> &out, lm_error *err) {
   if (!data || size < 8) {
     lm_error_set(err, "%s: %zu bytes are not an image", name, size);
     return false;
   }
+  if (!png_whole((const unsigned char *)data, size, name, err)) return false;
   Filesystem::IOMemReader proxy(data, size);
   auto in = open_memory(data, size, name, &proxy, err);
   if (!in) return false;
