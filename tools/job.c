@@ -20,6 +20,7 @@
 #define _GNU_SOURCE
 #include <dirent.h>
 #include <glob.h>
+#include <signal.h>
 #include <lauxlib.h>
 #include <lua.h>
 #include <stdio.h>
@@ -637,6 +638,10 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   }
 
   bool tty = isatty(STDOUT_FILENO);
+  /* For tests: SIGKILL ourselves after this many images, as an operator's
+   * kill would, at a point a timed kill cannot hit reliably. */
+  const char *kill_env = getenv("LIMN_JOB_KILL_AFTER");
+  int kill_after = kill_env ? atoi(kill_env) : 0;
   int mine = 0, done = 0, rendered = 0, skipped = 0;
   for (int i = 0; i < view_count; i++) mine += i % a->shards == a->shard;
   if (!rc && !a->quiet)
@@ -679,6 +684,7 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
       rendered++;
       snprintf(what, sizeof what, "%s (%.1f ms)", v->output, res.total_ms);
       progress(a, tty, ++done, mine, what);
+      if (kill_after > 0 && rendered == kill_after) raise(SIGKILL);
     }
     capture_result_free(&res);
   }
