@@ -133,7 +133,9 @@ void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_f
 /* Fills up to `max` lights; returns how many. */
 int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max);
 /* A parameter override: material `material`'s parameter `name` ("color",
- * "rho", "ka", "kd", "ks", "shininess") takes `values` for one draw. */
+ * "rho", "ka", "kd", "ks", "shininess") takes v[0 .. count) for one draw.
+ * (The frame graph carries these as lm_pass_material_param; the renderer
+ * copies them over, as scene and graph do not include each other.) */
 typedef struct lm_material_param {
   const char *material, *name;
   int count;
