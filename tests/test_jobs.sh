@@ -76,6 +76,8 @@ check "shard manifests" count_is "$(( $(entries out/manifest.shard-0-of-3.json) 
 check "bad shard" run 2 capture --job job.lua --shard 3/3
 check "bad shard message" err_has "--shard wants I/N"
 check "--force needs --job" run 2 capture --force
+check "--job with --size" run 2 capture --job job.lua --size 8x8
+check "--job with --size message" err_has "'--size' does not go with it"
 
 # Killed midway, then rerun: finished images are kept, the rest completed.
 # First at a known point (LIMN_JOB_KILL_AFTER: SIGKILL after N images) ...

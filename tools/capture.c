@@ -47,6 +47,7 @@ typedef struct capture_args {
   const char *scene, *script, *tech, *egl, *job;
   int shard, shards;
   bool force;
+  const char *single_flag; /* a flag of single captures (the job names these itself) */
   const char *outputs[16];
   int output_count;
   const char *sets[64];
@@ -106,6 +107,8 @@ static int parse_args(int argc, char **argv, capture_args *a) {
   optind = 1;
   int c;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
+    for (const struct option *o = opts; o->name && c && strchr("sptznc", c); o++)
+      if (o->val == c) a->single_flag = o->name;
     switch (c) {
     case 's': a->scene = optarg; break;
     case 'p': a->script = optarg; break;
@@ -167,6 +170,9 @@ static int parse_args(int argc, char **argv, capture_args *a) {
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
   if (a->job && (a->output_count || a->list_options))
     return usage_error("%s", "--job names its own outputs: no --output or --list-options with it");
+  if (a->job && a->single_flag)
+    return usage_error("--job names its scenes, script, techniques, sizes and frames: '--%s' does not go with it",
+                       a->single_flag);
   if (!a->job && (a->force || a->shards))
     return usage_error("%s", "--force and --shard go with --job");
   return 0;
