@@ -14,10 +14,12 @@ function gbuffer.targets(scale)
   }
 end
 
--- Draws the scene with material technique `technique` ("std") into G.
-function gbuffer.render(G, technique)
+-- Draws the scene with material technique `technique` ("std") into G;
+-- `materials` (optional) overrides material parameters by name:
+-- { wall = { color = { 1, 0, 0 }, ks = 0.2 } }.
+function gbuffer.render(G, technique, materials)
   scene{ "gbuffer", technique = technique or "std", out = { G.clr, G.nrm, G.dpt, G.mat },
-         depth = G.depth, clear = { 0, 0, 0, 0 } }
+         depth = G.depth, clear = { 0, 0, 0, 0 }, materials = materials }
   return G
 end
 

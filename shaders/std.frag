@@ -10,6 +10,10 @@ in vec2 tex_uv;
 uniform vec3 material_color;
 uniform float material_rho;
 uniform vec4 material_k; // k_a, k_d, k_s, shininess
+#ifdef BASE_COLOR_TEXTURE
+// The material's base-colour image, stored sRGB: texture() returns linear values.
+uniform sampler2D base_color_tex;
+#endif
 
 layout(location = 0) out vec4 out_clr;
 layout(location = 1) out vec4 out_nrm;
@@ -19,7 +23,11 @@ layout(location = 3) out vec4 out_mat;
 void main() {
   vec3 n = safe_normalize(world_normal, vec3(0.0, 1.0, 0.0));
   if (!gl_FrontFacing) n = -n; // two-sided: a wall seen from behind still lights
-  out_clr = vec4(saturate(material_color), saturate(material_rho));
+  vec3 albedo = material_color;
+#ifdef BASE_COLOR_TEXTURE
+  albedo *= texture(base_color_tex, tex_uv).rgb; // glTF: baseColorFactor * baseColorTexture
+#endif
+  out_clr = vec4(saturate(albedo), saturate(material_rho));
   out_nrm = vec4(n, max(material_k.w, 0.0));
   out_dpt = max(view_depth, 0.0) * frame.clip.z;
   out_mat = vec4(saturate(material_k.xyz), 1.0);

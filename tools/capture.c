@@ -9,6 +9,7 @@
 #include "image/image.h"
 #include "render/render.h"
 #include "scene/gltf.h"
+#include "capture.h"
 #include "tools.h"
 
 static const char capture_usage[] =
@@ -35,12 +36,20 @@ static const char capture_usage[] =
     "  --check-nan          debug: fail at the first pass that writes a NaN or Inf,\n"
     "                       naming the pass, target and pixel (slow)\n"
     "  --list-options       print the script's techniques and options, and exit\n"
+    "  --job FILE           run a capture job (a Lua table of scenes, camera lists,\n"
+    "                       techniques, sizes, options and an output pattern; see\n"
+    "                       README.md); --set adds to the job's options\n"
+    "  --force              with --job: render images that exist already\n"
+    "  --shard I/N          with --job: render views I, I+N, I+2N ... only\n"
     "  --quiet              no times, errors only\n"
     "  --verbose            debug messages (targets left out, GL messages)\n"
     "  --help               this text\n";
 
 typedef struct capture_args {
-  const char *scene, *script, *tech, *egl;
+  const char *scene, *script, *tech, *egl, *job;
+  int shard, shards;
+  bool force;
+  const char *single_flag; /* a flag of single captures (the job names these itself) */
   const char *outputs[16];
   int output_count;
   const char *sets[64];
@@ -74,7 +83,7 @@ static bool parse_size(const char *s, int *w, int *h) {
   return parse_int(buf, 1, 65536, w) && parse_int(x + 1, 1, 65536, h);
 }
 
-static bool known_extension(const char *path, bool *linear) {
+bool capture_known_extension(const char *path, bool *linear) {
   const char *dot = strrchr(path, '.');
   if (!dot || strchr(dot, '/')) return false;
   *linear = !strcasecmp(dot, ".exr") || !strcasecmp(dot, ".hdr");
@@ -94,11 +103,15 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       {"list-options", no_argument, 0, 'l'}, {"quiet", no_argument, 0, 'q'},
       {"verbose", no_argument, 0, 'v'},      {"help", no_argument, 0, 'h'},
       {"check-nan", no_argument, 0, 'N'},
+      {"job", required_argument, 0, 'j'},    {"force", no_argument, 0, 'f'},
+      {"shard", required_argument, 0, 'S'},
       {0, 0, 0, 0}};
   opterr = 0;
   optind = 1;
   int c;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
+    for (const struct option *o = opts; o->name && c && strchr("sptznc", c); o++)
+      if (o->val == c) a->single_flag = o->name;
     switch (c) {
     case 's': a->scene = optarg; break;
     case 'p': a->script = optarg; break;
@@ -120,7 +133,7 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       break;
     case 'o': {
       bool linear;
-      if (!known_extension(optarg, &linear))
+      if (!capture_known_extension(optarg, &linear))
         return usage_error("--output '%s': use a .png, .exr, .jpg, .tif or .hdr file", optarg);
       if (a->output_count == 16) return usage_error("%s", "at most 16 --output flags");
       a->outputs[a->output_count++] = optarg;
@@ -137,6 +150,18 @@ static int parse_args(int argc, char **argv, capture_args *a) {
         return usage_error("--egl wants auto, device or surfaceless, not '%s'", optarg);
       a->egl = optarg;
       break;
+    case 'j': a->job = optarg; break;
+    case 'f': a->force = true; break;
+    case 'S': {
+      char buf[64], *slash;
+      snprintf(buf, sizeof buf, "%s", optarg);
+      slash = strchr(buf, '/');
+      if (slash) *slash = '\0';
+      if (!slash || !parse_int(buf, 0, 1 << 20, &a->shard) || !parse_int(slash + 1, 1, 1 << 20, &a->shards) ||
+          a->shard >= a->shards)
+        return usage_error("--shard wants I/N with 0 <= I < N, not '%s'", optarg);
+      break;
+    }
     case 'l': a->list_options = true; break;
     case 'q': a->quiet = true; break;
     case 'v': a->verbose = true; break;
@@ -147,11 +172,18 @@ static int parse_args(int argc, char **argv, capture_args *a) {
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
+  if (a->job && (a->output_count || a->list_options))
+    return usage_error("%s", "--job names its own outputs: no --output or --list-options with it");
+  if (a->job && a->single_flag)
+    return usage_error("--job names its scenes, script, techniques, sizes and frames: '--%s' does not go with it",
+                       a->single_flag);
+  if (!a->job && (a->force || a->shards))
+    return usage_error("%s", "--force and --shard go with --job");
   return 0;
 }
 
 /* A relative script path that does not exist here is looked up under the root. */
-static void resolve_script(const char *given, char *out, size_t cap) {
+void capture_resolve(const char *given, char *out, size_t cap) {
   if (!given) {
     snprintf(out, cap, "%s/scripts/pp.lua", lm_root_dir());
   } else if (given[0] != '/' && !lm_file_exists(given)) {
@@ -162,11 +194,11 @@ static void resolve_script(const char *given, char *out, size_t cap) {
   }
 }
 
-typedef struct pass_times {
+typedef struct pass_samples {
   const char *name, *kind;
   double *ms;
   int count;
-} pass_times;
+} pass_samples;
 
 static int compare_double(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
@@ -179,43 +211,32 @@ static double median(double *v, int n) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-static void print_times(pass_times *t, int n, int frames, lm_clock clock) {
-  printf("pass times (median of %d frame%s; clock: %s)\n", frames, frames == 1 ? "" : "s",
-         lm_clock_name(clock));
-  double total = 0;
-  for (int i = 0; i < n; i++) {
-    double m = median(t[i].ms, t[i].count);
-    total += m;
-    printf("  %-24s %-10s %9.3f ms\n", t[i].name, t[i].kind, m);
-  }
-  printf("  %-24s %-10s %9.3f ms\n", "total", "", total);
-}
-
-static void collect_times(lm_graph *g, pass_times **times, int *count, int frames) {
+static void collect_times(lm_graph *g, pass_samples **times, int *count, int frames) {
   for (int i = 0; i < lm_graph_pass_count(g); i++) {
     lm_graph_pass_info p = lm_graph_pass(g, i);
     if (p.culled || p.ms < 0) continue;
-    pass_times *t = NULL;
+    pass_samples *t = NULL;
     for (int k = 0; k < *count && !t; k++)
       if (!strcmp((*times)[k].name, p.name)) t = &(*times)[k];
     if (!t) {
       *times = lm_realloc(*times, sizeof **times * (size_t)(*count + 1));
       t = &(*times)[(*count)++];
-      *t = (pass_times){lm_strdup(p.name), p.kind == LM_PASS_SCENE ? "scene" : "fullscreen",
-                        lm_alloc(sizeof(double) * (size_t)frames), 0};
+      *t = (pass_samples){lm_strdup(p.name), p.kind == LM_PASS_SCENE ? "scene" : "fullscreen",
+                          lm_alloc(sizeof(double) * (size_t)frames), 0};
     }
     if (t->count < frames) t->ms[t->count++] = p.ms;
   }
 }
 
-static bool write_outputs(lm_renderer *r, const capture_args *a, lm_error *err) {
-  size_t px = (size_t)a->width * a->height;
+static bool write_outputs(lm_renderer *r, int width, int height, const char *const *outputs, int count,
+                          bool quiet, lm_error *err) {
+  size_t px = (size_t)width * height;
   unsigned char *srgb = NULL;
   float *linear = NULL;
   bool ok = true;
-  for (int i = 0; i < a->output_count && ok; i++) {
+  for (int i = 0; i < count && ok; i++) {
     bool want_linear = false;
-    known_extension(a->outputs[i], &want_linear);
+    capture_known_extension(outputs[i], &want_linear);
     if (want_linear && !linear) {
       linear = lm_alloc(px * 3 * sizeof(float));
       ok = lm_renderer_read(r, true, linear, err);
@@ -224,13 +245,50 @@ static bool write_outputs(lm_renderer *r, const capture_args *a, lm_error *err) 
       ok = lm_renderer_read(r, false, srgb, err);
     }
     if (ok)
-      ok = lm_image_write(a->outputs[i], a->width, a->height, 3, want_linear,
+      ok = lm_image_write(outputs[i], width, height, 3, want_linear,
                           want_linear ? (void *)linear : (void *)srgb, err);
-    if (ok && !a->quiet) lm_info("wrote %s", a->outputs[i]);
+    if (ok && !quiet) lm_info("wrote %s", outputs[i]);
   }
   free(srgb);
   free(linear);
   return ok;
+}
+
+bool capture_render_write(lm_renderer *r, const capture_view *v, capture_result *res, lm_error *err) {
+  *res = (capture_result){0};
+  pass_samples *samples = NULL;
+  int n = 0;
+  lm_renderer_set_view(r, v->camera, v->width, v->height);
+  bool ok = true;
+  for (int f = 0; f < v->frames && ok; f++) {
+    ok = lm_renderer_frame(r, err);
+    if (ok) collect_times(lm_renderer_graph(r), &samples, &n, v->frames);
+  }
+  if (ok) ok = write_outputs(r, v->width, v->height, v->outputs, v->output_count, v->quiet, err);
+  res->passes = lm_alloc(sizeof *res->passes * (size_t)(n + 1));
+  for (int i = 0; i < n; i++) {
+    res->passes[i] = (capture_pass_time){samples[i].name, samples[i].kind, median(samples[i].ms, samples[i].count)};
+    res->total_ms += res->passes[i].ms;
+    free(samples[i].ms);
+  }
+  res->pass_count = n;
+  res->stats = lm_renderer_draw_stats(r);
+  free(samples);
+  return ok;
+}
+
+void capture_result_free(capture_result *res) {
+  for (int i = 0; i < res->pass_count; i++) free((char *)res->passes[i].name);
+  free(res->passes);
+  *res = (capture_result){0};
+}
+
+static void print_times(const capture_result *res, int frames, lm_clock clock) {
+  printf("pass times (median of %d frame%s; clock: %s)\n", frames, frames == 1 ? "" : "s",
+         lm_clock_name(clock));
+  for (int i = 0; i < res->pass_count; i++)
+    printf("  %-24s %-10s %9.3f ms\n", res->passes[i].name, res->passes[i].kind, res->passes[i].ms);
+  printf("  %-24s %-10s %9.3f ms\n", "total", "", res->total_ms);
 }
 
 int limn_capture(int argc, char **argv) {
@@ -239,9 +297,14 @@ int limn_capture(int argc, char **argv) {
   if (rc) return rc < 0 ? 0 : rc;
   if (a.verbose) lm_log_set_level(LM_LOG_DEBUG);
   if (a.quiet) lm_log_set_level(LM_LOG_WARN);
+  if (a.job)
+    return capture_job_run(&(capture_job_args){.path = a.job, .sets = a.sets, .set_count = a.set_count,
+                                               .shard = a.shard, .shards = a.shards ? a.shards : 1,
+                                               .force = a.force, .quiet = a.quiet, .verbose = a.verbose,
+                                               .egl = a.egl, .clock = a.clock});
 
   char script[2048];
-  resolve_script(a.script, script, sizeof script);
+  capture_resolve(a.script, script, sizeof script);
   lm_error err;
   lm_pipeline *pipeline = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, &err);
   if (!pipeline) {
@@ -294,7 +357,7 @@ int limn_capture(int argc, char **argv) {
   bool any_linear = false;
   for (int i = 0; i < a.output_count; i++) {
     bool l;
-    known_extension(a.outputs[i], &l);
+    capture_known_extension(a.outputs[i], &l);
     any_linear |= l;
   }
   lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = pipeline,
@@ -303,24 +366,19 @@ int limn_capture(int argc, char **argv) {
                                                           .linear_output = any_linear,
                                                           .check_finite = a.check_nan}, &err);
   bool ok = r != NULL;
-  pass_times *times = NULL;
-  int time_count = 0;
   if (ok && !a.quiet)
     lm_info("renderer: %s (%s, %s); scene %s; script %s; technique %s; %dx%d", lm_gl_renderer(),
             lm_gl_version(), lm_context_platform(), a.scene, script, lm_pipeline_technique(pipeline),
             a.width, a.height);
-  for (int f = 0; f < a.frames && ok; f++) {
-    ok = lm_renderer_frame(r, &err);
-    if (ok) collect_times(lm_renderer_graph(r), &times, &time_count, a.frames);
+  capture_result res = {0};
+  if (ok) {
+    capture_view v = {.camera = a.camera, .width = a.width, .height = a.height, .frames = a.frames,
+                      .outputs = a.outputs, .output_count = a.output_count, .quiet = a.quiet};
+    ok = capture_render_write(r, &v, &res, &err);
   }
-  if (ok) ok = write_outputs(r, &a, &err);
-  if (ok && !a.quiet) print_times(times, time_count, a.frames, lm_renderer_clock(r));
+  if (ok && !a.quiet) print_times(&res, a.frames, lm_renderer_clock(r));
   if (!ok) lm_log(LM_LOG_ERROR, "%s", err.msg);
-  for (int i = 0; i < time_count; i++) {
-    free((char *)times[i].name);
-    free(times[i].ms);
-  }
-  free(times);
+  capture_result_free(&res);
   lm_renderer_destroy(r);
   lm_programs_clear();
   lm_scene_destroy(scene);

@@ -85,6 +85,35 @@ bool lm_texture_create(lm_texture *tex, const lm_texture_desc *d, const char *la
   return true;
 }
 
+bool lm_texture_upload_rgba8(lm_texture *tex, int w, int h, const unsigned char *rgba, bool srgb,
+                             const char *label, lm_error *err) {
+  int max = lm_texture_max_size();
+  if (w < 1 || h < 1 || w > max || h > max) {
+    lm_error_set(err, "texture '%s': size %dx%d is outside 1x1 .. %dx%d", label, w, h, max, max);
+    return false;
+  }
+  while (glGetError() != GL_NO_ERROR) {}
+  GLuint id;
+  glCreateTextures(GL_TEXTURE_2D, 1, &id);
+  glTextureStorage2D(id, mip_levels(w, h), srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, w, h);
+  if (glGetError() == GL_OUT_OF_MEMORY) {
+    glDeleteTextures(1, &id);
+    lm_error_set(err, "texture '%s': out of GPU memory for %dx%d", label, w, h);
+    return false;
+  }
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  /* Row 0 (the image's top) goes to t = 0: glTF's uv (0, 0) is the image's
+   * top left, so its coordinates sample the upload as is. */
+  glTextureSubImage2D(id, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba);
+  glGenerateTextureMipmap(id);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  tex->id = id;
+  return true;
+}
+
 void lm_texture_destroy(lm_texture *tex) {
   if (!tex->id) return;
   lm_framebuffers_forget(*tex);

@@ -52,6 +52,11 @@ typedef struct lm_texture_desc {
 } lm_texture_desc;
 /* Refuses sizes over the GL limit with a message naming `label` and the size. */
 bool lm_texture_create(lm_texture *tex, const lm_texture_desc *desc, const char *label, lm_error *err);
+/* An image texture (a material's): RGBA8 texels, rows top first, stored as
+ * GL_SRGB8_ALPHA8 when `srgb` (sampling returns linear values) else RGBA8;
+ * mipmapped, trilinear, repeating. Refuses sizes over the GL limit. */
+bool lm_texture_upload_rgba8(lm_texture *tex, int width, int height, const unsigned char *rgba, bool srgb,
+                             const char *label, lm_error *err);
 void lm_texture_destroy(lm_texture *tex);
 void lm_texture_generate_mips(lm_texture tex);
 void lm_texture_clear(lm_texture tex); /* zero every texel of level 0 */

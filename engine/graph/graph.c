@@ -151,6 +151,13 @@ int lm_graph_add_pass(lm_graph *g, const lm_pass_desc *d, lm_error *err) {
     memcpy(views, d->views, sizeof *views * (size_t)d->view_count);
     c->views = views;
   }
+  lm_pass_material_param *mp = lm_arena_alloc(&g->arena, sizeof *mp * (size_t)(d->material_param_count + 1));
+  for (int i = 0; i < d->material_param_count; i++) {
+    mp[i] = d->material_params[i];
+    mp[i].material = arena_str(g, d->material_params[i].material);
+    mp[i].name = arena_str(g, d->material_params[i].name);
+  }
+  c->material_params = mp;
   int *out = lm_arena_alloc(&g->arena, sizeof *out * (size_t)(d->output_count + 1));
   memcpy(out, d->outputs, sizeof *out * (size_t)d->output_count);
   c->outputs = out;

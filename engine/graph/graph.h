@@ -46,6 +46,13 @@ typedef struct lm_pass_view {
   float view_proj[16];
   float depth[4];
 } lm_pass_view;
+/* A scene pass's override of a material parameter (scene{ materials = ...}):
+ * the scene checks the names when it draws. */
+typedef struct lm_pass_material_param {
+  const char *material, *name;
+  int count; /* 1 .. 4 numbers */
+  float v[4];
+} lm_pass_material_param;
 
 #define LM_MAX_PASS_INPUTS 16
 #define LM_MAX_PASS_PARAMS 64
@@ -67,6 +74,8 @@ typedef struct lm_pass_desc {
   float clear_color[4];
   const lm_pass_view *views; /* scene passes: draw once per view; none: the camera */
   int view_count;
+  const lm_pass_material_param *material_params; /* scene passes */
+  int material_param_count;
 } lm_pass_desc;
 
 lm_graph *lm_graph_create(void);
@@ -111,11 +120,23 @@ int lm_graph_find_target(const lm_graph *g, const char *name);
 int lm_graph_slot_count(const lm_graph *g);
 
 /* ---- executing --------------------------------------------------------- */
+/* What a scene pass hands the code that draws the scene. */
+typedef struct lm_scene_pass {
+  const lm_pass_desc *desc;  /* shader = the material technique */
+  const lm_program *program; /* bound, with the pass's inputs and parameters */
+  lm_graph *graph;
+  const lm_pass_view *view;  /* the tile being drawn; NULL: the camera */
+} lm_scene_pass;
+/* The technique's program with `defines` added to the pass's (a material's
+ * variant: "BASE_COLOR_TEXTURE"), bound, with the pass's inputs and
+ * parameters applied. NULL with a message naming the pass and shader file. */
+const lm_program *lm_scene_pass_variant(const lm_scene_pass *sp, const char *defines, lm_error *err);
+
 typedef struct lm_graph_exec_desc {
   lm_clock clock;
-  /* Draws the scene for a scene pass with the pass's program bound; view is
-   * NULL for the camera. */
-  void (*draw_scene)(void *user, const char *technique, const lm_program *p, const lm_pass_view *view);
+  /* Draws the scene for a scene pass (once per view); false with a message
+   * stops the frame. */
+  bool (*draw_scene)(void *user, const lm_scene_pass *sp, lm_error *err);
   /* Uniforms the scene sets on each draw (not bindable from a script). */
   bool (*scene_owns_uniform)(const char *name);
   void *user;

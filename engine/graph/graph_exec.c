@@ -117,6 +117,7 @@ static bool check_bindings(const lm_graph *g, const lm_pass_desc *d, const lm_pr
   for (int i = 0; i < p->uniform_count; i++) {
     const lm_uniform *u = &p->uniforms[i];
     if (!is_sampler(u->type) || u->location < 0) continue;
+    if (d->kind == LM_PASS_SCENE && x->scene_owns_uniform && x->scene_owns_uniform(u->name)) continue;
     bool bound = false;
     for (int k = 0; k < d->input_count && !bound; k++) bound = !strcmp(d->inputs[k].name, u->name);
     if (!bound) {
@@ -178,13 +179,14 @@ static void apply_params(const lm_pass_desc *d, const lm_program *p) {
   }
 }
 
-static lm_program *pass_program(const lm_pass_desc *d, lm_error *err) {
+static lm_program *pass_program(const lm_pass_desc *d, const char *extra, lm_error *err) {
   lm_program *p;
   if (d->kind == LM_PASS_SCENE) {
-    char vert[256], frag[256];
+    char vert[256], frag[256], defines[1200];
     snprintf(vert, sizeof vert, "%s.vert", d->shader);
     snprintf(frag, sizeof frag, "%s.frag", d->shader);
-    p = lm_program_get(vert, frag, d->defines, err);
+    snprintf(defines, sizeof defines, "%s%s%s", d->defines, d->defines[0] && extra[0] ? ";" : "", extra);
+    p = lm_program_get(vert, frag, defines, err);
   } else {
     p = lm_program_get("fullscreen.vert", d->shader, d->defines, err);
   }
@@ -218,10 +220,42 @@ static bool check_outputs_finite(const lm_graph *g, const lm_pass_desc *d, lm_er
   return true;
 }
 
+/* Binds p with the pass's inputs and parameters. */
+static void bind_pass(const lm_graph *g, const lm_pass_desc *d, const lm_program *p) {
+  lm_program_use(p);
+  for (int i = 0; i < d->input_count; i++)
+    lm_program_bind_texture(lm_program_uniform(p, d->inputs[i].name), g->targets[d->inputs[i].target].texture);
+  apply_params(d, p);
+}
+
+/* A shadow tile's view for the "shadow" technique (pass_view_proj, pass_depth). */
+static void set_view(const lm_program *p, const lm_pass_view *view) {
+  if (!view) return;
+  const lm_uniform *u_vp = lm_program_uniform(p, "pass_view_proj"), *u_depth = lm_program_uniform(p, "pass_depth");
+  if (u_vp) lm_program_set(p, u_vp, view->view_proj);
+  if (u_depth) lm_program_set(p, u_depth, view->depth);
+}
+
+/* What lm_scene_pass_variant needs beyond the public fields. */
+typedef struct scene_pass_ctx {
+  lm_scene_pass pub; /* first: the callback's pointer is this struct's */
+  const lm_graph_exec_desc *x;
+} scene_pass_ctx;
+
+const lm_program *lm_scene_pass_variant(const lm_scene_pass *sp, const char *defines, lm_error *err) {
+  const scene_pass_ctx *c = (const scene_pass_ctx *)sp;
+  const lm_pass_desc *d = sp->desc;
+  lm_program *p = pass_program(d, defines ? defines : "", err);
+  if (!p || !check_bindings(sp->graph, d, p, c->x, err)) return NULL;
+  bind_pass(sp->graph, d, p);
+  set_view(p, sp->view);
+  return p;
+}
+
 static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_graph_exec_desc *x,
                      lm_error *err) {
   const lm_pass_desc *d = &gp->desc;
-  lm_program *p = pass_program(d, err);
+  lm_program *p = pass_program(d, "", err);
   if (!p || !check_bindings(g, d, p, x, err)) return false;
   lm_attachments att = {.color_count = d->output_count};
   for (int i = 0; i < d->output_count; i++) {
@@ -237,32 +271,29 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
     lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
     return false;
   }
-  lm_program_use(p);
-  for (int i = 0; i < d->input_count; i++)
-    lm_program_bind_texture(lm_program_uniform(p, d->inputs[i].name), g->targets[d->inputs[i].target].texture);
-  apply_params(d, p);
+  bind_pass(g, d, p);
   lm_timer_begin(timer, x->clock);
+  bool ok = true;
   if (d->kind == LM_PASS_SCENE) {
     lm_set_scene_state(true, d->view_count > 0); /* tiles are shadow maps */
     if (d->clear) lm_clear(d->output_count, d->clear_color, d->depth >= 0, 1.0f);
-    if (d->view_count == 0 && x->draw_scene) x->draw_scene(x->user, d->shader, p, NULL);
-    const lm_uniform *u_vp = lm_program_uniform(p, "pass_view_proj");
-    const lm_uniform *u_depth = lm_program_uniform(p, "pass_depth");
-    for (int v = 0; v < d->view_count; v++) {
-      const lm_pass_view *view = &d->views[v];
-      lm_set_viewport(view->x, view->y, view->width, view->height);
-      if (u_vp) lm_program_set(p, u_vp, view->view_proj);
-      if (u_depth) lm_program_set(p, u_depth, view->depth);
-      if (x->draw_scene) x->draw_scene(x->user, d->shader, p, view);
+    scene_pass_ctx c = {{d, p, g, NULL}, x};
+    if (d->view_count == 0 && x->draw_scene) ok = x->draw_scene(x->user, &c.pub, err);
+    for (int v = 0; v < d->view_count && ok; v++) {
+      c.pub.view = &d->views[v];
+      lm_set_viewport(c.pub.view->x, c.pub.view->y, c.pub.view->width, c.pub.view->height);
+      set_view(p, c.pub.view);
+      if (x->draw_scene) ok = x->draw_scene(x->user, &c.pub, err);
     }
     lm_set_scene_state(false, false);
+    if (!ok) lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
   } else {
     lm_draw_fullscreen();
   }
   lm_timer_end(timer);
   for (int i = 0; i < d->output_count; i++)
     if (g->targets[d->outputs[i]].desc.mips) lm_texture_generate_mips(att.color[i]);
-  return !x->check_finite || check_outputs_finite(g, d, err);
+  return ok && (!x->check_finite || check_outputs_finite(g, d, err));
 }
 
 bool lm_graph_execute(lm_graph *g, const lm_graph_exec_desc *x, lm_error *err) {

@@ -15,6 +15,7 @@ struct lm_renderer {
   lm_frame_data camera;
   lm_shadow_plan shadows;
   double record_ms, compile_ms;
+  lm_scene_draw_stats stats;  /* this frame's scene draws */
 };
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
@@ -41,10 +42,44 @@ void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compi
   *compile_ms = r->compile_ms;
 }
 
-static void draw_scene(void *user, const char *technique, const lm_program *p, const lm_pass_view *view) {
-  (void)technique, (void)view;
-  lm_scene_draw(((lm_renderer *)user)->desc.scene, p);
+static const lm_program *scene_variant(void *ctx, const char *defines, lm_error *err) {
+  return lm_scene_pass_variant(ctx, defines, err);
 }
+
+static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
+  lm_renderer *r = user;
+  enum { MAX_PARAMS = 256 };
+  lm_material_param params[MAX_PARAMS];
+  int n = sp->desc->material_param_count < MAX_PARAMS ? sp->desc->material_param_count : MAX_PARAMS;
+  for (int i = 0; i < n; i++) {
+    const lm_pass_material_param *q = &sp->desc->material_params[i];
+    params[i] = (lm_material_param){q->material, q->name, q->count, {q->v[0], q->v[1], q->v[2], q->v[3]}};
+  }
+  if (!lm_scene_check_params(r->desc.scene, params, n, err)) return false;
+  /* Cull against the camera, or a spot or cube-face tile; a cascade tile
+   * draws everything, since casters before its near plane still cast. */
+  const float *view_proj = sp->view ? (sp->view->depth[3] > 0 ? sp->view->view_proj : NULL) : r->camera.view_proj;
+  lm_scene_draw_desc d = {.program = sp->program, .variant = scene_variant, .ctx = (void *)sp,
+                          .view_proj = r->desc.no_culling ? NULL : view_proj,
+                          .params = params, .param_count = n};
+  return lm_scene_draw(r->desc.scene, &d, sp->view ? NULL : &r->stats, err); /* camera draws only */
+}
+
+bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
+  if (!lm_scene_upload(scene, err)) return false;
+  r->desc.scene = scene;
+  r->frame = 0;
+  return true;
+}
+
+void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height) {
+  r->desc.camera = camera;
+  r->desc.width = width;
+  r->desc.height = height;
+  r->frame = 0; /* a new view has no previous frame to reproject from */
+}
+
+lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r) { return r->stats; }
 
 /* The engine's last pass: sanitize and encode what the script presented. */
 static bool add_output_stage(lm_renderer *r, int presented, lm_error *err) {
@@ -84,6 +119,7 @@ bool lm_renderer_frame(lm_renderer *r, lm_error *err) {
   r->record_ms = t1 - t0;
   r->compile_ms = lm_cpu_ms() - t1;
 
+  r->stats = (lm_scene_draw_stats){0};
   memcpy(frame->prev_view_proj, r->frame ? r->prev_view_proj : frame->view_proj, sizeof frame->prev_view_proj);
   memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
   frame->time[1] = (float)r->frame++;

@@ -17,12 +17,20 @@ typedef struct lm_renderer_desc {
   lm_clock clock;         /* LM_CLOCK_AUTO picks */
   bool linear_output;     /* also keep a float copy of the output (for EXR) */
   bool check_finite;      /* debug: name the first pass that writes a NaN or Inf */
+  bool no_culling;        /* draw every node, even those outside the frustum */
 } lm_renderer_desc;
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err);
 void lm_renderer_destroy(lm_renderer *r);
 bool lm_renderer_frame(lm_renderer *r, lm_error *err);
 lm_graph *lm_renderer_graph(lm_renderer *r);
+/* Another camera and output size for the next frames (a capture job's next
+ * view): the pipeline, its persistent targets and the texture pool stay. */
+void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height);
+/* Another scene (uploaded now if it was not) for the next frames. */
+bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err);
+/* The last frame's scene draws: nodes drawn and culled, triangles. */
+lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r); /* camera passes, not shadow tiles */
 lm_clock lm_renderer_clock(const lm_renderer *r);
 /* CPU milliseconds of the last frame spent in Lua (OnRender) and in compiling the graph. */
 void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compile_ms);

@@ -19,7 +19,7 @@
  *   zero-area triangles gets +Z. UVs (TEXCOORD_0) are optional (0 when
  *   absent). Coordinates must be finite and within LM_GLTF_MAX_COORD.
  *   Sparse accessors, skins and morph targets are not supported.
- * - Materials, metallic-roughness to Phong (emissive and textures ignored):
+ * - Materials, metallic-roughness to Phong (emissive ignored):
  *     color     = baseColorFactor.rgb, clamped to [0, 1]
  *     kd        = 1 - metallic               (metals have no diffuse part)
  *     ks        = mix(0.04, max(color), metallic)   (F0 of glass-like
@@ -43,10 +43,14 @@
  * - With no camera: "default_camera", 45 degrees vertical field of view,
  *   looking at the centre of the bounds from +Z and 20 degrees above, far
  *   enough that the bounding sphere fits.
- * Textures are not decoded: lm_material has no texture slots yet, and a bad
- * texture should not fail a scene that never reads it. The bridge installs
- * its own image loader (no stb_image) that keeps images undecoded; external
- * image files are not opened at all. */
+ * - A material's baseColorTexture (TEXCOORD_0) becomes a scene texture:
+ *   the bridge's image loader (no stb_image) keeps every image's bytes
+ *   encoded; the images a material uses are decoded through OpenImageIO
+ *   (engine/image) to RGBA8 as stored, and uploaded as sRGB so that shaders
+ *   sample linear colour, multiplied by baseColorFactor. An image that does
+ *   not decode, or an external one that is missing, fails the scene with a
+ *   message naming the material, texture and image index; an image no
+ *   material uses is never decoded. Samplers are ignored (trilinear, repeat). */
 #ifndef LIMN_GLTF_H
 #define LIMN_GLTF_H
 

@@ -5,9 +5,9 @@
 #define TINYGLTF_IMPLEMENTATION
 #define TINYGLTF_NO_STB_IMAGE       // images go through our loader, not stb
 #define TINYGLTF_NO_STB_IMAGE_WRITE // we never write glTF
-#define TINYGLTF_NO_EXTERNAL_IMAGE  // nor open image files nobody reads
 #include <tiny_gltf.h>
 
+#include "image/image.h"
 #include "scene/gltf.h"
 
 #include <strings.h>
@@ -28,6 +28,7 @@ struct Loader {
   lm_error *err;
   std::vector<std::vector<int>> meshes; // [mesh][primitive] -> lm mesh; -1 not yet, -2 skipped
   std::vector<int> materials;           // [material] -> lm material; -1 not yet
+  std::vector<int> textures;            // [image] -> lm texture; -1 not yet
   std::vector<int> nodes;               // [node] -> lm node; -1 not in the scene
   std::vector<int> unset_radius;        // lm lights whose range was absent
 };
@@ -308,6 +309,36 @@ int load_primitive(Loader &L, int mi, int pi) {
 
 // ---- materials -------------------------------------------------------------
 
+// lm texture of a material's baseColorTexture, decoded on first use through
+// OpenImageIO (the bytes stayed encoded since parsing); -1 on error.
+int texture_for(Loader &L, int material, const tinygltf::TextureInfo &info) {
+  const tinygltf::Model &m = L.m;
+  if ((size_t)info.index >= m.textures.size())
+    return fail(L, "material %d: baseColorTexture: texture %d does not exist (the file has %zu)", material,
+                info.index, m.textures.size()), -1;
+  int src = m.textures[info.index].source;
+  if (src < 0 || (size_t)src >= m.images.size())
+    return fail(L, "material %d: texture %d: image %d does not exist (the file has %zu)", material, info.index,
+                src, m.images.size()), -1;
+  if (L.textures[src] >= 0) return L.textures[src];
+  const tinygltf::Image &img = m.images[src];
+  char name[LM_NAME_MAX + 64];
+  snprintf(name, sizeof name, "image %d%s%s%s", src, img.name.empty() && img.uri.empty() ? "" : " ('",
+           img.name.empty() ? img.uri.substr(0, 40).c_str() : img.name.c_str(),
+           img.name.empty() && img.uri.empty() ? "" : "')");
+  if (img.image.empty())
+    return fail(L, "material %d: texture %d: %s: no image data (a missing file?)", material, info.index,
+                name), -1;
+  int w, h;
+  unsigned char *rgba;
+  lm_error why;
+  if (!lm_image_decode_rgba8(img.image.data(), img.image.size(), name, &w, &h, &rgba, &why))
+    return fail(L, "material %d: texture %d: %s", material, info.index, why.msg), -1;
+  char label[LM_NAME_MAX];
+  snprintf(label, sizeof label, "%s", img.name.empty() ? name : img.name.c_str());
+  return L.textures[src] = lm_scene_add_texture(L.s, label, w, h, rgba);
+}
+
 // lm material of glTF material `index`, converted on first use; -1 on error.
 int material_for(Loader &L, const char *where, int index) {
   if (index < 0) return -1;
@@ -336,6 +367,14 @@ int material_for(Loader &L, const char *where, int index) {
   double shin = r4 > 0 ? 2.0 / r4 - 2.0 : 1024.0;
   m.shininess = (float)(shin < 1 ? 1 : shin > 1024 ? 1024 : shin);
   m.rho = maxc * m.kd;
+  if (pbr.baseColorTexture.index >= 0) {
+    if (pbr.baseColorTexture.texCoord != 0)
+      lm_warn("%s: material %d: baseColorTexture uses TEXCOORD_%d; only TEXCOORD_0 is read", L.path, index,
+              pbr.baseColorTexture.texCoord);
+    int t = texture_for(L, index, pbr.baseColorTexture);
+    if (t < 0) return -1;
+    m.base_color_texture = t + 1;
+  }
   return L.materials[index] = lm_scene_add_material(L.s, &m);
 }
 
@@ -653,11 +692,13 @@ void add_defaults(lm_scene *s, const std::vector<int> &unset_radius) {
 
 // ---- parsing ---------------------------------------------------------------
 
-// lm_material has no texture slots yet: keep every image undecoded, so that
-// no stb_image runs and a broken texture cannot fail the scene. When textures
-// arrive, this is where OpenImageIO (engine/image) decodes `bytes`.
-bool keep_image_undecoded(tinygltf::Image *, const int, std::string *, std::string *, int, int,
-                          const unsigned char *, int, void *) {
+// Keeps each image's bytes encoded: texture_for decodes (through OpenImageIO)
+// only the images a material uses, so that no stb_image runs and a broken
+// image nobody reads cannot fail the scene.
+bool keep_image_undecoded(tinygltf::Image *image, const int, std::string *, std::string *, int, int,
+                          const unsigned char *bytes, int size, void *) {
+  if (bytes && size > 0) image->image.assign(bytes, bytes + size);
+  image->as_is = true;
   return true;
 }
 
@@ -738,9 +779,10 @@ bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
 
 // Fills `s` from the parsed model; false (message in L.err) on bad input.
 bool convert(const char *path, const tinygltf::Model &model, lm_scene *s, lm_error *err) {
-  Loader L{path, model, s, err, {}, {}, {}, {}};
+  Loader L{path, model, s, err, {}, {}, {}, {}, {}};
   L.meshes.resize(model.meshes.size());
   L.materials.assign(model.materials.size(), -1);
+  L.textures.assign(model.images.size(), -1);
   L.nodes.assign(model.nodes.size(), -1);
   if (!load_nodes(L)) return false;
   lm_scene_update(s);

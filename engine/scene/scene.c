@@ -20,6 +20,11 @@ void lm_scene_destroy(lm_scene *s) {
     free(s->meshes[i].vertices);
     free(s->meshes[i].indices);
   }
+  for (int i = 0; i < s->texture_count; i++) {
+    if (s->uploaded) lm_texture_destroy(&s->textures[i].gpu);
+    free(s->textures[i].rgba);
+  }
+  free(s->textures);
   free(s->nodes);
   free(s->meshes);
   free(s->materials);
@@ -43,15 +48,28 @@ int lm_scene_add_mesh(lm_scene *s, const char *name, const float *vertices, int 
                       sizeof(uint32_t) * (size_t)index_count);
   m->vertex_count = vertex_count;
   m->index_count = index_count;
-  glm_vec3_fill(m->bounds_min, FLT_MAX);
-  glm_vec3_fill(m->bounds_max, -FLT_MAX);
+  glm_vec3_fill(m->bounds[0], vertex_count ? FLT_MAX : 0);
+  glm_vec3_fill(m->bounds[1], vertex_count ? -FLT_MAX : 0);
   for (int i = 0; i < vertex_count; i++) {
     const float *p = vertices + (size_t)i * 8;
     if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
-    glm_vec3_minv(m->bounds_min, (float *)p, m->bounds_min);
-    glm_vec3_maxv(m->bounds_max, (float *)p, m->bounds_max);
+    glm_vec3_minv(m->bounds[0], (float *)p, m->bounds[0]);
+    glm_vec3_maxv(m->bounds[1], (float *)p, m->bounds[1]);
   }
   return s->mesh_count - 1;
+}
+
+int lm_scene_add_texture(lm_scene *s, const char *name, int width, int height, unsigned char *rgba) {
+  lm_scene_texture *t = LM_PUSH(s->textures, s->texture_count, s->texture_cap);
+  snprintf(t->name, sizeof t->name, "%s", name);
+  t->width = width, t->height = height, t->rgba = rgba;
+  return s->texture_count - 1;
+}
+
+int lm_scene_find_material(const lm_scene *s, const char *name) {
+  for (int i = 0; i < s->material_count; i++)
+    if (!strcmp(s->materials[i].name, name)) return i;
+  return -1;
 }
 
 int lm_scene_add_node(lm_scene *s, const char *name, int parent, const float local[16], int mesh,
@@ -99,12 +117,11 @@ bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]) {
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
     const lm_scene_mesh *m = &s->meshes[n->mesh];
-    if (m->bounds_min[0] > m->bounds_max[0]) continue;
+    if (m->bounds[0][0] > m->bounds[1][0]) continue;
     mat4 w;
     memcpy(w, n->world, sizeof w);
     for (int c = 0; c < 8; c++) {
-      vec4 p = {c & 1 ? m->bounds_max[0] : m->bounds_min[0], c & 2 ? m->bounds_max[1] : m->bounds_min[1],
-                c & 4 ? m->bounds_max[2] : m->bounds_min[2], 1}, q;
+      vec4 p = {m->bounds[c & 1 ? 1 : 0][0], m->bounds[c & 2 ? 1 : 0][1], m->bounds[c & 4 ? 1 : 0][2], 1}, q;
       glm_mat4_mulv(w, p, q);
       if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) continue;
       glm_vec3_minv(min, q, min);
@@ -120,13 +137,61 @@ bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]) {
 }
 
 bool lm_scene_upload(lm_scene *s, lm_error *err) {
-  (void)err;
   if (s->uploaded) return true;
+  for (int i = 0; i < s->texture_count; i++) {
+    lm_scene_texture *t = &s->textures[i];
+    if (!lm_texture_upload_rgba8(&t->gpu, t->width, t->height, t->rgba, true, t->name, err)) {
+      for (int k = 0; k < i; k++) lm_texture_destroy(&s->textures[k].gpu);
+      lm_error_prefix(err, "scene '%s'", s->name);
+      return false;
+    }
+  }
   for (int i = 0; i < s->mesh_count; i++) {
     lm_scene_mesh *m = &s->meshes[i];
     lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->indices, m->index_count);
   }
   s->uploaded = true;
+  return true;
+}
+
+bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err) {
+  bool same = s->node_count == from->node_count;
+  for (int i = 0; i < s->node_count && same; i++) same = s->nodes[i].mesh == from->nodes[i].mesh;
+  if (!same) {
+    lm_error_set(err, "scene '%s': the file's nodes changed (%d now, %d before): reload the whole scene",
+                 s->name, from->node_count, s->node_count);
+    return false;
+  }
+  lm_scene_texture *textures = lm_alloc(sizeof *textures * (size_t)(from->texture_count + 1));
+  for (int i = 0; i < from->texture_count; i++) {
+    const lm_scene_texture *t = &from->textures[i];
+    size_t bytes = (size_t)t->width * t->height * 4;
+    textures[i] = (lm_scene_texture){.width = t->width, .height = t->height,
+                                     .rgba = memcpy(lm_alloc(bytes), t->rgba, bytes)};
+    memcpy(textures[i].name, t->name, sizeof t->name);
+    if (s->uploaded && !lm_texture_upload_rgba8(&textures[i].gpu, t->width, t->height, t->rgba, true, t->name, err)) {
+      for (int k = 0; k <= i; k++) {
+        if (k < i) lm_texture_destroy(&textures[k].gpu);
+        free(textures[k].rgba);
+      }
+      free(textures);
+      return false;
+    }
+  }
+  for (int i = 0; i < s->texture_count; i++) {
+    if (s->uploaded) lm_texture_destroy(&s->textures[i].gpu);
+    free(s->textures[i].rgba);
+  }
+  free(s->textures);
+  s->textures = textures;
+  s->texture_count = from->texture_count;
+  s->texture_cap = from->texture_count + 1;
+  free(s->materials);
+  s->materials = memcpy(lm_alloc(sizeof *s->materials * (size_t)(from->material_count + 1)), from->materials,
+                        sizeof *s->materials * (size_t)from->material_count);
+  s->material_count = from->material_count;
+  s->material_cap = from->material_count + 1;
+  for (int i = 0; i < s->node_count; i++) s->nodes[i].material = from->nodes[i].material;
   return true;
 }
 
@@ -216,7 +281,7 @@ int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max) {
 }
 
 static const char *scene_uniforms[] = {"model", "normal_matrix", "material_color", "material_rho",
-                                       "material_k"};
+                                       "material_k", "base_color_tex"};
 
 bool lm_scene_owns_uniform(const char *name) {
   for (size_t i = 0; i < sizeof scene_uniforms / sizeof *scene_uniforms; i++)
@@ -225,32 +290,142 @@ bool lm_scene_owns_uniform(const char *name) {
 }
 
 const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n) {
-  static const lm_material fallback = {"default", {0.8f, 0.8f, 0.8f}, 0.8f, 0.1f, 0.9f, 0.0f, 16.0f};
+  static const lm_material fallback = {"default", {0.8f, 0.8f, 0.8f}, 0.8f, 0.1f, 0.9f, 0.0f, 16.0f, 0};
   return n->material >= 0 && n->material < s->material_count ? &s->materials[n->material] : &fallback;
 }
 
-void lm_scene_draw(const lm_scene *s, const lm_program *p) {
-  const lm_uniform *u_model = lm_program_uniform(p, "model");
-  const lm_uniform *u_normal = lm_program_uniform(p, "normal_matrix");
-  const lm_uniform *u_color = lm_program_uniform(p, "material_color");
-  const lm_uniform *u_rho = lm_program_uniform(p, "material_rho");
-  const lm_uniform *u_k = lm_program_uniform(p, "material_k");
+/* ---- material parameters ------------------------------------------------ */
+static const struct {
+  const char *name;
+  int count;
+} material_params[] = {{"color", 3}, {"rho", 1}, {"ka", 1}, {"kd", 1}, {"ks", 1}, {"shininess", 1}};
+enum { MATERIAL_PARAM_COUNT = sizeof material_params / sizeof *material_params };
+
+const char *lm_material_param_list(void) { return "color, rho, ka, kd, ks, shininess"; }
+
+static int material_param_index(const char *name) {
+  for (int i = 0; i < MATERIAL_PARAM_COUNT; i++)
+    if (!strcmp(material_params[i].name, name)) return i;
+  return -1;
+}
+
+bool lm_scene_check_params(const lm_scene *s, const lm_material_param *params, int count, lm_error *err) {
+  for (int i = 0; i < count; i++) {
+    const lm_material_param *p = &params[i];
+    if (lm_scene_find_material(s, p->material) < 0) {
+      lm_buf names = {0};
+      for (int k = 0; k < s->material_count && k < 24; k++)
+        lm_buf_printf(&names, "%s%s", k ? ", " : "", s->materials[k].name);
+      if (s->material_count > 24) lm_buf_printf(&names, ", ...");
+      lm_error_set(err, "material '%s': scene '%s' has no material of that name (it has: %s)", p->material,
+                   s->name, names.data ? names.data : "none");
+      lm_buf_free(&names);
+      return false;
+    }
+    int k = material_param_index(p->name);
+    if (k < 0) {
+      lm_error_set(err, "material '%s': unknown parameter '%s' (known: %s)", p->material, p->name,
+                   lm_material_param_list());
+      return false;
+    }
+    if (p->count != material_params[k].count) {
+      lm_error_set(err, "material '%s': parameter '%s' takes %d number%s, not %d", p->material, p->name,
+                   material_params[k].count, material_params[k].count == 1 ? "" : "s", p->count);
+      return false;
+    }
+    for (int c = 0; c < p->count; c++)
+      if (!isfinite(p->v[c])) {
+        lm_error_set(err, "material '%s': parameter '%s' is not finite", p->material, p->name);
+        return false;
+      }
+  }
+  return true;
+}
+
+static void apply_param(lm_material *m, const lm_material_param *p) {
+  switch (material_param_index(p->name)) {
+  case 0: memcpy(m->color, p->v, sizeof m->color); break;
+  case 1: m->rho = p->v[0]; break;
+  case 2: m->ka = p->v[0]; break;
+  case 3: m->kd = p->v[0]; break;
+  case 4: m->ks = p->v[0]; break;
+  case 5: m->shininess = p->v[0]; break;
+  default: break;
+  }
+}
+
+/* ---- drawing ------------------------------------------------------------ */
+bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const float hi[3]) {
+  /* All 8 corners beyond the same clip plane (x, y, z against +-w). */
+  int outside[6] = {0};
+  for (int c = 0; c < 8; c++) {
+    float p[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]}, q[4];
+    for (int r = 0; r < 4; r++)
+      q[r] = view_proj[r] * p[0] + view_proj[4 + r] * p[1] + view_proj[8 + r] * p[2] + view_proj[12 + r];
+    for (int k = 0; k < 3; k++) {
+      outside[2 * k] += q[k] < -q[3];
+      outside[2 * k + 1] += q[k] > q[3];
+    }
+  }
+  for (int k = 0; k < 6; k++)
+    if (outside[k] == 8) return true;
+  return false;
+}
+
+/* World bounds of a mesh under a node's transform (the box of the moved box). */
+static void world_bounds(const float w[16], const float b[2][3], float lo[3], float hi[3]) {
+  for (int r = 0; r < 3; r++) {
+    lo[r] = hi[r] = w[12 + r];
+    for (int k = 0; k < 3; k++) {
+      float a = w[4 * k + r] * b[0][k], c = w[4 * k + r] * b[1][k];
+      lo[r] += a < c ? a : c;
+      hi[r] += a < c ? c : a;
+    }
+  }
+}
+
+bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err) {
+  const lm_program *p = d->program;
+  bool textured = false; /* which variant is bound */
   for (int i = 0; i < s->node_count; i++) {
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
-    const lm_material *m = lm_scene_node_material(s, n);
+    const lm_scene_mesh *mesh = &s->meshes[n->mesh];
+    if (d->view_proj) {
+      float lo[3], hi[3];
+      world_bounds(n->world, mesh->bounds, lo, hi);
+      if (lm_box_outside_frustum(d->view_proj, lo, hi)) {
+        if (stats) stats->culled++;
+        continue;
+      }
+    }
+    lm_material m = *lm_scene_node_material(s, n);
+    for (int k = 0; k < d->param_count; k++)
+      if (!strcmp(d->params[k].material, m.name)) apply_param(&m, &d->params[k]);
+    int tex = m.base_color_texture - 1;
+    bool want_texture = tex >= 0 && tex < s->texture_count && d->variant;
+    if (want_texture != textured) { /* switch programs only when the variant changes */
+      p = d->variant(d->ctx, want_texture ? "BASE_COLOR_TEXTURE" : "", err);
+      if (!p) return false;
+      textured = want_texture;
+    }
     mat4 model, inv;
     mat3 normal;
     memcpy(model, n->world, sizeof model);
     glm_mat4_inv(model, inv);
     glm_mat4_transpose(inv);
     glm_mat4_pick3(inv, normal);
-    float k[4] = {m->ka, m->kd, m->ks, m->shininess};
-    if (u_model) lm_program_set(p, u_model, (float *)model);
-    if (u_normal) lm_program_set(p, u_normal, (float *)normal);
-    if (u_color) lm_program_set(p, u_color, m->color);
-    if (u_rho) lm_program_set(p, u_rho, &m->rho);
-    if (u_k) lm_program_set(p, u_k, k);
-    lm_mesh_draw(&s->meshes[n->mesh].gpu);
+    float k[4] = {m.ka, m.kd, m.ks, m.shininess};
+    const lm_uniform *u;
+    if ((u = lm_program_uniform(p, "model"))) lm_program_set(p, u, (float *)model);
+    if ((u = lm_program_uniform(p, "normal_matrix"))) lm_program_set(p, u, (float *)normal);
+    if ((u = lm_program_uniform(p, "material_color"))) lm_program_set(p, u, m.color);
+    if ((u = lm_program_uniform(p, "material_rho"))) lm_program_set(p, u, &m.rho);
+    if ((u = lm_program_uniform(p, "material_k"))) lm_program_set(p, u, k);
+    if (want_texture && (u = lm_program_uniform(p, "base_color_tex")))
+      lm_program_bind_texture(u, s->textures[tex].gpu);
+    lm_mesh_draw(&mesh->gpu);
+    if (stats) stats->drawn++, stats->triangles += mesh->index_count / 3;
   }
+  return true;
 }

@@ -13,7 +13,16 @@ typedef struct lm_material {
   float color[3];  /* diffuse albedo, linear */
   float rho;       /* reflectance, the G-buffer's "radiation mask" */
   float ka, kd, ks, shininess;
+  int base_color_texture; /* 1 + index into the scene's textures; 0: none */
 } lm_material;
+
+/* A material's image: RGBA8 texels (sRGB-encoded colour), rows top first. */
+typedef struct lm_scene_texture {
+  char name[LM_NAME_MAX];
+  int width, height;
+  unsigned char *rgba;
+  lm_texture gpu;
+} lm_scene_texture;
 
 typedef enum lm_light_type { LM_LIGHT_POINT, LM_LIGHT_SPOT, LM_LIGHT_DIRECTIONAL } lm_light_type;
 
@@ -52,7 +61,7 @@ typedef struct lm_scene_mesh {
   int vertex_count;
   uint32_t *indices;
   int index_count;
-  float bounds_min[3], bounds_max[3]; /* local space, finite positions only */
+  float bounds[2][3]; /* min, max of the finite positions, local space */
   lm_mesh gpu;
 } lm_scene_mesh;
 
@@ -76,6 +85,8 @@ typedef struct lm_scene {
   int light_count, light_cap;
   lm_camera *cameras;
   int camera_count, camera_cap;
+  lm_scene_texture *textures;
+  int texture_count, texture_cap;
   bool uploaded;
 } lm_scene;
 
@@ -88,20 +99,40 @@ int lm_scene_add_mesh(lm_scene *s, const char *name, const float *vertices, int 
 int lm_scene_add_node(lm_scene *s, const char *name, int parent, const float local[16], int mesh,
                       int material);
 int lm_scene_add_light(lm_scene *s, const lm_light *l);
+/* Takes ownership of `rgba` (malloc'd). Returns the texture's index. */
+int lm_scene_add_texture(lm_scene *s, const char *name, int width, int height, unsigned char *rgba);
+/* Index of the material called `name`, or -1. */
+int lm_scene_find_material(const lm_scene *s, const char *name);
 int lm_scene_add_camera(lm_scene *s, const lm_camera *c);
 /* World transforms from local ones (parents come before children). */
 void lm_scene_update(lm_scene *s);
 /* World-space box around every mesh node; false (and a unit box) when empty. */
 bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]);
 
+/* Reads a camera list (engine/scene/camlist.c: one view per line, "name
+ * eye_x eye_y eye_z target_x target_y target_z fov_y_degrees [near far]",
+ * '#' comments) and adds a camera per view. Returns the index of the first
+ * camera added and the count in *count; -1 with "file:line: ..." and the
+ * scene unchanged. Without near and far, far covers the whole scene. */
+int lm_scene_add_camera_list(lm_scene *s, const char *path, int *count, lm_error *err);
+
+
 /* The node's material, or the engine's default one (material -1 or out of range). */
 const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n);
 
-/* A scene built in code: "cornell", or "cornell_pov" (the box lit only by
- * lights POV-Ray matches exactly, engine/scene/pov.h). NULL with a message
- * listing the names. */
+/* A scene built in code: "cornell"; "cornell_pov" (the box lit only by
+ * lights POV-Ray matches exactly, engine/scene/pov.h); "field" (open ground
+ * under a sun, for cascaded shadows). NULL with a message listing the names. */
 lm_scene *lm_scene_builtin(const char *name, lm_error *err);
 const char *lm_scene_builtin_list(void);
+
+/* Takes the materials and textures of `from` (the same scene file read
+ * again after an artist changed it) for `s`, leaving geometry, lights and
+ * cameras alone: the viewer's reload. Both must have the same nodes (count
+ * and meshes), else a message and `s` unchanged. Textures are uploaded when
+ * `s` was. `from` keeps its own copies. Shaders reload separately through
+ * lm_programs_clear. */
+bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err);
 
 /* ---- rendering (needs a GL context) ------------------------------------ */
 bool lm_scene_upload(lm_scene *s, lm_error *err);
@@ -109,9 +140,42 @@ bool lm_scene_upload(lm_scene *s, lm_error *err);
 void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_frame_data *out);
 /* Fills up to `max` lights; returns how many. */
 int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max);
-/* Draws every mesh node with `p`, setting model, normal_matrix and the
- * material uniforms (material_color, material_rho, material_k). */
-void lm_scene_draw(const lm_scene *s, const lm_program *p);
+/* A parameter override: material `material`'s parameter `name` ("color",
+ * "rho", "ka", "kd", "ks", "shininess") takes v[0 .. count) for one draw.
+ * (The frame graph carries these as lm_pass_material_param; the renderer
+ * copies them over, as scene and graph do not include each other.) */
+typedef struct lm_material_param {
+  const char *material, *name;
+  int count;
+  float v[4];
+} lm_material_param;
+/* Checks overrides against the scene: an unknown material or parameter, or
+ * the wrong count of numbers, is a message naming it. */
+bool lm_scene_check_params(const lm_scene *s, const lm_material_param *params, int count, lm_error *err);
+/* Names of the parameters a material has, for messages. */
+const char *lm_material_param_list(void);
+
+typedef struct lm_scene_draw_desc {
+  const lm_program *program; /* bound: the technique's program */
+  /* The technique's program with `defines` added ("BASE_COLOR_TEXTURE" for a
+   * textured material), bound and ready; NULL with a message. NULL: every
+   * material draws with `program` and without its texture. */
+  const lm_program *(*variant)(void *ctx, const char *defines, lm_error *err);
+  void *ctx;
+  const float *view_proj; /* column-major: nodes wholly outside are culled; NULL: none are */
+  const lm_material_param *params; /* overrides (checked by lm_scene_check_params) */
+  int param_count;
+} lm_scene_draw_desc;
+typedef struct lm_scene_draw_stats {
+  int drawn, culled; /* mesh nodes drawn, and left out by the frustum test */
+  long triangles;    /* triangles drawn */
+} lm_scene_draw_stats;
+/* Draws every mesh node whose bounds reach into the frustum, setting model,
+ * normal_matrix, the material uniforms (material_color, material_rho,
+ * material_k) and base_color_tex. Adds to *stats (may be NULL). */
+bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err);
+/* True when the world-space box lo..hi lies wholly outside one clip plane of view_proj. */
+bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const float hi[3]);
 /* Uniforms a scene draw sets itself; scripts may not bind them. */
 bool lm_scene_owns_uniform(const char *name);
 

@@ -236,6 +236,7 @@ typedef struct pass_builder {
   int outputs[LM_MAX_COLOR_OUTPUTS];
   char where[256], defines[1024];
   char what[160];
+  lm_pass_material_param materials[LM_MAX_PASS_PARAMS];
 } pass_builder;
 
 static void read_outputs(lua_State *L, int idx, pass_builder *b) {
@@ -369,6 +370,65 @@ static void read_defines(lua_State *L, int idx, pass_builder *b) {
   b->desc.defines = b->defines;
 }
 
+static int compare_material_params(const void *a, const void *b) {
+  const lm_pass_material_param *x = a, *y = b;
+  int c = strcmp(x->material, y->material);
+  return c ? c : strcmp(x->name, y->name);
+}
+
+/* materials = { name = { color = {r, g, b}, ks = 0.5, ... } }: overrides of
+ * the scene's materials for this pass. The scene checks the names when it
+ * draws (it knows its materials); the shape is checked here. */
+static void read_materials(lua_State *L, int idx, pass_builder *b) {
+  lua_getfield(L, idx, "materials");
+  if (lua_isnil(L, -1)) {
+    lua_pop(L, 1);
+    return;
+  }
+  if (!lua_istable(L, -1))
+    luaL_error(L, "%s: field 'materials' must be a table { material = { parameter = value } }", b->what);
+  lua_pushnil(L);
+  while (lua_next(L, -2)) {
+    if (lua_type(L, -2) != LUA_TSTRING || !lua_istable(L, -1))
+      luaL_error(L, "%s: materials are named tables: materials = { wall = { color = {1, 0, 0} } }", b->what);
+    const char *material = lua_tostring(L, -2);
+    lua_pushnil(L);
+    while (lua_next(L, -2)) {
+      if (lua_type(L, -2) != LUA_TSTRING)
+        luaL_error(L, "%s: material '%s': parameters are named: { ks = 0.5 }", b->what, material);
+      const char *name = lua_tostring(L, -2);
+      if (b->desc.material_param_count >= LM_MAX_PASS_PARAMS)
+        luaL_error(L, "%s: at most %d material parameters", b->what, LM_MAX_PASS_PARAMS);
+      lm_pass_material_param *mp = &b->materials[b->desc.material_param_count++];
+      *mp = (lm_pass_material_param){.material = material, .name = name};
+      if (lua_type(L, -1) == LUA_TNUMBER) {
+        mp->v[mp->count++] = (float)lua_tonumber(L, -1);
+      } else if (lua_istable(L, -1)) {
+        int n = (int)lua_rawlen(L, -1);
+        if (n < 1 || n > 4) luaL_error(L, "%s: material '%s': parameter '%s': 1 to 4 numbers", b->what, material, name);
+        for (int i = 1; i <= n; i++) {
+          lua_rawgeti(L, -1, i);
+          if (lua_type(L, -1) != LUA_TNUMBER)
+            luaL_error(L, "%s: material '%s': parameter '%s': element %d is a %s, not a number", b->what,
+                       material, name, i, luaL_typename(L, -1));
+          mp->v[mp->count++] = (float)lua_tonumber(L, -1);
+          lua_pop(L, 1);
+        }
+      } else {
+        luaL_error(L, "%s: material '%s': parameter '%s': a number or list of numbers, not a %s", b->what,
+                   material, name, luaL_typename(L, -1));
+      }
+      for (int i = 0; i < mp->count; i++)
+        if (!isfinite(mp->v[i])) luaL_error(L, "%s: material '%s': parameter '%s' is not finite", b->what, material, name);
+      lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  qsort(b->materials, (size_t)b->desc.material_param_count, sizeof *b->materials, compare_material_params);
+  b->desc.material_params = b->materials;
+}
+
 static void begin_pass(lua_State *L, pass_builder *b, lm_pass_kind kind, const char *fn) {
   memset(b, 0, sizeof *b);
   luaL_checktype(L, 1, LUA_TTABLE);
@@ -398,7 +458,8 @@ static int l_scene(lua_State *L) {
   pass_builder b;
   int top = lua_gettop(L);
   begin_pass(L, &b, LM_PASS_SCENE, "scene");
-  static const char *const fields[] = {"technique", "out", "depth", "clear", "params", "defines", "views", NULL};
+  static const char *const fields[] = {"technique", "out", "depth", "clear", "params", "defines",
+                                       "materials", "views", NULL};
   check_fields(L, 1, b.what, fields);
   b.desc.shader = opt_string(L, 1, "technique", b.what);
   if (!b.desc.shader) b.desc.shader = "std";
@@ -429,6 +490,7 @@ static int l_scene(lua_State *L) {
     b.desc.view_count = plan->view_count;
   }
   lua_pop(L, 1);
+  read_materials(L, 1, &b);
   add_pass(L, p, &b);
   lua_settop(L, top);
   return 0;

@@ -1,0 +1,166 @@
+#!/usr/bin/env bash
+# Capture jobs as a user meets them: skipping what exists, --force, shards,
+# the manifest, a killed job completed by a rerun, and bad job files and
+# camera lists (a message naming the file and entry or line, exit non-zero).
+set -u
+limn=$1
+root=$2
+tmp=$(mktemp -d /tmp/limn-jobs-XXXXXX)
+trap 'rm -rf "$tmp"' EXIT
+passed=0 failed=0
+cd "$tmp"
+
+check() { # check NAME CONDITION...
+  local name=$1; shift
+  if "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $name"; fi
+}
+run() { # run EXPECTED_RC ARGS... : output in out.txt, err.txt
+  local want=$1; shift
+  "$limn" "$@" >out.txt 2>err.txt; rc=$?
+  [ "$rc" -eq "$want" ] || { echo "  '$*' exited $rc, wanted $want"; sed 's/^/  | /' err.txt | head -5; return 1; }
+}
+err_has() { grep -qF -- "$1" err.txt || { echo "  stderr lacks '$1':"; sed 's/^/  | /' err.txt | head -5; return 1; }; }
+out_has() { grep -qF -- "$1" out.txt || { echo "  stdout lacks '$1':"; sed 's/^/  | /' out.txt | tail -3; return 1; }; }
+count_is() { [ "$1" -eq "$2" ] || { echo "  counted $1, wanted $2"; return 1; }; }
+whole_pngs() { # every PNG ends in its IEND chunk
+  local f
+  for f in "$@"; do tail -c 12 "$f" | grep -q IEND || { echo "  $f is cut short"; return 1; }; done
+}
+entries() { grep -c '{"file": ' "$1"; }
+run_entries() { grep -c "\"run\": $2, \"scene\"" "$1"; }
+
+scenes=$root/data/scenes
+cat > job.lua <<LUA
+-- two scenes, two sizes: 2 * (4 + 4) = 16 views
+return {
+  scenes = { "$scenes/cornell.glb", { scene = "$scenes/garage.glb", cameras = "$scenes/garage.cams" } },
+  sizes = { "48x36", "64x48" },
+  techniques = { "dl" },
+  set = { ambient = 0.05 },
+  output = "out/{scene}/{camera}-{technique}-{size}.png",
+}
+LUA
+
+# A whole run: every view written, a manifest with hashes, strings and times.
+check "job runs" run 0 capture --job job.lua
+check "job writes 16 images" count_is "$(ls out/*/*.png | wc -l)" 16
+check "images are whole" whole_pngs out/*/*.png
+check "plain lines when not a tty" out_has "[16/16] out/garage/low-dl-64x48.png"
+check "manifest lists every image" count_is "$(entries out/manifest.json)" 16
+for key in '"job_hash": "' '"script_hash": "' '"shader_hash": "' '"scene_hash": "' '"renderer": "' \
+           '"gl_version": "' '"width": 64, "height": 48' '"passes": [{"name": "gbuffer", "kind": "scene", "ms": ' \
+           '"options": ["ambient=0.05"]'; do
+  check "manifest has $key" grep -qF -- "$key" out/manifest.json
+done
+
+# A rerun skips everything; deleting one image redoes that one only.
+check "rerun" run 0 capture --job job.lua
+check "rerun skips all" out_has "0 rendered, 16 skipped"
+rm out/cornell/high-dl-48x36.png
+check "rerun after a delete" run 0 capture --job job.lua
+check "only the deleted image is redone" out_has "1 rendered, 15 skipped"
+check "manifest keeps every image" count_is "$(entries out/manifest.json)" 16
+check "manifest: one image from run 3" count_is "$(run_entries out/manifest.json 3)" 1
+check "manifest: it is the deleted one" grep -q '"file": "out/cornell/high-dl-48x36.png", "view": 2, "run": 3' out/manifest.json
+check "--force redoes all" run 0 capture --job job.lua --force
+check "--force count" out_has "16 rendered, 0 skipped"
+
+# Shards split the views between them, each with its own manifest.
+rm -rf out
+check "shard 0/3" run 0 capture --job job.lua --shard 0/3
+check "shard 0/3 renders views 0, 3, ..." count_is "$(ls out/*/*.png | wc -l)" 6
+check "shard 2/3" run 0 capture --job job.lua --shard 2/3
+check "shard 1/3" run 0 capture --job job.lua --shard 1/3
+check "shards together render all" count_is "$(ls out/*/*.png | wc -l)" 16
+check "shard manifests" count_is "$(( $(entries out/manifest.shard-0-of-3.json) + $(entries out/manifest.shard-1-of-3.json) + $(entries out/manifest.shard-2-of-3.json) ))" 16
+check "bad shard" run 2 capture --job job.lua --shard 3/3
+check "bad shard message" err_has "--shard wants I/N"
+check "--force needs --job" run 2 capture --force
+check "--job with --size" run 2 capture --job job.lua --size 8x8
+check "--job with --size message" err_has "'--size' does not go with it"
+
+# Killed midway, then rerun: finished images are kept, the rest completed.
+# First at a known point (LIMN_JOB_KILL_AFTER: SIGKILL after N images) ...
+rm -rf out
+(LIMN_JOB_KILL_AFTER=5 "$limn" capture --job job.lua >/dev/null 2>&1) 2>/dev/null
+check "killed by SIGKILL" test $? -eq 137
+check "5 images before the kill" count_is "$(ls out/*/*.png | wc -l)" 5
+check "rerun after the kill at 5" run 0 capture --job job.lua
+check "rerun completes the other 11" out_has "11 rendered, 5 skipped"
+check "manifest: 5 from run 1, 11 from run 2" test "$(run_entries out/manifest.json 1)" -eq 5 -a "$(run_entries out/manifest.json 2)" -eq 11
+# ... then at whatever moment a timed kill lands (maybe mid-write).
+rm -rf out
+cat > slow.lua <<LUA
+return {
+  scenes = { "$scenes/outdoor.glb" },
+  sizes = { "64x48", "72x54", "80x60", "88x66" },
+  frames = 4,
+  output = "out/{scene}/{camera}-{size}.png",
+}
+LUA
+"$limn" capture --job slow.lua >slow.txt 2>&1 &
+pid=$!
+for _ in $(seq 1 300); do [ -n "$(ls out/outdoor/*.png 2>/dev/null)" ] && break; sleep 0.02; done
+kill -9 "$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+before=$(ls out/outdoor/*.png 2>/dev/null | wc -l)
+echo "killed after $before of 16 images"
+check "the kill came after an image" test "$before" -ge 1
+check "images left by the kill are whole" whole_pngs out/outdoor/*.png
+check "rerun after the kill" run 0 capture --job slow.lua
+check "rerun renders only what was missing" out_has "$((16 - before)) rendered, $before skipped"
+check "all images now" count_is "$(ls out/outdoor/*.png | wc -l)" 16
+check "no temporary files left" count_is "$(ls out/outdoor | grep -c tmp)" 0
+check "images are whole after the rerun" whole_pngs out/outdoor/*.png
+
+# Bad input: the job file and the entry, or the camera list and its line.
+bad() { # bad NAME RC MESSAGE JOB_BODY
+  printf '%s\n' "$4" > bad.lua
+  check "$1" run "$2" capture --job bad.lua
+  check "$1: message" err_has "$3"
+}
+bad "unknown scene file" 1 "bad.lua: scenes[2]: $tmp/nosuch.glb" \
+  "return { scenes = { '$scenes/cornell.glb', '$tmp/nosuch.glb' }, output = 'o/{camera}.png' }"
+bad "scene that is not glTF" 2 "bad.lua: scenes[1]: 'cornell' is not a .gltf or .glb file" \
+  "return { scenes = { 'cornell' }, output = 'o/{camera}.png' }"
+bad "unknown technique" 2 "bad.lua: techniques[2]: " \
+  "return { scenes = { '$scenes/cornell.glb' }, techniques = { 'dl', 'nosuch' }, output = 'o/{camera}.png' }"
+bad "unknown option" 2 "bad.lua: set.nosuch: " \
+  "return { scenes = { '$scenes/cornell.glb' }, set = { nosuch = 1 }, output = 'o/{camera}.png' }"
+bad "unknown field" 2 "bad.lua: unknown field 'outputs'" \
+  "return { scenes = { '$scenes/cornell.glb' }, outputs = 'o/{camera}.png' }"
+bad "bad size" 2 "bad.lua: sizes[1]: want \"WxH\"" \
+  "return { scenes = { '$scenes/cornell.glb' }, sizes = { '0x3' }, output = 'o/{camera}.png' }"
+bad "unknown placeholder" 1 "bad.lua: output: unknown placeholder '{cam}'" \
+  "return { scenes = { '$scenes/cornell.glb' }, output = 'o/{cam}.png' }"
+bad "outputs that collide" 1 "bad.lua: output: views 0 and 1 both write o/x.png" \
+  "return { scenes = { '$scenes/cornell.glb' }, output = 'o/x.png' }"
+bad "no scenes" 2 "bad.lua: scenes: the job names no scene" "return { output = 'o/{camera}.png' }"
+bad "syntax error" 2 "bad.lua:2:" "return {
+  scenes = { 'a.glb' } output = 'x.png' }"
+bad "not a table" 2 "bad.lua: the job file must return a table" "return 42"
+bad "runs forever" 2 "the job file runs too long" "while true do end"
+bad "no functions in a job" 2 "bad.lua:1:" "return { scenes = io.open('x') }"
+check "missing job file" run 2 capture --job nosuch.lua
+check "missing job file message" err_has "nosuch.lua"
+
+printf 'front 0 1 3.4  0 1 0  45\nside 0 1 x  0 1 0  45\n' > bad.cams
+bad "camera list: a number that does not parse" 1 "bad.cams:2: view 'side': eye_z 'x' is not a finite number" \
+  "return { scenes = { { scene = '$scenes/cornell.glb', cameras = '$tmp/bad.cams' } }, output = 'o/{camera}.png' }"
+check "camera list message names the job entry" err_has "bad.lua: scenes[1]: "
+printf '# views\n\nfront 0 1 3.4  0 1 0\n' > bad.cams
+check "camera list: too few fields" run 1 capture --job bad.lua
+check "too few fields message" err_has "bad.cams:3: 7 fields"
+printf 'front 0 1 3.4  0 1 3.4  45\n' > bad.cams
+check "camera list: eye at the target" run 1 capture --job bad.lua
+check "eye at the target message" err_has "bad.cams:1: view 'front': the eye is at the target"
+printf 'front 0 1 3.4  0 1 0  200\n' > bad.cams
+check "camera list: fov" run 1 capture --job bad.lua
+check "fov message" err_has "bad.cams:1: view 'front': fov_y_degrees 200 is outside"
+printf '# nothing\n' > bad.cams
+check "camera list: empty" run 1 capture --job bad.lua
+check "empty message" err_has "bad.cams: no views"
+check "no image from a failed job" test ! -e o
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]

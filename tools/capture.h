@@ -1,0 +1,48 @@
+/* What `limn capture` (tools/capture.c) and capture jobs (tools/job.c)
+ * share: one path that renders a view and writes its images. */
+#ifndef LIMN_CAPTURE_H
+#define LIMN_CAPTURE_H
+
+#include "render/render.h"
+
+typedef struct capture_view {
+  int camera, width, height, frames;
+  const char *const *outputs; /* .png (sRGB), .exr (linear), ... */
+  int output_count;
+  bool quiet;
+} capture_view;
+
+typedef struct capture_pass_time {
+  const char *name, *kind;
+  double ms; /* median over the frames */
+} capture_pass_time;
+
+typedef struct capture_result {
+  capture_pass_time *passes;
+  int pass_count;
+  double total_ms;
+  lm_scene_draw_stats stats; /* the last frame's */
+} capture_result;
+
+/* Points the renderer at the view, renders its frames and writes each
+ * output whole or not at all (lm_image_write). */
+bool capture_render_write(lm_renderer *r, const capture_view *v, capture_result *res, lm_error *err);
+void capture_result_free(capture_result *res);
+/* True for an image extension capture writes; *linear for float formats (EXR, HDR). */
+bool capture_known_extension(const char *path, bool *linear);
+/* A relative path that does not exist here is looked up under the engine's root. */
+void capture_resolve(const char *given, char *out, size_t cap);
+
+typedef struct capture_job_args {
+  const char *path;
+  const char *const *sets; /* extra NAME=VALUE options, after the job's own */
+  int set_count;
+  int shard, shards;       /* render views v with v % shards == shard */
+  bool force, quiet, verbose;
+  const char *egl;
+  lm_clock clock;
+} capture_job_args;
+/* `limn capture --job FILE`: the exit code. */
+int capture_job_run(const capture_job_args *a);
+
+#endif

@@ -1,0 +1,874 @@
+/* gen_scenes: writes the test scenes of data/scenes (GLB files, their camera
+ * lists and the PNG textures they embed). Deterministic: no clock, no
+ * libraries, a fixed pseudo-random sequence and fixed float formatting, so
+ * that running it again gives the same bytes (tests/test_gen_scenes.sh
+ * checks). Usage: gen_scenes OUTDIR */
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PI 3.14159265358979f
+
+/* ---- growable byte buffers ------------------------------------------------ */
+typedef struct buf {
+  unsigned char *data;
+  size_t len, cap;
+} buf;
+
+static void put(buf *b, const void *p, size_t n) {
+  if (n == 0) return;
+  if (b->len + n > b->cap) {
+    b->cap = (b->len + n) * 2 + 256;
+    b->data = realloc(b->data, b->cap);
+    if (!b->data) abort();
+  }
+  memcpy(b->data + b->len, p, n);
+  b->len += n;
+}
+
+__attribute__((format(printf, 2, 3))) static void putf(buf *b, const char *fmt, ...) {
+  char tmp[4096];
+  va_list ap;
+  va_start(ap, fmt);
+  int n = vsnprintf(tmp, sizeof tmp, fmt, ap);
+  va_end(ap);
+  put(b, tmp, (size_t)n);
+}
+
+static void put_u32le(buf *b, uint32_t v) {
+  unsigned char c[4] = {v & 255, (v >> 8) & 255, (v >> 16) & 255, v >> 24};
+  put(b, c, 4);
+}
+
+static void put_u32be(buf *b, uint32_t v) {
+  unsigned char c[4] = {v >> 24, (v >> 16) & 255, (v >> 8) & 255, v & 255};
+  put(b, c, 4);
+}
+
+/* A fixed linear congruential sequence (same on every machine). */
+static uint32_t rng_state = 12345;
+static float rnd(void) {
+  rng_state = rng_state * 1664525u + 1013904223u;
+  return (float)(rng_state >> 8) / 16777216.0f;
+}
+
+/* ---- PNG: stored (uncompressed) deflate, so no zlib version matters ------- */
+static uint32_t crc32_of(const unsigned char *p, size_t n) {
+  uint32_t c = 0xffffffffu;
+  for (size_t i = 0; i < n; i++) {
+    c ^= p[i];
+    for (int k = 0; k < 8; k++) c = c & 1 ? 0xedb88320u ^ (c >> 1) : c >> 1;
+  }
+  return c ^ 0xffffffffu;
+}
+
+static void png_chunk(buf *out, const char *type, const buf *body) {
+  put_u32be(out, (uint32_t)body->len);
+  buf t = {0};
+  put(&t, type, 4);
+  if (body->len) put(&t, body->data, body->len);
+  put(out, t.data, t.len);
+  put_u32be(out, crc32_of(t.data, t.len));
+  free(t.data);
+}
+
+/* RGB8 pixels, rows top first. */
+static void png_encode(buf *out, int w, int h, const unsigned char *rgb) {
+  static const unsigned char sig[8] = {137, 80, 78, 71, 13, 10, 26, 10};
+  put(out, sig, 8);
+  buf ihdr = {0};
+  put_u32be(&ihdr, (uint32_t)w);
+  put_u32be(&ihdr, (uint32_t)h);
+  unsigned char rest[5] = {8, 2, 0, 0, 0}; /* 8 bit, RGB */
+  put(&ihdr, rest, 5);
+  png_chunk(out, "IHDR", &ihdr);
+  buf raw = {0};
+  for (int y = 0; y < h; y++) {
+    unsigned char filter = 0;
+    put(&raw, &filter, 1);
+    put(&raw, rgb + (size_t)y * w * 3, (size_t)w * 3);
+  }
+  buf z = {0};
+  unsigned char zh[2] = {0x78, 0x01};
+  put(&z, zh, 2);
+  uint32_t a = 1, b2 = 0;
+  for (size_t i = 0; i < raw.len; i++) a = (a + raw.data[i]) % 65521, b2 = (b2 + a) % 65521;
+  for (size_t at = 0; at < raw.len;) {
+    size_t n = raw.len - at > 65535 ? 65535 : raw.len - at;
+    unsigned char hd[5] = {at + n == raw.len, n & 255, n >> 8, ~n & 255, (~n >> 8) & 255};
+    put(&z, hd, 5);
+    put(&z, raw.data + at, n);
+    at += n;
+  }
+  put_u32be(&z, (b2 << 16) | a);
+  png_chunk(out, "IDAT", &z);
+  buf none = {0};
+  png_chunk(out, "IEND", &none);
+  free(ihdr.data), free(raw.data), free(z.data);
+}
+
+/* ---- meshes ---------------------------------------------------------------- */
+typedef struct mesh {
+  float *v; /* position(3) normal(3) uv(2) */
+  int nv, vcap;
+  uint32_t *ix;
+  int ni, icap;
+} mesh;
+
+static int vert(mesh *m, float x, float y, float z, float nx, float ny, float nz, float u, float v) {
+  if (m->nv == m->vcap) m->vcap = m->vcap * 2 + 64, m->v = realloc(m->v, sizeof(float) * 8 * m->vcap);
+  float *o = m->v + (size_t)m->nv * 8;
+  o[0] = x, o[1] = y, o[2] = z, o[3] = nx, o[4] = ny, o[5] = nz, o[6] = u, o[7] = v;
+  return m->nv++;
+}
+
+static void tri(mesh *m, int a, int b, int c) {
+  if (m->ni + 3 > m->icap) m->icap = m->icap * 2 + 192, m->ix = realloc(m->ix, sizeof(uint32_t) * m->icap);
+  m->ix[m->ni++] = (uint32_t)a, m->ix[m->ni++] = (uint32_t)b, m->ix[m->ni++] = (uint32_t)c;
+}
+
+static void cross(const float a[3], const float b[3], float o[3]) {
+  o[0] = a[1] * b[2] - a[2] * b[1], o[1] = a[2] * b[0] - a[0] * b[2], o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static void normalize3(float v[3]) {
+  float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (l > 1e-20f) v[0] /= l, v[1] /= l, v[2] /= l;
+}
+
+/* Quad from corner o along edges u and v (facing u x v); uv repeats us x vs times. */
+static void quad(mesh *m, const float o[3], const float u[3], const float v[3], float us, float vs) {
+  float n[3];
+  cross(u, v, n);
+  normalize3(n);
+  int base = m->nv;
+  for (int c = 0; c < 4; c++) {
+    float a = (float)(c == 1 || c == 2), b = (float)(c >= 2);
+    vert(m, o[0] + u[0] * a + v[0] * b, o[1] + u[1] * a + v[1] * b, o[2] + u[2] * a + v[2] * b, n[0], n[1],
+         n[2], a * us, b * vs);
+  }
+  tri(m, base, base + 1, base + 2);
+  tri(m, base, base + 2, base + 3);
+}
+
+/* Axis-aligned box centred at c with half sizes h, outward faces. */
+static void box(mesh *m, float cx, float cy, float cz, float hx, float hy, float hz) {
+  float x0 = cx - hx, x1 = cx + hx, y0 = cy - hy, y1 = cy + hy, z0 = cz - hz, z1 = cz + hz;
+  float X = 2 * hx, Y = 2 * hy, Z = 2 * hz;
+  quad(m, (float[]){x0, y0, z1}, (float[]){X, 0, 0}, (float[]){0, Y, 0}, 1, 1);  /* +z */
+  quad(m, (float[]){x1, y0, z0}, (float[]){-X, 0, 0}, (float[]){0, Y, 0}, 1, 1); /* -z */
+  quad(m, (float[]){x1, y0, z1}, (float[]){0, 0, -Z}, (float[]){0, Y, 0}, 1, 1); /* +x */
+  quad(m, (float[]){x0, y0, z0}, (float[]){0, 0, Z}, (float[]){0, Y, 0}, 1, 1);  /* -x */
+  quad(m, (float[]){x0, y1, z1}, (float[]){X, 0, 0}, (float[]){0, 0, -Z}, 1, 1); /* +y */
+  quad(m, (float[]){x0, y0, z0}, (float[]){X, 0, 0}, (float[]){0, 0, Z}, 1, 1);  /* -y */
+}
+
+/* Cylinder along axis 'y' (or 'z' for wheels), radius r, from -h/2 to h/2, capped. */
+static void cylinder(mesh *m, float r, float h, int seg, char axis) {
+  for (int side = 0; side < 3; side++) {
+    int centre = -1;
+    if (side > 0) {
+      float y = side == 1 ? h / 2 : -h / 2, ny = side == 1 ? 1.0f : -1.0f;
+      centre = axis == 'y' ? vert(m, 0, y, 0, 0, ny, 0, 0.5f, 0.5f) : vert(m, 0, 0, y, 0, 0, ny, 0.5f, 0.5f);
+    }
+    int first = m->nv;
+    for (int i = 0; i <= seg; i++) {
+      float a = 2 * PI * (float)i / (float)seg, c = cosf(a), s = sinf(a);
+      for (int k = 0; k < (side == 0 ? 2 : 1); k++) {
+        float y = side == 0 ? (k ? h / 2 : -h / 2) : side == 1 ? h / 2 : -h / 2;
+        float nx = side == 0 ? c : 0, ns = side == 0 ? s : 0, ny = side == 0 ? 0 : side == 1 ? 1.0f : -1.0f;
+        if (axis == 'y') vert(m, r * c, y, r * s, nx, ny, ns, (float)i / (float)seg, (float)k);
+        else vert(m, r * c, r * s, y, nx, ns, ny, (float)i / (float)seg, (float)k);
+      }
+    }
+    for (int i = 0; i < seg; i++) {
+      if (side == 0) {
+        int a = first + i * 2;
+        /* outward winding: (bottom i, top i, bottom i+1) seen from outside */
+        if (axis == 'y') tri(m, a, a + 1, a + 3), tri(m, a, a + 3, a + 2);
+        else tri(m, a, a + 2, a + 3), tri(m, a, a + 3, a + 1);
+      } else {
+        int a = first + i, b = first + i + 1;
+        bool up = side == 1;
+        if (axis == 'y') up ? tri(m, centre, b, a) : tri(m, centre, a, b);
+        else up ? tri(m, centre, a, b) : tri(m, centre, b, a);
+      }
+    }
+  }
+}
+
+static void cone(mesh *m, float r, float h, float y0, int seg) {
+  float slope = r / h;
+  int tip_first = m->nv;
+  for (int i = 0; i < seg; i++) {
+    float a = 2 * PI * ((float)i + 0.5f) / (float)seg;
+    float n[3] = {cosf(a), slope, sinf(a)};
+    normalize3(n);
+    vert(m, 0, y0 + h, 0, n[0], n[1], n[2], 0.5f, 1);
+  }
+  int ring = m->nv;
+  for (int i = 0; i <= seg; i++) {
+    float a = 2 * PI * (float)i / (float)seg;
+    float n[3] = {cosf(a), slope, sinf(a)};
+    normalize3(n);
+    vert(m, r * cosf(a), y0, r * sinf(a), n[0], n[1], n[2], (float)i / (float)seg, 0);
+  }
+  for (int i = 0; i < seg; i++) tri(m, ring + i, tip_first + i, ring + i + 1);
+  int centre = vert(m, 0, y0, 0, 0, -1, 0, 0.5f, 0.5f);
+  int bottom = m->nv;
+  for (int i = 0; i <= seg; i++) {
+    float a = 2 * PI * (float)i / (float)seg;
+    vert(m, r * cosf(a), y0, r * sinf(a), 0, -1, 0, 0, 0);
+  }
+  for (int i = 0; i < seg; i++) tri(m, centre, bottom + i, bottom + i + 1);
+}
+
+static void sphere(mesh *m, float r, int seg, int rings) {
+  int first = m->nv;
+  for (int j = 0; j <= rings; j++) {
+    float t = PI * (float)j / (float)rings;
+    for (int i = 0; i <= seg; i++) {
+      float p = 2 * PI * (float)i / (float)seg;
+      float n[3] = {sinf(t) * cosf(p), cosf(t), sinf(t) * sinf(p)};
+      vert(m, r * n[0], r * n[1], r * n[2], n[0], n[1], n[2], (float)i / (float)seg, (float)j / (float)rings);
+    }
+  }
+  for (int j = 0; j < rings; j++)
+    for (int i = 0; i < seg; i++) {
+      int a = first + j * (seg + 1) + i, b = a + seg + 1;
+      tri(m, a, a + 1, b + 1);
+      tri(m, a, b + 1, b);
+    }
+}
+
+static void mesh_free(mesh *m) { free(m->v), free(m->ix), memset(m, 0, sizeof *m); }
+
+/* ---- the glTF document ---------------------------------------------------- */
+typedef struct node {
+  char name[64];
+  int parent;
+  float t[3], r[4], s[3];
+  int mesh, camera, light;
+} node;
+
+typedef struct doc {
+  buf bin;
+  buf views, accessors, meshes, materials, images, textures, cameras, lights;
+  int view_count, accessor_count, mesh_count, material_count, image_count, camera_count, light_count;
+  node *nodes;
+  int node_count, node_cap;
+  buf cams; /* the camera list text */
+} doc;
+
+static void sep(buf *b, int count) {
+  if (count) put(b, ",", 1);
+}
+
+static void align4(buf *b) {
+  static const unsigned char zero[4] = {0};
+  put(b, zero, (4 - b->len % 4) % 4);
+}
+
+static int add_view(doc *d, const void *data, size_t len, int target) {
+  align4(&d->bin);
+  size_t off = d->bin.len;
+  put(&d->bin, data, len);
+  sep(&d->views, d->view_count);
+  putf(&d->views, "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu", off, len);
+  if (target) putf(&d->views, ",\"target\":%d", target);
+  put(&d->views, "}", 1);
+  return d->view_count++;
+}
+
+static int add_accessor(doc *d, int view, int ctype, int count, const char *type, const float *mn,
+                        const float *mx) {
+  sep(&d->accessors, d->accessor_count);
+  putf(&d->accessors, "{\"bufferView\":%d,\"componentType\":%d,\"count\":%d,\"type\":\"%s\"", view, ctype,
+       count, type);
+  if (mn)
+    putf(&d->accessors, ",\"min\":[%.6g,%.6g,%.6g],\"max\":[%.6g,%.6g,%.6g]", mn[0], mn[1], mn[2], mx[0],
+         mx[1], mx[2]);
+  put(&d->accessors, "}", 1);
+  return d->accessor_count++;
+}
+
+/* The primitive's JSON for one mesh part: attributes, indices, material. */
+static void add_primitive(doc *d, buf *out, const mesh *m, int material) {
+  size_t nv = (size_t)m->nv;
+  float *pos = malloc(nv * 12), *nrm = malloc(nv * 12), *uv = malloc(nv * 8);
+  float mn[3] = {1e30f, 1e30f, 1e30f}, mx[3] = {-1e30f, -1e30f, -1e30f};
+  for (size_t i = 0; i < nv; i++) {
+    memcpy(pos + i * 3, m->v + i * 8, 12);
+    memcpy(nrm + i * 3, m->v + i * 8 + 3, 12);
+    memcpy(uv + i * 2, m->v + i * 8 + 6, 8);
+    for (int k = 0; k < 3; k++) mn[k] = fminf(mn[k], pos[i * 3 + k]), mx[k] = fmaxf(mx[k], pos[i * 3 + k]);
+  }
+  int ap = add_accessor(d, add_view(d, pos, nv * 12, 34962), 5126, m->nv, "VEC3", mn, mx);
+  int an = add_accessor(d, add_view(d, nrm, nv * 12, 34962), 5126, m->nv, "VEC3", NULL, NULL);
+  int at = add_accessor(d, add_view(d, uv, nv * 8, 34962), 5126, m->nv, "VEC2", NULL, NULL);
+  int ai;
+  if (nv <= 65535) { /* u16 indices keep the files small */
+    uint16_t *ix = malloc((size_t)m->ni * 2);
+    for (int i = 0; i < m->ni; i++) ix[i] = (uint16_t)m->ix[i];
+    ai = add_accessor(d, add_view(d, ix, (size_t)m->ni * 2, 34963), 5123, m->ni, "SCALAR", NULL, NULL);
+    free(ix);
+  } else {
+    ai = add_accessor(d, add_view(d, m->ix, (size_t)m->ni * 4, 34963), 5125, m->ni, "SCALAR", NULL, NULL);
+  }
+  putf(out, "{\"attributes\":{\"POSITION\":%d,\"NORMAL\":%d,\"TEXCOORD_0\":%d},\"indices\":%d,\"material\":%d}",
+       ap, an, at, ai, material);
+  free(pos), free(nrm), free(uv);
+}
+
+/* A mesh of `n` parts, part i with materials[i]. */
+static int add_mesh(doc *d, const char *name, mesh *parts, const int *materials, int n) {
+  sep(&d->meshes, d->mesh_count);
+  putf(&d->meshes, "{\"name\":\"%s\",\"primitives\":[", name);
+  for (int i = 0; i < n; i++) {
+    if (i) put(&d->meshes, ",", 1);
+    add_primitive(d, &d->meshes, &parts[i], materials[i]);
+  }
+  put(&d->meshes, "]}", 2);
+  return d->mesh_count++;
+}
+
+static int add_mesh1(doc *d, const char *name, mesh *m, int material) {
+  int id = add_mesh(d, name, m, &material, 1);
+  mesh_free(m);
+  return id;
+}
+
+static int add_texture(doc *d, int w, int h, const unsigned char *rgb) {
+  buf png = {0};
+  png_encode(&png, w, h, rgb);
+  int view = add_view(d, png.data, png.len, 0);
+  free(png.data);
+  sep(&d->images, d->image_count);
+  putf(&d->images, "{\"bufferView\":%d,\"mimeType\":\"image/png\"}", view);
+  sep(&d->textures, d->image_count);
+  putf(&d->textures, "{\"source\":%d}", d->image_count);
+  return d->image_count++;
+}
+
+/* texture -1: none. */
+static int add_material(doc *d, const char *name, float r, float g, float b, float metallic, float rough,
+                        int texture) {
+  sep(&d->materials, d->material_count);
+  putf(&d->materials,
+       "{\"name\":\"%s\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[%.4g,%.4g,%.4g,1],"
+       "\"metallicFactor\":%.4g,\"roughnessFactor\":%.4g",
+       name, r, g, b, metallic, rough);
+  if (texture >= 0) putf(&d->materials, ",\"baseColorTexture\":{\"index\":%d}", texture);
+  put(&d->materials, "}}", 2);
+  return d->material_count++;
+}
+
+static int add_node(doc *d, const char *name, int parent, float x, float y, float z) {
+  if (d->node_count == d->node_cap)
+    d->node_cap = d->node_cap * 2 + 64, d->nodes = realloc(d->nodes, sizeof *d->nodes * d->node_cap);
+  node *n = &d->nodes[d->node_count];
+  memset(n, 0, sizeof *n);
+  snprintf(n->name, sizeof n->name, "%s", name);
+  n->parent = parent;
+  n->t[0] = x, n->t[1] = y, n->t[2] = z;
+  n->r[3] = 1;
+  n->s[0] = n->s[1] = n->s[2] = 1;
+  n->mesh = n->camera = n->light = -1;
+  return d->node_count++;
+}
+
+static int mesh_node(doc *d, const char *name, int parent, int mesh_id, float x, float y, float z,
+                     float yaw_deg, float scale) {
+  int i = add_node(d, name, parent, x, y, z);
+  float a = yaw_deg * PI / 360.0f;
+  d->nodes[i].r[1] = sinf(a), d->nodes[i].r[3] = cosf(a);
+  d->nodes[i].s[0] = d->nodes[i].s[1] = d->nodes[i].s[2] = scale;
+  d->nodes[i].mesh = mesh_id;
+  return i;
+}
+
+/* Rotation whose -Z looks along dir (+Y up), as a quaternion. */
+static void look_quat(const float dir_in[3], float q[4]) {
+  float f[3] = {dir_in[0], dir_in[1], dir_in[2]}, up[3] = {0, 1, 0}, r[3], u[3];
+  normalize3(f);
+  if (fabsf(f[1]) > 0.999f) up[0] = 0, up[1] = 0, up[2] = -1;
+  cross(f, up, r);
+  normalize3(r);
+  cross(r, f, u);
+  float m00 = r[0], m11 = u[1], m22 = -f[2]; /* columns: r, u, -f */
+  float tr = m00 + m11 + m22;
+  if (tr > 0) {
+    float s = sqrtf(tr + 1) * 2;
+    q[3] = s / 4, q[0] = (u[2] + f[1]) / s, q[1] = (-f[0] - r[2]) / s, q[2] = (r[1] - u[0]) / s;
+  } else if (m00 > m11 && m00 > m22) {
+    float s = sqrtf(1 + m00 - m11 - m22) * 2;
+    q[3] = (u[2] + f[1]) / s, q[0] = s / 4, q[1] = (u[0] + r[1]) / s, q[2] = (-f[0] + r[2]) / s;
+  } else if (m11 > m22) {
+    float s = sqrtf(1 + m11 - m00 - m22) * 2;
+    q[3] = (-f[0] - r[2]) / s, q[0] = (u[0] + r[1]) / s, q[1] = s / 4, q[2] = (-f[1] + u[2]) / s;
+  } else {
+    float s = sqrtf(1 + m22 - m00 - m11) * 2;
+    q[3] = (r[1] - u[0]) / s, q[0] = (-f[0] + r[2]) / s, q[1] = (-f[1] + u[2]) / s, q[2] = s / 4;
+  }
+}
+
+/* A view: a glTF camera node (the first one is what `--scene FILE` shows) and a camera list line. */
+static void view(doc *d, const char *name, float ex, float ey, float ez, float tx, float ty, float tz,
+                 float fov_deg, float zfar) {
+  int n = add_node(d, name, -1, ex, ey, ez);
+  look_quat((float[]){tx - ex, ty - ey, tz - ez}, d->nodes[n].r);
+  sep(&d->cameras, d->camera_count);
+  putf(&d->cameras, "{\"name\":\"%s\",\"type\":\"perspective\",\"perspective\":{\"yfov\":%.6g,\"znear\":0.05,"
+       "\"zfar\":%.6g}}", name, fov_deg * PI / 180.0f, zfar);
+  d->nodes[n].camera = d->camera_count++;
+  putf(&d->cams, "%-10s %8.3f %8.3f %8.3f   %8.3f %8.3f %8.3f   %5.1f\n", name, ex, ey, ez, tx, ty, tz, fov_deg);
+}
+
+/* type: "point", "spot", "directional"; range 0: none. */
+static void light(doc *d, const char *name, const char *type, float x, float y, float z, const float dir[3],
+                  float r, float g, float b, float intensity, float range) {
+  int n = add_node(d, name, -1, x, y, z);
+  if (dir) look_quat(dir, d->nodes[n].r);
+  sep(&d->lights, d->light_count);
+  putf(&d->lights, "{\"name\":\"%s\",\"type\":\"%s\",\"color\":[%.4g,%.4g,%.4g],\"intensity\":%.4g", name, type,
+       r, g, b, intensity);
+  if (range > 0) putf(&d->lights, ",\"range\":%.4g", range);
+  if (!strcmp(type, "spot")) putf(&d->lights, ",\"spot\":{\"innerConeAngle\":0.5,\"outerConeAngle\":0.8}");
+  put(&d->lights, "}", 1);
+  d->nodes[n].light = d->light_count++;
+}
+
+static void write_file(const char *path, const void *data, size_t len) {
+  FILE *f = fopen(path, "wb");
+  if (!f || fwrite(data, 1, len, f) != len || fclose(f) != 0) {
+    fprintf(stderr, "gen_scenes: cannot write %s\n", path);
+    exit(1);
+  }
+}
+
+static void finish(doc *d, const char *dir, const char *name) {
+  buf j = {0};
+  putf(&j, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"limn tools/gen_scenes.c\"}");
+  if (d->light_count) putf(&j, ",\"extensionsUsed\":[\"KHR_lights_punctual\"]");
+  putf(&j, ",\"scene\":0,\"scenes\":[{\"name\":\"%s\",\"nodes\":[", name);
+  int first = 1;
+  for (int i = 0; i < d->node_count; i++)
+    if (d->nodes[i].parent < 0) putf(&j, first ? "%d" : ",%d", i), first = 0;
+  put(&j, "]}],\"nodes\":[", 13);
+  for (int i = 0; i < d->node_count; i++) {
+    node *n = &d->nodes[i];
+    putf(&j, "%s{\"name\":\"%s\"", i ? "," : "", n->name);
+    if (n->t[0] || n->t[1] || n->t[2]) putf(&j, ",\"translation\":[%.6g,%.6g,%.6g]", n->t[0], n->t[1], n->t[2]);
+    if (n->r[3] != 1) putf(&j, ",\"rotation\":[%.6g,%.6g,%.6g,%.6g]", n->r[0], n->r[1], n->r[2], n->r[3]);
+    if (n->s[0] != 1 || n->s[1] != 1 || n->s[2] != 1) putf(&j, ",\"scale\":[%.6g,%.6g,%.6g]", n->s[0], n->s[1], n->s[2]);
+    if (n->mesh >= 0) putf(&j, ",\"mesh\":%d", n->mesh);
+    if (n->camera >= 0) putf(&j, ",\"camera\":%d", n->camera);
+    if (n->light >= 0) putf(&j, ",\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}", n->light);
+    int kids = 0;
+    for (int k = i + 1; k < d->node_count; k++)
+      if (d->nodes[k].parent == i) putf(&j, kids++ ? ",%d" : ",\"children\":[%d", k);
+    if (kids) put(&j, "]", 1);
+    put(&j, "}", 1);
+  }
+  put(&j, "]", 1);
+#define SECTION(key, b, count) \
+  if (count) putf(&j, ",\"" key "\":["), put(&j, (b).data, (b).len), put(&j, "]", 1)
+  SECTION("meshes", d->meshes, d->mesh_count);
+  SECTION("materials", d->materials, d->material_count);
+  SECTION("textures", d->textures, d->image_count);
+  SECTION("images", d->images, d->image_count);
+  SECTION("cameras", d->cameras, d->camera_count);
+  SECTION("accessors", d->accessors, d->accessor_count);
+  SECTION("bufferViews", d->views, d->view_count);
+#undef SECTION
+  if (d->light_count) {
+    putf(&j, ",\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[");
+    put(&j, d->lights.data, d->lights.len);
+    put(&j, "]}}", 3);
+  }
+  align4(&d->bin);
+  putf(&j, ",\"buffers\":[{\"byteLength\":%zu}]}", d->bin.len);
+  while (j.len % 4) put(&j, " ", 1);
+
+  buf glb = {0};
+  put(&glb, "glTF", 4);
+  put_u32le(&glb, 2);
+  put_u32le(&glb, (uint32_t)(12 + 8 + j.len + 8 + d->bin.len));
+  put_u32le(&glb, (uint32_t)j.len);
+  put(&glb, "JSON", 4);
+  put(&glb, j.data, j.len);
+  put_u32le(&glb, (uint32_t)d->bin.len);
+  put(&glb, "BIN\0", 4);
+  put(&glb, d->bin.data, d->bin.len);
+
+  char path[1024];
+  snprintf(path, sizeof path, "%s/%s.glb", dir, name);
+  write_file(path, glb.data, glb.len);
+  buf cams = {0};
+  putf(&cams, "# Views of %s.glb for capture jobs (written by tools/gen_scenes.c).\n"
+              "# name      eye (x y z)                  target (x y z)               fov_y (degrees)\n", name);
+  put(&cams, d->cams.data, d->cams.len);
+  snprintf(path, sizeof path, "%s/%s.cams", dir, name);
+  write_file(path, cams.data, cams.len);
+  printf("%s: %zu bytes, %d nodes, %d meshes, %d textures\n", name, glb.len, d->node_count, d->mesh_count,
+         d->image_count);
+  free(j.data), free(glb.data), free(cams.data), free(d->bin.data), free(d->views.data);
+  free(d->accessors.data), free(d->meshes.data), free(d->materials.data), free(d->images.data);
+  free(d->textures.data), free(d->cameras.data), free(d->lights.data), free(d->nodes), free(d->cams.data);
+  memset(d, 0, sizeof *d);
+}
+
+/* ---- procedural textures (RGB8, sRGB-encoded like any PNG) ---------------- */
+static unsigned char *checker(int size, int cells, const unsigned char a[3], const unsigned char b[3]) {
+  unsigned char *p = malloc((size_t)size * size * 3);
+  for (int y = 0; y < size; y++)
+    for (int x = 0; x < size; x++)
+      memcpy(p + ((size_t)y * size + x) * 3, ((x * cells / size) + (y * cells / size)) % 2 ? a : b, 3);
+  return p;
+}
+
+/* Planks: stripes of varying brown with dark seams and grain. */
+static unsigned char *planks(int size) {
+  unsigned char *p = malloc((size_t)size * size * 3);
+  int rows = 8;
+  float tone[8];
+  for (int i = 0; i < rows; i++) tone[i] = 0.5f + 0.8f * rnd();
+  for (int y = 0; y < size; y++)
+    for (int x = 0; x < size; x++) {
+      int row = y * rows / size;
+      float seam = (y % (size / rows)) < 2 ? 0.3f : 1.0f;
+      float grain = 0.85f + 0.15f * sinf((float)x * 0.9f + (float)row * 3.0f + sinf((float)y * 0.7f) * 2.0f);
+      float k = tone[row] * seam * grain;
+      unsigned char *o = p + ((size_t)y * size + x) * 3;
+      o[0] = (unsigned char)fminf(255, 150 * k), o[1] = (unsigned char)fminf(255, 100 * k),
+      o[2] = (unsigned char)fminf(255, 60 * k);
+    }
+  return p;
+}
+
+/* Blocks: large red bricks of varying tone with light mortar lines (bold
+ * enough to survive a 96x72 capture). */
+static unsigned char *bricks(int size) {
+  unsigned char *p = malloc((size_t)size * size * 3);
+  int bh = size / 4, bw = size / 2;
+  for (int y = 0; y < size; y++)
+    for (int x = 0; x < size; x++) {
+      int row = y / bh, xo = (x + (row % 2) * bw / 2) % size;
+      bool mortar = y % bh < 4 || xo % bw < 4;
+      unsigned char *o = p + ((size_t)y * size + x) * 3;
+      float v = 0.55f + 0.45f * (float)(((xo / bw) * 7 + row * 13) % 5) / 4.0f;
+      if (mortar) o[0] = 210, o[1] = 205, o[2] = 195;
+      else o[0] = (unsigned char)(170 * v), o[1] = (unsigned char)(60 * v), o[2] = (unsigned char)(40 * v);
+    }
+  return p;
+}
+
+/* ---- the scenes ------------------------------------------------------------- */
+static const unsigned char WHITE8[3] = {230, 230, 230}, GREY8[3] = {60, 60, 70};
+
+static void cornell(const char *dir) {
+  doc d = {0};
+  int white = add_material(&d, "white", 0.73f, 0.73f, 0.73f, 0, 1, -1);
+  int red = add_material(&d, "red", 0.63f, 0.065f, 0.05f, 0, 1, -1);
+  int green = add_material(&d, "green", 0.14f, 0.45f, 0.091f, 0, 1, -1);
+  int boxm = add_material(&d, "box", 0.73f, 0.73f, 0.73f, 0, 0.45f, -1);
+  mesh m = {0};
+  quad(&m, (float[]){-1, 0, 1}, (float[]){2, 0, 0}, (float[]){0, 0, -2}, 1, 1);   /* floor */
+  quad(&m, (float[]){-1, 2, -1}, (float[]){2, 0, 0}, (float[]){0, 0, 2}, 1, 1);   /* ceiling */
+  quad(&m, (float[]){-1, 0, -1}, (float[]){2, 0, 0}, (float[]){0, 2, 0}, 1, 1);   /* back */
+  mesh_node(&d, "walls", -1, add_mesh1(&d, "walls", &m, white), 0, 0, 0, 0, 1);
+  quad(&m, (float[]){-1, 0, 1}, (float[]){0, 0, -2}, (float[]){0, 2, 0}, 1, 1);
+  mesh_node(&d, "left", -1, add_mesh1(&d, "left", &m, red), 0, 0, 0, 0, 1);
+  quad(&m, (float[]){1, 0, -1}, (float[]){0, 0, 2}, (float[]){0, 2, 0}, 1, 1);
+  mesh_node(&d, "right", -1, add_mesh1(&d, "right", &m, green), 0, 0, 0, 0, 1);
+  box(&m, 0, 0.5f, 0, 0.5f, 0.5f, 0.5f);
+  int cube = add_mesh1(&d, "cube", &m, boxm);
+  int s = mesh_node(&d, "short_box", -1, cube, 0.35f, 0, 0.3f, -17, 1);
+  d.nodes[s].s[0] = d.nodes[s].s[1] = d.nodes[s].s[2] = 0.6f;
+  int t = mesh_node(&d, "tall_box", -1, cube, -0.35f, 0, -0.35f, 17, 1);
+  d.nodes[t].s[0] = 0.6f, d.nodes[t].s[1] = 1.2f, d.nodes[t].s[2] = 0.6f;
+  light(&d, "ceiling_light", "point", 0, 1.85f, 0, NULL, 1, 0.95f, 0.85f, 1.6f, 4);
+  view(&d, "front", 0, 1, 3.4f, 0, 1, 0, 45, 20);
+  view(&d, "left", -0.6f, 1.2f, 2.6f, 0.1f, 0.8f, 0, 50, 20);
+  view(&d, "high", 0.3f, 1.8f, 2.2f, 0, 0.4f, 0, 55, 20);
+  view(&d, "boxes", 0.2f, 0.7f, 1.6f, 0, 0.5f, 0, 40, 20);
+  finish(&d, dir, "cornell");
+}
+
+/* A car-like object: a body and cabin, four wheels; one mesh, three primitives. */
+static int car_mesh(doc *d, int paint, int glass, int tyre) {
+  mesh parts[3] = {{0}};
+  box(&parts[0], 0, 0.45f, 0, 1.0f, 0.25f, 0.45f);
+  box(&parts[1], -0.1f, 0.9f, 0, 0.55f, 0.2f, 0.4f);
+  for (int i = 0; i < 4; i++) {
+    mesh w = {0};
+    cylinder(&w, 0.22f, 0.16f, 16, 'z');
+    float ox = i % 2 ? 0.62f : -0.62f, oz = i / 2 ? 0.42f : -0.42f;
+    for (int v = 0; v < w.nv; v++) {
+      float *p = w.v + v * 8;
+      vert(&parts[2], p[0] + ox, p[1] + 0.22f, p[2] + oz, p[3], p[4], p[5], p[6], p[7]);
+    }
+    for (int k = 0; k < w.ni; k += 3) {
+      int base = parts[2].nv - w.nv;
+      tri(&parts[2], base + (int)w.ix[k], base + (int)w.ix[k + 1], base + (int)w.ix[k + 2]);
+    }
+    mesh_free(&w);
+  }
+  int mats[3] = {paint, glass, tyre};
+  int id = add_mesh(d, "car", parts, mats, 3);
+  for (int i = 0; i < 3; i++) mesh_free(&parts[i]);
+  return id;
+}
+
+static void primitives(const char *dir) {
+  doc d = {0};
+  unsigned char *tex = checker(64, 8, WHITE8, GREY8);
+  int checker_tex = add_texture(&d, 64, 64, tex);
+  free(tex);
+  int ground = add_material(&d, "ground", 1, 1, 1, 0, 0.9f, checker_tex);
+  int paint = add_material(&d, "paint", 0.8f, 0.1f, 0.08f, 0.3f, 0.35f, -1);
+  int glass = add_material(&d, "glass", 0.15f, 0.2f, 0.25f, 0.0f, 0.1f, -1);
+  int tyre = add_material(&d, "tyre", 0.05f, 0.05f, 0.05f, 0, 0.9f, -1);
+  int blue = add_material(&d, "blue", 0.1f, 0.25f, 0.8f, 0, 0.5f, -1);
+  int yellow = add_material(&d, "yellow", 0.9f, 0.75f, 0.1f, 0, 0.6f, -1);
+  int green = add_material(&d, "green", 0.15f, 0.7f, 0.2f, 0, 0.7f, -1);
+  int gold = add_material(&d, "gold", 1.0f, 0.77f, 0.34f, 1, 0.3f, -1);
+  mesh m = {0};
+  quad(&m, (float[]){-8, 0, 8}, (float[]){16, 0, 0}, (float[]){0, 0, -16}, 8, 8);
+  mesh_node(&d, "ground", -1, add_mesh1(&d, "ground", &m, ground), 0, 0, 0, 0, 1);
+  sphere(&m, 0.5f, 32, 16);
+  mesh_node(&d, "sphere", -1, add_mesh1(&d, "sphere", &m, blue), -2.0f, 0.5f, 0.5f, 0, 1);
+  box(&m, 0, 0.4f, 0, 0.4f, 0.4f, 0.4f);
+  mesh_node(&d, "cube", -1, add_mesh1(&d, "cube", &m, yellow), 2.0f, 0, 0.8f, 30, 1);
+  cylinder(&m, 0.35f, 1.2f, 24, 'y');
+  mesh_node(&d, "cylinder", -1, add_mesh1(&d, "cylinder", &m, green), 1.2f, 0.6f, -1.6f, 0, 1);
+  cone(&m, 0.45f, 1.0f, 0, 24);
+  mesh_node(&d, "cone", -1, add_mesh1(&d, "cone", &m, gold), -1.5f, 0, -1.8f, 0, 1);
+  /* The car: a parent node with the mesh, rotated; a child marks its roof. */
+  int car = mesh_node(&d, "car", -1, car_mesh(&d, paint, glass, tyre), 0, 0, 0, 25, 1);
+  sphere(&m, 0.08f, 12, 6);
+  mesh_node(&d, "car_light", car, add_mesh1(&d, "beacon", &m, yellow), -0.1f, 1.15f, 0, 0, 1);
+  light(&d, "sun", "directional", 0, 10, 0, (float[]){-0.4f, -1, -0.6f}, 1, 0.97f, 0.9f, 1.2f, 0);
+  light(&d, "fill", "point", 2, 3, 3, NULL, 0.6f, 0.7f, 1, 1.0f, 10);
+  view(&d, "front", 0, 2.2f, 6.5f, 0, 0.4f, 0, 45, 60);
+  view(&d, "side", 6, 1.5f, 1, 0, 0.5f, 0, 45, 60);
+  view(&d, "top", 0.5f, 8, 3, 0, 0, 0, 50, 60);
+  view(&d, "car", 1.6f, 1.2f, 2.0f, 0, 0.6f, 0, 40, 60);
+  view(&d, "low", -4, 0.4f, 4, 0, 0.6f, 0, 50, 60);
+  finish(&d, dir, "primitives");
+}
+
+static void office(const char *dir) {
+  doc d = {0};
+  unsigned char *tex = planks(128);
+  int wood_tex = add_texture(&d, 128, 128, tex);
+  free(tex);
+  int floor = add_material(&d, "floor", 1, 1, 1, 0, 0.6f, wood_tex);
+  int wall = add_material(&d, "wall", 0.8f, 0.78f, 0.72f, 0, 1, -1);
+  int desk = add_material(&d, "desk", 0.45f, 0.3f, 0.18f, 0, 0.5f, wood_tex);
+  int metal = add_material(&d, "metal", 0.6f, 0.6f, 0.62f, 1, 0.35f, -1);
+  int fabric = add_material(&d, "fabric", 0.15f, 0.25f, 0.45f, 0, 0.9f, -1);
+  int screen = add_material(&d, "screen", 0.02f, 0.02f, 0.03f, 0, 0.2f, -1);
+  int books[3] = {add_material(&d, "book_red", 0.6f, 0.1f, 0.1f, 0, 0.8f, -1),
+                  add_material(&d, "book_green", 0.1f, 0.45f, 0.15f, 0, 0.8f, -1),
+                  add_material(&d, "book_cream", 0.85f, 0.8f, 0.6f, 0, 0.8f, -1)};
+  mesh m = {0};
+  float W = 3, D = 3, H = 2.6f; /* room x in [-W, W], z in [-D, D] */
+  quad(&m, (float[]){-W, 0, D}, (float[]){2 * W, 0, 0}, (float[]){0, 0, -2 * D}, 2, 2);
+  mesh_node(&d, "floor", -1, add_mesh1(&d, "floor", &m, floor), 0, 0, 0, 0, 1);
+  quad(&m, (float[]){-W, H, -D}, (float[]){2 * W, 0, 0}, (float[]){0, 0, 2 * D}, 1, 1);
+  quad(&m, (float[]){-W, 0, -D}, (float[]){2 * W, 0, 0}, (float[]){0, H, 0}, 1, 1);
+  quad(&m, (float[]){-W, 0, D}, (float[]){0, 0, -2 * D}, (float[]){0, H, 0}, 1, 1);
+  quad(&m, (float[]){W, 0, -D}, (float[]){0, 0, 2 * D}, (float[]){0, H, 0}, 1, 1);
+  quad(&m, (float[]){W, 0, D}, (float[]){-2 * W, 0, 0}, (float[]){0, H, 0}, 1, 1);
+  mesh_node(&d, "walls", -1, add_mesh1(&d, "walls", &m, wall), 0, 0, 0, 0, 1);
+  box(&m, 0, 0.74f, 0, 0.8f, 0.03f, 0.4f);
+  int top = add_mesh1(&d, "desk_top", &m, desk);
+  for (int i = 0; i < 4; i++) box(&m, i % 2 ? 0.75f : -0.75f, 0.36f, i / 2 ? 0.35f : -0.35f, 0.03f, 0.36f, 0.03f);
+  int legs = add_mesh1(&d, "desk_legs", &m, metal);
+  box(&m, 0, 0.45f, 0, 0.25f, 0.04f, 0.25f);
+  box(&m, 0, 0.75f, -0.23f, 0.25f, 0.3f, 0.03f);
+  int seat = add_mesh1(&d, "chair", &m, fabric);
+  cylinder(&m, 0.03f, 0.42f, 8, 'y');
+  int post = add_mesh1(&d, "chair_post", &m, metal);
+  box(&m, 0, 0.2f, 0, 0.3f, 0.15f, 0.02f);
+  int mon = add_mesh1(&d, "monitor", &m, screen);
+  for (int k = 0; k < 4; k++) { /* four desks with chairs and monitors */
+    float x = k % 2 ? 1.5f : -1.5f, z = k / 2 ? 1.2f : -1.2f;
+    char nm[64];
+    snprintf(nm, sizeof nm, "desk%d", k);
+    int dk = mesh_node(&d, nm, -1, top, x, 0, z, 0, 1);
+    snprintf(nm, sizeof nm, "desk%d_legs", k);
+    mesh_node(&d, nm, dk, legs, 0, 0, 0, 0, 1);
+    snprintf(nm, sizeof nm, "desk%d_monitor", k);
+    mesh_node(&d, nm, dk, mon, 0, 0.77f, -0.25f, 0, 1);
+    snprintf(nm, sizeof nm, "chair%d", k);
+    int ch = mesh_node(&d, nm, -1, seat, x + 0.1f, 0, z + 0.7f, 180 + 10 * (float)k, 1);
+    snprintf(nm, sizeof nm, "chair%d_post", k);
+    mesh_node(&d, nm, ch, post, 0, 0.21f, 0, 0, 1);
+  }
+  /* A shelf of books on the back wall. */
+  box(&m, 0, 0.9f, 0, 1.0f, 0.9f, 0.02f);
+  box(&m, 0, 0.6f, 0.15f, 1.0f, 0.02f, 0.15f);
+  box(&m, 0, 1.2f, 0.15f, 1.0f, 0.02f, 0.15f);
+  int shelf = mesh_node(&d, "shelf", -1, add_mesh1(&d, "shelf", &m, desk), 0, 0, -D + 0.02f, 0, 1);
+  for (int b = 0; b < 3; b++) {
+    for (int i = 0; i < 24; i++) {
+      float h = 0.18f + 0.08f * rnd(), x = -0.95f + (float)i * 0.08f;
+      if (i % 3 != b) continue;
+      box(&m, x, 0.62f + h / 2 + (i % 2 ? 0.6f : 0), 0.15f, 0.035f, h / 2, 0.1f);
+    }
+    char nm[32];
+    snprintf(nm, sizeof nm, "books%d", b);
+    mesh_node(&d, nm, shelf, add_mesh1(&d, nm, &m, books[b]), 0, 0, 0, 0, 1);
+  }
+  light(&d, "lamp_a", "point", -1.5f, 2.4f, 0, NULL, 1, 0.95f, 0.85f, 1.2f, 5);
+  light(&d, "lamp_b", "point", 1.5f, 2.4f, 0, NULL, 1, 0.95f, 0.85f, 1.2f, 5);
+  light(&d, "window", "directional", 0, 2, 0, (float[]){0.3f, -0.8f, -0.5f}, 0.9f, 0.95f, 1, 0.3f, 0);
+  view(&d, "door", 0, 1.6f, 2.9f, 0, 0.8f, -1, 60, 30);
+  view(&d, "corner", -2.8f, 2.2f, 2.8f, 0.5f, 0.5f, -0.5f, 60, 30);
+  view(&d, "desk", 1.4f, 1.2f, 2.3f, 1.5f, 0.7f, 1.0f, 50, 30);
+  view(&d, "shelf", 0.3f, 1.3f, -0.5f, 0, 0.9f, -3, 55, 30);
+  finish(&d, dir, "office");
+}
+
+static void garage(const char *dir) {
+  doc d = {0};
+  unsigned char *tex = bricks(128);
+  int brick_tex = add_texture(&d, 128, 128, tex);
+  free(tex);
+  int concrete = add_material(&d, "concrete", 0.5f, 0.5f, 0.5f, 0, 0.9f, -1);
+  int brick = add_material(&d, "brick", 1, 1, 1, 0, 0.9f, brick_tex);
+  int pillar = add_material(&d, "pillar", 0.7f, 0.7f, 0.65f, 0, 0.8f, -1);
+  int stripe = add_material(&d, "stripe", 0.9f, 0.8f, 0.1f, 0, 0.7f, -1);
+  int paints[3] = {add_material(&d, "paint_blue", 0.1f, 0.2f, 0.7f, 0.3f, 0.35f, -1),
+                   add_material(&d, "paint_white", 0.85f, 0.85f, 0.85f, 0.3f, 0.35f, -1),
+                   add_material(&d, "paint_red", 0.7f, 0.08f, 0.06f, 0.3f, 0.35f, -1)};
+  int glass = add_material(&d, "glass", 0.15f, 0.2f, 0.25f, 0, 0.1f, -1);
+  int tyre = add_material(&d, "tyre", 0.05f, 0.05f, 0.05f, 0, 0.9f, -1);
+  float W = 4, L = 20, H = 3; /* corridor x in [-W, W], z in [-L, 0] */
+  mesh m = {0};
+  quad(&m, (float[]){-W, 0, 0}, (float[]){2 * W, 0, 0}, (float[]){0, 0, -L}, 1, 1);
+  quad(&m, (float[]){-W, H, -L}, (float[]){2 * W, 0, 0}, (float[]){0, 0, L}, 1, 1);
+  mesh_node(&d, "slabs", -1, add_mesh1(&d, "slabs", &m, concrete), 0, 0, 0, 0, 1);
+  quad(&m, (float[]){-W, 0, 0}, (float[]){0, 0, -L}, (float[]){0, H, 0}, 10, 1);
+  quad(&m, (float[]){W, 0, -L}, (float[]){0, 0, L}, (float[]){0, H, 0}, 10, 1);
+  quad(&m, (float[]){-W, 0, -L}, (float[]){2 * W, 0, 0}, (float[]){0, H, 0}, 4, 1);
+  mesh_node(&d, "walls", -1, add_mesh1(&d, "walls", &m, brick), 0, 0, 0, 0, 1);
+  for (int i = 0; i < 8; i++) box(&m, 0, 0.002f, -1.25f - 2.5f * (float)i, 0.05f, 0.002f, 0.6f);
+  mesh_node(&d, "stripes", -1, add_mesh1(&d, "stripes", &m, stripe), 0, 0, 0, 0, 1);
+  box(&m, 0, H / 2, 0, 0.2f, H / 2, 0.2f);
+  int col = add_mesh1(&d, "pillar", &m, pillar);
+  int cars[3];
+  for (int k = 0; k < 3; k++) cars[k] = car_mesh(&d, paints[k], glass, tyre);
+  for (int i = 0; i < 5; i++) {
+    char nm[32];
+    float z = -2 - 4 * (float)i;
+    snprintf(nm, sizeof nm, "pillar_l%d", i);
+    mesh_node(&d, nm, -1, col, -1.8f, 0, z, 0, 1);
+    snprintf(nm, sizeof nm, "pillar_r%d", i);
+    mesh_node(&d, nm, -1, col, 1.8f, 0, z, 0, 1);
+  }
+  for (int i = 0; i < 6; i++) { /* parked cars along both walls, nose in */
+    char nm[32];
+    snprintf(nm, sizeof nm, "car%d", i);
+    float z = -4 - 3 * (float)i;
+    mesh_node(&d, nm, -1, cars[i % 3], i % 2 ? 2.9f : -2.9f, 0, z, i % 2 ? 0 : 180, 1);
+  }
+  for (int i = 0; i < 4; i++) {
+    char nm[32];
+    snprintf(nm, sizeof nm, "spot%d", i);
+    light(&d, nm, "spot", 0, H - 0.1f, -2.5f - 5 * (float)i, (float[]){0, -1, 0.0001f}, 1, 0.9f, 0.75f, 1.5f, 7);
+  }
+  for (int i = 0; i < 3; i++) { /* wall washers, so the brick shows */
+    char nm[32];
+    snprintf(nm, sizeof nm, "wash%d", i);
+    light(&d, nm, "point", i % 2 ? 2.8f : -2.8f, 2.6f, -3 - 6 * (float)i, NULL, 1, 0.85f, 0.7f, 1.0f, 8);
+  }
+  view(&d, "entrance", 0, 1.6f, -0.5f, 0, 1.2f, -20, 60, 40);
+  view(&d, "cars", -0.5f, 1.8f, -6, 3, 0.6f, -9, 55, 40);
+  view(&d, "end", 1, 2.2f, -19, -1, 0.8f, -8, 55, 40);
+  view(&d, "low", -1, 0.5f, -3, 2.5f, 0.5f, -8, 60, 40);
+  finish(&d, dir, "garage");
+}
+
+static float height(float x, float z) {
+  return 2.5f * sinf(x * 0.08f) * cosf(z * 0.07f) + 1.2f * sinf(x * 0.23f + z * 0.17f) +
+         0.4f * cosf(x * 0.5f - z * 0.41f);
+}
+
+static void outdoor(const char *dir) {
+  doc d = {0};
+  int grass = add_material(&d, "grass", 0.3f, 0.5f, 0.18f, 0, 0.95f, -1);
+  int bark = add_material(&d, "bark", 0.35f, 0.22f, 0.12f, 0, 0.9f, -1);
+  int leaves = add_material(&d, "leaves", 0.12f, 0.4f, 0.12f, 0, 0.8f, -1);
+  int rock = add_material(&d, "rock", 0.5f, 0.48f, 0.45f, 0, 0.8f, -1);
+  /* Terrain: a 180 x 180 grid (64.8k triangles) over 160 m, normals from the height field. */
+  int N = 180;
+  float S = 160, step = S / (float)N;
+  mesh m = {0};
+  for (int j = 0; j <= N; j++)
+    for (int i = 0; i <= N; i++) {
+      float x = -S / 2 + (float)i * step, z = -S / 2 + (float)j * step, e = 0.5f;
+      float n[3] = {height(x - e, z) - height(x + e, z), 2 * e, height(x, z - e) - height(x, z + e)};
+      normalize3(n);
+      vert(&m, x, height(x, z), z, n[0], n[1], n[2], (float)i / 8, (float)j / 8);
+    }
+  for (int j = 0; j < N; j++)
+    for (int i = 0; i < N; i++) {
+      int a = j * (N + 1) + i, b = a + N + 1;
+      tri(&m, a, b, a + 1);
+      tri(&m, a + 1, b, b + 1);
+    }
+  mesh_node(&d, "terrain", -1, add_mesh1(&d, "terrain", &m, grass), 0, 0, 0, 0, 1);
+  /* One tree mesh (trunk + two crowns, 200 triangles), placed 2000 times by node instancing. */
+  mesh parts[2] = {{0}};
+  cylinder(&parts[0], 0.15f, 1.6f, 10, 'y');
+  for (int v = 0; v < parts[0].nv; v++) parts[0].v[v * 8 + 1] += 0.8f;
+  cone(&parts[1], 1.1f, 2.2f, 1.2f, 20);
+  cone(&parts[1], 0.8f, 1.8f, 2.4f, 20);
+  int tm[2] = {bark, leaves};
+  int tree = add_mesh(&d, "tree", parts, tm, 2);
+  mesh_free(&parts[0]), mesh_free(&parts[1]);
+  sphere(&m, 1, 10, 6);
+  int boulder = add_mesh1(&d, "boulder", &m, rock);
+  int forest = add_node(&d, "forest", -1, 0, 0, 0);
+  for (int k = 0; k < 2000; k++) {
+    float x = (rnd() - 0.5f) * S * 0.9f, z = (rnd() - 0.5f) * S * 0.9f;
+    char nm[32];
+    snprintf(nm, sizeof nm, "tree%d", k);
+    mesh_node(&d, nm, forest, tree, x, height(x, z) - 0.1f, z, rnd() * 360, 0.7f + 0.8f * rnd());
+  }
+  for (int k = 0; k < 200; k++) {
+    float x = (rnd() - 0.5f) * S * 0.9f, z = (rnd() - 0.5f) * S * 0.9f;
+    char nm[32];
+    snprintf(nm, sizeof nm, "boulder%d", k);
+    int b = mesh_node(&d, nm, forest, boulder, x, height(x, z), z, rnd() * 360, 1);
+    float s = 0.3f + 0.6f * rnd();
+    d.nodes[b].s[0] = s * 1.4f, d.nodes[b].s[1] = s * 0.7f, d.nodes[b].s[2] = s;
+  }
+  light(&d, "sun", "directional", 0, 50, 0, (float[]){-0.5f, -0.7f, -0.3f}, 1, 0.95f, 0.85f, 1.3f, 0);
+  light(&d, "sky", "directional", 0, 50, 0, (float[]){0.3f, -1, 0.4f}, 0.4f, 0.5f, 0.7f, 0.35f, 0);
+  view(&d, "overview", 0, 40, 85, 0, 0, 0, 60, 400);
+  view(&d, "valley", -60, 12, 60, 10, 0, -10, 70, 400);
+  view(&d, "ground", 5, 4, 20, 0, 2, 0, 60, 400);
+  view(&d, "above", 0, 120, 1, 0, 0, 0, 60, 400);
+  finish(&d, dir, "outdoor");
+}
+
+int main(int argc, char **argv) {
+  if (argc != 2) {
+    fprintf(stderr, "usage: gen_scenes OUTDIR\n");
+    return 2;
+  }
+  cornell(argv[1]);
+  primitives(argv[1]);
+  office(argv[1]);
+  garage(argv[1]);
+  outdoor(argv[1]);
+  return 0;
+}

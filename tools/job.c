@@ -1,0 +1,750 @@
+/* limn capture --job FILE: many views of many scenes through one GL context
+ * and one pipeline. The job file is Lua data (evaluated with no libraries):
+ *
+ *   return {
+ *     script = "scripts/pp.lua",                  -- default scripts/pp.lua
+ *     scenes = { "data/scenes/cornell.glb",       -- views from cornell.cams beside it
+ *                { scene = "data/scenes/office.glb", cameras = "data/scenes/office.cams" } },
+ *     techniques = { "dl", "isr" },               -- default: the script's first
+ *     sizes = { "96x72" },                        -- default 256x192
+ *     set = { ambient = 0.05, ["isr.samples"] = 8 },
+ *     frames = 1,
+ *     output = "out/{scene}/{camera}_{technique}_{size}.png",
+ *     manifest = "out/manifest.json",             -- default: beside the images
+ *   }
+ *
+ * Views are numbered scene by scene, then size, technique and camera; a
+ * shard I/N renders views I, I+N, ... An image that exists is skipped unless
+ * --force. The manifest is rewritten (whole, renamed into place) after each
+ * image, so a killed job leaves it consistent with the files on disk. */
+#define _GNU_SOURCE
+#include <dirent.h>
+#include <glob.h>
+#include <signal.h>
+#include <lauxlib.h>
+#include <lua.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "capture.h"
+#include "scene/gltf.h"
+
+#define MAX_LIST 64
+
+typedef struct job_scene {
+  char path[1024], cameras[1024], name[LM_NAME_MAX];
+  lm_scene *scene;
+  int first_camera, camera_count;
+  uint64_t hash;
+} job_scene;
+
+typedef struct job {
+  char path[1024], dir[1024], script[1024], output[1024], manifest[1024];
+  job_scene scenes[MAX_LIST];
+  int scene_count;
+  char techniques[MAX_LIST][64];
+  int technique_count;
+  int sizes[MAX_LIST][2];
+  int size_count;
+  char set_names[MAX_LIST][128], set_values[MAX_LIST][256];
+  int set_count;
+  int frames;
+  uint64_t hash;
+} job;
+
+typedef struct view {
+  int scene, camera, size, technique;
+  char output[1024];
+} view;
+
+/* ---- reading the job file ---------------------------------------------- */
+
+static void hook_budget(lua_State *L, lua_Debug *ar) {
+  (void)ar;
+  luaL_error(L, "the job file runs too long (it should be a table of data)");
+}
+
+/* A path named in the job: beside the job file, else under the engine's root, else as given. */
+static void resolve(const job *j, const char *given, char *out, size_t cap) {
+  if (given[0] == '/') {
+    snprintf(out, cap, "%s", given);
+    return;
+  }
+  snprintf(out, cap, "%s/%s", j->dir, given);
+  if (!lm_file_exists(out)) capture_resolve(given, out, cap);
+}
+
+static bool field_string(lua_State *L, int t, const char *key, char *out, size_t cap, const char *path,
+                         lm_error *err) {
+  lua_getfield(L, t, key);
+  bool ok = true;
+  if (lua_type(L, -1) == LUA_TSTRING) {
+    snprintf(out, cap, "%s", lua_tostring(L, -1));
+  } else if (!lua_isnil(L, -1)) {
+    lm_error_set(err, "%s: %s: a string, not a %s", path, key, luaL_typename(L, -1));
+    ok = false;
+  }
+  lua_pop(L, 1);
+  return ok;
+}
+
+static bool parse_size(const char *s, int *w, int *h) {
+  char tail;
+  return sscanf(s, "%dx%d%c", w, h, &tail) == 2 && *w >= 1 && *h >= 1 && *w <= 16384 && *h <= 16384;
+}
+
+/* Reads the list at key: each element through `each` (index from 1). */
+static bool read_list(lua_State *L, int t, const char *key, const char *path, int *count, lm_error *err,
+                      bool (*each)(lua_State *L, job *j, int i, lm_error *err), job *j) {
+  lua_getfield(L, t, key);
+  bool ok = true;
+  if (lua_type(L, -1) == LUA_TSTRING) { /* one element, not a list */
+    ok = each(L, j, 1, err);
+    *count = ok;
+  } else if (lua_istable(L, -1)) {
+    int n = (int)lua_rawlen(L, -1);
+    if (n > MAX_LIST) {
+      lm_error_set(err, "%s: %s: at most %d entries", path, key, MAX_LIST);
+      ok = false;
+    }
+    for (int i = 1; i <= n && ok; i++) {
+      lua_rawgeti(L, -1, i);
+      ok = each(L, j, i, err);
+      lua_pop(L, 1);
+      if (ok) *count = i;
+    }
+  } else if (!lua_isnil(L, -1)) {
+    lm_error_set(err, "%s: %s: a list, not a %s", path, key, luaL_typename(L, -1));
+    ok = false;
+  }
+  lua_pop(L, 1);
+  return ok;
+}
+
+static bool each_scene(lua_State *L, job *j, int i, lm_error *err) {
+  job_scene *s = &j->scenes[i - 1];
+  char given[1024] = "", cams[1024] = "";
+  if (lua_type(L, -1) == LUA_TSTRING) {
+    snprintf(given, sizeof given, "%s", lua_tostring(L, -1));
+  } else if (lua_istable(L, -1)) {
+    char what[64];
+    snprintf(what, sizeof what, "%s: scenes[%d]", j->path, i);
+    if (!field_string(L, -1, "scene", given, sizeof given, what, err) ||
+        !field_string(L, -1, "cameras", cams, sizeof cams, what, err))
+      return false;
+  } else {
+    lm_error_set(err, "%s: scenes[%d]: a file name or { scene = FILE, cameras = FILE }, not a %s", j->path, i,
+                 luaL_typename(L, -1));
+    return false;
+  }
+  if (!given[0] || !lm_scene_is_gltf_name(given)) {
+    lm_error_set(err, "%s: scenes[%d]: '%s' is not a .gltf or .glb file", j->path, i, given);
+    return false;
+  }
+  resolve(j, given, s->path, sizeof s->path);
+  if (cams[0]) {
+    resolve(j, cams, s->cameras, sizeof s->cameras);
+  } else { /* beside the scene, .cams for .glb/.gltf */
+    memcpy(s->cameras, s->path, sizeof s->cameras);
+    char *dot = strrchr(s->cameras, '.'); /* there is one: the name ends in .gltf or .glb */
+    if ((size_t)(dot - s->cameras) + 6 <= sizeof s->cameras) memcpy(dot, ".cams", 6);
+  }
+  const char *base = strrchr(s->path, '/');
+  snprintf(s->name, sizeof s->name, "%s", base ? base + 1 : s->path);
+  char *dot = strrchr(s->name, '.');
+  if (dot) *dot = '\0';
+  return true;
+}
+
+static bool each_technique(lua_State *L, job *j, int i, lm_error *err) {
+  if (lua_type(L, -1) != LUA_TSTRING) {
+    lm_error_set(err, "%s: techniques[%d]: a name, not a %s", j->path, i, luaL_typename(L, -1));
+    return false;
+  }
+  snprintf(j->techniques[i - 1], sizeof j->techniques[0], "%s", lua_tostring(L, -1));
+  return true;
+}
+
+static bool each_size(lua_State *L, job *j, int i, lm_error *err) {
+  int *wh = j->sizes[i - 1];
+  if (lua_type(L, -1) != LUA_TSTRING || !parse_size(lua_tostring(L, -1), &wh[0], &wh[1])) {
+    lm_error_set(err, "%s: sizes[%d]: want \"WxH\" within 1x1 .. 16384x16384, not %s", j->path, i,
+                 lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : luaL_typename(L, -1));
+    return false;
+  }
+  return true;
+}
+
+static bool read_sets(lua_State *L, job *j, lm_error *err) {
+  lua_getfield(L, -1, "set");
+  bool ok = true;
+  if (lua_istable(L, -1)) {
+    lua_pushnil(L);
+    while (ok && lua_next(L, -2)) {
+      int vt = lua_type(L, -1);
+      if (lua_type(L, -2) != LUA_TSTRING) {
+        lm_error_set(err, "%s: set: option names are strings (set = { ambient = 0.1 })", j->path);
+        ok = false;
+      } else if (j->set_count == MAX_LIST) {
+        lm_error_set(err, "%s: set: at most %d options", j->path, MAX_LIST);
+        ok = false;
+      } else if (vt != LUA_TNUMBER && vt != LUA_TSTRING && vt != LUA_TBOOLEAN) {
+        lm_error_set(err, "%s: set.%s: a number, string or boolean, not a %s", j->path, lua_tostring(L, -2),
+                     luaL_typename(L, -1));
+        ok = false;
+      } else {
+        snprintf(j->set_names[j->set_count], sizeof j->set_names[0], "%s", lua_tostring(L, -2));
+        if (vt == LUA_TBOOLEAN) {
+          snprintf(j->set_values[j->set_count], sizeof j->set_values[0], "%s", lua_toboolean(L, -1) ? "true" : "false");
+        } else {
+          lua_pushvalue(L, -1); /* tostring on a copy keeps lua_next's key intact */
+          snprintf(j->set_values[j->set_count], sizeof j->set_values[0], "%s", lua_tostring(L, -1));
+          lua_pop(L, 1);
+        }
+        j->set_count++;
+      }
+      lua_pop(L, 1);
+    }
+    if (!ok) lua_pop(L, 1); /* the key lua_next left */
+  } else if (!lua_isnil(L, -1)) {
+    lm_error_set(err, "%s: set: a table { option = value }, not a %s", j->path, luaL_typename(L, -1));
+    ok = false;
+  }
+  lua_pop(L, 1);
+  return ok;
+}
+
+static int compare_sets(const void *a, const void *b) { return strcmp(a, b); }
+
+static bool read_job(job *j, const char *path, lm_error *err) {
+  memset(j, 0, sizeof *j);
+  snprintf(j->path, sizeof j->path, "%s", path);
+  lm_dirname(path, j->dir, sizeof j->dir);
+  size_t len;
+  char *text = lm_read_file(path, &len, err);
+  if (!text) return false;
+  j->hash = lm_hash(text, len, LM_HASH_SEED);
+  lua_State *L = luaL_newstate();
+  char chunk[1100];
+  snprintf(chunk, sizeof chunk, "@%s", path); /* messages say "job.lua:3:" */
+  bool ok = luaL_loadbufferx(L, text, len, chunk, "t") == LUA_OK;
+  free(text);
+  if (ok) {
+    lua_newtable(L); /* an empty environment: data, no functions */
+    lua_setupvalue(L, -2, 1);
+    lua_sethook(L, hook_budget, LUA_MASKCOUNT, 1000000);
+    ok = lua_pcall(L, 0, 1, 0) == LUA_OK;
+  }
+  if (!ok) {
+    lm_error_set(err, "%s", lua_tostring(L, -1));
+    lua_close(L);
+    return false;
+  }
+  if (!lua_istable(L, -1)) {
+    lm_error_set(err, "%s: the job file must return a table: return { scenes = {...}, output = \"...\" }", path);
+    lua_close(L);
+    return false;
+  }
+  static const char *const known[] = {"script", "scenes", "techniques", "sizes", "set", "frames", "output",
+                                      "manifest", NULL};
+  lua_pushnil(L);
+  while (ok && lua_next(L, -2)) {
+    lua_pop(L, 1);
+    bool found = false;
+    for (const char *const *k = known; *k && lua_type(L, -1) == LUA_TSTRING; k++) found |= !strcmp(*k, lua_tostring(L, -1));
+    if (!found) {
+      lm_error_set(err, "%s: unknown field '%s' (known: script, scenes, techniques, sizes, set, frames, output, "
+                   "manifest)", path, lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : luaL_typename(L, -1));
+      ok = false;
+      lua_pop(L, 1);
+    }
+  }
+  char script[1024] = "scripts/pp.lua", manifest[1024] = "";
+  ok = ok && field_string(L, -1, "script", script, sizeof script, path, err) &&
+       field_string(L, -1, "output", j->output, sizeof j->output, path, err) &&
+       field_string(L, -1, "manifest", manifest, sizeof manifest, path, err) &&
+       read_list(L, -1, "scenes", path, &j->scene_count, err, each_scene, j) &&
+       read_list(L, -1, "techniques", path, &j->technique_count, err, each_technique, j) &&
+       read_list(L, -1, "sizes", path, &j->size_count, err, each_size, j) && read_sets(L, j, err);
+  if (ok) {
+    lua_getfield(L, -1, "frames");
+    j->frames = lua_isnil(L, -1) ? 1 : (int)lua_tointeger(L, -1);
+    if (!lua_isinteger(L, -1) && !lua_isnil(L, -1)) j->frames = 0;
+    lua_pop(L, 1);
+    if (j->frames < 1 || j->frames > 1000) {
+      lm_error_set(err, "%s: frames: a whole number in 1 .. 1000", path);
+      ok = false;
+    }
+  }
+  lua_close(L);
+  if (!ok) return false;
+  if (!j->scene_count) {
+    lm_error_set(err, "%s: scenes: the job names no scene", path);
+    return false;
+  }
+  if (!j->output[0]) {
+    lm_error_set(err, "%s: output: missing (a pattern like \"out/{scene}_{camera}_{technique}.png\")", path);
+    return false;
+  }
+  bool linear;
+  if (!capture_known_extension(j->output, &linear)) {
+    lm_error_set(err, "%s: output '%s': end it in .png, .exr, .jpg, .tif or .hdr", path, j->output);
+    return false;
+  }
+  if (!j->size_count) j->sizes[0][0] = 256, j->sizes[0][1] = 192, j->size_count = 1;
+  resolve(j, script, j->script, sizeof j->script);
+  if (manifest[0]) {
+    snprintf(j->manifest, sizeof j->manifest, "%s", manifest);
+  } else { /* the fixed folder of the output pattern */
+    char prefix[1024];
+    snprintf(prefix, sizeof prefix, "%s", j->output);
+    char *brace = strchr(prefix, '{');
+    if (brace) *brace = '\0';
+    char *slash = strrchr(prefix, '/');
+    if (slash) slash[1] = '\0';
+    else prefix[0] = '\0';
+    snprintf(j->manifest, sizeof j->manifest, "%smanifest.json", prefix);
+  }
+  /* Table order varies between runs: sort, so hashes and messages do not. */
+  char sorted[MAX_LIST][384];
+  for (int i = 0; i < j->set_count; i++) snprintf(sorted[i], sizeof sorted[i], "%s=%s", j->set_names[i], j->set_values[i]);
+  qsort(sorted, (size_t)j->set_count, sizeof sorted[0], compare_sets);
+  for (int i = 0; i < j->set_count; i++) {
+    char *eq = strchr(sorted[i], '=');
+    *eq = '\0';
+    snprintf(j->set_names[i], sizeof j->set_names[0], "%s", sorted[i]);
+    snprintf(j->set_values[i], sizeof j->set_values[0], "%s", eq + 1);
+  }
+  return true;
+}
+
+/* ---- output names -------------------------------------------------------- */
+
+/* Fills the pattern's {scene} {camera} {view} {technique} {size} {width} {height}. */
+static bool expand(const job *j, const view *v, int index, char *out, size_t cap, lm_error *err) {
+  const job_scene *s = &j->scenes[v->scene];
+  lm_buf b = {0};
+  bool ok = true;
+  for (const char *p = j->output; *p && ok; p++) {
+    if (*p != '{') {
+      lm_buf_append(&b, p, 1);
+      continue;
+    }
+    const char *close = strchr(p, '}');
+    char key[32] = "";
+    if (close && close - p - 1 < (int)sizeof key) snprintf(key, sizeof key, "%.*s", (int)(close - p - 1), p + 1);
+    if (!strcmp(key, "scene")) lm_buf_printf(&b, "%s", s->name);
+    else if (!strcmp(key, "camera")) lm_buf_printf(&b, "%s", s->scene->cameras[v->camera].name);
+    else if (!strcmp(key, "view")) lm_buf_printf(&b, "%d", index);
+    else if (!strcmp(key, "technique")) lm_buf_printf(&b, "%s", j->techniques[v->technique]);
+    else if (!strcmp(key, "size")) lm_buf_printf(&b, "%dx%d", j->sizes[v->size][0], j->sizes[v->size][1]);
+    else if (!strcmp(key, "width")) lm_buf_printf(&b, "%d", j->sizes[v->size][0]);
+    else if (!strcmp(key, "height")) lm_buf_printf(&b, "%d", j->sizes[v->size][1]);
+    else {
+      lm_error_set(err, "%s: output: unknown placeholder '{%s}' (known: {scene} {camera} {view} {technique} "
+                   "{size} {width} {height})", j->path, key);
+      ok = false;
+    }
+    if (close) p = close;
+  }
+  if (ok) snprintf(out, cap, "%s", b.data ? b.data : "");
+  lm_buf_free(&b);
+  return ok;
+}
+
+/* mkdir -p of the file's folder. */
+static bool make_parent(const char *file, lm_error *err) {
+  char dir[1024];
+  lm_dirname(file, dir, sizeof dir);
+  for (char *p = dir + 1;; p++) {
+    char c = *p;
+    if (c == '/' || c == '\0') {
+      *p = '\0';
+      if (access(dir, F_OK) != 0 && mkdir(dir, 0777) != 0 && access(dir, F_OK) != 0) {
+        lm_error_set(err, "%s: cannot make folder %s", file, dir);
+        return false;
+      }
+      *p = c;
+    }
+    if (!c) break;
+  }
+  return true;
+}
+
+/* A killed run can leave its temporary files (lm_image_write's
+ * "<stem>.tmp-<pid><ext>"): remove those of this output. */
+static void remove_stale_temps(const char *output) {
+  char pattern[1200];
+  const char *dot = strrchr(output, '.'), *slash = strrchr(output, '/');
+  if (!dot || (slash && dot < slash)) return;
+  snprintf(pattern, sizeof pattern, "%.*s.tmp-*%s", (int)(dot - output), output, dot);
+  glob_t g;
+  if (glob(pattern, GLOB_NOSORT, NULL, &g) == 0)
+    for (size_t i = 0; i < g.gl_pathc; i++) remove(g.gl_pathv[i]);
+  globfree(&g);
+}
+
+/* ---- hashes -------------------------------------------------------------- */
+
+static int compare_names(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
+
+/* Every file of a folder (sorted, names and bytes), with `ext` ending. */
+static uint64_t hash_folder(const char *dir, const char *ext, uint64_t h) {
+  DIR *d = opendir(dir);
+  if (!d) return h;
+  char **names = NULL;
+  int n = 0, cap = 0;
+  for (struct dirent *e; (e = readdir(d));) {
+    size_t len = strlen(e->d_name), el = strlen(ext);
+    if (e->d_name[0] == '.' || len < el || strcmp(e->d_name + len - el, ext)) continue;
+    *LM_PUSH(names, n, cap) = lm_strdup(e->d_name);
+  }
+  closedir(d);
+  qsort(names, (size_t)n, sizeof *names, compare_names);
+  for (int i = 0; i < n; i++) {
+    char path[2048];
+    snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+    size_t len;
+    lm_error err;
+    char *text = lm_read_file(path, &len, &err);
+    h = lm_hash(names[i], strlen(names[i]), h);
+    if (text) h = lm_hash(text, len, h);
+    free(text);
+    free(names[i]);
+  }
+  free(names);
+  return h;
+}
+
+static uint64_t hash_file(const char *path, uint64_t h) {
+  size_t len;
+  lm_error err;
+  char *text = lm_read_file(path, &len, &err);
+  if (text) h = lm_hash(text, len, h);
+  free(text);
+  return h;
+}
+
+/* ---- the manifest ------------------------------------------------------ */
+
+static void json_string(lm_buf *b, const char *s) {
+  lm_buf_append(b, "\"", 1);
+  for (; *s; s++) {
+    unsigned char c = (unsigned char)*s;
+    if (c == '"' || c == '\\') lm_buf_printf(b, "\\%c", c);
+    else if (c < 0x20) lm_buf_printf(b, "\\u%04x", c);
+    else lm_buf_append(b, s, 1);
+  }
+  lm_buf_append(b, "\"", 1);
+}
+
+typedef struct manifest {
+  char *header;        /* everything before "images" */
+  char **entries;      /* one line of JSON per image, NULL: not rendered (yet) */
+  int run;             /* this run's number: the last one's + 1 */
+} manifest;
+
+/* The entries a previous run left, one line each, keyed by "file". */
+static void manifest_load(const char *path, const view *views, int view_count, manifest *m) {
+  size_t len;
+  lm_error err;
+  char *text = lm_read_file(path, &len, &err);
+  if (!text) return;
+  const char *run = strstr(text, "\"run\": ");
+  if (run) m->run = atoi(run + 7);
+  for (char *line = text, *next; line; line = next) {
+    next = strchr(line, '\n');
+    if (next) *next++ = '\0';
+    const char *f = strstr(line, "{\"file\": \"");
+    if (!f) continue;
+    size_t n = strlen(line);
+    while (n && (line[n - 1] == ',' || line[n - 1] == ' ')) line[--n] = '\0';
+    for (int i = 0; i < view_count; i++) {
+      lm_buf key = {0};
+      lm_buf_append(&key, "{\"file\": ", -1);
+      json_string(&key, views[i].output);
+      if (!strncmp(f, key.data, (size_t)key.len) && !m->entries[i]) m->entries[i] = lm_strdup(f);
+      lm_buf_free(&key);
+    }
+  }
+  free(text);
+}
+
+static bool manifest_write(const char *path, const manifest *m, int view_count, lm_error *err) {
+  lm_buf b = {0};
+  lm_buf_append(&b, m->header, -1);
+  lm_buf_append(&b, "  \"images\": [\n", -1);
+  bool first = true;
+  for (int i = 0; i < view_count; i++) {
+    if (!m->entries[i]) continue;
+    lm_buf_printf(&b, "%s    %s", first ? "" : ",\n", m->entries[i]);
+    first = false;
+  }
+  lm_buf_append(&b, "\n  ]\n}\n", -1);
+  char tmp[1100];
+  snprintf(tmp, sizeof tmp, "%s.tmp-%d", path, (int)getpid());
+  FILE *f = fopen(tmp, "w");
+  bool ok = f && fwrite(b.data, 1, (size_t)b.len, f) == (size_t)b.len;
+  ok = f && fclose(f) == 0 && ok;
+  ok = ok && rename(tmp, path) == 0;
+  if (!ok) {
+    remove(tmp);
+    lm_error_set(err, "%s: cannot write the manifest", path);
+  }
+  lm_buf_free(&b);
+  return ok;
+}
+
+static char *manifest_entry(const job *j, const view *v, int index, const capture_result *res, int run) {
+  const job_scene *s = &j->scenes[v->scene];
+  lm_buf b = {0};
+  lm_buf_append(&b, "{\"file\": ", -1);
+  json_string(&b, v->output);
+  lm_buf_printf(&b, ", \"view\": %d, \"run\": %d, \"scene\": ", index, run);
+  json_string(&b, s->path);
+  lm_buf_printf(&b, ", \"scene_hash\": \"%016llx\", \"camera\": ", (unsigned long long)s->hash);
+  json_string(&b, s->scene->cameras[v->camera].name);
+  lm_buf_append(&b, ", \"technique\": ", -1);
+  json_string(&b, j->techniques[v->technique]);
+  lm_buf_printf(&b, ", \"width\": %d, \"height\": %d, \"frames\": %d, \"drawn\": %d, \"culled\": %d, "
+                "\"triangles\": %ld, \"total_ms\": %.3f, \"passes\": [",
+                j->sizes[v->size][0], j->sizes[v->size][1], j->frames, res->stats.drawn, res->stats.culled,
+                res->stats.triangles, res->total_ms);
+  for (int i = 0; i < res->pass_count; i++) {
+    lm_buf_append(&b, i ? ", {\"name\": " : "{\"name\": ", -1);
+    json_string(&b, res->passes[i].name);
+    lm_buf_printf(&b, ", \"kind\": \"%s\", \"ms\": %.3f}", res->passes[i].kind, res->passes[i].ms);
+  }
+  lm_buf_append(&b, "]}", -1);
+  return b.data;
+}
+
+/* ---- running ------------------------------------------------------------- */
+
+static void progress(const capture_job_args *a, bool tty, int done, int total, const char *what) {
+  if (a->quiet) return;
+  if (tty) {
+    int width = 30, fill = total ? done * width / total : width;
+    printf("\r[%.*s%.*s] %d/%d %-60.60s", fill, "##############################", width - fill,
+           "..............................", done, total, what);
+    if (done == total) printf("\n");
+  } else {
+    printf("[%d/%d] %s\n", done, total, what);
+  }
+  fflush(stdout);
+}
+
+static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
+  lm_error err;
+  /* Every scene and camera list is read before anything renders: a bad
+   * entry stops the job at once, naming it. */
+  int view_count = 0;
+  for (int i = 0; i < j->scene_count; i++) {
+    job_scene *s = &j->scenes[i];
+    s->scene = lm_scene_load_gltf(s->path, &err);
+    if (s->scene) s->first_camera = lm_scene_add_camera_list(s->scene, s->cameras, &s->camera_count, &err);
+    if (!s->scene || s->first_camera < 0) {
+      lm_log(LM_LOG_ERROR, "%s: scenes[%d]: %s", j->path, i + 1, err.msg);
+      return 1;
+    }
+    s->hash = hash_file(s->cameras, hash_file(s->path, LM_HASH_SEED));
+    view_count += s->camera_count * j->size_count * j->technique_count;
+  }
+  view *views = lm_alloc(sizeof *views * (size_t)view_count);
+  int n = 0;
+  for (int si = 0; si < j->scene_count; si++)
+    for (int z = 0; z < j->size_count; z++)
+      for (int t = 0; t < j->technique_count; t++)
+        for (int c = 0; c < j->scenes[si].camera_count; c++) {
+          view *v = &views[n];
+          *v = (view){si, j->scenes[si].first_camera + c, z, t, ""};
+          if (!expand(j, v, n, v->output, sizeof v->output, &err)) {
+            lm_log(LM_LOG_ERROR, "%s", err.msg);
+            free(views);
+            return 1;
+          }
+          for (int k = 0; k < n; k++)
+            if (!strcmp(views[k].output, v->output)) {
+              lm_log(LM_LOG_ERROR, "%s: output: views %d and %d both write %s (add {camera}, {technique} or "
+                     "{size} to the pattern)", j->path, k, n, v->output);
+              free(views);
+              return 1;
+            }
+          n++;
+        }
+
+  char manifest_path[1100];
+  snprintf(manifest_path, sizeof manifest_path, "%s", j->manifest);
+  if (a->shards > 1) {
+    char *dot = strrchr(manifest_path, '.');
+    char tail[64];
+    snprintf(tail, sizeof tail, ".shard-%d-of-%d.json", a->shard, a->shards);
+    if (dot && !strchr(dot, '/')) *dot = '\0';
+    strncat(manifest_path, tail, sizeof manifest_path - strlen(manifest_path) - 1);
+  }
+  manifest m = {.entries = calloc((size_t)view_count + 1, sizeof(char *))};
+  manifest_load(manifest_path, views, view_count, &m);
+  m.run++;
+
+  int rc = 0;
+  bool any_linear;
+  capture_known_extension(j->output, &any_linear);
+  if (!make_parent(manifest_path, &err) ||
+      !lm_context_create_headless(&(lm_context_desc){.platform = a->egl, .debug = a->verbose}, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    rc = 1;
+  }
+  lm_renderer *r = NULL;
+  if (!rc) {
+    r = lm_renderer_create(&(lm_renderer_desc){.scene = j->scenes[0].scene, .pipeline = pipeline, .width = 1,
+                                               .height = 1, .clock = a->clock, .linear_output = any_linear}, &err);
+    if (!r) lm_log(LM_LOG_ERROR, "%s", err.msg), rc = 1;
+  }
+  if (!rc) {
+    char script_dir[1024], root_scripts[1100], shaders[1100];
+    lm_dirname(j->script, script_dir, sizeof script_dir);
+    uint64_t scripts = hash_folder(script_dir, ".lua", LM_HASH_SEED);
+    snprintf(root_scripts, sizeof root_scripts, "%s/scripts", lm_root_dir());
+    snprintf(shaders, sizeof shaders, "%s/shaders", lm_root_dir());
+    scripts = hash_folder(root_scripts, ".lua", hash_file(j->script, scripts));
+    uint64_t job_hash = j->hash;
+    for (int i = 0; i < a->set_count; i++) job_hash = lm_hash(a->sets[i], strlen(a->sets[i]), job_hash);
+    lm_buf h = {0};
+    lm_buf_append(&h, "{\n  \"job\": ", -1);
+    json_string(&h, j->path);
+    lm_buf_printf(&h, ",\n  \"job_hash\": \"%016llx\",\n  \"script\": ", (unsigned long long)job_hash);
+    json_string(&h, j->script);
+    lm_buf_printf(&h, ",\n  \"script_hash\": \"%016llx\",\n  \"shader_hash\": \"%016llx\",\n  \"renderer\": ",
+                  (unsigned long long)scripts, (unsigned long long)hash_folder(shaders, "", LM_HASH_SEED));
+    json_string(&h, lm_gl_renderer());
+    lm_buf_append(&h, ",\n  \"gl_version\": ", -1);
+    json_string(&h, lm_gl_version());
+    lm_buf_append(&h, ",\n  \"platform\": ", -1);
+    json_string(&h, lm_context_platform());
+    lm_buf_printf(&h, ",\n  \"clock\": \"%s\",\n  \"shard\": \"%d/%d\",\n  \"run\": %d,\n  \"options\": [",
+                  lm_clock_name(lm_renderer_clock(r)), a->shard, a->shards, m.run);
+    for (int i = 0; i < j->set_count + a->set_count; i++) {
+      char set[400];
+      if (i < j->set_count) snprintf(set, sizeof set, "%s=%s", j->set_names[i], j->set_values[i]);
+      else snprintf(set, sizeof set, "%s", a->sets[i - j->set_count]);
+      lm_buf_append(&h, i ? ", " : "", -1);
+      json_string(&h, set);
+    }
+    lm_buf_append(&h, "],\n", -1);
+    m.header = h.data;
+  }
+
+  bool tty = isatty(STDOUT_FILENO);
+  /* For tests: SIGKILL ourselves after this many images, as an operator's
+   * kill would, at a point a timed kill cannot hit reliably. */
+  const char *kill_env = getenv("LIMN_JOB_KILL_AFTER");
+  int kill_after = kill_env ? atoi(kill_env) : 0;
+  int mine = 0, done = 0, rendered = 0, skipped = 0;
+  for (int i = 0; i < view_count; i++) mine += i % a->shards == a->shard;
+  if (!rc && !a->quiet)
+    printf("job %s: %d view%s (%d in shard %d/%d); %s; %s\n", j->path, view_count, view_count == 1 ? "" : "s",
+           mine, a->shard, a->shards, lm_gl_renderer(), manifest_path);
+  lm_scene *current = j->scenes[0].scene;
+  for (int i = 0; i < view_count && !rc; i++) {
+    if (i % a->shards != a->shard) continue;
+    const view *v = &views[i];
+    const job_scene *s = &j->scenes[v->scene];
+    char what[1200];
+    remove_stale_temps(v->output);
+    if (!a->force && lm_file_exists(v->output)) {
+      skipped++;
+      snprintf(what, sizeof what, "%s: exists, skipped", v->output);
+      progress(a, tty, ++done, mine, what);
+      continue;
+    }
+    capture_result res = {0};
+    bool ok = make_parent(v->output, &err) && lm_pipeline_set_technique(pipeline, j->techniques[v->technique], &err);
+    if (ok && s->scene != current) ok = lm_renderer_set_scene(r, s->scene, &err), current = s->scene;
+    if (ok) {
+      const char *outs[1] = {v->output};
+      capture_view cv = {.camera = v->camera, .width = j->sizes[v->size][0], .height = j->sizes[v->size][1],
+                         .frames = j->frames, .outputs = outs, .output_count = 1, .quiet = true};
+      ok = capture_render_write(r, &cv, &res, &err);
+    }
+    if (ok) {
+      free(m.entries[i]);
+      m.entries[i] = manifest_entry(j, v, i, &res, m.run);
+      ok = manifest_write(manifest_path, &m, view_count, &err);
+    }
+    if (!ok) {
+      if (tty && !a->quiet) printf("\n");
+      lm_log(LM_LOG_ERROR, "%s: view %d (%s, camera '%s', %s, %dx%d): %s", j->path, i, s->name,
+             s->scene->cameras[v->camera].name, j->techniques[v->technique], j->sizes[v->size][0],
+             j->sizes[v->size][1], err.msg);
+      rc = 1;
+    } else {
+      rendered++;
+      snprintf(what, sizeof what, "%s (%.1f ms)", v->output, res.total_ms);
+      progress(a, tty, ++done, mine, what);
+      if (kill_after > 0 && rendered == kill_after) raise(SIGKILL);
+    }
+    capture_result_free(&res);
+  }
+  if (!rc && !a->quiet) printf("job %s: %d rendered, %d skipped (existing; --force redoes them)\n", j->path,
+                               rendered, skipped);
+  if (!rc && rendered == 0 && m.header) manifest_write(manifest_path, &m, view_count, &err);
+  lm_renderer_destroy(r);
+  lm_programs_clear();
+  for (int i = 0; i <= view_count; i++) free(m.entries[i]);
+  free(m.entries);
+  free(m.header);
+  free(views);
+  for (int i = 0; i < j->scene_count; i++) { /* GL objects go before the context */
+    lm_scene_destroy(j->scenes[i].scene);
+    j->scenes[i].scene = NULL;
+  }
+  lm_context_destroy();
+  return rc;
+}
+
+int capture_job_run(const capture_job_args *a) {
+  job *j = lm_alloc(sizeof *j);
+  lm_error err;
+  if (!read_job(j, a->path, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    free(j);
+    return 2;
+  }
+  int rc = 0;
+  lm_pipeline *pipeline = lm_pipeline_load(&(lm_pipeline_desc){.path = j->script}, &err);
+  if (!pipeline) {
+    lm_log(LM_LOG_ERROR, "%s: script: %s", j->path, err.msg);
+    rc = 2;
+  }
+  for (int i = 0; i < j->technique_count && !rc; i++)
+    if (!lm_pipeline_set_technique(pipeline, j->techniques[i], &err)) {
+      lm_log(LM_LOG_ERROR, "%s: techniques[%d]: %s", j->path, i + 1, err.msg);
+      rc = 2;
+    }
+  if (!rc && !j->technique_count) {
+    snprintf(j->techniques[0], sizeof j->techniques[0], "%s", lm_pipeline_technique_name(pipeline, 0));
+    j->technique_count = 1;
+  }
+  for (int i = 0; i < j->set_count && !rc; i++)
+    if (!lm_pipeline_set_option(pipeline, j->set_names[i], j->set_values[i], &err)) {
+      lm_log(LM_LOG_ERROR, "%s: set.%s: %s", j->path, j->set_names[i], err.msg);
+      rc = 2;
+    }
+  for (int i = 0; i < a->set_count && !rc; i++) {
+    char name[256];
+    const char *eq = strchr(a->sets[i], '=');
+    snprintf(name, sizeof name, "%.*s", (int)(eq - a->sets[i]), a->sets[i]);
+    if (!lm_pipeline_set_option(pipeline, name, eq + 1, &err)) {
+      lm_log(LM_LOG_ERROR, "--set %s: %s", a->sets[i], err.msg);
+      rc = 2;
+    }
+  }
+  if (!rc) rc = run(a, j, pipeline);
+  for (int i = 0; i < j->scene_count; i++) lm_scene_destroy(j->scenes[i].scene);
+  lm_pipeline_destroy(pipeline);
+  free(j);
+  return rc;
+}
