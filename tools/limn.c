@@ -27,6 +27,7 @@ int main(int argc, char **argv) {
     return 0;
   }
   if (!strcmp(cmd, "capture")) return limn_capture(argc - 1, argv + 1);
+  if (!strcmp(cmd, "view")) return limn_view(argc - 1, argv + 1);
   fprintf(stderr, "limn: unknown command '%s'\n\n%s", cmd, usage);
   return 2;
 }

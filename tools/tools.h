@@ -4,5 +4,6 @@
 #define LIMN_TOOLS_H
 
 int limn_capture(int argc, char **argv);
+int limn_view(int argc, char **argv);
 
 #endif

@@ -90,6 +90,9 @@ int lm_scene_add_light(lm_scene *s, const lm_light *l);
 int lm_scene_add_camera(lm_scene *s, const lm_camera *c);
 /* World transforms from local ones (parents come before children). */
 void lm_scene_update(lm_scene *s);
+/* Moves a node (a camera the viewer flies) so its world transform becomes
+ * `world`: its local transform is set against its parent's, then updated. */
+void lm_scene_node_set_world(lm_scene *s, int node, const float world[16]);
 
 /* A scene built in code: "cornell". NULL with a message listing the names. */
 lm_scene *lm_scene_builtin(const char *name, lm_error *err);
