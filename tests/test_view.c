@@ -414,7 +414,7 @@ static void inspector_writes_target_and_frame(void **state) {
 }
 
 /* 1000 script edits through the real file watch (every tenth broken, every
- * fiftieth rebuilding all shaders) leave the GL object and heap counts where
+ * hundredth rebuilding all shaders) leave the GL object and heap counts where
  * they were after the warm-up. */
 static void reload_loop_leaks_nothing(void **state) {
   (void)state;
