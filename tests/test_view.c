@@ -21,6 +21,7 @@
 #include "image/image.h"
 
 static char root[256];
+static pid_t running; /* the viewer a failed case left behind */
 
 static void sleep_ms(int ms) {
   struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
@@ -77,7 +78,10 @@ static pid_t spawn_view(const char *log, ...) {
   for (const char *a; (a = va_arg(ap, const char *)) && n < 63;) argv[n++] = a;
   va_end(ap);
   argv[n] = NULL;
+  FILE *f = fopen(log, "w"); /* empty now: a wait_for must not see the last run's lines */
+  if (f) fclose(f);
   pid_t pid = fork();
+  running = pid;
   if (pid == 0) {
     FILE *f = freopen(log, "w", stdout);
     if (!f || dup2(fileno(stdout), 2) < 0) _exit(127);
@@ -91,12 +95,23 @@ static pid_t spawn_view(const char *log, ...) {
 static int wait_exit(pid_t pid, int timeout_ms) {
   for (int t = 0; t < timeout_ms; t += 20) {
     int status;
-    if (waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    if (waitpid(pid, &status, WNOHANG) == pid) {
+      running = 0;
+      return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
     sleep_ms(20);
   }
   kill(pid, SIGKILL);
   waitpid(pid, NULL, 0);
+  running = 0;
   return -1;
+}
+
+/* After each case: a viewer still running (its case failed) is stopped. */
+static int stop_leftover(void **state) {
+  (void)state;
+  if (running > 0) wait_exit(running, 0);
+  return 0;
 }
 
 static bool alive(pid_t pid) {
@@ -413,6 +428,98 @@ static void inspector_writes_target_and_frame(void **state) {
   lm_image_free(&img);
 }
 
+/* ---- a glTF scene: one quad, a sun, two cameras (the second looks away) */
+static char *base64(const unsigned char *p, size_t n) {
+  static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  char *out = malloc(4 * ((n + 2) / 3) + 1), *o = out;
+  for (size_t i = 0; i < n; i += 3) {
+    uint32_t v = (uint32_t)p[i] << 16 | (i + 1 < n ? (uint32_t)p[i + 1] << 8 : 0) | (i + 2 < n ? p[i + 2] : 0);
+    *o++ = tab[v >> 18 & 63];
+    *o++ = tab[v >> 12 & 63];
+    *o++ = i + 1 < n ? tab[v >> 6 & 63] : '=';
+    *o++ = i + 2 < n ? tab[v & 63] : '=';
+  }
+  *o = '\0';
+  return out;
+}
+
+static void write_quad_scene(const char *rel, const char *color) {
+  static const float pos[12] = {-5, -5, 0, 5, -5, 0, 5, 5, 0, -5, 5, 0};
+  static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+  unsigned char bytes[sizeof pos + sizeof idx];
+  memcpy(bytes, pos, sizeof pos);
+  memcpy(bytes + sizeof pos, idx, sizeof idx);
+  char *b64 = base64(bytes, sizeof bytes), json[4096];
+  snprintf(json, sizeof json,
+           "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\"],"
+           "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"directional\",\"intensity\":2}]}},"
+           "\"scene\":0,\"scenes\":[{\"nodes\":[0,1,2,3]}],"
+           "\"nodes\":[{\"name\":\"quad\",\"mesh\":0},"
+           "{\"name\":\"sun\",\"translation\":[0,0,4],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}},"
+           "{\"name\":\"front\",\"translation\":[0,0,3],\"camera\":0},"
+           "{\"name\":\"back\",\"translation\":[0,0,3],\"rotation\":[0,1,0,0],\"camera\":0}],"
+           "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.1,\"zfar\":20}}],"
+           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]}],"
+           "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[%s,1],\"metallicFactor\":0}}],"
+           "\"buffers\":[{\"uri\":\"data:application/octet-stream;base64,%s\",\"byteLength\":%zu}],"
+           "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":24}],"
+           "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+           "\"min\":[-5,-5,0],\"max\":[5,5,0]},"
+           "{\"bufferView\":1,\"componentType\":5125,\"count\":6,\"type\":\"SCALAR\"}]}",
+           color, b64, sizeof bytes);
+  free(b64);
+  write_file(rel, json);
+}
+
+/* Number keys pick the scene's cameras; saving the scene file with another
+ * material colour shows at once. */
+static void cameras_and_scene_reload(void **state) {
+  (void)state;
+  char log[512], scene[512], front[512], back[512], edited[512];
+  log_path(log, "scene");
+  write_quad_scene("quad.gltf", "1,0,0");
+  path_in_root(scene, sizeof scene, "quad.gltf");
+  shot_path(front, "front.png");
+  shot_path(back, "back.png");
+  shot_path(edited, "edited.png");
+  pid_t pid = spawn_view(log, "--scene", scene, "--size", "128x96", "--overlay", "off", "--exit-after", "4",
+                         "--screenshot", front, NULL);
+  int rc = wait_exit(pid, 20000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  pid = spawn_view(log, "--scene", scene, "--size", "128x96", "--overlay", "off", "--exit-after", "6",
+                   "--script-keys", "1:3,2:2", "--screenshot", back, NULL);
+  assert_int_equal(wait_exit(pid, 20000), 0);
+  assert_true(file_has(log, "has 2 camera(s)"));
+  assert_true(file_has(log, "camera 2"));
+  lm_image a, b;
+  load("front.png", &a);
+  load("back.png", &b);
+  double fa[3], fb[3];
+  box_mean(&a, 0.2, 0.5, 0.8, 1, fa); /* below any message */
+  box_mean(&b, 0.2, 0.5, 0.8, 1, fb);
+  assert_true(fa[0] > 0.3 && fa[0] > 3 * fa[1]); /* the red quad, lit */
+  assert_true(fb[0] < 0.02 && fb[1] < 0.02);     /* nothing behind */
+  lm_image_free(&a);
+  lm_image_free(&b);
+
+  pid = spawn_view(log, "--scene", scene, "--size", "128x96", "--overlay", "off", "--exit-after", "1000000",
+                   "--screenshot", edited, NULL);
+  assert_true(wait_for(log, "limn: renderer:", 20000));
+  sleep_ms(200);
+  write_quad_scene("quad.gltf", "0,1,0");
+  bool reloaded = wait_for(log, "reloaded scene", 10000);
+  if (!reloaded) print_log(log);
+  assert_true(reloaded);
+  sleep_ms(300);
+  kill(pid, SIGTERM);
+  assert_int_equal(wait_exit(pid, 10000), 0);
+  load("edited.png", &a);
+  box_mean(&a, 0.2, 0.5, 0.8, 1, fa); /* below any message */
+  assert_true(fa[1] > 0.3 && fa[1] > 3 * fa[0]); /* now green */
+  lm_image_free(&a);
+}
+
 /* 1000 script edits through the real file watch (every tenth broken, every
  * hundredth rebuilding all shaders) leave the GL object and heap counts where
  * they were after the warm-up. */
@@ -444,12 +551,13 @@ static void reload_loop_leaks_nothing(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(window_shows_the_box),
-      cmocka_unit_test(keys_switch_techniques_and_options),
-      cmocka_unit_test(live_reload_survives_errors),
-      cmocka_unit_test(resize_to_1x1_and_back),
-      cmocka_unit_test(inspector_writes_target_and_frame),
-      cmocka_unit_test(reload_loop_leaks_nothing),
+      cmocka_unit_test_teardown(window_shows_the_box, stop_leftover),
+      cmocka_unit_test_teardown(keys_switch_techniques_and_options, stop_leftover),
+      cmocka_unit_test_teardown(live_reload_survives_errors, stop_leftover),
+      cmocka_unit_test_teardown(resize_to_1x1_and_back, stop_leftover),
+      cmocka_unit_test_teardown(inspector_writes_target_and_frame, stop_leftover),
+      cmocka_unit_test_teardown(cameras_and_scene_reload, stop_leftover),
+      cmocka_unit_test_teardown(reload_loop_leaks_nothing, stop_leftover),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

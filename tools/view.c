@@ -233,6 +233,7 @@ typedef struct viewer {
   char script_error[2048];  /* the last reload's error ("" when it loaded) */
   char frame_error[2048];   /* the current pipeline's last frame error */
   char shader_error[2048];  /* a shader rebuild that failed */
+  char scene_error[2048];   /* the scene file's last reload */
   char message[512];        /* a passing note (an unknown technique ...) */
   double message_until;
   double frame_ms;
@@ -405,11 +406,12 @@ static void reload_scene(viewer *v) {
     s = NULL;
   }
   if (!s) {
-    set_error(v->script_error, sizeof v->script_error, err.msg, "");
+    set_error(v->scene_error, sizeof v->scene_error, err.msg, "");
     return;
   }
-  /* The renderer borrows the scene: point it at the new one by re-creating it
-   * would drop the graph, so the scene's contents are swapped instead. */
+  set_error(v->scene_error, sizeof v->scene_error, "", "scene reloaded: error cleared");
+  /* The renderer borrows the scene pointer; re-creating the renderer would
+   * drop the frame graph and its history, so the contents are swapped. */
   lm_scene tmp = *v->scene;
   *v->scene = *s;
   *s = tmp;
@@ -431,6 +433,7 @@ static bool handle_changes(viewer *v) {
   char path[4096];
   while (lm_watch_next(v->watch, path, sizeof path)) {
     const char *name = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+    lm_debug("changed: %s", path);
     if (name[0] == '.') continue; /* editors' temporary files */
     if (has_suffix(name, ".lua")) script = true;
     else if (has_suffix(name, ".glsl") || has_suffix(name, ".frag") || has_suffix(name, ".vert")) shaders = true;
@@ -544,9 +547,10 @@ static void draw_overlay(viewer *v) {
   size_t bytes = (size_t)v->width * v->height * 4;
   memset(v->overlay, 0, bytes);
   lm_buf b = {0};
-  const char *error = v->script_error[0] ? v->script_error
+  const char *error = v->script_error[0]   ? v->script_error
+                      : v->scene_error[0]  ? v->scene_error
                       : v->shader_error[0] ? v->shader_error
-                                            : v->frame_error;
+                                           : v->frame_error;
   if (v->overlay_on) {
     lm_graph *g = lm_renderer_graph(v->renderer);
     double rec, comp;
