@@ -18,7 +18,7 @@
 #include "render/render.h"
 #include "scene/gltf.h"
 #include "tools.h"
-#include "view_text.h"
+#include "view.h"
 
 static const char view_usage[] =
     "usage: limn view [options]\n"
@@ -56,24 +56,6 @@ static const char view_usage[] =
     "  C channel (rgb r g b a), V false colour, Up/Down exposure;\n"
     "  P writes the shown target (EXR) and the frame (PNG); Escape quits\n";
 
-enum { MAX_SETS = 64, MAX_SCRIPT_KEYS = 256 };
-
-typedef struct script_key {
-  long frame;
-  char key[32];
-} script_key;
-
-typedef struct view_args {
-  const char *scene, *script, *tech, *screenshot, *capture_dir;
-  char *sets[MAX_SETS]; /* owned: toggles add and replace entries */
-  int set_count;
-  int width, height, camera;
-  long exit_after, reload_test;
-  bool overlay, quiet, verbose;
-  script_key keys[MAX_SCRIPT_KEYS];
-  int key_count;
-} view_args;
-
 /* ---- command line ------------------------------------------------------ */
 static int usage_error(const char *fmt, const char *arg) {
   fprintf(stderr, "limn view: ");
@@ -90,7 +72,7 @@ static bool parse_long(const char *s, long lo, long hi, long *out) {
   return true;
 }
 
-static bool parse_size(const char *s, int *w, int *h) {
+bool parse_size(const char *s, int *w, int *h) {
   long a, b;
   char buf[64];
   snprintf(buf, sizeof buf, "%s", s);
@@ -201,54 +183,13 @@ static void resolve_script(const char *given, char *out, size_t cap) {
   }
 }
 
-/* ---- the viewer's state ------------------------------------------------ */
-typedef struct fly {
-  float pos[3], yaw, pitch;
-} fly;
-
-typedef struct viewer {
-  view_args *args;
-  char script[2048];
-  lm_window *window;
-  lm_scene *scene;
-  lm_pipeline *pipeline;
-  lm_renderer *renderer;
-  lm_watch *watch;
-  lm_font *font;
-  int width, height;        /* the renderer's output (the window's framebuffer) */
-  lm_texture shown;         /* the last good frame: shown while a frame fails */
-  bool have_shown;
-  lm_texture overlay_tex;   /* text, rgba8 */
-  uint8_t *overlay;
-  lm_texture probe;         /* the inspected target's raw values, rgba32f */
-  int probe_w, probe_h;
-  int camera;
-  fly cam;
-  bool overlay_on;
-  int inspect;              /* target index, -1: the frame */
-  int channel;              /* 0 r, 1 g, 2 b, 3 a, 4 rgb */
-  bool false_colour;
-  float exposure;
-  float range[2];           /* of the inspected target, for false colour */
-  char script_error[2048];  /* the last reload's error ("" when it loaded) */
-  char frame_error[2048];   /* the current pipeline's last frame error */
-  char shader_error[2048];  /* a shader rebuild that failed */
-  char scene_error[2048];   /* the scene file's last reload */
-  char message[512];        /* a passing note (an unknown technique ...) */
-  double message_until;
-  double frame_ms;
-  long frame;
-  int captures;
-} viewer;
-
 static volatile sig_atomic_t stop_requested;
 static void on_signal(int sig) {
   (void)sig;
   stop_requested = 1;
 }
 
-static void say(viewer *v, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void say(viewer *v, const char *fmt, ...) {
+void say(viewer *v, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
   vsnprintf(v->message, sizeof v->message, fmt, ap);
@@ -258,7 +199,7 @@ static void say(viewer *v, const char *fmt, ...) {
 }
 
 /* An error shows once on stderr when it appears and once more when it clears. */
-static void set_error(char *slot, size_t cap, const char *msg, const char *cleared) {
+void set_error(char *slot, size_t cap, const char *msg, const char *cleared) {
   if (!msg) msg = "";
   if (!strcmp(slot, msg)) return;
   if (*msg)
@@ -447,222 +388,6 @@ static bool handle_changes(viewer *v) {
   return script && reload_script(v);
 }
 
-/* ---- inspector and overlay --------------------------------------------- */
-static const char *channel_name(int c) {
-  static const char *names[] = {"r", "g", "b", "a", "rgb"};
-  return names[c];
-}
-
-/* The inspected target's raw values into v->probe (rgba32f at its size). */
-static bool probe_target(viewer *v, lm_graph_target_info t, lm_error *err) {
-  if (!t.texture.id) {
-    lm_error_set(err, "target '%s' has no texture this frame (not used)", t.name);
-    return false;
-  }
-  if (v->probe_w != t.width || v->probe_h != t.height || !v->probe.id) {
-    lm_texture_destroy(&v->probe);
-    lm_texture_desc d = {LM_FORMAT_RGBA32F, t.width, t.height, false};
-    if (!lm_texture_create(&v->probe, &d, "viewer probe", err)) return false;
-    v->probe_w = t.width, v->probe_h = t.height;
-  }
-  lm_program *p = lm_program_get("fullscreen.vert", "view.frag", "PROBE", err);
-  lm_attachments att = {.color = {v->probe}, .color_count = 1, .width = t.width, .height = t.height};
-  if (!p || !lm_attachments_bind(&att, err)) return false;
-  lm_program_use(p);
-  lm_program_bind_texture(lm_program_uniform(p, "src"), t.texture);
-  lm_draw_fullscreen();
-  return true;
-}
-
-static void update_range(viewer *v) {
-  size_t n = (size_t)v->probe_w * v->probe_h;
-  float *px = lm_alloc(n * 16), lo = INFINITY, hi = -INFINITY;
-  lm_texture_read(v->probe, v->probe_w, v->probe_h, true, px);
-  int c = v->channel < 4 ? v->channel : 0;
-  for (size_t i = 0; i < n; i++) {
-    float x = px[i * 4 + c];
-    if (isfinite(x)) lo = fminf(lo, x), hi = fmaxf(hi, x);
-  }
-  free(px);
-  v->range[0] = isfinite(lo) ? lo : 0, v->range[1] = isfinite(hi) ? hi : 1;
-}
-
-/* Writes the inspected target (EXR, raw values) and the frame (PNG). */
-static void write_captures(viewer *v) {
-  lm_error err;
-  char path[4096];
-  int n = ++v->captures;
-  lm_graph *g = lm_renderer_graph(v->renderer);
-  if (v->inspect >= 0 && v->inspect < lm_graph_target_count(g)) {
-    lm_graph_target_info t = lm_graph_target(g, v->inspect);
-    char name[128];
-    snprintf(name, sizeof name, "%s", t.name);
-    for (char *c = name; *c; c++)
-      if (*c == '/' || *c == ' ') *c = '_';
-    snprintf(path, sizeof path, "%s/limn-%s-%04d.exr", v->args->capture_dir, name, n);
-    if (probe_target(v, t, &err)) {
-      float *px = lm_alloc((size_t)t.width * t.height * 16);
-      lm_texture_read(v->probe, t.width, t.height, true, px);
-      bool ok = lm_image_write(path, t.width, t.height, 4, true, px, &err);
-      free(px);
-      if (ok) say(v, "wrote %s", path);
-    }
-    if (err.msg[0] && !lm_file_exists(path)) say(v, "%s", err.msg);
-  }
-  lm_texture tex;
-  int w, h;
-  if (!lm_renderer_output(v->renderer, &tex, &w, &h)) return;
-  unsigned char *rgba = lm_alloc((size_t)w * h * 4), *rgb = lm_alloc((size_t)w * h * 3);
-  lm_texture_read(tex, w, h, false, rgba);
-  for (size_t i = 0; i < (size_t)w * h; i++) memcpy(rgb + i * 3, rgba + i * 4, 3);
-  snprintf(path, sizeof path, "%s/limn-frame-%04d.png", v->args->capture_dir, n);
-  if (lm_image_write(path, w, h, 3, false, rgb, &err))
-    say(v, "wrote %s", path);
-  else
-    say(v, "%s", err.msg);
-  free(rgba);
-  free(rgb);
-}
-
-/* A line of the overlay (wrapped to the window), its colour in 3 bytes in front. */
-static void add_line(viewer *v, lm_buf *b, const uint8_t *color, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-static void add_line(viewer *v, lm_buf *b, const uint8_t *color, const char *fmt, ...) {
-  char line[4096];
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(line, sizeof line, fmt, ap);
-  va_end(ap);
-  int cols = (v->width - 8) / lm_font_advance(v->font);
-  if (cols < 8) cols = 8;
-  for (char *seg = strtok(line, "\n"); seg; seg = strtok(NULL, "\n")) {
-    for (size_t len = strlen(seg), at = 0; at < len; at += (size_t)cols) {
-      lm_buf_printf(b, "%c%c%c%.*s\n", color[0] | 1, color[1] | 1, color[2] | 1, cols, seg + at);
-    }
-  }
-}
-
-static void draw_overlay(viewer *v) {
-  static const uint8_t white[3] = {235, 235, 235}, red[3] = {255, 96, 80}, yellow[3] = {255, 220, 96};
-  size_t bytes = (size_t)v->width * v->height * 4;
-  memset(v->overlay, 0, bytes);
-  lm_buf b = {0};
-  const char *error = v->script_error[0]   ? v->script_error
-                      : v->scene_error[0]  ? v->scene_error
-                      : v->shader_error[0] ? v->shader_error
-                                           : v->frame_error;
-  if (v->overlay_on) {
-    lm_graph *g = lm_renderer_graph(v->renderer);
-    double rec, comp;
-    lm_renderer_overhead(v->renderer, &rec, &comp);
-    add_line(v, &b, white, "%s | %s | %s | %dx%d", lm_pipeline_technique(v->pipeline), v->scene->name,
-             strrchr(v->script, '/') ? strrchr(v->script, '/') + 1 : v->script, v->width, v->height);
-    add_line(v, &b, white, "frame %.2f ms (Lua %.2f, graph %.2f)", v->frame_ms, rec, comp);
-    add_line(v, &b, white, "clock: %s", lm_clock_name(lm_renderer_clock(v->renderer)));
-    double total = 0;
-    for (int i = 0; i < lm_graph_pass_count(g); i++) {
-      lm_graph_pass_info p = lm_graph_pass(g, i);
-      if (p.culled || p.ms < 0) continue;
-      add_line(v, &b, white, "  %-14s %8.3f ms", p.name, p.ms);
-      total += p.ms;
-    }
-    add_line(v, &b, white, "  %-14s %8.3f ms", "passes", total);
-    lm_buf opts = {0};
-    lm_pipeline_list_options(v->pipeline, &opts);
-    int cols = (v->width - 8) / lm_font_advance(v->font), room = 2 * (cols > 8 ? cols : 8) - 12;
-    if (opts.len > room && room > 3) strcpy(opts.data + room - 3, "..."); /* two lines at most */
-    add_line(v, &b, white, "options: %s", opts.data ? opts.data : "none");
-    lm_buf_free(&opts);
-    if (v->inspect >= 0 && v->inspect < lm_graph_target_count(g)) {
-      lm_graph_target_info t = lm_graph_target(g, v->inspect);
-      add_line(v, &b, yellow, "target %d/%d '%s' %s %dx%d%s | %s | exposure %+.1f%s", v->inspect + 1,
-               lm_graph_target_count(g), t.name, lm_format_name(t.format), t.width, t.height,
-               t.texture.id ? "" : " (not used)", channel_name(v->channel), v->exposure,
-               v->false_colour ? " | false colour" : "");
-      if (v->false_colour) add_line(v, &b, yellow, "range %g .. %g", v->range[0], v->range[1]);
-    }
-  }
-  if (v->message[0] && lm_now_ms() < v->message_until) add_line(v, &b, yellow, "%s", v->message);
-  if (*error) add_line(v, &b, red, "error: %s", error);
-  int y = 2, lh = lm_font_line_height(v->font);
-  for (char *line = b.data; line && *line && y < v->height;) {
-    char *end = strchr(line, '\n');
-    *end = '\0';
-    uint8_t color[3] = {(uint8_t)line[0], (uint8_t)line[1], (uint8_t)line[2]};
-    lm_font_draw(v->font, v->overlay, v->width, v->height, 4, y, line + 3, color);
-    y += lh;
-    line = end + 1;
-  }
-  lm_buf_free(&b);
-  lm_texture_upload(v->overlay_tex, v->width, v->height, v->overlay);
-}
-
-/* ---- the window's content ---------------------------------------------- */
-static bool make_window_textures(viewer *v, lm_error *err) {
-  lm_texture_destroy(&v->shown);
-  lm_texture_destroy(&v->overlay_tex);
-  v->have_shown = false;
-  lm_texture_desc d = {LM_FORMAT_RGBA8, v->width, v->height, false};
-  if (!lm_texture_create(&v->shown, &d, "viewer frame", err) ||
-      !lm_texture_create(&v->overlay_tex, &d, "viewer overlay", err))
-    return false;
-  lm_texture_clear(v->shown);
-  free(v->overlay);
-  v->overlay = lm_alloc((size_t)v->width * v->height * 4);
-  return true;
-}
-
-static void set_float(const lm_program *p, const char *name, const float *x) {
-  const lm_uniform *u = lm_program_uniform(p, name);
-  if (u) lm_program_set(p, u, x);
-}
-
-static void set_int(const lm_program *p, const char *name, int x) {
-  const lm_uniform *u = lm_program_uniform(p, name);
-  if (u) lm_program_set_int(p, u, &x);
-}
-
-static void display(viewer *v) {
-  lm_error err;
-  lm_texture src = v->shown;
-  int mode = 0;
-  lm_graph *g = lm_renderer_graph(v->renderer);
-  if (v->inspect >= 0 && v->inspect < lm_graph_target_count(g)) {
-    lm_graph_target_info t = lm_graph_target(g, v->inspect);
-    if (probe_target(v, t, &err)) {
-      src = v->probe;
-      mode = v->false_colour ? 2 : 1;
-      if (v->false_colour) update_range(v);
-    }
-  }
-  draw_overlay(v);
-  lm_program *p = lm_program_get("fullscreen.vert", "view.frag", "", &err);
-  lm_screen_bind(v->width, v->height);
-  if (!p) { /* view.frag itself is broken: show what can be shown */
-    set_error(v->shader_error, sizeof v->shader_error, err.msg, "");
-    return;
-  }
-  lm_program_use(p);
-  lm_program_bind_texture(lm_program_uniform(p, "src"), src);
-  lm_program_bind_texture(lm_program_uniform(p, "overlay"), v->overlay_tex);
-  set_int(p, "mode", mode);
-  set_int(p, "channel", v->channel);
-  set_float(p, "exposure", &v->exposure);
-  set_float(p, "range", v->range);
-  lm_draw_fullscreen();
-}
-
-static bool screenshot(viewer *v, const char *path) {
-  uint8_t *rgb = lm_alloc((size_t)v->width * v->height * 3);
-  lm_screen_read(v->width, v->height, rgb);
-  lm_error err;
-  bool ok = lm_image_write(path, v->width, v->height, 3, false, rgb, &err);
-  free(rgb);
-  if (!ok) lm_log(LM_LOG_ERROR, "%s", err.msg);
-  else lm_info("wrote %s (%dx%d)", path, v->width, v->height);
-  return ok;
-}
-
 /* ---- keys -------------------------------------------------------------- */
 static void handle_key(viewer *v, const char *key) {
   static const struct { const char *key, *tech; } techs[] = {
@@ -716,7 +441,7 @@ static void render(viewer *v, bool already_rendered) {
   lm_error err;
   double t0 = lm_now_ms();
   bool ok = already_rendered || lm_renderer_frame(v->renderer, &err);
-  if (!already_rendered) v->frame_ms = lm_now_ms() - t0;
+  if (!already_rendered) v->render_ms = lm_now_ms() - t0;
   set_error(v->frame_error, sizeof v->frame_error, ok ? "" : err.msg, "frame error cleared");
   const char *shader = lm_programs_error();
   set_error(v->shader_error, sizeof v->shader_error, shader, "shaders rebuilt: error cleared");
@@ -724,7 +449,6 @@ static void render(viewer *v, bool already_rendered) {
   int w, h;
   if (ok && lm_renderer_output(v->renderer, &out, &w, &h) && w == v->width && h == v->height) {
     lm_texture_copy(v->shown, out, w, h);
-    v->have_shown = true;
   }
 }
 
@@ -876,6 +600,7 @@ static int run(viewer *v) {
     for (int i = 0; i < a->key_count; i++)
       if (a->keys[i].frame == v->frame) handle_key(v, a->keys[i].key);
     double now = lm_now_ms();
+    v->frame_ms = now - last;
     move_camera(v, now - last);
     last = now;
     if (!follow_size(v)) {
