@@ -428,6 +428,44 @@ static void inspector_writes_target_and_frame(void **state) {
   lm_image_free(&img);
 }
 
+/* Usage errors exit 2 naming the flag; a missing script or window exits 1 naming why. */
+static void command_line_errors(void **state) {
+  (void)state;
+  char log[512];
+  log_path(log, "usage");
+  static const struct {
+    const char *args[3], *says;
+    int rc;
+  } cases[] = {
+      {{"--bogus"}, "unknown flag '--bogus'", 2},
+      {{"--size", "0x5"}, "--size wants WxH", 2},
+      {{"--script-keys", "x:F5"}, "--script-keys wants FRAME:KEY", 2},
+      {{"--screenshot", "out.jpg"}, "give a .png file", 2},
+      {{"--tech", "nope"}, "unknown technique 'nope'", 2},
+      {{"--script", "nope.lua"}, "nope.lua: cannot open", 1},
+      {{"--scene", "nope"}, "nope", 2},
+      {{"--help"}, "F2 isr+esm", 0},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+    pid_t pid = spawn_view(log, cases[i].args[0], cases[i].args[1], cases[i].args[2], NULL);
+    int rc = wait_exit(pid, 10000);
+    if (rc != cases[i].rc || !file_has(log, cases[i].says)) {
+      print_log(log);
+      fail_msg("case %zu (%s): exit %d", i, cases[i].args[0], rc);
+    }
+  }
+  /* No X server: a message, not a crash. */
+  char *display = lm_strdup(getenv("DISPLAY"));
+  unsetenv("DISPLAY");
+  pid_t pid = spawn_view(log, "--exit-after", "1", NULL);
+  int rc = wait_exit(pid, 10000);
+  setenv("DISPLAY", display, 1);
+  free(display);
+  if (rc != 1 || !file_has(log, "no window system")) print_log(log);
+  assert_int_equal(rc, 1);
+  assert_true(file_has(log, "no window system"));
+}
+
 /* ---- a glTF scene: one quad, a sun, two cameras (the second looks away) */
 static char *base64(const unsigned char *p, size_t n) {
   static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -551,6 +589,7 @@ static void reload_loop_leaks_nothing(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test_teardown(command_line_errors, stop_leftover),
       cmocka_unit_test_teardown(window_shows_the_box, stop_leftover),
       cmocka_unit_test_teardown(keys_switch_techniques_and_options, stop_leftover),
       cmocka_unit_test_teardown(live_reload_survives_errors, stop_leftover),

@@ -314,11 +314,13 @@ void lm_texture_read(lm_texture tex, int width, int height, bool floats, void *o
 
 /* ---- uploads, copies and the window's framebuffer ---------------------- */
 void lm_texture_upload(lm_texture tex, int width, int height, const uint8_t *rgba) {
+  /* GL's row 0 is the image's last: flip into a copy, then one upload. */
+  size_t row = (size_t)width * 4;
+  uint8_t *flipped = lm_alloc(row * (size_t)height);
+  for (int y = 0; y < height; y++) memcpy(flipped + (size_t)y * row, rgba + (size_t)(height - 1 - y) * row, row);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  /* Row by row, bottom first: GL's row 0 is the image's last. */
-  for (int y = 0; y < height; y++)
-    glTextureSubImage2D(tex.id, 0, 0, y, width, 1, GL_RGBA, GL_UNSIGNED_BYTE,
-                        rgba + (size_t)(height - 1 - y) * (size_t)width * 4);
+  glTextureSubImage2D(tex.id, 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, flipped);
+  free(flipped);
 }
 
 void lm_texture_copy(lm_texture dst, lm_texture src, int width, int height) {
