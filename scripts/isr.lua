@@ -10,6 +10,8 @@
 --      eq 27-29)
 -- Sample pattern: a golden-angle (Vogel) spiral turned per pixel; see isr.frag.
 local gbuffer = require "gbuffer"
+local options = require "options"
+local shadow = require "shadow"
 
 local isr = {}
 
@@ -28,40 +30,17 @@ isr.defaults = {
 
 local views = { lit = 0, indirect = 1, ao = 2 }
 
-local function whole(v, lo, hi)
-  return type(v) == "number" and v == math.floor(v) and v >= lo and v <= hi
-end
-
-local function within(v, lo, hi)
-  return type(v) == "number" and v >= lo and v <= hi -- false for NaN
-end
-
--- Checks o (missing fields take the defaults); errors name the option and
--- point at the caller of isr.render.
-local function checked(o)
-  o = o or {}
-  local c = {}
-  for k, v in pairs(isr.defaults) do
-    if o[k] == nil then c[k] = v else c[k] = o[k] end
-  end
-  for k in pairs(o) do
-    if isr.defaults[k] == nil then error("isr." .. tostring(k) .. " is not an ISR option", 3) end
-  end
-  local function need(ok, msg, v)
-    if not ok then error(string.format("%s (got %s)", msg, tostring(v)), 4) end
-  end
-  need(whole(c.samples, 1, 256), "isr.samples must be a whole number in 1..256", c.samples)
-  need(within(c.radius, 0, math.huge) and c.radius > 0 and c.radius < math.huge, -- not NaN, 0 or Inf
-       "isr.radius must be a positive finite number (world units)", c.radius)
-  need(c.coarse == 1 or c.coarse == 2 or c.coarse == 4, "isr.coarse must be 1, 2 or 4", c.coarse)
-  need(whole(c.blur, 0, 32), "isr.blur must be a whole number in 0..32", c.blur)
-  need(within(c.k_isr, 0, 1), "isr.k_isr must be in 0..1", c.k_isr)
-  need(within(c.k_ssao, 0, 1), "isr.k_ssao must be in 0..1", c.k_ssao)
-  need(c.sender == "albedo" or c.sender == "lit", 'isr.sender must be "albedo" or "lit"', c.sender)
-  need(whole(c.bounces, 1, 4), "isr.bounces must be a whole number in 1..4", c.bounces)
-  need(views[c.view], 'isr.view must be "lit", "indirect" or "ao"', c.view)
-  return c
-end
+local rules = {
+  samples = options.whole(1, 256),
+  radius = options.positive(),
+  coarse = options.one_of(1, 2, 4),
+  blur = options.whole(0, 32),
+  k_isr = options.number(0, 1),
+  k_ssao = options.number(0, 1),
+  sender = options.one_of("albedo", "lit"),
+  bounces = options.whole(1, 4),
+  view = options.one_of("lit", "indirect", "ao"),
+}
 
 -- The coarse G-buffer: G itself at factor 1.
 local function coarse_gbuffer(G, f)
@@ -82,14 +61,16 @@ local function coarse_target(name, f)
 end
 
 -- Records ISR lighting of G with options o (see isr.defaults) and light =
--- { ambient = {r, g, b}, background = {r, g, b} }. Returns the lit target.
+-- { ambient = {r, g, b}, background = {r, g, b}, shadows = atlas or nil }.
+-- Returns the lit target.
 function isr.render(G, o, light)
-  o = checked(o)
+  o = options.check("isr", isr.defaults, o, rules, 2)
   local f = o.coarse
   local C = coarse_gbuffer(G, f)
   local sender = C.clr
   if o.sender == "lit" then
-    sender = pass{ "isr.sender", shader = "direct.frag", inputs = gbuffer.inputs(C),
+    local inputs, defines = shadow.bind(light.shadows, gbuffer.inputs(C), {})
+    sender = pass{ "isr.sender", shader = "direct.frag", inputs = inputs, defines = defines,
                    params = { ambient = light.ambient, background = light.background },
                    out = coarse_target("isr.sender", f) }
   end
@@ -109,9 +90,9 @@ function isr.render(G, o, light)
                 out = coarse_target("isr.blur_" .. axis[1], f) }
     end
   end
-  return pass{ "isr.light", shader = "isr_light.frag",
-               inputs = { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat,
-                          isr = E, coarse_dpt = C.dpt, coarse_mat = C.mat },
+  local inputs, defines = shadow.bind(light.shadows, { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat,
+                                                       isr = E, coarse_dpt = C.dpt, coarse_mat = C.mat }, {})
+  return pass{ "isr.light", shader = "isr_light.frag", inputs = inputs, defines = defines,
                params = { ambient = light.ambient, background = light.background,
                           k_isr = o.k_isr, k_ssao = o.k_ssao, view = views[o.view] },
                out = target{ "lit", format = "rgba16f" } }

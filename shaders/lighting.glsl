@@ -4,6 +4,9 @@
 #ifndef LIMN_LIGHTING_GLSL
 #define LIMN_LIGHTING_GLSL
 #include "common.glsl"
+#ifdef SHADOWS
+#include "shadow.glsl"
+#endif
 
 // Light arriving at p from light i: direction to the light in *l, radiance returned.
 vec3 light_incident(int i, vec3 p, out vec3 l) {
@@ -42,6 +45,9 @@ vec3 phong(vec3 albedo, vec3 k, float shininess, vec3 n, vec3 v, vec3 p, vec3 am
     vec3 radiance = light_incident(i, p, l);
     float ndl = dot(n, l);
     if (ndl <= 0.0) continue;
+#ifdef SHADOWS
+    radiance *= shadow_factor(i, p, n, l);
+#endif
     vec3 r = reflect(-l, n);
     // pow(0, 0) is undefined in GLSL: keep the base strictly positive.
     float spec = k.z > 0.0 ? pow(max(dot(r, v), 1e-8), max(shininess, 1.0)) : 0.0;

@@ -43,11 +43,11 @@ check "bad set" run 2 capture --set novalue
 check "unknown option" run 2 capture --set nope=1
 check "unknown option lists known" err_has "known: ambient="
 check "unknown technique" run 2 capture --tech nope
-check "unknown technique lists known" err_has "known: dl"
+check "unknown technique lists known" err_has "known: isr+esm, isr, dl+esm, dl"
 check "unknown scene" run 2 capture --scene nope
 check "bad option value" run 2 capture --set ambient=bright
 check "list options" run 0 capture --list-options
-check "list options shows techniques" out_has "techniques: dl"
+check "list options shows techniques" out_has "techniques: isr+esm isr dl+esm dl"
 
 # a good capture: both files, per-pass times with the clock named
 check "capture" run 0 capture --scene cornell --script scripts/pp.lua --tech dl --size 64x48 --frames 2 \
@@ -60,6 +60,17 @@ check "times name the clock" out_has "clock: "
 check "times list the gbuffer pass" out_has "gbuffer"
 check "times list the direct pass" out_has "direct"
 check "times are medians of 2" out_has "median of 2 frames"
+rm -f "$tmp/img/"*
+
+# effects: `--set bloom=true` turns on bloom.enabled; dotted names set parameters
+check "effects capture" run 0 capture --scene cornell --script scripts/pp.lua --tech dl --size 64x48 \
+  --set bloom=true --set hdr=true --set dof=on --set dof.focus=3.5 --set dof.mode=lens --output "$tmp/img/e.png"
+check "effects run their passes" out_has "hdr.tonemap"
+check "effects list dof" out_has "dof.gather"
+rm -f "$tmp/img/"*
+check "bad effect value" run 1 capture --size 64x48 --set dof.mode=pinhole --output "$tmp/img/f.png"
+check "bad effect value names it" first_error_has "dof.mode must be one of range, lens (got pinhole)"
+check "bad effect value leaves no file" no_files
 rm -f "$tmp/img/"*
 
 # broken scripts: exit 1, a first line naming script:line or the pass, no image

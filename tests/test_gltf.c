@@ -117,13 +117,13 @@ static const char *write_triangle(const char *name, int ctype) {
   snprintf(json, sizeof json,
            "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
            "\"nodes\":[{\"name\":\"tri\",\"mesh\":0}],"
-           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}%s,\"material\":0}]}],"
+         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}%s,\"material\":0}]}],"
            "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.25,1,1],"
            "\"metallicFactor\":0,\"roughnessFactor\":0.5}}],"
-           "\"buffers\":[{\"uri\":\"%%s\",\"byteLength\":%%zu}],"
-           "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36}"
+         "\"buffers\":[{\"uri\":\"%%s\",\"byteLength\":%%zu}],"
+         "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36}"
            ",{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}],"
-           "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}"
+         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}"
            ",{\"bufferView\":1,\"componentType\":%d,\"count\":3,\"type\":\"SCALAR\"}]}",
            ctype ? ",\"indices\":1" : "", ioff, 3 * isize, ctype ? ctype : 5125);
   return write_gltf(name, json, &b);
@@ -506,6 +506,16 @@ static void malformed_files_name_the_element(void **state) {
   EXPECT("metal.gltf", "\"metallicFactor\":0", "\"metallicFactor\":1e999", "");
 }
 
+/* One indexed triangle: 36 bytes of positions, then 3 uint16 indices; the
+ * buffer goes in as a data uri (write_gltf fills in the uri and length). */
+static const char tri_indexed_json[] =
+    "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],"
+    "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+    "\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}],"
+    "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
+    "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+    "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}";
+
 /* Vertex data a JSON edit cannot reach: written into the buffer itself. */
 static void bad_vertex_values_are_refused(void **state) {
   (void)state;
@@ -518,15 +528,8 @@ static void bad_vertex_values_are_refused(void **state) {
     blob_add(&b, pos, sizeof pos);
     static const uint16_t idx[4] = {0, 1, 2, 0};
     blob_add(&b, idx, 8);
-    const char *json =
-        "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],"
-        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
-        "\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}],"
-        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
-        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
-        "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}";
     lm_error err = {""};
-    const char *path = write_gltf("nan.gltf", json, &b);
+    const char *path = write_gltf("nan.gltf", tri_indexed_json, &b);
     assert_null(lm_scene_load_gltf(path, &err));
     assert_non_null(strstr(err.msg, path));
     if (!strstr(err.msg, "mesh 0 primitive 0: POSITION: accessor 0: element 1 has a non-finite or huge value"))
@@ -537,15 +540,8 @@ static void bad_vertex_values_are_refused(void **state) {
   blob_add(&b, tri_pos, sizeof tri_pos);
   static const uint16_t idx[4] = {0, 1, 3, 0};
   blob_add(&b, idx, 8);
-  const char *json =
-      "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],"
-      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
-      "\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}],"
-      "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
-      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
-      "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}";
   lm_error err = {""};
-  assert_null(lm_scene_load_gltf(write_gltf("index.gltf", json, &b), &err));
+  assert_null(lm_scene_load_gltf(write_gltf("index.gltf", tri_indexed_json, &b), &err));
   if (!strstr(err.msg, "mesh 0 primitive 0: indices: index 2 is 3, past the 3 vertices"))
     fail_msg("%s", err.msg);
 }

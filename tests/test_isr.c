@@ -13,99 +13,20 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/render.h"
+#include "gl_test.h"
 
 enum { W = 256, H = 192 };
 
-static lm_scene *scene;
-
-static int setup(void **state) {
-  (void)state;
-  lm_error err;
-  if (!lm_context_create_headless(&(lm_context_desc){0}, &err)) {
-    fprintf(stderr, "no OpenGL context: %s\n", err.msg);
-    return -1;
-  }
-  scene = lm_scene_builtin("cornell", &err);
-  return scene ? 0 : -1;
-}
-
-static int teardown(void **state) {
-  (void)state;
-  lm_programs_clear();
-  lm_scene_destroy(scene);
-  lm_context_destroy();
-  return 0;
-}
-
-typedef struct image {
-  float rgb[W * H * 3];  /* the output stage's linear copy */
-  float lit[W * H * 4];  /* the script's presented target, before the output stage sanitizes */
-  bool isr_pass, culled_isr_pass; /* a pass named isr.* was recorded / left out */
-} image;
-
 /* Renders one frame of pp.lua with technique `tech` and "name=value" options
- * (NULL-terminated). Returns false with the message in err. */
-static bool render(const char *tech, const char *const *sets, image *out, lm_error *err) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/scripts/pp.lua", lm_root_dir());
-  lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = path}, err);
-  assert_non_null(p);
-  assert_true(lm_pipeline_set_technique(p, tech, err));
-  for (; sets && *sets; sets++) {
-    char name[64];
-    const char *eq = strchr(*sets, '=');
-    snprintf(name, sizeof name, "%.*s", (int)(eq - *sets), *sets);
-    if (!lm_pipeline_set_option(p, name, eq + 1, err)) fail_msg("%s", err->msg);
-  }
-  lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = p, .width = W,
-                                                          .height = H, .linear_output = true}, err);
-  assert_non_null(r);
-  bool ok = lm_renderer_frame(r, err);
-  if (ok) {
-    assert_true(lm_renderer_read(r, true, out->rgb, err));
-    lm_graph *g = lm_renderer_graph(r);
-    lm_graph_target_info lit = lm_graph_target(g, lm_graph_find_target(g, "lit"));
-    assert_int_equal(lit.width, W);
-    lm_texture_read(lit.texture, W, H, true, out->lit);
-    out->isr_pass = out->culled_isr_pass = false;
-    for (int i = 0; i < lm_graph_pass_count(g); i++) {
-      lm_graph_pass_info pi = lm_graph_pass(g, i);
-      if (strncmp(pi.name, "isr.", 4)) continue;
-      out->isr_pass = true;
-      out->culled_isr_pass |= pi.culled;
-    }
-  }
-  lm_renderer_destroy(r);
-  lm_pipeline_destroy(p);
-  return ok;
+ * (NULL-terminated); r.ok false with the message in r.err. */
+static gl_result render(const char *tech, const char *const *sets) {
+  return gl_render(&(gl_run){.tech = tech, .sets = sets, .width = W, .height = H});
 }
 
-static image *render_ok(const char *tech, const char *const *sets) {
-  image *im = malloc(sizeof *im);
-  assert_non_null(im);
-  lm_error err;
-  if (!render(tech, sets, im, &err)) fail_msg("%s: %s", tech, err.msg);
-  return im;
-}
-
-/* Pixel of a world point for the box's camera (cornell.c: eye (0, 1, 3.4)
- * looking down -z, fov_y 45 degrees), top row first. */
-static void project(float x, float y, float z, int *col, int *row) {
-  float depth = 3.4f - z, t = tanf(0.5f * 45.0f * 3.14159265f / 180.0f), aspect = (float)W / H;
-  *col = (int)((x / (depth * t * aspect) + 1) * 0.5f * W);
-  *row = (int)((1 - (y - 1) / (depth * t)) * 0.5f * H);
-}
-
-/* Mean colour of the (2r+1)^2 pixels around a world point. */
-static void mean_around(const image *im, float x, float y, float z, int r, double out[3]) {
-  int c0, r0;
-  project(x, y, z, &c0, &r0);
-  out[0] = out[1] = out[2] = 0;
-  for (int row = r0 - r; row <= r0 + r; row++)
-    for (int col = c0 - r; col <= c0 + r; col++)
-      for (int k = 0; k < 3; k++) out[k] += im->rgb[(row * W + col) * 3 + k];
-  for (int k = 0; k < 3; k++) out[k] /= (2 * r + 1) * (2 * r + 1);
+static gl_result render_ok(const char *tech, const char *const *sets) {
+  gl_result r = render(tech, sets);
+  if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
+  return r;
 }
 
 /* Surfaces beside a coloured wall take its colour: ISR raises the ratio of
@@ -115,21 +36,21 @@ static void mean_around(const image *im, float x, float y, float z, int r, doubl
  * green wall shifts by about 3.5%. */
 static void indirect_light_bleeds_wall_colour(void **state) {
   (void)state;
-  image *dl = render_ok("dl", NULL), *isr = render_ok("isr", NULL);
-  double d[3], i[3];
-  mean_around(dl, -0.85f, 0.0f, 0.3f, 3, d); /* floor by the red wall */
-  mean_around(isr, -0.85f, 0.0f, 0.3f, 3, i);
-  double red_dl = d[0] / d[1], red_isr = i[0] / i[1];
-  mean_around(dl, 0.85f, 2.0f, 0.3f, 3, d);  /* ceiling by the green wall */
-  mean_around(isr, 0.85f, 2.0f, 0.3f, 3, i);
-  double green_dl = d[1] / d[0], green_isr = i[1] / i[0];
+  gl_result dl = render_ok("dl", NULL), isr = render_ok("isr", NULL);
+  float d[3], i[3];
+  gl_mean_around(&dl, -0.85f, 0.0f, 0.3f, 3, d); /* floor by the red wall */
+  gl_mean_around(&isr, -0.85f, 0.0f, 0.3f, 3, i);
+  double red_dl = (double)d[0] / d[1], red_isr = (double)i[0] / i[1];
+  gl_mean_around(&dl, 0.85f, 2.0f, 0.3f, 3, d);  /* ceiling by the green wall */
+  gl_mean_around(&isr, 0.85f, 2.0f, 0.3f, 3, i);
+  double green_dl = (double)d[1] / d[0], green_isr = (double)i[1] / i[0];
   print_message("red/green on the floor by the red wall: dl %.4f isr %.4f\n"
                 "green/red on the ceiling by the green wall: dl %.4f isr %.4f\n",
                 red_dl, red_isr, green_dl, green_isr);
   assert_true(red_isr > red_dl * 1.01);
   assert_true(green_isr > green_dl * 1.02);
-  free(dl);
-  free(isr);
+  gl_result_free(&dl);
+  gl_result_free(&isr);
 }
 
 /* With k_ISR = 0 and k_SSAO = 1, eq 29 is direct light times accessibility,
@@ -138,19 +59,19 @@ static void indirect_light_bleeds_wall_colour(void **state) {
 static void occlusion_darkens_inside_corners(void **state) {
   (void)state;
   static const char *const sets[] = {"isr.k_isr=0", "isr.k_ssao=1", NULL};
-  image *dl = render_ok("dl", NULL), *ao = render_ok("isr", sets);
-  double d[3], a[3];
-  mean_around(dl, 0.9f, 1.0f, -1.0f, 3, d);
-  mean_around(ao, 0.9f, 1.0f, -1.0f, 3, a);
-  double corner = a[1] / d[1];
-  mean_around(dl, 0.3f, 1.3f, -1.0f, 3, d);
-  mean_around(ao, 0.3f, 1.3f, -1.0f, 3, a);
-  double open = a[1] / d[1];
+  gl_result dl = render_ok("dl", NULL), ao = render_ok("isr", sets);
+  float d[3], a[3];
+  gl_mean_around(&dl, 0.9f, 1.0f, -1.0f, 3, d);
+  gl_mean_around(&ao, 0.9f, 1.0f, -1.0f, 3, a);
+  double corner = (double)a[1] / d[1];
+  gl_mean_around(&dl, 0.3f, 1.3f, -1.0f, 3, d);
+  gl_mean_around(&ao, 0.3f, 1.3f, -1.0f, 3, a);
+  double open = (double)a[1] / d[1];
   print_message("accessibility: corner %.3f, open wall %.3f\n", corner, open);
   assert_true(open > 0.9 && open <= 1.0 + 1e-4); /* occlusion only darkens */
   assert_true(corner < open - 0.1);
-  free(dl);
-  free(ao);
+  gl_result_free(&dl);
+  gl_result_free(&ao);
 }
 
 /* The seed's mean error, sum(|dR| + |dG| + |dB|) / (3 w h), between the
@@ -160,20 +81,14 @@ static void coarse_and_full_size_agree(void **state) {
   (void)state;
   static const char *const full[] = {"isr.coarse=1", "isr.k_isr=1", "isr.k_ssao=1", NULL};
   static const char *const half[] = {"isr.coarse=2", "isr.k_isr=1", "isr.k_ssao=1", NULL};
-  image *a = render_ok("isr", full), *b = render_ok("isr", half);
+  gl_result a = render_ok("isr", full), b = render_ok("isr", half);
   double sum = 0;
-  for (int i = 0; i < W * H * 3; i++) sum += fabs(a->rgb[i] - b->rgb[i]);
+  for (int i = 0; i < W * H * 3; i++) sum += fabs(a.rgb[i] - b.rgb[i]);
   double mean_error = sum / (3.0 * W * H);
   print_message("mean error coarse 1 vs 2: %.5f\n", mean_error);
   assert_true(mean_error < 0.01);
-  free(a);
-  free(b);
-}
-
-static bool all_finite(const image *im) {
-  for (int i = 0; i < W * H * 4; i++)
-    if (!isfinite(im->lit[i]) || im->lit[i] < 0) return false;
-  return true;
+  gl_result_free(&a);
+  gl_result_free(&b);
 }
 
 /* Extremes of every option give finite, non-negative light before the output
@@ -188,52 +103,40 @@ static void extreme_parameters_stay_finite(void **state) {
       {"isr.k_isr=1", "isr.k_ssao=1", "isr.sender=lit", "isr.bounces=4", NULL},
       {"isr.radius=1e-30", "isr.coarse=1", "isr.sender=lit", "isr.bounces=2", NULL},
   };
-  image *im = malloc(sizeof *im);
   for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
-    lm_error err;
-    if (!render("isr", cases[c], im, &err)) fail_msg("case %zu: %s", c, err.msg);
-    if (!all_finite(im)) fail_msg("case %zu (%s ...): a NaN, Inf or negative value", c, cases[c][0]);
+    gl_result r = render("isr", cases[c]);
+    if (!r.ok) fail_msg("case %zu: %s", c, r.err.msg);
+    if (!gl_target_finite(&r, "lit")) fail_msg("case %zu (%s ...): a NaN, Inf or negative value", c, cases[c][0]);
+    gl_result_free(&r);
   }
-  free(im);
 }
 
 /* Out-of-range options stop the frame with the option's name. */
 static void bad_options_name_themselves(void **state) {
   (void)state;
-  static const struct {
-    const char *set, *expect;
-  } cases[] = {
-      {"isr.samples=0", "isr.samples must be a whole number in 1..256 (got 0)"},
-      {"isr.samples=2.5", "isr.samples must be"},
-      {"isr.coarse=3", "isr.coarse must be 1, 2 or 4"},
-      {"isr.radius=0", "isr.radius must be a positive"},
-      {"isr.k_ssao=-1", "isr.k_ssao must be in 0..1"},
-      {"isr.sender=sun", "isr.sender must be \"albedo\" or \"lit\" (got sun)"},
-      {"isr.bounces=5", "isr.bounces must be"},
+  static const gl_bad_option cases[] = {
+      {"isr", "isr.samples=0", "isr.samples must be a whole number in 1..256 (got 0)"},
+      {"isr", "isr.samples=2.5", "isr.samples must be"},
+      {"isr", "isr.coarse=3", "isr.coarse must be one of 1, 2, 4"},
+      {"isr", "isr.radius=0", "isr.radius must be a positive"},
+      {"isr", "isr.k_ssao=-1", "isr.k_ssao must be a finite number in 0..1"},
+      {"isr", "isr.sender=sun", "isr.sender must be one of albedo, lit (got sun)"},
+      {"isr", "isr.bounces=5", "isr.bounces must be"},
   };
-  image *im = malloc(sizeof *im);
-  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
-    const char *sets[] = {cases[i].set, NULL};
-    lm_error err;
-    if (render("isr", sets, im, &err)) fail_msg("%s: rendered", cases[i].set);
-    if (!strstr(err.msg, cases[i].expect) || !strstr(err.msg, "pp.lua:"))
-      fail_msg("%s: '%s'", cases[i].set, err.msg);
-  }
-  free(im);
+  gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
 }
 
 static void dl_records_no_isr_pass(void **state) {
   (void)state;
-  image *dl = render_ok("dl", NULL), *isr = render_ok("isr", NULL);
-  assert_false(dl->isr_pass);
-  assert_true(isr->isr_pass);
-  assert_false(isr->culled_isr_pass); /* every ISR pass reaches the output */
-  free(dl);
-  free(isr);
+  gl_result dl = render_ok("dl", NULL), isr = render_ok("isr", NULL);
+  assert_false(gl_has_pass(&dl, "isr."));
+  assert_true(gl_has_pass(&isr, "isr."));
+  assert_int_equal(gl_culled(&isr, ""), 0); /* every ISR pass reaches the output */
+  gl_result_free(&dl);
+  gl_result_free(&isr);
 }
 
 int main(void) {
-  lm_log_set_level(LM_LOG_WARN);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(indirect_light_bleeds_wall_colour),
       cmocka_unit_test(occlusion_darkens_inside_corners),
@@ -242,5 +145,5 @@ int main(void) {
       cmocka_unit_test(bad_options_name_themselves),
       cmocka_unit_test(dl_records_no_isr_pass),
   };
-  return cmocka_run_group_tests(tests, setup, teardown);
+  return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

@@ -11,121 +11,35 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
+#include "gl_test.h"
 #include "image/image.h"
-#include "render/render.h"
 
 enum { W = 256, H = 192 };
 
-static char root[256], real_root[1024];
+static char real_root[1024]; /* the tree's, before the scratch root takes over */
+static bool check_finite; /* render() with the NaN/Inf check */
 
-static void write_file(const char *rel, const char *text) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/%s", root, rel);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  fputs(text, f);
-  fclose(f);
-}
-
-/* A scratch engine root: the real shaders and scripts linked in, plus test files. */
 static int setup(void **state) {
-  (void)state;
   snprintf(real_root, sizeof real_root, "%s", lm_root_dir());
-  snprintf(root, sizeof root, "/tmp/limn-render-XXXXXX");
-  if (!mkdtemp(root)) return -1;
-  char cmd[4096];
-  snprintf(cmd, sizeof cmd, "mkdir -p %s/shaders && ln -s %s/shaders/* %s/shaders/ && ln -s %s/scripts %s/scripts",
-           root, real_root, root, real_root, root);
-  if (system(cmd) != 0) return -1;
-  setenv("LIMN_ROOT", root, 1);
-  lm_log_set_level(LM_LOG_WARN);
-  lm_error err;
-  if (!lm_context_create_headless(&(lm_context_desc){0}, &err)) {
-    fprintf(stderr, "no GL context: %s\n", err.msg);
-    return -1;
-  }
-  return 0;
+  return gl_test_setup(state);
 }
 
-static int teardown(void **state) {
-  (void)state;
-  lm_programs_clear();
-  lm_context_destroy();
-  char cmd[300];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", root);
-  return system(cmd);
+
+static gl_result render(const char *script, const char *tech, int frames) {
+  return gl_render(&(gl_run){.script = script, .tech = tech, .frames = frames,
+                             .width = W, .height = H, .check_finite = check_finite});
 }
-
-typedef struct frame_result {
-  bool ok;
-  lm_error err;
-  float *linear;         /* W*H*3 */
-  unsigned char *srgb;   /* W*H*3 */
-  char pass_names[512];  /* passes that ran, space separated */
-} frame_result;
-
-static frame_result render(const char *script, const char *tech, int frames) {
-  frame_result fr = {0};
-  lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, &fr.err);
-  if (!p) return fr;
-  lm_scene *scene = lm_scene_builtin("cornell", &fr.err);
-  assert_non_null(scene);
-  if (tech && !lm_pipeline_set_technique(p, tech, &fr.err)) {
-    lm_scene_destroy(scene);
-    lm_pipeline_destroy(p);
-    return fr;
-  }
-  lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = p, .width = W,
-                                                          .height = H, .linear_output = true}, &fr.err);
-  assert_non_null(r);
-  fr.ok = true;
-  for (int f = 0; f < frames && fr.ok; f++) fr.ok = lm_renderer_frame(r, &fr.err);
-  if (fr.ok) {
-    fr.linear = malloc(sizeof(float) * W * H * 3);
-    fr.srgb = malloc(W * H * 3);
-    assert_true(lm_renderer_read(r, true, fr.linear, &fr.err));
-    assert_true(lm_renderer_read(r, false, fr.srgb, &fr.err));
-    lm_graph *g = lm_renderer_graph(r);
-    for (int i = 0; i < lm_graph_pass_count(g); i++) {
-      if (lm_graph_pass(g, i).culled) continue;
-      size_t n = strlen(fr.pass_names);
-      snprintf(fr.pass_names + n, sizeof fr.pass_names - n, "%s ", lm_graph_pass(g, i).name);
-    }
-  }
-  lm_renderer_destroy(r);
-  lm_scene_destroy(scene);
-  lm_pipeline_destroy(p);
-  return fr;
-}
-
-static void free_result(frame_result *fr) {
-  free(fr->linear);
-  free(fr->srgb);
-}
-
-/* Mean linear RGB over pixels x0..x1, y0..y1 (rows from the top). */
-static void region(const float *img, int x0, int y0, int x1, int y1, float out[3]) {
-  double sum[3] = {0};
-  int n = 0;
-  for (int y = y0; y <= y1; y++)
-    for (int x = x0; x <= x1; x++, n++)
-      for (int c = 0; c < 3; c++) sum[c] += img[((size_t)y * W + x) * 3 + c];
-  for (int c = 0; c < 3; c++) out[c] = (float)(sum[c] / n);
-}
-
-static float lum(const float c[3]) { return 0.27f * c[0] + 0.67f * c[1] + 0.06f * c[2]; }
 
 static char pp_lua[1100];
 
 static void cornell_box_has_light_and_colour_where_it_must(void **state) {
   (void)state;
-  frame_result fr = render(pp_lua, "dl", 1);
+  gl_result fr = render(pp_lua, "dl", 1);
   if (!fr.ok) fail_msg("%s", fr.err.msg);
   double mean = 0, mean2 = 0;
   for (int i = 0; i < W * H * 3; i++) {
-    float v = fr.linear[i];
+    float v = fr.rgb[i];
     if (!isfinite(v) || v < 0) fail_msg("pixel value %g at %d", v, i / 3);
     mean += v, mean2 += (double)v * v;
   }
@@ -136,26 +50,28 @@ static void cornell_box_has_light_and_colour_where_it_must(void **state) {
    * height, the floor in front of the tall box, the ceiling above the light
    * and near a front corner, and the black outside of the box. */
   float left[3], right[3], floor_[3], ceil_mid[3], ceil_corner[3], outside[3];
-  region(fr.linear, 45, 80, 65, 110, left);
-  region(fr.linear, 191, 80, 211, 110, right);
-  region(fr.linear, 62, 178, 90, 188, floor_);
-  region(fr.linear, 118, 24, 138, 32, ceil_mid);
-  region(fr.linear, 42, 3, 52, 8, ceil_corner);
-  region(fr.linear, 0, 60, 8, 130, outside);
+  gl_region(&fr, 45, 80, 65, 110, left);
+  gl_region(&fr, 191, 80, 211, 110, right);
+  gl_region(&fr, 62, 178, 90, 188, floor_);
+  gl_region(&fr, 118, 24, 138, 32, ceil_mid);
+  gl_region(&fr, 42, 3, 52, 8, ceil_corner);
+  gl_region(&fr, 0, 60, 8, 130, outside);
   assert_true(left[0] > 3 * left[1] && left[0] > 3 * left[2]);
   assert_true(right[1] > 2 * right[0] && right[1] > 2 * right[2]);
-  assert_true(lum(floor_) > 0.2f);
+  assert_true(gl_luminance(floor_) > 0.2f);
   assert_true(floor_[0] > 0.5f * floor_[1] && floor_[0] < 2.0f * floor_[1]); /* white floor stays grey */
-  assert_true(lum(ceil_mid) > 3 * lum(ceil_corner));                          /* light falls off */
-  assert_true(lum(outside) < 1e-3f);
-  assert_string_equal(fr.pass_names, "gbuffer direct output ");
-  free_result(&fr);
+  assert_true(gl_luminance(ceil_mid) > 3 * gl_luminance(ceil_corner));                          /* light falls off */
+  assert_true(gl_luminance(outside) < 1e-3f);
+  char names[256];
+  gl_pass_names(&fr, names, sizeof names);
+  assert_string_equal(names, "gbuffer direct output ");
+  gl_result_free(&fr);
 }
 
 /* Golden image: tools/regen-golden.sh rewrites data/golden/cornell_dl.png. */
 static void cornell_box_matches_the_golden_image(void **state) {
   (void)state;
-  frame_result fr = render(pp_lua, "dl", 1);
+  gl_result fr = render(pp_lua, "dl", 1);
   if (!fr.ok) fail_msg("%s", fr.err.msg);
   lm_image golden;
   lm_error err;
@@ -178,15 +94,16 @@ static void cornell_box_matches_the_golden_image(void **state) {
   if (mean > 1.0 / 255.0 || far_off > W * H * 3 / 200)
     fail_msg("mean error %.5f, %d values off by more than 8/255", mean, far_off);
   lm_image_free(&golden);
-  free_result(&fr);
+  gl_result_free(&fr);
 }
 
 static void shader_errors_name_the_original_file_and_line(void **state) {
   (void)state;
-  write_file("shaders/broken.frag", "#include \"common.glsl\"\nin vec2 uv;\nout vec4 o;\n\nvoid main() {\n"
-                                    "  o = vec4(no_such_thing);\n}\n");
-  write_file("shaders/bad_include.glsl", "float helper() {\n  return undefined_value;\n}\n");
-  write_file("shaders/uses_bad.frag", "#include \"bad_include.glsl\"\nout vec4 o;\nvoid main() { o = vec4(helper()); }\n");
+  assert_true(gl_write_file("shaders/broken.frag", "#include \"common.glsl\"\nin vec2 uv;\nout vec4 o;\n\n"
+                                                   "void main() {\n  o = vec4(no_such_thing);\n}\n"));
+  assert_true(gl_write_file("shaders/bad_include.glsl", "float helper() {\n  return undefined_value;\n}\n"));
+  assert_true(gl_write_file("shaders/uses_bad.frag",
+                            "#include \"bad_include.glsl\"\nout vec4 o;\nvoid main() { o = vec4(helper()); }\n"));
   lm_error err;
   assert_null(lm_program_get("fullscreen.vert", "broken.frag", NULL, &err));
   if (!strstr(err.msg, "shaders/broken.frag:6:")) fail_msg("%s", err.msg);
@@ -197,17 +114,15 @@ static void shader_errors_name_the_original_file_and_line(void **state) {
 }
 
 /* A pipeline that runs direct.frag with the given extra pass fields. */
-static frame_result direct_with(const char *fields) {
+static gl_result direct_with(const char *fields) {
   char text[2048];
   snprintf(text, sizeof text,
            "local gbuffer = require 'gbuffer'\nTechniques = { 'dl' }\n"
            "function OnRender(tech)\n  local G = gbuffer.render(gbuffer.targets())\n"
            "  local lit = target{ 'lit', format = 'rgba16f' }\n"
            "  pass{ 'direct', shader = 'direct.frag', out = lit, %s }\n  present(lit)\nend\n", fields);
-  write_file("bindings.lua", text);
-  char path[512];
-  snprintf(path, sizeof path, "%s/bindings.lua", root);
-  return render(path, NULL, 1);
+  assert_true(gl_write_file("bindings.lua", text));
+  return render("bindings.lua", NULL, 1);
 }
 
 static void wrong_uniforms_and_inputs_name_the_pass_and_parameter(void **state) {
@@ -228,36 +143,43 @@ static void wrong_uniforms_and_inputs_name_the_pass_and_parameter(void **state) 
        "input 'ambient': shaders/direct.frag declares no sampler of that name"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
-    frame_result fr = direct_with(cases[i].fields);
+    gl_result fr = direct_with(cases[i].fields);
     if (fr.ok || !strstr(fr.err.msg, cases[i].expect))
       fail_msg("case %zu: %s", i, fr.ok ? "rendered" : fr.err.msg);
-    free_result(&fr);
+    gl_result_free(&fr);
   }
-  frame_result fr = direct_with("inputs = gbuffer.inputs(G), params = { ambient = { 0.1, 0.1, 0.1 } }");
+  gl_result fr = direct_with("inputs = gbuffer.inputs(G), params = { ambient = { 0.1, 0.1, 0.1 } }");
   if (!fr.ok) fail_msg("%s", fr.err.msg);
-  free_result(&fr);
+  gl_result_free(&fr);
 }
 
 static void no_nan_or_inf_leaves_the_output_stage(void **state) {
   (void)state;
-  write_file("shaders/poison.frag", "in vec2 uv;\nuniform float zero = 0.0;\nout vec4 o;\n"
-                                    "void main() {\n  float z = zero;\n"
-                                    "  o = uv.x < 0.33 ? vec4(z / z) : uv.x < 0.66 ? vec4(1.0 / z) : vec4(-1.0 / z);\n}\n");
-  write_file("poison.lua", "Techniques = { 'x' }\nfunction OnRender()\n"
-                           "  present(pass{ 'poison', shader = 'poison.frag', out = target{ 'p', format = 'rgba32f' } })\nend\n");
-  char path[512];
-  snprintf(path, sizeof path, "%s/poison.lua", root);
-  frame_result fr = render(path, NULL, 1);
+  assert_true(gl_write_file("shaders/poison.frag",
+                            "in vec2 uv;\nuniform float zero = 0.0;\nout vec4 o;\nvoid main() {\n  float z = zero;\n"
+                            "  o = uv.x < 0.33 ? vec4(z / z) : uv.x < 0.66 ? vec4(1.0 / z) : vec4(-1.0 / z);\n}\n"));
+  assert_true(gl_write_file("poison.lua", "Techniques = { 'x' }\nfunction OnRender()\n  present(pass{ 'poison', "
+                                          "shader = 'poison.frag', out = target{ 'p', format = 'rgba32f' } })\nend\n"));
+  gl_result fr = render("poison.lua", NULL, 1);
   if (!fr.ok) fail_msg("%s", fr.err.msg);
   for (int i = 0; i < W * H * 3; i++)
-    if (!isfinite(fr.linear[i]) || fr.linear[i] < 0) fail_msg("value %g at pixel %d", fr.linear[i], i / 3);
-  free_result(&fr);
+    if (!isfinite(fr.rgb[i]) || fr.rgb[i] < 0) fail_msg("value %g at pixel %d", fr.rgb[i], i / 3);
+  gl_result_free(&fr);
+  /* The debug check names the pass, the target and the first bad pixel. */
+  check_finite = true;
+  fr = render("poison.lua", NULL, 1);
+  check_finite = false;
+  assert_false(fr.ok);
+  if (!strstr(fr.err.msg, "poison.lua:3: pass 'poison' wrote NaN to target 'p' at pixel (0, 0)"))
+    fail_msg("%s", fr.err.msg);
+  gl_result_free(&fr);
 }
 
 static void textures_are_pooled_across_frames(void **state) {
   (void)state;
   lm_error err;
   lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = pp_lua}, &err);
+  assert_true(lm_pipeline_set_technique(p, "dl", &err));
   lm_scene *scene = lm_scene_builtin("cornell", &err);
   lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = p, .width = 64,
                                                           .height = 48}, &err);
@@ -287,5 +209,5 @@ int main(void) {
       cmocka_unit_test(no_nan_or_inf_leaves_the_output_stage),
       cmocka_unit_test(textures_are_pooled_across_frames),
   };
-  return cmocka_run_group_tests(tests, setup, teardown);
+  return cmocka_run_group_tests(tests, setup, gl_test_teardown);
 }

@@ -32,6 +32,8 @@ static const char capture_usage[] =
     "  --clock auto|gpu|cpu how passes are timed (default auto: GL timer queries,\n"
     "                       or glFinish + a CPU clock on software renderers)\n"
     "  --egl auto|device|surfaceless   EGL platform (default auto)\n"
+    "  --check-nan          debug: fail at the first pass that writes a NaN or Inf,\n"
+    "                       naming the pass, target and pixel (slow)\n"
     "  --list-options       print the script's techniques and options, and exit\n"
     "  --quiet              no times, errors only\n"
     "  --verbose            debug messages (targets left out, GL messages)\n"
@@ -45,7 +47,7 @@ typedef struct capture_args {
   int set_count;
   int width, height, frames, camera;
   lm_clock clock;
-  bool list_options, quiet, verbose;
+  bool list_options, quiet, verbose, check_nan;
 } capture_args;
 
 static int usage_error(const char *fmt, const char *arg) {
@@ -91,6 +93,7 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       {"clock", required_argument, 0, 'k'},  {"egl", required_argument, 0, 'e'},
       {"list-options", no_argument, 0, 'l'}, {"quiet", no_argument, 0, 'q'},
       {"verbose", no_argument, 0, 'v'},      {"help", no_argument, 0, 'h'},
+      {"check-nan", no_argument, 0, 'N'},
       {0, 0, 0, 0}};
   opterr = 0;
   optind = 1;
@@ -137,6 +140,7 @@ static int parse_args(int argc, char **argv, capture_args *a) {
     case 'l': a->list_options = true; break;
     case 'q': a->quiet = true; break;
     case 'v': a->verbose = true; break;
+    case 'N': a->check_nan = true; break;
     case 'h': printf(capture_usage, lm_scene_builtin_list()); return -1;
     case ':': return usage_error("%s needs a value", argv[optind - 1]);
     default: return usage_error("unknown flag '%s'", argv[optind - 1]);
@@ -296,7 +300,8 @@ int limn_capture(int argc, char **argv) {
   lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = pipeline,
                                                           .width = a.width, .height = a.height,
                                                           .camera = a.camera, .clock = a.clock,
-                                                          .linear_output = any_linear}, &err);
+                                                          .linear_output = any_linear,
+                                                          .check_finite = a.check_nan}, &err);
   bool ok = r != NULL;
   pass_times *times = NULL;
   int time_count = 0;

@@ -68,26 +68,6 @@ static int usage_error(const char *fmt, const char *arg) {
   return 2;
 }
 
-static bool parse_long(const char *s, long lo, long hi, long *out) {
-  char *end;
-  long v = strtol(s, &end, 10);
-  if (end == s || *end || v < lo || v > hi) return false;
-  *out = v;
-  return true;
-}
-
-bool parse_size(const char *s, int *w, int *h) {
-  long a, b;
-  char buf[64];
-  snprintf(buf, sizeof buf, "%s", s);
-  char *x = strchr(buf, 'x');
-  if (!x) return false;
-  *x = '\0';
-  if (!parse_long(buf, 1, 16384, &a) || !parse_long(x + 1, 1, 16384, &b)) return false;
-  *w = (int)a, *h = (int)b;
-  return true;
-}
-
 /* "5:F5,10:F3,12:resize=1x1" */
 static bool parse_script_keys(const char *list, view_args *a) {
   char buf[4096];
@@ -97,10 +77,12 @@ static bool parse_script_keys(const char *list, view_args *a) {
     if (!colon || a->key_count == MAX_SCRIPT_KEYS) return false;
     *colon = '\0';
     script_key *k = &a->keys[a->key_count++];
-    if (!parse_long(item, 0, 1L << 30, &k->frame) || !colon[1]) return false;
+    int frame;
+    if (!limn_parse_int(item, 0, 1 << 30, &frame) || !colon[1]) return false;
+    k->frame = frame;
     snprintf(k->key, sizeof k->key, "%s", colon + 1);
     int w, h;
-    if (!strncmp(k->key, "resize=", 7) && !parse_size(k->key + 7, &w, &h)) return false;
+    if (!strncmp(k->key, "resize=", 7) && !limn_parse_size(k->key + 7, &w, &h)) return false;
   }
   return true;
 }
@@ -124,8 +106,7 @@ static int parse_args(int argc, char **argv, view_args *a) {
       {"help", no_argument, 0, 'h'},             {0, 0, 0, 0}};
   opterr = 0;
   optind = 1;
-  int c;
-  long n;
+  int c, n;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
     switch (c) {
     case 's': a->scene = optarg; break;
@@ -137,20 +118,19 @@ static int parse_args(int argc, char **argv, view_args *a) {
       a->sets[a->set_count++] = lm_strdup(optarg);
       break;
     case 'z':
-      if (!parse_size(optarg, &a->width, &a->height))
-        return usage_error("--size wants WxH with both in 1..16384, not '%s'", optarg);
+      if (!limn_parse_size(optarg, &a->width, &a->height))
+        return usage_error("--size wants WxH with both in 1..65536, not '%s'", optarg);
       break;
     case 'c':
-      if (!parse_long(optarg, 0, 1 << 20, &n)) return usage_error("--camera wants an index, not '%s'", optarg);
-      a->camera = (int)n;
+      if (!limn_parse_int(optarg, 0, 1 << 20, &a->camera)) return usage_error("--camera wants an index, not '%s'", optarg);
       break;
     case 'o':
-      if (strcmp(optarg, "on") && strcmp(optarg, "off")) return usage_error("--overlay wants on or off, not '%s'", optarg);
-      a->overlay = !strcmp(optarg, "on");
+      if (!limn_parse_on_off(optarg, &a->overlay)) return usage_error("--overlay wants on or off, not '%s'", optarg);
       break;
     case 'C': a->capture_dir = optarg; break;
     case 'n':
-      if (!parse_long(optarg, 1, 1L << 30, &a->exit_after)) return usage_error("--exit-after wants a frame count, not '%s'", optarg);
+      if (!limn_parse_int(optarg, 1, 1 << 30, &n)) return usage_error("--exit-after wants a frame count, not '%s'", optarg);
+      a->exit_after = n;
       break;
     case 'S': {
       const char *dot = strrchr(optarg, '.');
@@ -163,7 +143,8 @@ static int parse_args(int argc, char **argv, view_args *a) {
         return usage_error("--script-keys wants FRAME:KEY,... (e.g. 5:F5,10:resize=64x48), not '%s'", optarg);
       break;
     case 'R':
-      if (!parse_long(optarg, 1, 1000000, &a->reload_test)) return usage_error("--reload-test wants a count, not '%s'", optarg);
+      if (!limn_parse_int(optarg, 1, 1000000, &n)) return usage_error("--reload-test wants a count, not '%s'", optarg);
+      a->reload_test = n;
       break;
     case 'q': a->quiet = true; break;
     case 'v': a->verbose = true; break;
@@ -406,7 +387,7 @@ static void handle_key(viewer *v, const char *key) {
   int targets = lm_graph_target_count(lm_renderer_graph(v->renderer));
   if (!strncmp(key, "resize=", 7)) {
     int w, h;
-    if (parse_size(key + 7, &w, &h)) lm_window_resize(v->window, w, h);
+    if (limn_parse_size(key + 7, &w, &h)) lm_window_resize(v->window, w, h);
   } else if (key[0] >= '1' && key[0] <= '9' && !key[1]) {
     int c = key[0] - '1';
     if (c >= v->scene->camera_count) {

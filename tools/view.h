@@ -69,7 +69,6 @@ typedef struct viewer {
 void say(viewer *v, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* An error shows once on stderr when it appears and once (as `cleared`) when it goes. */
 void set_error(char *slot, size_t cap, const char *msg, const char *cleared);
-bool parse_size(const char *s, int *w, int *h);
 
 /* view_display.c */
 bool make_window_textures(viewer *v, lm_error *err);

@@ -178,22 +178,51 @@ void lm_draw_fullscreen(void) {
   glDrawArrays(GL_TRIANGLES, 0, 3); /* one triangle covering the viewport */
 }
 
-void lm_set_scene_state(bool on) {
+void lm_set_viewport(int x, int y, int width, int height) { glViewport(x, y, width, height); }
+
+enum { STORAGE_BINDINGS = 8 };
+static struct {
+  GLuint buffer;
+  size_t size;
+} storage[STORAGE_BINDINGS];
+
+void lm_storage_upload(int binding, const void *data, size_t bytes) {
+  if (binding < 0 || binding >= STORAGE_BINDINGS) return;
+  size_t copy = bytes;
+  if (bytes < 16) bytes = 16; /* an empty binding is an error in some drivers */
+  if (bytes > storage[binding].size) {
+    if (storage[binding].buffer) glDeleteBuffers(1, &storage[binding].buffer);
+    glCreateBuffers(1, &storage[binding].buffer);
+    glNamedBufferData(storage[binding].buffer, (GLsizeiptr)bytes, NULL, GL_DYNAMIC_DRAW);
+    storage[binding].size = bytes;
+  }
+  if (data && copy) glNamedBufferSubData(storage[binding].buffer, 0, (GLsizeiptr)copy, data);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)binding, storage[binding].buffer);
+}
+
+void lm_set_scene_state(bool on, bool shadow_caster) {
+  if (on && shadow_caster)
+    glEnable(GL_DEPTH_CLAMP);
+  else
+    glDisable(GL_DEPTH_CLAMP);
   if (on) {
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
-    glEnable(GL_CULL_FACE);
-    glCullFace(GL_BACK);
+    if (shadow_caster) {
+      glDisable(GL_CULL_FACE);
+    } else {
+      glEnable(GL_CULL_FACE);
+      glCullFace(GL_BACK);
+    }
   } else {
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
   }
 }
 
-/* ---- frame block and light buffer -------------------------------------- */
-static GLuint frame_ubo, light_ssbo;
-static GLsizeiptr light_ssbo_size;
+/* ---- frame block ------------------------------------------------------- */
+static GLuint frame_ubo;
 
 void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, int light_count) {
   if (!frame_ubo) {
@@ -202,16 +231,7 @@ void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, in
   }
   glNamedBufferSubData(frame_ubo, 0, sizeof *frame, frame);
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, frame_ubo);
-  /* An empty SSBO binding is an error in some drivers: keep one element. */
-  GLsizeiptr need = (GLsizeiptr)sizeof(lm_light_data) * (light_count > 0 ? light_count : 1);
-  if (need > light_ssbo_size) {
-    if (light_ssbo) glDeleteBuffers(1, &light_ssbo);
-    glCreateBuffers(1, &light_ssbo);
-    glNamedBufferData(light_ssbo, need, NULL, GL_DYNAMIC_DRAW);
-    light_ssbo_size = need;
-  }
-  if (light_count > 0) glNamedBufferSubData(light_ssbo, 0, need, lights);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, light_ssbo);
+  lm_storage_upload(1, lights, sizeof *lights * (size_t)(light_count > 0 ? light_count : 0));
 }
 
 /* ---- meshes ------------------------------------------------------------ */

@@ -69,8 +69,13 @@ typedef struct lm_attachments {
 bool lm_attachments_bind(const lm_attachments *att, lm_error *err);
 void lm_clear(int color_count, const float rgba[4], bool clear_depth, float depth);
 void lm_draw_fullscreen(void);
-/* Depth test and face culling for scene passes; off for full-screen ones. */
-void lm_set_scene_state(bool on);
+void lm_set_viewport(int x, int y, int width, int height);
+/* Uploads a shader storage block to `binding` (grows its buffer as needed). */
+void lm_storage_upload(int binding, const void *data, size_t bytes);
+/* Depth test and back-face culling for scene passes; off for full-screen
+ * ones. Shadow casters draw both faces (a light inside a closed mesh sees
+ * its back faces) and clamp depth (casters before the near plane count). */
+void lm_set_scene_state(bool on, bool shadow_caster);
 /* Framebuffers cache by attachment set; drop entries that name this texture. */
 void lm_framebuffers_forget(lm_texture tex);
 

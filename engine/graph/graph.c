@@ -121,6 +121,10 @@ int lm_graph_add_pass(lm_graph *g, const lm_pass_desc *d, lm_error *err) {
       return -1;
     }
   }
+  if (d->view_count < 0 || (d->view_count > 0 && (d->kind != LM_PASS_SCENE || !d->views))) {
+    lm_error_set(err, "%s: pass '%s': only scene passes take views", where, name);
+    return -1;
+  }
   if (d->depth >= g->target_count) {
     lm_error_set(err, "%s: pass '%s': depth is not a target of this frame", where, name);
     return -1;
@@ -142,6 +146,11 @@ int lm_graph_add_pass(lm_graph *g, const lm_pass_desc *d, lm_error *err) {
     pa[i].name = arena_str(g, d->params[i].name);
   }
   c->params = pa;
+  if (d->view_count > 0) {
+    lm_pass_view *views = lm_arena_alloc(&g->arena, sizeof *views * (size_t)d->view_count);
+    memcpy(views, d->views, sizeof *views * (size_t)d->view_count);
+    c->views = views;
+  }
   int *out = lm_arena_alloc(&g->arena, sizeof *out * (size_t)(d->output_count + 1));
   memcpy(out, d->outputs, sizeof *out * (size_t)d->output_count);
   c->outputs = out;

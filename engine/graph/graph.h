@@ -38,6 +38,15 @@ typedef struct lm_pass_param {
   double v[16];
 } lm_pass_param;
 
+/* A scene pass drawn from another point of view into part of its targets
+ * (a shadow map tile): the pass's program gets `pass_view_proj` and
+ * `pass_depth` (light position and 1 / range; w = 0 for orthographic). */
+typedef struct lm_pass_view {
+  int x, y, width, height; /* viewport, pixels */
+  float view_proj[16];
+  float depth[4];
+} lm_pass_view;
+
 #define LM_MAX_PASS_INPUTS 16
 #define LM_MAX_PASS_PARAMS 64
 
@@ -56,6 +65,8 @@ typedef struct lm_pass_desc {
   int depth;          /* depth target, or -1 */
   bool clear;         /* full-screen passes always cover every pixel */
   float clear_color[4];
+  const lm_pass_view *views; /* scene passes: draw once per view; none: the camera */
+  int view_count;
 } lm_pass_desc;
 
 lm_graph *lm_graph_create(void);
@@ -102,11 +113,15 @@ int lm_graph_slot_count(const lm_graph *g);
 /* ---- executing --------------------------------------------------------- */
 typedef struct lm_graph_exec_desc {
   lm_clock clock;
-  /* Draws the scene for a scene pass with the pass's program bound. */
-  void (*draw_scene)(void *user, const char *technique, const lm_program *p);
+  /* Draws the scene for a scene pass with the pass's program bound; view is
+   * NULL for the camera. */
+  void (*draw_scene)(void *user, const char *technique, const lm_program *p, const lm_pass_view *view);
   /* Uniforms the scene sets on each draw (not bindable from a script). */
   bool (*scene_owns_uniform)(const char *name);
   void *user;
+  /* Debug: read back every float output after its pass and fail at the first
+   * NaN or Inf, naming the pass, the target and the pixel. Slow. */
+  bool check_finite;
 } lm_graph_exec_desc;
 bool lm_graph_execute(lm_graph *g, const lm_graph_exec_desc *x, lm_error *err);
 /* Moves the textures (and contents) of `from`'s persistent targets into the

@@ -43,12 +43,16 @@ static void pool_end_frame(lm_graph *g) {
 
 void lm_graph_pool_stats(const lm_graph *g, int *textures, double *bytes) {
   double b = 0;
+  int n = g->pool_count;
   for (int i = 0; i < g->pool_count; i++)
     b += (double)g->pool[i].desc.width * g->pool[i].desc.height * lm_format_bytes(g->pool[i].desc.format);
+  /* A persistent target no pass has used yet holds no texture. */
   for (int i = 0; i < g->persistent_count; i++)
-    if (g->targets[i].texture.id)
+    if (g->targets[i].texture.id) {
       b += (double)g->targets[i].width * g->targets[i].height * lm_format_bytes(g->targets[i].desc.format);
-  *textures = g->pool_count + g->persistent_count;
+      n++;
+    }
+  *textures = n;
   *bytes = b;
 }
 
@@ -124,9 +128,11 @@ static bool check_bindings(const lm_graph *g, const lm_pass_desc *d, const lm_pr
   for (int i = 0; i < d->param_count; i++) {
     const lm_pass_param *pa = &d->params[i];
     const lm_uniform *u = lm_program_uniform(p, pa->name);
-    if (!u || (d->kind == LM_PASS_SCENE && x->scene_owns_uniform && x->scene_owns_uniform(pa->name))) {
+    bool engine_owned = !strcmp(pa->name, "pass_view_proj") || !strcmp(pa->name, "pass_depth") ||
+                        (d->kind == LM_PASS_SCENE && x->scene_owns_uniform && x->scene_owns_uniform(pa->name));
+    if (!u || engine_owned) {
       lm_error_set(err, "%s: pass '%s': parameter '%s': %s %s", where, name, pa->name, p->label,
-                   u ? "sets this uniform from the scene's materials" : "declares no uniform of that name");
+                   u ? "has this uniform set by the engine" : "declares no uniform of that name");
       return false;
     }
     int want = lm_uniform_type_components(u->type);
@@ -186,6 +192,32 @@ static lm_program *pass_program(const lm_pass_desc *d, lm_error *err) {
   return p;
 }
 
+static bool is_float_format(lm_format f) {
+  return f == LM_FORMAT_RGBA16F || f == LM_FORMAT_RGBA32F || f == LM_FORMAT_R16F ||
+         f == LM_FORMAT_R32F || f == LM_FORMAT_RG16F || f == LM_FORMAT_RG32F;
+}
+
+/* The first non-finite texel of a pass's float outputs, as an error. */
+static bool check_outputs_finite(const lm_graph *g, const lm_pass_desc *d, lm_error *err) {
+  for (int i = 0; i < d->output_count; i++) {
+    const graph_target *t = &g->targets[d->outputs[i]];
+    if (!is_float_format(t->desc.format)) continue;
+    float *px = lm_alloc(sizeof(float) * 4 * (size_t)t->width * (size_t)t->height);
+    lm_texture_read(t->texture, t->width, t->height, true, px);
+    for (size_t k = 0; k < (size_t)t->width * t->height * 4; k++) {
+      if (isfinite(px[k])) continue;
+      size_t texel = k / 4;
+      lm_error_set(err, "%s: pass '%s' wrote %s to target '%s' at pixel (%zu, %zu) (channel %zu, rows from the top)",
+                   d->where, d->name, isnan(px[k]) ? "NaN" : "Inf", t->desc.name, texel % (size_t)t->width,
+                   texel / (size_t)t->width, k % 4);
+      free(px);
+      return false;
+    }
+    free(px);
+  }
+  return true;
+}
+
 static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_graph_exec_desc *x,
                      lm_error *err) {
   const lm_pass_desc *d = &gp->desc;
@@ -211,17 +243,26 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
   apply_params(d, p);
   lm_timer_begin(timer, x->clock);
   if (d->kind == LM_PASS_SCENE) {
-    lm_set_scene_state(true);
+    lm_set_scene_state(true, d->view_count > 0); /* tiles are shadow maps */
     if (d->clear) lm_clear(d->output_count, d->clear_color, d->depth >= 0, 1.0f);
-    if (x->draw_scene) x->draw_scene(x->user, d->shader, p);
-    lm_set_scene_state(false);
+    if (d->view_count == 0 && x->draw_scene) x->draw_scene(x->user, d->shader, p, NULL);
+    const lm_uniform *u_vp = lm_program_uniform(p, "pass_view_proj");
+    const lm_uniform *u_depth = lm_program_uniform(p, "pass_depth");
+    for (int v = 0; v < d->view_count; v++) {
+      const lm_pass_view *view = &d->views[v];
+      lm_set_viewport(view->x, view->y, view->width, view->height);
+      if (u_vp) lm_program_set(p, u_vp, view->view_proj);
+      if (u_depth) lm_program_set(p, u_depth, view->depth);
+      if (x->draw_scene) x->draw_scene(x->user, d->shader, p, view);
+    }
+    lm_set_scene_state(false, false);
   } else {
     lm_draw_fullscreen();
   }
   lm_timer_end(timer);
   for (int i = 0; i < d->output_count; i++)
     if (g->targets[d->outputs[i]].desc.mips) lm_texture_generate_mips(att.color[i]);
-  return true;
+  return !x->check_finite || check_outputs_finite(g, d, err);
 }
 
 bool lm_graph_execute(lm_graph *g, const lm_graph_exec_desc *x, lm_error *err) {

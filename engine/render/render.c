@@ -12,6 +12,8 @@ struct lm_renderer {
   int output_srgb, output_linear;
   int frame;
   float prev_view_proj[16];
+  lm_frame_data camera;
+  lm_shadow_plan shadows;
   double record_ms, compile_ms;
   bool sharing;
 };
@@ -31,6 +33,7 @@ lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
 void lm_renderer_destroy(lm_renderer *r) {
   if (!r) return;
   lm_graph_destroy(r->graph);
+  lm_shadow_plan_free(&r->shadows);
   free(r);
 }
 
@@ -42,8 +45,8 @@ void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compi
   *compile_ms = r->compile_ms;
 }
 
-static void draw_scene(void *user, const char *technique, const lm_program *p) {
-  (void)technique;
+static void draw_scene(void *user, const char *technique, const lm_program *p, const lm_pass_view *view) {
+  (void)technique, (void)view;
   lm_scene_draw(((lm_renderer *)user)->desc.scene, p);
 }
 
@@ -71,6 +74,10 @@ static bool add_output_stage(lm_renderer *r, lm_graph *g, lm_pipeline *p, int pr
 /* Records (OnRender) and compiles one frame of pipeline p into g. */
 static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_error *err) {
   lm_graph_begin(g, r->desc.width, r->desc.height);
+  lm_frame_data *frame = &r->camera;
+  lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, frame);
+  lm_shadow_plan_free(&r->shadows);
+  lm_pipeline_set_scene(p, r->desc.scene, frame, &r->shadows);
   double t0 = lm_cpu_ms();
   int presented = -1;
   if (!lm_pipeline_record(p, g, &presented, err)) return false;
@@ -81,18 +88,20 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
   return true;
 }
 
+/* Runs what record() compiled into g (the camera and shadow plan it made). */
 static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
-  lm_frame_data frame;
-  lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, &frame);
-  memcpy(frame.prev_view_proj, r->frame ? r->prev_view_proj : frame.view_proj, sizeof frame.prev_view_proj);
-  memcpy(r->prev_view_proj, frame.view_proj, sizeof r->prev_view_proj);
-  frame.time[1] = (float)r->frame++;
+  lm_frame_data *frame = &r->camera;
+  memcpy(frame->prev_view_proj, r->frame ? r->prev_view_proj : frame->view_proj, sizeof frame->prev_view_proj);
+  memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
+  frame->time[1] = (float)r->frame++;
   lm_light_data lights[MAX_LIGHTS];
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
-  frame.counts[0] = n;
-  lm_frame_upload(&frame, lights, n);
+  frame->counts[0] = n;
+  lm_frame_upload(frame, lights, n);
+  lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
   lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene,
-                          .scene_owns_uniform = lm_scene_owns_uniform, .user = r};
+                          .scene_owns_uniform = lm_scene_owns_uniform, .user = r,
+                          .check_finite = r->desc.check_finite};
   return lm_graph_execute(g, &x, err);
 }
 

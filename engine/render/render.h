@@ -16,6 +16,7 @@ typedef struct lm_renderer_desc {
   int camera;             /* index into the scene's cameras */
   lm_clock clock;         /* LM_CLOCK_AUTO picks */
   bool linear_output;     /* also keep a float copy of the output (for EXR) */
+  bool check_finite;      /* debug: name the first pass that writes a NaN or Inf */
 } lm_renderer_desc;
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err);

@@ -1,6 +1,7 @@
 #include "scene/scene.h"
 
 #include <cglm/cglm.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -42,6 +43,14 @@ int lm_scene_add_mesh(lm_scene *s, const char *name, const float *vertices, int 
                       sizeof(uint32_t) * (size_t)index_count);
   m->vertex_count = vertex_count;
   m->index_count = index_count;
+  glm_vec3_fill(m->bounds_min, FLT_MAX);
+  glm_vec3_fill(m->bounds_max, -FLT_MAX);
+  for (int i = 0; i < vertex_count; i++) {
+    const float *p = vertices + (size_t)i * 8;
+    if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
+    glm_vec3_minv(m->bounds_min, (float *)p, m->bounds_min);
+    glm_vec3_maxv(m->bounds_max, (float *)p, m->bounds_max);
+  }
   return s->mesh_count - 1;
 }
 
@@ -97,6 +106,33 @@ void lm_scene_update(lm_scene *s) {
       memcpy(n->world, n->local, sizeof n->world);
     }
   }
+}
+
+bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]) {
+  glm_vec3_fill(min, FLT_MAX);
+  glm_vec3_fill(max, -FLT_MAX);
+  for (int i = 0; i < s->node_count; i++) {
+    const lm_node *n = &s->nodes[i];
+    if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
+    const lm_scene_mesh *m = &s->meshes[n->mesh];
+    if (m->bounds_min[0] > m->bounds_max[0]) continue;
+    mat4 w;
+    memcpy(w, n->world, sizeof w);
+    for (int c = 0; c < 8; c++) {
+      vec4 p = {c & 1 ? m->bounds_max[0] : m->bounds_min[0], c & 2 ? m->bounds_max[1] : m->bounds_min[1],
+                c & 4 ? m->bounds_max[2] : m->bounds_min[2], 1}, q;
+      glm_mat4_mulv(w, p, q);
+      if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) continue;
+      glm_vec3_minv(min, q, min);
+      glm_vec3_maxv(max, q, max);
+    }
+  }
+  if (min[0] > max[0]) {
+    glm_vec3_fill(min, -1);
+    glm_vec3_fill(max, 1);
+    return false;
+  }
+  return true;
 }
 
 bool lm_scene_upload(lm_scene *s, lm_error *err) {
@@ -204,18 +240,21 @@ bool lm_scene_owns_uniform(const char *name) {
   return false;
 }
 
+const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n) {
+  static const lm_material fallback = {"default", {0.8f, 0.8f, 0.8f}, 0.8f, 0.1f, 0.9f, 0.0f, 16.0f};
+  return n->material >= 0 && n->material < s->material_count ? &s->materials[n->material] : &fallback;
+}
+
 void lm_scene_draw(const lm_scene *s, const lm_program *p) {
   const lm_uniform *u_model = lm_program_uniform(p, "model");
   const lm_uniform *u_normal = lm_program_uniform(p, "normal_matrix");
   const lm_uniform *u_color = lm_program_uniform(p, "material_color");
   const lm_uniform *u_rho = lm_program_uniform(p, "material_rho");
   const lm_uniform *u_k = lm_program_uniform(p, "material_k");
-  static const lm_material fallback = {"default", {0.8f, 0.8f, 0.8f}, 0.8f, 0.1f, 0.9f, 0.0f, 16.0f};
   for (int i = 0; i < s->node_count; i++) {
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
-    const lm_material *m = n->material >= 0 && n->material < s->material_count
-                               ? &s->materials[n->material] : &fallback;
+    const lm_material *m = lm_scene_node_material(s, n);
     mat4 model, inv;
     mat3 normal;
     memcpy(model, n->world, sizeof model);

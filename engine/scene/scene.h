@@ -52,6 +52,7 @@ typedef struct lm_scene_mesh {
   int vertex_count;
   uint32_t *indices;
   int index_count;
+  float bounds_min[3], bounds_max[3]; /* local space, finite positions only */
   lm_mesh gpu;
 } lm_scene_mesh;
 
@@ -93,8 +94,15 @@ void lm_scene_update(lm_scene *s);
 /* Moves a node (a camera the viewer flies) so its world transform becomes
  * `world`: its local transform is set against its parent's, then updated. */
 void lm_scene_node_set_world(lm_scene *s, int node, const float world[16]);
+/* World-space box around every mesh node; false (and a unit box) when empty. */
+bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]);
 
-/* A scene built in code: "cornell". NULL with a message listing the names. */
+/* The node's material, or the engine's default one (material -1 or out of range). */
+const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n);
+
+/* A scene built in code: "cornell", or "cornell_pov" (the box lit only by
+ * lights POV-Ray matches exactly, engine/scene/pov.h). NULL with a message
+ * listing the names. */
 lm_scene *lm_scene_builtin(const char *name, lm_error *err);
 const char *lm_scene_builtin_list(void);
 

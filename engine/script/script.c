@@ -260,6 +260,16 @@ bool lm_pipeline_set_option(lm_pipeline *p, const char *name, const char *value,
       rest = dot + 1;
       continue;
     }
+    /* "bloom=true" on a table with a boolean `enabled` sets bloom.enabled. */
+    if (!dot && lua_istable(L, -1)) {
+      lua_getfield(L, -1, "enabled");
+      bool has_switch = lua_isboolean(L, -1);
+      lua_pop(L, 1);
+      if (has_switch) {
+        rest = "enabled";
+        continue;
+      }
+    }
     if (dot || lua_isnil(L, -1) || lua_istable(L, -1)) break;
     int type = lua_type(L, -1);
     lua_pop(L, 1);
@@ -408,6 +418,13 @@ void lm_pipeline_destroy(lm_pipeline *p) {
 }
 
 bool lm_pipeline_created(const lm_pipeline *p) { return p->created; }
+
+void lm_pipeline_set_scene(lm_pipeline *p, const lm_scene *scene, const lm_frame_data *camera,
+                           lm_shadow_plan *shadows) {
+  p->scene = scene;
+  p->camera = camera;
+  p->shadows = shadows;
+}
 
 const char *lm_pipeline_present_where(const lm_pipeline *p) { return p->present_where; }
 

@@ -6,7 +6,7 @@
 #ifndef LIMN_SCRIPT_H
 #define LIMN_SCRIPT_H
 
-#include "graph/graph.h"
+#include "shadow/shadow.h"
 
 typedef struct lm_pipeline lm_pipeline;
 
@@ -34,6 +34,11 @@ bool lm_pipeline_set_option(lm_pipeline *p, const char *name, const char *value,
 bool lm_pipeline_get_option(const lm_pipeline *p, const char *name, char *value, size_t cap);
 /* "name=default" lines of every option. */
 void lm_pipeline_list_options(const lm_pipeline *p, lm_buf *out);
+
+/* What shadow_plan() plans from: the scene, the camera's frame block, and
+ * where the plan goes (owned by the caller, kept until the frame executes). */
+void lm_pipeline_set_scene(lm_pipeline *p, const lm_scene *scene, const lm_frame_data *camera,
+                           lm_shadow_plan *shadows);
 
 /* Records one frame into g (lm_graph_begin already called): OnCreate the
  * first time, then OnRender(tech). *presented gets the target passed to

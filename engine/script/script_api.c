@@ -8,6 +8,7 @@
 #include <string.h>
 
 #define TARGET_META "limn.target"
+#define PLAN_META "limn.shadow_plan"
 
 typedef struct target_handle {
   int id;
@@ -139,6 +140,92 @@ static int l_target_index(lua_State *L) {
     return 1;
   }
   return luaL_error(L, "target '%s' has no field '%s' (it has: name)", t->name, k);
+}
+
+/* ---- shadow_plan{} ----------------------------------------------------- */
+static float opt_number(lua_State *L, int idx, const char *field, float def, float lo, float hi,
+                        const char *what) {
+  lua_getfield(L, idx, field);
+  float v = def;
+  if (!lua_isnil(L, -1)) {
+    double d = lua_tonumber(L, -1);
+    if (!lua_isnumber(L, -1) || !(d >= lo && d <= hi))
+      luaL_error(L, "%s: %s must be a number in %g .. %g", what, field, (double)lo, (double)hi);
+    v = (float)d;
+  }
+  lua_pop(L, 1);
+  return v;
+}
+
+/* shadow_plan{ technique, resolution, c, blur, cascades, lambda, bias, distance,
+ * blend, radius, stabilize }: tiles for every light that casts shadows, or nil
+ * when none does. scene{ views = plan } draws them. */
+static int l_shadow_plan(lua_State *L) {
+  lm_pipeline *p = recording(L, "shadow_plan");
+  if (p->in_create) return luaL_error(L, "shadow_plan() is called from OnRender");
+  if (!p->scene || !p->shadows) return luaL_error(L, "shadow_plan: this pipeline renders no scene");
+  if (p->shadows_frame == p->frame) return luaL_error(L, "shadow_plan: called twice in one frame");
+  luaL_checktype(L, 1, LUA_TTABLE);
+  static const char *const fields[] = {"technique", "resolution", "c", "blur", "cascades", "lambda",
+                                       "bias", "distance", "blend", "radius", "stabilize", NULL};
+  check_fields(L, 1, "shadow_plan", fields);
+  lm_shadow_settings st;
+  lm_shadow_settings_default(&st);
+  const char *technique = opt_string(L, 1, "technique", "shadow_plan");
+  if (technique) {
+    int t = lm_shadow_technique_parse(technique);
+    if (t < 0) return luaL_error(L, "shadow_plan: unknown technique '%s' (esm, pcf, poisson, hard)", technique);
+    st.technique = (lm_shadow_technique)t;
+  }
+  const char *what = "shadow_plan";
+  st.resolution = (int)opt_number(L, 1, "resolution", (float)st.resolution, 16, 8192, what);
+  st.c = opt_number(L, 1, "c", st.c, 1e-3f, 10000, what);
+  st.blur = (int)opt_number(L, 1, "blur", (float)st.blur, 0, 32, what);
+  st.cascades = (int)opt_number(L, 1, "cascades", (float)st.cascades, 1, 4, what);
+  st.lambda = opt_number(L, 1, "lambda", st.lambda, 0, 1, what);
+  st.bias = opt_number(L, 1, "bias", st.bias, -0.5f, 0.5f, what);
+  st.distance = opt_number(L, 1, "distance", st.distance, 0, 1e9f, what);
+  st.blend = opt_number(L, 1, "blend", st.blend, 0, 1, what);
+  st.radius = opt_number(L, 1, "radius", st.radius, 0, 32, what);
+  lua_getfield(L, 1, "stabilize");
+  if (!lua_isnil(L, -1)) st.stabilize = lua_toboolean(L, -1);
+  lua_pop(L, 1);
+  lm_shadow_plan_free(p->shadows);
+  lm_error err;
+  if (!lm_shadow_plan_make(p->shadows, p->scene, p->camera, &st, &err)) return luaL_error(L, "shadow_plan: %s", err.msg);
+  p->shadows_frame = p->frame;
+  if (p->shadows->view_count == 0) {
+    lm_info("left out: shadows (no light in scene '%s' casts shadows)", p->scene->name);
+    lua_pushnil(L);
+    return 1;
+  }
+  unsigned *handle = lua_newuserdatauv(L, sizeof *handle, 0);
+  *handle = p->frame;
+  luaL_setmetatable(L, PLAN_META);
+  return 1;
+}
+
+static const lm_shadow_plan *to_plan(lua_State *L, int idx, const char *what) {
+  lm_pipeline *p = lm_script_pipeline(L);
+  unsigned *handle = luaL_testudata(L, idx, PLAN_META);
+  if (!handle) luaL_error(L, "%s: expected a shadow plan (from shadow_plan{...}), got a %s", what, luaL_typename(L, idx));
+  if (*handle != p->frame || p->shadows_frame != p->frame)
+    luaL_error(L, "%s: the shadow plan belongs to an earlier frame", what);
+  return p->shadows;
+}
+
+static int l_plan_index(lua_State *L) {
+  const lm_shadow_plan *plan = to_plan(L, 1, "shadow plan");
+  const char *k = luaL_checkstring(L, 2);
+  if (!strcmp(k, "width")) lua_pushinteger(L, plan->atlas_width);
+  else if (!strcmp(k, "height")) lua_pushinteger(L, plan->atlas_height);
+  else if (!strcmp(k, "tile")) lua_pushinteger(L, plan->tile);
+  else if (!strcmp(k, "views")) lua_pushinteger(L, plan->view_count);
+  else if (!strcmp(k, "c")) lua_pushnumber(L, plan->settings.c);
+  else if (!strcmp(k, "blur")) lua_pushinteger(L, plan->settings.blur);
+  else if (!strcmp(k, "technique")) lua_pushstring(L, (const char *[]){"esm", "pcf", "poisson", "hard"}[plan->settings.technique]);
+  else return luaL_error(L, "shadow plan has no field '%s' (width, height, tile, views, c, blur, technique)", k);
+  return 1;
 }
 
 /* ---- shared pass fields ----------------------------------------------- */
@@ -311,7 +398,7 @@ static int l_scene(lua_State *L) {
   pass_builder b;
   int top = lua_gettop(L);
   begin_pass(L, &b, LM_PASS_SCENE, "scene");
-  static const char *const fields[] = {"technique", "out", "depth", "clear", "params", "defines", NULL};
+  static const char *const fields[] = {"technique", "out", "depth", "clear", "params", "defines", "views", NULL};
   check_fields(L, 1, b.what, fields);
   b.desc.shader = opt_string(L, 1, "technique", b.what);
   if (!b.desc.shader) b.desc.shader = "std";
@@ -335,6 +422,13 @@ static int l_scene(lua_State *L) {
   lua_pop(L, 1);
   read_params(L, 1, &b);
   read_defines(L, 1, &b);
+  lua_getfield(L, 1, "views");
+  if (!lua_isnil(L, -1)) {
+    const lm_shadow_plan *plan = to_plan(L, -1, b.what);
+    b.desc.views = plan->views;
+    b.desc.view_count = plan->view_count;
+  }
+  lua_pop(L, 1);
   add_pass(L, p, &b);
   lua_settop(L, top);
   return 0;
@@ -382,6 +476,10 @@ static int l_output_size(lua_State *L) {
 }
 
 void lm_script_open_api(lua_State *L) {
+  luaL_newmetatable(L, PLAN_META);
+  lua_pushcfunction(L, l_plan_index);
+  lua_setfield(L, -2, "__index");
+  lua_pop(L, 1);
   luaL_newmetatable(L, TARGET_META);
   lua_pushcfunction(L, l_target_tostring);
   lua_setfield(L, -2, "__tostring");
@@ -389,7 +487,8 @@ void lm_script_open_api(lua_State *L) {
   lua_setfield(L, -2, "__index");
   lua_pop(L, 1);
   static const luaL_Reg api[] = {{"target", l_target}, {"scene", l_scene}, {"pass", l_pass},
-                                 {"present", l_present}, {"output_size", l_output_size}, {NULL, NULL}};
+                                 {"present", l_present}, {"output_size", l_output_size},
+                                 {"shadow_plan", l_shadow_plan}, {NULL, NULL}};
   lua_pushglobaltable(L);
   luaL_setfuncs(L, api, 0);
   lua_pop(L, 1);

@@ -20,6 +20,10 @@ struct lm_pipeline {
   int presented;
   char present_where[256];
   int options_ref;    /* registry: the Options table with overrides applied */
+  const lm_scene *scene;
+  const lm_frame_data *camera;
+  lm_shadow_plan *shadows;
+  unsigned shadows_frame; /* frame serial of the plan in *shadows */
 };
 
 /* Registers target, scene, pass, present, output_size in the global table. */

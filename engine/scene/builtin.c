@@ -1,7 +1,8 @@
-/* The built-in scenes, made in code so that a capture needs no file. */
+/* The built-in scenes, made in code so that a capture and the tests need no file. */
 #include "scene/scene.h"
 
 #include <cglm/cglm.h>
+#include <stdio.h>
 #include <string.h>
 
 /* A quad p0 p1 p2 p3, counter-clockwise seen from the side it faces. */
@@ -56,9 +57,13 @@ static void trs(vec3 t, float yaw_deg, vec3 scale, mat4 out) {
 }
 
 /* The classic box: interior x in [-1, 1], y in [0, 2], z in [-1, 1], open
- * toward +z; red wall at -x, green at +x, a point light under the ceiling. */
-static lm_scene *cornell(void) {
-  lm_scene *s = lm_scene_create("cornell");
+ * toward +z; red wall at -x, green at +x, a point light under the ceiling.
+ * pov: the same box lit only as POV-Ray can light it too (limn export-pov
+ * matches it exactly): an inverse-square point light under the ceiling, a
+ * dim parallel light through the open side and a spot (no falloff) on the
+ * tall box, so that every light model the export claims is exercised. */
+static lm_scene *cornell(bool pov) {
+  lm_scene *s = lm_scene_create(pov ? "cornell_pov" : "cornell");
   lm_material white = {"white", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.0f, 1.0f};
   lm_material red = {"red", {0.63f, 0.065f, 0.05f}, 0.63f, 1.0f, 1.0f, 0.0f, 1.0f};
   lm_material green = {"green", {0.14f, 0.45f, 0.091f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f};
@@ -93,9 +98,27 @@ static lm_scene *cornell(void) {
   glm_rotate_x(m, glm_rad(-90.0f), m); /* shine down (-Z of the node) */
   int light_node = lm_scene_add_node(s, "light", -1, (float *)m, -1, -1);
   lm_scene_add_light(s, &(lm_light){.name = "ceiling_light", .type = LM_LIGHT_POINT,
-                                     .color = {1.0f, 0.95f, 0.85f}, .power = 1.6f, .radius = 4.0f,
-                                     .inner_cone = glm_rad(30), .outer_cone = glm_rad(45),
+                                     .color = {1.0f, 0.95f, 0.85f}, .power = pov ? 2.4f : 1.6f,
+                                     .radius = 4.0f, .inner_cone = glm_rad(30), .outer_cone = glm_rad(45),
+                                     .falloff = pov ? LM_FALLOFF_INVERSE_SQUARE : LM_FALLOFF_WINDOW,
                                      .casts_shadows = true, .node = light_node});
+  if (pov) {
+    /* Parallel light from the open side, above and to the right, shining down into the box. */
+    glm_mat4_identity(m);
+    glm_rotate_y(m, glm_rad(20.0f), m);
+    glm_rotate_x(m, glm_rad(-35.0f), m);
+    int sun = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
+    lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL,
+                                       .color = {0.6f, 0.7f, 1.0f}, .power = 0.25f,
+                                       .casts_shadows = true, .node = sun});
+    /* Spot from the front right corner onto the tall box. */
+    glm_lookat((vec3){0.8f, 1.7f, 0.9f}, (vec3){-0.35f, 0.8f, -0.35f}, (vec3){0, 1, 0}, m);
+    glm_mat4_inv(m, m); /* lookat gives the view; the node holds its inverse */
+    int spot = lm_scene_add_node(s, "spot", -1, (float *)m, -1, -1);
+    lm_scene_add_light(s, &(lm_light){.name = "spot", .type = LM_LIGHT_SPOT, .color = {1.0f, 0.9f, 0.6f},
+                                       .power = 0.5f, .inner_cone = glm_rad(8), .outer_cone = glm_rad(16),
+                                       .falloff = LM_FALLOFF_NONE, .casts_shadows = true, .node = spot});
+  }
 
   glm_translate_make(m, (vec3){0.0f, 1.0f, 3.4f});
   int cam_node = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
@@ -105,10 +128,46 @@ static lm_scene *cornell(void) {
   return s;
 }
 
-const char *lm_scene_builtin_list(void) { return "cornell"; }
+/* An open field for directional light and cascaded shadows: a 200 x 200
+ * ground, rows of posts reaching far from the camera, a low sun. */
+static lm_scene *field(void) {
+  lm_scene *s = lm_scene_create("field");
+  lm_material ground = {"ground", {0.45f, 0.5f, 0.35f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f};
+  lm_material post = {"post", {0.7f, 0.6f, 0.5f}, 0.6f, 1.0f, 1.0f, 0.1f, 16.0f};
+  int m_ground = lm_scene_add_material(s, &ground), m_post = lm_scene_add_material(s, &post);
+  const float g[4][3] = {{-100, 0, 100}, {100, 0, 100}, {100, 0, -100}, {-100, 0, -100}};
+  mat4 id = GLM_MAT4_IDENTITY_INIT, m;
+  lm_scene_add_node(s, "ground", -1, (float *)id, quad_mesh(s, "ground", g), m_ground);
+  int cube = cube_mesh(s);
+  for (int row = 0; row < 12; row++) {
+    for (int col = -2; col <= 2; col++) {
+      char name[32];
+      snprintf(name, sizeof name, "post_%d_%d", row, col + 2);
+      trs((vec3){col * 4.0f, 1.0f, 2.0f - row * 6.0f}, 10.0f * col, (vec3){0.6f, 2.0f, 0.6f}, m);
+      lm_scene_add_node(s, name, -1, (float *)m, cube, m_post);
+    }
+  }
+  glm_mat4_identity(m);
+  glm_rotate_y(m, glm_rad(35.0f), m);
+  glm_rotate_x(m, glm_rad(-40.0f), m); /* -Z points down and away */
+  int sun = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1.0f, 0.95f, 0.9f},
+                                     .power = 1.0f, .casts_shadows = true, .node = sun});
+  glm_translate_make(m, (vec3){0.0f, 2.5f, 8.0f});
+  glm_rotate_x(m, glm_rad(-8.0f), m);
+  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "front", .fov_y = glm_rad(50.0f), .znear = 0.1f,
+                                      .zfar = 150.0f, .node = cam});
+  lm_scene_update(s);
+  return s;
+}
+
+const char *lm_scene_builtin_list(void) { return "cornell, cornell_pov, field"; }
 
 lm_scene *lm_scene_builtin(const char *name, lm_error *err) {
-  if (!strcmp(name, "cornell")) return cornell();
+  if (!strcmp(name, "cornell")) return cornell(false);
+  if (!strcmp(name, "cornell_pov")) return cornell(true);
+  if (!strcmp(name, "field")) return field();
   lm_error_set(err, "unknown scene '%s' (built in: %s)", name, lm_scene_builtin_list());
   return NULL;
 }

@@ -1,0 +1,359 @@
+/* POV-Ray 3.7 export of one view (see pov.h for how each part matches). */
+#include "scene/pov.h"
+
+#include <cglm/cglm.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void lm_pov_radiosity_defaults(lm_pov_radiosity *r) {
+  *r = (lm_pov_radiosity){.count = 250, .error_bound = 0.25, .pretrace_start = 0.08,
+                          .pretrace_end = 0.01, .recursion_limit = 2, .brightness = 1.0};
+}
+
+const char *lm_pov_radiosity_check(const lm_pov_radiosity *r) {
+  /* POV-Ray 3.7's own limits: count up to 1600 directions, recursion 1..20,
+   * pretrace sizes in (0, 1] with the end no larger than the start. */
+  if (r->count < 1 || r->count > 1600) return "count (1..1600)";
+  if (!(r->error_bound > 0) || !isfinite(r->error_bound)) return "error_bound (> 0)";
+  if (!(r->pretrace_start > 0 && r->pretrace_start <= 1)) return "pretrace_start (0 < s <= 1)";
+  if (!(r->pretrace_end > 0 && r->pretrace_end <= r->pretrace_start))
+    return "pretrace_end (0 < e <= pretrace_start)";
+  if (r->recursion_limit < 1 || r->recursion_limit > 20) return "recursion_limit (1..20)";
+  if (!(r->brightness >= 0) || !isfinite(r->brightness)) return "brightness (>= 0)";
+  return NULL;
+}
+
+typedef struct pov_ctx {
+  const lm_pov_desc *desc;
+  lm_buf *out, *warnings;
+  lm_error *err;
+  char nonfinite[160]; /* the first element that wrote Inf or NaN (POV-Ray cannot parse them) */
+} pov_ctx;
+
+/* Something the engine does that POV-Ray cannot: refused when strict, else a warning. */
+static bool mismatch(pov_ctx *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static bool mismatch(pov_ctx *c, const char *fmt, ...) {
+  char msg[1024];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  if (c->desc->strict) {
+    lm_error_set(c->err, "%s", msg);
+    return false;
+  }
+  if (c->warnings) lm_buf_printf(c->warnings, "%s\n", msg);
+  return true;
+}
+
+/* `what` names the element in the error should a number not be finite. */
+static void put_vec(pov_ctx *c, const double v[3], const char *what) {
+  if (!c->nonfinite[0] && !(isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2])))
+    snprintf(c->nonfinite, sizeof c->nonfinite, "%s", what);
+  lm_buf_printf(c->out, "<%.9g, %.9g, %.9g>", v[0], v[1], v[2]);
+}
+
+static double clamp01(double x) { return x > 0 ? (x < 1 ? x : 1) : 0; } /* NaN -> 0 */
+
+/* World-space bounds of every mesh node (a unit box around the origin when
+ * there is none), for placing parallel lights outside the scene. */
+static void scene_bounds(const lm_scene *s, double center[3], double *radius) {
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int i = 0; i < s->node_count; i++) {
+    const lm_node *n = &s->nodes[i];
+    if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
+    const lm_scene_mesh *m = &s->meshes[n->mesh];
+    for (int v = 0; v < m->vertex_count; v++) {
+      const float *p = m->vertices + (size_t)v * 8;
+      for (int r = 0; r < 3; r++) {
+        double w = n->world[r] * p[0] + n->world[4 + r] * p[1] + n->world[8 + r] * p[2] + n->world[12 + r];
+        lo[r] = fmin(lo[r], w), hi[r] = fmax(hi[r], w);
+      }
+    }
+  }
+  if (!(lo[0] <= hi[0])) {
+    for (int r = 0; r < 3; r++) lo[r] = -1, hi[r] = 1;
+  }
+  double d2 = 0;
+  for (int r = 0; r < 3; r++) {
+    center[r] = 0.5 * (lo[r] + hi[r]);
+    d2 += (hi[r] - lo[r]) * (hi[r] - lo[r]);
+  }
+  *radius = 0.5 * sqrt(d2);
+}
+
+static void write_header(pov_ctx *c, const lm_scene *s) {
+  const lm_pov_desc *d = c->desc;
+  lm_buf *b = c->out;
+  lm_buf_printf(b,
+                "// Limn export of scene '%s', camera %d, for %dx%d (engine/scene/pov.h says how it matches).\n"
+                "// Render linear OpenEXR, one sample a pixel as the engine does:\n"
+                "//   povray -D -V +I<this file> +O<image>.exr +FE +W%d +H%d -A\n"
+                "#version 3.7;\n\n"
+                "global_settings {\n"
+                "  assumed_gamma 1\n"
+                "  max_trace_level 5\n",
+                s->name, d->camera, d->width, d->height, d->width, d->height);
+  if (d->radiosity) {
+    const lm_pov_radiosity *r = &d->rad;
+    lm_buf_printf(b,
+                  "  radiosity {\n"
+                  "    count %d\n"
+                  "    error_bound %.9g\n"
+                  "    pretrace_start %.9g\n"
+                  "    pretrace_end %.9g\n"
+                  "    recursion_limit %d\n"
+                  "    brightness %.9g\n"
+                  "  }\n",
+                  r->count, r->error_bound, r->pretrace_start, r->pretrace_end, r->recursion_limit,
+                  r->brightness);
+  }
+  lm_buf_printf(b, "}\n\nbackground { rgb 0 }\n\n");
+}
+
+/* The engine's own rays (lm_scene_frame_data): POV-Ray's ray for image
+ * position (x, y) in [0, 1]^2, y down, is direction + (x - 1/2) right +
+ * (1/2 - y) up; the engine's is frustum_o + u frustum_u + v frustum_v with
+ * v up. Equal when direction = o + (u + v) / 2, right = u, up = v. */
+static void write_camera(pov_ctx *c, const lm_scene *s) {
+  lm_frame_data f;
+  lm_scene_frame_data(s, c->desc->camera, c->desc->width, c->desc->height, &f);
+  double loc[3], dir[3], right[3], up[3];
+  for (int i = 0; i < 3; i++) {
+    loc[i] = f.camera_pos[i];
+    dir[i] = f.frustum_o[i] + 0.5 * (f.frustum_u[i] + f.frustum_v[i]);
+    right[i] = f.frustum_u[i];
+    up[i] = f.frustum_v[i];
+  }
+  const char *name = c->desc->camera < s->camera_count ? s->cameras[c->desc->camera].name : "default";
+  char what[128];
+  snprintf(what, sizeof what, "camera '%s'", name);
+  lm_buf_printf(c->out, "// camera '%s'\ncamera {\n  perspective\n  location ", name);
+  put_vec(c, loc, what);
+  lm_buf_printf(c->out, "\n  direction ");
+  put_vec(c, dir, what);
+  lm_buf_printf(c->out, "\n  right ");
+  put_vec(c, right, what);
+  lm_buf_printf(c->out, "\n  up ");
+  put_vec(c, up, what);
+  lm_buf_printf(c->out, "\n}\n\n");
+}
+
+static bool write_light(pov_ctx *c, const lm_light *l, const lm_light_data *ld, const double center[3],
+                        double radius) {
+  lm_buf *b = c->out;
+  double pos[3], dir[3], col[3];
+  for (int i = 0; i < 3; i++) pos[i] = ld->position[i], dir[i] = ld->direction[i], col[i] = ld->color[i];
+  int type = (int)lroundf(ld->position[3]);
+  int falloff = (int)lroundf(ld->params[1]);
+  /* Without shadows at all the meshes are no_shadow instead (write_mesh_node):
+   * POV-Ray 3.7 drops a shadowless spotlight's cone, and lights everything. */
+  bool shadowless = !l->casts_shadows;
+  if (shadowless && type == LM_LIGHT_SPOT &&
+      !mismatch(c, "light '%s': a spot that casts no shadows: POV-Ray 3.7 ignores the cone of a "
+                   "shadowless spotlight", l->name))
+    return false;
+  bool fade = false;
+  if (type != LM_LIGHT_DIRECTIONAL) {
+    if (falloff == LM_FALLOFF_INVERSE_SQUARE) {
+      fade = true;
+      for (int i = 0; i < 3; i++) col[i] /= 2.0 * LM_POV_FADE_DISTANCE * LM_POV_FADE_DISTANCE;
+    } else if (falloff != LM_FALLOFF_NONE &&
+               !mismatch(c, "light '%s': the window falloff saturate(1 - (d/r)^2) (seed 000 eq 16) has no "
+                            "POV-Ray form; give the light falloff none or inverse-square "
+                            "(--approximate writes it without falloff)", l->name)) {
+      return false;
+    }
+  }
+  char what[128];
+  snprintf(what, sizeof what, "light '%s'", l->name);
+  lm_buf_printf(b, "// light '%s'\nlight_source {\n  ", l->name);
+  if (type == LM_LIGHT_DIRECTIONAL) {
+    /* A parallel light's shadow rays end at the plane through its location:
+     * put it well outside the scene. */
+    double loc[3], at[3];
+    for (int i = 0; i < 3; i++) {
+      loc[i] = center[i] - dir[i] * (2.0 * radius + 1.0);
+      at[i] = loc[i] + dir[i];
+    }
+    put_vec(c, loc, what);
+    lm_buf_printf(b, "\n  color rgb ");
+    put_vec(c, col, what);
+    lm_buf_printf(b, "\n  parallel\n  point_at ");
+    put_vec(c, at, what);
+  } else {
+    put_vec(c, pos, what);
+    lm_buf_printf(b, "\n  color rgb ");
+    put_vec(c, col, what);
+    if (type == LM_LIGHT_SPOT) {
+      /* POV-Ray: pow(cos, tightness) * cubic_spline(cos falloff, cos radius, cos),
+       * the spline being smoothstep; tightness 0 leaves the smoothstep alone.
+       * It only holds for cones under 90 degrees (POV-Ray drops cos <= 0 and
+       * the spline when cos radius <= 0). */
+      /* The engine only sees the cosines, so a negative angle acts as its size. */
+      double inner = fabs(l->inner_cone), outer = fabs(l->outer_cone);
+      if (!(outer < GLM_PI_2) &&
+          !mismatch(c, "light '%s': spot cone of %.6g degrees: POV-Ray's spotlight only matches cones "
+                       "under 90 degrees", l->name, glm_deg((float)outer)))
+        return false;
+      /* inner >= outer: the engine's smoothstep spans 1e-4 in cosine, a hard
+       * edge at the outer cone, which is what radius = falloff gives. */
+      if (inner > outer) inner = outer;
+      double at[3];
+      for (int i = 0; i < 3; i++) at[i] = pos[i] + dir[i];
+      lm_buf_printf(b, "\n  spotlight\n  radius %.9g\n  falloff %.9g\n  tightness 0\n  point_at ",
+                    glm_deg((float)inner), glm_deg((float)outer));
+      put_vec(c, at, what);
+    }
+    if (fade) lm_buf_printf(b, "\n  fade_distance %.9g\n  fade_power 2", LM_POV_FADE_DISTANCE);
+  }
+  lm_buf_printf(b, "%s\n}\n\n", shadowless ? "\n  shadowless" : "");
+  return true;
+}
+
+static bool write_material(pov_ctx *c, const lm_material *m, const char *id) {
+  double col[3], kd = clamp01(m->kd), ks = clamp01(m->ks);
+  bool clamped = kd != m->kd || ks != m->ks;
+  for (int i = 0; i < 3; i++) {
+    col[i] = clamp01(m->color[i]);
+    clamped |= col[i] != m->color[i];
+  }
+  /* The G-buffer stores colour and k in [0, 1] (8 bits each): what it keeps is what we write. */
+  if (clamped && !mismatch(c, "material '%s': colour, kd or ks outside [0, 1]; the engine clamps them "
+                              "and so does the export", m->name))
+    return false;
+  double size = m->shininess >= 1 ? m->shininess : 1; /* the engine's max(shininess, 1) */
+  lm_buf_printf(c->out,
+                "// material '%s'\n#declare %s = texture {\n"
+                "  pigment { rgb <%.9g, %.9g, %.9g> }\n"
+                "  finish { ambient 0 emission 0 diffuse %.9g brilliance 1 phong %.9g phong_size %.9g }\n"
+                "}\n\n",
+                m->name, id, col[0], col[1], col[2], kd, ks, size);
+  return true;
+}
+
+static void material_id(const lm_scene *s, const lm_node *n, char *out, size_t cap) {
+  if (n->material >= 0 && n->material < s->material_count) snprintf(out, cap, "limn_material_%d", n->material);
+  else snprintf(out, cap, "limn_material_default");
+}
+
+/* One mesh2 in world space; false when an index is out of range. */
+static bool write_mesh_node(pov_ctx *c, const lm_scene *s, const lm_node *n) {
+  const lm_scene_mesh *m = &s->meshes[n->mesh];
+  lm_buf *b = c->out;
+  for (int i = 0; i < m->index_count; i++)
+    if (m->indices[i] >= (uint32_t)m->vertex_count) {
+      lm_error_set(c->err, "node '%s': mesh '%s': index %d is %u, past its %d vertices", n->name, m->name, i,
+                   m->indices[i], m->vertex_count);
+      return false;
+    }
+  mat4 w, inv;
+  memcpy(w, n->world, sizeof w); /* aligned copy for cglm */
+  glm_mat4_inv(w, inv);
+  double *wp = lm_alloc(sizeof(double) * 3 * (size_t)(m->vertex_count > 0 ? m->vertex_count : 1));
+  for (int v = 0; v < m->vertex_count; v++) {
+    const float *p = m->vertices + (size_t)v * 8;
+    for (int r = 0; r < 3; r++)
+      wp[v * 3 + r] = w[0][r] * p[0] + w[1][r] * p[1] + w[2][r] * p[2] + w[3][r];
+  }
+  /* Zero-area triangles: POV-Ray drops them itself, and fails on a mesh with none left. */
+  int tri = 0, total = m->index_count / 3;
+  bool *keep = lm_alloc(sizeof(bool) * (size_t)(total > 0 ? total : 1));
+  for (int t = 0; t < total; t++) {
+    const double *a = wp + m->indices[t * 3] * 3, *bb = wp + m->indices[t * 3 + 1] * 3,
+                 *cc = wp + m->indices[t * 3 + 2] * 3;
+    double e1[3] = {bb[0] - a[0], bb[1] - a[1], bb[2] - a[2]}, e2[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
+    double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2], z = e1[0] * e2[1] - e1[1] * e2[0];
+    keep[t] = sqrt(x * x + y * y + z * z) > 1e-9;
+    tri += keep[t];
+  }
+  if (tri > 0) {
+    char id[64], what[160];
+    snprintf(what, sizeof what, "node '%s'", n->name);
+    material_id(s, n, id, sizeof id);
+    lm_buf_printf(b, "// node '%s', mesh '%s'\nmesh2 {\n  vertex_vectors {\n    %d", n->name, m->name, m->vertex_count);
+    for (int v = 0; v < m->vertex_count; v++) {
+      lm_buf_printf(b, ",\n    ");
+      put_vec(c, wp + v * 3, what);
+    }
+    lm_buf_printf(b, "\n  }\n  normal_vectors {\n    %d", m->vertex_count);
+    for (int v = 0; v < m->vertex_count; v++) {
+      const float *nn = m->vertices + (size_t)v * 8 + 3;
+      double wn[3], len = 0;
+      for (int r = 0; r < 3; r++) { /* inverse transpose: (inv^T)_{r,k} = inv[r][k] in cglm's columns */
+        wn[r] = inv[r][0] * nn[0] + inv[r][1] * nn[1] + inv[r][2] * nn[2];
+        len += wn[r] * wn[r];
+      }
+      len = sqrt(len);
+      if (len > 1e-20 && isfinite(len)) {
+        for (int r = 0; r < 3; r++) wn[r] /= len;
+      } else { /* the engine's safe_normalize falls back to +Y */
+        wn[0] = 0, wn[1] = 1, wn[2] = 0;
+      }
+      lm_buf_printf(b, ",\n    ");
+      put_vec(c, wn, what);
+    }
+    lm_buf_printf(b, "\n  }\n  face_indices {\n    %d", tri);
+    for (int t = 0; t < total; t++)
+      if (keep[t])
+        lm_buf_printf(b, ",\n    <%u, %u, %u>", m->indices[t * 3], m->indices[t * 3 + 1], m->indices[t * 3 + 2]);
+    lm_buf_printf(b, "\n  }\n  texture { %s }\n%s}\n\n", id, c->desc->shadows ? "" : "  no_shadow\n");
+  }
+  free(keep);
+  free(wp);
+  return true;
+}
+
+bool lm_pov_export(const lm_scene *s, const lm_pov_desc *desc, lm_buf *out, lm_buf *warnings,
+                   lm_error *err) {
+  pov_ctx c = {.desc = desc, .out = out, .warnings = warnings, .err = err};
+  if (desc->width < 1 || desc->height < 1) {
+    lm_error_set(err, "output size %dx%d: both must be at least 1", desc->width, desc->height);
+    return false;
+  }
+  if (desc->camera < 0 || (desc->camera > 0 && desc->camera >= s->camera_count)) {
+    lm_error_set(err, "camera %d: scene '%s' has %d camera(s)", desc->camera, s->name, s->camera_count);
+    return false;
+  }
+  const char *bad = desc->radiosity ? lm_pov_radiosity_check(&desc->rad) : NULL;
+  if (bad) {
+    lm_error_set(err, "radiosity setting out of range: %s", bad);
+    return false;
+  }
+  write_header(&c, s);
+  write_camera(&c, s);
+
+  double center[3], radius;
+  scene_bounds(s, center, &radius);
+  lm_light_data *ld = lm_alloc(sizeof *ld * (size_t)(s->light_count > 0 ? s->light_count : 1));
+  int n = lm_scene_light_data(s, ld, s->light_count);
+  bool ok = true;
+  for (int i = 0; i < n && ok; i++) ok = write_light(&c, &s->lights[i], &ld[i], center, radius);
+  free(ld);
+
+  /* Declare each material that a mesh node uses, once. */
+  bool *declared = lm_alloc(sizeof(bool) * (size_t)(s->material_count + 1));
+  for (int i = 0; i < s->node_count && ok; i++) {
+    const lm_node *nd = &s->nodes[i];
+    if (nd->mesh < 0 || nd->mesh >= s->mesh_count) continue;
+    int slot = nd->material >= 0 && nd->material < s->material_count ? nd->material : s->material_count;
+    if (declared[slot]) continue;
+    declared[slot] = true;
+    char id[64];
+    material_id(s, nd, id, sizeof id);
+    ok = write_material(&c, lm_scene_node_material(s, nd), id);
+  }
+  free(declared);
+  for (int i = 0; i < s->node_count && ok; i++) {
+    const lm_node *nd = &s->nodes[i];
+    if (nd->mesh >= 0 && nd->mesh < s->mesh_count) ok = write_mesh_node(&c, s, nd);
+  }
+  if (ok && c.nonfinite[0]) {
+    lm_error_set(err, "%s: a coordinate or colour is not finite (Inf or NaN)", c.nonfinite);
+    ok = false;
+  }
+  return ok;
+}

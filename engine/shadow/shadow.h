@@ -1,0 +1,67 @@
+/* shadow: the shadow manager. Plans one atlas of shadow-map tiles for every
+ * light that casts shadows: cascades for directional lights (practical split
+ * scheme, stabilized as seed 003), one perspective tile for a spot light, six
+ * cube faces for a point light. The plan becomes one scene pass drawn once
+ * per tile, and two storage blocks the lighting shaders read through
+ * shaders/shadow.glsl. A frame that plans nothing renders no shadow map. */
+#ifndef LIMN_SHADOW_H
+#define LIMN_SHADOW_H
+
+#include "graph/graph.h"
+#include "scene/scene.h"
+
+typedef enum lm_shadow_technique {
+  LM_SHADOW_ESM,     /* exponential shadow maps, seed 000 eq 30 and Listing 8 */
+  LM_SHADOW_PCF,     /* 3x3 percentage-closer filtering with a bias */
+  LM_SHADOW_POISSON, /* 16 Poisson-disc taps over a wider radius */
+  LM_SHADOW_HARD,    /* one compare with a bias */
+} lm_shadow_technique;
+/* "esm", "pcf", "poisson", "hard"; -1 when unknown. */
+int lm_shadow_technique_parse(const char *name);
+
+typedef struct lm_shadow_settings {
+  lm_shadow_technique technique;
+  int resolution;  /* tile size in texels (16 .. 8192) */
+  float c;         /* ESM exponent on depth normalized to the light's range */
+  int blur;        /* ESM Gaussian radius in texels (0: none) */
+  int cascades;    /* directional lights: 1 .. 4 */
+  float lambda;    /* split scheme: 0 uniform, 1 logarithmic */
+  float bias;      /* in normalized depth */
+  float distance;  /* how far from the camera cascades reach (0: the far plane) */
+  float blend;     /* share of a cascade blended into the next one */
+  float radius;    /* Poisson disc radius in texels */
+  bool stabilize;  /* bounding spheres and texel snapping (seed 003) */
+} lm_shadow_settings;
+void lm_shadow_settings_default(lm_shadow_settings *s);
+
+/* std430 layouts mirrored by shaders/shadow.glsl. */
+typedef struct lm_shadow_light_data {
+  int32_t info[4]; /* first view, view count, kind (0 none, 1 cascades, 2 spot, 3 point), technique */
+  float splits[4]; /* cascades: camera depth where each ends */
+  float params[4]; /* c, bias, blend, Poisson radius */
+} lm_shadow_light_data;
+typedef struct lm_shadow_view_data {
+  float view_proj[16];
+  float rect[4];  /* the tile in atlas uv: offset xy, size zw */
+  float depth[4]; /* light position xyz, 1 / range (0: orthographic) */
+} lm_shadow_view_data;
+
+typedef struct lm_shadow_plan {
+  lm_shadow_settings settings;
+  int tile, columns, rows, atlas_width, atlas_height;
+  lm_pass_view *views; /* for the scene pass, one per tile */
+  lm_shadow_view_data *view_data;
+  int view_count;
+  lm_shadow_light_data *lights; /* one per scene light */
+  int light_count;
+} lm_shadow_plan;
+
+/* Plans the tiles for `camera` (a frame block from lm_scene_frame_data).
+ * view_count is 0 when no light casts shadows. */
+bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *camera,
+                         const lm_shadow_settings *settings, lm_error *err);
+void lm_shadow_plan_free(lm_shadow_plan *plan);
+/* Storage blocks 2 (per light) and 3 (per tile); a NULL plan marks every light unshadowed. */
+void lm_shadow_plan_upload(const lm_shadow_plan *plan, int light_count);
+
+#endif

@@ -1,0 +1,46 @@
+-- Bloom (seed 001 lines 1355-1400, 1745-1781): a bright pass with a soft
+-- knee at 1/downsample of the size, a separable Gaussian (blur.frag), and
+-- the sum with the image, before tone mapping. Half floats throughout, each
+-- pass clamping under their largest finite value.
+local options = require "options"
+
+local bloom = {}
+
+bloom.defaults = {
+  enabled = false,
+  threshold = 1.0,  -- brightness (largest channel) where bloom starts, >= 0
+  knee = 0.5,       -- soft transition either side of the threshold, >= 0
+  strength = 0.5,   -- how much of the blurred light is added, >= 0
+  radius = 8,       -- Gaussian taps each side at the bloom's size, 0..32 (0: no blur)
+  downsample = 2,   -- bloom resolution: 1/1, 1/2 or 1/4 a side
+}
+
+local rules = {
+  enabled = options.boolean,
+  threshold = options.number(0, 1e6),
+  knee = options.number(0, 1e6),
+  strength = options.number(0, 1e3),
+  radius = options.whole(0, 32),
+  downsample = options.one_of(1, 2, 4),
+}
+
+-- Records bloom over `src` (output-sized). Returns the sum, or src when off.
+function bloom.render(src, o)
+  o = options.check("bloom", bloom.defaults, o, rules, 2)
+  if not o.enabled then return src end
+  local f = o.downsample
+  local function small(name) return target{ name, format = "rgba16f", scale = 1 / f } end
+  local b = pass{ "bloom.bright", shader = "bloom_bright.frag", inputs = { src = src },
+                  params = { threshold = o.threshold, knee = o.knee }, defines = { FACTOR = f },
+                  out = small("bloom.bright") }
+  if o.radius > 0 then
+    for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
+      b = pass{ "bloom.blur_" .. axis[1], shader = "blur.frag", inputs = { src = b },
+                params = { axis = axis[2], radius = o.radius }, out = small("bloom.blur_" .. axis[1]) }
+    end
+  end
+  return pass{ "bloom.add", shader = "bloom_add.frag", inputs = { src = src, bloom = b },
+               params = { strength = o.strength }, out = target{ "bloom.add", format = "rgba16f" } }
+end
+
+return bloom

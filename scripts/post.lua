@@ -1,0 +1,40 @@
+-- The post-processing chain over a lit image, in a fixed order:
+--   motion_blur, dof           scene-referred (HDR), as a camera would blur
+--   bloom                      added before tone mapping (seed 001)
+--   hdr                        tone mapping with eye adaptation
+--   radial_blur, glass, tiles, sepia    display-referred stylization
+-- Each effect is a module with `defaults` and `render(src, o, G)`; an effect
+-- whose `enabled` is false records no pass. Any pipeline can use the chain
+-- (post.render) or the modules one by one.
+local options = require "options"
+
+local post = {}
+
+post.order = { "motion_blur", "dof", "bloom", "hdr", "radial_blur", "glass", "tiles", "sepia" }
+
+local modules = {}
+for _, name in ipairs(post.order) do modules[name] = require(name) end
+
+-- A fresh table of every effect's defaults, { bloom = { enabled = false, ... }, ... }.
+function post.defaults()
+  local d = {}
+  for _, name in ipairs(post.order) do d[name] = options.copy(modules[name].defaults) end
+  return d
+end
+
+-- Declares the effects' lasting targets; call from OnCreate.
+function post.create()
+  modules.hdr.create()
+end
+
+-- Records the chain over `lit` with o = { bloom = {...}, dof = {...}, ... }
+-- (missing tables take the defaults) and the G-buffer G (for dof and
+-- motion_blur). Returns the final target.
+function post.render(lit, o, G)
+  o = o or {}
+  local img = lit
+  for _, name in ipairs(post.order) do img = modules[name].render(img, o[name], G) end
+  return img
+end
+
+return post

@@ -1,0 +1,69 @@
+-- Shadow maps for every light that casts shadows. The engine plans the tiles
+-- (engine/shadow: cascades for directional lights, one tile for a spot, six
+-- cube faces for a point light, all in one atlas); this module records the
+-- passes: depth from each light, then for ESM a separable blur in log space.
+-- Lighting shaders read the atlas through shaders/shadow.glsl.
+local options = require "options"
+
+local shadow = {}
+
+-- The options a pipeline exposes (pp.lua's Options.shadow), with defaults.
+shadow.defaults = {
+  technique = "esm",  -- "esm" (seed 000 eq 30), "pcf" (3x3), "poisson" (16 taps), "hard"
+  resolution = 512,   -- tile size in texels, 16..8192 (the seed: 512)
+  c = 90,             -- ESM exponent on depth normalized to the light's range (the seed: 90)
+  blur = 2,           -- ESM Gaussian radius in texels, 0..32
+  cascades = 3,       -- directional lights, 1..4
+  lambda = 0.75,      -- cascade splits: 0 uniform .. 1 logarithmic
+  bias = 0.002,       -- depth bias in normalized depth (the seed: 0 for ESM, which darkens lit
+                      -- slanted surfaces by 1-2%; 0.005 for its plain shadow map)
+  distance = 0,       -- how far cascades reach from the camera (0: the far plane)
+  blend = 0.1,        -- share of a cascade blended into the next one
+  radius = 2.5,       -- Poisson disc radius in texels
+  stabilize = true,   -- bounding spheres and texel snapping (seed 003)
+  debug = false,      -- present the shadow atlas instead of the image
+}
+
+-- shadow_plan{} checks the rest (engine/script/script_api.c).
+local rules = { technique = options.one_of("esm", "pcf", "poisson", "hard") }
+
+-- Records the shadow passes. Returns the atlas a lighting pass reads as
+-- `shadow_atlas`, or nil when no light casts shadows (nothing is recorded).
+function shadow.render(o)
+  o = options.check("shadow", shadow.defaults, o, rules, 2)
+  local settings = {}
+  for k, v in pairs(o) do
+    if k ~= "debug" then settings[k] = v end
+  end
+  local plan = shadow_plan(settings)
+  if not plan then return nil end
+  local size = { plan.width, plan.height }
+  local map = target{ "shadow.map", format = "r32f", size = size }
+  scene{ "shadow.depth", technique = "shadow", views = plan, out = map, clear = { 1, 1, 1, 1 },
+         depth = target{ "shadow.zbuffer", format = "depth32f", size = size } }
+  if plan.technique ~= "esm" or plan.blur == 0 then return map end
+  local blurred = map
+  for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
+    blurred = pass{ "shadow.blur_" .. axis[1], shader = "esm_blur.frag", inputs = { src = blurred },
+                    params = { direction = axis[2], radius = plan.blur, c = plan.c, tile = plan.tile },
+                    out = target{ "shadow.esm_" .. axis[1], format = "r32f", size = size } }
+  end
+  return blurred
+end
+
+-- Adds the atlas to a lighting pass's inputs and defines (no-op without one).
+function shadow.bind(atlas, inputs, defines)
+  if atlas then
+    inputs.shadow_atlas = atlas
+    defines.SHADOWS = true
+  end
+  return inputs, defines
+end
+
+-- A viewable image of the atlas: depth as grey, tiles outlined.
+function shadow.debug(atlas)
+  return pass{ "shadow.debug", shader = "shadow_debug.frag", inputs = { atlas = atlas },
+               out = target{ "shadow.debug", format = "rgba8" } }
+end
+
+return shadow

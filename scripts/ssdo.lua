@@ -1,0 +1,92 @@
+-- Screen-space directional occlusion (seed 001, lines 422-568, 864-948,
+-- 1222-1318) over the G-buffer of gbuffer.lua and a direct-lit image
+-- (direct.frag's, or any with the same meaning: shadows go in there):
+--   merged    the author's variant: one pass (ssdo.frag, MERGED) gives the
+--             modulation factor M per channel and the bounce from the lit
+--             image; both blurred together, upsampled when computed at 1/2
+--             or 1/4 size, applied as M (lit + bounce) (gi_apply.frag)
+--   two_step  the original: L_dir with directional occlusion (DIRECT), then
+--             the bounce from L_dir (BOUNCE); full size only (it computes
+--             intensities, which do not survive subsampling, seed line 979);
+--             applied as L_dir + L_ind
+-- Shadows: the merged variant takes them from `lit` (give it a shadowed
+-- direct pass: one line in the pipeline); the two-step one relights, and
+-- light_visibility() in ssdo.frag is where a light's shadow factor goes.
+-- Sampling: halton.glsl (bases 5, 2, 3, a per-pixel rotation). With
+-- `adaptive`, a 1/16-size edge map (ssdo_edges.frag) picks 10, 20 or 30
+-- samples a pixel and `samples` is not used.
+local gbuffer = require "gbuffer"
+local filters = require "filters"
+local options = require "options"
+
+local ssdo = {}
+
+ssdo.defaults = {
+  variant = "merged",  -- "merged" (modulation factor) or "two_step" (the original)
+  samples = 20,        -- K, a multiple of 10 in 10..300 (Halton period of bases 2 and 5)
+  adaptive = false,    -- 10/20/30 samples from a 1/16-size edge map instead
+  r_max = 0.3,         -- sampling radius, world units, > 0
+  bounce = 1.0,        -- bounce strength: A_s in units of pi r_max^2 / K, 0..100 (0: none)
+  lobe = 4,            -- light lobe exponent n of L_in (ssdo.frag), 1..64
+  resolution = 1,      -- computed at 1/resolution a side: 1, 2 or 4 (merged only)
+  interleave = 4,      -- per-pixel rotation tile side: 1 (none), 2 or 4
+}
+
+local rules = {
+  variant = options.one_of("merged", "two_step"),
+  samples = options.multiple(10, 10, 300),
+  adaptive = options.boolean,
+  r_max = options.number(1e-6, 1e6),
+  bounce = options.number(0, 100),
+  lobe = options.number(1, 64),
+  resolution = {
+    options.one_of(1, 2, 4),
+    function(v, c) -- the two-step variant computes intensities, which do not survive subsampling
+      if c.variant == "two_step" and v ~= 1 then return '1 with variant "two_step" (it computes intensities)' end
+    end,
+  },
+  interleave = options.one_of(1, 2, 4),
+}
+filters.expose(ssdo.defaults, rules)
+
+-- Records SSDO for G lit by `lit` with options o (see ssdo.defaults) and
+-- light = { ambient = {r, g, b} } (the two-step variant relights ambient).
+-- Returns the result, a full-size rgba16f target "ssdo.lit".
+function ssdo.render(G, lit, o, light)
+  o = options.check("ssdo", ssdo.defaults, o, rules, 2)
+  local f, merged = o.resolution, o.variant == "merged"
+  local edges
+  if o.adaptive then
+    edges = pass{ "ssdo.edges", shader = "ssdo_edges.frag", inputs = { nrm = G.nrm, dpt = G.dpt, mat = G.mat },
+                  out = target{ "ssdo.edges", format = "r16f", scale = 1 / 16 } }
+  end
+  local params = { samples = o.samples, r_max = o.r_max, bounce = o.bounce, lobe = o.lobe,
+                   interleave = o.interleave, factor = f }
+  local function inputs(sender)
+    local t = gbuffer.inputs(G)
+    t.sender, t.edges = sender, edges
+    return t
+  end
+  local a, b
+  if merged then
+    a = target{ "ssdo.m", format = "rgba16f", scale = 1 / f }
+    b = target{ "ssdo.bounce", format = "rgba16f", scale = 1 / f }
+    pass{ "ssdo.merged", shader = "ssdo.frag", inputs = inputs(lit), params = params,
+          defines = { MERGED = true, ADAPTIVE = o.adaptive }, out = { a, b } }
+  else
+    params.ambient = light and light.ambient or { 0, 0, 0 }
+    a = pass{ "ssdo.direct", shader = "ssdo.frag", inputs = inputs(nil), params = params,
+              defines = { DIRECT = true, ADAPTIVE = o.adaptive },
+              out = target{ "ssdo.direct", format = "rgba16f" } }
+    params.ambient = nil
+    b = pass{ "ssdo.indirect", shader = "ssdo.frag", inputs = inputs(a), params = params,
+              defines = { BOUNCE = true, ADAPTIVE = o.adaptive },
+              out = target{ "ssdo.indirect", format = "rgba16f" } }
+  end
+  a, b = filters.smooth({ a, b }, G, o, "ssdo", "rgba16f", f)
+  return pass{ "ssdo.apply", shader = "gi_apply.frag", inputs = { lit = lit, mat = G.mat, a = a, b = b },
+               defines = { MERGED = merged, TWO_STEP = not merged },
+               out = target{ "ssdo.lit", format = "rgba16f" } }
+end
+
+return ssdo

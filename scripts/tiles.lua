@@ -1,0 +1,29 @@
+-- The image as square tiles with grout lines (tiles.frag), the seed viewer's F12.
+local options = require "options"
+
+local tiles = {}
+
+tiles.defaults = {
+  enabled = false,
+  size = 16,     -- tile side in pixels, 1..1024
+  grout = 1,     -- grout width in pixels, 0..size
+  grout_grey = 0.05, -- grout colour (grey), 0..1e4
+}
+
+local rules = {
+  enabled = options.boolean,
+  size = options.number(1, 1024),
+  grout = options.number(0, 1024),
+  grout_grey = options.number(0, 1e4),
+}
+
+function tiles.render(src, o)
+  o = options.check("tiles", tiles.defaults, o, rules, 2)
+  if not o.enabled then return src end
+  local g = o.grout_grey
+  return pass{ "tiles", shader = "tiles.frag", inputs = { src = src },
+               params = { size = o.size, grout = o.grout, grout_color = { g, g, g } },
+               out = target{ "tiles", format = "rgba16f" } }
+end
+
+return tiles

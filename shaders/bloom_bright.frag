@@ -1,0 +1,33 @@
+// Bloom's bright pass (seed 001, lines 1355-1400): at a lower resolution,
+// keep what exceeds `threshold`, with a soft knee of width `knee` so that the
+// cut does not show as an edge. Each output texel averages the FACTOR x FACTOR
+// source texels under it, so no bright pixel falls between the taps.
+#include "post.glsl"
+
+in vec2 uv;
+uniform sampler2D src;
+uniform float threshold = 1.0; // luminance-like brightness where bloom starts
+uniform float knee = 0.5;      // soft transition width, >= 0
+
+#ifndef FACTOR
+#define FACTOR 2
+#endif
+
+out vec4 dst;
+
+void main() {
+  ivec2 base = ivec2(gl_FragCoord.xy) * FACTOR, last = textureSize(src, 0) - 1;
+  vec3 c = vec3(0.0);
+  for (int y = 0; y < FACTOR; y++)
+    for (int x = 0; x < FACTOR; x++)
+      c += hdr_clamp(texelFetch(src, min(base + ivec2(x, y), last), 0).rgb, HALF_MAX);
+  c /= float(FACTOR * FACTOR);
+  // Quadratic soft knee: the kept fraction rises smoothly from
+  // threshold - knee to threshold + knee, then follows brightness - threshold.
+  float t = max(threshold, 0.0), k = max(knee, 0.0);
+  float b = max(c.r, max(c.g, c.b));
+  float soft = clamp(b - t + k, 0.0, 2.0 * k);
+  soft = soft * soft / (4.0 * k + 1e-4);
+  float kept = max(soft, b - t) / max(b, 1e-4);
+  dst = vec4(hdr_clamp(c * saturate(kept), HALF_MAX), 1.0);
+}

@@ -1,0 +1,44 @@
+// The log-average luminance (seed 001 eq 2.1), one level of a reduction:
+//   L_avg = exp( (1/N) sum ln(delta + L_w(x, y)) )
+// Each output texel covers a BLOCK x BLOCK square of its source. The first
+// level (FIRST) reads the HDR image and writes, per block, the mean of
+// ln(delta + luminance) and how many pixels it covers; later levels take the
+// count-weighted mean of the level below. Blocks cut by the image's edge
+// count only the pixels they hold, so the result is the exact mean for any
+// size (glGenerateMipmap's box filter drops or blends edge texels of odd
+// sizes). Output: r = mean ln, g = pixel count.
+#include "post.glsl"
+
+in vec2 uv;
+uniform sampler2D src;
+#ifdef FIRST
+uniform float delta = 1e-4; // against ln(0) (seed 001: "a small constant")
+#endif
+
+#ifndef BLOCK
+#define BLOCK 8
+#endif
+
+out vec4 dst;
+
+void main() {
+  ivec2 base = ivec2(gl_FragCoord.xy) * BLOCK, size = textureSize(src, 0);
+  float sum = 0.0, count = 0.0;
+  for (int y = 0; y < BLOCK; y++) {
+    for (int x = 0; x < BLOCK; x++) {
+      ivec2 q = base + ivec2(x, y);
+      if (any(greaterThanEqual(q, size))) continue;
+      vec4 t = texelFetch(src, q, 0);
+#ifdef FIRST
+      // Up to 1e30 (an fp32 input may hold far more than a half float).
+      float l = luminance(hdr_clamp(t.rgb, 1e30));
+      sum += log(max(delta, 1e-30) + l);
+      count += 1.0;
+#else
+      sum += t.r * t.g;
+      count += t.g;
+#endif
+    }
+  }
+  dst = vec4(count > 0.0 ? sum / count : 0.0, count, 0.0, 0.0);
+}

@@ -1,0 +1,32 @@
+// Helpers shared by the post-processing effects (scripts/post.lua).
+#ifndef LIMN_POST_GLSL
+#define LIMN_POST_GLSL
+#include "common.glsl"
+
+// Under rgba16f's largest finite value (65504): what an effect may write to a
+// half-float target without it turning into Inf.
+const float HALF_MAX = 65000.0;
+
+// NaN and negatives become 0, +Inf and anything above hi becomes hi. Effects
+// call it on what they read (a lighting pass may have overflowed) and on what
+// they write to a half-float target (hi = HALF_MAX).
+vec3 hdr_clamp(vec3 c, float hi) {
+  c = mix(c, vec3(0.0), isnan(c));
+  return clamp(c, vec3(0.0), vec3(hi));
+}
+vec4 hdr_clamp(vec4 c, float hi) { return vec4(hdr_clamp(c.rgb, hi), c.a); }
+
+// Linear eye depth at a G-buffer texel: dpt holds depth / far, 0 where no
+// geometry was drawn (the background counts as the far plane).
+float eye_depth(float depth01) {
+  float far = max(frame.clip.y, EPS);
+  return depth01 > 0.0 ? clamp(depth01, 0.0, 1.0) * far : far;
+}
+
+// The i-th of n points of a golden-angle (Vogel) spiral filling the unit disc.
+vec2 vogel_disc(int i, int n) {
+  float r = sqrt((float(i) + 0.5) / float(max(n, 1)));
+  float a = float(i) * 2.39996323; // the golden angle
+  return r * vec2(cos(a), sin(a));
+}
+#endif

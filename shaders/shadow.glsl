@@ -1,0 +1,104 @@
+// The shadow factor of a light at a world position: the one place lighting
+// shaders read shadows (ESM, PCF, Poisson or hard compares, cascades for
+// directional lights, cube faces for point lights). Needs `#define SHADOWS`
+// and a pass input `shadow_atlas` (what scripts/shadow.lua returns).
+#ifndef LIMN_SHADOW_GLSL
+#define LIMN_SHADOW_GLSL
+#include "common.glsl"
+
+struct ShadowLight {
+  ivec4 info;  // first view, view count, kind (0 none, 1 cascades, 2 spot, 3 point), technique
+  vec4 splits; // cascades: camera depth where each ends
+  vec4 params; // c, bias, blend, Poisson radius
+};
+struct ShadowView {
+  mat4 view_proj;
+  vec4 rect;  // tile in atlas uv: offset, size
+  vec4 depth; // light position, 1 / range (0: orthographic)
+};
+layout(std430, binding = 2) readonly buffer LimnShadowLights { ShadowLight shadow_lights[]; };
+layout(std430, binding = 3) readonly buffer LimnShadowViews { ShadowView shadow_views[]; };
+
+uniform sampler2D shadow_atlas;
+
+const vec2 POISSON[16] = vec2[](
+  vec2(-0.942, -0.399), vec2(0.946, -0.769), vec2(-0.094, -0.929), vec2(0.345, 0.294),
+  vec2(-0.916, 0.458), vec2(-0.815, -0.879), vec2(-0.383, 0.277), vec2(0.975, 0.756),
+  vec2(0.443, -0.975), vec2(0.537, -0.474), vec2(-0.264, -0.419), vec2(0.792, 0.191),
+  vec2(-0.242, 0.997), vec2(-0.814, 0.914), vec2(0.200, 0.786), vec2(0.144, -0.141));
+
+float shadow_texel(ivec2 t, ivec2 lo, ivec2 hi) { return texelFetch(shadow_atlas, clamp(t, lo, hi), 0).r; }
+
+// Visibility in [0, 1] of p from view v.
+float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
+  ShadowView sv = shadow_views[v];
+  vec4 ls = sv.view_proj * vec4(p, 1.0);
+  if (ls.w <= 1e-12) return 1.0;
+  vec3 ndc = ls.xyz / ls.w;
+  vec2 tuv = ndc.xy * 0.5 + 0.5;
+  if (any(lessThan(tuv, vec2(0.0))) || any(greaterThan(tuv, vec2(1.0)))) return 1.0; // outside: lit
+  float r = sv.depth.w > 0.0 ? length(p - sv.depth.xyz) * sv.depth.w : ndc.z * 0.5 + 0.5;
+  if (r >= 1.0) return 1.0;
+  vec2 size = vec2(textureSize(shadow_atlas, 0));
+  ivec2 lo = ivec2(sv.rect.xy * size + 0.5), hi = ivec2((sv.rect.xy + sv.rect.zw) * size + 0.5) - 1;
+  vec2 texel = (sv.rect.xy + tuv * sv.rect.zw) * size - 0.5;
+  ivec2 base = ivec2(floor(texel));
+  vec2 f = texel - vec2(base);
+  float bias = s.params.y;
+  int technique = s.info.w;
+  // Filters reach `spread` texels away, where a tilted receiver is deeper:
+  // scale the bias by the tilt (tan of the light's angle, capped).
+  float spread = technique == 1 ? 1.5 : technique == 2 ? s.params.w : 0.0;
+  float c = saturate(ndl), tan_tilt = min(sqrt(max(1.0 - c * c, 0.0)) / max(c, 0.1), 10.0);
+  bias *= 1.0 + spread * tan_tilt;
+  if (technique == 0) {
+    // ESM with the seed's 4-tap bilinear combination (seed 000, Listing 8):
+    // the depth difference is clamped at 0 and scaled by n.l, then exp(-c d).
+    float k = s.params.x, scale = saturate(ndl);
+    vec4 z = vec4(shadow_texel(base, lo, hi), shadow_texel(base + ivec2(1, 0), lo, hi),
+                  shadow_texel(base + ivec2(0, 1), lo, hi), shadow_texel(base + ivec2(1, 1), lo, hi));
+    vec4 vis = exp(-k * max(vec4(r) - z - bias, 0.0) * scale);
+    return mix(mix(vis.x, vis.y, f.x), mix(vis.z, vis.w, f.x), f.y);
+  }
+  if (technique == 1) { // PCF 3x3
+    float lit = 0.0;
+    for (int y = -1; y <= 1; y++)
+      for (int x = -1; x <= 1; x++) lit += r - bias <= shadow_texel(base + ivec2(x, y), lo, hi) ? 1.0 : 0.0;
+    return lit / 9.0;
+  }
+  if (technique == 2) { // Poisson disc
+    float lit = 0.0;
+    for (int i = 0; i < 16; i++)
+      lit += r - bias <= shadow_texel(ivec2(floor(texel + 0.5 + POISSON[i] * s.params.w)), lo, hi) ? 1.0 : 0.0;
+    return lit / 16.0;
+  }
+  return r - bias <= shadow_texel(ivec2(floor(texel + 0.5)), lo, hi) ? 1.0 : 0.0;
+}
+
+float shadow_factor(int light, vec3 p, vec3 n, vec3 l) {
+  ShadowLight s = shadow_lights[light];
+  int first = s.info.x, count = s.info.y, kind = s.info.z;
+  if (count <= 0) return 1.0;
+  float ndl = dot(n, l);
+  if (kind == 3) { // point light: the cube face of the major axis
+    vec3 d = p - shadow_views[first].depth.xyz;
+    vec3 a = abs(d);
+    int face = a.x >= a.y && a.x >= a.z ? (d.x >= 0.0 ? 0 : 1) : a.y >= a.z ? (d.y >= 0.0 ? 2 : 3) : (d.z >= 0.0 ? 4 : 5);
+    return shadow_view_lookup(first + face, s, p, ndl);
+  }
+  if (kind == 2) return shadow_view_lookup(first, s, p, ndl);
+  // Cascades: by camera depth, blended over the last `blend` share of each.
+  float z = -(frame.view * vec4(p, 1.0)).z;
+  int k = 0;
+  while (k < count - 1 && z > s.splits[k]) k++;
+  if (z > s.splits[count - 1]) return 1.0; // beyond the shadowed distance
+  float vis = shadow_view_lookup(first + k, s, p, ndl);
+  float start = k > 0 ? s.splits[k - 1] : frame.clip.x;
+  float band = (s.splits[k] - start) * s.params.z;
+  if (k < count - 1 && band > 0.0 && z > s.splits[k] - band) {
+    float t = saturate((z - (s.splits[k] - band)) / band);
+    vis = mix(vis, shadow_view_lookup(first + k + 1, s, p, ndl), t);
+  }
+  return vis;
+}
+#endif

@@ -1,0 +1,211 @@
+#define _POSIX_C_SOURCE 200809L
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl_test.h"
+
+static lm_scene *cornell;
+static char scratch[256];
+
+static bool scratch_create(void) {
+  char real_root[1024], cmd[4096];
+  snprintf(real_root, sizeof real_root, "%s", lm_root_dir());
+  snprintf(scratch, sizeof scratch, "/tmp/limn-test-XXXXXX");
+  if (!mkdtemp(scratch)) return false;
+  snprintf(cmd, sizeof cmd, "mkdir -p %s/shaders && ln -s %s/shaders/* %s/shaders/ && ln -s %s/scripts %s/scripts",
+           scratch, real_root, scratch, real_root, scratch);
+  if (system(cmd) != 0) return false;
+  setenv("LIMN_ROOT", scratch, 1);
+  return true;
+}
+
+int gl_test_setup(void **state) {
+  (void)state;
+  lm_log_set_level(LM_LOG_WARN);
+  lm_error err;
+  if (!scratch_create()) {
+    fprintf(stderr, "no scratch root in /tmp\n");
+    return -1;
+  }
+  if (!(cornell = lm_scene_builtin("cornell", &err))) {
+    fprintf(stderr, "%s\n", err.msg);
+    return -1;
+  }
+  if (!lm_context_create_headless(&(lm_context_desc){0}, &err)) {
+    fprintf(stderr, "no OpenGL context: %s\n", err.msg);
+    return -1;
+  }
+  return 0;
+}
+
+int gl_test_teardown(void **state) {
+  (void)state;
+  lm_scene_destroy(cornell); /* its GL buffers go before the context */
+  cornell = NULL;
+  lm_programs_clear();
+  lm_context_destroy();
+  char cmd[300];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", scratch);
+  return system(cmd) == 0 ? 0 : -1;
+}
+
+lm_scene *gl_cornell(void) { return cornell; }
+
+bool gl_write_file(const char *rel, const char *text) {
+  char path[512];
+  snprintf(path, sizeof path, "%s/%s", scratch, rel);
+  FILE *f = fopen(path, "w");
+  if (!f) return false;
+  bool ok = fputs(text, f) >= 0;
+  return fclose(f) == 0 && ok;
+}
+
+static bool read_output(gl_result *r) {
+  return lm_renderer_read(r->renderer, true, r->rgb, &r->err) &&
+         lm_renderer_read(r->renderer, false, r->srgb, &r->err);
+}
+
+bool gl_set(gl_result *r, const char *assignment) {
+  char name[128];
+  const char *eq = strchr(assignment, '=');
+  if (!eq) {
+    lm_error_set(&r->err, "option '%s': expected name=value", assignment);
+    return false;
+  }
+  snprintf(name, sizeof name, "%.*s", (int)(eq - assignment), assignment);
+  return lm_pipeline_set_option(r->pipeline, name, eq + 1, &r->err);
+}
+
+gl_result gl_render(const gl_run *run) {
+  gl_result r = {.width = run->width ? run->width : 256, .height = run->height ? run->height : 192};
+  const char *script = run->script ? run->script : "scripts/pp.lua";
+  char path[1024];
+  if (script[0] == '/') snprintf(path, sizeof path, "%s", script);
+  else snprintf(path, sizeof path, "%s/%s", lm_root_dir(), script);
+  r.pipeline = lm_pipeline_load(&(lm_pipeline_desc){.path = path}, &r.err);
+  if (!r.pipeline) return r;
+  if (run->tech && !lm_pipeline_set_technique(r.pipeline, run->tech, &r.err)) return r;
+  for (const char *const *s = run->sets; s && *s; s++)
+    if (!gl_set(&r, *s)) return r;
+  r.renderer = lm_renderer_create(&(lm_renderer_desc){.scene = run->scene ? run->scene : cornell,
+                                                      .pipeline = r.pipeline, .width = r.width,
+                                                      .height = r.height, .linear_output = true,
+                                                      .check_finite = run->check_finite}, &r.err);
+  if (!r.renderer) return r;
+  r.rgb = malloc(sizeof(float) * 3 * (size_t)r.width * (size_t)r.height);
+  r.srgb = malloc(3 * (size_t)r.width * (size_t)r.height);
+  r.ok = true;
+  for (int f = 0; f < (run->frames ? run->frames : 1) && r.ok; f++) r.ok = lm_renderer_frame(r.renderer, &r.err);
+  if (r.ok) r.ok = read_output(&r);
+  return r;
+}
+
+bool gl_render_again(gl_result *r) {
+  r->ok = lm_renderer_frame(r->renderer, &r->err) && read_output(r);
+  return r->ok;
+}
+
+void gl_result_free(gl_result *r) {
+  lm_renderer_destroy(r->renderer);
+  lm_pipeline_destroy(r->pipeline);
+  free(r->rgb);
+  free(r->srgb);
+  *r = (gl_result){0};
+}
+
+void gl_pass_names(const gl_result *r, char *out, size_t cap) {
+  lm_graph *g = lm_renderer_graph(r->renderer);
+  out[0] = '\0';
+  for (int i = 0; i < lm_graph_pass_count(g); i++) {
+    if (lm_graph_pass(g, i).culled) continue;
+    size_t n = strlen(out);
+    snprintf(out + n, cap - n, "%s ", lm_graph_pass(g, i).name);
+  }
+}
+
+bool gl_has_pass(const gl_result *r, const char *prefix) {
+  lm_graph *g = lm_renderer_graph(r->renderer);
+  for (int i = 0; i < lm_graph_pass_count(g); i++)
+    if (!strncmp(lm_graph_pass(g, i).name, prefix, strlen(prefix))) return true;
+  return false;
+}
+
+int gl_culled(const gl_result *r, const char *prefix) {
+  lm_graph *g = lm_renderer_graph(r->renderer);
+  int n = 0;
+  for (int i = 0; i < lm_graph_pass_count(g); i++) {
+    lm_graph_pass_info p = lm_graph_pass(g, i);
+    n += p.culled && !strncmp(p.name, prefix, strlen(prefix));
+  }
+  return n;
+}
+
+void gl_region(const gl_result *r, int x0, int y0, int x1, int y1, float out[3]) {
+  double sum[3] = {0};
+  int n = 0;
+  for (int y = y0; y <= y1; y++)
+    for (int x = x0; x <= x1; x++, n++)
+      for (int c = 0; c < 3; c++) sum[c] += r->rgb[((size_t)y * r->width + x) * 3 + c];
+  for (int c = 0; c < 3; c++) out[c] = n ? (float)(sum[c] / n) : 0.0f;
+}
+
+float gl_luminance(const float c[3]) { return 0.27f * c[0] + 0.67f * c[1] + 0.06f * c[2]; }
+
+static bool finite_not_negative(const float *v, size_t n) {
+  for (size_t i = 0; i < n; i++)
+    if (!isfinite(v[i]) || v[i] < 0) return false;
+  return true;
+}
+
+bool gl_all_finite(const gl_result *r) { return finite_not_negative(r->rgb, (size_t)r->width * r->height * 3); }
+
+float *gl_read_target(gl_result *r, const char *name, int *width, int *height) {
+  lm_graph *g = lm_renderer_graph(r->renderer);
+  int id = lm_graph_find_target(g, name);
+  if (id < 0) return NULL;
+  lm_graph_target_info t = lm_graph_target(g, id);
+  if (!t.used || !t.texture.id) return NULL; /* an unused target's slot holds another's texels */
+  float *px = malloc(sizeof(float) * 4 * (size_t)t.width * (size_t)t.height);
+  lm_texture_read(t.texture, t.width, t.height, true, px);
+  *width = t.width;
+  *height = t.height;
+  return px;
+}
+
+bool gl_target_finite(gl_result *r, const char *name) {
+  int w, h;
+  float *px = gl_read_target(r, name, &w, &h);
+  bool ok = px && finite_not_negative(px, (size_t)w * h * 4);
+  free(px);
+  return ok;
+}
+
+void gl_project(int width, int height, float x, float y, float z, int *col, int *row) {
+  float depth = 3.4f - z, t = tanf(0.5f * 45.0f * 3.14159265f / 180.0f), aspect = (float)width / height;
+  *col = (int)((x / (depth * t * aspect) + 1) * 0.5f * width);
+  *row = (int)((1 - (y - 1) / (depth * t)) * 0.5f * height);
+}
+
+void gl_mean_around(const gl_result *r, float x, float y, float z, int radius, float out[3]) {
+  int col, row;
+  gl_project(r->width, r->height, x, y, z, &col, &row);
+  gl_region(r, col - radius, row - radius, col + radius, row + radius, out);
+}
+
+void gl_assert_bad_options(const gl_bad_option *cases, size_t n, const char *where) {
+  for (size_t i = 0; i < n; i++) {
+    const char *sets[] = {cases[i].set, NULL};
+    gl_result r = gl_render(&(gl_run){.tech = cases[i].tech, .sets = sets});
+    if (r.ok) fail_msg("%s: rendered", cases[i].set);
+    if (!strstr(r.err.msg, cases[i].expect) || !strstr(r.err.msg, where))
+      fail_msg("%s: '%s'", cases[i].set, r.err.msg);
+    gl_result_free(&r);
+  }
+}

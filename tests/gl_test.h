@@ -1,0 +1,80 @@
+/* Shared by the GL tests: a headless context, the built-in Cornell box and a
+ * scratch engine root for test shaders and scripts; frames of a pipeline
+ * script over a scene, kept open so a test can look at any target
+ * afterwards; where the box's camera sees a world point; option errors. */
+#ifndef LIMN_GL_TEST_H
+#define LIMN_GL_TEST_H
+
+#include "render/render.h"
+
+typedef struct gl_run {
+  lm_scene *scene;          /* borrowed; NULL: gl_cornell() */
+  const char *script;       /* NULL: scripts/pp.lua; a relative path is under the root (LIMN_ROOT) */
+  const char *tech;         /* NULL: the script's default */
+  const char *const *sets;  /* "name=value" options, NULL-terminated (may be NULL) */
+  int width, height;        /* 0: 256 x 192 */
+  int frames;               /* 0: 1 */
+  bool check_finite;        /* the renderer's NaN/Inf attribution */
+} gl_run;
+
+typedef struct gl_result {
+  bool ok;
+  lm_error err;
+  int width, height;
+  float *rgb;               /* the output stage's linear RGB, rows top first */
+  unsigned char *srgb;      /* and its 8-bit sRGB encoding */
+  lm_pipeline *pipeline;
+  lm_renderer *renderer;    /* still open: lm_renderer_graph() shows the last frame */
+} gl_result;
+
+/* Makes the context (fails the test run when there is none), the Cornell
+ * box and a scratch engine root in /tmp: the real shaders linked in one by
+ * one (so a test can add its own) and scripts/ linked whole; LIMN_ROOT
+ * points at it from then on. A cmocka group setup; teardown undoes it. */
+int gl_test_setup(void **state);
+int gl_test_teardown(void **state);
+/* The built-in Cornell box (a test that changes it puts it back). */
+lm_scene *gl_cornell(void);
+/* Writes text to the file `rel` under the scratch root; false when it cannot. */
+bool gl_write_file(const char *rel, const char *text);
+gl_result gl_render(const gl_run *run);
+/* Sets a "name=value" option for the next frame; false with the message in r->err. */
+bool gl_set(gl_result *r, const char *assignment);
+/* Renders one more frame with the same pipeline (after moving a camera, say). */
+bool gl_render_again(gl_result *r);
+void gl_result_free(gl_result *r);
+/* The passes of the last frame that ran, space separated, into out. */
+void gl_pass_names(const gl_result *r, char *out, size_t cap);
+/* Was a pass whose name starts with `prefix` recorded (culled or not)? */
+bool gl_has_pass(const gl_result *r, const char *prefix);
+/* How many passes whose names start with `prefix` ("": any) were recorded and culled. */
+int gl_culled(const gl_result *r, const char *prefix);
+/* Mean linear RGB over x0..x1, y0..y1 (rows from the top). */
+void gl_region(const gl_result *r, int x0, int y0, int x1, int y1, float out[3]);
+float gl_luminance(const float rgb[3]);
+/* Every value finite and not negative. */
+bool gl_all_finite(const gl_result *r);
+/* A used target of the last frame as RGBA floats, rows top first (caller
+ * frees); NULL when the frame has none of that name. */
+float *gl_read_target(gl_result *r, const char *name, int *width, int *height);
+/* Does that target hold only finite values that are not negative? (It is
+ * read before the output stage, which would hide a NaN.) */
+bool gl_target_finite(gl_result *r, const char *name);
+
+/* The pixel of world point (x, y, z) for the camera of the built-in Cornell
+ * box (cornell.c: eye (0, 1, 3.4) looking down -z, fov_y 45 degrees) in a
+ * width x height image, rows from the top. */
+void gl_project(int width, int height, float x, float y, float z, int *col, int *row);
+/* Mean linear RGB of the (2 radius + 1)^2 pixels around a world point of the box. */
+void gl_mean_around(const gl_result *r, float x, float y, float z, int radius, float out[3]);
+
+/* An option that must stop the frame: `set` alone with technique `tech` of
+ * pp.lua fails with a message holding `expect`. */
+typedef struct gl_bad_option {
+  const char *tech, *set, *expect;
+} gl_bad_option;
+/* Fails the test unless each case fails so and its message also holds
+ * `where` (the line to blame, "pp.lua:" say). */
+void gl_assert_bad_options(const gl_bad_option *cases, size_t n, const char *where);
+
+#endif

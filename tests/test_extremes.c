@@ -1,0 +1,193 @@
+/* The extreme-case suite (docs/extremes.md has the table): each case renders
+ * and asserts finite output and a sane image. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <cglm/cglm.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl_test.h"
+
+static lm_scene *builtin(const char *name) {
+  lm_error err;
+  lm_scene *s = lm_scene_builtin(name, &err);
+  assert_non_null(s);
+  return s;
+}
+
+static gl_result render_ok(lm_scene *s, const char *tech, const char *const *sets, int w, int h) {
+  gl_result r = gl_render(&(gl_run){.scene = s, .tech = tech, .sets = sets, .width = w, .height = h});
+  if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
+  if (!gl_all_finite(&r)) fail_msg("%s: a pixel is NaN, Inf or negative", tech);
+  return r;
+}
+
+static float mean_luminance(const gl_result *r) {
+  float all[3];
+  gl_region(r, 0, 0, r->width - 1, r->height - 1, all);
+  return gl_luminance(all);
+}
+
+static const char *const every_technique[] = {"isr+esm", "isr", "dl+esm", "dl", "ssdo+esm", "ssdo", "ssao+esm", "ssao"};
+enum { TECHNIQUES = sizeof every_technique / sizeof *every_technique };
+
+/* Radiance from 1e-8 to 1e6 in one image: a blinding light, a faint background. */
+static void hdr_radiance_from_1e_8_to_1e6(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  s->lights[0].power = 1e6f;
+  static const char *const plain[] = {"background=1e-8", NULL};
+  static const char *const mapped[] = {"background=1e-8", "hdr=true", "bloom=true", NULL};
+  for (int t = 0; t < TECHNIQUES; t++) {
+    gl_result r = render_ok(s, every_technique[t], plain, 64, 48);
+    assert_true(mean_luminance(&r) > 1e3f); /* linear output keeps the radiance */
+    gl_result_free(&r);
+  }
+  gl_result r = render_ok(s, "isr+esm", mapped, 64, 48);
+  assert_true(mean_luminance(&r) <= 1.0f); /* tone mapped into display range */
+  gl_result_free(&r);
+  s->lights[0].power = 1e-8f;
+  r = render_ok(s, "dl", NULL, 64, 48);
+  assert_true(mean_luminance(&r) < 0.05f);
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+}
+
+/* The point light inside the tall box: with shadows the room goes dark. */
+static void a_light_inside_geometry(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  float *m = s->nodes[s->lights[0].node].local;
+  m[12] = -0.35f, m[13] = 0.6f, m[14] = -0.35f;
+  lm_scene_update(s);
+  gl_result open = render_ok(s, "dl", NULL, 128, 96), closed = render_ok(s, "dl+esm", NULL, 128, 96);
+  printf("light in the box: mean luminance %.4f without shadows, %.4f with\n", mean_luminance(&open),
+         mean_luminance(&closed));
+  assert_true(mean_luminance(&closed) < 0.2f * mean_luminance(&open));
+  gl_result_free(&open);
+  gl_result_free(&closed);
+  lm_scene_destroy(s);
+}
+
+/* Camera near 1e-4 and far 1e6: depth precision at its worst. */
+static void near_1e_4_far_1e6(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  s->cameras[0].znear = 1e-4f;
+  s->cameras[0].zfar = 1e6f;
+  for (int t = 0; t < TECHNIQUES; t++) {
+    gl_result r = render_ok(s, every_technique[t], NULL, 128, 96);
+    float left[3];
+    gl_region(&r, 22, 40, 32, 55, left); /* the red wall still reads red */
+    if (!(left[0] > 2 * left[1])) fail_msg("%s: left wall %g %g %g", every_technique[t], left[0], left[1], left[2]);
+    gl_result_free(&r);
+  }
+  lm_scene_destroy(s);
+}
+
+static void outputs_of_1x1_and_8192x8192(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  for (int t = 0; t < TECHNIQUES; t++) {
+    gl_result r = render_ok(s, every_technique[t], NULL, 1, 1);
+    gl_result_free(&r);
+  }
+  gl_result r = render_ok(s, "dl", NULL, 8192, 8192);
+  float centre[3];
+  gl_region(&r, 4000, 4000, 4100, 4100, centre); /* the back wall */
+  assert_true(gl_luminance(centre) > 0.1f);
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+}
+
+static void zero_lights_and_64_lights(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  gl_result one = render_ok(s, "dl", NULL, 64, 48);
+  lm_light light = s->lights[0];
+  s->light_count = 0;
+  for (int t = 0; t < TECHNIQUES; t++) {
+    gl_result r = render_ok(s, every_technique[t], NULL, 64, 48);
+    assert_true(mean_luminance(&r) < 0.05f); /* ambient only */
+    gl_result_free(&r);
+  }
+  for (int i = 0; i < 64; i++) {
+    lm_light l = light;
+    l.power = 0.05f;
+    l.casts_shadows = i % 8 == 0;
+    mat4 m;
+    glm_translate_make(m, (vec3){-0.9f + 1.8f * (float)(i % 8) / 7.0f, 1.9f, -0.9f + 1.8f * (float)(i / 8) / 7.0f});
+    l.node = lm_scene_add_node(s, "light", -1, (float *)m, -1, -1);
+    lm_scene_add_light(s, &l);
+  }
+  lm_scene_update(s);
+  assert_int_equal(s->light_count, 64);
+  gl_result many = render_ok(s, "isr+esm", NULL, 64, 48);
+  assert_true(mean_luminance(&many) > 0.5f * mean_luminance(&one));
+  gl_result_free(&many);
+  gl_result_free(&one);
+  lm_scene_destroy(s);
+}
+
+/* A scene of one triangle whose corners coincide, and one with a NaN corner. */
+static void degenerate_and_nan_geometry(void **state) {
+  (void)state;
+  for (int kind = 0; kind < 2; kind++) {
+    lm_scene *s = lm_scene_create("degenerate");
+    float v[3 * 8] = {0};
+    for (int i = 0; i < 3; i++) v[i * 8 + 2] = -2.0f; /* all at one point */
+    if (kind == 1) v[8] = NAN, v[9] = 1, v[16] = 1; /* a real triangle with a NaN corner */
+    uint32_t idx[3] = {0, 1, 2};
+    mat4 id = GLM_MAT4_IDENTITY_INIT;
+    lm_material m = {"m", {0.5f, 0.5f, 0.5f}, 0.5f, 1, 1, 0, 1};
+    lm_scene_add_node(s, "tri", -1, (float *)id, lm_scene_add_mesh(s, "tri", v, 3, idx, 3),
+                      lm_scene_add_material(s, &m));
+    int ln = lm_scene_add_node(s, "light", -1, (float *)id, -1, -1);
+    lm_scene_add_light(s, &(lm_light){.name = "l", .type = LM_LIGHT_POINT, .color = {1, 1, 1}, .power = 1,
+                                       .radius = 10, .casts_shadows = true, .node = ln});
+    lm_scene_update(s);
+    for (int t = 0; t < TECHNIQUES; t++) {
+      gl_result r = render_ok(s, every_technique[t], NULL, 64, 48);
+      assert_true(mean_luminance(&r) < 0.5f);
+      gl_result_free(&r);
+    }
+    lm_scene_destroy(s);
+  }
+}
+
+/* A target larger than the GL limit is refused, naming it and its size. */
+static void oversize_targets_are_refused(void **state) {
+  (void)state;
+  const char *path = "/tmp/limn-extremes-huge.lua";
+  FILE *f = fopen(path, "w");
+  assert_non_null(f);
+  fputs("Techniques = { 'x' }\nfunction OnRender()\n"
+        "  local t = target{ 'huge', format = 'r32f', size = { 65536, 65536 } }\n"
+        "  scene{ 'fill', technique = 'shadow', out = t }\n  present(t)\nend\n", f);
+  fclose(f);
+  lm_scene *s = builtin("cornell");
+  gl_result r = gl_render(&(gl_run){.scene = s, .script = path, .width = 8, .height = 8});
+  assert_false(r.ok);
+  if (!strstr(r.err.msg, "target 'huge': size 65536x65536 is outside 1x1 ..")) fail_msg("%s", r.err.msg);
+  gl_result_free(&r);
+  remove(path);
+  lm_scene_destroy(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(hdr_radiance_from_1e_8_to_1e6),
+      cmocka_unit_test(a_light_inside_geometry),
+      cmocka_unit_test(near_1e_4_far_1e6),
+      cmocka_unit_test(outputs_of_1x1_and_8192x8192),
+      cmocka_unit_test(zero_lights_and_64_lights),
+      cmocka_unit_test(degenerate_and_nan_geometry),
+      cmocka_unit_test(oversize_targets_are_refused),
+  };
+  return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
+}

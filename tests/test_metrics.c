@@ -1,0 +1,170 @@
+/* Image metrics (engine/image/metrics.h) against values worked out by hand
+ * on tiny images, and their defined results where a formula has none
+ * (identical images, constant images). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <string.h>
+
+#include "image/metrics.h"
+
+static lm_image img(int w, int h, int c, float *px) { return (lm_image){w, h, c, px}; }
+
+/* A = (0,0,0) (1,1,1); B = (0.5,0,0) (1,1,0.5): differences 0.5 0 0 0 0 0.5. */
+static void two_pixels_by_hand(void **state) {
+  (void)state;
+  float pa[] = {0, 0, 0, 1, 1, 1}, pb[] = {0.5f, 0, 0, 1, 1, 0.5f};
+  lm_image a = img(2, 1, 3, pa), b = img(2, 1, 3, pb);
+  lm_metrics m;
+  lm_metrics_compute(&a, &b, &m);
+  assert_int_equal(m.channels, 3);
+  assert_float_equal(m.mean_error, 1.0 / 6.0, 1e-12);        /* eq 19: (0.5 + 0.5) / (3 * 2) */
+  assert_float_equal(m.max_error, 0.5, 1e-12);
+  assert_float_equal(m.rmse, sqrt(0.5 / 6.0), 1e-12);         /* sqrt((0.25 + 0.25) / 6) */
+  assert_float_equal(m.psnr, 10.0 * log10(12.0), 1e-9);       /* mse 1/12 */
+  assert_false(m.identical);
+  /* eq 20: means 0.5 and 0.5; sum xy = 1, sum xx = 1.5, sum yy = 1 */
+  assert_float_equal(m.pearson, 1.0 / sqrt(1.5), 1e-12);
+  assert_true(m.ssim > 0 && m.ssim < 1);
+  assert_float_equal(m.closer, -1, 0);
+}
+
+/* One pixel, one channel: the window is the pixel itself, so both variances
+ * and the covariance are 0 and SSIM = (2xy + C1) / (x^2 + y^2 + C1). */
+static void ssim_of_one_pixel_by_hand(void **state) {
+  (void)state;
+  float pa[] = {0.5f}, pb[] = {0.25f};
+  lm_image a = img(1, 1, 1, pa), b = img(1, 1, 1, pb);
+  lm_metrics m;
+  lm_metrics_compute(&a, &b, &m);
+  double c1 = 0.01 * 0.01;
+  assert_float_equal(m.ssim, (2 * 0.5 * 0.25 + c1) / (0.25 + 0.0625 + c1), 1e-12);
+  assert_float_equal(m.mean_error, 0.25, 1e-12);
+  assert_int_equal(m.channels, 1);
+}
+
+static void ssim_is_symmetric_and_one_for_identical(void **state) {
+  (void)state;
+  float pa[4 * 4 * 3], pb[4 * 4 * 3];
+  for (int i = 0; i < 48; i++) pa[i] = (float)((i * 7) % 11) / 10.0f, pb[i] = (float)((i * 5) % 13) / 12.0f;
+  lm_image a = img(4, 4, 3, pa), b = img(4, 4, 3, pb);
+  lm_metrics ab, ba, aa;
+  lm_metrics_compute(&a, &b, &ab);
+  lm_metrics_compute(&b, &a, &ba);
+  lm_metrics_compute(&a, &a, &aa);
+  assert_float_equal(ab.ssim, ba.ssim, 1e-12);
+  assert_float_equal(ab.pearson, ba.pearson, 1e-12);
+  assert_true(ab.ssim < 0.9);
+  assert_float_equal(aa.ssim, 1.0, 1e-12);
+  assert_float_equal(aa.pearson, 1.0, 1e-12);
+  assert_true(aa.identical);
+  assert_true(isinf(aa.psnr) && aa.psnr > 0);
+  assert_float_equal(aa.mean_error, 0, 0);
+  assert_float_equal(aa.rmse, 0, 0);
+}
+
+/* Pearson of a constant image is 0/0 by the formula: defined as 1 when both
+ * are constant and equal, else 0 - never NaN. */
+static void constant_images_have_a_defined_pearson(void **state) {
+  (void)state;
+  float k1[] = {0.3f, 0.3f, 0.3f, 0.3f, 0.3f, 0.3f}, k2[] = {0.7f, 0.7f, 0.7f, 0.7f, 0.7f, 0.7f};
+  float v[] = {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f};
+  lm_image c1 = img(2, 1, 3, k1), c2 = img(2, 1, 3, k2), var = img(2, 1, 3, v);
+  lm_metrics m;
+  lm_metrics_compute(&c1, &c1, &m);
+  assert_float_equal(m.pearson, 1.0, 0);
+  lm_metrics_compute(&c1, &c2, &m);
+  assert_float_equal(m.pearson, 0.0, 0);
+  assert_float_equal(m.mean_error, 0.4, 1e-6);
+  lm_metrics_compute(&c1, &var, &m);
+  assert_float_equal(m.pearson, 0.0, 0);
+  lm_metrics_compute(&var, &c2, &m);
+  assert_float_equal(m.pearson, 0.0, 0);
+  assert_false(isnan(m.ssim));
+  /* a linear map of an image correlates perfectly; a negated one at -1 */
+  float lin[6], neg[6];
+  for (int i = 0; i < 6; i++) lin[i] = 2 * v[i] + 0.1f, neg[i] = 1 - v[i];
+  lm_image l = img(2, 1, 3, lin), n = img(2, 1, 3, neg);
+  lm_metrics_compute(&var, &l, &m);
+  assert_float_equal(m.pearson, 1.0, 1e-6);
+  lm_metrics_compute(&var, &n, &m);
+  assert_float_equal(m.pearson, -1.0, 1e-6);
+}
+
+/* Alpha is left out: two RGBA images that differ only in alpha are identical. */
+static void alpha_is_not_compared(void **state) {
+  (void)state;
+  float pa[] = {0.1f, 0.2f, 0.3f, 1.0f}, pb[] = {0.1f, 0.2f, 0.3f, 0.0f};
+  lm_image a = img(1, 1, 4, pa), b = img(1, 1, 4, pb);
+  lm_metrics m;
+  lm_metrics_compute(&a, &b, &m);
+  assert_int_equal(m.channels, 3);
+  assert_true(m.identical);
+}
+
+/* Pixel 0: A off by 0.1, B by 0.3 (A closer); pixel 1: both off by 0.2
+ * (tie); pixel 2: A off by 0.5, B exact (B closer); pixel 3: A exact. */
+static void closer_share_by_hand(void **state) {
+  (void)state;
+  float pr[] = {0.5f, 0.5f, 0.5f, 0.5f}, pa[] = {0.6f, 0.7f, 0.0f, 0.5f}, pb[] = {0.2f, 0.3f, 0.5f, 0.9f};
+  lm_image r = img(4, 1, 1, pr), a = img(4, 1, 1, pa), b = img(4, 1, 1, pb);
+  lm_metrics m;
+  lm_metrics_compute(&a, &b, &m);
+  lm_metrics_closer(&a, &b, &r, &m);
+  assert_float_equal(m.closer, 0.5, 1e-12);
+  assert_float_equal(m.ties, 0.25, 1e-12);
+}
+
+static void mismatched_images_are_refused_by_name(void **state) {
+  (void)state;
+  float p[12] = {0};
+  lm_image a = img(2, 2, 3, p), b = img(2, 1, 3, p), c = img(2, 2, 1, p), e = img(0, 0, 3, NULL);
+  lm_error err;
+  assert_true(lm_metrics_check(&a, "a.exr", &a, "b.exr", &err));
+  assert_false(lm_metrics_check(&a, "a.exr", &b, "b.png", &err));
+  assert_string_equal(err.msg, "sizes differ: a.exr is 2x2, b.png is 2x1");
+  assert_false(lm_metrics_check(&a, "a.exr", &c, "c.png", &err));
+  assert_string_equal(err.msg, "channel counts differ: a.exr has 3, c.png has 1");
+  assert_false(lm_metrics_check(&a, "a.exr", &e, "e.exr", &err));
+  assert_string_equal(err.msg, "e.exr: empty image");
+  float bad[12] = {0};
+  bad[3 * 3 + 1] = NAN; /* pixel (1, 1), green */
+  lm_image n = img(2, 2, 3, bad);
+  assert_false(lm_metrics_check(&a, "a.exr", &n, "n.exr", &err));
+  assert_string_equal(err.msg, "n.exr: pixel (1, 1) channel 1 is not finite (NaN or Inf)");
+  bad[3 * 3 + 1] = 0;
+  bad[3] = INFINITY;
+  assert_false(lm_metrics_check(&n, "n.exr", &a, "a.exr", &err));
+  assert_string_equal(err.msg, "n.exr: pixel (1, 0) channel 0 is not finite (NaN or Inf)");
+  bad[3] = 0;
+  assert_true(lm_metrics_check(&n, "n.exr", &a, "a.exr", &err));
+}
+
+/* The heat map's ramp: 0 black, half the scale red, the scale and beyond white. */
+static void heatmap_ramp(void **state) {
+  (void)state;
+  float pa[] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, pb[] = {0, 0, 0, 0.5f, 0.5f, 0.5f, 2, 2, 2};
+  lm_image a = img(3, 1, 3, pa), b = img(3, 1, 3, pb);
+  unsigned char rgb[9];
+  lm_metrics_heatmap(&a, &b, 1.0, rgb);
+  static const unsigned char want[9] = {0, 0, 0, 255, 0, 0, 255, 255, 255};
+  assert_memory_equal(rgb, want, 9);
+  assert_float_equal(lm_metrics_max_pixel_error(&a, &b), 2.0, 1e-12);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(two_pixels_by_hand),
+      cmocka_unit_test(ssim_of_one_pixel_by_hand),
+      cmocka_unit_test(ssim_is_symmetric_and_one_for_identical),
+      cmocka_unit_test(constant_images_have_a_defined_pearson),
+      cmocka_unit_test(alpha_is_not_compared),
+      cmocka_unit_test(closer_share_by_hand),
+      cmocka_unit_test(mismatched_images_are_refused_by_name),
+      cmocka_unit_test(heatmap_ramp),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,270 @@
+/* The shadow manager: plans (no GL), then shadows on the Cornell box and the
+ * field, every filter, extreme exponents and depth ranges, cascade
+ * stabilization, and that nothing is rendered when nothing casts or reads. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <cglm/cglm.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl_test.h"
+#include "shadow/shadow.h"
+
+static lm_scene *builtin(const char *name) {
+  lm_error err;
+  lm_scene *s = lm_scene_builtin(name, &err);
+  assert_non_null(s);
+  return s;
+}
+
+/* ---- plans (no GL) ------------------------------------------------------ */
+static void plans_cover_every_caster(void **state) {
+  (void)state;
+  lm_scene *s = builtin("field");
+  lm_frame_data cam;
+  lm_scene_frame_data(s, 0, 256, 192, &cam);
+  lm_shadow_settings st;
+  lm_shadow_settings_default(&st);
+  lm_shadow_plan plan;
+  lm_error err;
+  assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+  assert_int_equal(plan.view_count, 3); /* one sun, three cascades */
+  assert_int_equal(plan.lights[0].info[2], 1);
+  float last = cam.clip[0];
+  for (int k = 0; k < 3; k++) {
+    assert_true(plan.lights[0].splits[k] > last);
+    last = plan.lights[0].splits[k];
+  }
+  assert_float_equal(last, cam.clip[1], 1e-3f);
+  assert_int_equal(plan.atlas_width, 2 * 512);
+  assert_int_equal(plan.atlas_height, 2 * 512);
+  lm_shadow_plan_free(&plan);
+  /* lambda 0: uniform splits. */
+  st.lambda = 0;
+  st.cascades = 4;
+  assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+  float step = (cam.clip[1] - cam.clip[0]) / 4;
+  for (int k = 0; k < 4; k++) assert_float_equal(plan.lights[0].splits[k], cam.clip[0] + step * (k + 1), 1e-2f);
+  lm_shadow_plan_free(&plan);
+  st.cascades = 5;
+  assert_false(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+  lm_scene_destroy(s);
+
+  s = builtin("cornell"); /* a point light: six cube faces */
+  lm_scene_frame_data(s, 0, 256, 192, &cam);
+  lm_shadow_settings_default(&st);
+  assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+  assert_int_equal(plan.view_count, 6);
+  assert_int_equal(plan.lights[0].info[2], 3);
+  assert_float_equal(plan.view_data[0].depth[3], 1.0f / 4.0f, 1e-6f); /* 1 / radius */
+  lm_shadow_plan_free(&plan);
+  s->lights[0].casts_shadows = false;
+  assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+  assert_int_equal(plan.view_count, 0);
+  lm_shadow_plan_free(&plan);
+  lm_scene_destroy(s);
+}
+
+/* ---- images ------------------------------------------------------------- */
+/* Ratio of luminance with shadows to without, over a region. */
+static float shadow_ratio(const gl_result *lit, const gl_result *shadowed, int x0, int y0, int x1, int y1) {
+  float a[3], b[3];
+  gl_region(lit, x0, y0, x1, y1, a);
+  gl_region(shadowed, x0, y0, x1, y1, b);
+  return gl_luminance(b) / fmaxf(gl_luminance(a), 1e-12f);
+}
+
+static gl_result render_ok(lm_scene *s, const char *tech, const char *const *sets) {
+  gl_result r = gl_render(&(gl_run){.scene = s, .tech = tech, .sets = sets});
+  if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
+  if (!gl_all_finite(&r)) fail_msg("%s: a pixel is NaN, Inf or negative", tech);
+  return r;
+}
+
+/* In the Cornell box the tall box shades the lower left wall (pixels 66..78 x
+ * 116..156) from the ceiling light; the back wall and the floor in front of
+ * the tall box stay lit. */
+static void check_cornell(lm_scene *s, const gl_result *plain, const char *const *sets, float dark) {
+  gl_result r = render_ok(s, "dl+esm", sets);
+  float occluded = shadow_ratio(plain, &r, 66, 116, 78, 156);
+  float back = shadow_ratio(plain, &r, 110, 40, 150, 80), floor_ = shadow_ratio(plain, &r, 62, 178, 90, 188);
+  if (!(occluded < dark && back > 0.97f && back < 1.001f && floor_ > 0.97f && floor_ < 1.001f))
+    fail_msg("%s: occluded %.3f, back wall %.3f, floor %.3f", sets && sets[0] ? sets[0] : "defaults",
+             occluded, back, floor_);
+  gl_result_free(&r);
+}
+
+static void occluded_points_are_dark_for_every_filter(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  gl_result plain = render_ok(s, "dl", NULL);
+  check_cornell(s, &plain, NULL, 0.1f);
+  static const char *const filters[][2] = {{"shadow.technique=pcf", NULL}, {"shadow.technique=poisson", NULL},
+                                           {"shadow.technique=hard", NULL}, {"shadow.blur=0", NULL}};
+  for (size_t i = 0; i < sizeof filters / sizeof *filters; i++) check_cornell(s, &plain, filters[i], 0.1f);
+  gl_result_free(&plain);
+  /* The same light as a spot shining down: one perspective tile. */
+  s->lights[0].type = LM_LIGHT_SPOT;
+  s->lights[0].inner_cone = glm_rad(55.0f);
+  s->lights[0].outer_cone = glm_rad(75.0f);
+  plain = render_ok(s, "dl", NULL);
+  check_cornell(s, &plain, NULL, 0.1f);
+  gl_result_free(&plain);
+  lm_scene_destroy(s);
+}
+
+static void extreme_exponents_stay_finite_and_on_the_right_side(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  gl_result plain = render_ok(s, "dl", NULL);
+  static const char *const c500[] = {"shadow.c=500", NULL}, *const c1[] = {"shadow.c=1", NULL};
+  check_cornell(s, &plain, c500, 0.1f);
+  /* c = 1 softens so much that shadows nearly vanish, but nothing breaks. */
+  gl_result r = render_ok(s, "dl+esm", c1);
+  assert_true(shadow_ratio(&plain, &r, 66, 116, 78, 156) <= 1.001f);
+  gl_result_free(&r);
+  gl_result_free(&plain);
+  lm_scene_destroy(s);
+}
+
+/* Share of ground pixels (rows 120..191) that shadows darken below half. */
+static float shadowed_share(const gl_result *plain, const gl_result *r) {
+  int dark = 0, n = 0;
+  for (int y = 120; y < r->height; y++)
+    for (int x = 0; x < r->width; x++, n++) {
+      const float *a = plain->rgb + ((size_t)y * r->width + x) * 3, *b = r->rgb + ((size_t)y * r->width + x) * 3;
+      dark += gl_luminance(b) < 0.5f * gl_luminance(a);
+    }
+  return (float)dark / (float)n;
+}
+
+static void the_sun_casts_cascaded_shadows_at_any_depth_range(void **state) {
+  (void)state;
+  lm_scene *s = builtin("field");
+  gl_result plain = render_ok(s, "dl", NULL), r = render_ok(s, "dl+esm", NULL);
+  float share = shadowed_share(&plain, &r);
+  if (!(share > 0.02f && share < 0.6f)) fail_msg("shadowed share %.3f", share);
+  gl_result_free(&r);
+  gl_result_free(&plain);
+  /* Near 1e-2 and far 1e4, with c = 500; cascades reach 60 m (left to the
+   * far plane they would spread 512 texels over kilometres). */
+  s->cameras[0].znear = 1e-2f;
+  s->cameras[0].zfar = 1e4f;
+  static const char *const c500[] = {"shadow.c=500", "shadow.distance=60", NULL};
+  plain = render_ok(s, "dl", NULL);
+  r = render_ok(s, "dl+esm", c500);
+  share = shadowed_share(&plain, &r);
+  if (!(share > 0.01f && share < 0.6f)) fail_msg("shadowed share %.3f at near 1e-2, far 1e4", share);
+  gl_result_free(&r);
+  gl_result_free(&plain);
+  lm_scene_destroy(s);
+}
+
+/* Mean difference between the first cascade's tile in two maps, at the best
+ * whole-texel shift: a stabilized map only ever moves by whole texels. */
+static double tile_change(const float *a, const float *b, int width, int height, int tile) {
+  double best = INFINITY;
+  for (int dy = -2; dy <= 2; dy++)
+    for (int dx = -2; dx <= 2; dx++) {
+      double sum = 0;
+      int n = 0;
+      for (int y = 4; y < tile - 4; y++)
+        for (int x = 4; x < tile - 4; x++, n++) {
+          int row = height - 1 - y; /* the tile is the atlas's bottom-left; rows come top first */
+          sum += fabs(a[((size_t)row * width + x) * 4] - b[((size_t)(row - dy) * width + x + dx) * 4]);
+        }
+      best = fmin(best, sum / n);
+    }
+  return best;
+}
+
+static double shimmer(lm_scene *s, const char *stabilize, bool rotate) {
+  const char *sets[] = {stabilize, "shadow.resolution=256", NULL};
+  float *cam = s->nodes[s->cameras[0].node].local;
+  float saved[16];
+  memcpy(saved, cam, sizeof saved);
+  gl_result r = render_ok(s, "dl+esm", sets);
+  int w, h;
+  float *before = gl_read_target(&r, "shadow.map", &w, &h);
+  assert_non_null(before);
+  /* Sub-texel: a cascade-0 texel here is several centimetres wide. */
+  if (rotate) {
+    mat4 m;
+    memcpy(m, cam, sizeof m);
+    glm_rotate_y(m, glm_rad(0.05f), m);
+    memcpy(cam, m, sizeof m);
+  } else {
+    cam[12] += 0.004f;
+    cam[14] -= 0.003f;
+  }
+  lm_scene_update(s);
+  assert_true(gl_render_again(&r));
+  float *after = gl_read_target(&r, "shadow.map", &w, &h);
+  double change = tile_change(before, after, w, h, 256);
+  memcpy(cam, saved, sizeof saved);
+  lm_scene_update(s);
+  free(before);
+  free(after);
+  gl_result_free(&r);
+  return change;
+}
+
+static void stabilized_cascades_do_not_shimmer(void **state) {
+  (void)state;
+  lm_scene *s = builtin("field");
+  for (int rotate = 0; rotate < 2; rotate++) {
+    double stable = shimmer(s, "shadow.stabilize=true", rotate), loose = shimmer(s, "shadow.stabilize=false", rotate);
+    printf("cascade 0 change after a sub-texel %s: stabilized %.3g, unstabilized %.3g\n",
+           rotate ? "turn" : "move", stable, loose);
+    if (!(stable < 1e-5 && loose > 10 * stable + 1e-5)) fail_msg("stabilized %g, unstabilized %g", stable, loose);
+  }
+  lm_scene_destroy(s);
+}
+
+static void nothing_casts_or_nothing_reads_means_no_shadow_pass(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  gl_result r = render_ok(s, "dl", NULL);
+  assert_false(gl_has_pass(&r, "shadow."));
+  gl_result_free(&r);
+  r = render_ok(s, "dl+esm", NULL);
+  assert_true(gl_has_pass(&r, "shadow.depth"));
+  gl_result_free(&r);
+  s->lights[0].casts_shadows = false;
+  r = render_ok(s, "dl+esm", NULL);
+  assert_false(gl_has_pass(&r, "shadow."));
+  assert_int_equal(lm_graph_find_target(lm_renderer_graph(r.renderer), "shadow.map"), -1);
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+}
+
+static void the_atlas_can_be_viewed(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  static const char *const debug[] = {"shadow.debug=true", NULL};
+  gl_result r = render_ok(s, "dl+esm", debug);
+  float all[3];
+  gl_region(&r, 0, 0, r.width - 1, r.height - 1, all);
+  assert_true(gl_luminance(all) > 0.05f);
+  assert_false(gl_has_pass(&r, "gbuffer"));
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(plans_cover_every_caster),
+      cmocka_unit_test(occluded_points_are_dark_for_every_filter),
+      cmocka_unit_test(extreme_exponents_stay_finite_and_on_the_right_side),
+      cmocka_unit_test(the_sun_casts_cascaded_shadows_at_any_depth_range),
+      cmocka_unit_test(stabilized_cascades_do_not_shimmer),
+      cmocka_unit_test(nothing_casts_or_nothing_reads_means_no_shadow_pass),
+      cmocka_unit_test(the_atlas_can_be_viewed),
+  };
+  return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
+}

@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# limn export-pov and limn compare as a user meets them: help, bad flags
+# (exit 2), refusals naming the light, mismatched images (exit 2 with both
+# sizes in the message), JSON with a defined PSNR for identical images.
+set -u
+limn=$1
+root=$2
+tmp=$(mktemp -d /tmp/limn-tools-XXXXXX)
+trap 'rm -rf "$tmp"' EXIT
+passed=0 failed=0
+check() {
+  local name=$1; shift
+  if "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $name"; fi
+}
+run() {
+  local want=$1; shift
+  "$limn" "$@" >"$tmp/out" 2>"$tmp/err"; rc=$?
+  [ "$rc" -eq "$want" ] || { echo "  '$*' exited $rc, wanted $want"; sed 's/^/  | /' "$tmp/err" | head -5; return 1; }
+}
+err_has() { grep -qF -- "$1" "$tmp/err" || { echo "  stderr lacks '$1':"; sed 's/^/  | /' "$tmp/err" | head -5; return 1; }; }
+out_has() { grep -qF -- "$1" "$tmp/out" || { echo "  stdout lacks '$1':"; sed 's/^/  | /' "$tmp/out" | head -5; return 1; }; }
+
+# export-pov
+check "help lists export-pov" run 0 --help
+check "help names export-pov" out_has "export-pov"
+check "help names compare" out_has "compare"
+check "export help" run 0 export-pov --help
+for flag in --scene --camera --size --radiosity --count --error-bound --pretrace-start --pretrace-end \
+            --recursion-limit --brightness --shadows --approximate --output; do
+  check "export help names $flag" out_has "$flag"
+done
+check "export needs output" run 2 export-pov --scene cornell_pov
+check "export needs output message" err_has "--output FILE.pov is required"
+check "export bad radiosity" run 2 export-pov --radiosity maybe --output "$tmp/x.pov"
+check "export bad count" run 2 export-pov --count 0 --output "$tmp/x.pov"
+check "export bad pretrace order" run 2 export-pov --pretrace-start 0.01 --pretrace-end 0.08 --output "$tmp/x.pov"
+check "export bad pretrace message" err_has "pretrace_end"
+check "export unknown scene" run 2 export-pov --scene nope --output "$tmp/x.pov"
+check "export bad camera" run 2 export-pov --scene cornell_pov --camera 4 --output "$tmp/x.pov"
+check "export bad camera message" err_has "has 1 camera(s)"
+check "export refuses the window falloff" run 1 export-pov --scene cornell --output "$tmp/w.pov"
+check "refusal names the light" err_has "light 'ceiling_light': the window falloff"
+check "refusal writes nothing" test ! -e "$tmp/w.pov"
+check "approximate writes with a warning" run 0 export-pov --scene cornell --approximate --output "$tmp/w.pov"
+check "approximate warns by name" err_has "light 'ceiling_light'"
+check "approximate wrote the file" test -s "$tmp/w.pov"
+check "export cornell_pov" run 0 export-pov --scene cornell_pov --size 64x48 --count 100 --brightness 1.5 \
+  --output "$tmp/c.pov"
+check "radiosity flags reach the file" grep -q "count 100" "$tmp/c.pov"
+check "brightness reaches the file" grep -q "brightness 1.5" "$tmp/c.pov"
+check "no temporary file left" bash -c "[ -z \"\$(ls '$tmp' | grep tmp-)\" ]"
+
+# compare: images made by capture (PNG and EXR) at two sizes
+"$limn" capture --scene cornell --size 32x24 --output "$tmp/a.png" --output "$tmp/a.exr" --quiet
+"$limn" capture --scene cornell --size 32x24 --set ambient=0.2 --output "$tmp/b.png" --output "$tmp/b.exr" --quiet
+"$limn" capture --scene cornell --size 16x12 --output "$tmp/small.png" --quiet
+check "compare help" run 0 compare --help
+check "compare help names --ref" out_has "--ref"
+check "compare needs two images" run 2 compare "$tmp/a.png"
+check "compare needs two images message" err_has "wants two images"
+check "compare unreadable file" run 2 compare "$tmp/a.png" "$tmp/nope.png"
+check "compare unreadable names it" err_has "nope.png"
+check "compare sizes differ" run 2 compare "$tmp/a.png" "$tmp/small.png"
+check "sizes differ message" err_has "sizes differ: $tmp/a.png is 32x24, $tmp/small.png is 16x12"
+check "compare bad diff type" run 2 compare "$tmp/a.png" "$tmp/b.png" --diff "$tmp/d.bmp"
+check "compare identical" run 0 compare "$tmp/a.exr" "$tmp/a.exr"
+check "identical PSNR is inf" out_has "inf (identical)"
+check "compare identical json" run 0 compare "$tmp/a.exr" "$tmp/a.exr" --json
+check "identical PSNR is null in JSON" out_has '"psnr": null, "identical": true'
+check "identical Pearson is 1" out_has '"pearson": 1,'
+check "compare exr" run 0 compare "$tmp/a.exr" "$tmp/b.exr" --ref "$tmp/a.exr" --json --diff "$tmp/d.png"
+check "different images have a finite PSNR" out_has '"identical": false'
+# a pixel of A is closer to A than B's, or a tie where ambient changes nothing (the background)
+closer_and_ties() { grep -o '"closer": [0-9.e-]*, "ties": [0-9.e-]*' "$tmp/out" | awk '{ exit !($2 + $4 > 0.999999 && $2 > 0.5) }'; }
+check "A is closer to itself than B, or tied" closer_and_ties
+check "heat map written" test -s "$tmp/d.png"
+check "compare png with exr diff" run 0 compare "$tmp/a.png" "$tmp/b.png" --diff "$tmp/d.exr"
+check "table names eq 19" out_has "mean error (eq 19)"
+check "diff exr written" test -s "$tmp/d.exr"
+
+# bench: two sizes, one frame each; the clock named, a fit per pass
+check "bench help" run 0 bench --help
+check "bench bad sizes" run 2 bench --sizes 32x24,big
+check "bench bad sizes message" err_has "--sizes wants WxH"
+check "bench json" run 0 bench --tech dl --sizes 32x24,64x48 --frames 1 --warmup 0 --json
+check "bench names the clock" out_has '"clock": "'
+check "bench has overhead" out_has '"overhead_ms": '
+check "bench fits the direct pass" out_has '{"name": "direct", "ms": ['
+check "bench fit per pixel" out_has '"ns_per_pixel": '
+check "bench table" run 0 bench --sizes 32x24,64x48 --frames 1 --warmup 0
+check "bench table names the fit" out_has "fit: a ms + b ns/pixel"
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]

@@ -1,0 +1,50 @@
+/* Flag values shared by the limn subcommands. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tools.h"
+
+bool limn_parse_int(const char *s, int lo, int hi, int *out) {
+  char *end;
+  long v = strtol(s, &end, 10);
+  if (end == s || *end || v < lo || v > hi) return false;
+  *out = (int)v;
+  return true;
+}
+
+bool limn_parse_double(const char *s, double *out) {
+  char *end;
+  double v = strtod(s, &end);
+  if (end == s || *end || !isfinite(v)) return false;
+  *out = v;
+  return true;
+}
+
+bool limn_parse_size(const char *s, int *w, int *h) {
+  char buf[64];
+  snprintf(buf, sizeof buf, "%s", s);
+  char *x = strchr(buf, 'x');
+  if (!x) return false;
+  *x = '\0';
+  return limn_parse_int(buf, 1, 65536, w) && limn_parse_int(x + 1, 1, 65536, h);
+}
+
+bool limn_parse_on_off(const char *s, bool *out) {
+  if (!strcmp(s, "on")) *out = true;
+  else if (!strcmp(s, "off")) *out = false;
+  else return false;
+  return true;
+}
+
+void limn_json_string(const char *s) {
+  putchar('"');
+  for (; *s; s++) {
+    unsigned char ch = (unsigned char)*s;
+    if (ch == '"' || ch == '\\') printf("\\%c", ch);
+    else if (ch < 0x20) printf("\\u%04x", ch);
+    else putchar(ch);
+  }
+  putchar('"');
+}

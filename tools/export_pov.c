@@ -1,0 +1,183 @@
+/* limn export-pov: one view of a scene as POV-Ray 3.7 SDL (engine/scene/pov.h). */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "scene/gltf.h"
+#include "scene/pov.h"
+#include "tools.h"
+
+static const char export_usage[] =
+    "usage: limn export-pov [options] --output FILE.pov\n"
+    "\n"
+    "Writes the scene, lights and camera of one view as POV-Ray 3.7 scene\n"
+    "description, linear (assumed_gamma 1), with the engine's camera, mesh2\n"
+    "geometry in world space and a finish per material that matches the\n"
+    "engine's direct light. What POV-Ray cannot match (the window falloff,\n"
+    "spot cones of 90 degrees or more, colours outside [0, 1]) is refused,\n"
+    "naming the light or material. Render the file with the command in its\n"
+    "first lines (povray ... +FE: OpenEXR, one sample a pixel).\n"
+    "\n"
+    "options:\n"
+    "  --scene NAME|FILE      built-in scene or .gltf/.glb file (default cornell;\n"
+    "                         built in: %s)\n"
+    "  --camera N             camera index of the scene (default 0)\n"
+    "  --size WxH             output size, for the aspect (default 256x192)\n"
+    "  --radiosity on|off     radiosity block (default on)\n"
+    "  --count N              radiosity count (default 250)\n"
+    "  --error-bound X        radiosity error_bound (default 0.25)\n"
+    "  --pretrace-start X     radiosity pretrace_start (default 0.08)\n"
+    "  --pretrace-end X       radiosity pretrace_end (default 0.01)\n"
+    "  --recursion-limit N    radiosity recursion_limit (default 2)\n"
+    "  --brightness X         radiosity brightness (default 1)\n"
+    "  --shadows on|off       lights cast shadows as the scene says (default on);\n"
+    "                         off: no mesh casts shadows, as in the engine's direct\n"
+    "                         light without shadow maps\n"
+    "  --approximate          write what cannot match in its nearest form, with a\n"
+    "                         warning, instead of refusing\n"
+    "  --output FILE          the .pov file to write (written whole or not at all)\n"
+    "  --help                 this text\n"
+    "\n"
+    "exit codes: 0 written, 1 refused or not written, 2 bad usage.\n";
+
+typedef struct export_args {
+  const char *scene, *output;
+  lm_pov_desc desc;
+} export_args;
+
+static int usage_error(const char *fmt, const char *arg) {
+  fprintf(stderr, "limn export-pov: ");
+  fprintf(stderr, fmt, arg);
+  fprintf(stderr, "\n(see limn export-pov --help)\n");
+  return 2;
+}
+
+/* Returns 0 to go on, -1 after --help, else the exit code. */
+static int parse_args(int argc, char **argv, export_args *a) {
+  *a = (export_args){.scene = "cornell"};
+  a->desc = (lm_pov_desc){.width = 256, .height = 192, .radiosity = true, .shadows = true, .strict = true};
+  lm_pov_radiosity_defaults(&a->desc.rad);
+  static const struct option opts[] = {
+      {"scene", required_argument, 0, 's'},          {"camera", required_argument, 0, 'c'},
+      {"size", required_argument, 0, 'z'},           {"radiosity", required_argument, 0, 'r'},
+      {"count", required_argument, 0, 'n'},          {"error-bound", required_argument, 0, 'e'},
+      {"pretrace-start", required_argument, 0, 'S'}, {"pretrace-end", required_argument, 0, 'E'},
+      {"recursion-limit", required_argument, 0, 'l'}, {"brightness", required_argument, 0, 'b'},
+      {"shadows", required_argument, 0, 'w'},        {"approximate", no_argument, 0, 'a'},
+      {"output", required_argument, 0, 'o'},         {"help", no_argument, 0, 'h'},
+      {0, 0, 0, 0}};
+  opterr = 0;
+  optind = 1;
+  int c;
+  lm_pov_radiosity *r = &a->desc.rad;
+  while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
+    switch (c) {
+    case 's': a->scene = optarg; break;
+    case 'c':
+      if (!limn_parse_int(optarg, 0, 1 << 20, &a->desc.camera))
+        return usage_error("--camera wants an index, not '%s'", optarg);
+      break;
+    case 'z':
+      if (!limn_parse_size(optarg, &a->desc.width, &a->desc.height))
+        return usage_error("--size wants WxH with both in 1..65536, not '%s'", optarg);
+      break;
+    case 'r':
+      if (!limn_parse_on_off(optarg, &a->desc.radiosity)) return usage_error("--radiosity wants on or off, not '%s'", optarg);
+      break;
+    case 'w':
+      if (!limn_parse_on_off(optarg, &a->desc.shadows)) return usage_error("--shadows wants on or off, not '%s'", optarg);
+      break;
+    case 'n':
+      if (!limn_parse_int(optarg, 1, 1600, &r->count)) return usage_error("--count wants 1..1600, not '%s'", optarg);
+      break;
+    case 'l':
+      if (!limn_parse_int(optarg, 1, 20, &r->recursion_limit))
+        return usage_error("--recursion-limit wants 1..20, not '%s'", optarg);
+      break;
+    case 'e':
+      if (!limn_parse_double(optarg, &r->error_bound) || r->error_bound <= 0)
+        return usage_error("--error-bound wants a number > 0, not '%s'", optarg);
+      break;
+    case 'S':
+      if (!limn_parse_double(optarg, &r->pretrace_start) || r->pretrace_start <= 0 || r->pretrace_start > 1)
+        return usage_error("--pretrace-start wants a number in (0, 1], not '%s'", optarg);
+      break;
+    case 'E':
+      if (!limn_parse_double(optarg, &r->pretrace_end) || r->pretrace_end <= 0 || r->pretrace_end > 1)
+        return usage_error("--pretrace-end wants a number in (0, 1], not '%s'", optarg);
+      break;
+    case 'b':
+      if (!limn_parse_double(optarg, &r->brightness) || r->brightness < 0)
+        return usage_error("--brightness wants a number >= 0, not '%s'", optarg);
+      break;
+    case 'a': a->desc.strict = false; break;
+    case 'o': a->output = optarg; break;
+    case 'h': printf(export_usage, lm_scene_builtin_list()); return -1;
+    case ':': return usage_error("%s needs a value", argv[optind - 1]);
+    default: return usage_error("unknown flag '%s'", argv[optind - 1]);
+    }
+  }
+  if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
+  if (!a->output) return usage_error("%s", "--output FILE.pov is required");
+  const char *bad = a->desc.radiosity ? lm_pov_radiosity_check(r) : NULL;
+  if (bad) return usage_error("radiosity setting out of range: %s", bad);
+  return 0;
+}
+
+/* Written under a temporary name and renamed: the file appears whole or not at all. */
+static bool write_whole(const char *path, const char *data, size_t len, lm_error *err) {
+  char tmp[4096];
+  snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
+  FILE *f = fopen(tmp, "wb");
+  if (!f) {
+    lm_error_set(err, "%s: cannot write (%s)", path, strerror(errno));
+    return false;
+  }
+  bool ok = fwrite(data, 1, len, f) == len;
+  ok = fclose(f) == 0 && ok;
+  if (ok && rename(tmp, path) != 0) ok = false;
+  if (!ok) {
+    lm_error_set(err, "%s: cannot write (%s)", path, strerror(errno));
+    remove(tmp);
+  }
+  return ok;
+}
+
+int limn_export_pov(int argc, char **argv) {
+  export_args a;
+  int rc = parse_args(argc, argv, &a);
+  if (rc) return rc < 0 ? 0 : rc;
+  lm_error err;
+  lm_scene *scene = lm_scene_load(a.scene, &err);
+  if (!scene) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    return 2;
+  }
+  if (a.desc.camera > 0 && a.desc.camera >= scene->camera_count) {
+    lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a.desc.camera, a.scene, scene->camera_count);
+    lm_scene_destroy(scene);
+    return 2;
+  }
+  lm_buf sdl = {0}, warnings = {0};
+  bool ok = lm_pov_export(scene, &a.desc, &sdl, &warnings, &err);
+  for (char *line = warnings.data; line && *line;) { /* one warning a line */
+    char *nl = strchr(line, '\n');
+    if (nl) *nl = '\0';
+    lm_warn("%s", line);
+    line = nl ? nl + 1 : line + strlen(line);
+  }
+  if (!ok) lm_error_prefix(&err, "%s", a.scene);
+  if (ok) ok = write_whole(a.output, sdl.data, (size_t)sdl.len, &err);
+  if (ok) lm_info("wrote %s (scene %s, camera %d, %dx%d, radiosity %s, shadows %s)", a.output, a.scene,
+                  a.desc.camera, a.desc.width, a.desc.height, a.desc.radiosity ? "on" : "off",
+                  a.desc.shadows ? "on" : "off");
+  else lm_log(LM_LOG_ERROR, "%s", err.msg);
+  lm_buf_free(&sdl);
+  lm_buf_free(&warnings);
+  lm_scene_destroy(scene);
+  return ok ? 0 : 1;
+}
