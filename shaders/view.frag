@@ -6,7 +6,7 @@
 in vec2 uv;
 uniform sampler2D src;     // the frame (sRGB-encoded bytes) or a target (linear values)
 uniform sampler2D overlay; // text, premultiplied alpha
-uniform int mode = 0;      // 0: the frame; 1: a target; 2: a target in false colour
+uniform int mode = 0;      // 0: the frame; 1: a target; 2: a target in false colour; 3: black
 uniform int channel = 4;   // 0 r, 1 g, 2 b, 3 a, 4 rgb
 uniform float exposure = 0.0;          // stops
 uniform vec2 range = vec2(0.0, 1.0);   // false colour: min and max shown
@@ -35,7 +35,9 @@ void main() {
   color = v;
 #else
   vec3 c = v.rgb;
-  if (mode > 0) {
+  if (mode == 3) {
+    c = vec3(0.0);
+  } else if (mode > 0) {
     float one = channel < 4 ? v[channel] : v.r;
     if (mode == 2) {
       float span = range.y - range.x;

@@ -121,13 +121,29 @@ static void draw_overlay(viewer *v) {
                       : v->scene_error[0]  ? v->scene_error
                       : v->shader_error[0] ? v->shader_error
                                            : v->frame_error;
+  lm_graph *g = lm_renderer_graph(v->renderer);
   int y = 2;
-  if (v->overlay_on) {
-    lm_graph *g = lm_renderer_graph(v->renderer);
-    double rec, comp;
-    lm_renderer_overhead(v->renderer, &rec, &comp);
+  /* What matters most first: a small window cuts the list at its bottom. */
+  if (v->overlay_on)
     draw_line(v, &y, white, "%s | %s | %s | %dx%d", lm_pipeline_technique(v->pipeline), v->scene->name,
               strrchr(v->script, '/') ? strrchr(v->script, '/') + 1 : v->script, v->width, v->height);
+  if (v->overlay_on && v->inspect >= 0 && v->inspect < lm_graph_target_count(g)) {
+    lm_graph_target_info t = lm_graph_target(g, v->inspect);
+    draw_line(v, &y, yellow, "target %d/%d '%s' %s %dx%d%s | %s | exposure %+.1f%s", v->inspect + 1,
+              lm_graph_target_count(g), t.name, lm_format_name(t.format), t.width, t.height,
+              t.texture.id ? "" : " (not used this frame)", channel_name(v->channel), v->exposure,
+              v->false_colour ? " | false colour" : "");
+    if (v->false_colour && t.texture.id) draw_line(v, &y, yellow, "range %g .. %g", v->range[0], v->range[1]);
+  }
+  if (*error) {
+    char text[2100];
+    snprintf(text, sizeof text, "error: %s", error);
+    draw_text(v, &y, red, 8, text); /* the cause first; a traceback's top lines */
+  }
+  if (v->message[0] && lm_now_ms() < v->message_until) draw_text(v, &y, yellow, 3, v->message);
+  if (v->overlay_on) {
+    double rec, comp;
+    lm_renderer_overhead(v->renderer, &rec, &comp);
     draw_line(v, &y, white, "frame %.2f ms, render %.2f (Lua %.2f, graph %.2f)", v->frame_ms, v->render_ms,
               rec, comp);
     draw_line(v, &y, white, "clock: %s", lm_clock_name(lm_renderer_clock(v->renderer)));
@@ -143,20 +159,6 @@ static void draw_overlay(viewer *v) {
     lm_pipeline_list_options(v->pipeline, &opts);
     draw_line(v, &y, white, "options: %s", opts.data ? opts.data : "none");
     lm_buf_free(&opts);
-    if (v->inspect >= 0 && v->inspect < lm_graph_target_count(g)) {
-      lm_graph_target_info t = lm_graph_target(g, v->inspect);
-      draw_line(v, &y, yellow, "target %d/%d '%s' %s %dx%d%s | %s | exposure %+.1f%s", v->inspect + 1,
-                lm_graph_target_count(g), t.name, lm_format_name(t.format), t.width, t.height,
-                t.texture.id ? "" : " (not used)", channel_name(v->channel), v->exposure,
-                v->false_colour ? " | false colour" : "");
-      if (v->false_colour) draw_line(v, &y, yellow, "range %g .. %g", v->range[0], v->range[1]);
-    }
-  }
-  if (v->message[0] && lm_now_ms() < v->message_until) draw_text(v, &y, yellow, 3, v->message);
-  if (*error) {
-    char text[2100];
-    snprintf(text, sizeof text, "error: %s", error);
-    draw_text(v, &y, red, 8, text); /* the cause first; a traceback's top lines */
   }
   lm_texture_upload(v->overlay_tex, v->width, v->height, v->overlay);
 }
@@ -196,6 +198,8 @@ void display(viewer *v) {
       src = v->probe;
       mode = v->false_colour ? 2 : 1;
       if (v->false_colour) update_range(v);
+    } else {
+      mode = 3; /* a target with no texture this frame: black, not the frame */
     }
   }
   draw_overlay(v);

@@ -118,7 +118,8 @@ bool lm_renderer_swap_pipeline(lm_renderer *r, lm_pipeline *p, lm_error *err) {
   int out[2];
   bool ok = record(r, g, p, out, err);
   if (ok) {
-    lm_graph_take_persistent(g, r->graph);
+    int kept = lm_graph_take_persistent(g, r->graph);
+    lm_debug("new pipeline: %d persistent target(s) kept their textures", kept);
     ok = execute(r, g, err);
     if (!ok) lm_graph_take_persistent(r->graph, g); /* give the history back */
   }
