@@ -452,6 +452,59 @@ static void inspector_writes_target_and_frame(void **state) {
   lm_image_free(&img);
 }
 
+/* Black pixels (outside the box) and the mean x of red-wall pixels. */
+static void look(const lm_image *img, int *black, double *red_x) {
+  int reds = 0;
+  double sum = 0;
+  *black = 0;
+  for (int y = 0; y < img->height; y++)
+    for (int x = 0; x < img->width; x++) {
+      const float *p = img->pixels + ((size_t)y * img->width + x) * img->channels;
+      *black += p[0] + p[1] + p[2] < 0.02f;
+      if (p[0] > 0.4f && p[0] > 2 * p[1] && p[0] > 2 * p[2]) reds++, sum += x;
+    }
+  *red_x = reds ? sum / reds / img->width : 0;
+}
+
+/* W held for 30 frames walks into the box (the black outside leaves the
+ * view, the walls keep their sides); dragging left turns left (the red wall
+ * moves toward the middle). Scripted runs step 1/60 s a frame. */
+static void camera_moves_and_turns(void **state) {
+  (void)state;
+  char log[512], base[512], fwd[512], turn[512];
+  log_path(log, "camera");
+  shot_path(base, "cam0.png");
+  shot_path(fwd, "cam1.png");
+  shot_path(turn, "cam2.png");
+  const char *shots[3] = {base, fwd, turn};
+  const char *keys[3] = {"1:F5", "2:hold=W,32:release=W", "2:drag=-60;0"};
+  for (int i = 0; i < 3; i++) {
+    pid_t pid = spawn_view(log, "--tech", "dl", "--size", "128x96", "--overlay", "off", "--exit-after", "34",
+                           "--script-keys", keys[i], "--screenshot", shots[i], NULL);
+    int rc = wait_exit(pid, 30000);
+    if (rc) print_log(log);
+    assert_int_equal(rc, 0);
+  }
+  lm_image a, b, c;
+  load("cam0.png", &a);
+  load("cam1.png", &b);
+  load("cam2.png", &c);
+  int black[3];
+  double red_x[3];
+  look(&a, &black[0], &red_x[0]);
+  look(&b, &black[1], &red_x[1]);
+  look(&c, &black[2], &red_x[2]);
+  print_message("black pixels %d, %d, %d; red wall at x %.3f, %.3f, %.3f\n", black[0], black[1], black[2],
+                red_x[0], red_x[1], red_x[2]);
+  assert_true(black[0] > 200);               /* the box seen from outside */
+  assert_true(black[1] < black[0] / 10);     /* walked in: the box fills the view */
+  assert_walls(&b);
+  assert_true(red_x[2] > red_x[0] + 0.15);   /* turned left: the red wall comes to the middle */
+  lm_image_free(&a);
+  lm_image_free(&b);
+  lm_image_free(&c);
+}
+
 /* Usage errors exit 2 naming the flag; a missing script or window exits 1 naming why. */
 static void command_line_errors(void **state) {
   (void)state;
@@ -621,6 +674,7 @@ int main(void) {
       cmocka_unit_test_teardown(resize_to_1x1_and_back, stop_leftover),
       cmocka_unit_test_teardown(inspector_writes_target_and_frame, stop_leftover),
       cmocka_unit_test_teardown(cameras_and_scene_reload, stop_leftover),
+      cmocka_unit_test_teardown(camera_moves_and_turns, stop_leftover),
       cmocka_unit_test_teardown(reload_loop_leaks_nothing, stop_leftover),
   };
   return cmocka_run_group_tests(tests, setup, teardown);

@@ -44,7 +44,9 @@ static const char view_usage[] =
     "  --exit-after N       close after N frames\n"
     "  --screenshot FILE    write the window's content at exit (PNG)\n"
     "  --script-keys LIST   press keys at frames, e.g. \"5:F5,10:F3\" (for tests);\n"
-    "                       a key may also be resize=WxH\n"
+    "                       also resize=WxH, hold=W|A|S|D, release=W|A|S|D and\n"
+    "                       drag=DX;DY (a left-button drag, pixels); camera steps\n"
+    "                       are then 1/60 s a frame\n"
     "  --reload-test N      test hook: N edits of a copy of the script, each one\n"
     "                       reloaded through the file watch; prints GL object and\n"
     "                       heap counts and fails when any grew\n"
@@ -223,12 +225,23 @@ static void fly_to_camera(viewer *v) {
   lm_scene_node_set_world(v->scene, node, m);
 }
 
+/* A key held on the keyboard or by --script-keys hold=K. */
+static bool key_down(const viewer *v, const char *key) {
+  for (int i = 0; i < 4; i++)
+    if (v->held[i] && !strcmp(key, (const char *[]){"W", "A", "S", "D"}[i])) return true;
+  return lm_window_key_down(v->window, key);
+}
+
 static void move_camera(viewer *v, double dt_ms) {
   double dx, dy;
   lm_window_mouse_drag(v->window, &dx, &dy);
-  float step = (float)(fmin(dt_ms, 100.0) * 0.0015); /* 1.5 units a second */
-  float ahead = (lm_window_key_down(v->window, "W") ? 1.0f : 0.0f) - (lm_window_key_down(v->window, "S") ? 1.0f : 0.0f);
-  float side = (lm_window_key_down(v->window, "D") ? 1.0f : 0.0f) - (lm_window_key_down(v->window, "A") ? 1.0f : 0.0f);
+  dx += v->drag[0], dy += v->drag[1];
+  v->drag[0] = v->drag[1] = 0;
+  /* 1.5 units a second; scripted runs (tests) step 1/60 s a frame so they repeat. */
+  if (v->args->key_count) dt_ms = 1000.0 / 60.0;
+  float step = (float)(fmin(dt_ms, 100.0) * 0.0015);
+  float ahead = (key_down(v, "W") ? 1.0f : 0.0f) - (key_down(v, "S") ? 1.0f : 0.0f);
+  float side = (key_down(v, "D") ? 1.0f : 0.0f) - (key_down(v, "A") ? 1.0f : 0.0f);
   if (!ahead && !side && !dx && !dy) return; /* the scene's own transform stays exact */
   v->cam.yaw -= (float)dx * 0.005f;
   v->cam.pitch = fmaxf(-1.5f, fminf(1.5f, v->cam.pitch - (float)dy * 0.005f));
@@ -388,6 +401,13 @@ static void handle_key(viewer *v, const char *key) {
   if (!strncmp(key, "resize=", 7)) {
     int w, h;
     if (limn_parse_size(key + 7, &w, &h)) lm_window_resize(v->window, w, h);
+  } else if (!strncmp(key, "hold=", 5) || !strncmp(key, "release=", 8)) {
+    const char *k = strchr(key, '=') + 1;
+    for (int i = 0; i < 4; i++)
+      if (!strcmp(k, (const char *[]){"W", "A", "S", "D"}[i])) v->held[i] = key[0] == 'h';
+  } else if (!strncmp(key, "drag=", 5)) {
+    double dx, dy;
+    if (sscanf(key + 5, "%lf;%lf", &dx, &dy) == 2) v->drag[0] += dx, v->drag[1] += dy;
   } else if (key[0] >= '1' && key[0] <= '9' && !key[1]) {
     int c = key[0] - '1';
     if (c >= v->scene->camera_count) {

@@ -47,6 +47,8 @@ typedef struct viewer {
   int probe_w, probe_h;
   int camera;
   fly cam;
+  bool held[4];             /* W A S D held by --script-keys */
+  double drag[2];           /* a scripted drag not yet applied */
   bool overlay_on;
   int inspect;              /* target index, -1: the frame */
   int channel;              /* 0 r, 1 g, 2 b, 3 a, 4 rgb */
