@@ -1,10 +1,13 @@
+#define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "core/core.h"
 
@@ -83,6 +86,41 @@ static void files_read_and_dirname(void **state) {
   assert_string_equal(dir, "/");
 }
 
+/* A write and a rename-over (how editors save) are both reported, once each. */
+static void watch_sees_writes_and_renames(void **state) {
+  (void)state;
+  char dir[] = "/tmp/limn-watch-XXXXXX", path[512], got[600];
+  assert_non_null(mkdtemp(dir));
+  lm_error err;
+  lm_watch *w = lm_watch_create(&err);
+  assert_non_null(w);
+  assert_false(lm_watch_dir(w, "/nonexistent/dir", &err));
+  assert_non_null(strstr(err.msg, "/nonexistent/dir"));
+  assert_true(lm_watch_dir(w, dir, &err));
+  assert_false(lm_watch_next(w, got, sizeof got));
+  snprintf(path, sizeof path, "%s/a.lua", dir);
+  FILE *f = fopen(path, "w");
+  fputs("x = 1\n", f);
+  fclose(f);
+  assert_true(lm_watch_next(w, got, sizeof got));
+  assert_string_equal(got, path);
+  assert_false(lm_watch_next(w, got, sizeof got));
+  char tmp[520], b[520];
+  snprintf(tmp, sizeof tmp, "%s/.b.tmp", dir);
+  snprintf(b, sizeof b, "%s/b.glsl", dir);
+  f = fopen(tmp, "w");
+  fclose(f);
+  assert_true(lm_watch_next(w, got, sizeof got)); /* the temporary file's write */
+  assert_int_equal(rename(tmp, b), 0);
+  assert_true(lm_watch_next(w, got, sizeof got));
+  assert_string_equal(got, b);
+  assert_false(lm_watch_next(w, got, sizeof got));
+  lm_watch_destroy(w);
+  unlink(path);
+  unlink(b);
+  rmdir(dir);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(buf_appends_and_formats),
@@ -91,6 +129,7 @@ int main(void) {
       cmocka_unit_test(hash_is_fnv1a),
       cmocka_unit_test(errors_prefix),
       cmocka_unit_test(files_read_and_dirname),
+      cmocka_unit_test(watch_sees_writes_and_renames),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

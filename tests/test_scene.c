@@ -89,6 +89,32 @@ static void children_follow_their_parents(void **state) {
   lm_scene_destroy(s);
 }
 
+/* The viewer flies a camera by world transform; a parented node gets the
+ * local transform that puts it there, and its children follow. */
+static void nodes_move_to_a_world_transform(void **state) {
+  (void)state;
+  lm_scene *s = lm_scene_create("fly");
+  mat4 a, b, want;
+  glm_translate_make(a, (vec3){1, 0, 0});
+  glm_rotate_z(a, GLM_PI_2f, a);
+  glm_translate_make(b, (vec3){2, 0, 0});
+  int root = lm_scene_add_node(s, "root", -1, (float *)a, -1, -1);
+  int cam = lm_scene_add_node(s, "camera", root, (float *)b, -1, -1);
+  int child = lm_scene_add_node(s, "child", cam, (float *)b, -1, -1);
+  lm_scene_update(s);
+  glm_translate_make(want, (vec3){5, 6, 7});
+  glm_rotate_y(want, 0.5f, want);
+  lm_scene_node_set_world(s, cam, (float *)want);
+  for (int i = 0; i < 16; i++) assert_float_equal(s->nodes[cam].world[i], ((float *)want)[i], 1e-5f);
+  /* the child sits 2 along the camera's own +x */
+  assert_float_equal(s->nodes[child].world[12], 5 + 2 * cosf(0.5f), 1e-5f);
+  assert_float_equal(s->nodes[child].world[14], 7 - 2 * sinf(0.5f), 1e-5f);
+  lm_scene_node_set_world(s, root, (float *)want); /* a root takes it as its local */
+  assert_float_equal(s->nodes[root].local[12], 5, 0);
+  lm_scene_node_set_world(s, 99, (float *)want);   /* no such node: nothing happens */
+  lm_scene_destroy(s);
+}
+
 static void lights_take_position_and_direction_from_nodes(void **state) {
   (void)state;
   lm_error err;
@@ -113,6 +139,7 @@ int main(void) {
       cmocka_unit_test(positions_rebuild_from_linear_depth),
       cmocka_unit_test(extreme_cameras_stay_finite),
       cmocka_unit_test(children_follow_their_parents),
+      cmocka_unit_test(nodes_move_to_a_world_transform),
       cmocka_unit_test(lights_take_position_and_direction_from_nodes),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

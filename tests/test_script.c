@@ -148,6 +148,17 @@ static void options_are_typed_and_listed(void **state) {
   assert_non_null(strstr(err.msg, "unknown technique 'isr'"));
   assert_non_null(strstr(err.msg, "known: dl, other"));
   assert_true(lm_pipeline_set_technique(p, "other", &err));
+  /* What the viewer reads before it flips an option. */
+  char v[64];
+  assert_true(lm_pipeline_get_option(p, "bloom", v, sizeof v));
+  assert_string_equal(v, "true");
+  assert_true(lm_pipeline_get_option(p, "dof", v, sizeof v));
+  assert_string_equal(v, "table");
+  assert_true(lm_pipeline_get_option(p, "dof.focus", v, sizeof v));
+  assert_string_equal(v, "7");
+  assert_false(lm_pipeline_get_option(p, "dof.nope", v, sizeof v));
+  assert_false(lm_pipeline_get_option(p, "bloom.enabled", v, sizeof v));
+  assert_false(lm_pipeline_get_option(p, "nope", v, sizeof v));
   lm_pipeline_destroy(p);
 }
 

@@ -14,6 +14,7 @@ static const char usage[] =
     "  export-pov  one view of a scene as POV-Ray 3.7 scene description (references)\n"
     "  compare   mean error, RMSE, PSNR, Pearson, SSIM of two images; difference image\n"
     "  bench     compositor overhead per frame and pass times against resolution\n"
+    "  view      a window with live reload of scripts and shaders, timings, target inspector\n"
     "  help      this text; `limn <command> --help` describes a command's flags\n"
     "\n"
     "example:\n"
@@ -30,6 +31,7 @@ int main(int argc, char **argv) {
     return 0;
   }
   if (!strcmp(cmd, "capture")) return limn_capture(argc - 1, argv + 1);
+  if (!strcmp(cmd, "view")) return limn_view(argc - 1, argv + 1);
   if (!strcmp(cmd, "export-pov")) return limn_export_pov(argc - 1, argv + 1);
   if (!strcmp(cmd, "compare")) return limn_compare(argc - 1, argv + 1);
   if (!strcmp(cmd, "bench")) return limn_bench(argc - 1, argv + 1);

@@ -6,6 +6,7 @@
 #include <stdbool.h>
 
 int limn_capture(int argc, char **argv);
+int limn_view(int argc, char **argv);
 int limn_export_pov(int argc, char **argv);
 int limn_compare(int argc, char **argv);
 int limn_bench(int argc, char **argv);

@@ -47,6 +47,18 @@ void lm_dirname(const char *path, char *out, size_t cap);
 /* The engine's root (holds shaders/ and scripts/): $LIMN_ROOT or the source tree. */
 const char *lm_root_dir(void);
 
+/* ---- file watching (Linux inotify) ------------------------------------ */
+/* Reports files that were written (closed after writing) or renamed into a
+ * watched folder, so editors that save by rename are seen too. */
+typedef struct lm_watch lm_watch;
+lm_watch *lm_watch_create(lm_error *err);
+void lm_watch_destroy(lm_watch *w);
+/* Watches every file directly in `dir` (not its subfolders). */
+bool lm_watch_dir(lm_watch *w, const char *dir, lm_error *err);
+/* Never blocks: writes the next changed file's path ("<dir>/<name>", dir as
+ * given to lm_watch_dir) and returns true, or returns false when none is pending. */
+bool lm_watch_next(lm_watch *w, char *path, size_t cap);
+
 /* ---- hashing (FNV-1a, 64 bit) ----------------------------------------- */
 uint64_t lm_hash(const void *data, size_t len, uint64_t seed);
 #define LM_HASH_SEED 0xcbf29ce484222325ull

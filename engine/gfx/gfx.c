@@ -39,6 +39,8 @@ const char *lm_format_list(void) {
 }
 
 /* ---- textures ---------------------------------------------------------- */
+static int live_textures; /* for lm_gfx_stats */
+
 int lm_texture_max_size(void) {
   GLint n = 0;
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &n);
@@ -82,6 +84,7 @@ bool lm_texture_create(lm_texture *tex, const lm_texture_desc *d, const char *la
   glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   if (label) glObjectLabel(GL_TEXTURE, id, -1, label);
   tex->id = id;
+  live_textures++;
   return true;
 }
 
@@ -119,6 +122,7 @@ void lm_texture_destroy(lm_texture *tex) {
   lm_framebuffers_forget(*tex);
   glDeleteTextures(1, &tex->id);
   tex->id = 0;
+  live_textures--;
 }
 
 void lm_texture_generate_mips(lm_texture tex) { glGenerateTextureMipmap(tex.id); }
@@ -355,4 +359,40 @@ void lm_texture_read(lm_texture tex, int width, int height, bool floats, void *o
     memcpy(b, tmp, row);
   }
   free(tmp);
+}
+
+/* ---- uploads, copies and the window's framebuffer ---------------------- */
+void lm_texture_upload(lm_texture tex, int width, int height, const uint8_t *rgba) {
+  /* GL's row 0 is the image's last: flip into a copy, then one upload. */
+  size_t row = (size_t)width * 4;
+  uint8_t *flipped = lm_alloc(row * (size_t)height);
+  for (int y = 0; y < height; y++) memcpy(flipped + (size_t)y * row, rgba + (size_t)(height - 1 - y) * row, row);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTextureSubImage2D(tex.id, 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, flipped);
+  free(flipped);
+}
+
+void lm_texture_copy(lm_texture dst, lm_texture src, int width, int height) {
+  glCopyImageSubData(src.id, GL_TEXTURE_2D, 0, 0, 0, 0, dst.id, GL_TEXTURE_2D, 0, 0, 0, 0, width, height, 1);
+}
+
+void lm_screen_bind(int width, int height) {
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glViewport(0, 0, width, height);
+}
+
+void lm_screen_read(int width, int height, uint8_t *rgb) {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  size_t row = (size_t)width * 3;
+  for (int y = 0; y < height; y++) /* top row first */
+    glReadPixels(0, height - 1 - y, width, 1, GL_RGB, GL_UNSIGNED_BYTE, rgb + (size_t)y * row);
+}
+
+/* ---- object counts ----------------------------------------------------- */
+int lm_program_live_count(void); /* program.c */
+
+lm_gfx_counts lm_gfx_stats(void) {
+  return (lm_gfx_counts){live_textures, fbo_count, lm_program_live_count()};
 }

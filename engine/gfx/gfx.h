@@ -136,6 +136,12 @@ void lm_program_set_int(const lm_program *p, const lm_uniform *u, const int *val
 void lm_program_bind_texture(const lm_uniform *u, lm_texture tex);
 /* Forget every compiled program (shader files changed). */
 void lm_programs_clear(void);
+/* Shader files changed, keeping what runs: each cached program is rebuilt on
+ * its next use; when that fails the old program stays in use and
+ * lm_programs_error says why (file:line) until a later rebuild succeeds. */
+void lm_programs_invalidate(void);
+/* The first failed rebuild's message since the last invalidation, or NULL. */
+const char *lm_programs_error(void);
 int lm_program_count(void);
 /* The directory shader paths are relative to: <root>/shaders. */
 const char *lm_shader_dir(void);
@@ -184,5 +190,41 @@ void lm_finish(void);
 /* ---- readback ---------------------------------------------------------- */
 /* RGBA rows, top row first. `floats` selects float32 or uint8 output. */
 void lm_texture_read(lm_texture tex, int width, int height, bool floats, void *out);
+
+/* ---- uploads, copies and the window's framebuffer ---------------------- */
+/* Replaces level 0 of an rgba8 texture with RGBA bytes, top row first. */
+void lm_texture_upload(lm_texture tex, int width, int height, const uint8_t *rgba);
+/* Copies level 0 of src into dst (same format and size). */
+void lm_texture_copy(lm_texture dst, lm_texture src, int width, int height);
+/* Binds the window's (default) framebuffer and sets the viewport. */
+void lm_screen_bind(int width, int height);
+/* The default framebuffer's back buffer as RGB bytes, top row first. */
+void lm_screen_read(int width, int height, uint8_t *rgb);
+
+/* ---- object counts (leak checks) --------------------------------------- */
+typedef struct lm_gfx_counts {
+  int textures, framebuffers, programs; /* GL objects alive now */
+} lm_gfx_counts;
+lm_gfx_counts lm_gfx_stats(void);
+
+/* ---- windows (GLFW) ---------------------------------------------------- */
+/* A window with an OpenGL 4.5 core context, made current and adopted (one
+ * window per process). Keys are named as on the keyboard: "A".."Z",
+ * "0".."9", "F1".."F12", "Tab", "Escape", "Space", "PageUp", "PageDown",
+ * "Home", "End", "Left", "Right", "Up", "Down", "Enter", "Backspace". */
+typedef struct lm_window lm_window;
+lm_window *lm_window_create(const char *title, int width, int height, lm_error *err);
+void lm_window_destroy(lm_window *w);
+bool lm_window_should_close(const lm_window *w);
+void lm_window_poll(lm_window *w);
+void lm_window_swap(lm_window *w);
+/* The framebuffer's size in pixels: 0x0 while the window is minimized. */
+void lm_window_size(const lm_window *w, int *width, int *height);
+void lm_window_resize(lm_window *w, int width, int height);
+/* The next key pressed since the last call (its name); false when none. */
+bool lm_window_next_key(lm_window *w, char *name, size_t cap);
+bool lm_window_key_down(const lm_window *w, const char *name);
+/* Cursor movement in pixels since the last call while the left button is held. */
+void lm_window_mouse_drag(lm_window *w, double *dx, double *dy);
 
 #endif

@@ -10,6 +10,8 @@
 typedef struct cached_program {
   char key[1024];
   lm_program *program;
+  bool stale;  /* its files changed: rebuild on next use */
+  char *error; /* why the last rebuild failed (the old program stays) */
 } cached_program;
 static cached_program *cache;
 static int cache_count, cache_cap;
@@ -135,8 +137,12 @@ static GLuint compile(GLenum stage, const lm_shader_source *src, lm_error *err) 
   return 0;
 }
 
+static int live_programs; /* GL program objects, for lm_gfx_stats */
+int lm_program_live_count(void);
+int lm_program_live_count(void) { return live_programs; }
+
 static void program_free(lm_program *p) {
-  if (p->id) glDeleteProgram(p->id);
+  if (p->id) glDeleteProgram(p->id), live_programs--;
   free(p->uniforms);
   free(p);
 }
@@ -158,6 +164,7 @@ static lm_program *build(const char *vert, const char *frag, const char *defines
   GLuint v = compile(GL_VERTEX_SHADER, &vs, err), f = v ? compile(GL_FRAGMENT_SHADER, &fs, err) : 0;
   if (v && f) {
     prog->id = glCreateProgram();
+    live_programs++;
     glAttachShader(prog->id, v);
     glAttachShader(prog->id, f);
     glLinkProgram(prog->id);
@@ -200,14 +207,43 @@ static lm_program *build(const char *vert, const char *frag, const char *defines
 lm_program *lm_program_get(const char *vert, const char *frag, const char *defines, lm_error *err) {
   char key[1024];
   snprintf(key, sizeof key, "%s|%s|%s", vert, frag, defines ? defines : "");
-  for (int i = 0; i < cache_count; i++)
-    if (!strcmp(cache[i].key, key)) return cache[i].program;
+  for (int i = 0; i < cache_count; i++) {
+    cached_program *c = &cache[i];
+    if (strcmp(c->key, key)) continue;
+    if (c->stale) {
+      /* Rebuilt once per invalidation; a failure keeps the last good program running. */
+      c->stale = false;
+      lm_error why;
+      lm_program *p = build(vert, frag, defines, &why);
+      if (p) {
+        program_free(c->program);
+        c->program = p;
+      } else {
+        c->error = lm_strdup(why.msg);
+      }
+    }
+    return c->program;
+  }
   lm_program *p = build(vert, frag, defines, err);
   if (!p) return NULL;
   cached_program *c = LM_PUSH(cache, cache_count, cache_cap);
   snprintf(c->key, sizeof c->key, "%s", key);
   c->program = p;
   return p;
+}
+
+void lm_programs_invalidate(void) {
+  for (int i = 0; i < cache_count; i++) {
+    cache[i].stale = true;
+    free(cache[i].error);
+    cache[i].error = NULL;
+  }
+}
+
+const char *lm_programs_error(void) {
+  for (int i = 0; i < cache_count; i++)
+    if (cache[i].error) return cache[i].error;
+  return NULL;
 }
 
 const lm_uniform *lm_program_uniform(const lm_program *p, const char *name) {
@@ -250,7 +286,10 @@ void lm_program_bind_texture(const lm_uniform *u, lm_texture tex) {
 }
 
 void lm_programs_clear(void) {
-  for (int i = 0; i < cache_count; i++) program_free(cache[i].program);
+  for (int i = 0; i < cache_count; i++) {
+    program_free(cache[i].program);
+    free(cache[i].error);
+  }
   free(cache);
   cache = NULL;
   cache_count = cache_cap = 0;

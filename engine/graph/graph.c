@@ -257,7 +257,8 @@ static void plan_slots(lm_graph *g) {
       lm_texture_desc want = {gt->desc.format, gt->width, gt->height, gt->desc.mips};
       int found = -1;
       for (int s = 0; s < g->slot_count && found < 0; s++)
-        if (lm_texture_desc_equal(&g->slots[s].desc, &want) && g->slots[s].free_after < pi) found = s;
+        if (!g->no_sharing && lm_texture_desc_equal(&g->slots[s].desc, &want) && g->slots[s].free_after < pi)
+          found = s;
       if (found < 0) {
         graph_slot *s = LM_PUSH(g->slots, g->slot_count, g->slot_cap);
         s->desc = want;
@@ -333,3 +334,26 @@ lm_graph_target_info lm_graph_target(const lm_graph *g, int i) {
 }
 
 int lm_graph_slot_count(const lm_graph *g) { return g->slot_count; }
+
+void lm_graph_set_sharing(lm_graph *g, bool on) { g->no_sharing = !on; }
+
+static bool same_rule(const lm_target_desc *a, const lm_target_desc *b) {
+  return !strcmp(a->name, b->name) && a->format == b->format && a->mips == b->mips &&
+         a->width == b->width && a->height == b->height && a->scale == b->scale;
+}
+
+int lm_graph_take_persistent(lm_graph *to, lm_graph *from) {
+  int moved = 0;
+  for (int i = 0; i < to->persistent_count; i++) {
+    graph_target *t = &to->targets[i];
+    for (int k = 0; k < from->persistent_count && !t->texture.id; k++) {
+      graph_target *f = &from->targets[k];
+      if (!f->texture.id || !same_rule(&t->desc, &f->desc)) continue;
+      t->texture = f->texture;
+      t->alloc_w = f->alloc_w, t->alloc_h = f->alloc_h;
+      f->texture = (lm_texture){0};
+      moved++;
+    }
+  }
+  return moved;
+}

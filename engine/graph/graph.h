@@ -145,6 +145,15 @@ typedef struct lm_graph_exec_desc {
   bool check_finite;
 } lm_graph_exec_desc;
 bool lm_graph_execute(lm_graph *g, const lm_graph_exec_desc *x, lm_error *err);
+/* Moves the textures (and contents) of `from`'s persistent targets into the
+ * persistent targets of `to` that have the same name, format, mips and size
+ * rule (scale or absolute size) and no texture yet. A reloaded pipeline
+ * keeps its history this way: record its first frame into a new graph,
+ * take from the old one, execute. Returns how many moved. */
+int lm_graph_take_persistent(lm_graph *to, lm_graph *from);
+/* Off: every transient target gets a texture of its own, so each can be
+ * read after the frame (the viewer's inspector); costs memory. On by default. */
+void lm_graph_set_sharing(lm_graph *g, bool on);
 /* Pooled textures alive now, and their bytes. */
 void lm_graph_pool_stats(const lm_graph *g, int *textures, double *bytes);
 

@@ -54,6 +54,7 @@ struct lm_graph {
   lm_timer *timers; /* reused across frames, one per pass index */
   int timer_count, timer_cap;
   bool compiled;
+  bool no_sharing; /* lm_graph_set_sharing(g, false) */
 };
 
 #endif

@@ -15,7 +15,8 @@ struct lm_renderer {
   lm_frame_data camera;
   lm_shadow_plan shadows;
   double record_ms, compile_ms;
-  lm_scene_draw_stats stats;  /* this frame's scene draws */
+  lm_scene_draw_stats stats;  /* this frame's camera draws */
+  bool sharing;
 };
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
@@ -23,6 +24,9 @@ lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
   lm_renderer *r = lm_alloc(sizeof *r);
   r->desc = *desc;
   r->graph = lm_graph_create();
+  r->sharing = true;
+  r->output_srgb = r->output_linear = -1;
+  lm_renderer_resize(r, desc->width, desc->height);
   r->clock = lm_clock_choose(desc->clock);
   return r;
 }
@@ -73,52 +77,54 @@ bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
 }
 
 void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height) {
-  r->desc.camera = camera;
-  r->desc.width = width;
-  r->desc.height = height;
+  lm_renderer_set_camera(r, camera);
+  lm_renderer_resize(r, width, height);
   r->frame = 0; /* a new view has no previous frame to reproject from */
 }
 
 lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r) { return r->stats; }
 
-/* The engine's last pass: sanitize and encode what the script presented. */
-static bool add_output_stage(lm_renderer *r, int presented, lm_error *err) {
-  lm_graph *g = r->graph;
-  r->output_srgb = lm_graph_add_target(g, &(lm_target_desc){.name = "output.srgb",
-                                                            .format = LM_FORMAT_RGBA8}, err);
-  r->output_linear = -1;
+/* The engine's last pass: sanitize and encode what the script presented.
+ * out[0], out[1] get the sRGB and linear outputs (-1: none). */
+static bool add_output_stage(lm_renderer *r, lm_graph *g, lm_pipeline *p, int presented, int out[2],
+                             lm_error *err) {
+  out[0] = lm_graph_add_target(g, &(lm_target_desc){.name = "output.srgb", .format = LM_FORMAT_RGBA8}, err);
+  out[1] = -1;
   if (r->desc.linear_output)
-    r->output_linear = lm_graph_add_target(g, &(lm_target_desc){.name = "output.linear",
-                                                                .format = LM_FORMAT_RGBA32F}, err);
-  if (r->output_srgb < 0 || (r->desc.linear_output && r->output_linear < 0)) return false;
-  int outputs[2] = {r->output_srgb, r->output_linear};
+    out[1] = lm_graph_add_target(g, &(lm_target_desc){.name = "output.linear",
+                                                      .format = LM_FORMAT_RGBA32F}, err);
+  if (out[0] < 0 || (r->desc.linear_output && out[1] < 0)) return false;
   lm_pass_input input = {"src", presented};
-  lm_pass_desc d = {.kind = LM_PASS_FULLSCREEN, .name = "output",
-                    .where = lm_pipeline_present_where(r->desc.pipeline),
+  lm_pass_desc d = {.kind = LM_PASS_FULLSCREEN, .name = "output", .where = lm_pipeline_present_where(p),
                     .shader = "output.frag", .defines = r->desc.linear_output ? "LINEAR_OUTPUT" : "",
-                    .inputs = &input, .input_count = 1, .outputs = outputs,
+                    .inputs = &input, .input_count = 1, .outputs = out,
                     .output_count = r->desc.linear_output ? 2 : 1, .depth = -1};
   if (lm_graph_add_pass(g, &d, err) < 0) return false;
-  lm_graph_mark_output(g, r->output_srgb);
-  if (r->output_linear >= 0) lm_graph_mark_output(g, r->output_linear);
+  lm_graph_mark_output(g, out[0]);
+  if (out[1] >= 0) lm_graph_mark_output(g, out[1]);
   return true;
 }
 
-bool lm_renderer_frame(lm_renderer *r, lm_error *err) {
-  lm_graph *g = r->graph;
+/* Records (OnRender) and compiles one frame of pipeline p into g. */
+static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_error *err) {
   lm_graph_begin(g, r->desc.width, r->desc.height);
   lm_frame_data *frame = &r->camera;
   lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, frame);
   lm_shadow_plan_free(&r->shadows);
-  lm_pipeline_set_scene(r->desc.pipeline, r->desc.scene, frame, &r->shadows);
+  lm_pipeline_set_scene(p, r->desc.scene, frame, &r->shadows);
   double t0 = lm_cpu_ms();
   int presented = -1;
-  if (!lm_pipeline_record(r->desc.pipeline, g, &presented, err)) return false;
+  if (!lm_pipeline_record(p, g, &presented, err)) return false;
   double t1 = lm_cpu_ms();
-  if (!add_output_stage(r, presented, err) || !lm_graph_compile(g, err)) return false;
+  if (!add_output_stage(r, g, p, presented, out, err) || !lm_graph_compile(g, err)) return false;
   r->record_ms = t1 - t0;
   r->compile_ms = lm_cpu_ms() - t1;
+  return true;
+}
 
+/* Runs what record() compiled into g (the camera and shadow plan it made). */
+static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
+  lm_frame_data *frame = &r->camera;
   r->stats = (lm_scene_draw_stats){0};
   memcpy(frame->prev_view_proj, r->frame ? r->prev_view_proj : frame->view_proj, sizeof frame->prev_view_proj);
   memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
@@ -132,6 +138,56 @@ bool lm_renderer_frame(lm_renderer *r, lm_error *err) {
                           .scene_owns_uniform = lm_scene_owns_uniform, .user = r,
                           .check_finite = r->desc.check_finite};
   return lm_graph_execute(g, &x, err);
+}
+
+bool lm_renderer_frame(lm_renderer *r, lm_error *err) {
+  int out[2];
+  if (!record(r, r->graph, r->desc.pipeline, out, err)) return false;
+  r->output_srgb = out[0], r->output_linear = out[1];
+  return execute(r, r->graph, err);
+}
+
+bool lm_renderer_swap_pipeline(lm_renderer *r, lm_pipeline *p, lm_error *err) {
+  lm_graph *g = lm_graph_create();
+  lm_graph_set_sharing(g, r->sharing);
+  int out[2];
+  bool ok = record(r, g, p, out, err);
+  if (ok) {
+    int kept = lm_graph_take_persistent(g, r->graph);
+    lm_debug("new pipeline: %d persistent target(s) kept their textures", kept);
+    ok = execute(r, g, err);
+    if (!ok) lm_graph_take_persistent(r->graph, g); /* give the history back */
+  }
+  if (!ok) {
+    lm_graph_destroy(g);
+    return false;
+  }
+  lm_graph_destroy(r->graph);
+  r->graph = g;
+  r->desc.pipeline = p;
+  r->output_srgb = out[0], r->output_linear = out[1];
+  return true;
+}
+
+void lm_renderer_resize(lm_renderer *r, int width, int height) {
+  r->desc.width = width > 0 ? width : 1;
+  r->desc.height = height > 0 ? height : 1;
+}
+
+void lm_renderer_set_camera(lm_renderer *r, int camera) { r->desc.camera = camera; }
+
+void lm_renderer_set_sharing(lm_renderer *r, bool on) {
+  r->sharing = on;
+  lm_graph_set_sharing(r->graph, on);
+}
+
+bool lm_renderer_output(lm_renderer *r, lm_texture *tex, int *width, int *height) {
+  if (r->output_srgb < 0 || r->output_srgb >= lm_graph_target_count(r->graph)) return false;
+  lm_graph_target_info t = lm_graph_target(r->graph, r->output_srgb);
+  if (!t.texture.id) return false;
+  *tex = t.texture;
+  *width = t.width, *height = t.height;
+  return true;
 }
 
 bool lm_renderer_read(lm_renderer *r, bool linear, void *rgb, lm_error *err) {

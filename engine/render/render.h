@@ -38,4 +38,20 @@ void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compi
  * (needs linear_output). */
 bool lm_renderer_read(lm_renderer *r, bool linear, void *rgb, lm_error *err);
 
+/* Output size from the next frame on (a window resized); never below 1x1.
+ * Targets sized by the output follow; absolute ones stay. */
+void lm_renderer_resize(lm_renderer *r, int width, int height);
+void lm_renderer_set_camera(lm_renderer *r, int camera);
+/* Targets share textures where lifetimes allow (default); off keeps every
+ * target's content readable after the frame (lm_graph_set_sharing). */
+void lm_renderer_set_sharing(lm_renderer *r, bool on);
+/* Renders a frame with pipeline p (a reloaded script) into a new frame
+ * graph. On success p replaces the pipeline (the caller still owns both),
+ * and persistent targets with the same name, format and size rule keep their
+ * textures and contents (lm_graph_take_persistent); the others start clear.
+ * On failure nothing changes and err says why. */
+bool lm_renderer_swap_pipeline(lm_renderer *r, lm_pipeline *p, lm_error *err);
+/* The last frame's sRGB output texture (rgba8) and its size. */
+bool lm_renderer_output(lm_renderer *r, lm_texture *tex, int *width, int *height);
+
 #endif

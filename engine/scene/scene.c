@@ -95,6 +95,22 @@ int lm_scene_add_camera(lm_scene *s, const lm_camera *c) {
 
 /* The node's matrices are plain float[16] at any alignment; cglm's SIMD
  * product loads aligned, so it works on aligned copies. */
+void lm_scene_node_set_world(lm_scene *s, int node, const float world[16]) {
+  if (node < 0 || node >= s->node_count) return;
+  lm_node *n = &s->nodes[node];
+  if (n->parent >= 0 && n->parent < node) {
+    mat4 parent, inv, w, local; /* aligned copies: cglm's SSE loads need them */
+    memcpy(parent, s->nodes[n->parent].world, sizeof parent);
+    memcpy(w, world, sizeof w);
+    glm_mat4_inv(parent, inv);
+    glm_mat4_mul(inv, w, local);
+    memcpy(n->local, local, sizeof n->local);
+  } else {
+    memcpy(n->local, world, sizeof n->local);
+  }
+  lm_scene_update(s);
+}
+
 void lm_scene_update(lm_scene *s) {
   for (int i = 0; i < s->node_count; i++) {
     lm_node *n = &s->nodes[i];

@@ -106,6 +106,9 @@ int lm_scene_find_material(const lm_scene *s, const char *name);
 int lm_scene_add_camera(lm_scene *s, const lm_camera *c);
 /* World transforms from local ones (parents come before children). */
 void lm_scene_update(lm_scene *s);
+/* Moves a node (a camera the viewer flies) so its world transform becomes
+ * `world`: its local transform is set against its parent's, then updated. */
+void lm_scene_node_set_world(lm_scene *s, int node, const float world[16]);
 /* World-space box around every mesh node; false (and a unit box) when empty. */
 bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]);
 

@@ -213,6 +213,29 @@ void lm_pipeline_list_options(const lm_pipeline *p, lm_buf *out) {
   lua_pop(p->L, 1);
 }
 
+bool lm_pipeline_get_option(const lm_pipeline *p, const char *name, char *value, size_t cap) {
+  lua_State *L = p->L;
+  int top = lua_gettop(L);
+  lua_rawgeti(L, LUA_REGISTRYINDEX, p->options_ref);
+  char key[256];
+  for (const char *rest = name;;) {
+    const char *dot = strchr(rest, '.');
+    snprintf(key, sizeof key, "%.*s", dot ? (int)(dot - rest) : (int)strlen(rest), rest);
+    if (!lua_istable(L, -1)) break;
+    lua_getfield(L, -1, key);
+    if (dot) {
+      rest = dot + 1;
+      continue;
+    }
+    bool found = !lua_isnil(L, -1);
+    if (found) snprintf(value, cap, "%s", lua_istable(L, -1) ? "table" : luaL_tolstring(L, -1, NULL));
+    lua_settop(L, top);
+    return found;
+  }
+  lua_settop(L, top);
+  return false;
+}
+
 static bool parse_bool(const char *v, bool *out) {
   static const char *yes[] = {"true", "1", "on", "yes"}, *no[] = {"false", "0", "off", "no"};
   for (int i = 0; i < 4; i++) {

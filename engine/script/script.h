@@ -29,6 +29,9 @@ const char *lm_pipeline_technique(const lm_pipeline *p);
  * the value parsed by the default's type. Unknown names are an error that
  * lists the known ones. */
 bool lm_pipeline_set_option(lm_pipeline *p, const char *name, const char *value, lm_error *err);
+/* The current value of an option by dotted name, as text ("true", "0.5",
+ * "table" for a table of options); false when the script declares none. */
+bool lm_pipeline_get_option(const lm_pipeline *p, const char *name, char *value, size_t cap);
 /* "name=default" lines of every option. */
 void lm_pipeline_list_options(const lm_pipeline *p, lm_buf *out);
 

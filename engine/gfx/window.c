@@ -1,0 +1,139 @@
+/* A window for the viewer through GLFW: an OpenGL 4.5 core context, key
+ * presses as names, mouse drags. One window per process. */
+#include "gfx/gfx.h"
+
+#define GLFW_INCLUDE_NONE /* GL comes through epoxy in the rest of gfx */
+#include <GLFW/glfw3.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { KEY_QUEUE = 64 };
+
+struct lm_window {
+  GLFWwindow *glfw;
+  int queue[KEY_QUEUE]; /* GLFW key codes pressed, oldest first */
+  int head, count;
+  double last_x, last_y;
+  bool dragging;
+};
+
+static const struct {
+  const char *name;
+  int key;
+} named_keys[] = {
+    {"Tab", GLFW_KEY_TAB},          {"Escape", GLFW_KEY_ESCAPE},      {"Space", GLFW_KEY_SPACE},
+    {"PageUp", GLFW_KEY_PAGE_UP},   {"PageDown", GLFW_KEY_PAGE_DOWN}, {"Home", GLFW_KEY_HOME},
+    {"End", GLFW_KEY_END},          {"Left", GLFW_KEY_LEFT},          {"Right", GLFW_KEY_RIGHT},
+    {"Up", GLFW_KEY_UP},            {"Down", GLFW_KEY_DOWN},          {"Enter", GLFW_KEY_ENTER},
+    {"Backspace", GLFW_KEY_BACKSPACE},
+};
+
+static bool key_name(int key, char *out, size_t cap) {
+  if (key >= GLFW_KEY_A && key <= GLFW_KEY_Z) return snprintf(out, cap, "%c", 'A' + key - GLFW_KEY_A), true;
+  if (key >= GLFW_KEY_0 && key <= GLFW_KEY_9) return snprintf(out, cap, "%c", '0' + key - GLFW_KEY_0), true;
+  if (key >= GLFW_KEY_F1 && key <= GLFW_KEY_F12) return snprintf(out, cap, "F%d", 1 + key - GLFW_KEY_F1), true;
+  for (size_t i = 0; i < sizeof named_keys / sizeof *named_keys; i++)
+    if (named_keys[i].key == key) return snprintf(out, cap, "%s", named_keys[i].name), true;
+  return false;
+}
+
+static int key_code(const char *name) {
+  if (name[0] && !name[1]) {
+    if (name[0] >= 'A' && name[0] <= 'Z') return GLFW_KEY_A + name[0] - 'A';
+    if (name[0] >= '0' && name[0] <= '9') return GLFW_KEY_0 + name[0] - '0';
+  }
+  if (name[0] == 'F' && name[1]) {
+    int n = atoi(name + 1);
+    if (n >= 1 && n <= 12) return GLFW_KEY_F1 + n - 1;
+  }
+  for (size_t i = 0; i < sizeof named_keys / sizeof *named_keys; i++)
+    if (!strcmp(named_keys[i].name, name)) return named_keys[i].key;
+  return GLFW_KEY_UNKNOWN;
+}
+
+static void on_key(GLFWwindow *glfw, int key, int scancode, int action, int mods) {
+  (void)scancode, (void)mods;
+  lm_window *w = glfwGetWindowUserPointer(glfw);
+  if (action != GLFW_PRESS || w->count == KEY_QUEUE) return; /* a full queue drops keys */
+  w->queue[(w->head + w->count++) % KEY_QUEUE] = key;
+}
+
+static char glfw_message[512];
+static void on_error(int code, const char *message) {
+  snprintf(glfw_message, sizeof glfw_message, "GLFW error 0x%x: %s", code, message);
+}
+
+lm_window *lm_window_create(const char *title, int width, int height, lm_error *err) {
+  glfwSetErrorCallback(on_error);
+  if (!glfwInit()) {
+    lm_error_set(err, "no window system (%s); is DISPLAY set? (tests use xvfb-run)",
+                 glfw_message[0] ? glfw_message : "glfwInit failed");
+    return NULL;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  GLFWwindow *glfw = glfwCreateWindow(width, height, title, NULL, NULL);
+  if (!glfw) {
+    lm_error_set(err, "no OpenGL 4.5 core window: %s", glfw_message[0] ? glfw_message : "unknown reason");
+    glfwTerminate();
+    return NULL;
+  }
+  glfwMakeContextCurrent(glfw);
+  glfwSwapInterval(1);
+  if (!lm_context_adopt_current(err)) {
+    glfwDestroyWindow(glfw);
+    glfwTerminate();
+    return NULL;
+  }
+  lm_window *w = lm_alloc(sizeof *w);
+  w->glfw = glfw;
+  glfwSetWindowUserPointer(glfw, w);
+  glfwSetKeyCallback(glfw, on_key);
+  return w;
+}
+
+void lm_window_destroy(lm_window *w) {
+  if (!w) return;
+  glfwMakeContextCurrent(NULL);
+  glfwDestroyWindow(w->glfw);
+  /* No glfwTerminate: closing the display unloads Mesa's driver, which
+   * leaks an allocation LeakSanitizer reports against an unknown module
+   * (as eglTerminate does; see context.c). The process ends soon after. */
+  free(w);
+}
+
+bool lm_window_should_close(const lm_window *w) { return glfwWindowShouldClose(w->glfw); }
+void lm_window_poll(lm_window *w) { (void)w, glfwPollEvents(); }
+void lm_window_swap(lm_window *w) { glfwSwapBuffers(w->glfw); }
+void lm_window_size(const lm_window *w, int *width, int *height) {
+  glfwGetFramebufferSize(w->glfw, width, height);
+}
+void lm_window_resize(lm_window *w, int width, int height) { glfwSetWindowSize(w->glfw, width, height); }
+
+bool lm_window_next_key(lm_window *w, char *name, size_t cap) {
+  while (w->count > 0) {
+    int key = w->queue[w->head];
+    w->head = (w->head + 1) % KEY_QUEUE;
+    w->count--;
+    if (key_name(key, name, cap)) return true;
+  }
+  return false;
+}
+
+bool lm_window_key_down(const lm_window *w, const char *name) {
+  int key = key_code(name);
+  return key != GLFW_KEY_UNKNOWN && glfwGetKey(w->glfw, key) == GLFW_PRESS;
+}
+
+void lm_window_mouse_drag(lm_window *w, double *dx, double *dy) {
+  double x, y;
+  glfwGetCursorPos(w->glfw, &x, &y);
+  bool down = glfwGetMouseButton(w->glfw, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+  *dx = down && w->dragging ? x - w->last_x : 0;
+  *dy = down && w->dragging ? y - w->last_y : 0;
+  w->dragging = down;
+  w->last_x = x, w->last_y = y;
+}

@@ -1,0 +1,53 @@
+// The viewer's display: the frame as rendered, or a target of the frame graph
+// (exposure, one channel, false colour), under the text overlay. With PROBE
+// defined it writes the target's raw values instead (for EXR and ranges).
+#include "common.glsl"
+
+in vec2 uv;
+uniform sampler2D src;     // the frame (sRGB-encoded bytes) or a target (linear values)
+uniform sampler2D overlay; // text, premultiplied alpha
+uniform int mode = 0;      // 0: the frame; 1: a target; 2: a target in false colour; 3: black
+uniform int channel = 4;   // 0 r, 1 g, 2 b, 3 a, 4 rgb
+uniform float exposure = 0.0;          // stops
+uniform vec2 range = vec2(0.0, 1.0);   // false colour: min and max shown
+
+out vec4 color;
+
+vec3 srgb_encode(vec3 c) {
+  c = saturate(c);
+  vec3 lo = c * 12.92, hi = 1.055 * pow(max(c, vec3(1e-8)), vec3(1.0 / 2.4)) - 0.055;
+  return mix(lo, hi, step(vec3(0.0031308), c));
+}
+
+// Blue (low) through cyan, green, yellow to red (high).
+vec3 false_colour(float t) {
+  t = saturate(t);
+  return saturate(vec3(1.5 - abs(4.0 * t - 3.0), 1.5 - abs(4.0 * t - 2.0), 1.5 - abs(4.0 * t - 1.0)));
+}
+
+// NaN and Inf become 0; negative values (normals) stay.
+float finite(float x) { return isnan(x) || isinf(x) ? 0.0 : x; }
+
+void main() {
+  vec4 v = texture(src, uv);
+  v = vec4(finite(v.r), finite(v.g), finite(v.b), finite(v.a));
+#ifdef PROBE
+  color = v;
+#else
+  vec3 c = v.rgb;
+  if (mode == 3) {
+    c = vec3(0.0);
+  } else if (mode > 0) {
+    float one = channel < 4 ? v[channel] : v.r;
+    if (mode == 2) {
+      float span = range.y - range.x;
+      c = false_colour(span > 1e-20 ? (one - range.x) / span : 0.5);
+    } else {
+      c = (channel < 4 ? vec3(one) : v.rgb) * exp2(clamp(exposure, -40.0, 40.0));
+      c = srgb_encode(c);
+    }
+  }
+  vec4 o = texture(overlay, uv);
+  color = vec4(c * (1.0 - o.a) + o.rgb, 1.0);
+#endif
+}

@@ -1,0 +1,650 @@
+/* limn view: a window on a scene through a pipeline script, reloading the
+ * script, its modules, shaders and the scene file as they are saved. Keys
+ * follow the seed viewer (F2-F5 techniques, F6-F12 effects); the overlay
+ * shows per-pass times, the inspector steps through the frame graph's targets. */
+#define _GNU_SOURCE
+#include <getopt.h>
+#include <malloc.h>
+#ifdef __SANITIZE_ADDRESS__
+/* libasan's (GCC ships no allocator_interface.h to declare it). */
+size_t __sanitizer_get_current_allocated_bytes(void);
+#endif
+#include <math.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+
+#include "image/image.h"
+#include "render/render.h"
+#include "scene/gltf.h"
+#include "tools.h"
+#include "view.h"
+
+static const char view_usage[] =
+    "usage: limn view [options]\n"
+    "\n"
+    "Opens a window on a scene rendered through a pipeline script. Saving the\n"
+    "script (or a module it requires), a shader (or a file it includes) or the\n"
+    "scene file takes effect at once; on an error the last good pipeline keeps\n"
+    "running and the error (file:line) shows on screen and on stderr.\n"
+    "\n"
+    "options:\n"
+    "  --scene NAME|FILE    built-in scene or a .gltf/.glb file (default cornell)\n"
+    "  --script FILE        pipeline script (default scripts/pp.lua)\n"
+    "  --tech NAME          technique to start with (default: the script's first)\n"
+    "  --set NAME=VALUE     set an option the script declares (repeatable)\n"
+    "  --size WxH           window size (default 512x384)\n"
+    "  --camera N           scene camera to start from (default 0)\n"
+    "  --overlay on|off     show the overlay at start (default on; F1/Tab toggles)\n"
+    "  --capture-dir DIR    where P writes images (default .)\n"
+    "  --exit-after N       close after N frames\n"
+    "  --screenshot FILE    write the window's content at exit (PNG)\n"
+    "  --script-keys LIST   press keys at frames, e.g. \"5:F5,10:F3\" (for tests);\n"
+    "                       also resize=WxH, hold=W|A|S|D, release=W|A|S|D and\n"
+    "                       drag=DX;DY (a left-button drag, pixels); camera steps\n"
+    "                       are then 1/60 s a frame\n"
+    "  --reload-test N      test hook: N edits of a copy of the script, each one\n"
+    "                       reloaded through the file watch; prints GL object and\n"
+    "                       heap counts and fails when any grew\n"
+    "  --quiet | --verbose  errors only | debug messages\n"
+    "  --help               this text\n"
+    "\n"
+    "keys:\n"
+    "  W/S/A/D move, left mouse drag looks around, 1-9 the scene's cameras\n"
+    "  F2 isr+esm  F3 isr  F4 dl+esm  F5 dl (techniques the script lists)\n"
+    "  F6 bloom  F7 dof  F8 glass  F9 radial_blur  F11 sepia  F12 tiles (options\n"
+    "  the script declares, a boolean or a table with `enabled`)\n"
+    "  F1/Tab overlay; PageDown/PageUp step through targets, Home the frame again;\n"
+    "  C channel (rgb r g b a), V false colour, Up/Down exposure;\n"
+    "  P writes the shown target (EXR) and the frame (PNG); Escape quits\n";
+
+/* ---- command line ------------------------------------------------------ */
+static int usage_error(const char *fmt, const char *arg) {
+  fprintf(stderr, "limn view: ");
+  fprintf(stderr, fmt, arg);
+  fprintf(stderr, "\n(see limn view --help)\n");
+  return 2;
+}
+
+/* "5:F5,10:F3,12:resize=1x1" */
+static bool parse_script_keys(const char *list, view_args *a) {
+  char buf[4096];
+  snprintf(buf, sizeof buf, "%s", list);
+  for (char *save = NULL, *item = strtok_r(buf, ",", &save); item; item = strtok_r(NULL, ",", &save)) {
+    char *colon = strchr(item, ':');
+    if (!colon || a->key_count == MAX_SCRIPT_KEYS) return false;
+    *colon = '\0';
+    script_key *k = &a->keys[a->key_count++];
+    int frame;
+    if (!limn_parse_int(item, 0, 1 << 30, &frame) || !colon[1]) return false;
+    k->frame = frame;
+    snprintf(k->key, sizeof k->key, "%s", colon + 1);
+    int w, h;
+    if (!strncmp(k->key, "resize=", 7) && !limn_parse_size(k->key + 7, &w, &h)) return false;
+  }
+  return true;
+}
+
+static void free_args(view_args *a) {
+  for (int i = 0; i < a->set_count; i++) free(a->sets[i]);
+  a->set_count = 0;
+}
+
+/* Returns 0 to go on, -1 when done (help), else the exit code. */
+static int parse_args(int argc, char **argv, view_args *a) {
+  *a = (view_args){.scene = "cornell", .capture_dir = ".", .width = 512, .height = 384, .overlay = true};
+  static const struct option opts[] = {
+      {"scene", required_argument, 0, 's'},      {"script", required_argument, 0, 'p'},
+      {"tech", required_argument, 0, 't'},       {"set", required_argument, 0, 'D'},
+      {"size", required_argument, 0, 'z'},       {"camera", required_argument, 0, 'c'},
+      {"overlay", required_argument, 0, 'o'},    {"capture-dir", required_argument, 0, 'C'},
+      {"exit-after", required_argument, 0, 'n'}, {"screenshot", required_argument, 0, 'S'},
+      {"script-keys", required_argument, 0, 'k'}, {"reload-test", required_argument, 0, 'R'},
+      {"quiet", no_argument, 0, 'q'},            {"verbose", no_argument, 0, 'v'},
+      {"help", no_argument, 0, 'h'},             {0, 0, 0, 0}};
+  opterr = 0;
+  optind = 1;
+  int c, n;
+  while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
+    switch (c) {
+    case 's': a->scene = optarg; break;
+    case 'p': a->script = optarg; break;
+    case 't': a->tech = optarg; break;
+    case 'D':
+      if (!strchr(optarg, '=') || optarg[0] == '=') return usage_error("--set wants NAME=VALUE, not '%s'", optarg);
+      if (a->set_count == MAX_SETS) return usage_error("%s", "at most 64 --set flags");
+      a->sets[a->set_count++] = lm_strdup(optarg);
+      break;
+    case 'z':
+      if (!limn_parse_size(optarg, &a->width, &a->height))
+        return usage_error("--size wants WxH with both in 1..65536, not '%s'", optarg);
+      break;
+    case 'c':
+      if (!limn_parse_int(optarg, 0, 1 << 20, &a->camera)) return usage_error("--camera wants an index, not '%s'", optarg);
+      break;
+    case 'o':
+      if (!limn_parse_on_off(optarg, &a->overlay)) return usage_error("--overlay wants on or off, not '%s'", optarg);
+      break;
+    case 'C': a->capture_dir = optarg; break;
+    case 'n':
+      if (!limn_parse_int(optarg, 1, 1 << 30, &n)) return usage_error("--exit-after wants a frame count, not '%s'", optarg);
+      a->exit_after = n;
+      break;
+    case 'S': {
+      const char *dot = strrchr(optarg, '.');
+      if (!dot || strcasecmp(dot, ".png")) return usage_error("--screenshot '%s': give a .png file", optarg);
+      a->screenshot = optarg;
+      break;
+    }
+    case 'k':
+      if (!parse_script_keys(optarg, a))
+        return usage_error("--script-keys wants FRAME:KEY,... (e.g. 5:F5,10:resize=64x48), not '%s'", optarg);
+      break;
+    case 'R':
+      if (!limn_parse_int(optarg, 1, 1000000, &n)) return usage_error("--reload-test wants a count, not '%s'", optarg);
+      a->reload_test = n;
+      break;
+    case 'q': a->quiet = true; break;
+    case 'v': a->verbose = true; break;
+    case 'h': fputs(view_usage, stdout); return -1;
+    case ':': return usage_error("%s needs a value", argv[optind - 1]);
+    default: return usage_error("unknown flag '%s'", argv[optind - 1]);
+    }
+  }
+  if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
+  return 0;
+}
+
+static void resolve_script(const char *given, char *out, size_t cap) {
+  if (!given) {
+    snprintf(out, cap, "%s/scripts/pp.lua", lm_root_dir());
+  } else if (given[0] != '/' && !lm_file_exists(given)) {
+    snprintf(out, cap, "%s/%s", lm_root_dir(), given);
+    if (!lm_file_exists(out)) snprintf(out, cap, "%s", given);
+  } else {
+    snprintf(out, cap, "%s", given);
+  }
+}
+
+static volatile sig_atomic_t stop_requested;
+static void on_signal(int sig) {
+  (void)sig;
+  stop_requested = 1;
+}
+
+void say(viewer *v, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(v->message, sizeof v->message, fmt, ap);
+  va_end(ap);
+  v->message_until = lm_now_ms() + 4000;
+  lm_info("%s", v->message);
+}
+
+/* An error shows once on stderr when it appears and once more when it clears. */
+void set_error(char *slot, size_t cap, const char *msg, const char *cleared) {
+  if (!msg) msg = "";
+  if (!strcmp(slot, msg)) return;
+  if (*msg)
+    lm_log(LM_LOG_ERROR, "%s", msg);
+  else if (*slot)
+    lm_info("%s", cleared);
+  snprintf(slot, cap, "%s", msg);
+}
+
+/* ---- camera ------------------------------------------------------------ */
+static int camera_node(const viewer *v) {
+  return v->camera < v->scene->camera_count ? v->scene->cameras[v->camera].node : -1;
+}
+
+static void fly_from_camera(viewer *v) {
+  int node = camera_node(v);
+  if (node < 0) return;
+  const float *m = v->scene->nodes[node].world;
+  float f[3] = {-m[8], -m[9], -m[10]}, len = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+  if (len > 1e-12f)
+    for (int i = 0; i < 3; i++) f[i] /= len;
+  memcpy(v->cam.pos, m + 12, sizeof v->cam.pos);
+  v->cam.yaw = atan2f(-f[0], -f[2]);
+  v->cam.pitch = asinf(fmaxf(-1.0f, fminf(1.0f, f[1])));
+}
+
+static void fly_to_camera(viewer *v) {
+  int node = camera_node(v);
+  if (node < 0) return;
+  float cy = cosf(v->cam.yaw), sy = sinf(v->cam.yaw), cp = cosf(v->cam.pitch), sp = sinf(v->cam.pitch);
+  float f[3] = {-sy * cp, sp, -cy * cp};
+  float r[3] = {cy, 0, -sy}; /* cross(f, +Y), normalized: pitch stays below the poles */
+  float u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
+  float m[16] = {r[0], r[1], r[2], 0, u[0], u[1], u[2], 0, -f[0], -f[1], -f[2], 0,
+                 v->cam.pos[0], v->cam.pos[1], v->cam.pos[2], 1};
+  lm_scene_node_set_world(v->scene, node, m);
+}
+
+/* A key held on the keyboard or by --script-keys hold=K. */
+static bool key_down(const viewer *v, const char *key) {
+  for (int i = 0; i < 4; i++)
+    if (v->held[i] && !strcmp(key, (const char *[]){"W", "A", "S", "D"}[i])) return true;
+  return lm_window_key_down(v->window, key);
+}
+
+static void move_camera(viewer *v, double dt_ms) {
+  double dx, dy;
+  lm_window_mouse_drag(v->window, &dx, &dy);
+  dx += v->drag[0], dy += v->drag[1];
+  v->drag[0] = v->drag[1] = 0;
+  /* 1.5 units a second; scripted runs (tests) step 1/60 s a frame so they repeat. */
+  if (v->args->key_count) dt_ms = 1000.0 / 60.0;
+  float step = (float)(fmin(dt_ms, 100.0) * 0.0015);
+  float ahead = (key_down(v, "W") ? 1.0f : 0.0f) - (key_down(v, "S") ? 1.0f : 0.0f);
+  float side = (key_down(v, "D") ? 1.0f : 0.0f) - (key_down(v, "A") ? 1.0f : 0.0f);
+  if (!ahead && !side && !dx && !dy) return; /* the scene's own transform stays exact */
+  v->cam.yaw -= (float)dx * 0.005f;
+  v->cam.pitch = fmaxf(-1.5f, fminf(1.5f, v->cam.pitch - (float)dy * 0.005f));
+  float cy = cosf(v->cam.yaw), sy = sinf(v->cam.yaw), cp = cosf(v->cam.pitch), sp = sinf(v->cam.pitch);
+  float f[3] = {-sy * cp, sp, -cy * cp}, r[3] = {cy, 0, -sy};
+  for (int i = 0; i < 3; i++) v->cam.pos[i] += step * (ahead * f[i] + side * r[i]);
+  fly_to_camera(v);
+}
+
+/* ---- options and techniques -------------------------------------------- */
+/* Records NAME=VALUE so a reloaded script gets it again. */
+static void remember_set(viewer *v, const char *name, const char *value) {
+  view_args *a = v->args;
+  size_t n = strlen(name);
+  char *entry = lm_alloc(n + strlen(value) + 2);
+  sprintf(entry, "%s=%s", name, value);
+  for (int i = 0; i < a->set_count; i++) {
+    if (!strncmp(a->sets[i], name, n) && a->sets[i][n] == '=') {
+      free(a->sets[i]);
+      a->sets[i] = entry;
+      return;
+    }
+  }
+  if (a->set_count < MAX_SETS)
+    a->sets[a->set_count++] = entry;
+  else
+    free(entry);
+}
+
+/* Applies --set and toggled options; returns false (err) on the first bad one. */
+static bool apply_sets(viewer *v, lm_pipeline *p, lm_error *err) {
+  for (int i = 0; i < v->args->set_count; i++) {
+    char name[256];
+    const char *s = v->args->sets[i], *eq = strchr(s, '=');
+    snprintf(name, sizeof name, "%.*s", (int)(eq - s), s);
+    if (!lm_pipeline_set_option(p, name, eq + 1, err)) return false;
+  }
+  return true;
+}
+
+static void toggle_option(viewer *v, const char *name) {
+  char value[64], field[128];
+  snprintf(field, sizeof field, "%s", name);
+  if (lm_pipeline_get_option(v->pipeline, name, value, sizeof value) && !strcmp(value, "table"))
+    snprintf(field, sizeof field, "%s.enabled", name);
+  if (!lm_pipeline_get_option(v->pipeline, field, value, sizeof value) ||
+      (strcmp(value, "true") && strcmp(value, "false"))) {
+    say(v, "%s declares no option '%s' (a boolean, or a table with enabled)", v->script, name);
+    return;
+  }
+  const char *flipped = strcmp(value, "true") ? "true" : "false";
+  lm_error err;
+  if (!lm_pipeline_set_option(v->pipeline, field, flipped, &err)) {
+    say(v, "%s", err.msg);
+    return;
+  }
+  remember_set(v, field, flipped);
+  say(v, "%s = %s", field, flipped);
+}
+
+static void set_technique(viewer *v, const char *name) {
+  lm_error err;
+  if (!lm_pipeline_set_technique(v->pipeline, name, &err)) {
+    say(v, "%s", err.msg);
+    return;
+  }
+  say(v, "technique %s", name);
+}
+
+/* ---- reloading --------------------------------------------------------- */
+/* Loads the script again and swaps it in when its first frame renders. */
+static bool reload_script(viewer *v) {
+  lm_error err;
+  lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = v->script}, &err);
+  bool ok = p != NULL;
+  if (ok) {
+    lm_error ignore;
+    const char *tech = lm_pipeline_technique(v->pipeline);
+    if (!lm_pipeline_set_technique(p, tech, &ignore))
+      say(v, "technique %s is gone from %s: %s", tech, v->script, lm_pipeline_technique(p));
+    ok = apply_sets(v, p, &err) && lm_renderer_swap_pipeline(v->renderer, p, &err);
+  }
+  if (!ok) {
+    lm_pipeline_destroy(p);
+    set_error(v->script_error, sizeof v->script_error, err.msg, "");
+    return false;
+  }
+  lm_pipeline_destroy(v->pipeline);
+  v->pipeline = p;
+  v->frame_error[0] = '\0';
+  set_error(v->script_error, sizeof v->script_error, "", "script reloaded: error cleared");
+  lm_info("reloaded %s", v->script);
+  return true;
+}
+
+static void reload_scene(viewer *v) {
+  lm_error err;
+  lm_scene *s = lm_scene_load(v->args->scene, &err);
+  if (s && !lm_scene_upload(s, &err)) {
+    lm_scene_destroy(s);
+    s = NULL;
+  }
+  if (!s) {
+    set_error(v->scene_error, sizeof v->scene_error, err.msg, "");
+    return;
+  }
+  set_error(v->scene_error, sizeof v->scene_error, "", "scene reloaded: error cleared");
+  /* The renderer borrows the scene pointer; re-creating the renderer would
+   * drop the frame graph and its history, so the contents are swapped. */
+  lm_scene tmp = *v->scene;
+  *v->scene = *s;
+  *s = tmp;
+  lm_scene_destroy(s);
+  if (v->camera >= v->scene->camera_count) v->camera = 0;
+  lm_renderer_set_camera(v->renderer, v->camera);
+  fly_from_camera(v);
+  lm_info("reloaded scene %s", v->args->scene);
+}
+
+static bool has_suffix(const char *s, const char *suffix) {
+  size_t n = strlen(s), k = strlen(suffix);
+  return n >= k && !strcmp(s + n - k, suffix);
+}
+
+/* Drains the watch. Returns true when a frame was rendered (a reloaded script's first). */
+static bool handle_changes(viewer *v) {
+  bool script = false, shaders = false, scene = false;
+  char path[4096];
+  while (lm_watch_next(v->watch, path, sizeof path)) {
+    const char *name = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+    lm_debug("changed: %s", path);
+    if (name[0] == '.') continue; /* editors' temporary files */
+    if (has_suffix(name, ".lua")) script = true;
+    else if (has_suffix(name, ".glsl") || has_suffix(name, ".frag") || has_suffix(name, ".vert")) shaders = true;
+    else if (lm_scene_is_gltf_name(v->args->scene) && !strcmp(name, strrchr(v->args->scene, '/') ? strrchr(v->args->scene, '/') + 1 : v->args->scene)) scene = true;
+  }
+  if (shaders) {
+    lm_programs_invalidate();
+    lm_info("shaders changed: rebuilding");
+  }
+  if (scene) reload_scene(v);
+  return script && reload_script(v);
+}
+
+/* ---- keys -------------------------------------------------------------- */
+static void handle_key(viewer *v, const char *key) {
+  static const struct { const char *key, *tech; } techs[] = {
+      {"F2", "isr+esm"}, {"F3", "isr"}, {"F4", "dl+esm"}, {"F5", "dl"}};
+  static const struct { const char *key, *option; } toggles[] = {
+      {"F6", "bloom"}, {"F7", "dof"},   {"F8", "glass"}, {"F9", "radial_blur"},
+      {"F11", "sepia"}, {"F12", "tiles"}};
+  for (size_t i = 0; i < sizeof techs / sizeof *techs; i++)
+    if (!strcmp(key, techs[i].key)) return set_technique(v, techs[i].tech);
+  for (size_t i = 0; i < sizeof toggles / sizeof *toggles; i++)
+    if (!strcmp(key, toggles[i].key)) return toggle_option(v, toggles[i].option);
+  int targets = lm_graph_target_count(lm_renderer_graph(v->renderer));
+  if (!strncmp(key, "resize=", 7)) {
+    int w, h;
+    if (limn_parse_size(key + 7, &w, &h)) lm_window_resize(v->window, w, h);
+  } else if (!strncmp(key, "hold=", 5) || !strncmp(key, "release=", 8)) {
+    const char *k = strchr(key, '=') + 1;
+    for (int i = 0; i < 4; i++)
+      if (!strcmp(k, (const char *[]){"W", "A", "S", "D"}[i])) v->held[i] = key[0] == 'h';
+  } else if (!strncmp(key, "drag=", 5)) {
+    double dx, dy;
+    if (sscanf(key + 5, "%lf;%lf", &dx, &dy) == 2) v->drag[0] += dx, v->drag[1] += dy;
+  } else if (key[0] >= '1' && key[0] <= '9' && !key[1]) {
+    int c = key[0] - '1';
+    if (c >= v->scene->camera_count) {
+      say(v, "scene %s has %d camera(s)", v->scene->name, v->scene->camera_count);
+      return;
+    }
+    v->camera = c;
+    lm_renderer_set_camera(v->renderer, c);
+    fly_from_camera(v);
+    say(v, "camera %d (%s)", c + 1, v->scene->cameras[c].name);
+  } else if (!strcmp(key, "F1") || !strcmp(key, "Tab")) {
+    v->overlay_on = !v->overlay_on;
+  } else if (!strcmp(key, "PageDown") || !strcmp(key, "PageUp")) {
+    if (targets < 1) return;
+    int step = !strcmp(key, "PageDown") ? 1 : -1;
+    v->inspect = v->inspect < 0 ? (step > 0 ? 0 : targets - 1) : (v->inspect + step + targets) % targets;
+    lm_renderer_set_sharing(v->renderer, false); /* every target readable after the frame */
+  } else if (!strcmp(key, "Home")) {
+    v->inspect = -1;
+    lm_renderer_set_sharing(v->renderer, true);
+  } else if (!strcmp(key, "C")) {
+    v->channel = (v->channel + 1) % 5;
+  } else if (!strcmp(key, "V")) {
+    v->false_colour = !v->false_colour;
+  } else if (!strcmp(key, "Up") || !strcmp(key, "Down")) {
+    v->exposure += !strcmp(key, "Up") ? 0.5f : -0.5f;
+  } else if (!strcmp(key, "P")) {
+    write_captures(v);
+  } else if (!strcmp(key, "Escape")) {
+    stop_requested = 1;
+  }
+}
+
+/* ---- one frame --------------------------------------------------------- */
+static void render(viewer *v, bool already_rendered) {
+  lm_error err;
+  double t0 = lm_now_ms();
+  bool ok = already_rendered || lm_renderer_frame(v->renderer, &err);
+  if (!already_rendered) v->render_ms = lm_now_ms() - t0;
+  set_error(v->frame_error, sizeof v->frame_error, ok ? "" : err.msg, "frame error cleared");
+  const char *shader = lm_programs_error();
+  set_error(v->shader_error, sizeof v->shader_error, shader, "shaders rebuilt: error cleared");
+  lm_texture out;
+  int w, h;
+  if (ok && lm_renderer_output(v->renderer, &out, &w, &h) && w == v->width && h == v->height) {
+    lm_texture_copy(v->shown, out, w, h);
+  }
+}
+
+/* Follows the window's framebuffer; false while it is 0x0 (minimized). */
+static bool follow_size(viewer *v) {
+  int w, h;
+  lm_window_size(v->window, &w, &h);
+  if (w < 1 || h < 1) return false; /* nothing to draw into: skip the frame, never a 0x0 target */
+  if (w == v->width && h == v->height) return true;
+  v->width = w, v->height = h;
+  lm_renderer_resize(v->renderer, w, h);
+  lm_error err;
+  if (!make_window_textures(v, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    return false;
+  }
+  lm_info("window %dx%d", w, h);
+  return true;
+}
+
+/* ---- the reload test hook ---------------------------------------------- */
+/* Bytes the program has allocated and not freed: glibc's count, or
+ * AddressSanitizer's when it replaces malloc (glibc's then reads 0). */
+static long heap_in_use(void) {
+#ifdef __SANITIZE_ADDRESS__
+  return (long)__sanitizer_get_current_allocated_bytes();
+#else
+  struct mallinfo2 m = mallinfo2();
+  return (long)m.uordblks + (long)m.hblkhd;
+#endif
+}
+
+/* N edits of a copy of the script next to it (every tenth with a syntax
+ * error, every hundredth a shader rebuild too), each reloaded through the
+ * real watch. GL objects and heap bytes are counted after a warm-up and at
+ * the end; any growth fails. */
+static int reload_test(viewer *v, long n) {
+  char *text = lm_read_file(v->script, NULL, NULL);
+  if (!text) return 1;
+  char dir[2048], copy[4096];
+  lm_dirname(v->script, dir, sizeof dir);
+  snprintf(copy, sizeof copy, "%s/limn-reload-test.lua", dir);
+  snprintf(v->script, sizeof v->script, "%s", copy);
+  lm_gfx_counts before = {0};
+  long heap_before = 0, failed = 0;
+  enum { WARM_UP = 20 };
+  for (long i = 0; i < n + WARM_UP; i++) {
+    if (i == WARM_UP) {
+      before = lm_gfx_stats();
+      heap_before = heap_in_use();
+    }
+    FILE *f = fopen(copy, "w");
+    if (!f) break;
+    bool bad = i % 10 == 9;
+    fprintf(f, "%s\n-- edit %ld\n%s\n", text, i, bad ? "local broken = = 1" : "");
+    fclose(f);
+    if (i % 100 == 99) lm_programs_invalidate();
+    bool rendered = handle_changes(v);
+    render(v, rendered);
+    if (bad == rendered) failed++; /* a bad edit must not load; a good one must */
+    display(v); /* no swap: the counts are the point, not the pace */
+  }
+  unlink(copy);
+  free(text);
+  lm_gfx_counts after = lm_gfx_stats();
+  long heap_after = heap_in_use();
+  printf("reload test: %ld edits, %ld reloads that went the wrong way\n", n, failed);
+  printf("  GL textures %d -> %d, framebuffers %d -> %d, programs %d -> %d\n", before.textures,
+         after.textures, before.framebuffers, after.framebuffers, before.programs, after.programs);
+  printf("  heap bytes in use %ld -> %ld (%+ld)\n", heap_before, heap_after, heap_after - heap_before);
+  /* Heap: a little slack for allocator bookkeeping; a leak of even 100 bytes
+   * an edit would pass 64 KiB well before the end. */
+  bool grew = after.textures > before.textures || after.framebuffers > before.framebuffers ||
+              after.programs > before.programs || heap_after - heap_before > 65536;
+  return failed || grew ? 1 : 0;
+}
+
+/* ---- main -------------------------------------------------------------- */
+static bool watch_dirs(viewer *v, lm_error *err) {
+  char dir[2048];
+  v->watch = lm_watch_create(err);
+  if (!v->watch || !lm_watch_dir(v->watch, lm_shader_dir(), err)) return false;
+  snprintf(dir, sizeof dir, "%s/scripts", lm_root_dir());
+  if (lm_file_exists(dir) && !lm_watch_dir(v->watch, dir, err)) return false;
+  lm_dirname(v->script, dir, sizeof dir);
+  if (!lm_watch_dir(v->watch, dir, err)) return false;
+  if (lm_scene_is_gltf_name(v->args->scene)) {
+    lm_dirname(v->args->scene, dir, sizeof dir);
+    if (!lm_watch_dir(v->watch, dir, err)) return false;
+  }
+  return true;
+}
+
+static void viewer_free(viewer *v) {
+  lm_texture_destroy(&v->shown);
+  lm_texture_destroy(&v->overlay_tex);
+  lm_texture_destroy(&v->probe);
+  free(v->overlay);
+  lm_renderer_destroy(v->renderer);
+  lm_programs_clear();
+  lm_scene_destroy(v->scene);
+  lm_pipeline_destroy(v->pipeline);
+  lm_watch_destroy(v->watch);
+  lm_font_close(v->font);
+  lm_window_destroy(v->window);
+}
+
+static int run(viewer *v) {
+  view_args *a = v->args;
+  lm_error err;
+  v->pipeline = lm_pipeline_load(&(lm_pipeline_desc){.path = v->script}, &err);
+  if (!v->pipeline) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    return 1;
+  }
+  if ((a->tech && !lm_pipeline_set_technique(v->pipeline, a->tech, &err)) || !apply_sets(v, v->pipeline, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    return 2;
+  }
+  v->scene = lm_scene_load(a->scene, &err);
+  if (!v->scene) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    return 2;
+  }
+  if (a->camera > 0 && a->camera >= v->scene->camera_count) {
+    lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a->camera, a->scene, v->scene->camera_count);
+    return 2;
+  }
+  v->font = lm_font_open(11, &err);
+  if (!v->font || !watch_dirs(v, &err) ||
+      !(v->window = lm_window_create("limn view", a->width, a->height, &err))) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    return 1;
+  }
+  v->camera = a->camera;
+  lm_window_size(v->window, &v->width, &v->height);
+  if (v->width < 1 || v->height < 1) v->width = a->width, v->height = a->height;
+  v->renderer = lm_renderer_create(&(lm_renderer_desc){.scene = v->scene, .pipeline = v->pipeline,
+                                                       .width = v->width, .height = v->height,
+                                                       .camera = v->camera}, &err);
+  if (!v->renderer || !make_window_textures(v, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    return 1;
+  }
+  fly_from_camera(v);
+  lm_info("renderer: %s (%s); scene %s; script %s; technique %s; %dx%d", lm_gl_renderer(), lm_gl_version(),
+          a->scene, v->script, lm_pipeline_technique(v->pipeline), v->width, v->height);
+  if (a->reload_test) return reload_test(v, a->reload_test);
+
+  double last = lm_now_ms();
+  for (v->frame = 0; !stop_requested && !lm_window_should_close(v->window); v->frame++) {
+    lm_window_poll(v->window);
+    char key[64];
+    while (lm_window_next_key(v->window, key, sizeof key)) handle_key(v, key);
+    for (int i = 0; i < a->key_count; i++)
+      if (a->keys[i].frame == v->frame) handle_key(v, a->keys[i].key);
+    double now = lm_now_ms();
+    v->frame_ms = now - last;
+    move_camera(v, now - last);
+    last = now;
+    if (!follow_size(v)) {
+      usleep(16000); /* minimized: nothing to draw */
+      if (a->exit_after && v->frame + 1 >= a->exit_after) break;
+      continue;
+    }
+    render(v, handle_changes(v));
+    display(v);
+    if (a->exit_after && v->frame + 1 >= a->exit_after) break;
+    lm_window_swap(v->window);
+  }
+  if (stop_requested || lm_window_should_close(v->window)) display(v); /* the back buffer after a swap is undefined */
+  lm_info("%ld frames", v->frame + 1);
+  if (a->screenshot && !screenshot(v, a->screenshot)) return 1;
+  return 0;
+}
+
+int limn_view(int argc, char **argv) {
+  view_args a;
+  int rc = parse_args(argc, argv, &a);
+  if (rc) {
+    free_args(&a);
+    return rc < 0 ? 0 : rc;
+  }
+  if (a.verbose) lm_log_set_level(LM_LOG_DEBUG);
+  if (a.quiet) lm_log_set_level(LM_LOG_WARN);
+  signal(SIGINT, on_signal);
+  signal(SIGTERM, on_signal);
+  viewer v = {.args = &a, .inspect = -1, .channel = 4, .overlay_on = a.overlay, .range = {0, 1}};
+  resolve_script(a.script, v.script, sizeof v.script);
+  rc = run(&v);
+  viewer_free(&v);
+  free_args(&a);
+  return rc;
+}

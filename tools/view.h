@@ -1,0 +1,84 @@
+/* The viewer's state, shared by view.c (command line, keys, reloading, the
+ * loop) and view_display.c (inspector, overlay, what reaches the window). */
+#ifndef LIMN_VIEW_H
+#define LIMN_VIEW_H
+
+#include <stdint.h>
+
+#include "render/render.h"
+#include "view_text.h"
+
+enum { MAX_SETS = 64, MAX_SCRIPT_KEYS = 256 };
+
+typedef struct script_key {
+  long frame;
+  char key[32];
+} script_key;
+
+typedef struct view_args {
+  const char *scene, *script, *tech, *screenshot, *capture_dir;
+  char *sets[MAX_SETS]; /* owned: toggles add and replace entries */
+  int set_count;
+  int width, height, camera;
+  long exit_after, reload_test;
+  bool overlay, quiet, verbose;
+  script_key keys[MAX_SCRIPT_KEYS];
+  int key_count;
+} view_args;
+
+typedef struct fly {
+  float pos[3], yaw, pitch;
+} fly;
+
+typedef struct viewer {
+  view_args *args;
+  char script[2048];
+  lm_window *window;
+  lm_scene *scene;
+  lm_pipeline *pipeline;
+  lm_renderer *renderer;
+  lm_watch *watch;
+  lm_font *font;
+  int width, height;        /* the renderer's output (the window's framebuffer) */
+  lm_texture shown;         /* the last good frame: shown while a frame fails */
+  lm_texture overlay_tex;   /* text, rgba8 */
+  uint8_t *overlay;
+  lm_texture probe;         /* the inspected target's raw values, rgba32f */
+  int probe_w, probe_h;
+  int camera;
+  fly cam;
+  bool held[4];             /* W A S D held by --script-keys */
+  double drag[2];           /* a scripted drag not yet applied */
+  bool overlay_on;
+  int inspect;              /* target index, -1: the frame */
+  int channel;              /* 0 r, 1 g, 2 b, 3 a, 4 rgb */
+  bool false_colour;
+  float exposure;
+  float range[2];           /* of the inspected target, for false colour */
+  char script_error[2048];  /* the last reload's error ("" when it loaded) */
+  char frame_error[2048];   /* the current pipeline's last frame error */
+  char shader_error[2048];  /* a shader rebuild that failed */
+  char scene_error[2048];   /* the scene file's last reload */
+  char message[512];        /* a passing note (an unknown technique ...) */
+  double message_until;
+  double frame_ms;           /* from one frame's start to the next's */
+  double render_ms;          /* recording, compiling and running the frame graph */
+  long frame;
+  int captures;
+} viewer;
+
+/* A note on screen for a few seconds and on stderr. */
+void say(viewer *v, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* An error shows once on stderr when it appears and once (as `cleared`) when it goes. */
+void set_error(char *slot, size_t cap, const char *msg, const char *cleared);
+
+/* view_display.c */
+bool make_window_textures(viewer *v, lm_error *err);
+/* Draws the frame (or the inspected target) and the overlay into the back buffer. */
+void display(viewer *v);
+/* The inspected target as EXR and the frame as PNG, into --capture-dir. */
+void write_captures(viewer *v);
+/* The back buffer as a PNG. */
+bool screenshot(viewer *v, const char *path);
+
+#endif
