@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "gl_test.h"
+#include "scene/gltf.h"
 
 static lm_scene *builtin(const char *name) {
   lm_error err;
@@ -179,6 +180,29 @@ static void oversize_targets_are_refused(void **state) {
   lm_scene_destroy(s);
 }
 
+/* Every post effect at once over every lighting technique on every scene
+ * of data/scenes: finite before the output stage too (the "lit" target). */
+static void every_effect_on_every_test_scene(void **state) {
+  (void)state;
+  static const char *const scenes[] = {"cornell.glb", "primitives.glb", "office.glb", "garage.glb", "outdoor.glb"};
+  static const char *const all[] = {"hdr=true", "bloom=true", "dof=true", "motion_blur=true", "sepia=true",
+                                    "radial_blur=true", "glass=true", "tiles=true", NULL};
+  for (size_t i = 0; i < sizeof scenes / sizeof *scenes; i++) {
+    char path[1200];
+    snprintf(path, sizeof path, "%s/data/scenes/%s", LIMN_SOURCE_ROOT, scenes[i]);
+    lm_error err;
+    lm_scene *s = lm_scene_load(path, &err);
+    if (!s) fail_msg("%s", err.msg);
+    for (int t = 0; t < TECHNIQUES; t++) {
+      gl_result r = render_ok(s, every_technique[t], all, 64, 48);
+      if (!gl_target_finite(&r, "lit")) fail_msg("%s, %s: a non-finite lit value", scenes[i], every_technique[t]);
+      assert_true(mean_luminance(&r) > 1e-3f);
+      gl_result_free(&r);
+    }
+    lm_scene_destroy(s);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(hdr_radiance_from_1e_8_to_1e6),
@@ -188,6 +212,7 @@ int main(void) {
       cmocka_unit_test(zero_lights_and_64_lights),
       cmocka_unit_test(degenerate_and_nan_geometry),
       cmocka_unit_test(oversize_targets_are_refused),
+      cmocka_unit_test(every_effect_on_every_test_scene),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }
