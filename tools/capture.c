@@ -66,22 +66,6 @@ static int usage_error(const char *fmt, const char *arg) {
   return 2;
 }
 
-static bool parse_int(const char *s, int lo, int hi, int *out) {
-  char *end;
-  long v = strtol(s, &end, 10);
-  if (end == s || *end || v < lo || v > hi) return false;
-  *out = (int)v;
-  return true;
-}
-
-static bool parse_size(const char *s, int *w, int *h) {
-  char buf[64];
-  snprintf(buf, sizeof buf, "%s", s);
-  char *x = strchr(buf, 'x');
-  if (!x) return false;
-  *x = '\0';
-  return parse_int(buf, 1, 65536, w) && parse_int(x + 1, 1, 65536, h);
-}
 
 bool capture_known_extension(const char *path, bool *linear) {
   const char *dot = strrchr(path, '.');
@@ -122,14 +106,14 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       a->sets[a->set_count++] = optarg;
       break;
     case 'z':
-      if (!parse_size(optarg, &a->width, &a->height))
+      if (!limn_parse_size(optarg, &a->width, &a->height))
         return usage_error("--size wants WxH with both in 1..65536, not '%s'", optarg);
       break;
     case 'n':
-      if (!parse_int(optarg, 1, 100000, &a->frames)) return usage_error("--frames wants 1..100000, not '%s'", optarg);
+      if (!limn_parse_int(optarg, 1, 100000, &a->frames)) return usage_error("--frames wants 1..100000, not '%s'", optarg);
       break;
     case 'c':
-      if (!parse_int(optarg, 0, 1 << 20, &a->camera)) return usage_error("--camera wants an index, not '%s'", optarg);
+      if (!limn_parse_int(optarg, 0, 1 << 20, &a->camera)) return usage_error("--camera wants an index, not '%s'", optarg);
       break;
     case 'o': {
       bool linear;
@@ -157,7 +141,7 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       snprintf(buf, sizeof buf, "%s", optarg);
       slash = strchr(buf, '/');
       if (slash) *slash = '\0';
-      if (!slash || !parse_int(buf, 0, 1 << 20, &a->shard) || !parse_int(slash + 1, 1, 1 << 20, &a->shards) ||
+      if (!slash || !limn_parse_int(buf, 0, 1 << 20, &a->shard) || !limn_parse_int(slash + 1, 1, 1 << 20, &a->shards) ||
           a->shard >= a->shards)
         return usage_error("--shard wants I/N with 0 <= I < N, not '%s'", optarg);
       break;

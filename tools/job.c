@@ -30,6 +30,7 @@
 #include <unistd.h>
 
 #include "capture.h"
+#include "tools.h"
 #include "scene/gltf.h"
 
 #define MAX_LIST 64
@@ -91,10 +92,6 @@ static bool field_string(lua_State *L, int t, const char *key, char *out, size_t
   return ok;
 }
 
-static bool parse_size(const char *s, int *w, int *h) {
-  char tail;
-  return sscanf(s, "%dx%d%c", w, h, &tail) == 2 && *w >= 1 && *h >= 1 && *w <= 16384 && *h <= 16384;
-}
 
 /* Reads the list at key: each element through `each` (index from 1). */
 static bool read_list(lua_State *L, int t, const char *key, const char *path, int *count, lm_error *err,
@@ -170,7 +167,7 @@ static bool each_technique(lua_State *L, job *j, int i, lm_error *err) {
 
 static bool each_size(lua_State *L, job *j, int i, lm_error *err) {
   int *wh = j->sizes[i - 1];
-  if (lua_type(L, -1) != LUA_TSTRING || !parse_size(lua_tostring(L, -1), &wh[0], &wh[1])) {
+  if (lua_type(L, -1) != LUA_TSTRING || !limn_parse_size(lua_tostring(L, -1), &wh[0], &wh[1])) {
     lm_error_set(err, "%s: sizes[%d]: want \"WxH\" within 1x1 .. 16384x16384, not %s", j->path, i,
                  lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : luaL_typename(L, -1));
     return false;
