@@ -27,8 +27,8 @@ static const char report_usage[] =
     "missing ones are rendered first) and writes DIR/report.csv, report.json,\n"
     "report.svg (mean error against milliseconds, Pareto front marked) and\n"
     "report.md (gain over direct light per view, mean and median gain, share\n"
-    "of views and pixels improved, Pearson before and after). Direct light\n"
-    "(" BASELINE ") is the baseline and is always rendered.\n"
+    "of views and pixels improved, Pearson before and after). The baseline\n"
+    "(--baseline, default direct light: " BASELINE ") is always rendered.\n"
     "\n"
     "SPEC: TECH, or TECH:OPTION=V1,V2,...;OPTION=V1,... for every combination,\n"
     "  e.g. --sweep \"isr:isr.samples=8,16,32;isr.coarse=1,2\" --sweep ssao\n"
@@ -38,6 +38,8 @@ static const char report_usage[] =
     "                       set ambient = 0 to compare with POV-Ray)\n"
     "  --sweep SPEC         techniques and settings (repeatable)\n"
     "  --out DIR            where the report goes (default out/report)\n"
+    "  --baseline TECH      the technique gains are measured against (default " BASELINE ";\n"
+    "                       dl+esm when the references have shadows to match)\n"
     "  --frames N           timed frames per image; times are medians (default 5)\n"
     "  --warmup N           frames rendered first, untimed (default 2)\n"
     "  --refs DIR           the references (default out/reference)\n"
@@ -58,7 +60,7 @@ typedef struct report_row {
 } report_row;
 
 typedef struct report_args {
-  const char *job, *out;
+  const char *job, *out, *baseline;
   report_setting *settings;
   int setting_count, frames, warmup;
   bool require_refs;
@@ -113,7 +115,7 @@ static void place_name(const job *j, const job_view *v, char *out, size_t cap) {
 static void write_csv(lm_buf *b, const report_args *a, const job *j, const job_view *places,
                       const report_row *rows, int n) {
   lm_buf_append(b, "technique,setting,view,scene,camera,width,height,mean_error,rmse,psnr,pearson,ssim,"
-                   "closer_than_dl,total_ms,passes_ms\n", -1);
+                   "closer_than_baseline,total_ms,passes_ms\n", -1);
   for (int i = 0; i < n; i++) {
     const report_row *r = &rows[i];
     const report_setting *s = &a->settings[r->setting];
@@ -130,7 +132,7 @@ static void write_csv(lm_buf *b, const report_args *a, const job *j, const job_v
     csv_str(b, sc->name);
     lm_buf_append(b, ",", 1);
     csv_str(b, sc->scene->cameras[v->camera].name);
-    lm_buf_printf(b, ",%d,%d,%.6g,%.6g,", j->sizes[v->size][0], j->sizes[v->size][1], r->m.mean_error, r->m.rmse);
+    lm_buf_printf(b, ",%d,%d,%.9g,%.9g,", j->sizes[v->size][0], j->sizes[v->size][1], r->m.mean_error, r->m.rmse);
     if (r->m.identical) lm_buf_append(b, "inf", -1);
     else lm_buf_printf(b, "%.4f", r->m.psnr);
     lm_buf_printf(b, ",%.6f,%.6f,%.6f,%.3f,\"", r->m.pearson, r->m.ssim, r->closer, r->total_ms);
@@ -146,8 +148,9 @@ static void write_json(lm_buf *b, const report_args *a, const job *j, const job_
   json_str(b, j->path);
   lm_buf_printf(b, ",\n  \"clock\": \"%s\",\n  \"renderer\": ", clock);
   json_str(b, lm_gl_renderer());
-  lm_buf_printf(b, ",\n  \"frames\": %d,\n  \"warmup\": %d,\n  \"baseline\": \"" BASELINE "\",\n  \"rows\": [\n",
-                frames, warmup);
+  lm_buf_printf(b, ",\n  \"frames\": %d,\n  \"warmup\": %d,\n  \"baseline\": ", frames, warmup);
+  json_str(b, a->baseline);
+  lm_buf_append(b, ",\n  \"rows\": [\n", -1);
   for (int i = 0; i < n; i++) {
     const report_row *r = &rows[i];
     const report_setting *s = &a->settings[r->setting];
@@ -172,11 +175,11 @@ static void write_json(lm_buf *b, const report_args *a, const job *j, const job_
     json_str(b, sc->path);
     lm_buf_append(b, ", \"camera\": ", -1);
     json_str(b, sc->scene->cameras[v->camera].name);
-    lm_buf_printf(b, ", \"width\": %d, \"height\": %d, \"mean_error\": %.6g, \"rmse\": %.6g, \"psnr\": ",
+    lm_buf_printf(b, ", \"width\": %d, \"height\": %d, \"mean_error\": %.9g, \"rmse\": %.9g, \"psnr\": ",
                   j->sizes[v->size][0], j->sizes[v->size][1], r->m.mean_error, r->m.rmse);
     if (r->m.identical) lm_buf_append(b, "null", -1);
     else lm_buf_printf(b, "%.4f", r->m.psnr);
-    lm_buf_printf(b, ", \"pearson\": %.6f, \"ssim\": %.6f, \"closer_than_dl\": %.6f, \"total_ms\": %.3f, "
+    lm_buf_printf(b, ", \"pearson\": %.6f, \"ssim\": %.6f, \"closer_than_baseline\": %.6f, \"total_ms\": %.3f, "
                   "\"passes\": [", r->m.pearson, r->m.ssim, r->closer, r->total_ms);
     for (int p = 0; p < r->res.pass_count; p++) {
       lm_buf_append(b, p ? ", {\"name\": " : "{\"name\": ", -1);
@@ -292,11 +295,11 @@ static void write_md(lm_buf *b, const report_args *a, const job *j, const job_vi
   lm_buf_printf(b, "`, %d view%s; renderer ", place_count, place_count == 1 ? "" : "s");
   xml_str(b, lm_gl_renderer());
   lm_buf_printf(b, "; times are medians of %d frame%s after %d warm-up frame%s (clock: %s). Mean error is seed eq "
-                "19 (sum of |dR|+|dG|+|dB| over 3wh), against POV-Ray radiosity references. Gain over direct "
-                "light (" BASELINE ") = 100 (e_dl - e) / e_dl.\n\n",
-                frames, frames == 1 ? "" : "s", warmup, warmup == 1 ? "" : "s", clock);
+                "19 (sum of |dR|+|dG|+|dB| over 3wh), against POV-Ray radiosity references. Gain over the "
+                "baseline %s = 100 (e_base - e) / e_base.\n\n",
+                frames, frames == 1 ? "" : "s", warmup, warmup == 1 ? "" : "s", clock, a->baseline);
   lm_buf_append(b, "| setting | mean error | ms | mean gain % | median gain % | views improved | pixels closer "
-                   "| Pearson dl -> setting | Pareto |\n|---|---|---|---|---|---|---|---|---|\n", -1);
+                   "| Pearson baseline -> setting | Pareto |\n|---|---|---|---|---|---|---|---|---|\n", -1);
   double *be = lm_alloc(sizeof(double) * (size_t)(place_count + 1) * 6);
   double *e = be + place_count, *cl = e + place_count, *px = cl + place_count, *pb = px + place_count,
          *pa = pb + place_count;
@@ -326,8 +329,8 @@ static void write_md(lm_buf *b, const report_args *a, const job *j, const job_vi
                   sum.mean_gain, sum.median_gain, 100 * sum.views_improved, 100 * sum.pixels_closer,
                   sum.pearson_before, sum.pearson_after, front[s] ? "yes" : "");
   }
-  lm_buf_append(b, "\n## Per view\n\n| setting | view | error dl | error | gain % | pixels closer | Pearson dl | "
-                   "Pearson |\n|---|---|---|---|---|---|---|---|\n", -1);
+  lm_buf_append(b, "\n## Per view\n\n| setting | view | error baseline | error | gain % | pixels closer | "
+                   "Pearson baseline | Pearson |\n|---|---|---|---|---|---|---|---|\n", -1);
   for (int i = 0; i < n; i++) {
     if (rows[i].setting == 0) continue;
     const report_row *base = &rows[i - rows[i].setting];
@@ -520,20 +523,21 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
 }
 
 int limn_report(int argc, char **argv) {
-  report_args a = {.out = "out/report", .frames = 5, .warmup = 2};
+  report_args a = {.out = "out/report", .baseline = BASELINE, .frames = 5, .warmup = 2};
   reference_defaults(&a.ref);
   report_setting *settings = lm_alloc(sizeof *settings * REPORT_MAX_SETTINGS);
   a.settings = settings;
   lm_error err;
-  report_sweep_parse(BASELINE, settings, &a.setting_count, &err); /* the baseline comes first */
-  struct option opts[14 + LIMN_POV_OPTION_COUNT] = {
+  const char *sweeps_given[REPORT_MAX_SETTINGS];
+  struct option opts[15 + LIMN_POV_OPTION_COUNT] = {
       {"job", required_argument, 0, 'J'},    {"sweep", required_argument, 0, 'W'},
       {"out", required_argument, 0, 'o'},    {"frames", required_argument, 0, 'f'},
       {"warmup", required_argument, 0, 'u'}, {"refs", required_argument, 0, 'R'},
       {"require-refs", no_argument, 0, 'Q'}, {"jobs", required_argument, 0, 'j'},
       {"povray", required_argument, 0, 'P'}, {"force", no_argument, 0, 'F'},
-      {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'}};
-  memcpy(opts + 12, limn_pov_options, sizeof(struct option) * LIMN_POV_OPTION_COUNT);
+      {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
+      {"baseline", required_argument, 0, 'B'}};
+  memcpy(opts + 13, limn_pov_options, sizeof(struct option) * LIMN_POV_OPTION_COUNT);
   opterr = 0;
   optind = 1;
   int c, rc = 0, sweeps = 0;
@@ -544,13 +548,10 @@ int limn_report(int argc, char **argv) {
     switch (c) {
     case 'J': a.job = optarg; break;
     case 'W':
-      sweeps++;
-      if (!strcmp(optarg, BASELINE)) break; /* always there */
-      if (!report_sweep_parse(optarg, settings, &a.setting_count, &err)) {
-        fprintf(stderr, "limn report: %s\n", err.msg);
-        rc = 2;
-      }
+      if (sweeps == REPORT_MAX_SETTINGS) rc = usage_error("at most %s --sweep flags", "256");
+      else sweeps_given[sweeps++] = optarg;
       break;
+    case 'B': a.baseline = optarg; break;
     case 'o': a.out = optarg; break;
     case 'f':
       if (!limn_parse_int(optarg, 1, 10000, &a.frames)) rc = usage_error("--frames wants 1..10000, not '%s'", optarg);
@@ -574,6 +575,16 @@ int limn_report(int argc, char **argv) {
   if (!rc && optind < argc) rc = usage_error("unexpected argument '%s'", argv[optind]);
   if (!rc && !a.job) rc = usage_error("%s", "--job FILE is required");
   if (!rc && !sweeps) rc = usage_error("%s", "--sweep SPEC is required (e.g. --sweep \"isr:isr.samples=8,16\")");
+  /* The baseline first (every row's gain refers to it), then the sweeps. */
+  if (!rc && !report_sweep_parse(a.baseline, settings, &a.setting_count, &err))
+    rc = usage_error("--baseline: %s", err.msg);
+  for (int i = 0; i < sweeps && !rc; i++) {
+    if (!strcmp(sweeps_given[i], a.baseline)) continue; /* always there */
+    if (!report_sweep_parse(sweeps_given[i], settings, &a.setting_count, &err)) {
+      fprintf(stderr, "limn report: %s\n", err.msg);
+      rc = 2;
+    }
+  }
   const char *bad = !rc && a.ref.pov.radiosity ? lm_pov_radiosity_check(&a.ref.pov.rad) : NULL;
   if (bad) rc = usage_error("radiosity setting out of range: %s", bad);
   job *j = rc ? NULL : lm_alloc(sizeof *j);
