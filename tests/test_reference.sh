@@ -70,6 +70,15 @@ ls refs-bad/ball/*.exr 2>/dev/null && fail "a failed run left an image"
 [ $? = 1 ] || fail "a missing POV-Ray program did not fail"
 grep -q "cannot run" log5 || { cat log5; fail "a missing program is not said"; }
 
+# Lights POV-Ray cannot match (cornell.glb's window falloff) are refused by name, before POV-Ray runs.
+printf 'return { scenes = { "%s/data/scenes/cornell.glb" }, sizes = { "32x24" }, output = "o/{camera}.png" }\n' \
+  "$root" > cornell.lua
+"$limn" reference --job cornell.lua "${fast[@]}" --refs refs-cornell >log8 2>&1
+[ $? = 1 ] || { cat log8; fail "an unmatchable light was not refused"; }
+grep -q "view 0 (cornell, camera 'front', 32x24): .*light 'ceiling_light': the window falloff" log8 \
+  || { cat log8; fail "the refusal does not name the view and the light"; }
+ls refs-cornell/cornell/*.exr 2>/dev/null && fail "a refused view was rendered"
+
 # 3. a two-setting sweep on the one view: the reference is cached
 "$limn" report --job job.lua "${fast[@]}" --out rep --frames 2 --warmup 1 --sweep "isr:isr.samples=8,16" \
   >log6 2>&1 || { cat log6; fail "report"; }

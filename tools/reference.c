@@ -63,7 +63,7 @@ bool reference_export(const reference_args *a, const job *j, const job_view *v, 
   for (char *line = warnings.data; line && *line;) {
     char *nl = strchr(line, '\n');
     if (nl) *nl = '\0';
-    if (!a->quiet) lm_warn("%s: %s", s->name, line);
+    lm_warn("%s: %s", s->name, line);
     line = nl ? nl + 1 : line + strlen(line);
   }
   lm_buf_free(&warnings);
