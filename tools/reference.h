@@ -18,7 +18,7 @@ typedef struct reference_args {
 } reference_args;
 
 void reference_defaults(reference_args *a);
-/* Exports place v and names its reference file (into path); *hash too. */
+/* Exports place v into sdl and names its reference file (into path). */
 bool reference_export(const reference_args *a, const job *j, const job_view *v, lm_buf *sdl, char *path,
                       size_t cap, lm_error *err);
 /* Renders every place whose reference is missing (all with force): at most
