@@ -13,7 +13,7 @@ packages=(
   liblua5.4-dev libcglm-dev libopenimageio-dev libepoxy-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri libcmocka-dev libtinygltf-dev nlohmann-json3-dev
   libglfw3-dev libfreetype-dev fonts-dejavu-core xvfb xauth
-  clang libclang-rt-14-dev povray valgrind
+  clang libclang-rt-14-dev povray valgrind libxml2-utils
 )
 
 deps() {

@@ -56,25 +56,71 @@ static int usage_error(const char *fmt, const char *arg) {
   return 2;
 }
 
+/* The flags that set the export (also taken by `limn reference` and `limn report`). */
+const struct option limn_pov_options[] = {
+    {"radiosity", required_argument, 0, 'r'},      {"count", required_argument, 0, 'n'},
+    {"error-bound", required_argument, 0, 'e'},    {"pretrace-start", required_argument, 0, 'S'},
+    {"pretrace-end", required_argument, 0, 'E'},   {"recursion-limit", required_argument, 0, 'l'},
+    {"brightness", required_argument, 0, 'b'},     {"shadows", required_argument, 0, 'w'},
+    {"approximate", no_argument, 0, 'a'},          {0, 0, 0, 0}};
+
+void limn_pov_defaults(lm_pov_desc *d) {
+  *d = (lm_pov_desc){.width = 256, .height = 192, .radiosity = true, .shadows = true, .strict = true};
+  lm_pov_radiosity_defaults(&d->rad);
+}
+
+int limn_pov_flag(const char *cmd, int c, const char *arg, lm_pov_desc *d) {
+  lm_pov_radiosity *r = &d->rad;
+  const char *bad = NULL;
+  switch (c) {
+  case 'r': if (!limn_parse_on_off(arg, &d->radiosity)) bad = "--radiosity wants on or off, not '%s'"; break;
+  case 'w': if (!limn_parse_on_off(arg, &d->shadows)) bad = "--shadows wants on or off, not '%s'"; break;
+  case 'n': if (!limn_parse_int(arg, 1, 1600, &r->count)) bad = "--count wants 1..1600, not '%s'"; break;
+  case 'l':
+    if (!limn_parse_int(arg, 1, 20, &r->recursion_limit)) bad = "--recursion-limit wants 1..20, not '%s'";
+    break;
+  case 'e':
+    if (!limn_parse_double(arg, &r->error_bound) || r->error_bound <= 0)
+      bad = "--error-bound wants a number > 0, not '%s'";
+    break;
+  case 'S':
+    if (!limn_parse_double(arg, &r->pretrace_start) || r->pretrace_start <= 0 || r->pretrace_start > 1)
+      bad = "--pretrace-start wants a number in (0, 1], not '%s'";
+    break;
+  case 'E':
+    if (!limn_parse_double(arg, &r->pretrace_end) || r->pretrace_end <= 0 || r->pretrace_end > 1)
+      bad = "--pretrace-end wants a number in (0, 1], not '%s'";
+    break;
+  case 'b':
+    if (!limn_parse_double(arg, &r->brightness) || r->brightness < 0)
+      bad = "--brightness wants a number >= 0, not '%s'";
+    break;
+  case 'a': d->strict = false; break;
+  default: return 1;
+  }
+  if (!bad) return 0;
+  fprintf(stderr, "limn %s: ", cmd);
+  fprintf(stderr, bad, arg);
+  fprintf(stderr, "\n(see limn %s --help)\n", cmd);
+  return 2;
+}
+
 /* Returns 0 to go on, -1 after --help, else the exit code. */
 static int parse_args(int argc, char **argv, export_args *a) {
   *a = (export_args){.scene = "cornell"};
-  a->desc = (lm_pov_desc){.width = 256, .height = 192, .radiosity = true, .shadows = true, .strict = true};
-  lm_pov_radiosity_defaults(&a->desc.rad);
-  static const struct option opts[] = {
-      {"scene", required_argument, 0, 's'},          {"camera", required_argument, 0, 'c'},
-      {"size", required_argument, 0, 'z'},           {"radiosity", required_argument, 0, 'r'},
-      {"count", required_argument, 0, 'n'},          {"error-bound", required_argument, 0, 'e'},
-      {"pretrace-start", required_argument, 0, 'S'}, {"pretrace-end", required_argument, 0, 'E'},
-      {"recursion-limit", required_argument, 0, 'l'}, {"brightness", required_argument, 0, 'b'},
-      {"shadows", required_argument, 0, 'w'},        {"approximate", no_argument, 0, 'a'},
-      {"output", required_argument, 0, 'o'},         {"help", no_argument, 0, 'h'},
-      {0, 0, 0, 0}};
+  limn_pov_defaults(&a->desc);
+  struct option opts[16] = {
+      {"scene", required_argument, 0, 's'}, {"camera", required_argument, 0, 'c'},
+      {"size", required_argument, 0, 'z'},  {"output", required_argument, 0, 'o'},
+      {"help", no_argument, 0, 'h'}};
+  memcpy(opts + 5, limn_pov_options, sizeof limn_pov_options); /* 10 entries with the end */
   opterr = 0;
   optind = 1;
   int c;
-  lm_pov_radiosity *r = &a->desc.rad;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
+    int pov = limn_pov_flag("export-pov", c, optarg, &a->desc);
+    if (pov == 2) return 2;
+    if (pov == 0) continue;
     switch (c) {
     case 's': a->scene = optarg; break;
     case 'c':
@@ -85,36 +131,6 @@ static int parse_args(int argc, char **argv, export_args *a) {
       if (!limn_parse_size(optarg, &a->desc.width, &a->desc.height))
         return usage_error("--size wants WxH with both in 1..65536, not '%s'", optarg);
       break;
-    case 'r':
-      if (!limn_parse_on_off(optarg, &a->desc.radiosity)) return usage_error("--radiosity wants on or off, not '%s'", optarg);
-      break;
-    case 'w':
-      if (!limn_parse_on_off(optarg, &a->desc.shadows)) return usage_error("--shadows wants on or off, not '%s'", optarg);
-      break;
-    case 'n':
-      if (!limn_parse_int(optarg, 1, 1600, &r->count)) return usage_error("--count wants 1..1600, not '%s'", optarg);
-      break;
-    case 'l':
-      if (!limn_parse_int(optarg, 1, 20, &r->recursion_limit))
-        return usage_error("--recursion-limit wants 1..20, not '%s'", optarg);
-      break;
-    case 'e':
-      if (!limn_parse_double(optarg, &r->error_bound) || r->error_bound <= 0)
-        return usage_error("--error-bound wants a number > 0, not '%s'", optarg);
-      break;
-    case 'S':
-      if (!limn_parse_double(optarg, &r->pretrace_start) || r->pretrace_start <= 0 || r->pretrace_start > 1)
-        return usage_error("--pretrace-start wants a number in (0, 1], not '%s'", optarg);
-      break;
-    case 'E':
-      if (!limn_parse_double(optarg, &r->pretrace_end) || r->pretrace_end <= 0 || r->pretrace_end > 1)
-        return usage_error("--pretrace-end wants a number in (0, 1], not '%s'", optarg);
-      break;
-    case 'b':
-      if (!limn_parse_double(optarg, &r->brightness) || r->brightness < 0)
-        return usage_error("--brightness wants a number >= 0, not '%s'", optarg);
-      break;
-    case 'a': a->desc.strict = false; break;
     case 'o': a->output = optarg; break;
     case 'h': printf(export_usage, lm_scene_builtin_list()); return -1;
     case ':': return usage_error("%s needs a value", argv[optind - 1]);
@@ -123,13 +139,13 @@ static int parse_args(int argc, char **argv, export_args *a) {
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
   if (!a->output) return usage_error("%s", "--output FILE.pov is required");
-  const char *bad = a->desc.radiosity ? lm_pov_radiosity_check(r) : NULL;
+  const char *bad = a->desc.radiosity ? lm_pov_radiosity_check(&a->desc.rad) : NULL;
   if (bad) return usage_error("radiosity setting out of range: %s", bad);
   return 0;
 }
 
 /* Written under a temporary name and renamed: the file appears whole or not at all. */
-static bool write_whole(const char *path, const char *data, size_t len, lm_error *err) {
+bool limn_write_whole(const char *path, const char *data, size_t len, lm_error *err) {
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
   FILE *f = fopen(tmp, "wb");
@@ -171,7 +187,7 @@ int limn_export_pov(int argc, char **argv) {
     line = nl ? nl + 1 : line + strlen(line);
   }
   if (!ok) lm_error_prefix(&err, "%s", a.scene);
-  if (ok) ok = write_whole(a.output, sdl.data, (size_t)sdl.len, &err);
+  if (ok) ok = limn_write_whole(a.output, sdl.data, (size_t)sdl.len, &err);
   if (ok) lm_info("wrote %s (scene %s, camera %d, %dx%d, radiosity %s, shadows %s)", a.output, a.scene,
                   a.desc.camera, a.desc.width, a.desc.height, a.desc.radiosity ? "on" : "off",
                   a.desc.shadows ? "on" : "off");

@@ -29,37 +29,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "capture.h"
+#include "job.h"
 #include "tools.h"
 #include "scene/gltf.h"
-
-#define MAX_LIST 64
-
-typedef struct job_scene {
-  char path[1024], cameras[1024], name[LM_NAME_MAX];
-  lm_scene *scene;
-  int first_camera, camera_count;
-  uint64_t hash;
-} job_scene;
-
-typedef struct job {
-  char path[1024], dir[1024], script[1024], output[1024], manifest[1024];
-  job_scene scenes[MAX_LIST];
-  int scene_count;
-  char techniques[MAX_LIST][64];
-  int technique_count;
-  int sizes[MAX_LIST][2];
-  int size_count;
-  char set_names[MAX_LIST][128], set_values[MAX_LIST][256];
-  int set_count;
-  int frames;
-  uint64_t hash;
-} job;
-
-typedef struct view {
-  int scene, camera, size, technique;
-  char output[1024];
-} view;
 
 /* ---- reading the job file ---------------------------------------------- */
 
@@ -216,7 +188,7 @@ static bool read_sets(lua_State *L, job *j, lm_error *err) {
 
 static int compare_sets(const void *a, const void *b) { return strcmp(a, b); }
 
-static bool read_job(job *j, const char *path, lm_error *err) {
+bool job_read(job *j, const char *path, lm_error *err) {
   memset(j, 0, sizeof *j);
   snprintf(j->path, sizeof j->path, "%s", path);
   lm_dirname(path, j->dir, sizeof j->dir);
@@ -321,7 +293,7 @@ static bool read_job(job *j, const char *path, lm_error *err) {
 /* ---- output names -------------------------------------------------------- */
 
 /* Fills the pattern's {scene} {camera} {view} {technique} {size} {width} {height}. */
-static bool expand(const job *j, const view *v, int index, char *out, size_t cap, lm_error *err) {
+static bool expand(const job *j, const job_view *v, int index, char *out, size_t cap, lm_error *err) {
   const job_scene *s = &j->scenes[v->scene];
   lm_buf b = {0};
   bool ok = true;
@@ -353,7 +325,7 @@ static bool expand(const job *j, const view *v, int index, char *out, size_t cap
 }
 
 /* mkdir -p of the file's folder. */
-static bool make_parent(const char *file, lm_error *err) {
+bool job_make_parent(const char *file, lm_error *err) {
   char dir[1024];
   lm_dirname(file, dir, sizeof dir);
   for (char *p = dir + 1;; p++) {
@@ -445,7 +417,7 @@ typedef struct manifest {
 } manifest;
 
 /* The entries a previous run left, one line each, keyed by "file". */
-static void manifest_load(const char *path, const view *views, int view_count, manifest *m) {
+static void manifest_load(const char *path, const job_view *views, int view_count, manifest *m) {
   size_t len;
   lm_error err;
   char *text = lm_read_file(path, &len, &err);
@@ -495,7 +467,7 @@ static bool manifest_write(const char *path, const manifest *m, int view_count, 
   return ok;
 }
 
-static char *manifest_entry(const job *j, const view *v, int index, const capture_result *res, int run) {
+static char *manifest_entry(const job *j, const job_view *v, int index, const capture_result *res, int run) {
   const job_scene *s = &j->scenes[v->scene];
   lm_buf b = {0};
   lm_buf_append(&b, "{\"file\": ", -1);
@@ -519,10 +491,66 @@ static char *manifest_entry(const job *j, const view *v, int index, const captur
   return b.data;
 }
 
+bool job_views(job *j, bool all_techniques, job_view **out, int *count, lm_error *err) {
+  *out = NULL;
+  *count = 0;
+  /* Every scene and camera list is read before anything renders: a bad
+   * entry stops the job at once, naming it. */
+  int techniques = all_techniques ? j->technique_count : 1, view_count = 0;
+  for (int i = 0; i < j->scene_count; i++) {
+    job_scene *s = &j->scenes[i];
+    if (!s->scene) {
+      s->scene = lm_scene_load_gltf(s->path, err);
+      if (s->scene) s->first_camera = lm_scene_add_camera_list(s->scene, s->cameras, &s->camera_count, err);
+      if (!s->scene || s->first_camera < 0) {
+        lm_error_prefix(err, "%s: scenes[%d]", j->path, i + 1);
+        return false;
+      }
+      s->hash = hash_file(s->cameras, hash_file(s->path, LM_HASH_SEED));
+    }
+    view_count += s->camera_count * j->size_count * techniques;
+  }
+  job_view *views = lm_alloc(sizeof *views * (size_t)(view_count + 1));
+  int n = 0;
+  for (int si = 0; si < j->scene_count; si++)
+    for (int z = 0; z < j->size_count; z++)
+      for (int t = 0; t < techniques; t++)
+        for (int c = 0; c < j->scenes[si].camera_count; c++) {
+          job_view *v = &views[n];
+          *v = (job_view){si, j->scenes[si].first_camera + c, z, t, ""};
+          if (!all_techniques) { /* places only: no output pattern */
+            n++;
+            continue;
+          }
+          if (!expand(j, v, n, v->output, sizeof v->output, err)) {
+            free(views);
+            return false;
+          }
+          for (int k = 0; k < n; k++)
+            if (!strcmp(views[k].output, v->output)) {
+              lm_error_set(err, "%s: output: views %d and %d both write %s (add {camera}, {technique} or "
+                           "{size} to the pattern)", j->path, k, n, v->output);
+              free(views);
+              return false;
+            }
+          n++;
+        }
+  *out = views;
+  *count = n;
+  return true;
+}
+
+void job_free_scenes(job *j) {
+  for (int i = 0; i < j->scene_count; i++) {
+    lm_scene_destroy(j->scenes[i].scene);
+    j->scenes[i].scene = NULL;
+  }
+}
+
 /* ---- running ------------------------------------------------------------- */
 
-static void progress(const capture_job_args *a, bool tty, int done, int total, const char *what) {
-  if (a->quiet) return;
+void job_progress(bool quiet, bool tty, int done, int total, const char *what) {
+  if (quiet) return;
   if (tty) {
     int width = 30, fill = total ? done * width / total : width;
     printf("\r[%.*s%.*s] %d/%d %-60.60s", fill, "##############################", width - fill,
@@ -536,42 +564,12 @@ static void progress(const capture_job_args *a, bool tty, int done, int total, c
 
 static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   lm_error err;
-  /* Every scene and camera list is read before anything renders: a bad
-   * entry stops the job at once, naming it. */
-  int view_count = 0;
-  for (int i = 0; i < j->scene_count; i++) {
-    job_scene *s = &j->scenes[i];
-    s->scene = lm_scene_load_gltf(s->path, &err);
-    if (s->scene) s->first_camera = lm_scene_add_camera_list(s->scene, s->cameras, &s->camera_count, &err);
-    if (!s->scene || s->first_camera < 0) {
-      lm_log(LM_LOG_ERROR, "%s: scenes[%d]: %s", j->path, i + 1, err.msg);
-      return 1;
-    }
-    s->hash = hash_file(s->cameras, hash_file(s->path, LM_HASH_SEED));
-    view_count += s->camera_count * j->size_count * j->technique_count;
+  job_view *views;
+  int view_count;
+  if (!job_views(j, true, &views, &view_count, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    return 1;
   }
-  view *views = lm_alloc(sizeof *views * (size_t)view_count);
-  int n = 0;
-  for (int si = 0; si < j->scene_count; si++)
-    for (int z = 0; z < j->size_count; z++)
-      for (int t = 0; t < j->technique_count; t++)
-        for (int c = 0; c < j->scenes[si].camera_count; c++) {
-          view *v = &views[n];
-          *v = (view){si, j->scenes[si].first_camera + c, z, t, ""};
-          if (!expand(j, v, n, v->output, sizeof v->output, &err)) {
-            lm_log(LM_LOG_ERROR, "%s", err.msg);
-            free(views);
-            return 1;
-          }
-          for (int k = 0; k < n; k++)
-            if (!strcmp(views[k].output, v->output)) {
-              lm_log(LM_LOG_ERROR, "%s: output: views %d and %d both write %s (add {camera}, {technique} or "
-                     "{size} to the pattern)", j->path, k, n, v->output);
-              free(views);
-              return 1;
-            }
-          n++;
-        }
 
   char manifest_path[1100];
   snprintf(manifest_path, sizeof manifest_path, "%s", j->manifest);
@@ -589,7 +587,7 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   int rc = 0;
   bool any_linear;
   capture_known_extension(j->output, &any_linear);
-  if (!make_parent(manifest_path, &err) ||
+  if (!job_make_parent(manifest_path, &err) ||
       !lm_context_create_headless(&(lm_context_desc){.platform = a->egl, .debug = a->verbose}, &err)) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     rc = 1;
@@ -647,18 +645,18 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   lm_scene *current = j->scenes[0].scene;
   for (int i = 0; i < view_count && !rc; i++) {
     if (i % a->shards != a->shard) continue;
-    const view *v = &views[i];
+    const job_view *v = &views[i];
     const job_scene *s = &j->scenes[v->scene];
     char what[1200];
     remove_stale_temps(v->output);
     if (!a->force && lm_file_exists(v->output)) {
       skipped++;
       snprintf(what, sizeof what, "%s: exists, skipped", v->output);
-      progress(a, tty, ++done, mine, what);
+      job_progress(a->quiet, tty, ++done, mine, what);
       continue;
     }
     capture_result res = {0};
-    bool ok = make_parent(v->output, &err) && lm_pipeline_set_technique(pipeline, j->techniques[v->technique], &err);
+    bool ok = job_make_parent(v->output, &err) && lm_pipeline_set_technique(pipeline, j->techniques[v->technique], &err);
     if (ok && s->scene != current) ok = lm_renderer_set_scene(r, s->scene, &err), current = s->scene;
     if (ok) {
       const char *outs[1] = {v->output};
@@ -680,7 +678,7 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     } else {
       rendered++;
       snprintf(what, sizeof what, "%s (%.1f ms)", v->output, res.total_ms);
-      progress(a, tty, ++done, mine, what);
+      job_progress(a->quiet, tty, ++done, mine, what);
       if (kill_after > 0 && rendered == kill_after) raise(SIGKILL);
     }
     capture_result_free(&res);
@@ -702,21 +700,15 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   return rc;
 }
 
-int capture_job_run(const capture_job_args *a) {
-  job *j = lm_alloc(sizeof *j);
+lm_pipeline *job_pipeline(job *j, const char *const *sets, int set_count, bool check_techniques) {
   lm_error err;
-  if (!read_job(j, a->path, &err)) {
-    lm_log(LM_LOG_ERROR, "%s", err.msg);
-    free(j);
-    return 2;
-  }
   int rc = 0;
   lm_pipeline *pipeline = lm_pipeline_load(&(lm_pipeline_desc){.path = j->script}, &err);
   if (!pipeline) {
     lm_log(LM_LOG_ERROR, "%s: script: %s", j->path, err.msg);
     rc = 2;
   }
-  for (int i = 0; i < j->technique_count && !rc; i++)
+  for (int i = 0; i < j->technique_count && !rc && check_techniques; i++)
     if (!lm_pipeline_set_technique(pipeline, j->techniques[i], &err)) {
       lm_log(LM_LOG_ERROR, "%s: techniques[%d]: %s", j->path, i + 1, err.msg);
       rc = 2;
@@ -730,15 +722,33 @@ int capture_job_run(const capture_job_args *a) {
       lm_log(LM_LOG_ERROR, "%s: set.%s: %s", j->path, j->set_names[i], err.msg);
       rc = 2;
     }
-  for (int i = 0; i < a->set_count && !rc; i++) {
+  for (int i = 0; i < set_count && !rc; i++) {
     char name[256];
-    const char *eq = strchr(a->sets[i], '=');
-    snprintf(name, sizeof name, "%.*s", (int)(eq - a->sets[i]), a->sets[i]);
+    const char *eq = strchr(sets[i], '=');
+    snprintf(name, sizeof name, "%.*s", (int)(eq - sets[i]), sets[i]);
     if (!lm_pipeline_set_option(pipeline, name, eq + 1, &err)) {
-      lm_log(LM_LOG_ERROR, "--set %s: %s", a->sets[i], err.msg);
+      lm_log(LM_LOG_ERROR, "--set %s: %s", sets[i], err.msg);
       rc = 2;
     }
   }
+  if (rc) {
+    lm_pipeline_destroy(pipeline);
+    return NULL;
+  }
+  return pipeline;
+}
+
+int capture_job_run(const capture_job_args *a) {
+  job *j = lm_alloc(sizeof *j);
+  lm_error err;
+  if (!job_read(j, a->path, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    free(j);
+    return 2;
+  }
+  int rc = 0;
+  lm_pipeline *pipeline = job_pipeline(j, a->sets, a->set_count, true);
+  if (!pipeline) rc = 2;
   if (!rc) rc = run(a, j, pipeline);
   for (int i = 0; i < j->scene_count; i++) lm_scene_destroy(j->scenes[i].scene);
   lm_pipeline_destroy(pipeline);

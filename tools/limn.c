@@ -13,6 +13,8 @@ static const char usage[] =
     "  capture   render headless (EGL, no window) to PNG or EXR and print per-pass times\n"
     "  export-pov  one view of a scene as POV-Ray 3.7 scene description (references)\n"
     "  compare   mean error, RMSE, PSNR, Pearson, SSIM of two images; difference image\n"
+    "  reference  POV-Ray references (radiosity) of a capture job's views, cached by hash\n"
+    "  report    error against POV-Ray references and run time for a sweep of techniques\n"
     "  bench     compositor overhead per frame and pass times against resolution\n"
     "  view      a window with live reload of scripts and shaders, timings, target inspector\n"
     "  help      this text; `limn <command> --help` describes a command's flags\n"
@@ -34,6 +36,8 @@ int main(int argc, char **argv) {
   if (!strcmp(cmd, "view")) return limn_view(argc - 1, argv + 1);
   if (!strcmp(cmd, "export-pov")) return limn_export_pov(argc - 1, argv + 1);
   if (!strcmp(cmd, "compare")) return limn_compare(argc - 1, argv + 1);
+  if (!strcmp(cmd, "reference")) return limn_reference(argc - 1, argv + 1);
+  if (!strcmp(cmd, "report")) return limn_report(argc - 1, argv + 1);
   if (!strcmp(cmd, "bench")) return limn_bench(argc - 1, argv + 1);
   fprintf(stderr, "limn: unknown command '%s'\n\n%s", cmd, usage);
   return 2;

@@ -4,12 +4,16 @@
 #define LIMN_TOOLS_H
 
 #include <stdbool.h>
+#include <getopt.h>
+#include <stddef.h>
 
 int limn_capture(int argc, char **argv);
 int limn_view(int argc, char **argv);
 int limn_export_pov(int argc, char **argv);
 int limn_compare(int argc, char **argv);
 int limn_bench(int argc, char **argv);
+int limn_reference(int argc, char **argv);
+int limn_report(int argc, char **argv);
 
 /* Flag values (tools/args.c): false when `s` is not one. */
 bool limn_parse_int(const char *s, int lo, int hi, int *out);
@@ -18,5 +22,18 @@ bool limn_parse_size(const char *s, int *w, int *h); /* WxH, each 1..65536 */
 bool limn_parse_on_off(const char *s, bool *out);
 /* Prints s as a JSON string (quotes, backslashes and control characters escaped). */
 void limn_json_string(const char *s);
+
+/* export-pov's flags (tools/export_pov.c), shared by reference and report:
+ * limn_pov_options ends with a zero entry (10 entries in all);
+ * limn_pov_flag returns 0 when it took getopt's c, 1 when c is not one of
+ * them, 2 after printing a usage error for `limn CMD`. */
+struct lm_pov_desc;
+extern const struct option limn_pov_options[];
+#define LIMN_POV_OPTION_COUNT 10
+void limn_pov_defaults(struct lm_pov_desc *d);
+int limn_pov_flag(const char *cmd, int c, const char *arg, struct lm_pov_desc *d);
+/* Writes the file under a temporary name and renames it: whole or not at all. */
+typedef struct lm_error lm_error;
+bool limn_write_whole(const char *path, const char *data, size_t len, lm_error *err);
 
 #endif

@@ -1,0 +1,126 @@
+#!/usr/bin/env bash
+# limn reference and limn report on one small view (data/scenes/pov_ball.gltf
+# at 48x36, POV-Ray radiosity with a low count so a run takes a second):
+# - references are cached by the export's hash: a second run renders
+#   nothing; a changed scene renders a new reference;
+# - a failing POV-Ray run names the view, shows POV-Ray's error lines, exits
+#   1 and leaves no reference or temporary file;
+# - a two-setting sweep writes the CSV, the JSON, the SVG (it parses as XML)
+#   and the Markdown summary, with consistent numbers.
+# Skipped (77) where povray is not installed (tools/dev.sh installs it).
+set -u
+limn=$1
+root=$2
+command -v povray >/dev/null || { echo "povray not installed: skipped (tools/dev.sh installs it)"; exit 77; }
+tmp=$(mktemp -d /tmp/limn-ref-XXXXXX)   # POV-Ray's default I/O policy allows writing under /tmp
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+cd "$tmp" || exit 1
+cp "$root/data/scenes/pov_ball.gltf" ball.gltf
+printf '# name eye target fov\nfront 0 1.5 3  0 0.3 0  45\n' > ball.cams
+cat > job.lua <<'JOB'
+return {
+  scenes = { { scene = "ball.gltf", cameras = "ball.cams" } },
+  sizes = { "48x36" },
+  set = { ambient = 0 },
+  output = "out/{camera}_{technique}.png",
+}
+JOB
+fast=(--count 10 --pretrace-start 0.2 --pretrace-end 0.1 --refs refs --jobs 2)
+
+# 1. caching
+"$limn" reference --job job.lua "${fast[@]}" >log1 2>&1 || { cat log1; fail "first reference run"; }
+cat log1
+grep -q "1 rendered, 0 cached" log1 || fail "the first run did not render the view"
+first=$(ls refs/ball/front_48x36-*.exr) || fail "no reference file"
+[ "$(echo "$first" | wc -l)" = 1 ] || fail "more than one reference: $first"
+ls refs/ball | grep -q "tmp" && fail "a temporary file was left: $(ls refs/ball)"
+"$limn" reference --job job.lua "${fast[@]}" >log2 2>&1 || { cat log2; fail "second reference run"; }
+grep -q "0 rendered, 1 cached" log2 || { cat log2; fail "the second run rendered again"; }
+# A changed scene (the sun's intensity) is a new export: rendered again.
+sed -i 's/"intensity": 2.0/"intensity": 1.5/' ball.gltf
+grep -q '"intensity": 1.5' ball.gltf || fail "could not change the scene"
+"$limn" reference --job job.lua "${fast[@]}" >log3 2>&1 || { cat log3; fail "third reference run"; }
+grep -q "1 rendered, 0 cached" log3 || { cat log3; fail "a changed scene was not rendered again"; }
+[ "$(ls refs/ball/front_48x36-*.exr | wc -l)" = 2 ] || fail "the changed scene did not get its own reference"
+# The new reference is darker (less sun): its mean error against the old one is not 0.
+second=$(ls refs/ball/front_48x36-*.exr | grep -v "$first")
+"$limn" compare "$first" "$second" --json >m.json || fail "compare references"
+mean=$(grep -o '"mean_error": [-0-9.e+]*' m.json | awk '{print $2}')
+awk -v m="$mean" 'BEGIN { exit !(m > 0.005) }' || { cat m.json; fail "references equal (mean error $mean)"; }
+
+# 2. a failing POV-Ray run: named by view, its error lines shown, exit 1
+cat > fakepov <<'FAKE'
+#!/bin/sh
+echo "Persistence of Vision(tm) Ray Tracer"
+echo "File 'x.pov' line 3: Parse Error: Expected 'object', undeclared identifier 'oops' found instead"
+echo "Fatal error in parser: Cannot parse input."
+exit 1
+FAKE
+chmod +x fakepov
+"$limn" reference --job job.lua "${fast[@]}" --refs refs-bad --povray "$tmp/fakepov" >log4 2>&1
+rc=$?
+cat log4
+[ $rc = 1 ] || fail "a failing POV-Ray run exited $rc, not 1"
+grep -q "view 0 (ball, camera 'front', 48x36): POV-Ray failed" log4 || fail "the failure does not name the view"
+grep -q "Parse Error: Expected 'object'" log4 || fail "POV-Ray's error line is not shown"
+ls refs-bad/ball/*.exr 2>/dev/null && fail "a failed run left an image"
+# A program that is not there is a failure too.
+"$limn" reference --job job.lua "${fast[@]}" --refs refs-bad --povray "$tmp/nothere" >log5 2>&1
+[ $? = 1 ] || fail "a missing POV-Ray program did not fail"
+grep -q "cannot run" log5 || { cat log5; fail "a missing program is not said"; }
+
+# Lights POV-Ray cannot match (cornell.glb's window falloff) are refused by name, before POV-Ray runs.
+printf 'return { scenes = { "%s/data/scenes/cornell.glb" }, sizes = { "32x24" }, output = "o/{camera}.png" }\n' \
+  "$root" > cornell.lua
+"$limn" reference --job cornell.lua "${fast[@]}" --refs refs-cornell >log8 2>&1
+[ $? = 1 ] || { cat log8; fail "an unmatchable light was not refused"; }
+grep -q "view 0 (cornell, camera 'front', 32x24): .*light 'ceiling_light': the window falloff" log8 \
+  || { cat log8; fail "the refusal does not name the view and the light"; }
+ls refs-cornell/cornell/*.exr 2>/dev/null && fail "a refused view was rendered"
+
+# 3. a two-setting sweep on the one view: the reference is cached
+"$limn" report --job job.lua "${fast[@]}" --out rep --frames 2 --warmup 1 --sweep "isr:isr.samples=8,16" \
+  >log6 2>&1 || { cat log6; fail "report"; }
+cat log6
+grep -q "0 rendered, 1 cached" log6 || fail "the report rendered a cached reference again"
+for f in report.csv report.json report.svg report.md; do [ -s rep/$f ] || fail "no rep/$f"; done
+cat rep/report.csv rep/report.md
+# CSV: a header and three rows: the baseline dl and the two settings
+[ "$(wc -l < rep/report.csv)" = 4 ] || fail "the CSV has not 1 + 3 lines"
+grep -q '^"dl","dl","ball/front/48x36"' rep/report.csv || fail "no baseline row"
+grep -q '^"isr","isr samples=8",' rep/report.csv || fail "no samples=8 row"
+grep -q '^"isr","isr samples=16",' rep/report.csv || fail "no samples=16 row"
+grep -q "isr.transport=" rep/report.csv || fail "no per-pass times"
+# every error finite and in range, every total time above 0
+awk -F, 'NR > 1 { if (!($8 > 0 && $8 < 1 && $14 > 0)) bad = 1 } END { exit bad }' rep/report.csv \
+  || fail "an error or time out of range"
+grep -q '"clock": "' rep/report.json || fail "the JSON does not name the clock"
+[ "$(grep -c '"technique": ' rep/report.json)" = 3 ] || fail "the JSON has not three rows"
+if command -v python3 >/dev/null; then python3 -m json.tool rep/report.json >/dev/null || fail "JSON does not parse"; fi
+# SVG: XML that parses, one point per setting, the Pareto front marked
+if command -v xmllint >/dev/null; then
+  xmllint --noout rep/report.svg || fail "the SVG is not XML"
+elif command -v python3 >/dev/null; then
+  python3 -c 'import sys, xml.dom.minidom; xml.dom.minidom.parse(sys.argv[1])' rep/report.svg || fail "the SVG is not XML"
+else
+  fail "neither xmllint (libxml2-utils, tools/dev.sh) nor python3 to parse the SVG"
+fi
+[ "$(grep -c '<circle class="point' rep/report.svg)" = 3 ] || fail "the SVG has not three points"
+grep -q 'class="point pareto"' rep/report.svg || fail "no point on the Pareto front"
+# Markdown: the gain of each setting is 100 (e_dl - e) / e_dl from the CSV's errors
+grep -q "| dl (baseline) |" rep/report.md || fail "no baseline line in the summary"
+e_dl=$(awk -F, 'NR == 2 { print $8 }' rep/report.csv)
+e_8=$(awk -F, 'NR == 3 { print $8 }' rep/report.csv)
+gain=$(awk -v b="$e_dl" -v e="$e_8" 'BEGIN { printf "%.2f", 100 * (b - e) / b }')
+grep -q "| isr samples=8 | [0-9.]* | [0-9.]* | $gain | $gain | " rep/report.md \
+  || fail "the summary's gain for samples=8 is not $gain"
+# The images are there to look at.
+[ "$(ls rep/images/*.exr | wc -l)" = 3 ] || fail "not three images"
+
+# 4. --require-refs names the command when a reference is missing
+"$limn" report --job job.lua "${fast[@]}" --refs refs-none --require-refs --out rep2 --sweep dl >log7 2>&1
+[ $? = 1 ] || { cat log7; fail "--require-refs without references did not fail"; }
+grep -q "limn reference --job job.lua --refs refs-none" log7 || { cat log7; fail "the command is not named"; }
+[ -e rep2/report.csv ] && fail "a failed report wrote its CSV"
+echo "passed"

@@ -1,0 +1,109 @@
+/* The report's arithmetic (tools/report_math.h): the Pareto front of a
+ * crafted set of points, the gains and summary against hand values, and the
+ * sweep syntax with its errors. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <string.h>
+
+#include "report_math.h"
+
+/* Points (ms, error), lower is better in both:
+ *   0 (1, 10)  front: fastest
+ *   1 (2, 5)   front
+ *   2 (3, 6)   dominated by 1
+ *   3 (4, 2)   front
+ *   4 (4, 2)   front: equal to 3, neither dominates
+ *   5 (5, 2)   dominated by 3 (same error, slower)
+ *   6 (6, 1)   front: most accurate
+ *   7 (2, 7)   dominated by 1 (same time, worse error) */
+static void pareto_crafted(void **state) {
+  (void)state;
+  double ms[] = {1, 2, 3, 4, 4, 5, 6, 2}, err[] = {10, 5, 6, 2, 2, 2, 1, 7};
+  bool front[8];
+  report_pareto(ms, err, 8, front);
+  bool want[] = {true, true, false, true, true, false, true, false};
+  for (int i = 0; i < 8; i++) assert_int_equal(front[i], want[i]);
+  /* One point is its own front; none is fine. */
+  report_pareto(ms, err, 1, front);
+  assert_true(front[0]);
+  report_pareto(ms, err, 0, front);
+}
+
+static void gains_by_hand(void **state) {
+  (void)state;
+  assert_float_equal(report_gain(0.1, 0.09), 10.0, 1e-9);
+  assert_float_equal(report_gain(0.2, 0.25), -25.0, 1e-9);
+  assert_float_equal(report_gain(0.0, 0.1), 0.0, 0); /* nothing to gain: defined, not Inf */
+  /* Four views. Baseline errors 0.1 0.2 0.4 0.5, the setting's 0.09 0.25 0.3
+   * 0.5: gains 10, -25, 25, 0; mean 2.5, median (0 + 10) / 2 = 5; improved
+   * 2 of 4. Pixels closer 0.5, 0.1, 0.9, 0 of 100, 100, 200, 100 pixels:
+   * (50 + 10 + 180 + 0) / 500 = 0.48. Pearson means 0.8 and 0.85. */
+  double base[] = {0.1, 0.2, 0.4, 0.5}, e[] = {0.09, 0.25, 0.3, 0.5}, closer[] = {0.5, 0.1, 0.9, 0};
+  double px[] = {100, 100, 200, 100}, pb[] = {0.7, 0.8, 0.9, 0.8}, pa[] = {0.8, 0.8, 0.9, 0.9};
+  report_summary s;
+  report_summarize(4, base, e, closer, px, pb, pa, &s);
+  assert_int_equal(s.views, 4);
+  assert_float_equal(s.mean_gain, 2.5, 1e-9);
+  assert_float_equal(s.median_gain, 5.0, 1e-9);
+  assert_float_equal(s.views_improved, 0.5, 1e-12);
+  assert_float_equal(s.pixels_closer, 0.48, 1e-12);
+  assert_float_equal(s.pearson_before, 0.8, 1e-12);
+  assert_float_equal(s.pearson_after, 0.85, 1e-12);
+  /* An odd count takes the middle gain. */
+  report_summarize(3, base, e, closer, px, pb, pa, &s);
+  assert_float_equal(s.median_gain, 10.0, 1e-9);
+  assert_float_equal(s.mean_gain, 10.0 / 3.0, 1e-9);
+  report_summarize(0, base, e, closer, px, pb, pa, &s);
+  assert_int_equal(s.views, 0);
+  assert_float_equal(s.mean_gain, 0, 0);
+}
+
+static void sweep_syntax(void **state) {
+  (void)state;
+  static report_setting list[REPORT_MAX_SETTINGS];
+  int n = 0;
+  lm_error err;
+  assert_true(report_sweep_parse("dl", list, &n, &err));
+  assert_int_equal(n, 1);
+  assert_string_equal(list[0].technique, "dl");
+  assert_int_equal(list[0].option_count, 0);
+  assert_true(report_sweep_parse("isr:isr.samples=8,16,32;isr.coarse=1,2", list, &n, &err));
+  assert_int_equal(n, 7); /* 3 x 2 more */
+  assert_string_equal(list[1].technique, "isr");
+  assert_string_equal(list[1].names[0], "isr.samples");
+  assert_string_equal(list[1].values[0], "8");
+  assert_string_equal(list[1].values[1], "1");
+  assert_string_equal(list[2].values[0], "8"); /* the last option varies fastest */
+  assert_string_equal(list[2].values[1], "2");
+  assert_string_equal(list[6].values[0], "32");
+  assert_string_equal(list[6].values[1], "2");
+  assert_string_equal(list[6].label, "isr samples=32 coarse=2");
+  assert_true(report_sweep_parse(" ssao : ssao.radius = 0.1 , 0.2 ", list, &n, &err));
+  assert_int_equal(n, 9);
+  assert_string_equal(list[8].technique, "ssao");
+  assert_string_equal(list[8].values[0], "0.2");
+  /* Errors name the spec and leave the list as it was. */
+  const char *bad[] = {"", ":a=1", "isr:samples", "isr:=1", "isr:a=1,,2", "isr:a=", "a=1"};
+  for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+    assert_false(report_sweep_parse(bad[i], list, &n, &err));
+    assert_non_null(strstr(err.msg, "--sweep"));
+    assert_int_equal(n, 9);
+  }
+  /* More settings than a report holds. */
+  assert_false(report_sweep_parse("isr:a=1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16;b=1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16",
+                                  list, &n, &err));
+  assert_non_null(strstr(err.msg, "more than"));
+  assert_int_equal(n, 9);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(pareto_crafted),
+      cmocka_unit_test(gains_by_hand),
+      cmocka_unit_test(sweep_syntax),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,55 @@
+/* Capture jobs (tools/job.c) as `limn capture --job`, `limn reference` and
+ * `limn report` share them: the job file read, its views enumerated, its
+ * pipeline set up, the progress line. */
+#ifndef LIMN_JOB_H
+#define LIMN_JOB_H
+
+#include "capture.h"
+
+#define MAX_LIST 64
+
+typedef struct job_scene {
+  char path[1024], cameras[1024], name[LM_NAME_MAX];
+  lm_scene *scene;
+  int first_camera, camera_count;
+  uint64_t hash;
+} job_scene;
+
+typedef struct job {
+  char path[1024], dir[1024], script[1024], output[1024], manifest[1024];
+  job_scene scenes[MAX_LIST];
+  int scene_count;
+  char techniques[MAX_LIST][64];
+  int technique_count;
+  int sizes[MAX_LIST][2];
+  int size_count;
+  char set_names[MAX_LIST][128], set_values[MAX_LIST][256];
+  int set_count;
+  int frames;
+  uint64_t hash;
+} job;
+
+typedef struct job_view {
+  int scene, camera, size, technique;
+  char output[1024];
+} job_view;
+
+
+/* Reads and checks the job file (Lua data); false with a message naming it. */
+bool job_read(job *j, const char *path, lm_error *err);
+/* Loads every scene and camera list (once) and lists the views in the job's
+ * order: scene, size, technique, camera, with their outputs. Without
+ * all_techniques, the places only (technique 0, no output): what does not
+ * depend on the technique, as a reference render. *out is malloc'd. */
+bool job_views(job *j, bool all_techniques, job_view **out, int *count, lm_error *err);
+void job_free_scenes(job *j);
+/* The job's script with its `set` options and then `sets` (NAME=VALUE);
+ * with check_techniques its techniques must exist (an empty list becomes
+ * the script's first). NULL after logging what is wrong. */
+lm_pipeline *job_pipeline(job *j, const char *const *sets, int set_count, bool check_techniques);
+/* Creates the folders above `file`. */
+bool job_make_parent(const char *file, lm_error *err);
+/* A progress bar on a terminal (tty), else one line per item. */
+void job_progress(bool quiet, bool tty, int done, int total, const char *what);
+
+#endif

@@ -1,0 +1,603 @@
+/* limn report --job FILE --sweep SPEC: error against POV-Ray references and
+ * run time for every technique and setting of a sweep, on every view of a
+ * capture job. Writes report.csv, report.json, report.svg and report.md
+ * (seed 000 chapter 5.3: mean error eq 19, Pearson eq 20, gain over direct
+ * light, share of pixels closer to the reference). */
+#define _GNU_SOURCE
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "image/metrics.h"
+#include "reference.h"
+#include "report_math.h"
+#include "tools.h"
+
+#define BASELINE "dl"
+
+static const char report_usage[] =
+    "usage: limn report --job FILE --sweep SPEC [--sweep SPEC ...] [options]\n"
+    "\n"
+    "Renders every view of a capture job (scenes, cameras, sizes; the job's\n"
+    "techniques are replaced by the sweep's) with each technique and setting,\n"
+    "compares each image with the view's POV-Ray reference (limn reference;\n"
+    "missing ones are rendered first) and writes DIR/report.csv, report.json,\n"
+    "report.svg (mean error against milliseconds, Pareto front marked) and\n"
+    "report.md (gain over direct light per view, mean and median gain, share\n"
+    "of views and pixels improved, Pearson before and after). The baseline\n"
+    "(--baseline, default direct light: " BASELINE ") is always rendered.\n"
+    "\n"
+    "SPEC: TECH, or TECH:OPTION=V1,V2,...;OPTION=V1,... for every combination,\n"
+    "  e.g. --sweep \"isr:isr.samples=8,16,32;isr.coarse=1,2\" --sweep ssao\n"
+    "\n"
+    "options:\n"
+    "  --job FILE           the capture job (its `set` applies to every setting;\n"
+    "                       set ambient = 0 to compare with POV-Ray)\n"
+    "  --sweep SPEC         techniques and settings (repeatable)\n"
+    "  --out DIR            where the report goes (default out/report)\n"
+    "  --baseline TECH      the technique gains are measured against (default " BASELINE ";\n"
+    "                       dl+esm when the references have shadows to match)\n"
+    "  --frames N           timed frames per image; times are medians (default 5)\n"
+    "  --warmup N           frames rendered first, untimed (default 2)\n"
+    "  --refs DIR           the references (default out/reference)\n"
+    "  --require-refs       fail, naming the command, when a reference is missing,\n"
+    "                       instead of rendering it\n"
+    "  --jobs N, --povray PROGRAM, --force: as limn reference, for missing ones\n"
+    "  --radiosity, --count, ... --approximate: as export-pov (the references')\n"
+    "  --quiet              no progress\n"
+    "\n"
+    "exit codes: 0 written, 1 a render, reference or file failed, 2 bad usage.\n";
+
+typedef struct report_row {
+  int setting, place;
+  lm_metrics m;      /* against the reference */
+  double closer;     /* share of pixels closer to the reference than the baseline's */
+  double total_ms;
+  capture_result res;
+} report_row;
+
+typedef struct report_args {
+  const char *job, *out, *baseline;
+  report_setting *settings;
+  int setting_count, frames, warmup;
+  bool require_refs;
+  reference_args ref;
+} report_args;
+
+static int usage_error(const char *fmt, const char *arg) {
+  fprintf(stderr, "limn report: ");
+  fprintf(stderr, fmt, arg);
+  fprintf(stderr, "\n(see limn report --help)\n");
+  return 2;
+}
+
+/* ---- writing ------------------------------------------------------------ */
+
+static void json_str(lm_buf *b, const char *s) {
+  lm_buf_append(b, "\"", 1);
+  for (; *s; s++) {
+    unsigned char c = (unsigned char)*s;
+    if (c == '"' || c == '\\') lm_buf_printf(b, "\\%c", c);
+    else if (c < 0x20) lm_buf_printf(b, "\\u%04x", c);
+    else lm_buf_append(b, s, 1);
+  }
+  lm_buf_append(b, "\"", 1);
+}
+
+/* A CSV field: quoted, quotes doubled. */
+static void csv_str(lm_buf *b, const char *s) {
+  lm_buf_append(b, "\"", 1);
+  for (; *s; s++) lm_buf_append(b, *s == '"' ? "\"\"" : s, 1 + (*s == '"'));
+  lm_buf_append(b, "\"", 1);
+}
+
+/* SVG and Markdown text: <, >, & escaped. */
+static void xml_str(lm_buf *b, const char *s) {
+  for (; *s; s++) {
+    if (*s == '<') lm_buf_append(b, "&lt;", -1);
+    else if (*s == '>') lm_buf_append(b, "&gt;", -1);
+    else if (*s == '&') lm_buf_append(b, "&amp;", -1);
+    else if (*s == '"') lm_buf_append(b, "&quot;", -1);
+    else lm_buf_append(b, s, 1);
+  }
+}
+
+static void place_name(const job *j, const job_view *v, char *out, size_t cap) {
+  const job_scene *s = &j->scenes[v->scene];
+  snprintf(out, cap, "%s/%s/%dx%d", s->name, s->scene->cameras[v->camera].name, j->sizes[v->size][0],
+           j->sizes[v->size][1]);
+}
+
+/* PSNR is infinite for identical images: JSON null, CSV "inf". */
+static void write_csv(lm_buf *b, const report_args *a, const job *j, const job_view *places,
+                      const report_row *rows, int n) {
+  lm_buf_append(b, "technique,setting,view,scene,camera,width,height,mean_error,rmse,psnr,pearson,ssim,"
+                   "closer_than_baseline,total_ms,passes_ms\n", -1);
+  for (int i = 0; i < n; i++) {
+    const report_row *r = &rows[i];
+    const report_setting *s = &a->settings[r->setting];
+    const job_view *v = &places[r->place];
+    const job_scene *sc = &j->scenes[v->scene];
+    char view[512];
+    place_name(j, v, view, sizeof view);
+    csv_str(b, s->technique);
+    lm_buf_append(b, ",", 1);
+    csv_str(b, s->label);
+    lm_buf_append(b, ",", 1);
+    csv_str(b, view);
+    lm_buf_append(b, ",", 1);
+    csv_str(b, sc->name);
+    lm_buf_append(b, ",", 1);
+    csv_str(b, sc->scene->cameras[v->camera].name);
+    lm_buf_printf(b, ",%d,%d,%.9g,%.9g,", j->sizes[v->size][0], j->sizes[v->size][1], r->m.mean_error, r->m.rmse);
+    if (r->m.identical) lm_buf_append(b, "inf", -1);
+    else lm_buf_printf(b, "%.4f", r->m.psnr);
+    lm_buf_printf(b, ",%.6f,%.6f,%.6f,%.3f,\"", r->m.pearson, r->m.ssim, r->closer, r->total_ms);
+    for (int p = 0; p < r->res.pass_count; p++)
+      lm_buf_printf(b, "%s%s=%.3f", p ? ";" : "", r->res.passes[p].name, r->res.passes[p].ms);
+    lm_buf_append(b, "\"\n", -1);
+  }
+}
+
+static void write_json(lm_buf *b, const report_args *a, const job *j, const job_view *places,
+                       const report_row *rows, int n, const char *clock, int frames, int warmup) {
+  lm_buf_append(b, "{\n  \"job\": ", -1);
+  json_str(b, j->path);
+  lm_buf_printf(b, ",\n  \"clock\": \"%s\",\n  \"renderer\": ", clock);
+  json_str(b, lm_gl_renderer());
+  lm_buf_printf(b, ",\n  \"frames\": %d,\n  \"warmup\": %d,\n  \"baseline\": ", frames, warmup);
+  json_str(b, a->baseline);
+  lm_buf_append(b, ",\n  \"rows\": [\n", -1);
+  for (int i = 0; i < n; i++) {
+    const report_row *r = &rows[i];
+    const report_setting *s = &a->settings[r->setting];
+    const job_view *v = &places[r->place];
+    const job_scene *sc = &j->scenes[v->scene];
+    char view[512];
+    place_name(j, v, view, sizeof view);
+    lm_buf_append(b, "    {\"technique\": ", -1);
+    json_str(b, s->technique);
+    lm_buf_append(b, ", \"setting\": ", -1);
+    json_str(b, s->label);
+    lm_buf_append(b, ", \"options\": {", -1);
+    for (int o = 0; o < s->option_count; o++) {
+      lm_buf_append(b, o ? ", " : "", -1);
+      json_str(b, s->names[o]);
+      lm_buf_append(b, ": ", -1);
+      json_str(b, s->values[o]);
+    }
+    lm_buf_append(b, "}, \"view\": ", -1);
+    json_str(b, view);
+    lm_buf_append(b, ", \"scene\": ", -1);
+    json_str(b, sc->path);
+    lm_buf_append(b, ", \"camera\": ", -1);
+    json_str(b, sc->scene->cameras[v->camera].name);
+    lm_buf_printf(b, ", \"width\": %d, \"height\": %d, \"mean_error\": %.9g, \"rmse\": %.9g, \"psnr\": ",
+                  j->sizes[v->size][0], j->sizes[v->size][1], r->m.mean_error, r->m.rmse);
+    if (r->m.identical) lm_buf_append(b, "null", -1);
+    else lm_buf_printf(b, "%.4f", r->m.psnr);
+    lm_buf_printf(b, ", \"pearson\": %.6f, \"ssim\": %.6f, \"closer_than_baseline\": %.6f, \"total_ms\": %.3f, "
+                  "\"passes\": [", r->m.pearson, r->m.ssim, r->closer, r->total_ms);
+    for (int p = 0; p < r->res.pass_count; p++) {
+      lm_buf_append(b, p ? ", {\"name\": " : "{\"name\": ", -1);
+      json_str(b, r->res.passes[p].name);
+      lm_buf_printf(b, ", \"ms\": %.3f}", r->res.passes[p].ms);
+    }
+    lm_buf_printf(b, "]}%s\n", i + 1 < n ? "," : "");
+  }
+  lm_buf_append(b, "  ]\n}\n", -1);
+}
+
+/* Per setting, over the views: mean error and mean total milliseconds. */
+static void setting_means(const report_row *rows, int n, int settings, double *err, double *ms) {
+  int *count = calloc((size_t)settings, sizeof *count);
+  for (int s = 0; s < settings; s++) err[s] = ms[s] = 0;
+  for (int i = 0; i < n; i++) {
+    err[rows[i].setting] += rows[i].m.mean_error;
+    ms[rows[i].setting] += rows[i].total_ms;
+    count[rows[i].setting]++;
+  }
+  for (int s = 0; s < settings; s++)
+    if (count[s]) err[s] /= count[s], ms[s] /= count[s];
+  free(count);
+}
+
+static const char *const palette[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
+                                      "#e377c2", "#17becf"};
+
+/* Hand-written SVG: a scatter plot needs a few dozen elements, and no
+ * Debian C library writes plots without pulling in a toolkit (plplot,
+ * cairo), so text is simpler and keeps the output byte-stable. */
+static void write_svg(lm_buf *b, const report_args *a, const double *err, const double *ms, const bool *front,
+                      const char *clock) {
+  int n = a->setting_count;
+  const double W = 720, H = 480, L = 80, R = 200, T = 40, B = 60;
+  double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+  for (int i = 0; i < n; i++) {
+    if (ms[i] > x1) x1 = ms[i];
+    if (err[i] > y1) y1 = err[i];
+  }
+  x1 = x1 > 0 ? x1 * 1.1 : 1;
+  y1 = y1 > 0 ? y1 * 1.1 : 1;
+#define PX(v) (L + ((v) - x0) / (x1 - x0) * (W - L - R))
+#define PY(v) (H - B - ((v) - y0) / (y1 - y0) * (H - T - B))
+  lm_buf_printf(b, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+                "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+                "viewBox=\"0 0 %.0f %.0f\" font-family=\"sans-serif\" font-size=\"12\">\n"
+                "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n"
+                "<text x=\"%.0f\" y=\"24\" font-size=\"15\">Mean error (seed eq 19) against time per frame</text>\n",
+                W, H, W, H, L);
+  /* axes with five ticks each */
+  lm_buf_printf(b, "<g stroke=\"black\"><line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>"
+                "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/></g>\n",
+                L, H - B, W - R, H - B, L, H - B, L, T);
+  for (int k = 0; k <= 4; k++) {
+    double xv = x0 + (x1 - x0) * k / 4, yv = y0 + (y1 - y0) * k / 4;
+    lm_buf_printf(b, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%.3g</text>\n", PX(xv), H - B + 18, xv);
+    lm_buf_printf(b, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%.3g</text>\n", L - 6, PY(yv) + 4, yv);
+  }
+  lm_buf_printf(b, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">total ms per frame (median; clock: %s)</text>\n",
+                (L + W - R) / 2, H - 16, clock);
+  lm_buf_printf(b, "<text x=\"16\" y=\"%.1f\" transform=\"rotate(-90 16 %.1f)\" text-anchor=\"middle\">"
+                "mean error against POV-Ray</text>\n", (T + H - B) / 2, (T + H - B) / 2);
+  /* the Pareto front: a step line through its points by time */
+  int *order = calloc((size_t)n + 1, sizeof *order), fn = 0;
+  for (int i = 0; i < n; i++)
+    if (front[i]) order[fn++] = i;
+  for (int i = 1; i < fn; i++)
+    for (int k = i; k > 0 && ms[order[k]] < ms[order[k - 1]]; k--) {
+      int t = order[k];
+      order[k] = order[k - 1];
+      order[k - 1] = t;
+    }
+  if (fn > 1) {
+    lm_buf_append(b, "<polyline class=\"pareto\" fill=\"none\" stroke=\"#444\" stroke-dasharray=\"4 3\" points=\"", -1);
+    for (int i = 0; i < fn; i++) lm_buf_printf(b, "%s%.1f,%.1f", i ? " " : "", PX(ms[order[i]]), PY(err[order[i]]));
+    lm_buf_append(b, "\"/>\n", -1);
+  }
+  free(order);
+  /* points, one colour per technique */
+  char techs[REPORT_MAX_SETTINGS][64];
+  int tech_count = 0;
+  for (int i = 0; i < n; i++) {
+    int t = 0;
+    while (t < tech_count && strcmp(techs[t], a->settings[i].technique)) t++;
+    if (t == tech_count) snprintf(techs[tech_count++], sizeof techs[0], "%s", a->settings[i].technique);
+    const char *col = palette[t % 8];
+    lm_buf_printf(b, "<circle class=\"%s\" cx=\"%.1f\" cy=\"%.1f\" r=\"%d\" fill=\"%s\" stroke=\"%s\" "
+                  "stroke-width=\"2\"><title>", front[i] ? "point pareto" : "point", PX(ms[i]), PY(err[i]),
+                  front[i] ? 6 : 4, front[i] ? "white" : col, col);
+    xml_str(b, a->settings[i].label);
+    lm_buf_printf(b, ": %.4g ms, mean error %.4g%s</title></circle>\n", ms[i], err[i],
+                  front[i] ? " (Pareto front)" : "");
+  }
+  for (int t = 0; t < tech_count; t++) {
+    lm_buf_printf(b, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/><text x=\"%.1f\" y=\"%.1f\">",
+                  W - R + 20, T + 10 + 18.0 * t, palette[t % 8], W - R + 30, T + 14 + 18.0 * t);
+    xml_str(b, techs[t]);
+    lm_buf_append(b, "</text>\n", -1);
+  }
+  lm_buf_printf(b, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"6\" fill=\"white\" stroke=\"black\" stroke-width=\"2\"/>"
+                "<text x=\"%.1f\" y=\"%.1f\">Pareto front</text>\n</svg>\n",
+                W - R + 20, T + 10 + 18.0 * tech_count, W - R + 30, T + 14 + 18.0 * tech_count);
+#undef PX
+#undef PY
+}
+
+static void write_md(lm_buf *b, const report_args *a, const job *j, const job_view *places, int place_count,
+                     const report_row *rows, int n, const double *err, const double *ms, const bool *front,
+                     const char *clock, int frames, int warmup) {
+  lm_buf_append(b, "# Error against POV-Ray and run time\n\nJob `", -1);
+  xml_str(b, j->path);
+  lm_buf_printf(b, "`, %d view%s; renderer ", place_count, place_count == 1 ? "" : "s");
+  xml_str(b, lm_gl_renderer());
+  lm_buf_printf(b, "; times are medians of %d frame%s after %d warm-up frame%s (clock: %s). Mean error is seed eq "
+                "19 (sum of |dR|+|dG|+|dB| over 3wh), against POV-Ray radiosity references. Gain over the "
+                "baseline %s = 100 (e_base - e) / e_base.\n\n",
+                frames, frames == 1 ? "" : "s", warmup, warmup == 1 ? "" : "s", clock, a->baseline);
+  lm_buf_append(b, "| setting | mean error | ms | mean gain % | median gain % | views improved | pixels closer "
+                   "| Pearson baseline -> setting | Pareto |\n|---|---|---|---|---|---|---|---|---|\n", -1);
+  double *be = lm_alloc(sizeof(double) * (size_t)(place_count + 1) * 6);
+  double *e = be + place_count, *cl = e + place_count, *px = cl + place_count, *pb = px + place_count,
+         *pa = pb + place_count;
+  for (int s = 0; s < a->setting_count; s++) {
+    int k = 0;
+    for (int i = 0; i < n; i++) {
+      if (rows[i].setting != s) continue;
+      const report_row *base = &rows[i - s]; /* rows go place by place, the baseline first */
+      be[k] = base->m.mean_error;
+      e[k] = rows[i].m.mean_error;
+      cl[k] = rows[i].closer;
+      px[k] = (double)rows[i].m.width * rows[i].m.height;
+      pb[k] = base->m.pearson;
+      pa[k] = rows[i].m.pearson;
+      k++;
+    }
+    report_summary sum;
+    report_summarize(k, be, e, cl, px, pb, pa, &sum);
+    lm_buf_append(b, "| ", -1);
+    xml_str(b, a->settings[s].label);
+    if (s == 0) {
+      lm_buf_printf(b, " (baseline) | %.5f | %.3f | | | | | %.4f | %s |\n", err[s], ms[s], sum.pearson_before,
+                    front[s] ? "yes" : "");
+      continue;
+    }
+    lm_buf_printf(b, " | %.5f | %.3f | %.2f | %.2f | %.0f%% | %.2f%% | %.4f -> %.4f | %s |\n", err[s], ms[s],
+                  sum.mean_gain, sum.median_gain, 100 * sum.views_improved, 100 * sum.pixels_closer,
+                  sum.pearson_before, sum.pearson_after, front[s] ? "yes" : "");
+  }
+  lm_buf_append(b, "\n## Per view\n\n| setting | view | error baseline | error | gain % | pixels closer | "
+                   "Pearson baseline | Pearson |\n|---|---|---|---|---|---|---|---|\n", -1);
+  for (int i = 0; i < n; i++) {
+    if (rows[i].setting == 0) continue;
+    const report_row *base = &rows[i - rows[i].setting];
+    char view[512];
+    place_name(j, &places[rows[i].place], view, sizeof view);
+    lm_buf_append(b, "| ", -1);
+    xml_str(b, a->settings[rows[i].setting].label);
+    lm_buf_append(b, " | ", -1);
+    xml_str(b, view);
+    lm_buf_printf(b, " | %.5f | %.5f | %.2f | %.2f%% | %.4f | %.4f |\n", base->m.mean_error, rows[i].m.mean_error,
+                  report_gain(base->m.mean_error, rows[i].m.mean_error), 100 * rows[i].closer, base->m.pearson,
+                  rows[i].m.pearson);
+  }
+  free(be);
+}
+
+/* ---- running ------------------------------------------------------------ */
+
+static bool write_file(const report_args *a, const char *name, lm_buf *b, lm_error *err) {
+  char path[1100];
+  snprintf(path, sizeof path, "%s/%s", a->out, name);
+  bool ok = job_make_parent(path, err) && limn_write_whole(path, b->data ? b->data : "", (size_t)b->len, err);
+  if (ok && !a->ref.quiet) printf("wrote %s\n", path);
+  lm_buf_free(b);
+  return ok;
+}
+
+static bool set_setting(lm_pipeline *p, const report_setting *s, lm_error *err) {
+  if (!lm_pipeline_set_technique(p, s->technique, err)) return false;
+  for (int i = 0; i < s->option_count; i++)
+    if (!lm_pipeline_set_option(p, s->names[i], s->values[i], err)) {
+      lm_error_prefix(err, "%s=%s", s->names[i], s->values[i]);
+      return false;
+    }
+  return true;
+}
+
+static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
+  lm_error err;
+  job_view *places = NULL;
+  int place_count = 0;
+  if (!job_views(j, false, &places, &place_count, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    return 2;
+  }
+  /* Every setting is checked before anything renders. */
+  for (int s = 0; s < a->setting_count; s++)
+    if (!set_setting(pipeline, &a->settings[s], &err)) {
+      lm_log(LM_LOG_ERROR, "--sweep %s: %s", a->settings[s].label, err.msg);
+      free(places);
+      return 2;
+    }
+  char (*refs)[1024] = lm_alloc(sizeof *refs * (size_t)(place_count + 1));
+  int rc = 0;
+  if (a->require_refs) {
+    for (int i = 0; i < place_count && !rc; i++) {
+      lm_buf sdl = {0};
+      if (!reference_export(&a->ref, j, &places[i], &sdl, refs[i], sizeof refs[i], &err)) {
+        lm_log(LM_LOG_ERROR, "%s", err.msg);
+        rc = 1;
+      } else if (!lm_file_exists(refs[i])) {
+        lm_log(LM_LOG_ERROR, "%s: view %d: no reference %s (make them with: limn reference --job %s --refs %s, "
+               "with the same export flags)", j->path, i, refs[i], j->path, a->ref.refs);
+        rc = 1;
+      }
+      lm_buf_free(&sdl);
+    }
+  } else {
+    rc = reference_run(&a->ref, j, places, place_count, refs);
+  }
+  if (rc) {
+    free(refs);
+    free(places);
+    return rc;
+  }
+
+  if (!lm_context_create_headless(&(lm_context_desc){0}, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    free(refs);
+    free(places);
+    return 1;
+  }
+  lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = j->scenes[0].scene, .pipeline = pipeline,
+                                                          .width = 1, .height = 1, .linear_output = true}, &err);
+  if (!r) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    rc = 1;
+  }
+  int total = place_count * a->setting_count, n = 0;
+  report_row *rows = lm_alloc(sizeof *rows * (size_t)(total + 1));
+  memset(rows, 0, sizeof *rows * (size_t)(total + 1));
+  bool tty = isatty(STDOUT_FILENO);
+  const lm_scene *current = j->scenes[0].scene;
+  if (r && !a->ref.quiet) printf("report of %s: %d setting%s x %d view%s on %s\n", j->path, a->setting_count,
+                                 a->setting_count == 1 ? "" : "s", place_count, place_count == 1 ? "" : "s",
+                                 lm_gl_renderer());
+  for (int p = 0; p < place_count && !rc; p++) {
+    const job_view *v = &places[p];
+    job_scene *sc = &j->scenes[v->scene];
+    int w = j->sizes[v->size][0], h = j->sizes[v->size][1];
+    lm_image ref = {0}, base = {0};
+    bool ok = lm_image_read(refs[p], &ref, &err);
+    if (ok && sc->scene != current) ok = lm_renderer_set_scene(r, sc->scene, &err), current = sc->scene;
+    for (int s = 0; s < a->setting_count && ok; s++) {
+      report_row *row = &rows[n];
+      row->setting = s;
+      row->place = p;
+      char out[1400], view[512], cam[LM_NAME_MAX];
+      snprintf(cam, sizeof cam, "%s", sc->scene->cameras[v->camera].name);
+      for (char *c = cam; *c; c++)
+        if (*c == '/' || *c == ' ') *c = '_';
+      snprintf(out, sizeof out, "%s/images/%s_%s_%dx%d_%d.exr", a->out, sc->name, cam, w, h, s);
+      const char *outs[1] = {out};
+      capture_view warm = {.camera = v->camera, .width = w, .height = h, .frames = a->warmup, .quiet = true};
+      capture_view cv = {.camera = v->camera, .width = w, .height = h, .frames = a->frames, .outputs = outs,
+                         .output_count = 1, .quiet = true};
+      capture_result scratch = {0};
+      ok = set_setting(pipeline, &a->settings[s], &err) && job_make_parent(out, &err) &&
+           (a->warmup == 0 || capture_render_write(r, &warm, &scratch, &err)) &&
+           capture_render_write(r, &cv, &row->res, &err);
+      capture_result_free(&scratch);
+      lm_image img = {0};
+      if (ok) ok = lm_image_read(out, &img, &err);
+      if (ok) ok = lm_metrics_check(&img, out, &ref, refs[p], &err);
+      if (ok) {
+        lm_metrics_compute(&img, &ref, &row->m);
+        if (s == 0) {
+          row->closer = 0;
+          base = img;
+          img = (lm_image){0};
+        } else {
+          lm_metrics closer = row->m;
+          lm_metrics_closer(&img, &base, &ref, &closer);
+          row->closer = closer.closer;
+        }
+        row->total_ms = row->res.total_ms;
+        n++;
+        place_name(j, v, view, sizeof view);
+        char what[1200];
+        snprintf(what, sizeof what, "%s %s: error %.5f, %.2f ms", a->settings[s].label, view, row->m.mean_error,
+                 row->total_ms);
+        job_progress(a->ref.quiet, tty, n, total, what);
+      } else {
+        capture_result_free(&row->res);
+        if (tty && !a->ref.quiet) printf("\n");
+        lm_log(LM_LOG_ERROR, "%s: view %d (%s, camera '%s', %dx%d), %s: %s", j->path, p, sc->name,
+               sc->scene->cameras[v->camera].name, w, h, a->settings[s].label, err.msg);
+        rc = 1;
+      }
+      lm_image_free(&img);
+    }
+    if (!ok && !rc) {
+      lm_log(LM_LOG_ERROR, "%s: view %d (%s): %s", j->path, p, sc->name, err.msg);
+      rc = 1;
+    }
+    lm_image_free(&ref);
+    lm_image_free(&base);
+  }
+  const char *clock = r ? lm_clock_name(lm_renderer_clock(r)) : "";
+  if (!rc) {
+    int sn = a->setting_count;
+    double *err_mean = lm_alloc(sizeof(double) * (size_t)sn * 2), *ms_mean = err_mean + sn;
+    bool *front = lm_alloc(sizeof(bool) * (size_t)sn);
+    setting_means(rows, n, sn, err_mean, ms_mean);
+    report_pareto(ms_mean, err_mean, sn, front);
+    lm_buf csv = {0}, json = {0}, svg = {0}, md = {0};
+    write_csv(&csv, a, j, places, rows, n);
+    write_json(&json, a, j, places, rows, n, clock, a->frames, a->warmup);
+    write_svg(&svg, a, err_mean, ms_mean, front, clock);
+    write_md(&md, a, j, places, place_count, rows, n, err_mean, ms_mean, front, clock, a->frames, a->warmup);
+    bool ok = write_file(a, "report.csv", &csv, &err) && write_file(a, "report.json", &json, &err) &&
+              write_file(a, "report.svg", &svg, &err) && write_file(a, "report.md", &md, &err);
+    lm_buf_free(&csv);
+    lm_buf_free(&json);
+    lm_buf_free(&svg);
+    lm_buf_free(&md);
+    if (!ok) lm_log(LM_LOG_ERROR, "%s", err.msg), rc = 1;
+    free(err_mean);
+    free(front);
+  }
+  for (int i = 0; i < n; i++) capture_result_free(&rows[i].res);
+  free(rows);
+  lm_renderer_destroy(r);
+  lm_programs_clear();
+  job_free_scenes(j); /* GL objects go before the context */
+  lm_context_destroy();
+  free(refs);
+  free(places);
+  return rc;
+}
+
+int limn_report(int argc, char **argv) {
+  report_args a = {.out = "out/report", .baseline = BASELINE, .frames = 5, .warmup = 2};
+  reference_defaults(&a.ref);
+  report_setting *settings = lm_alloc(sizeof *settings * REPORT_MAX_SETTINGS);
+  a.settings = settings;
+  lm_error err;
+  const char *sweeps_given[REPORT_MAX_SETTINGS];
+  struct option opts[15 + LIMN_POV_OPTION_COUNT] = {
+      {"job", required_argument, 0, 'J'},    {"sweep", required_argument, 0, 'W'},
+      {"out", required_argument, 0, 'o'},    {"frames", required_argument, 0, 'f'},
+      {"warmup", required_argument, 0, 'u'}, {"refs", required_argument, 0, 'R'},
+      {"require-refs", no_argument, 0, 'Q'}, {"jobs", required_argument, 0, 'j'},
+      {"povray", required_argument, 0, 'P'}, {"force", no_argument, 0, 'F'},
+      {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
+      {"baseline", required_argument, 0, 'B'}};
+  memcpy(opts + 13, limn_pov_options, sizeof(struct option) * LIMN_POV_OPTION_COUNT);
+  opterr = 0;
+  optind = 1;
+  int c, rc = 0, sweeps = 0;
+  while (!rc && (c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
+    int pov = limn_pov_flag("report", c, optarg, &a.ref.pov);
+    if (pov == 2) rc = 2;
+    if (pov != 1) continue;
+    switch (c) {
+    case 'J': a.job = optarg; break;
+    case 'W':
+      if (sweeps == REPORT_MAX_SETTINGS) rc = usage_error("at most %s --sweep flags", "256");
+      else sweeps_given[sweeps++] = optarg;
+      break;
+    case 'B': a.baseline = optarg; break;
+    case 'o': a.out = optarg; break;
+    case 'f':
+      if (!limn_parse_int(optarg, 1, 10000, &a.frames)) rc = usage_error("--frames wants 1..10000, not '%s'", optarg);
+      break;
+    case 'u':
+      if (!limn_parse_int(optarg, 0, 10000, &a.warmup)) rc = usage_error("--warmup wants 0..10000, not '%s'", optarg);
+      break;
+    case 'R': a.ref.refs = optarg; break;
+    case 'Q': a.require_refs = true; break;
+    case 'j':
+      if (!limn_parse_int(optarg, 1, 1024, &a.ref.jobs)) rc = usage_error("--jobs wants 1..1024, not '%s'", optarg);
+      break;
+    case 'P': a.ref.povray = optarg; break;
+    case 'F': a.ref.force = true; break;
+    case 'q': a.ref.quiet = true; break;
+    case 'h': fputs(report_usage, stdout); free(settings); return 0;
+    case ':': rc = usage_error("%s needs a value", argv[optind - 1]); break;
+    default: rc = usage_error("unknown flag '%s'", argv[optind - 1]); break;
+    }
+  }
+  if (!rc && optind < argc) rc = usage_error("unexpected argument '%s'", argv[optind]);
+  if (!rc && !a.job) rc = usage_error("%s", "--job FILE is required");
+  if (!rc && !sweeps) rc = usage_error("%s", "--sweep SPEC is required (e.g. --sweep \"isr:isr.samples=8,16\")");
+  /* The baseline first (every row's gain refers to it), then the sweeps. */
+  if (!rc && !report_sweep_parse(a.baseline, settings, &a.setting_count, &err))
+    rc = usage_error("--baseline: %s", err.msg);
+  for (int i = 0; i < sweeps && !rc; i++) {
+    if (!strcmp(sweeps_given[i], a.baseline)) continue; /* always there */
+    if (!report_sweep_parse(sweeps_given[i], settings, &a.setting_count, &err)) {
+      fprintf(stderr, "limn report: %s\n", err.msg);
+      rc = 2;
+    }
+  }
+  const char *bad = !rc && a.ref.pov.radiosity ? lm_pov_radiosity_check(&a.ref.pov.rad) : NULL;
+  if (bad) rc = usage_error("radiosity setting out of range: %s", bad);
+  job *j = rc ? NULL : lm_alloc(sizeof *j);
+  if (j && !job_read(j, a.job, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    rc = 2;
+  }
+  lm_pipeline *pipeline = rc ? NULL : job_pipeline(j, NULL, 0, false);
+  if (!rc && !pipeline) rc = 2;
+  if (!rc) rc = run(&a, j, pipeline);
+  if (j) job_free_scenes(j);
+  lm_pipeline_destroy(pipeline);
+  free(j);
+  free(settings);
+  return rc;
+}

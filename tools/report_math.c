@@ -1,0 +1,147 @@
+/* The report's arithmetic (tools/report_math.h). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "report_math.h"
+
+static void trim(char *s) {
+  size_t n = strlen(s), i = 0;
+  while (n && (s[n - 1] == ' ' || s[n - 1] == '\t')) s[--n] = '\0';
+  while (s[i] == ' ' || s[i] == '\t') i++;
+  memmove(s, s + i, n - i + 1);
+}
+
+/* Splits s in place at sep into at most max parts; returns how many. */
+static int split(char *s, char sep, char **parts, int max) {
+  int n = 0;
+  for (char *p = s;; n++) {
+    if (n == max) return max + 1;
+    parts[n] = p;
+    char *q = strchr(p, sep);
+    if (!q) return n + 1;
+    *q = '\0';
+    p = q + 1;
+  }
+}
+
+bool report_sweep_parse(const char *spec, report_setting *list, int *count, lm_error *err) {
+  char buf[2048];
+  if (strlen(spec) >= sizeof buf) {
+    lm_error_set(err, "--sweep '%.40s...': too long", spec);
+    return false;
+  }
+  snprintf(buf, sizeof buf, "%s", spec);
+  char *colon = strchr(buf, ':');
+  if (colon) *colon = '\0';
+  report_setting base = {0};
+  snprintf(base.technique, sizeof base.technique, "%s", buf);
+  trim(base.technique);
+  if (!base.technique[0] || strchr(base.technique, '=') || strchr(base.technique, ',')) {
+    lm_error_set(err, "--sweep '%s': want TECH or TECH:OPTION=V1,V2;OPTION=V1,V2 (a technique name first)", spec);
+    return false;
+  }
+  char *opts[REPORT_MAX_OPTIONS + 1];
+  char *values[REPORT_MAX_OPTIONS][64];
+  int value_counts[REPORT_MAX_OPTIONS], option_count = 0;
+  if (colon) {
+    option_count = split(colon + 1, ';', opts, REPORT_MAX_OPTIONS);
+    if (option_count > REPORT_MAX_OPTIONS) {
+      lm_error_set(err, "--sweep '%s': at most %d options", spec, REPORT_MAX_OPTIONS);
+      return false;
+    }
+    for (int i = 0; i < option_count; i++) {
+      char *eq = strchr(opts[i], '=');
+      if (!eq) {
+        lm_error_set(err, "--sweep '%s': '%s' wants OPTION=V1,V2,...", spec, opts[i]);
+        return false;
+      }
+      *eq = '\0';
+      trim(opts[i]);
+      if (!opts[i][0] || strlen(opts[i]) >= sizeof base.names[0]) {
+        lm_error_set(err, "--sweep '%s': option %d has no name (or too long a one)", spec, i + 1);
+        return false;
+      }
+      value_counts[i] = split(eq + 1, ',', values[i], 64);
+      for (int k = 0; k < value_counts[i] && value_counts[i] <= 64; k++) {
+        trim(values[i][k]);
+        if (!values[i][k][0] || strlen(values[i][k]) >= sizeof base.values[0]) {
+          lm_error_set(err, "--sweep '%s': %s: value %d is empty (or too long)", spec, opts[i], k + 1);
+          return false;
+        }
+      }
+      if (value_counts[i] > 64) {
+        lm_error_set(err, "--sweep '%s': %s: at most 64 values", spec, opts[i]);
+        return false;
+      }
+    }
+  }
+  long total = 1;
+  for (int i = 0; i < option_count; i++) total *= value_counts[i];
+  if (*count + total > REPORT_MAX_SETTINGS) {
+    lm_error_set(err, "--sweep '%s': %ld settings, more than the %d a report holds", spec, total,
+                 REPORT_MAX_SETTINGS);
+    return false;
+  }
+  /* Every combination, the last option varying fastest. */
+  for (long c = 0; c < total; c++) {
+    report_setting *s = &list[(*count)++];
+    *s = base;
+    s->option_count = option_count;
+    int len = snprintf(s->label, sizeof s->label, "%s", s->technique);
+    long rest = c;
+    for (int i = option_count - 1; i >= 0; i--) {
+      snprintf(s->names[i], sizeof s->names[i], "%s", opts[i]);
+      snprintf(s->values[i], sizeof s->values[i], "%s", values[i][rest % value_counts[i]]);
+      rest /= value_counts[i];
+    }
+    for (int i = 0; i < option_count && len < (int)sizeof s->label; i++) {
+      /* "isr.samples" labels as "samples" under technique isr */
+      const char *name = s->names[i];
+      size_t tl = strlen(s->technique);
+      if (!strncmp(name, s->technique, tl) && name[tl] == '.') name += tl + 1;
+      len += snprintf(s->label + len, sizeof s->label - (size_t)len, " %s=%s", name, s->values[i]);
+    }
+  }
+  return true;
+}
+
+void report_pareto(const double *x, const double *y, int n, bool *front) {
+  for (int i = 0; i < n; i++) {
+    front[i] = true;
+    for (int j = 0; j < n && front[i]; j++)
+      if (j != i && x[j] <= x[i] && y[j] <= y[i] && (x[j] < x[i] || y[j] < y[i])) front[i] = false;
+  }
+}
+
+double report_gain(double base_error, double error) {
+  return base_error > 0 ? 100.0 * (base_error - error) / base_error : 0.0;
+}
+
+static int compare_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+void report_summarize(int n, const double *base_error, const double *error, const double *closer,
+                      const double *pixels, const double *pearson_base, const double *pearson,
+                      report_summary *out) {
+  *out = (report_summary){.views = n};
+  if (n <= 0) return;
+  double *gains = lm_alloc(sizeof *gains * (size_t)n);
+  double improved = 0, closer_px = 0, all_px = 0;
+  for (int i = 0; i < n; i++) {
+    gains[i] = report_gain(base_error[i], error[i]);
+    out->mean_gain += gains[i] / n;
+    improved += gains[i] > 0;
+    closer_px += closer[i] * pixels[i];
+    all_px += pixels[i];
+    out->pearson_before += pearson_base[i] / n;
+    out->pearson_after += pearson[i] / n;
+  }
+  qsort(gains, (size_t)n, sizeof *gains, compare_double);
+  out->median_gain = n % 2 ? gains[n / 2] : 0.5 * (gains[n / 2 - 1] + gains[n / 2]);
+  out->views_improved = improved / n;
+  out->pixels_closer = all_px > 0 ? closer_px / all_px : 0;
+  free(gains);
+}

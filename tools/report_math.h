@@ -1,0 +1,51 @@
+/* What `limn report` computes that needs no GL or files, kept apart so that
+ * unit tests check it against hand values: the sweep syntax, the Pareto
+ * front and the gains over the baseline (seed 000 chapter 5.3.2). */
+#ifndef LIMN_REPORT_MATH_H
+#define LIMN_REPORT_MATH_H
+
+#include "core/core.h"
+
+#define REPORT_MAX_OPTIONS 8
+#define REPORT_MAX_SETTINGS 256
+
+/* One technique with one value for each swept option. */
+typedef struct report_setting {
+  char technique[64];
+  char names[REPORT_MAX_OPTIONS][128], values[REPORT_MAX_OPTIONS][64];
+  int option_count;
+  char label[512]; /* "isr samples=8 coarse=2" */
+} report_setting;
+
+/* Adds the settings of one --sweep SPEC to list[*count]:
+ *   TECH                          the technique as the job sets it
+ *   TECH:OPT=V1,V2,...[;OPT=...]  every combination of the values
+ * e.g. "isr:isr.samples=8,16;isr.coarse=1,2" gives four settings. False with
+ * a message naming SPEC and what is wrong (no technique, an option without
+ * values, an empty value, more than REPORT_MAX_SETTINGS in all). */
+bool report_sweep_parse(const char *spec, report_setting *list, int *count, lm_error *err);
+
+/* front[i] = no point j is at least as good in both x and y and better in
+ * one (lower is better: milliseconds, error). Equal points are all on it. */
+void report_pareto(const double *x, const double *y, int n, bool *front);
+
+/* Seed 000 chapter 5.3.2: gain = 100 (e_base - e) / e_base percent; 0 when
+ * e_base is 0 (nothing to gain). */
+double report_gain(double base_error, double error);
+
+typedef struct report_summary {
+  int views;
+  double mean_gain, median_gain;  /* percent, over views */
+  double views_improved;          /* share of views with gain > 0 */
+  double pixels_closer;           /* share of all pixels closer than the baseline's */
+  double pearson_before, pearson_after; /* means over views */
+} report_summary;
+
+/* Over n views: the baseline's and the setting's mean errors, the share of
+ * each view's pixels closer to the reference than the baseline's, its pixel
+ * count (weights the pixel share) and both Pearson coefficients. */
+void report_summarize(int n, const double *base_error, const double *error, const double *closer,
+                      const double *pixels, const double *pearson_base, const double *pearson,
+                      report_summary *out);
+
+#endif
