@@ -8,8 +8,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-20}
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DLIMN_FUZZ=ON -DCMAKE_BUILD_TYPE=Debug >/dev/null
-cmake --build build-fuzz -j "$(nproc)" --target fuzz_shader_source fuzz_gltf fuzz_pipeline
-for target in fuzz_shader_source fuzz_gltf fuzz_pipeline; do
+cmake --build build-fuzz -j "$(nproc)" --target fuzz_shader_source fuzz_gltf fuzz_pipeline fuzz_job
+for target in fuzz_shader_source fuzz_gltf fuzz_pipeline fuzz_job; do
   work=$(mktemp -d)
   echo "fuzzing $target for ${seconds}s"
   (cd build-fuzz && "./tests/$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
