@@ -38,13 +38,20 @@ bool limn_parse_on_off(const char *s, bool *out) {
   return true;
 }
 
-void limn_json_string(const char *s) {
-  putchar('"');
+void limn_json_append(lm_buf *b, const char *s) {
+  lm_buf_append(b, "\"", 1);
   for (; *s; s++) {
-    unsigned char ch = (unsigned char)*s;
-    if (ch == '"' || ch == '\\') printf("\\%c", ch);
-    else if (ch < 0x20) printf("\\u%04x", ch);
-    else putchar(ch);
+    unsigned char c = (unsigned char)*s;
+    if (c == '"' || c == '\\') lm_buf_printf(b, "\\%c", c);
+    else if (c < 0x20) lm_buf_printf(b, "\\u%04x", c);
+    else lm_buf_append(b, s, 1);
   }
-  putchar('"');
+  lm_buf_append(b, "\"", 1);
+}
+
+void limn_json_string(const char *s) {
+  lm_buf b = {0};
+  limn_json_append(&b, s);
+  fputs(b.data, stdout);
+  lm_buf_free(&b);
 }

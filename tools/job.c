@@ -399,16 +399,6 @@ static uint64_t hash_file(const char *path, uint64_t h) {
 
 /* ---- the manifest ------------------------------------------------------ */
 
-static void json_string(lm_buf *b, const char *s) {
-  lm_buf_append(b, "\"", 1);
-  for (; *s; s++) {
-    unsigned char c = (unsigned char)*s;
-    if (c == '"' || c == '\\') lm_buf_printf(b, "\\%c", c);
-    else if (c < 0x20) lm_buf_printf(b, "\\u%04x", c);
-    else lm_buf_append(b, s, 1);
-  }
-  lm_buf_append(b, "\"", 1);
-}
 
 typedef struct manifest {
   char *header;        /* everything before "images" */
@@ -434,7 +424,7 @@ static void manifest_load(const char *path, const job_view *views, int view_coun
     for (int i = 0; i < view_count; i++) {
       lm_buf key = {0};
       lm_buf_append(&key, "{\"file\": ", -1);
-      json_string(&key, views[i].output);
+      limn_json_append(&key, views[i].output);
       if (!strncmp(f, key.data, (size_t)key.len) && !m->entries[i]) m->entries[i] = lm_strdup(f);
       lm_buf_free(&key);
     }
@@ -471,20 +461,20 @@ static char *manifest_entry(const job *j, const job_view *v, int index, const ca
   const job_scene *s = &j->scenes[v->scene];
   lm_buf b = {0};
   lm_buf_append(&b, "{\"file\": ", -1);
-  json_string(&b, v->output);
+  limn_json_append(&b, v->output);
   lm_buf_printf(&b, ", \"view\": %d, \"run\": %d, \"scene\": ", index, run);
-  json_string(&b, s->path);
+  limn_json_append(&b, s->path);
   lm_buf_printf(&b, ", \"scene_hash\": \"%016llx\", \"camera\": ", (unsigned long long)s->hash);
-  json_string(&b, s->scene->cameras[v->camera].name);
+  limn_json_append(&b, s->scene->cameras[v->camera].name);
   lm_buf_append(&b, ", \"technique\": ", -1);
-  json_string(&b, j->techniques[v->technique]);
+  limn_json_append(&b, j->techniques[v->technique]);
   lm_buf_printf(&b, ", \"width\": %d, \"height\": %d, \"frames\": %d, \"drawn\": %d, \"culled\": %d, "
                 "\"triangles\": %ld, \"total_ms\": %.3f, \"passes\": [",
                 j->sizes[v->size][0], j->sizes[v->size][1], j->frames, res->stats.drawn, res->stats.culled,
                 res->stats.triangles, res->total_ms);
   for (int i = 0; i < res->pass_count; i++) {
     lm_buf_append(&b, i ? ", {\"name\": " : "{\"name\": ", -1);
-    json_string(&b, res->passes[i].name);
+    limn_json_append(&b, res->passes[i].name);
     lm_buf_printf(&b, ", \"kind\": \"%s\", \"ms\": %.3f}", res->passes[i].kind, res->passes[i].ms);
   }
   lm_buf_append(&b, "]}", -1);
@@ -609,16 +599,16 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     for (int i = 0; i < a->set_count; i++) job_hash = lm_hash(a->sets[i], strlen(a->sets[i]), job_hash);
     lm_buf h = {0};
     lm_buf_append(&h, "{\n  \"job\": ", -1);
-    json_string(&h, j->path);
+    limn_json_append(&h, j->path);
     lm_buf_printf(&h, ",\n  \"job_hash\": \"%016llx\",\n  \"script\": ", (unsigned long long)job_hash);
-    json_string(&h, j->script);
+    limn_json_append(&h, j->script);
     lm_buf_printf(&h, ",\n  \"script_hash\": \"%016llx\",\n  \"shader_hash\": \"%016llx\",\n  \"renderer\": ",
                   (unsigned long long)scripts, (unsigned long long)hash_folder(shaders, "", LM_HASH_SEED));
-    json_string(&h, lm_gl_renderer());
+    limn_json_append(&h, lm_gl_renderer());
     lm_buf_append(&h, ",\n  \"gl_version\": ", -1);
-    json_string(&h, lm_gl_version());
+    limn_json_append(&h, lm_gl_version());
     lm_buf_append(&h, ",\n  \"platform\": ", -1);
-    json_string(&h, lm_context_platform());
+    limn_json_append(&h, lm_context_platform());
     lm_buf_printf(&h, ",\n  \"clock\": \"%s\",\n  \"shard\": \"%d/%d\",\n  \"run\": %d,\n  \"options\": [",
                   lm_clock_name(lm_renderer_clock(r)), a->shard, a->shards, m.run);
     for (int i = 0; i < j->set_count + a->set_count; i++) {
@@ -626,7 +616,7 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
       if (i < j->set_count) snprintf(set, sizeof set, "%s=%s", j->set_names[i], j->set_values[i]);
       else snprintf(set, sizeof set, "%s", a->sets[i - j->set_count]);
       lm_buf_append(&h, i ? ", " : "", -1);
-      json_string(&h, set);
+      limn_json_append(&h, set);
     }
     lm_buf_append(&h, "],\n", -1);
     m.header = h.data;

@@ -76,16 +76,6 @@ static int usage_error(const char *fmt, const char *arg) {
 
 /* ---- writing ------------------------------------------------------------ */
 
-static void json_str(lm_buf *b, const char *s) {
-  lm_buf_append(b, "\"", 1);
-  for (; *s; s++) {
-    unsigned char c = (unsigned char)*s;
-    if (c == '"' || c == '\\') lm_buf_printf(b, "\\%c", c);
-    else if (c < 0x20) lm_buf_printf(b, "\\u%04x", c);
-    else lm_buf_append(b, s, 1);
-  }
-  lm_buf_append(b, "\"", 1);
-}
 
 /* A CSV field: quoted, quotes doubled. */
 static void csv_str(lm_buf *b, const char *s) {
@@ -145,11 +135,11 @@ static void write_csv(lm_buf *b, const report_args *a, const job *j, const job_v
 static void write_json(lm_buf *b, const report_args *a, const job *j, const job_view *places,
                        const report_row *rows, int n, const char *clock, int frames, int warmup) {
   lm_buf_append(b, "{\n  \"job\": ", -1);
-  json_str(b, j->path);
+  limn_json_append(b, j->path);
   lm_buf_printf(b, ",\n  \"clock\": \"%s\",\n  \"renderer\": ", clock);
-  json_str(b, lm_gl_renderer());
+  limn_json_append(b, lm_gl_renderer());
   lm_buf_printf(b, ",\n  \"frames\": %d,\n  \"warmup\": %d,\n  \"baseline\": ", frames, warmup);
-  json_str(b, a->baseline);
+  limn_json_append(b, a->baseline);
   lm_buf_append(b, ",\n  \"rows\": [\n", -1);
   for (int i = 0; i < n; i++) {
     const report_row *r = &rows[i];
@@ -159,22 +149,22 @@ static void write_json(lm_buf *b, const report_args *a, const job *j, const job_
     char view[512];
     place_name(j, v, view, sizeof view);
     lm_buf_append(b, "    {\"technique\": ", -1);
-    json_str(b, s->technique);
+    limn_json_append(b, s->technique);
     lm_buf_append(b, ", \"setting\": ", -1);
-    json_str(b, s->label);
+    limn_json_append(b, s->label);
     lm_buf_append(b, ", \"options\": {", -1);
     for (int o = 0; o < s->option_count; o++) {
       lm_buf_append(b, o ? ", " : "", -1);
-      json_str(b, s->names[o]);
+      limn_json_append(b, s->names[o]);
       lm_buf_append(b, ": ", -1);
-      json_str(b, s->values[o]);
+      limn_json_append(b, s->values[o]);
     }
     lm_buf_append(b, "}, \"view\": ", -1);
-    json_str(b, view);
+    limn_json_append(b, view);
     lm_buf_append(b, ", \"scene\": ", -1);
-    json_str(b, sc->path);
+    limn_json_append(b, sc->path);
     lm_buf_append(b, ", \"camera\": ", -1);
-    json_str(b, sc->scene->cameras[v->camera].name);
+    limn_json_append(b, sc->scene->cameras[v->camera].name);
     lm_buf_printf(b, ", \"width\": %d, \"height\": %d, \"mean_error\": %.9g, \"rmse\": %.9g, \"psnr\": ",
                   j->sizes[v->size][0], j->sizes[v->size][1], r->m.mean_error, r->m.rmse);
     if (r->m.identical) lm_buf_append(b, "null", -1);
@@ -183,7 +173,7 @@ static void write_json(lm_buf *b, const report_args *a, const job *j, const job_
                   "\"passes\": [", r->m.pearson, r->m.ssim, r->closer, r->total_ms);
     for (int p = 0; p < r->res.pass_count; p++) {
       lm_buf_append(b, p ? ", {\"name\": " : "{\"name\": ", -1);
-      json_str(b, r->res.passes[p].name);
+      limn_json_append(b, r->res.passes[p].name);
       lm_buf_printf(b, ", \"ms\": %.3f}", r->res.passes[p].ms);
     }
     lm_buf_printf(b, "]}%s\n", i + 1 < n ? "," : "");

@@ -7,6 +7,8 @@
 #include <getopt.h>
 #include <stddef.h>
 
+#include "core/core.h"
+
 int limn_capture(int argc, char **argv);
 int limn_view(int argc, char **argv);
 int limn_export_pov(int argc, char **argv);
@@ -21,7 +23,8 @@ bool limn_parse_double(const char *s, double *out); /* finite */
 bool limn_parse_size(const char *s, int *w, int *h); /* WxH, each 1..65536 */
 bool limn_parse_on_off(const char *s, bool *out);
 /* Prints s as a JSON string (quotes, backslashes and control characters escaped). */
-void limn_json_string(const char *s);
+void limn_json_string(const char *s);          /* a quoted, escaped JSON string to stdout */
+void limn_json_append(lm_buf *b, const char *s); /* the same, appended to b */
 
 /* export-pov's flags (tools/export_pov.c), shared by reference and report:
  * limn_pov_options ends with a zero entry (10 entries in all);

@@ -1,43 +1,27 @@
 /* libFuzzer target: the capture-job reader and the camera-list parser. The
  * input is split at its first NUL into a job file and a camera list; the job
  * may name "scene.gltf" (a small valid scene) and "scene.cams" (the list). */
-#define _POSIX_C_SOURCE 200809L
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <unistd.h>
-
+#include "fuzz_files.h"
 #include "job.h"
 
-static char dir[64];
-
-static void write_file(const char *name, const unsigned char *data, size_t n) {
-  char path[128];
-  snprintf(path, sizeof path, "%s/%s", dir, name);
-  FILE *f = fopen(path, "wb");
-  if (!f) abort();
-  fwrite(data, 1, n, f);
-  fclose(f);
-}
-
 int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size) {
-  if (!dir[0]) {
-    snprintf(dir, sizeof dir, "/tmp/limn-fuzz-job-XXXXXX");
-    if (!mkdtemp(dir)) abort();
+  static bool ready;
+  const char *dir = fuzz_dir("job");
+  if (!ready) {
+    ready = true;
     lm_log_set_level(LM_LOG_QUIET);
     lm_error err;
     size_t n;
     char *scene = lm_read_file(LIMN_SOURCE_ROOT "/tests/fuzz/corpus/fuzz_gltf/triangle.gltf", &n, &err);
     if (!scene) abort();
-    write_file("scene.gltf", (const unsigned char *)scene, n);
+    fuzz_write(dir, "scene.gltf", scene, n);
     free(scene);
   }
-  const unsigned char *nul = memchr(data, 0, size);
-  size_t job_len = nul ? (size_t)(nul - data) : size;
-  write_file("job.lua", data, job_len);
-  write_file("scene.cams", nul ? nul + 1 : data, nul ? size - job_len - 1 : 0);
-  char path[128];
-  snprintf(path, sizeof path, "%s/job.lua", dir);
+  const unsigned char *cams;
+  size_t cams_len, job_len = fuzz_split(data, size, &cams, &cams_len);
+  fuzz_write(dir, "scene.cams", cams, cams_len);
+  char path[160];
+  snprintf(path, sizeof path, "%s", fuzz_write(dir, "job.lua", data, job_len));
   job *j = lm_alloc(sizeof *j);
   lm_error err;
   if (job_read(j, path, &err)) {

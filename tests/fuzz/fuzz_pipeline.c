@@ -1,12 +1,7 @@
 /* libFuzzer target: the Lua pipeline API. Input bytes pick a random sequence
  * of API calls with random arguments; each becomes a line of a pipeline
  * script that is loaded, recorded for two frames and compiled (no GL). */
-#define _POSIX_C_SOURCE 200809L
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <unistd.h>
-
+#include "fuzz_files.h"
 #include "script/script.h"
 
 typedef struct bytes {
@@ -57,12 +52,8 @@ static void table(bytes *b, lm_buf *out) {
 }
 
 int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size) {
-  static char path[64];
   static lm_scene *scene;
-  if (!path[0]) {
-    char dir[] = "/tmp/limn-fuzz-lua-XXXXXX";
-    if (!mkdtemp(dir)) abort();
-    snprintf(path, sizeof path, "%s/fuzz.lua", dir);
+  if (!scene) {
     lm_log_set_level(LM_LOG_QUIET);
     lm_error err;
     scene = lm_scene_builtin("cornell", &err);
@@ -87,10 +78,7 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size) {
     lm_buf_append(&src, " end)\n", -1);
   }
   lm_buf_append(&src, "  present(T[#T] or target{ 'last', format = 'rgba8' })\nend\n", -1);
-  FILE *f = fopen(path, "w");
-  if (!f) abort();
-  fputs(src.data, f);
-  fclose(f);
+  const char *path = fuzz_write(fuzz_dir("lua"), "fuzz.lua", src.data, (size_t)src.len);
   lm_buf_free(&src);
   lm_error err;
   lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = path, .instruction_budget = 1000000}, &err);
