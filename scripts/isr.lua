@@ -80,6 +80,7 @@ function isr.render(G, o, light)
     inputs.sender, inputs.previous = sender, E
     E = pass{ b == 1 and "isr.transport" or "isr.transport" .. b, shader = "isr.frag",
               inputs = inputs, params = { samples = o.samples, radius = o.radius },
+              fetches = 4 + o.samples * (E and 6 or 5), -- at most: G-buffer and sender (and bounce) a sample
               defines = { BOUNCE = E ~= nil }, out = coarse_target("isr.e" .. b, f) }
   end
   if o.blur > 0 then

@@ -36,6 +36,7 @@ local function grey(x) return { x, x, x } end
 local function direct(G, tech, shadows)
   local inputs, defines = shadow.bind(shadows, gbuffer.inputs(G), {})
   return pass{ "direct", shader = "direct.frag", inputs = inputs, defines = defines,
+               fetches = not shadows and 4 or nil, -- the G-buffer; shadow lookups vary with the lights
                params = { ambient = grey(tech.ambient), background = grey(tech.background) },
                out = target{ "lit", format = "rgba16f" } }
 end

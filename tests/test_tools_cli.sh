@@ -89,6 +89,15 @@ check "bench fits the direct pass" out_has '{"name": "direct", "ms": ['
 check "bench fit per pixel" out_has '"ns_per_pixel": '
 check "bench table" run 0 bench --sizes 32x24,64x48 --frames 1 --warmup 0
 check "bench table names the fit" out_has "fit: a ms + b ns/pixel"
+check "bench bad vary" run 2 bench --vary isr.samples
+check "bench bad vary message" err_has "--vary wants NAME=V1,V2,..."
+check "bench vary" run 0 bench --tech isr --sizes 32x24,64x48 --frames 1 --warmup 0 --json --vary isr.samples=4,32
+check "bench vary values" out_has '"vary": {"option": "isr.samples", "values": [4, 32]}'
+check "bench vary fit" out_has '"vary_fit": {"ms": '
+check "bench calibrates fetches" out_has '"calibration": {"ns_per_fetch": '
+check "bench declared fetches" out_has '"fetches_per_pixel": 244, "fetches_per_second": '  # 4 + 5 * 48 samples (isr.lua)
+check "bench vary unknown option" run 1 bench --tech isr --sizes 32x24 --frames 1 --warmup 0 --vary isr.nope=1,2
+check "bench vary unknown option message" err_has "unknown option 'isr.nope'"
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

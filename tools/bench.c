@@ -1,5 +1,7 @@
-/* limn bench: the compositor's own cost per frame, and how each pass's time
- * grows with the output's pixel count (a least-squares line per pass). */
+/* limn bench: the compositor's own cost per frame; how each pass's time
+ * grows with the output's pixel count and with an option's value (a
+ * least-squares line per pass); and each pass's texture fetch rate against a
+ * calibration pass of known fetches, all measured in one run. */
 #define _GNU_SOURCE
 #include <getopt.h>
 #include <math.h>
@@ -18,7 +20,11 @@ static const char bench_usage[] =
     "the frame's wall time, the CPU time of Lua (OnRender) plus frame-graph\n"
     "compilation against it (the compositor's overhead), and each pass's time;\n"
     "then per pass a line ms = a + b * pixels fitted over the sizes. Medians\n"
-    "over --frames after --warmup frames; the pass clock is named.\n"
+    "over --frames after --warmup frames; the pass clock is named. A calibration\n"
+    "pass (scripts/calibrate.lua: 8 and 64 texel fetches a pixel) at the largest\n"
+    "size gives the machine's fetch rate; a pass whose script declares its\n"
+    "fetches (pass{ fetches = N }) is shown as a share of that rate, any other\n"
+    "as the fetches a pixel its time would allow.\n"
     "\n"
     "options:\n"
     "  --scene NAME|FILE   (default cornell)\n"
@@ -27,6 +33,9 @@ static const char bench_usage[] =
     "  --sizes LIST        comma-separated WxH (default 64x48,128x96,256x192)\n"
     "  --frames N          timed frames per size (default 5)\n"
     "  --warmup N          untimed frames first (default 2)\n"
+    "  --vary NAME=V1,V2,...  at the largest size, also render with each value of\n"
+    "                      a script option (e.g. isr.samples=8,16,32,64) and fit\n"
+    "                      each pass's time against it\n"
     "  --clock auto|gpu|cpu\n"
     "  --json              one JSON object on stdout instead of the tables\n"
     "  --help              this text\n";
@@ -35,12 +44,21 @@ enum { MAX_SIZES = 16, MAX_PASSES = 64 };
 
 typedef struct bench_pass {
   char name[64];
-  double ms[MAX_SIZES]; /* median per size; -1 when not run at that size */
+  double ms[MAX_SIZES];     /* median per size; -1 when not run at that size */
+  double vary_ms[MAX_SIZES]; /* median per --vary value at the largest size */
+  double fetches;           /* declared fetches a pixel (0: not said) */
+  int width, height;        /* its output at the largest size */
 } bench_pass;
 
 typedef struct bench {
   int sizes[MAX_SIZES][2], size_count, frames, warmup;
   const char *scene, *script, *tech;
+  char vary_name[128];
+  char vary_text[MAX_SIZES][64];
+  double vary[MAX_SIZES];
+  int vary_count, largest;  /* largest: index of the size with the most pixels */
+  double ns_per_fetch;      /* calibrated; 0 when the calibration failed */
+  int calibration_size[2];
   lm_clock clock;
   bool json;
   double frame_ms[MAX_SIZES], overhead_ms[MAX_SIZES];
@@ -63,7 +81,8 @@ static int parse_args(int argc, char **argv, bench *b) {
       {"tech", required_argument, 0, 't'},  {"sizes", required_argument, 0, 'z'},
       {"frames", required_argument, 0, 'n'}, {"warmup", required_argument, 0, 'w'},
       {"clock", required_argument, 0, 'k'}, {"json", no_argument, 0, 'j'},
-      {"help", no_argument, 0, 'h'},        {0, 0, 0, 0}};
+      {"vary", required_argument, 0, 'V'},  {"help", no_argument, 0, 'h'},
+      {0, 0, 0, 0}};
   opterr = 0;
   optind = 1;
   int c;
@@ -86,6 +105,21 @@ static int parse_args(int argc, char **argv, bench *b) {
       else return usage_error("--clock wants auto, gpu or cpu, not '%s'", optarg);
       break;
     case 'j': b->json = true; break;
+    case 'V': {
+      const char *eq = strchr(optarg, '=');
+      if (!eq || eq == optarg || !eq[1]) return usage_error("--vary wants NAME=V1,V2,..., not '%s'", optarg);
+      snprintf(b->vary_name, sizeof b->vary_name, "%.*s", (int)(eq - optarg), optarg);
+      char values[1024];
+      snprintf(values, sizeof values, "%s", eq + 1);
+      b->vary_count = 0;
+      for (char *save = NULL, *tok = strtok_r(values, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        if (b->vary_count == MAX_SIZES) return usage_error("%s", "--vary takes at most 16 values");
+        if (!limn_parse_double(tok, &b->vary[b->vary_count]))
+          return usage_error("--vary wants numbers, not '%s'", tok);
+        snprintf(b->vary_text[b->vary_count++], sizeof b->vary_text[0], "%s", tok);
+      }
+      break;
+    }
     case 'h': fputs(bench_usage, stdout); return -1;
     case ':': return usage_error("%s needs a value", argv[optind - 1]);
     default: return usage_error("unknown flag '%s'", argv[optind - 1]);
@@ -100,6 +134,9 @@ static int parse_args(int argc, char **argv, bench *b) {
     if (!limn_parse_size(tok, &s[0], &s[1])) return usage_error("--sizes wants WxH,WxH,..., not '%s'", tok);
   }
   if (b->size_count == 0) return usage_error("%s", "--sizes is empty");
+  for (int s = 1; s < b->size_count; s++)
+    if ((double)b->sizes[s][0] * b->sizes[s][1] > (double)b->sizes[b->largest][0] * b->sizes[b->largest][1])
+      b->largest = s;
   return 0;
 }
 
@@ -119,14 +156,17 @@ static bench_pass *find_pass(bench *b, const char *name) {
   if (b->pass_count == MAX_PASSES) return NULL;
   bench_pass *p = &b->passes[b->pass_count++];
   snprintf(p->name, sizeof p->name, "%s", name);
-  for (int s = 0; s < MAX_SIZES; s++) p->ms[s] = -1;
+  for (int s = 0; s < MAX_SIZES; s++) p->ms[s] = p->vary_ms[s] = -1;
   return p;
 }
 
-/* One size: warm-up, then medians of frame wall time, overhead and passes. */
-static bool run_size(bench *b, int si, lm_scene *scene, lm_pipeline *pipe, lm_clock *used, lm_error *err) {
+/* One configuration (size si; `vary` picks the --vary series, column si):
+ * warm-up, then medians of frame wall time, overhead and passes. */
+static bool run_size(bench *b, int si, bool vary, lm_scene *scene, lm_pipeline *pipe, lm_clock *used,
+                     lm_error *err) {
+  int size = vary ? b->largest : si;
   lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = pipe,
-                                                          .width = b->sizes[si][0], .height = b->sizes[si][1],
+                                                          .width = b->sizes[size][0], .height = b->sizes[size][1],
                                                           .clock = b->clock}, err);
   if (!r) return false;
   *used = lm_renderer_clock(r);
@@ -152,16 +192,17 @@ static bool run_size(bench *b, int si, lm_scene *scene, lm_pipeline *pipe, lm_cl
       if (p.culled || p.ms < 0) continue;
       bench_pass *bp = find_pass(b, p.name);
       if (!bp) continue;
+      if (!vary && size == b->largest) bp->fetches = p.fetches, bp->width = p.width, bp->height = p.height;
       int slot = (int)(bp - b->passes);
       if (pass_n[slot] < b->frames) pass_ms[slot * b->frames + pass_n[slot]++] = p.ms;
     }
   }
-  if (ok) {
+  if (ok && !vary) {
     b->frame_ms[si] = median(wall, b->frames);
     b->overhead_ms[si] = median(over, b->frames);
-    for (int i = 0; i < b->pass_count; i++)
-      if (pass_n[i]) b->passes[i].ms[si] = median(pass_ms + i * b->frames, pass_n[i]);
   }
+  for (int i = 0; i < b->pass_count && ok; i++)
+    if (pass_n[i]) (vary ? b->passes[i].vary_ms : b->passes[i].ms)[si] = median(pass_ms + i * b->frames, pass_n[i]);
   free(wall);
   free(over);
   free(pass_ms);
@@ -169,13 +210,15 @@ static bool run_size(bench *b, int si, lm_scene *scene, lm_pipeline *pipe, lm_cl
   return ok;
 }
 
-/* Least squares ms = a + b * pixels over the sizes where the pass ran;
- * false with fewer than two distinct pixel counts. */
-static bool fit(const bench *b, const bench_pass *p, double *a, double *slope, double *r2) {
+/* Least squares ms = a + b * x over the points where the pass ran (x: the
+ * pixel count of each size, or each --vary value); false with fewer than
+ * two distinct x. */
+static bool fit(const bench *b, const bench_pass *p, bool vary, double *a, double *slope, double *r2) {
   double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
-  for (int s = 0; s < b->size_count; s++) {
-    if (p->ms[s] < 0) continue;
-    double x = (double)b->sizes[s][0] * b->sizes[s][1], y = p->ms[s];
+  for (int s = 0; s < (vary ? b->vary_count : b->size_count); s++) {
+    double y = vary ? p->vary_ms[s] : p->ms[s];
+    if (y < 0) continue;
+    double x = vary ? b->vary[s] : (double)b->sizes[s][0] * b->sizes[s][1];
     n++, sx += x, sy += y, sxx += x * x, sxy += x * y, syy += y * y;
   }
   double den = n * sxx - sx * sx;
@@ -184,6 +227,19 @@ static bool fit(const bench *b, const bench_pass *p, double *a, double *slope, d
   *a = (sy - *slope * sx) / n;
   double vy = n * syy - sy * sy;
   *r2 = vy > 0 ? (*slope * (n * sxy - sx * sy)) / vy : 1.0; /* all times equal: the flat line fits */
+  return true;
+}
+
+/* A pass's fetches against the calibration at the largest size: *rate in
+ * fetches a second and *share of the calibrated rate when it declares its
+ * fetches, else *equivalent fetches a pixel its time would allow. False
+ * when there is no calibration or no time. */
+static bool fetch_figures(const bench *b, const bench_pass *p, double *rate, double *share, double *equivalent) {
+  double ms = p->ms[b->largest], pixels = (double)p->width * p->height;
+  if (!(b->ns_per_fetch > 0) || !(ms > 0) || !(pixels > 0)) return false;
+  *rate = p->fetches > 0 ? p->fetches * pixels / (ms * 1e-3) : -1;
+  *share = p->fetches > 0 ? *rate / (1e9 / b->ns_per_fetch) : -1;
+  *equivalent = ms * 1e6 / (b->ns_per_fetch * pixels);
   return true;
 }
 
@@ -202,8 +258,37 @@ static void print_tables(const bench *b, lm_clock clock) {
     printf("  %-24s", p->name);
     for (int s = 0; s < b->size_count; s++) printf(" %14.3f", p->ms[s]);
     double a, sl, r2;
-    if (fit(b, p, &a, &sl, &r2)) printf("  %.3f + %.3f (%.3f)\n", a, sl * 1e6, r2);
+    if (fit(b, p, false, &a, &sl, &r2)) printf("  %.3f + %.3f (%.3f)\n", a, sl * 1e6, r2);
     else printf("  -\n");
+  }
+  if (b->vary_count) {
+    printf("  %-24s", b->vary_name);
+    for (int v = 0; v < b->vary_count; v++) printf(" %14s", b->vary_text[v]);
+    printf("  fit: a ms + b ms/unit (r^2), at %dx%d\n", b->sizes[b->largest][0], b->sizes[b->largest][1]);
+    for (int i = 0; i < b->pass_count; i++) {
+      const bench_pass *p = &b->passes[i];
+      printf("  %-24s", p->name);
+      for (int v = 0; v < b->vary_count; v++) printf(" %14.3f", p->vary_ms[v]);
+      double a, sl, r2;
+      if (fit(b, p, true, &a, &sl, &r2)) printf("  %.3f + %.4f (%.3f)\n", a, sl, r2);
+      else printf("  -\n");
+    }
+  }
+  if (!(b->ns_per_fetch > 0)) {
+    printf("fetch calibration: no result (the calibration pass did not slow with more fetches)\n");
+    return;
+  }
+  printf("fetch calibration at %dx%d: %.4f ns a fetch (%.3g fetches/s)\n", b->calibration_size[0],
+         b->calibration_size[1], b->ns_per_fetch, 1e9 / b->ns_per_fetch);
+  printf("  %-24s %12s %14s %10s %16s\n", "pass", "fetches/px", "fetches/s", "of calib.", "time = fetches/px");
+  for (int i = 0; i < b->pass_count; i++) {
+    const bench_pass *p = &b->passes[i];
+    double rate, share, eq;
+    if (!fetch_figures(b, p, &rate, &share, &eq)) continue;
+    if (p->fetches > 0)
+      printf("  %-24s %12.1f %14.3g %9.1f%% %16.1f\n", p->name, p->fetches, rate, 100 * share, eq);
+    else
+      printf("  %-24s %12s %14s %10s %16.1f\n", p->name, "-", "-", "-", eq);
   }
 }
 
@@ -225,10 +310,65 @@ static void print_json(const bench *b, lm_clock clock) {
       else printf("%s%.6g", s ? ", " : "", p->ms[s]);
     }
     double a, sl, r2;
-    if (fit(b, p, &a, &sl, &r2)) printf("], \"fit\": {\"ms\": %.6g, \"ns_per_pixel\": %.6g, \"r2\": %.6g}}", a, sl * 1e6, r2);
-    else printf("], \"fit\": null}");
+    if (fit(b, p, false, &a, &sl, &r2)) printf("], \"fit\": {\"ms\": %.6g, \"ns_per_pixel\": %.6g, \"r2\": %.6g}", a, sl * 1e6, r2);
+    else printf("], \"fit\": null");
+    if (b->vary_count) {
+      printf(", \"vary_ms\": [");
+      for (int v = 0; v < b->vary_count; v++)
+        printf(p->vary_ms[v] < 0 ? "%snull" : "%s%.6g", v ? ", " : "", p->vary_ms[v]);
+      if (fit(b, p, true, &a, &sl, &r2)) printf("], \"vary_fit\": {\"ms\": %.6g, \"ms_per_unit\": %.6g, \"r2\": %.6g}", a, sl, r2);
+      else printf("], \"vary_fit\": null");
+    }
+    double rate, share, eq;
+    if (fetch_figures(b, p, &rate, &share, &eq)) {
+      printf(", \"fetches_per_pixel_equivalent\": %.6g", eq);
+      if (p->fetches > 0)
+        printf(", \"fetches_per_pixel\": %.6g, \"fetches_per_second\": %.6g, \"share_of_calibration\": %.6g",
+               p->fetches, rate, share);
+    }
+    printf("}");
   }
-  printf("]}\n");
+  printf("]");
+  if (b->vary_count) {
+    printf(", \"vary\": {\"option\": ");
+    limn_json_string(b->vary_name);
+    printf(", \"values\": [");
+    for (int v = 0; v < b->vary_count; v++) printf("%s%.6g", v ? ", " : "", b->vary[v]);
+    printf("]}");
+  }
+  if (b->ns_per_fetch > 0) printf(", \"calibration\": {\"ns_per_fetch\": %.6g}", b->ns_per_fetch);
+  else printf(", \"calibration\": null");
+  printf("}\n");
+}
+
+/* The calibration pass with 8 and 64 fetches a pixel: the time per fetch is
+ * the difference over 56 fetches a pixel. At the largest size but at least
+ * 256x192, after at least 2 warm-up frames (the first compiles), median of
+ * at least 3: small or cold runs drown the difference in noise. */
+static bool calibrate(bench *b, lm_scene *scene, lm_error *err) {
+  static bench cal; /* large: off the stack */
+  char path[1100];
+  snprintf(path, sizeof path, "%s/scripts/calibrate.lua", lm_root_dir());
+  lm_pipeline *pipe = lm_pipeline_load(&(lm_pipeline_desc){.path = path}, err);
+  if (!pipe) return false;
+  double ms[2] = {-1, -1};
+  const char *counts[2] = {"8", "64"};
+  bool ok = true;
+  for (int k = 0; k < 2 && ok; k++) {
+    cal = (bench){.frames = b->frames > 3 ? b->frames : 3, .warmup = b->warmup > 2 ? b->warmup : 2,
+                  .clock = b->clock, .size_count = 1};
+    memcpy(cal.sizes[0], b->sizes[b->largest], sizeof cal.sizes[0]);
+    if ((double)cal.sizes[0][0] * cal.sizes[0][1] < 256.0 * 192.0) cal.sizes[0][0] = 256, cal.sizes[0][1] = 192;
+    lm_clock used;
+    ok = lm_pipeline_set_option(pipe, "fetches", counts[k], err) && run_size(&cal, 0, false, scene, pipe, &used, err);
+    for (int i = 0; i < cal.pass_count && ok; i++)
+      if (!strcmp(cal.passes[i].name, "calibrate")) ms[k] = cal.passes[i].ms[0];
+  }
+  lm_pipeline_destroy(pipe);
+  double pixels = (double)cal.sizes[0][0] * cal.sizes[0][1];
+  b->calibration_size[0] = cal.sizes[0][0], b->calibration_size[1] = cal.sizes[0][1];
+  b->ns_per_fetch = ok && ms[1] > ms[0] && ms[0] >= 0 ? (ms[1] - ms[0]) * 1e6 / (56.0 * pixels) : 0;
+  return ok;
 }
 
 int limn_bench(int argc, char **argv) {
@@ -257,7 +397,12 @@ int limn_bench(int argc, char **argv) {
   }
   bool ok = lm_context_create_headless(&(lm_context_desc){.platform = "auto"}, &err);
   lm_clock used = LM_CLOCK_AUTO;
-  for (int s = 0; s < b.size_count && ok; s++) ok = run_size(&b, s, scene, pipe, &used, &err);
+  for (int s = 0; s < b.size_count && ok; s++) ok = run_size(&b, s, false, scene, pipe, &used, &err);
+  for (int v = 0; v < b.vary_count && ok; v++) {
+    ok = lm_pipeline_set_option(pipe, b.vary_name, b.vary_text[v], &err);
+    if (ok) ok = run_size(&b, v, true, scene, pipe, &used, &err);
+  }
+  if (ok) ok = calibrate(&b, scene, &err);
   if (ok) {
     if (b.json) print_json(&b, used);
     else print_tables(&b, used);

@@ -72,6 +72,7 @@ typedef struct lm_pass_desc {
   int depth;          /* depth target, or -1 */
   bool clear;         /* full-screen passes always cover every pixel */
   float clear_color[4];
+  double fetches;     /* texture fetches a pixel, as the script declares (0: not said); for bench */
   const lm_pass_view *views; /* scene passes: draw once per view; none: the camera */
   int view_count;
   const lm_pass_material_param *material_params; /* scene passes */
@@ -101,6 +102,8 @@ typedef struct lm_graph_pass_info {
   lm_pass_kind kind;
   bool culled;
   double ms;        /* last execution, -1 when not run */
+  double fetches;   /* texture fetches a pixel the script declared, 0: not said */
+  int width, height; /* its first output's size */
 } lm_graph_pass_info;
 int lm_graph_pass_count(const lm_graph *g);
 lm_graph_pass_info lm_graph_pass(const lm_graph *g, int i);

@@ -504,7 +504,7 @@ static int l_pass(lua_State *L) {
   pass_builder b;
   int top = lua_gettop(L);
   begin_pass(L, &b, LM_PASS_FULLSCREEN, "pass");
-  static const char *const fields[] = {"shader", "inputs", "params", "out", "defines", NULL};
+  static const char *const fields[] = {"shader", "inputs", "params", "out", "defines", "fetches", NULL};
   check_fields(L, 1, b.what, fields);
   b.desc.shader = opt_string(L, 1, "shader", b.what);
   if (!b.desc.shader) return luaL_error(L, "%s: field 'shader' is missing (a file in shaders/)", b.what);
@@ -513,6 +513,7 @@ static int l_pass(lua_State *L) {
   read_inputs(L, 1, &b);
   read_params(L, 1, &b);
   read_defines(L, 1, &b);
+  b.desc.fetches = opt_number(L, 1, "fetches", 0, 0, 1e6f, b.what);
   add_pass(L, p, &b);
   lua_settop(L, top);
   lua_getfield(L, 1, "out");
