@@ -57,6 +57,7 @@ int gl_test_teardown(void **state) {
 }
 
 lm_scene *gl_cornell(void) { return cornell; }
+const char *gl_root(void) { return scratch; }
 
 bool gl_write_file(const char *rel, const char *text) {
   char path[512];

@@ -33,6 +33,9 @@ typedef struct gl_result {
  * points at it from then on. A cmocka group setup; teardown undoes it. */
 int gl_test_setup(void **state);
 int gl_test_teardown(void **state);
+/* The scratch root's folder (LIMN_ROOT); shaders/ and scripts/ in it are
+ * links into the source tree: write new files there, never over theirs. */
+const char *gl_root(void);
 /* The built-in Cornell box (a test that changes it puts it back). */
 lm_scene *gl_cornell(void);
 /* Writes text to the file `rel` under the scratch root; false when it cannot. */

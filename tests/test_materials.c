@@ -13,15 +13,15 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "render/render.h"
+#include "gl_test.h"
 #include "scene/gltf.h"
 
 enum { W = 96, H = 72 };
 
-static char tmp[256], pp_lua[1024];
+static char pp_lua[1024];
 
 static void scene_path(const char *name, char *out, size_t cap) {
-  snprintf(out, cap, "%s/data/scenes/%s.glb", lm_root_dir(), name);
+  snprintf(out, cap, "%s/data/scenes/%s.glb", LIMN_SOURCE_ROOT, name);
 }
 
 static lm_scene *load(const char *name) {
@@ -34,11 +34,8 @@ static lm_scene *load(const char *name) {
 }
 
 static void write_file(const char *name, const char *text, char *path, size_t cap) {
-  snprintf(path, cap, "%s/%s", tmp, name);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  fputs(text, f);
-  fclose(f);
+  assert_true(gl_write_file(name, text));
+  snprintf(path, cap, "%s/%s", gl_root(), name);
 }
 
 typedef struct shot {
@@ -292,7 +289,7 @@ static void mutated_scene_files_never_crash(void **state) {
       default: len = json_end + rng() % (len - json_end); break; /* cut the buffer short */
       }
     }
-    snprintf(out, sizeof out, "%s/mutant.glb", tmp);
+    snprintf(out, sizeof out, "%s/mutant.glb", gl_root());
     FILE *f = fopen(out, "wb");
     assert_non_null(f);
     assert_int_equal(fwrite(b, 1, len, f), len);
@@ -315,29 +312,13 @@ static void mutated_scene_files_never_crash(void **state) {
 }
 
 static int setup(void **state) {
-  (void)state;
-  snprintf(tmp, sizeof tmp, "/tmp/limn-materials-XXXXXX");
-  if (!mkdtemp(tmp)) return -1;
-  lm_log_set_level(LM_LOG_ERROR);
-  lm_error err;
-  if (!lm_context_create_headless(&(lm_context_desc){0}, &err)) {
-    fprintf(stderr, "no GL context: %s\n", err.msg);
-    return -1;
-  }
-  return 0;
-}
-
-static int teardown(void **state) {
-  (void)state;
-  lm_programs_clear();
-  lm_context_destroy();
-  char cmd[300];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", tmp);
-  return system(cmd);
+  int rc = gl_test_setup(state);
+  lm_log_set_level(LM_LOG_ERROR); /* the bad-texture cases warn by design */
+  return rc;
 }
 
 int main(void) {
-  snprintf(pp_lua, sizeof pp_lua, "%s/scripts/pp.lua", lm_root_dir());
+  snprintf(pp_lua, sizeof pp_lua, "%s/scripts/pp.lua", LIMN_SOURCE_ROOT);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(textures_show_as_detail),
       cmocka_unit_test(culling_drops_what_the_camera_cannot_see),
@@ -346,5 +327,5 @@ int main(void) {
       cmocka_unit_test(bad_textures_name_material_texture_and_image),
       cmocka_unit_test(mutated_scene_files_never_crash),
   };
-  return cmocka_run_group_tests(tests, setup, teardown);
+  return cmocka_run_group_tests(tests, setup, gl_test_teardown);
 }

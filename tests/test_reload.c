@@ -13,20 +13,11 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "render/render.h"
+#include "gl_test.h"
 
 enum { W = 32, H = 24 };
 
-static char root[256];
-
-static void write_file(const char *rel, const char *text) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/%s", root, rel);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  fputs(text, f);
-  fclose(f);
-}
+static void write_file(const char *rel, const char *text) { assert_true(gl_write_file(rel, text)); }
 
 static const char fill_frag[] = "uniform vec4 c = vec4(0.0);\nout vec4 o;\nvoid main() { o = c; }\n";
 static const char copy_frag[] =
@@ -54,37 +45,11 @@ static const char reader_lua[] =
     "                out = target{ \"shown\", format = \"rgba16f\" } })\n"
     "end\n";
 
-static int setup(void **state) {
-  (void)state;
-  snprintf(root, sizeof root, "/tmp/limn-reload-XXXXXX");
-  if (!mkdtemp(root)) return -1;
-  char cmd[2048];
-  snprintf(cmd, sizeof cmd, "mkdir -p %s/shaders %s/scripts && cp %s/shaders/* %s/shaders/", root, root,
-           LIMN_SOURCE_ROOT, root);
-  if (system(cmd) != 0) return -1;
-  setenv("LIMN_ROOT", root, 1);
-  lm_log_set_level(LM_LOG_WARN);
-  lm_error err;
-  if (!lm_context_create_headless(&(lm_context_desc){0}, &err)) {
-    fprintf(stderr, "no GL context: %s\n", err.msg);
-    return -1;
-  }
-  return 0;
-}
-
-static int teardown(void **state) {
-  (void)state;
-  lm_programs_clear();
-  lm_context_destroy();
-  char cmd[300];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", root);
-  return system(cmd);
-}
 
 static lm_pipeline *load(const char *rel, const char *text) {
   write_file(rel, text);
   char path[512];
-  snprintf(path, sizeof path, "%s/%s", root, rel);
+  snprintf(path, sizeof path, "%s/%s", gl_root(), rel);
   lm_error err;
   lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = path}, &err);
   if (!p) fail_msg("%s", err.msg);
@@ -98,7 +63,7 @@ static lm_pipeline *reader(const char *format) {
   char rest[1024];
   snprintf(rest, sizeof rest, "%s", at + 6);
   sprintf(at, "%s%s", format, rest);
-  return load("scripts/reader.lua", text);
+  return load("reader.lua", text);
 }
 
 /* The middle pixel of the last frame's output (sRGB bytes). */
@@ -116,7 +81,7 @@ static void swaps_keep_matching_history(void **state) {
   lm_gfx_counts at_start = lm_gfx_stats();
   lm_error err;
   lm_scene *scene = lm_scene_builtin("cornell", &err);
-  lm_pipeline *a = load("scripts/writer.lua", writer_lua);
+  lm_pipeline *a = load("writer.lua", writer_lua);
   lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = a, .width = W, .height = H},
                                       &err);
   assert_non_null(r);
@@ -133,7 +98,7 @@ static void swaps_keep_matching_history(void **state) {
   assert_int_equal(px[0], 255);
 
   /* A script whose first frame fails leaves b running, history and all. */
-  lm_pipeline *bad = load("scripts/bad.lua", "Techniques = { \"x\" }\n"
+  lm_pipeline *bad = load("bad.lua", "Techniques = { \"x\" }\n"
                                              "function OnRender(tech)\n"
                                              "  error(\"broken on purpose\")\n"
                                              "end\n");
@@ -142,7 +107,7 @@ static void swaps_keep_matching_history(void **state) {
   lm_pipeline_destroy(bad);
   /* One that records fine but whose shader does not compile fails at execution. */
   write_file("shaders/nope.frag", "out vec4 o;\nvoid main() { o = vec4(1.0) }\n");
-  bad = load("scripts/bad2.lua", "Techniques = { \"x\" }\n"
+  bad = load("bad2.lua", "Techniques = { \"x\" }\n"
                                  "function OnRender(tech)\n"
                                  "  present(pass{ \"p\", shader = \"nope.frag\", out = target{ \"t\", format = \"rgba8\" } })\n"
                                  "end\n");
@@ -186,7 +151,7 @@ static void resize_follows_the_output(void **state) {
   (void)state;
   lm_error err;
   lm_scene *scene = lm_scene_builtin("cornell", &err);
-  lm_pipeline *p = load("scripts/resize.lua", "Techniques = { \"x\" }\n"
+  lm_pipeline *p = load("resize.lua", "Techniques = { \"x\" }\n"
                                               "function OnRender(tech)\n"
                                               "  present(pass{ \"p\", shader = \"fill.frag\", params = { c = { 0, 1, 0, 1 } },\n"
                                               "                out = target{ \"half\", format = \"rgba8\", scale = 0.5 } })\n"
@@ -218,5 +183,5 @@ int main(void) {
       cmocka_unit_test(swaps_keep_matching_history),
       cmocka_unit_test(resize_follows_the_output),
   };
-  return cmocka_run_group_tests(tests, setup, teardown);
+  return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }
