@@ -172,6 +172,9 @@ static void script_errors_name_the_field(void **state) {
       {"target{ 't', format = 'rgb9' }", "bad.lua:3: target 't': unknown format 'rgb9'"},
       {"target{ 't', format = 'rgba8', scale = -1 }", "bad.lua:3: target 't': scale must be"},
       {"pass{ shader = 'x.frag' }", "bad.lua:3: pass: give the pass a name first"},
+      /* Found by fuzz_pipeline: a number as the name was freed while in use. */
+      {"target{ 16, format = 'rgba8' }", "bad.lua:3: target: the name (first entry) must be a string, not a number"},
+      {"scene{ 16, out = target{ 't', format = 'rgba8' } }", "bad.lua:3: scene: the name (first entry) must be a string"},
       {"pass{ 'p', out = target{ 't', format = 'rgba8' } }", "bad.lua:3: pass 'p': field 'shader' is missing"},
       {"pass{ 'p', shader = 'x.frag', out = 5 }", "bad.lua:3: pass 'p': field 'out' must be a target"},
       {"pass{ 'p', shader = 'x.frag', params = { k = 'a' }, out = target{ 't', format = 'rgba8' } }",

@@ -25,6 +25,18 @@ static void caller_where(lua_State *L, char *out, size_t cap) {
   while (n > 0 && (out[n - 1] == ' ' || out[n - 1] == ':')) out[--n] = '\0';
 }
 
+/* The name in t[1]: a string that lives as long as the table (a number would
+ * be converted into a string nothing keeps alive). NULL when t[1] is nil. */
+static const char *first_name(lua_State *L, int t, const char *fn) {
+  lua_rawgeti(L, t, 1);
+  int type = lua_type(L, -1);
+  const char *name = type == LUA_TSTRING ? lua_tostring(L, -1) : NULL;
+  lua_pop(L, 1);
+  if (type != LUA_TSTRING && type != LUA_TNIL)
+    luaL_error(L, "%s: the name (first entry) must be a string, not a %s", fn, lua_typename(L, type));
+  return name;
+}
+
 static lm_pipeline *recording(lua_State *L, const char *fn) {
   lm_pipeline *p = lm_script_pipeline(L);
   if (!p->graph) luaL_error(L, "%s() is called from OnCreate or OnRender only", fn);
@@ -82,9 +94,7 @@ static int l_target(lua_State *L) {
   static const char *const fields[] = {"name", "format", "scale", "size", "mips", NULL};
   check_fields(L, 1, "target", fields);
   lm_target_desc d = {.scale = 1.0f, .persistent = p->in_create};
-  lua_rawgeti(L, 1, 1);
-  d.name = lua_tostring(L, -1);
-  lua_pop(L, 1);
+  d.name = first_name(L, 1, "target");
   if (!d.name) d.name = opt_string(L, 1, "name", "target");
   if (!d.name) return luaL_error(L, "target: give it a name: target{ \"lit\", format = \"rgba16f\" }");
   char what[128];
@@ -439,9 +449,7 @@ static void begin_pass(lua_State *L, pass_builder *b, lm_pass_kind kind, const c
   b->desc.depth = -1;
   caller_where(L, b->where, sizeof b->where);
   b->desc.where = b->where;
-  lua_rawgeti(L, 1, 1);
-  b->desc.name = lua_tostring(L, -1);
-  lua_pop(L, 1);
+  b->desc.name = first_name(L, 1, fn);
   if (!b->desc.name) luaL_error(L, "%s: give the pass a name first: %s{ \"name\", ... }", fn, fn);
   snprintf(b->what, sizeof b->what, "pass '%s'", b->desc.name);
 }
