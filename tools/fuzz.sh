@@ -12,7 +12,13 @@ cmake --build build-fuzz -j "$(nproc)" --target fuzz_shader_source fuzz_gltf fuz
 for target in fuzz_shader_source fuzz_gltf fuzz_pipeline fuzz_job; do
   work=$(mktemp -d)
   echo "fuzzing $target for ${seconds}s"
-  (cd build-fuzz && "./tests/$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
-     -print_final_stats=1 "$work" "../tests/fuzz/corpus/$target" 2>&1 | tail -4)
-  rm -rf "$work"
+  log=$(mktemp)
+  if ! (cd build-fuzz && "./tests/$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+          -print_final_stats=1 "$work" "../tests/fuzz/corpus/$target" >"$log" 2>&1); then
+    grep -v "^INFO\|^#" "$log" | head -60 # the sanitizer's report and the input's file name
+    rm -rf "$work" "$log"
+    exit 1
+  fi
+  tail -4 "$log"
+  rm -rf "$work" "$log"
 done
