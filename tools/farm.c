@@ -19,12 +19,13 @@
 static const char farm_usage[] =
     "usage: limn farm slurm --job FILE --shards N [--partition P] [--time T] [--mem M]\n"
     "                       [--cpus-per-task C] [--gres G] [--account A] [--sbatch FLAG]...\n"
-    "                       [--set NAME=VALUE]... [--references [--refs DIR] [export-pov flags]]\n"
+    "                       [--set NAME=VALUE]... [--references [--refs DIR] [--povray PROGRAM]\n"
+    "                       [export-pov flags]]\n"
     "                       [--dir DIR] [--name NAME] [--submit]\n"
     "\n"
     "Writes DIR/NAME.sbatch, a Slurm job array of N tasks: task I renders shard I/N\n"
-    "of the capture job (limn capture --job FILE --shard auto/N; with --references\n"
-    "also limn reference --shard auto/N), writing its own manifest. Run with bash,\n"
+    "of the capture job (limn capture --job FILE --shard auto/N, after limn reference\n"
+    "--shard auto/N with --references), writing its own manifest. Run with bash,\n"
     "the script submits the array and a merge task that waits for all of it\n"
     "(limn manifest merge); `bash DIR/NAME.sbatch --array=1,4` reruns shards 1\n"
     "and 4 and merges again. Logs go to DIR/logs. The current folder, this limn\n"
@@ -39,6 +40,7 @@ static const char farm_usage[] =
     "  --set NAME=VALUE     added to the job's options (repeatable)\n"
     "  --references         render the job's POV-Ray references too\n"
     "  --refs DIR           where they go (default out/reference)\n"
+    "  --povray PROGRAM     the POV-Ray program on the nodes (default povray)\n"
     "  --dir DIR            the script and its logs (default farm)\n"
     "  --name NAME          the Slurm job name (default limn-<job file's stem>)\n"
     "  --submit             run the script: submit the array and the merge\n"
@@ -53,7 +55,7 @@ static int usage_error(const char *fmt, const char *arg) {
 }
 
 typedef struct farm_args {
-  const char *job, *dir, *name, *refs;
+  const char *job, *dir, *name, *refs, *povray;
   const char *sbatch[64]; /* "--partition=P" ... */
   int sbatch_count;
   const char *sets[64];
@@ -114,13 +116,15 @@ static void script_text(const farm_args *a, const char *cwd, const char *self, c
   lm_buf_printf(b, "if [ \"${LIMN_FARM_STEP:-}\" = merge ]; then\n"
                 "  exec \"$limn\" manifest merge --job %s --shards %d%s", job.data, a->shards, sets.data ? sets.data : "");
   if (a->references) lm_buf_append(b, " --refs ", -1), quote(b, a->refs), lm_buf_append(b, pov.data ? pov.data : "", -1);
-  lm_buf_printf(b, "\nfi\nrc=0\n\"$limn\" capture --job %s --shard auto/%d%s || rc=1\n", job.data, a->shards,
-                sets.data ? sets.data : "");
+  lm_buf_append(b, "\nfi\nrc=0\n", -1);
   if (a->references) {
     lm_buf_printf(b, "\"$limn\" reference --job %s --shard auto/%d --refs ", job.data, a->shards);
     quote(b, a->refs);
+    if (a->povray) lm_buf_append(b, " --povray ", -1), quote(b, a->povray);
     lm_buf_printf(b, "%s || rc=1\n", pov.data ? pov.data : "");
   }
+  lm_buf_printf(b, "\"$limn\" capture --job %s --shard auto/%d%s || rc=1\n", job.data, a->shards,
+                sets.data ? sets.data : "");
   lm_buf_append(b, "exit $rc\n", -1);
   lm_buf_free(&sets);
   lm_buf_free(&pov);
@@ -224,8 +228,9 @@ int limn_farm(int argc, char **argv) {
       {"sbatch", required_argument, 0, 'B'},    {"set", required_argument, 0, 'D'},
       {"references", no_argument, 0, 'X'},      {"refs", required_argument, 0, 'R'},
       {"dir", required_argument, 0, 'd'},       {"name", required_argument, 0, 'N'},
-      {"submit", no_argument, 0, 's'},          {"help", no_argument, 0, 'h'}};
-  memcpy(opts + 16, limn_pov_options, sizeof(struct option) * LIMN_POV_OPTION_COUNT);
+      {"submit", no_argument, 0, 's'},          {"help", no_argument, 0, 'h'},
+      {"povray", required_argument, 0, 'P'}};
+  memcpy(opts + 17, limn_pov_options, sizeof(struct option) * LIMN_POV_OPTION_COUNT);
   opterr = 0;
   optind = 1;
   int c, rc = -1;
@@ -263,6 +268,7 @@ int limn_farm(int argc, char **argv) {
       break;
     case 'X': a.references = true; break;
     case 'R': a.refs = optarg; break;
+    case 'P': a.povray = optarg; break;
     case 'd': a.dir = optarg; break;
     case 'N': a.name = optarg; break;
     case 's': a.submit = true; break;
