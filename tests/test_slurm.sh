@@ -13,7 +13,7 @@
 set -u
 limn=$1
 root=$2
-for p in munged slurmctld slurmd sbatch squeue scancel scontrol povray; do
+for p in munged slurmctld slurmd sbatch squeue sinfo scancel scontrol povray; do
   command -v "$p" >/dev/null || { echo "$p not installed: skipped (tools/dev.sh installs munge, slurmctld, slurmd, slurm-client, povray)"; exit 77; }
 done
 [ "$(id -u)" = 0 ] || { echo "not root: skipped (the one-node cluster runs slurmd as root)"; exit 77; }
