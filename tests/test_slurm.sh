@@ -36,6 +36,7 @@ stop() {
   rm -rf "$tmp"
 }
 trap stop EXIT
+trap "exit 1" INT TERM HUP # the EXIT trap runs then too
 fail() {
   echo "FAIL: $*"
   for f in "$tmp"/log/slurm*.log "$tmp"/work/farm/logs/*.log; do [ -e "$f" ] && { echo "--- $f"; tail -15 "$f"; }; done

@@ -107,12 +107,15 @@ static void script_text(const farm_args *a, const char *cwd, const char *self, c
   quote(b, script);
   lm_buf_printf(b, ") || exit 1\n  array=${array%%%%;*}\n"
                 "  merge=$(sbatch --parsable --dependency=afterany:\"$array\" --array=0 --job-name=%s-merge \\\n"
-                "    --output=%s/logs/%s-merge-%%j.log --export=ALL,LIMN_FARM_STEP=merge ",
-                a->name, a->dir, a->name);
+                "    --output=", a->name);
+  lm_buf merge_log = {0};
+  lm_buf_printf(&merge_log, "%s/logs/%s-merge-%%j.log", a->dir, a->name);
+  quote(b, merge_log.data);
+  lm_buf_free(&merge_log);
+  lm_buf_append(b, " --export=ALL,LIMN_FARM_STEP=merge ", -1);
   quote(b, script);
-  lm_buf_printf(b, ") || exit 1\n"
-                "  echo \"submitted the shards as job $array, the merge as job ${merge%%%%;*} (logs in %s/logs)\"\n"
-                "  exit 0\nfi\n", a->dir);
+  lm_buf_append(b, ") || exit 1\n  echo \"submitted the shards as job $array, the merge as job ${merge%%;*}\"\n"
+                "  exit 0\nfi\n", -1);
   lm_buf_printf(b, "if [ \"${LIMN_FARM_STEP:-}\" = merge ]; then\n"
                 "  exec \"$limn\" manifest merge --job %s --shards %d%s", job.data, a->shards, sets.data ? sets.data : "");
   if (a->references) lm_buf_append(b, " --refs ", -1), quote(b, a->refs), lm_buf_append(b, pov.data ? pov.data : "", -1);
@@ -216,7 +219,7 @@ int limn_farm(int argc, char **argv) {
   }
   argc--, argv++;
   farm_args a = {.dir = "farm", .refs = "out/reference"};
-  static char sbatch_flags[6][1100]; /* --partition=P ... (at most one of each) */
+  char sbatch_flags[6][1100] = {{0}}; /* --partition=P ... (at most one of each) */
   static const char *const named[6] = {"partition", "time", "mem", "cpus-per-task", "gres", "account"};
   lm_pov_desc pov;
   limn_pov_defaults(&pov);

@@ -162,8 +162,10 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
   pov_run *runs = lm_alloc(sizeof *runs * (size_t)jobs);
   char what[1200];
   for (int i = 0; i < n; i++) mine += i % a->shards == a->shard;
-  if (!a->quiet) printf("references of %s: %d view%s (%d in shard %d/%d), up to %d POV-Ray run%s at once; %s\n",
-                        j->path, n, n == 1 ? "" : "s", mine, a->shard, a->shards, jobs, jobs == 1 ? "" : "s", a->refs);
+  char in_shard[64] = "";
+  if (a->shards > 1) snprintf(in_shard, sizeof in_shard, " (%d in shard %d/%d)", mine, a->shard, a->shards);
+  if (!a->quiet) printf("references of %s: %d view%s%s, up to %d POV-Ray run%s at once; %s\n", j->path, n,
+                        n == 1 ? "" : "s", in_shard, jobs, jobs == 1 ? "" : "s", a->refs);
   for (int i = 0; i <= n; i++) {
     /* Start place i when a slot is free; after the last, wait for the rest. */
     while (running > 0 && (running == jobs || i == n)) {
