@@ -140,16 +140,15 @@ exec povray "\$@"
 HOLD
 chmod +x povray-hold
 "$limn" farm slurm --job job.lua --shards 3 --references --refs refs --povray "$tmp/work/povray-hold" \
-  --count 10 --pretrace-start 0.2 --pretrace-end 0.1 --time 5 > farm.txt 2>&1 || { cat farm.txt; fail "limn farm slurm"; }
-cat farm.txt
+  --count 10 --pretrace-start 0.2 --pretrace-end 0.1 --time 5 --submit > submit1.txt 2>&1 \
+  || { cat submit1.txt; fail "limn farm slurm --submit"; }
+cat submit1.txt
 script=farm/limn-job.sbatch
 grep -q '^#SBATCH --array=0-2$' $script || fail "the script is not a 3-task array"
 grep -q '^#SBATCH --time=5$' $script || fail "--time is not passed to sbatch"
 # shards: views 0,3,6,9 / 1,4,7 / 2,5,8; references: places 0,3 / 1,4 / 2
 
 # ---- 1. the whole array and its merge ---------------------------------------
-bash $script > submit1.txt 2>&1 || { cat submit1.txt; fail "submitting"; }
-cat submit1.txt
 read -r array1 merge1 < <(sed -n 's/.*as job \([0-9]*\), the merge as job \([0-9]*\).*/\1 \2/p' submit1.txt)
 [ -n "${merge1:-}" ] || fail "no job ids in: $(cat submit1.txt)"
 wait_jobs
