@@ -15,9 +15,11 @@ shadow.defaults = {
   blur = 2,           -- ESM Gaussian radius in texels, 0..32
   cascades = 3,       -- directional lights, 1..4
   lambda = 0.75,      -- cascade splits: 0 uniform .. 1 logarithmic
-  bias = 0.002,       -- depth bias in normalized depth (the seed: 0 for ESM, which darkens lit
-                      -- slanted surfaces by 1-2%; 0.005 for its plain shadow map)
-  distance = 0,       -- how far cascades reach from the camera (0: the far plane)
+  bias = 1,           -- depth bias in texels: the world size of a shadow-map texel where the
+                      -- receiver is, 0..64 (the seed: 0 for ESM, which darkens lit slanted
+                      -- surfaces by 1-2%)
+  distance = 0,       -- how far cascades reach from the camera, world units (0: as far as
+                      -- anything is seen)
   blend = 0.1,        -- share of a cascade blended into the next one
   radius = 2.5,       -- Poisson disc radius in texels
   stabilize = true,   -- bounding spheres and texel snapping (seed 003)

@@ -9,12 +9,13 @@
 struct ShadowLight {
   ivec4 info;  // first view, view count, kind (0 none, 1 cascades, 2 spot, 3 point), technique
   vec4 splits; // cascades: camera depth where each ends
-  vec4 params; // c, bias, blend, Poisson radius
+  vec4 params; // c, bias (texels), blend, Poisson radius
 };
 struct ShadowView {
   mat4 view_proj;
   vec4 rect;  // tile in atlas uv: offset, size
   vec4 depth; // light position, 1 / range (0: orthographic)
+  vec4 texel; // a texel's world size (orthographic) or its size per unit of distance; world depth 0..1 spans
 };
 layout(std430, binding = 2) readonly buffer LimnShadowLights { ShadowLight shadow_lights[]; };
 layout(std430, binding = 3) readonly buffer LimnShadowViews { ShadowView shadow_views[]; };
@@ -44,7 +45,10 @@ float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
   vec2 texel = (sv.rect.xy + tuv * sv.rect.zw) * size - 0.5;
   ivec2 base = ivec2(floor(texel));
   vec2 f = texel - vec2(base);
-  float bias = s.params.y;
+  // The bias is given in texels: the world size of one where p is, as a
+  // share of the world depth the tile's 0..1 spans (any unit, any tile).
+  float world_texel = sv.texel.x * (sv.depth.w > 0.0 ? length(p - sv.depth.xyz) : 1.0);
+  float bias = s.params.y * world_texel / max(sv.texel.y, 1e-30);
   int technique = s.info.w;
   // Filters reach `spread` texels away, where a tilted receiver is deeper:
   // scale the bias by the tilt (tan of the light's angle, capped).

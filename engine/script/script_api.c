@@ -193,7 +193,7 @@ static int l_shadow_plan(lua_State *L) {
   st.blur = (int)opt_number(L, 1, "blur", (float)st.blur, 0, 32, what);
   st.cascades = (int)opt_number(L, 1, "cascades", (float)st.cascades, 1, 4, what);
   st.lambda = opt_number(L, 1, "lambda", st.lambda, 0, 1, what);
-  st.bias = opt_number(L, 1, "bias", st.bias, -0.5f, 0.5f, what);
+  st.bias = opt_number(L, 1, "bias", st.bias, 0.0f, 64.0f, what);
   st.distance = opt_number(L, 1, "distance", st.distance, 0, 1e9f, what);
   st.blend = opt_number(L, 1, "blend", st.blend, 0, 1, what);
   st.radius = opt_number(L, 1, "radius", st.radius, 0, 32, what);

@@ -1,0 +1,112 @@
+/* The same image in any unit and at any depth range (issue 16): a scene whose
+ * root is scaled by s (cameras under it, lights' ranges converted as an
+ * exporter would) renders within a stated tolerance of the scale-1 image, and
+ * so does a camera with near 1e-5 and far 1e6. Two scenes at 96x72: the field
+ * under a sun (cascades) and the Cornell box under a spot light. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <cglm/cglm.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl_test.h"
+
+enum { W = 96, H = 72 };
+/* Relative mean difference from the scale-1 image (sum |a - b| / sum |a|). */
+#define TOLERANCE 0.02
+
+static const float scales[] = {1e-3f, 1e-2f, 1e-1f, 1e3f, 1e5f};
+
+/* The scene `name` in a unit s times smaller: a root node scaled by s above
+ * everything (cameras included), and the lights' ranges, which glTF keeps out
+ * of node scale, written in the new unit. */
+static lm_scene *scaled(const char *name, float s) {
+  lm_error err;
+  lm_scene *scene = lm_scene_builtin(name, &err);
+  assert_non_null(scene);
+  if (!strcmp(name, "cornell")) { /* its point light as a spot shining down */
+    scene->lights[0].type = LM_LIGHT_SPOT;
+    scene->lights[0].inner_cone = glm_rad(55.0f);
+    scene->lights[0].outer_cone = glm_rad(75.0f);
+  }
+  if (s != 1.0f) {
+    mat4 m;
+    glm_scale_make(m, (vec3){s, s, s});
+    lm_scene_add_root(scene, "unit", (float *)m);
+    for (int i = 0; i < scene->light_count; i++) scene->lights[i].radius *= s;
+  }
+  return scene;
+}
+
+static double relative_difference(const gl_result *a, const gl_result *b) {
+  double diff = 0, sum = 0;
+  for (size_t i = 0; i < (size_t)W * H * 3; i++) {
+    diff += fabs((double)a->rgb[i] - b->rgb[i]);
+    sum += fabs((double)a->rgb[i]);
+  }
+  return diff / fmax(sum, 1e-30);
+}
+
+static gl_result render(lm_scene *s, const char *tech, float unit) {
+  /* ISR's disc radius is a world length (scripts/isr.lua): give it in the unit. */
+  char radius[64];
+  snprintf(radius, sizeof radius, "isr.radius=%.9g", 0.5 * unit);
+  const char *sets[] = {radius, NULL};
+  gl_result r = gl_render(&(gl_run){.scene = s, .tech = tech, .sets = sets, .width = W, .height = H});
+  if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
+  if (!gl_all_finite(&r)) fail_msg("%s at scale %g: a pixel is NaN, Inf or negative", tech, unit);
+  return r;
+}
+
+static void sweep(const char *name) {
+  static const char *const techs[] = {"dl+esm", "isr+esm"};
+  bool ok = true;
+  for (int t = 0; t < 2; t++) {
+    lm_scene *one = scaled(name, 1.0f);
+    gl_result ref = render(one, techs[t], 1.0f);
+    for (size_t k = 0; k < sizeof scales / sizeof *scales; k++) {
+      lm_scene *s = scaled(name, scales[k]);
+      gl_result r = render(s, techs[t], scales[k]);
+      double d = relative_difference(&ref, &r);
+      float all[3];
+      gl_region(&r, 0, 0, W - 1, H - 1, all);
+      printf("%s %s scale %g: relative mean difference %.4f (mean %.4f)\n", name, techs[t], scales[k], d, gl_luminance(all));
+      ok &= d < TOLERANCE;
+      gl_result_free(&r);
+      lm_scene_destroy(s);
+    }
+    one->cameras[0].znear = 1e-5f;
+    one->cameras[0].zfar = 1e6f;
+    gl_result r = render(one, techs[t], 1.0f);
+    double d = relative_difference(&ref, &r);
+    printf("%s %s near 1e-5 far 1e6: relative mean difference %.4f\n", name, techs[t], d);
+    ok &= d < TOLERANCE;
+    gl_result_free(&r);
+    gl_result_free(&ref);
+    lm_scene_destroy(one);
+  }
+  if (!ok) fail_msg("%s: an image differs by %.0f%% or more from scale 1", name, TOLERANCE * 100);
+}
+
+static void the_sun_on_the_field_at_every_scale(void **state) {
+  (void)state;
+  sweep("field");
+}
+
+static void a_spot_in_the_box_at_every_scale(void **state) {
+  (void)state;
+  sweep("cornell");
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(the_sun_on_the_field_at_every_scale),
+      cmocka_unit_test(a_spot_in_the_box_at_every_scale),
+  };
+  return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
+}
