@@ -171,6 +171,36 @@ static void the_sun_casts_cascaded_shadows_at_any_depth_range(void **state) {
   lm_scene_destroy(s);
 }
 
+/* Cascades fit the camera depths the G-buffer holds (the depth-range
+ * reduction read back before the shadow pass), here 0.1 .. 150 m of camera
+ * range of which the field shows about 4 .. 96 m. */
+static void cascades_fit_the_depths_the_frame_sees(void **state) {
+  (void)state;
+  lm_scene *s = builtin("field");
+  gl_result r = render_ok(s, "dl+esm", NULL);
+  lm_renderer_set_sharing(r.renderer, false); /* keep gbuffer.dpt readable */
+  assert_true(gl_render_again(&r));
+  int w, h;
+  float *dpt = gl_read_target(&r, "gbuffer.dpt", &w, &h);
+  assert_non_null(dpt);
+  float lo = INFINITY, hi = 0;
+  for (size_t i = 0; i < (size_t)w * h; i++)
+    if (dpt[i * 4] > 0) lo = fminf(lo, dpt[i * 4]), hi = fmaxf(hi, dpt[i * 4]);
+  free(dpt);
+  lm_frame_data cam;
+  lm_scene_frame_data(s, 0, r.width, r.height, &cam);
+  const lm_shadow_plan *plan = lm_renderer_shadows(r.renderer);
+  printf("seen %g .. %g m (G-buffer %g .. %g), camera %g .. %g, read back in %.3f ms\n", plan->seen[0],
+         plan->seen[1], lo * cam.clip[1], hi * cam.clip[1], cam.clip[0], cam.clip[1], lm_renderer_fit_ms(r.renderer));
+  assert_float_equal(plan->seen[0], lo * cam.clip[1], 1e-4f * plan->seen[0]);
+  assert_float_equal(plan->seen[1], hi * cam.clip[1], 1e-4f * plan->seen[1]);
+  assert_true(plan->seen[0] > 10 * cam.clip[0] && plan->seen[1] < 0.8f * cam.clip[1]);
+  float last = plan->lights[0].splits[2];
+  assert_true(last >= plan->seen[1] && last <= plan->seen[1] * 1.0625f);
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+}
+
 /* Mean difference between the first cascade's tile in two maps, at the best
  * whole-texel shift: a stabilized map only ever moves by whole texels. */
 static double tile_change(const float *a, const float *b, int width, int height, int tile) {
@@ -257,7 +287,7 @@ static void the_atlas_can_be_viewed(void **state) {
   float all[3];
   gl_region(&r, 0, 0, r.width - 1, r.height - 1, all);
   assert_true(gl_luminance(all) > 0.05f);
-  assert_false(gl_has_pass(&r, "gbuffer"));
+  assert_false(gl_has_pass(&r, "direct")); /* the G-buffer runs: the cascades fit its depths */
   gl_result_free(&r);
   lm_scene_destroy(s);
 }
@@ -268,6 +298,7 @@ int main(void) {
       cmocka_unit_test(occluded_points_are_dark_for_every_filter),
       cmocka_unit_test(extreme_exponents_stay_finite_and_on_the_right_side),
       cmocka_unit_test(the_sun_casts_cascaded_shadows_at_any_depth_range),
+      cmocka_unit_test(cascades_fit_the_depths_the_frame_sees),
       cmocka_unit_test(stabilized_cascades_do_not_shimmer),
       cmocka_unit_test(nothing_casts_or_nothing_reads_means_no_shadow_pass),
       cmocka_unit_test(the_atlas_can_be_viewed),

@@ -255,6 +255,13 @@ const lm_program *lm_scene_pass_variant(const lm_scene_pass *sp, const char *def
 static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_graph_exec_desc *x,
                      lm_error *err) {
   const lm_pass_desc *d = &gp->desc;
+  const graph_target *fit = d->fits_views ? &g->targets[d->fit_target] : NULL;
+  /* The views live in the graph's arena: the callback may rewrite them. */
+  if (fit && x->fit_views &&
+      !x->fit_views(x->user, d, fit->texture, fit->width, fit->height, (lm_pass_view *)d->views, err)) {
+    lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
+    return false;
+  }
   lm_program *p = pass_program(d, "", err);
   if (!p || !check_bindings(g, d, p, x, err)) return false;
   lm_attachments att = {.color_count = d->output_count};

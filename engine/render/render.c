@@ -14,7 +14,7 @@ struct lm_renderer {
   float prev_view_proj[16];
   lm_frame_data camera;
   lm_shadow_plan shadows;
-  double record_ms, compile_ms;
+  double record_ms, compile_ms, fit_ms;
   lm_scene_draw_stats stats;  /* this frame's camera draws */
   bool sharing;
 };
@@ -44,6 +44,31 @@ lm_clock lm_renderer_clock(const lm_renderer *r) { return r->clock; }
 void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compile_ms) {
   *record_ms = r->record_ms;
   *compile_ms = r->compile_ms;
+}
+
+double lm_renderer_fit_ms(const lm_renderer *r) { return r->fit_ms; }
+const lm_shadow_plan *lm_renderer_shadows(const lm_renderer *r) { return &r->shadows; }
+
+/* The shadow pass fits its views to the camera depths the G-buffer holds
+ * (the script's reduction: min in r, max in g, as depth / far). Reading them
+ * back waits for the passes before it; the frame accepts that wait (it is
+ * timed: lm_renderer_fit_ms) rather than fit to last frame's depths. */
+static bool fit_views(void *user, const lm_pass_desc *d, lm_texture fit, int w, int h, lm_pass_view *views,
+                      lm_error *err) {
+  (void)err;
+  lm_renderer *r = user;
+  lm_shadow_plan *plan = &r->shadows;
+  if (d->view_count != plan->view_count || w < 1 || h < 1) return true;
+  double t0 = lm_now_ms();
+  float *px = lm_alloc(sizeof(float) * 4 * (size_t)w * (size_t)h);
+  lm_texture_read(fit, w, h, true, px);
+  float far = r->camera.clip[1];
+  lm_shadow_plan_fit(plan, r->desc.scene, &r->camera, px[0] * far, px[1] * far);
+  free(px);
+  for (int v = 0; v < plan->view_count; v++) views[v] = plan->views[v];
+  lm_shadow_plan_upload(plan, plan->light_count);
+  r->fit_ms += lm_now_ms() - t0;
+  return true;
 }
 
 static const lm_program *scene_variant(void *ctx, const char *defines, lm_error *err) {
@@ -134,7 +159,8 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   frame->counts[0] = n;
   lm_frame_upload(frame, lights, n);
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
-  lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene,
+  r->fit_ms = 0;
+  lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene, .fit_views = fit_views,
                           .scene_owns_uniform = lm_scene_owns_uniform, .user = r,
                           .check_finite = r->desc.check_finite};
   return lm_graph_execute(g, &x, err);
