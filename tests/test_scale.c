@@ -22,9 +22,7 @@ enum { W = 96, H = 72 };
 
 static const float scales[] = {1e-3f, 1e-2f, 1e-1f, 1e3f, 1e5f};
 
-/* The scene `name` in a unit s times smaller: a root node scaled by s above
- * everything (cameras included), and the lights' ranges, which glTF keeps out
- * of node scale, written in the new unit. */
+/* The scene `name` in a unit s times smaller (gl_rescale). */
 static lm_scene *scaled(const char *name, float s) {
   lm_error err;
   lm_scene *scene = lm_scene_builtin(name, &err);
@@ -34,12 +32,7 @@ static lm_scene *scaled(const char *name, float s) {
     scene->lights[0].inner_cone = glm_rad(55.0f);
     scene->lights[0].outer_cone = glm_rad(75.0f);
   }
-  if (s != 1.0f) {
-    mat4 m;
-    glm_scale_make(m, (vec3){s, s, s});
-    lm_scene_add_root(scene, "unit", (float *)m);
-    for (int i = 0; i < scene->light_count; i++) scene->lights[i].radius *= s;
-  }
+  if (s != 1.0f) gl_rescale(scene, s);
   return scene;
 }
 
@@ -93,6 +86,48 @@ static void sweep(const char *name) {
   if (!ok) fail_msg("%s: an image differs by %.0f%% or more from scale 1", name, TOLERANCE * 100);
 }
 
+/* View depth (gbuffer.dpt times far) of every pixel, 0 where nothing is. */
+static float *view_depths(lm_scene *s) {
+  gl_result r = gl_render(&(gl_run){.scene = s, .tech = "dl", .width = W, .height = H});
+  assert_true(r.ok);
+  lm_renderer_set_sharing(r.renderer, false); /* keep gbuffer.dpt readable */
+  assert_true(gl_render_again(&r));
+  int w, h;
+  float *dpt = gl_read_target(&r, "gbuffer.dpt", &w, &h);
+  assert_non_null(dpt);
+  lm_frame_data cam;
+  lm_scene_frame_data(s, 0, W, H, &cam);
+  for (size_t i = 0; i < (size_t)w * h; i++) dpt[i] = dpt[i * 4] * cam.clip[1];
+  gl_result_free(&r);
+  return dpt;
+}
+
+/* Near 1e-5 and far 1e6 (a ratio of 1e11): the depth test still finds the
+ * nearest surface everywhere, and the G-buffer's depth agrees with that of
+ * near 0.1, far 100 to float precision, whatever the unit. */
+static void depth_is_exact_at_a_near_far_ratio_of_1e11(void **state) {
+  (void)state;
+  for (int u = 0; u < 3; u++) {
+    float unit = u == 0 ? 1.0f : u == 1 ? 1e-3f : 1e5f;
+    lm_scene *s = scaled("cornell", unit);
+    s->cameras[0].znear = 0.1f, s->cameras[0].zfar = 100.0f;
+    float *ref = view_depths(s);
+    s->cameras[0].znear = 1e-5f, s->cameras[0].zfar = 1e6f;
+    float *d = view_depths(s);
+    double worst = 0;
+    for (size_t i = 0; i < (size_t)W * H; i++) {
+      if ((ref[i] > 0) != (d[i] > 0)) fail_msg("unit %g: pixel %zu covered in one image only", unit, i);
+      if (ref[i] > 0) worst = fmax(worst, fabs(d[i] - ref[i]) / ref[i]);
+    }
+    printf("unit %g: near 1e-5 far 1e6 against near 0.1 far 100: largest relative depth difference %.3g\n", unit,
+           worst);
+    if (!(worst < 1e-5)) fail_msg("unit %g: depth differs by %g", unit, worst);
+    free(ref);
+    free(d);
+    lm_scene_destroy(s);
+  }
+}
+
 static void the_sun_on_the_field_at_every_scale(void **state) {
   (void)state;
   sweep("field");
@@ -105,6 +140,7 @@ static void a_spot_in_the_box_at_every_scale(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(depth_is_exact_at_a_near_far_ratio_of_1e11),
       cmocka_unit_test(the_sun_on_the_field_at_every_scale),
       cmocka_unit_test(a_spot_in_the_box_at_every_scale),
   };

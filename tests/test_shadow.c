@@ -124,6 +124,35 @@ static void occluded_points_are_dark_for_every_filter(void **state) {
   lm_scene_destroy(s);
 }
 
+/* The same points stay dark and lit with the box in millimetres (a scaled
+ * root; the light's range in the new unit) and with near 1e-5, far 1e6, for
+ * the point light (cube faces) and the spot. */
+static void occluded_points_stay_dark_at_any_scale_and_depth_range(void **state) {
+  (void)state;
+  for (int spot = 0; spot < 2; spot++) {
+    for (int c = 0; c < 2; c++) {
+      lm_scene *s = builtin("cornell");
+      if (spot) {
+        s->lights[0].type = LM_LIGHT_SPOT;
+        s->lights[0].inner_cone = glm_rad(55.0f);
+        s->lights[0].outer_cone = glm_rad(75.0f);
+      }
+      if (c == 0) {
+        gl_rescale(s, 1e-3f);
+      } else {
+        s->cameras[0].znear = 1e-5f;
+        s->cameras[0].zfar = 1e6f;
+      }
+      gl_result plain = render_ok(s, "dl", NULL);
+      static const char *const pcf[] = {"shadow.technique=pcf", NULL};
+      check_cornell(s, &plain, NULL, 0.1f);
+      check_cornell(s, &plain, pcf, 0.1f);
+      gl_result_free(&plain);
+      lm_scene_destroy(s);
+    }
+  }
+}
+
 static void extreme_exponents_stay_finite_and_on_the_right_side(void **state) {
   (void)state;
   lm_scene *s = builtin("cornell");
@@ -235,7 +264,7 @@ static double shimmer(lm_scene *s, const char *stabilize, bool rotate) {
     glm_rotate_y(m, glm_rad(0.05f), m);
     memcpy(cam, m, sizeof m);
   } else {
-    cam[12] += 0.004f;
+    cam[12] += 0.004f; /* in the camera node's unit: under a scaled root, scaled */
     cam[14] -= 0.003f;
   }
   lm_scene_update(s);
@@ -250,16 +279,23 @@ static double shimmer(lm_scene *s, const char *stabilize, bool rotate) {
   return change;
 }
 
+/* At every scale: the field in millimetres, metres and hundreds of kilometres. */
 static void stabilized_cascades_do_not_shimmer(void **state) {
   (void)state;
-  lm_scene *s = builtin("field");
-  for (int rotate = 0; rotate < 2; rotate++) {
-    double stable = shimmer(s, "shadow.stabilize=true", rotate), loose = shimmer(s, "shadow.stabilize=false", rotate);
-    printf("cascade 0 change after a sub-texel %s: stabilized %.3g, unstabilized %.3g\n",
-           rotate ? "turn" : "move", stable, loose);
-    if (!(stable < 1e-5 && loose > 10 * stable + 1e-5)) fail_msg("stabilized %g, unstabilized %g", stable, loose);
+  static const float units[] = {1e-3f, 1.0f, 1e5f};
+  for (size_t u = 0; u < sizeof units / sizeof *units; u++) {
+    lm_scene *s = builtin("field");
+    if (units[u] != 1.0f) gl_rescale(s, units[u]);
+    for (int rotate = 0; rotate < 2; rotate++) {
+      double stable = shimmer(s, "shadow.stabilize=true", rotate);
+      double loose = shimmer(s, "shadow.stabilize=false", rotate);
+      printf("scale %g: cascade 0 change after a sub-texel %s: stabilized %.3g, unstabilized %.3g\n", units[u],
+             rotate ? "turn" : "move", stable, loose);
+      if (!(stable < 1e-5 && loose > 10 * stable + 1e-5))
+        fail_msg("scale %g: stabilized %g, unstabilized %g", units[u], stable, loose);
+    }
+    lm_scene_destroy(s);
   }
-  lm_scene_destroy(s);
 }
 
 static void nothing_casts_or_nothing_reads_means_no_shadow_pass(void **state) {
@@ -296,6 +332,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(plans_cover_every_caster),
       cmocka_unit_test(occluded_points_are_dark_for_every_filter),
+      cmocka_unit_test(occluded_points_stay_dark_at_any_scale_and_depth_range),
       cmocka_unit_test(extreme_exponents_stay_finite_and_on_the_right_side),
       cmocka_unit_test(the_sun_casts_cascaded_shadows_at_any_depth_range),
       cmocka_unit_test(cascades_fit_the_depths_the_frame_sees),
