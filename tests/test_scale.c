@@ -45,16 +45,19 @@ static double relative_difference(const gl_result *a, const gl_result *b) {
   return diff / fmax(sum, 1e-30);
 }
 
-static gl_result render(lm_scene *s, const char *tech, float unit) {
+static gl_result render_with(lm_scene *s, const char *tech, float unit, const char *const *more) {
   /* ISR's disc radius is a world length (scripts/isr.lua): give it in the unit. */
   char radius[64];
   snprintf(radius, sizeof radius, "isr.radius=%.9g", 0.5 * unit);
-  const char *sets[] = {radius, NULL};
+  const char *sets[8] = {radius};
+  for (int i = 0; more && more[i] && i < 6; i++) sets[i + 1] = more[i];
   gl_result r = gl_render(&(gl_run){.scene = s, .tech = tech, .sets = sets, .width = W, .height = H});
   if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
   if (!gl_all_finite(&r)) fail_msg("%s at scale %g: a pixel is NaN, Inf or negative", tech, unit);
   return r;
 }
+
+static gl_result render(lm_scene *s, const char *tech, float unit) { return render_with(s, tech, unit, NULL); }
 
 static void sweep(const char *name) {
   static const char *const techs[] = {"dl+esm", "isr+esm"};
@@ -138,11 +141,39 @@ static void a_spot_in_the_box_at_every_scale(void **state) {
   sweep("cornell");
 }
 
+/* Depth of field with its defaults (autofocus, range and lens relative to
+ * the focus and the field of view) blurs the same in any unit. */
+static void depth_of_field_defaults_hold_at_every_scale(void **state) {
+  (void)state;
+  static const char *const range[] = {"dof=true", NULL}, *const lens[] = {"dof=true", "dof.mode=lens", "dof.f_number=0.5", NULL};
+  const char *const *modes[] = {range, lens};
+  for (int m = 0; m < 2; m++) {
+    lm_scene *one = scaled("cornell", 1.0f);
+    gl_result ref = render_with(one, "dl", 1.0f, modes[m]), sharp = render(one, "dl", 1.0f);
+    double blur = relative_difference(&ref, &sharp);
+    for (int u = 0; u < 2; u++) {
+      float unit = u ? 1e5f : 1e-3f;
+      lm_scene *s = scaled("cornell", unit);
+      gl_result r = render_with(s, "dl", unit, modes[m]);
+      double d = relative_difference(&ref, &r);
+      printf("dof %s at scale %g: relative mean difference %.4f (the blur itself: %.4f)\n", m ? "lens" : "range",
+             unit, d, blur);
+      if (!(d < TOLERANCE && blur > 2 * d)) fail_msg("dof at scale %g: %g (blur %g)", unit, d, blur);
+      gl_result_free(&r);
+      lm_scene_destroy(s);
+    }
+    gl_result_free(&ref);
+    gl_result_free(&sharp);
+    lm_scene_destroy(one);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(depth_is_exact_at_a_near_far_ratio_of_1e11),
       cmocka_unit_test(the_sun_on_the_field_at_every_scale),
       cmocka_unit_test(a_spot_in_the_box_at_every_scale),
+      cmocka_unit_test(depth_of_field_defaults_hold_at_every_scale),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }
