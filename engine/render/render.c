@@ -16,6 +16,7 @@ struct lm_renderer {
   lm_shadow_plan shadows;
   double record_ms, compile_ms, fit_ms;
   lm_scene_draw_stats stats;  /* this frame's camera draws */
+  lm_scene_draw_stats shadow_stats; /* and its shadow tiles' */
   bool sharing;
 };
 
@@ -85,13 +86,14 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
     params[i] = (lm_material_param){q->material, q->name, q->count, {q->v[0], q->v[1], q->v[2], q->v[3]}};
   }
   if (!lm_scene_check_params(r->desc.scene, params, n, err)) return false;
-  /* Cull against the camera, or a spot or cube-face tile; a cascade tile
-   * draws everything, since casters before its near plane still cast. */
-  const float *view_proj = sp->view ? (sp->view->depth[3] > 0 ? sp->view->view_proj : NULL) : r->camera.view_proj;
+  /* Cull against the camera or the tile; a cascade tile keeps casters before
+   * its near plane, which its depth clamp flattens onto it (pancaking). */
+  const float *view_proj = sp->view ? sp->view->view_proj : r->camera.view_proj;
   lm_scene_draw_desc d = {.program = sp->program, .variant = scene_variant, .ctx = (void *)sp,
                           .view_proj = r->desc.no_culling ? NULL : view_proj,
+                          .pancake = sp->view && sp->view->depth[3] == 0,
                           .params = params, .param_count = n};
-  return lm_scene_draw(r->desc.scene, &d, sp->view ? NULL : &r->stats, err); /* camera draws only */
+  return lm_scene_draw(r->desc.scene, &d, sp->view ? &r->shadow_stats : &r->stats, err);
 }
 
 bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
@@ -108,6 +110,7 @@ void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height) {
 }
 
 lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r) { return r->stats; }
+lm_scene_draw_stats lm_renderer_shadow_draw_stats(const lm_renderer *r) { return r->shadow_stats; }
 
 /* The engine's last pass: sanitize and encode what the script presented.
  * out[0], out[1] get the sRGB and linear outputs (-1: none). */
@@ -150,7 +153,7 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
 /* Runs what record() compiled into g (the camera and shadow plan it made). */
 static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_frame_data *frame = &r->camera;
-  r->stats = (lm_scene_draw_stats){0};
+  r->stats = r->shadow_stats = (lm_scene_draw_stats){0};
   memcpy(frame->prev_view_proj, r->frame ? r->prev_view_proj : frame->view_proj, sizeof frame->prev_view_proj);
   memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
   frame->time[1] = (float)r->frame++;

@@ -31,6 +31,8 @@ void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height);
 bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err);
 /* The last frame's scene draws: nodes drawn and culled, triangles. */
 lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r); /* camera passes, not shadow tiles */
+/* The same for the last frame's shadow tiles, summed over the tiles. */
+lm_scene_draw_stats lm_renderer_shadow_draw_stats(const lm_renderer *r);
 lm_clock lm_renderer_clock(const lm_renderer *r);
 /* CPU milliseconds of the last frame spent in Lua (OnRender) and in compiling the graph. */
 void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compile_ms);

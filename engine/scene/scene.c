@@ -402,8 +402,9 @@ static void apply_param(lm_material *m, const lm_material_param *p) {
 }
 
 /* ---- drawing ------------------------------------------------------------ */
-bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const float hi[3]) {
-  /* All 8 corners beyond the same clip plane (x, y, z against +-w). */
+/* All 8 corners beyond the same clip plane (x, y, z against +-w); with
+ * `pancake`, z < -w (before an orthographic tile's near plane) does not count. */
+static bool box_outside(const float view_proj[16], const float lo[3], const float hi[3], bool pancake) {
   int outside[6] = {0};
   for (int c = 0; c < 8; c++) {
     float p[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]}, q[4];
@@ -415,8 +416,12 @@ bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const 
     }
   }
   for (int k = 0; k < 6; k++)
-    if (outside[k] == 8) return true;
+    if (outside[k] == 8 && !(pancake && k == 4)) return true;
   return false;
+}
+
+bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const float hi[3]) {
+  return box_outside(view_proj, lo, hi, false);
 }
 
 /* World bounds of a mesh under a node's transform (the box of the moved box). */
@@ -451,7 +456,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     if (d->view_proj) {
       float lo[3], hi[3];
       world_bounds(n->world, mesh->bounds, lo, hi);
-      if (lm_box_outside_frustum(d->view_proj, lo, hi)) {
+      if (box_outside(d->view_proj, lo, hi, d->pancake)) {
         if (stats) stats->culled++;
         continue;
       }

@@ -172,6 +172,7 @@ typedef struct lm_scene_draw_desc {
   const lm_program *(*variant)(void *ctx, const char *defines, lm_error *err);
   void *ctx;
   const float *view_proj; /* column-major: nodes wholly outside are culled; NULL: none are */
+  bool pancake; /* an orthographic shadow tile: nodes before its near plane still cast, so stay */
   const lm_material_param *params; /* overrides (checked by lm_scene_check_params) */
   int param_count;
 } lm_scene_draw_desc;

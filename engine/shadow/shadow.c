@@ -85,8 +85,9 @@ static void visible_depth(const lm_scene *s, const lm_frame_data *cam, float out
   if (!(out[0] < out[1])) out[0] = n, out[1] = f;
 }
 
-/* Light-view depth range [*zn, *zf] of the mesh nodes inside the tile's
- * rectangle l..r x b..t: casters and receivers. Unchanged when none is. */
+/* Narrows [*zn, *zf] to the light-view depths of the mesh nodes inside the
+ * tile's rectangle l..r x b..t (casters and receivers alike); unchanged
+ * when none is. The caller handles a range this leaves empty. */
 static void caster_depth(const lm_scene *s, mat4 view, float l, float r, float b, float t, float *zn, float *zf) {
   float cmin = FLT_MAX, cmax = -FLT_MAX, lo[3], hi[3];
   for (int i = 0; i < s->node_count; i++) {
@@ -103,7 +104,6 @@ static void caster_depth(const lm_scene *s, mat4 view, float l, float r, float b
   }
   if (cmin > cmax) return;
   *zn = fmaxf(*zn, cmin), *zf = fminf(*zf, cmax);
-  if (*zn >= *zf) *zf = *zn + (*zf - *zn > 0 ? 0 : 1e-6f * fabsf(*zn) + FLT_MIN);
 }
 
 static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
