@@ -10,6 +10,7 @@ struct ShadowLight {
   ivec4 info;  // first view, view count, kind (0 none, 1 cascades, 2 spot, 3 point), technique
   vec4 splits; // cascades: camera depth where each ends
   vec4 params; // c, bias (texels), blend, Poisson radius
+  ivec4 cube;  // point lights: x = the cube faces drawn (bit f: face f), their views in face order
 };
 struct ShadowView {
   mat4 view_proj;
@@ -88,7 +89,8 @@ float shadow_factor(int light, vec3 p, vec3 n, vec3 l) {
     vec3 d = p - shadow_views[first].depth.xyz;
     vec3 a = abs(d);
     int face = a.x >= a.y && a.x >= a.z ? (d.x >= 0.0 ? 0 : 1) : a.y >= a.z ? (d.y >= 0.0 ? 2 : 3) : (d.z >= 0.0 ? 4 : 5);
-    return shadow_view_lookup(first + face, s, p, ndl);
+    if ((s.cube.x & (1 << face)) == 0) return 1.0; // no visible pixel was to sample it
+    return shadow_view_lookup(first + bitCount(s.cube.x & ((1 << face) - 1)), s, p, ndl);
   }
   if (kind == 2) return shadow_view_lookup(first, s, p, ndl);
   // Cascades: by camera depth, blended over the last `blend` share of each.

@@ -303,6 +303,39 @@ static void stabilized_cascades_do_not_shimmer(void **state) {
   }
 }
 
+/* Looking straight down at the short box and the floor under the ceiling
+ * light, every visible pixel samples the light's -Y cube face: the other
+ * five are not planned, drawn or filtered (the atlas is one tile), and the
+ * box still shades the floor beside it. */
+static void cube_faces_no_pixel_samples_are_not_drawn(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  mat4 view, world;
+  glm_lookat((vec3){0.55f, 1.2f, 0.5f}, (vec3){0.55f, 0.0f, 0.5f}, (vec3){0, 0, -1}, view);
+  glm_mat4_inv(view, world);
+  lm_scene_node_set_world(s, s->cameras[0].node, (float *)world);
+  s->cameras[0].fov_y = glm_rad(40.0f);
+  gl_result plain = render_ok(s, "dl", NULL), r = render_ok(s, "dl+esm", NULL);
+  const lm_shadow_plan *plan = lm_renderer_shadows(r.renderer);
+  assert_int_equal(plan->view_count, 1);
+  assert_int_equal(plan->lights[0].cube[0], 1 << 3); /* -Y */
+  lm_graph *g = lm_renderer_graph(r.renderer);
+  lm_graph_target_info map = lm_graph_target(g, lm_graph_find_target(g, "shadow.map"));
+  assert_int_equal(map.width, 512);
+  assert_int_equal(map.height, 512);
+  int dark = 0, lit = 0, n = r.width * r.height;
+  for (int i = 0; i < n; i++) {
+    float a = gl_luminance(plain.rgb + (size_t)i * 3), b = gl_luminance(r.rgb + (size_t)i * 3);
+    dark += b < 0.5f * a, lit += b > 0.97f * a;
+  }
+  printf("looking down: %d views, %.1f%% of pixels in shadow, %.1f%% lit\n", plan->view_count, 100.0 * dark / n,
+         100.0 * lit / n);
+  assert_true(dark > n / 100 && lit > n / 3);
+  gl_result_free(&r);
+  gl_result_free(&plain);
+  lm_scene_destroy(s);
+}
+
 static void nothing_casts_or_nothing_reads_means_no_shadow_pass(void **state) {
   (void)state;
   lm_scene *s = builtin("cornell");
@@ -342,6 +375,7 @@ int main(void) {
       cmocka_unit_test(the_sun_casts_cascaded_shadows_at_any_depth_range),
       cmocka_unit_test(cascades_fit_the_depths_the_frame_sees),
       cmocka_unit_test(stabilized_cascades_do_not_shimmer),
+      cmocka_unit_test(cube_faces_no_pixel_samples_are_not_drawn),
       cmocka_unit_test(nothing_casts_or_nothing_reads_means_no_shadow_pass),
       cmocka_unit_test(the_atlas_can_be_viewed),
   };

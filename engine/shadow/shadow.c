@@ -190,23 +190,65 @@ static float light_range(const lm_scene *s, const lm_light *l, const vec3 pos) {
   return range > 0 && isfinite(range) ? range * 1.01f : 1.0f;
 }
 
-static void plan_perspective(lm_shadow_plan *plan, const vec3 pos, const vec3 dir, float fov, float range) {
+static void perspective_view_proj(const vec3 pos, const vec3 dir, float fov, float range, mat4 vp) {
   vec3 up, target;
   up_for(dir, up);
   glm_vec3_add((float *)pos, (float *)dir, target);
-  mat4 view, proj, vp;
+  mat4 view, proj;
   glm_lookat((float *)pos, target, up, view);
   glm_perspective(fov, 1.0f, range * 1e-4f, range, proj);
   glm_mat4_mul(proj, view, vp);
+}
+
+static void plan_perspective(lm_shadow_plan *plan, const vec3 pos, const vec3 dir, float fov, float range) {
+  mat4 vp;
+  perspective_view_proj(pos, dir, fov, range, vp);
   /* A texel's world size per unit of distance, and the world depth 0..1 spans. */
   add_view(plan, vp, (float[4]){pos[0], pos[1], pos[2], 1.0f / range},
            (float[4]){2.0f * tanf(fov * 0.5f) / (float)plan->tile, range, 0, 0});
+}
+
+/* Point light: cube faces +X -X +Y -Y +Z -Z (shadow.glsl picks by major axis). */
+static const float cube_faces[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+
+/* All n points beyond the same clip plane of view_proj. */
+static bool points_outside(mat4 vp, const vec3 *p, int n) {
+  int outside[6] = {0};
+  for (int i = 0; i < n; i++) {
+    vec4 q, w = {p[i][0], p[i][1], p[i][2], 1};
+    glm_mat4_mulv(vp, w, q);
+    for (int k = 0; k < 3; k++) outside[2 * k] += q[k] < -q[3], outside[2 * k + 1] += q[k] > q[3];
+  }
+  for (int k = 0; k < 6; k++)
+    if (outside[k] == n) return true;
+  return false;
+}
+
+/* The cube faces a visible pixel may sample (bit f: face f): those that
+ * reach into the camera's slice of seen depths and hold a mesh the camera
+ * sees. Conservative: a seen point lies in a seen mesh's box and one face. */
+static int cube_faces_seen(const lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam, const vec3 pos,
+                           float range) {
+  vec3 slice[8], lo, hi;
+  slice_corners(cam, plan->seen[0], plan->seen[1], slice);
+  int mask = 0;
+  for (int f = 0; f < 6; f++) {
+    mat4 vp;
+    perspective_view_proj(pos, cube_faces[f], GLM_PI_2f, range, vp);
+    if (points_outside(vp, (const vec3 *)slice, 8)) continue;
+    for (int i = 0; i < s->node_count && !(mask & 1 << f); i++)
+      if (lm_scene_node_bounds(s, i, lo, hi) && !lm_box_outside_frustum(cam->view_proj, lo, hi) &&
+          !lm_box_outside_frustum((float *)vp, lo, hi))
+        mask |= 1 << f;
+  }
+  return mask;
 }
 
 static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam, int i,
                        const lm_light_data *ld) {
   const lm_light *l = &s->lights[i];
   lm_shadow_light_data *out = &plan->lights[i];
+  int faces = out->cube[0]; /* chosen when the plan was made; a fit keeps them */
   memset(out, 0, sizeof *out);
   out->info[3] = plan->settings.technique;
   out->params[0] = plan->settings.c;
@@ -229,11 +271,12 @@ static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
     plan_perspective(plan, pos, dir, fov, range);
     return;
   }
-  /* Point light: cube faces +X -X +Y -Y +Z -Z (shadow.glsl picks by major axis). */
-  static const float faces[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  out->info[1] = 6;
+  /* Point light: the faces a visible pixel may sample, in face order. */
+  out->info[1] = __builtin_popcount((unsigned)faces);
   out->info[2] = KIND_POINT;
-  for (int f = 0; f < 6; f++) plan_perspective(plan, pos, faces[f], GLM_PI_2f, range);
+  out->cube[0] = faces;
+  for (int f = 0; f < 6; f++)
+    if (faces & 1 << f) plan_perspective(plan, pos, cube_faces[f], GLM_PI_2f, range);
 }
 
 /* Every light's views for the camera; then the tiles' places in the atlas. */
@@ -270,12 +313,24 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
   plan->light_count = s->light_count;
   plan->lights = lm_alloc(sizeof *plan->lights * (size_t)(s->light_count + 1));
   visible_depth(s, cam, plan->seen);
-  /* How many views, then tiles in a near-square grid, shrunk to fit the GL
-   * limit if needed; the views depend on the tile size (texel snapping). */
+  /* How many views (a point light's faces chosen now, for the whole frame),
+   * then tiles in a near-square grid, shrunk to fit the GL limit if needed;
+   * the views depend on the tile size (texel snapping). */
+  lm_light_data *ld = lm_alloc(sizeof *ld * (size_t)(s->light_count + 1));
+  lm_scene_light_data(s, ld, s->light_count);
   int count = 0;
-  for (int i = 0; i < s->light_count; i++)
-    if (s->lights[i].casts_shadows)
-      count += s->lights[i].type == LM_LIGHT_DIRECTIONAL ? st->cascades : s->lights[i].type == LM_LIGHT_SPOT ? 1 : 6;
+  for (int i = 0; i < s->light_count; i++) {
+    const lm_light *l = &s->lights[i];
+    if (!l->casts_shadows) continue;
+    if (l->type == LM_LIGHT_POINT) {
+      vec3 pos = {ld[i].position[0], ld[i].position[1], ld[i].position[2]};
+      plan->lights[i].cube[0] = cube_faces_seen(plan, s, cam, pos, light_range(s, l, pos));
+    }
+    count += l->type == LM_LIGHT_DIRECTIONAL ? st->cascades
+             : l->type == LM_LIGHT_SPOT      ? 1
+                                             : __builtin_popcount((unsigned)plan->lights[i].cube[0]);
+  }
+  free(ld);
   plan->tile = st->resolution;
   plan->columns = count ? (int)ceil(sqrt((double)count)) : 0;
   plan->rows = count ? (count + plan->columns - 1) / plan->columns : 0;

@@ -39,6 +39,7 @@ typedef struct lm_shadow_light_data {
   int32_t info[4]; /* first view, view count, kind (0 none, 1 cascades, 2 spot, 3 point), technique */
   float splits[4]; /* cascades: camera depth where each ends */
   float params[4]; /* c, bias (texels), blend, Poisson radius */
+  int32_t cube[4]; /* point lights: x = the cube faces drawn (bit f: face f, +X -X +Y -Y +Z -Z), in order */
 } lm_shadow_light_data;
 typedef struct lm_shadow_view_data {
   float view_proj[16];
