@@ -1,8 +1,9 @@
 /* The same image in any unit and at any depth range (issue 16): a scene whose
  * root is scaled by s (cameras under it, lights' ranges converted as an
  * exporter would) renders within a stated tolerance of the scale-1 image, and
- * so does a camera with near 1e-5 and far 1e6. Two scenes at 96x72: the field
- * under a sun (cascades) and the Cornell box under a spot light. */
+ * so does a camera with near 1e-5 and far 1e6. At 96x72: the field under a
+ * sun (cascades), the Cornell box under a spot light, and the office (glTF,
+ * a sunlit room, a camera-list view). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -15,6 +16,7 @@
 #include <string.h>
 
 #include "gl_test.h"
+#include "scene/gltf.h"
 
 enum { W = 96, H = 72 };
 /* Relative mean difference from the scale-1 image (sum |a - b| / sum |a|). */
@@ -22,11 +24,22 @@ enum { W = 96, H = 72 };
 
 static const float scales[] = {1e-3f, 1e-2f, 1e-1f, 1e3f, 1e5f};
 
-/* The scene `name` in a unit s times smaller (gl_rescale). */
+/* The scene `name` (built in, or data/scenes/NAME.glb seen from the first
+ * view of its camera list) in a unit s times smaller (gl_rescale). */
 static lm_scene *scaled(const char *name, float s) {
   lm_error err;
-  lm_scene *scene = lm_scene_builtin(name, &err);
-  assert_non_null(scene);
+  char path[1024];
+  snprintf(path, sizeof path, "%s/../data/scenes/%s.glb", LIMN_TEST_DIR, name);
+  lm_scene *scene = strcmp(name, "office") ? lm_scene_builtin(name, &err) : lm_scene_load_gltf(path, &err);
+  if (!scene) fail_msg("%s: %s", name, err.msg);
+  if (!strcmp(name, "office")) {
+    int n;
+    snprintf(path, sizeof path, "%s/../data/scenes/%s.cams", LIMN_TEST_DIR, name);
+    int first = lm_scene_add_camera_list(scene, path, &n, &err);
+    if (first < 0) fail_msg("%s", err.msg);
+    lm_camera c = scene->cameras[0];
+    scene->cameras[0] = scene->cameras[first], scene->cameras[first] = c;
+  }
   if (!strcmp(name, "cornell")) { /* its point light as a spot shining down */
     scene->lights[0].type = LM_LIGHT_SPOT;
     scene->lights[0].inner_cone = glm_rad(55.0f);
@@ -141,6 +154,12 @@ static void a_spot_in_the_box_at_every_scale(void **state) {
   sweep("cornell");
 }
 
+/* The issue's case: a sunlit room from glTF, its camera list's first view. */
+static void the_office_at_every_scale(void **state) {
+  (void)state;
+  sweep("office");
+}
+
 /* Depth of field with its defaults (autofocus, range and lens relative to
  * the focus and the field of view) blurs the same in any unit. */
 static void depth_of_field_defaults_hold_at_every_scale(void **state) {
@@ -173,6 +192,7 @@ int main(void) {
       cmocka_unit_test(depth_is_exact_at_a_near_far_ratio_of_1e11),
       cmocka_unit_test(the_sun_on_the_field_at_every_scale),
       cmocka_unit_test(a_spot_in_the_box_at_every_scale),
+      cmocka_unit_test(the_office_at_every_scale),
       cmocka_unit_test(depth_of_field_defaults_hold_at_every_scale),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
