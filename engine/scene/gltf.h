@@ -29,8 +29,8 @@
  *     ka        = 1; rho = max(color) * kd   (what diffuse bounce returns)
  *   A primitive without a material gets material -1, the engine's default.
  * - Perspective cameras: yfov, znear, zfar; the aspect ratio is the output's.
- *   An infinite far plane (zfar absent) becomes LM_GLTF_INFINITE_ZFAR, or
- *   10 * znear when that is larger.
+ *   An infinite far plane (zfar absent) becomes LM_GLTF_INFINITE_ZFAR_RATIO
+ *   times znear: relative, so any unit works (reversed float depth holds it).
  *   Orthographic cameras are skipped with a warning.
  * - KHR_lights_punctual point, spot and directional lights, one lm light per
  *   node that names one. The engine's lighting is unitless, so
@@ -62,7 +62,7 @@ extern "C" {
 #include "scene/scene.h"
 
 #define LM_GLTF_MAX_COORD 1e9f      /* largest |coordinate| a vertex may have */
-#define LM_GLTF_INFINITE_ZFAR 1000.0f /* zfar of a camera with an infinite far plane */
+#define LM_GLTF_INFINITE_ZFAR_RATIO 1e6f /* zfar / znear of a camera with an infinite far plane */
 #define LM_GLTF_MAX_ELEMENTS (1 << 26) /* most vertices or indices per primitive */
 
 /* Reads a .gltf or .glb file (told apart by the GLB magic, not the name).
