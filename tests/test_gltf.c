@@ -322,7 +322,9 @@ static void assert_lights_and_cameras(const lm_scene *s) {
   assert_string_equal(spot->name, "spot");
   assert_int_equal(spot->type, LM_LIGHT_SPOT);
   assert_float_equal(spot->color[1], 0.5, 1e-6);
-  assert_float_equal(spot->power, 5, 0);
+  /* KHR_lights_punctual: candela and lux through the exposure, the range window */
+  assert_float_equal(spot->power / LM_GLTF_EXPOSURE, 5, 1e-4);
+  assert_int_equal(spot->falloff, LM_FALLOFF_RANGE);
   assert_float_equal(spot->radius, 10, 0);
   assert_float_equal(spot->inner_cone, 0.2, 1e-6);
   assert_float_equal(spot->outer_cone, 0.6, 1e-6);
@@ -330,11 +332,13 @@ static void assert_lights_and_cameras(const lm_scene *s) {
   assert_float_equal(s->nodes[spot->node].world[13], 4, 0);
   assert_int_equal(bulb->type, LM_LIGHT_POINT);
   assert_float_equal(bulb->color[0], 1, 0); /* default white */
-  assert_float_equal(bulb->power, 2, 0);
-  /* No range: twice the bounds' diagonal, the triangle's sqrt(2), at least 1. */
-  assert_float_equal(bulb->radius, 2 * sqrtf(2), 1e-5);
+  assert_float_equal(bulb->power / LM_GLTF_EXPOSURE, 2, 1e-4);
+  /* No range: no window, the light reaches everywhere. */
+  assert_float_equal(bulb->radius, 0, 0);
+  assert_true(isinf(lm_light_reach(bulb)));
+  assert_float_equal(lm_light_reach(spot), 10, 0);
   assert_int_equal(sun->type, LM_LIGHT_DIRECTIONAL);
-  assert_float_equal(sun->power, 1, 0);
+  assert_float_equal(sun->power / LM_GLTF_EXPOSURE, 1, 1e-4);
   assert_int_equal(s->camera_count, 2);
   assert_string_equal(s->cameras[0].name, "main");
   assert_float_equal(s->cameras[0].fov_y, 0.7, 1e-6);

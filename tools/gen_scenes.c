@@ -428,7 +428,13 @@ static void view(doc *d, const char *name, float ex, float ey, float ez, float t
   putf(&d->cams, "%-10s %8.3f %8.3f %8.3f   %8.3f %8.3f %8.3f   %5.1f\n", name, ex, ey, ez, tx, ty, tz, fov_deg);
 }
 
-/* type: "point", "spot", "directional"; range 0: none. */
+/* type: "point", "spot", "directional"; intensity in candela (point, spot) or
+ * lux (directional), KHR_lights_punctual's units; range 0: none, so that the
+ * light falls off as 1 / d^2 alone, which POV-Ray matches exactly. The
+ * candela values below give about the light the scenes had under the seed's
+ * window falloff at the surfaces each light faces (the floor below it):
+ * old * (1 - (d/r)^2) * d^2 * 683 pi, engine/scene/gltf.h's exposure (the
+ * Cornell box's less: its walls are near the light). */
 static void light(doc *d, const char *name, const char *type, float x, float y, float z, const float dir[3],
                   float r, float g, float b, float intensity, float range) {
   int n = add_node(d, name, -1, x, y, z);
@@ -591,7 +597,7 @@ static void cornell(const char *dir) {
   d.nodes[s].s[0] = d.nodes[s].s[1] = d.nodes[s].s[2] = 0.6f;
   int t = mesh_node(&d, "tall_box", -1, cube, -0.35f, 0, -0.35f, 17, 1);
   d.nodes[t].s[0] = 0.6f, d.nodes[t].s[1] = 1.2f, d.nodes[t].s[2] = 0.6f;
-  light(&d, "ceiling_light", "point", 0, 1.85f, 0, NULL, 1, 0.95f, 0.85f, 1.6f, 4);
+  light(&d, "ceiling_light", "point", 0, 1.7f, 0, NULL, 1, 0.95f, 0.85f, 6000, 0);
   view(&d, "front", 0, 1, 3.4f, 0, 1, 0, 45, 20);
   view(&d, "left", -0.6f, 1.2f, 2.6f, 0.1f, 0.8f, 0, 50, 20);
   view(&d, "high", 0.3f, 1.8f, 2.2f, 0, 0.4f, 0, 55, 20);
@@ -652,8 +658,8 @@ static void primitives(const char *dir) {
   int car = mesh_node(&d, "car", -1, car_mesh(&d, paint, glass, tyre), 0, 0, 0, 25, 1);
   sphere(&m, 0.08f, 12, 6);
   mesh_node(&d, "car_light", car, add_mesh1(&d, "beacon", &m, yellow), -0.1f, 1.15f, 0, 0, 1);
-  light(&d, "sun", "directional", 0, 10, 0, (float[]){-0.4f, -1, -0.6f}, 1, 0.97f, 0.9f, 1.2f, 0);
-  light(&d, "fill", "point", 2, 3, 3, NULL, 0.6f, 0.7f, 1, 1.0f, 10);
+  light(&d, "sun", "directional", 0, 10, 0, (float[]){-0.4f, -1, -0.6f}, 1, 0.97f, 0.9f, 2575, 0);
+  light(&d, "fill", "point", 2, 3, 3, NULL, 0.6f, 0.7f, 1, 36800, 0);
   view(&d, "front", 0, 2.2f, 6.5f, 0, 0.4f, 0, 45, 60);
   view(&d, "side", 6, 1.5f, 1, 0, 0.5f, 0, 45, 60);
   view(&d, "top", 0.5f, 8, 3, 0, 0, 0, 50, 60);
@@ -726,9 +732,9 @@ static void office(const char *dir) {
     snprintf(nm, sizeof nm, "books%d", b);
     mesh_node(&d, nm, shelf, add_mesh1(&d, nm, &m, books[b]), 0, 0, 0, 0, 1);
   }
-  light(&d, "lamp_a", "point", -1.5f, 2.4f, 0, NULL, 1, 0.95f, 0.85f, 1.2f, 5);
-  light(&d, "lamp_b", "point", 1.5f, 2.4f, 0, NULL, 1, 0.95f, 0.85f, 1.2f, 5);
-  light(&d, "window", "directional", 0, 2, 0, (float[]){0.3f, -0.8f, -0.5f}, 0.9f, 0.95f, 1, 0.3f, 0);
+  light(&d, "lamp_a", "point", -1.5f, 2.1f, 0, NULL, 1, 0.95f, 0.85f, 8700, 0);
+  light(&d, "lamp_b", "point", 1.5f, 2.1f, 0, NULL, 1, 0.95f, 0.85f, 8700, 0);
+  light(&d, "window", "directional", 0, 2, 0, (float[]){0.3f, -0.8f, -0.5f}, 0.9f, 0.95f, 1, 644, 0);
   view(&d, "door", 0, 1.6f, 2.9f, 0, 0.8f, -1, 60, 30);
   view(&d, "corner", -2.8f, 2.2f, 2.8f, 0.5f, 0.5f, -0.5f, 60, 30);
   view(&d, "desk", 1.4f, 1.2f, 2.3f, 1.5f, 0.7f, 1.0f, 50, 30);
@@ -782,12 +788,12 @@ static void garage(const char *dir) {
   for (int i = 0; i < 4; i++) {
     char nm[32];
     snprintf(nm, sizeof nm, "spot%d", i);
-    light(&d, nm, "spot", 0, H - 0.1f, -2.5f - 5 * (float)i, (float[]){0, -1, 0.0001f}, 1, 0.9f, 0.75f, 1.5f, 7);
+    light(&d, nm, "spot", 0, H - 0.1f, -2.5f - 5 * (float)i, (float[]){0, -1, 0.0001f}, 1, 0.9f, 0.75f, 22400, 0);
   }
   for (int i = 0; i < 3; i++) { /* wall washers, so the brick shows */
     char nm[32];
     snprintf(nm, sizeof nm, "wash%d", i);
-    light(&d, nm, "point", i % 2 ? 2.8f : -2.8f, 2.6f, -3 - 6 * (float)i, NULL, 1, 0.85f, 0.7f, 1.0f, 8);
+    light(&d, nm, "point", i % 2 ? 2.8f : -2.8f, 2.6f, -3 - 6 * (float)i, NULL, 1, 0.85f, 0.7f, 13000, 0);
   }
   view(&d, "entrance", 0, 1.6f, -0.5f, 0, 1.2f, -20, 60, 40);
   view(&d, "cars", -0.5f, 1.8f, -6, 3, 0.6f, -9, 55, 40);
@@ -851,8 +857,8 @@ static void outdoor(const char *dir) {
     float s = 0.3f + 0.6f * rnd();
     d.nodes[b].s[0] = s * 1.4f, d.nodes[b].s[1] = s * 0.7f, d.nodes[b].s[2] = s;
   }
-  light(&d, "sun", "directional", 0, 50, 0, (float[]){-0.5f, -0.7f, -0.3f}, 1, 0.95f, 0.85f, 1.3f, 0);
-  light(&d, "sky", "directional", 0, 50, 0, (float[]){0.3f, -1, 0.4f}, 0.4f, 0.5f, 0.7f, 0.35f, 0);
+  light(&d, "sun", "directional", 0, 50, 0, (float[]){-0.5f, -0.7f, -0.3f}, 1, 0.95f, 0.85f, 2789, 0);
+  light(&d, "sky", "directional", 0, 50, 0, (float[]){0.3f, -1, 0.4f}, 0.4f, 0.5f, 0.7f, 751, 0);
   view(&d, "overview", 0, 40, 85, 0, 0, 0, 60, 400);
   view(&d, "valley", -60, 12, 60, 10, 0, -10, 70, 400);
   view(&d, "ground", 5, 4, 20, 0, 2, 0, 60, 400);

@@ -33,11 +33,13 @@
  *   10 * znear when that is larger.
  *   Orthographic cameras are skipped with a warning.
  * - KHR_lights_punctual point, spot and directional lights, one lm light per
- *   node that names one. The engine's lighting is unitless, so
- *   power = intensity (candela for point and spot, lux for directional) as a
- *   plain multiplier on color. radius = range; an absent range (infinite in
- *   glTF) becomes twice the diagonal of the scene's bounds (at least 1).
- *   Spot cone angles carry over as the inner and outer half-angles.
+ *   node that names one, as the extension says: point and spot lights fall
+ *   off as 1 / d^2 times its range window clamp(1 - (d / range)^4, 0, 1)
+ *   (LM_FALLOFF_RANGE, radius = range; no range: no window). Intensity is
+ *   photometric (candela for point and spot, lux for directional) and the
+ *   engine's light is radiometric, folded with Lambert's 1 / pi (its Phong
+ *   has none): power = intensity * LM_GLTF_EXPOSURE. Spot cone angles carry
+ *   over as the inner and outer half-angles.
  * - With no light in the scene: "default_light", directional, white, power
  *   1, shining down along normalize(-0.3, -1, -0.5) from above the bounds.
  * - With no camera: "default_camera", 45 degrees vertical field of view,
@@ -64,6 +66,11 @@ extern "C" {
 #define LM_GLTF_MAX_COORD 1e9f      /* largest |coordinate| a vertex may have */
 #define LM_GLTF_INFINITE_ZFAR 1000.0f /* zfar of a camera with an infinite far plane */
 #define LM_GLTF_MAX_ELEMENTS (1 << 26) /* most vertices or indices per primitive */
+/* Engine light per glTF candela or lux: 1 / (683 lm/W * pi). Blender's
+ * exporter writes W / (4 pi) * 683 cd for a point light of W watts and
+ * 683 lux per W/m^2 of sun, so a Lambert surface shows here the radiance
+ * Blender (Cycles, exposure 0, Standard view) shows. */
+#define LM_GLTF_EXPOSURE (1.0 / (683.0 * 3.14159265358979))
 
 /* Reads a .gltf or .glb file (told apart by the GLB magic, not the name).
  * NULL on any error, with a message naming the file and the element

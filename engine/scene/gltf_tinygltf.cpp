@@ -30,7 +30,6 @@ struct Loader {
   std::vector<int> materials;           // [material] -> lm material; -1 not yet
   std::vector<int> textures;            // [image] -> lm texture; -1 not yet
   std::vector<int> nodes;               // [node] -> lm node; -1 not in the scene
-  std::vector<int> unset_radius;        // lm lights whose range was absent
 };
 
 // Every failure goes through here: "path: what".
@@ -470,14 +469,14 @@ bool add_light(Loader &L, int ni, int li, int node) {
     return fail(L, "light %d: spot cone angles need 0 <= inner < outer <= pi/2; got %g, %g", li,
                 inner, outer);
   for (int c = 0; c < 3; c++) l.color[c] = gl.color.empty() ? 1.0f : (float)gl.color[c];
-  l.power = (float)gl.intensity;
-  l.radius = (float)gl.range;
+  l.power = (float)(gl.intensity * LM_GLTF_EXPOSURE);
+  l.radius = (float)gl.range; // 0 (absent): no range, the light reaches everywhere
+  l.falloff = LM_FALLOFF_RANGE;
   l.inner_cone = l.type == LM_LIGHT_SPOT ? (float)inner : 0.0f;
   l.outer_cone = l.type == LM_LIGHT_SPOT ? (float)outer : (float)(M_PI / 2);
   l.casts_shadows = true;
   l.node = node;
-  int id = lm_scene_add_light(L.s, &l);
-  if (gl.range <= 0) L.unset_radius.push_back(id);
+  lm_scene_add_light(L.s, &l);
   return true;
 }
 
@@ -650,12 +649,11 @@ void look_along(const double eye[3], const double dir[3], float out[16]) {
   out[3] = out[7] = out[11] = 0, out[15] = 1;
 }
 
-void add_defaults(lm_scene *s, const std::vector<int> &unset_radius) {
+void add_defaults(lm_scene *s) {
   double lo[3], hi[3], c[3], diag = 0;
   scene_bounds(s, lo, hi);
   for (int k = 0; k < 3; k++) c[k] = 0.5 * (lo[k] + hi[k]), diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
   diag = std::fmax(std::sqrt(diag), 1e-3);
-  for (int id : unset_radius) s->lights[id].radius = (float)std::fmax(2 * diag, 1.0);
 
   float m[16];
   if (s->light_count == 0) {
@@ -779,7 +777,7 @@ bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
 
 // Fills `s` from the parsed model; false (message in L.err) on bad input.
 bool convert(const char *path, const tinygltf::Model &model, lm_scene *s, lm_error *err) {
-  Loader L{path, model, s, err, {}, {}, {}, {}, {}};
+  Loader L{path, model, s, err, {}, {}, {}, {}};
   L.meshes.resize(model.meshes.size());
   L.materials.assign(model.materials.size(), -1);
   L.textures.assign(model.images.size(), -1);
@@ -787,7 +785,7 @@ bool convert(const char *path, const tinygltf::Model &model, lm_scene *s, lm_err
   if (!load_nodes(L)) return false;
   lm_scene_update(s);
   if (!check_world(L)) return false;
-  add_defaults(s, L.unset_radius);
+  add_defaults(s);
   return true;
 }
 

@@ -273,6 +273,29 @@ void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_f
   out->counts[0] = s->light_count;
 }
 
+float lm_light_falloff(lm_falloff f, float d, float radius) {
+  if (f == LM_FALLOFF_NONE) return 1.0f;
+  float inv_d2 = 1.0f / fmaxf(d * d, 1e-8f);
+  if (f == LM_FALLOFF_INVERSE_SQUARE) return inv_d2;
+  if (f == LM_FALLOFF_RANGE) {
+    if (!(radius > 0)) return inv_d2;
+    float q = d / radius;
+    q *= q;
+    return glm_clamp(1.0f - q * q, 0.0f, 1.0f) * inv_d2;
+  }
+  float r = fmaxf(radius, 1e-12f), q = d / r;
+  return glm_clamp(1.0f - q * q, 0.0f, 1.0f);
+}
+
+float lm_light_reach(const lm_light *l) {
+  if (l->type == LM_LIGHT_DIRECTIONAL) return INFINITY;
+  switch (l->falloff) {
+  case LM_FALLOFF_WINDOW: return fmaxf(l->radius, 0.0f);
+  case LM_FALLOFF_RANGE: return l->radius > 0 ? l->radius : INFINITY;
+  default: return INFINITY;
+  }
+}
+
 int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max) {
   int n = s->light_count < max ? s->light_count : max;
   for (int i = 0; i < n; i++) {

@@ -31,20 +31,30 @@ typedef enum lm_falloff {
   LM_FALLOFF_WINDOW,         /* saturate(1 - (d / radius)^2), seed 000 eq 16 (the default) */
   LM_FALLOFF_NONE,           /* constant: POV-Ray's default light */
   LM_FALLOFF_INVERSE_SQUARE, /* 1 / d^2: physical, and POV-Ray's fade_power 2 */
+  LM_FALLOFF_RANGE,          /* KHR_lights_punctual: clamp(1 - (d / radius)^4, 0, 1) / d^2,
+                                radius 0: no range (plain 1 / d^2); glTF's point and spot lights */
 } lm_falloff;
+
+/* The falloff at distance d >= 0 (shaders/lighting.glsl's light_falloff, its
+ * GLSL twin: change both together). Finite for every d and radius. */
+float lm_light_falloff(lm_falloff f, float d, float radius);
 
 /* Position and direction come from the node (lights shine along the node's -Z). */
 typedef struct lm_light {
   char name[LM_NAME_MAX];
   lm_light_type type;
   float color[3];
-  float power;
-  float radius;
+  float power;  /* engine units; glTF's candela and lux arrive scaled by LM_GLTF_EXPOSURE */
+  float radius; /* the window's radius or the range; see lm_falloff */
   float inner_cone, outer_cone; /* spot half-angles, radians */
   lm_falloff falloff;
   bool casts_shadows;
   int node;
 } lm_light;
+
+/* Distance beyond which a point or spot light adds nothing (the window's or
+ * range's radius); INFINITY for directional lights and unbounded falloffs. */
+float lm_light_reach(const lm_light *l);
 
 /* Looks along the node's -Z with +Y up, as in glTF. */
 typedef struct lm_camera {
