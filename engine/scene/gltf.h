@@ -13,8 +13,10 @@
  *   primitive holds it itself; a node whose mesh has several gets one child
  *   node per primitive ("<node>.<i>", identity transform), so that each node
  *   keeps one material. Nodes sharing a mesh share its lm meshes.
- * - Triangles only (mode 4, indexed by u8/u16/u32 or not indexed); points,
- *   lines, strips and fans are skipped with a warning. Normals absent from
+ * - Triangles, triangle strips and fans (modes 4, 5, 6, indexed by
+ *   u8/u16/u32 or not indexed); strips and fans become triangle lists with
+ *   their winding kept. Points and lines (modes 0 to 3) are skipped, with one
+ *   warning per file. Normals absent from
  *   the file are computed, area-weighted; a vertex that only touches
  *   zero-area triangles gets +Z. UVs (TEXCOORD_0) are optional (0 when
  *   absent). Coordinates must be finite and within LM_GLTF_MAX_COORD.

@@ -30,6 +30,8 @@ struct Loader {
   std::vector<int> materials;           // [material] -> lm material; -1 not yet
   std::vector<int> textures;            // [image] -> lm texture; -1 not yet
   std::vector<int> nodes;               // [node] -> lm node; -1 not in the scene
+  int skipped = 0;                      // point and line primitives, warned about once
+  std::string first_skipped;            // "mesh M primitive P (mode K)"
 };
 
 // Every failure goes through here: "path: what".
@@ -261,16 +263,35 @@ void normalize_normals(std::vector<float> &verts) {
   }
 }
 
+// A strip's or fan's indices as a triangle list, winding kept (glTF 2.0
+// section 3.7.2.1: strip triangle i is (i, i + 1 + i % 2, i + 2 - i % 2),
+// fan triangle i is (i + 1, i + 2, 0)).
+std::vector<uint32_t> triangle_list(int mode, const std::vector<uint32_t> &in) {
+  std::vector<uint32_t> out;
+  out.reserve((in.size() - 2) * 3);
+  for (size_t i = 0; i + 2 < in.size(); i++) {
+    if (mode == TINYGLTF_MODE_TRIANGLE_STRIP)
+      out.insert(out.end(), {in[i], in[i + 1 + i % 2], in[i + 2 - i % 2]});
+    else
+      out.insert(out.end(), {in[i + 1], in[i + 2], in[0]});
+  }
+  return out;
+}
+
 // lm mesh of primitive pi of mesh mi; -2 when skipped, -1 on error.
 int load_primitive(Loader &L, int mi, int pi) {
   const tinygltf::Mesh &mesh = L.m.meshes[mi];
   const tinygltf::Primitive &p = mesh.primitives[pi];
   char where[64];
   snprintf(where, sizeof where, "mesh %d primitive %d", mi, pi);
-  if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES) {
-    lm_warn("%s: %s: mode %d is not triangles; skipped", L.path, where, p.mode);
+  int mode = p.mode == -1 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+  if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP) {
+    if (!L.skipped++) L.first_skipped = std::string(where) + " (mode " + std::to_string(mode) + ")";
     return -2;
   }
+  if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+      mode != TINYGLTF_MODE_TRIANGLE_FAN)
+    return fail(L, "%s: mode %d is not a glTF primitive mode (0 to 6)", where, mode), -1;
   auto pos = p.attributes.find("POSITION");
   if (pos == p.attributes.end()) return fail(L, "%s: no POSITION attribute", where), -1;
   char what[160];
@@ -292,9 +313,16 @@ int load_primitive(Loader &L, int mi, int pi) {
     idx.resize(count);
     for (size_t i = 0; i < count; i++) idx[i] = (uint32_t)i;
   }
-  if (idx.size() % 3)
+  if (mode == TINYGLTF_MODE_TRIANGLES && idx.size() % 3)
     return fail(L, "%s: %zu %s, not a multiple of 3 (triangles)", where, idx.size(),
                 p.indices >= 0 ? "indices" : "vertices"), -1;
+  if (mode != TINYGLTF_MODE_TRIANGLES) {
+    if (idx.size() < 3)
+      return fail(L, "%s: a triangle %s of %zu %s, fewer than 3", where,
+                  mode == TINYGLTF_MODE_TRIANGLE_STRIP ? "strip" : "fan", idx.size(),
+                  p.indices >= 0 ? "indices" : "vertices"), -1;
+    idx = triangle_list(mode, idx);
+  }
   if (has_normals) normalize_normals(verts);
   else compute_normals(verts, idx);
 
@@ -777,12 +805,15 @@ bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
 
 // Fills `s` from the parsed model; false (message in L.err) on bad input.
 bool convert(const char *path, const tinygltf::Model &model, lm_scene *s, lm_error *err) {
-  Loader L{path, model, s, err, {}, {}, {}, {}};
+  Loader L{path, model, s, err, {}, {}, {}, {}, 0, {}};
   L.meshes.resize(model.meshes.size());
   L.materials.assign(model.materials.size(), -1);
   L.textures.assign(model.images.size(), -1);
   L.nodes.assign(model.nodes.size(), -1);
   if (!load_nodes(L)) return false;
+  if (L.skipped)
+    lm_warn("%s: %d point or line primitive%s skipped (the first: %s): only triangles are drawn", path,
+            L.skipped, L.skipped > 1 ? "s" : "", L.first_skipped.c_str());
   lm_scene_update(s);
   if (!check_world(L)) return false;
   add_defaults(s);
