@@ -37,6 +37,12 @@ check "unknown flag message" err_has "unknown flag '--bogus'"
 check "bad size" run 2 capture --size 0x5
 check "bad size message" err_has "--size wants WxH"
 check "missing value" run 2 capture --size
+# A glTF file that requires an extension the engine lacks: refused by name, before its data is read.
+sed 's/"extensionsUsed": \[/"extensionsRequired": ["KHR_draco_mesh_compression"], "extensionsUsed": [/' \
+  "$root/data/scenes/pov_ball.gltf" > "$tmp/draco.gltf"
+check "required extension" run 2 capture --scene "$tmp/draco.gltf" --size 32x24 --output "$tmp/img/d.png"
+check "required extension named" first_error_has "draco.gltf: extensionsRequired names 'KHR_draco_mesh_compression'"
+check "required extension: no image" no_files
 check "bad output type" run 2 capture --output "$tmp/img/x.bmp"
 check "bad frames" run 2 capture --frames -3
 check "bad set" run 2 capture --set novalue

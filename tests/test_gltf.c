@@ -303,6 +303,29 @@ static void strips_and_fans_become_triangles(void **state) {
   assert_non_null(strstr(err.msg, "mesh 0 primitive 0: mode 7 is not a glTF primitive mode"));
 }
 
+/* A required extension the engine lacks is named, in .gltf and .glb alike,
+ * before any of the data it governs is read (here: an accessor with no
+ * bufferView, as Draco leaves them). A supported one loads. */
+static void unsupported_required_extension_is_named(void **state) {
+  (void)state;
+  static const char json[] =
+      "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\",\"%s\"],"
+      "\"extensionsRequired\":[\"KHR_lights_punctual\",\"%s\"],\"scenes\":[{\"nodes\":[0]}],"
+      "\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+      "\"accessors\":[{\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+      "{\"bufferView\":7,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}";
+  char text[2048];
+  snprintf(text, sizeof text, json, "KHR_draco_mesh_compression", "KHR_draco_mesh_compression");
+  lm_error err = {""};
+  assert_null(lm_scene_load_gltf(write_bytes("draco.gltf", text, strlen(text)), &err));
+  assert_non_null(strstr(err.msg, "draco.gltf: extensionsRequired names 'KHR_draco_mesh_compression', which "));
+  blob b = {0};
+  unsigned char glb[4096];
+  size_t n = make_glb(text, &b, glb, sizeof glb);
+  assert_null(lm_scene_load_gltf(write_bytes("draco.glb", glb, n), &err));
+  assert_non_null(strstr(err.msg, "draco.glb: extensionsRequired names 'KHR_draco_mesh_compression'"));
+}
+
 static const char two_prims_json[] =
     "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0,1]}],"
     "\"nodes\":[{\"name\":\"two\",\"mesh\":0},{\"name\":\"again\",\"mesh\":0,\"translation\":[5,0,0]}],"
@@ -838,6 +861,7 @@ int main(void) {
       cmocka_unit_test(triangle_loads_with_every_index_type),
       cmocka_unit_test(two_primitives_become_two_meshes_and_children),
       cmocka_unit_test(strips_and_fans_become_triangles),
+      cmocka_unit_test(unsupported_required_extension_is_named),
       cmocka_unit_test(hierarchy_composes_rotated_parents),
       cmocka_unit_test(lights_and_cameras_come_over),
       cmocka_unit_test(glb_loads_like_gltf),

@@ -4,6 +4,8 @@
  * over is checked again here before a byte is read.
  *
  * What comes over, and how:
+ * - extensionsRequired first: a file that requires an extension other than
+ *   those the loader reads (KHR_lights_punctual) is refused, naming it.
  * - Nodes of the file's default scene (scene 0 when it names none; every
  *   root node when it has no scenes), parents before children. A node's
  *   local transform is its matrix, or T * R * S. Every world transform must

@@ -12,6 +12,7 @@
 
 #include <strings.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -764,6 +765,25 @@ std::string locate_bad_indices(const unsigned char *text, size_t len) {
   return "";
 }
 
+// The extensions this loader reads: a file that requires any other is refused
+// before tinygltf sees it (which would fail later, on data it cannot decode).
+const char *const kSupportedExtensions[] = {"KHR_lights_punctual"};
+
+// The first name in the file's extensionsRequired that is not supported, or "".
+std::string unsupported_required(const unsigned char *text, size_t len) {
+  using nlohmann::json;
+  json doc = json::parse(text, text + len, nullptr, false);
+  if (!doc.is_object() || !doc.contains("extensionsRequired") || !doc["extensionsRequired"].is_array())
+    return "";
+  for (const json &e : doc["extensionsRequired"]) {
+    std::string name = e.is_string() ? e.get<std::string>() : e.dump();
+    bool known = false;
+    for (const char *k : kSupportedExtensions) known |= name == k;
+    if (!known) return name;
+  }
+  return "";
+}
+
 bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
   size_t len;
   char *data = lm_read_file(path, &len, err);
@@ -781,10 +801,26 @@ bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
   char dir[4096];
   lm_dirname(path, dir, sizeof dir);
 
+  bool glb = len >= 4 && !memcmp(bytes.data(), "glTF", 4);
+  // The JSON: a GLB's chunk 0 (when its length fits the file), else the whole text.
+  uint32_t json_len = (uint32_t)len;
+  if (glb) {
+    json_len = 0;
+    if (len >= 20) memcpy(&json_len, bytes.data() + 12, 4);
+    if (json_len > len - std::min(len, (size_t)20)) json_len = 0;
+  }
+  std::string missing = unsupported_required(bytes.data() + (glb ? 20 : 0), json_len);
+  if (!missing.empty()) {
+    std::string known;
+    for (const char *k : kSupportedExtensions) known += std::string(known.empty() ? "" : ", ") + k;
+    lm_error_set(err, "%s: extensionsRequired names '%s', which this engine does not support (it reads %s)",
+                 path, missing.c_str(), known.c_str());
+    return false;
+  }
+
   tinygltf::TinyGLTF gltf;
   gltf.SetImageLoader(keep_image_undecoded, nullptr);
   std::string why, warn;
-  bool glb = len >= 4 && !memcmp(bytes.data(), "glTF", 4);
   bool ok = glb ? gltf.LoadBinaryFromMemory(model, &why, &warn, bytes.data(), (unsigned)len, dir)
                 : gltf.LoadASCIIFromString(model, &why, &warn, (const char *)bytes.data(),
                                            (unsigned)len, dir);
@@ -794,8 +830,6 @@ bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
   if (ok && why.empty()) return true;
   std::string what = first_line(why);
   if (what.find("primitive indices accessor out of bounds") != std::string::npos) {
-    uint32_t json_len = (uint32_t)len; // GLB: tinygltf got this far, so chunk 0 is whole
-    if (glb) memcpy(&json_len, bytes.data() + 12, 4);
     std::string where = locate_bad_indices(bytes.data() + (glb ? 20 : 0), json_len);
     if (!where.empty()) what = where;
   }
