@@ -326,6 +326,72 @@ static void unsupported_required_extension_is_named(void **state) {
   assert_non_null(strstr(err.msg, "draco.glb: extensionsRequired names 'KHR_draco_mesh_compression'"));
 }
 
+/* Every corner of the scene's bounds, seen through camera `cam` at w x h,
+ * lies inside the view; returns the largest |NDC| (how tight the framing is). */
+static float corners_in_view(const lm_scene *s, int cam, int w, int h) {
+  float lo[3], hi[3], most = 0;
+  lm_scene_bounds(s, lo, hi);
+  lm_frame_data f;
+  lm_scene_frame_data(s, cam, w, h, &f);
+  for (int k = 0; k < 8; k++) {
+    float p[3] = {(k & 1 ? hi : lo)[0], (k & 2 ? hi : lo)[1], (k & 4 ? hi : lo)[2]}, clip[4];
+    for (int r = 0; r < 4; r++)
+      clip[r] = f.view_proj[r] * p[0] + f.view_proj[4 + r] * p[1] + f.view_proj[8 + r] * p[2] + f.view_proj[12 + r];
+    assert_true(clip[3] > 0);
+    for (int r = 0; r < 3; r++) {
+      float ndc = clip[r] / clip[3];
+      assert_true(ndc >= -1 && ndc <= 1);
+      if (r < 2) most = fmaxf(most, fabsf(ndc));
+    }
+  }
+  return most;
+}
+
+/* A file without a camera gets one framing its bounds (a long, flat part off
+ * the origin, as an engine block might be): every corner in view on wide
+ * outputs, and tightly (the longest side fills most of the frame). An
+ * "auto" camera fits a given output, a tall one too. A glTF orthographic
+ * camera keeps its index and is refused by name where it would be used. */
+static void cameras_frame_the_bounds(void **state) {
+  (void)state;
+  static const float v[4][3] = {{100, 20, -5}, {160, 20, -5}, {100, 26, 3}, {160, 26, 3}};
+  static const uint16_t idx[6] = {0, 1, 2, 1, 3, 2};
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(write_topology("long.gltf", &v[0][0], 4, idx, 6, 4), &err);
+  if (!s) fail_msg("%s", err.msg);
+  assert_int_equal(s->camera_count, 1);
+  assert_string_equal(s->cameras[0].name, "default_camera");
+  corners_in_view(s, 0, 96, 72);
+  corners_in_view(s, 0, 192, 72);
+  assert_true(corners_in_view(s, 0, 72, 72) > 0.8f); /* fitted for square and wider outputs */
+  int tall = lm_scene_add_framing_camera(s, "auto", 0.5f);
+  assert_int_equal(tall, 1);
+  assert_true(corners_in_view(s, tall, 48, 96) > 0.8f);
+  assert_true(lm_scene_camera_check(s, 0, &err));
+  lm_scene_destroy(s);
+
+  static const char ortho_json[] =
+      "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0,1,2]}],"
+      "\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5]},{\"camera\":1,\"translation\":[0,0,4]}],"
+      "\"cameras\":[{\"name\":\"plan\",\"type\":\"orthographic\",\"orthographic\":{\"xmag\":2,\"ymag\":1.5,"
+      "\"znear\":0.1,\"zfar\":10}},{\"name\":\"eye\",\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,"
+      "\"znear\":0.1}}],"
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+      "\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}";
+  blob b = {0};
+  blob_add(&b, tri_pos, sizeof tri_pos);
+  s = lm_scene_load_gltf(write_gltf("ortho.gltf", ortho_json, &b), &err);
+  if (!s) fail_msg("%s", err.msg);
+  assert_int_equal(s->camera_count, 2); /* the file's indices hold */
+  assert_string_equal(s->cameras[1].name, "eye");
+  assert_float_equal(s->cameras[0].ortho[0], 2, 0);
+  assert_false(lm_scene_camera_check(s, 0, &err));
+  assert_non_null(strstr(err.msg, "camera 'plan' (0) is orthographic (xmag 2, ymag 1.5)"));
+  assert_true(lm_scene_camera_check(s, 1, &err));
+  lm_scene_destroy(s);
+}
+
 static const char two_prims_json[] =
     "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0,1]}],"
     "\"nodes\":[{\"name\":\"two\",\"mesh\":0},{\"name\":\"again\",\"mesh\":0,\"translation\":[5,0,0]}],"
@@ -862,6 +928,7 @@ int main(void) {
       cmocka_unit_test(two_primitives_become_two_meshes_and_children),
       cmocka_unit_test(strips_and_fans_become_triangles),
       cmocka_unit_test(unsupported_required_extension_is_named),
+      cmocka_unit_test(cameras_frame_the_bounds),
       cmocka_unit_test(hierarchy_composes_rotated_parents),
       cmocka_unit_test(lights_and_cameras_come_over),
       cmocka_unit_test(glb_loads_like_gltf),

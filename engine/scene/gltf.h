@@ -35,7 +35,8 @@
  * - Perspective cameras: yfov, znear, zfar; the aspect ratio is the output's.
  *   An infinite far plane (zfar absent) becomes LM_GLTF_INFINITE_ZFAR, or
  *   10 * znear when that is larger.
- *   Orthographic cameras are skipped with a warning.
+ *   Orthographic cameras are kept (so camera indices stay the file's) and
+ *   refused by name when a view uses one (lm_scene_camera_check).
  * - KHR_lights_punctual point, spot and directional lights, one lm light per
  *   node that names one, as the extension says: point and spot lights fall
  *   off as 1 / d^2 times its range window clamp(1 - (d / range)^4, 0, 1)
@@ -46,9 +47,9 @@
  *   over as the inner and outer half-angles.
  * - With no light in the scene: "default_light", directional, white, power
  *   1, shining down along normalize(-0.3, -1, -0.5) from above the bounds.
- * - With no camera: "default_camera", 45 degrees vertical field of view,
- *   looking at the centre of the bounds from +Z and 20 degrees above, far
- *   enough that the bounding sphere fits.
+ * - With no camera: "default_camera" from lm_scene_add_framing_camera, every
+ *   corner of the bounds in view on any output at least as wide as high
+ *   (`--camera auto` fits the output's own aspect).
  * - A material's baseColorTexture (TEXCOORD_0) becomes a scene texture:
  *   the bridge's image loader (no stb_image) keeps every image's bytes
  *   encoded; the images a material uses are decoded through OpenImageIO

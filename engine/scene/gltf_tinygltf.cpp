@@ -447,11 +447,23 @@ bool add_camera(Loader &L, int ni, int ci, int node) {
   if (ci < 0 || (size_t)ci >= L.m.cameras.size())
     return fail(L, "node %d: camera %d does not exist (the file has %zu)", ni, ci, L.m.cameras.size());
   const tinygltf::Camera &c = L.m.cameras[ci];
-  if (c.type != "perspective") {
-    lm_warn("%s: camera %d: type '%s' is not supported (perspective only); skipped", L.path, ci,
-            c.type.c_str());
+  if (c.type == "orthographic") {
+    const tinygltf::OrthographicCamera &o = c.orthographic;
+    if (!(o.xmag > 0 && o.xmag < 1e30) || !(o.ymag > 0 && o.ymag < 1e30) || !(o.znear >= 0) ||
+        !(o.zfar > o.znear && o.zfar < 1e30))
+      return fail(L, "camera %d: orthographic wants xmag, ymag > 0 and zfar > znear >= 0; got %g, %g, %g, %g",
+                  ci, o.xmag, o.ymag, o.znear, o.zfar);
+    lm_camera cam = {};
+    snprintf(cam.name, sizeof cam.name, "%s", c.name.empty() ? "camera" : c.name.c_str());
+    cam.fov_y = (float)(M_PI / 4);
+    cam.znear = (float)std::fmax(o.znear, 1e-6), cam.zfar = (float)o.zfar;
+    cam.ortho[0] = (float)o.xmag, cam.ortho[1] = (float)o.ymag;
+    cam.node = node;
+    lm_scene_add_camera(L.s, &cam);
     return true;
   }
+  if (c.type != "perspective")
+    return fail(L, "camera %d: type '%s' is neither perspective nor orthographic", ci, c.type.c_str());
   const tinygltf::PerspectiveCamera &p = c.perspective;
   if (!(p.yfov > 0 && p.yfov < M_PI) || !(p.znear > 0 && p.znear < 1e30) ||
       !(p.zfar == 0 || (p.zfar > p.znear && p.zfar < 1e30)))
@@ -700,21 +712,8 @@ void add_defaults(lm_scene *s) {
     l.node = lm_scene_add_node(s, "default_light", -1, m, -1, -1);
     lm_scene_add_light(s, &l);
   }
-  if (s->camera_count == 0) {
-    const double fov = M_PI / 4, pitch = 20 * M_PI / 180, r = diag / 2;
-    double d = r / std::sin(fov / 2), eye[3], dir[3];
-    double back[3] = {0, std::sin(pitch), std::cos(pitch)};
-    for (int k = 0; k < 3; k++) eye[k] = c[k] + back[k] * d, dir[k] = -back[k];
-    look_along(eye, dir, m);
-    lm_camera cam = {};
-    snprintf(cam.name, sizeof cam.name, "default_camera");
-    cam.fov_y = (float)fov;
-    cam.znear = (float)std::fmax(0.5 * (d - r), 1e-3 * d);
-    cam.zfar = (float)(2 * (d + r));
-    cam.node = lm_scene_add_node(s, "default_camera", -1, m, -1, -1);
-    lm_scene_add_camera(s, &cam);
-  }
   lm_scene_update(s);
+  if (s->camera_count == 0) lm_scene_add_framing_camera(s, "default_camera", 0);
 }
 
 // ---- parsing ---------------------------------------------------------------

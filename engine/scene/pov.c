@@ -335,6 +335,7 @@ bool lm_pov_export(const lm_scene *s, const lm_pov_desc *desc, lm_buf *out, lm_b
     lm_error_set(err, "camera %d: scene '%s' has %d camera(s)", desc->camera, s->name, s->camera_count);
     return false;
   }
+  if (!lm_scene_camera_check(s, desc->camera, err)) return false;
   const char *bad = desc->radiosity ? lm_pov_radiosity_check(&desc->rad) : NULL;
   if (bad) {
     lm_error_set(err, "radiosity setting out of range: %s", bad);

@@ -63,6 +63,8 @@ typedef struct lm_camera {
   float znear, zfar;
   int node;
   float aspect; /* width / height; 0: the output's */
+  float ortho[2]; /* glTF orthographic xmag, ymag; 0, 0: perspective. Kept so that a
+                     file's camera indices hold, refused by lm_scene_camera_check. */
 } lm_camera;
 
 typedef struct lm_scene_mesh {
@@ -121,6 +123,18 @@ void lm_scene_update(lm_scene *s);
 void lm_scene_node_set_world(lm_scene *s, int node, const float world[16]);
 /* World-space box around every mesh node; false (and a unit box) when empty. */
 bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]);
+/* Adds a camera (and its node) called `name` that frames the scene's bounds:
+ * 45 degrees vertical field of view, looking at the bounds' centre from +Z
+ * and 20 degrees above, as near as every corner of the bounds allows with a
+ * 5% margin at an output of width / height `aspect` (<= 0: any output at
+ * least as wide as high). Near and far enclose the bounds. Returns the
+ * camera's index. World transforms are updated. */
+int lm_scene_add_framing_camera(lm_scene *s, const char *name, float aspect);
+/* False, with a message naming the camera, when the passes cannot render
+ * through camera `cam` (an orthographic one: every pass rebuilds positions
+ * from depth along rays from one eye, common.glsl's position_from_depth). An
+ * index with no camera is the engine's default one, which they can. */
+bool lm_scene_camera_check(const lm_scene *s, int cam, lm_error *err);
 
 /* Reads a camera list (engine/scene/camlist.c: one view per line, "name
  * eye_x eye_y eye_z target_x target_y target_z fov_y_degrees [near far]",
