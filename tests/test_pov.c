@@ -127,12 +127,14 @@ static void mesh_vertices_are_in_world_space(void **state) {
   lm_scene_destroy(s);
 }
 
-/* The seed's window falloff cannot be written: refused by name, or written
- * without falloff with a warning naming the light. */
+/* The seed's window falloff (glTF point and spot lights use it) cannot be
+ * written: refused by name, or written without falloff with a warning naming
+ * the light. The built-in box's light made the seed's way: */
 static void window_falloff_is_refused_or_warned_by_name(void **state) {
   (void)state;
   lm_error err;
   lm_scene *s = lm_scene_builtin("cornell", &err);
+  s->lights[0].falloff = LM_FALLOFF_WINDOW;
   lm_pov_desc d = desc_for(64, 48);
   lm_buf out = {0}, warn = {0};
   assert_false(lm_pov_export(s, &d, &out, &warn, &err));
@@ -144,6 +146,22 @@ static void window_falloff_is_refused_or_warned_by_name(void **state) {
   assert_null(strstr(out.data, "fade_power"));
   lm_buf_free(&out);
   lm_buf_free(&warn);
+  lm_scene_destroy(s);
+}
+
+/* The built-in box's one light is an inverse-square point light: it
+ * exports exactly (fade_power 2), so the box has a POV-Ray reference. */
+static void builtin_cornell_exports_exactly(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *s = lm_scene_builtin("cornell", &err);
+  assert_int_equal(s->light_count, 1);
+  lm_pov_desc d = desc_for(64, 48);
+  lm_buf out = {0}, warn = {0};
+  assert_true(lm_pov_export(s, &d, &out, &warn, &err));
+  assert_null(warn.data);
+  assert_non_null(strstr(out.data, "fade_power 2"));
+  lm_buf_free(&out);
   lm_scene_destroy(s);
 }
 
@@ -214,6 +232,7 @@ int main(void) {
       cmocka_unit_test(camera_lights_and_materials_match),
       cmocka_unit_test(mesh_vertices_are_in_world_space),
       cmocka_unit_test(window_falloff_is_refused_or_warned_by_name),
+      cmocka_unit_test(builtin_cornell_exports_exactly),
       cmocka_unit_test(unmatched_spots_and_materials_are_named),
       cmocka_unit_test(bad_views_are_refused),
   };

@@ -43,6 +43,8 @@ faithful() {
 # that GL's rasterizer gives to the ceiling and POV-Ray to the wall. Elsewhere
 # the two agree to about 0.1% (the G-buffer's 8-bit albedo, 16-bit light).
 faithful cornell_pov cornell 0.005
+# The built-in box with its one inverse-square light. Measured 0.0010.
+faithful cornell cornell1 0.005
 # A glTF file: parented, rotated and non-uniformly scaled nodes (normals by
 # the inverse transpose), smooth normals, a rotated camera with its own fov,
 # a parallel light, Phong from metallic-roughness. Measured 0.0007.

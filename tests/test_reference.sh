@@ -6,7 +6,9 @@
 # - a failing POV-Ray run names the view, shows POV-Ray's error lines, exits
 #   1 and leaves no reference or temporary file;
 # - a two-setting sweep writes the CSV, the JSON, the SVG (it parses as XML)
-#   and the Markdown summary, with consistent numbers.
+#   and the Markdown summary, with consistent numbers; it renders (once) the
+#   direct-only reference of the view, whose error against the baseline is
+#   the floor of the share of indirect error removed.
 # Skipped (77) where povray is not installed (tools/dev.sh installs it).
 set -u
 limn=$1
@@ -84,6 +86,9 @@ ls refs-cornell/cornell/*.exr 2>/dev/null && fail "a refused view was rendered"
   >log6 2>&1 || { cat log6; fail "report"; }
 cat log6
 grep -q "0 rendered, 1 cached" log6 || fail "the report rendered a cached reference again"
+# ... and rendered the direct-only one (no radiosity block) beside it
+[ "$(ls refs/ball/front_48x36-*.exr | wc -l)" = 3 ] || fail "no direct-only reference beside the two"
+[ "$(grep -L "radiosity {" refs/ball/*.pov | wc -l)" = 1 ] || fail "not one export without radiosity"
 for f in report.csv report.json report.svg report.md; do [ -s rep/$f ] || fail "no rep/$f"; done
 cat rep/report.csv rep/report.md
 # CSV: a header and three rows: the baseline dl and the two settings
@@ -115,6 +120,25 @@ e_8=$(awk -F, 'NR == 3 { print $8 }' rep/report.csv)
 gain=$(awk -v b="$e_dl" -v e="$e_8" 'BEGIN { printf "%.2f", 100 * (b - e) / b }')
 grep -q "| isr samples=8 | [0-9.]* | [0-9.]* | $gain | $gain | " rep/report.md \
   || fail "the summary's gain for samples=8 is not $gain"
+# The direct-only floor: one value for the view on every row; the share of
+# indirect error removed is 100 (e_dl - e) / (e_dl - floor), n/a for the baseline.
+floor=$(awk -F, 'NR == 2 { print $16 }' rep/report.csv)
+awk -F, -v f="$floor" 'NR > 1 && $16 != f { bad = 1 } END { exit bad }' rep/report.csv \
+  || fail "the floor differs between rows of one view"
+awk -v f="$floor" -v b="$e_dl" 'BEGIN { exit !(f > 0 && f < b) }' \
+  || fail "the floor $floor is not between 0 and the baseline's error $e_dl"
+awk -F, 'NR == 2 { exit $17 != "n/a" }' rep/report.csv || fail "the baseline has a share of indirect error removed"
+share=$(awk -F, 'NR == 3 { print $17 }' rep/report.csv)
+awk -v s="$share" -v b="$e_dl" -v e="$e_8" -v f="$floor" 'BEGIN { w = 100 * (b - e) / (b - f); exit !(s - w < 0.01 && w - s < 0.01) }' \
+  || fail "indirect error removed $share is not 100 ($e_dl - $e_8) / ($e_dl - $floor)"
+grep -q '"direct_floor": ' rep/report.json || fail "the JSON has no direct_floor"
+grep -q '"indirect_removed": null' rep/report.json || fail "the JSON's baseline share is not null"
+grep -q "^Direct-only floor, mean over the views: " rep/report.md || fail "the summary does not give the floor"
+grep -q "| indirect error removed % |" rep/report.md || fail "the summary has no indirect share column"
+# The SVG draws the floor and zooms its error axis to the data: the lowest tick is above 0.
+[ "$(grep -c '<line class="floor"' rep/report.svg)" = 1 ] || fail "the SVG has no floor line"
+low=$(grep -o 'text-anchor="end">[-0-9.e+]*<' rep/report.svg | head -1 | tr -dc '0-9.e+-')
+awk -v l="$low" 'BEGIN { exit !(l > 0) }' || fail "the error axis starts at $low, not at the data"
 # The images are there to look at.
 [ "$(ls rep/images/*.exr | wc -l)" = 3 ] || fail "not three images"
 
@@ -123,4 +147,9 @@ grep -q "| isr samples=8 | [0-9.]* | [0-9.]* | $gain | $gain | " rep/report.md \
 [ $? = 1 ] || { cat log7; fail "--require-refs without references did not fail"; }
 grep -q "limn reference --job job.lua --refs refs-none" log7 || { cat log7; fail "the command is not named"; }
 [ -e rep2/report.csv ] && fail "a failed report wrote its CSV"
+# ... and names the direct-only one's command when only that is missing
+mkdir -p refs-rad/ball && cp $(grep -l "radiosity {" refs/ball/*.pov | sed 's/pov$/exr/') refs-rad/ball/
+"$limn" report --job job.lua "${fast[@]}" --refs refs-rad --require-refs --out rep3 --sweep dl >log9 2>&1
+[ $? = 1 ] || { cat log9; fail "--require-refs without direct-only references did not fail"; }
+grep -q "limn reference --job job.lua --refs refs-rad --radiosity off" log9 || { cat log9; fail "the direct-only command is not named"; }
 echo "passed"

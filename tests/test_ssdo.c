@@ -265,17 +265,20 @@ static void rotation_beats_raw_pattern(void **state) {
 }
 
 /* Under a white light the per-channel modulation factor is one factor, and
- * the merged variant should match the original two-step one. */
+ * the merged variant should match the original two-step one. The light is
+ * the seed's (window falloff), as in the seed's comparison: the box's own
+ * inverse-square light puts a hot spot on the ceiling that weighs more in
+ * the mean error than the variants' difference elsewhere. */
 static void variants_agree_under_white_light(void **state) {
   (void)state;
   lm_scene *scene = gl_cornell();
-  float saved[3];
-  memcpy(saved, scene->lights[0].color, sizeof saved);
+  lm_light saved = scene->lights[0];
   scene->lights[0].color[0] = scene->lights[0].color[1] = scene->lights[0].color[2] = 1.0f;
+  scene->lights[0].falloff = LM_FALLOFF_WINDOW, scene->lights[0].power = 1.6f;
   static const char *const merged[] = {"ssdo.variant=merged", "ssdo.samples=30", NULL};
   static const char *const two_step[] = {"ssdo.variant=two_step", "ssdo.samples=30", NULL};
   gl_result a = render_ok("ssdo", merged), b = render_ok("ssdo", two_step);
-  memcpy(scene->lights[0].color, saved, sizeof saved);
+  scene->lights[0] = saved;
   double e = mean_error(&a, &b);
   float ca[3], cb[3];
   gl_mean_around(&a, 0.675f, 0.0f, 0.40f, 2, ca);
