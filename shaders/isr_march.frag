@@ -10,9 +10,10 @@
 // weighs 1 / samples and the cosines cancel), Halton points (halton.glsl)
 // turned per pixel in a 4 x 4 tile that the blur averages. A ray counts a
 // sender only when the depth buffer says it is seen: the ray is marched in
-// `steps` samples at distances t_j = t_0 (t_end / t_0)^((j + u) / steps),
-// u a per-ray jitter, from t_0 = one coarse texel's footprint at p's depth to
-// t_end, where the ray leaves the view frustum. The spacing is geometric,
+// `steps` samples at distances t_j = t_0 (t_end / t_0)^((j + u) / (steps - 1 + u)),
+// j = 0 .. steps - 1, u in (0, 1) a per-ray jitter, from about t_0 = one
+// coarse texel's footprint at p's depth to t_end, where the ray leaves the
+// view frustum. The spacing is geometric,
 // so the march reaches across the whole visible scene with a few samples and
 // has no length in world units (a scene in millimetres or kilometres gives
 // the same image). A sample behind the depth buffer ends the coarse march;
@@ -92,7 +93,8 @@ void main() {
     float t_prev = 0.0;
     ivec2 q = px;
     for (int j = 0; j < m && t_end > foot; j++) {
-      float t = foot * pow(t_end / foot, (float(j) + u.z) / float(m));
+      // The last sample lies on t_end: a surface where the ray leaves the view is met too.
+      float t = foot * pow(t_end / foot, (float(j) + u.z) / max(float(m) - 1.0 + u.z, 1e-6));
       vec4 c = a + t * b;
       float zq = buffer_depth(c, size, q);
       if (zq <= 0.0 || c.w <= zq) { // background or in front of the surface there
