@@ -3,10 +3,11 @@
 # its mean error must lie below dl+esm's by a stated margin (ambient 0 on the
 # engine's side, as the export has none). The reference is rendered here, with
 # the export's (the seed's) radiosity settings. Skipped (77) without povray.
-#   test_gi_reference.sh LIMN ROOT NAME TECH MAX_RATIO [--set ...]
-# passes when error(TECH) <= MAX_RATIO * error(dl+esm).
+#   test_gi_reference.sh LIMN ROOT NAME TECH [MIN_RATIO..]MAX_RATIO [--set ...]
+# passes when MIN_RATIO * error(dl+esm) <= error(TECH) <= MAX_RATIO * error(dl+esm).
 set -u
-limn=$1 root=$2 name=$3 tech=$4 ratio=$5
+limn=$1 root=$2 name=$3 tech=$4 ratio=${5#*..} low=0
+case $5 in *..*) low=${5%%..*} ;; esac
 shift 5
 command -v povray >/dev/null || { echo "povray not installed: skipped (tools/dev.sh installs it)"; exit 77; }
 tmp=$(mktemp -d /tmp/limn-gi-XXXXXX)   # POV-Ray's default I/O policy allows writing under /tmp
@@ -25,7 +26,8 @@ error_of() { # TECH [--set ...]: mean error against the reference
 }
 base=$(error_of dl+esm) || exit 1
 e=$(error_of "$tech" "$@") || exit 1
-echo "$name ($tech $*) at $size: mean error $e; dl+esm $base; bound $ratio x dl+esm"
-awk -v e="$e" -v b="$base" -v r="$ratio" 'BEGIN { exit !(e <= r * b) }' \
-  || fail "$name: mean error $e is not at most $ratio x dl+esm's $base"
+echo "$name ($tech $*) at $size: mean error $e; dl+esm $base; ratio $(awk -v e="$e" -v b="$base" \
+  'BEGIN { printf "%.4f", e / b }'), bounds $low..$ratio"
+awk -v e="$e" -v b="$base" -v r="$ratio" -v l="$low" 'BEGIN { exit !(e <= r * b && e >= l * b) }' \
+  || fail "$name: mean error $e is not within $low..$ratio x dl+esm's $base"
 echo "passed"
