@@ -431,7 +431,13 @@ static void view(doc *d, const char *name, float ex, float ey, float ez, float t
   putf(&d->cams, "%-10s %8.3f %8.3f %8.3f   %8.3f %8.3f %8.3f   %5.1f\n", name, ex, ey, ez, tx, ty, tz, fov_deg);
 }
 
-/* type: "point", "spot", "directional"; range 0: none. */
+/* type: "point", "spot", "directional"; intensity in candela (point, spot) or
+ * lux (directional), KHR_lights_punctual's units; range 0: none, so that the
+ * light falls off as 1 / d^2 alone, which POV-Ray matches exactly. The
+ * candela values below give about the light the scenes had under the seed's
+ * window falloff at the surfaces each light faces (the floor below it):
+ * old * (1 - (d/r)^2) * d^2 * 683 pi, engine/scene/gltf.h's exposure (the
+ * Cornell box's less: its walls are near the light). */
 static void light(doc *d, const char *name, const char *type, float x, float y, float z, const float dir[3],
                   float r, float g, float b, float intensity, float range) {
   int n = add_node(d, name, -1, x, y, z);
@@ -594,7 +600,7 @@ static void cornell(const char *dir) {
   d.nodes[s].s[0] = d.nodes[s].s[1] = d.nodes[s].s[2] = 0.6f;
   int t = mesh_node(&d, "tall_box", -1, cube, -0.35f, 0, -0.35f, 17, 1);
   d.nodes[t].s[0] = 0.6f, d.nodes[t].s[1] = 1.2f, d.nodes[t].s[2] = 0.6f;
-  light(&d, "ceiling_light", "point", 0, 1.85f, 0, NULL, 1, 0.95f, 0.85f, 1.6f, 4);
+  light(&d, "ceiling_light", "point", 0, 1.7f, 0, NULL, 1, 0.95f, 0.85f, 6000, 0);
   view(&d, "front", 0, 1, 3.4f, 0, 1, 0, 45, 20);
   view(&d, "left", -0.6f, 1.2f, 2.6f, 0.1f, 0.8f, 0, 50, 20);
   view(&d, "high", 0.3f, 1.8f, 2.2f, 0, 0.4f, 0, 55, 20);
@@ -655,8 +661,8 @@ static void primitives(const char *dir) {
   int car = mesh_node(&d, "car", -1, car_mesh(&d, paint, glass, tyre), 0, 0, 0, 25, 1);
   sphere(&m, 0.08f, 12, 6);
   mesh_node(&d, "car_light", car, add_mesh1(&d, "beacon", &m, yellow), -0.1f, 1.15f, 0, 0, 1);
-  light(&d, "sun", "directional", 0, 10, 0, (float[]){-0.4f, -1, -0.6f}, 1, 0.97f, 0.9f, 1.2f, 0);
-  light(&d, "fill", "point", 2, 3, 3, NULL, 0.6f, 0.7f, 1, 1.0f, 10);
+  light(&d, "sun", "directional", 0, 10, 0, (float[]){-0.4f, -1, -0.6f}, 1, 0.97f, 0.9f, 2575, 0);
+  light(&d, "fill", "point", 2, 3, 3, NULL, 0.6f, 0.7f, 1, 36800, 0);
   view(&d, "front", 0, 2.2f, 6.5f, 0, 0.4f, 0, 45, 60);
   view(&d, "side", 6, 1.5f, 1, 0, 0.5f, 0, 45, 60);
   view(&d, "top", 0.5f, 8, 3, 0, 0, 0, 50, 60);
@@ -729,9 +735,9 @@ static void office(const char *dir) {
     snprintf(nm, sizeof nm, "books%d", b);
     mesh_node(&d, nm, shelf, add_mesh1(&d, nm, &m, books[b]), 0, 0, 0, 0, 1);
   }
-  light(&d, "lamp_a", "point", -1.5f, 2.4f, 0, NULL, 1, 0.95f, 0.85f, 1.2f, 5);
-  light(&d, "lamp_b", "point", 1.5f, 2.4f, 0, NULL, 1, 0.95f, 0.85f, 1.2f, 5);
-  light(&d, "window", "directional", 0, 2, 0, (float[]){0.3f, -0.8f, -0.5f}, 0.9f, 0.95f, 1, 0.3f, 0);
+  light(&d, "lamp_a", "point", -1.5f, 2.1f, 0, NULL, 1, 0.95f, 0.85f, 8700, 0);
+  light(&d, "lamp_b", "point", 1.5f, 2.1f, 0, NULL, 1, 0.95f, 0.85f, 8700, 0);
+  light(&d, "window", "directional", 0, 2, 0, (float[]){0.3f, -0.8f, -0.5f}, 0.9f, 0.95f, 1, 644, 0);
   view(&d, "door", 0, 1.6f, 2.9f, 0, 0.8f, -1, 60, 30);
   view(&d, "corner", -2.8f, 2.2f, 2.8f, 0.5f, 0.5f, -0.5f, 60, 30);
   view(&d, "desk", 1.4f, 1.2f, 2.3f, 1.5f, 0.7f, 1.0f, 50, 30);
@@ -785,12 +791,12 @@ static void garage(const char *dir) {
   for (int i = 0; i < 4; i++) {
     char nm[32];
     snprintf(nm, sizeof nm, "spot%d", i);
-    light(&d, nm, "spot", 0, H - 0.1f, -2.5f - 5 * (float)i, (float[]){0, -1, 0.0001f}, 1, 0.9f, 0.75f, 1.5f, 7);
+    light(&d, nm, "spot", 0, H - 0.1f, -2.5f - 5 * (float)i, (float[]){0, -1, 0.0001f}, 1, 0.9f, 0.75f, 22400, 0);
   }
   for (int i = 0; i < 3; i++) { /* wall washers, so the brick shows */
     char nm[32];
     snprintf(nm, sizeof nm, "wash%d", i);
-    light(&d, nm, "point", i % 2 ? 2.8f : -2.8f, 2.6f, -3 - 6 * (float)i, NULL, 1, 0.85f, 0.7f, 1.0f, 8);
+    light(&d, nm, "point", i % 2 ? 2.8f : -2.8f, 2.6f, -3 - 6 * (float)i, NULL, 1, 0.85f, 0.7f, 13000, 0);
   }
   view(&d, "entrance", 0, 1.6f, -0.5f, 0, 1.2f, -20, 60, 40);
   view(&d, "cars", -0.5f, 1.8f, -6, 3, 0.6f, -9, 55, 40);
@@ -854,8 +860,8 @@ static void outdoor(const char *dir) {
     float s = 0.3f + 0.6f * rnd();
     d.nodes[b].s[0] = s * 1.4f, d.nodes[b].s[1] = s * 0.7f, d.nodes[b].s[2] = s;
   }
-  light(&d, "sun", "directional", 0, 50, 0, (float[]){-0.5f, -0.7f, -0.3f}, 1, 0.95f, 0.85f, 1.3f, 0);
-  light(&d, "sky", "directional", 0, 50, 0, (float[]){0.3f, -1, 0.4f}, 0.4f, 0.5f, 0.7f, 0.35f, 0);
+  light(&d, "sun", "directional", 0, 50, 0, (float[]){-0.5f, -0.7f, -0.3f}, 1, 0.95f, 0.85f, 2789, 0);
+  light(&d, "sky", "directional", 0, 50, 0, (float[]){0.3f, -1, 0.4f}, 0.4f, 0.5f, 0.7f, 751, 0);
   view(&d, "overview", 0, 40, 85, 0, 0, 0, 60, 400);
   view(&d, "valley", -60, 12, 60, 10, 0, -10, 70, 400);
   view(&d, "ground", 5, 4, 20, 0, 2, 0, 60, 400);
@@ -867,7 +873,9 @@ static void outdoor(const char *dir) {
  * Scenes where indirect light is a large share of the image, lit only by
  * lights that limn export-pov matches exactly (directional lights), so that
  * POV-Ray's radiosity gives each view's reference. No ambient term: the job
- * sets ambient = 0. Written under OUTDIR/reference/. */
+ * sets ambient = 0. Written under OUTDIR/reference/. Sun intensities are
+ * lux: SUN * 683 pi is SUN in the engine's units (engine/scene/gltf.h). */
+#define LUX (683 * PI)
 
 /* A wall in the plane x = x0 facing +x (sign 1) or -x (sign -1), z in [z0, z1], y in [y0, y1]. */
 static void wall_x(mesh *m, float x0, float sign, float z0, float z1, float y0, float y1) {
@@ -920,7 +928,7 @@ static void ref_room(const char *dir) {
   mesh_node(&d, "chest", -1, add_mesh1(&d, "chest", &m, chest), 0, 0, 0, 0, 1);
   box(&m, 1.8f, 0.9f, 1.2f, 0.2f, 0.9f, 0.6f);
   mesh_node(&d, "shelf", -1, add_mesh1(&d, "shelf", &m, shelf), 0, 0, 0, 0, 1);
-  light(&d, "sun", "directional", -6, 5, 0, (float[]){1, -0.7f, 0.25f}, 1, 0.96f, 0.9f, 3, 0);
+  light(&d, "sun", "directional", -6, 5, 0, (float[]){1, -0.7f, 0.25f}, 1, 0.96f, 0.9f, 3 * LUX, 0);
   view(&d, "window", 1.2f, 1.5f, 1.8f, -1.2f, 0.8f, -0.4f, 60, 20);
   view(&d, "back", -1.6f, 1.4f, 1.5f, 0.6f, 0.9f, -1.2f, 60, 20);
   view(&d, "ceiling", 1.5f, 0.4f, -1.5f, -0.5f, 2.3f, 0.8f, 65, 20);
@@ -951,7 +959,7 @@ static void ref_street(const char *dir) {
   mesh_node(&d, "crates", -1, add_mesh1(&d, "crates", &m, crate), 0, 0, 0, 0, 1);
   box(&m, -2.6f, 0.25f, -9, 0.25f, 0.25f, 1.2f);
   mesh_node(&d, "bench", -1, add_mesh1(&d, "bench", &m, bench), 0, 0, 0, 0, 1);
-  light(&d, "sun", "directional", 0, 20, 0, (float[]){0.6f, -0.8f, -0.25f}, 1, 0.96f, 0.9f, 2, 0);
+  light(&d, "sun", "directional", 0, 20, 0, (float[]){0.6f, -0.8f, -0.25f}, 1, 0.96f, 0.9f, 2 * LUX, 0);
   view(&d, "along", 0, 1.7f, 1.5f, 0, 1.2f, -12, 60, 60);
   view(&d, "shade", 1.5f, 1.6f, -4, -3, 1.4f, -9, 60, 60);
   view(&d, "sunny", -1.5f, 1.6f, -5, 3, 1.6f, -10, 60, 60);
@@ -976,7 +984,7 @@ static void ref_blocks(const char *dir) {
   mesh_node(&d, "yellow", -1, add_mesh1(&d, "yellow", &m, yellow), 1.0f, 0.55f, 0.4f, 0, 1);
   box(&m, 0.2f, 0.35f, 1.5f, 1.4f, 0.35f, 0.3f);
   mesh_node(&d, "green", -1, add_mesh1(&d, "green", &m, green), 0, 0, 0, 0, 1);
-  light(&d, "sun", "directional", 0, 20, 0, (float[]){-0.7f, -0.55f, -0.45f}, 1, 0.96f, 0.9f, 2, 0);
+  light(&d, "sun", "directional", 0, 20, 0, (float[]){-0.7f, -0.55f, -0.45f}, 1, 0.96f, 0.9f, 2 * LUX, 0);
   view(&d, "front", 0.5f, 2.2f, 5.5f, 0, 0.6f, 0, 45, 60);
   view(&d, "shaded", -4, 1.6f, -3.5f, 0, 0.6f, 0, 45, 60);
   view(&d, "low", 3.5f, 0.6f, 2.5f, -0.5f, 0.7f, -0.5f, 55, 60);

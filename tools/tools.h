@@ -22,6 +22,12 @@ bool limn_parse_int(const char *s, int lo, int hi, int *out);
 bool limn_parse_double(const char *s, double *out); /* finite */
 bool limn_parse_size(const char *s, int *w, int *h); /* WxH, each 1..65536 */
 bool limn_parse_on_off(const char *s, bool *out);
+/* --camera: an index, or "auto" (LIMN_CAMERA_AUTO): a camera framing the
+ * scene's bounds at the output's aspect, added by limn_camera_resolve. */
+#define LIMN_CAMERA_AUTO (-1)
+bool limn_parse_camera(const char *s, int *out);
+struct lm_scene;
+int limn_camera_resolve(struct lm_scene *s, int camera, int width, int height);
 /* Prints s as a JSON string (quotes, backslashes and control characters escaped). */
 void limn_json_string(const char *s);          /* a quoted, escaped JSON string to stdout */
 void limn_json_append(lm_buf *b, const char *s); /* the same, appended to b */
