@@ -119,7 +119,7 @@ function isr.render(G, direct, o, light)
       inputs.sender = C.direct
       E = pass{ name, shader = "isr_march.frag", inputs = inputs,
                 params = { samples = o.samples, steps = o.steps, thickness = o.thickness },
-                fetches = 4 + o.samples * (o.steps + 3 + (E and 7 or 6)), -- march, refinement, hit
+                fetches = 4 + o.samples * (o.steps + (E and 11 or 10)), -- march, one bisection, the hit
                 defines = { BOUNCE = E ~= nil }, out = coarse_target("isr.e" .. b, f) }
     end
   end
