@@ -15,6 +15,7 @@ Techniques = { "isr+esm", "isr", "dl+esm", "dl", "ssdo+esm", "ssdo", "ssao+esm",
 Options = {
   ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
   background = 0.0,        -- radiance where no geometry is
+  materials = "phong",     -- "phong" (the std technique) or "pbr" (glTF metallic-roughness, GGX)
   isr = {},                -- see isr.defaults in scripts/isr.lua
   shadow = {},             -- see shadow.defaults in scripts/shadow.lua
   ssdo = {},               -- see ssdo.defaults in scripts/ssdo.lua
@@ -52,7 +53,9 @@ function OnRender(tech)
   if shadows and lighting == "ssdo" and tech.ssdo.variant ~= "merged" then
     error('ssdo+esm needs ssdo.variant = "merged" (the two-step variant relights without shadows)')
   end
-  local G = gbuffer.render(gbuffer.targets())
+  local materials = ({ phong = "std", pbr = "pbr" })[tech.materials]
+  if not materials then error('materials must be "phong" or "pbr" (got "' .. tostring(tech.materials) .. '")') end
+  local G = gbuffer.render(gbuffer.targets(1, materials), materials)
   local lit
   if lighting == "isr" then
     lit = isr.render(G, tech.isr, { ambient = grey(tech.ambient), background = grey(tech.background),
@@ -63,6 +66,10 @@ function OnRender(tech)
     lit = ssao.render(G, direct(G, tech, shadows), tech.ssao)
   else
     lit = direct(G, tech, shadows)
+  end
+  if G.emi then -- emitted light, after the lighting that never sees it
+    lit = pass{ "emissive", shader = "bloom_add.frag", inputs = { src = lit, bloom = G.emi },
+                out = target{ "lit.emissive", format = "rgba16f" } }
   end
   present(post.render(lit, tech, G))
 end

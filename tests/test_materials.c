@@ -228,9 +228,9 @@ static void bad_textures_name_material_texture_and_image(void **state) {
     const char *textures, *images, *expect;
   } cases[] = {
       {"[{\"source\":0}]", "[{\"uri\":\"data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAA\"}]",
-       "material 0: texture 0: image 0"},
-      {"[{\"source\":0}]", "[{\"uri\":\"missing.png\"}]", "material 0: texture 0: image 0 ('missing.png'): no image data"},
-      {"[{\"source\":3}]", "[{\"uri\":\"missing.png\"}]", "material 0: texture 0: image 3 does not exist"},
+       "material 0: baseColorTexture: texture 0: image 0"},
+      {"[{\"source\":0}]", "[{\"uri\":\"missing.png\"}]", "material 0: baseColorTexture: texture 0: image 0 ('missing.png'): no image data"},
+      {"[{\"source\":3}]", "[{\"uri\":\"missing.png\"}]", "material 0: baseColorTexture: texture 0: image 3 does not exist"},
       {"[]", "[]", "material 0: baseColorTexture: texture 0 does not exist (the file has 0)"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {

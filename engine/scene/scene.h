@@ -7,20 +7,48 @@
 
 #define LM_NAME_MAX 64
 
+/* A material's textures beyond the base colour, for the "pbr" technique. */
+typedef enum lm_texture_slot {
+  LM_TEX_BASE_COLOR,         /* sRGB rgb, alpha a */
+  LM_TEX_METALLIC_ROUGHNESS, /* linear: roughness g, metallic b */
+  LM_TEX_NORMAL,             /* linear, tangent space */
+  LM_TEX_OCCLUSION,          /* linear r */
+  LM_TEX_EMISSIVE,           /* sRGB */
+  LM_TEX_SLOTS
+} lm_texture_slot;
+
+typedef enum lm_alpha_mode { LM_ALPHA_OPAQUE, LM_ALPHA_MASK, LM_ALPHA_BLEND } lm_alpha_mode;
+
 /* Phong material of seed 000 plus the reflectance rho that ISR reads. */
 typedef struct lm_material {
   char name[LM_NAME_MAX];
-  float color[3];  /* diffuse albedo, linear */
+  float color[3];  /* diffuse albedo, linear (the pbr technique: the base colour) */
   float rho;       /* reflectance, the G-buffer's "radiation mask" */
   float ka, kd, ks, shininess;
   int base_color_texture; /* 1 + index into the scene's textures; 0: none */
 } lm_material;
+
+/* glTF's metallic-roughness data of a material, beside it (lm_scene's
+ * material_pbr, same index), for the "pbr" technique (shaders/pbr.frag). A
+ * material without it (set false) gets it derived from its Phong values. */
+typedef struct lm_material_pbr {
+  bool set;
+  float metallic, roughness, normal_scale, occlusion_strength;
+  float emissive[3];   /* factor times KHR_materials_emissive_strength */
+  float alpha;         /* base colour alpha */
+  lm_alpha_mode alpha_mode;
+  float alpha_cutoff;
+  int textures[LM_TEX_SLOTS]; /* 1 + index; 0: none (the base colour's is the material's) */
+  /* KHR_texture_transform per slot: uv' = (a b c; d e f) (u v 1); all zero: identity */
+  float uv_transform[LM_TEX_SLOTS][6];
+} lm_material_pbr;
 
 /* A material's image: RGBA8 texels (sRGB-encoded colour), rows top first. */
 typedef struct lm_scene_texture {
   char name[LM_NAME_MAX];
   int width, height;
   unsigned char *rgba;
+  bool linear;     /* data (metallic-roughness, normals, occlusion), not sRGB colour */
   lm_texture gpu;
 } lm_scene_texture;
 
@@ -92,6 +120,7 @@ typedef struct lm_scene {
   lm_scene_mesh *meshes;
   int mesh_count, mesh_cap;
   lm_material *materials;
+  lm_material_pbr *material_pbr; /* one per material (zero: none) */
   int material_count, material_cap;
   lm_light *lights;
   int light_count, light_cap;
