@@ -231,6 +231,25 @@ static bool write_light(pov_ctx *c, const lm_light *l, const lm_light_data *ld, 
   return true;
 }
 
+/* The pbr technique's material as POV-Ray's closest finish (pov.h), with a
+ * warning that says what is approximated. */
+static void write_pbr_material(pov_ctx *c, const lm_material *m, const lm_material_pbr *p, const char *id) {
+  double metal = clamp01(p->metallic), rough = p->roughness > 0.08 ? clamp01(p->roughness) : 0.08;
+  double f0 = 0.04, r4 = rough * rough * rough * rough, s = 2.0 / r4 - 2.0;
+  for (int i = 0; i < 3; i++) f0 = fmax(f0, 0.04 + (clamp01(m->color[i]) - 0.04) * metal);
+  if (c->warnings)
+    lm_buf_printf(c->warnings, "material '%s': metallic-roughness written as POV-Ray's closest finish (Blinn "
+                  "specular of the matching exponent, no Fresnel rise or Smith shadowing, no textures)\n", m->name);
+  lm_buf_printf(c->out,
+                "// material '%s' (metallic %.3g, roughness %.3g: approximated)\n#declare %s = texture {\n"
+                "  pigment { rgb <%.9g, %.9g, %.9g> }\n"
+                "  finish { ambient 0 emission rgb <%.9g, %.9g, %.9g> diffuse %.9g brilliance 1 specular %.9g "
+                "roughness %.9g metallic %.9g }\n}\n\n",
+                m->name, metal, rough, id, clamp01(m->color[0]), clamp01(m->color[1]), clamp01(m->color[2]),
+                p->emissive[0], p->emissive[1], p->emissive[2], 1.0 - metal, f0 * (s + 2.0) / 8.0, 1.0 / fmax(s, 1.0),
+                metal);
+}
+
 static bool write_material(pov_ctx *c, const lm_material *m, const char *id) {
   double col[3], kd = clamp01(m->kd), ks = clamp01(m->ks);
   bool clamped = kd != m->kd || ks != m->ks;
@@ -362,7 +381,10 @@ bool lm_pov_export(const lm_scene *s, const lm_pov_desc *desc, lm_buf *out, lm_b
     declared[slot] = true;
     char id[64];
     material_id(s, nd, id, sizeof id);
-    ok = write_material(&c, lm_scene_node_material(s, nd), id);
+    if (desc->pbr_materials && slot < s->material_count && s->material_pbr[slot].set)
+      write_pbr_material(&c, lm_scene_node_material(s, nd), &s->material_pbr[slot], id);
+    else
+      ok = write_material(&c, lm_scene_node_material(s, nd), id);
   }
   free(declared);
   for (int i = 0; i < s->node_count && ok; i++) {

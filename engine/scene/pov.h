@@ -24,7 +24,15 @@
  *   pigment rgb color; finish { ambient 0 emission 0 diffuse kd brilliance 1
  *   phong ks phong_size max(shininess, 1) }. POV-Ray's diffuse is
  *   kd * pigment * light * (n.l) and its phong ks * (r.v)^size * light,
- *   the engine's Phong exactly (seed 000 lines 2753-2767). The engine's
+ *   the engine's Phong exactly (seed 000 lines 2753-2767). With
+ *   pbr_materials, the pbr technique's GGX has no POV-Ray form; the closest
+ *   finish is written and a warning says so (never refused): pigment the
+ *   base colour, diffuse 1 - metallic, specular (Blinn) with the exponent
+ *   s = 2 / roughness^4 - 2 whose lobe matches GGX's and the normalized
+ *   amplitude max(F0) (s + 2) / 8, metallic tinting it with the pigment,
+ *   emission the emissive colour; Fresnel's rise at grazing angles, Smith
+ *   shadowing, the 1 - F diffuse weight and textures are not carried. The
+ *   engine's
  *   ambient term (k_a * ambient) has no counterpart: render the engine with
  *   the option ambient = 0 when comparing.
  * - Lights, colour = color * power:
@@ -82,6 +90,7 @@ typedef struct lm_pov_desc {
   lm_pov_radiosity rad;
   bool shadows;       /* false: no mesh casts shadows */
   bool strict;        /* refuse what cannot match instead of warning */
+  bool pbr_materials; /* the pbr technique's materials (approximated, warned) instead of Phong */
 } lm_pov_desc;
 
 /* Appends the SDL for the view to `out`. Warnings (one per line, naming the
