@@ -214,8 +214,10 @@ const char *lm_material_param_list(void);
 typedef struct lm_scene_draw_desc {
   const lm_program *program; /* bound: the technique's program */
   /* The technique's program with `defines` added ("BASE_COLOR_TEXTURE" for a
-   * textured material), bound and ready; NULL with a message. NULL: every
-   * material draws with `program` and without its texture. */
+   * textured material; for a technique that declares material_pbr also
+   * MR_TEXTURE, NORMAL_TEXTURE, OCCLUSION_TEXTURE, EMISSIVE_TEXTURE, joined
+   * by ';'), bound and ready; NULL with a message. NULL: every material
+   * draws with `program` and without its textures. */
   const lm_program *(*variant)(void *ctx, const char *defines, lm_error *err);
   void *ctx;
   const float *view_proj; /* column-major: nodes wholly outside are culled; NULL: none are */
@@ -228,7 +230,10 @@ typedef struct lm_scene_draw_stats {
 } lm_scene_draw_stats;
 /* Draws every mesh node whose bounds reach into the frustum, setting model,
  * normal_matrix, the material uniforms (material_color, material_rho,
- * material_k) and base_color_tex. Adds to *stats (may be NULL). */
+ * material_k; material_pbr, material_emissive, material_alpha) and the
+ * textures with their transforms (base_color_tex, base_color_xform, mr_tex,
+ * ...). With a technique that declares material_pbr, a material whose
+ * alphaMode is BLEND is an error naming it. Adds to *stats (may be NULL). */
 bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err);
 /* True when the world-space box lo..hi lies wholly outside one clip plane of view_proj. */
 bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const float hi[3]);
