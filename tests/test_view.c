@@ -567,7 +567,7 @@ static void write_quad_scene(const char *rel, const char *color) {
   char *b64 = base64(bytes, sizeof bytes), json[4096];
   snprintf(json, sizeof json,
            "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\"],"
-           "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"directional\",\"intensity\":2}]}},"
+           "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"directional\",\"intensity\":4291}]}},"
            "\"scene\":0,\"scenes\":[{\"nodes\":[0,1,2,3]}],"
            "\"nodes\":[{\"name\":\"quad\",\"mesh\":0},"
            "{\"name\":\"sun\",\"translation\":[0,0,4],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}},"
