@@ -305,7 +305,8 @@ static void strips_and_fans_become_triangles(void **state) {
 
 /* A required extension the engine lacks is named, in .gltf and .glb alike,
  * before any of the data it governs is read (here: an accessor with no
- * bufferView, as Draco leaves them). A supported one loads. */
+ * bufferView, as Draco leaves them). (pbr_materials_come_over requires a
+ * supported one.) */
 static void unsupported_required_extension_is_named(void **state) {
   (void)state;
   static const char json[] =
