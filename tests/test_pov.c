@@ -183,6 +183,27 @@ static void range_window_is_exact_or_refused_by_name(void **state) {
   lm_scene_destroy(s);
 }
 
+/* --materials pbr: POV-Ray's closest finish for each material, written even
+ * when strict, each named in a warning; Phong materials get the metallic and
+ * roughness the pbr technique derives for them. */
+static void pbr_materials_are_approximated_and_said(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *s = lm_scene_builtin("cornell_pov", &err);
+  lm_pov_desc d = desc_for(64, 48);
+  d.pbr_materials = true;
+  lm_buf out = {0}, warn = {0};
+  assert_true(lm_pov_export(s, &d, &out, &warn, &err));
+  assert_non_null(strstr(warn.data, "material 'red': metallic-roughness written as POV-Ray's closest finish"));
+  /* red: kd 1, shininess 1: metallic 0, roughness (2 / 3)^(1/4) */
+  assert_non_null(strstr(out.data, "// material 'red' (metallic 0, roughness 0.904: approximated)"));
+  assert_non_null(strstr(out.data, "diffuse 1 brilliance 1 specular"));
+  assert_null(strstr(out.data, " phong "));
+  lm_buf_free(&out);
+  lm_buf_free(&warn);
+  lm_scene_destroy(s);
+}
+
 /* The C twin of lighting.glsl's light_falloff, and where each light ends. */
 static void falloff_and_reach(void **state) {
   (void)state;
@@ -276,6 +297,7 @@ int main(void) {
       cmocka_unit_test(window_falloff_is_refused_or_warned_by_name),
       cmocka_unit_test(range_window_is_exact_or_refused_by_name),
       cmocka_unit_test(falloff_and_reach),
+      cmocka_unit_test(pbr_materials_are_approximated_and_said),
       cmocka_unit_test(unmatched_spots_and_materials_are_named),
       cmocka_unit_test(bad_views_are_refused),
   };

@@ -381,10 +381,13 @@ bool lm_pov_export(const lm_scene *s, const lm_pov_desc *desc, lm_buf *out, lm_b
     declared[slot] = true;
     char id[64];
     material_id(s, nd, id, sizeof id);
-    if (desc->pbr_materials && slot < s->material_count && s->material_pbr[slot].set)
-      write_pbr_material(&c, lm_scene_node_material(s, nd), &s->material_pbr[slot], id);
-    else
-      ok = write_material(&c, lm_scene_node_material(s, nd), id);
+    const lm_material *m = lm_scene_node_material(s, nd);
+    if (desc->pbr_materials) {
+      lm_material_pbr p = lm_scene_material_pbr(s, nd->material, m);
+      write_pbr_material(&c, m, &p, id);
+    } else {
+      ok = write_material(&c, m, id);
+    }
   }
   free(declared);
   for (int i = 0; i < s->node_count && ok; i++) {

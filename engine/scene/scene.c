@@ -484,12 +484,9 @@ static void world_bounds(const float w[16], const float b[2][3], float lo[3], fl
   }
 }
 
-/* The node's metallic-roughness data: glTF's, or for a Phong material the
- * metal share 1 - kd and the roughness whose GGX lobe its exponent matches
- * (alpha^2 = 2 / (shininess + 2), the inverse of gltf.h's conversion). */
-static lm_material_pbr node_pbr(const lm_scene *s, const lm_node *n, const lm_material *m) {
-  if (n->material >= 0 && n->material < s->material_count && s->material_pbr[n->material].set)
-    return s->material_pbr[n->material];
+lm_material_pbr lm_scene_material_pbr(const lm_scene *s, int material, const lm_material *m) {
+  if (material >= 0 && material < s->material_count && s->material_pbr[material].set)
+    return s->material_pbr[material];
   lm_material_pbr p = {.metallic = glm_clamp(1.0f - m->kd, 0.0f, 1.0f),
                        .roughness = powf(2.0f / (fmaxf(m->shininess, 0.0f) + 2.0f), 0.25f),
                        .normal_scale = 1, .occlusion_strength = 1, .alpha = 1};
@@ -543,7 +540,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     lm_material m = *lm_scene_node_material(s, n);
     for (int k = 0; k < d->param_count; k++)
       if (!strcmp(d->params[k].material, m.name)) apply_param(&m, &d->params[k]);
-    lm_material_pbr mp = node_pbr(s, n, &m);
+    lm_material_pbr mp = lm_scene_material_pbr(s, n->material, &m);
     if (pbr && mp.alpha_mode == LM_ALPHA_BLEND) {
       lm_error_set(err, "material '%s' (node '%s'): alphaMode BLEND is not drawn by this technique (the "
                    "G-buffer keeps one opaque surface a pixel); make it OPAQUE or MASK, or draw with std",

@@ -43,6 +43,13 @@ typedef struct lm_material_pbr {
   float uv_transform[LM_TEX_SLOTS][6];
 } lm_material_pbr;
 
+/* Material `material`'s metallic-roughness data (m: its Phong values, with
+ * any overrides): glTF's when set, else derived from m: metallic 1 - kd and
+ * the roughness whose GGX lobe the exponent matches (alpha^2 = 2 /
+ * (shininess + 2), the inverse of gltf.h's conversion). */
+struct lm_scene;
+lm_material_pbr lm_scene_material_pbr(const struct lm_scene *s, int material, const lm_material *m);
+
 /* A material's image: RGBA8 texels (sRGB-encoded colour), rows top first. */
 typedef struct lm_scene_texture {
   char name[LM_NAME_MAX];
