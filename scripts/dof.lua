@@ -8,26 +8,30 @@ local dof = {}
 
 dof.defaults = {
   enabled = false,
+  -- Lengths are world units when set; 0 (the default) makes each relative to
+  -- the view, so the same image comes out in any unit.
   mode = "range",       -- "range": focus and range; "lens": thin lens
-  focus = 3.5,          -- focus distance from the eye, world units (clamped to near .. far)
-  range = 1.0,          -- range: depth distance from the focus to full blur, > 0
+  focus = 0,            -- focus distance from the eye (clamped to near .. far);
+                        -- 0: the depth at the image's centre (autofocus)
+  range = 0,            -- range: depth distance from the focus to full blur; 0: focus / 3
   max_radius = 8,       -- largest circle of confusion in pixels, 0..32 (0: sharp)
   samples = 48,         -- gather taps, 1..256
-  focal_length = 0.05,  -- lens: world units (0.05: 50 mm when a unit is a metre), > 0
+  focal_length = 0,     -- lens: 0: focus / 70 (a 50 mm lens focused at 3.5 m)
   f_number = 2.8,       -- lens: N, aperture = focal_length / N, > 0
-  sensor = 0.024,       -- lens: sensor height, world units, > 0
+  sensor = 0,           -- lens: sensor height; 0: what gives the camera's field
+                        -- of view with that focal length (focused at infinity)
 }
 
 local rules = {
   enabled = options.boolean,
   mode = options.one_of("range", "lens"),
-  focus = options.number(0, 1e6),
-  range = options.positive(1e6),
+  focus = options.number(0, 1e30),
+  range = options.number(0, 1e30),
   max_radius = options.number(0, 32),
   samples = options.whole(1, 256),
-  focal_length = options.positive(100),
+  focal_length = options.number(0, 1e30),
   f_number = options.positive(1000),
-  sensor = options.positive(100),
+  sensor = options.number(0, 1e30),
 }
 
 -- Records depth of field over `src` (output-sized) with the G-buffer G.

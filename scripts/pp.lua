@@ -48,14 +48,15 @@ end
 
 function OnRender(tech)
   local lighting = tech.name:match("^[^+]*")
-  local shadows = tech.name:find("+esm", 1, true) and shadow.render(tech.shadow) or nil
-  if shadows and tech.shadow.debug then return present(shadow.debug(shadows)) end
-  if shadows and lighting == "ssdo" and tech.ssdo.variant ~= "merged" then
+  if tech.name:find("+esm", 1, true) and lighting == "ssdo" and tech.ssdo.variant ~= "merged" then
     error('ssdo+esm needs ssdo.variant = "merged" (the two-step variant relights without shadows)')
   end
   local materials = ({ phong = "std", pbr = "pbr" })[tech.materials]
   if not materials then error('materials must be "phong" or "pbr" (got "' .. tostring(tech.materials) .. '")') end
   local G = gbuffer.render(gbuffer.targets(1, materials), materials)
+  -- Shadows after the G-buffer: their cascades fit the depths it sees.
+  local shadows = tech.name:find("+esm", 1, true) and shadow.render(tech.shadow, G) or nil
+  if shadows and tech.shadow.debug then return present(shadow.debug(shadows)) end
   local lit
   if lighting == "isr" then
     lit = isr.render(G, tech.isr, { ambient = grey(tech.ambient), background = grey(tech.background),

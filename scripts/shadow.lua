@@ -15,9 +15,11 @@ shadow.defaults = {
   blur = 2,           -- ESM Gaussian radius in texels, 0..32
   cascades = 3,       -- directional lights, 1..4
   lambda = 0.75,      -- cascade splits: 0 uniform .. 1 logarithmic
-  bias = 0.002,       -- depth bias in normalized depth (the seed: 0 for ESM, which darkens lit
-                      -- slanted surfaces by 1-2%; 0.005 for its plain shadow map)
-  distance = 0,       -- how far cascades reach from the camera (0: the far plane)
+  bias = 1,           -- depth bias in texels: the world size of a shadow-map texel where the
+                      -- receiver is, 0..64 (the seed: 0 for ESM, which darkens lit slanted
+                      -- surfaces by 1-2%)
+  distance = 0,       -- how far cascades reach from the camera, world units (0: as far as
+                      -- anything is seen)
   blend = 0.1,        -- share of a cascade blended into the next one
   radius = 2.5,       -- Poisson disc radius in texels
   stabilize = true,   -- bounding spheres and texel snapping (seed 003)
@@ -27,9 +29,27 @@ shadow.defaults = {
 -- shadow_plan{} checks the rest (engine/script/script_api.c).
 local rules = { technique = options.one_of("esm", "pcf", "poisson", "hard") }
 
+local BLOCK = 8
+
+-- The least and greatest camera depth the G-buffer G sees (depth / far in r
+-- and g of a 1x1 target), by BLOCK x BLOCK min/max reduction passes.
+function shadow.depth_range(G)
+  local w, h = output_size()
+  local level, n = G.dpt, 0
+  repeat
+    w, h, n = (w + BLOCK - 1) // BLOCK, (h + BLOCK - 1) // BLOCK, n + 1
+    level = pass{ "shadow.range" .. n, shader = "depth_range.frag", inputs = { src = level },
+                  defines = { FIRST = n == 1, BLOCK = BLOCK },
+                  out = target{ "shadow.range" .. n, format = "rg32f", size = { w, h } } }
+  until w == 1 and h == 1
+  return level
+end
+
 -- Records the shadow passes. Returns the atlas a lighting pass reads as
 -- `shadow_atlas`, or nil when no light casts shadows (nothing is recorded).
-function shadow.render(o)
+-- With the G-buffer G (recorded before), cascades fit the depths it sees
+-- (shadow.depth_range); without, the depths of the meshes in view.
+function shadow.render(o, G)
   o = options.check("shadow", shadow.defaults, o, rules, 2)
   local settings = {}
   for k, v in pairs(o) do
@@ -39,13 +59,15 @@ function shadow.render(o)
   if not plan then return nil end
   local size = { plan.width, plan.height }
   local map = target{ "shadow.map", format = "r32f", size = size }
-  scene{ "shadow.depth", technique = "shadow", views = plan, out = map, clear = { 1, 1, 1, 1 },
+  scene{ "shadow.depth", technique = "shadow", views = plan, fit = G and shadow.depth_range(G) or nil,
+         out = map, clear = { 1, 1, 1, 1 },
          depth = target{ "shadow.zbuffer", format = "depth32f", size = size } }
   if plan.technique ~= "esm" or plan.blur == 0 then return map end
   local blurred = map
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
     blurred = pass{ "shadow.blur_" .. axis[1], shader = "esm_blur.frag", inputs = { src = blurred },
-                    params = { direction = axis[2], radius = plan.blur, c = plan.c, tile = plan.tile },
+                    params = { direction = axis[2], radius = plan.blur, c = plan.c, tile = plan.tile,
+                               views = plan.views },
                     out = target{ "shadow.esm_" .. axis[1], format = "r32f", size = size } }
   end
   return blurred

@@ -7,33 +7,40 @@
 //          through the sensor height, capped at max_radius.
 // The focus is clamped into [near, far] and beyond the focal length, so a
 // focus on either plane, or closer than the lens can focus, stays finite.
+// Lengths of 0 are relative to the view (scripts/dof.lua), so any unit gives
+// the same image: focus the depth at the centre, range focus / 3, focal
+// length focus / 70, sensor 2 f tan(fov_y / 2).
 #include "post.glsl"
 
 in vec2 uv;
 uniform sampler2D dpt;
-uniform float focus = 3.5;        // world units from the eye
-uniform float range = 1.0;        // RANGE: depth distance to full blur, > 0
+uniform float focus = 0.0;        // world units from the eye; 0: the depth at the centre
+uniform float range = 0.0;        // RANGE: depth distance to full blur; 0: focus / 3
 uniform float max_radius = 8.0;   // pixels, >= 0
-uniform float focal_length = 0.05;// LENS: world units (50 mm)
+uniform float focal_length = 0.0; // LENS: world units; 0: focus / 70 (50 mm at 3.5 m)
 uniform float f_number = 2.8;     // LENS: > 0
-uniform float sensor = 0.024;     // LENS: sensor height in world units (24 mm)
+uniform float sensor = 0.0;       // LENS: sensor height, world units; 0: from the field of view
 
 out vec4 coc;
 
 void main() {
   float z = eye_depth(texture(dpt, uv).r);
-  float near = max(frame.clip.x, EPS), far = max(frame.clip.y, near);
+  float near = frame.clip.x, far = max(frame.clip.y, near);
+  float tiny = near * 1e-6; // a length under anything the view resolves
   float cap = max(max_radius, 0.0);
+  float focused = focus > 0.0 ? focus : eye_depth(texelFetch(dpt, textureSize(dpt, 0) / 2, 0).r);
   float c;
 #ifdef LENS
-  float f = max(focal_length, 1e-6);
-  float s = clamp(focus, max(near, 1.001 * f), max(far, 1.001 * f));
+  float f = max(focal_length > 0.0 ? focal_length : focused / 70.0, tiny);
+  float s = clamp(focused, max(near, 1.001 * f), max(far, 1.001 * f));
   float aperture = f / max(f_number, 1e-3);
-  float on_sensor = aperture * f * (z - s) / (max(z, EPS) * (s - f)); // s - f >= 0.001 f
-  c = on_sensor / max(sensor, 1e-6) * frame.output_size.y;
+  float on_sensor = aperture * f * (z - s) / (max(z, tiny) * (s - f)); // s - f >= 0.001 f
+  float height = sensor > 0.0 ? sensor : 2.0 * f * frame.clip.w;
+  c = on_sensor / max(height, tiny) * frame.output_size.y;
 #else
-  float s = clamp(focus, near, far);
-  c = sign(z - s) * saturate(abs(z - s) / max(range, 1e-6)) * cap;
+  float s = clamp(focused, near, far);
+  float r = range > 0.0 ? range : s / 3.0;
+  c = sign(z - s) * saturate(abs(z - s) / max(r, tiny)) * cap;
 #endif
   coc = vec4(clamp(c, -cap, cap), z, 0.0, 0.0);
 }

@@ -9,12 +9,18 @@ uniform vec2 direction = vec2(1.0, 0.0); // in texels
 uniform int radius = 2;
 uniform float c = 90.0;
 uniform float tile = 512.0;
+uniform int views = 1 << 30; // tiles in use, row by row; the grid's spare cells stay clear
 
 out float blurred;
 
 void main() {
   ivec2 size = textureSize(src, 0);
   ivec2 p = ivec2(gl_FragCoord.xy);
+  ivec2 cell = ivec2(vec2(p) / tile);
+  if (cell.x + cell.y * int(float(size.x) / tile) >= views) {
+    blurred = 1.0; // no tile here: what the shadow pass clears to
+    return;
+  }
   ivec2 lo = ivec2(floor(vec2(p) / tile) * tile);
   ivec2 hi = min(lo + ivec2(tile) - 1, size - 1);
   int r = clamp(radius, 0, 32);

@@ -32,7 +32,7 @@ Geometry geometry_at(sampler2D nrm, sampler2D dpt, sampler2D mat, ivec2 q, int f
 // sigma_normal. Background taps weigh 0.
 float geometry_weight(Geometry c, Geometry t, float sigma_depth, float sigma_normal) {
   if (!t.covered) return 0.0;
-  float scale = max(c.z * frame.clip.y * sigma_depth, 1e-12);
+  float scale = max(dpt_view_depth(c.z) * sigma_depth, 1e-30);
   float off = dot(c.n, t.p - c.p) / scale;
   float bend = (1.0 - dot(c.n, t.n)) / max(sigma_normal, 1e-6);
   return exp(-0.5 * (off * off + bend * bend));

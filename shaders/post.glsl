@@ -19,8 +19,7 @@ vec4 hdr_clamp(vec4 c, float hi) { return vec4(hdr_clamp(c.rgb, hi), c.a); }
 // Linear eye depth at a G-buffer texel: dpt holds depth / far, 0 where no
 // geometry was drawn (the background counts as the far plane).
 float eye_depth(float depth01) {
-  float far = max(frame.clip.y, EPS);
-  return depth01 > 0.0 ? clamp(depth01, 0.0, 1.0) * far : far;
+  return dpt_view_depth(depth01 > 0.0 ? min(depth01, 1.0) : 1.0);
 }
 
 // The i-th of n points of a golden-angle (Vogel) spiral filling the unit disc.

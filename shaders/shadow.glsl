@@ -9,12 +9,14 @@
 struct ShadowLight {
   ivec4 info;  // first view, view count, kind (0 none, 1 cascades, 2 spot, 3 point), technique
   vec4 splits; // cascades: camera depth where each ends
-  vec4 params; // c, bias, blend, Poisson radius
+  vec4 params; // c, bias (texels), blend, Poisson radius
+  ivec4 cube;  // point lights: x = the cube faces drawn (bit f: face f), their views in face order
 };
 struct ShadowView {
   mat4 view_proj;
   vec4 rect;  // tile in atlas uv: offset, size
   vec4 depth; // light position, 1 / range (0: orthographic)
+  vec4 texel; // a texel's world size (orthographic) or its size per unit of distance; world depth 0..1 spans
 };
 layout(std430, binding = 2) readonly buffer LimnShadowLights { ShadowLight shadow_lights[]; };
 layout(std430, binding = 3) readonly buffer LimnShadowViews { ShadowView shadow_views[]; };
@@ -44,7 +46,10 @@ float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
   vec2 texel = (sv.rect.xy + tuv * sv.rect.zw) * size - 0.5;
   ivec2 base = ivec2(floor(texel));
   vec2 f = texel - vec2(base);
-  float bias = s.params.y;
+  // The bias is given in texels: the world size of one where p is, as a
+  // share of the world depth the tile's 0..1 spans (any unit, any tile).
+  float world_texel = sv.texel.x * (sv.depth.w > 0.0 ? length(p - sv.depth.xyz) : 1.0);
+  float bias = s.params.y * world_texel / max(sv.texel.y, 1e-30);
   int technique = s.info.w;
   // Filters reach `spread` texels away, where a tilted receiver is deeper:
   // scale the bias by the tilt (tan of the light's angle, capped).
@@ -84,7 +89,8 @@ float shadow_factor(int light, vec3 p, vec3 n, vec3 l) {
     vec3 d = p - shadow_views[first].depth.xyz;
     vec3 a = abs(d);
     int face = a.x >= a.y && a.x >= a.z ? (d.x >= 0.0 ? 0 : 1) : a.y >= a.z ? (d.y >= 0.0 ? 2 : 3) : (d.z >= 0.0 ? 4 : 5);
-    return shadow_view_lookup(first + face, s, p, ndl);
+    if ((s.cube.x & (1 << face)) == 0) return 1.0; // no visible pixel was to sample it
+    return shadow_view_lookup(first + bitCount(s.cube.x & ((1 << face) - 1)), s, p, ndl);
   }
   if (kind == 2) return shadow_view_lookup(first, s, p, ndl);
   // Cascades: by camera depth, blended over the last `blend` share of each.

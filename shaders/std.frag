@@ -30,6 +30,6 @@ void main() {
 #endif
   out_clr = vec4(saturate(albedo), saturate(material_rho));
   out_nrm = vec4(n, max(material_k.w, 0.0));
-  out_dpt = max(view_depth, 0.0) * frame.clip.z;
+  out_dpt = dpt_encode(view_depth);
   out_mat = vec4(saturate(material_k.xyz), 1.0);
 }

@@ -188,6 +188,12 @@ bool gl_target_finite(gl_result *r, const char *name) {
   return ok;
 }
 
+void gl_rescale(lm_scene *s, float unit) {
+  float m[16] = {unit, 0, 0, 0, 0, unit, 0, 0, 0, 0, unit, 0, 0, 0, 0, 1};
+  lm_scene_add_root(s, "unit", m);
+  for (int i = 0; i < s->light_count; i++) s->lights[i].radius *= unit;
+}
+
 void gl_project(int width, int height, float x, float y, float z, int *col, int *row) {
   float depth = 3.4f - z, t = tanf(0.5f * 45.0f * 3.14159265f / 180.0f), aspect = (float)width / height;
   *col = (int)((x / (depth * t * aspect) + 1) * 0.5f * width);

@@ -64,6 +64,11 @@ float *gl_read_target(gl_result *r, const char *name, int *width, int *height);
  * read before the output stage, which would hide a NaN.) */
 bool gl_target_finite(gl_result *r, const char *name);
 
+/* The same scene in a unit `unit` times smaller: a root node scaled by unit
+ * above everything (cameras under it scale near and far with it), and the
+ * lights' ranges, which glTF keeps out of node scale, written in the new unit. */
+void gl_rescale(lm_scene *s, float unit);
+
 /* The pixel of world point (x, y, z) for the camera of the built-in Cornell
  * box (cornell.c: eye (0, 1, 3.4) looking down -z, fov_y 45 degrees) in a
  * width x height image, rows from the top. */

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Capture jobs as a user meets them: skipping what exists, --force, shards,
-# the manifest, a killed job completed by a rerun, and bad job files and
-# camera lists (a message naming the file and entry or line, exit non-zero).
+# merging shard manifests, --shard auto, limn farm slurm's script (its tasks
+# run here without Slurm), the manifest, a killed job completed by a rerun,
+# and bad job files and camera lists (a message naming the file and entry or
+# line, exit non-zero).
 set -u
 limn=$1
 root=$2
@@ -73,6 +75,83 @@ check "shard 2/3" run 0 capture --job job.lua --shard 2/3
 check "shard 1/3" run 0 capture --job job.lua --shard 1/3
 check "shards together render all" count_is "$(ls out/*/*.png | wc -l)" 16
 check "shard manifests" count_is "$(( $(entries out/manifest.shard-0-of-3.json) + $(entries out/manifest.shard-1-of-3.json) + $(entries out/manifest.shard-2-of-3.json) ))" 16
+# Merging the shards' manifests: every view once, the same hashes, else nothing written.
+check "merge" run 0 manifest merge --job job.lua --shards 3
+check "merge says so" out_has "job.lua: 16 views from 3 shards, each rendered once; 0 references there; out/manifest.json"
+check "merged manifest lists every image" count_is "$(entries out/manifest.json)" 16
+check "merged manifest in view order" test "$(grep -o '"view": [0-9]*' out/manifest.json | awk '{ printf "%s ", $2 }')" = "0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 "
+check "merged manifest says its shards" grep -qF '"shards": 3,' out/manifest.json
+rm out/manifest.json out/garage/low-dl-48x36.png
+check "merge with an image missing" run 1 manifest merge --job job.lua --shards 3
+check "the missing image is named with its shard" err_has "view 11 (garage, camera 'low', dl, 48x36) out/garage/low-dl-48x36.png: missing (in the manifest, not on disk) (shard 2/3)"
+check "the shard to rerun is named" err_has "1 of 16 views missing, 0 duplicated, 0 of 0 references missing: nothing written. Rerun shards 2 "
+check "a failed merge writes nothing" test ! -e out/manifest.json
+check "shard 2 rerun" run 0 capture --job job.lua --shard 2/3
+check "shard 2 rerun renders the missing image only" out_has "1 rendered, 4 skipped"
+cp out/manifest.shard-1-of-3.json shard1.json
+view0=$(grep '"view": 0,' out/manifest.shard-0-of-3.json | sed 's/,$//')
+awk -v l="$view0" '{ print } /"images": \[/ { print "    " l "," }' shard1.json > out/manifest.shard-1-of-3.json
+check "merge with a view in two manifests" run 1 manifest merge --job job.lua --shards 3
+check "the duplicate is named" err_has "view 0 (cornell, camera 'front', dl, 48x36) out/cornell/front-dl-48x36.png: rendered 2 times, in out/manifest.shard-0-of-3.json and out/manifest.shard-1-of-3.json"
+sed 's/"shader_hash": "[0-9a-f]*"/"shader_hash": "0123456789abcdef"/' shard1.json > out/manifest.shard-1-of-3.json
+check "merge of shards with other shaders" run 1 manifest merge --job job.lua --shards 3
+check "the differing hash is named" err_has "shard 1/3: out/manifest.shard-1-of-3.json has shader_hash 0123456789abcdef, out/manifest.shard-0-of-3.json has "
+cp shard1.json out/manifest.shard-1-of-3.json
+check "merge with other --set flags" run 1 manifest merge --job job.lua --shards 3 --set ambient=0.2
+check "another job hash is named" err_has "shard 0/3: out/manifest.shard-0-of-3.json has job_hash "
+check "merge with a shard not run" run 1 manifest merge --job job.lua --shards 4
+check "the shard not run is named" err_has "shard 3/4: no manifest out/manifest.shard-3-of-4.json"
+check "merge needs --shards" run 2 manifest merge --job job.lua
+check "merge: only merge" run 2 manifest join --job job.lua
+
+# --shard auto: the shard from a scheduler's environment, said on stderr.
+shard_env() { # shard_env RC MESSAGE SHARD ENV...: capture --job with --shard SHARD under ENV
+  local want=$1 msg=$2 shard=$3; shift 3
+  env -u SLURM_ARRAY_TASK_ID -u SLURM_ARRAY_TASK_MIN -u SLURM_ARRAY_TASK_MAX -u SLURM_ARRAY_TASK_COUNT \
+    -u JOB_COMPLETION_INDEX "$@" "$limn" capture --job job.lua --shard "$shard" >out.txt 2>err.txt
+  [ $? = "$want" ] || { echo "  exited $?, wanted $want"; cat err.txt; return 1; }
+  err_has "$msg"
+}
+check "auto: Slurm's id, min and count" shard_env 0 "shard 1/3 from SLURM_ARRAY_TASK_ID=1 less SLURM_ARRAY_TASK_MIN=0, of SLURM_ARRAY_TASK_COUNT=3" \
+  auto SLURM_ARRAY_TASK_ID=1 SLURM_ARRAY_TASK_MIN=0 SLURM_ARRAY_TASK_COUNT=3
+check "auto renders shard 1/3's views" out_has "16 views (5 in shard 1/3)"
+check "auto: Slurm's min and max" shard_env 0 "shard 2/3 from SLURM_ARRAY_TASK_ID=6 less SLURM_ARRAY_TASK_MIN=4, of MAX - MIN + 1 = 3" \
+  auto SLURM_ARRAY_TASK_ID=6 SLURM_ARRAY_TASK_MIN=4 SLURM_ARRAY_TASK_MAX=6
+check "auto: an array with steps" shard_env 2 "the array's indices are not a range 0-4 (SLURM_ARRAY_TASK_COUNT=3)" \
+  auto SLURM_ARRAY_TASK_ID=2 SLURM_ARRAY_TASK_MIN=0 SLURM_ARRAY_TASK_MAX=4 SLURM_ARRAY_TASK_COUNT=3
+check "auto/N: Slurm's id as it is" shard_env 0 "shard 1/3 from SLURM_ARRAY_TASK_ID=1, count 3 given" \
+  auto/3 SLURM_ARRAY_TASK_ID=1 SLURM_ARRAY_TASK_MIN=1 SLURM_ARRAY_TASK_COUNT=1
+check "auto/N: Kubernetes' index" shard_env 0 "shard 2/3 from JOB_COMPLETION_INDEX=2, count 3 given" auto/3 JOB_COMPLETION_INDEX=2
+check "auto: Kubernetes without a count" shard_env 2 "JOB_COMPLETION_INDEX=2 (a Kubernetes Indexed Job) gives no count" auto JOB_COMPLETION_INDEX=2
+check "auto: an index past the count" shard_env 2 "shard 3 is not in 0 .. 2 (SLURM_ARRAY_TASK_ID=3, count 3 given)" auto/3 SLURM_ARRAY_TASK_ID=3
+check "auto: no scheduler" shard_env 2 "neither SLURM_ARRAY_TASK_ID (a Slurm job array) nor JOB_COMPLETION_INDEX" auto
+check "auto: not a number" shard_env 2 "SLURM_ARRAY_TASK_ID='x' is not a whole number" auto SLURM_ARRAY_TASK_ID=x
+
+# limn farm slurm: the array script (its tasks run here as Slurm would run them).
+check "farm" run 0 farm slurm --job job.lua --shards 3 --partition debug --mem 2G --time 10 \
+  --sbatch=--qos=low --set ambient=0.05 --dir jobfarm
+check "farm says what it wrote" out_has "job.lua: 16 views in 3 shards (at most 6 views a task); wrote jobfarm/limn-job.sbatch"
+for line in '#SBATCH --array=0-2' '#SBATCH --partition=debug' '#SBATCH --mem=2G' '#SBATCH --time=10' \
+            '#SBATCH --qos=low' "#SBATCH --chdir=$tmp" '#SBATCH --output=jobfarm/logs/limn-job-%A_%a.log' \
+            "capture --job 'job.lua' --shard auto/3 --set 'ambient=0.05'" \
+            "manifest merge --job 'job.lua' --shards 3 --set 'ambient=0.05'"; do
+  check "farm script has $line" grep -qF -- "$line" jobfarm/limn-job.sbatch
+done
+check "farm makes the log folder" test -d jobfarm/logs
+rm out/cornell/*-48x36.png
+for i in 0 1 2; do SLURM_ARRAY_TASK_ID=$i bash jobfarm/limn-job.sbatch >>tasks.txt 2>&1; done
+check "farm tasks render every image" count_is "$(ls out/*/*.png | wc -l)" 16
+check "farm tasks render only the 4 missing" test "$(grep -o '[0-9]* rendered' tasks.txt | awk '{ s += $1 } END { print s }')" = 4
+LIMN_FARM_STEP=merge SLURM_ARRAY_TASK_ID=0 bash jobfarm/limn-job.sbatch >out.txt 2>err.txt
+check "farm merge task" out_has "job.lua: 16 views from 3 shards, each rendered once"
+printf 'return { scenes = { "%s" }, techniques = { "nosuch" }, output = "o/{camera}.png" }\n' "$scenes/cornell.glb" > badtech.lua
+check "farm checks the job first" run 2 farm slurm --job badtech.lua --shards 2 --dir badfarm
+check "farm: the bad entry named" err_has "badtech.lua: techniques[1]: "
+check "farm: no script for a bad job" test ! -e badfarm/limn-badtech.sbatch
+check "farm: --shards required" run 2 farm slurm --job job.lua
+check "farm: a bad name" run 2 farm slurm --job job.lua --shards 2 --name 'a b'
+check "farm: a value on two lines" run 2 farm slurm --job job.lua --shards 2 --partition "$(printf 'a\nb')"
+check "farm: only slurm" run 2 farm pbs --job job.lua --shards 2
 check "bad shard" run 2 capture --job job.lua --shard 3/3
 check "bad shard message" err_has "--shard wants I/N"
 check "--force needs --job" run 2 capture --force

@@ -182,6 +182,8 @@ static void script_errors_name_the_field(void **state) {
       {"pass{ 'p', shader = 'x.frag', params = { k = 0/0 }, out = target{ 't', format = 'rgba8' } }",
        "bad.lua:3: pass 'p': parameter 'k' is not finite"},
       {"present(3)", "bad.lua:3: present: expected a target"},
+      {"scene{ 's', out = target{ 't', format = 'rgba8' }, fit = target{ 'r', format = 'rg32f' } }",
+       "bad.lua:3: pass 's': fit is for a pass with views (a shadow plan)"},
       {"local t = target{ 't', format = 'rgba8' }\n"
        "pass{ 'light', shader = 'x.frag', inputs = { src = target{ 'never', format = 'rgba8' } }, out = t }\n"
        "present(t)", "bad.lua:4: pass 'light' reads target 'never' that no pass writes before it"},

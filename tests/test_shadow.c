@@ -35,21 +35,27 @@ static void plans_cover_every_caster(void **state) {
   assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
   assert_int_equal(plan.view_count, 3); /* one sun, three cascades */
   assert_int_equal(plan.lights[0].info[2], 1);
+  /* Cascades reach as far as the ground is seen (about 108 m), not the far
+   * plane (150 m): the end is rounded up by less than 1/16. */
+  assert_true(plan.seen[0] >= cam.clip[0] && plan.seen[1] > 100 && plan.seen[1] < 120);
   float last = cam.clip[0];
   for (int k = 0; k < 3; k++) {
     assert_true(plan.lights[0].splits[k] > last);
     last = plan.lights[0].splits[k];
   }
-  assert_float_equal(last, cam.clip[1], 1e-3f);
+  assert_true(last >= plan.seen[1] && last <= plan.seen[1] * 1.0625f);
   assert_int_equal(plan.atlas_width, 2 * 512);
   assert_int_equal(plan.atlas_height, 2 * 512);
+  /* Fitted to a depth range the G-buffer saw: 2 .. 40 m. */
+  lm_shadow_plan_fit(&plan, s, &cam, 2.0f, 40.0f);
+  assert_true(plan.lights[0].splits[2] >= 40.0f && plan.lights[0].splits[2] <= 42.5f);
   lm_shadow_plan_free(&plan);
   /* lambda 0: uniform splits. */
   st.lambda = 0;
   st.cascades = 4;
   assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
-  float step = (cam.clip[1] - cam.clip[0]) / 4;
-  for (int k = 0; k < 4; k++) assert_float_equal(plan.lights[0].splits[k], cam.clip[0] + step * (k + 1), 1e-2f);
+  float first = plan.lights[0].splits[0], step = (plan.lights[0].splits[3] - first) / 3;
+  for (int k = 1; k < 4; k++) assert_float_equal(plan.lights[0].splits[k], first + step * k, 1e-2f);
   lm_shadow_plan_free(&plan);
   st.cascades = 5;
   assert_false(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
@@ -118,6 +124,35 @@ static void occluded_points_are_dark_for_every_filter(void **state) {
   lm_scene_destroy(s);
 }
 
+/* The same points stay dark and lit with the box in millimetres (a scaled
+ * root; the light's range in the new unit) and with near 1e-5, far 1e6, for
+ * the point light (cube faces) and the spot. */
+static void occluded_points_stay_dark_at_any_scale_and_depth_range(void **state) {
+  (void)state;
+  for (int spot = 0; spot < 2; spot++) {
+    for (int c = 0; c < 2; c++) {
+      lm_scene *s = builtin("cornell");
+      if (spot) {
+        s->lights[0].type = LM_LIGHT_SPOT;
+        s->lights[0].inner_cone = glm_rad(55.0f);
+        s->lights[0].outer_cone = glm_rad(75.0f);
+      }
+      if (c == 0) {
+        gl_rescale(s, 1e-3f);
+      } else {
+        s->cameras[0].znear = 1e-5f;
+        s->cameras[0].zfar = 1e6f;
+      }
+      gl_result plain = render_ok(s, "dl", NULL);
+      static const char *const pcf[] = {"shadow.technique=pcf", NULL};
+      check_cornell(s, &plain, NULL, 0.1f);
+      check_cornell(s, &plain, pcf, 0.1f);
+      gl_result_free(&plain);
+      lm_scene_destroy(s);
+    }
+  }
+}
+
 static void extreme_exponents_stay_finite_and_on_the_right_side(void **state) {
   (void)state;
   lm_scene *s = builtin("cornell");
@@ -165,6 +200,41 @@ static void the_sun_casts_cascaded_shadows_at_any_depth_range(void **state) {
   lm_scene_destroy(s);
 }
 
+/* Cascades fit the camera depths the G-buffer holds (the depth-range
+ * reduction read back before the shadow pass), here 0.1 .. 150 m of camera
+ * range of which the field shows about 4 .. 96 m. */
+static void cascades_fit_the_depths_the_frame_sees(void **state) {
+  (void)state;
+  lm_scene *s = builtin("field");
+  gl_result r = render_ok(s, "dl+esm", NULL);
+  lm_renderer_set_sharing(r.renderer, false); /* keep gbuffer.dpt readable */
+  assert_true(gl_render_again(&r));
+  int w, h;
+  float *dpt = gl_read_target(&r, "gbuffer.dpt", &w, &h);
+  assert_non_null(dpt);
+  float lo = INFINITY, hi = 0;
+  for (size_t i = 0; i < (size_t)w * h; i++)
+    if (dpt[i * 4] > 0) lo = fminf(lo, dpt[i * 4]), hi = fmaxf(hi, dpt[i * 4]);
+  free(dpt);
+  lm_frame_data cam;
+  lm_scene_frame_data(s, 0, r.width, r.height, &cam);
+  const lm_shadow_plan *plan = lm_renderer_shadows(r.renderer);
+  printf("seen %g .. %g m (G-buffer %g .. %g), camera %g .. %g, read back in %.3f ms\n", plan->seen[0],
+         plan->seen[1], lo * cam.clip[1], hi * cam.clip[1], cam.clip[0], cam.clip[1], lm_renderer_fit_ms(r.renderer));
+  assert_float_equal(plan->seen[0], lo * cam.clip[1], 1e-4f * plan->seen[0]);
+  assert_float_equal(plan->seen[1], hi * cam.clip[1], 1e-4f * plan->seen[1]);
+  assert_true(plan->seen[0] > 10 * cam.clip[0] && plan->seen[1] < 0.8f * cam.clip[1]);
+  float last = plan->lights[0].splits[2];
+  assert_true(last >= plan->seen[1] && last <= plan->seen[1] * 1.0625f);
+  /* Each cascade draws only the casters over its tile (keeping those before
+   * its near plane): of 3 x 61 meshes, 35 are left out (none were before). */
+  lm_scene_draw_stats st = lm_renderer_shadow_draw_stats(r.renderer);
+  printf("cascade tiles: %d meshes drawn, %d culled\n", st.drawn, st.culled);
+  assert_true(st.drawn + st.culled == 3 * 61 && st.culled >= 25 && st.drawn >= 3);
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+}
+
 /* Mean difference between the first cascade's tile in two maps, at the best
  * whole-texel shift: a stabilized map only ever moves by whole texels. */
 static double tile_change(const float *a, const float *b, int width, int height, int tile) {
@@ -199,7 +269,7 @@ static double shimmer(lm_scene *s, const char *stabilize, bool rotate) {
     glm_rotate_y(m, glm_rad(0.05f), m);
     memcpy(cam, m, sizeof m);
   } else {
-    cam[12] += 0.004f;
+    cam[12] += 0.004f; /* in the camera node's unit: under a scaled root, scaled */
     cam[14] -= 0.003f;
   }
   lm_scene_update(s);
@@ -214,15 +284,55 @@ static double shimmer(lm_scene *s, const char *stabilize, bool rotate) {
   return change;
 }
 
+/* At every scale: the field in millimetres, metres and hundreds of kilometres. */
 static void stabilized_cascades_do_not_shimmer(void **state) {
   (void)state;
-  lm_scene *s = builtin("field");
-  for (int rotate = 0; rotate < 2; rotate++) {
-    double stable = shimmer(s, "shadow.stabilize=true", rotate), loose = shimmer(s, "shadow.stabilize=false", rotate);
-    printf("cascade 0 change after a sub-texel %s: stabilized %.3g, unstabilized %.3g\n",
-           rotate ? "turn" : "move", stable, loose);
-    if (!(stable < 1e-5 && loose > 10 * stable + 1e-5)) fail_msg("stabilized %g, unstabilized %g", stable, loose);
+  static const float units[] = {1e-3f, 1.0f, 1e5f};
+  for (size_t u = 0; u < sizeof units / sizeof *units; u++) {
+    lm_scene *s = builtin("field");
+    if (units[u] != 1.0f) gl_rescale(s, units[u]);
+    for (int rotate = 0; rotate < 2; rotate++) {
+      double stable = shimmer(s, "shadow.stabilize=true", rotate);
+      double loose = shimmer(s, "shadow.stabilize=false", rotate);
+      printf("scale %g: cascade 0 change after a sub-texel %s: stabilized %.3g, unstabilized %.3g\n", units[u],
+             rotate ? "turn" : "move", stable, loose);
+      if (!(stable < 1e-5 && loose > 10 * stable + 1e-5))
+        fail_msg("scale %g: stabilized %g, unstabilized %g", units[u], stable, loose);
+    }
+    lm_scene_destroy(s);
   }
+}
+
+/* Looking straight down at the short box and the floor under the ceiling
+ * light, every visible pixel samples the light's -Y cube face: the other
+ * five are not planned, drawn or filtered (the atlas is one tile), and the
+ * box still shades the floor beside it. */
+static void cube_faces_no_pixel_samples_are_not_drawn(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  mat4 view, world;
+  glm_lookat((vec3){0.55f, 1.2f, 0.5f}, (vec3){0.55f, 0.0f, 0.5f}, (vec3){0, 0, -1}, view);
+  glm_mat4_inv(view, world);
+  lm_scene_node_set_world(s, s->cameras[0].node, (float *)world);
+  s->cameras[0].fov_y = glm_rad(40.0f);
+  gl_result plain = render_ok(s, "dl", NULL), r = render_ok(s, "dl+esm", NULL);
+  const lm_shadow_plan *plan = lm_renderer_shadows(r.renderer);
+  assert_int_equal(plan->view_count, 1);
+  assert_int_equal(plan->lights[0].cube[0], 1 << 3); /* -Y */
+  lm_graph *g = lm_renderer_graph(r.renderer);
+  lm_graph_target_info map = lm_graph_target(g, lm_graph_find_target(g, "shadow.map"));
+  assert_int_equal(map.width, 512);
+  assert_int_equal(map.height, 512);
+  int dark = 0, lit = 0, n = r.width * r.height;
+  for (int i = 0; i < n; i++) {
+    float a = gl_luminance(plain.rgb + (size_t)i * 3), b = gl_luminance(r.rgb + (size_t)i * 3);
+    dark += b < 0.5f * a, lit += b > 0.97f * a;
+  }
+  printf("looking down: %d views, %.1f%% of pixels in shadow, %.1f%% lit\n", plan->view_count, 100.0 * dark / n,
+         100.0 * lit / n);
+  assert_true(dark > n / 100 && lit > n / 3);
+  gl_result_free(&r);
+  gl_result_free(&plain);
   lm_scene_destroy(s);
 }
 
@@ -251,7 +361,7 @@ static void the_atlas_can_be_viewed(void **state) {
   float all[3];
   gl_region(&r, 0, 0, r.width - 1, r.height - 1, all);
   assert_true(gl_luminance(all) > 0.05f);
-  assert_false(gl_has_pass(&r, "gbuffer"));
+  assert_false(gl_has_pass(&r, "direct")); /* the G-buffer runs: the cascades fit its depths */
   gl_result_free(&r);
   lm_scene_destroy(s);
 }
@@ -260,9 +370,12 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(plans_cover_every_caster),
       cmocka_unit_test(occluded_points_are_dark_for_every_filter),
+      cmocka_unit_test(occluded_points_stay_dark_at_any_scale_and_depth_range),
       cmocka_unit_test(extreme_exponents_stay_finite_and_on_the_right_side),
       cmocka_unit_test(the_sun_casts_cascaded_shadows_at_any_depth_range),
+      cmocka_unit_test(cascades_fit_the_depths_the_frame_sees),
       cmocka_unit_test(stabilized_cascades_do_not_shimmer),
+      cmocka_unit_test(cube_faces_no_pixel_samples_are_not_drawn),
       cmocka_unit_test(nothing_casts_or_nothing_reads_means_no_shadow_pass),
       cmocka_unit_test(the_atlas_can_be_viewed),
   };

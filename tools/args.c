@@ -52,6 +52,84 @@ bool limn_parse_on_off(const char *s, bool *out) {
   return true;
 }
 
+static bool env_index(const char *name, int *out, bool *set, char *msg, size_t cap) {
+  const char *v = getenv(name);
+  *set = v != NULL;
+  if (v && !limn_parse_int(v, 0, 1 << 24, out)) {
+    snprintf(msg, cap, "--shard auto: %s='%s' is not a whole number", name, v);
+    return false;
+  }
+  return true;
+}
+
+bool limn_parse_shard(const char *s, int *shard, int *shards, char *msg, size_t cap) {
+  char buf[64];
+  snprintf(buf, sizeof buf, "%s", s);
+  char *count = strchr(buf, '/');
+  if (count) *count++ = '\0';
+  int n = 0;
+  msg[0] = '\0';
+  if (strcmp(buf, "auto")) {
+    if (!count || !limn_parse_int(count, 1, 1 << 20, &n) || !limn_parse_int(buf, 0, n - 1, shard)) {
+      snprintf(msg, cap, "--shard wants I/N with 0 <= I < N, auto or auto/N, not '%s'", s);
+      return false;
+    }
+    *shards = n;
+    return true;
+  }
+  if (count && !limn_parse_int(count, 1, 1 << 20, &n)) {
+    snprintf(msg, cap, "--shard auto/N wants a count N >= 1, not '%s'", count);
+    return false;
+  }
+  int id = 0, min = 0, max = 0, total = 0, k8s = 0;
+  bool has_id, has_min, has_max, has_total, has_k8s;
+  if (!env_index("SLURM_ARRAY_TASK_ID", &id, &has_id, msg, cap) ||
+      !env_index("SLURM_ARRAY_TASK_MIN", &min, &has_min, msg, cap) ||
+      !env_index("SLURM_ARRAY_TASK_MAX", &max, &has_max, msg, cap) ||
+      !env_index("SLURM_ARRAY_TASK_COUNT", &total, &has_total, msg, cap) ||
+      !env_index("JOB_COMPLETION_INDEX", &k8s, &has_k8s, msg, cap))
+    return false;
+  if (has_id && n) {
+    *shard = id, *shards = n;
+    snprintf(msg, cap, "SLURM_ARRAY_TASK_ID=%d, count %d given", id, n);
+  } else if (has_id) {
+    if (!has_min || (!has_max && !has_total)) {
+      snprintf(msg, cap, "--shard auto: SLURM_ARRAY_TASK_ID is set without SLURM_ARRAY_TASK_MIN and "
+               "SLURM_ARRAY_TASK_COUNT or _MAX: give the count, --shard auto/N");
+      return false;
+    }
+    int span = has_max ? max - min + 1 : total;
+    if (has_total && has_max && total != span) {
+      snprintf(msg, cap, "--shard auto: the array's indices are not a range %d-%d (SLURM_ARRAY_TASK_COUNT=%d): "
+               "give the count, --shard auto/N", min, max, total);
+      return false;
+    }
+    *shard = id - min, *shards = span;
+    if (has_total) snprintf(msg, cap, "SLURM_ARRAY_TASK_ID=%d less SLURM_ARRAY_TASK_MIN=%d, of SLURM_ARRAY_TASK_COUNT=%d",
+                            id, min, total);
+    else snprintf(msg, cap, "SLURM_ARRAY_TASK_ID=%d less SLURM_ARRAY_TASK_MIN=%d, of MAX - MIN + 1 = %d", id, min, span);
+  } else if (has_k8s) {
+    if (!n) {
+      snprintf(msg, cap, "--shard auto: JOB_COMPLETION_INDEX=%d (a Kubernetes Indexed Job) gives no count: "
+               "--shard auto/N with N the job's completions", k8s);
+      return false;
+    }
+    *shard = k8s, *shards = n;
+    snprintf(msg, cap, "JOB_COMPLETION_INDEX=%d, count %d given", k8s, n);
+  } else {
+    snprintf(msg, cap, "--shard auto: neither SLURM_ARRAY_TASK_ID (a Slurm job array) nor JOB_COMPLETION_INDEX "
+             "(a Kubernetes Indexed Job) is set: give --shard I/N");
+    return false;
+  }
+  if (*shard < 0 || *shard >= *shards) {
+    char from[256];
+    snprintf(from, sizeof from, "%s", msg);
+    snprintf(msg, cap, "--shard %s: shard %d is not in 0 .. %d (%s)", s, *shard, *shards - 1, from);
+    return false;
+  }
+  return true;
+}
+
 void limn_json_append(lm_buf *b, const char *s) {
   lm_buf_append(b, "\"", 1);
   for (; *s; s++) {

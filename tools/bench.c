@@ -24,7 +24,9 @@ static const char bench_usage[] =
     "pass (scripts/calibrate.lua: 8 and 64 texel fetches a pixel) at the largest\n"
     "size gives the machine's fetch rate; a pass whose script declares its\n"
     "fetches (pass{ fetches = N }) is shown as a share of that rate, any other\n"
-    "as the fetches a pixel its time would allow.\n"
+    "as the fetches a pixel its time would allow. With shadows fitted to the\n"
+    "depths the frame sees, the cost of that fit (the depth-range reduction\n"
+    "passes plus reading their result back) is shown as a share of the frame.\n"
     "\n"
     "options:\n"
     "  --scene NAME|FILE   (default cornell)\n"
@@ -62,6 +64,7 @@ typedef struct bench {
   lm_clock clock;
   bool json;
   double frame_ms[MAX_SIZES], overhead_ms[MAX_SIZES];
+  double readback_ms[MAX_SIZES]; /* the shadow fit's read-back and refit (wall clock) */
   bench_pass passes[MAX_PASSES];
   int pass_count;
 } bench;
@@ -171,6 +174,7 @@ static bool run_size(bench *b, int si, bool vary, lm_scene *scene, lm_pipeline *
   if (!r) return false;
   *used = lm_renderer_clock(r);
   double *wall = lm_alloc(sizeof(double) * (size_t)b->frames), *over = lm_alloc(sizeof(double) * (size_t)b->frames);
+  double *readback = lm_alloc(sizeof(double) * (size_t)b->frames);
   double *pass_ms = lm_alloc(sizeof(double) * (size_t)b->frames * MAX_PASSES);
   int pass_n[MAX_PASSES] = {0};
   bool ok = true;
@@ -186,6 +190,7 @@ static bool run_size(bench *b, int si, bool vary, lm_scene *scene, lm_pipeline *
     lm_renderer_overhead(r, &rec, &comp);
     wall[k] = t1 - t0;
     over[k] = rec + comp;
+    readback[k] = lm_renderer_fit_ms(r);
     lm_graph *g = lm_renderer_graph(r);
     for (int i = 0; i < lm_graph_pass_count(g); i++) {
       lm_graph_pass_info p = lm_graph_pass(g, i);
@@ -200,11 +205,13 @@ static bool run_size(bench *b, int si, bool vary, lm_scene *scene, lm_pipeline *
   if (ok && !vary) {
     b->frame_ms[si] = median(wall, b->frames);
     b->overhead_ms[si] = median(over, b->frames);
+    b->readback_ms[si] = median(readback, b->frames);
   }
   for (int i = 0; i < b->pass_count && ok; i++)
     if (pass_n[i]) (vary ? b->passes[i].vary_ms : b->passes[i].ms)[si] = median(pass_ms + i * b->frames, pass_n[i]);
   free(wall);
   free(over);
+  free(readback);
   free(pass_ms);
   lm_renderer_destroy(r);
   return ok;
@@ -243,6 +250,17 @@ static bool fetch_figures(const bench *b, const bench_pass *p, double *rate, dou
   return true;
 }
 
+/* The shadow fit at size s: its reduction passes (shadow.range*) and the
+ * read-back; false when the frame fits no shadows. */
+static bool shadow_fit_ms(const bench *b, int s, double *passes, double *readback) {
+  *passes = 0, *readback = b->readback_ms[s];
+  bool any = false;
+  for (int i = 0; i < b->pass_count; i++)
+    if (!strncmp(b->passes[i].name, "shadow.range", 12) && b->passes[i].ms[s] >= 0)
+      *passes += b->passes[i].ms[s], any = true;
+  return any;
+}
+
 static void print_tables(const bench *b, lm_clock clock) {
   printf("frame (wall clock, glFinish before and after) and compositor overhead (CPU: Lua + graph compile);\n"
          "passes: clock %s; medians of %d frames after %d warm-up\n", lm_clock_name(clock), b->frames, b->warmup);
@@ -250,6 +268,11 @@ static void print_tables(const bench *b, lm_clock clock) {
   for (int s = 0; s < b->size_count; s++)
     printf("  %5dx%-6d %10d %12.3f %12.3f %8.1f%%\n", b->sizes[s][0], b->sizes[s][1], b->sizes[s][0] * b->sizes[s][1],
            b->frame_ms[s], b->overhead_ms[s], b->frame_ms[s] > 0 ? 100 * b->overhead_ms[s] / b->frame_ms[s] : 0);
+  double fp, fr;
+  for (int s = 0; s < b->size_count; s++)
+    if (shadow_fit_ms(b, s, &fp, &fr))
+      printf("  shadow fit at %dx%d: reduction %.3f ms + read-back %.3f ms = %.1f%% of the frame\n", b->sizes[s][0],
+             b->sizes[s][1], fp, fr, b->frame_ms[s] > 0 ? 100 * (fp + fr) / b->frame_ms[s] : 0);
   printf("  %-24s", "pass (ms)");
   for (int s = 0; s < b->size_count; s++) printf(" %9dx%-4d", b->sizes[s][0], b->sizes[s][1]);
   printf("  fit: a ms + b ns/pixel (r^2)\n");
@@ -296,9 +319,13 @@ static void print_json(const bench *b, lm_clock clock) {
   printf("{\"clock\": ");
   limn_json_string(lm_clock_name(clock));
   printf(", \"frames\": %d, \"warmup\": %d, \"sizes\": [", b->frames, b->warmup);
-  for (int s = 0; s < b->size_count; s++)
-    printf("%s{\"width\": %d, \"height\": %d, \"frame_ms\": %.6g, \"overhead_ms\": %.6g}", s ? ", " : "",
+  for (int s = 0; s < b->size_count; s++) {
+    printf("%s{\"width\": %d, \"height\": %d, \"frame_ms\": %.6g, \"overhead_ms\": %.6g", s ? ", " : "",
            b->sizes[s][0], b->sizes[s][1], b->frame_ms[s], b->overhead_ms[s]);
+    double fp, fr;
+    if (shadow_fit_ms(b, s, &fp, &fr)) printf(", \"shadow_fit_ms\": %.6g, \"shadow_readback_ms\": %.6g", fp + fr, fr);
+    printf("}");
+  }
   printf("], \"passes\": [");
   for (int i = 0; i < b->pass_count; i++) {
     const bench_pass *p = &b->passes[i];

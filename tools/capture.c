@@ -42,6 +42,9 @@ static const char capture_usage[] =
     "                       README.md); --set adds to the job's options\n"
     "  --force              with --job: render images that exist already\n"
     "  --shard I/N          with --job: render views I, I+N, I+2N ... only\n"
+    "  --shard auto[/N]     the shard from a job array: Slurm's SLURM_ARRAY_TASK_ID\n"
+    "                       (less _MIN, of _COUNT shards; with /N as it is, of N),\n"
+    "                       or Kubernetes' JOB_COMPLETION_INDEX (auto/N)\n"
     "  --quiet              no times, errors only\n"
     "  --verbose            debug messages (targets left out, GL messages)\n"
     "  --help               this text\n";
@@ -49,6 +52,7 @@ static const char capture_usage[] =
 typedef struct capture_args {
   const char *scene, *script, *tech, *egl, *job;
   int shard, shards;
+  char shard_from[256]; /* where --shard auto found the shard */
   bool force;
   const char *single_flag; /* a flag of single captures (the job names these itself) */
   const char *outputs[16];
@@ -137,16 +141,10 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       break;
     case 'j': a->job = optarg; break;
     case 'f': a->force = true; break;
-    case 'S': {
-      char buf[64], *slash;
-      snprintf(buf, sizeof buf, "%s", optarg);
-      slash = strchr(buf, '/');
-      if (slash) *slash = '\0';
-      if (!slash || !limn_parse_int(buf, 0, 1 << 20, &a->shard) || !limn_parse_int(slash + 1, 1, 1 << 20, &a->shards) ||
-          a->shard >= a->shards)
-        return usage_error("--shard wants I/N with 0 <= I < N, not '%s'", optarg);
+    case 'S':
+      if (!limn_parse_shard(optarg, &a->shard, &a->shards, a->shard_from, sizeof a->shard_from))
+        return usage_error("%s", a->shard_from);
       break;
-    }
     case 'l': a->list_options = true; break;
     case 'q': a->quiet = true; break;
     case 'v': a->verbose = true; break;
@@ -282,6 +280,7 @@ int limn_capture(int argc, char **argv) {
   if (rc) return rc < 0 ? 0 : rc;
   if (a.verbose) lm_log_set_level(LM_LOG_DEBUG);
   if (a.quiet) lm_log_set_level(LM_LOG_WARN);
+  if (a.shard_from[0]) lm_info("shard %d/%d from %s", a.shard, a.shards, a.shard_from);
   if (a.job)
     return capture_job_run(&(capture_job_args){.path = a.job, .sets = a.sets, .set_count = a.set_count,
                                                .shard = a.shard, .shards = a.shards ? a.shards : 1,

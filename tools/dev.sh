@@ -14,6 +14,7 @@ packages=(
   libegl-dev libegl-mesa0 libgl1-mesa-dri libcmocka-dev libtinygltf-dev nlohmann-json3-dev
   libglfw3-dev libfreetype-dev fonts-dejavu-core xvfb xauth
   clang libclang-rt-14-dev povray valgrind libxml2-utils
+  slurmctld slurmd slurm-client munge    # tests/test_slurm.sh starts a one-node cluster
 )
 
 deps() {

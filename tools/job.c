@@ -400,20 +400,16 @@ static uint64_t hash_file(const char *path, uint64_t h) {
 /* ---- the manifest ------------------------------------------------------ */
 
 
-typedef struct manifest {
-  char *header;        /* everything before "images" */
-  char **entries;      /* one line of JSON per image, NULL: not rendered (yet) */
-  int run;             /* this run's number: the last one's + 1 */
-} manifest;
-
 /* The entries a previous run left, one line each, keyed by "file". */
-static void manifest_load(const char *path, const job_view *views, int view_count, manifest *m) {
+bool job_manifest_load(const char *path, const job_view *views, int view_count, job_manifest *m) {
   size_t len;
   lm_error err;
   char *text = lm_read_file(path, &len, &err);
-  if (!text) return;
+  if (!text) return false;
+  const char *images = strstr(text, "  \"images\": [");
+  if (images) m->header = lm_strdup(text), m->header[images - text] = '\0';
   const char *run = strstr(text, "\"run\": ");
-  if (run) m->run = atoi(run + 7);
+  if (run && (!images || run < images)) m->run = atoi(run + 7);
   for (char *line = text, *next; line; line = next) {
     next = strchr(line, '\n');
     if (next) *next++ = '\0';
@@ -425,14 +421,28 @@ static void manifest_load(const char *path, const job_view *views, int view_coun
       lm_buf key = {0};
       lm_buf_append(&key, "{\"file\": ", -1);
       limn_json_append(&key, views[i].output);
+      lm_buf_append(&key, ",", 1);
       if (!strncmp(f, key.data, (size_t)key.len) && !m->entries[i]) m->entries[i] = lm_strdup(f);
       lm_buf_free(&key);
     }
   }
   free(text);
+  return true;
 }
 
-static bool manifest_write(const char *path, const manifest *m, int view_count, lm_error *err) {
+bool job_manifest_field(const job_manifest *m, const char *key, char *out, size_t cap) {
+  char pattern[128];
+  snprintf(pattern, sizeof pattern, "\n  \"%s\": ", key);
+  const char *p = m->header ? strstr(m->header, pattern) : NULL;
+  if (!p) return false;
+  p += strlen(pattern);
+  if (*p == '"') p++;
+  size_t n = strcspn(p, "\",\n");
+  snprintf(out, cap, "%.*s", (int)n, p);
+  return true;
+}
+
+bool job_manifest_write(const char *path, const job_manifest *m, int view_count, lm_error *err) {
   lm_buf b = {0};
   lm_buf_append(&b, m->header, -1);
   lm_buf_append(&b, "  \"images\": [\n", -1);
@@ -443,18 +453,25 @@ static bool manifest_write(const char *path, const manifest *m, int view_count, 
     first = false;
   }
   lm_buf_append(&b, "\n  ]\n}\n", -1);
-  char tmp[1100];
-  snprintf(tmp, sizeof tmp, "%s.tmp-%d", path, (int)getpid());
-  FILE *f = fopen(tmp, "w");
-  bool ok = f && fwrite(b.data, 1, (size_t)b.len, f) == (size_t)b.len;
-  ok = f && fclose(f) == 0 && ok;
-  ok = ok && rename(tmp, path) == 0;
-  if (!ok) {
-    remove(tmp);
-    lm_error_set(err, "%s: cannot write the manifest", path);
-  }
+  bool ok = limn_write_whole(path, b.data, (size_t)b.len, err);
   lm_buf_free(&b);
   return ok;
+}
+
+void job_manifest_path(const job *j, int shard, int shards, char *out, size_t cap) {
+  snprintf(out, cap, "%s", j->manifest);
+  if (shards <= 1) return;
+  char *dot = strrchr(out, '.');
+  char tail[64];
+  snprintf(tail, sizeof tail, ".shard-%d-of-%d.json", shard, shards);
+  if (dot && !strchr(dot, '/')) *dot = '\0';
+  strncat(out, tail, cap - strlen(out) - 1);
+}
+
+uint64_t job_hash_with(const job *j, const char *const *sets, int set_count) {
+  uint64_t h = j->hash;
+  for (int i = 0; i < set_count; i++) h = lm_hash(sets[i], strlen(sets[i]), h);
+  return h;
 }
 
 static char *manifest_entry(const job *j, const job_view *v, int index, const capture_result *res, int run) {
@@ -562,16 +579,11 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   }
 
   char manifest_path[1100];
-  snprintf(manifest_path, sizeof manifest_path, "%s", j->manifest);
-  if (a->shards > 1) {
-    char *dot = strrchr(manifest_path, '.');
-    char tail[64];
-    snprintf(tail, sizeof tail, ".shard-%d-of-%d.json", a->shard, a->shards);
-    if (dot && !strchr(dot, '/')) *dot = '\0';
-    strncat(manifest_path, tail, sizeof manifest_path - strlen(manifest_path) - 1);
-  }
-  manifest m = {.entries = calloc((size_t)view_count + 1, sizeof(char *))};
-  manifest_load(manifest_path, views, view_count, &m);
+  job_manifest_path(j, a->shard, a->shards, manifest_path, sizeof manifest_path);
+  job_manifest m = {.entries = calloc((size_t)view_count + 1, sizeof(char *))};
+  job_manifest_load(manifest_path, views, view_count, &m);
+  free(m.header); /* written anew below */
+  m.header = NULL;
   m.run++;
 
   int rc = 0;
@@ -595,8 +607,7 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     snprintf(root_scripts, sizeof root_scripts, "%s/scripts", lm_root_dir());
     snprintf(shaders, sizeof shaders, "%s/shaders", lm_root_dir());
     scripts = hash_folder(root_scripts, ".lua", hash_file(j->script, scripts));
-    uint64_t job_hash = j->hash;
-    for (int i = 0; i < a->set_count; i++) job_hash = lm_hash(a->sets[i], strlen(a->sets[i]), job_hash);
+    uint64_t job_hash = job_hash_with(j, a->sets, a->set_count);
     lm_buf h = {0};
     lm_buf_append(&h, "{\n  \"job\": ", -1);
     limn_json_append(&h, j->path);
@@ -657,7 +668,7 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     if (ok) {
       free(m.entries[i]);
       m.entries[i] = manifest_entry(j, v, i, &res, m.run);
-      ok = manifest_write(manifest_path, &m, view_count, &err);
+      ok = job_manifest_write(manifest_path, &m, view_count, &err);
     }
     if (!ok) {
       if (tty && !a->quiet) printf("\n");
@@ -675,7 +686,7 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   }
   if (!rc && !a->quiet) printf("job %s: %d rendered, %d skipped (existing; --force redoes them)\n", j->path,
                                rendered, skipped);
-  if (!rc && rendered == 0 && m.header) manifest_write(manifest_path, &m, view_count, &err);
+  if (!rc && rendered == 0 && m.header) job_manifest_write(manifest_path, &m, view_count, &err);
   lm_renderer_destroy(r);
   lm_programs_clear();
   for (int i = 0; i <= view_count; i++) free(m.entries[i]);

@@ -52,4 +52,28 @@ bool job_make_parent(const char *file, lm_error *err);
 /* A progress bar on a terminal (tty), else one line per item. */
 void job_progress(bool quiet, bool tty, int done, int total, const char *what);
 
+/* The manifest of a capture job (a shard's when shards > 1:
+ * <manifest stem>.shard-I-of-N.json). */
+void job_manifest_path(const job *j, int shard, int shards, char *out, size_t cap);
+/* The job hash a manifest records: the job file's, then the --set flags. */
+uint64_t job_hash_with(const job *j, const char *const *sets, int set_count);
+
+/* A manifest as capture writes it: the header's JSON text (everything
+ * before "images"), then one line of JSON per view (NULL: not rendered). */
+typedef struct job_manifest {
+  char *header;
+  char **entries; /* one per view */
+  int run;        /* the run that last wrote it (0: none) */
+} job_manifest;
+
+/* Reads the file's header and its entries, each put at the view whose
+ * output it names; false when there is no such file (m stays empty).
+ * m->entries must hold `count` pointers. */
+bool job_manifest_load(const char *path, const job_view *views, int count, job_manifest *m);
+/* Writes the header and the entries whole (a temporary file renamed). */
+bool job_manifest_write(const char *path, const job_manifest *m, int count, lm_error *err);
+/* A string or number field of the header ("job_hash"), unquoted, into out;
+ * false when it is not there. */
+bool job_manifest_field(const job_manifest *m, const char *key, char *out, size_t cap);
+
 #endif

@@ -15,6 +15,8 @@ static const char usage[] =
     "  compare   mean error, RMSE, PSNR, Pearson, SSIM of two images; difference image\n"
     "  reference  POV-Ray references (radiosity) of a capture job's views, cached by hash\n"
     "  report    error against POV-Ray references and run time for a sweep of techniques\n"
+    "  farm      a capture job (and its references) as a Slurm job array: limn farm slurm\n"
+    "  manifest  merge the manifests of a sharded capture job: limn manifest merge\n"
     "  bench     compositor overhead per frame and pass times against resolution\n"
     "  view      a window with live reload of scripts and shaders, timings, target inspector\n"
     "  help      this text; `limn <command> --help` describes a command's flags\n"
@@ -38,6 +40,8 @@ int main(int argc, char **argv) {
   if (!strcmp(cmd, "compare")) return limn_compare(argc - 1, argv + 1);
   if (!strcmp(cmd, "reference")) return limn_reference(argc - 1, argv + 1);
   if (!strcmp(cmd, "report")) return limn_report(argc - 1, argv + 1);
+  if (!strcmp(cmd, "farm")) return limn_farm(argc - 1, argv + 1);
+  if (!strcmp(cmd, "manifest")) return limn_manifest(argc - 1, argv + 1);
   if (!strcmp(cmd, "bench")) return limn_bench(argc - 1, argv + 1);
   fprintf(stderr, "limn: unknown command '%s'\n\n%s", cmd, usage);
   return 2;

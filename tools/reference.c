@@ -16,7 +16,8 @@
 #include "tools.h"
 
 static const char reference_usage[] =
-    "usage: limn reference --job FILE [--refs DIR] [--force] [--jobs N] [export-pov flags]\n"
+    "usage: limn reference --job FILE [--refs DIR] [--force] [--jobs N] [--shard I/N|auto[/N]]\n"
+    "                      [export-pov flags]\n"
     "\n"
     "Renders a POV-Ray reference (radiosity on, OpenEXR, linear) of every view of\n"
     "a capture job: each scene, camera and size (techniques do not matter here).\n"
@@ -30,6 +31,9 @@ static const char reference_usage[] =
     "  --force              render again even what exists\n"
     "  --jobs N             POV-Ray runs at once (default: the core count)\n"
     "  --povray PROGRAM     the POV-Ray program (default povray)\n"
+    "  --shard I/N          views I, I+N, I+2N ... only (numbered as capture's,\n"
+    "                       without techniques: scene, size, camera)\n"
+    "  --shard auto[/N]     the shard from a job array (as limn capture --shard)\n"
     "  --quiet              no progress\n"
     "  --radiosity, --count, --error-bound, --pretrace-start, --pretrace-end,\n"
     "  --recursion-limit, --brightness, --shadows, --approximate: as export-pov\n"
@@ -38,7 +42,7 @@ static const char reference_usage[] =
     "exit codes: 0 all references there, 1 an export or POV-Ray run failed, 2 bad usage.\n";
 
 void reference_defaults(reference_args *a) {
-  *a = (reference_args){.refs = "out/reference", .povray = "povray"};
+  *a = (reference_args){.refs = "out/reference", .povray = "povray", .shards = 1};
   limn_pov_defaults(&a->pov);
   long cores = sysconf(_SC_NPROCESSORS_ONLN);
   a->jobs = cores > 0 ? (int)cores : 1;
@@ -150,15 +154,18 @@ static void show_log(const char *log) {
 
 int reference_run(const reference_args *a, const job *j, const job_view *places, int n, char (*paths)[1024]) {
   lm_error err;
-  int rc = 0, done = 0, rendered = 0, cached = 0, running = 0;
+  int rc = 0, done = 0, rendered = 0, cached = 0, running = 0, mine = 0;
   int jobs = a->jobs > 0 ? a->jobs : 1;
   long cores = sysconf(_SC_NPROCESSORS_ONLN);
   int threads = cores > jobs ? (int)(cores / jobs) : 1;
   bool tty = isatty(STDOUT_FILENO);
   pov_run *runs = lm_alloc(sizeof *runs * (size_t)jobs);
   char what[1200];
-  if (!a->quiet) printf("references of %s: %d view%s, up to %d POV-Ray run%s at once; %s\n", j->path, n,
-                        n == 1 ? "" : "s", jobs, jobs == 1 ? "" : "s", a->refs);
+  for (int i = 0; i < n; i++) mine += i % a->shards == a->shard;
+  char in_shard[64] = "";
+  if (a->shards > 1) snprintf(in_shard, sizeof in_shard, " (%d in shard %d/%d)", mine, a->shard, a->shards);
+  if (!a->quiet) printf("references of %s: %d view%s%s, up to %d POV-Ray run%s at once; %s\n", j->path, n,
+                        n == 1 ? "" : "s", in_shard, jobs, jobs == 1 ? "" : "s", a->refs);
   for (int i = 0; i <= n; i++) {
     /* Start place i when a slot is free; after the last, wait for the rest. */
     while (running > 0 && (running == jobs || i == n)) {
@@ -180,7 +187,7 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
         remove(log);
         rendered++;
         snprintf(what, sizeof what, "%s", final);
-        job_progress(a->quiet, tty, ++done, n, what);
+        job_progress(a->quiet, tty, ++done, mine, what);
       } else {
         remove(r->tmp);
         if (tty && !a->quiet) printf("\n");
@@ -194,6 +201,7 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
       *r = runs[--running];
     }
     if (i == n) break;
+    if (i % a->shards != a->shard) continue;
     const job_view *v = &places[i];
     const job_scene *s = &j->scenes[v->scene];
     lm_buf sdl = {0};
@@ -203,7 +211,7 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
     if (ok && !a->force && lm_file_exists(path)) {
       cached++;
       snprintf(what, sizeof what, "%s: unchanged, cached", path);
-      job_progress(a->quiet, tty, ++done, n, what);
+      job_progress(a->quiet, tty, ++done, mine, what);
       lm_buf_free(&sdl);
       continue;
     }
@@ -247,12 +255,13 @@ int limn_reference(int argc, char **argv) {
   reference_args a;
   reference_defaults(&a);
   const char *job_path = NULL;
-  struct option opts[8 + LIMN_POV_OPTION_COUNT] = {
+  char shard_from[256] = "";
+  struct option opts[9 + LIMN_POV_OPTION_COUNT] = {
       {"job", required_argument, 0, 'J'},    {"refs", required_argument, 0, 'R'},
       {"force", no_argument, 0, 'F'},        {"jobs", required_argument, 0, 'j'},
       {"povray", required_argument, 0, 'P'}, {"quiet", no_argument, 0, 'q'},
-      {"help", no_argument, 0, 'h'}};
-  memcpy(opts + 7, limn_pov_options, sizeof(struct option) * LIMN_POV_OPTION_COUNT);
+      {"help", no_argument, 0, 'h'},         {"shard", required_argument, 0, 'I'}};
+  memcpy(opts + 8, limn_pov_options, sizeof(struct option) * LIMN_POV_OPTION_COUNT);
   opterr = 0;
   optind = 1;
   int c;
@@ -268,6 +277,10 @@ int limn_reference(int argc, char **argv) {
       if (!limn_parse_int(optarg, 1, 1024, &a.jobs)) return usage_error("--jobs wants 1..1024, not '%s'", optarg);
       break;
     case 'P': a.povray = optarg; break;
+    case 'I':
+      if (!limn_parse_shard(optarg, &a.shard, &a.shards, shard_from, sizeof shard_from))
+        return usage_error("%s", shard_from);
+      break;
     case 'q': a.quiet = true; break;
     case 'h': fputs(reference_usage, stdout); return 0;
     case ':': return usage_error("%s needs a value", argv[optind - 1]);
@@ -278,6 +291,7 @@ int limn_reference(int argc, char **argv) {
   if (!job_path) return usage_error("%s", "--job FILE is required");
   const char *bad = a.pov.radiosity ? lm_pov_radiosity_check(&a.pov.rad) : NULL;
   if (bad) return usage_error("radiosity setting out of range: %s", bad);
+  if (shard_from[0]) lm_info("shard %d/%d from %s", a.shard, a.shards, shard_from);
   job *j = lm_alloc(sizeof *j);
   lm_error err;
   job_view *places = NULL;

@@ -16,6 +16,8 @@ int limn_compare(int argc, char **argv);
 int limn_bench(int argc, char **argv);
 int limn_reference(int argc, char **argv);
 int limn_report(int argc, char **argv);
+int limn_manifest(int argc, char **argv);
+int limn_farm(int argc, char **argv);
 
 /* Flag values (tools/args.c): false when `s` is not one. */
 bool limn_parse_int(const char *s, int lo, int hi, int *out);
@@ -28,6 +30,13 @@ bool limn_parse_on_off(const char *s, bool *out);
 bool limn_parse_camera(const char *s, int *out);
 struct lm_scene;
 int limn_camera_resolve(struct lm_scene *s, int camera, int width, int height);
+/* --shard I/N, auto or auto/N. `auto` takes the index from the scheduler:
+ * Slurm's SLURM_ARRAY_TASK_ID less SLURM_ARRAY_TASK_MIN, of
+ * SLURM_ARRAY_TASK_COUNT (or MAX - MIN + 1) shards; `auto/N` takes
+ * SLURM_ARRAY_TASK_ID as it is, or a Kubernetes Indexed Job's
+ * JOB_COMPLETION_INDEX, of N shards. msg gets where the shard came from
+ * ("" for I/N), or on false what is wrong. */
+bool limn_parse_shard(const char *s, int *shard, int *shards, char *msg, size_t cap);
 /* Prints s as a JSON string (quotes, backslashes and control characters escaped). */
 void limn_json_string(const char *s);          /* a quoted, escaped JSON string to stdout */
 void limn_json_append(lm_buf *b, const char *s); /* the same, appended to b */

@@ -220,7 +220,13 @@ static void fly_to_camera(viewer *v) {
   float f[3] = {-sy * cp, sp, -cy * cp};
   float r[3] = {cy, 0, -sy}; /* cross(f, +Y), normalized: pitch stays below the poles */
   float u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
-  float m[16] = {r[0], r[1], r[2], 0, u[0], u[1], u[2], 0, -f[0], -f[1], -f[2], 0,
+  /* Keep the node's scale: a camera under a scaled root scales near and far with it. */
+  const float *w = v->scene->nodes[node].world;
+  float det = w[0] * (w[5] * w[10] - w[9] * w[6]) - w[4] * (w[1] * w[10] - w[9] * w[2]) +
+              w[8] * (w[1] * w[6] - w[5] * w[2]);
+  float k = cbrtf(fabsf(det));
+  if (!(k > 0) || !isfinite(k)) k = 1;
+  float m[16] = {k * r[0], k * r[1], k * r[2], 0, k * u[0], k * u[1], k * u[2], 0, -k * f[0], -k * f[1], -k * f[2], 0,
                  v->cam.pos[0], v->cam.pos[1], v->cam.pos[2], 1};
   lm_scene_node_set_world(v->scene, node, m);
 }
@@ -237,9 +243,14 @@ static void move_camera(viewer *v, double dt_ms) {
   lm_window_mouse_drag(v->window, &dx, &dy);
   dx += v->drag[0], dy += v->drag[1];
   v->drag[0] = v->drag[1] = 0;
-  /* 1.5 units a second; scripted runs (tests) step 1/60 s a frame so they repeat. */
+  /* 0.45 of the scene's diagonal a second (1.5 units in the Cornell box), in
+   * any unit; scripted runs (tests) step 1/60 s a frame so they repeat. */
   if (v->args->key_count) dt_ms = 1000.0 / 60.0;
-  float step = (float)(fmin(dt_ms, 100.0) * 0.0015);
+  float lo[3], hi[3];
+  lm_scene_bounds(v->scene, lo, hi);
+  float size = sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                     (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  float step = (float)(fmin(dt_ms, 100.0) * 0.45e-3) * size;
   float ahead = (key_down(v, "W") ? 1.0f : 0.0f) - (key_down(v, "S") ? 1.0f : 0.0f);
   float side = (key_down(v, "D") ? 1.0f : 0.0f) - (key_down(v, "A") ? 1.0f : 0.0f);
   if (!ahead && !side && !dx && !dy) return; /* the scene's own transform stays exact */

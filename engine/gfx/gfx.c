@@ -229,14 +229,20 @@ void lm_storage_upload(int binding, const void *data, size_t bytes) {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)binding, storage[binding].buffer);
 }
 
+float lm_scene_clear_depth(bool shadow_caster) { return shadow_caster ? 1.0f : 0.0f; }
+
 void lm_set_scene_state(bool on, bool shadow_caster) {
   if (on && shadow_caster)
     glEnable(GL_DEPTH_CLAMP);
   else
     glDisable(GL_DEPTH_CLAMP);
+  /* Camera views use reversed depth (lm_scene_frame_data's projection: near
+   * 1, far 0) in a 0..1 clip range, so float depth keeps its precision;
+   * shadow tiles keep the usual mapping their shaders read. */
+  glClipControl(GL_LOWER_LEFT, on && !shadow_caster ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
   if (on) {
     glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
+    glDepthFunc(shadow_caster ? GL_LESS : GL_GREATER);
     glDepthMask(GL_TRUE);
     if (shadow_caster) {
       glDisable(GL_CULL_FACE);

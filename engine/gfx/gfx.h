@@ -78,9 +78,12 @@ void lm_set_viewport(int x, int y, int width, int height);
 /* Uploads a shader storage block to `binding` (grows its buffer as needed). */
 void lm_storage_upload(int binding, const void *data, size_t bytes);
 /* Depth test and back-face culling for scene passes; off for full-screen
- * ones. Shadow casters draw both faces (a light inside a closed mesh sees
- * its back faces) and clamp depth (casters before the near plane count). */
+ * ones. Camera views test reversed depth (near 1, far 0). Shadow casters
+ * draw both faces (a light inside a closed mesh sees its back faces) and
+ * clamp depth (casters before the near plane count). */
 void lm_set_scene_state(bool on, bool shadow_caster);
+/* The depth a scene pass clears to: far, so 0 for a camera, 1 for a shadow tile. */
+float lm_scene_clear_depth(bool shadow_caster);
 /* Framebuffers cache by attachment set; drop entries that name this texture. */
 void lm_framebuffers_forget(lm_texture tex);
 

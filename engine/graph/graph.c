@@ -125,6 +125,10 @@ int lm_graph_add_pass(lm_graph *g, const lm_pass_desc *d, lm_error *err) {
     lm_error_set(err, "%s: pass '%s': only scene passes take views", where, name);
     return -1;
   }
+  if (d->fits_views && (d->view_count == 0 || d->fit_target < 0 || d->fit_target >= g->target_count)) {
+    lm_error_set(err, "%s: pass '%s': fits views to a target it does not have", where, name);
+    return -1;
+  }
   if (d->depth >= g->target_count) {
     lm_error_set(err, "%s: pass '%s': depth is not a target of this frame", where, name);
     return -1;
@@ -210,6 +214,11 @@ static bool validate_pass(lm_graph *g, int pi, lm_error *err) {
     lm_error_set(err, "%s: pass '%s': full-screen passes take no depth target", where, name);
     return false;
   }
+  if (d->fits_views && !g->targets[d->fit_target].desc.persistent && last_writer(g, d->fit_target, pi) < 0) {
+    lm_error_set(err, "%s: pass '%s' fits its views to target '%s' that no pass writes before it", where, name,
+                 g->targets[d->fit_target].desc.name);
+    return false;
+  }
   for (int i = 0; i < d->input_count; i++) {
     int t = d->inputs[i].target;
     const graph_target *gt = &g->targets[t];
@@ -233,6 +242,7 @@ static void keep(lm_graph *g, int pi, bool *needed) {
   needed[pi] = true;
   const lm_pass_desc *d = &g->passes[pi].desc;
   for (int i = 0; i < d->input_count; i++) keep(g, last_writer(g, d->inputs[i].target, pi), needed);
+  if (d->fits_views) keep(g, last_writer(g, d->fit_target, pi), needed);
   /* A scene pass that does not clear draws over what an earlier pass left. */
   if (d->kind == LM_PASS_SCENE && !d->clear) {
     for (int i = 0; i < d->output_count; i++) keep(g, last_writer(g, d->outputs[i], pi), needed);
@@ -305,6 +315,7 @@ bool lm_graph_compile(lm_graph *g, lm_error *err) {
       continue;
     }
     for (int i = 0; i < p->desc.input_count; i++) touch(&g->targets[p->desc.inputs[i].target], pi);
+    if (p->desc.fits_views) touch(&g->targets[p->desc.fit_target], pi);
     for (int i = 0; i < p->desc.output_count; i++) touch(&g->targets[p->desc.outputs[i]], pi);
     if (p->desc.depth >= 0) touch(&g->targets[p->desc.depth], pi);
   }

@@ -75,6 +75,12 @@ typedef struct lm_pass_desc {
   double fetches;     /* texture fetches a pixel, as the script declares (0: not said); for bench */
   const lm_pass_view *views; /* scene passes: draw once per view; none: the camera */
   int view_count;
+  /* Scene passes with views: a target the engine reads on the CPU just before
+   * the pass to fit the views again (lm_graph_exec_desc.fit_views), e.g. the
+   * depth range the camera saw for shadow cascades. Kept alive and ordered
+   * like an input. */
+  bool fits_views;
+  int fit_target;
   const lm_pass_material_param *material_params; /* scene passes */
   int material_param_count;
 } lm_pass_desc;
@@ -140,6 +146,11 @@ typedef struct lm_graph_exec_desc {
   /* Draws the scene for a scene pass (once per view); false with a message
    * stops the frame. */
   bool (*draw_scene)(void *user, const lm_scene_pass *sp, lm_error *err);
+  /* Before a scene pass that fits its views: `fit` is the texture of the
+   * pass's fit_target (w x h); the callback may read it and rewrite the
+   * views' matrices. NULL: the views stay as recorded. */
+  bool (*fit_views)(void *user, const lm_pass_desc *d, lm_texture fit, int w, int h, lm_pass_view *views,
+                    lm_error *err);
   /* Uniforms the scene sets on each draw (not bindable from a script). */
   bool (*scene_owns_uniform)(const char *name);
   void *user;

@@ -255,6 +255,13 @@ const lm_program *lm_scene_pass_variant(const lm_scene_pass *sp, const char *def
 static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_graph_exec_desc *x,
                      lm_error *err) {
   const lm_pass_desc *d = &gp->desc;
+  const graph_target *fit = d->fits_views ? &g->targets[d->fit_target] : NULL;
+  /* The views live in the graph's arena: the callback may rewrite them. */
+  if (fit && x->fit_views &&
+      !x->fit_views(x->user, d, fit->texture, fit->width, fit->height, (lm_pass_view *)d->views, err)) {
+    lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
+    return false;
+  }
   lm_program *p = pass_program(d, "", err);
   if (!p || !check_bindings(g, d, p, x, err)) return false;
   lm_attachments att = {.color_count = d->output_count};
@@ -276,7 +283,7 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
   bool ok = true;
   if (d->kind == LM_PASS_SCENE) {
     lm_set_scene_state(true, d->view_count > 0); /* tiles are shadow maps */
-    if (d->clear) lm_clear(d->output_count, d->clear_color, d->depth >= 0, 1.0f);
+    if (d->clear) lm_clear(d->output_count, d->clear_color, d->depth >= 0, lm_scene_clear_depth(d->view_count > 0));
     scene_pass_ctx c = {{d, p, g, NULL}, x};
     if (d->view_count == 0 && x->draw_scene) ok = x->draw_scene(x->user, &c.pub, err);
     for (int v = 0; v < d->view_count && ok; v++) {

@@ -14,8 +14,9 @@ struct lm_renderer {
   float prev_view_proj[16];
   lm_frame_data camera;
   lm_shadow_plan shadows;
-  double record_ms, compile_ms;
+  double record_ms, compile_ms, fit_ms;
   lm_scene_draw_stats stats;  /* this frame's camera draws */
+  lm_scene_draw_stats shadow_stats; /* and its shadow tiles' */
   bool sharing;
 };
 
@@ -46,6 +47,31 @@ void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compi
   *compile_ms = r->compile_ms;
 }
 
+double lm_renderer_fit_ms(const lm_renderer *r) { return r->fit_ms; }
+const lm_shadow_plan *lm_renderer_shadows(const lm_renderer *r) { return &r->shadows; }
+
+/* The shadow pass fits its views to the camera depths the G-buffer holds
+ * (the script's reduction: min in r, max in g, as depth / far). Reading them
+ * back waits for the passes before it; the frame accepts that wait (it is
+ * timed: lm_renderer_fit_ms) rather than fit to last frame's depths. */
+static bool fit_views(void *user, const lm_pass_desc *d, lm_texture fit, int w, int h, lm_pass_view *views,
+                      lm_error *err) {
+  (void)err;
+  lm_renderer *r = user;
+  lm_shadow_plan *plan = &r->shadows;
+  if (d->view_count != plan->view_count || w < 1 || h < 1) return true;
+  double t0 = lm_now_ms();
+  float *px = lm_alloc(sizeof(float) * 4 * (size_t)w * (size_t)h);
+  lm_texture_read(fit, w, h, true, px);
+  float far = r->camera.clip[1];
+  lm_shadow_plan_fit(plan, r->desc.scene, &r->camera, px[0] * far, px[1] * far);
+  free(px);
+  for (int v = 0; v < plan->view_count; v++) views[v] = plan->views[v];
+  lm_shadow_plan_upload(plan, plan->light_count);
+  r->fit_ms += lm_now_ms() - t0;
+  return true;
+}
+
 static const lm_program *scene_variant(void *ctx, const char *defines, lm_error *err) {
   return lm_scene_pass_variant(ctx, defines, err);
 }
@@ -60,13 +86,14 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
     params[i] = (lm_material_param){q->material, q->name, q->count, {q->v[0], q->v[1], q->v[2], q->v[3]}};
   }
   if (!lm_scene_check_params(r->desc.scene, params, n, err)) return false;
-  /* Cull against the camera, or a spot or cube-face tile; a cascade tile
-   * draws everything, since casters before its near plane still cast. */
-  const float *view_proj = sp->view ? (sp->view->depth[3] > 0 ? sp->view->view_proj : NULL) : r->camera.view_proj;
+  /* Cull against the camera or the tile; a cascade tile keeps casters before
+   * its near plane, which its depth clamp flattens onto it (pancaking). */
+  const float *view_proj = sp->view ? sp->view->view_proj : r->camera.view_proj;
   lm_scene_draw_desc d = {.program = sp->program, .variant = scene_variant, .ctx = (void *)sp,
                           .view_proj = r->desc.no_culling ? NULL : view_proj,
+                          .pancake = sp->view && sp->view->depth[3] == 0,
                           .params = params, .param_count = n};
-  return lm_scene_draw(r->desc.scene, &d, sp->view ? NULL : &r->stats, err); /* camera draws only */
+  return lm_scene_draw(r->desc.scene, &d, sp->view ? &r->shadow_stats : &r->stats, err);
 }
 
 bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
@@ -83,6 +110,7 @@ void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height) {
 }
 
 lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r) { return r->stats; }
+lm_scene_draw_stats lm_renderer_shadow_draw_stats(const lm_renderer *r) { return r->shadow_stats; }
 
 /* The engine's last pass: sanitize and encode what the script presented.
  * out[0], out[1] get the sRGB and linear outputs (-1: none). */
@@ -126,7 +154,7 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
 /* Runs what record() compiled into g (the camera and shadow plan it made). */
 static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_frame_data *frame = &r->camera;
-  r->stats = (lm_scene_draw_stats){0};
+  r->stats = r->shadow_stats = (lm_scene_draw_stats){0};
   memcpy(frame->prev_view_proj, r->frame ? r->prev_view_proj : frame->view_proj, sizeof frame->prev_view_proj);
   memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
   frame->time[1] = (float)r->frame++;
@@ -135,7 +163,8 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   frame->counts[0] = n;
   lm_frame_upload(frame, lights, n);
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
-  lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene,
+  r->fit_ms = 0;
+  lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene, .fit_views = fit_views,
                           .scene_owns_uniform = lm_scene_owns_uniform, .user = r,
                           .check_finite = r->desc.check_finite};
   return lm_graph_execute(g, &x, err);

@@ -31,9 +31,16 @@ void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height);
 bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err);
 /* The last frame's scene draws: nodes drawn and culled, triangles. */
 lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r); /* camera passes, not shadow tiles */
+/* The same for the last frame's shadow tiles, summed over the tiles. */
+lm_scene_draw_stats lm_renderer_shadow_draw_stats(const lm_renderer *r);
 lm_clock lm_renderer_clock(const lm_renderer *r);
 /* CPU milliseconds of the last frame spent in Lua (OnRender) and in compiling the graph. */
 void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compile_ms);
+/* Wall milliseconds the last frame spent reading back the depth range its
+ * shadow views fit to (a wait for the passes before it; 0 when none). */
+double lm_renderer_fit_ms(const lm_renderer *r);
+/* The last frame's shadow plan (view_count 0 when it drew no shadows). */
+const lm_shadow_plan *lm_renderer_shadows(const lm_renderer *r);
 /* The last frame's output, top row first: RGB 8-bit sRGB, or RGB float linear
  * (needs linear_output). */
 bool lm_renderer_read(lm_renderer *r, bool linear, void *rgb, lm_error *err);

@@ -33,7 +33,8 @@ static void scene_sphere(const lm_scene *s, vec3 centre, float *radius) {
     return;
   }
   glm_vec3_center(lo, hi, centre);
-  *radius = fmaxf(0.5f * glm_vec3_distance(lo, hi), 1e-3f);
+  *radius = 0.5f * glm_vec3_distance(lo, hi);
+  if (!(*radius > 0)) *radius = glm_vec3_norm(centre) > 0 ? 1e-3f * glm_vec3_norm(centre) : 1; /* one point */
 }
 
 /* World transform of an eye at `eye` looking at `target` (-Z forward, +Y up). */
@@ -103,7 +104,7 @@ int lm_scene_add_camera_list(lm_scene *s, const char *path, int *count, lm_error
     }
     if (!ok) break;
     vec3 eye = {v[0], v[1], v[2]}, target = {v[3], v[4], v[5]};
-    if (glm_vec3_distance(eye, target) < 1e-6f) {
+    if (!(glm_vec3_distance(eye, target) > 1e-6f * fmaxf(glm_vec3_norm(eye), glm_vec3_norm(target)))) {
       lm_error_set(err, "%s:%d: view '%s': the eye is at the target", path, line_no, tok[0]);
       ok = false;
     } else if (!(v[6] > 0.1f && v[6] < 179.0f)) {
@@ -117,10 +118,9 @@ int lm_scene_add_camera_list(lm_scene *s, const char *path, int *count, lm_error
     float world[16];
     look_at_world(eye, target, world);
     lm_camera c = {.fov_y = glm_rad(v[6]), .znear = v[7], .zfar = v[8]};
-    if (n == 8) { /* far enough for the whole scene, near a small part of that */
-      c.zfar = 1.5f * (glm_vec3_distance(eye, centre) + radius);
-      c.znear = fmaxf(c.zfar * 1e-4f, 1e-3f);
-      c.znear = fminf(c.znear, 0.05f);
+    if (n == 8) { /* far enough for the whole scene, near a small part of that (any unit: */
+      c.zfar = 1.5f * (glm_vec3_distance(eye, centre) + radius); /* reversed float depth */
+      c.znear = c.zfar * 1e-4f;                                  /* holds any ratio) */
     }
     snprintf(c.name, sizeof c.name, "%s", tok[0]);
     c.node = lm_scene_add_node(s, c.name, -1, world, -1, -1);

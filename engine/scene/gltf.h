@@ -41,8 +41,8 @@
  *   Colour images (base colour, emissive) are sampled as sRGB, data images
  *   as they are (one image used both ways is uploaded twice).
  * - Perspective cameras: yfov, znear, zfar; the aspect ratio is the output's.
- *   An infinite far plane (zfar absent) becomes LM_GLTF_INFINITE_ZFAR, or
- *   10 * znear when that is larger.
+ *   An infinite far plane (zfar absent) becomes LM_GLTF_INFINITE_ZFAR_RATIO
+ *   times znear: relative, so any unit works (reversed float depth holds it).
  *   Orthographic cameras are kept (so camera indices stay the file's) and
  *   refused by name when a view uses one (lm_scene_camera_check).
  * - KHR_lights_punctual point, spot and directional lights, one lm light per
@@ -77,7 +77,7 @@ extern "C" {
 #include "scene/scene.h"
 
 #define LM_GLTF_MAX_COORD 1e9f      /* largest |coordinate| a vertex may have */
-#define LM_GLTF_INFINITE_ZFAR 1000.0f /* zfar of a camera with an infinite far plane */
+#define LM_GLTF_INFINITE_ZFAR_RATIO 1e6f /* zfar / znear of a camera with an infinite far plane */
 #define LM_GLTF_MAX_ELEMENTS (1 << 26) /* most vertices or indices per primitive */
 /* Engine light per glTF candela or lux: 1 / (683 lm/W * pi). Blender's
  * exporter writes W / (4 pi) * 683 cd for a point light of W watts and

@@ -553,7 +553,7 @@ bool add_camera(Loader &L, int ni, int ci, int node) {
   snprintf(cam.name, sizeof cam.name, "%s", c.name.empty() ? "camera" : c.name.c_str());
   cam.fov_y = (float)p.yfov;
   cam.znear = (float)p.znear;
-  cam.zfar = p.zfar > 0 ? (float)p.zfar : std::fmax(LM_GLTF_INFINITE_ZFAR, 10.0f * cam.znear);
+  cam.zfar = p.zfar > 0 ? (float)p.zfar : LM_GLTF_INFINITE_ZFAR_RATIO * cam.znear;
   cam.node = node;
   if (p.aspectRatio > 0 && p.aspectRatio < 1e6) cam.aspect = (float)p.aspectRatio;
   lm_scene_add_camera(L.s, &cam);

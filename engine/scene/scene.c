@@ -96,6 +96,22 @@ int lm_scene_add_camera(lm_scene *s, const lm_camera *c) {
   return s->camera_count - 1;
 }
 
+int lm_scene_add_root(lm_scene *s, const char *name, const float local[16]) {
+  LM_PUSH(s->nodes, s->node_count, s->node_cap);
+  memmove(s->nodes + 1, s->nodes, sizeof *s->nodes * (size_t)(s->node_count - 1));
+  for (int i = 1; i < s->node_count; i++) s->nodes[i].parent = s->nodes[i].parent >= 0 ? s->nodes[i].parent + 1 : 0;
+  for (int i = 0; i < s->light_count; i++) s->lights[i].node += s->lights[i].node >= 0;
+  for (int i = 0; i < s->camera_count; i++) s->cameras[i].node += s->cameras[i].node >= 0;
+  lm_node *n = &s->nodes[0];
+  memset(n, 0, sizeof *n);
+  snprintf(n->name, sizeof n->name, "%s", name);
+  n->parent = -1;
+  memcpy(n->local, local, sizeof n->local);
+  n->mesh = n->material = -1;
+  lm_scene_update(s);
+  return 0;
+}
+
 /* The node's matrices are plain float[16] at any alignment; cglm's SIMD
  * product loads aligned, so it works on aligned copies. */
 void lm_scene_node_set_world(lm_scene *s, int node, const float world[16]) {
@@ -282,16 +298,31 @@ void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_f
   memset(out, 0, sizeof *out);
   lm_camera c = {.fov_y = glm_rad(45.0f), .znear = 0.1f, .zfar = 100.0f, .node = -1};
   if (cam >= 0 && cam < s->camera_count) c = s->cameras[cam];
-  /* Keep the projection invertible whatever a scene file says. */
-  c.fov_y = isfinite(c.fov_y) ? glm_clamp(c.fov_y, 1e-4f, GLM_PIf - 1e-3f) : glm_rad(45.0f);
-  c.znear = isfinite(c.znear) && c.znear > 1e-6f ? c.znear : 1e-6f;
-  c.zfar = isfinite(c.zfar) && c.zfar > c.znear * 1.001f ? c.zfar : c.znear * 1.001f;
-  float aspect = c.aspect > 0 && isfinite(c.aspect) ? c.aspect
-                                                   : (float)(width > 0 ? width : 1) / (float)(height > 0 ? height : 1);
   mat4 world = GLM_MAT4_IDENTITY_INIT, view, proj, vp, inv_view;
   if (c.node >= 0) memcpy(world, s->nodes[c.node].world, sizeof world);
+  /* A camera under a scaled node (a scene exported in another unit) keeps a
+   * rigid view; near and far are in its node's units, so they scale with it. */
+  float scale = cbrtf(fabsf(glm_mat4_det(world)));
+  if (isfinite(scale) && scale > 0 && fabsf(scale - 1.0f) > 1e-6f) {
+    for (int k = 0; k < 3; k++) glm_vec3_normalize(world[k]);
+    c.znear *= scale, c.zfar *= scale;
+  }
+  /* Keep the projection invertible whatever a scene file says; any unit and
+   * any near/far ratio up to 1e12 (reversed float depth keeps them apart). */
+  c.fov_y = isfinite(c.fov_y) ? glm_clamp(c.fov_y, 1e-4f, GLM_PIf - 1e-3f) : glm_rad(45.0f);
+  bool far_ok = isfinite(c.zfar) && c.zfar > 0 && c.zfar < 1e30f;
+  if (!(isfinite(c.znear) && c.znear > 0 && c.znear < 1e30f)) c.znear = far_ok ? c.zfar * 1e-4f : 0.1f;
+  c.znear = fmaxf(c.znear, far_ok ? c.zfar * 1e-12f : 1e-30f);
+  c.zfar = far_ok && c.zfar > c.znear * 1.001f ? c.zfar : c.znear * 1.001f;
+  float aspect = c.aspect > 0 && isfinite(c.aspect) ? c.aspect
+                                                   : (float)(width > 0 ? width : 1) / (float)(height > 0 ? height : 1);
   glm_mat4_inv(world, view);
+  /* Reversed depth (near 1, far 0, with glClipControl's 0..1 range: gfx
+   * lm_set_scene_state): float depth then keeps the same relative precision
+   * at every distance, where the usual mapping rounds far depths together. */
   glm_perspective(c.fov_y, aspect, c.znear, c.zfar, proj);
+  proj[2][2] = c.znear / (c.zfar - c.znear);
+  proj[3][2] = c.znear * c.zfar / (c.zfar - c.znear);
   glm_mat4_mul(proj, view, vp);
   glm_mat4_inv(view, inv_view);
   memcpy(out->view, view, 64);
@@ -455,8 +486,9 @@ static void apply_param(lm_material *m, const lm_material_param *p) {
 }
 
 /* ---- drawing ------------------------------------------------------------ */
-bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const float hi[3]) {
-  /* All 8 corners beyond the same clip plane (x, y, z against +-w). */
+/* All 8 corners beyond the same clip plane (x, y, z against +-w); with
+ * `pancake`, z < -w (before an orthographic tile's near plane) does not count. */
+static bool box_outside(const float view_proj[16], const float lo[3], const float hi[3], bool pancake) {
   int outside[6] = {0};
   for (int c = 0; c < 8; c++) {
     float p[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]}, q[4];
@@ -468,8 +500,12 @@ bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const 
     }
   }
   for (int k = 0; k < 6; k++)
-    if (outside[k] == 8) return true;
+    if (outside[k] == 8 && !(pancake && k == 4)) return true;
   return false;
+}
+
+bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const float hi[3]) {
+  return box_outside(view_proj, lo, hi, false);
 }
 
 /* World bounds of a mesh under a node's transform (the box of the moved box). */
@@ -520,6 +556,16 @@ static void uv_matrix(const float t[6], float out[9]) {
   memcpy(out, m, sizeof m);
 }
 
+bool lm_scene_node_bounds(const lm_scene *s, int node, float lo[3], float hi[3]) {
+  if (node < 0 || node >= s->node_count) return false;
+  const lm_node *n = &s->nodes[node];
+  if (n->mesh < 0 || n->mesh >= s->mesh_count) return false;
+  const lm_scene_mesh *m = &s->meshes[n->mesh];
+  if (!(m->bounds[0][0] <= m->bounds[1][0])) return false;
+  world_bounds(n->world, m->bounds, lo, hi);
+  return isfinite(lo[0] + lo[1] + lo[2] + hi[0] + hi[1] + hi[2]);
+}
+
 bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err) {
   const lm_program *p = d->program;
   /* A technique that reads material_pbr (shaders/pbr.frag) takes every texture slot. */
@@ -532,7 +578,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     if (d->view_proj) {
       float lo[3], hi[3];
       world_bounds(n->world, mesh->bounds, lo, hi);
-      if (lm_box_outside_frustum(d->view_proj, lo, hi)) {
+      if (box_outside(d->view_proj, lo, hi, d->pancake)) {
         if (stats) stats->culled++;
         continue;
       }

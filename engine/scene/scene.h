@@ -152,11 +152,17 @@ int lm_scene_add_texture(lm_scene *s, const char *name, int width, int height, u
 /* Index of the material called `name`, or -1. */
 int lm_scene_find_material(const lm_scene *s, const char *name);
 int lm_scene_add_camera(lm_scene *s, const lm_camera *c);
+/* Puts a new node (index 0) above every root: all node indices, and the
+ * lights' and cameras' nodes, move up by one. A scaled root is the same scene
+ * in another unit (cameras under it see the same image: lm_scene_frame_data). */
+int lm_scene_add_root(lm_scene *s, const char *name, const float local[16]);
 /* World transforms from local ones (parents come before children). */
 void lm_scene_update(lm_scene *s);
 /* Moves a node (a camera the viewer flies) so its world transform becomes
  * `world`: its local transform is set against its parent's, then updated. */
 void lm_scene_node_set_world(lm_scene *s, int node, const float world[16]);
+/* World-space box of one mesh node; false for a node without a mesh, empty or not finite bounds. */
+bool lm_scene_node_bounds(const lm_scene *s, int node, float lo[3], float hi[3]);
 /* World-space box around every mesh node; false (and a unit box) when empty. */
 bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]);
 /* Adds a camera (and its node) called `name` that frames the scene's bounds:
@@ -228,6 +234,7 @@ typedef struct lm_scene_draw_desc {
   const lm_program *(*variant)(void *ctx, const char *defines, lm_error *err);
   void *ctx;
   const float *view_proj; /* column-major: nodes wholly outside are culled; NULL: none are */
+  bool pancake; /* an orthographic shadow tile: nodes before its near plane still cast, so stay */
   const lm_material_param *params; /* overrides (checked by lm_scene_check_params) */
   int param_count;
 } lm_scene_draw_desc;

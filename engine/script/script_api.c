@@ -169,7 +169,9 @@ static float opt_number(lua_State *L, int idx, const char *field, float def, flo
 
 /* shadow_plan{ technique, resolution, c, blur, cascades, lambda, bias, distance,
  * blend, radius, stabilize }: tiles for every light that casts shadows, or nil
- * when none does. scene{ views = plan } draws them. */
+ * when none does. scene{ views = plan } draws them; scene{ views = plan, fit =
+ * T } first fits them to the camera depths T's first texel holds (min in r,
+ * max in g, as depth / far). */
 static int l_shadow_plan(lua_State *L) {
   lm_pipeline *p = recording(L, "shadow_plan");
   if (p->in_create) return luaL_error(L, "shadow_plan() is called from OnRender");
@@ -193,7 +195,7 @@ static int l_shadow_plan(lua_State *L) {
   st.blur = (int)opt_number(L, 1, "blur", (float)st.blur, 0, 32, what);
   st.cascades = (int)opt_number(L, 1, "cascades", (float)st.cascades, 1, 4, what);
   st.lambda = opt_number(L, 1, "lambda", st.lambda, 0, 1, what);
-  st.bias = opt_number(L, 1, "bias", st.bias, -0.5f, 0.5f, what);
+  st.bias = opt_number(L, 1, "bias", st.bias, 0.0f, 64.0f, what);
   st.distance = opt_number(L, 1, "distance", st.distance, 0, 1e9f, what);
   st.blend = opt_number(L, 1, "blend", st.blend, 0, 1, what);
   st.radius = opt_number(L, 1, "radius", st.radius, 0, 32, what);
@@ -459,7 +461,8 @@ static void add_pass(lua_State *L, lm_pipeline *p, pass_builder *b) {
   if (lm_graph_add_pass(p->graph, &b->desc, &err) < 0) luaL_error(L, "%s", err.msg);
 }
 
-/* scene{ "name", technique = "std", out = {...}, depth = T, clear = bool | {r,g,b,a}, ... } */
+/* scene{ "name", technique = "std", out = {...}, depth = T, clear = bool | {r,g,b,a}, ...,
+ * views = plan, fit = T } */
 static int l_scene(lua_State *L) {
   lm_pipeline *p = recording(L, "scene");
   if (p->in_create) return luaL_error(L, "scene() records a pass: call it from OnRender");
@@ -467,7 +470,7 @@ static int l_scene(lua_State *L) {
   int top = lua_gettop(L);
   begin_pass(L, &b, LM_PASS_SCENE, "scene");
   static const char *const fields[] = {"technique", "out", "depth", "clear", "params", "defines",
-                                       "materials", "views", NULL};
+                                       "materials", "views", "fit", NULL};
   check_fields(L, 1, b.what, fields);
   b.desc.shader = opt_string(L, 1, "technique", b.what);
   if (!b.desc.shader) b.desc.shader = "std";
@@ -496,6 +499,13 @@ static int l_scene(lua_State *L) {
     const lm_shadow_plan *plan = to_plan(L, -1, b.what);
     b.desc.views = plan->views;
     b.desc.view_count = plan->view_count;
+  }
+  lua_pop(L, 1);
+  lua_getfield(L, 1, "fit");
+  if (!lua_isnil(L, -1)) {
+    if (!b.desc.view_count) return luaL_error(L, "%s: fit is for a pass with views (a shadow plan)", b.what);
+    b.desc.fits_views = true;
+    b.desc.fit_target = to_target(L, -1, b.what)->id;
   }
   lua_pop(L, 1);
   read_materials(L, 1, &b);

@@ -19,7 +19,7 @@ void lm_shadow_settings_default(lm_shadow_settings *s) {
   *s = (lm_shadow_settings){.technique = LM_SHADOW_ESM, .resolution = 512, .c = 90.0f, .blur = 2,
                             .cascades = 3, .lambda = 0.75f, .distance = 0.0f,
                             .blend = 0.1f, .radius = 2.5f, .stabilize = true};
-  s->bias = 0.002f; /* the seed has 0: lit slanted surfaces then lose 1-2% to ESM */
+  s->bias = 1.0f; /* texels; the seed has 0: lit slanted surfaces then lose 1-2% to ESM */
 }
 
 /* An up vector that is not parallel to dir. */
@@ -30,12 +30,13 @@ static void up_for(const vec3 dir, vec3 up) {
     glm_vec3_copy((vec3){1, 0, 0}, up);
 }
 
-static int add_view(lm_shadow_plan *plan, mat4 view_proj, const float depth[4]) {
+static int add_view(lm_shadow_plan *plan, mat4 view_proj, const float depth[4], const float texel[4]) {
   int i = plan->view_count++;
   plan->views = lm_realloc(plan->views, sizeof *plan->views * (size_t)plan->view_count);
   plan->view_data = lm_realloc(plan->view_data, sizeof *plan->view_data * (size_t)plan->view_count);
   memcpy(plan->view_data[i].view_proj, view_proj, 64);
   memcpy(plan->view_data[i].depth, depth, 16);
+  memcpy(plan->view_data[i].texel, texel, 16);
   memcpy(plan->views[i].view_proj, view_proj, 64);
   memcpy(plan->views[i].depth, depth, 16);
   return i;
@@ -59,14 +60,62 @@ static float split_depth(float n, float f, int i, int count, float lambda) {
   return lambda * lg + (1.0f - lambda) * un;
 }
 
-static void plan_cascades(lm_shadow_plan *plan, const lm_frame_data *cam,
+/* x rounded up (or down) to a step of 1/16 .. 1/32 of itself: a relative
+ * grid, so that small changes leave it alone in any unit. */
+static float round_relative(float x, bool up) {
+  if (!(x > 0) || !isfinite(x)) return x;
+  float q = exp2f(floorf(log2f(x)) - 4.0f);
+  return (up ? ceilf(x / q) : floorf(x / q)) * q;
+}
+
+/* The camera depths of the mesh nodes the camera sees, within near .. far:
+ * where receivers can be. The whole near .. far when it sees none. */
+static void visible_depth(const lm_scene *s, const lm_frame_data *cam, float out[2]) {
+  float n = cam->clip[0], f = cam->clip[1], lo[3], hi[3];
+  out[0] = f, out[1] = n;
+  for (int i = 0; i < s->node_count; i++) {
+    if (!lm_scene_node_bounds(s, i, lo, hi) || lm_box_outside_frustum(cam->view_proj, lo, hi)) continue;
+    for (int c = 0; c < 8; c++) {
+      vec4 p = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2], 1};
+      float z = -(cam->view[2] * p[0] + cam->view[6] * p[1] + cam->view[10] * p[2] + cam->view[14]);
+      out[0] = fminf(out[0], z), out[1] = fmaxf(out[1], z);
+    }
+  }
+  out[0] = fmaxf(out[0], n), out[1] = fminf(out[1], f);
+  if (!(out[0] < out[1])) out[0] = n, out[1] = f;
+}
+
+/* Narrows [*zn, *zf] to the light-view depths of the mesh nodes inside the
+ * tile's rectangle l..r x b..t (casters and receivers alike); unchanged
+ * when none is. The caller handles a range this leaves empty. */
+static void caster_depth(const lm_scene *s, mat4 view, float l, float r, float b, float t, float *zn, float *zf) {
+  float cmin = FLT_MAX, cmax = -FLT_MAX, lo[3], hi[3];
+  for (int i = 0; i < s->node_count; i++) {
+    if (!lm_scene_node_bounds(s, i, lo, hi)) continue;
+    vec3 bl = {FLT_MAX, FLT_MAX, FLT_MAX}, bh = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    for (int c = 0; c < 8; c++) {
+      vec4 p = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2], 1}, q;
+      glm_mat4_mulv(view, p, q);
+      glm_vec3_minv(bl, q, bl);
+      glm_vec3_maxv(bh, q, bh);
+    }
+    if (bh[0] < l || bl[0] > r || bh[1] < b || bl[1] > t) continue;
+    cmin = fminf(cmin, -bh[2]), cmax = fmaxf(cmax, -bl[2]); /* the light looks down -z */
+  }
+  if (cmin > cmax) return;
+  *zn = fmaxf(*zn, cmin), *zf = fminf(*zf, cmax);
+}
+
+static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
                           const lm_light_data *light, lm_shadow_light_data *out) {
   const lm_shadow_settings *st = &plan->settings;
   vec3 dir;
   glm_vec3_normalize_to((float *)light->direction, dir);
-  float n = cam->clip[0], f = cam->clip[1];
-  float reach = st->distance > 0 ? fminf(st->distance, f) : f;
-  if (reach <= n) reach = n * 1.001f;
+  /* Cascades cover the depths where receivers are seen (plan->seen), snapped
+   * outwards to a relative grid so that a small camera move keeps them. */
+  float n = round_relative(plan->seen[0], false), reach = round_relative(plan->seen[1], true);
+  if (st->distance > 0) reach = fminf(st->distance, reach);
+  if (!(reach > n)) reach = n * 1.001f;
   out->info[0] = plan->view_count;
   out->info[1] = st->cascades;
   out->info[2] = KIND_CASCADES;
@@ -79,7 +128,7 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_frame_data *cam,
     for (int c = 0; c < 8; c++) glm_vec3_muladds(corners[c], 1.0f / 8.0f, center);
     float l, r, b, t, extent = 0;
     for (int c = 0; c < 8; c++) extent = fmaxf(extent, glm_vec3_distance(corners[c], center));
-    extent = ceilf(extent * 16.0f) / 16.0f + 1e-3f;
+    extent = round_relative(extent * 1.0001f, true);
     /* The eye sits on a plane across the light snapped to steps of extent/16,
      * so a small camera move changes no stored depth. */
     float step = extent / 16.0f, along = glm_vec3_dot(center, dir);
@@ -87,7 +136,7 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_frame_data *cam,
     vec3 up, eye;
     up_for(dir, up);
     glm_vec3_copy(center, eye);
-    glm_vec3_muladds(dir, -(behind + 1.0f), eye);
+    glm_vec3_muladds(dir, -(behind + extent), eye);
     mat4 view, proj, vp;
     glm_lookat(eye, center, up, view);
     if (st->stabilize) {
@@ -102,10 +151,15 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_frame_data *cam,
         l = fminf(l, q[0]), r = fmaxf(r, q[0]), b = fminf(b, q[1]), t = fmaxf(t, q[1]);
       }
     }
-    /* Depth spans the slice's sphere only, so ESM's c acts on a short range
-     * (no light leaks across a big scene); casters nearer the light than the
-     * near plane are clamped onto it by depth clamping in the shadow pass. */
-    float zn = 1.0f - extent, zf = 1.0f + step + extent; /* holds the sphere whatever `behind` is */
+    /* Depth spans the slice's sphere (whatever `behind` is), narrowed to the
+     * meshes inside the tile and snapped to steps, so ESM's c acts on a short
+     * range and no light leaks across a big scene. Casters nearer the light
+     * than the near plane are clamped onto it by depth clamping in the
+     * shadow pass ("pancaking"). */
+    float zn = 0, zf = 2.0f * extent + step;
+    caster_depth(s, view, l, r, b, t, &zn, &zf);
+    zn = fmaxf(floorf(zn / step) * step, 0.0f), zf = fminf(ceilf(zf / step) * step, 2.0f * extent + step);
+    if (!(zf > zn)) zn = 0, zf = 2.0f * extent + step;
     glm_ortho(l, r, b, t, zn, zf, proj);
     glm_mat4_mul(proj, view, vp);
     if (st->stabilize) {
@@ -118,7 +172,8 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_frame_data *cam,
       proj[3][0] += dx, proj[3][1] += dy;
       glm_mat4_mul(proj, view, vp);
     }
-    add_view(plan, vp, (float[4]){0, 0, 0, 0});
+    /* A texel's world size and the world depth the tile's 0..1 spans. */
+    add_view(plan, vp, (float[4]){0, 0, 0, 0}, (float[4]){(r - l) / (float)plan->tile, zf - zn, 0, 0});
   }
 }
 
@@ -126,30 +181,74 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_frame_data *cam,
  * else far enough to reach the whole scene. */
 static float light_range(const lm_scene *s, const lm_light *l, const vec3 pos) {
   if (l->falloff == LM_FALLOFF_WINDOW && l->radius > 0) return l->radius;
-  float bmin[3], bmax[3], range = 1e-3f;
+  float bmin[3], bmax[3], range = 0;
   lm_scene_bounds(s, bmin, bmax);
   for (int c = 0; c < 8; c++) {
     vec3 p = {c & 1 ? bmax[0] : bmin[0], c & 2 ? bmax[1] : bmin[1], c & 4 ? bmax[2] : bmin[2]};
     range = fmaxf(range, glm_vec3_distance(p, (float *)pos));
   }
-  return range * 1.01f;
+  return range > 0 && isfinite(range) ? range * 1.01f : 1.0f;
 }
 
-static void plan_perspective(lm_shadow_plan *plan, const vec3 pos, const vec3 dir, float fov, float range) {
+static void perspective_view_proj(const vec3 pos, const vec3 dir, float fov, float range, mat4 vp) {
   vec3 up, target;
   up_for(dir, up);
   glm_vec3_add((float *)pos, (float *)dir, target);
-  mat4 view, proj, vp;
+  mat4 view, proj;
   glm_lookat((float *)pos, target, up, view);
-  glm_perspective(fov, 1.0f, fmaxf(range * 1e-4f, 1e-5f), range, proj);
+  glm_perspective(fov, 1.0f, range * 1e-4f, range, proj);
   glm_mat4_mul(proj, view, vp);
-  add_view(plan, vp, (float[4]){pos[0], pos[1], pos[2], 1.0f / range});
+}
+
+static void plan_perspective(lm_shadow_plan *plan, const vec3 pos, const vec3 dir, float fov, float range) {
+  mat4 vp;
+  perspective_view_proj(pos, dir, fov, range, vp);
+  /* A texel's world size per unit of distance, and the world depth 0..1 spans. */
+  add_view(plan, vp, (float[4]){pos[0], pos[1], pos[2], 1.0f / range},
+           (float[4]){2.0f * tanf(fov * 0.5f) / (float)plan->tile, range, 0, 0});
+}
+
+/* Point light: cube faces +X -X +Y -Y +Z -Z (shadow.glsl picks by major axis). */
+static const float cube_faces[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+
+/* All n points beyond the same clip plane of view_proj. */
+static bool points_outside(mat4 vp, const vec3 *p, int n) {
+  int outside[6] = {0};
+  for (int i = 0; i < n; i++) {
+    vec4 q, w = {p[i][0], p[i][1], p[i][2], 1};
+    glm_mat4_mulv(vp, w, q);
+    for (int k = 0; k < 3; k++) outside[2 * k] += q[k] < -q[3], outside[2 * k + 1] += q[k] > q[3];
+  }
+  for (int k = 0; k < 6; k++)
+    if (outside[k] == n) return true;
+  return false;
+}
+
+/* The cube faces a visible pixel may sample (bit f: face f): those that
+ * reach into the camera's slice of seen depths and hold a mesh the camera
+ * sees. Conservative: a seen point lies in a seen mesh's box and one face. */
+static int cube_faces_seen(const lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam, const vec3 pos,
+                           float range) {
+  vec3 slice[8], lo, hi;
+  slice_corners(cam, plan->seen[0], plan->seen[1], slice);
+  int mask = 0;
+  for (int f = 0; f < 6; f++) {
+    mat4 vp;
+    perspective_view_proj(pos, cube_faces[f], GLM_PI_2f, range, vp);
+    if (points_outside(vp, (const vec3 *)slice, 8)) continue;
+    for (int i = 0; i < s->node_count && !(mask & 1 << f); i++)
+      if (lm_scene_node_bounds(s, i, lo, hi) && !lm_box_outside_frustum(cam->view_proj, lo, hi) &&
+          !lm_box_outside_frustum((float *)vp, lo, hi))
+        mask |= 1 << f;
+  }
+  return mask;
 }
 
 static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam, int i,
                        const lm_light_data *ld) {
   const lm_light *l = &s->lights[i];
   lm_shadow_light_data *out = &plan->lights[i];
+  int faces = out->cube[0]; /* chosen when the plan was made; a fit keeps them */
   memset(out, 0, sizeof *out);
   out->info[3] = plan->settings.technique;
   out->params[0] = plan->settings.c;
@@ -158,7 +257,7 @@ static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
   out->params[3] = plan->settings.radius;
   if (!l->casts_shadows) return;
   if (l->type == LM_LIGHT_DIRECTIONAL) {
-    plan_cascades(plan, cam, ld, out);
+    plan_cascades(plan, s, cam, ld, out);
     return;
   }
   vec3 pos = {ld->position[0], ld->position[1], ld->position[2]};
@@ -172,39 +271,21 @@ static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
     plan_perspective(plan, pos, dir, fov, range);
     return;
   }
-  /* Point light: cube faces +X -X +Y -Y +Z -Z (shadow.glsl picks by major axis). */
-  static const float faces[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  out->info[1] = 6;
+  /* Point light: the faces a visible pixel may sample, in face order. */
+  out->info[1] = __builtin_popcount((unsigned)faces);
   out->info[2] = KIND_POINT;
-  for (int f = 0; f < 6; f++) plan_perspective(plan, pos, faces[f], GLM_PI_2f, range);
+  out->cube[0] = faces;
+  for (int f = 0; f < 6; f++)
+    if (faces & 1 << f) plan_perspective(plan, pos, cube_faces[f], GLM_PI_2f, range);
 }
 
-bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
-                         const lm_shadow_settings *settings, lm_error *err) {
-  *plan = (lm_shadow_plan){.settings = *settings};
-  const lm_shadow_settings *st = settings;
-  if (st->resolution < 16 || st->resolution > 8192 || st->cascades < 1 || st->cascades > 4 ||
-      !(st->c > 0 && st->c <= 10000) || st->blur < 0 || st->blur > 32 || !(st->lambda >= 0 && st->lambda <= 1) ||
-      !(fabsf(st->bias) < 1) || !(st->distance >= 0) || !(st->blend >= 0 && st->blend <= 1) ||
-      !(st->radius >= 0 && st->radius <= 32) || (unsigned)st->technique > LM_SHADOW_HARD) {
-    lm_error_set(err, "shadow settings out of range");
-    return false;
-  }
-  plan->tile = st->resolution;
-  plan->light_count = s->light_count;
-  plan->lights = lm_alloc(sizeof *plan->lights * (size_t)(s->light_count + 1));
+/* Every light's views for the camera; then the tiles' places in the atlas. */
+static void plan_views(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam) {
+  plan->view_count = 0;
   lm_light_data *ld = lm_alloc(sizeof *ld * (size_t)(s->light_count + 1));
   lm_scene_light_data(s, ld, s->light_count);
   for (int i = 0; i < s->light_count; i++) plan_light(plan, s, cam, i, &ld[i]);
   free(ld);
-  if (plan->view_count == 0) return true;
-  /* Tiles in a near-square grid, shrunk to fit the GL limit if needed. */
-  plan->columns = (int)ceil(sqrt((double)plan->view_count));
-  plan->rows = (plan->view_count + plan->columns - 1) / plan->columns;
-  int max = 16384;
-  while (plan->tile * plan->columns > max || plan->tile * plan->rows > max) plan->tile /= 2;
-  plan->atlas_width = plan->tile * plan->columns;
-  plan->atlas_height = plan->tile * plan->rows;
   for (int v = 0; v < plan->view_count; v++) {
     int cx = v % plan->columns, cy = v / plan->columns;
     plan->views[v].x = cx * plan->tile;
@@ -216,7 +297,57 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
     rect[2] = 1.0f / (float)plan->columns;
     rect[3] = 1.0f / (float)plan->rows;
   }
+}
+
+bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
+                         const lm_shadow_settings *settings, lm_error *err) {
+  *plan = (lm_shadow_plan){.settings = *settings};
+  const lm_shadow_settings *st = settings;
+  if (st->resolution < 16 || st->resolution > 8192 || st->cascades < 1 || st->cascades > 4 ||
+      !(st->c > 0 && st->c <= 10000) || st->blur < 0 || st->blur > 32 || !(st->lambda >= 0 && st->lambda <= 1) ||
+      !(st->bias >= 0 && st->bias <= 64) || !(st->distance >= 0) || !(st->blend >= 0 && st->blend <= 1) ||
+      !(st->radius >= 0 && st->radius <= 32) || (unsigned)st->technique > LM_SHADOW_HARD) {
+    lm_error_set(err, "shadow settings out of range");
+    return false;
+  }
+  plan->light_count = s->light_count;
+  plan->lights = lm_alloc(sizeof *plan->lights * (size_t)(s->light_count + 1));
+  visible_depth(s, cam, plan->seen);
+  /* How many views (a point light's faces chosen now, for the whole frame),
+   * then tiles in a near-square grid, shrunk to fit the GL limit if needed;
+   * the views depend on the tile size (texel snapping). */
+  lm_light_data *ld = lm_alloc(sizeof *ld * (size_t)(s->light_count + 1));
+  lm_scene_light_data(s, ld, s->light_count);
+  int count = 0;
+  for (int i = 0; i < s->light_count; i++) {
+    const lm_light *l = &s->lights[i];
+    if (!l->casts_shadows) continue;
+    if (l->type == LM_LIGHT_POINT) {
+      vec3 pos = {ld[i].position[0], ld[i].position[1], ld[i].position[2]};
+      plan->lights[i].cube[0] = cube_faces_seen(plan, s, cam, pos, light_range(s, l, pos));
+    }
+    count += l->type == LM_LIGHT_DIRECTIONAL ? st->cascades
+             : l->type == LM_LIGHT_SPOT      ? 1
+                                             : __builtin_popcount((unsigned)plan->lights[i].cube[0]);
+  }
+  free(ld);
+  plan->tile = st->resolution;
+  plan->columns = count ? (int)ceil(sqrt((double)count)) : 0;
+  plan->rows = count ? (count + plan->columns - 1) / plan->columns : 0;
+  int max = 16384;
+  while (count && (plan->tile * plan->columns > max || plan->tile * plan->rows > max)) plan->tile /= 2;
+  plan->atlas_width = plan->tile * plan->columns;
+  plan->atlas_height = plan->tile * plan->rows;
+  plan_views(plan, s, cam);
   return true;
+}
+
+void lm_shadow_plan_fit(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam, float zmin, float zmax) {
+  if (plan->view_count == 0 || !(zmin > 0 && zmin < zmax && isfinite(zmax))) return;
+  plan->seen[0] = fmaxf(zmin, cam->clip[0]);
+  plan->seen[1] = fminf(zmax, cam->clip[1]);
+  if (!(plan->seen[0] < plan->seen[1])) return;
+  plan_views(plan, s, cam);
 }
 
 void lm_shadow_plan_free(lm_shadow_plan *plan) {

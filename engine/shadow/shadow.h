@@ -26,8 +26,8 @@ typedef struct lm_shadow_settings {
   int blur;        /* ESM Gaussian radius in texels (0: none) */
   int cascades;    /* directional lights: 1 .. 4 */
   float lambda;    /* split scheme: 0 uniform, 1 logarithmic */
-  float bias;      /* in normalized depth */
-  float distance;  /* how far from the camera cascades reach (0: the far plane) */
+  float bias;      /* depth bias in texels of the tile (world size of a texel at the receiver) */
+  float distance;  /* how far from the camera cascades reach, world units (0: all that is seen) */
   float blend;     /* share of a cascade blended into the next one */
   float radius;    /* Poisson disc radius in texels */
   bool stabilize;  /* bounding spheres and texel snapping (seed 003) */
@@ -38,12 +38,14 @@ void lm_shadow_settings_default(lm_shadow_settings *s);
 typedef struct lm_shadow_light_data {
   int32_t info[4]; /* first view, view count, kind (0 none, 1 cascades, 2 spot, 3 point), technique */
   float splits[4]; /* cascades: camera depth where each ends */
-  float params[4]; /* c, bias, blend, Poisson radius */
+  float params[4]; /* c, bias (texels), blend, Poisson radius */
+  int32_t cube[4]; /* point lights: x = the cube faces drawn (bit f: face f, +X -X +Y -Y +Z -Z), in order */
 } lm_shadow_light_data;
 typedef struct lm_shadow_view_data {
   float view_proj[16];
   float rect[4];  /* the tile in atlas uv: offset xy, size zw */
   float depth[4]; /* light position xyz, 1 / range (0: orthographic) */
+  float texel[4]; /* a texel's world size (orthographic) or its size per unit of distance; the world depth 0..1 spans */
 } lm_shadow_view_data;
 
 typedef struct lm_shadow_plan {
@@ -54,12 +56,19 @@ typedef struct lm_shadow_plan {
   int view_count;
   lm_shadow_light_data *lights; /* one per scene light */
   int light_count;
+  float seen[2]; /* camera depths cascades cover: where receivers are seen */
 } lm_shadow_plan;
 
 /* Plans the tiles for `camera` (a frame block from lm_scene_frame_data).
- * view_count is 0 when no light casts shadows. */
+ * view_count is 0 when no light casts shadows. Cascades cover the camera
+ * depths of the mesh nodes in view until lm_shadow_plan_fit says more. */
 bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *camera,
                          const lm_shadow_settings *settings, lm_error *err);
+/* Fits the views again to the camera depths zmin .. zmax actually seen (the
+ * G-buffer's, from the depth-range reduction); the tiles and their count
+ * stay. Ignored unless 0 < zmin < zmax. */
+void lm_shadow_plan_fit(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *camera, float zmin,
+                        float zmax);
 void lm_shadow_plan_free(lm_shadow_plan *plan);
 /* Storage blocks 2 (per light) and 3 (per tile); a NULL plan marks every light unshadowed. */
 void lm_shadow_plan_upload(const lm_shadow_plan *plan, int light_count);
