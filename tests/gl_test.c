@@ -191,7 +191,13 @@ bool gl_target_finite(gl_result *r, const char *name) {
 void gl_rescale(lm_scene *s, float unit) {
   float m[16] = {unit, 0, 0, 0, 0, unit, 0, 0, 0, 0, unit, 0, 0, 0, 0, 1};
   lm_scene_add_root(s, "unit", m);
-  for (int i = 0; i < s->light_count; i++) s->lights[i].radius *= unit;
+  for (int i = 0; i < s->light_count; i++) {
+    lm_light *l = &s->lights[i];
+    l->radius *= unit;
+    /* 1 / d^2 in the new unit: the intensity per unit^2 keeps the light on a surface */
+    if (l->type != LM_LIGHT_DIRECTIONAL && (l->falloff == LM_FALLOFF_INVERSE_SQUARE || l->falloff == LM_FALLOFF_RANGE))
+      l->power *= unit * unit;
+  }
 }
 
 void gl_project(int width, int height, float x, float y, float z, int *col, int *row) {
