@@ -445,6 +445,72 @@ static void pbr_sphere_grid_is_finite_and_monotonic(void **state) {
   lm_scene_destroy(s);
 }
 
+/* A file drawing `n` float3 vertices (`b64`, then `ni` u16 indices when ni >
+ * 0) as primitive `mode`, seen by one camera. */
+static lm_scene *topology_scene(const char *b64, int n, int ni, int mode) {
+  char json[2048], path[512];
+  size_t bytes = (size_t)n * 12 + (size_t)ni * 2, padded = (bytes + 3) & ~(size_t)3;
+  snprintf(json, sizeof json,
+           "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0,1]}],"
+           "\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[1.5,0.75,5]}],"
+           "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.1,\"zfar\":20}}],"
+           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":%d%s}]}],"
+           "\"buffers\":[{\"uri\":\"data:application/octet-stream;base64,%s\",\"byteLength\":%zu}],"
+           "\"bufferViews\":[{\"buffer\":0,\"byteLength\":%d},{\"buffer\":0,\"byteOffset\":%d,\"byteLength\":%d}],"
+           "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\","
+           "\"min\":[0,0,0],\"max\":[3,1.5,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":%d,"
+           "\"type\":\"SCALAR\"}]}",
+           mode, ni ? ",\"indices\":1" : "", b64, padded, n * 12, n * 12, ni ? ni * 2 : 2, n, ni ? ni : 1);
+  write_file("topology.gltf", json, path, sizeof path);
+  lm_error err;
+  lm_scene *s = lm_scene_load_gltf(path, &err);
+  if (!s) fail_msg("%s", err.msg);
+  return s;
+}
+
+/* A triangle strip, a fan and their indexed forms render the same image as
+ * the triangle list of the same triangles (a square, and with a fifth
+ * vertex three triangles). */
+static void strips_and_fans_render_as_their_triangle_lists(void **state) {
+  (void)state;
+  static const struct { const char *b64; int n, ni, mode; } shapes[] = {
+      /* the square as a list, a strip, an indexed strip (vertices stored in reverse) */
+      {"AAAAAAAAAAAAAAAAAAAAQAAAAAAAAAAAAAAAAAAAwD8AAAAAAAAAQAAAAAAAAAAAAAAAQAAAwD8AAAAAAAAAAAAAwD8AAAAA", 6, 0, 4},
+      {"AAAAAAAAAAAAAAAAAAAAQAAAAAAAAAAAAAAAAAAAwD8AAAAAAAAAQAAAwD8AAAAA", 4, 0, 5},
+      {"AABAQAAAwD8AAAAAAAAAQAAAwD8AAAAAAAAAAAAAwD8AAAAAAAAAQAAAAAAAAAAAAAAAAAAAAAAAAAAABAADAAIAAQA=", 5, 4, 5},
+      /* three triangles as a list, a fan, an indexed fan */
+      {"AAAAAAAAAAAAAAAAAAAAQAAAAAAAAAAAAAAAAAAAwD8AAAAAAAAAQAAAAAAAAAAAAAAAQAAAwD8AAAAAAAAAAAAAwD8AAAAAAAAAQAAAAAAA"
+       "AAAAAABAQAAAwD8AAAAAAAAAQAAAwD8AAAAA", 9, 0, 4},
+      {"AAAAQAAAAAAAAAAAAABAQAAAwD8AAAAAAAAAQAAAwD8AAAAAAAAAAAAAwD8AAAAAAAAAAAAAAAAAAAAA", 5, 0, 6},
+      {"AABAQAAAwD8AAAAAAAAAQAAAwD8AAAAAAAAAAAAAwD8AAAAAAAAAQAAAAAAAAAAAAAAAAAAAAAAAAAAAAwAAAAEAAgAEAAAA", 5, 5, 6},
+  };
+  const char *sets[] = {"ambient=0.1", NULL};
+  gl_result ref = {0};
+  lm_scene *ref_scene = NULL; /* kept while its renderer is */
+  for (int i = 0; i < 6; i++) {
+    lm_scene *s = topology_scene(shapes[i].b64, shapes[i].n, shapes[i].ni, shapes[i].mode);
+    gl_result g = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = sets, .width = 64, .height = 48});
+    if (!g.ok) fail_msg("shape %d: %s", i, g.err.msg);
+    if (i % 3 == 0) { /* the list: what the other two must show */
+      gl_result_free(&ref);
+      lm_scene_destroy(ref_scene);
+      ref = g, ref_scene = s;
+      float all[3];
+      gl_region(&ref, 0, 0, 63, 47, all);
+      assert_true(gl_luminance(all) > 0.02f); /* something drawn */
+    } else {
+      double worst = 0;
+      for (int k = 0; k < 64 * 48 * 3; k++) worst = fmax(worst, fabs((double)g.rgb[k] - ref.rgb[k]));
+      printf("shape %d against its list: max difference %g\n", i, worst);
+      assert_true(worst < 1e-6);
+      gl_result_free(&g);
+      lm_scene_destroy(s);
+    }
+  }
+  gl_result_free(&ref);
+  lm_scene_destroy(ref_scene);
+}
+
 static int setup(void **state) {
   int rc = gl_test_setup(state);
   lm_log_set_level(LM_LOG_ERROR); /* the bad-texture cases warn by design */
@@ -460,6 +526,7 @@ int main(void) {
       cmocka_unit_test(materials_reload_without_a_restart),
       cmocka_unit_test(bad_textures_name_material_texture_and_image),
       cmocka_unit_test(pbr_sphere_grid_is_finite_and_monotonic),
+      cmocka_unit_test(strips_and_fans_render_as_their_triangle_lists),
       cmocka_unit_test(mutated_scene_files_never_crash),
   };
   return cmocka_run_group_tests(tests, setup, gl_test_teardown);
