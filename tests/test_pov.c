@@ -57,13 +57,17 @@ static void camera_lights_and_materials_match(void **state) {
   assert_float_equal(up[1], h, 1e-4);
   assert_float_equal(right[0], h * 128.0 / 96.0, 1e-4);
   assert_float_equal(right[1], 0, 1e-6);
-  /* inverse square: colour 2.4 * (1, 0.95, 0.85) / (2 f^2), fade_power 2 */
-  double col[3];
-  vector_after(strstr(t, "// light 'ceiling_light'"), "color rgb", col);
-  double k = 1.0 / (2 * LM_POV_FADE_DISTANCE * LM_POV_FADE_DISTANCE);
+  /* inverse square: colour 2.4 * (1, 0.95, 0.85) / (2 f^2), fade_power 2, f a
+   * millionth of the bounding sphere's radius (the box: 2 x 2 x 2) */
+  double col[3], f;
+  const char *light = strstr(t, "// light 'ceiling_light'");
+  vector_after(light, "color rgb", col);
+  assert_int_equal(sscanf(strstr(light, "fade_distance"), "fade_distance %lf", &f), 1);
+  assert_float_equal(f, LM_POV_FADE_FRACTION * sqrt(3.0), 1e-12);
+  double k = 1.0 / (2 * f * f);
   assert_float_equal(col[0] / k, 2.4, 1e-6);
   assert_float_equal(col[2] / k, 2.4 * 0.85, 1e-6);
-  assert_non_null(strstr(t, "fade_distance 0.001\n  fade_power 2"));
+  assert_non_null(strstr(light, "\n  fade_power 2"));
   /* the sun is parallel, placed outside the box, shining along its node's -Z */
   const char *sun = strstr(t, "// light 'sun'");
   assert_non_null(sun);

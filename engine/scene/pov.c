@@ -157,6 +157,8 @@ static bool write_light(pov_ctx *c, const lm_light *l, const lm_light_data *ld, 
                    "shadowless spotlight", l->name))
     return false;
   bool fade = false;
+  /* relative to the scene, so that every unit gets the same accuracy */
+  double fade_distance = LM_POV_FADE_FRACTION * (radius > 0 && isfinite(radius) ? radius : 1.0);
   if (type != LM_LIGHT_DIRECTIONAL) {
     double range = ld->color[3];
     if (falloff == LM_FALLOFF_RANGE && range > 0) {
@@ -177,7 +179,7 @@ static bool write_light(pov_ctx *c, const lm_light *l, const lm_light_data *ld, 
     }
     if (falloff == LM_FALLOFF_INVERSE_SQUARE || falloff == LM_FALLOFF_RANGE) {
       fade = true;
-      for (int i = 0; i < 3; i++) col[i] /= 2.0 * LM_POV_FADE_DISTANCE * LM_POV_FADE_DISTANCE;
+      for (int i = 0; i < 3; i++) col[i] /= 2.0 * fade_distance * fade_distance;
     } else if (falloff != LM_FALLOFF_NONE &&
                !mismatch(c, "light '%s': the window falloff saturate(1 - (d/r)^2) (seed 000 eq 16) has no "
                             "POV-Ray form; give the light falloff none or inverse-square "
@@ -225,7 +227,7 @@ static bool write_light(pov_ctx *c, const lm_light *l, const lm_light_data *ld, 
                     glm_deg((float)inner), glm_deg((float)outer));
       put_vec(c, at, what);
     }
-    if (fade) lm_buf_printf(b, "\n  fade_distance %.9g\n  fade_power 2", LM_POV_FADE_DISTANCE);
+    if (fade) lm_buf_printf(b, "\n  fade_distance %.9g\n  fade_power 2", fade_distance);
   }
   lm_buf_printf(b, "%s\n}\n\n", shadowless ? "\n  shadowless" : "");
   return true;

@@ -39,9 +39,10 @@
  *   directional -> parallel light placed outside the scene's bounds;
  *   point, LM_FALLOFF_NONE -> plain point light;
  *   point, LM_FALLOFF_INVERSE_SQUARE -> fade_power 2 and fade_distance
- *     LM_POV_FADE_DISTANCE (f) with the colour divided by 2 f^2: POV-Ray's
- *     2 / (1 + (d / f)^2) then gives 1 / (d^2 + f^2), which is 1 / d^2 to a
- *     relative 1e-6 at d = 1;
+ *     f = LM_POV_FADE_FRACTION times the radius of the scene's bounding
+ *     sphere, with the colour divided by 2 f^2: POV-Ray's 2 / (1 + (d / f)^2)
+ *     then gives 1 / (d^2 + f^2), which is 1 / d^2 to a relative 1e-6 at a
+ *     thousandth of the scene's size, in any unit;
  *   point, LM_FALLOFF_RANGE (glTF's) -> the same as inverse square when the
  *     range window clamp(1 - (d / range)^4, 0, 1) stays above
  *     1 - LM_POV_RANGE_EXACT over the scene's bounding sphere (no range, or
@@ -63,7 +64,7 @@
 
 #include "scene/scene.h"
 
-#define LM_POV_FADE_DISTANCE 1e-3
+#define LM_POV_FADE_FRACTION 1e-6
 /* Largest departure from 1 of a glTF range window written as plain inverse
  * square: below the G-buffer's 8-bit albedo step. */
 #define LM_POV_RANGE_EXACT (1.0 / 512.0)
