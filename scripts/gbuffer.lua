@@ -2,23 +2,27 @@
 -- and record the geometry pass that fills them.
 local gbuffer = {}
 
--- Targets at `scale` of the output (1 by default). Fields: clr, nrm, dpt, mat, depth.
-function gbuffer.targets(scale)
+-- Targets at `scale` of the output (1 by default). Fields: clr, nrm, dpt, mat, depth;
+-- for material technique "pbr" also emi (emitted radiance, added after lighting).
+function gbuffer.targets(scale, technique)
   scale = scale or 1
-  return {
+  local G = {
     clr = target{ "gbuffer.clr", format = "rgba8", scale = scale },      -- albedo, rho
     nrm = target{ "gbuffer.nrm", format = "rgba16f", scale = scale },    -- world normal, shininess
     dpt = target{ "gbuffer.dpt", format = "r32f", scale = scale },       -- linear depth / far
     mat = target{ "gbuffer.mat", format = "rgba8", scale = scale },      -- k_a, k_d, k_s, coverage
     depth = target{ "gbuffer.depth", format = "depth32f", scale = scale },
   }
+  if technique == "pbr" then G.emi = target{ "gbuffer.emi", format = "rgba16f", scale = scale } end
+  return G
 end
 
--- Draws the scene with material technique `technique` ("std") into G;
+-- Draws the scene with material technique `technique` ("std" Phong, or "pbr"
+-- glTF metallic-roughness, which writes the same channels) into G;
 -- `materials` (optional) overrides material parameters by name:
 -- { wall = { color = { 1, 0, 0 }, ks = 0.2 } }.
 function gbuffer.render(G, technique, materials)
-  scene{ "gbuffer", technique = technique or "std", out = { G.clr, G.nrm, G.dpt, G.mat },
+  scene{ "gbuffer", technique = technique or "std", out = { G.clr, G.nrm, G.dpt, G.mat, G.emi },
          depth = G.depth, clear = { 0, 0, 0, 0 }, materials = materials }
   return G
 end

@@ -16,6 +16,7 @@ Techniques = { "isr+esm", "isr", "dl+esm", "dl", "ssdo+esm", "ssdo", "ssao+esm",
 Options = {
   ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
   background = 0.0,        -- radiance where no geometry is
+  materials = "phong",     -- "phong" (the std technique) or "pbr" (glTF metallic-roughness, GGX)
   isr = {},                -- see isr.defaults in scripts/isr.lua
   shadow = {},             -- see shadow.defaults in scripts/shadow.lua
   ssdo = {},               -- see ssdo.defaults in scripts/ssdo.lua
@@ -60,7 +61,9 @@ function OnRender(tech)
   if tech.name:find("+esm", 1, true) and lighting == "ssdo" and tech.ssdo.variant == "two_step" then
     error('ssdo+esm cannot take ssdo.variant = "two_step" (it relights without shadows)')
   end
-  local G = gbuffer.render(gbuffer.targets())
+  local materials = ({ phong = "std", pbr = "pbr" })[tech.materials]
+  if not materials then error('materials must be "phong" or "pbr" (got "' .. tostring(tech.materials) .. '")') end
+  local G = gbuffer.render(gbuffer.targets(1, materials), materials)
   -- Shadows after the G-buffer: their cascades fit the depths it sees.
   local shadows = tech.name:find("+esm", 1, true) and shadow.render(tech.shadow, G) or nil
   if shadows and tech.shadow.debug then return present(shadow.debug(shadows)) end
@@ -77,6 +80,10 @@ function OnRender(tech)
     else
       lit = ssao.render(G, d, tech.ssao, light)
     end
+  end
+  if G.emi then -- emitted light, after the lighting that never sees it
+    lit = pass{ "emissive", shader = "bloom_add.frag", inputs = { src = lit, bloom = G.emi },
+                out = target{ "lit.emissive", format = "rgba16f" } }
   end
   present(post.render(lit, tech, G))
 end

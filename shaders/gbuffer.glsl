@@ -4,6 +4,19 @@
 #define LIMN_GBUFFER_GLSL
 #include "lighting.glsl"
 
+// The pbr technique (pbr.frag) writes this in mat.a: covered (>= 0.5) and
+// told apart from std's 1.
+const float PBR_MARK = 0.75;
+const float PBR_MIN_ROUGHNESS = 0.08; // keeps pbr_shininess within rgba16f
+
+// The Blinn-Phong exponent whose lobe matches GGX of alpha = roughness^2
+// (2 / alpha^2 - 2, as gltf.h converts for std), and back.
+float pbr_shininess(float roughness) {
+  float r2 = roughness * roughness;
+  return clamp(2.0 / max(r2 * r2, 1e-6) - 2.0, 0.0, 60000.0);
+}
+float pbr_roughness(float shininess) { return sqrt(sqrt(2.0 / (max(shininess, 0.0) + 2.0))); }
+
 struct Surface {
   vec3 albedo;     // clr.rgb
   float rho;       // clr.a: reflectance, the seed's "radiation mask"
@@ -13,6 +26,9 @@ struct Surface {
   vec3 k;          // mat.xyz: k_a, k_d, k_s
   bool covered;    // mat.a >= 0.5: geometry, not background
   vec3 p;          // world position (eq 23-24)
+  bool pbr;        // written by the pbr technique: k = (occlusion, 1 - metallic, max F0)
+  float roughness; // pbr: from the shininess
+  vec3 f0;         // pbr: mix(0.04, albedo, metallic)
 };
 
 Surface gbuffer_decode(vec4 c, vec4 nn, float d, vec4 m, vec2 uv) {
@@ -25,6 +41,9 @@ Surface gbuffer_decode(vec4 c, vec4 nn, float d, vec4 m, vec2 uv) {
   s.k = m.xyz;
   s.covered = m.a >= 0.5;
   s.p = position_from_depth(uv, s.depth01);
+  s.pbr = s.covered && m.a < 0.5 * (PBR_MARK + 1.0);
+  s.roughness = pbr_roughness(s.shininess);
+  s.f0 = mix(vec3(0.04), s.albedo, 1.0 - s.k.y);
   return s;
 }
 
@@ -40,9 +59,11 @@ Surface gbuffer_fetch(sampler2D clr, sampler2D nrm, sampler2D dpt, sampler2D mat
                         texelFetch(mat, q, 0), uv);
 }
 
-// Direct light leaving a covered surface toward the eye (Phong, lighting.glsl).
+// Direct light leaving a covered surface toward the eye (lighting.glsl: Phong,
+// or GGX for the pbr technique's surfaces).
 vec3 direct_light(Surface s, vec3 ambient) {
   vec3 v = safe_normalize(frame.camera_pos.xyz - s.p, s.n);
+  if (s.pbr) return pbr_light(s.k.y * s.albedo, s.f0, s.roughness, s.k.x, s.n, v, s.p, ambient);
   return phong(s.albedo, s.k, s.shininess, s.n, v, s.p, ambient);
 }
 #endif

@@ -45,21 +45,53 @@ vec3 light_incident(int i, vec3 p, out vec3 l) {
   return li.color.rgb * fall;
 }
 
+// Light i on a surface at p facing n: false when it arrives from behind;
+// else its direction l, n.l and its radiance (shadowed with SHADOWS).
+bool light_on_surface(int i, vec3 p, vec3 n, out vec3 l, out float ndl, out vec3 radiance) {
+  radiance = light_incident(i, p, l);
+  ndl = dot(n, l);
+  if (ndl <= 0.0) return false;
+#ifdef SHADOWS
+  radiance *= shadow_factor(i, p, n, l);
+#endif
+  return true;
+}
+
 // k = (k_a, k_d, k_s), shininess >= 0; n and v unit vectors (v toward the eye).
 vec3 phong(vec3 albedo, vec3 k, float shininess, vec3 n, vec3 v, vec3 p, vec3 ambient) {
   vec3 sum = k.x * ambient * albedo;
   for (int i = 0; i < frame.counts.x; i++) {
-    vec3 l;
-    vec3 radiance = light_incident(i, p, l);
-    float ndl = dot(n, l);
-    if (ndl <= 0.0) continue;
-#ifdef SHADOWS
-    radiance *= shadow_factor(i, p, n, l);
-#endif
+    vec3 l, radiance;
+    float ndl;
+    if (!light_on_surface(i, p, n, l, ndl, radiance)) continue;
     vec3 r = reflect(-l, n);
     // pow(0, 0) is undefined in GLSL: keep the base strictly positive.
     float spec = k.z > 0.0 ? pow(max(dot(r, v), 1e-8), max(shininess, 1.0)) : 0.0;
     sum += radiance * (k.y * albedo * ndl + k.z * spec);
+  }
+  return sum;
+}
+
+// glTF's metallic-roughness BRDF: Lambert diffuse weighted by 1 - F, GGX
+// (Trowbridge-Reitz) specular with Smith's height-correlated visibility and
+// Schlick's Fresnel from f0. The engine's lights carry Lambert's 1 / pi
+// already (Phong has none; engine/scene/gltf.h), so the specular term is
+// pi times the BRDF. Ambient light reaches the diffuse part times occlusion.
+vec3 pbr_light(vec3 diffuse, vec3 f0, float roughness, float occlusion, vec3 n, vec3 v, vec3 p, vec3 ambient) {
+  float a = max(roughness * roughness, 1e-3), a2 = a * a;
+  float ndv = max(dot(n, v), 1e-4);
+  vec3 sum = occlusion * ambient * diffuse;
+  for (int i = 0; i < frame.counts.x; i++) {
+    vec3 l, radiance;
+    float ndl;
+    if (!light_on_surface(i, p, n, l, ndl, radiance)) continue;
+    vec3 h = safe_normalize(l + v, n);
+    float ndh = saturate(dot(n, h)), vdh = saturate(dot(v, h));
+    float dd = ndh * ndh * (a2 - 1.0) + 1.0;
+    float d = a2 / max(PI * dd * dd, 1e-12);
+    float vis = 0.5 / max(ndl * sqrt(ndv * ndv * (1.0 - a2) + a2) + ndv * sqrt(ndl * ndl * (1.0 - a2) + a2), 1e-8);
+    vec3 f = f0 + (1.0 - f0) * pow(1.0 - vdh, 5.0);
+    sum += radiance * ndl * ((1.0 - f) * diffuse + PI * f * d * vis);
   }
   return sum;
 }

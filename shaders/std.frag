@@ -13,6 +13,7 @@ uniform vec4 material_k; // k_a, k_d, k_s, shininess
 #ifdef BASE_COLOR_TEXTURE
 // The material's base-colour image, stored sRGB: texture() returns linear values.
 uniform sampler2D base_color_tex;
+uniform mat3 base_color_xform; // KHR_texture_transform
 #endif
 
 layout(location = 0) out vec4 out_clr;
@@ -25,7 +26,7 @@ void main() {
   if (!gl_FrontFacing) n = -n; // two-sided: a wall seen from behind still lights
   vec3 albedo = material_color;
 #ifdef BASE_COLOR_TEXTURE
-  albedo *= texture(base_color_tex, tex_uv).rgb; // glTF: baseColorFactor * baseColorTexture
+  albedo *= texture(base_color_tex, (base_color_xform * vec3(tex_uv, 1.0)).xy).rgb; // glTF: factor * texture
 #endif
   out_clr = vec4(saturate(albedo), saturate(material_rho));
   out_nrm = vec4(n, max(material_k.w, 0.0));

@@ -1,4 +1,4 @@
-// The "std" material technique: geometry into the G-buffer.
+// The "std" material technique: geometry into the G-buffer (pbr.vert too).
 #include "common.glsl"
 
 layout(location = 0) in vec3 in_position;
@@ -9,12 +9,14 @@ uniform mat4 model;
 uniform mat3 normal_matrix;
 
 out vec3 world_normal;
+out vec3 world_pos; // for derivative tangent frames (pbr.frag)
 out float view_depth;
 out vec2 tex_uv;
 
 void main() {
   vec4 world = model * vec4(in_position, 1.0);
   world_normal = normal_matrix * in_normal;
+  world_pos = world.xyz;
   view_depth = -(frame.view * world).z; // OpenGL looks down -z
   tex_uv = in_uv;
   gl_Position = frame.view_proj * world;

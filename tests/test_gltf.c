@@ -305,7 +305,8 @@ static void strips_and_fans_become_triangles(void **state) {
 
 /* A required extension the engine lacks is named, in .gltf and .glb alike,
  * before any of the data it governs is read (here: an accessor with no
- * bufferView, as Draco leaves them). A supported one loads. */
+ * bufferView, as Draco leaves them). (pbr_materials_come_over requires a
+ * supported one.) */
 static void unsupported_required_extension_is_named(void **state) {
   (void)state;
   static const char json[] =
@@ -390,6 +391,65 @@ static void cameras_frame_the_bounds(void **state) {
   assert_non_null(strstr(err.msg, "camera 'plan' (0) is orthographic (xmag 2, ymag 1.5)"));
   assert_true(lm_scene_camera_check(s, 1, &err));
   lm_scene_destroy(s);
+}
+
+/* glTF's metallic-roughness material comes over whole for the pbr
+ * technique: factors, textures (data ones linear), KHR_texture_transform,
+ * KHR_materials_emissive_strength, alpha mode and cutoff; a bad extension
+ * value is named. */
+static void pbr_materials_come_over(void **state) {
+  (void)state;
+  static const char json[] =
+      "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_texture_transform\","
+      "\"KHR_materials_emissive_strength\"],\"extensionsRequired\":[\"KHR_texture_transform\"],"
+      "\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
+      "\"materials\":[{\"name\":\"lamp\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0.5,0.25,0.6],"
+      "\"metallicFactor\":0.75,\"roughnessFactor\":0.4,\"baseColorTexture\":{\"index\":0,"
+      "\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0,1],\"rotation\":1.5707963268,"
+      "\"scale\":[0.5,0.5]}}},\"metallicRoughnessTexture\":{\"index\":0}},"
+      "\"normalTexture\":{\"index\":0,\"scale\":0.5},\"occlusionTexture\":{\"index\":0,\"strength\":0.25},"
+      "\"emissiveTexture\":{\"index\":0},\"emissiveFactor\":[1,0.5,0],\"alphaMode\":\"MASK\",\"alphaCutoff\":0.3,"
+      "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":%s}}}],"
+      "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,"
+      "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR4nGM4kWL0HwAFtAJeHzr7ywAAAABJRU5ErkJggg==\"}],"
+      "\"buffers\":[{\"uri\":\"%%s\",\"byteLength\":%%zu}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}";
+  blob b = {0};
+  blob_add(&b, tri_pos, sizeof tri_pos);
+  char text[4096];
+  snprintf(text, sizeof text, json, "4");
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(write_gltf("pbr.gltf", text, &b), &err);
+  if (!s) fail_msg("%s", err.msg);
+  const lm_material *m = &s->materials[0];
+  const lm_material_pbr *p = &s->material_pbr[0];
+  assert_true(p->set);
+  assert_float_equal(p->metallic, 0.75, 1e-6), assert_float_equal(p->roughness, 0.4, 1e-6);
+  assert_float_equal(m->kd, 0.25, 1e-6); /* the std technique's view of it stays */
+  assert_float_equal(p->alpha, 0.6, 1e-6);
+  assert_int_equal(p->alpha_mode, LM_ALPHA_MASK);
+  assert_float_equal(p->alpha_cutoff, 0.3, 1e-6);
+  assert_float_equal(p->normal_scale, 0.5, 1e-6), assert_float_equal(p->occlusion_strength, 0.25, 1e-6);
+  assert_float_equal(p->emissive[0], 4, 1e-6), assert_float_equal(p->emissive[1], 2, 1e-6);
+  /* one image, two textures: sRGB for colour, linear for data */
+  assert_int_equal(s->texture_count, 2);
+  int colour = m->base_color_texture - 1, data = p->textures[LM_TEX_METALLIC_ROUGHNESS] - 1;
+  assert_false(s->textures[colour].linear);
+  assert_true(s->textures[data].linear);
+  assert_int_equal(p->textures[LM_TEX_NORMAL] - 1, data);
+  assert_int_equal(p->textures[LM_TEX_OCCLUSION] - 1, data);
+  assert_int_equal(p->textures[LM_TEX_EMISSIVE] - 1, colour);
+  /* uv' = T R S uv: the spec's example, the lower left quadrant turned: (1, 0) -> (0, 0.5), (0, 1) -> (0.5, 1) */
+  const float *t = p->uv_transform[LM_TEX_BASE_COLOR];
+  assert_float_equal(t[0] * 1 + t[2], 0, 1e-6), assert_float_equal(t[3] * 1 + t[5], 0.5, 1e-6);
+  assert_float_equal(t[1] * 1 + t[2], 0.5, 1e-6), assert_float_equal(t[4] * 1 + t[5], 1, 1e-6);
+  for (int k = 0; k < 6; k++) assert_float_equal(p->uv_transform[LM_TEX_NORMAL][k], 0, 0); /* none: identity */
+  lm_scene_destroy(s);
+
+  snprintf(text, sizeof text, json, "-1");
+  assert_null(lm_scene_load_gltf(write_gltf("pbr.gltf", text, &b), &err));
+  assert_non_null(strstr(err.msg, "material 0: KHR_materials_emissive_strength wants emissiveStrength"));
 }
 
 static const char two_prims_json[] =
@@ -929,6 +989,7 @@ int main(void) {
       cmocka_unit_test(strips_and_fans_become_triangles),
       cmocka_unit_test(unsupported_required_extension_is_named),
       cmocka_unit_test(cameras_frame_the_bounds),
+      cmocka_unit_test(pbr_materials_come_over),
       cmocka_unit_test(hierarchy_composes_rotated_parents),
       cmocka_unit_test(lights_and_cameras_come_over),
       cmocka_unit_test(glb_loads_like_gltf),

@@ -228,9 +228,9 @@ static void bad_textures_name_material_texture_and_image(void **state) {
     const char *textures, *images, *expect;
   } cases[] = {
       {"[{\"source\":0}]", "[{\"uri\":\"data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAA\"}]",
-       "material 0: texture 0: image 0"},
-      {"[{\"source\":0}]", "[{\"uri\":\"missing.png\"}]", "material 0: texture 0: image 0 ('missing.png'): no image data"},
-      {"[{\"source\":3}]", "[{\"uri\":\"missing.png\"}]", "material 0: texture 0: image 3 does not exist"},
+       "material 0: baseColorTexture: texture 0: image 0"},
+      {"[{\"source\":0}]", "[{\"uri\":\"missing.png\"}]", "material 0: baseColorTexture: texture 0: image 0 ('missing.png'): no image data"},
+      {"[{\"source\":3}]", "[{\"uri\":\"missing.png\"}]", "material 0: baseColorTexture: texture 0: image 3 does not exist"},
       {"[]", "[]", "material 0: baseColorTexture: texture 0 does not exist (the file has 0)"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
@@ -311,6 +311,206 @@ static void mutated_scene_files_never_crash(void **state) {
   assert_true(loaded > 0 && loaded < iters);
 }
 
+/* A UV sphere of radius r at the origin (position, normal, uv). */
+static int add_sphere(lm_scene *s, float r) {
+  enum { SEG = 32, RINGS = 16 };
+  static float v[(SEG + 1) * (RINGS + 1) * 8];
+  static uint32_t idx[SEG * RINGS * 6];
+  int nv = 0, ni = 0;
+  for (int j = 0; j <= RINGS; j++)
+    for (int i = 0; i <= SEG; i++) {
+      float th = 3.14159265f * (float)j / RINGS, ph = 2 * 3.14159265f * (float)i / SEG;
+      float n[3] = {sinf(th) * cosf(ph), cosf(th), -sinf(th) * sinf(ph)};
+      float *o = v + nv++ * 8;
+      for (int k = 0; k < 3; k++) o[k] = r * n[k], o[3 + k] = n[k];
+      o[6] = (float)i / SEG, o[7] = (float)j / RINGS;
+    }
+  for (int j = 0; j < RINGS; j++)
+    for (int i = 0; i < SEG; i++) {
+      uint32_t a = (uint32_t)(j * (SEG + 1) + i), b = a + SEG + 1;
+      uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
+      memcpy(idx + ni, q, sizeof q), ni += 6;
+    }
+  return lm_scene_add_mesh(s, "sphere", v, nv, idx, ni);
+}
+
+/* The pbr technique over a grid of spheres, metallic (rows) by roughness
+ * (columns), lit from the eye: every value finite, each row's highlight
+ * falls as roughness grows while the diffuse part stays, a metal's
+ * highlight takes its base colour; and the GI passes take the same
+ * G-buffer (finite, lit). */
+static void pbr_sphere_grid_is_finite_and_monotonic(void **state) {
+  (void)state;
+  enum { GW = 128, GH = 96, ROWS = 3, COLS = 4 };
+  static const float metallic[ROWS] = {0, 0.5f, 1}, roughness[COLS] = {0.3f, 0.5f, 0.7f, 1.0f};
+  lm_scene *s = lm_scene_create("grid");
+  int sphere = add_sphere(s, 0.42f);
+  float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  for (int r = 0; r < ROWS; r++)
+    for (int c = 0; c < COLS; c++) {
+      lm_material mat = {.color = {0.8f, 0.35f, 0.1f}, .rho = 0.8f, .ka = 1, .kd = 1, .ks = 0.04f, .shininess = 16};
+      snprintf(mat.name, sizeof mat.name, "m%d_r%d", r, c);
+      int id = lm_scene_add_material(s, &mat);
+      s->material_pbr[id] = (lm_material_pbr){.set = true, .metallic = metallic[r], .roughness = roughness[c],
+                                              .normal_scale = 1, .occlusion_strength = 1, .alpha = 1};
+      m[12] = ((float)c - 1.5f), m[13] = (1.0f - (float)r);
+      lm_scene_add_node(s, mat.name, -1, m, sphere, id);
+    }
+  m[12] = 0, m[13] = 0, m[14] = 8;
+  int eye = lm_scene_add_node(s, "eye", -1, m, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "eye", .fov_y = 0.42f, .znear = 1, .zfar = 20, .node = eye});
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 2,
+                                     .outer_cone = 1.5707964f, .node = eye});
+  lm_scene_update(s);
+  const char *sets[] = {"materials=pbr", "ambient=0", NULL};
+  gl_result g = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = sets, .width = GW, .height = GH,
+                                    .check_finite = true});
+  if (!g.ok) fail_msg("%s", g.err.msg);
+  assert_true(gl_all_finite(&g));
+  lm_frame_data f;
+  lm_scene_frame_data(s, 0, GW, GH, &f);
+  float peak[ROWS][COLS], peak_rgb[ROWS][COLS][3], edge[ROWS][COLS];
+  for (int r = 0; r < ROWS; r++)
+    for (int c = 0; c < COLS; c++) {
+      float p[3] = {(float)c - 1.5f, 1.0f - (float)r, 0}, clip[4];
+      for (int k = 0; k < 4; k++)
+        clip[k] = f.view_proj[k] * p[0] + f.view_proj[4 + k] * p[1] + f.view_proj[8 + k] * p[2] + f.view_proj[12 + k];
+      int cx = (int)((clip[0] / clip[3] * 0.5f + 0.5f) * GW), cy = (int)((0.5f - clip[1] / clip[3] * 0.5f) * GH);
+      peak[r][c] = 0;
+      for (int y = cy - 4; y <= cy + 4; y++)
+        for (int x = cx - 4; x <= cx + 4; x++) {
+          const float *q = g.rgb + (y * GW + x) * 3;
+          float l = gl_luminance(q);
+          if (l > peak[r][c]) peak[r][c] = l, memcpy(peak_rgb[r][c], q, sizeof peak_rgb[r][c]);
+        }
+      float side[3]; /* a patch toward the rim, away from the highlight: the diffuse part */
+      gl_region(&g, cx + 7, cy - 1, cx + 8, cy + 1, side);
+      edge[r][c] = gl_luminance(side);
+    }
+  for (int r = 0; r < ROWS; r++) {
+    printf("metallic %.1f: peak", (double)metallic[r]);
+    for (int c = 0; c < COLS; c++) printf(" %.3f", (double)peak[r][c]);
+    printf("  rim");
+    for (int c = 0; c < COLS; c++) printf(" %.3f", (double)edge[r][c]);
+    printf("\n");
+    for (int c = 0; c + 1 < COLS; c++) assert_true(peak[r][c] > peak[r][c + 1]);
+  }
+  /* dielectrics keep their diffuse colour at the rim; a full metal has none */
+  assert_true(edge[0][COLS - 1] > 0.05f);
+  assert_true(edge[ROWS - 1][COLS - 1] < edge[0][COLS - 1]);
+  /* a metal's highlight is its base colour (F0 = base), a dielectric's is white */
+  assert_true(peak_rgb[ROWS - 1][0][0] > 2 * peak_rgb[ROWS - 1][0][2]);
+  gl_result_free(&g);
+
+  static const char *const gi[] = {"isr", "ssdo", "ssao"};
+  for (int i = 0; i < 3; i++) {
+    g = gl_render(&(gl_run){.scene = s, .tech = gi[i], .sets = sets, .width = 64, .height = 48,
+                            .check_finite = true});
+    if (!g.ok) fail_msg("%s: %s", gi[i], g.err.msg);
+    assert_true(gl_all_finite(&g));
+    float all[3];
+    gl_region(&g, 0, 0, 63, 47, all);
+    assert_true(gl_luminance(all) > 0.01f);
+    gl_result_free(&g);
+  }
+
+  /* alpha mask: a sphere under its cutoff is not drawn; emission lights a
+   * sphere the sun does not (the sun off); blending is refused by name */
+  s->lights[0].power = 0;
+  s->material_pbr[0].alpha = 0.3f, s->material_pbr[0].alpha_mode = LM_ALPHA_MASK;
+  s->material_pbr[0].alpha_cutoff = 0.5f;
+  s->material_pbr[5].emissive[1] = 0.5f;
+  g = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = sets, .width = GW, .height = GH});
+  if (!g.ok) fail_msg("%s", g.err.msg);
+  float pix[3];
+  int sphere_px[2][2] = {{0, 0}, {1, 1}}; /* (row, column) of materials 0 and 5 */
+  for (int k = 0; k < 2; k++) {
+    float p[3] = {(float)sphere_px[k][1] - 1.5f, 1.0f - (float)sphere_px[k][0], 0}, clip[4];
+    for (int i = 0; i < 4; i++)
+      clip[i] = f.view_proj[i] * p[0] + f.view_proj[4 + i] * p[1] + f.view_proj[8 + i] * p[2] + f.view_proj[12 + i];
+    int cx = (int)((clip[0] / clip[3] * 0.5f + 0.5f) * GW), cy = (int)((0.5f - clip[1] / clip[3] * 0.5f) * GH);
+    gl_region(&g, cx - 1, cy - 1, cx + 1, cy + 1, pix);
+    if (k == 0) assert_true(gl_luminance(pix) < 1e-4f); /* masked away: background */
+    else assert_float_equal(pix[1], 0.5, 0.02), assert_true(pix[0] < 1e-3f); /* its emission alone */
+  }
+  gl_result_free(&g);
+  s->material_pbr[3].alpha_mode = LM_ALPHA_BLEND;
+  g = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = sets, .width = GW, .height = GH});
+  assert_false(g.ok);
+  assert_non_null(strstr(g.err.msg, "material 'm0_r3' (node 'm0_r3'): alphaMode BLEND is not drawn"));
+  gl_result_free(&g);
+  g = gl_render(&(gl_run){.scene = s, .tech = "dl", .width = GW, .height = GH}); /* std draws it opaque */
+  if (!g.ok) fail_msg("%s", g.err.msg);
+  gl_result_free(&g);
+  lm_scene_destroy(s);
+}
+
+/* A file drawing `n` float3 vertices (`b64`, then `ni` u16 indices when ni >
+ * 0) as primitive `mode`, seen by one camera. */
+static lm_scene *topology_scene(const char *b64, int n, int ni, int mode) {
+  char json[2048], path[512];
+  size_t bytes = (size_t)n * 12 + (size_t)ni * 2, padded = (bytes + 3) & ~(size_t)3;
+  snprintf(json, sizeof json,
+           "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0,1]}],"
+           "\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[1.5,0.75,5]}],"
+           "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.1,\"zfar\":20}}],"
+           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":%d%s}]}],"
+           "\"buffers\":[{\"uri\":\"data:application/octet-stream;base64,%s\",\"byteLength\":%zu}],"
+           "\"bufferViews\":[{\"buffer\":0,\"byteLength\":%d},{\"buffer\":0,\"byteOffset\":%d,\"byteLength\":%d}],"
+           "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\","
+           "\"min\":[0,0,0],\"max\":[3,1.5,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":%d,"
+           "\"type\":\"SCALAR\"}]}",
+           mode, ni ? ",\"indices\":1" : "", b64, padded, n * 12, n * 12, ni ? ni * 2 : 2, n, ni ? ni : 1);
+  write_file("topology.gltf", json, path, sizeof path);
+  lm_error err;
+  lm_scene *s = lm_scene_load_gltf(path, &err);
+  if (!s) fail_msg("%s", err.msg);
+  return s;
+}
+
+/* A triangle strip, a fan and their indexed forms render the same image as
+ * the triangle list of the same triangles (a square, and with a fifth
+ * vertex three triangles). */
+static void strips_and_fans_render_as_their_triangle_lists(void **state) {
+  (void)state;
+  static const struct { const char *b64; int n, ni, mode; } shapes[] = {
+      /* the square as a list, a strip, an indexed strip (vertices stored in reverse) */
+      {"AAAAAAAAAAAAAAAAAAAAQAAAAAAAAAAAAAAAAAAAwD8AAAAAAAAAQAAAAAAAAAAAAAAAQAAAwD8AAAAAAAAAAAAAwD8AAAAA", 6, 0, 4},
+      {"AAAAAAAAAAAAAAAAAAAAQAAAAAAAAAAAAAAAAAAAwD8AAAAAAAAAQAAAwD8AAAAA", 4, 0, 5},
+      {"AABAQAAAwD8AAAAAAAAAQAAAwD8AAAAAAAAAAAAAwD8AAAAAAAAAQAAAAAAAAAAAAAAAAAAAAAAAAAAABAADAAIAAQA=", 5, 4, 5},
+      /* three triangles as a list, a fan, an indexed fan */
+      {"AAAAAAAAAAAAAAAAAAAAQAAAAAAAAAAAAAAAAAAAwD8AAAAAAAAAQAAAAAAAAAAAAAAAQAAAwD8AAAAAAAAAAAAAwD8AAAAAAAAAQAAAAAAA"
+       "AAAAAABAQAAAwD8AAAAAAAAAQAAAwD8AAAAA", 9, 0, 4},
+      {"AAAAQAAAAAAAAAAAAABAQAAAwD8AAAAAAAAAQAAAwD8AAAAAAAAAAAAAwD8AAAAAAAAAAAAAAAAAAAAA", 5, 0, 6},
+      {"AABAQAAAwD8AAAAAAAAAQAAAwD8AAAAAAAAAAAAAwD8AAAAAAAAAQAAAAAAAAAAAAAAAAAAAAAAAAAAAAwAAAAEAAgAEAAAA", 5, 5, 6},
+  };
+  const char *sets[] = {"ambient=0.1", NULL};
+  gl_result ref = {0};
+  lm_scene *ref_scene = NULL; /* kept while its renderer is */
+  for (int i = 0; i < 6; i++) {
+    lm_scene *s = topology_scene(shapes[i].b64, shapes[i].n, shapes[i].ni, shapes[i].mode);
+    gl_result g = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = sets, .width = 64, .height = 48});
+    if (!g.ok) fail_msg("shape %d: %s", i, g.err.msg);
+    if (i % 3 == 0) { /* the list: what the other two must show */
+      gl_result_free(&ref);
+      lm_scene_destroy(ref_scene);
+      ref = g, ref_scene = s;
+      float all[3];
+      gl_region(&ref, 0, 0, 63, 47, all);
+      assert_true(gl_luminance(all) > 0.02f); /* something drawn */
+    } else {
+      double worst = 0;
+      for (int k = 0; k < 64 * 48 * 3; k++) worst = fmax(worst, fabs((double)g.rgb[k] - ref.rgb[k]));
+      printf("shape %d against its list: max difference %g\n", i, worst);
+      assert_true(worst < 1e-6);
+      gl_result_free(&g);
+      lm_scene_destroy(s);
+    }
+  }
+  gl_result_free(&ref);
+  lm_scene_destroy(ref_scene);
+}
+
 static int setup(void **state) {
   int rc = gl_test_setup(state);
   lm_log_set_level(LM_LOG_ERROR); /* the bad-texture cases warn by design */
@@ -325,6 +525,8 @@ int main(void) {
       cmocka_unit_test(scripts_override_materials_by_name),
       cmocka_unit_test(materials_reload_without_a_restart),
       cmocka_unit_test(bad_textures_name_material_texture_and_image),
+      cmocka_unit_test(pbr_sphere_grid_is_finite_and_monotonic),
+      cmocka_unit_test(strips_and_fans_render_as_their_triangle_lists),
       cmocka_unit_test(mutated_scene_files_never_crash),
   };
   return cmocka_run_group_tests(tests, setup, gl_test_teardown);

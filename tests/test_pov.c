@@ -57,13 +57,17 @@ static void camera_lights_and_materials_match(void **state) {
   assert_float_equal(up[1], h, 1e-4);
   assert_float_equal(right[0], h * 128.0 / 96.0, 1e-4);
   assert_float_equal(right[1], 0, 1e-6);
-  /* inverse square: colour 2.4 * (1, 0.95, 0.85) / (2 f^2), fade_power 2 */
-  double col[3];
-  vector_after(strstr(t, "// light 'ceiling_light'"), "color rgb", col);
-  double k = 1.0 / (2 * LM_POV_FADE_DISTANCE * LM_POV_FADE_DISTANCE);
+  /* inverse square: colour 2.4 * (1, 0.95, 0.85) / (2 f^2), fade_power 2, f a
+   * millionth of the bounding sphere's radius (the box: 2 x 2 x 2) */
+  double col[3], f;
+  const char *light = strstr(t, "// light 'ceiling_light'");
+  vector_after(light, "color rgb", col);
+  assert_int_equal(sscanf(strstr(light, "fade_distance"), "fade_distance %lf", &f), 1);
+  assert_float_equal(f, LM_POV_FADE_FRACTION * sqrt(3.0), 1e-12);
+  double k = 1.0 / (2 * f * f);
   assert_float_equal(col[0] / k, 2.4, 1e-6);
   assert_float_equal(col[2] / k, 2.4 * 0.85, 1e-6);
-  assert_non_null(strstr(t, "fade_distance 0.001\n  fade_power 2"));
+  assert_non_null(strstr(light, "\n  fade_power 2"));
   /* the sun is parallel, placed outside the box, shining along its node's -Z */
   const char *sun = strstr(t, "// light 'sun'");
   assert_non_null(sun);
@@ -201,6 +205,27 @@ static void range_window_is_exact_or_refused_by_name(void **state) {
   lm_scene_destroy(s);
 }
 
+/* --materials pbr: POV-Ray's closest finish for each material, written even
+ * when strict, each named in a warning; Phong materials get the metallic and
+ * roughness the pbr technique derives for them. */
+static void pbr_materials_are_approximated_and_said(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *s = lm_scene_builtin("cornell_pov", &err);
+  lm_pov_desc d = desc_for(64, 48);
+  d.pbr_materials = true;
+  lm_buf out = {0}, warn = {0};
+  assert_true(lm_pov_export(s, &d, &out, &warn, &err));
+  assert_non_null(strstr(warn.data, "material 'red': metallic-roughness written as POV-Ray's closest finish"));
+  /* red: kd 1, shininess 1: metallic 0, roughness (2 / 3)^(1/4) */
+  assert_non_null(strstr(out.data, "// material 'red' (metallic 0, roughness 0.904: approximated)"));
+  assert_non_null(strstr(out.data, "diffuse 1 brilliance 1 specular"));
+  assert_null(strstr(out.data, " phong "));
+  lm_buf_free(&out);
+  lm_buf_free(&warn);
+  lm_scene_destroy(s);
+}
+
 /* The C twin of lighting.glsl's light_falloff, and where each light ends. */
 static void falloff_and_reach(void **state) {
   (void)state;
@@ -295,6 +320,7 @@ int main(void) {
       cmocka_unit_test(builtin_cornell_exports_exactly),
       cmocka_unit_test(range_window_is_exact_or_refused_by_name),
       cmocka_unit_test(falloff_and_reach),
+      cmocka_unit_test(pbr_materials_are_approximated_and_said),
       cmocka_unit_test(unmatched_spots_and_materials_are_named),
       cmocka_unit_test(bad_views_are_refused),
   };

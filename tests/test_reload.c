@@ -62,7 +62,9 @@ static lm_pipeline *reader(const char *format) {
   at = strstr(text, "FORMAT");
   char rest[1024];
   snprintf(rest, sizeof rest, "%s", at + 6);
-  sprintf(at, "%s%s", format, rest);
+  size_t head = (size_t)(at - text);
+  int n = snprintf(at, sizeof text - head, "%s%s", format, rest);
+  assert_true(n >= 0 && (size_t)n < sizeof text - head);
   return load("reader.lua", text);
 }
 

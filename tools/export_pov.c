@@ -40,6 +40,9 @@ static const char export_usage[] =
     "                         light without shadow maps\n"
     "  --approximate          write what cannot match in its nearest form, with a\n"
     "                         warning, instead of refusing\n"
+    "  --materials phong|pbr  the finish of the std technique (phong, exact; the\n"
+    "                         default) or POV-Ray's closest to the pbr one (pbr,\n"
+    "                         with a warning naming what it approximates)\n"
     "  --output FILE          the .pov file to write (written whole or not at all)\n"
     "  --help                 this text\n"
     "\n"
@@ -63,7 +66,8 @@ const struct option limn_pov_options[] = {
     {"error-bound", required_argument, 0, 'e'},    {"pretrace-start", required_argument, 0, 'S'},
     {"pretrace-end", required_argument, 0, 'E'},   {"recursion-limit", required_argument, 0, 'l'},
     {"brightness", required_argument, 0, 'b'},     {"shadows", required_argument, 0, 'w'},
-    {"approximate", no_argument, 0, 'a'},          {0, 0, 0, 0}};
+    {"approximate", no_argument, 0, 'a'},          {"materials", required_argument, 0, 'M'},
+    {0, 0, 0, 0}};
 
 void limn_pov_defaults(lm_pov_desc *d) {
   *d = (lm_pov_desc){.width = 256, .height = 192, .radiosity = true, .shadows = true, .strict = true};
@@ -97,6 +101,10 @@ int limn_pov_flag(const char *cmd, int c, const char *arg, lm_pov_desc *d) {
       bad = "--brightness wants a number >= 0, not '%s'";
     break;
   case 'a': d->strict = false; break;
+  case 'M':
+    if (!strcmp(arg, "pbr") || !strcmp(arg, "phong")) d->pbr_materials = !strcmp(arg, "pbr");
+    else bad = "--materials wants phong or pbr, not '%s'";
+    break;
   default: return 1;
   }
   if (!bad) return 0;
@@ -114,7 +122,7 @@ static int parse_args(int argc, char **argv, export_args *a) {
       {"scene", required_argument, 0, 's'}, {"camera", required_argument, 0, 'c'},
       {"size", required_argument, 0, 'z'},  {"output", required_argument, 0, 'o'},
       {"help", no_argument, 0, 'h'}};
-  memcpy(opts + 5, limn_pov_options, sizeof limn_pov_options); /* 10 entries with the end */
+  memcpy(opts + 5, limn_pov_options, sizeof limn_pov_options); /* 11 entries with the end */
   opterr = 0;
   optind = 1;
   int c;

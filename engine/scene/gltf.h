@@ -5,7 +5,8 @@
  *
  * What comes over, and how:
  * - extensionsRequired first: a file that requires an extension other than
- *   those the loader reads (KHR_lights_punctual) is refused, naming it.
+ *   those the loader reads (KHR_lights_punctual, KHR_texture_transform,
+ *   KHR_materials_emissive_strength) is refused, naming it.
  * - Nodes of the file's default scene (scene 0 when it names none; every
  *   root node when it has no scenes), parents before children. A node's
  *   local transform is its matrix, or T * R * S. Every world transform must
@@ -32,6 +33,13 @@
  *                 exponent whose lobe matches GGX of alpha = roughness^2)
  *     ka        = 1; rho = max(color) * kd   (what diffuse bounce returns)
  *   A primitive without a material gets material -1, the engine's default.
+ *   Beside it (lm_scene.material_pbr) the metallic-roughness model whole,
+ *   for the pbr technique: factors, alphaMode and alphaCutoff, normal scale,
+ *   occlusion strength, emissiveFactor times KHR_materials_emissive_strength,
+ *   and the textures (metallic-roughness, normal, occlusion, emissive), each
+ *   with its KHR_texture_transform (TEXCOORD_0 only; another set warns).
+ *   Colour images (base colour, emissive) are sampled as sRGB, data images
+ *   as they are (one image used both ways is uploaded twice).
  * - Perspective cameras: yfov, znear, zfar; the aspect ratio is the output's.
  *   An infinite far plane (zfar absent) becomes LM_GLTF_INFINITE_ZFAR_RATIO
  *   times znear: relative, so any unit works (reversed float depth holds it).

@@ -29,7 +29,7 @@ struct Loader {
   lm_error *err;
   std::vector<std::vector<int>> meshes; // [mesh][primitive] -> lm mesh; -1 not yet, -2 skipped
   std::vector<int> materials;           // [material] -> lm material; -1 not yet
-  std::vector<int> textures;            // [image] -> lm texture; -1 not yet
+  std::vector<int> textures;            // [image * 2 + linear] -> lm texture; -1 not yet
   std::vector<int> nodes;               // [node] -> lm node; -1 not in the scene
   int skipped = 0;                      // point and line primitives, warned about once
   std::string first_skipped;            // "mesh M primitive P (mode K)"
@@ -337,34 +337,83 @@ int load_primitive(Loader &L, int mi, int pi) {
 
 // ---- materials -------------------------------------------------------------
 
-// lm texture of a material's baseColorTexture, decoded on first use through
-// OpenImageIO (the bytes stayed encoded since parsing); -1 on error.
-int texture_for(Loader &L, int material, const tinygltf::TextureInfo &info) {
+// lm texture of texture `index` (for material `material`'s `what`), decoded
+// on first use through OpenImageIO (the bytes stayed encoded since parsing);
+// colour images are sampled as sRGB, data images (`linear`) as they are.
+// -1 on error.
+int texture_for(Loader &L, int material, const char *what, int index, bool linear) {
   const tinygltf::Model &m = L.m;
-  if ((size_t)info.index >= m.textures.size())
-    return fail(L, "material %d: baseColorTexture: texture %d does not exist (the file has %zu)", material,
-                info.index, m.textures.size()), -1;
-  int src = m.textures[info.index].source;
+  if (index < 0 || (size_t)index >= m.textures.size())
+    return fail(L, "material %d: %s: texture %d does not exist (the file has %zu)", material, what, index,
+                m.textures.size()), -1;
+  int src = m.textures[index].source;
   if (src < 0 || (size_t)src >= m.images.size())
-    return fail(L, "material %d: texture %d: image %d does not exist (the file has %zu)", material, info.index,
-                src, m.images.size()), -1;
-  if (L.textures[src] >= 0) return L.textures[src];
+    return fail(L, "material %d: %s: texture %d: image %d does not exist (the file has %zu)", material, what,
+                index, src, m.images.size()), -1;
+  int &cached = L.textures[(size_t)src * 2 + linear];
+  if (cached >= 0) return cached;
   const tinygltf::Image &img = m.images[src];
   char name[LM_NAME_MAX + 64];
   snprintf(name, sizeof name, "image %d%s%s%s", src, img.name.empty() && img.uri.empty() ? "" : " ('",
            img.name.empty() ? img.uri.substr(0, 40).c_str() : img.name.c_str(),
            img.name.empty() && img.uri.empty() ? "" : "')");
   if (img.image.empty())
-    return fail(L, "material %d: texture %d: %s: no image data (a missing file?)", material, info.index,
+    return fail(L, "material %d: %s: texture %d: %s: no image data (a missing file?)", material, what, index,
                 name), -1;
   int w, h;
   unsigned char *rgba;
   lm_error why;
   if (!lm_image_decode_rgba8(img.image.data(), img.image.size(), name, &w, &h, &rgba, &why))
-    return fail(L, "material %d: texture %d: %s", material, info.index, why.msg), -1;
+    return fail(L, "material %d: %s: texture %d: %s", material, what, index, why.msg), -1;
   char label[LM_NAME_MAX];
   snprintf(label, sizeof label, "%s", img.name.empty() ? name : img.name.c_str());
-  return L.textures[src] = lm_scene_add_texture(L.s, label, w, h, rgba);
+  cached = lm_scene_add_texture(L.s, label, w, h, rgba);
+  L.s->textures[cached].linear = linear;
+  return cached;
+}
+
+// A number array of `n` finite values from extension object `o`'s `key`, if there.
+bool ext_numbers(const tinygltf::Value &o, const char *key, double *out, int n) {
+  if (!o.Has(key)) return true;
+  const tinygltf::Value &v = o.Get(key);
+  if (n == 1) {
+    if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble())) return false;
+    out[0] = v.GetNumberAsDouble();
+    return true;
+  }
+  if (!v.IsArray() || v.ArrayLen() != (size_t)n) return false;
+  for (int i = 0; i < n; i++) {
+    if (!v.Get(i).IsNumber() || !std::isfinite(v.Get(i).GetNumberAsDouble())) return false;
+    out[i] = v.Get(i).GetNumberAsDouble();
+  }
+  return true;
+}
+
+// Material texture `what` into slot `slot` of m, with its KHR_texture_transform.
+bool material_texture(Loader &L, int material, const char *what, lm_texture_slot slot, int index, int tex_coord,
+                      const tinygltf::ExtensionMap &ext, lm_material *m, lm_material_pbr *p) {
+  if (index < 0) return true;
+  auto it = ext.find("KHR_texture_transform");
+  if (it != ext.end()) {
+    const tinygltf::Value &o = it->second;
+    double offset[2] = {0, 0}, rotation = 0, scale[2] = {1, 1}, coord = tex_coord;
+    if (!o.IsObject() || !ext_numbers(o, "offset", offset, 2) || !ext_numbers(o, "rotation", &rotation, 1) ||
+        !ext_numbers(o, "scale", scale, 2) || !ext_numbers(o, "texCoord", &coord, 1))
+      return fail(L, "material %d: %s: KHR_texture_transform wants offset [2], rotation, scale [2] and "
+                  "texCoord, finite numbers", material, what);
+    tex_coord = (int)coord;
+    // uv' = T(offset) R(rotation) S(scale) uv; rotation turns the UVs counter-clockwise (v points down).
+    double c = std::cos(rotation), sn = std::sin(rotation);
+    const double t[6] = {scale[0] * c, scale[1] * sn, offset[0], -scale[0] * sn, scale[1] * c, offset[1]};
+    for (int k = 0; k < 6; k++) p->uv_transform[slot][k] = (float)t[k];
+  }
+  if (tex_coord != 0)
+    lm_warn("%s: material %d: %s uses TEXCOORD_%d; only TEXCOORD_0 is read", L.path, material, what, tex_coord);
+  bool linear = slot == LM_TEX_METALLIC_ROUGHNESS || slot == LM_TEX_NORMAL || slot == LM_TEX_OCCLUSION;
+  int t = texture_for(L, material, what, index, linear);
+  if (t < 0) return false;
+  (slot == LM_TEX_BASE_COLOR ? m->base_color_texture : p->textures[slot]) = t + 1;
+  return true;
 }
 
 // lm material of glTF material `index`, converted on first use; -1 on error.
@@ -380,6 +429,11 @@ int material_for(Loader &L, const char *where, int index) {
       !std::isfinite(pbr.metallicFactor) || !std::isfinite(pbr.roughnessFactor))
     return fail(L, "material %d: baseColorFactor needs 4 finite numbers, metallicFactor and "
                 "roughnessFactor finite ones", index), -1;
+  if ((!gm.emissiveFactor.empty() && gm.emissiveFactor.size() != 3) || !finite_all(gm.emissiveFactor) ||
+      !std::isfinite(gm.alphaCutoff) || !std::isfinite(gm.normalTexture.scale) ||
+      !std::isfinite(gm.occlusionTexture.strength))
+    return fail(L, "material %d: emissiveFactor needs 3 finite numbers; alphaCutoff, normalTexture.scale and "
+                "occlusionTexture.strength finite ones", index), -1;
   lm_material m = {};
   snprintf(m.name, sizeof m.name, "%s", gm.name.empty() ? "material" : gm.name.c_str());
   float maxc = 0;
@@ -395,15 +449,41 @@ int material_for(Loader &L, const char *where, int index) {
   double shin = r4 > 0 ? 2.0 / r4 - 2.0 : 1024.0;
   m.shininess = (float)(shin < 1 ? 1 : shin > 1024 ? 1024 : shin);
   m.rho = maxc * m.kd;
-  if (pbr.baseColorTexture.index >= 0) {
-    if (pbr.baseColorTexture.texCoord != 0)
-      lm_warn("%s: material %d: baseColorTexture uses TEXCOORD_%d; only TEXCOORD_0 is read", L.path, index,
-              pbr.baseColorTexture.texCoord);
-    int t = texture_for(L, index, pbr.baseColorTexture);
-    if (t < 0) return -1;
-    m.base_color_texture = t + 1;
-  }
-  return L.materials[index] = lm_scene_add_material(L.s, &m);
+
+  // The metallic-roughness model as glTF gives it, for the pbr technique.
+  lm_material_pbr p = {};
+  p.set = true;
+  p.metallic = metal, p.roughness = rough;
+  p.normal_scale = (float)gm.normalTexture.scale;
+  p.occlusion_strength = clamp01(gm.occlusionTexture.strength);
+  p.alpha = clamp01(pbr.baseColorFactor[3]);
+  p.alpha_mode = gm.alphaMode == "MASK" ? LM_ALPHA_MASK : gm.alphaMode == "BLEND" ? LM_ALPHA_BLEND : LM_ALPHA_OPAQUE;
+  if (gm.alphaMode != "MASK" && gm.alphaMode != "BLEND" && gm.alphaMode != "OPAQUE" && !gm.alphaMode.empty())
+    return fail(L, "material %d: alphaMode '%s' is none of OPAQUE, MASK, BLEND", index, gm.alphaMode.c_str()), -1;
+  p.alpha_cutoff = (float)std::fmax(gm.alphaCutoff, 0.0);
+  double strength = 1;
+  auto es = gm.extensions.find("KHR_materials_emissive_strength");
+  if (es != gm.extensions.end() && (!es->second.IsObject() ||
+                                    !ext_numbers(es->second, "emissiveStrength", &strength, 1) || strength < 0))
+    return fail(L, "material %d: KHR_materials_emissive_strength wants emissiveStrength, a finite number >= 0",
+                index), -1;
+  for (int c = 0; c < 3 && !gm.emissiveFactor.empty(); c++)
+    p.emissive[c] = (float)(std::fmax(gm.emissiveFactor[c], 0.0) * strength);
+  if (!material_texture(L, index, "baseColorTexture", LM_TEX_BASE_COLOR, pbr.baseColorTexture.index,
+                        pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions, &m, &p) ||
+      !material_texture(L, index, "metallicRoughnessTexture", LM_TEX_METALLIC_ROUGHNESS,
+                        pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+                        pbr.metallicRoughnessTexture.extensions, &m, &p) ||
+      !material_texture(L, index, "normalTexture", LM_TEX_NORMAL, gm.normalTexture.index,
+                        gm.normalTexture.texCoord, gm.normalTexture.extensions, &m, &p) ||
+      !material_texture(L, index, "occlusionTexture", LM_TEX_OCCLUSION, gm.occlusionTexture.index,
+                        gm.occlusionTexture.texCoord, gm.occlusionTexture.extensions, &m, &p) ||
+      !material_texture(L, index, "emissiveTexture", LM_TEX_EMISSIVE, gm.emissiveTexture.index,
+                        gm.emissiveTexture.texCoord, gm.emissiveTexture.extensions, &m, &p))
+    return -1;
+  L.materials[index] = lm_scene_add_material(L.s, &m);
+  L.s->material_pbr[L.materials[index]] = p;
+  return L.materials[index];
 }
 
 // ---- nodes -----------------------------------------------------------------
@@ -766,7 +846,8 @@ std::string locate_bad_indices(const unsigned char *text, size_t len) {
 
 // The extensions this loader reads: a file that requires any other is refused
 // before tinygltf sees it (which would fail later, on data it cannot decode).
-const char *const kSupportedExtensions[] = {"KHR_lights_punctual"};
+const char *const kSupportedExtensions[] = {"KHR_lights_punctual", "KHR_texture_transform",
+                                            "KHR_materials_emissive_strength"};
 
 // The first name in the file's extensionsRequired that is not supported, or "".
 std::string unsupported_required(const unsigned char *text, size_t len) {
@@ -841,7 +922,7 @@ bool convert(const char *path, const tinygltf::Model &model, lm_scene *s, lm_err
   Loader L{path, model, s, err, {}, {}, {}, {}, 0, {}};
   L.meshes.resize(model.meshes.size());
   L.materials.assign(model.materials.size(), -1);
-  L.textures.assign(model.images.size(), -1);
+  L.textures.assign(model.images.size() * 2, -1);
   L.nodes.assign(model.nodes.size(), -1);
   if (!load_nodes(L)) return false;
   if (L.skipped)

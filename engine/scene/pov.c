@@ -157,6 +157,8 @@ static bool write_light(pov_ctx *c, const lm_light *l, const lm_light_data *ld, 
                    "shadowless spotlight", l->name))
     return false;
   bool fade = false;
+  /* relative to the scene, so that every unit gets the same accuracy */
+  double fade_distance = LM_POV_FADE_FRACTION * (radius > 0 && isfinite(radius) ? radius : 1.0);
   if (type != LM_LIGHT_DIRECTIONAL) {
     double range = ld->color[3];
     if (falloff == LM_FALLOFF_RANGE && range > 0) {
@@ -177,7 +179,7 @@ static bool write_light(pov_ctx *c, const lm_light *l, const lm_light_data *ld, 
     }
     if (falloff == LM_FALLOFF_INVERSE_SQUARE || falloff == LM_FALLOFF_RANGE) {
       fade = true;
-      for (int i = 0; i < 3; i++) col[i] /= 2.0 * LM_POV_FADE_DISTANCE * LM_POV_FADE_DISTANCE;
+      for (int i = 0; i < 3; i++) col[i] /= 2.0 * fade_distance * fade_distance;
     } else if (falloff != LM_FALLOFF_NONE &&
                !mismatch(c, "light '%s': the window falloff saturate(1 - (d/r)^2) (seed 000 eq 16) has no "
                             "POV-Ray form; give the light falloff none or inverse-square "
@@ -225,10 +227,29 @@ static bool write_light(pov_ctx *c, const lm_light *l, const lm_light_data *ld, 
                     glm_deg((float)inner), glm_deg((float)outer));
       put_vec(c, at, what);
     }
-    if (fade) lm_buf_printf(b, "\n  fade_distance %.9g\n  fade_power 2", LM_POV_FADE_DISTANCE);
+    if (fade) lm_buf_printf(b, "\n  fade_distance %.9g\n  fade_power 2", fade_distance);
   }
   lm_buf_printf(b, "%s\n}\n\n", shadowless ? "\n  shadowless" : "");
   return true;
+}
+
+/* The pbr technique's material as POV-Ray's closest finish (pov.h), with a
+ * warning that says what is approximated. */
+static void write_pbr_material(pov_ctx *c, const lm_material *m, const lm_material_pbr *p, const char *id) {
+  double metal = clamp01(p->metallic), rough = p->roughness > 0.08 ? clamp01(p->roughness) : 0.08;
+  double f0 = 0.04, r4 = rough * rough * rough * rough, s = 2.0 / r4 - 2.0;
+  for (int i = 0; i < 3; i++) f0 = fmax(f0, 0.04 + (clamp01(m->color[i]) - 0.04) * metal);
+  if (c->warnings)
+    lm_buf_printf(c->warnings, "material '%s': metallic-roughness written as POV-Ray's closest finish (Blinn "
+                  "specular of the matching exponent, no Fresnel rise or Smith shadowing, no textures)\n", m->name);
+  lm_buf_printf(c->out,
+                "// material '%s' (metallic %.3g, roughness %.3g: approximated)\n#declare %s = texture {\n"
+                "  pigment { rgb <%.9g, %.9g, %.9g> }\n"
+                "  finish { ambient 0 emission rgb <%.9g, %.9g, %.9g> diffuse %.9g brilliance 1 specular %.9g "
+                "roughness %.9g metallic %.9g }\n}\n\n",
+                m->name, metal, rough, id, clamp01(m->color[0]), clamp01(m->color[1]), clamp01(m->color[2]),
+                p->emissive[0], p->emissive[1], p->emissive[2], 1.0 - metal, f0 * (s + 2.0) / 8.0, 1.0 / fmax(s, 1.0),
+                metal);
 }
 
 static bool write_material(pov_ctx *c, const lm_material *m, const char *id) {
@@ -362,7 +383,13 @@ bool lm_pov_export(const lm_scene *s, const lm_pov_desc *desc, lm_buf *out, lm_b
     declared[slot] = true;
     char id[64];
     material_id(s, nd, id, sizeof id);
-    ok = write_material(&c, lm_scene_node_material(s, nd), id);
+    const lm_material *m = lm_scene_node_material(s, nd);
+    if (desc->pbr_materials) {
+      lm_material_pbr p = lm_scene_material_pbr(s, nd->material, m);
+      write_pbr_material(&c, m, &p, id);
+    } else {
+      ok = write_material(&c, m, id);
+    }
   }
   free(declared);
   for (int i = 0; i < s->node_count && ok; i++) {

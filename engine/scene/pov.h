@@ -24,16 +24,25 @@
  *   pigment rgb color; finish { ambient 0 emission 0 diffuse kd brilliance 1
  *   phong ks phong_size max(shininess, 1) }. POV-Ray's diffuse is
  *   kd * pigment * light * (n.l) and its phong ks * (r.v)^size * light,
- *   the engine's Phong exactly (seed 000 lines 2753-2767). The engine's
+ *   the engine's Phong exactly (seed 000 lines 2753-2767). With
+ *   pbr_materials, the pbr technique's GGX has no POV-Ray form; the closest
+ *   finish is written and a warning says so (never refused): pigment the
+ *   base colour, diffuse 1 - metallic, specular (Blinn) with the exponent
+ *   s = 2 / roughness^4 - 2 whose lobe matches GGX's and the normalized
+ *   amplitude max(F0) (s + 2) / 8, metallic tinting it with the pigment,
+ *   emission the emissive colour; Fresnel's rise at grazing angles, Smith
+ *   shadowing, the 1 - F diffuse weight and textures are not carried. The
+ *   engine's
  *   ambient term (k_a * ambient) has no counterpart: render the engine with
  *   the option ambient = 0 when comparing.
  * - Lights, colour = color * power:
  *   directional -> parallel light placed outside the scene's bounds;
  *   point, LM_FALLOFF_NONE -> plain point light;
  *   point, LM_FALLOFF_INVERSE_SQUARE -> fade_power 2 and fade_distance
- *     LM_POV_FADE_DISTANCE (f) with the colour divided by 2 f^2: POV-Ray's
- *     2 / (1 + (d / f)^2) then gives 1 / (d^2 + f^2), which is 1 / d^2 to a
- *     relative 1e-6 at d = 1;
+ *     f = LM_POV_FADE_FRACTION times the radius of the scene's bounding
+ *     sphere, with the colour divided by 2 f^2: POV-Ray's 2 / (1 + (d / f)^2)
+ *     then gives 1 / (d^2 + f^2), which is 1 / d^2 to a relative 1e-6 at a
+ *     thousandth of the scene's size, in any unit;
  *   point, LM_FALLOFF_RANGE (glTF's) -> the same as inverse square when the
  *     range window clamp(1 - (d / range)^4, 0, 1) stays above
  *     1 - LM_POV_RANGE_EXACT over the scene's bounding sphere (no range, or
@@ -55,7 +64,7 @@
 
 #include "scene/scene.h"
 
-#define LM_POV_FADE_DISTANCE 1e-3
+#define LM_POV_FADE_FRACTION 1e-6
 /* Largest departure from 1 of a glTF range window written as plain inverse
  * square: below the G-buffer's 8-bit albedo step. */
 #define LM_POV_RANGE_EXACT (1.0 / 512.0)
@@ -82,6 +91,7 @@ typedef struct lm_pov_desc {
   lm_pov_radiosity rad;
   bool shadows;       /* false: no mesh casts shadows */
   bool strict;        /* refuse what cannot match instead of warning */
+  bool pbr_materials; /* the pbr technique's materials (approximated, warned) instead of Phong */
 } lm_pov_desc;
 
 /* Appends the SDL for the view to `out`. Warnings (one per line, naming the

@@ -28,13 +28,16 @@ void lm_scene_destroy(lm_scene *s) {
   free(s->nodes);
   free(s->meshes);
   free(s->materials);
+  free(s->material_pbr);
   free(s->lights);
   free(s->cameras);
   free(s);
 }
 
 int lm_scene_add_material(lm_scene *s, const lm_material *m) {
+  int cap = s->material_cap; /* material_pbr keeps material_cap entries, zeroed when new */
   *LM_PUSH(s->materials, s->material_count, s->material_cap) = *m;
+  s->material_pbr = lm_grow(s->material_pbr, &cap, s->material_cap, sizeof *s->material_pbr);
   return s->material_count - 1;
 }
 
@@ -215,7 +218,7 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
   if (s->uploaded) return true;
   for (int i = 0; i < s->texture_count; i++) {
     lm_scene_texture *t = &s->textures[i];
-    if (!lm_texture_upload_rgba8(&t->gpu, t->width, t->height, t->rgba, true, t->name, err)) {
+    if (!lm_texture_upload_rgba8(&t->gpu, t->width, t->height, t->rgba, !t->linear, t->name, err)) {
       for (int k = 0; k < i; k++) lm_texture_destroy(&s->textures[k].gpu);
       lm_error_prefix(err, "scene '%s'", s->name);
       return false;
@@ -241,10 +244,11 @@ bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err)
   for (int i = 0; i < from->texture_count; i++) {
     const lm_scene_texture *t = &from->textures[i];
     size_t bytes = (size_t)t->width * t->height * 4;
-    textures[i] = (lm_scene_texture){.width = t->width, .height = t->height,
+    textures[i] = (lm_scene_texture){.width = t->width, .height = t->height, .linear = t->linear,
                                      .rgba = memcpy(lm_alloc(bytes), t->rgba, bytes)};
     memcpy(textures[i].name, t->name, sizeof t->name);
-    if (s->uploaded && !lm_texture_upload_rgba8(&textures[i].gpu, t->width, t->height, t->rgba, true, t->name, err)) {
+    if (s->uploaded &&
+        !lm_texture_upload_rgba8(&textures[i].gpu, t->width, t->height, t->rgba, !t->linear, t->name, err)) {
       for (int k = 0; k <= i; k++) {
         if (k < i) lm_texture_destroy(&textures[k].gpu);
         free(textures[k].rgba);
@@ -262,6 +266,9 @@ bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err)
   s->texture_count = from->texture_count;
   s->texture_cap = from->texture_count + 1;
   free(s->materials);
+  free(s->material_pbr);
+  s->material_pbr = memcpy(lm_alloc(sizeof *s->material_pbr * (size_t)(from->material_count + 1)),
+                           from->material_pbr, sizeof *s->material_pbr * (size_t)from->material_count);
   s->materials = memcpy(lm_alloc(sizeof *s->materials * (size_t)(from->material_count + 1)), from->materials,
                         sizeof *s->materials * (size_t)from->material_count);
   s->material_count = from->material_count;
@@ -393,8 +400,19 @@ int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max) {
   return n;
 }
 
-static const char *scene_uniforms[] = {"model", "normal_matrix", "material_color", "material_rho",
-                                       "material_k", "base_color_tex"};
+/* Per slot (lm_texture_slot): the sampler, its KHR_texture_transform and the
+ * define that turns its use on in a material technique. */
+static const char *const slot_sampler[LM_TEX_SLOTS] = {"base_color_tex", "mr_tex", "normal_tex", "occlusion_tex",
+                                                        "emissive_tex"};
+static const char *const slot_xform[LM_TEX_SLOTS] = {"base_color_xform", "mr_xform", "normal_xform",
+                                                      "occlusion_xform", "emissive_xform"};
+static const char *const slot_define[LM_TEX_SLOTS] = {"BASE_COLOR_TEXTURE", "MR_TEXTURE", "NORMAL_TEXTURE",
+                                                       "OCCLUSION_TEXTURE", "EMISSIVE_TEXTURE"};
+
+static const char *scene_uniforms[] = {"model", "normal_matrix", "material_color", "material_rho", "material_k",
+                                       "material_pbr", "material_emissive", "material_alpha", "base_color_tex",
+                                       "mr_tex", "normal_tex", "occlusion_tex", "emissive_tex", "base_color_xform",
+                                       "mr_xform", "normal_xform", "occlusion_xform", "emissive_xform"};
 
 bool lm_scene_owns_uniform(const char *name) {
   for (size_t i = 0; i < sizeof scene_uniforms / sizeof *scene_uniforms; i++)
@@ -502,6 +520,42 @@ static void world_bounds(const float w[16], const float b[2][3], float lo[3], fl
   }
 }
 
+lm_material_pbr lm_scene_material_pbr(const lm_scene *s, int material, const lm_material *m) {
+  if (material >= 0 && material < s->material_count && s->material_pbr[material].set)
+    return s->material_pbr[material];
+  lm_material_pbr p = {.metallic = glm_clamp(1.0f - m->kd, 0.0f, 1.0f),
+                       .roughness = powf(2.0f / (fmaxf(m->shininess, 0.0f) + 2.0f), 0.25f),
+                       .normal_scale = 1, .occlusion_strength = 1, .alpha = 1};
+  return p;
+}
+
+/* The index (or -1) of the texture in `slot`. */
+static int slot_texture(const lm_scene *s, const lm_material *m, const lm_material_pbr *p, int slot) {
+  int t = (slot == LM_TEX_BASE_COLOR ? m->base_color_texture : p->textures[slot]) - 1;
+  return t >= 0 && t < s->texture_count ? t : -1;
+}
+
+/* The variant's defines: a define per texture the technique reads (every
+ * slot for a pbr one, the base colour for the others). */
+static void material_defines(const lm_scene *s, const lm_material *m, const lm_material_pbr *p, bool pbr,
+                             char *out, size_t cap) {
+  out[0] = '\0';
+  for (int slot = 0; slot < LM_TEX_SLOTS; slot++) {
+    if (slot_texture(s, m, p, slot) < 0 || (slot != LM_TEX_BASE_COLOR && !pbr)) continue;
+    size_t len = strlen(out);
+    snprintf(out + len, cap - len, "%s%s", len ? ";" : "", slot_define[slot]);
+  }
+}
+
+/* KHR_texture_transform as GLSL's column-major mat3 (identity when unset). */
+static void uv_matrix(const float t[6], float out[9]) {
+  bool set = false;
+  for (int i = 0; i < 6; i++) set |= t[i] != 0;
+  const float id[6] = {1, 0, 0, 0, 1, 0}, *a = set ? t : id;
+  float m[9] = {a[0], a[3], 0, a[1], a[4], 0, a[2], a[5], 1};
+  memcpy(out, m, sizeof m);
+}
+
 bool lm_scene_node_bounds(const lm_scene *s, int node, float lo[3], float hi[3]) {
   if (node < 0 || node >= s->node_count) return false;
   const lm_node *n = &s->nodes[node];
@@ -514,7 +568,9 @@ bool lm_scene_node_bounds(const lm_scene *s, int node, float lo[3], float hi[3])
 
 bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err) {
   const lm_program *p = d->program;
-  bool textured = false; /* which variant is bound */
+  /* A technique that reads material_pbr (shaders/pbr.frag) takes every texture slot. */
+  bool pbr = lm_program_uniform(d->program, "material_pbr") != NULL;
+  char bound[160] = ""; /* the defines of the variant that is bound */
   for (int i = 0; i < s->node_count; i++) {
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
@@ -530,12 +586,19 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     lm_material m = *lm_scene_node_material(s, n);
     for (int k = 0; k < d->param_count; k++)
       if (!strcmp(d->params[k].material, m.name)) apply_param(&m, &d->params[k]);
-    int tex = m.base_color_texture - 1;
-    bool want_texture = tex >= 0 && tex < s->texture_count && d->variant;
-    if (want_texture != textured) { /* switch programs only when the variant changes */
-      p = d->variant(d->ctx, want_texture ? "BASE_COLOR_TEXTURE" : "", err);
+    lm_material_pbr mp = lm_scene_material_pbr(s, n->material, &m);
+    if (pbr && mp.alpha_mode == LM_ALPHA_BLEND) {
+      lm_error_set(err, "material '%s' (node '%s'): alphaMode BLEND is not drawn by this technique (the "
+                   "G-buffer keeps one opaque surface a pixel); make it OPAQUE or MASK, or draw with std",
+                   m.name, n->name);
+      return false;
+    }
+    char defines[160] = "";
+    if (d->variant) material_defines(s, &m, &mp, pbr, defines, sizeof defines);
+    if (strcmp(defines, bound)) { /* switch programs only when the variant changes */
+      p = d->variant(d->ctx, defines, err);
       if (!p) return false;
-      textured = want_texture;
+      snprintf(bound, sizeof bound, "%s", defines);
     }
     mat4 model, inv;
     mat3 normal;
@@ -544,14 +607,25 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     glm_mat4_transpose(inv);
     glm_mat4_pick3(inv, normal);
     float k[4] = {m.ka, m.kd, m.ks, m.shininess};
+    float params[4] = {mp.metallic, mp.roughness, mp.normal_scale, mp.occlusion_strength};
+    float alpha[2] = {mp.alpha, mp.alpha_mode == LM_ALPHA_MASK ? mp.alpha_cutoff : -1.0f};
     const lm_uniform *u;
     if ((u = lm_program_uniform(p, "model"))) lm_program_set(p, u, (float *)model);
     if ((u = lm_program_uniform(p, "normal_matrix"))) lm_program_set(p, u, (float *)normal);
     if ((u = lm_program_uniform(p, "material_color"))) lm_program_set(p, u, m.color);
     if ((u = lm_program_uniform(p, "material_rho"))) lm_program_set(p, u, &m.rho);
     if ((u = lm_program_uniform(p, "material_k"))) lm_program_set(p, u, k);
-    if (want_texture && (u = lm_program_uniform(p, "base_color_tex")))
-      lm_program_bind_texture(u, s->textures[tex].gpu);
+    if ((u = lm_program_uniform(p, "material_pbr"))) lm_program_set(p, u, params);
+    if ((u = lm_program_uniform(p, "material_emissive"))) lm_program_set(p, u, mp.emissive);
+    if ((u = lm_program_uniform(p, "material_alpha"))) lm_program_set(p, u, alpha);
+    for (int slot = 0; slot < LM_TEX_SLOTS && defines[0]; slot++) {
+      if (!strstr(defines, slot_define[slot])) continue;
+      if ((u = lm_program_uniform(p, slot_sampler[slot])))
+        lm_program_bind_texture(u, s->textures[slot_texture(s, &m, &mp, slot)].gpu);
+      float xf[9];
+      uv_matrix(mp.uv_transform[slot], xf);
+      if ((u = lm_program_uniform(p, slot_xform[slot]))) lm_program_set(p, u, xf);
+    }
     lm_mesh_draw(&mesh->gpu);
     if (stats) stats->drawn++, stats->triangles += mesh->index_count / 3;
   }

@@ -7,20 +7,55 @@
 
 #define LM_NAME_MAX 64
 
+/* A material's textures beyond the base colour, for the "pbr" technique. */
+typedef enum lm_texture_slot {
+  LM_TEX_BASE_COLOR,         /* sRGB rgb, alpha a */
+  LM_TEX_METALLIC_ROUGHNESS, /* linear: roughness g, metallic b */
+  LM_TEX_NORMAL,             /* linear, tangent space */
+  LM_TEX_OCCLUSION,          /* linear r */
+  LM_TEX_EMISSIVE,           /* sRGB */
+  LM_TEX_SLOTS
+} lm_texture_slot;
+
+typedef enum lm_alpha_mode { LM_ALPHA_OPAQUE, LM_ALPHA_MASK, LM_ALPHA_BLEND } lm_alpha_mode;
+
 /* Phong material of seed 000 plus the reflectance rho that ISR reads. */
 typedef struct lm_material {
   char name[LM_NAME_MAX];
-  float color[3];  /* diffuse albedo, linear */
+  float color[3];  /* diffuse albedo, linear (the pbr technique: the base colour) */
   float rho;       /* reflectance, the G-buffer's "radiation mask" */
   float ka, kd, ks, shininess;
   int base_color_texture; /* 1 + index into the scene's textures; 0: none */
 } lm_material;
+
+/* glTF's metallic-roughness data of a material, beside it (lm_scene's
+ * material_pbr, same index), for the "pbr" technique (shaders/pbr.frag). A
+ * material without it (set false) gets it derived from its Phong values. */
+typedef struct lm_material_pbr {
+  bool set;
+  float metallic, roughness, normal_scale, occlusion_strength;
+  float emissive[3];   /* factor times KHR_materials_emissive_strength */
+  float alpha;         /* base colour alpha */
+  lm_alpha_mode alpha_mode;
+  float alpha_cutoff;
+  int textures[LM_TEX_SLOTS]; /* 1 + index; 0: none (the base colour's is the material's) */
+  /* KHR_texture_transform per slot: uv' = (a b c; d e f) (u v 1); all zero: identity */
+  float uv_transform[LM_TEX_SLOTS][6];
+} lm_material_pbr;
+
+/* Material `material`'s metallic-roughness data (m: its Phong values, with
+ * any overrides): glTF's when set, else derived from m: metallic 1 - kd and
+ * the roughness whose GGX lobe the exponent matches (alpha^2 = 2 /
+ * (shininess + 2), the inverse of gltf.h's conversion). */
+struct lm_scene;
+lm_material_pbr lm_scene_material_pbr(const struct lm_scene *s, int material, const lm_material *m);
 
 /* A material's image: RGBA8 texels (sRGB-encoded colour), rows top first. */
 typedef struct lm_scene_texture {
   char name[LM_NAME_MAX];
   int width, height;
   unsigned char *rgba;
+  bool linear;     /* data (metallic-roughness, normals, occlusion), not sRGB colour */
   lm_texture gpu;
 } lm_scene_texture;
 
@@ -92,6 +127,7 @@ typedef struct lm_scene {
   lm_scene_mesh *meshes;
   int mesh_count, mesh_cap;
   lm_material *materials;
+  lm_material_pbr *material_pbr; /* one per material (zero: none) */
   int material_count, material_cap;
   lm_light *lights;
   int light_count, light_cap;
@@ -191,8 +227,10 @@ const char *lm_material_param_list(void);
 typedef struct lm_scene_draw_desc {
   const lm_program *program; /* bound: the technique's program */
   /* The technique's program with `defines` added ("BASE_COLOR_TEXTURE" for a
-   * textured material), bound and ready; NULL with a message. NULL: every
-   * material draws with `program` and without its texture. */
+   * textured material; for a technique that declares material_pbr also
+   * MR_TEXTURE, NORMAL_TEXTURE, OCCLUSION_TEXTURE, EMISSIVE_TEXTURE, joined
+   * by ';'), bound and ready; NULL with a message. NULL: every material
+   * draws with `program` and without its textures. */
   const lm_program *(*variant)(void *ctx, const char *defines, lm_error *err);
   void *ctx;
   const float *view_proj; /* column-major: nodes wholly outside are culled; NULL: none are */
@@ -206,7 +244,10 @@ typedef struct lm_scene_draw_stats {
 } lm_scene_draw_stats;
 /* Draws every mesh node whose bounds reach into the frustum, setting model,
  * normal_matrix, the material uniforms (material_color, material_rho,
- * material_k) and base_color_tex. Adds to *stats (may be NULL). */
+ * material_k; material_pbr, material_emissive, material_alpha) and the
+ * textures with their transforms (base_color_tex, base_color_xform, mr_tex,
+ * ...). With a technique that declares material_pbr, a material whose
+ * alphaMode is BLEND is an error naming it. Adds to *stats (may be NULL). */
 bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err);
 /* True when the world-space box lo..hi lies wholly outside one clip plane of view_proj. */
 bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const float hi[3]);

@@ -177,17 +177,19 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_fram
   }
 }
 
-/* Range of a point or spot light: its radius under the seed's window falloff,
- * else far enough to reach the whole scene. */
+/* Range of a point or spot light: where its light ends (lm_light_reach: the
+ * seed's window or a glTF range), or the whole scene when that is nearer. */
 static float light_range(const lm_scene *s, const lm_light *l, const vec3 pos) {
-  if (l->falloff == LM_FALLOFF_WINDOW && l->radius > 0) return l->radius;
+  float reach = lm_light_reach(l);
+  if (l->falloff == LM_FALLOFF_WINDOW && reach > 0) return reach;
   float bmin[3], bmax[3], range = 0;
   lm_scene_bounds(s, bmin, bmax);
   for (int c = 0; c < 8; c++) {
     vec3 p = {c & 1 ? bmax[0] : bmin[0], c & 2 ? bmax[1] : bmin[1], c & 4 ? bmax[2] : bmin[2]};
     range = fmaxf(range, glm_vec3_distance(p, (float *)pos));
   }
-  return range > 0 && isfinite(range) ? range * 1.01f : 1.0f;
+  if (!(range > 0 && isfinite(range))) return reach > 0 && isfinite(reach) ? reach : 1.0f;
+  return fminf(range * 1.01f, reach);
 }
 
 static void perspective_view_proj(const vec3 pos, const vec3 dir, float fov, float range, mat4 vp) {
