@@ -37,10 +37,35 @@ vec3 light_incident(int i, vec3 p, out vec3 l) {
   return li.color.rgb * fall;
 }
 
+// The lights that may reach p: light_index(r, j) for j < r.count. Every light
+// when culling is off or p lies outside the grid (a point off screen).
+struct LightList { int count, global; uint offset; bool all; };
+
+LightList lights_near(vec3 p) {
+  LightList all = LightList(frame.counts.x, 0, 0u, true);
+  if (grid.w <= 0) return all;
+  vec4 c = frame.view_proj * vec4(p, 1.0);
+  float z = -(frame.view * vec4(p, 1.0)).z;
+  if (!(c.w > 0.0) || !(z >= slicing.y)) return all;
+  vec2 px = (c.xy / c.w * 0.5 + 0.5) * frame.output_size.xy;
+  ivec3 q = ivec3(floor(vec3(px / float(grid.w), log(z / slicing.y) * slicing.x)));
+  if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, grid.xyz))) return all;
+  int cell = (q.z * grid.y + q.y) * grid.x + q.x;
+  int global = int(grid_global.x);
+  return LightList(global + int(cells[2 * cell + 1]), global, cells[2 * cell], false);
+}
+
+int light_index(LightList r, int j) {
+  if (r.all) return j;
+  return int(j < r.global ? cells[grid_global.y + uint(j)] : cells[r.offset + uint(j - r.global)]);
+}
+
 // k = (k_a, k_d, k_s), shininess >= 0; n and v unit vectors (v toward the eye).
 vec3 phong(vec3 albedo, vec3 k, float shininess, vec3 n, vec3 v, vec3 p, vec3 ambient) {
   vec3 sum = k.x * ambient * albedo;
-  for (int i = 0; i < frame.counts.x; i++) {
+  LightList near = lights_near(p);
+  for (int j = 0; j < near.count; j++) {
+    int i = light_index(near, j);
     vec3 l;
     vec3 radiance = light_incident(i, p, l);
     float ndl = dot(n, l);

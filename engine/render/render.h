@@ -18,6 +18,7 @@ typedef struct lm_renderer_desc {
   bool linear_output;     /* also keep a float copy of the output (for EXR) */
   bool check_finite;      /* debug: name the first pass that writes a NaN or Inf */
   bool no_culling;        /* draw every node, even those outside the frustum */
+  bool no_light_culling;  /* every pixel evaluates every light (the reference for light culling) */
 } lm_renderer_desc;
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err);
@@ -32,6 +33,8 @@ bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err);
 /* The last frame's scene draws: nodes drawn and culled, triangles. */
 lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r); /* camera passes, not shadow tiles */
 lm_clock lm_renderer_clock(const lm_renderer *r);
+/* The last frame's light grid (lm_light_grid_build), read by the lighting shaders. */
+const lm_light_grid *lm_renderer_light_grid(const lm_renderer *r);
 /* CPU milliseconds of the last frame spent in Lua (OnRender) and in compiling the graph. */
 void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compile_ms);
 /* The last frame's output, top row first: RGB 8-bit sRGB, or RGB float linear
