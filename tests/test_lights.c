@@ -29,6 +29,10 @@ static lm_scene *box_with_lights(int count) {
   lm_scene *s = lm_scene_builtin("cornell", &err);
   assert_non_null(s);
   s->lights[0].casts_shadows = false;
+  mat4 sun;
+  glm_rotate_make(sun, glm_rad(-60.0f), (vec3){1, 0.3f, 0}); /* listed for every cluster */
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {0.2f, 0.2f, 0.3f},
+                                    .power = 1, .node = lm_scene_add_node(s, "sun", -1, (float *)sun, -1, -1)});
   for (int i = 0; i < count; i++) {
     float p[3] = {-0.9f + 1.8f * uniform01(), 0.1f + 1.8f * uniform01(), -0.9f + 1.8f * uniform01()};
     float wall = fminf(fminf(1 - fabsf(p[0]), fminf(p[1], 2 - p[1])), 1 - fabsf(p[2]));
@@ -66,10 +70,12 @@ static void every_reaching_light_is_listed(void **state) {
   lm_scene_frame_data(s, 0, W, H, &f);
   lm_light_data lights[MAX];
   int n = lm_scene_light_data(s, lights, MAX);
-  assert_int_equal(n, 41);
+  assert_int_equal(n, 42);
   lm_light_grid g = {0};
   lm_light_grid_build(&g, &f, lights, n, true);
   assert_true(g.tile_px > 0);
+  assert_int_equal(g.global, 1); /* the sun, in every cluster */
+  for (int c = 0; c < g.tiles_x * g.tiles_y * g.slices; c++) assert_true(lm_light_grid_has(&g, c, 1));
   /* Culling does something: a cluster lists a small share of the lights. */
   double mean = (double)g.listed / (g.tiles_x * g.tiles_y * g.slices);
   printf("lights a cluster lists: %.2f on average of %d\n", mean, n);

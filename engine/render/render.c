@@ -137,7 +137,7 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   frame->counts[0] = n;
   lm_frame_upload(frame, lights, n);
   lm_light_grid_build(&r->light_grid, frame, lights, n, !r->desc.no_light_culling);
-  lm_storage_upload(3, r->light_grid.data, r->light_grid.count * sizeof *r->light_grid.data);
+  lm_storage_upload(4, r->light_grid.data, r->light_grid.count * sizeof *r->light_grid.data);
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
   lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene,
                           .scene_owns_uniform = lm_scene_owns_uniform, .user = r,

@@ -116,7 +116,7 @@ void lm_light_grid_build(lm_light_grid *g, const lm_frame_data *f, const lm_ligh
   uint32_t global_offset = (uint32_t)(g->count - HEADER), global = 0;
   for (int i = 0; i < n; i++)
     if (!g->tile_px || isinf(lm_light_reach(&lights[i]))) push(g, (uint32_t)i), global++;
-  g->data[6] = global, g->data[7] = global_offset;
+  g->data[8] = global, g->data[9] = global_offset;
   /* Lights with a finite reach, in view space. */
   typedef struct { float pos[3], axis[3], reach, cos_outer; bool spot; int index; } near_light;
   near_light *near = lm_alloc(sizeof *near * (size_t)(n > 0 ? n : 1));
@@ -163,7 +163,7 @@ int lm_light_grid_count(const lm_light_grid *g, int cluster, int light_count) {
 
 bool lm_light_grid_has(const lm_light_grid *g, int cluster, int light) {
   if (cluster < 0) return true;
-  const uint32_t *global = g->data + HEADER + g->data[7];
+  const uint32_t *global = g->data + HEADER + g->data[9];
   const uint32_t *list = g->data + HEADER + g->data[HEADER + 2 * cluster];
   for (int j = 0; j < g->global; j++)
     if (global[j] == (uint32_t)light) return true;
