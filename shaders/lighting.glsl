@@ -69,7 +69,8 @@ vec3 phong(vec3 albedo, vec3 k, float shininess, vec3 n, vec3 v, vec3 p, vec3 am
     vec3 l;
     vec3 radiance = light_incident(i, p, l);
     float ndl = dot(n, l);
-    if (ndl <= 0.0) continue;
+    // Facing away, or beyond the light's range or cone: no shadow lookup.
+    if (ndl <= 0.0 || max(radiance.r, max(radiance.g, radiance.b)) <= 0.0) continue;
 #ifdef SHADOWS
     radiance *= shadow_factor(i, p, n, l);
 #endif

@@ -30,6 +30,7 @@ static const char bench_usage[] =
     "  --scene NAME|FILE   (default cornell)\n"
     "  --script FILE       (default scripts/pp.lua)\n"
     "  --tech NAME         technique (default: the script's first)\n"
+    "  --set NAME=VALUE    set a script option, as limn capture does (repeatable)\n"
     "  --sizes LIST        comma-separated WxH (default 64x48,128x96,256x192)\n"
     "  --frames N          timed frames per size (default 5)\n"
     "  --warmup N          untimed frames first (default 2)\n"
@@ -62,6 +63,8 @@ typedef struct bench_pass {
 typedef struct bench {
   int sizes[MAX_SIZES][2], size_count, frames, warmup;
   const char *scene, *script, *tech;
+  const char *sets[64];
+  int set_count;
   char vary_name[128];
   char vary_text[MAX_SIZES][64];
   double vary[MAX_SIZES];
@@ -94,7 +97,7 @@ static int parse_args(int argc, char **argv, bench *b) {
       {"frames", required_argument, 0, 'n'}, {"warmup", required_argument, 0, 'w'},
       {"clock", required_argument, 0, 'k'}, {"json", no_argument, 0, 'j'},
       {"vary", required_argument, 0, 'V'},  {"help", no_argument, 0, 'h'},
-      {"lights", required_argument, 0, 'L'}, {"light-reach", required_argument, 0, 'R'},
+      {"set", required_argument, 0, 'S'},   {"lights", required_argument, 0, 'L'}, {"light-reach", required_argument, 0, 'R'},
       {0, 0, 0, 0}};
   opterr = 0;
   optind = 1;
@@ -133,6 +136,11 @@ static int parse_args(int argc, char **argv, bench *b) {
       }
       break;
     }
+    case 'S':
+      if (!strchr(optarg, '=') || optarg[0] == '=') return usage_error("--set wants NAME=VALUE, not '%s'", optarg);
+      if (b->set_count == 64) return usage_error("%s", "at most 64 --set");
+      b->sets[b->set_count++] = optarg;
+      break;
     case 'L': {
       char values[1024];
       snprintf(values, sizeof values, "%s", optarg);
@@ -522,6 +530,16 @@ int limn_bench(int argc, char **argv) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     lm_pipeline_destroy(pipe);
     return 2;
+  }
+  for (int i = 0; i < b.set_count; i++) {
+    char name[256];
+    const char *eq = strchr(b.sets[i], '=');
+    snprintf(name, sizeof name, "%.*s", (int)(eq - b.sets[i]), b.sets[i]);
+    if (!lm_pipeline_set_option(pipe, name, eq + 1, &err)) {
+      lm_log(LM_LOG_ERROR, "%s", err.msg);
+      lm_pipeline_destroy(pipe);
+      return 2;
+    }
   }
   lm_scene *scene = lm_scene_load(b.scene, &err);
   if (!scene) {
