@@ -92,6 +92,12 @@ static bool touches(const float c[3], float r, const float *axis, float cos_oute
   return !(gap > rad || along < -rad);
 }
 
+typedef struct near_light {
+  float pos[3], axis[3], reach, cos_outer;
+  bool spot; /* a cone under 90 degrees */
+  int index;
+} near_light;
+
 static void to_view(const float m[16], const float p[3], float w, float out[3]) {
   for (int i = 0; i < 3; i++) out[i] = m[i] * p[0] + m[4 + i] * p[1] + m[8 + i] * p[2] + m[12 + i] * w;
 }
@@ -115,10 +121,9 @@ void lm_light_grid_build(lm_light_grid *g, const lm_frame_data *f, const lm_ligh
   for (int c = 0; c < 2 * clusters; c++) push(g, 0);
   uint32_t global_offset = (uint32_t)(g->count - HEADER), global = 0;
   for (int i = 0; i < n; i++)
-    if (!g->tile_px || isinf(lm_light_reach(&lights[i]))) push(g, (uint32_t)i), global++;
+    if (clusters && isinf(lm_light_reach(&lights[i]))) push(g, (uint32_t)i), global++;
   g->data[8] = global, g->data[9] = global_offset;
   /* Lights with a finite reach, in view space. */
-  typedef struct { float pos[3], axis[3], reach, cos_outer; bool spot; int index; } near_light;
   near_light *near = lm_alloc(sizeof *near * (size_t)(n > 0 ? n : 1));
   int near_count = 0;
   for (int i = 0; i < n && clusters; i++) {
