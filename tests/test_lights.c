@@ -25,6 +25,7 @@ static float uniform01(void) {
  * every third a spot aimed at a wall; no shadows, so that only light
  * evaluation differs. */
 static lm_scene *box_with_lights(int count) {
+  rng = 12345; /* the same lights in every test */
   lm_error err;
   lm_scene *s = lm_scene_builtin("cornell", &err);
   assert_non_null(s);
@@ -62,12 +63,13 @@ static bool reaches(const lm_light_data *l, const float p[3]) {
   return along > l->direction[3] * dist;
 }
 
-static void every_reaching_light_is_listed(void **state) {
-  (void)state;
-  lm_scene *s = box_with_lights(40);
+/* Points at 99.9% of each light's range (and anywhere inside), inside its
+ * cone, that a pixel of camera `cam`'s view sees: each light must be in the
+ * point's cluster. Returns how many points were checked. */
+static long check_listed(lm_scene *s, int cam) {
   enum { W = 96, H = 72, MAX = 64 };
   lm_frame_data f;
-  lm_scene_frame_data(s, 0, W, H, &f);
+  lm_scene_frame_data(s, cam, W, H, &f);
   lm_light_data lights[MAX];
   int n = lm_scene_light_data(s, lights, MAX);
   assert_int_equal(n, 42);
@@ -78,7 +80,7 @@ static void every_reaching_light_is_listed(void **state) {
   for (int c = 0; c < g.tiles_x * g.tiles_y * g.slices; c++) assert_true(lm_light_grid_has(&g, c, 1));
   /* Culling does something: a cluster lists a small share of the lights. */
   double mean = (double)g.listed / (g.tiles_x * g.tiles_y * g.slices);
-  printf("lights a cluster lists: %.2f on average of %d\n", mean, n);
+  printf("camera %d: lights a cluster lists: %.2f on average of %d\n", cam, mean, n);
   assert_true(mean < n / 4.0);
   long checked = 0;
   for (int i = 0; i < n; i++) {
@@ -100,16 +102,33 @@ static void every_reaching_light_is_listed(void **state) {
       if (cluster < 0) continue;
       checked++;
       if (!lm_light_grid_has(&g, cluster, i))
-        fail_msg("light %d (reach %g) left out of cluster %d at (%g, %g, %g)", i, reach, cluster, p[0], p[1], p[2]);
+        fail_msg("camera %d: light %d (reach %g) left out of cluster %d at (%g, %g, %g)", cam, i, reach, cluster, p[0],
+                 p[1], p[2]);
     }
   }
-  printf("points checked in their clusters: %ld\n", checked);
-  assert_true(checked > 20000);
   /* Off: no grid, every pixel evaluates every light. */
   lm_light_grid_build(&g, &f, lights, n, false);
   assert_int_equal(lm_light_grid_cluster(&g, 10, 10, 0.5f), -1);
   assert_int_equal(lm_light_grid_count(&g, -1, n), n);
   lm_light_grid_free(&g);
+  return checked;
+}
+
+/* From the box's camera, and from inside the box among the lights (some
+ * behind the eye, some reaching over the near plane). */
+static void every_reaching_light_is_listed(void **state) {
+  (void)state;
+  lm_scene *s = box_with_lights(40);
+  mat4 m;
+  glm_translate_make(m, (vec3){0.1f, 1.0f, 0.2f});
+  glm_rotate_y(m, glm_rad(30.0f), m);
+  int node = lm_scene_add_node(s, "inside", -1, (float *)m, -1, -1);
+  int inside = lm_scene_add_camera(s, &(lm_camera){.name = "inside", .fov_y = glm_rad(70.0f), .znear = 0.05f,
+                                                   .zfar = 10.0f, .node = node});
+  lm_scene_update(s);
+  long outside_checked = check_listed(s, 0), inside_checked = check_listed(s, inside);
+  printf("points checked in their clusters: %ld from the front, %ld from inside\n", outside_checked, inside_checked);
+  assert_true(outside_checked > 20000 && inside_checked > 10000);
   lm_scene_destroy(s);
 }
 
