@@ -45,8 +45,8 @@ LightList lights_near(vec3 p) {
   LightList all = LightList(frame.counts.x, 0, 0u, true);
   if (grid.w <= 0) return all;
   vec4 c = frame.view_proj * vec4(p, 1.0);
-  float z = -(frame.view * vec4(p, 1.0)).z;
-  if (!(c.w > 0.0) || !(z >= slicing.y)) return all;
+  float z = c.w; // a perspective's clip w is the view depth
+  if (!(z >= slicing.y)) return all;
   vec2 px = (c.xy / c.w * 0.5 + 0.5) * frame.output_size.xy;
   ivec3 q = ivec3(floor(vec3(px / float(grid.w), log(z / slicing.y) * slicing.x)));
   if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, grid.xyz))) return all;
@@ -57,7 +57,7 @@ LightList lights_near(vec3 p) {
 
 int light_index(LightList r, int j) {
   if (r.all) return j;
-  return int(j < r.global ? cells[grid_global.y + uint(j)] : cells[r.offset + uint(j - r.global)]);
+  return int(cells[j < r.global ? grid_global.y + uint(j) : r.offset + uint(j - r.global)]);
 }
 
 // k = (k_a, k_d, k_s), shininess >= 0; n and v unit vectors (v toward the eye).

@@ -130,6 +130,20 @@ static void every_reaching_light_is_listed(void **state) {
   printf("points checked in their clusters: %ld from the front, %ld from inside\n", outside_checked, inside_checked);
   assert_true(outside_checked > 20000 && inside_checked > 10000);
   lm_scene_destroy(s);
+  /* A sun alone: nothing to cull, no grid. */
+  lm_error err;
+  s = lm_scene_builtin("field", &err);
+  assert_non_null(s);
+  lm_frame_data f;
+  lm_scene_frame_data(s, 0, 96, 72, &f);
+  lm_light_data sun[4];
+  int n = lm_scene_light_data(s, sun, 4);
+  lm_light_grid g = {0};
+  lm_light_grid_build(&g, &f, sun, n, true);
+  assert_int_equal(g.tile_px, 0);
+  assert_int_equal(lm_light_grid_count(&g, lm_light_grid_cluster(&g, 5, 5, 0.5f), n), n);
+  lm_light_grid_free(&g);
+  lm_scene_destroy(s);
 }
 
 static void culled_frame_matches_every_light_evaluated(void **state) {

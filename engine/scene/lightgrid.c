@@ -111,7 +111,22 @@ void lm_light_grid_build(lm_light_grid *g, const lm_frame_data *f, const lm_ligh
   g->near = f->clip[0], g->far = f->clip[1];
   float ratio = f->clip[1] / f->clip[0];
   g->slice_scale = ratio > 1.0001f ? (float)SLICES / logf(ratio) : 0;
-  if (!cull || !(g->slice_scale > 0) || g->tiles_x < 1 || g->tiles_y < 1) g->tile_px = 0; /* every light everywhere */
+  /* Lights with a finite reach, in view space. */
+  near_light *near = lm_alloc(sizeof *near * (size_t)(n > 0 ? n : 1));
+  int near_count = 0;
+  for (int i = 0; i < n; i++) {
+    const lm_light_data *l = &lights[i];
+    float r = lm_light_reach(l);
+    if (isinf(r)) continue;
+    near_light *q = &near[near_count++];
+    to_view(f->view, l->position, 1, q->pos);
+    to_view(f->view, l->direction, 0, q->axis);
+    q->reach = r, q->cos_outer = l->direction[3], q->index = i;
+    q->spot = (int)(l->position[3] + 0.5f) == LM_LIGHT_SPOT && q->cos_outer > 0;
+  }
+  /* No grid (every light everywhere) when asked, when the camera gives no
+   * slices, or when no light has a finite reach: nothing to cull. */
+  if (!cull || !(g->slice_scale > 0) || g->tiles_x < 1 || g->tiles_y < 1 || !near_count) g->tile_px = 0;
   int clusters = g->tile_px ? g->tiles_x * g->tiles_y * g->slices : 0;
   /* Header, then two words a cluster (offset into the words after the
    * header, count), the lights that reach everywhere, the cluster lists. */
@@ -123,19 +138,6 @@ void lm_light_grid_build(lm_light_grid *g, const lm_frame_data *f, const lm_ligh
   for (int i = 0; i < n; i++)
     if (clusters && isinf(lm_light_reach(&lights[i]))) push(g, (uint32_t)i), global++;
   g->data[8] = global, g->data[9] = global_offset;
-  /* Lights with a finite reach, in view space. */
-  near_light *near = lm_alloc(sizeof *near * (size_t)(n > 0 ? n : 1));
-  int near_count = 0;
-  for (int i = 0; i < n && clusters; i++) {
-    const lm_light_data *l = &lights[i];
-    float r = lm_light_reach(l);
-    if (isinf(r) || !(r > 0)) continue; /* listed globally, or lights nothing */
-    near_light *q = &near[near_count++];
-    to_view(f->view, l->position, 1, q->pos);
-    to_view(f->view, l->direction, 0, q->axis);
-    q->reach = r, q->cos_outer = l->direction[3], q->index = i;
-    q->spot = (int)(l->position[3] + 0.5f) == LM_LIGHT_SPOT && q->cos_outer > 0;
-  }
   g->listed = 0;
   for (int c = 0; c < clusters; c++) {
     int tx = c % g->tiles_x, ty = c / g->tiles_x % g->tiles_y, k = c / (g->tiles_x * g->tiles_y);
@@ -144,7 +146,8 @@ void lm_light_grid_build(lm_light_grid *g, const lm_frame_data *f, const lm_ligh
     uint32_t offset = (uint32_t)(g->count - HEADER), count = 0;
     for (int i = 0; i < near_count; i++) {
       const near_light *q = &near[i];
-      if (touches(q->pos, q->reach, q->spot ? q->axis : NULL, q->cos_outer, lo, hi)) push(g, (uint32_t)q->index), count++;
+      if (q->reach > 0 && touches(q->pos, q->reach, q->spot ? q->axis : NULL, q->cos_outer, lo, hi))
+        push(g, (uint32_t)q->index), count++;
     }
     g->data[HEADER + 2 * c] = offset, g->data[HEADER + 2 * c + 1] = count;
     g->listed += count;
