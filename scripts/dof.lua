@@ -2,6 +2,13 @@
 -- (dof_coc.frag: focus and range, or a thin lens) and a gather blur that
 -- keeps a sharp foreground from bleeding onto a blurred background and lets
 -- a blurred foreground spread over a sharp one (dof_gather.frag).
+-- The gather covers, per 8 x 8 tile, only the largest circle reaching it
+-- (dof_tiles.frag). At downsample 2 (the default; the seed is silent on how
+-- depth of field is computed) it runs at half size a side with half the
+-- taps (a quarter gave visibly more noise for little gain), and only the
+-- light it moves between pixels comes back to full size, through ISR's
+-- depth-aware upsampling, so sharp pixels keep their full-size detail
+-- (dof_reduce.frag, dof_composite.frag).
 local options = require "options"
 
 local dof = {}
@@ -15,7 +22,8 @@ dof.defaults = {
                         -- 0: the depth at the image's centre (autofocus)
   range = 0,            -- range: depth distance from the focus to full blur; 0: focus / 3
   max_radius = 8,       -- largest circle of confusion in pixels, 0..32 (0: sharp)
-  samples = 48,         -- gather taps, 1..256
+  samples = 48,         -- gather taps over max_radius at full size, 1..256
+  downsample = 2,       -- gather resolution: 1/1 or 1/2 a side
   focal_length = 0,     -- lens: 0: focus / 70 (a 50 mm lens focused at 3.5 m)
   f_number = 2.8,       -- lens: N, aperture = focal_length / N, > 0
   sensor = 0,           -- lens: sensor height; 0: what gives the camera's field
@@ -29,6 +37,7 @@ local rules = {
   range = options.number(0, 1e30),
   max_radius = options.number(0, 32),
   samples = options.whole(1, 256),
+  downsample = options.one_of(1, 2),
   focal_length = options.number(0, 1e30),
   f_number = options.positive(1000),
   sensor = options.number(0, 1e30),
@@ -47,9 +56,30 @@ function dof.render(src, o, G)
                       or { focus = o.focus, range = o.range, max_radius = o.max_radius },
                     defines = { LENS = o.mode == "lens" },
                     out = target{ "dof.coc", format = "rg32f" } }
-  return pass{ "dof.gather", shader = "dof_gather.frag", inputs = { src = src, coc = coc },
-               params = { max_radius = o.max_radius, samples = o.samples },
-               out = target{ "dof.gather", format = "rgba16f" } }
+  local f = o.downsample
+  local image, circles = src, coc
+  if f > 1 then
+    image = target{ "dof.small", format = "rgba16f", scale = 1 / f }
+    circles = target{ "dof.small_coc", format = "rg32f", scale = 1 / f }
+    pass{ "dof.reduce", shader = "dof_reduce.frag", inputs = { src = src, coc = coc }, defines = { FACTOR = f },
+          out = { image, circles } }
+  end
+  -- The largest circle reaching each 8 x 8 tile: the gather spreads its taps
+  -- over that radius, as many as keep the density of `samples` over max_radius.
+  local tile, radius = 8, o.max_radius / f
+  local tiles = pass{ "dof.tiles", shader = "dof_tiles.frag", inputs = { src = circles }, defines = { TILE = tile },
+                      out = target{ "dof.tiles", format = "r16f", scale = 1 / (tile * f) } }
+  tiles = pass{ "dof.dilate", shader = "dof_tiles.frag", inputs = { src = tiles },
+                params = { max_radius = radius }, defines = { TILE = tile, DILATE = true },
+                out = target{ "dof.dilate", format = "r16f", scale = 1 / (tile * f) } }
+  local gathered = pass{ "dof.gather", shader = "dof_gather.frag", inputs = { src = image, coc = circles, tiles = tiles },
+                         params = { max_radius = radius, samples = math.max(1, o.samples // f) },
+                         defines = { TILE = tile, FOREIGN = f > 1 },
+                         out = target{ "dof.gather", format = "rgba16f", scale = 1 / f } }
+  if f == 1 then return gathered end
+  return pass{ "dof.composite", shader = "dof_composite.frag",
+               inputs = { src = src, coc = coc, foreign = gathered, small_coc = circles },
+               out = target{ "dof.composite", format = "rgba16f" } }
 end
 
 return dof

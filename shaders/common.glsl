@@ -22,6 +22,16 @@ struct Light {
 };
 layout(std430, binding = 1) readonly buffer LimnLights { Light lights[]; };
 
+// Light culling, built once a frame (engine/scene/lightgrid.c): the frustum in
+// screen tiles and depth slices, each cluster listing the lights that may
+// reach it. Read through lights_near() (lighting.glsl).
+layout(std430, binding = 4) readonly buffer LimnLightGrid {
+  ivec4 grid;        // tiles x, y, depth slices, tile side in pixels (0: every light everywhere)
+  vec4 slicing;      // x: slices / log(far / near), y: near
+  uvec4 grid_global; // x: lights of infinite reach, y: where their list starts in cells
+  uint cells[];      // per cluster (offset, count) into cells, then the lists
+};
+
 const float PI = 3.14159265358979;
 const float EPS = 1e-6;
 

@@ -11,10 +11,17 @@
 // A sharp pixel keeps its own light and a blurred foreground covers it in
 // proportion to how much of its circle reaches it. Weights fall off over the
 // last half pixel of a circle so that edges do not alias.
+// The taps spread over the largest circle that reaches this pixel's tile
+// (dof_tiles.frag) instead of max_radius, their count cut to keep the density
+// of `samples` over max_radius: a tap beyond every circle would weigh 0, so
+// only the sampling pattern changes, and a tile no circle reaches costs one
+// fetch a pixel. With FOREIGN (the reduced-resolution path of dof.lua) it
+// writes the light from other pixels and their share of the weight instead,
+// for dof_composite.frag to lay over the full-size image.
 #include "post.glsl"
 
 in vec2 uv;
-uniform sampler2D src, coc;
+uniform sampler2D src, coc, tiles;
 uniform float max_radius = 8.0; // pixels, >= 0
 uniform int samples = 48;       // 1..256
 
@@ -25,17 +32,25 @@ void main() {
   vec3 centre = hdr_clamp(texelFetch(src, p, 0).rgb, HALF_MAX);
   vec2 cp = texelFetch(coc, p, 0).rg; // signed coc, eye depth
   float rmax = max(max_radius, 0.0);
-  if (rmax < 0.5) { // a zero-size blur
+  ivec2 tile = min(p / TILE, textureSize(tiles, 0) - 1);
+  float reach_max = texelFetch(tiles, tile, 0).r;
+  if (rmax < 0.5 || reach_max < 0.5) { // a zero-size blur, or no circle reaches beyond its own pixel
+#ifdef FOREIGN
+    dst = vec4(0.0);
+#else
     dst = vec4(centre, 1.0);
+#endif
     return;
   }
-  int n = clamp(samples, 1, 256);
-  float tap_area = PI * rmax * rmax / float(n);
+  float r = min(rmax, reach_max + 0.5);
+  int all = clamp(samples, 1, 256);
+  int n = clamp(int(ceil(float(all) * r * r / (rmax * rmax))), min(all, 8), all);
+  float tap_area = PI * r * r / float(n);
   float w0 = min(1.0, 1.0 / (PI * max(cp.x * cp.x, 0.25)));
-  vec3 sum = w0 * centre;
+  vec3 sum = vec3(0.0);
   float wsum = w0;
   for (int i = 0; i < n; i++) {
-    ivec2 off = ivec2(round(vogel_disc(i, n) * rmax));
+    ivec2 off = ivec2(round(vogel_disc(i, n) * r));
     ivec2 q = clamp(p + off, ivec2(0), last);
     if (q == p) continue;
     vec2 cq = texelFetch(coc, q, 0).rg;
@@ -46,5 +61,9 @@ void main() {
     sum += w * hdr_clamp(texelFetch(src, q, 0).rgb, HALF_MAX);
     wsum += w;
   }
-  dst = vec4(hdr_clamp(sum / wsum, HALF_MAX), 1.0);
+#ifdef FOREIGN
+  dst = vec4(hdr_clamp(sum / wsum, HALF_MAX), 1.0 - w0 / wsum);
+#else
+  dst = vec4(hdr_clamp((sum + w0 * centre) / wsum, HALF_MAX), 1.0);
+#endif
 }

@@ -45,22 +45,48 @@ vec3 light_incident(int i, vec3 p, out vec3 l) {
   return li.color.rgb * fall;
 }
 
-// Light i on a surface at p facing n: false when it arrives from behind;
-// else its direction l, n.l and its radiance (shadowed with SHADOWS).
+// Light i on a surface at p facing n: false when it arrives from behind or
+// gives nothing there (beyond its range or cone: no shadow lookup); else its
+// direction l, n.l and its radiance (shadowed with SHADOWS).
 bool light_on_surface(int i, vec3 p, vec3 n, out vec3 l, out float ndl, out vec3 radiance) {
   radiance = light_incident(i, p, l);
   ndl = dot(n, l);
-  if (ndl <= 0.0) return false;
+  if (ndl <= 0.0 || max(radiance.r, max(radiance.g, radiance.b)) <= 0.0) return false;
 #ifdef SHADOWS
   radiance *= shadow_factor(i, p, n, l);
 #endif
   return true;
 }
 
+// The lights that may reach p: light_index(r, j) for j < r.count. Every light
+// when culling is off or p lies outside the grid (a point off screen).
+struct LightList { int count, global; uint offset; bool all; };
+
+LightList lights_near(vec3 p) {
+  LightList all = LightList(frame.counts.x, 0, 0u, true);
+  if (grid.w <= 0) return all;
+  vec4 c = frame.view_proj * vec4(p, 1.0);
+  float z = c.w; // a perspective's clip w is the view depth
+  if (!(z >= slicing.y)) return all;
+  vec2 px = (c.xy / c.w * 0.5 + 0.5) * frame.output_size.xy;
+  ivec3 q = ivec3(floor(vec3(px / float(grid.w), log(z / slicing.y) * slicing.x)));
+  if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, grid.xyz))) return all;
+  int cell = (q.z * grid.y + q.y) * grid.x + q.x;
+  int global = int(grid_global.x);
+  return LightList(global + int(cells[2 * cell + 1]), global, cells[2 * cell], false);
+}
+
+int light_index(LightList r, int j) {
+  if (r.all) return j;
+  return int(cells[j < r.global ? grid_global.y + uint(j) : r.offset + uint(j - r.global)]);
+}
+
 // k = (k_a, k_d, k_s), shininess >= 0; n and v unit vectors (v toward the eye).
 vec3 phong(vec3 albedo, vec3 k, float shininess, vec3 n, vec3 v, vec3 p, vec3 ambient) {
   vec3 sum = k.x * ambient * albedo;
-  for (int i = 0; i < frame.counts.x; i++) {
+  LightList near = lights_near(p);
+  for (int j = 0; j < near.count; j++) {
+    int i = light_index(near, j);
     vec3 l, radiance;
     float ndl;
     if (!light_on_surface(i, p, n, l, ndl, radiance)) continue;
@@ -81,7 +107,9 @@ vec3 pbr_light(vec3 diffuse, vec3 f0, float roughness, float occlusion, vec3 n, 
   float a = max(roughness * roughness, 1e-3), a2 = a * a;
   float ndv = max(dot(n, v), 1e-4);
   vec3 sum = occlusion * ambient * diffuse;
-  for (int i = 0; i < frame.counts.x; i++) {
+  LightList near = lights_near(p);
+  for (int j = 0; j < near.count; j++) {
+    int i = light_index(near, j);
     vec3 l, radiance;
     float ndl;
     if (!light_on_surface(i, p, n, l, ndl, radiance)) continue;

@@ -15,6 +15,7 @@ typedef struct gl_run {
   int width, height;        /* 0: 256 x 192 */
   int frames;               /* 0: 1 */
   bool check_finite;        /* the renderer's NaN/Inf attribution */
+  bool no_light_culling;    /* every pixel evaluates every light */
 } gl_run;
 
 typedef struct gl_result {

@@ -328,6 +328,32 @@ static void depth_of_field_orders_foreground_and_background(void **state) {
   free(w);
 }
 
+/* The half-size gather (dof.downsample 2, the default) against the full-size
+ * one: close on average (edges differ most: the blur is built from half-size
+ * texels); and where no circle of confusion exceeds a pixel, both leave every
+ * pixel as it was (the tile test's shortcut and the composite's (1 - a) L_p). */
+static void depth_of_field_at_half_size_follows_the_full_size_one(void **state) {
+  (void)state;
+  static const char *const sharp[] = {NULL};
+  static const char *const full[] = {"dof=true", "dof.focus=4.4", "dof.range=1", "dof.downsample=1", NULL};
+  static const char *const half[] = {"dof=true", "dof.focus=4.4", "dof.range=1", "dof.downsample=2", NULL};
+  static const char *const still1[] = {"dof=true", "dof.range=1e6", "dof.downsample=1", NULL};
+  static const char *const still2[] = {"dof=true", "dof.range=1e6", "dof.downsample=2", NULL};
+  float *s = render_once(pp_lua, "dl", sharp), *a = render_once(pp_lua, "dl", full);
+  float *b = render_once(pp_lua, "dl", half);
+  float *c = render_once(pp_lua, "dl", still1), *d = render_once(pp_lua, "dl", still2);
+  double diff = 0, blur = 0;
+  for (int i = 0; i < W * H * 3; i++) {
+    diff += fabsf(a[i] - b[i]);
+    blur += fabsf(a[i] - s[i]);
+    if (c[i] != s[i] || d[i] != s[i]) fail_msg("a blur under a pixel changed value %d: %g, %g, %g", i, s[i], c[i], d[i]);
+  }
+  print_message("dof: half against full size %.5f a channel; full size against sharp %.5f\n", diff / (W * H * 3),
+                blur / (W * H * 3));
+  assert_true(diff < 0.25 * blur);
+  free(s), free(a), free(b), free(c), free(d);
+}
+
 /* ---- motion blur ------------------------------------------------------- */
 /* A still camera leaves the image as it was; a camera moving sideways blurs
  * along x: the horizontal gradient energy drops to under half, and by more
@@ -385,7 +411,8 @@ static void assert_targets_finite(lm_graph *g, const char *what) {
     if (!ti.used || lm_format_is_depth(ti.format) || ti.format == LM_FORMAT_RGBA8 || !ti.texture.id) continue;
     lm_texture_read(ti.texture, ti.width, ti.height, true, px);
     /* A signed circle of confusion; mean logarithms of luminance. */
-    bool signed_ok = !strcmp(ti.name, "dof.coc") || !strncmp(ti.name, "hdr.reduce", 10);
+    bool signed_ok = !strcmp(ti.name, "dof.coc") || !strcmp(ti.name, "dof.small_coc") ||
+                     !strncmp(ti.name, "hdr.reduce", 10);
     for (int i = 0; i < ti.width * ti.height * 4; i++)
       if (!isfinite(px[i]) || (!signed_ok && px[i] < 0))
         fail_msg("%s: target '%s' holds %g at %d", what, ti.name, px[i], i / 4);
@@ -450,7 +477,7 @@ static void degenerate_settings_stay_finite(void **state) {
 static void an_effect_off_records_no_pass(void **state) {
   (void)state;
   static const char *const passes[EFFECTS] = {
-      "motion_blur ", "dof.coc dof.gather ", "bloom.bright bloom.blur_x bloom.blur_y bloom.add ",
+      "motion_blur ", "dof.coc dof.reduce dof.tiles dof.dilate dof.gather dof.composite ", "bloom.bright bloom.blur_x bloom.blur_y bloom.add ",
       "hdr.reduce1 hdr.reduce2 hdr.reduce3 hdr.adapt hdr.tonemap ", "radial_blur ", "glass ", "tiles ", "sepia "};
   char names[1024], want[1024];
   gl_result r = start(pp_lua, "dl", NULL);
@@ -503,6 +530,7 @@ int main(void) {
       cmocka_unit_test(bloom_spreads_one_bright_pixel_and_nothing_else),
       cmocka_unit_test(depth_of_field_keeps_the_focus_plane_sharp),
       cmocka_unit_test(depth_of_field_orders_foreground_and_background),
+      cmocka_unit_test(depth_of_field_at_half_size_follows_the_full_size_one),
       cmocka_unit_test(motion_blur_follows_the_camera),
       cmocka_unit_test(every_effect_renders_finite_with_dl_and_isr),
       cmocka_unit_test(degenerate_settings_stay_finite),

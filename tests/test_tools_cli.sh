@@ -101,6 +101,16 @@ check "bench calibrates fetches" out_has '"calibration": {"ns_per_fetch": '
 check "bench declared fetches" out_has '"fetches_per_pixel": 244, "fetches_per_second": '  # 4 + 5 * 48 samples (isr.lua)
 check "bench vary unknown option" run 1 bench --tech isr --sizes 32x24 --frames 1 --warmup 0 --vary isr.nope=1,2
 check "bench vary unknown option message" err_has "unknown option 'isr.nope'"
+check "bench set" run 0 bench --tech dl --sizes 32x24 --frames 1 --warmup 0 --json --set dof=true
+check "bench set reaches the script" out_has '{"name": "dof.gather", "ms": ['
+check "bench bad set" run 2 bench --set nope=1 --sizes 32x24
+check "bench bad set message" err_has "unknown option 'nope'"
+check "bench lights not ascending" run 2 bench --lights 8,1
+check "bench lights message" err_has "--lights wants ascending counts"
+# 64 lights over the box, each reaching 5% of its diagonal: a pixel evaluates far fewer than 65
+check "bench lights" run 0 bench --tech dl --sizes 64x48 --frames 1 --warmup 0 --lights 0,64 --light-reach 0.05
+check "bench lights unculled: every light" awk '/lights\/pixel all/ { ok = $3 == 1 && $4 == 65 } END { exit !ok }' "$tmp/out"
+check "bench lights culled: a few" awk '/lights\/pixel culled/ { ok = $3 == 1 && $4 < 16 } END { exit !ok }' "$tmp/out"
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -32,12 +32,21 @@ static const char bench_usage[] =
     "  --scene NAME|FILE   (default cornell)\n"
     "  --script FILE       (default scripts/pp.lua)\n"
     "  --tech NAME         technique (default: the script's first)\n"
+    "  --set NAME=VALUE    set a script option, as limn capture does (repeatable)\n"
     "  --sizes LIST        comma-separated WxH (default 64x48,128x96,256x192)\n"
     "  --frames N          timed frames per size (default 5)\n"
     "  --warmup N          untimed frames first (default 2)\n"
     "  --vary NAME=V1,V2,...  at the largest size, also render with each value of\n"
     "                      a script option (e.g. isr.samples=8,16,32,64) and fit\n"
     "                      each pass's time against it\n"
+    "  --lights N1,N2,...  at the largest size, also render with N small point lights\n"
+    "                      scattered over the scene (ascending counts; a fixed\n"
+    "                      sequence, so each count adds to the last), with light\n"
+    "                      culling on and off; prints the lights a covered pixel\n"
+    "                      evaluates and fits each pass's time against it and\n"
+    "                      against N\n"
+    "  --light-reach F     those lights' range, a fraction of the scene's\n"
+    "                      bounding-box diagonal (default 0.08)\n"
     "  --clock auto|gpu|cpu\n"
     "  --json              one JSON object on stdout instead of the tables\n"
     "  --help              this text\n";
@@ -48,6 +57,7 @@ typedef struct bench_pass {
   char name[64];
   double ms[MAX_SIZES];     /* median per size; -1 when not run at that size */
   double vary_ms[MAX_SIZES]; /* median per --vary value at the largest size */
+  double lights_ms[2][MAX_SIZES]; /* median per --lights count: culled, every light everywhere */
   double fetches;           /* declared fetches a pixel (0: not said) */
   int width, height;        /* its output at the largest size */
 } bench_pass;
@@ -55,10 +65,15 @@ typedef struct bench_pass {
 typedef struct bench {
   int sizes[MAX_SIZES][2], size_count, frames, warmup;
   const char *scene, *script, *tech;
+  const char *sets[64];
+  int set_count;
   char vary_name[128];
   char vary_text[MAX_SIZES][64];
   double vary[MAX_SIZES];
   int vary_count, largest;  /* largest: index of the size with the most pixels */
+  int lights[MAX_SIZES], lights_count, scene_lights;
+  double light_reach;
+  double per_pixel[2][MAX_SIZES]; /* lights a covered pixel evaluates: culled, not */
   double ns_per_fetch;      /* calibrated; 0 when the calibration failed */
   int calibration_size[2];
   lm_clock clock;
@@ -77,7 +92,7 @@ static int usage_error(const char *fmt, const char *arg) {
 }
 
 static int parse_args(int argc, char **argv, bench *b) {
-  *b = (bench){.frames = 5, .warmup = 2, .scene = "cornell"};
+  *b = (bench){.frames = 5, .warmup = 2, .scene = "cornell", .light_reach = 0.08};
   const char *sizes = "64x48,128x96,256x192";
   static const struct option opts[] = {
       {"scene", required_argument, 0, 's'}, {"script", required_argument, 0, 'p'},
@@ -85,6 +100,7 @@ static int parse_args(int argc, char **argv, bench *b) {
       {"frames", required_argument, 0, 'n'}, {"warmup", required_argument, 0, 'w'},
       {"clock", required_argument, 0, 'k'}, {"json", no_argument, 0, 'j'},
       {"vary", required_argument, 0, 'V'},  {"help", no_argument, 0, 'h'},
+      {"set", required_argument, 0, 'S'},   {"lights", required_argument, 0, 'L'}, {"light-reach", required_argument, 0, 'R'},
       {0, 0, 0, 0}};
   opterr = 0;
   optind = 1;
@@ -123,6 +139,28 @@ static int parse_args(int argc, char **argv, bench *b) {
       }
       break;
     }
+    case 'S':
+      if (!strchr(optarg, '=') || optarg[0] == '=') return usage_error("--set wants NAME=VALUE, not '%s'", optarg);
+      if (b->set_count == 64) return usage_error("%s", "at most 64 --set");
+      b->sets[b->set_count++] = optarg;
+      break;
+    case 'L': {
+      char values[1024];
+      snprintf(values, sizeof values, "%s", optarg);
+      b->lights_count = 0;
+      for (char *save = NULL, *tok = strtok_r(values, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        int *v = &b->lights[b->lights_count];
+        if (b->lights_count == MAX_SIZES) return usage_error("%s", "--lights takes at most 16 counts");
+        if (!limn_parse_int(tok, 0, 200, v) || (b->lights_count && *v < v[-1]))
+          return usage_error("--lights wants ascending counts 0..200, not '%s'", tok);
+        b->lights_count++;
+      }
+      break;
+    }
+    case 'R':
+      if (!limn_parse_double(optarg, &b->light_reach) || !(b->light_reach > 0 && b->light_reach <= 10))
+        return usage_error("--light-reach wants a fraction in (0, 10], not '%s'", optarg);
+      break;
     case 'h': fputs(bench_usage, stdout); return -1;
     case ':': return usage_error("%s needs a value", argv[optind - 1]);
     default: return usage_error("unknown flag '%s'", argv[optind - 1]);
@@ -159,19 +197,57 @@ static bench_pass *find_pass(bench *b, const char *name) {
   if (b->pass_count == MAX_PASSES) return NULL;
   bench_pass *p = &b->passes[b->pass_count++];
   snprintf(p->name, sizeof p->name, "%s", name);
-  for (int s = 0; s < MAX_SIZES; s++) p->ms[s] = p->vary_ms[s] = -1;
+  for (int s = 0; s < MAX_SIZES; s++) p->ms[s] = p->vary_ms[s] = p->lights_ms[0][s] = p->lights_ms[1][s] = -1;
   return p;
 }
 
-/* One configuration (size si; `vary` picks the --vary series, column si):
- * warm-up, then medians of frame wall time, overhead and passes. */
-static bool run_size(bench *b, int si, bool vary, lm_scene *scene, lm_pipeline *pipe, lm_clock *used,
+/* Which series a configuration fills: the sizes, --vary, --lights culled or not. */
+enum { SERIES_SIZES, SERIES_VARY, SERIES_LIGHTS, SERIES_LIGHTS_ALL };
+
+static double *series_ms(bench_pass *p, int series) {
+  return series == SERIES_SIZES ? p->ms
+         : series == SERIES_VARY ? p->vary_ms
+                                 : p->lights_ms[series - SERIES_LIGHTS];
+}
+
+/* Mean count of lights a covered pixel of r's last frame evaluates (the G-buffer's depth and the light grid). */
+static double lights_per_pixel(lm_renderer *r, int light_count) {
+  lm_graph *g = lm_renderer_graph(r);
+  int id = lm_graph_find_target(g, "gbuffer.dpt"), mid = lm_graph_find_target(g, "gbuffer.mat");
+  if (id < 0 || mid < 0) return -1;
+  lm_graph_target_info t = lm_graph_target(g, id), m = lm_graph_target(g, mid);
+  if (!t.used || !t.texture.id || !m.used || !m.texture.id) return -1;
+  size_t px = (size_t)t.width * (size_t)t.height;
+  float *depth = lm_alloc(sizeof(float) * 4 * px), *mat = lm_alloc(sizeof(float) * 4 * px);
+  lm_texture_read(t.texture, t.width, t.height, true, depth);
+  lm_texture_read(m.texture, m.width, m.height, true, mat);
+  const lm_light_grid *grid = lm_renderer_light_grid(r);
+  double sum = 0, covered = 0;
+  for (int row = 0; row < t.height; row++)
+    for (int x = 0; x < t.width; x++) {
+      size_t i = (size_t)row * (size_t)t.width + (size_t)x;
+      if (mat[4 * i + 3] < 0.5f) continue; /* background: no light evaluated */
+      float y = (float)(t.height - 1 - row) + 0.5f; /* rows were read top first */
+      sum += lm_light_grid_count(grid, lm_light_grid_cluster(grid, (float)x + 0.5f, y, depth[4 * i]), light_count);
+      covered++;
+    }
+  free(depth);
+  free(mat);
+  return covered > 0 ? sum / covered : 0;
+}
+
+/* One configuration (size si, or column si of another series): warm-up,
+ * then medians of frame wall time, overhead and passes. */
+static bool run_size(bench *b, int si, int series, lm_scene *scene, lm_pipeline *pipe, lm_clock *used,
                      lm_error *err) {
+  bool vary = series != SERIES_SIZES;
   int size = vary ? b->largest : si;
   lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = pipe,
                                                           .width = b->sizes[size][0], .height = b->sizes[size][1],
-                                                          .clock = b->clock}, err);
+                                                          .clock = b->clock,
+                                                          .no_light_culling = series == SERIES_LIGHTS_ALL}, err);
   if (!r) return false;
+  if (series >= SERIES_LIGHTS) lm_renderer_set_sharing(r, false); /* the G-buffer stays readable */
   *used = lm_renderer_clock(r);
   double *wall = lm_alloc(sizeof(double) * (size_t)b->frames), *over = lm_alloc(sizeof(double) * (size_t)b->frames);
   double *readback = lm_alloc(sizeof(double) * (size_t)b->frames);
@@ -207,8 +283,10 @@ static bool run_size(bench *b, int si, bool vary, lm_scene *scene, lm_pipeline *
     b->overhead_ms[si] = median(over, b->frames);
     b->readback_ms[si] = median(readback, b->frames);
   }
+  if (ok && series >= SERIES_LIGHTS)
+    b->per_pixel[series - SERIES_LIGHTS][si] = lights_per_pixel(r, b->scene_lights + b->lights[si]);
   for (int i = 0; i < b->pass_count && ok; i++)
-    if (pass_n[i]) (vary ? b->passes[i].vary_ms : b->passes[i].ms)[si] = median(pass_ms + i * b->frames, pass_n[i]);
+    if (pass_n[i]) series_ms(&b->passes[i], series)[si] = median(pass_ms + i * b->frames, pass_n[i]);
   free(wall);
   free(over);
   free(readback);
@@ -217,15 +295,13 @@ static bool run_size(bench *b, int si, bool vary, lm_scene *scene, lm_pipeline *
   return ok;
 }
 
-/* Least squares ms = a + b * x over the points where the pass ran (x: the
- * pixel count of each size, or each --vary value); false with fewer than
- * two distinct x. */
-static bool fit(const bench *b, const bench_pass *p, bool vary, double *a, double *slope, double *r2) {
+/* Least squares y = a + b * x over the points with y >= 0; false with
+ * fewer than two distinct x. */
+static bool fit_line(const double *xs, const double *ys, int count, double *a, double *slope, double *r2) {
   double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
-  for (int s = 0; s < (vary ? b->vary_count : b->size_count); s++) {
-    double y = vary ? p->vary_ms[s] : p->ms[s];
-    if (y < 0) continue;
-    double x = vary ? b->vary[s] : (double)b->sizes[s][0] * b->sizes[s][1];
+  for (int s = 0; s < count; s++) {
+    double x = xs[s], y = ys[s];
+    if (y < 0 || x < 0) continue;
     n++, sx += x, sy += y, sxx += x * x, sxy += x * y, syy += y * y;
   }
   double den = n * sxx - sx * sx;
@@ -235,6 +311,14 @@ static bool fit(const bench *b, const bench_pass *p, bool vary, double *a, doubl
   double vy = n * syy - sy * sy;
   *r2 = vy > 0 ? (*slope * (n * sxy - sx * sy)) / vy : 1.0; /* all times equal: the flat line fits */
   return true;
+}
+
+/* A pass's time against the pixel count of each size, or each --vary value. */
+static bool fit(const bench *b, const bench_pass *p, bool vary, double *a, double *slope, double *r2) {
+  double xs[MAX_SIZES];
+  int n = vary ? b->vary_count : b->size_count;
+  for (int s = 0; s < n; s++) xs[s] = vary ? b->vary[s] : (double)b->sizes[s][0] * b->sizes[s][1];
+  return fit_line(xs, vary ? p->vary_ms : p->ms, n, a, slope, r2);
 }
 
 /* A pass's fetches against the calibration at the largest size: *rate in
@@ -387,7 +471,7 @@ static bool calibrate(bench *b, lm_scene *scene, lm_error *err) {
     memcpy(cal.sizes[0], b->sizes[b->largest], sizeof cal.sizes[0]);
     if ((double)cal.sizes[0][0] * cal.sizes[0][1] < 256.0 * 192.0) cal.sizes[0][0] = 256, cal.sizes[0][1] = 192;
     lm_clock used;
-    ok = lm_pipeline_set_option(pipe, "fetches", counts[k], err) && run_size(&cal, 0, false, scene, pipe, &used, err);
+    ok = lm_pipeline_set_option(pipe, "fetches", counts[k], err) && run_size(&cal, 0, SERIES_SIZES, scene, pipe, &used, err);
     for (int i = 0; i < cal.pass_count && ok; i++)
       if (!strcmp(cal.passes[i].name, "calibrate")) ms[k] = cal.passes[i].ms[0];
   }
@@ -396,6 +480,64 @@ static bool calibrate(bench *b, lm_scene *scene, lm_error *err) {
   b->calibration_size[0] = cal.sizes[0][0], b->calibration_size[1] = cal.sizes[0][1];
   b->ns_per_fetch = ok && ms[1] > ms[0] && ms[0] >= 0 ? (ms[1] - ms[0]) * 1e6 / (56.0 * pixels) : 0;
   return ok;
+}
+
+/* Adds lights from..to-1 of a fixed sequence of small white point lights,
+ * uniformly over the scene's bounding box, their range `reach` times its
+ * diagonal (no unit), casting no shadows. */
+static void scatter_lights(lm_scene *s, int from, int to, double reach) {
+  float lo[3], hi[3];
+  lm_scene_bounds(s, lo, hi);
+  float diag = sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                     (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  for (int i = from; i < to; i++) {
+    uint32_t h = 2166136261u ^ (uint32_t)i;
+    float p[3], m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    for (int c = 0; c < 3; c++) {
+      h = h * 1664525u + 1013904223u;
+      p[c] = lo[c] + (hi[c] - lo[c]) * (float)(h >> 8) / 16777216.0f;
+    }
+    memcpy(m + 12, p, sizeof p);
+    char name[LM_NAME_MAX];
+    snprintf(name, sizeof name, "bench_light_%d", i);
+    int node = lm_scene_add_node(s, name, -1, m, -1, -1);
+    lm_light l = {.type = LM_LIGHT_POINT, .color = {1, 1, 1}, .power = 1, .radius = (float)reach * diag,
+                  .falloff = LM_FALLOFF_WINDOW, .node = node};
+    snprintf(l.name, sizeof l.name, "%s", name);
+    lm_scene_add_light(s, &l);
+  }
+  lm_scene_update(s);
+}
+
+/* The --lights series: lights a covered pixel evaluates, each pass's time
+ * culled and with every light everywhere, and lines fitted to both. */
+static void print_lights(const bench *b) {
+  printf("--lights at %dx%d: %d scene light(s) plus N small ones (range %.3g of the bounding-box diagonal)\n",
+         b->sizes[b->largest][0], b->sizes[b->largest][1], b->scene_lights, b->light_reach);
+  printf("  %-24s", "N");
+  for (int v = 0; v < b->lights_count; v++) printf(" %13d", b->lights[v]);
+  printf("\n  %-24s", "lights/pixel culled");
+  for (int v = 0; v < b->lights_count; v++) printf(" %13.2f", b->per_pixel[0][v]);
+  printf("\n  %-24s", "lights/pixel all");
+  for (int v = 0; v < b->lights_count; v++) printf(" %13.2f", b->per_pixel[1][v]);
+  printf("\n  pass: ms culled / all      fits: culled against lights/pixel | culled against N | all against N\n");
+  double n[MAX_SIZES];
+  for (int v = 0; v < b->lights_count; v++) n[v] = b->lights[v];
+  for (int i = 0; i < b->pass_count; i++) {
+    const bench_pass *p = &b->passes[i];
+    if (p->lights_ms[0][0] < 0) continue;
+    printf("  %-24s", p->name);
+    for (int v = 0; v < b->lights_count; v++) printf(" %6.1f/%-6.1f", p->lights_ms[0][v], p->lights_ms[1][v]);
+    double a, sl, r2;
+    const double *fits[3][2] = {{b->per_pixel[0], p->lights_ms[0]}, {n, p->lights_ms[0]}, {n, p->lights_ms[1]}};
+    for (int f = 0; f < 3; f++) {
+      if (fit_line(fits[f][0], fits[f][1], b->lights_count, &a, &sl, &r2))
+        printf("%s%.1f + %.2f x (r2 %.2f)", f ? " | " : "  ", a, sl, r2);
+      else
+        printf("%s-", f ? " | " : "  ");
+    }
+    printf("\n");
+  }
 }
 
 int limn_bench(int argc, char **argv) {
@@ -416,6 +558,16 @@ int limn_bench(int argc, char **argv) {
     lm_pipeline_destroy(pipe);
     return 2;
   }
+  for (int i = 0; i < b.set_count; i++) {
+    char name[256];
+    const char *eq = strchr(b.sets[i], '=');
+    snprintf(name, sizeof name, "%.*s", (int)(eq - b.sets[i]), b.sets[i]);
+    if (!lm_pipeline_set_option(pipe, name, eq + 1, &err)) {
+      lm_log(LM_LOG_ERROR, "%s", err.msg);
+      lm_pipeline_destroy(pipe);
+      return 2;
+    }
+  }
   lm_scene *scene = lm_scene_load(b.scene, &err);
   if (!scene) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
@@ -424,15 +576,22 @@ int limn_bench(int argc, char **argv) {
   }
   bool ok = lm_context_create_headless(&(lm_context_desc){.platform = "auto"}, &err);
   lm_clock used = LM_CLOCK_AUTO;
-  for (int s = 0; s < b.size_count && ok; s++) ok = run_size(&b, s, false, scene, pipe, &used, &err);
+  for (int s = 0; s < b.size_count && ok; s++) ok = run_size(&b, s, SERIES_SIZES, scene, pipe, &used, &err);
   for (int v = 0; v < b.vary_count && ok; v++) {
     ok = lm_pipeline_set_option(pipe, b.vary_name, b.vary_text[v], &err);
-    if (ok) ok = run_size(&b, v, true, scene, pipe, &used, &err);
+    if (ok) ok = run_size(&b, v, SERIES_VARY, scene, pipe, &used, &err);
+  }
+  b.scene_lights = scene->light_count;
+  for (int v = 0; v < b.lights_count && ok; v++) {
+    scatter_lights(scene, scene->light_count - b.scene_lights, b.lights[v], b.light_reach);
+    ok = run_size(&b, v, SERIES_LIGHTS, scene, pipe, &used, &err) &&
+         run_size(&b, v, SERIES_LIGHTS_ALL, scene, pipe, &used, &err);
   }
   if (ok) ok = calibrate(&b, scene, &err);
   if (ok) {
     if (b.json) print_json(&b, used);
     else print_tables(&b, used);
+    if (b.lights_count && !b.json) print_lights(&b); /* tables only */
   } else {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
   }

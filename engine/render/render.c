@@ -14,6 +14,7 @@ struct lm_renderer {
   float prev_view_proj[16];
   lm_frame_data camera;
   lm_shadow_plan shadows;
+  lm_light_grid light_grid;
   double record_ms, compile_ms, fit_ms;
   lm_scene_draw_stats stats;  /* this frame's camera draws */
   lm_scene_draw_stats shadow_stats; /* and its shadow tiles' */
@@ -36,11 +37,13 @@ void lm_renderer_destroy(lm_renderer *r) {
   if (!r) return;
   lm_graph_destroy(r->graph);
   lm_shadow_plan_free(&r->shadows);
+  lm_light_grid_free(&r->light_grid);
   free(r);
 }
 
 lm_graph *lm_renderer_graph(lm_renderer *r) { return r->graph; }
 lm_clock lm_renderer_clock(const lm_renderer *r) { return r->clock; }
+const lm_light_grid *lm_renderer_light_grid(const lm_renderer *r) { return &r->light_grid; }
 
 void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compile_ms) {
   *record_ms = r->record_ms;
@@ -162,6 +165,8 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
   frame->counts[0] = n;
   lm_frame_upload(frame, lights, n);
+  lm_light_grid_build(&r->light_grid, frame, lights, n, !r->desc.no_light_culling);
+  lm_storage_upload(4, r->light_grid.data, r->light_grid.count * sizeof *r->light_grid.data);
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
   r->fit_ms = 0;
   lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene, .fit_views = fit_views,

@@ -18,6 +18,7 @@ typedef struct lm_renderer_desc {
   bool linear_output;     /* also keep a float copy of the output (for EXR) */
   bool check_finite;      /* debug: name the first pass that writes a NaN or Inf */
   bool no_culling;        /* draw every node, even those outside the frustum */
+  bool no_light_culling;  /* every pixel evaluates every light (the reference for light culling) */
 } lm_renderer_desc;
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err);
@@ -34,6 +35,8 @@ lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r); /* camera pass
 /* The same for the last frame's shadow tiles, summed over the tiles. */
 lm_scene_draw_stats lm_renderer_shadow_draw_stats(const lm_renderer *r);
 lm_clock lm_renderer_clock(const lm_renderer *r);
+/* The last frame's light grid (lm_light_grid_build), read by the lighting shaders. */
+const lm_light_grid *lm_renderer_light_grid(const lm_renderer *r);
 /* CPU milliseconds of the last frame spent in Lua (OnRender) and in compiling the graph. */
 void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compile_ms);
 /* Wall milliseconds the last frame spent reading back the depth range its

@@ -209,6 +209,35 @@ bool lm_scene_upload(lm_scene *s, lm_error *err);
 void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_frame_data *out);
 /* Fills up to `max` lights; returns how many. */
 int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max);
+/* How far light d reaches (world units): where its falloff (shaders/lighting.glsl)
+ * becomes zero; INFINITY for directional lights and falloffs without a range.
+ * The one place light culling learns a light's extent. */
+float lm_light_reach(const lm_light_data *d);
+
+/* Clustered light culling (engine/scene/lightgrid.c): the frustum cut into
+ * screen tiles and exponential depth slices, each listing the lights whose
+ * reach (and cone) touches it; lights of infinite reach are listed once for
+ * all. `data` is the LimnLightGrid storage block (shaders/common.glsl). */
+typedef struct lm_light_grid {
+  int tiles_x, tiles_y, slices, tile_px; /* tile_px 0: no culling, every light everywhere */
+  float near, far, slice_scale;          /* slice = floor(log(z / near) * slice_scale) */
+  int global;                            /* lights of infinite reach */
+  long listed;                           /* entries of all cluster lists */
+  uint32_t *data;
+  size_t count, cap;                     /* words */
+} lm_light_grid;
+/* Fills g for frame f's camera and lights; cull false lists every light for
+ * every pixel (the reference the culled result must match). */
+void lm_light_grid_build(lm_light_grid *g, const lm_frame_data *f, const lm_light_data *lights, int n, bool cull);
+/* The cluster of a pixel at (x, y) (output pixels from the bottom left) and
+ * linear depth / far depth01; -1 outside the grid (it evaluates every light). */
+int lm_light_grid_cluster(const lm_light_grid *g, float x, float y, float depth01);
+/* How many lights a pixel of `cluster` evaluates, of light_count in the frame. */
+int lm_light_grid_count(const lm_light_grid *g, int cluster, int light_count);
+/* Does a pixel of `cluster` evaluate light i? */
+bool lm_light_grid_has(const lm_light_grid *g, int cluster, int light);
+void lm_light_grid_free(lm_light_grid *g);
+
 /* A parameter override: material `material`'s parameter `name` ("color",
  * "rho", "ka", "kd", "ks", "shininess") takes v[0 .. count) for one draw.
  * (The frame graph carries these as lm_pass_material_param; the renderer

@@ -1,0 +1,181 @@
+#!/usr/bin/env python3
+"""Times this checkout against another revision in one run.
+
+    tools/bench_compare.py REV [--case SCENE[:TECH[:NAME=VALUE,...]]] ... [options]
+
+Builds REV's `limn` in a scratch git worktree (under /tmp, removed at the end
+unless --keep), then renders every case with both builds in turn, round after
+round, the order swapped each round so that both see the same machine load.
+Each run is `limn capture --frames F`; a pass's time is its median over the
+rounds of the per-run medians, the frame time the median of the runs' sums.
+Prints per case and pass both times and the ratio REV / this (above 1: this
+checkout is faster), and the mean error between the two images (limn compare),
+so that a speed-up that changes the picture shows. Standard library only.
+"""
+import argparse
+import json
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DEFAULT_CASES = ["garage:isr+esm", "office:isr+esm", "outdoor:isr+esm"]
+TIME_LINE = re.compile(r"^\s+(\S+)\s+(?:\S+\s+)?([0-9.]+) ms$")
+
+
+def fail(msg):
+    print(f"bench_compare: {msg}", file=sys.stderr)
+    sys.exit(2)
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, check=True, text=True, **kw)
+
+
+def build(src, build_dir, quiet):
+    """Configures (once) and builds the limn command of the tree at src."""
+    out = subprocess.DEVNULL if quiet else None
+    if not os.path.exists(os.path.join(build_dir, "CMakeCache.txt")):
+        run(["cmake", "-S", src, "-B", build_dir, "-DCMAKE_BUILD_TYPE=RelWithDebInfo"], stdout=out)
+    run(["cmake", "--build", build_dir, "-j", str(os.cpu_count() or 1), "--target", "limn"], stdout=out)
+    return os.path.join(build_dir, "limn")
+
+
+def parse_case(text):
+    parts = text.split(":", 2)
+    scene = parts[0]
+    if not scene:
+        fail(f"--case '{text}': no scene")
+    if not scene.endswith((".glb", ".gltf")) and os.path.exists(os.path.join(ROOT, "data/scenes", scene + ".glb")):
+        scene = os.path.join(ROOT, "data/scenes", scene + ".glb")  # the same file for both revisions
+    tech = parts[1] if len(parts) > 1 and parts[1] else None
+    sets = [s for s in parts[2].split(",") if s] if len(parts) > 2 else []
+    for s in sets:
+        if "=" not in s:
+            fail(f"--case '{text}': '{s}' is not NAME=VALUE")
+    return {"label": text, "scene": scene, "tech": tech, "sets": sets}
+
+
+def capture(limn, case, args, image):
+    cmd = [limn, "capture", "--scene", case["scene"], "--size", args.size, "--frames", str(args.frames),
+           "--output", image]
+    if case["tech"]:
+        cmd += ["--tech", case["tech"]]
+    for s in case["sets"] + args.set:
+        cmd += ["--set", s]
+    p = subprocess.run(cmd, text=True, capture_output=True)
+    if p.returncode != 0:
+        fail(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stderr.strip()}")
+    passes, in_table = {}, False
+    for line in p.stdout.splitlines():
+        if line.startswith("pass times"):
+            in_table = True
+            continue
+        m = TIME_LINE.match(line) if in_table else None
+        if m:
+            passes[m.group(1)] = float(m.group(2))
+    if "total" not in passes:
+        fail(f"no pass times in the output of {' '.join(cmd)}")
+    return passes
+
+
+def mean_error(limn, a, b):
+    p = subprocess.run([limn, "compare", a, b, "--json"], text=True, capture_output=True)
+    try:
+        return json.loads(p.stdout)["mean_error"]
+    except (ValueError, KeyError):
+        return None
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[1], formatter_class=argparse.RawTextHelpFormatter)
+    ap.add_argument("rev", help="the other revision (anything git rev-parse takes)")
+    ap.add_argument("--case", action="append", default=[],
+                    help="SCENE[:TECH[:NAME=VALUE,...]]: a scene of data/scenes or a built-in, a technique and\n"
+                         "options (repeatable; default: garage, office and outdoor with isr+esm)")
+    ap.add_argument("--set", action="append", default=[], help="NAME=VALUE for every case (repeatable)")
+    ap.add_argument("--size", default="512x384")
+    ap.add_argument("--frames", type=int, default=3, help="frames a run (the median is taken)")
+    ap.add_argument("--rounds", type=int, default=3, help="runs of each revision per case, alternated")
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"), help="this checkout's build folder")
+    ap.add_argument("--keep", metavar="DIR", help="keep REV's worktree and build in DIR (reused when it exists)")
+    ap.add_argument("--json", action="store_true", help="print one JSON object instead of the tables")
+    args = ap.parse_args()
+    if args.frames < 1 or args.rounds < 1:
+        fail("--frames and --rounds want at least 1")
+    cases = [parse_case(c) for c in (args.case or DEFAULT_CASES)]
+    try:
+        sha = run(["git", "-C", ROOT, "rev-parse", "--verify", args.rev + "^{commit}"],
+                  capture_output=True).stdout.strip()
+    except subprocess.CalledProcessError:
+        fail(f"'{args.rev}' is not a revision of {ROOT}")
+    here = run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True).stdout.strip()
+    dirty = run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
+                capture_output=True).stdout.strip() != ""
+    scratch = args.keep or tempfile.mkdtemp(prefix="limn-compare-")
+    tree = os.path.join(scratch, "tree")
+    images = tempfile.mkdtemp(prefix="limn-compare-images-")
+    log = sys.stderr
+    try:
+        if not os.path.exists(os.path.join(tree, ".git")):
+            run(["git", "-C", ROOT, "worktree", "add", "--detach", tree, sha], stdout=subprocess.DEVNULL)
+        elif run(["git", "-C", tree, "rev-parse", "HEAD"], capture_output=True).stdout.strip() != sha:
+            run(["git", "-C", tree, "checkout", "--detach", "-q", sha])
+        print(f"building {args.rev} ({sha[:10]}) in {tree} ...", file=log)
+        limn = {"base": build(tree, os.path.join(scratch, "build"), True),
+                "this": build(ROOT, args.build, True)}
+        results = []
+        for case in cases:
+            times = {"base": [], "this": []}
+            for r in range(args.rounds):
+                order = ("base", "this") if r % 2 == 0 else ("this", "base")
+                for who in order:
+                    print(f"  {case['label']}: round {r + 1}/{args.rounds}, {who}", file=log)
+                    img = os.path.join(images, f"{len(results)}-{who}.exr")
+                    times[who].append(capture(limn[who], case, args, img))
+            err = mean_error(limn["this"], os.path.join(images, f"{len(results)}-base.exr"),
+                             os.path.join(images, f"{len(results)}-this.exr"))
+            names = [n for n in times["base"][0] if n != "total"]
+            names += [n for n in times["this"][0] if n != "total" and n not in names]
+            rows = []
+            for n in names + ["total"]:
+                row = {"pass": n if n != "total" else "frame"}
+                for who in ("base", "this"):
+                    v = [t[n] for t in times[who] if n in t]
+                    row[who] = statistics.median(v) if v else None
+                row["ratio"] = row["base"] / row["this"] if row["base"] and row["this"] else None
+                rows.append(row)
+            results.append({"case": case["label"], "passes": rows, "mean_error": err})
+    finally:
+        shutil.rmtree(images, ignore_errors=True)
+        if not args.keep:
+            subprocess.run(["git", "-C", ROOT, "worktree", "remove", "--force", tree],
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            shutil.rmtree(scratch, ignore_errors=True)
+    label = here + (" (uncommitted changes)" if dirty else "")
+    if args.json:
+        print(json.dumps({"base": sha, "this": label, "size": args.size, "frames": args.frames,
+                          "rounds": args.rounds, "sets": args.set, "cases": results}, indent=1))
+        return
+    print(f"base {args.rev} ({sha[:10]}) against this checkout {label}; {args.size}, medians of "
+          f"{args.rounds} alternated runs of {args.frames} frames; ratio = base / this (> 1: faster now)")
+    fmt = "  {:<26} {:>10} {:>10} {:>8}"
+    for res in results:
+        err = res["mean_error"]
+        print(f"{res['case']}  (mean error between the two images: {'-' if err is None else f'{err:.4g}'})")
+        print(fmt.format("pass (ms)", "base", "this", "ratio"))
+        for row in res["passes"]:
+            cell = lambda v, f: "-" if v is None else f.format(v)
+            print(fmt.format(row["pass"], cell(row["base"], "{:.2f}"), cell(row["this"], "{:.2f}"),
+                             cell(row["ratio"], "{:.2f}x")))
+    frames = [row["ratio"] for res in results for row in res["passes"] if row["pass"] == "frame" and row["ratio"]]
+    if frames:
+        print(f"frame ratio: geometric mean {statistics.geometric_mean(frames):.2f}x over {len(frames)} case(s)")
+
+
+if __name__ == "__main__":
+    main()
