@@ -57,7 +57,7 @@ static lm_scene *box_with_lights(int count) {
 static bool reaches(const lm_light_data *l, const float p[3]) {
   float d[3] = {p[0] - l->position[0], p[1] - l->position[1], p[2] - l->position[2]};
   float dist = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-  if (!(dist < lm_light_reach(l))) return false;
+  if (!(dist < lm_light_data_reach(l))) return false;
   if ((int)(l->position[3] + 0.5f) != LM_LIGHT_SPOT) return true;
   float along = d[0] * l->direction[0] + d[1] * l->direction[1] + d[2] * l->direction[2];
   return along > l->direction[3] * dist;
@@ -84,7 +84,7 @@ static long check_listed(lm_scene *s, int cam) {
   assert_true(mean < n / 4.0);
   long checked = 0;
   for (int i = 0; i < n; i++) {
-    float reach = lm_light_reach(&lights[i]);
+    float reach = lm_light_data_reach(&lights[i]);
     if (isinf(reach)) continue;
     for (int k = 0; k < 4000; k++) {
       /* A point at 99.9% of the range (most), or anywhere inside. */

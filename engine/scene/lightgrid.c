@@ -15,12 +15,11 @@ enum {
   HEADER = 12,      /* words before the cells: ivec4 grid, vec4 slicing, uvec4 global */
 };
 
-float lm_light_reach(const lm_light_data *d) {
-  int type = (int)(d->position[3] + 0.5f);
-  int falloff = (int)(d->params[1] + 0.5f);
-  if (type == LM_LIGHT_DIRECTIONAL || falloff != LM_FALLOFF_WINDOW) return INFINITY;
-  /* The window saturate(1 - (d / r)^2) (lighting.glsl) is zero from r on. */
-  return d->color[3] > 0 && isfinite(d->color[3]) ? d->color[3] : 0;
+float lm_light_data_reach(const lm_light_data *d) {
+  lm_light l = {.type = (lm_light_type)(int)(d->position[3] + 0.5f),
+                .falloff = (lm_falloff)(int)(d->params[1] + 0.5f),
+                .radius = d->color[3]};
+  return lm_light_reach(&l);
 }
 
 static void push(lm_light_grid *g, uint32_t word) {
@@ -116,7 +115,7 @@ void lm_light_grid_build(lm_light_grid *g, const lm_frame_data *f, const lm_ligh
   int near_count = 0;
   for (int i = 0; i < n; i++) {
     const lm_light_data *l = &lights[i];
-    float r = lm_light_reach(l);
+    float r = lm_light_data_reach(l);
     if (isinf(r)) continue;
     near_light *q = &near[near_count++];
     to_view(f->view, l->position, 1, q->pos);
@@ -136,7 +135,7 @@ void lm_light_grid_build(lm_light_grid *g, const lm_frame_data *f, const lm_ligh
   for (int c = 0; c < 2 * clusters; c++) push(g, 0);
   uint32_t global_offset = (uint32_t)(g->count - HEADER), global = 0;
   for (int i = 0; i < n; i++)
-    if (clusters && isinf(lm_light_reach(&lights[i]))) push(g, (uint32_t)i), global++;
+    if (clusters && isinf(lm_light_data_reach(&lights[i]))) push(g, (uint32_t)i), global++;
   g->data[8] = global, g->data[9] = global_offset;
   g->listed = 0;
   for (int c = 0; c < clusters; c++) {

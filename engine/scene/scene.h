@@ -209,10 +209,8 @@ bool lm_scene_upload(lm_scene *s, lm_error *err);
 void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_frame_data *out);
 /* Fills up to `max` lights; returns how many. */
 int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max);
-/* How far light d reaches (world units): where its falloff (shaders/lighting.glsl)
- * becomes zero; INFINITY for directional lights and falloffs without a range.
- * The one place light culling learns a light's extent. */
-float lm_light_reach(const lm_light_data *d);
+/* lm_light_reach of the light packed in d: what light culling reads. */
+float lm_light_data_reach(const lm_light_data *d);
 
 /* Clustered light culling (engine/scene/lightgrid.c): the frustum cut into
  * screen tiles and exponential depth slices, each listing the lights whose
