@@ -270,9 +270,9 @@ static void depth_of_field_keeps_the_focus_plane_sharp(void **state) {
   static const char *const near[] = {"dof=true", "dof.focus=1.5", "dof.range=2", "dof.max_radius=6", NULL};
   /* 50 mm at f/2.8 on a 24 mm sensor: about 3 pixels of blur at 4.4 when focused at 1.5. */
   static const char *const lens_focused[] = {"dof=true", "dof.mode=lens", "dof.focus=4.4", "dof.focal_length=0.05",
-                                             "dof.f_number=2.8", "dof.max_radius=6", NULL};
+                                             "dof.f_number=2.8", "dof.sensor=0.024", "dof.max_radius=6", NULL};
   static const char *const lens_near[] = {"dof=true", "dof.mode=lens", "dof.focus=1.5", "dof.focal_length=0.05",
-                                          "dof.f_number=2.8", "dof.max_radius=6", NULL};
+                                          "dof.f_number=2.8", "dof.sensor=0.024", "dof.max_radius=6", NULL};
   const char *const *cases[] = {sharp, focused, near, lens_focused, lens_near};
   double e[5][2];
   for (int c = 0; c < 5; c++) {
