@@ -168,7 +168,7 @@ static float opt_number(lua_State *L, int idx, const char *field, float def, flo
 }
 
 /* shadow_plan{ technique, resolution, c, blur, cascades, lambda, bias, distance,
- * blend, radius, stabilize }: tiles for every light that casts shadows, or nil
+ * blend, radius, stabilize, size, penumbra }: tiles for every light that casts shadows, or nil
  * when none does. scene{ views = plan } draws them; scene{ views = plan, fit =
  * T } first fits them to the camera depths T's first texel holds (min in r,
  * max in g, as depth / far). */
@@ -179,14 +179,15 @@ static int l_shadow_plan(lua_State *L) {
   if (p->shadows_frame == p->frame) return luaL_error(L, "shadow_plan: called twice in one frame");
   luaL_checktype(L, 1, LUA_TTABLE);
   static const char *const fields[] = {"technique", "resolution", "c", "blur", "cascades", "lambda",
-                                       "bias", "distance", "blend", "radius", "stabilize", NULL};
+                                       "bias", "distance", "blend", "radius", "stabilize", "size",
+                                       "penumbra", NULL};
   check_fields(L, 1, "shadow_plan", fields);
   lm_shadow_settings st;
   lm_shadow_settings_default(&st);
   const char *technique = opt_string(L, 1, "technique", "shadow_plan");
   if (technique) {
     int t = lm_shadow_technique_parse(technique);
-    if (t < 0) return luaL_error(L, "shadow_plan: unknown technique '%s' (esm, pcf, poisson, hard)", technique);
+    if (t < 0) return luaL_error(L, "shadow_plan: unknown technique '%s' (esm, pcf, poisson, hard, pcss)", technique);
     st.technique = (lm_shadow_technique)t;
   }
   const char *what = "shadow_plan";
@@ -199,6 +200,8 @@ static int l_shadow_plan(lua_State *L) {
   st.distance = opt_number(L, 1, "distance", st.distance, 0, 1e9f, what);
   st.blend = opt_number(L, 1, "blend", st.blend, 0, 1, what);
   st.radius = opt_number(L, 1, "radius", st.radius, 0, 32, what);
+  st.size = opt_number(L, 1, "size", st.size, -1, 1e30f, what);
+  st.penumbra = opt_number(L, 1, "penumbra", st.penumbra, 1, 64, what);
   lua_getfield(L, 1, "stabilize");
   if (!lua_isnil(L, -1)) st.stabilize = lua_toboolean(L, -1);
   lua_pop(L, 1);
@@ -235,7 +238,7 @@ static int l_plan_index(lua_State *L) {
   else if (!strcmp(k, "views")) lua_pushinteger(L, plan->view_count);
   else if (!strcmp(k, "c")) lua_pushnumber(L, plan->settings.c);
   else if (!strcmp(k, "blur")) lua_pushinteger(L, plan->settings.blur);
-  else if (!strcmp(k, "technique")) lua_pushstring(L, (const char *[]){"esm", "pcf", "poisson", "hard"}[plan->settings.technique]);
+  else if (!strcmp(k, "technique")) lua_pushstring(L, (const char *[]){"esm", "pcf", "poisson", "hard", "pcss"}[plan->settings.technique]);
   else return luaL_error(L, "shadow plan has no field '%s' (width, height, tile, views, c, blur, technique)", k);
   return 1;
 }
