@@ -3,6 +3,7 @@
 #ifndef LIMN_GBUFFER_GLSL
 #define LIMN_GBUFFER_GLSL
 #include "lighting.glsl"
+#include "sky.glsl"
 
 struct Surface {
   vec3 albedo;     // clr.rgb
@@ -40,9 +41,10 @@ Surface gbuffer_fetch(sampler2D clr, sampler2D nrm, sampler2D dpt, sampler2D mat
                         texelFetch(mat, q, 0), uv);
 }
 
-// Direct light leaving a covered surface toward the eye (Phong, lighting.glsl).
+// Direct light leaving a covered surface toward the eye (Phong, lighting.glsl),
+// with the sky in the ambient term where SKY is defined.
 vec3 direct_light(Surface s, vec3 ambient) {
   vec3 v = safe_normalize(frame.camera_pos.xyz - s.p, s.n);
-  return phong(s.albedo, s.k, s.shininess, s.n, v, s.p, ambient);
+  return phong(s.albedo, s.k, s.shininess, s.n, v, s.p, sky_ambient(ambient, s.n));
 }
 #endif

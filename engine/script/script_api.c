@@ -243,6 +243,60 @@ static int l_plan_index(lua_State *L) {
   return 1;
 }
 
+/* ---- sky_sh{} ---------------------------------------------------------- */
+static void opt_colour(lua_State *L, int idx, const char *field, float out[3]) {
+  lua_getfield(L, idx, field);
+  if (!lua_istable(L, -1) || lua_rawlen(L, -1) != 3)
+    luaL_error(L, "sky_sh: %s must be a list of 3 numbers (r, g, b)", field);
+  for (int i = 0; i < 3; i++) {
+    lua_rawgeti(L, -1, i + 1);
+    double d = lua_tonumber(L, -1);
+    if (!lua_isnumber(L, -1) || !(d >= 0 && d <= 1e6))
+      luaL_error(L, "sky_sh: %s[%d] must be a number in 0 .. 1e6", field, i + 1);
+    out[i] = (float)d;
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+}
+
+/* sky_sh{ zenith = {r, g, b}, horizon = {r, g, b}, intensity = x, map = path }:
+ * the sky's LM_SKY_SH coefficients (scene/sky.h) as three lists of 9, for r,
+ * g and b: the gradient's, or with `map` an equirectangular HDR file's (read
+ * once and kept while the path stays the same). */
+static int l_sky_sh(lua_State *L) {
+  lm_pipeline *p = lm_script_pipeline(L);
+  luaL_checktype(L, 1, LUA_TTABLE);
+  static const char *const fields[] = {"zenith", "horizon", "intensity", "map", NULL};
+  check_fields(L, 1, "sky_sh", fields);
+  lm_sky sky = {.intensity = opt_number(L, 1, "intensity", 1.0f, 0.0f, 1e6f, "sky_sh")};
+  const char *map = opt_string(L, 1, "map", "sky_sh");
+  float sh[LM_SKY_SH];
+  if (map && *map) {
+    if (strcmp(map, p->sky_map) != 0) {
+      lm_error err;
+      p->sky_map[0] = '\0';
+      if (strlen(map) >= sizeof p->sky_map) return luaL_error(L, "sky_sh: map path is too long");
+      if (!lm_sky_sh_map(map, 1.0f, p->sky_map_sh, &err)) return luaL_error(L, "sky_sh: %s", err.msg);
+      snprintf(p->sky_map, sizeof p->sky_map, "%s", map);
+    }
+    for (int i = 0; i < LM_SKY_SH; i++) sh[i] = sky.intensity * p->sky_map_sh[i];
+  } else {
+    opt_colour(L, 1, "zenith", sky.zenith);
+    opt_colour(L, 1, "horizon", sky.horizon);
+    lm_sky_sh_gradient(&sky, sh);
+  }
+  lua_createtable(L, 3, 0);
+  for (int k = 0; k < 3; k++) {
+    lua_createtable(L, 9, 0);
+    for (int i = 0; i < 9; i++) {
+      lua_pushnumber(L, sh[k * 9 + i]);
+      lua_rawseti(L, -2, i + 1);
+    }
+    lua_rawseti(L, -2, k + 1);
+  }
+  return 1;
+}
+
 /* ---- shared pass fields ----------------------------------------------- */
 typedef struct pass_builder {
   lm_pass_desc desc;
@@ -572,7 +626,8 @@ void lm_script_open_api(lua_State *L) {
   lua_pop(L, 1);
   static const luaL_Reg api[] = {{"target", l_target}, {"scene", l_scene}, {"pass", l_pass},
                                  {"present", l_present}, {"output_size", l_output_size},
-                                 {"shadow_plan", l_shadow_plan}, {NULL, NULL}};
+                                 {"shadow_plan", l_shadow_plan}, {"sky_sh", l_sky_sh},
+                                 {NULL, NULL}};
   lua_pushglobaltable(L);
   luaL_setfuncs(L, api, 0);
   lua_pop(L, 1);
