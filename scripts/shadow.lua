@@ -25,7 +25,7 @@ shadow.defaults = {
   radius = 2.5,       -- Poisson disc radius in texels
   stabilize = true,   -- bounding spheres and texel snapping (seed 003)
   size = -1,          -- PCSS: every light's size (its diameter in the scene's unit; for the sun its
-                      -- angular diameter, radians); -1: each light's own (glTF extras.size, else
+                      -- angular diameter, radians); <= 0: each light's own (glTF extras.size, else
                       -- 0.0093 rad for directional lights, 1% of the shadow map's range for others)
   penumbra = 16,      -- PCSS: the widest penumbra radius (and blocker search), texels, 1..64
   debug = false,      -- present the shadow atlas instead of the image

@@ -257,7 +257,7 @@ static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
   out->params[2] = plan->settings.blend;
   out->params[3] = plan->settings.radius;
   out->soft[1] = plan->settings.penumbra;
-  float size = plan->settings.size >= 0 ? plan->settings.size : l->size;
+  float size = plan->settings.size > 0 ? plan->settings.size : l->size;
   if (!l->casts_shadows) return;
   if (l->type == LM_LIGHT_DIRECTIONAL) {
     out->soft[0] = size > 0 ? size : LM_LIGHT_SUN_SIZE;

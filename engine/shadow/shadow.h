@@ -32,7 +32,7 @@ typedef struct lm_shadow_settings {
   float blend;     /* share of a cascade blended into the next one */
   float radius;    /* Poisson disc radius in texels */
   bool stabilize;  /* bounding spheres and texel snapping (seed 003) */
-  float size;      /* PCSS: every light's size (see lm_light.size); < 0: each light's own */
+  float size;      /* PCSS: every light's size (see lm_light.size); <= 0: each light's own */
   float penumbra;  /* PCSS: the widest penumbra radius and blocker search, texels */
 } lm_shadow_settings;
 void lm_shadow_settings_default(lm_shadow_settings *s);
