@@ -62,7 +62,7 @@ function OnRender(tech)
   end
   local lighting = tech.name:match("^[^+]*")
   if tech.name:find("+esm", 1, true) and lighting == "ssdo" and tech.ssdo.variant == "two_step" then
-    error('ssdo+esm needs ssdo.variant = "merged" (the two-step variant relights without shadows)')
+    error('ssdo+esm cannot take ssdo.variant = "two_step" (it relights without shadows)')
   end
   local G = gbuffer.render(gbuffer.targets())
   -- Shadows after the G-buffer: their cascades fit the depths it sees.

@@ -66,7 +66,8 @@ bool gl_target_finite(gl_result *r, const char *name);
 
 /* The same scene in a unit `unit` times smaller: a root node scaled by unit
  * above everything (cameras under it scale near and far with it), and the
- * lights' ranges, which glTF keeps out of node scale, written in the new unit. */
+ * lights' ranges and inverse-square intensities, which glTF keeps out of node
+ * scale, written in the new unit. */
 void gl_rescale(lm_scene *s, float unit);
 
 /* The pixel of world point (x, y, z) for the camera of the built-in Cornell

@@ -5,6 +5,8 @@
 #   nothing; a changed scene renders a new reference;
 # - a failing POV-Ray run names the view, shows POV-Ray's error lines, exits
 #   1 and leaves no reference or temporary file;
+# - the reference set (data/jobs/reference.lua) has at least four scenes and
+#   twelve views, each exported to POV-Ray exactly;
 # - a two-setting sweep writes the CSV, the JSON, the SVG (it parses as XML)
 #   and the Markdown summary, with consistent numbers; it renders (once) the
 #   direct-only reference of the view, whose error against the baseline is
@@ -83,6 +85,21 @@ printf 'return { scenes = { { scene = "near.gltf", cameras = "ball.cams" } }, si
 grep -q "view 0 (near, camera 'front', 32x24): .*light 'sun': range 0.5: the KHR_lights_punctual window" log8 \
   || { cat log8; fail "the refusal does not name the view and the light"; }
 ls refs-near/near/*.exr 2>/dev/null && fail "a refused view was rendered"
+
+# The reference set (data/jobs/reference.lua): at least four scenes and twelve views, every one exported
+# strictly (a light or material POV-Ray cannot match would be refused); a stand-in POV-Ray writes the images.
+cat > povstub <<'STUB'
+#!/bin/sh
+for a; do case $a in +O*) : > "${a#+O}" ;; esac; done
+STUB
+chmod +x povstub
+"$limn" reference --job "$root/data/jobs/reference.lua" --refs refs-set --povray "$tmp/povstub" >log10 2>&1 \
+  || { cat log10; fail "the reference set does not export"; }
+grep -qi "warn" log10 && { cat log10; fail "the reference set's export warns"; }
+views=$(sed -n 's/.*: \([0-9]*\) rendered, 0 cached.*/\1/p' log10)
+scenes=$(ls refs-set | wc -l)
+echo "reference set: $views views of $scenes scenes"
+[ "${views:-0}" -ge 12 ] && [ "$scenes" -ge 4 ] || fail "the reference set has $views views of $scenes scenes"
 
 # 3. a two-setting sweep on the one view: the reference is cached
 "$limn" report --job job.lua "${fast[@]}" --out rep --frames 2 --warmup 1 --sweep "isr:isr.samples=8,16" \

@@ -1,3 +1,4 @@
+# shellcheck shell=bash
 # The techniques that the main job (tools/dev.sh run) and the fidelity
 # benchmark (tools/fidelity.sh) compare, named in this one place, and the
 # table both print. Sourced; LIMN names the limn binary. The default
@@ -5,6 +6,7 @@
 # Techniques, what `limn capture` renders without --tech, so a new default
 # needs no edit here.
 
+# shellcheck disable=SC2034 # used by the scripts that source this file
 LIMN_BASELINE=dl+esm  # direct light with shadows: the references have shadows
 
 # The default technique (the pipeline's first).
