@@ -21,6 +21,7 @@
 --   4. bilateral upsampling and the composite (isr_light.frag)
 local gbuffer = require "gbuffer"
 local options = require "options"
+local sky = require "sky"
 
 local isr = {}
 
@@ -137,10 +138,12 @@ function isr.render(G, direct, o, light)
   else
     params.k = o.k
   end
+  local defines = { SEED = seed ~= nil }
+  sky.bind(light.sky, params, defines)
   return pass{ "isr.light", shader = "isr_light.frag",
                inputs = { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat, direct = direct,
                           isr = E, coarse_dpt = C.dpt, coarse_mat = C.mat },
-               defines = { SEED = seed ~= nil }, params = params,
+               defines = defines, params = params,
                out = target{ "lit", format = "rgba16f" } }
 end
 

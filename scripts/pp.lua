@@ -3,6 +3,7 @@
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local shadow = require "shadow"
+local sky = require "sky"
 local ssdo = require "ssdo"
 local ssao = require "ssao"
 local post = require "post"
@@ -19,11 +20,13 @@ Options = {
   materials = "phong",     -- "phong" (the std technique) or "pbr" (glTF metallic-roughness, GGX)
   isr = {},                -- see isr.defaults in scripts/isr.lua
   shadow = {},             -- see shadow.defaults in scripts/shadow.lua
+  sky = {},                -- see sky.defaults in scripts/sky.lua (off by default)
   ssdo = {},               -- see ssdo.defaults in scripts/ssdo.lua
   ssao = {},               -- see ssao.defaults in scripts/ssao.lua
 }
 for k, v in pairs(isr.defaults) do Options.isr[k] = v end
 for k, v in pairs(shadow.defaults) do Options.shadow[k] = v end
+for k, v in pairs(sky.defaults) do Options.sky[k] = v end
 for k, v in pairs(ssdo.defaults) do Options.ssdo[k] = v end
 for k, v in pairs(ssao.defaults) do Options.ssao[k] = v end
 -- Post effects, each off by default (the seed viewer's F6 bloom, F7 dof, F8
@@ -38,11 +41,12 @@ local function grey(x) return { x, x, x } end
 -- the ambient term) or, for the GI techniques, the lights alone (ambient 0:
 -- the GI composite adds the ambient term, occluded, and the indirect light),
 -- which also serves as the GI senders' radiance.
-local function direct(G, tech, shadows, ambient, name)
+local function direct(G, tech, shadows, ambient, name, skylight)
   local inputs, defines = shadow.bind(shadows, gbuffer.inputs(G), {})
+  local params = sky.bind(skylight, { ambient = grey(ambient), background = grey(tech.background) }, defines)
   return pass{ "direct", shader = "direct.frag", inputs = inputs, defines = defines,
                fetches = not shadows and 4 or nil, -- the G-buffer; shadow lookups vary with the lights
-               params = { ambient = grey(ambient), background = grey(tech.background) },
+               params = params,
                out = target{ name, format = "rgba16f" } }
 end
 
@@ -68,11 +72,12 @@ function OnRender(tech)
   local shadows = tech.name:find("+esm", 1, true) and shadow.render(tech.shadow, G) or nil
   if shadows and tech.shadow.debug then return present(shadow.debug(shadows)) end
   local lit
+  local skylight = sky.light(tech.sky) -- nil when off: then nothing of it is recorded
   if lighting == "dl" then
-    lit = direct(G, tech, shadows, tech.ambient, "lit")
+    lit = direct(G, tech, shadows, tech.ambient, "lit", skylight)
   else
     local d = direct(G, tech, shadows, 0, "direct")
-    local light = { ambient = grey(tech.ambient), background = grey(tech.background) }
+    local light = { ambient = grey(tech.ambient), background = grey(tech.background), sky = skylight }
     if lighting == "isr" then
       lit = isr.render(G, d, tech.isr, light)
     elseif lighting == "ssdo" then

@@ -9,7 +9,8 @@ local shadow = {}
 
 -- The options a pipeline exposes (pp.lua's Options.shadow), with defaults.
 shadow.defaults = {
-  technique = "esm",  -- "esm" (seed 000 eq 30), "pcf" (3x3), "poisson" (16 taps), "hard"
+  technique = "esm",  -- "esm" (seed 000 eq 30), "pcf" (3x3), "poisson" (16 taps), "hard",
+                      -- "pcss" (soft shadows whose penumbra grows with the blocker's distance, seed 003)
   resolution = 512,   -- tile size in texels, 16..8192 (the seed: 512)
   c = 90,             -- ESM exponent on depth normalized to the light's range (the seed: 90)
   blur = 2,           -- ESM Gaussian radius in texels, 0..32
@@ -23,11 +24,15 @@ shadow.defaults = {
   blend = 0.1,        -- share of a cascade blended into the next one
   radius = 2.5,       -- Poisson disc radius in texels
   stabilize = true,   -- bounding spheres and texel snapping (seed 003)
+  size = -1,          -- PCSS: every light's size (its diameter in the scene's unit; for the sun its
+                      -- angular diameter, radians); <= 0: each light's own (glTF extras.size, else
+                      -- 0.0093 rad for directional lights, 1% of the shadow map's range for others)
+  penumbra = 16,      -- PCSS: the widest penumbra radius (and blocker search), texels, 1..64
   debug = false,      -- present the shadow atlas instead of the image
 }
 
 -- shadow_plan{} checks the rest (engine/script/script_api.c).
-local rules = { technique = options.one_of("esm", "pcf", "poisson", "hard") }
+local rules = { technique = options.one_of("esm", "pcf", "poisson", "hard", "pcss") }
 
 local BLOCK = 8
 

@@ -6,6 +6,7 @@
 -- direct light; `apply = "lit"` darkens everything, as seed 001 does.
 local filters = require "filters"
 local options = require "options"
+local sky = require "sky"
 
 local ssao = {}
 
@@ -46,8 +47,10 @@ function ssao.render(G, lit, o, light)
                               strength = o.strength, bias = o.bias, interleave = o.interleave, factor = f },
                    out = target{ "ssao.ao", format = "r16f", scale = 1 / f } }
   ao = filters.smooth(ao, G, o, "ssao", "r16f", f)
-  return pass{ "ssao.apply", shader = "gi_apply.frag", inputs = { lit = lit, clr = G.clr, mat = G.mat, a = ao },
-               params = { ambient = light.ambient }, defines = { AO = true, AO_LIT = o.apply == "lit" },
+  local inputs, params, defines = { lit = lit, clr = G.clr, mat = G.mat, a = ao }, { ambient = light.ambient },
+    { AO = true, AO_LIT = o.apply == "lit" }
+  sky.bind(light.sky, params, defines, inputs, G)
+  return pass{ "ssao.apply", shader = "gi_apply.frag", inputs = inputs, params = params, defines = defines,
                out = target{ "ssao.lit", format = "rgba16f" } }
 end
 

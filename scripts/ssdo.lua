@@ -22,6 +22,7 @@
 local gbuffer = require "gbuffer"
 local filters = require "filters"
 local options = require "options"
+local sky = require "sky"
 
 local ssdo = {}
 
@@ -81,19 +82,20 @@ function ssdo.render(G, lit, o, light)
     pass{ physical and "ssdo.physical" or "ssdo.merged", shader = "ssdo.frag", inputs = inputs(lit), params = params,
           defines = { MERGED = merged, PHYSICAL = physical, ADAPTIVE = o.adaptive }, out = { a, b } }
   else
-    params.ambient = light.ambient
-    a = pass{ "ssdo.direct", shader = "ssdo.frag", inputs = inputs(nil), params = params,
-              defines = { DIRECT = true, ADAPTIVE = o.adaptive },
+    local defines = { DIRECT = true, ADAPTIVE = o.adaptive }
+    local direct_params = sky.bind(light.sky, { ambient = light.ambient }, defines)
+    for k, v in pairs(params) do direct_params[k] = v end
+    a = pass{ "ssdo.direct", shader = "ssdo.frag", inputs = inputs(nil), params = direct_params, defines = defines,
               out = target{ "ssdo.direct", format = "rgba16f" } }
-    params.ambient = nil
     b = pass{ "ssdo.indirect", shader = "ssdo.frag", inputs = inputs(a), params = params,
               defines = { BOUNCE = true, ADAPTIVE = o.adaptive },
               out = target{ "ssdo.indirect", format = "rgba16f" } }
   end
   a, b = filters.smooth({ a, b }, G, o, "ssdo", "rgba16f", f)
-  return pass{ "ssdo.apply", shader = "gi_apply.frag", inputs = { lit = lit, clr = G.clr, mat = G.mat, a = a, b = b },
-               params = { ambient = light.ambient },
-               defines = { PHYSICAL = physical, MERGED = merged, TWO_STEP = o.variant == "two_step" },
+  local inputs_, params_, defines = { lit = lit, clr = G.clr, mat = G.mat, a = a, b = b }, { ambient = light.ambient },
+    { PHYSICAL = physical, MERGED = merged, TWO_STEP = o.variant == "two_step" }
+  sky.bind(light.sky, params_, defines, inputs_, G)
+  return pass{ "ssdo.apply", shader = "gi_apply.frag", inputs = inputs_, params = params_, defines = defines,
                out = target{ "ssdo.lit", format = "rgba16f" } }
 end
 

@@ -3,6 +3,7 @@
 #ifndef LIMN_GBUFFER_GLSL
 #define LIMN_GBUFFER_GLSL
 #include "lighting.glsl"
+#include "sky.glsl"
 
 // The pbr technique (pbr.frag) writes this in mat.a: covered (>= 0.5) and
 // told apart from std's 1.
@@ -60,10 +61,12 @@ Surface gbuffer_fetch(sampler2D clr, sampler2D nrm, sampler2D dpt, sampler2D mat
 }
 
 // Direct light leaving a covered surface toward the eye (lighting.glsl: Phong,
-// or GGX for the pbr technique's surfaces).
+// or GGX for the pbr technique's surfaces), with the sky in the ambient term
+// where SKY is defined.
 vec3 direct_light(Surface s, vec3 ambient) {
   vec3 v = safe_normalize(frame.camera_pos.xyz - s.p, s.n);
-  if (s.pbr) return pbr_light(s.k.y * s.albedo, s.f0, s.roughness, s.k.x, s.n, v, s.p, ambient);
-  return phong(s.albedo, s.k, s.shininess, s.n, v, s.p, ambient);
+  vec3 a = sky_ambient(ambient, s.n);
+  if (s.pbr) return pbr_light(s.k.y * s.albedo, s.f0, s.roughness, s.k.x, s.n, v, s.p, a);
+  return phong(s.albedo, s.k, s.shininess, s.n, v, s.p, a);
 }
 #endif

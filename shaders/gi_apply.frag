@@ -9,10 +9,14 @@
 //  AO        out = lit + A sky         SSAO's accessibility (a.r) on the sky alone;
 //            with AO_LIT out = A (lit + sky), seed 001's darkening of everything
 #include "common.glsl"
+#include "sky.glsl"
 
 in vec2 uv;
 uniform sampler2D lit, clr, mat;
 uniform sampler2D a;
+#ifdef SKY
+uniform sampler2D nrm;
+#endif
 #ifndef AO
 uniform sampler2D b;
 #endif
@@ -28,7 +32,12 @@ void main() {
     result = vec4(l, 1.0);
     return;
   }
-  vec3 sky = m.x * ambient * texelFetch(clr, p, 0).rgb;
+#ifdef SKY
+  vec3 n = safe_normalize(texelFetch(nrm, p, 0).xyz, vec3(0.0, 1.0, 0.0));
+#else
+  vec3 n = vec3(0.0, 1.0, 0.0);
+#endif
+  vec3 sky = m.x * sky_ambient(ambient, n) * texelFetch(clr, p, 0).rgb;
   vec4 x = texelFetch(a, p, 0);
 #if defined(PHYSICAL)
   vec3 c = l + saturate(x.r) * sky + texelFetch(b, p, 0).rgb;

@@ -63,7 +63,7 @@ void main() {
     return;
   }
   vec4 e = upsample(s.depth01);
-  vec3 d = texelFetch(direct, ivec2(gl_FragCoord.xy), 0).rgb, sky = s.k.x * ambient * s.albedo;
+  vec3 d = texelFetch(direct, ivec2(gl_FragCoord.xy), 0).rgb, sky = s.k.x * sky_ambient(ambient, s.n) * s.albedo;
 #ifdef SEED
   vec3 indirect = s.rho * e.rgb;
   vec3 l = (d + sky) * saturate(e.a + 1.0 - k_ssao) + k_isr * indirect;

@@ -1,6 +1,6 @@
 // The shadow factor of a light at a world position: the one place lighting
 // shaders read shadows (ESM, PCF, Poisson or hard compares, cascades for
-// directional lights, cube faces for point lights). Needs `#define SHADOWS`
+// directional lights, cube faces for point lights; PCSS). Needs `#define SHADOWS`
 // and a pass input `shadow_atlas` (what scripts/shadow.lua returns).
 #ifndef LIMN_SHADOW_GLSL
 #define LIMN_SHADOW_GLSL
@@ -11,6 +11,7 @@ struct ShadowLight {
   vec4 splits; // cascades: camera depth where each ends
   vec4 params; // c, bias (texels), blend, Poisson radius
   ivec4 cube;  // point lights: x = the cube faces drawn (bit f: face f), their views in face order
+  vec4 soft;   // PCSS: light size (radians for cascades, world units else), widest penumbra (texels)
 };
 struct ShadowView {
   mat4 view_proj;
@@ -30,6 +31,50 @@ const vec2 POISSON[16] = vec2[](
   vec2(-0.242, 0.997), vec2(-0.814, 0.914), vec2(0.200, 0.786), vec2(0.144, -0.141));
 
 float shadow_texel(ivec2 t, ivec2 lo, ivec2 hi) { return texelFetch(shadow_atlas, clamp(t, lo, hi), 0).r; }
+
+// PCSS penumbra width in texels for a blocker at normalized depth zb over a
+// receiver at r (similar triangles, as ratios: no world unit). Orthographic:
+// the world depth between them times the light's angular size, over the
+// texel's world size. Perspective: the light's size times (d - db) / (d db),
+// an angle, over the texel's angle (its size per unit of distance).
+float pcss_penumbra(ShadowView sv, float size, float r, float zb) {
+  if (sv.depth.w > 0.0) {
+    float d = r / sv.depth.w, db = max(zb, 1e-6) / sv.depth.w;
+    return size * max(d - db, 0.0) / max(d * db * sv.texel.x, 1e-30);
+  }
+  return max(r - zb, 0.0) * sv.texel.y * 2.0 * tan(0.5 * min(size, 3.0)) / max(sv.texel.x, 1e-30);
+}
+
+// PCSS (seed 003, section 4.4): the mean depth of the blockers within the
+// widest penumbra a blocker could cast, the penumbra that depth gives, then
+// that many texels of Poisson taps, each a bilinear compare. Taps are at
+// fixed offsets from the point's own texel position, so the result follows
+// the stabilized map (whole-texel moves only). The bias grows with each
+// tap's distance along a tilted receiver.
+float pcss_lookup(ShadowLight s, ShadowView sv, vec2 texel, float r, float bias, float tan_tilt, ivec2 lo,
+                  ivec2 hi) {
+  float size = s.soft.x, widest = s.soft.y;
+  float search = clamp(0.5 * pcss_penumbra(sv, size, r, sv.depth.w > 0.0 ? 0.1 * r : 0.0), 1.0, widest);
+  float sum = 0.0, n = 0.0;
+  for (int i = 0; i < 16; i++) {
+    vec2 o = POISSON[i] * search;
+    float z = shadow_texel(ivec2(floor(texel + 0.5 + o)), lo, hi);
+    if (r - bias * (1.0 + length(o) * tan_tilt) > z) { sum += z; n += 1.0; }
+  }
+  if (n == 0.0) return 1.0;
+  float radius = clamp(0.5 * pcss_penumbra(sv, size, r, sum / n), 1.0, widest);
+  float lit = 0.0;
+  for (int i = 0; i < 16; i++) {
+    vec2 o = POISSON[i] * radius, t = texel + o;
+    ivec2 b = ivec2(floor(t));
+    vec2 f = t - vec2(b);
+    float rb = r - bias * (1.0 + (length(o) + 1.0) * tan_tilt);
+    vec4 v = step(vec4(rb), vec4(shadow_texel(b, lo, hi), shadow_texel(b + ivec2(1, 0), lo, hi),
+                                 shadow_texel(b + ivec2(0, 1), lo, hi), shadow_texel(b + ivec2(1, 1), lo, hi)));
+    lit += mix(mix(v.x, v.y, f.x), mix(v.z, v.w, f.x), f.y);
+  }
+  return lit / 16.0;
+}
 
 // Visibility in [0, 1] of p from view v.
 float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
@@ -55,6 +100,7 @@ float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
   // scale the bias by the tilt (tan of the light's angle, capped).
   float spread = technique == 1 ? 1.5 : technique == 2 ? s.params.w : 0.0;
   float c = saturate(ndl), tan_tilt = min(sqrt(max(1.0 - c * c, 0.0)) / max(c, 0.1), 10.0);
+  if (technique == 4) return pcss_lookup(s, sv, texel, r, bias, tan_tilt, lo, hi);
   bias *= 1.0 + spread * tan_tilt;
   if (technique == 0) {
     // ESM with the seed's 4-tap bilinear combination (seed 000, Listing 8):

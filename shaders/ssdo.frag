@@ -199,7 +199,7 @@ void main() {
   vec3 v = safe_normalize(frame.camera_pos.xyz - s.p, s.n);
   vec3 diffuse = phong(s.albedo, vec3(0.0, s.k.y, 0.0), s.shininess, s.n, v, s.p, vec3(0.0));
   vec3 specular = phong(s.albedo, vec3(0.0, 0.0, s.k.z), s.shininess, s.n, v, s.p, vec3(0.0));
-  out0 = vec4(s.k.x * ambient * s.albedo * access + specular + diffuse * m, 1.0);
+  out0 = vec4(s.k.x * sky_ambient(ambient, s.n) * s.albedo * access + specular + diffuse * m, 1.0);
 #else
   out0 = vec4(rho / PI * gathered, 0.0);
 #endif

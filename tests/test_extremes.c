@@ -161,6 +161,38 @@ static void degenerate_and_nan_geometry(void **state) {
   }
 }
 
+/* PCSS with light sizes 0 and 1e30 (the sun's capped at 3 rad), penumbrae of
+ * 1 and 64 texels, near 1e-4 and far 1e6, on the box (point light) and the
+ * field (sun): finite, and shadows darken without ever brightening (a
+ * 3 rad sun spreads every penumbra over 64 texels: 1.2% darker). */
+static void pcss_sizes_and_depth_ranges_at_both_ends(void **state) {
+  (void)state;
+  static const char *const sizes[][4] = {
+      {"shadow.technique=pcss", "shadow.size=0", "shadow.penumbra=1", NULL},
+      {"shadow.technique=pcss", "shadow.size=1e30", "shadow.penumbra=64", NULL},
+      {"shadow.technique=pcss", "shadow.size=1e-30", "shadow.penumbra=64", NULL},
+      {"shadow.technique=pcss", NULL}};
+  const char *const scenes[] = {"cornell", "field"};
+  for (int k = 0; k < 2; k++) {
+    lm_scene *s = builtin(scenes[k]);
+    for (int range = 0; range < 2; range++) {
+      if (range) s->cameras[0].znear = 1e-4f, s->cameras[0].zfar = 1e6f;
+      gl_result plain = render_ok(s, "dl", NULL, 64, 48);
+      for (size_t i = 0; i < sizeof sizes / sizeof *sizes; i++) {
+        gl_result r = render_ok(s, "dl+esm", sizes[i], 64, 48);
+        float lit = mean_luminance(&r), all = mean_luminance(&plain);
+        printf("pcss %s %s near %g: %s: mean luminance %.4f (no shadows %.4f)\n", scenes[k], sizes[i][1] ? sizes[i][1] : "",
+               (double)s->cameras[0].znear, sizes[i][2] ? sizes[i][2] : "", lit, all);
+        if (!(lit <= all * 1.001f && lit < 0.995f * all))
+          fail_msg("%s %s: %g against %g", scenes[k], sizes[i][1] ? sizes[i][1] : "defaults", lit, all);
+        gl_result_free(&r);
+      }
+      gl_result_free(&plain);
+    }
+    lm_scene_destroy(s);
+  }
+}
+
 /* A target larger than the GL limit is refused, naming it and its size. */
 static void oversize_targets_are_refused(void **state) {
   (void)state;
@@ -214,6 +246,7 @@ int main(void) {
       cmocka_unit_test(outputs_of_1x1_and_8192x8192),
       cmocka_unit_test(zero_lights_and_64_lights),
       cmocka_unit_test(degenerate_and_nan_geometry),
+      cmocka_unit_test(pcss_sizes_and_depth_ranges_at_both_ends),
       cmocka_unit_test(oversize_targets_are_refused),
       cmocka_unit_test(every_effect_on_every_test_scene),
   };

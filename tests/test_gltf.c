@@ -561,7 +561,7 @@ static const char lights_json[] =
     "{\"name\":\"spot\",\"type\":\"spot\",\"color\":[1,0.5,0.25],\"intensity\":5,\"range\":10,"
     "\"spot\":{\"innerConeAngle\":0.2,\"outerConeAngle\":0.6}},"
     "{\"name\":\"bulb\",\"type\":\"point\",\"intensity\":2},"
-    "{\"name\":\"sun\",\"type\":\"directional\"}]}},"
+    "{\"name\":\"sun\",\"type\":\"directional\",\"extras\":{\"size\":0.02}}]}},"
     "\"scenes\":[{\"nodes\":[0,1,2,3,4,5]}],"
     "\"nodes\":[{\"name\":\"tri\",\"mesh\":0},"
     "{\"name\":\"spot_node\",\"translation\":[0,4,0],"
@@ -601,6 +601,8 @@ static void assert_lights_and_cameras(const lm_scene *s) {
   assert_float_equal(lm_light_reach(spot), 10, 0);
   assert_int_equal(sun->type, LM_LIGHT_DIRECTIONAL);
   assert_float_equal(sun->power / LM_GLTF_EXPOSURE, 1, 1e-4);
+  assert_float_equal(sun->size, 0.02, 1e-7); /* extras.size: PCSS's angular diameter */
+  assert_float_equal(spot->size, 0, 0);       /* none given: the default */
   assert_int_equal(s->camera_count, 2);
   assert_string_equal(s->cameras[0].name, "main");
   assert_float_equal(s->cameras[0].fov_y, 0.7, 1e-6);
@@ -768,6 +770,10 @@ static void malformed_files_name_the_element(void **state) {
          "\"mesh\":0,\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
          "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"spot\",\"spot\":{\"innerConeAngle\":0.9,\"outerConeAngle\":0.5}}]}},\"extras\":[0",
          "light 0: spot cone angles");
+  EXPECT("bad_size.gltf", "\"mesh\":0}",
+         "\"mesh\":0,\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
+         "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"point\",\"extras\":{\"size\":-1}}]}},\"extras\":[0",
+         "light 0: extras.size must be a finite number >= 0");
   EXPECT("color.gltf", "[0.5,0.25,1,1]", "[0.5,0.25]", "baseColorFactor");
   EXPECT("metal.gltf", "\"metallicFactor\":0", "\"metallicFactor\":1e999", "");
 }

@@ -7,9 +7,12 @@
 #include <cmocka.h>
 #include <cglm/cglm.h>
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
+#include "image/image.h"
 #include "scene/scene.h"
+#include "scene/sky.h"
 
 /* Projects p with the frame's matrices, rebuilds it from uv and linear
  * depth / far the way shaders do, and returns the distance between the two. */
@@ -134,9 +137,73 @@ static void lights_take_position_and_direction_from_nodes(void **state) {
   lm_scene_destroy(s);
 }
 
+/* E(n) / pi from the sky's coefficients, as shaders/sky.glsl sums them. */
+static void sky_at(const float sh[LM_SKY_SH], float x, float y, float z, float out[3]) {
+  const float b[9] = {0.282094792f, 0.488602512f * y, 0.488602512f * z, 0.488602512f * x, 1.092548431f * x * y,
+                      1.092548431f * y * z, 0.315391565f * (3 * z * z - 1), 1.092548431f * x * z,
+                      0.546274215f * (x * x - y * y)};
+  for (int k = 0; k < 3; k++) {
+    out[k] = 0;
+    for (int i = 0; i < 9; i++) out[k] += sh[k * 9 + i] * b[i];
+  }
+}
+
+/* A uniform sky of radiance L gives every normal L (gi-scale.md: a plane of
+ * albedo a under it sends a L); a sky bright at the zenith alone (L = y)
+ * gives an upward normal 2/3, a sideways one 2 / (3 pi) and a downward one nothing, to the 3 bands'
+ * accuracy; an equirectangular map of the same gradient gives the same
+ * coefficients; a missing map or one holding NaN is refused by name. */
+static void sky_harmonics_match_the_sky(void **state) {
+  (void)state;
+  float sh[LM_SKY_SH], e[3];
+  lm_sky uniform = {{0.5f, 1.0f, 2.0f}, {0.5f, 1.0f, 2.0f}, 2.0f};
+  lm_sky_sh_gradient(&uniform, sh);
+  static const float normals[][3] = {{0, 1, 0}, {0, -1, 0}, {1, 0, 0}, {0, 0, -1}, {0.6f, 0.0f, 0.8f}};
+  for (int i = 0; i < 5; i++) {
+    sky_at(sh, normals[i][0], normals[i][1], normals[i][2], e);
+    for (int k = 0; k < 3; k++) assert_float_equal(e[k], 2.0f * uniform.zenith[k], 2e-3f * uniform.zenith[k]);
+  }
+  lm_sky zenith = {{1, 1, 1}, {0, 0, 0}, 1.0f};
+  lm_sky_sh_gradient(&zenith, sh);
+  float up[3], down[3], side[3];
+  sky_at(sh, 0, 1, 0, up);
+  sky_at(sh, 0, -1, 0, down);
+  sky_at(sh, 1, 0, 0, side);
+  printf("zenith-only sky: up %.4f (exact 2/3), side %.4f (exact 2/(3 pi)), down %.4f (exact 0)\n", up[0], side[0], down[0]);
+  assert_float_equal(up[0], 2.0f / 3.0f, 0.03f);
+  assert_float_equal(side[0], 2.0f / (3.0f * GLM_PIf), 0.03f);
+  assert_true(fabsf(down[0]) < 0.04f);
+  /* The same gradient as a 128 x 64 map (rows from the zenith), with a blue tint. */
+  enum { W = 128, H = 64 };
+  static float texels[W * H * 3];
+  for (int r = 0; r < H; r++)
+    for (int c = 0; c < W; c++) {
+      float y = cosf(GLM_PIf * ((float)r + 0.5f) / H), v = y > 0 ? y : 0;
+      float *t = texels + ((size_t)r * W + (size_t)c) * 3;
+      t[0] = t[1] = v, t[2] = 2 * v;
+    }
+  const char *path = "/tmp/limn-test-sky.exr";
+  lm_error err;
+  assert_true(lm_image_write(path, W, H, 3, true, texels, &err));
+  float map[LM_SKY_SH];
+  assert_true(lm_sky_sh_map(path, 1.0f, map, &err));
+  for (int i = 0; i < 9; i++) {
+    assert_float_equal(map[i], sh[i], 2e-3f);
+    assert_float_equal(map[18 + i], 2 * sh[i], 4e-3f);
+  }
+  texels[5] = NAN;
+  assert_true(lm_image_write(path, W, H, 3, true, texels, &err));
+  assert_false(lm_sky_sh_map(path, 1.0f, map, &err));
+  assert_non_null(strstr(err.msg, path));
+  remove(path);
+  assert_false(lm_sky_sh_map("/tmp/limn-no-such-sky.exr", 1.0f, map, &err));
+  assert_non_null(strstr(err.msg, "limn-no-such-sky.exr"));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(positions_rebuild_from_linear_depth),
+      cmocka_unit_test(sky_harmonics_match_the_sky),
       cmocka_unit_test(extreme_cameras_stay_finite),
       cmocka_unit_test(children_follow_their_parents),
       cmocka_unit_test(nodes_move_to_a_world_transform),

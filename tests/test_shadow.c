@@ -113,7 +113,8 @@ static void occluded_points_are_dark_for_every_filter(void **state) {
   gl_result plain = render_ok(s, "dl", NULL);
   check_cornell(s, &plain, NULL, 0.1f);
   static const char *const filters[][2] = {{"shadow.technique=pcf", NULL}, {"shadow.technique=poisson", NULL},
-                                           {"shadow.technique=hard", NULL}, {"shadow.blur=0", NULL}};
+                                           {"shadow.technique=hard", NULL}, {"shadow.blur=0", NULL},
+                                           {"shadow.technique=pcss", NULL}};
   for (size_t i = 0; i < sizeof filters / sizeof *filters; i++) check_cornell(s, &plain, filters[i], 0.1f);
   gl_result_free(&plain);
   /* The same light as a spot shining down: one perspective tile. */
@@ -146,9 +147,10 @@ static void occluded_points_stay_dark_at_any_scale_and_depth_range(void **state)
         s->cameras[0].zfar = 1e6f;
       }
       gl_result plain = render_ok(s, "dl", NULL);
-      static const char *const pcf[] = {"shadow.technique=pcf", NULL};
+      static const char *const pcf[] = {"shadow.technique=pcf", NULL}, *const pcss[] = {"shadow.technique=pcss", NULL};
       check_cornell(s, &plain, NULL, 0.1f);
       check_cornell(s, &plain, pcf, 0.1f);
+      check_cornell(s, &plain, pcss, 0.1f);
       gl_result_free(&plain);
       lm_scene_destroy(s);
     }
@@ -255,8 +257,8 @@ static double tile_change(const float *a, const float *b, int width, int height,
   return best;
 }
 
-static double shimmer(lm_scene *s, const char *stabilize, bool rotate) {
-  const char *sets[] = {stabilize, "shadow.resolution=256", NULL};
+static double shimmer(lm_scene *s, const char *stabilize, bool rotate, const char *technique) {
+  const char *sets[] = {stabilize, "shadow.resolution=256", technique, NULL};
   float *cam = s->nodes[s->cameras[0].node].local;
   float saved[16];
   memcpy(saved, cam, sizeof saved);
@@ -294,15 +296,93 @@ static void stabilized_cascades_do_not_shimmer(void **state) {
     lm_scene *s = builtin("field");
     if (units[u] != 1.0f) gl_rescale(s, units[u]);
     for (int rotate = 0; rotate < 2; rotate++) {
-      double stable = shimmer(s, "shadow.stabilize=true", rotate);
-      double loose = shimmer(s, "shadow.stabilize=false", rotate);
+      double stable = shimmer(s, "shadow.stabilize=true", rotate, NULL);
+      double loose = shimmer(s, "shadow.stabilize=false", rotate, NULL);
       printf("scale %g: cascade 0 change after a sub-texel %s: stabilized %.3g, unstabilized %.3g\n", units[u],
              rotate ? "turn" : "move", stable, loose);
       if (!(stable < 1e-5 && loose > 10 * stable + 1e-5))
         fail_msg("scale %g: stabilized %g, unstabilized %g", units[u], stable, loose);
     }
+    /* PCSS reads the same unblurred map at fixed texel offsets from each
+     * point: a map that keeps still keeps its penumbrae still. */
+    double pcss = shimmer(s, "shadow.stabilize=true", false, "shadow.technique=pcss");
+    printf("scale %g: pcss cascade 0 change after a sub-texel move: %.3g\n", units[u], pcss);
+    if (!(pcss < 1e-5)) fail_msg("scale %g: pcss %g", units[u], pcss);
     lm_scene_destroy(s);
   }
+}
+
+/* ---- PCSS ------------------------------------------------------------- */
+/* Normalized visibility along world points c + across * t, t = 0 .. 1.2 in
+ * steps of 1/240: the shadowed over the unshadowed luminance, 0 inside the
+ * shadow's core, 1 lit. Returns the distance between the first points past
+ * 0.2 and past 0.8: the penumbra's width, in the scene's unit. */
+static float edge_width(const gl_result *plain, const gl_result *r, mat4 vp, const vec3 c, const vec3 across) {
+  enum { N = 289 };
+  float v[N];
+  for (int i = 0; i < N; i++) {
+    float t = (float)i / 240.0f;
+    vec4 p = {c[0] + across[0] * t, c[1] + across[1] * t, c[2] + across[2] * t, 1.0f}, q;
+    glm_mat4_mulv(vp, p, q);
+    int col = (int)((q[0] / q[3] * 0.5f + 0.5f) * (float)r->width);
+    int row = (int)((0.5f - q[1] / q[3] * 0.5f) * (float)r->height);
+    assert_true(col >= 0 && col < r->width && row >= 0 && row < r->height);
+    size_t k = ((size_t)row * (size_t)r->width + (size_t)col) * 3;
+    v[i] = gl_luminance(r->rgb + k) / fmaxf(gl_luminance(plain->rgb + k), 1e-6f);
+  }
+  float lo = v[0], hi = v[N - 1];
+  assert_true(hi > lo + 0.2f);
+  int a = -1, b = -1;
+  for (int i = 0; i < N; i++) {
+    float x = (v[i] - lo) / (hi - lo);
+    if (a < 0 && x > 0.2f) a = i;
+    if (b < 0 && x > 0.8f) b = i;
+  }
+  assert_true(a >= 0 && b >= a);
+  return (float)(b - a) / 240.0f;
+}
+
+/* Looking straight down at the shadow of the field's first post in a sun of
+ * 0.1 rad, the edge across the shadow of a point 1.6 m up the post is wider
+ * than that of a point 0.4 m up, four times nearer the ground along the
+ * light; with hard shadows both are as narrow as a texel or pixel allows. */
+static void pcss_penumbra_widens_with_blocker_distance(void **state) {
+  (void)state;
+  lm_scene *s = builtin("field");
+  const float *sun = s->nodes[s->lights[0].node].world;
+  vec3 l = {-sun[8], -sun[9], -sun[10]}; /* the light travels along the node's -Z */
+  glm_vec3_normalize(l);
+  vec3 h = {l[0] / -l[1], 0.0f, l[2] / -l[1]}, across = {-h[2], 0.0f, h[0]};
+  glm_vec3_normalize(across);
+  const vec3 base = {0.0f, 0.0f, 2.0f}; /* post_0_2 stands here, 0.6 x 2 x 0.6 */
+  vec3 mid = {base[0] + h[0], 0.0f, base[2] + h[2]};
+  mat4 view, world, proj, vp;
+  glm_lookat((vec3){mid[0], 4.0f, mid[2]}, mid, (vec3){0, 0, -1}, view);
+  glm_mat4_inv(view, world);
+  lm_scene_node_set_world(s, s->cameras[0].node, (float *)world);
+  s->cameras[0].fov_y = glm_rad(45.0f);
+  glm_perspective(s->cameras[0].fov_y, 256.0f / 192.0f, s->cameras[0].znear, s->cameras[0].zfar, proj);
+  glm_mat4_mul(proj, view, vp);
+  static const char *const pcss[] = {"shadow.technique=pcss", "shadow.size=0.1", "shadow.penumbra=64", NULL};
+  static const char *const hard[] = {"shadow.technique=hard", NULL};
+  gl_result plain = render_ok(s, "dl", NULL), soft = render_ok(s, "dl+esm", pcss), sharp = render_ok(s, "dl+esm", hard);
+  float width[2][2];
+  for (int k = 0; k < 2; k++) {
+    float y = k ? 1.6f : 0.4f;
+    vec3 c = {base[0] + h[0] * y, 0.0f, base[2] + h[2] * y};
+    width[0][k] = edge_width(&plain, &soft, vp, c, across);
+    width[1][k] = edge_width(&plain, &sharp, vp, c, across);
+  }
+  printf("penumbra width (m) under a point 0.4 m / 1.6 m up: pcss %.3f / %.3f, hard %.3f / %.3f "
+         "(0.1 rad: full widths %.3f / %.3f)\n", width[0][0], width[0][1], width[1][0], width[1][1],
+         0.4f * 0.1f / -l[1], 1.6f * 0.1f / -l[1]);
+  if (!(width[0][1] > 2.5f * width[0][0] && width[0][0] > 0.0f && width[1][1] < 0.5f * width[0][1] &&
+        width[1][0] <= width[0][0] + 0.01f))
+    fail_msg("pcss %g / %g, hard %g / %g", width[0][0], width[0][1], width[1][0], width[1][1]);
+  gl_result_free(&sharp);
+  gl_result_free(&soft);
+  gl_result_free(&plain);
+  lm_scene_destroy(s);
 }
 
 /* Looking straight down at the short box and the floor under the ceiling
@@ -377,6 +457,7 @@ int main(void) {
       cmocka_unit_test(the_sun_casts_cascaded_shadows_at_any_depth_range),
       cmocka_unit_test(cascades_fit_the_depths_the_frame_sees),
       cmocka_unit_test(stabilized_cascades_do_not_shimmer),
+      cmocka_unit_test(pcss_penumbra_widens_with_blocker_distance),
       cmocka_unit_test(cube_faces_no_pixel_samples_are_not_drawn),
       cmocka_unit_test(nothing_casts_or_nothing_reads_means_no_shadow_pass),
       cmocka_unit_test(the_atlas_can_be_viewed),

@@ -38,6 +38,9 @@ static const char export_usage[] =
     "  --shadows on|off       lights cast shadows as the scene says (default on);\n"
     "                         off: no mesh casts shadows, as in the engine's direct\n"
     "                         light without shadow maps\n"
+    "  --sky Z:H[:I]          a sky of radiance I (h + (z - h) max(y, 0)) for\n"
+    "                         radiosity to gather, as the script's sky option\n"
+    "                         (colours r,g,b or one grey number; I default 1)\n"
     "  --approximate          write what cannot match in its nearest form, with a\n"
     "                         warning, instead of refusing\n"
     "  --materials phong|pbr  the finish of the std technique (phong, exact; the\n"
@@ -60,6 +63,37 @@ static int usage_error(const char *fmt, const char *arg) {
   return 2;
 }
 
+enum { SKY_FLAG = 0x100 }; /* beyond any one-letter flag */
+
+/* "r,g,b" or one grey number, each finite in 0 .. 1e6. */
+static bool parse_colour(const char *s, float out[3]) {
+  double v[3];
+  int n = 0;
+  char buf[256];
+  snprintf(buf, sizeof buf, "%s", s);
+  for (char *save = NULL, *t = strtok_r(buf, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+    if (n == 3 || !limn_parse_double(t, &v[n]) || !(v[n] >= 0 && v[n] <= 1e6)) return false;
+    n++;
+  }
+  if (n == 1) v[1] = v[2] = v[0];
+  else if (n != 3) return false;
+  for (int i = 0; i < 3; i++) out[i] = (float)v[i];
+  return true;
+}
+
+/* --sky ZENITH:HORIZON[:INTENSITY], as scripts/sky.lua's options. */
+static bool parse_sky(const char *s, lm_sky *sky) {
+  char buf[512];
+  snprintf(buf, sizeof buf, "%s", s);
+  char *save = NULL, *z = strtok_r(buf, ":", &save), *h = strtok_r(NULL, ":", &save);
+  char *i = strtok_r(NULL, ":", &save), *rest = strtok_r(NULL, ":", &save);
+  double intensity = 1.0;
+  if (!z || !h || rest || !parse_colour(z, sky->zenith) || !parse_colour(h, sky->horizon)) return false;
+  if (i && !(limn_parse_double(i, &intensity) && intensity >= 0 && intensity <= 1e6)) return false;
+  sky->intensity = (float)intensity;
+  return true;
+}
+
 /* The flags that set the export (also taken by `limn reference` and `limn report`). */
 const struct option limn_pov_options[] = {
     {"radiosity", required_argument, 0, 'r'},      {"count", required_argument, 0, 'n'},
@@ -67,7 +101,10 @@ const struct option limn_pov_options[] = {
     {"pretrace-end", required_argument, 0, 'E'},   {"recursion-limit", required_argument, 0, 'l'},
     {"brightness", required_argument, 0, 'b'},     {"shadows", required_argument, 0, 'w'},
     {"approximate", no_argument, 0, 'a'},          {"materials", required_argument, 0, 'M'},
+    {"sky", required_argument, 0, SKY_FLAG},
     {0, 0, 0, 0}};
+_Static_assert(sizeof limn_pov_options / sizeof *limn_pov_options == LIMN_POV_OPTION_COUNT,
+               "LIMN_POV_OPTION_COUNT (tools.h) counts limn_pov_options");
 
 void limn_pov_defaults(lm_pov_desc *d) {
   *d = (lm_pov_desc){.width = 256, .height = 192, .radiosity = true, .shadows = true, .strict = true};
@@ -105,6 +142,10 @@ int limn_pov_flag(const char *cmd, int c, const char *arg, lm_pov_desc *d) {
     if (!strcmp(arg, "pbr") || !strcmp(arg, "phong")) d->pbr_materials = !strcmp(arg, "pbr");
     else bad = "--materials wants phong or pbr, not '%s'";
     break;
+  case SKY_FLAG:
+    d->has_sky = parse_sky(arg, &d->sky);
+    if (!d->has_sky) bad = "--sky wants ZENITH:HORIZON[:INTENSITY], colours r,g,b or one grey number, not '%s'";
+    break;
   default: return 1;
   }
   if (!bad) return 0;
@@ -118,11 +159,11 @@ int limn_pov_flag(const char *cmd, int c, const char *arg, lm_pov_desc *d) {
 static int parse_args(int argc, char **argv, export_args *a) {
   *a = (export_args){.scene = "cornell"};
   limn_pov_defaults(&a->desc);
-  struct option opts[16] = {
+  struct option opts[5 + LIMN_POV_OPTION_COUNT] = {
       {"scene", required_argument, 0, 's'}, {"camera", required_argument, 0, 'c'},
       {"size", required_argument, 0, 'z'},  {"output", required_argument, 0, 'o'},
       {"help", no_argument, 0, 'h'}};
-  memcpy(opts + 5, limn_pov_options, sizeof limn_pov_options); /* 11 entries with the end */
+  memcpy(opts + 5, limn_pov_options, sizeof limn_pov_options); /* LIMN_POV_OPTION_COUNT entries with the end */
   opterr = 0;
   optind = 1;
   int c;

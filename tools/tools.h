@@ -42,12 +42,12 @@ void limn_json_string(const char *s);          /* a quoted, escaped JSON string 
 void limn_json_append(lm_buf *b, const char *s); /* the same, appended to b */
 
 /* export-pov's flags (tools/export_pov.c), shared by reference and report:
- * limn_pov_options ends with a zero entry (11 entries in all);
+ * limn_pov_options ends with a zero entry (12 entries in all);
  * limn_pov_flag returns 0 when it took getopt's c, 1 when c is not one of
  * them, 2 after printing a usage error for `limn CMD`. */
 struct lm_pov_desc;
 extern const struct option limn_pov_options[];
-#define LIMN_POV_OPTION_COUNT 11
+#define LIMN_POV_OPTION_COUNT 12
 void limn_pov_defaults(struct lm_pov_desc *d);
 int limn_pov_flag(const char *cmd, int c, const char *arg, struct lm_pov_desc *d);
 /* Writes the file under a temporary name and renames it: whole or not at all. */

@@ -595,6 +595,14 @@ bool add_light(Loader &L, int ni, int li, int node) {
   l.falloff = LM_FALLOFF_RANGE;
   l.inner_cone = l.type == LM_LIGHT_SPOT ? (float)inner : 0.0f;
   l.outer_cone = l.type == LM_LIGHT_SPOT ? (float)outer : (float)(M_PI / 2);
+  if (gl.extras.IsObject() && gl.extras.Has("size")) { // soft shadows: see lm_light.size
+    const tinygltf::Value &v = gl.extras.Get("size");
+    double size = v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
+    if (!(size >= 0 && size < 1e30))
+      return fail(L, "light %d: extras.size must be a finite number >= 0 (the light's diameter, radians "
+                     "for a directional light)", li);
+    l.size = (float)size;
+  }
   l.casts_shadows = true;
   l.node = node;
   lm_scene_add_light(L.s, &l);

@@ -112,6 +112,18 @@ static void write_header(pov_ctx *c, const lm_scene *s) {
                   r->brightness);
   }
   lm_buf_printf(b, "}\n\nbackground { rgb 0 }\n\n");
+  if (d->has_sky) {
+    const lm_sky *k = &d->sky;
+    float h[3], z[3];
+    for (int i = 0; i < 3; i++) h[i] = k->intensity * k->horizon[i], z[i] = k->intensity * k->zenith[i];
+    lm_buf_printf(b,
+                  "// The sky (scene/sky.h): radiance horizon + (zenith - horizon) * max(y, 0).\n"
+                  "sky_sphere {\n"
+                  "  pigment { function { max(y, 0) }\n"
+                  "    color_map { [0 rgb <%.9g, %.9g, %.9g>] [1 rgb <%.9g, %.9g, %.9g>] } }\n"
+                  "}\n\n",
+                  h[0], h[1], h[2], z[0], z[1], z[2]);
+  }
 }
 
 /* The engine's own rays (lm_scene_frame_data): POV-Ray's ray for image

@@ -7,6 +7,9 @@
  * - global_settings: assumed_gamma 1 (linear; render to OpenEXR with +FE),
  *   max_trace_level 5, and with radiosity on a radiosity block from
  *   lm_pov_radiosity. Background black (the engine's default background).
+ * - With a sky (lm_pov_desc.sky, scripts/sky.lua's gradient): a sky_sphere of
+ *   the same radiance, intensity * (horizon + (zenith - horizon) * max(y, 0)),
+ *   which radiosity gathers as the engine gathers its spherical harmonics.
  * - Camera: perspective with explicit vectors taken from the engine's own
  *   frustum (lm_scene_frame_data): direction = the ray to the centre of the
  *   far plane, right/up = its frustum_u/frustum_v. POV-Ray builds a ray as
@@ -63,6 +66,7 @@
 #define LIMN_POV_H
 
 #include "scene/scene.h"
+#include "scene/sky.h"
 
 #define LM_POV_FADE_FRACTION 1e-6
 /* Largest departure from 1 of a glTF range window written as plain inverse
@@ -92,6 +96,8 @@ typedef struct lm_pov_desc {
   bool shadows;       /* false: no mesh casts shadows */
   bool strict;        /* refuse what cannot match instead of warning */
   bool pbr_materials; /* the pbr technique's materials (approximated, warned) instead of Phong */
+  bool has_sky;       /* write `sky` as a sky_sphere (it lights the scene through radiosity) */
+  lm_sky sky;
 } lm_pov_desc;
 
 /* Appends the SDL for the view to `out`. Warnings (one per line, naming the

@@ -85,7 +85,13 @@ typedef struct lm_light {
   lm_falloff falloff;
   bool casts_shadows;
   int node;
+  /* Soft shadows (PCSS): the light's diameter in the scene's unit (point,
+   * spot) or its angular diameter in radians (directional); 0: the default,
+   * LM_LIGHT_SUN_SIZE, or LM_LIGHT_SIZE_SHARE of the shadow map's range. */
+  float size;
 } lm_light;
+#define LM_LIGHT_SUN_SIZE 0.0093f  /* the sun's angular diameter, radians (0.53 degrees) */
+#define LM_LIGHT_SIZE_SHARE 0.01f  /* a local light's default size as a share of its range */
 
 /* Distance beyond which a point or spot light adds nothing (the window's or
  * range's radius); INFINITY for directional lights and unbounded falloffs. */

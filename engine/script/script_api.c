@@ -168,7 +168,7 @@ static float opt_number(lua_State *L, int idx, const char *field, float def, flo
 }
 
 /* shadow_plan{ technique, resolution, c, blur, cascades, lambda, bias, distance,
- * blend, radius, stabilize }: tiles for every light that casts shadows, or nil
+ * blend, radius, stabilize, size, penumbra }: tiles for every light that casts shadows, or nil
  * when none does. scene{ views = plan } draws them; scene{ views = plan, fit =
  * T } first fits them to the camera depths T's first texel holds (min in r,
  * max in g, as depth / far). */
@@ -179,14 +179,15 @@ static int l_shadow_plan(lua_State *L) {
   if (p->shadows_frame == p->frame) return luaL_error(L, "shadow_plan: called twice in one frame");
   luaL_checktype(L, 1, LUA_TTABLE);
   static const char *const fields[] = {"technique", "resolution", "c", "blur", "cascades", "lambda",
-                                       "bias", "distance", "blend", "radius", "stabilize", NULL};
+                                       "bias", "distance", "blend", "radius", "stabilize", "size",
+                                       "penumbra", NULL};
   check_fields(L, 1, "shadow_plan", fields);
   lm_shadow_settings st;
   lm_shadow_settings_default(&st);
   const char *technique = opt_string(L, 1, "technique", "shadow_plan");
   if (technique) {
     int t = lm_shadow_technique_parse(technique);
-    if (t < 0) return luaL_error(L, "shadow_plan: unknown technique '%s' (esm, pcf, poisson, hard)", technique);
+    if (t < 0) return luaL_error(L, "shadow_plan: unknown technique '%s' (esm, pcf, poisson, hard, pcss)", technique);
     st.technique = (lm_shadow_technique)t;
   }
   const char *what = "shadow_plan";
@@ -199,6 +200,8 @@ static int l_shadow_plan(lua_State *L) {
   st.distance = opt_number(L, 1, "distance", st.distance, 0, 1e9f, what);
   st.blend = opt_number(L, 1, "blend", st.blend, 0, 1, what);
   st.radius = opt_number(L, 1, "radius", st.radius, 0, 32, what);
+  st.size = opt_number(L, 1, "size", st.size, -1, 1e30f, what);
+  st.penumbra = opt_number(L, 1, "penumbra", st.penumbra, 1, 64, what);
   lua_getfield(L, 1, "stabilize");
   if (!lua_isnil(L, -1)) st.stabilize = lua_toboolean(L, -1);
   lua_pop(L, 1);
@@ -235,8 +238,62 @@ static int l_plan_index(lua_State *L) {
   else if (!strcmp(k, "views")) lua_pushinteger(L, plan->view_count);
   else if (!strcmp(k, "c")) lua_pushnumber(L, plan->settings.c);
   else if (!strcmp(k, "blur")) lua_pushinteger(L, plan->settings.blur);
-  else if (!strcmp(k, "technique")) lua_pushstring(L, (const char *[]){"esm", "pcf", "poisson", "hard"}[plan->settings.technique]);
+  else if (!strcmp(k, "technique")) lua_pushstring(L, (const char *[]){"esm", "pcf", "poisson", "hard", "pcss"}[plan->settings.technique]);
   else return luaL_error(L, "shadow plan has no field '%s' (width, height, tile, views, c, blur, technique)", k);
+  return 1;
+}
+
+/* ---- sky_sh{} ---------------------------------------------------------- */
+static void opt_colour(lua_State *L, int idx, const char *field, float out[3]) {
+  lua_getfield(L, idx, field);
+  if (!lua_istable(L, -1) || lua_rawlen(L, -1) != 3)
+    luaL_error(L, "sky_sh: %s must be a list of 3 numbers (r, g, b)", field);
+  for (int i = 0; i < 3; i++) {
+    lua_rawgeti(L, -1, i + 1);
+    double d = lua_tonumber(L, -1);
+    if (!lua_isnumber(L, -1) || !(d >= 0 && d <= 1e6))
+      luaL_error(L, "sky_sh: %s[%d] must be a number in 0 .. 1e6", field, i + 1);
+    out[i] = (float)d;
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+}
+
+/* sky_sh{ zenith = {r, g, b}, horizon = {r, g, b}, intensity = x, map = path }:
+ * the sky's LM_SKY_SH coefficients (scene/sky.h) as three lists of 9, for r,
+ * g and b: the gradient's, or with `map` an equirectangular HDR file's (read
+ * once and kept while the path stays the same). */
+static int l_sky_sh(lua_State *L) {
+  lm_pipeline *p = lm_script_pipeline(L);
+  luaL_checktype(L, 1, LUA_TTABLE);
+  static const char *const fields[] = {"zenith", "horizon", "intensity", "map", NULL};
+  check_fields(L, 1, "sky_sh", fields);
+  lm_sky sky = {.intensity = opt_number(L, 1, "intensity", 1.0f, 0.0f, 1e6f, "sky_sh")};
+  const char *map = opt_string(L, 1, "map", "sky_sh");
+  float sh[LM_SKY_SH];
+  if (map && *map) {
+    if (strcmp(map, p->sky_map) != 0) {
+      lm_error err;
+      p->sky_map[0] = '\0';
+      if (strlen(map) >= sizeof p->sky_map) return luaL_error(L, "sky_sh: map path is too long");
+      if (!lm_sky_sh_map(map, 1.0f, p->sky_map_sh, &err)) return luaL_error(L, "sky_sh: %s", err.msg);
+      snprintf(p->sky_map, sizeof p->sky_map, "%s", map);
+    }
+    for (int i = 0; i < LM_SKY_SH; i++) sh[i] = sky.intensity * p->sky_map_sh[i];
+  } else {
+    opt_colour(L, 1, "zenith", sky.zenith);
+    opt_colour(L, 1, "horizon", sky.horizon);
+    lm_sky_sh_gradient(&sky, sh);
+  }
+  lua_createtable(L, 3, 0);
+  for (int k = 0; k < 3; k++) {
+    lua_createtable(L, 9, 0);
+    for (int i = 0; i < 9; i++) {
+      lua_pushnumber(L, sh[k * 9 + i]);
+      lua_rawseti(L, -2, i + 1);
+    }
+    lua_rawseti(L, -2, k + 1);
+  }
   return 1;
 }
 
@@ -569,7 +626,8 @@ void lm_script_open_api(lua_State *L) {
   lua_pop(L, 1);
   static const luaL_Reg api[] = {{"target", l_target}, {"scene", l_scene}, {"pass", l_pass},
                                  {"present", l_present}, {"output_size", l_output_size},
-                                 {"shadow_plan", l_shadow_plan}, {NULL, NULL}};
+                                 {"shadow_plan", l_shadow_plan}, {"sky_sh", l_sky_sh},
+                                 {NULL, NULL}};
   lua_pushglobaltable(L);
   luaL_setfuncs(L, api, 0);
   lua_pop(L, 1);

@@ -3,6 +3,7 @@
 #ifndef LIMN_SCRIPT_INTERNAL_H
 #define LIMN_SCRIPT_INTERNAL_H
 
+#include "scene/sky.h"
 #include "script/script.h"
 
 #include <lauxlib.h>
@@ -24,9 +25,11 @@ struct lm_pipeline {
   const lm_frame_data *camera;
   lm_shadow_plan *shadows;
   unsigned shadows_frame; /* frame serial of the plan in *shadows */
+  char sky_map[1024];     /* the sky map sky_sh{} read last ("" none) and its coefficients */
+  float sky_map_sh[LM_SKY_SH];
 };
 
-/* Registers target, scene, pass, present, output_size in the global table. */
+/* Registers target, scene, pass, present, output_size, shadow_plan, sky_sh in the global table. */
 void lm_script_open_api(lua_State *L);
 /* The pipeline that owns L. */
 lm_pipeline *lm_script_pipeline(lua_State *L);

@@ -15,8 +15,9 @@ typedef enum lm_shadow_technique {
   LM_SHADOW_PCF,     /* 3x3 percentage-closer filtering with a bias */
   LM_SHADOW_POISSON, /* 16 Poisson-disc taps over a wider radius */
   LM_SHADOW_HARD,    /* one compare with a bias */
+  LM_SHADOW_PCSS,    /* percentage-closer soft shadows: blocker search, penumbra from the light's size */
 } lm_shadow_technique;
-/* "esm", "pcf", "poisson", "hard"; -1 when unknown. */
+/* "esm", "pcf", "poisson", "hard", "pcss"; -1 when unknown. */
 int lm_shadow_technique_parse(const char *name);
 
 typedef struct lm_shadow_settings {
@@ -31,6 +32,8 @@ typedef struct lm_shadow_settings {
   float blend;     /* share of a cascade blended into the next one */
   float radius;    /* Poisson disc radius in texels */
   bool stabilize;  /* bounding spheres and texel snapping (seed 003) */
+  float size;      /* PCSS: every light's size (see lm_light.size); <= 0: each light's own */
+  float penumbra;  /* PCSS: the widest penumbra radius and blocker search, texels */
 } lm_shadow_settings;
 void lm_shadow_settings_default(lm_shadow_settings *s);
 
@@ -40,6 +43,7 @@ typedef struct lm_shadow_light_data {
   float splits[4]; /* cascades: camera depth where each ends */
   float params[4]; /* c, bias (texels), blend, Poisson radius */
   int32_t cube[4]; /* point lights: x = the cube faces drawn (bit f: face f, +X -X +Y -Y +Z -Z), in order */
+  float soft[4];   /* PCSS: light size (radians for cascades, world units else), widest penumbra (texels) */
 } lm_shadow_light_data;
 typedef struct lm_shadow_view_data {
   float view_proj[16];

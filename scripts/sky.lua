@@ -1,0 +1,71 @@
+-- Sky light for outdoor scenes (seed 003, section 5.3): the light of a sky,
+-- a gradient from the horizon to the zenith or an equirectangular HDR map,
+-- as 3-band spherical harmonics (sky_sh{}, engine/scene/sky.h) evaluated at
+-- each surface's normal. It joins the ambient term (k_a times the albedo),
+-- which the GI techniques occlude (ISR's and SSDO's accessibility, SSAO's
+-- factor); `dl` has no visibility to apply and leaves it unoccluded. Off by
+-- default, and then nothing of it is in the frame. `limn export-pov --sky`
+-- writes the same gradient as a sky_sphere that POV-Ray's radiosity gathers.
+local options = require "options"
+
+local sky = {}
+
+-- Radiances are the engine's (as `ambient`): a uniform sky of radiance L
+-- gives a white Lambertian plane facing it L (shared/design/gi-scale.md).
+sky.defaults = {
+  enabled = false,
+  zenith = "0.1,0.15,0.3",  -- radiance straight up: "r,g,b" or one grey number
+  horizon = "0.3,0.32,0.35", -- radiance at the horizon and below it
+  intensity = 1.0,          -- multiplies the sky, 0..1e6
+  map = "",                 -- an equirectangular HDR file (OpenImageIO) instead of the gradient:
+                            -- top row the zenith, the middle column looking along -Z
+}
+
+-- "r,g,b" or "x" (grey) as a list of 3 numbers; nil when it is neither.
+local function colour(v)
+  if type(v) == "number" then return { v, v, v } end
+  if type(v) ~= "string" then return nil end
+  local c = {}
+  for x in (v .. ","):gmatch("([^,]*),") do c[#c + 1] = tonumber(x) end
+  if #c == 1 then c[2], c[3] = c[1], c[1] end
+  if #c ~= 3 then return nil end
+  for i = 1, 3 do
+    if not (c[i] and c[i] >= 0 and c[i] <= 1e6) then return nil end
+  end
+  return c
+end
+
+local function colour_rule(v)
+  if not colour(v) then return '"r,g,b" or one number, each in 0..1e6' end
+end
+
+local rules = {
+  enabled = options.boolean,
+  zenith = colour_rule,
+  horizon = colour_rule,
+  intensity = options.number(0, 1e6),
+  map = function(v) if type(v) ~= "string" then return "a file name (\"\": the gradient)" end end,
+}
+
+-- The sky's pass parameters (sky_r, sky_g, sky_b: shaders/sky.glsl), or nil
+-- when it is off.
+function sky.light(o)
+  o = options.check("sky", sky.defaults, o, rules, 2)
+  if not o.enabled then return nil end
+  local sh = sky_sh{ zenith = colour(o.zenith), horizon = colour(o.horizon), intensity = o.intensity,
+                     map = o.map ~= "" and o.map or nil }
+  return { sky_r = sh[1], sky_g = sh[2], sky_b = sh[3] }
+end
+
+-- Adds the sky (from sky.light, may be nil) to a pass's params and defines;
+-- with G, also the normals gi_apply.frag reads for it.
+function sky.bind(light, params, defines, inputs, G)
+  if light then
+    for k, v in pairs(light) do params[k] = v end
+    defines.SKY = true
+    if inputs and G then inputs.nrm = G.nrm end
+  end
+  return params, defines
+end
+
+return sky
