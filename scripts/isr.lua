@@ -1,58 +1,93 @@
--- Image-space radiosity (seed 000, Listing 3, lines 1303-1331) over the
--- G-buffer of gbuffer.lua:
---   1. coarse CLR, NRM, DPT, MAT (isr_downsample.frag; skipped at coarse 1)
---   2. sender radiance L_X: the coarse albedo (the seed) or its direct light
---   3. the ISR step: indirect light and ambient occlusion (isr.frag, eq 25-26),
---      repeated for more bounces with the last bounce added to L_X
---   4. a separable Gaussian blur of the coarse result that skips background
+-- Image-space radiosity over the G-buffer of gbuffer.lua and the frame's
+-- direct light (one `direct` pass, shared by the senders and the composite).
+-- Two modes:
+--   physical (default; /work/shared/design/gi-scale.md) the indirect light
+--            POV-Ray's radiosity computes, k_d albedo (1/pi) int L cos dw,
+--            gathered along `samples` cosine-weighted rays a pixel, each
+--            marched in depth (isr_march.frag) until it meets a surface of
+--            the depth buffer (the sender, seen) or leaves the view; a
+--            sender sends its lit radiance (its direct light, and for more
+--            bounces its own indirect light of the last step)
+--   seed     seed 000's ISR (Listing 3, lines 1303-1331; eq 25-29, its
+--            defaults in isr.seed): albedo or lit senders in a disc of world
+--            radius, no visibility, k_ISR and k_SSAO (isr.frag)
+-- Steps:
+--   1. coarse CLR, NRM, DPT, MAT and direct light (isr_downsample.frag;
+--      skipped at coarse 1)
+--   2. the transport step, repeated for more bounces with the last step's
+--      indirect light added to the senders' radiance
+--   3. a separable Gaussian blur of the coarse result that skips background
 --      and does not cross depth edges (blur.frag)
---   5. direct light, bilateral upsampling and the composite (isr_light.frag,
---      eq 27-29)
--- Sample pattern: a golden-angle (Vogel) spiral turned per pixel; see isr.frag.
+--   4. bilateral upsampling and the composite (isr_light.frag)
 local gbuffer = require "gbuffer"
 local options = require "options"
-local shadow = require "shadow"
 
 local isr = {}
 
 -- The options a pipeline exposes (pp.lua's Options.isr), with their defaults.
 isr.defaults = {
-  samples = 48,      -- N samples a pixel, 1..256 (the seed timed 48; 80 after its fig 5.7)
-  radius = 0.5,      -- sampling disc radius in world units, > 0
+  mode = "physical", -- "physical" (gi-scale.md) or "seed" (seed 000's eq 25-29, options in isr.seed)
+  samples = 12,      -- rays a coarse pixel, 1..256
+  steps = 10,        -- depth-march steps a ray, 1..64, spread geometrically from one coarse
+                     -- pixel's footprint to where the ray leaves the view (no world unit)
+  thickness = 0.02,  -- a surface hides what lies this fraction of its depth behind it, 0..1
+  k = 1.0,           -- indirect light factor, 0..16 (1: physical)
+  bounces = 2,       -- transport steps, 1..4 (POV-Ray's recursion_limit 2: two bounces)
   coarse = 2,        -- coarse factor a side: 1, 2 or 4
   blur = 4,          -- Gaussian taps each side at coarse size, 0..32 (0: no blur)
-  k_isr = 0.5,       -- indirect light power k_ISR, 0..1
-  k_ssao = 0.5,      -- ambient occlusion power k_SSAO, 0..1
-  sender = "albedo", -- L_X: "albedo" (unlit, the seed) or "lit" (direct light)
-  bounces = 1,       -- transport steps, 1..4 (1: the seed)
-  view = "lit",      -- "lit"; "indirect" (rho L_ISR) or "ao" (accessibility) to inspect
+  view = "lit",      -- "lit"; "indirect" (the indirect light) or "ao" (accessibility) to inspect
+  seed = {           -- mode "seed": the dissertation's parameters
+    samples = 48,      -- N samples a pixel, 1..256 (the seed timed 48; 80 after its fig 5.7)
+    radius = 0.5,      -- sampling disc radius in world units, > 0
+    k_isr = 0.5,       -- indirect light power k_ISR, 0..1
+    k_ssao = 0.5,      -- ambient occlusion power k_SSAO, 0..1
+    sender = "albedo", -- L_X: "albedo" (unlit, the seed) or "lit" (direct light)
+    bounces = 1,       -- transport steps, 1..4 (1: the seed)
+  },
 }
 
 local views = { lit = 0, indirect = 1, ao = 2 }
 
-local rules = {
+local seed_rules = {
   samples = options.whole(1, 256),
   radius = options.positive(),
-  coarse = options.one_of(1, 2, 4),
-  blur = options.whole(0, 32),
   k_isr = options.number(0, 1),
   k_ssao = options.number(0, 1),
   sender = options.one_of("albedo", "lit"),
   bounces = options.whole(1, 4),
-  view = options.one_of("lit", "indirect", "ao"),
 }
 
--- The coarse G-buffer: G itself at factor 1.
-local function coarse_gbuffer(G, f)
-  if f == 1 then return G end
+local rules = {
+  mode = options.one_of("physical", "seed"),
+  samples = options.whole(1, 256),
+  steps = options.whole(1, 64),
+  thickness = options.number(0, 1),
+  k = options.number(0, 16),
+  bounces = options.whole(1, 4),
+  coarse = options.one_of(1, 2, 4),
+  blur = options.whole(0, 32),
+  view = options.one_of("lit", "indirect", "ao"),
+  seed = function(v) if type(v) ~= "table" then return "a table of the seed mode's options" end end,
+}
+
+-- The coarse G-buffer and direct light: G itself at factor 1.
+local function coarse_gbuffer(G, direct, f)
+  if f == 1 then
+    local C = gbuffer.inputs(G)
+    C.direct = direct
+    return C
+  end
   local C = {
     clr = target{ "isr.clr", format = "rgba8", scale = 1 / f },
     nrm = target{ "isr.nrm", format = "rgba16f", scale = 1 / f },
     dpt = target{ "isr.dpt", format = "r32f", scale = 1 / f },
     mat = target{ "isr.mat", format = "rgba8", scale = 1 / f },
+    direct = target{ "isr.direct", format = "rgba16f", scale = 1 / f },
   }
-  pass{ "isr.downsample", shader = "isr_downsample.frag", inputs = gbuffer.inputs(G),
-        defines = { FACTOR = f }, out = { C.clr, C.nrm, C.dpt, C.mat } }
+  local inputs = gbuffer.inputs(G)
+  inputs.direct = direct
+  pass{ "isr.downsample", shader = "isr_downsample.frag", inputs = inputs,
+        defines = { FACTOR = f }, out = { C.clr, C.nrm, C.dpt, C.mat, C.direct } }
   return C
 end
 
@@ -60,28 +95,33 @@ local function coarse_target(name, f)
   return target{ name, format = "rgba16f", scale = 1 / f }
 end
 
--- Records ISR lighting of G with options o (see isr.defaults) and light =
--- { ambient = {r, g, b}, background = {r, g, b}, shadows = atlas or nil }.
+-- Records ISR lighting of G given its direct light `direct` (lights only, no
+-- ambient term: a target from direct.frag with ambient 0), with options o
+-- (see isr.defaults) and light = { ambient = {r, g, b}, background = {r, g, b} }.
 -- Returns the lit target.
-function isr.render(G, o, light)
+function isr.render(G, direct, o, light)
   o = options.check("isr", isr.defaults, o, rules, 2)
+  local seed = options.check("isr.seed", isr.defaults.seed, o.seed, seed_rules, 2) -- checked in either mode
+  if o.mode ~= "seed" then seed = nil end
   local f = o.coarse
-  local C = coarse_gbuffer(G, f)
-  local sender = C.clr
-  if o.sender == "lit" then
-    local inputs, defines = shadow.bind(light.shadows, gbuffer.inputs(C), {})
-    sender = pass{ "isr.sender", shader = "direct.frag", inputs = inputs, defines = defines,
-                   params = { ambient = light.ambient, background = light.background },
-                   out = coarse_target("isr.sender", f) }
-  end
+  local C = coarse_gbuffer(G, direct, f)
   local E
-  for b = 1, o.bounces do
+  for b = 1, seed and seed.bounces or o.bounces do
     local inputs = gbuffer.inputs(C)
-    inputs.sender, inputs.previous = sender, E
-    E = pass{ b == 1 and "isr.transport" or "isr.transport" .. b, shader = "isr.frag",
-              inputs = inputs, params = { samples = o.samples, radius = o.radius },
-              fetches = 4 + o.samples * (E and 6 or 5), -- at most: G-buffer and sender (and bounce) a sample
-              defines = { BOUNCE = E ~= nil }, out = coarse_target("isr.e" .. b, f) }
+    inputs.previous = E
+    local name = b == 1 and "isr.transport" or "isr.transport" .. b
+    if seed then
+      inputs.sender = seed.sender == "lit" and C.direct or C.clr
+      E = pass{ name, shader = "isr.frag", inputs = inputs, params = { samples = seed.samples, radius = seed.radius },
+                fetches = 4 + seed.samples * (E and 6 or 5), -- at most: G-buffer and sender (and bounce) a sample
+                defines = { BOUNCE = E ~= nil }, out = coarse_target("isr.e" .. b, f) }
+    else
+      inputs.sender = C.direct
+      E = pass{ name, shader = "isr_march.frag", inputs = inputs,
+                params = { samples = o.samples, steps = o.steps, thickness = o.thickness },
+                fetches = 4 + o.samples * (o.steps + (E and 11 or 10)), -- march, one bisection, the hit
+                defines = { BOUNCE = E ~= nil }, out = coarse_target("isr.e" .. b, f) }
+    end
   end
   if o.blur > 0 then
     for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
@@ -91,11 +131,16 @@ function isr.render(G, o, light)
                 out = coarse_target("isr.blur_" .. axis[1], f) }
     end
   end
-  local inputs, defines = shadow.bind(light.shadows, { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat,
-                                                       isr = E, coarse_dpt = C.dpt, coarse_mat = C.mat }, {})
-  return pass{ "isr.light", shader = "isr_light.frag", inputs = inputs, defines = defines,
-               params = { ambient = light.ambient, background = light.background,
-                          k_isr = o.k_isr, k_ssao = o.k_ssao, view = views[o.view] },
+  local params = { ambient = light.ambient, background = light.background, view = views[o.view] }
+  if seed then
+    params.k_isr, params.k_ssao = seed.k_isr, seed.k_ssao
+  else
+    params.k = o.k
+  end
+  return pass{ "isr.light", shader = "isr_light.frag",
+               inputs = { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat, direct = direct,
+                          isr = E, coarse_dpt = C.dpt, coarse_mat = C.mat },
+               defines = { SEED = seed ~= nil }, params = params,
                out = target{ "lit", format = "rgba16f" } }
 end
 

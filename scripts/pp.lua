@@ -6,6 +6,7 @@ local shadow = require "shadow"
 local ssdo = require "ssdo"
 local ssao = require "ssao"
 local post = require "post"
+local options = require "options"
 
 -- The seed's viewer modes: isr+esm (F2, the default), isr (F3), dl+esm (F4),
 -- dl (F5); then screen-space directional and ambient occlusion (seed 001).
@@ -32,22 +33,31 @@ for name, d in pairs(post.defaults()) do Options[name] = d end
 
 local function grey(x) return { x, x, x } end
 
--- Direct light alone (the seed's F4/F5 modes).
-local function direct(G, tech, shadows)
+-- The frame's direct light, computed once: the dl techniques' result (with
+-- the ambient term) or, for the GI techniques, the lights alone (ambient 0:
+-- the GI composite adds the ambient term, occluded, and the indirect light),
+-- which also serves as the GI senders' radiance.
+local function direct(G, tech, shadows, ambient, name)
   local inputs, defines = shadow.bind(shadows, gbuffer.inputs(G), {})
   return pass{ "direct", shader = "direct.frag", inputs = inputs, defines = defines,
                fetches = not shadows and 4 or nil, -- the G-buffer; shadow lookups vary with the lights
-               params = { ambient = grey(tech.ambient), background = grey(tech.background) },
-               out = target{ "lit", format = "rgba16f" } }
+               params = { ambient = grey(ambient), background = grey(tech.background) },
+               out = target{ name, format = "rgba16f" } }
 end
+
+local rules = { ambient = options.number(0, 1e6), background = options.number(0, 1e6) }
 
 function OnCreate()
   post.create()
 end
 
 function OnRender(tech)
+  for _, k in ipairs{ "ambient", "background" } do
+    local want = rules[k](tech[k])
+    if want then error(string.format("%s must be %s (got %s)", k, want, tostring(tech[k])), 2) end
+  end
   local lighting = tech.name:match("^[^+]*")
-  if tech.name:find("+esm", 1, true) and lighting == "ssdo" and tech.ssdo.variant ~= "merged" then
+  if tech.name:find("+esm", 1, true) and lighting == "ssdo" and tech.ssdo.variant == "two_step" then
     error('ssdo+esm needs ssdo.variant = "merged" (the two-step variant relights without shadows)')
   end
   local G = gbuffer.render(gbuffer.targets())
@@ -55,15 +65,18 @@ function OnRender(tech)
   local shadows = tech.name:find("+esm", 1, true) and shadow.render(tech.shadow, G) or nil
   if shadows and tech.shadow.debug then return present(shadow.debug(shadows)) end
   local lit
-  if lighting == "isr" then
-    lit = isr.render(G, tech.isr, { ambient = grey(tech.ambient), background = grey(tech.background),
-                                    shadows = shadows })
-  elseif lighting == "ssdo" then
-    lit = ssdo.render(G, direct(G, tech, shadows), tech.ssdo, { ambient = grey(tech.ambient) })
-  elseif lighting == "ssao" then
-    lit = ssao.render(G, direct(G, tech, shadows), tech.ssao)
+  if lighting == "dl" then
+    lit = direct(G, tech, shadows, tech.ambient, "lit")
   else
-    lit = direct(G, tech, shadows)
+    local d = direct(G, tech, shadows, 0, "direct")
+    local light = { ambient = grey(tech.ambient), background = grey(tech.background) }
+    if lighting == "isr" then
+      lit = isr.render(G, d, tech.isr, light)
+    elseif lighting == "ssdo" then
+      lit = ssdo.render(G, d, tech.ssdo, light)
+    else
+      lit = ssao.render(G, d, tech.ssao, light)
+    end
   end
   present(post.render(lit, tech, G))
 end

@@ -1,7 +1,9 @@
 -- Screen-space ambient occlusion as seed 001 (lines 364-420, 1320-1353)
 -- over the G-buffer of gbuffer.lua: the darkening factor (ssao.frag), the
 -- geometry-aware blur and, at 1/2 or 1/4 size, joint bilateral upsampling
--- (filters.lua), then lit times the factor (gi_apply.frag).
+-- (filters.lua), then the factor applied (gi_apply.frag): by default to the
+-- ambient term alone (the light of the sky, which occluders hide), never to
+-- direct light; `apply = "lit"` darkens everything, as seed 001 does.
 local filters = require "filters"
 local options = require "options"
 
@@ -9,8 +11,11 @@ local ssao = {}
 
 ssao.defaults = {
   samples = 20,       -- a multiple of 10 in 10..300
-  radius = 0.3,       -- sampling disc radius, world units (scaled by depth on screen), > 0
-  tolerance = 0.3,    -- depth tolerance, world units: samples' depth reach and the occluder range, > 0
+  reach = 0.08,       -- radius and tolerance as a fraction of the pixel's view depth, > 0
+  radius = 0,         -- sampling disc radius, world units (scaled by depth on screen), >= 0 (0: reach)
+  tolerance = 0,      -- depth tolerance, world units: samples' depth reach and the occluder range,
+                      -- >= 0 (0: reach)
+  apply = "ambient",  -- what the factor darkens: "ambient" (the sky term) or "lit" (seed 001: all)
   strength = 1.0,     -- 0..1
   bias = 0.002,       -- depth bias, fraction of the depth, 0..0.1
   resolution = 1,     -- 1, 2 or 4
@@ -19,8 +24,10 @@ ssao.defaults = {
 
 local rules = {
   samples = options.multiple(10, 10, 300),
-  radius = options.number(1e-6, 1e6),
-  tolerance = options.number(1e-6, 1e6),
+  reach = options.number(1e-6, 100),
+  radius = options.number(0, 1e6),
+  tolerance = options.number(0, 1e6),
+  apply = options.one_of("ambient", "lit"),
   strength = options.number(0, 1),
   bias = options.number(0, 0.1),
   resolution = options.one_of(1, 2, 4),
@@ -28,18 +35,20 @@ local rules = {
 }
 filters.expose(ssao.defaults, rules)
 
--- Records SSAO of G applied to `lit` with options o (see ssao.defaults).
+-- Records SSAO of G applied to `lit` (direct light, no ambient term) with
+-- options o (see ssao.defaults) and light = { ambient = {r, g, b} }.
 -- Returns the result, a full-size rgba16f target "ssao.lit".
-function ssao.render(G, lit, o)
+function ssao.render(G, lit, o, light)
   o = options.check("ssao", ssao.defaults, o, rules, 2)
   local f = o.resolution
   local ao = pass{ "ssao.ao", shader = "ssao.frag", inputs = { nrm = G.nrm, dpt = G.dpt, mat = G.mat },
-                   params = { samples = o.samples, radius = o.radius, tolerance = o.tolerance,
+                   params = { samples = o.samples, radius = o.radius, tolerance = o.tolerance, reach = o.reach,
                               strength = o.strength, bias = o.bias, interleave = o.interleave, factor = f },
                    out = target{ "ssao.ao", format = "r16f", scale = 1 / f } }
   ao = filters.smooth(ao, G, o, "ssao", "r16f", f)
-  return pass{ "ssao.apply", shader = "gi_apply.frag", inputs = { lit = lit, mat = G.mat, a = ao },
-               defines = { AO = true }, out = target{ "ssao.lit", format = "rgba16f" } }
+  return pass{ "ssao.apply", shader = "gi_apply.frag", inputs = { lit = lit, clr = G.clr, mat = G.mat, a = ao },
+               params = { ambient = light.ambient }, defines = { AO = true, AO_LIT = o.apply == "lit" },
+               out = target{ "ssao.lit", format = "rgba16f" } }
 end
 
 return ssao

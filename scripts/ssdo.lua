@@ -1,6 +1,10 @@
 -- Screen-space directional occlusion (seed 001, lines 422-568, 864-948,
--- 1222-1318) over the G-buffer of gbuffer.lua and a direct-lit image
--- (direct.frag's, or any with the same meaning: shadows go in there):
+-- 1222-1318) over the G-buffer of gbuffer.lua and the frame's direct light
+-- (direct.frag's with no ambient term; shadows go in there):
+--   physical  the default: the direct light as it is, the ambient (sky) term
+--             times the accessibility, plus the bounce from the lit senders
+--             the occluded samples see, on POV-Ray's radiosity scale
+--             (gi-scale.md; ssdo.frag, PHYSICAL): out = lit + A sky + B
 --   merged    the author's variant: one pass (ssdo.frag, MERGED) gives the
 --             modulation factor M per channel and the bounce from the lit
 --             image; both blurred together, upsampled when computed at 1/2
@@ -22,21 +26,24 @@ local options = require "options"
 local ssdo = {}
 
 ssdo.defaults = {
-  variant = "merged",  -- "merged" (modulation factor) or "two_step" (the original)
+  variant = "physical", -- "physical", "merged" (the seed's modulation factor) or "two_step" (the original)
   samples = 20,        -- K, a multiple of 10 in 10..300 (Halton period of bases 2 and 5)
   adaptive = false,    -- 10/20/30 samples from a 1/16-size edge map instead
-  r_max = 0.3,         -- sampling radius, world units, > 0
-  bounce = 1.0,        -- bounce strength: A_s in units of pi r_max^2 / K, 0..100 (0: none)
+  radius = 0.5,        -- sampling radius as a fraction of the pixel's view depth, > 0
+  r_max = 0,           -- sampling radius in world units, >= 0 (0: `radius` instead)
+  bounce = 1.0,        -- bounce strength, 0..100 (0: none; physical: 1 is physical; merged, two_step:
+                       -- A_s in units of pi r_max^2 / K)
   lobe = 4,            -- light lobe exponent n of L_in (ssdo.frag), 1..64
   resolution = 1,      -- computed at 1/resolution a side: 1, 2 or 4 (merged only)
   interleave = 4,      -- per-pixel rotation tile side: 1 (none), 2 or 4
 }
 
 local rules = {
-  variant = options.one_of("merged", "two_step"),
+  variant = options.one_of("physical", "merged", "two_step"),
   samples = options.multiple(10, 10, 300),
   adaptive = options.boolean,
-  r_max = options.number(1e-6, 1e6),
+  radius = options.number(1e-6, 100),
+  r_max = options.number(0, 1e6),
   bounce = options.number(0, 100),
   lobe = options.number(1, 64),
   resolution = {
@@ -49,18 +56,18 @@ local rules = {
 }
 filters.expose(ssdo.defaults, rules)
 
--- Records SSDO for G lit by `lit` with options o (see ssdo.defaults) and
--- light = { ambient = {r, g, b} } (the two-step variant relights ambient).
+-- Records SSDO for G lit by `lit` (direct light, no ambient term) with
+-- options o (see ssdo.defaults) and light = { ambient = {r, g, b} }.
 -- Returns the result, a full-size rgba16f target "ssdo.lit".
 function ssdo.render(G, lit, o, light)
   o = options.check("ssdo", ssdo.defaults, o, rules, 2)
-  local f, merged = o.resolution, o.variant == "merged"
+  local f, merged, physical = o.resolution, o.variant == "merged", o.variant == "physical"
   local edges
   if o.adaptive then
     edges = pass{ "ssdo.edges", shader = "ssdo_edges.frag", inputs = { nrm = G.nrm, dpt = G.dpt, mat = G.mat },
                   out = target{ "ssdo.edges", format = "r16f", scale = 1 / 16 } }
   end
-  local params = { samples = o.samples, r_max = o.r_max, bounce = o.bounce, lobe = o.lobe,
+  local params = { samples = o.samples, r_max = o.r_max, radius = o.radius, bounce = o.bounce, lobe = o.lobe,
                    interleave = o.interleave, factor = f }
   local function inputs(sender)
     local t = gbuffer.inputs(G)
@@ -68,13 +75,13 @@ function ssdo.render(G, lit, o, light)
     return t
   end
   local a, b
-  if merged then
+  if merged or physical then
     a = target{ "ssdo.m", format = "rgba16f", scale = 1 / f }
     b = target{ "ssdo.bounce", format = "rgba16f", scale = 1 / f }
-    pass{ "ssdo.merged", shader = "ssdo.frag", inputs = inputs(lit), params = params,
-          defines = { MERGED = true, ADAPTIVE = o.adaptive }, out = { a, b } }
+    pass{ physical and "ssdo.physical" or "ssdo.merged", shader = "ssdo.frag", inputs = inputs(lit), params = params,
+          defines = { MERGED = merged, PHYSICAL = physical, ADAPTIVE = o.adaptive }, out = { a, b } }
   else
-    params.ambient = light and light.ambient or { 0, 0, 0 }
+    params.ambient = light.ambient
     a = pass{ "ssdo.direct", shader = "ssdo.frag", inputs = inputs(nil), params = params,
               defines = { DIRECT = true, ADAPTIVE = o.adaptive },
               out = target{ "ssdo.direct", format = "rgba16f" } }
@@ -84,8 +91,9 @@ function ssdo.render(G, lit, o, light)
               out = target{ "ssdo.indirect", format = "rgba16f" } }
   end
   a, b = filters.smooth({ a, b }, G, o, "ssdo", "rgba16f", f)
-  return pass{ "ssdo.apply", shader = "gi_apply.frag", inputs = { lit = lit, mat = G.mat, a = a, b = b },
-               defines = { MERGED = merged, TWO_STEP = not merged },
+  return pass{ "ssdo.apply", shader = "gi_apply.frag", inputs = { lit = lit, clr = G.clr, mat = G.mat, a = a, b = b },
+               params = { ambient = light.ambient },
+               defines = { PHYSICAL = physical, MERGED = merged, TWO_STEP = o.variant == "two_step" },
                out = target{ "ssdo.lit", format = "rgba16f" } }
 end
 

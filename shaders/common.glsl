@@ -17,7 +17,8 @@ struct Light {
   vec4 position;  // xyz, w: 0 point, 1 spot, 2 directional
   vec4 direction; // xyz unit (from the light), w: cos(outer cone)
   vec4 color;     // rgb * power, w: radius
-  vec4 params;    // x: cos(inner cone), y: falloff (0 seed window, 1 none, 2 inverse square)
+  vec4 params;    // x: cos(inner cone), y: falloff (0 seed window, 1 none, 2 inverse square,
+                  //    3 inverse square with KHR_lights_punctual's range window)
 };
 layout(std430, binding = 1) readonly buffer LimnLights { Light lights[]; };
 

@@ -1,35 +1,45 @@
-// Applies a screen-space GI result, already at full size, to the direct-lit
-// image (seed 001, lines 1301-1313: "the bounce and the intensity is then
-// darkened using the modulation factor, then summed together"). Background
-// keeps the lit colour. One of:
-//  MERGED    out = M (lit + B)          SSDO modulation factor and bounce
-//  TWO_STEP  out = L_dir + L_ind        the original SSDO's two results
-//  AO        out = A lit                SSAO's darkening factor (a.r)
+// Applies a screen-space GI result, already at full size, to the frame's
+// direct light `lit` (lights and shadows, no ambient term; seed 001, lines
+// 1301-1313). sky = k_a L_a albedo is the ambient term, the light of the sky
+// in the physical variants, the only light occlusion may take away.
+// Background keeps the lit colour. One of:
+//  PHYSICAL  out = lit + A sky + B     SSDO: accessibility and bounce
+//  MERGED    out = M (lit + sky + B)   SSDO modulation factor and bounce (the seed's)
+//  TWO_STEP  out = L_dir + L_ind       the original SSDO's two results
+//  AO        out = lit + A sky         SSAO's accessibility (a.r) on the sky alone;
+//            with AO_LIT out = A (lit + sky), seed 001's darkening of everything
 #include "common.glsl"
 
 in vec2 uv;
-uniform sampler2D lit, mat;
+uniform sampler2D lit, clr, mat;
 uniform sampler2D a;
 #ifndef AO
 uniform sampler2D b;
 #endif
+uniform vec3 ambient = vec3(0.0);
 
 out vec4 result;
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   vec3 l = texelFetch(lit, p, 0).rgb;
-  if (texelFetch(mat, p, 0).a < 0.5) {
+  vec4 m = texelFetch(mat, p, 0);
+  if (m.a < 0.5) {
     result = vec4(l, 1.0);
     return;
   }
+  vec3 sky = m.x * ambient * texelFetch(clr, p, 0).rgb;
   vec4 x = texelFetch(a, p, 0);
-#if defined(MERGED)
-  vec3 c = saturate(x.rgb) * (l + texelFetch(b, p, 0).rgb);
+#if defined(PHYSICAL)
+  vec3 c = l + saturate(x.r) * sky + texelFetch(b, p, 0).rgb;
+#elif defined(MERGED)
+  vec3 c = saturate(x.rgb) * (l + sky + texelFetch(b, p, 0).rgb);
 #elif defined(TWO_STEP)
   vec3 c = x.rgb + texelFetch(b, p, 0).rgb;
+#elif defined(AO_LIT)
+  vec3 c = saturate(x.r) * (l + sky);
 #else
-  vec3 c = saturate(x.r) * l;
+  vec3 c = l + saturate(x.r) * sky;
 #endif
   result = vec4(c, 1.0);
 }

@@ -1,17 +1,27 @@
 // The ISR lighting pass (seed 000, eq 27-29, Listing 7, lines 1564-1702):
-// direct light, the coarse ISR buffer brought to full size by depth-aware
-// bilateral upsampling, and the composite
-//   L = C0 k_dl saturate(A + 1 - k_SSAO) + k_ISR rho L_ISR
-// where C0 k_dl is the direct light of lighting.glsl and A the accessibility
-// (isr.frag: 1 open, 0 occluded).
+// the coarse ISR buffer (rgb E, a A) brought to full size by depth-aware
+// bilateral upsampling, and the composite with the frame's direct light D
+// (the `direct` pass: lights and shadows, no ambient term) and the ambient
+// term k_a L_a albedo:
+//   physical  L = D + k_a L_a albedo A + k k_d albedo E
+//             (isr_march.frag: E = (1/pi) int L cos dw over the seen senders,
+//             A the cosine-weighted share of rays that see no surface, the
+//             ambient light being the sky's: only it is occluded)
+//   SEED      L = (D + k_a L_a albedo) saturate(A + 1 - k_SSAO) + k_ISR rho E
+//             (isr.frag; C0 k_dl of eq 29 is the direct light with its
+//             ambient term, A the accessibility: 1 open, 0 occluded)
 #include "gbuffer.glsl"
 
 in vec2 uv;
-uniform sampler2D clr, nrm, dpt, mat;          // full-size G-buffer
+uniform sampler2D clr, nrm, dpt, mat, direct;  // full-size G-buffer and direct light
 uniform sampler2D isr, coarse_dpt, coarse_mat; // coarse ISR (rgb E, a A) and its depth
 uniform vec3 ambient = vec3(0.0);
 uniform vec3 background = vec3(0.0);
+#ifdef SEED
 uniform float k_isr = 0.5, k_ssao = 0.5;
+#else
+uniform float k = 1.0;
+#endif
 uniform int view = 0; // 0: the composite, 1: rho L_ISR alone, 2: accessibility A
 
 out vec4 lit;
@@ -53,9 +63,15 @@ void main() {
     return;
   }
   vec4 e = upsample(s.depth01);
-  vec3 direct = direct_light(s, ambient);
-  vec3 l = direct * saturate(e.a + 1.0 - k_ssao) + k_isr * s.rho * e.rgb;
-  if (view == 1) l = s.rho * e.rgb;
+  vec3 d = texelFetch(direct, ivec2(gl_FragCoord.xy), 0).rgb, sky = s.k.x * ambient * s.albedo;
+#ifdef SEED
+  vec3 indirect = s.rho * e.rgb;
+  vec3 l = (d + sky) * saturate(e.a + 1.0 - k_ssao) + k_isr * indirect;
+#else
+  vec3 indirect = max(k, 0.0) * s.k.y * s.albedo * e.rgb;
+  vec3 l = d + sky * saturate(e.a) + indirect;
+#endif
+  if (view == 1) l = indirect;
   if (view == 2) l = vec3(e.a);
   lit = vec4(l, 1.0); // unsanitized: tests check the guards, output.frag the rest
 }

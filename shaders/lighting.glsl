@@ -1,12 +1,29 @@
 // Direct light: Phong (seed 000, lines 2753-2767) with the seed's point light
 // fall-off saturate(1 - (d / r)^2) (eq 16) or none or 1/d^2 (the falloffs
-// POV-Ray can match), spot cones and directional lights.
+// POV-Ray can match) or KHR_lights_punctual's 1/d^2 with its range window,
+// spot cones and directional lights.
 #ifndef LIMN_LIGHTING_GLSL
 #define LIMN_LIGHTING_GLSL
 #include "common.glsl"
 #ifdef SHADOWS
 #include "shadow.glsl"
 #endif
+
+// How a point or spot light fades at distance d (lm_falloff; the C twin is
+// lm_light_falloff in engine/scene/scene.c, lm_light_reach says where it ends).
+float light_falloff(int mode, float d, float radius) {
+  if (mode == 1) return 1.0; // none: POV-Ray's default point light
+  float inv_d2 = 1.0 / max(d * d, 1e-8); // inverse square, finite at the light itself
+  if (mode == 2) return inv_d2;
+  if (mode == 3) { // KHR_lights_punctual: clamp(1 - (d / range)^4, 0, 1) / d^2; range 0: none
+    if (radius <= 0.0) return inv_d2;
+    float q = d / radius;
+    q *= q;
+    return saturate(1.0 - q * q) * inv_d2;
+  }
+  float radius_safe = max(radius, 1e-12); // the seed's window (eq 16), zero beyond the radius
+  return saturate(1.0 - (d / radius_safe) * (d / radius_safe));
+}
 
 // Light arriving at p from light i: direction to the light in *l, radiance returned.
 vec3 light_incident(int i, vec3 p, out vec3 l) {
@@ -19,16 +36,7 @@ vec3 light_incident(int i, vec3 p, out vec3 l) {
   vec3 to_light = li.position.xyz - p;
   float d = length(to_light);
   l = d > 1e-12 ? to_light / d : vec3(0.0, 1.0, 0.0);
-  float fall;
-  int mode = int(li.params.y + 0.5);
-  if (mode == 1) { // none: POV-Ray's default point light
-    fall = 1.0;
-  } else if (mode == 2) { // inverse square, finite at the light itself
-    fall = 1.0 / max(d * d, 1e-8);
-  } else { // the seed's window (eq 16), zero beyond the radius
-    float radius = max(li.color.w, 1e-12);
-    fall = saturate(1.0 - (d / radius) * (d / radius));
-  }
+  float fall = light_falloff(int(li.params.y + 0.5), d, li.color.w);
   if (type == 1) {
     float cos_angle = dot(-l, li.direction.xyz);
     float inner = li.params.x, outer = li.direction.w;

@@ -17,8 +17,9 @@
 in vec2 uv;
 uniform sampler2D nrm, dpt, mat; // full-size G-buffer
 uniform int samples = 20;        // multiple of 10
-uniform float radius = 0.3;      // world units
-uniform float tolerance = 0.3;   // world units
+uniform float radius = 0.0;      // world units (0: reach z)
+uniform float tolerance = 0.0;   // world units (0: reach z)
+uniform float reach = 0.08;      // fraction of the view depth z
 uniform float strength = 1.0;    // 0..1
 uniform float bias = 0.002;      // fraction of the depth
 uniform int interleave = 4;
@@ -37,7 +38,8 @@ void main() {
   float far = frame.clip.y, z = max(texelFetch(dpt, g, 0).r, 0.0) * far;
   vec3 nw = safe_normalize(texelFetch(nrm, g, 0).xyz, vec3(0.0, 1.0, 0.0));
   vec3 n = safe_normalize(mat3(frame.view) * nw, vec3(0.0, 0.0, 1.0));
-  float rad = max(radius, 0.0), tol = max(tolerance, 0.0);
+  float rel = max(reach, 0.0) * z; // scale-free default: a fraction of the depth
+  float rad = radius > 0.0 ? radius : rel, tol = tolerance > 0.0 ? tolerance : rel;
   vec2 centre = (vec2(g) + 0.5) / vec2(gsize);
   int k = clamp(samples / 10 * 10, 10, HALTON_MAX);
   mat3 frame_n = tangent_frame(n);

@@ -21,6 +21,15 @@
 // the cosine-weighted fraction of visible samples.
 //
 // Variants (defines):
+//  PHYSICAL      the default (/work/shared/design/gi-scale.md): cosine-
+//                weighted directions; the lit image is not darkened (its
+//                shadows come from the shadow maps), only the ambient (sky)
+//                term, by the accessibility; the bounce is the share of the
+//                irradiance integral the occluded samples see,
+//                E = (1/K) sum over occluded samples of L_i, each sample
+//                standing for its direction (pdf cos / pi: the cosines
+//                cancel), so that k_d albedo E is on POV-Ray's scale with
+//                bounce = 1. out0 = (A, A, A, A), out1 = (bounce k_d albedo E, 0).
 //  MERGED        the author's (eq 4.1-4.4): cosine-weighted directions
 //                (p = cos / pi: the cosines cancel), one loop gives M and
 //                the bounce from `sender`, the scene without SSDO darkening.
@@ -47,14 +56,15 @@
 
 in vec2 uv;
 uniform sampler2D clr, nrm, dpt, mat; // full-size G-buffer
-#if defined(MERGED) || defined(BOUNCE)
+#if defined(MERGED) || defined(BOUNCE) || defined(PHYSICAL)
 uniform sampler2D sender;             // full-size: undarkened lit colour or L_dir
 #endif
 #ifdef ADAPTIVE
 uniform sampler2D edges;              // 1/16 size: 10, 20 or 30 samples (ssdo_edges.frag)
 #endif
 uniform int samples = 20;     // K, a multiple of 10
-uniform float r_max = 0.3;    // world units
+uniform float r_max = 0.0;    // world units; 0: `radius` of P's view depth
+uniform float radius = 0.5;   // fraction of P's view depth
 uniform float bounce = 1.0;   // A_s over the seed's pi r_max^2 / K
 uniform float lobe = 4.0;     // light lobe exponent n
 uniform int interleave = 4;   // rotation tile side (halton.glsl)
@@ -64,7 +74,7 @@ uniform vec3 ambient = vec3(0.0);
 #endif
 
 layout(location = 0) out vec4 out0;
-#ifdef MERGED
+#if defined(MERGED) || defined(PHYSICAL)
 layout(location = 1) out vec4 out1;
 #endif
 
@@ -89,7 +99,7 @@ void main() {
   ivec2 g = clamp(px * f + f / 2, ivec2(0), gsize - 1);
   Surface s = gbuffer_fetch(clr, nrm, dpt, mat, g);
   if (!s.covered) { // background: nothing to darken or light
-#if defined(MERGED)
+#if defined(MERGED) || defined(PHYSICAL)
     out0 = vec4(1.0);
     out1 = vec4(0.0);
 #else
@@ -103,7 +113,7 @@ void main() {
   int k = samples;
 #endif
   k = clamp(k / 10 * 10, 10, HALTON_MAX);
-  float rmax = max(r_max, 0.0);
+  float rmax = r_max > 0.0 ? r_max : max(radius, 0.0) * s.depth01 * frame.clip.y;
   float area = max(bounce, 0.0) * PI * rmax * rmax / float(k);  // A_s
   float far = frame.clip.y;
   mat3 frame_n = tangent_frame(s.n);
@@ -112,7 +122,7 @@ void main() {
   float open = 0.0;
   for (int i = 0; i < k; i++) {
     vec3 u = halton_sample(i, offset);
-#ifdef MERGED
+#if defined(MERGED) || defined(PHYSICAL)
     vec3 wl = hemisphere_cosine(u.xy);
 #else
     vec3 wl = hemisphere_uniform(u.xy);
@@ -147,6 +157,13 @@ void main() {
     total += lin * weight;
     if (!occluded) visible += lin * weight, open += weight;
 #endif
+#ifdef PHYSICAL
+    if (!occluded) open += 1.0;
+    else {
+      Surface x = gbuffer_fetch(clr, nrm, dpt, mat, q);
+      if (dot(x.n, -safe_normalize(x.p - s.p, w)) > 0.0) gathered += texelFetch(sender, q, 0).rgb;
+    }
+#endif
 #if defined(MERGED) || defined(BOUNCE)
     if (occluded && area > 0.0) {
       Surface x = gbuffer_fetch(clr, nrm, dpt, mat, q);
@@ -171,7 +188,11 @@ void main() {
                 total.b > 1e-8 ? visible.b / total.b : access);
   m = saturate(m);
 #endif
-#ifdef MERGED
+#ifdef PHYSICAL
+  float access = open / float(k);
+  out0 = vec4(access);
+  out1 = vec4(max(bounce, 0.0) * rho * gathered / float(k), 0.0);
+#elif defined(MERGED)
   out0 = vec4(m, access);
   out1 = vec4(rho / PI * gathered, 0.0);
 #elif defined(DIRECT)

@@ -37,6 +37,22 @@ check "unknown flag message" err_has "unknown flag '--bogus'"
 check "bad size" run 2 capture --size 0x5
 check "bad size message" err_has "--size wants WxH"
 check "missing value" run 2 capture --size
+# A glTF file that requires an extension the engine lacks: refused by name, before its data is read.
+sed 's/"extensionsUsed": \[/"extensionsRequired": ["KHR_draco_mesh_compression"], "extensionsUsed": [/' \
+  "$root/data/scenes/pov_ball.gltf" > "$tmp/draco.gltf"
+check "required extension" run 2 capture --scene "$tmp/draco.gltf" --size 32x24 --output "$tmp/img/d.png"
+check "required extension named" first_error_has "draco.gltf: extensionsRequired names 'KHR_draco_mesh_compression'"
+check "required extension: no image" no_files
+# --camera auto frames the scene at the output's aspect; an orthographic glTF camera is refused by name.
+check "camera auto" run 0 capture --scene "$root/data/scenes/pov_ball.gltf" --camera auto --size 24x48 --output "$tmp/auto.png"
+check "camera auto wrote" test -s "$tmp/auto.png"
+sed -e 's/"type": "perspective",/"type": "orthographic",/' -e 's/"perspective": {/"orthographic": { "xmag": 2, "ymag": 1.5,/' \
+  "$root/data/scenes/pov_ball.gltf" > "$tmp/ortho.gltf"
+check "orthographic camera" run 1 capture --scene "$tmp/ortho.gltf" --size 32x24 --output "$tmp/img/o.png"
+check "orthographic camera named" first_error_has "camera 'view' (0) is orthographic"
+check "orthographic: no image" no_files
+check "orthographic export" run 1 export-pov --scene "$tmp/ortho.gltf" --size 32x24 --output "$tmp/img/o.pov"
+check "orthographic export named" first_error_has "camera 'view' (0) is orthographic"
 check "bad output type" run 2 capture --output "$tmp/img/x.bmp"
 check "bad frames" run 2 capture --frames -3
 check "bad set" run 2 capture --set novalue

@@ -190,6 +190,208 @@ static void triangle_loads_with_every_index_type(void **state) {
   }
 }
 
+/* Vertices `pos` (n of them, xyz) drawn as `mode`, through u16 `idx` when ni > 0. */
+static const char *write_topology(const char *name, const float *pos, int n, const uint16_t *idx, int ni,
+                                  int mode) {
+  blob b = {0};
+  blob_add(&b, pos, sizeof(float) * 3 * (size_t)n);
+  size_t ioff = ni ? blob_add(&b, idx, sizeof(uint16_t) * (size_t)ni) : 0;
+  char json[2048];
+  snprintf(json, sizeof json,
+           "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":%d%s}]}],"
+           "\"buffers\":[{\"uri\":\"%%s\",\"byteLength\":%%zu}],"
+           "\"bufferViews\":[{\"buffer\":0,\"byteLength\":%d},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%d}],"
+           "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\"},"
+           "{\"bufferView\":1,\"componentType\":5123,\"count\":%d,\"type\":\"SCALAR\"}]}",
+           mode, ni ? ",\"indices\":1" : "", 12 * n, ioff, ni ? 2 * ni : 2, n, ni ? ni : 1);
+  return write_gltf(name, json, &b);
+}
+
+/* The scene's triangles as 9 floats each, each rotated to start at its
+ * smallest vertex (winding kept) and the list sorted: equal lists draw the
+ * same image. */
+static int compare_tri(const void *a, const void *b) {
+  return memcmp(a, b, 9 * sizeof(float)) ? (memcmp(a, b, 9 * sizeof(float)) < 0 ? -1 : 1) : 0;
+}
+static int vertex_less(const float *a, const float *b) {
+  for (int k = 0; k < 3; k++)
+    if (a[k] != b[k]) return a[k] < b[k];
+  return 0;
+}
+static int scene_triangles(const lm_scene *s, float *out, int cap) {
+  assert_int_equal(s->mesh_count, 1);
+  const lm_scene_mesh *m = &s->meshes[0];
+  int n = m->index_count / 3;
+  assert_true(n <= cap);
+  for (int t = 0; t < n; t++) {
+    const float *v[3];
+    for (int j = 0; j < 3; j++) v[j] = m->vertices + m->indices[t * 3 + j] * 8;
+    int first = vertex_less(v[1], v[0]) ? 1 : 0;
+    if (vertex_less(v[2], v[first])) first = 2;
+    for (int j = 0; j < 3; j++) memcpy(out + t * 9 + j * 3, v[(first + j) % 3], 3 * sizeof(float));
+    for (int j = 0; j < 3; j++) /* planar: every normal +Z, as in the list */
+      assert_float_equal(v[j][5], 1, 1e-6);
+  }
+  qsort(out, (size_t)n, 9 * sizeof(float), compare_tri);
+  return n;
+}
+
+/* A strip, a fan and their indexed forms load as the same triangles, wound
+ * the same way, as the triangle list of that shape; points and lines are
+ * skipped (one warning for the file). */
+static void strips_and_fans_become_triangles(void **state) {
+  (void)state;
+  /* a unit square's corners and a fifth point: 3 counter-clockwise triangles */
+  static const float v[5][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}};
+  static const int list[] = {0, 1, 2, 1, 3, 2, 1, 4, 3};
+  static const int strip[] = {0, 1, 2, 3}, fan[] = {1, 4, 3, 2, 0};
+  float pos[16][3];
+  uint16_t idx[16];
+  for (int i = 0; i < 9; i++) memcpy(pos[i], v[list[i]], sizeof pos[i]);
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(write_topology("list.gltf", &pos[0][0], 9, NULL, 0, 4), &err);
+  if (!s) fail_msg("%s", err.msg);
+  float want[8 * 9], got[8 * 9];
+  int n = scene_triangles(s, want, 8);
+  assert_int_equal(n, 3);
+  lm_scene_destroy(s);
+  /* the strip covers the square (2 triangles), the fan all 3 (it pivots on vertex 1) */
+  struct { const char *name; const int *order; int count, mode, tris; } shapes[] = {
+      {"strip", strip, 4, 5, 2}, {"fan", fan, 5, 6, 3}};
+  for (int k = 0; k < 2; k++) {
+    for (int indexed = 0; indexed < 2; indexed++) {
+      char name[32];
+      snprintf(name, sizeof name, "%s%d.gltf", shapes[k].name, indexed);
+      const char *path;
+      if (!indexed) {
+        for (int i = 0; i < shapes[k].count; i++) memcpy(pos[i], v[shapes[k].order[i]], sizeof pos[i]);
+        path = write_topology(name, &pos[0][0], shapes[k].count, NULL, 0, shapes[k].mode);
+      } else { /* the vertices stored in reverse, reached through indices */
+        for (int i = 0; i < 5; i++) memcpy(pos[i], v[4 - i], sizeof pos[i]);
+        for (int i = 0; i < shapes[k].count; i++) idx[i] = (uint16_t)(4 - shapes[k].order[i]);
+        path = write_topology(name, &pos[0][0], 5, idx, shapes[k].count, shapes[k].mode);
+      }
+      s = lm_scene_load_gltf(path, &err);
+      if (!s) fail_msg("%s: %s", name, err.msg);
+      assert_int_equal(scene_triangles(s, got, 8), shapes[k].tris);
+      lm_scene_destroy(s);
+      if (shapes[k].tris == 3) {
+        assert_memory_equal(got, want, sizeof(float) * 27);
+      } else { /* the list's first two triangles */
+        float part[2 * 9];
+        for (int i = 0; i < 6; i++) memcpy(pos[i], v[list[i]], sizeof pos[i]);
+        s = lm_scene_load_gltf(write_topology("half.gltf", &pos[0][0], 6, NULL, 0, 4), &err);
+        assert_non_null(s);
+        scene_triangles(s, part, 2);
+        lm_scene_destroy(s);
+        assert_memory_equal(got, part, sizeof part);
+      }
+    }
+  }
+  /* lines and points: nothing to draw, no error */
+  for (int mode = 0; mode <= 3; mode++) {
+    s = lm_scene_load_gltf(write_topology("lines.gltf", &v[0][0], 4, NULL, 0, mode), &err);
+    if (!s) fail_msg("%s", err.msg);
+    assert_int_equal(s->mesh_count, 0);
+    lm_scene_destroy(s);
+  }
+  /* a strip too short, and a mode glTF does not have */
+  assert_null(lm_scene_load_gltf(write_topology("short.gltf", &v[0][0], 2, NULL, 0, 5), &err));
+  assert_non_null(strstr(err.msg, "mesh 0 primitive 0: a triangle strip of 2 vertices, fewer than 3"));
+  assert_null(lm_scene_load_gltf(write_topology("mode7.gltf", &v[0][0], 3, NULL, 0, 7), &err));
+  assert_non_null(strstr(err.msg, "mesh 0 primitive 0: mode 7 is not a glTF primitive mode"));
+}
+
+/* A required extension the engine lacks is named, in .gltf and .glb alike,
+ * before any of the data it governs is read (here: an accessor with no
+ * bufferView, as Draco leaves them). A supported one loads. */
+static void unsupported_required_extension_is_named(void **state) {
+  (void)state;
+  static const char json[] =
+      "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\",\"%s\"],"
+      "\"extensionsRequired\":[\"KHR_lights_punctual\",\"%s\"],\"scenes\":[{\"nodes\":[0]}],"
+      "\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+      "\"accessors\":[{\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+      "{\"bufferView\":7,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}";
+  char text[2048];
+  snprintf(text, sizeof text, json, "KHR_draco_mesh_compression", "KHR_draco_mesh_compression");
+  lm_error err = {""};
+  assert_null(lm_scene_load_gltf(write_bytes("draco.gltf", text, strlen(text)), &err));
+  assert_non_null(strstr(err.msg, "draco.gltf: extensionsRequired names 'KHR_draco_mesh_compression', which "));
+  blob b = {0};
+  unsigned char glb[4096];
+  size_t n = make_glb(text, &b, glb, sizeof glb);
+  assert_null(lm_scene_load_gltf(write_bytes("draco.glb", glb, n), &err));
+  assert_non_null(strstr(err.msg, "draco.glb: extensionsRequired names 'KHR_draco_mesh_compression'"));
+}
+
+/* Every corner of the scene's bounds, seen through camera `cam` at w x h,
+ * lies inside the view; returns the largest |NDC| (how tight the framing is). */
+static float corners_in_view(const lm_scene *s, int cam, int w, int h) {
+  float lo[3], hi[3], most = 0;
+  lm_scene_bounds(s, lo, hi);
+  lm_frame_data f;
+  lm_scene_frame_data(s, cam, w, h, &f);
+  for (int k = 0; k < 8; k++) {
+    float p[3] = {(k & 1 ? hi : lo)[0], (k & 2 ? hi : lo)[1], (k & 4 ? hi : lo)[2]}, clip[4];
+    for (int r = 0; r < 4; r++)
+      clip[r] = f.view_proj[r] * p[0] + f.view_proj[4 + r] * p[1] + f.view_proj[8 + r] * p[2] + f.view_proj[12 + r];
+    assert_true(clip[3] > 0);
+    for (int r = 0; r < 3; r++) {
+      float ndc = clip[r] / clip[3];
+      assert_true(ndc >= -1 && ndc <= 1);
+      if (r < 2) most = fmaxf(most, fabsf(ndc));
+    }
+  }
+  return most;
+}
+
+/* A file without a camera gets one framing its bounds (a long, flat part off
+ * the origin, as an engine block might be): every corner in view on wide
+ * outputs, and tightly (the longest side fills most of the frame). An
+ * "auto" camera fits a given output, a tall one too. A glTF orthographic
+ * camera keeps its index and is refused by name where it would be used. */
+static void cameras_frame_the_bounds(void **state) {
+  (void)state;
+  static const float v[4][3] = {{100, 20, -5}, {160, 20, -5}, {100, 26, 3}, {160, 26, 3}};
+  static const uint16_t idx[6] = {0, 1, 2, 1, 3, 2};
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(write_topology("long.gltf", &v[0][0], 4, idx, 6, 4), &err);
+  if (!s) fail_msg("%s", err.msg);
+  assert_int_equal(s->camera_count, 1);
+  assert_string_equal(s->cameras[0].name, "default_camera");
+  corners_in_view(s, 0, 96, 72);
+  corners_in_view(s, 0, 192, 72);
+  assert_true(corners_in_view(s, 0, 72, 72) > 0.8f); /* fitted for square and wider outputs */
+  int tall = lm_scene_add_framing_camera(s, "auto", 0.5f);
+  assert_int_equal(tall, 1);
+  assert_true(corners_in_view(s, tall, 48, 96) > 0.8f);
+  assert_true(lm_scene_camera_check(s, 0, &err));
+  lm_scene_destroy(s);
+
+  static const char ortho_json[] =
+      "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0,1,2]}],"
+      "\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5]},{\"camera\":1,\"translation\":[0,0,4]}],"
+      "\"cameras\":[{\"name\":\"plan\",\"type\":\"orthographic\",\"orthographic\":{\"xmag\":2,\"ymag\":1.5,"
+      "\"znear\":0.1,\"zfar\":10}},{\"name\":\"eye\",\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,"
+      "\"znear\":0.1}}],"
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+      "\"buffers\":[{\"uri\":\"%s\",\"byteLength\":%zu}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}";
+  blob b = {0};
+  blob_add(&b, tri_pos, sizeof tri_pos);
+  s = lm_scene_load_gltf(write_gltf("ortho.gltf", ortho_json, &b), &err);
+  if (!s) fail_msg("%s", err.msg);
+  assert_int_equal(s->camera_count, 2); /* the file's indices hold */
+  assert_string_equal(s->cameras[1].name, "eye");
+  assert_float_equal(s->cameras[0].ortho[0], 2, 0);
+  assert_false(lm_scene_camera_check(s, 0, &err));
+  assert_non_null(strstr(err.msg, "camera 'plan' (0) is orthographic (xmag 2, ymag 1.5)"));
+  assert_true(lm_scene_camera_check(s, 1, &err));
+  lm_scene_destroy(s);
+}
+
 static const char two_prims_json[] =
     "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0,1]}],"
     "\"nodes\":[{\"name\":\"two\",\"mesh\":0},{\"name\":\"again\",\"mesh\":0,\"translation\":[5,0,0]}],"
@@ -322,7 +524,9 @@ static void assert_lights_and_cameras(const lm_scene *s) {
   assert_string_equal(spot->name, "spot");
   assert_int_equal(spot->type, LM_LIGHT_SPOT);
   assert_float_equal(spot->color[1], 0.5, 1e-6);
-  assert_float_equal(spot->power, 5, 0);
+  /* KHR_lights_punctual: candela and lux through the exposure, the range window */
+  assert_float_equal(spot->power / LM_GLTF_EXPOSURE, 5, 1e-4);
+  assert_int_equal(spot->falloff, LM_FALLOFF_RANGE);
   assert_float_equal(spot->radius, 10, 0);
   assert_float_equal(spot->inner_cone, 0.2, 1e-6);
   assert_float_equal(spot->outer_cone, 0.6, 1e-6);
@@ -330,11 +534,13 @@ static void assert_lights_and_cameras(const lm_scene *s) {
   assert_float_equal(s->nodes[spot->node].world[13], 4, 0);
   assert_int_equal(bulb->type, LM_LIGHT_POINT);
   assert_float_equal(bulb->color[0], 1, 0); /* default white */
-  assert_float_equal(bulb->power, 2, 0);
-  /* No range: twice the bounds' diagonal, the triangle's sqrt(2), at least 1. */
-  assert_float_equal(bulb->radius, 2 * sqrtf(2), 1e-5);
+  assert_float_equal(bulb->power / LM_GLTF_EXPOSURE, 2, 1e-4);
+  /* No range: no window, the light reaches everywhere. */
+  assert_float_equal(bulb->radius, 0, 0);
+  assert_true(isinf(lm_light_reach(bulb)));
+  assert_float_equal(lm_light_reach(spot), 10, 0);
   assert_int_equal(sun->type, LM_LIGHT_DIRECTIONAL);
-  assert_float_equal(sun->power, 1, 0);
+  assert_float_equal(sun->power / LM_GLTF_EXPOSURE, 1, 1e-4);
   assert_int_equal(s->camera_count, 2);
   assert_string_equal(s->cameras[0].name, "main");
   assert_float_equal(s->cameras[0].fov_y, 0.7, 1e-6);
@@ -720,6 +926,9 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(triangle_loads_with_every_index_type),
       cmocka_unit_test(two_primitives_become_two_meshes_and_children),
+      cmocka_unit_test(strips_and_fans_become_triangles),
+      cmocka_unit_test(unsupported_required_extension_is_named),
+      cmocka_unit_test(cameras_frame_the_bounds),
       cmocka_unit_test(hierarchy_composes_rotated_parents),
       cmocka_unit_test(lights_and_cameras_come_over),
       cmocka_unit_test(glb_loads_like_gltf),

@@ -127,12 +127,14 @@ static void mesh_vertices_are_in_world_space(void **state) {
   lm_scene_destroy(s);
 }
 
-/* The seed's window falloff cannot be written: refused by name, or written
- * without falloff with a warning naming the light. */
+/* The seed's window falloff (eq 16) cannot be written: refused by name, or
+ * written without falloff with a warning naming the light. The built-in
+ * box's light made the seed's way: */
 static void window_falloff_is_refused_or_warned_by_name(void **state) {
   (void)state;
   lm_error err;
   lm_scene *s = lm_scene_builtin("cornell", &err);
+  s->lights[0].falloff = LM_FALLOFF_WINDOW;
   lm_pov_desc d = desc_for(64, 48);
   lm_buf out = {0}, warn = {0};
   assert_false(lm_pov_export(s, &d, &out, &warn, &err));
@@ -145,6 +147,82 @@ static void window_falloff_is_refused_or_warned_by_name(void **state) {
   lm_buf_free(&out);
   lm_buf_free(&warn);
   lm_scene_destroy(s);
+}
+
+/* The built-in box's one light is an inverse-square point light: it
+ * exports exactly (fade_power 2), so the box has a POV-Ray reference. */
+static void builtin_cornell_exports_exactly(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *s = lm_scene_builtin("cornell", &err);
+  assert_int_equal(s->light_count, 1);
+  lm_pov_desc d = desc_for(64, 48);
+  lm_buf out = {0}, warn = {0};
+  assert_true(lm_pov_export(s, &d, &out, &warn, &err));
+  assert_null(warn.data);
+  assert_non_null(strstr(out.data, "fade_power 2"));
+  lm_buf_free(&out);
+  lm_scene_destroy(s);
+}
+
+/* glTF's range window (LM_FALLOFF_RANGE): no range, or one so far that the
+ * window stays within LM_POV_RANGE_EXACT of 1 over the scene, is written as
+ * inverse square; a nearer range is refused by name, saying why. */
+static void range_window_is_exact_or_refused_by_name(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *s = lm_scene_builtin("cornell_pov", &err);
+  lm_light *l = &s->lights[0];
+  assert_int_equal(l->falloff, LM_FALLOFF_INVERSE_SQUARE);
+  lm_pov_desc d = desc_for(64, 48);
+  lm_buf square = {0}, out = {0}, warn = {0};
+  assert_true(lm_pov_export(s, &d, &square, NULL, &err));
+  l->falloff = LM_FALLOFF_RANGE;
+  float ranges[] = {0, 100};
+  for (int i = 0; i < 2; i++) {
+    l->radius = ranges[i];
+    assert_true(lm_pov_export(s, &d, &out, &warn, &err));
+    assert_null(warn.data);
+    assert_string_equal(out.data, square.data);
+    lm_buf_free(&out);
+  }
+  l->radius = 3;
+  assert_false(lm_pov_export(s, &d, &out, &warn, &err));
+  assert_non_null(strstr(err.msg, "light 'ceiling_light': range 3: the KHR_lights_punctual window"));
+  assert_non_null(strstr(err.msg, "no POV-Ray light fades to zero at a distance"));
+  lm_buf_free(&out);
+  d.strict = false;
+  assert_true(lm_pov_export(s, &d, &out, &warn, &err));
+  assert_non_null(strstr(warn.data, "light 'ceiling_light': range 3"));
+  assert_string_equal(out.data, square.data);
+  lm_buf_free(&out);
+  lm_buf_free(&warn);
+  lm_buf_free(&square);
+  lm_scene_destroy(s);
+}
+
+/* The C twin of lighting.glsl's light_falloff, and where each light ends. */
+static void falloff_and_reach(void **state) {
+  (void)state;
+  assert_float_equal(lm_light_falloff(LM_FALLOFF_NONE, 7, 1), 1, 0);
+  assert_float_equal(lm_light_falloff(LM_FALLOFF_INVERSE_SQUARE, 2, 1), 0.25, 1e-7);
+  assert_float_equal(lm_light_falloff(LM_FALLOFF_INVERSE_SQUARE, 0, 1), 1e8, 1);
+  assert_float_equal(lm_light_falloff(LM_FALLOFF_WINDOW, 1, 2), 0.75, 1e-7);
+  assert_float_equal(lm_light_falloff(LM_FALLOFF_WINDOW, 3, 2), 0, 0);
+  assert_float_equal(lm_light_falloff(LM_FALLOFF_RANGE, 2, 0), 0.25, 1e-7);
+  assert_float_equal(lm_light_falloff(LM_FALLOFF_RANGE, 2, 4), (1 - 1 / 16.0) / 4, 1e-7);
+  assert_float_equal(lm_light_falloff(LM_FALLOFF_RANGE, 4, 4), 0, 0);
+  assert_float_equal(lm_light_falloff(LM_FALLOFF_RANGE, 9, 4), 0, 0);
+  lm_light l = {.type = LM_LIGHT_POINT, .falloff = LM_FALLOFF_RANGE, .radius = 4};
+  assert_float_equal(lm_light_reach(&l), 4, 0);
+  l.radius = 0;
+  assert_true(isinf(lm_light_reach(&l)));
+  l.falloff = LM_FALLOFF_WINDOW, l.radius = 3;
+  assert_float_equal(lm_light_reach(&l), 3, 0);
+  l.falloff = LM_FALLOFF_INVERSE_SQUARE;
+  assert_true(isinf(lm_light_reach(&l)));
+  l.type = LM_LIGHT_DIRECTIONAL, l.falloff = LM_FALLOFF_WINDOW;
+  assert_true(isinf(lm_light_reach(&l)));
 }
 
 static void unmatched_spots_and_materials_are_named(void **state) {
@@ -214,6 +292,9 @@ int main(void) {
       cmocka_unit_test(camera_lights_and_materials_match),
       cmocka_unit_test(mesh_vertices_are_in_world_space),
       cmocka_unit_test(window_falloff_is_refused_or_warned_by_name),
+      cmocka_unit_test(builtin_cornell_exports_exactly),
+      cmocka_unit_test(range_window_is_exact_or_refused_by_name),
+      cmocka_unit_test(falloff_and_reach),
       cmocka_unit_test(unmatched_spots_and_materials_are_named),
       cmocka_unit_test(bad_views_are_refused),
   };

@@ -43,10 +43,30 @@ faithful() {
 # that GL's rasterizer gives to the ceiling and POV-Ray to the wall. Elsewhere
 # the two agree to about 0.1% (the G-buffer's 8-bit albedo, 16-bit light).
 faithful cornell_pov cornell 0.005
+# The built-in box with its one inverse-square light. Measured 0.0010.
+faithful cornell cornell1 0.005
 # A glTF file: parented, rotated and non-uniformly scaled nodes (normals by
 # the inverse transpose), smooth normals, a rotated camera with its own fov,
 # a parallel light, Phong from metallic-roughness. Measured 0.0007.
 faithful "$root/data/scenes/pov_ball.gltf" ball 0.003
+
+# glTF point and spot lights (KHR_lights_punctual: 1/d^2, candela through the
+# exposure) at several heights over a floor, without range and with ranges far
+# enough that the window is 1 to within 1/512 over the scene; the intensity
+# grows with the height squared so the floor stays about as bright. A range
+# ending inside the scene is refused by name. Measured at most 0.0004 (Pearson 0.9999999).
+for view in 0.5: 0.5:40 1.5:100 3: 3:40; do
+  y=${view%%:*} range=${view#*:}
+  intensity=$(awk -v h=$y 'BEGIN { printf "%.6g", 1.5 * h * h * 683 * 3.14159265 }')
+  name=lights_h${y/./_}_r${range:-none}
+  sed -e "s/@H@/$y/g" -e "s/@I@/$intensity/g" -e "s/@RANGE@/${range:+, \"range\": $range}/g" \
+    "$root/tests/pov_lights.gltf.in" >"$tmp/$name.gltf"
+  faithful "$tmp/$name.gltf" "$name" 0.003
+done
+sed -e "s/@H@/1.5/g" -e "s/@I@/5000/g" -e 's/@RANGE@/, "range": 4/g' "$root/tests/pov_lights.gltf.in" >"$tmp/near.gltf"
+"$limn" export-pov --scene "$tmp/near.gltf" --size $size --output "$tmp/near.pov" 2>"$tmp/near.err" \
+  && fail "a range ending inside the scene was exported"
+grep -q "light 'bulb': range 4: the KHR_lights_punctual window" "$tmp/near.err" || { cat "$tmp/near.err"; fail "the refusal does not name the light"; }
 
 # The radiosity export parses and renders (small and coarse to stay fast),
 # and its indirect light changes the image while the geometry stays put.

@@ -6,7 +6,9 @@
 # - a failing POV-Ray run names the view, shows POV-Ray's error lines, exits
 #   1 and leaves no reference or temporary file;
 # - a two-setting sweep writes the CSV, the JSON, the SVG (it parses as XML)
-#   and the Markdown summary, with consistent numbers.
+#   and the Markdown summary, with consistent numbers; it renders (once) the
+#   direct-only reference of the view, whose error against the baseline is
+#   the floor of the share of indirect error removed.
 # Skipped (77) where povray is not installed (tools/dev.sh installs it).
 set -u
 limn=$1
@@ -38,8 +40,8 @@ ls refs/ball | grep -q "tmp" && fail "a temporary file was left: $(ls refs/ball)
 "$limn" reference --job job.lua "${fast[@]}" >log2 2>&1 || { cat log2; fail "second reference run"; }
 grep -q "0 rendered, 1 cached" log2 || { cat log2; fail "the second run rendered again"; }
 # A changed scene (the sun's intensity) is a new export: rendered again.
-sed -i 's/"intensity": 2.0/"intensity": 1.5/' ball.gltf
-grep -q '"intensity": 1.5' ball.gltf || fail "could not change the scene"
+sed -i 's/"intensity": 4291.327/"intensity": 3000/' ball.gltf
+grep -q '"intensity": 3000' ball.gltf || fail "could not change the scene"
 "$limn" reference --job job.lua "${fast[@]}" >log3 2>&1 || { cat log3; fail "third reference run"; }
 grep -q "1 rendered, 0 cached" log3 || { cat log3; fail "a changed scene was not rendered again"; }
 [ "$(ls refs/ball/front_48x36-*.exr | wc -l)" = 2 ] || fail "the changed scene did not get its own reference"
@@ -70,20 +72,26 @@ ls refs-bad/ball/*.exr 2>/dev/null && fail "a failed run left an image"
 [ $? = 1 ] || fail "a missing POV-Ray program did not fail"
 grep -q "cannot run" log5 || { cat log5; fail "a missing program is not said"; }
 
-# Lights POV-Ray cannot match (cornell.glb's window falloff) are refused by name, before POV-Ray runs.
-printf 'return { scenes = { "%s/data/scenes/cornell.glb" }, sizes = { "32x24" }, output = "o/{camera}.png" }\n' \
-  "$root" > cornell.lua
-"$limn" reference --job cornell.lua "${fast[@]}" --refs refs-cornell >log8 2>&1
+# Lights POV-Ray cannot match (a glTF point light whose range ends inside the scene) are refused by
+# name, before POV-Ray runs.
+sed 's/"type": "directional",/"type": "point", "range": 0.5,/' ball.gltf > near.gltf
+grep -q '"range": 0.5' near.gltf || fail "could not write near.gltf"
+printf 'return { scenes = { { scene = "near.gltf", cameras = "ball.cams" } }, sizes = { "32x24" }, output = "o/{camera}.png" }\n' \
+  > near.lua
+"$limn" reference --job near.lua "${fast[@]}" --refs refs-near >log8 2>&1
 [ $? = 1 ] || { cat log8; fail "an unmatchable light was not refused"; }
-grep -q "view 0 (cornell, camera 'front', 32x24): .*light 'ceiling_light': the window falloff" log8 \
+grep -q "view 0 (near, camera 'front', 32x24): .*light 'sun': range 0.5: the KHR_lights_punctual window" log8 \
   || { cat log8; fail "the refusal does not name the view and the light"; }
-ls refs-cornell/cornell/*.exr 2>/dev/null && fail "a refused view was rendered"
+ls refs-near/near/*.exr 2>/dev/null && fail "a refused view was rendered"
 
 # 3. a two-setting sweep on the one view: the reference is cached
 "$limn" report --job job.lua "${fast[@]}" --out rep --frames 2 --warmup 1 --sweep "isr:isr.samples=8,16" \
   >log6 2>&1 || { cat log6; fail "report"; }
 cat log6
 grep -q "0 rendered, 1 cached" log6 || fail "the report rendered a cached reference again"
+# ... and rendered the direct-only one (no radiosity block) beside it
+[ "$(ls refs/ball/front_48x36-*.exr | wc -l)" = 3 ] || fail "no direct-only reference beside the two"
+[ "$(grep -L "radiosity {" refs/ball/*.pov | wc -l)" = 1 ] || fail "not one export without radiosity"
 for f in report.csv report.json report.svg report.md; do [ -s rep/$f ] || fail "no rep/$f"; done
 cat rep/report.csv rep/report.md
 # CSV: a header and three rows: the baseline dl and the two settings
@@ -115,6 +123,25 @@ e_8=$(awk -F, 'NR == 3 { print $8 }' rep/report.csv)
 gain=$(awk -v b="$e_dl" -v e="$e_8" 'BEGIN { printf "%.2f", 100 * (b - e) / b }')
 grep -q "| isr samples=8 | [0-9.]* | [0-9.]* | $gain | $gain | " rep/report.md \
   || fail "the summary's gain for samples=8 is not $gain"
+# The direct-only floor: one value for the view on every row; the share of
+# indirect error removed is 100 (e_dl - e) / (e_dl - floor), n/a for the baseline.
+floor=$(awk -F, 'NR == 2 { print $16 }' rep/report.csv)
+awk -F, -v f="$floor" 'NR > 1 && $16 != f { bad = 1 } END { exit bad }' rep/report.csv \
+  || fail "the floor differs between rows of one view"
+awk -v f="$floor" -v b="$e_dl" 'BEGIN { exit !(f > 0 && f < b) }' \
+  || fail "the floor $floor is not between 0 and the baseline's error $e_dl"
+awk -F, 'NR == 2 { exit $17 != "n/a" }' rep/report.csv || fail "the baseline has a share of indirect error removed"
+share=$(awk -F, 'NR == 3 { print $17 }' rep/report.csv)
+awk -v s="$share" -v b="$e_dl" -v e="$e_8" -v f="$floor" 'BEGIN { w = 100 * (b - e) / (b - f); exit !(s - w < 0.01 && w - s < 0.01) }' \
+  || fail "indirect error removed $share is not 100 ($e_dl - $e_8) / ($e_dl - $floor)"
+grep -q '"direct_floor": ' rep/report.json || fail "the JSON has no direct_floor"
+grep -q '"indirect_removed": null' rep/report.json || fail "the JSON's baseline share is not null"
+grep -q "^Direct-only floor, mean over the views: " rep/report.md || fail "the summary does not give the floor"
+grep -q "| indirect error removed % |" rep/report.md || fail "the summary has no indirect share column"
+# The SVG draws the floor and zooms its error axis to the data: the lowest tick is above 0.
+[ "$(grep -c '<line class="floor"' rep/report.svg)" = 1 ] || fail "the SVG has no floor line"
+low=$(grep -o 'text-anchor="end">[-0-9.e+]*<' rep/report.svg | head -1 | tr -dc '0-9.e+-')
+awk -v l="$low" 'BEGIN { exit !(l > 0) }' || fail "the error axis starts at $low, not at the data"
 # The images are there to look at.
 [ "$(ls rep/images/*.exr | wc -l)" = 3 ] || fail "not three images"
 
@@ -123,4 +150,9 @@ grep -q "| isr samples=8 | [0-9.]* | [0-9.]* | $gain | $gain | " rep/report.md \
 [ $? = 1 ] || { cat log7; fail "--require-refs without references did not fail"; }
 grep -q "limn reference --job job.lua --refs refs-none" log7 || { cat log7; fail "the command is not named"; }
 [ -e rep2/report.csv ] && fail "a failed report wrote its CSV"
+# ... and names the direct-only one's command when only that is missing
+mkdir -p refs-rad/ball && cp $(grep -l "radiosity {" refs/ball/*.pov | sed 's/pov$/exr/') refs-rad/ball/
+"$limn" report --job job.lua "${fast[@]}" --refs refs-rad --require-refs --out rep3 --sweep dl >log9 2>&1
+[ $? = 1 ] || { cat log9; fail "--require-refs without direct-only references did not fail"; }
+grep -q "limn reference --job job.lua --refs refs-rad --radiosity off" log9 || { cat log9; fail "the direct-only command is not named"; }
 echo "passed"

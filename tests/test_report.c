@@ -43,8 +43,11 @@ static void gains_by_hand(void **state) {
    * (50 + 10 + 180 + 0) / 500 = 0.48. Pearson means 0.8 and 0.85. */
   double base[] = {0.1, 0.2, 0.4, 0.5}, e[] = {0.09, 0.25, 0.3, 0.5}, closer[] = {0.5, 0.1, 0.9, 0};
   double px[] = {100, 100, 200, 100}, pb[] = {0.7, 0.8, 0.9, 0.8}, pa[] = {0.8, 0.8, 0.9, 0.9};
+  /* Direct-only floors 0.05 0.1 0.4 0.1: indirect errors 0.05 0.1 (none) 0.4;
+   * removed 20, -50, n/a, 0: mean over the three views -10. */
+  double fl[] = {0.05, 0.1, 0.4, 0.1};
   report_summary s;
-  report_summarize(4, base, e, closer, px, pb, pa, &s);
+  report_summarize(4, base, fl, e, closer, px, pb, pa, &s);
   assert_int_equal(s.views, 4);
   assert_float_equal(s.mean_gain, 2.5, 1e-9);
   assert_float_equal(s.median_gain, 5.0, 1e-9);
@@ -52,13 +55,39 @@ static void gains_by_hand(void **state) {
   assert_float_equal(s.pixels_closer, 0.48, 1e-12);
   assert_float_equal(s.pearson_before, 0.8, 1e-12);
   assert_float_equal(s.pearson_after, 0.85, 1e-12);
+  assert_float_equal(s.views_pearson_rose, 0.5, 1e-12); /* views 0 and 3 */
+  assert_int_equal(s.indirect_views, 3);
+  assert_float_equal(s.indirect_removed, -10.0, 1e-9);
+  assert_float_equal(s.floor, 0.1625, 1e-12);
   /* An odd count takes the middle gain. */
-  report_summarize(3, base, e, closer, px, pb, pa, &s);
+  report_summarize(3, base, fl, e, closer, px, pb, pa, &s);
   assert_float_equal(s.median_gain, 10.0, 1e-9);
   assert_float_equal(s.mean_gain, 10.0 / 3.0, 1e-9);
-  report_summarize(0, base, e, closer, px, pb, pa, &s);
+  assert_int_equal(s.indirect_views, 2);
+  assert_float_equal(s.indirect_removed, -15.0, 1e-9);
+  report_summarize(0, base, fl, e, closer, px, pb, pa, &s);
   assert_int_equal(s.views, 0);
   assert_float_equal(s.mean_gain, 0, 0);
+  assert_int_equal(s.indirect_views, 0);
+  assert_float_equal(s.indirect_removed, 0, 0);
+}
+
+/* The share of indirect error removed: by hand, and n/a (false, the output
+ * untouched) when the floor is not below the baseline: never a division by 0. */
+static void indirect_share_by_hand(void **state) {
+  (void)state;
+  double v = 123;
+  assert_true(report_indirect_removed(0.04, 0.01, 0.025, &v));
+  assert_float_equal(v, 50.0, 1e-9);
+  assert_true(report_indirect_removed(0.04, 0.01, 0.01, &v));
+  assert_float_equal(v, 100.0, 1e-9); /* down to the floor: all of it */
+  assert_true(report_indirect_removed(0.04, 0.01, 0.05, &v));
+  assert_float_equal(v, -100.0 / 3.0, 1e-9);
+  v = 123;
+  assert_false(report_indirect_removed(0.04, 0.04, 0.03, &v));
+  assert_false(report_indirect_removed(0.04, 0.05, 0.03, &v));
+  assert_false(report_indirect_removed(0, 0, 0, &v));
+  assert_float_equal(v, 123, 0);
 }
 
 static void sweep_syntax(void **state) {
@@ -103,6 +132,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(pareto_crafted),
       cmocka_unit_test(gains_by_hand),
+      cmocka_unit_test(indirect_share_by_hand),
       cmocka_unit_test(sweep_syntax),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "tools.h"
+#include "scene/scene.h"
 
 bool limn_parse_int(const char *s, int lo, int hi, int *out) {
   char *end;
@@ -29,6 +30,19 @@ bool limn_parse_size(const char *s, int *w, int *h) {
   if (!x) return false;
   *x = '\0';
   return limn_parse_int(buf, 1, 65536, w) && limn_parse_int(x + 1, 1, 65536, h);
+}
+
+bool limn_parse_camera(const char *s, int *out) {
+  if (!strcmp(s, "auto")) {
+    *out = LIMN_CAMERA_AUTO;
+    return true;
+  }
+  return limn_parse_int(s, 0, 1 << 20, out);
+}
+
+int limn_camera_resolve(lm_scene *s, int camera, int width, int height) {
+  if (camera != LIMN_CAMERA_AUTO) return camera;
+  return lm_scene_add_framing_camera(s, "auto", (float)width / (float)height);
 }
 
 bool limn_parse_on_off(const char *s, bool *out) {

@@ -28,7 +28,8 @@ static const char capture_usage[] =
     "                       (repeatable; dotted names reach nested options)\n"
     "  --size WxH           output size (default 256x192)\n"
     "  --frames N           frames to render (default 1); times are medians\n"
-    "  --camera N           camera index of the scene (default 0)\n"
+    "  --camera N           camera index of the scene (default 0), or auto:\n"
+    "                       one framing the scene's bounds\n"
     "  --output FILE        image to write, .png or .exr (repeatable)\n"
     "  --clock auto|gpu|cpu how passes are timed (default auto: GL timer queries,\n"
     "                       or glFinish + a CPU clock on software renderers)\n"
@@ -117,7 +118,7 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       if (!limn_parse_int(optarg, 1, 100000, &a->frames)) return usage_error("--frames wants 1..100000, not '%s'", optarg);
       break;
     case 'c':
-      if (!limn_parse_int(optarg, 0, 1 << 20, &a->camera)) return usage_error("--camera wants an index, not '%s'", optarg);
+      if (!limn_parse_camera(optarg, &a->camera)) return usage_error("--camera wants an index or auto, not '%s'", optarg);
       break;
     case 'o': {
       bool linear;
@@ -325,6 +326,7 @@ int limn_capture(int argc, char **argv) {
     lm_pipeline_destroy(pipeline);
     return 2;
   }
+  a.camera = limn_camera_resolve(scene, a.camera, a.width, a.height);
   if (a.camera > 0 && a.camera >= scene->camera_count) {
     lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a.camera, a.scene, scene->camera_count);
     lm_scene_destroy(scene);

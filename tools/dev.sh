@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # One entry point for a fresh Debian 12 checkout:
-#   tools/dev.sh run    install what is missing, build, capture the default scene
+#   tools/dev.sh run    install what is missing, build, render the Cornell box with the default
+#                       technique, then error against time for dl+esm, the seed's ISR and the
+#                       default against POV-Ray references (data/jobs/quick.lua, cached)
 #   tools/dev.sh test   install what is missing, build, run the whole test suite
 #   tools/dev.sh build  install what is missing and build
 # BUILD_DIR (default build) and CMAKE_ARGS pass through to CMake.
@@ -47,8 +49,15 @@ case "${1:-run}" in
   run)
     deps; build
     mkdir -p out
-    "${BUILD_DIR:-build}/limn" capture --scene cornell --script scripts/pp.lua --tech dl --size 256x192 \
+    LIMN=${BUILD_DIR:-build}/limn
+    # shellcheck source=tools/techniques.sh
+    . tools/techniques.sh
+    "$LIMN" capture --scene cornell --script scripts/pp.lua --tech "$(limn_default_technique)" --size 256x192 \
       --frames 5 --output out/cornell.png --output out/cornell.exr
+    echo
+    echo "Error against time on the reference set at 80x60, POV-Ray references (rendered once, cached in out/reference):"
+    limn_gi_report out/quick data/jobs/quick.lua 3 "$LIMN_BASELINE=$LIMN_BASELINE" \
+      "seed ISR=$(limn_seed_isr_spec)" "default=$(limn_default_spec)"
     ;;
   test)
     deps; build

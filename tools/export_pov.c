@@ -25,7 +25,8 @@ static const char export_usage[] =
     "options:\n"
     "  --scene NAME|FILE      built-in scene or .gltf/.glb file (default cornell;\n"
     "                         built in: %s)\n"
-    "  --camera N             camera index of the scene (default 0)\n"
+    "  --camera N             camera index of the scene (default 0), or auto:\n"
+    "                         one framing the scene's bounds\n"
     "  --size WxH             output size, for the aspect (default 256x192)\n"
     "  --radiosity on|off     radiosity block (default on)\n"
     "  --count N              radiosity count (default 250)\n"
@@ -124,8 +125,8 @@ static int parse_args(int argc, char **argv, export_args *a) {
     switch (c) {
     case 's': a->scene = optarg; break;
     case 'c':
-      if (!limn_parse_int(optarg, 0, 1 << 20, &a->desc.camera))
-        return usage_error("--camera wants an index, not '%s'", optarg);
+      if (!limn_parse_camera(optarg, &a->desc.camera))
+        return usage_error("--camera wants an index or auto, not '%s'", optarg);
       break;
     case 'z':
       if (!limn_parse_size(optarg, &a->desc.width, &a->desc.height))
@@ -173,6 +174,7 @@ int limn_export_pov(int argc, char **argv) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 2;
   }
+  a.desc.camera = limn_camera_resolve(scene, a.desc.camera, a.desc.width, a.desc.height);
   if (a.desc.camera > 0 && a.desc.camera >= scene->camera_count) {
     lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a.desc.camera, a.scene, scene->camera_count);
     lm_scene_destroy(scene);

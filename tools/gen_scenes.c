@@ -1,8 +1,10 @@
 /* gen_scenes: writes the test scenes of data/scenes (GLB files, their camera
- * lists and the PNG textures they embed). Deterministic: no clock, no
+ * lists and the PNG textures they embed) and the reference set's scenes
+ * under data/scenes/reference. Deterministic: no clock, no
  * libraries, a fixed pseudo-random sequence and fixed float formatting, so
  * that running it again gives the same bytes (tests/test_gen_scenes.sh
  * checks). Usage: gen_scenes OUTDIR */
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdbool.h>
@@ -10,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #define PI 3.14159265358979f
 
@@ -428,7 +431,13 @@ static void view(doc *d, const char *name, float ex, float ey, float ez, float t
   putf(&d->cams, "%-10s %8.3f %8.3f %8.3f   %8.3f %8.3f %8.3f   %5.1f\n", name, ex, ey, ez, tx, ty, tz, fov_deg);
 }
 
-/* type: "point", "spot", "directional"; range 0: none. */
+/* type: "point", "spot", "directional"; intensity in candela (point, spot) or
+ * lux (directional), KHR_lights_punctual's units; range 0: none, so that the
+ * light falls off as 1 / d^2 alone, which POV-Ray matches exactly. The
+ * candela values below give about the light the scenes had under the seed's
+ * window falloff at the surfaces each light faces (the floor below it):
+ * old * (1 - (d/r)^2) * d^2 * 683 pi, engine/scene/gltf.h's exposure (the
+ * Cornell box's less: its walls are near the light). */
 static void light(doc *d, const char *name, const char *type, float x, float y, float z, const float dir[3],
                   float r, float g, float b, float intensity, float range) {
   int n = add_node(d, name, -1, x, y, z);
@@ -591,7 +600,7 @@ static void cornell(const char *dir) {
   d.nodes[s].s[0] = d.nodes[s].s[1] = d.nodes[s].s[2] = 0.6f;
   int t = mesh_node(&d, "tall_box", -1, cube, -0.35f, 0, -0.35f, 17, 1);
   d.nodes[t].s[0] = 0.6f, d.nodes[t].s[1] = 1.2f, d.nodes[t].s[2] = 0.6f;
-  light(&d, "ceiling_light", "point", 0, 1.85f, 0, NULL, 1, 0.95f, 0.85f, 1.6f, 4);
+  light(&d, "ceiling_light", "point", 0, 1.7f, 0, NULL, 1, 0.95f, 0.85f, 6000, 0);
   view(&d, "front", 0, 1, 3.4f, 0, 1, 0, 45, 20);
   view(&d, "left", -0.6f, 1.2f, 2.6f, 0.1f, 0.8f, 0, 50, 20);
   view(&d, "high", 0.3f, 1.8f, 2.2f, 0, 0.4f, 0, 55, 20);
@@ -652,8 +661,8 @@ static void primitives(const char *dir) {
   int car = mesh_node(&d, "car", -1, car_mesh(&d, paint, glass, tyre), 0, 0, 0, 25, 1);
   sphere(&m, 0.08f, 12, 6);
   mesh_node(&d, "car_light", car, add_mesh1(&d, "beacon", &m, yellow), -0.1f, 1.15f, 0, 0, 1);
-  light(&d, "sun", "directional", 0, 10, 0, (float[]){-0.4f, -1, -0.6f}, 1, 0.97f, 0.9f, 1.2f, 0);
-  light(&d, "fill", "point", 2, 3, 3, NULL, 0.6f, 0.7f, 1, 1.0f, 10);
+  light(&d, "sun", "directional", 0, 10, 0, (float[]){-0.4f, -1, -0.6f}, 1, 0.97f, 0.9f, 2575, 0);
+  light(&d, "fill", "point", 2, 3, 3, NULL, 0.6f, 0.7f, 1, 36800, 0);
   view(&d, "front", 0, 2.2f, 6.5f, 0, 0.4f, 0, 45, 60);
   view(&d, "side", 6, 1.5f, 1, 0, 0.5f, 0, 45, 60);
   view(&d, "top", 0.5f, 8, 3, 0, 0, 0, 50, 60);
@@ -726,9 +735,9 @@ static void office(const char *dir) {
     snprintf(nm, sizeof nm, "books%d", b);
     mesh_node(&d, nm, shelf, add_mesh1(&d, nm, &m, books[b]), 0, 0, 0, 0, 1);
   }
-  light(&d, "lamp_a", "point", -1.5f, 2.4f, 0, NULL, 1, 0.95f, 0.85f, 1.2f, 5);
-  light(&d, "lamp_b", "point", 1.5f, 2.4f, 0, NULL, 1, 0.95f, 0.85f, 1.2f, 5);
-  light(&d, "window", "directional", 0, 2, 0, (float[]){0.3f, -0.8f, -0.5f}, 0.9f, 0.95f, 1, 0.3f, 0);
+  light(&d, "lamp_a", "point", -1.5f, 2.1f, 0, NULL, 1, 0.95f, 0.85f, 8700, 0);
+  light(&d, "lamp_b", "point", 1.5f, 2.1f, 0, NULL, 1, 0.95f, 0.85f, 8700, 0);
+  light(&d, "window", "directional", 0, 2, 0, (float[]){0.3f, -0.8f, -0.5f}, 0.9f, 0.95f, 1, 644, 0);
   view(&d, "door", 0, 1.6f, 2.9f, 0, 0.8f, -1, 60, 30);
   view(&d, "corner", -2.8f, 2.2f, 2.8f, 0.5f, 0.5f, -0.5f, 60, 30);
   view(&d, "desk", 1.4f, 1.2f, 2.3f, 1.5f, 0.7f, 1.0f, 50, 30);
@@ -782,12 +791,12 @@ static void garage(const char *dir) {
   for (int i = 0; i < 4; i++) {
     char nm[32];
     snprintf(nm, sizeof nm, "spot%d", i);
-    light(&d, nm, "spot", 0, H - 0.1f, -2.5f - 5 * (float)i, (float[]){0, -1, 0.0001f}, 1, 0.9f, 0.75f, 1.5f, 7);
+    light(&d, nm, "spot", 0, H - 0.1f, -2.5f - 5 * (float)i, (float[]){0, -1, 0.0001f}, 1, 0.9f, 0.75f, 22400, 0);
   }
   for (int i = 0; i < 3; i++) { /* wall washers, so the brick shows */
     char nm[32];
     snprintf(nm, sizeof nm, "wash%d", i);
-    light(&d, nm, "point", i % 2 ? 2.8f : -2.8f, 2.6f, -3 - 6 * (float)i, NULL, 1, 0.85f, 0.7f, 1.0f, 8);
+    light(&d, nm, "point", i % 2 ? 2.8f : -2.8f, 2.6f, -3 - 6 * (float)i, NULL, 1, 0.85f, 0.7f, 13000, 0);
   }
   view(&d, "entrance", 0, 1.6f, -0.5f, 0, 1.2f, -20, 60, 40);
   view(&d, "cars", -0.5f, 1.8f, -6, 3, 0.6f, -9, 55, 40);
@@ -851,13 +860,135 @@ static void outdoor(const char *dir) {
     float s = 0.3f + 0.6f * rnd();
     d.nodes[b].s[0] = s * 1.4f, d.nodes[b].s[1] = s * 0.7f, d.nodes[b].s[2] = s;
   }
-  light(&d, "sun", "directional", 0, 50, 0, (float[]){-0.5f, -0.7f, -0.3f}, 1, 0.95f, 0.85f, 1.3f, 0);
-  light(&d, "sky", "directional", 0, 50, 0, (float[]){0.3f, -1, 0.4f}, 0.4f, 0.5f, 0.7f, 0.35f, 0);
+  light(&d, "sun", "directional", 0, 50, 0, (float[]){-0.5f, -0.7f, -0.3f}, 1, 0.95f, 0.85f, 2789, 0);
+  light(&d, "sky", "directional", 0, 50, 0, (float[]){0.3f, -1, 0.4f}, 0.4f, 0.5f, 0.7f, 751, 0);
   view(&d, "overview", 0, 40, 85, 0, 0, 0, 60, 400);
   view(&d, "valley", -60, 12, 60, 10, 0, -10, 70, 400);
   view(&d, "ground", 5, 4, 20, 0, 2, 0, 60, 400);
   view(&d, "above", 0, 120, 1, 0, 0, 0, 60, 400);
   finish(&d, dir, "outdoor");
+}
+
+/* ---- the reference set (data/jobs/reference.lua) ---------------------------
+ * Scenes where indirect light is a large share of the image, lit only by
+ * lights that limn export-pov matches exactly (directional lights), so that
+ * POV-Ray's radiosity gives each view's reference. No ambient term: the job
+ * sets ambient = 0. Written under OUTDIR/reference/. Sun intensities are
+ * lux: SUN * 683 pi is SUN in the engine's units (engine/scene/gltf.h). */
+#define LUX (683 * PI)
+
+/* A wall in the plane x = x0 facing +x (sign 1) or -x (sign -1), z in [z0, z1], y in [y0, y1]. */
+static void wall_x(mesh *m, float x0, float sign, float z0, float z1, float y0, float y1) {
+  if (sign > 0) quad(m, (float[]){x0, y0, z1}, (float[]){0, 0, z0 - z1}, (float[]){0, y1 - y0, 0}, 1, 1);
+  else quad(m, (float[]){x0, y0, z0}, (float[]){0, 0, z1 - z0}, (float[]){0, y1 - y0, 0}, 1, 1);
+}
+
+/* A wall in the plane z = z0 facing +z (sign 1) or -z (sign -1), x in [x0, x1], y in [y0, y1]. */
+static void wall_z(mesh *m, float z0, float sign, float x0, float x1, float y0, float y1) {
+  if (sign > 0) quad(m, (float[]){x0, y0, z0}, (float[]){x1 - x0, 0, 0}, (float[]){0, y1 - y0, 0}, 1, 1);
+  else quad(m, (float[]){x1, y0, z0}, (float[]){x0 - x1, 0, 0}, (float[]){0, y1 - y0, 0}, 1, 1);
+}
+
+/* A floor (facing up, at y) or a ceiling (facing down) over x in [x0, x1], z in [z0, z1]. */
+static void slab(mesh *m, float y, bool up, float x0, float x1, float z0, float z1) {
+  if (up) quad(m, (float[]){x0, y, z1}, (float[]){x1 - x0, 0, 0}, (float[]){0, 0, z0 - z1}, 1, 1);
+  else quad(m, (float[]){x0, y, z0}, (float[]){x1 - x0, 0, 0}, (float[]){0, 0, z1 - z0}, 1, 1);
+}
+
+static int diffuse(doc *d, const char *name, float r, float g, float b) {
+  return add_material(d, name, r, g, b, 0, 1, -1);
+}
+
+/* A closed room, 4 x 2.5 x 4, lit only by a sun through a window in its
+ * left wall: a bright patch on the floor, everything else bounce light. */
+static void ref_room(const char *dir) {
+  doc d = {0};
+  int wall = diffuse(&d, "plaster", 0.8f, 0.78f, 0.74f), floor = diffuse(&d, "floor", 0.6f, 0.42f, 0.28f);
+  int ceiling = diffuse(&d, "ceiling", 0.85f, 0.85f, 0.85f), sofa = diffuse(&d, "sofa", 0.2f, 0.3f, 0.65f);
+  int chest = diffuse(&d, "chest", 0.75f, 0.45f, 0.12f), shelf = diffuse(&d, "shelf", 0.25f, 0.55f, 0.3f);
+  float W = 2, H = 2.5f, D = 2; /* x in [-W, W], z in [-D, D] */
+  float wz0 = -0.9f, wz1 = 0.9f, wy0 = 0.8f, wy1 = 2.1f; /* the window in the x = -W wall */
+  mesh m = {0};
+  slab(&m, 0, true, -W, W, -D, D);
+  mesh_node(&d, "floor", -1, add_mesh1(&d, "floor", &m, floor), 0, 0, 0, 0, 1);
+  slab(&m, H, false, -W, W, -D, D);
+  mesh_node(&d, "ceiling", -1, add_mesh1(&d, "ceiling", &m, ceiling), 0, 0, 0, 0, 1);
+  wall_x(&m, -W, 1, -D, D, 0, wy0);      /* under the window */
+  wall_x(&m, -W, 1, -D, D, wy1, H);      /* over it */
+  wall_x(&m, -W, 1, -D, wz0, wy0, wy1);  /* beside it */
+  wall_x(&m, -W, 1, wz1, D, wy0, wy1);
+  wall_x(&m, W, -1, -D, D, 0, H);
+  wall_z(&m, -D, 1, -W, W, 0, H);
+  wall_z(&m, D, -1, -W, W, 0, H);
+  mesh_node(&d, "walls", -1, add_mesh1(&d, "walls", &m, wall), 0, 0, 0, 0, 1);
+  box(&m, 0.3f, 0.25f, -1.55f, 0.9f, 0.25f, 0.4f);
+  box(&m, 0.3f, 0.6f, -1.88f, 0.9f, 0.35f, 0.08f);
+  mesh_node(&d, "sofa", -1, add_mesh1(&d, "sofa", &m, sofa), 0, 0, 0, 0, 1);
+  box(&m, 0.4f, 0.3f, 0.5f, 0.35f, 0.3f, 0.3f);
+  mesh_node(&d, "chest", -1, add_mesh1(&d, "chest", &m, chest), 0, 0, 0, 0, 1);
+  box(&m, 1.8f, 0.9f, 1.2f, 0.2f, 0.9f, 0.6f);
+  mesh_node(&d, "shelf", -1, add_mesh1(&d, "shelf", &m, shelf), 0, 0, 0, 0, 1);
+  light(&d, "sun", "directional", -6, 5, 0, (float[]){1, -0.7f, 0.25f}, 1, 0.96f, 0.9f, 3 * LUX, 0);
+  view(&d, "window", 1.2f, 1.5f, 1.8f, -1.2f, 0.8f, -0.4f, 60, 20);
+  view(&d, "back", -1.6f, 1.4f, 1.5f, 0.6f, 0.9f, -1.2f, 60, 20);
+  view(&d, "ceiling", 1.5f, 0.4f, -1.5f, -0.5f, 2.3f, 0.8f, 65, 20);
+  view(&d, "corner", -1.2f, 1.6f, -1.2f, 1.5f, 1.0f, 1.5f, 60, 20);
+  finish(&d, dir, "room");
+}
+
+/* A street of coloured walls open to a black sky: the sun lights the right
+ * wall and a strip of road; the left wall and the rest of the road are in
+ * shade and see the sunlit wall. */
+static void ref_street(const char *dir) {
+  doc d = {0};
+  int road = diffuse(&d, "road", 0.5f, 0.5f, 0.5f), left = diffuse(&d, "terracotta", 0.75f, 0.4f, 0.25f);
+  int right = diffuse(&d, "ochre", 0.85f, 0.75f, 0.4f), crate = diffuse(&d, "crate", 0.3f, 0.45f, 0.7f);
+  int bench = diffuse(&d, "bench", 0.8f, 0.8f, 0.8f);
+  float W = 3, L = 24, H = 4; /* x in [-W, W], z in [-L, 0] */
+  mesh m = {0};
+  slab(&m, 0, true, -W, W, -L, 0);
+  mesh_node(&d, "road", -1, add_mesh1(&d, "road", &m, road), 0, 0, 0, 0, 1);
+  wall_x(&m, -W, 1, -L, 0, 0, H);
+  mesh_node(&d, "left", -1, add_mesh1(&d, "left", &m, left), 0, 0, 0, 0, 1);
+  wall_x(&m, W, -1, -L, 0, 0, H);
+  wall_z(&m, -L, 1, -W, W, 0, H);
+  mesh_node(&d, "right", -1, add_mesh1(&d, "right", &m, right), 0, 0, 0, 0, 1);
+  box(&m, -2.3f, 0.4f, -6, 0.4f, 0.4f, 0.4f);
+  box(&m, 2.2f, 0.5f, -11, 0.5f, 0.5f, 0.6f);
+  box(&m, -2.5f, 0.3f, -14, 0.3f, 0.3f, 0.3f);
+  mesh_node(&d, "crates", -1, add_mesh1(&d, "crates", &m, crate), 0, 0, 0, 0, 1);
+  box(&m, -2.6f, 0.25f, -9, 0.25f, 0.25f, 1.2f);
+  mesh_node(&d, "bench", -1, add_mesh1(&d, "bench", &m, bench), 0, 0, 0, 0, 1);
+  light(&d, "sun", "directional", 0, 20, 0, (float[]){0.6f, -0.8f, -0.25f}, 1, 0.96f, 0.9f, 2 * LUX, 0);
+  view(&d, "along", 0, 1.7f, 1.5f, 0, 1.2f, -12, 60, 60);
+  view(&d, "shade", 1.5f, 1.6f, -4, -3, 1.4f, -9, 60, 60);
+  view(&d, "sunny", -1.5f, 1.6f, -5, 3, 1.6f, -10, 60, 60);
+  view(&d, "end", 1, 2.5f, -14, -0.5f, 1.0f, -24, 60, 60);
+  finish(&d, dir, "street");
+}
+
+/* Coloured blocks on a bright ground under a low sun and a black sky. */
+static void ref_blocks(const char *dir) {
+  doc d = {0};
+  int ground = diffuse(&d, "ground", 0.75f, 0.75f, 0.72f), red = diffuse(&d, "red", 0.75f, 0.12f, 0.1f);
+  int blue = diffuse(&d, "blue", 0.12f, 0.25f, 0.75f), yellow = diffuse(&d, "yellow", 0.85f, 0.7f, 0.15f);
+  int green = diffuse(&d, "green", 0.15f, 0.6f, 0.2f);
+  mesh m = {0};
+  slab(&m, 0, true, -8, 8, -8, 8);
+  mesh_node(&d, "ground", -1, add_mesh1(&d, "ground", &m, ground), 0, 0, 0, 0, 1);
+  box(&m, -1.2f, 0.6f, 0, 0.6f, 0.6f, 0.6f);
+  mesh_node(&d, "red", -1, add_mesh1(&d, "red", &m, red), 0, 0, 0, 0, 1);
+  box(&m, 0, 1.2f, -1.5f, 0.5f, 1.2f, 0.5f);
+  mesh_node(&d, "blue", -1, add_mesh1(&d, "blue", &m, blue), 0, 0, 0, 0, 1);
+  sphere(&m, 0.55f, 24, 12);
+  mesh_node(&d, "yellow", -1, add_mesh1(&d, "yellow", &m, yellow), 1.0f, 0.55f, 0.4f, 0, 1);
+  box(&m, 0.2f, 0.35f, 1.5f, 1.4f, 0.35f, 0.3f);
+  mesh_node(&d, "green", -1, add_mesh1(&d, "green", &m, green), 0, 0, 0, 0, 1);
+  light(&d, "sun", "directional", 0, 20, 0, (float[]){-0.7f, -0.55f, -0.45f}, 1, 0.96f, 0.9f, 2 * LUX, 0);
+  view(&d, "front", 0.5f, 2.2f, 5.5f, 0, 0.6f, 0, 45, 60);
+  view(&d, "shaded", -4, 1.6f, -3.5f, 0, 0.6f, 0, 45, 60);
+  view(&d, "low", 3.5f, 0.6f, 2.5f, -0.5f, 0.7f, -0.5f, 55, 60);
+  finish(&d, dir, "blocks");
 }
 
 int main(int argc, char **argv) {
@@ -870,5 +1001,14 @@ int main(int argc, char **argv) {
   office(argv[1]);
   garage(argv[1]);
   outdoor(argv[1]);
+  char ref[1024];
+  snprintf(ref, sizeof ref, "%s/reference", argv[1]);
+  if (mkdir(ref, 0777) != 0 && errno != EEXIST) {
+    fprintf(stderr, "gen_scenes: cannot make %s: %s\n", ref, strerror(errno));
+    return 1;
+  }
+  ref_room(ref);
+  ref_street(ref);
+  ref_blocks(ref);
   return 0;
 }

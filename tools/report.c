@@ -29,6 +29,10 @@ static const char report_usage[] =
     "report.md (gain over direct light per view, mean and median gain, share\n"
     "of views and pixels improved, Pearson before and after). The baseline\n"
     "(--baseline, default direct light: " BASELINE ") is always rendered.\n"
+    "With radiosity on, each view's direct-only reference (POV-Ray without\n"
+    "radiosity, cached too) gives its floor, the baseline's error against it,\n"
+    "and each setting's share of the baseline's indirect error removed:\n"
+    "100 (e_base - e) / (e_base - floor), n/a where the floor is not below.\n"
     "\n"
     "SPEC: TECH, or TECH:OPTION=V1,V2,...;OPTION=V1,... for every combination,\n"
     "  e.g. --sweep \"isr:isr.samples=8,16,32;isr.coarse=1,2\" --sweep ssao\n"
@@ -54,6 +58,7 @@ static const char report_usage[] =
 typedef struct report_row {
   int setting, place;
   lm_metrics m;      /* against the reference */
+  double floor;      /* the view's direct-only floor: the baseline against POV-Ray without radiosity */
   double closer;     /* share of pixels closer to the reference than the baseline's */
   double total_ms;
   capture_result res;
@@ -105,7 +110,7 @@ static void place_name(const job *j, const job_view *v, char *out, size_t cap) {
 static void write_csv(lm_buf *b, const report_args *a, const job *j, const job_view *places,
                       const report_row *rows, int n) {
   lm_buf_append(b, "technique,setting,view,scene,camera,width,height,mean_error,rmse,psnr,pearson,ssim,"
-                   "closer_than_baseline,total_ms,passes_ms\n", -1);
+                   "closer_than_baseline,total_ms,passes_ms,direct_floor,indirect_removed\n", -1);
   for (int i = 0; i < n; i++) {
     const report_row *r = &rows[i];
     const report_setting *s = &a->settings[r->setting];
@@ -128,7 +133,12 @@ static void write_csv(lm_buf *b, const report_args *a, const job *j, const job_v
     lm_buf_printf(b, ",%.6f,%.6f,%.6f,%.3f,\"", r->m.pearson, r->m.ssim, r->closer, r->total_ms);
     for (int p = 0; p < r->res.pass_count; p++)
       lm_buf_printf(b, "%s%s=%.3f", p ? ";" : "", r->res.passes[p].name, r->res.passes[p].ms);
-    lm_buf_append(b, "\"\n", -1);
+    lm_buf_printf(b, "\",%.9g,", r->floor);
+    double share;
+    if (r->setting > 0 && report_indirect_removed(r[-r->setting].m.mean_error, r->floor, r->m.mean_error, &share))
+      lm_buf_printf(b, "%.4f", share);
+    else lm_buf_append(b, "n/a", -1);
+    lm_buf_append(b, "\n", -1);
   }
 }
 
@@ -169,8 +179,13 @@ static void write_json(lm_buf *b, const report_args *a, const job *j, const job_
                   j->sizes[v->size][0], j->sizes[v->size][1], r->m.mean_error, r->m.rmse);
     if (r->m.identical) lm_buf_append(b, "null", -1);
     else lm_buf_printf(b, "%.4f", r->m.psnr);
-    lm_buf_printf(b, ", \"pearson\": %.6f, \"ssim\": %.6f, \"closer_than_baseline\": %.6f, \"total_ms\": %.3f, "
-                  "\"passes\": [", r->m.pearson, r->m.ssim, r->closer, r->total_ms);
+    lm_buf_printf(b, ", \"pearson\": %.6f, \"ssim\": %.6f, \"closer_than_baseline\": %.6f, \"direct_floor\": %.9g, "
+                  "\"indirect_removed\": ", r->m.pearson, r->m.ssim, r->closer, r->floor);
+    double share;
+    if (r->setting > 0 && report_indirect_removed(r[-r->setting].m.mean_error, r->floor, r->m.mean_error, &share))
+      lm_buf_printf(b, "%.4f", share);
+    else lm_buf_append(b, "null", -1);
+    lm_buf_printf(b, ", \"total_ms\": %.3f, \"passes\": [", r->total_ms);
     for (int p = 0; p < r->res.pass_count; p++) {
       lm_buf_append(b, p ? ", {\"name\": " : "{\"name\": ", -1);
       limn_json_append(b, r->res.passes[p].name);
@@ -200,18 +215,22 @@ static const char *const palette[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"
 
 /* Hand-written SVG: a scatter plot needs a few dozen elements, and no
  * Debian C library writes plots without pulling in a toolkit (plplot,
- * cairo), so text is simpler and keeps the output byte-stable. */
+ * cairo), so text is simpler and keeps the output byte-stable. The error
+ * axis spans the data and the direct-only floor (floor < 0: none), not 0:
+ * settings differ by a few percent of an error that is mostly there. */
 static void write_svg(lm_buf *b, const report_args *a, const double *err, const double *ms, const bool *front,
-                      const char *clock) {
+                      double floor, const char *clock) {
   int n = a->setting_count;
   const double W = 720, H = 480, L = 80, R = 200, T = 40, B = 60;
-  double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+  double x0 = 0, x1 = 0, lo = floor >= 0 ? floor : err[0], hi = lo;
   for (int i = 0; i < n; i++) {
     if (ms[i] > x1) x1 = ms[i];
-    if (err[i] > y1) y1 = err[i];
+    lo = fmin(lo, err[i]);
+    hi = fmax(hi, err[i]);
   }
   x1 = x1 > 0 ? x1 * 1.1 : 1;
-  y1 = y1 > 0 ? y1 * 1.1 : 1;
+  double pad = hi > lo ? 0.1 * (hi - lo) : hi > 0 ? 0.1 * hi : 1e-3;
+  double y0 = fmax(0, lo - pad), y1 = hi + pad;
 #define PX(v) (L + ((v) - x0) / (x1 - x0) * (W - L - R))
 #define PY(v) (H - B - ((v) - y0) / (y1 - y0) * (H - T - B))
   lm_buf_printf(b, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -227,12 +246,16 @@ static void write_svg(lm_buf *b, const report_args *a, const double *err, const 
   for (int k = 0; k <= 4; k++) {
     double xv = x0 + (x1 - x0) * k / 4, yv = y0 + (y1 - y0) * k / 4;
     lm_buf_printf(b, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%.3g</text>\n", PX(xv), H - B + 18, xv);
-    lm_buf_printf(b, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%.3g</text>\n", L - 6, PY(yv) + 4, yv);
+    lm_buf_printf(b, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%.4g</text>\n", L - 6, PY(yv) + 4, yv);
   }
   lm_buf_printf(b, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">total ms per frame (median; clock: %s)</text>\n",
                 (L + W - R) / 2, H - 16, clock);
   lm_buf_printf(b, "<text x=\"16\" y=\"%.1f\" transform=\"rotate(-90 16 %.1f)\" text-anchor=\"middle\">"
                 "mean error against POV-Ray</text>\n", (T + H - B) / 2, (T + H - B) / 2);
+  if (floor >= 0)
+    lm_buf_printf(b, "<line class=\"floor\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#888\" "
+                  "stroke-width=\"2\"><title>direct-only floor: the baseline against POV-Ray without radiosity, "
+                  "mean error %.4g</title></line>\n", L, PY(floor), W - R, PY(floor), floor);
   /* the Pareto front: a step line through its points by time */
   int *order = calloc((size_t)n + 1, sizeof *order), fn = 0;
   for (int i = 0; i < n; i++)
@@ -271,34 +294,45 @@ static void write_svg(lm_buf *b, const report_args *a, const double *err, const 
     lm_buf_append(b, "</text>\n", -1);
   }
   lm_buf_printf(b, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"6\" fill=\"white\" stroke=\"black\" stroke-width=\"2\"/>"
-                "<text x=\"%.1f\" y=\"%.1f\">Pareto front</text>\n</svg>\n",
+                "<text x=\"%.1f\" y=\"%.1f\">Pareto front</text>\n",
                 W - R + 20, T + 10 + 18.0 * tech_count, W - R + 30, T + 14 + 18.0 * tech_count);
+  if (floor >= 0)
+    lm_buf_printf(b, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#888\" stroke-width=\"2\"/>"
+                  "<text x=\"%.1f\" y=\"%.1f\">direct-only floor</text>\n", W - R + 12, T + 28 + 18.0 * tech_count,
+                  W - R + 26, T + 28 + 18.0 * tech_count, W - R + 30, T + 32 + 18.0 * tech_count);
+  lm_buf_append(b, "</svg>\n", -1);
 #undef PX
 #undef PY
 }
 
 static void write_md(lm_buf *b, const report_args *a, const job *j, const job_view *places, int place_count,
                      const report_row *rows, int n, const double *err, const double *ms, const bool *front,
-                     const char *clock, int frames, int warmup) {
+                     double floor, const char *clock, int frames, int warmup) {
   lm_buf_append(b, "# Error against POV-Ray and run time\n\nJob `", -1);
   xml_str(b, j->path);
   lm_buf_printf(b, "`, %d view%s; renderer ", place_count, place_count == 1 ? "" : "s");
   xml_str(b, lm_gl_renderer());
   lm_buf_printf(b, "; times are medians of %d frame%s after %d warm-up frame%s (clock: %s). Mean error is seed eq "
                 "19 (sum of |dR|+|dG|+|dB| over 3wh), against POV-Ray radiosity references. Gain over the "
-                "baseline %s = 100 (e_base - e) / e_base.\n\n",
+                "baseline %s = 100 (e_base - e) / e_base. The direct-only floor of a view is the baseline's "
+                "error against POV-Ray without radiosity: what is left when indirect light is perfect. Indirect "
+                "error removed = 100 (e_base - e) / (e_base - floor), the mean over the views where the floor is "
+                "below the baseline (n/a where none is).\n\n",
                 frames, frames == 1 ? "" : "s", warmup, warmup == 1 ? "" : "s", clock, a->baseline);
-  lm_buf_append(b, "| setting | mean error | ms | mean gain % | median gain % | views improved | pixels closer "
-                   "| Pearson baseline -> setting | Pareto |\n|---|---|---|---|---|---|---|---|---|\n", -1);
-  double *be = lm_alloc(sizeof(double) * (size_t)(place_count + 1) * 6);
+  if (floor >= 0) lm_buf_printf(b, "Direct-only floor, mean over the views: %.5f.\n\n", floor);
+  lm_buf_append(b, "| setting | mean error | ms | mean gain % | median gain % | indirect error removed % | views "
+                   "improved | views Pearson rose | pixels closer | Pearson baseline -> setting | Pareto |\n"
+                   "|---|---|---|---|---|---|---|---|---|---|---|\n", -1);
+  double *be = lm_alloc(sizeof(double) * (size_t)(place_count + 1) * 7);
   double *e = be + place_count, *cl = e + place_count, *px = cl + place_count, *pb = px + place_count,
-         *pa = pb + place_count;
+         *pa = pb + place_count, *fl = pa + place_count;
   for (int s = 0; s < a->setting_count; s++) {
     int k = 0;
     for (int i = 0; i < n; i++) {
       if (rows[i].setting != s) continue;
       const report_row *base = &rows[i - s]; /* rows go place by place, the baseline first */
       be[k] = base->m.mean_error;
+      fl[k] = rows[i].floor;
       e[k] = rows[i].m.mean_error;
       cl[k] = rows[i].closer;
       px[k] = (double)rows[i].m.width * rows[i].m.height;
@@ -307,20 +341,24 @@ static void write_md(lm_buf *b, const report_args *a, const job *j, const job_vi
       k++;
     }
     report_summary sum;
-    report_summarize(k, be, e, cl, px, pb, pa, &sum);
+    report_summarize(k, be, fl, e, cl, px, pb, pa, &sum);
     lm_buf_append(b, "| ", -1);
     xml_str(b, a->settings[s].label);
     if (s == 0) {
-      lm_buf_printf(b, " (baseline) | %.5f | %.3f | | | | | %.4f | %s |\n", err[s], ms[s], sum.pearson_before,
+      lm_buf_printf(b, " (baseline) | %.5f | %.3f | | | | | | | %.4f | %s |\n", err[s], ms[s], sum.pearson_before,
                     front[s] ? "yes" : "");
       continue;
     }
-    lm_buf_printf(b, " | %.5f | %.3f | %.2f | %.2f | %.0f%% | %.2f%% | %.4f -> %.4f | %s |\n", err[s], ms[s],
-                  sum.mean_gain, sum.median_gain, 100 * sum.views_improved, 100 * sum.pixels_closer,
-                  sum.pearson_before, sum.pearson_after, front[s] ? "yes" : "");
+    lm_buf_printf(b, " | %.5f | %.3f | %.2f | %.2f | ", err[s], ms[s], sum.mean_gain, sum.median_gain);
+    if (sum.indirect_views) lm_buf_printf(b, "%.2f", sum.indirect_removed);
+    else lm_buf_append(b, "n/a", -1);
+    lm_buf_printf(b, " | %.0f%% | %.0f%% | %.2f%% | %.4f -> %.4f | %s |\n", 100 * sum.views_improved,
+                  100 * sum.views_pearson_rose, 100 * sum.pixels_closer, sum.pearson_before, sum.pearson_after,
+                  front[s] ? "yes" : "");
   }
-  lm_buf_append(b, "\n## Per view\n\n| setting | view | error baseline | error | gain % | pixels closer | "
-                   "Pearson baseline | Pearson |\n|---|---|---|---|---|---|---|---|\n", -1);
+  lm_buf_append(b, "\n## Per view\n\n| setting | view | error baseline | error | gain % | direct-only floor | "
+                   "indirect error removed % | pixels closer | Pearson baseline | Pearson |\n"
+                   "|---|---|---|---|---|---|---|---|---|---|\n", -1);
   for (int i = 0; i < n; i++) {
     if (rows[i].setting == 0) continue;
     const report_row *base = &rows[i - rows[i].setting];
@@ -330,9 +368,13 @@ static void write_md(lm_buf *b, const report_args *a, const job *j, const job_vi
     xml_str(b, a->settings[rows[i].setting].label);
     lm_buf_append(b, " | ", -1);
     xml_str(b, view);
-    lm_buf_printf(b, " | %.5f | %.5f | %.2f | %.2f%% | %.4f | %.4f |\n", base->m.mean_error, rows[i].m.mean_error,
-                  report_gain(base->m.mean_error, rows[i].m.mean_error), 100 * rows[i].closer, base->m.pearson,
-                  rows[i].m.pearson);
+    lm_buf_printf(b, " | %.5f | %.5f | %.2f | %.5f | ", base->m.mean_error, rows[i].m.mean_error,
+                  report_gain(base->m.mean_error, rows[i].m.mean_error), rows[i].floor);
+    double share;
+    if (report_indirect_removed(base->m.mean_error, rows[i].floor, rows[i].m.mean_error, &share))
+      lm_buf_printf(b, "%.2f", share);
+    else lm_buf_append(b, "n/a", -1);
+    lm_buf_printf(b, " | %.2f%% | %.4f | %.4f |\n", 100 * rows[i].closer, base->m.pearson, rows[i].m.pearson);
   }
   free(be);
 }
@@ -358,6 +400,29 @@ static bool set_setting(lm_pipeline *p, const report_setting *s, lm_error *err) 
   return true;
 }
 
+/* Every place's reference with ref's settings (paths into refs): rendered
+ * when missing, or with --require-refs named with the command that makes
+ * them (flags: what that command needs besides the job and the folder). */
+static int get_refs(const report_args *a, const reference_args *ref, const job *j, const job_view *places, int n,
+                    char (*refs)[1024], const char *flags) {
+  if (!a->require_refs) return reference_run(ref, j, places, n, refs);
+  lm_error err;
+  int rc = 0;
+  for (int i = 0; i < n && !rc; i++) {
+    lm_buf sdl = {0};
+    if (!reference_export(ref, j, &places[i], &sdl, refs[i], sizeof refs[i], &err)) {
+      lm_log(LM_LOG_ERROR, "%s", err.msg);
+      rc = 1;
+    } else if (!lm_file_exists(refs[i])) {
+      lm_log(LM_LOG_ERROR, "%s: view %d: no reference %s (make them with: limn reference --job %s --refs %s%s, "
+             "with the same export flags)", j->path, i, refs[i], j->path, ref->refs, flags);
+      rc = 1;
+    }
+    lm_buf_free(&sdl);
+  }
+  return rc;
+}
+
 static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
   lm_error err;
   job_view *places = NULL;
@@ -373,24 +438,13 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
       free(places);
       return 2;
     }
-  char (*refs)[1024] = lm_alloc(sizeof *refs * (size_t)(place_count + 1));
-  int rc = 0;
-  if (a->require_refs) {
-    for (int i = 0; i < place_count && !rc; i++) {
-      lm_buf sdl = {0};
-      if (!reference_export(&a->ref, j, &places[i], &sdl, refs[i], sizeof refs[i], &err)) {
-        lm_log(LM_LOG_ERROR, "%s", err.msg);
-        rc = 1;
-      } else if (!lm_file_exists(refs[i])) {
-        lm_log(LM_LOG_ERROR, "%s: view %d: no reference %s (make them with: limn reference --job %s --refs %s, "
-               "with the same export flags)", j->path, i, refs[i], j->path, a->ref.refs);
-        rc = 1;
-      }
-      lm_buf_free(&sdl);
-    }
-  } else {
-    rc = reference_run(&a->ref, j, places, place_count, refs);
-  }
+  /* The references, then (with radiosity on) the direct-only ones that give each view's floor. */
+  char (*refs)[1024] = lm_alloc(sizeof *refs * (size_t)(place_count + 1) * 2);
+  char (*direct)[1024] = refs + place_count + 1;
+  reference_args direct_args = a->ref;
+  direct_args.pov.radiosity = false;
+  int rc = get_refs(a, &a->ref, j, places, place_count, refs, "");
+  if (!rc && a->ref.pov.radiosity) rc = get_refs(a, &direct_args, j, places, place_count, direct, " --radiosity off");
   if (rc) {
     free(refs);
     free(places);
@@ -421,8 +475,11 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
     const job_view *v = &places[p];
     job_scene *sc = &j->scenes[v->scene];
     int w = j->sizes[v->size][0], h = j->sizes[v->size][1];
-    lm_image ref = {0}, base = {0};
+    lm_image ref = {0}, base = {0}, floor_ref = {0};
     bool ok = lm_image_read(refs[p], &ref, &err);
+    if (ok && a->ref.pov.radiosity)
+      ok = lm_image_read(direct[p], &floor_ref, &err) && lm_metrics_check(&floor_ref, direct[p], &ref, refs[p], &err);
+    double floor = 0;
     if (ok && sc->scene != current) ok = lm_renderer_set_scene(r, sc->scene, &err), current = sc->scene;
     for (int s = 0; s < a->setting_count && ok; s++) {
       report_row *row = &rows[n];
@@ -448,6 +505,9 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
       if (ok) {
         lm_metrics_compute(&img, &ref, &row->m);
         if (s == 0) {
+          lm_metrics fm = row->m;
+          if (a->ref.pov.radiosity) lm_metrics_compute(&img, &floor_ref, &fm);
+          floor = fm.mean_error; /* without radiosity the reference is direct-only: no indirect error */
           row->closer = 0;
           base = img;
           img = (lm_image){0};
@@ -456,6 +516,7 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
           lm_metrics_closer(&img, &base, &ref, &closer);
           row->closer = closer.closer;
         }
+        row->floor = floor;
         row->total_ms = row->res.total_ms;
         n++;
         place_name(j, v, view, sizeof view);
@@ -477,6 +538,7 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
       rc = 1;
     }
     lm_image_free(&ref);
+    lm_image_free(&floor_ref);
     lm_image_free(&base);
   }
   const char *clock = r ? lm_clock_name(lm_renderer_clock(r)) : "";
@@ -485,12 +547,17 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
     double *err_mean = lm_alloc(sizeof(double) * (size_t)sn * 2), *ms_mean = err_mean + sn;
     bool *front = lm_alloc(sizeof(bool) * (size_t)sn);
     setting_means(rows, n, sn, err_mean, ms_mean);
+    double floor = -1; /* none without radiosity */
+    if (a->ref.pov.radiosity && place_count > 0) {
+      floor = 0;
+      for (int i = 0; i < n; i++) floor += rows[i].setting == 0 ? rows[i].floor / place_count : 0;
+    }
     report_pareto(ms_mean, err_mean, sn, front);
     lm_buf csv = {0}, json = {0}, svg = {0}, md = {0};
     write_csv(&csv, a, j, places, rows, n);
     write_json(&json, a, j, places, rows, n, clock, a->frames, a->warmup);
-    write_svg(&svg, a, err_mean, ms_mean, front, clock);
-    write_md(&md, a, j, places, place_count, rows, n, err_mean, ms_mean, front, clock, a->frames, a->warmup);
+    write_svg(&svg, a, err_mean, ms_mean, front, floor, clock);
+    write_md(&md, a, j, places, place_count, rows, n, err_mean, ms_mean, front, floor, clock, a->frames, a->warmup);
     bool ok = write_file(a, "report.csv", &csv, &err) && write_file(a, "report.json", &json, &err) &&
               write_file(a, "report.svg", &svg, &err) && write_file(a, "report.md", &md, &err);
     lm_buf_free(&csv);

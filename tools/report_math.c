@@ -123,9 +123,15 @@ static int compare_double(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-void report_summarize(int n, const double *base_error, const double *error, const double *closer,
-                      const double *pixels, const double *pearson_base, const double *pearson,
-                      report_summary *out) {
+bool report_indirect_removed(double base_error, double floor, double error, double *out) {
+  if (!(floor < base_error)) return false;
+  *out = 100.0 * (base_error - error) / (base_error - floor);
+  return true;
+}
+
+void report_summarize(int n, const double *base_error, const double *floor, const double *error,
+                      const double *closer, const double *pixels, const double *pearson_base,
+                      const double *pearson, report_summary *out) {
   *out = (report_summary){.views = n};
   if (n <= 0) return;
   double *gains = lm_alloc(sizeof *gains * (size_t)n);
@@ -138,7 +144,13 @@ void report_summarize(int n, const double *base_error, const double *error, cons
     all_px += pixels[i];
     out->pearson_before += pearson_base[i] / n;
     out->pearson_after += pearson[i] / n;
+    out->views_pearson_rose += (double)(pearson[i] > pearson_base[i]) / n;
+    out->floor += floor[i] / n;
+    double share;
+    if (report_indirect_removed(base_error[i], floor[i], error[i], &share))
+      out->indirect_removed += share, out->indirect_views++;
   }
+  if (out->indirect_views) out->indirect_removed /= out->indirect_views;
   qsort(gains, (size_t)n, sizeof *gains, compare_double);
   out->median_gain = n % 2 ? gains[n / 2] : 0.5 * (gains[n / 2 - 1] + gains[n / 2]);
   out->views_improved = improved / n;

@@ -1,6 +1,7 @@
 /* What `limn report` computes that needs no GL or files, kept apart so that
  * unit tests check it against hand values: the sweep syntax, the Pareto
- * front and the gains over the baseline (seed 000 chapter 5.3.2). */
+ * front, the gains over the baseline (seed 000 chapter 5.3.2) and the share
+ * of its indirect error removed. */
 #ifndef LIMN_REPORT_MATH_H
 #define LIMN_REPORT_MATH_H
 
@@ -33,19 +34,31 @@ void report_pareto(const double *x, const double *y, int n, bool *front);
  * e_base is 0 (nothing to gain). */
 double report_gain(double base_error, double error);
 
+/* The share of the baseline's indirect error a setting removes, percent:
+ * 100 (e_base - e) / (e_base - floor), floor being the baseline's error
+ * against the direct-only reference (what is left when indirect light is
+ * perfect). False (n/a) when floor is not below e_base: no indirect error
+ * to remove. */
+bool report_indirect_removed(double base_error, double floor, double error, double *out);
+
 typedef struct report_summary {
   int views;
   double mean_gain, median_gain;  /* percent, over views */
   double views_improved;          /* share of views with gain > 0 */
   double pixels_closer;           /* share of all pixels closer than the baseline's */
   double pearson_before, pearson_after; /* means over views */
+  double views_pearson_rose;      /* share of views whose Pearson is above the baseline's */
+  double indirect_removed;        /* percent, mean over the views where it is defined */
+  int indirect_views;             /* those views (0: n/a) */
+  double floor;                   /* mean direct-only floor over views */
 } report_summary;
 
-/* Over n views: the baseline's and the setting's mean errors, the share of
- * each view's pixels closer to the reference than the baseline's, its pixel
- * count (weights the pixel share) and both Pearson coefficients. */
-void report_summarize(int n, const double *base_error, const double *error, const double *closer,
-                      const double *pixels, const double *pearson_base, const double *pearson,
-                      report_summary *out);
+/* Over n views: the baseline's and the setting's mean errors, the direct-only
+ * floor (report_indirect_removed), the share of each view's pixels closer to
+ * the reference than the baseline's, its pixel count (weights the pixel
+ * share) and both Pearson coefficients. */
+void report_summarize(int n, const double *base_error, const double *floor, const double *error,
+                      const double *closer, const double *pixels, const double *pearson_base,
+                      const double *pearson, report_summary *out);
 
 #endif

@@ -31,6 +31,12 @@ bool limn_parse_on_off(const char *s, bool *out);
  * JOB_COMPLETION_INDEX, of N shards. msg gets where the shard came from
  * ("" for I/N), or on false what is wrong. */
 bool limn_parse_shard(const char *s, int *shard, int *shards, char *msg, size_t cap);
+/* --camera: an index, or "auto" (LIMN_CAMERA_AUTO): a camera framing the
+ * scene's bounds at the output's aspect, added by limn_camera_resolve. */
+#define LIMN_CAMERA_AUTO (-1)
+bool limn_parse_camera(const char *s, int *out);
+struct lm_scene;
+int limn_camera_resolve(struct lm_scene *s, int camera, int width, int height);
 /* Prints s as a JSON string (quotes, backslashes and control characters escaped). */
 void limn_json_string(const char *s);          /* a quoted, escaped JSON string to stdout */
 void limn_json_append(lm_buf *b, const char *s); /* the same, appended to b */

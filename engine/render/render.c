@@ -135,6 +135,7 @@ static bool add_output_stage(lm_renderer *r, lm_graph *g, lm_pipeline *p, int pr
 
 /* Records (OnRender) and compiles one frame of pipeline p into g. */
 static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_error *err) {
+  if (!lm_scene_camera_check(r->desc.scene, r->desc.camera, err)) return false;
   lm_graph_begin(g, r->desc.width, r->desc.height);
   lm_frame_data *frame = &r->camera;
   lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, frame);

@@ -4,6 +4,8 @@
  * over is checked again here before a byte is read.
  *
  * What comes over, and how:
+ * - extensionsRequired first: a file that requires an extension other than
+ *   those the loader reads (KHR_lights_punctual) is refused, naming it.
  * - Nodes of the file's default scene (scene 0 when it names none; every
  *   root node when it has no scenes), parents before children. A node's
  *   local transform is its matrix, or T * R * S. Every world transform must
@@ -13,8 +15,10 @@
  *   primitive holds it itself; a node whose mesh has several gets one child
  *   node per primitive ("<node>.<i>", identity transform), so that each node
  *   keeps one material. Nodes sharing a mesh share its lm meshes.
- * - Triangles only (mode 4, indexed by u8/u16/u32 or not indexed); points,
- *   lines, strips and fans are skipped with a warning. Normals absent from
+ * - Triangles, triangle strips and fans (modes 4, 5, 6, indexed by
+ *   u8/u16/u32 or not indexed); strips and fans become triangle lists with
+ *   their winding kept. Points and lines (modes 0 to 3) are skipped, with one
+ *   warning per file. Normals absent from
  *   the file are computed, area-weighted; a vertex that only touches
  *   zero-area triangles gets +Z. UVs (TEXCOORD_0) are optional (0 when
  *   absent). Coordinates must be finite and within LM_GLTF_MAX_COORD.
@@ -31,18 +35,21 @@
  * - Perspective cameras: yfov, znear, zfar; the aspect ratio is the output's.
  *   An infinite far plane (zfar absent) becomes LM_GLTF_INFINITE_ZFAR_RATIO
  *   times znear: relative, so any unit works (reversed float depth holds it).
- *   Orthographic cameras are skipped with a warning.
+ *   Orthographic cameras are kept (so camera indices stay the file's) and
+ *   refused by name when a view uses one (lm_scene_camera_check).
  * - KHR_lights_punctual point, spot and directional lights, one lm light per
- *   node that names one. The engine's lighting is unitless, so
- *   power = intensity (candela for point and spot, lux for directional) as a
- *   plain multiplier on color. radius = range; an absent range (infinite in
- *   glTF) becomes twice the diagonal of the scene's bounds (at least 1).
- *   Spot cone angles carry over as the inner and outer half-angles.
+ *   node that names one, as the extension says: point and spot lights fall
+ *   off as 1 / d^2 times its range window clamp(1 - (d / range)^4, 0, 1)
+ *   (LM_FALLOFF_RANGE, radius = range; no range: no window). Intensity is
+ *   photometric (candela for point and spot, lux for directional) and the
+ *   engine's light is radiometric, folded with Lambert's 1 / pi (its Phong
+ *   has none): power = intensity * LM_GLTF_EXPOSURE. Spot cone angles carry
+ *   over as the inner and outer half-angles.
  * - With no light in the scene: "default_light", directional, white, power
  *   1, shining down along normalize(-0.3, -1, -0.5) from above the bounds.
- * - With no camera: "default_camera", 45 degrees vertical field of view,
- *   looking at the centre of the bounds from +Z and 20 degrees above, far
- *   enough that the bounding sphere fits.
+ * - With no camera: "default_camera" from lm_scene_add_framing_camera, every
+ *   corner of the bounds in view on any output at least as wide as high
+ *   (`--camera auto` fits the output's own aspect).
  * - A material's baseColorTexture (TEXCOORD_0) becomes a scene texture:
  *   the bridge's image loader (no stb_image) keeps every image's bytes
  *   encoded; the images a material uses are decoded through OpenImageIO
@@ -64,6 +71,11 @@ extern "C" {
 #define LM_GLTF_MAX_COORD 1e9f      /* largest |coordinate| a vertex may have */
 #define LM_GLTF_INFINITE_ZFAR_RATIO 1e6f /* zfar / znear of a camera with an infinite far plane */
 #define LM_GLTF_MAX_ELEMENTS (1 << 26) /* most vertices or indices per primitive */
+/* Engine light per glTF candela or lux: 1 / (683 lm/W * pi). Blender's
+ * exporter writes W / (4 pi) * 683 cd for a point light of W watts and
+ * 683 lux per W/m^2 of sun, so a Lambert surface shows here the radiance
+ * Blender (Cycles, exposure 0, Standard view) shows. */
+#define LM_GLTF_EXPOSURE (1.0 / (683.0 * 3.14159265358979))
 
 /* Reads a .gltf or .glb file (told apart by the GLB magic, not the name).
  * NULL on any error, with a message naming the file and the element

@@ -12,6 +12,7 @@
 
 #include <strings.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -30,7 +31,8 @@ struct Loader {
   std::vector<int> materials;           // [material] -> lm material; -1 not yet
   std::vector<int> textures;            // [image] -> lm texture; -1 not yet
   std::vector<int> nodes;               // [node] -> lm node; -1 not in the scene
-  std::vector<int> unset_radius;        // lm lights whose range was absent
+  int skipped = 0;                      // point and line primitives, warned about once
+  std::string first_skipped;            // "mesh M primitive P (mode K)"
 };
 
 // Every failure goes through here: "path: what".
@@ -262,16 +264,35 @@ void normalize_normals(std::vector<float> &verts) {
   }
 }
 
+// A strip's or fan's indices as a triangle list, winding kept (glTF 2.0
+// section 3.7.2.1: strip triangle i is (i, i + 1 + i % 2, i + 2 - i % 2),
+// fan triangle i is (i + 1, i + 2, 0)).
+std::vector<uint32_t> triangle_list(int mode, const std::vector<uint32_t> &in) {
+  std::vector<uint32_t> out;
+  out.reserve((in.size() - 2) * 3);
+  for (size_t i = 0; i + 2 < in.size(); i++) {
+    if (mode == TINYGLTF_MODE_TRIANGLE_STRIP)
+      out.insert(out.end(), {in[i], in[i + 1 + i % 2], in[i + 2 - i % 2]});
+    else
+      out.insert(out.end(), {in[i + 1], in[i + 2], in[0]});
+  }
+  return out;
+}
+
 // lm mesh of primitive pi of mesh mi; -2 when skipped, -1 on error.
 int load_primitive(Loader &L, int mi, int pi) {
   const tinygltf::Mesh &mesh = L.m.meshes[mi];
   const tinygltf::Primitive &p = mesh.primitives[pi];
   char where[64];
   snprintf(where, sizeof where, "mesh %d primitive %d", mi, pi);
-  if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES) {
-    lm_warn("%s: %s: mode %d is not triangles; skipped", L.path, where, p.mode);
+  int mode = p.mode == -1 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+  if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP) {
+    if (!L.skipped++) L.first_skipped = std::string(where) + " (mode " + std::to_string(mode) + ")";
     return -2;
   }
+  if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+      mode != TINYGLTF_MODE_TRIANGLE_FAN)
+    return fail(L, "%s: mode %d is not a glTF primitive mode (0 to 6)", where, mode), -1;
   auto pos = p.attributes.find("POSITION");
   if (pos == p.attributes.end()) return fail(L, "%s: no POSITION attribute", where), -1;
   char what[160];
@@ -293,9 +314,16 @@ int load_primitive(Loader &L, int mi, int pi) {
     idx.resize(count);
     for (size_t i = 0; i < count; i++) idx[i] = (uint32_t)i;
   }
-  if (idx.size() % 3)
+  if (mode == TINYGLTF_MODE_TRIANGLES && idx.size() % 3)
     return fail(L, "%s: %zu %s, not a multiple of 3 (triangles)", where, idx.size(),
                 p.indices >= 0 ? "indices" : "vertices"), -1;
+  if (mode != TINYGLTF_MODE_TRIANGLES) {
+    if (idx.size() < 3)
+      return fail(L, "%s: a triangle %s of %zu %s, fewer than 3", where,
+                  mode == TINYGLTF_MODE_TRIANGLE_STRIP ? "strip" : "fan", idx.size(),
+                  p.indices >= 0 ? "indices" : "vertices"), -1;
+    idx = triangle_list(mode, idx);
+  }
   if (has_normals) normalize_normals(verts);
   else compute_normals(verts, idx);
 
@@ -419,11 +447,23 @@ bool add_camera(Loader &L, int ni, int ci, int node) {
   if (ci < 0 || (size_t)ci >= L.m.cameras.size())
     return fail(L, "node %d: camera %d does not exist (the file has %zu)", ni, ci, L.m.cameras.size());
   const tinygltf::Camera &c = L.m.cameras[ci];
-  if (c.type != "perspective") {
-    lm_warn("%s: camera %d: type '%s' is not supported (perspective only); skipped", L.path, ci,
-            c.type.c_str());
+  if (c.type == "orthographic") {
+    const tinygltf::OrthographicCamera &o = c.orthographic;
+    if (!(o.xmag > 0 && o.xmag < 1e30) || !(o.ymag > 0 && o.ymag < 1e30) || !(o.znear >= 0) ||
+        !(o.zfar > o.znear && o.zfar < 1e30))
+      return fail(L, "camera %d: orthographic wants xmag, ymag > 0 and zfar > znear >= 0; got %g, %g, %g, %g",
+                  ci, o.xmag, o.ymag, o.znear, o.zfar);
+    lm_camera cam = {};
+    snprintf(cam.name, sizeof cam.name, "%s", c.name.empty() ? "camera" : c.name.c_str());
+    cam.fov_y = (float)(M_PI / 4);
+    cam.znear = (float)std::fmax(o.znear, 1e-6), cam.zfar = (float)o.zfar;
+    cam.ortho[0] = (float)o.xmag, cam.ortho[1] = (float)o.ymag;
+    cam.node = node;
+    lm_scene_add_camera(L.s, &cam);
     return true;
   }
+  if (c.type != "perspective")
+    return fail(L, "camera %d: type '%s' is neither perspective nor orthographic", ci, c.type.c_str());
   const tinygltf::PerspectiveCamera &p = c.perspective;
   if (!(p.yfov > 0 && p.yfov < M_PI) || !(p.znear > 0 && p.znear < 1e30) ||
       !(p.zfar == 0 || (p.zfar > p.znear && p.zfar < 1e30)))
@@ -470,14 +510,14 @@ bool add_light(Loader &L, int ni, int li, int node) {
     return fail(L, "light %d: spot cone angles need 0 <= inner < outer <= pi/2; got %g, %g", li,
                 inner, outer);
   for (int c = 0; c < 3; c++) l.color[c] = gl.color.empty() ? 1.0f : (float)gl.color[c];
-  l.power = (float)gl.intensity;
-  l.radius = (float)gl.range;
+  l.power = (float)(gl.intensity * LM_GLTF_EXPOSURE);
+  l.radius = (float)gl.range; // 0 (absent): no range, the light reaches everywhere
+  l.falloff = LM_FALLOFF_RANGE;
   l.inner_cone = l.type == LM_LIGHT_SPOT ? (float)inner : 0.0f;
   l.outer_cone = l.type == LM_LIGHT_SPOT ? (float)outer : (float)(M_PI / 2);
   l.casts_shadows = true;
   l.node = node;
-  int id = lm_scene_add_light(L.s, &l);
-  if (gl.range <= 0) L.unset_radius.push_back(id);
+  lm_scene_add_light(L.s, &l);
   return true;
 }
 
@@ -650,12 +690,11 @@ void look_along(const double eye[3], const double dir[3], float out[16]) {
   out[3] = out[7] = out[11] = 0, out[15] = 1;
 }
 
-void add_defaults(lm_scene *s, const std::vector<int> &unset_radius) {
+void add_defaults(lm_scene *s) {
   double lo[3], hi[3], c[3], diag = 0;
   scene_bounds(s, lo, hi);
   for (int k = 0; k < 3; k++) c[k] = 0.5 * (lo[k] + hi[k]), diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
   diag = std::fmax(std::sqrt(diag), 1e-3);
-  for (int id : unset_radius) s->lights[id].radius = (float)std::fmax(2 * diag, 1.0);
 
   float m[16];
   if (s->light_count == 0) {
@@ -673,21 +712,8 @@ void add_defaults(lm_scene *s, const std::vector<int> &unset_radius) {
     l.node = lm_scene_add_node(s, "default_light", -1, m, -1, -1);
     lm_scene_add_light(s, &l);
   }
-  if (s->camera_count == 0) {
-    const double fov = M_PI / 4, pitch = 20 * M_PI / 180, r = diag / 2;
-    double d = r / std::sin(fov / 2), eye[3], dir[3];
-    double back[3] = {0, std::sin(pitch), std::cos(pitch)};
-    for (int k = 0; k < 3; k++) eye[k] = c[k] + back[k] * d, dir[k] = -back[k];
-    look_along(eye, dir, m);
-    lm_camera cam = {};
-    snprintf(cam.name, sizeof cam.name, "default_camera");
-    cam.fov_y = (float)fov;
-    cam.znear = (float)std::fmax(0.5 * (d - r), 1e-3 * d);
-    cam.zfar = (float)(2 * (d + r));
-    cam.node = lm_scene_add_node(s, "default_camera", -1, m, -1, -1);
-    lm_scene_add_camera(s, &cam);
-  }
   lm_scene_update(s);
+  if (s->camera_count == 0) lm_scene_add_framing_camera(s, "default_camera", 0);
 }
 
 // ---- parsing ---------------------------------------------------------------
@@ -738,6 +764,25 @@ std::string locate_bad_indices(const unsigned char *text, size_t len) {
   return "";
 }
 
+// The extensions this loader reads: a file that requires any other is refused
+// before tinygltf sees it (which would fail later, on data it cannot decode).
+const char *const kSupportedExtensions[] = {"KHR_lights_punctual"};
+
+// The first name in the file's extensionsRequired that is not supported, or "".
+std::string unsupported_required(const unsigned char *text, size_t len) {
+  using nlohmann::json;
+  json doc = json::parse(text, text + len, nullptr, false);
+  if (!doc.is_object() || !doc.contains("extensionsRequired") || !doc["extensionsRequired"].is_array())
+    return "";
+  for (const json &e : doc["extensionsRequired"]) {
+    std::string name = e.is_string() ? e.get<std::string>() : e.dump();
+    bool known = false;
+    for (const char *k : kSupportedExtensions) known |= name == k;
+    if (!known) return name;
+  }
+  return "";
+}
+
 bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
   size_t len;
   char *data = lm_read_file(path, &len, err);
@@ -755,10 +800,26 @@ bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
   char dir[4096];
   lm_dirname(path, dir, sizeof dir);
 
+  bool glb = len >= 4 && !memcmp(bytes.data(), "glTF", 4);
+  // The JSON: a GLB's chunk 0 (when its length fits the file), else the whole text.
+  uint32_t json_len = (uint32_t)len;
+  if (glb) {
+    json_len = 0;
+    if (len >= 20) memcpy(&json_len, bytes.data() + 12, 4);
+    if (json_len > len - std::min(len, (size_t)20)) json_len = 0;
+  }
+  std::string missing = unsupported_required(bytes.data() + (glb ? 20 : 0), json_len);
+  if (!missing.empty()) {
+    std::string known;
+    for (const char *k : kSupportedExtensions) known += std::string(known.empty() ? "" : ", ") + k;
+    lm_error_set(err, "%s: extensionsRequired names '%s', which this engine does not support (it reads %s)",
+                 path, missing.c_str(), known.c_str());
+    return false;
+  }
+
   tinygltf::TinyGLTF gltf;
   gltf.SetImageLoader(keep_image_undecoded, nullptr);
   std::string why, warn;
-  bool glb = len >= 4 && !memcmp(bytes.data(), "glTF", 4);
   bool ok = glb ? gltf.LoadBinaryFromMemory(model, &why, &warn, bytes.data(), (unsigned)len, dir)
                 : gltf.LoadASCIIFromString(model, &why, &warn, (const char *)bytes.data(),
                                            (unsigned)len, dir);
@@ -768,8 +829,6 @@ bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
   if (ok && why.empty()) return true;
   std::string what = first_line(why);
   if (what.find("primitive indices accessor out of bounds") != std::string::npos) {
-    uint32_t json_len = (uint32_t)len; // GLB: tinygltf got this far, so chunk 0 is whole
-    if (glb) memcpy(&json_len, bytes.data() + 12, 4);
     std::string where = locate_bad_indices(bytes.data() + (glb ? 20 : 0), json_len);
     if (!where.empty()) what = where;
   }
@@ -779,15 +838,18 @@ bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
 
 // Fills `s` from the parsed model; false (message in L.err) on bad input.
 bool convert(const char *path, const tinygltf::Model &model, lm_scene *s, lm_error *err) {
-  Loader L{path, model, s, err, {}, {}, {}, {}, {}};
+  Loader L{path, model, s, err, {}, {}, {}, {}, 0, {}};
   L.meshes.resize(model.meshes.size());
   L.materials.assign(model.materials.size(), -1);
   L.textures.assign(model.images.size(), -1);
   L.nodes.assign(model.nodes.size(), -1);
   if (!load_nodes(L)) return false;
+  if (L.skipped)
+    lm_warn("%s: %d point or line primitive%s skipped (the first: %s): only triangles are drawn", path,
+            L.skipped, L.skipped > 1 ? "s" : "", L.first_skipped.c_str());
   lm_scene_update(s);
   if (!check_world(L)) return false;
-  add_defaults(s, L.unset_radius);
+  add_defaults(s);
   return true;
 }
 

@@ -158,7 +158,24 @@ static bool write_light(pov_ctx *c, const lm_light *l, const lm_light_data *ld, 
     return false;
   bool fade = false;
   if (type != LM_LIGHT_DIRECTIONAL) {
-    if (falloff == LM_FALLOFF_INVERSE_SQUARE) {
+    double range = ld->color[3];
+    if (falloff == LM_FALLOFF_RANGE && range > 0) {
+      /* No POV-Ray light fades to zero at a distance; the window is 1 to
+       * within LM_POV_RANGE_EXACT wherever the scene's bounding sphere
+       * reaches, or the light is refused. */
+      double far = 0;
+      for (int i = 0; i < 3; i++) far += (pos[i] - center[i]) * (pos[i] - center[i]);
+      far = sqrt(far) + radius;
+      double q = far / range, window = 1.0 - q * q * q * q;
+      if (window < 1.0 - LM_POV_RANGE_EXACT &&
+          !mismatch(c, "light '%s': range %.6g: the KHR_lights_punctual window clamp(1 - (d/range)^4, 0, 1) "
+                       "falls to %.3g within the scene (which reaches %.6g from the light), and no POV-Ray "
+                       "light fades to zero at a distance; drop the range or make it at least %.6g "
+                       "(--approximate writes it without the window)",
+                    l->name, range, window > 0 ? window : 0.0, far, far * pow(LM_POV_RANGE_EXACT, -0.25)))
+        return false;
+    }
+    if (falloff == LM_FALLOFF_INVERSE_SQUARE || falloff == LM_FALLOFF_RANGE) {
       fade = true;
       for (int i = 0; i < 3; i++) col[i] /= 2.0 * LM_POV_FADE_DISTANCE * LM_POV_FADE_DISTANCE;
     } else if (falloff != LM_FALLOFF_NONE &&
@@ -318,6 +335,7 @@ bool lm_pov_export(const lm_scene *s, const lm_pov_desc *desc, lm_buf *out, lm_b
     lm_error_set(err, "camera %d: scene '%s' has %d camera(s)", desc->camera, s->name, s->camera_count);
     return false;
   }
+  if (!lm_scene_camera_check(s, desc->camera, err)) return false;
   const char *bad = desc->radiosity ? lm_pov_radiosity_check(&desc->rad) : NULL;
   if (bad) {
     lm_error_set(err, "radiosity setting out of range: %s", bad);

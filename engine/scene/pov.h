@@ -34,6 +34,12 @@
  *     LM_POV_FADE_DISTANCE (f) with the colour divided by 2 f^2: POV-Ray's
  *     2 / (1 + (d / f)^2) then gives 1 / (d^2 + f^2), which is 1 / d^2 to a
  *     relative 1e-6 at d = 1;
+ *   point, LM_FALLOFF_RANGE (glTF's) -> the same as inverse square when the
+ *     range window clamp(1 - (d / range)^4, 0, 1) stays above
+ *     1 - LM_POV_RANGE_EXACT over the scene's bounding sphere (no range, or
+ *     one at least 4.76 times the farthest distance), else refused: POV-Ray
+ *     has no light that fades to zero at a distance (its fade is
+ *     2 / (1 + (d / f)^p) with p > 0 only);
  *   spot -> spotlight with radius = inner, falloff = outer half-angle and
  *     tightness 0: POV-Ray's cubic_spline(cos outer, cos inner, cos) is the
  *     engine's smoothstep; it matches when 0 <= inner < outer < 90 degrees;
@@ -50,6 +56,9 @@
 #include "scene/scene.h"
 
 #define LM_POV_FADE_DISTANCE 1e-3
+/* Largest departure from 1 of a glTF range window written as plain inverse
+ * square: below the G-buffer's 8-bit albedo step. */
+#define LM_POV_RANGE_EXACT (1.0 / 512.0)
 
 /* POV-Ray's radiosity settings (seed 000 chapter 5, with brightness 1 since
  * the export is linear and its light matches the engine's). */

@@ -168,6 +168,49 @@ bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]) {
   return true;
 }
 
+int lm_scene_add_framing_camera(lm_scene *s, const char *name, float aspect) {
+  vec3 lo, hi, c;
+  lm_scene_bounds(s, lo, hi);
+  glm_vec3_center(lo, hi, c);
+  const float fov = glm_rad(45.0f), pitch = glm_rad(20.0f), margin = 1.05f;
+  vec3 fwd = {0, -sinf(pitch), -cosf(pitch)}, right = {1, 0, 0}, up = {0, cosf(pitch), -sinf(pitch)};
+  float ty = tanf(fov / 2), tx = ty * (aspect > 0 && isfinite(aspect) ? aspect : 1.0f);
+  /* Eye at c - D fwd: a corner q (from c) lies at depth D + q.fwd; it is in
+   * view when |q.right| <= tx depth and |q.up| <= ty depth. */
+  float dist = 0, zmin = FLT_MAX, zmax = -FLT_MAX, extent = glm_vec3_distance(lo, hi);
+  for (int k = 0; k < 8; k++) {
+    vec3 q = {(k & 1 ? hi : lo)[0] - c[0], (k & 2 ? hi : lo)[1] - c[1], (k & 4 ? hi : lo)[2] - c[2]};
+    float x = glm_vec3_dot(q, right), y = glm_vec3_dot(q, up), z = glm_vec3_dot(q, fwd);
+    dist = fmaxf(dist, fmaxf(margin * fabsf(x) / tx, margin * fabsf(y) / ty) - z);
+    zmin = fminf(zmin, z), zmax = fmaxf(zmax, z);
+  }
+  /* In front of the eye even when flat, and never at the centre itself. */
+  dist = fmaxf(dist, fmaxf(-zmin, 0) + 1e-3f * fmaxf(extent, 1e-3f));
+  float world[16] = {0};
+  for (int i = 0; i < 3; i++) {
+    world[i] = right[i], world[4 + i] = up[i], world[8 + i] = -fwd[i];
+    world[12 + i] = c[i] - fwd[i] * dist;
+  }
+  world[15] = 1;
+  lm_camera cam = {.fov_y = fov, .znear = fmaxf(0.5f * (dist + zmin), 1e-4f * dist), .zfar = 1.5f * (dist + zmax)};
+  snprintf(cam.name, sizeof cam.name, "%s", name);
+  cam.node = lm_scene_add_node(s, name, -1, world, -1, -1);
+  lm_scene_update(s);
+  return lm_scene_add_camera(s, &cam);
+}
+
+bool lm_scene_camera_check(const lm_scene *s, int cam, lm_error *err) {
+  if (cam < 0 || cam >= s->camera_count) return true;
+  const lm_camera *c = &s->cameras[cam];
+  if (c->ortho[0] > 0 || c->ortho[1] > 0) {
+    lm_error_set(err, "camera '%s' (%d) is orthographic (xmag %g, ymag %g): the passes rebuild positions "
+                 "from depth along rays from one eye and cannot take it; give the view a perspective camera "
+                 "(or --camera auto)", c->name, cam, (double)c->ortho[0], (double)c->ortho[1]);
+    return false;
+  }
+  return true;
+}
+
 bool lm_scene_upload(lm_scene *s, lm_error *err) {
   if (s->uploaded) return true;
   for (int i = 0; i < s->texture_count; i++) {
@@ -302,6 +345,29 @@ void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_f
   out->output_size[2] = 1.0f / (float)(width > 0 ? width : 1);
   out->output_size[3] = 1.0f / (float)(height > 0 ? height : 1);
   out->counts[0] = s->light_count;
+}
+
+float lm_light_falloff(lm_falloff f, float d, float radius) {
+  if (f == LM_FALLOFF_NONE) return 1.0f;
+  float inv_d2 = 1.0f / fmaxf(d * d, 1e-8f);
+  if (f == LM_FALLOFF_INVERSE_SQUARE) return inv_d2;
+  if (f == LM_FALLOFF_RANGE) {
+    if (!(radius > 0)) return inv_d2;
+    float q = d / radius;
+    q *= q;
+    return glm_clamp(1.0f - q * q, 0.0f, 1.0f) * inv_d2;
+  }
+  float r = fmaxf(radius, 1e-12f), q = d / r;
+  return glm_clamp(1.0f - q * q, 0.0f, 1.0f);
+}
+
+float lm_light_reach(const lm_light *l) {
+  if (l->type == LM_LIGHT_DIRECTIONAL) return INFINITY;
+  switch (l->falloff) {
+  case LM_FALLOFF_WINDOW: return fmaxf(l->radius, 0.0f);
+  case LM_FALLOFF_RANGE: return l->radius > 0 ? l->radius : INFINITY;
+  default: return INFINITY;
+  }
 }
 
 int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max) {

@@ -31,20 +31,30 @@ typedef enum lm_falloff {
   LM_FALLOFF_WINDOW,         /* saturate(1 - (d / radius)^2), seed 000 eq 16 (the default) */
   LM_FALLOFF_NONE,           /* constant: POV-Ray's default light */
   LM_FALLOFF_INVERSE_SQUARE, /* 1 / d^2: physical, and POV-Ray's fade_power 2 */
+  LM_FALLOFF_RANGE,          /* KHR_lights_punctual: clamp(1 - (d / radius)^4, 0, 1) / d^2,
+                                radius 0: no range (plain 1 / d^2); glTF's point and spot lights */
 } lm_falloff;
+
+/* The falloff at distance d >= 0 (shaders/lighting.glsl's light_falloff, its
+ * GLSL twin: change both together). Finite for every d and radius. */
+float lm_light_falloff(lm_falloff f, float d, float radius);
 
 /* Position and direction come from the node (lights shine along the node's -Z). */
 typedef struct lm_light {
   char name[LM_NAME_MAX];
   lm_light_type type;
   float color[3];
-  float power;
-  float radius;
+  float power;  /* engine units; glTF's candela and lux arrive scaled by LM_GLTF_EXPOSURE */
+  float radius; /* the window's radius or the range; see lm_falloff */
   float inner_cone, outer_cone; /* spot half-angles, radians */
   lm_falloff falloff;
   bool casts_shadows;
   int node;
 } lm_light;
+
+/* Distance beyond which a point or spot light adds nothing (the window's or
+ * range's radius); INFINITY for directional lights and unbounded falloffs. */
+float lm_light_reach(const lm_light *l);
 
 /* Looks along the node's -Z with +Y up, as in glTF. */
 typedef struct lm_camera {
@@ -53,6 +63,8 @@ typedef struct lm_camera {
   float znear, zfar;
   int node;
   float aspect; /* width / height; 0: the output's */
+  float ortho[2]; /* glTF orthographic xmag, ymag; 0, 0: perspective. Kept so that a
+                     file's camera indices hold, refused by lm_scene_camera_check. */
 } lm_camera;
 
 typedef struct lm_scene_mesh {
@@ -117,6 +129,18 @@ void lm_scene_node_set_world(lm_scene *s, int node, const float world[16]);
 bool lm_scene_node_bounds(const lm_scene *s, int node, float lo[3], float hi[3]);
 /* World-space box around every mesh node; false (and a unit box) when empty. */
 bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]);
+/* Adds a camera (and its node) called `name` that frames the scene's bounds:
+ * 45 degrees vertical field of view, looking at the bounds' centre from +Z
+ * and 20 degrees above, as near as every corner of the bounds allows with a
+ * 5% margin at an output of width / height `aspect` (<= 0: any output at
+ * least as wide as high). Near and far enclose the bounds. Returns the
+ * camera's index. World transforms are updated. */
+int lm_scene_add_framing_camera(lm_scene *s, const char *name, float aspect);
+/* False, with a message naming the camera, when the passes cannot render
+ * through camera `cam` (an orthographic one: every pass rebuilds positions
+ * from depth along rays from one eye, common.glsl's position_from_depth). An
+ * index with no camera is the engine's default one, which they can. */
+bool lm_scene_camera_check(const lm_scene *s, int cam, lm_error *err);
 
 /* Reads a camera list (engine/scene/camlist.c: one view per line, "name
  * eye_x eye_y eye_z target_x target_y target_z fov_y_degrees [near far]",
