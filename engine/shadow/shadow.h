@@ -3,7 +3,9 @@
  * scheme, stabilized as seed 003), one perspective tile for a spot light, six
  * cube faces for a point light. The plan becomes one scene pass drawn once
  * per tile, and two storage blocks the lighting shaders read through
- * shaders/shadow.glsl. A frame that plans nothing renders no shadow map. */
+ * shaders/shadow.glsl. A frame that plans nothing renders no shadow map.
+ * With settings.rsm the same pass also writes reflective shadow maps
+ * (scripts/shadow.lua, shaders/rsm.glsl). */
 #ifndef LIMN_SHADOW_H
 #define LIMN_SHADOW_H
 
@@ -31,6 +33,9 @@ typedef struct lm_shadow_settings {
   float blend;     /* share of a cascade blended into the next one */
   float radius;    /* Poisson disc radius in texels */
   bool stabilize;  /* bounding spheres and texel snapping (seed 003) */
+  float rsm;       /* > 0: a frame reads reflective shadow maps (seed 004's senders); each
+                    * directional light gets one more tile, over the sphere around all
+                    * that is seen with its radius times rsm (senders off screen), 0..64 */
 } lm_shadow_settings;
 void lm_shadow_settings_default(lm_shadow_settings *s);
 
@@ -39,7 +44,9 @@ typedef struct lm_shadow_light_data {
   int32_t info[4]; /* first view, view count, kind (0 none, 1 cascades, 2 spot, 3 point), technique */
   float splits[4]; /* cascades: camera depth where each ends */
   float params[4]; /* c, bias (texels), blend, Poisson radius */
-  int32_t cube[4]; /* point lights: x = the cube faces drawn (bit f: face f, +X -X +Y -Y +Z -Z), in order */
+  int32_t cube[4]; /* x: point lights' cube faces drawn (bit f: face f, +X -X +Y -Y +Z -Z), in order;
+                    * y, z: the light's RSM views (first, count; count 0 without RSM): the
+                    * wide tile of a directional light, else its shadow views */
 } lm_shadow_light_data;
 typedef struct lm_shadow_view_data {
   float view_proj[16];
