@@ -106,8 +106,9 @@ static void caster_depth(const lm_scene *s, mat4 view, float l, float r, float b
   *zn = fmaxf(*zn, cmin), *zf = fminf(*zf, cmax);
 }
 
-/* One orthographic tile along dir over the camera's slice z0 .. z1, its
- * bounding sphere's radius times grow. */
+/* One orthographic tile along dir over the camera's slice z0 .. z1: a
+ * cascade (grow 0), or the RSM's wide tile over the slice's bounding sphere
+ * with its radius times grow. */
 static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam, vec3 dir,
                            float z0, float z1, float grow) {
   const lm_shadow_settings *st = &plan->settings;
@@ -116,7 +117,7 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
   for (int c = 0; c < 8; c++) glm_vec3_muladds(corners[c], 1.0f / 8.0f, center);
   float l, r, b, t, extent = 0;
   for (int c = 0; c < 8; c++) extent = fmaxf(extent, glm_vec3_distance(corners[c], center));
-  extent = round_relative(extent * grow * 1.0001f, true);
+  extent = round_relative(extent * fmaxf(grow, 1.0f) * 1.0001f, true);
   /* The eye sits on a plane across the light snapped to steps of extent/16,
    * so a small camera move changes no stored depth. */
   float step = extent / 16.0f, along = glm_vec3_dot(center, dir);
@@ -145,9 +146,18 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
    * than the near plane are clamped onto it by depth clamping in the
    * shadow pass ("pancaking"). */
   float zn = 0, zf = 2.0f * extent + step;
-  caster_depth(s, view, l, r, b, t, &zn, &zf);
-  zn = fmaxf(floorf(zn / step) * step, 0.0f), zf = fminf(ceilf(zf / step) * step, 2.0f * extent + step);
-  if (!(zf > zn)) zn = 0, zf = 2.0f * extent + step;
+  if (grow > 0) {
+    /* The RSM's tile: every mesh in the rectangle, however deep (a sender
+     * below the slice's sphere still lights it), a step to spare at either
+     * end so that none lies on a clip plane. */
+    zf = FLT_MAX;
+    caster_depth(s, view, l, r, b, t, &zn, &zf);
+    zn = fmaxf(floorf(zn / step) * step - step, 0.0f), zf = ceilf(zf / step) * step + step;
+  } else {
+    caster_depth(s, view, l, r, b, t, &zn, &zf);
+    zn = fmaxf(floorf(zn / step) * step, 0.0f), zf = fminf(ceilf(zf / step) * step, 2.0f * extent + step);
+  }
+  if (!(zf > zn) || !isfinite(zf)) zn = 0, zf = 2.0f * extent + step;
   glm_ortho(l, r, b, t, zn, zf, proj);
   glm_mat4_mul(proj, view, vp);
   if (st->stabilize) {
@@ -181,7 +191,7 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_fram
     float z0 = split_depth(n, reach, k, st->cascades, st->lambda);
     float z1 = split_depth(n, reach, k + 1, st->cascades, st->lambda);
     out->splits[k] = z1;
-    add_slice_view(plan, s, cam, dir, z0, z1, 1.0f);
+    add_slice_view(plan, s, cam, dir, z0, z1, 0.0f);
   }
   if (st->rsm > 0) { /* the RSM's wide tile: what the cascades cover and around it, in one */
     out->cube[1] = plan->view_count, out->cube[2] = 1;
