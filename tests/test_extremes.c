@@ -34,7 +34,7 @@ static float mean_luminance(const gl_result *r) {
   return gl_luminance(all);
 }
 
-static const char *const every_technique[] = {"isr+esm", "isr",  "dl+esm",  "dl",     "ssdo+esm",
+static const char *const every_technique[] = {"isr+esm", "isr",      "dl+esm", "dl",      "ssdo+esm",
                                               "ssdo",    "ssao+esm", "ssao", "rsm+esm", "isr+rsm+esm"};
 enum { TECHNIQUES = sizeof every_technique / sizeof *every_technique };
 
