@@ -3,6 +3,7 @@
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local rsm = require "rsm"
+local vpl = require "vpl"
 local shadow = require "shadow"
 local ssdo = require "ssdo"
 local ssao = require "ssao"
@@ -13,21 +14,25 @@ local options = require "options"
 -- dl (F5); then screen-space directional and ambient occlusion (seed 001).
 -- "+esm" turns shadows on; shadow.technique picks their filter. rsm+esm:
 -- indirect light from reflective shadow maps (seed 004, scripts/rsm.lua);
--- isr+rsm+esm: the two together, each sender counted once (docs/gi-combined.md).
+-- vpl+esm: indirect point lights and negative lights in them (seed 002,
+-- scripts/vpl.lua); isr+rsm+esm: RSM and ISR together, each sender counted
+-- once (docs/gi-combined.md).
 Techniques = { "isr+esm", "isr", "dl+esm", "dl", "ssdo+esm", "ssdo", "ssao+esm", "ssao", "rsm+esm",
-               "isr+rsm+esm" }
+               "vpl+esm", "isr+rsm+esm" }
 
 Options = {
   ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
   background = 0.0,        -- radiance where no geometry is
   isr = {},                -- see isr.defaults in scripts/isr.lua
   rsm = {},                -- see rsm.defaults in scripts/rsm.lua
+  vpl = {},                -- see vpl.defaults in scripts/vpl.lua
   shadow = {},             -- see shadow.defaults in scripts/shadow.lua
   ssdo = {},               -- see ssdo.defaults in scripts/ssdo.lua
   ssao = {},               -- see ssao.defaults in scripts/ssao.lua
 }
 for k, v in pairs(isr.defaults) do Options.isr[k] = v end
 for k, v in pairs(rsm.defaults) do Options.rsm[k] = v end
+for k, v in pairs(vpl.defaults) do Options.vpl[k] = v end
 for k, v in pairs(shadow.defaults) do Options.shadow[k] = v end
 for k, v in pairs(ssdo.defaults) do Options.ssdo[k] = v end
 for k, v in pairs(ssao.defaults) do Options.ssao[k] = v end
@@ -68,18 +73,21 @@ function OnRender(tech)
   end
   local G = gbuffer.render(gbuffer.targets())
   -- Shadows after the G-buffer: their cascades fit the depths it sees.
-  local o_rsm = tech.name:find("rsm+", 1, true) and rsm.check(tech.rsm) or nil
+  -- The RSM's options, when the technique reads one (the shadow pass then writes it).
+  local o_rsm = lighting == "vpl" and vpl.check(tech.vpl) or tech.name:find("rsm+", 1, true) and rsm.check(tech.rsm)
   local shadows, R
   if tech.name:find("+esm", 1, true) then shadows, R = shadow.render(tech.shadow, G, o_rsm and o_rsm.reach) end
   if shadows and tech.shadow.debug then return present(shadow.debug(shadows)) end
   local lit
-  if lighting == "dl" or lighting == "rsm" and not R then -- no light casts shadows: no RSM
+  if lighting == "dl" or (lighting == "rsm" or lighting == "vpl") and not R then -- no caster: no RSM
     lit = direct(G, tech, shadows, tech.ambient, "lit")
   else
     local d = direct(G, tech, shadows, 0, "direct")
     local light = { ambient = grey(tech.ambient), background = grey(tech.background) }
     if lighting == "rsm" then
       lit = rsm.render(G, d, shadows, R, o_rsm, light)
+    elseif lighting == "vpl" then
+      lit = vpl.render(G, d, shadows, R, o_rsm, light)
     elseif lighting == "isr" then
       lit = isr.render(G, d, tech.isr, light, R and function(C, E, f) return rsm.gather(C, f, R, shadows, o_rsm, E) end)
     elseif lighting == "ssdo" then

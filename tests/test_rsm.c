@@ -1,5 +1,5 @@
-/* Reflective shadow maps (scripts/rsm.lua, shaders/rsm.frag) through
- * pp.lua: colour bleeding from a sunlit floor onto a ceiling the sun cannot
+/* Reflective shadow maps (scripts/rsm.lua, shaders/rsm.frag) and indirect
+ * point lights in them (scripts/vpl.lua) through pp.lua: colour bleeding from a sunlit floor onto a ceiling the sun cannot
  * reach and the camera sees alone (present with rsm, absent with isr), on
  * POV-Ray's scale; a closed room lit by one spot patch lights its ceiling;
  * a frame that reads no RSM renders none; extremes stay finite. Needs a GL
@@ -101,15 +101,19 @@ static void sunlit_floor_bleeds_onto_a_ceiling_the_sun_cannot_reach(void **state
   (void)state;
   static const char *const sets[] = {"ambient=0", "rsm.reach=16", NULL};
   lm_scene *s = canopy_scene();
+  static const char *const vpl_sets[] = {"ambient=0", "vpl.reach=16", "vpl.focus=16", "vpl.lights=400", NULL};
   gl_result rsm = render_ok(s, "rsm+esm", sets), isr = render_ok(s, "isr+esm", sets),
-            both = render_ok(s, "isr+rsm+esm", sets);
-  float a[3], b[3], c[3];
+            both = render_ok(s, "isr+rsm+esm", sets), vpl = render_ok(s, "vpl+esm", vpl_sets);
+  float a[3], b[3], c[3], v[3];
+  gl_region(&vpl, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, v);
   gl_region(&rsm, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, a);
   gl_region(&isr, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, b);
   gl_region(&both, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, c);
   double red = canopy_expected(0.8, 0.8), green = canopy_expected(0.8, 0.1);
-  print_message("canopy: rsm %.4f %.4f %.4f (expected %.4f %.4f), isr %.5f, combined %.4f\n", a[0], a[1], a[2], red,
-                green, b[0], c[0]);
+  print_message("canopy: rsm %.4f %.4f %.4f (expected %.4f %.4f), isr %.5f, combined %.4f, vpl %.4f %.4f\n", a[0],
+                a[1], a[2], red, green, b[0], c[0], v[0], v[1]);
+  assert_true(fabs(v[0] - red) < 0.15 * red); /* 400 lights over the tile, about 150 on the lit floor: 7% */
+  assert_true(v[0] > 4 * v[1]);
   assert_true(fabs(a[0] - red) < 0.1 * red);
   assert_true(fabs(a[1] - green) < 0.1 * green + 0.002);
   assert_true(a[0] > 4 * a[1]); /* red, from the floor */
@@ -118,6 +122,7 @@ static void sunlit_floor_bleeds_onto_a_ceiling_the_sun_cannot_reach(void **state
   gl_result_free(&rsm);
   gl_result_free(&isr);
   gl_result_free(&both);
+  gl_result_free(&vpl);
   lm_scene_destroy(s);
 }
 
@@ -157,19 +162,23 @@ static void a_closed_room_with_one_lit_patch_lights_its_ceiling(void **state) {
   static const char *const sets[] = {"ambient=0", NULL};
   for (int k = 0; k < 2; k++) {
     lm_scene *s = closed_room(k ? LM_LIGHT_POINT : LM_LIGHT_SPOT);
-    gl_result dl = render_ok(s, "dl+esm", sets), rsm = render_ok(s, "rsm+esm", sets);
-    float a[3], b[3];
+    gl_result dl = render_ok(s, "dl+esm", sets), rsm = render_ok(s, "rsm+esm", sets),
+              vpl = render_ok(s, "vpl+esm", sets);
+    float a[3], b[3], c[3];
     gl_region(&dl, W / 4, H / 4, 3 * W / 4, 3 * H / 4, a);
     gl_region(&rsm, W / 4, H / 4, 3 * W / 4, 3 * H / 4, b);
-    print_message("%s: ceiling dl %.5f, rsm %.5f\n", k ? "point" : "spot", gl_luminance(a), gl_luminance(b));
+    gl_region(&vpl, W / 4, H / 4, 3 * W / 4, 3 * H / 4, c);
+    print_message("%s: ceiling dl %.5f, rsm %.5f, vpl %.5f\n", k ? "point" : "spot", gl_luminance(a), gl_luminance(b),
+                  gl_luminance(c));
     if (k == 0) {
       assert_true(gl_luminance(a) < 1e-4f);
-      assert_true(gl_luminance(b) > 0.002f);
+      assert_true(gl_luminance(b) > 0.002f && gl_luminance(c) > 0.002f);
     } else {
-      assert_true(gl_luminance(b) > 1.05f * gl_luminance(a));
+      assert_true(gl_luminance(b) > 1.05f * gl_luminance(a) && gl_luminance(c) > 1.05f * gl_luminance(a));
     }
     gl_result_free(&dl);
     gl_result_free(&rsm);
+    gl_result_free(&vpl);
     lm_scene_destroy(s);
   }
 }
@@ -178,15 +187,15 @@ static void a_closed_room_with_one_lit_patch_lights_its_ceiling(void **state) {
  * in a frame that reads them. */
 static void a_frame_that_reads_no_rsm_renders_none(void **state) {
   (void)state;
-  const char *const techs[] = {"dl+esm", "isr+esm", "rsm+esm", "isr+rsm+esm"};
+  const char *const techs[] = {"dl+esm", "isr+esm", "rsm+esm", "isr+rsm+esm", "vpl+esm"};
   lm_scene *s = canopy_scene();
-  for (int t = 0; t < 4; t++) {
+  for (int t = 0; t < 5; t++) {
     gl_result r = render_ok(s, techs[t], NULL);
     bool reads = t >= 2;
     lm_graph *g = lm_renderer_graph(r.renderer);
     assert_int_equal(lm_graph_find_target(g, "shadow.rsm_flux") >= 0, reads);
     assert_int_equal(lm_graph_find_target(g, "shadow.rsm_pos") >= 0, reads);
-    assert_int_equal(gl_has_pass(&r, "rsm."), reads);
+    assert_int_equal(gl_has_pass(&r, "rsm.") || gl_has_pass(&r, "vpl."), reads);
     assert_int_equal(lm_renderer_shadows(r.renderer)->view_count, 3 + reads); /* cascades (+ the wide tile) */
     assert_int_equal(gl_culled(&r, ""), 0);
     gl_result_free(&r);
@@ -203,15 +212,25 @@ static void extremes_stay_finite(void **state) {
       {"rsm.samples=1", NULL}, {"rsm.samples=4096", "rsm.coarse=4", NULL}, {"rsm.steps=32", NULL},
       {"rsm.radius=2", "rsm.reach=64", NULL}, {"rsm.coarse=1", "rsm.blur=0", NULL},
   };
+  static const char *const vpl_cases[][4] = {
+      {"vpl.lights=0", NULL}, {"vpl.lights=4096", "vpl.negative=4096", "vpl.coarse=4", NULL},
+      {"vpl.negative=0", "vpl.threshold=0", NULL}, {"vpl.threshold=2", "vpl.focus=0.05", NULL},
+  };
   lm_scene *room = closed_room(LM_LIGHT_POINT);
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
     gl_result r = render_ok(room, "isr+rsm+esm", cases[i]);
+    gl_result_free(&r);
+  }
+  for (size_t i = 0; i < sizeof vpl_cases / sizeof *vpl_cases; i++) {
+    gl_result r = render_ok(room, "vpl+esm", vpl_cases[i]);
     gl_result_free(&r);
   }
   lm_scene_destroy(room);
   lm_scene *closed = closed_room(LM_LIGHT_SPOT);
   closed->lights[0].outer_cone = closed->lights[0].inner_cone = 1e-6f;
   gl_result r = render_ok(closed, "rsm+esm", NULL);
+  gl_result_free(&r);
+  r = render_ok(closed, "vpl+esm", NULL);
   gl_result_free(&r);
   lm_scene_destroy(closed);
   /* The camera outside the box, the point light inside it. */
@@ -222,6 +241,8 @@ static void extremes_stay_finite(void **state) {
   lm_scene_update(outside);
   r = render_ok(outside, "rsm+esm", NULL);
   gl_result_free(&r);
+  r = render_ok(outside, "vpl+esm", NULL);
+  gl_result_free(&r);
   lm_scene_destroy(outside);
 }
 
@@ -231,6 +252,8 @@ static void bad_options_name_themselves(void **state) {
       {"rsm+esm", "rsm.samples=0", "rsm.samples"},    {"rsm+esm", "rsm.samples=4097", "rsm.samples"},
       {"rsm+esm", "rsm.radius=0", "rsm.radius"},      {"rsm+esm", "rsm.reach=0.5", "rsm.reach"},
       {"isr+rsm+esm", "rsm.steps=33", "rsm.steps"},   {"rsm+esm", "rsm.coarse=3", "rsm.coarse"},
+      {"vpl+esm", "vpl.lights=-1", "vpl.lights"},     {"vpl+esm", "vpl.negative=4097", "vpl.negative"},
+      {"vpl+esm", "vpl.threshold=3", "vpl.threshold"}, {"vpl+esm", "vpl.focus=0", "vpl.focus"},
   };
   gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
 }
