@@ -4,6 +4,7 @@ local gbuffer = require "gbuffer"
 local isr = require "isr"
 local rsm = require "rsm"
 local vpl = require "vpl"
+local temporal = require "temporal"
 local shadow = require "shadow"
 local ssdo = require "ssdo"
 local ssao = require "ssao"
@@ -60,6 +61,7 @@ local rules = { ambient = options.number(0, 1e6), background = options.number(0,
 
 function OnCreate()
   post.create()
+  temporal.create("rsm", 1 / rsm.defaults.coarse) -- rsm.temporal's history
 end
 
 function OnRender(tech)

@@ -8,6 +8,7 @@ local gbuffer = require "gbuffer"
 local isr = require "isr"
 local options = require "options"
 local shadow = require "shadow"
+local temporal = require "temporal"
 
 local rsm = {}
 
@@ -19,12 +20,15 @@ rsm.defaults = {
                      -- its radius times reach, 1..64 (senders off screen; no world unit)
   steps = 0,         -- screen-space visibility march a sample, 0..32 (0: none; the seed's
                      -- test, which about halves its frame rate)
-  rotate = 0,        -- pattern turn a frame in degrees, 0..180 (the seed: 10, with temporal
-                     -- reuse; 0 keeps a still image still)
+  rotate = 10,       -- pattern turn a frame in degrees with temporal reuse, 0..180 (the seed: 10);
+                     -- without, the pattern stays (a still camera, a still image)
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
   coarse = 2,        -- coarse factor a side: 1, 2 or 4 (the seed: half resolution)
   blur = 4,          -- Gaussian taps each side at coarse size, 0..32
+  temporal = {},     -- temporal reuse (scripts/temporal.lua): enabled, frames, epsilon, bias;
+                     -- its history is at coarse 2 (pp.lua's OnCreate)
 }
+for k, v in pairs(temporal.defaults) do rsm.defaults.temporal[k] = v end
 
 local rules = {
   samples = options.whole(1, 4096),
@@ -35,11 +39,16 @@ local rules = {
   k = options.number(0, 16),
   coarse = options.one_of(1, 2, 4),
   blur = options.whole(0, 32),
+  temporal = function(v) if type(v) ~= "table" then return "a table of temporal reuse options" end end,
 }
 
 -- Checked options (errors name the option, pointing at the caller's caller);
 -- shadow.render(..., o.reach) then writes the maps.
-function rsm.check(o) return options.check("rsm", rsm.defaults, o, rules, 3) end
+function rsm.check(o)
+  o = options.check("rsm", rsm.defaults, o, rules, 3)
+  o.temporal = temporal.check("rsm.temporal", o.temporal)
+  return o
+end
 
 -- Records the gather over the coarse G-buffer C (isr.coarse_gbuffer) from
 -- the RSM targets R (shadow.render's second result) and the atlas `shadows`.
@@ -50,7 +59,8 @@ function rsm.gather(C, f, R, shadows, o, base)
                                       { VISIBILITY = o.steps > 0, BASE = base ~= nil, EXCLUDE_SEEN = base ~= nil })
   inputs.rsm_flux, inputs.rsm_nrm, inputs.rsm_pos, inputs.base = R.flux, R.nrm, R.pos, base
   return pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines,
-               params = { samples = o.samples, radius = o.radius, steps = o.steps, rotate = o.rotate / 360 },
+               params = { samples = o.samples, radius = o.radius, steps = o.steps,
+                          rotate = o.temporal.enabled and o.rotate / 360 or 0 },
                fetches = 4 + o.samples * (3 + o.steps * 2 + (base and 3 or 0)),
                out = target{ "rsm.e", format = "rgba16f", scale = 1 / f } }
 end
@@ -62,7 +72,8 @@ end
 function rsm.render(G, direct, shadows, R, o, light)
   local f = o.coarse
   local C = isr.coarse_gbuffer(G, direct, f)
-  local E = isr.blur(rsm.gather(C, f, R, shadows, o), C, f, o.blur)
+  local E = temporal.apply("rsm", rsm.gather(C, f, R, shadows, o), C, o.temporal, 1 / f)
+  E = isr.blur(E, C, f, o.blur)
   return isr.composite(G, direct, C, E, { ambient = light.ambient, background = light.background, k = o.k }, false)
 end
 

@@ -246,6 +246,92 @@ static void extremes_stay_finite(void **state) {
   lm_scene_destroy(outside);
 }
 
+
+static double mean_abs_diff(const float *a, const float *b, int n) {
+  double sum = 0;
+  for (int i = 0; i < n; i++) sum += fabs(a[i] - b[i]);
+  return sum / n;
+}
+
+/* A still camera with temporal reuse (16 samples a frame, the pattern
+ * turning 10 degrees a frame): the change from one frame to the next falls
+ * from frame 2 to frame 40 by more than 5x and ends below 1e-3 of the
+ * image's mean (mean over the linear RGB values), and the result lies nearer
+ * a 1024-sample frame than one frame of 16 samples does. */
+static void still_frames_with_temporal_reuse_converge(void **state) {
+  (void)state;
+  static const char *const on[] = {"ambient=0", "rsm.samples=16", "rsm.temporal.enabled=true", NULL};
+  static const char *const off[] = {"ambient=0", "rsm.samples=16", NULL};
+  static const char *const ref[] = {"ambient=0", "rsm.samples=1024", NULL};
+  lm_scene *s = closed_room(LM_LIGHT_POINT);
+  int n = W * H * 3;
+  float *last = malloc(sizeof(float) * (size_t)n);
+  gl_result r = gl_render(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = on, .width = W, .height = H, .frames = 2});
+  assert_true(r.ok);
+  memcpy(last, r.rgb, sizeof(float) * (size_t)n);
+  assert_true(gl_render_again(&r));
+  double early = mean_abs_diff(last, r.rgb, n), late = 0;
+  for (int f = 3; f < 40; f++) {
+    memcpy(last, r.rgb, sizeof(float) * (size_t)n);
+    assert_true(gl_render_again(&r));
+    late = mean_abs_diff(last, r.rgb, n);
+  }
+  gl_result one = render_ok(s, "rsm+esm", off), best = render_ok(s, "rsm+esm", ref);
+  double e_acc = mean_abs_diff(r.rgb, best.rgb, n), e_one = mean_abs_diff(one.rgb, best.rgb, n);
+  float all[3];
+  gl_region(&r, 0, 0, W - 1, H - 1, all);
+  double mean = (all[0] + all[1] + all[2]) / 3.0;
+  print_message("temporal: change %.2e (frame 3) -> %.2e (frame 40) of a mean %.3f; error to 1024 samples %.2e "
+                "(one frame %.2e)\n", early, late, mean, e_acc, e_one);
+  assert_true(gl_all_finite(&r));
+  assert_true(late < 1e-3 * mean && late * 5 < early);
+  assert_true(e_acc < e_one);
+  free(last);
+  gl_result_free(&r);
+  gl_result_free(&one);
+  gl_result_free(&best);
+  lm_scene_destroy(s);
+}
+
+/* A camera move with temporal reuse: after 20 still frames the camera
+ * slides sideways by a tenth of the room; the first frame after the move
+ * differs from a frame of 1024 samples without reuse at the new place by
+ * less than 1% of
+ * the image's mean, edges (ceiling and walls, the lit patch) included,
+ * where a ghost trail would show the old ones: reprojection keeps what is
+ * still seen, the disocclusion test drops what was not. */
+static void a_camera_move_leaves_no_ghost_edge(void **state) {
+  (void)state;
+  static const char *const on[] = {"ambient=0", "rsm.temporal.enabled=true", NULL};
+  static const char *const off[] = {"ambient=0", "rsm.samples=1024", NULL};
+  lm_scene *s = closed_room(LM_LIGHT_POINT);
+  /* Look along the room at the far wall, ceiling in the upper half. */
+  int cam = s->cameras[0].node;
+  mat4 m;
+  glm_translate_make(m, (vec3){0, -0.5f, 0.9f});
+  glm_rotate(m, glm_rad(20.0f), (vec3){1, 0, 0});
+  memcpy(s->nodes[cam].local, m, sizeof m);
+  lm_scene_update(s);
+  gl_result r = gl_render(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = on, .width = W, .height = H, .frames = 20});
+  assert_true(r.ok);
+  glm_translate_make(m, (vec3){0.2f, -0.5f, 0.9f});
+  glm_rotate(m, glm_rad(20.0f), (vec3){1, 0, 0});
+  memcpy(s->nodes[cam].local, m, sizeof m);
+  lm_scene_update(s);
+  assert_true(gl_render_again(&r));
+  gl_result plain = render_ok(s, "rsm+esm", off);
+  double diff = mean_abs_diff(r.rgb, plain.rgb, W * H * 3);
+  float all[3];
+  gl_region(&plain, 0, 0, W - 1, H - 1, all);
+  double mean = (all[0] + all[1] + all[2]) / 3.0;
+  print_message("after the move: mean difference to no reuse %.2e of a mean %.3f\n", diff, mean);
+  assert_true(gl_all_finite(&r));
+  assert_true(diff < 0.01 * mean);
+  gl_result_free(&r);
+  gl_result_free(&plain);
+  lm_scene_destroy(s);
+}
+
 static void bad_options_name_themselves(void **state) {
   (void)state;
   static const gl_bad_option cases[] = {
@@ -254,6 +340,7 @@ static void bad_options_name_themselves(void **state) {
       {"isr+rsm+esm", "rsm.steps=33", "rsm.steps"},   {"rsm+esm", "rsm.coarse=3", "rsm.coarse"},
       {"vpl+esm", "vpl.lights=-1", "vpl.lights"},     {"vpl+esm", "vpl.negative=4097", "vpl.negative"},
       {"vpl+esm", "vpl.threshold=3", "vpl.threshold"}, {"vpl+esm", "vpl.focus=0", "vpl.focus"},
+      {"rsm+esm", "rsm.temporal.frames=0", "rsm.temporal.frames"},
   };
   gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
 }
@@ -263,6 +350,8 @@ int main(void) {
       cmocka_unit_test(sunlit_floor_bleeds_onto_a_ceiling_the_sun_cannot_reach),
       cmocka_unit_test(a_closed_room_with_one_lit_patch_lights_its_ceiling),
       cmocka_unit_test(a_frame_that_reads_no_rsm_renders_none),
+      cmocka_unit_test(still_frames_with_temporal_reuse_converge),
+      cmocka_unit_test(a_camera_move_leaves_no_ghost_edge),
       cmocka_unit_test(extremes_stay_finite),
       cmocka_unit_test(bad_options_name_themselves),
   };
