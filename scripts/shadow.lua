@@ -76,7 +76,7 @@ function shadow.render(o, G, rsm)
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
     blurred = pass{ "shadow.blur_" .. axis[1], shader = "esm_blur.frag", inputs = { src = blurred },
                     params = { direction = axis[2], radius = plan.blur, c = plan.c, tile = plan.tile,
-                               views = plan.views },
+                               views = plan.shadow_views }, -- not the RSM's wide tiles after them
                     out = target{ "shadow.esm_" .. axis[1], format = "r32f", size = size } }
   end
   return blurred, R

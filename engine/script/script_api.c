@@ -234,10 +234,12 @@ static int l_plan_index(lua_State *L) {
   else if (!strcmp(k, "height")) lua_pushinteger(L, plan->atlas_height);
   else if (!strcmp(k, "tile")) lua_pushinteger(L, plan->tile);
   else if (!strcmp(k, "views")) lua_pushinteger(L, plan->view_count);
+  else if (!strcmp(k, "shadow_views")) lua_pushinteger(L, plan->shadow_views);
   else if (!strcmp(k, "c")) lua_pushnumber(L, plan->settings.c);
   else if (!strcmp(k, "blur")) lua_pushinteger(L, plan->settings.blur);
   else if (!strcmp(k, "technique")) lua_pushstring(L, (const char *[]){"esm", "pcf", "poisson", "hard"}[plan->settings.technique]);
-  else return luaL_error(L, "shadow plan has no field '%s' (width, height, tile, views, c, blur, technique)", k);
+  else return luaL_error(L, "shadow plan has no field '%s' (width, height, tile, views, shadow_views, c, blur, "
+                         "technique)", k);
   return 1;
 }
 

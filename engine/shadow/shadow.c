@@ -174,16 +174,21 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
   add_view(plan, vp, (float[4]){0, 0, 0, 0}, (float[4]){(r - l) / (float)plan->tile, zf - zn, 0, 0});
 }
 
+/* Cascades cover the depths where receivers are seen (plan->seen), snapped
+ * outwards to a relative grid so that a small camera move keeps them. */
+static void cascade_range(const lm_shadow_plan *plan, float *n, float *reach) {
+  *n = round_relative(plan->seen[0], false), *reach = round_relative(plan->seen[1], true);
+  if (plan->settings.distance > 0) *reach = fminf(plan->settings.distance, *reach);
+  if (!(*reach > *n)) *reach = *n * 1.001f;
+}
+
 static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
                           const lm_light_data *light, lm_shadow_light_data *out) {
   const lm_shadow_settings *st = &plan->settings;
   vec3 dir;
   glm_vec3_normalize_to((float *)light->direction, dir);
-  /* Cascades cover the depths where receivers are seen (plan->seen), snapped
-   * outwards to a relative grid so that a small camera move keeps them. */
-  float n = round_relative(plan->seen[0], false), reach = round_relative(plan->seen[1], true);
-  if (st->distance > 0) reach = fminf(st->distance, reach);
-  if (!(reach > n)) reach = n * 1.001f;
+  float n, reach;
+  cascade_range(plan, &n, &reach);
   out->info[0] = plan->view_count;
   out->info[1] = st->cascades;
   out->info[2] = KIND_CASCADES;
@@ -193,10 +198,19 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_fram
     out->splits[k] = z1;
     add_slice_view(plan, s, cam, dir, z0, z1, 0.0f);
   }
-  if (st->rsm > 0) { /* the RSM's wide tile: what the cascades cover and around it, in one */
-    out->cube[1] = plan->view_count, out->cube[2] = 1;
-    add_slice_view(plan, s, cam, dir, n, reach, st->rsm);
-  }
+}
+
+/* The RSM's wide tile of a directional light: what its cascades cover and
+ * around it, in one; after every shadow view, so that the ESM blur, which
+ * it does not need, stops before it (plan->shadow_views). */
+static void plan_wide_tile(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
+                           const lm_light_data *light, lm_shadow_light_data *out) {
+  vec3 dir;
+  glm_vec3_normalize_to((float *)light->direction, dir);
+  float n, reach;
+  cascade_range(plan, &n, &reach);
+  out->cube[1] = plan->view_count, out->cube[2] = 1;
+  add_slice_view(plan, s, cam, dir, n, reach, plan->settings.rsm);
 }
 
 /* Range of a point or spot light: its radius under the seed's window falloff,
@@ -309,6 +323,10 @@ static void plan_views(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
   lm_light_data *ld = lm_alloc(sizeof *ld * (size_t)(s->light_count + 1));
   lm_scene_light_data(s, ld, s->light_count);
   for (int i = 0; i < s->light_count; i++) plan_light(plan, s, cam, i, &ld[i]);
+  plan->shadow_views = plan->view_count;
+  for (int i = 0; i < s->light_count; i++)
+    if (plan->settings.rsm > 0 && s->lights[i].casts_shadows && s->lights[i].type == LM_LIGHT_DIRECTIONAL)
+      plan_wide_tile(plan, s, cam, &ld[i], &plan->lights[i]);
   free(ld);
   for (int v = 0; v < plan->view_count; v++) {
     int cx = v % plan->columns, cy = v / plan->columns;

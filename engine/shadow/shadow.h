@@ -61,6 +61,7 @@ typedef struct lm_shadow_plan {
   lm_pass_view *views; /* for the scene pass, one per tile */
   lm_shadow_view_data *view_data;
   int view_count;
+  int shadow_views; /* the first views, those shadow lookups read (the RSM's wide tiles follow) */
   lm_shadow_light_data *lights; /* one per scene light */
   int light_count;
   float seen[2]; /* camera depths cascades cover: where receivers are seen */
