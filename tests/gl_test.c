@@ -191,7 +191,13 @@ bool gl_target_finite(gl_result *r, const char *name) {
 void gl_rescale(lm_scene *s, float unit) {
   float m[16] = {unit, 0, 0, 0, 0, unit, 0, 0, 0, 0, unit, 0, 0, 0, 0, 1};
   lm_scene_add_root(s, "unit", m);
-  for (int i = 0; i < s->light_count; i++) s->lights[i].radius *= unit;
+  for (int i = 0; i < s->light_count; i++) {
+    lm_light *l = &s->lights[i];
+    l->radius *= unit;
+    /* An inverse-square light's intensity is per unit of distance squared. */
+    bool inverse_square = l->falloff == LM_FALLOFF_INVERSE_SQUARE || l->falloff == LM_FALLOFF_RANGE;
+    if (inverse_square && l->type != LM_LIGHT_DIRECTIONAL) l->power *= unit * unit;
+  }
 }
 
 void gl_project(int width, int height, float x, float y, float z, int *col, int *row) {

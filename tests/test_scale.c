@@ -59,11 +59,10 @@ static double relative_difference(const gl_result *a, const gl_result *b) {
 }
 
 static gl_result render_with(lm_scene *s, const char *tech, float unit, const char *const *more) {
-  /* ISR's disc radius is a world length (scripts/isr.lua): give it in the unit. */
-  char radius[64];
-  snprintf(radius, sizeof radius, "isr.radius=%.9g", 0.5 * unit);
-  const char *sets[8] = {radius};
-  for (int i = 0; more && more[i] && i < 6; i++) sets[i + 1] = more[i];
+  /* Every default is relative to the view (ISR's rays march from a pixel's
+   * footprint to the view's edge): nothing is given in the unit. */
+  const char *sets[8] = {NULL};
+  for (int i = 0; more && more[i] && i < 7; i++) sets[i] = more[i];
   gl_result r = gl_render(&(gl_run){.scene = s, .tech = tech, .sets = sets, .width = W, .height = H});
   if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
   if (!gl_all_finite(&r)) fail_msg("%s at scale %g: a pixel is NaN, Inf or negative", tech, unit);

@@ -172,9 +172,11 @@ static void assert_walls(const lm_image *img) {
   box_mean(img, 0.75, 0.42, 0.82, 0.57, right);
   fprintf(stderr, "walls: left %.3f %.3f %.3f, right %.3f %.3f %.3f (%dx%d, %d channels)\n", left[0], left[1],
           left[2], right[0], right[1], right[2], img->width, img->height, img->channels);
-  /* sRGB-encoded: the linear ratios (3x, 2x in test_render.c) shrink. */
-  assert_true(left[0] > 0.5 && left[0] > 2 * left[1] && left[0] > 2 * left[2]);
-  assert_true(right[1] > 0.5 && right[1] > 1.4 * right[0] && right[1] > 1.4 * right[2]);
+  /* sRGB-encoded: the linear ratios (3x, 2x in test_render.c) shrink. The
+   * inverse-square ceiling light leaves the walls' middle near 0.5 from
+   * inside the box. */
+  assert_true(left[0] > 0.4 && left[0] > 2 * left[1] && left[0] > 2 * left[2]);
+  assert_true(right[1] > 0.4 && right[1] > 1.4 * right[0] && right[1] > 1.4 * right[2]);
 }
 
 static int setup(void **state) {
