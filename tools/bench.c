@@ -11,6 +11,7 @@
 
 #include "render/render.h"
 #include "scene/gltf.h"
+#include "trace/trace.h"
 #include "tools.h"
 
 static const char bench_usage[] =
@@ -27,6 +28,10 @@ static const char bench_usage[] =
     "as the fetches a pixel its time would allow. With shadows fitted to the\n"
     "depths the frame sees, the cost of that fit (the depth-range reduction\n"
     "passes plus reading their result back) is shown as a share of the frame.\n"
+    "With --trace, the CPU ray tracer (engine/trace) on the scene: its build, its\n"
+    "rate on the reflection rays of a view where every surface is a mirror at\n"
+    "800x450 (the seed's quarter of 1600x900), and the same at a quarter of the\n"
+    "largest size against that size's frame time, as a ratio.\n"
     "\n"
     "options:\n"
     "  --scene NAME|FILE   (default cornell)\n"
@@ -39,6 +44,8 @@ static const char bench_usage[] =
     "                      a script option (e.g. isr.samples=8,16,32,64) and fit\n"
     "                      each pass's time against it\n"
     "  --clock auto|gpu|cpu\n"
+    "  --trace             also measure the ray tracer (see above)\n"
+    "  --trace-threads N   its threads (default 2)\n"
     "  --json              one JSON object on stdout instead of the tables\n"
     "  --help              this text\n";
 
@@ -67,6 +74,12 @@ typedef struct bench {
   double readback_ms[MAX_SIZES]; /* the shadow fit's read-back and refit (wall clock) */
   bench_pass passes[MAX_PASSES];
   int pass_count;
+  bool trace;
+  int trace_threads;
+  lm_trace_stats trace_stats;
+  int trace_rays, frame_rays;  /* reflection rays at 800x450, and at a quarter of the largest size */
+  double trace_ms, frame_trace_ms; /* medians of tracing them (wall clock) */
+  double trace_cpu_ms;         /* median CPU time (all threads) of the 800x450 rays */
 } bench;
 
 static int usage_error(const char *fmt, const char *arg) {
@@ -77,7 +90,7 @@ static int usage_error(const char *fmt, const char *arg) {
 }
 
 static int parse_args(int argc, char **argv, bench *b) {
-  *b = (bench){.frames = 5, .warmup = 2, .scene = "cornell"};
+  *b = (bench){.frames = 5, .warmup = 2, .scene = "cornell", .trace_threads = 2};
   const char *sizes = "64x48,128x96,256x192";
   static const struct option opts[] = {
       {"scene", required_argument, 0, 's'}, {"script", required_argument, 0, 'p'},
@@ -85,6 +98,7 @@ static int parse_args(int argc, char **argv, bench *b) {
       {"frames", required_argument, 0, 'n'}, {"warmup", required_argument, 0, 'w'},
       {"clock", required_argument, 0, 'k'}, {"json", no_argument, 0, 'j'},
       {"vary", required_argument, 0, 'V'},  {"help", no_argument, 0, 'h'},
+      {"trace", no_argument, 0, 'r'},       {"trace-threads", required_argument, 0, 'T'},
       {0, 0, 0, 0}};
   opterr = 0;
   optind = 1;
@@ -108,6 +122,11 @@ static int parse_args(int argc, char **argv, bench *b) {
       else return usage_error("--clock wants auto, gpu or cpu, not '%s'", optarg);
       break;
     case 'j': b->json = true; break;
+    case 'r': b->trace = true; break;
+    case 'T':
+      if (!limn_parse_int(optarg, 1, 256, &b->trace_threads))
+        return usage_error("--trace-threads wants 1..256, not '%s'", optarg);
+      break;
     case 'V': {
       const char *eq = strchr(optarg, '=');
       if (!eq || eq == optarg || !eq[1]) return usage_error("--vary wants NAME=V1,V2,..., not '%s'", optarg);
@@ -261,6 +280,97 @@ static bool shadow_fit_ms(const bench *b, int s, double *passes, double *readbac
   return any;
 }
 
+/* Reflection rays as the GPU's ray pass writes them for a view in which every
+ * surface is a mirror (the seed's worst case, 003 Table 7.2): a primary ray a
+ * pixel finds the surface, the reflected ray leaves it, nudged off along the
+ * normal by a fraction of the scene's size (scale-free). Returns the count. */
+static int mirror_rays(const lm_trace *t, const lm_scene *s, int threads, int w, int h, lm_trace_ray *out) {
+  lm_frame_data f;
+  lm_scene_frame_data(s, 0, w, h, &f);
+  float lo[3], hi[3];
+  lm_scene_bounds(s, lo, hi);
+  float eps = 1e-5f * sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                            (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  int n = w * h;
+  lm_trace_ray *prim = lm_alloc(sizeof *prim * (size_t)n);
+  lm_trace_hit *hits = lm_alloc(sizeof *hits * (size_t)n);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      float u = (x + 0.5f) / w, v = (y + 0.5f) / h;
+      lm_trace_ray *r = &prim[y * w + x];
+      *r = (lm_trace_ray){.tmax = INFINITY};
+      for (int k = 0; k < 3; k++)
+        r->origin[k] = f.camera_pos[k], r->dir[k] = f.frustum_o[k] + f.frustum_u[k] * u + f.frustum_v[k] * v;
+    }
+  lm_trace_rays(t, prim, hits, n, threads);
+  int count = 0;
+  for (int i = 0; i < n; i++) {
+    if (hits[i].tri < 0) continue;
+    lm_trace_surface sf;
+    lm_trace_surface_at(t, &prim[i], &hits[i], &sf);
+    const float *d = prim[i].dir, *nn = sf.normal;
+    float dn = d[0] * nn[0] + d[1] * nn[1] + d[2] * nn[2];
+    lm_trace_ray *r = &out[count++];
+    *r = (lm_trace_ray){.tmax = INFINITY};
+    for (int k = 0; k < 3; k++) r->origin[k] = sf.position[k] + eps * nn[k], r->dir[k] = d[k] - 2 * dn * nn[k];
+  }
+  free(prim);
+  free(hits);
+  return count;
+}
+
+/* Median wall time of tracing `n` rays over the bench's frames, and of the
+ * process's CPU time (every thread's) in *cpu_ms. */
+static double trace_median_ms(const bench *b, const lm_trace *t, const lm_trace_ray *rays, int n, double *cpu_ms) {
+  lm_trace_hit *hits = lm_alloc(sizeof *hits * (size_t)(n ? n : 1));
+  double *ms = lm_alloc(sizeof(double) * 2 * (size_t)(b->warmup + b->frames)), *cpu = ms + b->warmup + b->frames;
+  for (int f = 0; f < b->warmup + b->frames; f++) {
+    double t0 = lm_now_ms(), c0 = lm_cpu_ms();
+    lm_trace_rays(t, rays, hits, n, b->trace_threads);
+    ms[f] = lm_now_ms() - t0;
+    cpu[f] = lm_cpu_ms() - c0;
+  }
+  double m = median(ms + b->warmup, b->frames);
+  *cpu_ms = median(cpu + b->warmup, b->frames);
+  free(ms);
+  free(hits);
+  return m;
+}
+
+static void trace_figures(bench *b, const lm_scene *s) {
+  lm_trace *t = lm_trace_create(s, &b->trace_stats);
+  lm_trace_ray *rays = lm_alloc(sizeof *rays * 800 * 450);
+  b->trace_rays = mirror_rays(t, s, b->trace_threads, 800, 450, rays);
+  b->trace_ms = trace_median_ms(b, t, rays, b->trace_rays, &b->trace_cpu_ms);
+  int w = b->sizes[b->largest][0] / 2, h = b->sizes[b->largest][1] / 2;
+  w = w > 1 ? w : 1, h = h > 1 ? h : 1;
+  lm_trace_ray *frame = lm_alloc(sizeof *frame * (size_t)w * (size_t)h);
+  b->frame_rays = mirror_rays(t, s, b->trace_threads, w, h, frame);
+  double cpu;
+  b->frame_trace_ms = trace_median_ms(b, t, frame, b->frame_rays, &cpu);
+  free(frame);
+  free(rays);
+  lm_trace_destroy(t);
+}
+
+static double rays_per_s(int rays, double ms) { return ms > 0 ? rays / (ms * 1e-3) : 0; }
+
+static void print_trace(const bench *b) {
+  const lm_trace_stats *st = &b->trace_stats;
+  double frame = b->frame_ms[b->largest];
+  printf("ray tracer (engine/trace, %d threads): %d triangles (%d skipped), BVH of %d nodes, depth %d, "
+         "built in %.1f ms\n", b->trace_threads, st->triangles, st->skipped, st->nodes, st->depth, st->build_ms);
+  printf("  every surface a mirror, 800x450: %d reflection rays in %.3f ms = %.2f million rays/s (wall clock)\n",
+         b->trace_rays, b->trace_ms, rays_per_s(b->trace_rays, b->trace_ms) * 1e-6);
+  /* on a shared machine the wall clock counts other processes' time too */
+  printf("  CPU time %.3f ms: %.2f million rays/s a core, %.2f on %d dedicated cores\n", b->trace_cpu_ms,
+         rays_per_s(b->trace_rays, b->trace_cpu_ms) * 1e-6,
+         rays_per_s(b->trace_rays, b->trace_cpu_ms) * 1e-6 * b->trace_threads, b->trace_threads);
+  printf("  at %dx%d (rays at %dx%d): %d rays in %.3f ms against the frame's %.3f ms: ratio %.3f\n",
+         b->sizes[b->largest][0], b->sizes[b->largest][1], b->sizes[b->largest][0] / 2, b->sizes[b->largest][1] / 2,
+         b->frame_rays, b->frame_trace_ms, frame, frame > 0 ? b->frame_trace_ms / frame : 0);
+}
+
 static void print_tables(const bench *b, lm_clock clock) {
   printf("frame (wall clock, glFinish before and after) and compositor overhead (CPU: Lua + graph compile);\n"
          "passes: clock %s; medians of %d frames after %d warm-up\n", lm_clock_name(clock), b->frames, b->warmup);
@@ -363,6 +473,15 @@ static void print_json(const bench *b, lm_clock clock) {
     for (int v = 0; v < b->vary_count; v++) printf("%s%.6g", v ? ", " : "", b->vary[v]);
     printf("]}");
   }
+  if (b->trace) {
+    double frame = b->frame_ms[b->largest];
+    printf(", \"trace\": {\"threads\": %d, \"triangles\": %d, \"skipped\": %d, \"nodes\": %d, \"build_ms\": %.6g, "
+           "\"rays\": %d, \"ms\": %.6g, \"cpu_ms\": %.6g, \"rays_per_second\": %.6g, \"frame_rays\": %d, \"frame_trace_ms\": %.6g, "
+           "\"ratio_to_frame\": %.6g}",
+           b->trace_threads, b->trace_stats.triangles, b->trace_stats.skipped, b->trace_stats.nodes,
+           b->trace_stats.build_ms, b->trace_rays, b->trace_ms, b->trace_cpu_ms, rays_per_s(b->trace_rays, b->trace_ms), b->frame_rays,
+           b->frame_trace_ms, frame > 0 ? b->frame_trace_ms / frame : 0);
+  }
   if (b->ns_per_fetch > 0) printf(", \"calibration\": {\"ns_per_fetch\": %.6g}", b->ns_per_fetch);
   else printf(", \"calibration\": null");
   printf("}\n");
@@ -430,9 +549,11 @@ int limn_bench(int argc, char **argv) {
     if (ok) ok = run_size(&b, v, true, scene, pipe, &used, &err);
   }
   if (ok) ok = calibrate(&b, scene, &err);
+  if (ok && b.trace) trace_figures(&b, scene);
   if (ok) {
     if (b.json) print_json(&b, used);
     else print_tables(&b, used);
+    if (b.trace && !b.json) print_trace(&b);
   } else {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
   }

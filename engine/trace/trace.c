@@ -383,14 +383,19 @@ int lm_trace_cores(void) {
 }
 
 /* ---- traversal ---------------------------------------------------------- */
+/* Plain comparisons, not fminf/fmaxf (library calls for their NaN rules):
+ * slab distances are never NaN, since corners and origins are finite and the
+ * inverse direction is finite and non-zero. */
+static inline float min2(float a, float b) { return a < b ? a : b; }
+static inline float max2(float a, float b) { return a > b ? a : b; }
+
 /* Entry distance of the ray into the box, or false when it misses it before tmax. */
 static inline bool box_hit(const bvh_node *n, const float *o, const float *inv, float tmin, float tmax, float *tn) {
-  float lo = tmin, hi = tmax;
-  for (int k = 0; k < 3; k++) {
-    float a = (n->lo[k] - o[k]) * inv[k], b = (n->hi[k] - o[k]) * inv[k];
-    lo = fmaxf(lo, fminf(a, b));
-    hi = fminf(hi, fmaxf(a, b));
-  }
+  float a0 = (n->lo[0] - o[0]) * inv[0], b0 = (n->hi[0] - o[0]) * inv[0];
+  float a1 = (n->lo[1] - o[1]) * inv[1], b1 = (n->hi[1] - o[1]) * inv[1];
+  float a2 = (n->lo[2] - o[2]) * inv[2], b2 = (n->hi[2] - o[2]) * inv[2];
+  float lo = max2(max2(tmin, min2(a0, b0)), max2(min2(a1, b1), min2(a2, b2)));
+  float hi = min2(min2(tmax, max2(a0, b0)), min2(max2(a1, b1), max2(a2, b2)));
   *tn = lo;
   return lo <= hi;
 }
