@@ -146,7 +146,7 @@ static void degenerate_and_nan_geometry(void **state) {
     if (kind == 1) v[8] = NAN, v[9] = 1, v[16] = 1; /* a real triangle with a NaN corner */
     uint32_t idx[3] = {0, 1, 2};
     mat4 id = GLM_MAT4_IDENTITY_INIT;
-    lm_material m = {"m", {0.5f, 0.5f, 0.5f}, 0.5f, 1, 1, 0, 1, 0};
+    lm_material m = {"m", {0.5f, 0.5f, 0.5f}, 0.5f, 1, 1, 0, 1, 0, 0};
     lm_scene_add_node(s, "tri", -1, (float *)id, lm_scene_add_mesh(s, "tri", v, 3, idx, 3),
                       lm_scene_add_material(s, &m));
     int ln = lm_scene_add_node(s, "light", -1, (float *)id, -1, -1);

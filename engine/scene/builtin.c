@@ -64,10 +64,10 @@ static void trs(vec3 t, float yaw_deg, vec3 scale, mat4 out) {
  * tall box, so that every light model the export claims is exercised. */
 static lm_scene *cornell(bool pov) {
   lm_scene *s = lm_scene_create(pov ? "cornell_pov" : "cornell");
-  lm_material white = {"white", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.0f, 1.0f, 0};
-  lm_material red = {"red", {0.63f, 0.065f, 0.05f}, 0.63f, 1.0f, 1.0f, 0.0f, 1.0f, 0};
-  lm_material green = {"green", {0.14f, 0.45f, 0.091f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f, 0};
-  lm_material box = {"box", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.15f, 24.0f, 0};
+  lm_material white = {"white", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.0f, 1.0f, 0, 0};
+  lm_material red = {"red", {0.63f, 0.065f, 0.05f}, 0.63f, 1.0f, 1.0f, 0.0f, 1.0f, 0, 0};
+  lm_material green = {"green", {0.14f, 0.45f, 0.091f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f, 0, 0};
+  lm_material box = {"box", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.15f, 24.0f, 0, 0};
   int m_white = lm_scene_add_material(s, &white), m_red = lm_scene_add_material(s, &red);
   int m_green = lm_scene_add_material(s, &green), m_box = lm_scene_add_material(s, &box);
 
@@ -132,8 +132,8 @@ static lm_scene *cornell(bool pov) {
  * ground, rows of posts reaching far from the camera, a low sun. */
 static lm_scene *field(void) {
   lm_scene *s = lm_scene_create("field");
-  lm_material ground = {"ground", {0.45f, 0.5f, 0.35f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f, 0};
-  lm_material post = {"post", {0.7f, 0.6f, 0.5f}, 0.6f, 1.0f, 1.0f, 0.1f, 16.0f, 0};
+  lm_material ground = {"ground", {0.45f, 0.5f, 0.35f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f, 0, 0};
+  lm_material post = {"post", {0.7f, 0.6f, 0.5f}, 0.6f, 1.0f, 1.0f, 0.1f, 16.0f, 0, 0};
   int m_ground = lm_scene_add_material(s, &ground), m_post = lm_scene_add_material(s, &post);
   const float g[4][3] = {{-100, 0, 100}, {100, 0, 100}, {100, 0, -100}, {-100, 0, -100}};
   mat4 id = GLM_MAT4_IDENTITY_INIT, m;

@@ -367,6 +367,13 @@ int material_for(Loader &L, const char *where, int index) {
   double shin = r4 > 0 ? 2.0 / r4 - 2.0 : 1024.0;
   m.shininess = (float)(shin < 1 ? 1 : shin > 1024 ? 1024 : shin);
   m.rho = maxc * m.kd;
+  if (gm.extras.IsObject() && gm.extras.Has("reflectivity")) {
+    const tinygltf::Value &r = gm.extras.Get("reflectivity");
+    double v = r.IsNumber() ? r.GetNumberAsDouble() : -1;
+    if (!(v >= 0 && v <= 1))
+      return fail(L, "material %d ('%s'): extras.reflectivity must be a number in [0, 1]", index, m.name), -1;
+    m.reflectivity = (float)v;
+  }
   if (pbr.baseColorTexture.index >= 0) {
     if (pbr.baseColorTexture.texCoord != 0)
       lm_warn("%s: material %d: baseColorTexture uses TEXCOORD_%d; only TEXCOORD_0 is read", L.path, index,

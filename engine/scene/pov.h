@@ -24,7 +24,11 @@
  *   pigment rgb color; finish { ambient 0 emission 0 diffuse kd brilliance 1
  *   phong ks phong_size max(shininess, 1) }. POV-Ray's diffuse is
  *   kd * pigment * light * (n.l) and its phong ks * (r.v)^size * light,
- *   the engine's Phong exactly (seed 000 lines 2753-2767). The engine's
+ *   the engine's Phong exactly (seed 000 lines 2753-2767). A reflective
+ *   material (reflectivity r > 0) adds "reflection r": POV-Ray adds r times
+ *   the colour seen along the mirror direction on top of diffuse and phong
+ *   (no conserve_energy, no fresnel), one bounce deep as the engine's
+ *   ray-traced reflections (engine/trace). The engine's
  *   ambient term (k_a * ambient) has no counterpart: render the engine with
  *   the option ambient = 0 when comparing.
  * - Lights, colour = color * power:

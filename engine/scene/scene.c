@@ -337,7 +337,7 @@ bool lm_scene_owns_uniform(const char *name) {
 }
 
 const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n) {
-  static const lm_material fallback = {"default", {0.8f, 0.8f, 0.8f}, 0.8f, 0.1f, 0.9f, 0.0f, 16.0f, 0};
+  static const lm_material fallback = {"default", {0.8f, 0.8f, 0.8f}, 0.8f, 0.1f, 0.9f, 0.0f, 16.0f, 0, 0};
   return n->material >= 0 && n->material < s->material_count ? &s->materials[n->material] : &fallback;
 }
 
@@ -345,10 +345,11 @@ const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n) {
 static const struct {
   const char *name;
   int count;
-} material_params[] = {{"color", 3}, {"rho", 1}, {"ka", 1}, {"kd", 1}, {"ks", 1}, {"shininess", 1}};
+} material_params[] = {{"color", 3}, {"rho", 1}, {"ka", 1}, {"kd", 1}, {"ks", 1}, {"shininess", 1},
+                       {"reflectivity", 1}};
 enum { MATERIAL_PARAM_COUNT = sizeof material_params / sizeof *material_params };
 
-const char *lm_material_param_list(void) { return "color, rho, ka, kd, ks, shininess"; }
+const char *lm_material_param_list(void) { return "color, rho, ka, kd, ks, shininess, reflectivity"; }
 
 static int material_param_index(const char *name) {
   for (int i = 0; i < MATERIAL_PARAM_COUNT; i++)
@@ -397,6 +398,7 @@ static void apply_param(lm_material *m, const lm_material_param *p) {
   case 3: m->kd = p->v[0]; break;
   case 4: m->ks = p->v[0]; break;
   case 5: m->shininess = p->v[0]; break;
+  case 6: m->reflectivity = p->v[0]; break;
   default: break;
   }
 }

@@ -14,6 +14,10 @@ typedef struct lm_material {
   float rho;       /* reflectance, the G-buffer's "radiation mask" */
   float ka, kd, ks, shininess;
   int base_color_texture; /* 1 + index into the scene's textures; 0: none */
+  /* Mirror reflection in [0, 1] (seed 003 chapter 6): the share of the
+   * reflected view added on top of the surface's own light, as POV-Ray's
+   * finish { reflection r } does. 0: not reflective. */
+  float reflectivity;
 } lm_material;
 
 /* A material's image: RGBA8 texels (sRGB-encoded colour), rows top first. */
@@ -150,7 +154,7 @@ void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_f
 /* Fills up to `max` lights; returns how many. */
 int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max);
 /* A parameter override: material `material`'s parameter `name` ("color",
- * "rho", "ka", "kd", "ks", "shininess") takes v[0 .. count) for one draw.
+ * "rho", "ka", "kd", "ks", "shininess", "reflectivity") takes v[0 .. count) for one draw.
  * (The frame graph carries these as lm_pass_material_param; the renderer
  * copies them over, as scene and graph do not include each other.) */
 typedef struct lm_material_param {
