@@ -12,6 +12,7 @@ struct Surface {
   float depth01;   // dpt: linear depth / far
   vec3 k;          // mat.xyz: k_a, k_d, k_s
   bool covered;    // mat.a >= 0.5: geometry, not background
+  float reflectivity; // mat.a (mat_alpha_reflectivity): mirror share, 0 .. 1
   vec3 p;          // world position (eq 23-24)
 };
 
@@ -24,6 +25,7 @@ Surface gbuffer_decode(vec4 c, vec4 nn, float d, vec4 m, vec2 uv) {
   s.depth01 = max(d, 0.0);
   s.k = m.xyz;
   s.covered = m.a >= 0.5;
+  s.reflectivity = mat_alpha_reflectivity(m.a);
   s.p = position_from_depth(uv, s.depth01);
   return s;
 }

@@ -328,11 +328,17 @@ int lm_scene_light_data(const lm_scene *s, lm_light_data *out, int max) {
 }
 
 static const char *scene_uniforms[] = {"model", "normal_matrix", "material_color", "material_rho",
-                                       "material_k", "base_color_tex"};
+                                       "material_k", "material_reflectivity", "base_color_tex"};
 
 bool lm_scene_owns_uniform(const char *name) {
   for (size_t i = 0; i < sizeof scene_uniforms / sizeof *scene_uniforms; i++)
     if (!strcmp(scene_uniforms[i], name)) return true;
+  return false;
+}
+
+bool lm_scene_reflective(const lm_scene *s) {
+  for (int i = 0; i < s->node_count; i++)
+    if (s->nodes[i].mesh >= 0 && lm_scene_node_material(s, &s->nodes[i])->reflectivity > 0) return true;
   return false;
 }
 
@@ -486,6 +492,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     if ((u = lm_program_uniform(p, "material_color"))) lm_program_set(p, u, m.color);
     if ((u = lm_program_uniform(p, "material_rho"))) lm_program_set(p, u, &m.rho);
     if ((u = lm_program_uniform(p, "material_k"))) lm_program_set(p, u, k);
+    if ((u = lm_program_uniform(p, "material_reflectivity"))) lm_program_set(p, u, &m.reflectivity);
     if (want_texture && (u = lm_program_uniform(p, "base_color_tex")))
       lm_program_bind_texture(u, s->textures[tex].gpu);
     lm_mesh_draw(&mesh->gpu);

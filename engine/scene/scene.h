@@ -105,6 +105,8 @@ int lm_scene_add_node(lm_scene *s, const char *name, int parent, const float loc
 int lm_scene_add_light(lm_scene *s, const lm_light *l);
 /* Takes ownership of `rgba` (malloc'd). Returns the texture's index. */
 int lm_scene_add_texture(lm_scene *s, const char *name, int width, int height, unsigned char *rgba);
+/* True when a mesh node's material has a reflectivity above 0. */
+bool lm_scene_reflective(const lm_scene *s);
 /* Index of the material called `name`, or -1. */
 int lm_scene_find_material(const lm_scene *s, const char *name);
 int lm_scene_add_camera(lm_scene *s, const lm_camera *c);
@@ -134,7 +136,8 @@ int lm_scene_add_camera_list(lm_scene *s, const char *path, int *count, lm_error
 const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n);
 
 /* A scene built in code: "cornell"; "cornell_pov" (the box lit only by
- * lights POV-Ray matches exactly, engine/scene/pov.h); "field" (open ground
+ * lights POV-Ray matches exactly, engine/scene/pov.h); "cornell_mirror"
+ * (cornell_pov with a mirror for its left wall); "field" (open ground
  * under a sun, for cascaded shadows). NULL with a message listing the names. */
 lm_scene *lm_scene_builtin(const char *name, lm_error *err);
 const char *lm_scene_builtin_list(void);
@@ -186,7 +189,7 @@ typedef struct lm_scene_draw_stats {
 } lm_scene_draw_stats;
 /* Draws every mesh node whose bounds reach into the frustum, setting model,
  * normal_matrix, the material uniforms (material_color, material_rho,
- * material_k) and base_color_tex. Adds to *stats (may be NULL). */
+ * material_k, material_reflectivity) and base_color_tex. Adds to *stats (may be NULL). */
 bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err);
 /* True when the world-space box lo..hi lies wholly outside one clip plane of view_proj. */
 bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const float hi[3]);

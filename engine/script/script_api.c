@@ -539,6 +539,36 @@ static int l_pass(lua_State *L) {
   return 1;
 }
 
+/* cpu{ "name", fn = "trace", inputs = {...}, params = {...}, out = T | {...} }: a
+ * CPU pass (the engine's function `fn` between GPU passes); returns its first output. */
+static int l_cpu(lua_State *L) {
+  lm_pipeline *p = recording(L, "cpu");
+  if (p->in_create) return luaL_error(L, "cpu() records a pass: call it from OnRender");
+  pass_builder b;
+  int top = lua_gettop(L);
+  begin_pass(L, &b, LM_PASS_CPU, "cpu");
+  static const char *const fields[] = {"fn", "inputs", "params", "out", NULL};
+  check_fields(L, 1, b.what, fields);
+  b.desc.shader = opt_string(L, 1, "fn", b.what);
+  if (!b.desc.shader) return luaL_error(L, "%s: field 'fn' is missing (an engine function: trace)", b.what);
+  read_outputs(L, 1, &b);
+  if (b.desc.output_count == 0) return luaL_error(L, "%s: field 'out' is missing", b.what);
+  read_inputs(L, 1, &b);
+  read_params(L, 1, &b);
+  add_pass(L, p, &b);
+  lua_settop(L, top);
+  lua_getfield(L, 1, "out");
+  if (lua_istable(L, -1)) lua_rawgeti(L, -1, 1);
+  return 1;
+}
+
+/* scene_reflective(): whether a material the scene draws is reflective. */
+static int l_scene_reflective(lua_State *L) {
+  lm_pipeline *p = recording(L, "scene_reflective");
+  lua_pushboolean(L, p->scene && lm_scene_reflective(p->scene));
+  return 1;
+}
+
 static int l_present(lua_State *L) {
   lm_pipeline *p = recording(L, "present");
   if (p->in_create) return luaL_error(L, "present() is called from OnRender");
@@ -569,7 +599,8 @@ void lm_script_open_api(lua_State *L) {
   lua_pop(L, 1);
   static const luaL_Reg api[] = {{"target", l_target}, {"scene", l_scene}, {"pass", l_pass},
                                  {"present", l_present}, {"output_size", l_output_size},
-                                 {"shadow_plan", l_shadow_plan}, {NULL, NULL}};
+                                 {"shadow_plan", l_shadow_plan}, {"cpu", l_cpu},
+                                 {"scene_reflective", l_scene_reflective}, {NULL, NULL}};
   lua_pushglobaltable(L);
   luaL_setfuncs(L, api, 0);
   lua_pop(L, 1);

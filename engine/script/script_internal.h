@@ -26,7 +26,7 @@ struct lm_pipeline {
   unsigned shadows_frame; /* frame serial of the plan in *shadows */
 };
 
-/* Registers target, scene, pass, present, output_size in the global table. */
+/* Registers target, scene, pass, cpu, present, output_size, shadow_plan and scene_reflective in the global table. */
 void lm_script_open_api(lua_State *L);
 /* The pipeline that owns L. */
 lm_pipeline *lm_script_pipeline(lua_State *L);
