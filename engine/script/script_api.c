@@ -461,6 +461,15 @@ static void add_pass(lua_State *L, lm_pipeline *p, pass_builder *b) {
   if (lm_graph_add_pass(p->graph, &b->desc, &err) < 0) luaL_error(L, "%s", err.msg);
 }
 
+/* Adds the pass and returns its first output (pass{} and cpu{} chain). */
+static int add_pass_returning_output(lua_State *L, lm_pipeline *p, pass_builder *b, int top) {
+  add_pass(L, p, b);
+  lua_settop(L, top);
+  lua_getfield(L, 1, "out");
+  if (lua_istable(L, -1)) lua_rawgeti(L, -1, 1);
+  return 1;
+}
+
 /* scene{ "name", technique = "std", out = {...}, depth = T, clear = bool | {r,g,b,a}, ...,
  * views = plan, fit = T } */
 static int l_scene(lua_State *L) {
@@ -532,11 +541,7 @@ static int l_pass(lua_State *L) {
   read_params(L, 1, &b);
   read_defines(L, 1, &b);
   b.desc.fetches = opt_number(L, 1, "fetches", 0, 0, 1e6f, b.what);
-  add_pass(L, p, &b);
-  lua_settop(L, top);
-  lua_getfield(L, 1, "out");
-  if (lua_istable(L, -1)) lua_rawgeti(L, -1, 1);
-  return 1;
+  return add_pass_returning_output(L, p, &b, top);
 }
 
 /* cpu{ "name", fn = "trace", inputs = {...}, params = {...}, out = T | {...} }: a
@@ -555,11 +560,7 @@ static int l_cpu(lua_State *L) {
   if (b.desc.output_count == 0) return luaL_error(L, "%s: field 'out' is missing", b.what);
   read_inputs(L, 1, &b);
   read_params(L, 1, &b);
-  add_pass(L, p, &b);
-  lua_settop(L, top);
-  lua_getfield(L, 1, "out");
-  if (lua_istable(L, -1)) lua_rawgeti(L, -1, 1);
-  return 1;
+  return add_pass_returning_output(L, p, &b, top);
 }
 
 /* scene_reflective(): whether a material the scene draws is reflective. */
