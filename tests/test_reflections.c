@@ -169,11 +169,48 @@ static void every_technique_reflects(void **state) {
   lm_scene_destroy(s);
 }
 
+/* The same mirror in units 1e-3 and 1e5 (the rays' offset is a share of the
+ * eye distance, max_distance 0 is unlimited): finite and the same image; a
+ * 1x1 output reflects too. */
+static void reflections_hold_at_every_scale(void **state) {
+  (void)state;
+  const char *on[] = {"ambient=0", "reflections.enabled=true", NULL};
+  const float units[] = {1, 1e-3f, 1e5f};
+  float ratio1 = 0;
+  for (int i = 0; i < 3; i++) {
+    lm_error err;
+    lm_scene *s = lm_scene_builtin("cornell_mirror", &err);
+    for (int l = 0; l < s->light_count; l++) s->lights[l].falloff = LM_FALLOFF_NONE; /* light free of the unit */
+    if (units[i] != 1) gl_rescale(s, units[i]);
+    gl_result r = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = on, .width = 48, .height = 36,
+                                      .check_finite = true});
+    if (!r.ok) fail_msg("%s", r.err.msg);
+    assert_true(gl_all_finite(&r));
+    float c[3], all[3];
+    gl_region(&r, 8, 10, 12, 26, c);
+    gl_region(&r, 0, 0, 47, 35, all);
+    float ratio = gl_luminance(c) / gl_luminance(all);
+    if (i == 0) ratio1 = ratio;
+    print_message("unit %g: mirror / image %.4f (unit 1: %.4f)\n", units[i], ratio, ratio1);
+    assert_true(gl_luminance(c) > 0.0f && isfinite(ratio));
+    assert_true(fabsf(ratio - ratio1) < 0.02f * ratio1);
+    gl_result_free(&r);
+    if (i == 0) {
+      r = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = on, .width = 1, .height = 1, .check_finite = true});
+      if (!r.ok) fail_msg("1x1: %s", r.err.msg);
+      assert_true(gl_all_finite(&r));
+      gl_result_free(&r);
+    }
+    lm_scene_destroy(s);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(a_mirror_shows_the_box_where_the_tracer_says),
       cmocka_unit_test(nothing_reflective_records_no_pass),
       cmocka_unit_test(every_technique_reflects),
+      cmocka_unit_test(reflections_hold_at_every_scale),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }
