@@ -2,6 +2,8 @@
 // wrote is a G-buffer (std.frag's layout, with the position given rather than
 // rebuilt from depth), lit by the same Phong and shadows as the camera's view
 // (lighting.glsl), seen from the reflecting surface. A miss sees the background.
+// Alpha is 1 where a ray was traced, 0 where the surface does not reflect, so
+// that the upsampling's average can be renormalized to the traced texels.
 #include "gbuffer.glsl"
 
 uniform sampler2D hit_clr, hit_nrm, hit_pos, hit_mat, rays_o, rays_d;
@@ -13,7 +15,7 @@ out vec4 lit;
 void main() {
   ivec2 q = ivec2(gl_FragCoord.xy);
   if (texelFetch(rays_o, q, 0).w < 0.5) { // not reflective: nothing traced
-    lit = vec4(0.0, 0.0, 0.0, 1.0);
+    lit = vec4(0.0);
     return;
   }
   vec4 m = texelFetch(hit_mat, q, 0);
