@@ -375,9 +375,8 @@ void lm_trace_destroy(lm_trace *t) {
   free(t);
 }
 
-int lm_trace_triangle_count(const lm_trace *t) { return t->count; }
-
-int lm_trace_cores(void) {
+/* Online cores (at least 1). */
+static int online_cores(void) {
   long n = sysconf(_SC_NPROCESSORS_ONLN);
   return n > 0 ? (int)n : 1;
 }
@@ -495,7 +494,7 @@ static void *trace_worker(void *arg) {
 
 void lm_trace_rays(const lm_trace *t, const lm_trace_ray *rays, lm_trace_hit *hits, int count, int threads) {
   if (count <= 0) return;
-  if (threads <= 0) threads = lm_trace_cores();
+  if (threads <= 0) threads = online_cores();
   int chunks = (count + CHUNK - 1) / CHUNK;
   if (threads > chunks) threads = chunks;
   if (threads > 256) threads = 256;

@@ -73,8 +73,5 @@ void lm_trace_rays(const lm_trace *t, const lm_trace_ray *rays, lm_trace_hit *hi
 /* The surface at a hit (hit->tri >= 0). */
 void lm_trace_surface_at(const lm_trace *t, const lm_trace_ray *ray, const lm_trace_hit *hit,
                          lm_trace_surface *out);
-int lm_trace_triangle_count(const lm_trace *t);
-/* Online cores (at least 1). */
-int lm_trace_cores(void);
 
 #endif
