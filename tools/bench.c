@@ -28,6 +28,8 @@ static const char bench_usage[] =
     "as the fetches a pixel its time would allow. With shadows fitted to the\n"
     "depths the frame sees, the cost of that fit (the depth-range reduction\n"
     "passes plus reading their result back) is shown as a share of the frame.\n"
+    "CPU passes (cpu{}, e.g. reflections' ray tracing, with their read-back and\n"
+    "upload) are shown against the rest of the frame as a ratio.\n"
     "With --trace, the CPU ray tracer (engine/trace) on the scene: its build, its\n"
     "rate on the reflection rays of a view where every surface is a mirror at\n"
     "800x450 (the seed's quarter of 1600x900), and the same at a quarter of the\n"
@@ -37,6 +39,7 @@ static const char bench_usage[] =
     "  --scene NAME|FILE   (default cornell)\n"
     "  --script FILE       (default scripts/pp.lua)\n"
     "  --tech NAME         technique (default: the script's first)\n"
+    "  --set NAME=VALUE    set a script option, as capture does (repeatable)\n"
     "  --sizes LIST        comma-separated WxH (default 64x48,128x96,256x192)\n"
     "  --frames N          timed frames per size (default 5)\n"
     "  --warmup N          untimed frames first (default 2)\n"
@@ -56,12 +59,15 @@ typedef struct bench_pass {
   double ms[MAX_SIZES];     /* median per size; -1 when not run at that size */
   double vary_ms[MAX_SIZES]; /* median per --vary value at the largest size */
   double fetches;           /* declared fetches a pixel (0: not said) */
+  bool cpu;                 /* a CPU pass (cpu{}: the ray tracer's step) */
   int width, height;        /* its output at the largest size */
 } bench_pass;
 
 typedef struct bench {
   int sizes[MAX_SIZES][2], size_count, frames, warmup;
   const char *scene, *script, *tech;
+  const char *sets[32];     /* --set NAME=VALUE */
+  int set_count;
   char vary_name[128];
   char vary_text[MAX_SIZES][64];
   double vary[MAX_SIZES];
@@ -99,6 +105,7 @@ static int parse_args(int argc, char **argv, bench *b) {
       {"clock", required_argument, 0, 'k'}, {"json", no_argument, 0, 'j'},
       {"vary", required_argument, 0, 'V'},  {"help", no_argument, 0, 'h'},
       {"trace", no_argument, 0, 'r'},       {"trace-threads", required_argument, 0, 'T'},
+      {"set", required_argument, 0, 'D'},
       {0, 0, 0, 0}};
   opterr = 0;
   optind = 1;
@@ -123,6 +130,11 @@ static int parse_args(int argc, char **argv, bench *b) {
       break;
     case 'j': b->json = true; break;
     case 'r': b->trace = true; break;
+    case 'D':
+      if (!strchr(optarg, '=') || optarg[0] == '=') return usage_error("--set wants NAME=VALUE, not '%s'", optarg);
+      if (b->set_count == 32) return usage_error("%s", "at most 32 --set");
+      b->sets[b->set_count++] = optarg;
+      break;
     case 'T':
       if (!limn_parse_int(optarg, 1, 256, &b->trace_threads))
         return usage_error("--trace-threads wants 1..256, not '%s'", optarg);
@@ -217,6 +229,7 @@ static bool run_size(bench *b, int si, bool vary, lm_scene *scene, lm_pipeline *
       bench_pass *bp = find_pass(b, p.name);
       if (!bp) continue;
       if (!vary && size == b->largest) bp->fetches = p.fetches, bp->width = p.width, bp->height = p.height;
+      bp->cpu = p.kind == LM_PASS_CPU;
       int slot = (int)(bp - b->passes);
       if (pass_n[slot] < b->frames) pass_ms[slot * b->frames + pass_n[slot]++] = p.ms;
     }
@@ -371,6 +384,15 @@ static void print_trace(const bench *b) {
          b->frame_rays, b->frame_trace_ms, frame, frame > 0 ? b->frame_trace_ms / frame : 0);
 }
 
+/* CPU passes' time at size s; false when the frame has none. */
+static bool cpu_pass_ms(const bench *b, int s, double *ms) {
+  *ms = 0;
+  bool any = false;
+  for (int i = 0; i < b->pass_count; i++)
+    if (b->passes[i].cpu && b->passes[i].ms[s] >= 0) *ms += b->passes[i].ms[s], any = true;
+  return any;
+}
+
 static void print_tables(const bench *b, lm_clock clock) {
   printf("frame (wall clock, glFinish before and after) and compositor overhead (CPU: Lua + graph compile);\n"
          "passes: clock %s; medians of %d frames after %d warm-up\n", lm_clock_name(clock), b->frames, b->warmup);
@@ -383,6 +405,11 @@ static void print_tables(const bench *b, lm_clock clock) {
     if (shadow_fit_ms(b, s, &fp, &fr))
       printf("  shadow fit at %dx%d: reduction %.3f ms + read-back %.3f ms = %.1f%% of the frame\n", b->sizes[s][0],
              b->sizes[s][1], fp, fr, b->frame_ms[s] > 0 ? 100 * (fp + fr) / b->frame_ms[s] : 0);
+  double cpu;
+  for (int s = 0; s < b->size_count; s++)
+    if (cpu_pass_ms(b, s, &cpu))
+      printf("  CPU passes at %dx%d: %.3f ms against the rest of the frame's %.3f ms: ratio %.3f\n", b->sizes[s][0],
+             b->sizes[s][1], cpu, b->frame_ms[s] - cpu, b->frame_ms[s] > cpu ? cpu / (b->frame_ms[s] - cpu) : 0);
   printf("  %-24s", "pass (ms)");
   for (int s = 0; s < b->size_count; s++) printf(" %9dx%-4d", b->sizes[s][0], b->sizes[s][1]);
   printf("  fit: a ms + b ns/pixel (r^2)\n");
@@ -434,6 +461,8 @@ static void print_json(const bench *b, lm_clock clock) {
            b->sizes[s][0], b->sizes[s][1], b->frame_ms[s], b->overhead_ms[s]);
     double fp, fr;
     if (shadow_fit_ms(b, s, &fp, &fr)) printf(", \"shadow_fit_ms\": %.6g, \"shadow_readback_ms\": %.6g", fp + fr, fr);
+    double cpu;
+    if (cpu_pass_ms(b, s, &cpu)) printf(", \"cpu_pass_ms\": %.6g", cpu);
     printf("}");
   }
   printf("], \"passes\": [");
@@ -530,7 +559,14 @@ int limn_bench(int argc, char **argv) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 1;
   }
-  if (b.tech && !lm_pipeline_set_technique(pipe, b.tech, &err)) {
+  bool set_ok = true;
+  for (int i = 0; i < b.set_count && set_ok; i++) {
+    char name[256];
+    const char *eq = strchr(b.sets[i], '=');
+    snprintf(name, sizeof name, "%.*s", (int)(eq - b.sets[i]), b.sets[i]);
+    set_ok = lm_pipeline_set_option(pipe, name, eq + 1, &err);
+  }
+  if (!set_ok || (b.tech && !lm_pipeline_set_technique(pipe, b.tech, &err))) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     lm_pipeline_destroy(pipe);
     return 2;
