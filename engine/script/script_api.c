@@ -523,22 +523,30 @@ static int l_scene(lua_State *L) {
   return 0;
 }
 
+/* What pass{} and cpu{} share: the program (field `field`: a shader or a CPU
+ * function), outputs, inputs and parameters. */
+static lm_pipeline *begin_output_pass(lua_State *L, pass_builder *b, lm_pass_kind kind, const char *fn,
+                                      const char *const *fields, const char *field, const char *hint) {
+  lm_pipeline *p = recording(L, fn);
+  if (p->in_create) luaL_error(L, "%s() records a pass: call it from OnRender", fn);
+  begin_pass(L, b, kind, fn);
+  check_fields(L, 1, b->what, fields);
+  b->desc.shader = opt_string(L, 1, field, b->what);
+  if (!b->desc.shader) luaL_error(L, "%s: field '%s' is missing (%s)", b->what, field, hint);
+  read_outputs(L, 1, b);
+  if (b->desc.output_count == 0) luaL_error(L, "%s: field 'out' is missing", b->what);
+  read_inputs(L, 1, b);
+  read_params(L, 1, b);
+  return p;
+}
+
 /* pass{ "name", shader = "x.frag", inputs = {...}, params = {...}, out = T | {...}, defines = {...} }
  * returns its first output, so passes chain. */
 static int l_pass(lua_State *L) {
-  lm_pipeline *p = recording(L, "pass");
-  if (p->in_create) return luaL_error(L, "pass() records a pass: call it from OnRender");
+  static const char *const fields[] = {"shader", "inputs", "params", "out", "defines", "fetches", NULL};
   pass_builder b;
   int top = lua_gettop(L);
-  begin_pass(L, &b, LM_PASS_FULLSCREEN, "pass");
-  static const char *const fields[] = {"shader", "inputs", "params", "out", "defines", "fetches", NULL};
-  check_fields(L, 1, b.what, fields);
-  b.desc.shader = opt_string(L, 1, "shader", b.what);
-  if (!b.desc.shader) return luaL_error(L, "%s: field 'shader' is missing (a file in shaders/)", b.what);
-  read_outputs(L, 1, &b);
-  if (b.desc.output_count == 0) return luaL_error(L, "%s: field 'out' is missing", b.what);
-  read_inputs(L, 1, &b);
-  read_params(L, 1, &b);
+  lm_pipeline *p = begin_output_pass(L, &b, LM_PASS_FULLSCREEN, "pass", fields, "shader", "a file in shaders/");
   read_defines(L, 1, &b);
   b.desc.fetches = opt_number(L, 1, "fetches", 0, 0, 1e6f, b.what);
   return add_pass_returning_output(L, p, &b, top);
@@ -547,19 +555,10 @@ static int l_pass(lua_State *L) {
 /* cpu{ "name", fn = "trace", inputs = {...}, params = {...}, out = T | {...} }: a
  * CPU pass (the engine's function `fn` between GPU passes); returns its first output. */
 static int l_cpu(lua_State *L) {
-  lm_pipeline *p = recording(L, "cpu");
-  if (p->in_create) return luaL_error(L, "cpu() records a pass: call it from OnRender");
+  static const char *const fields[] = {"fn", "inputs", "params", "out", NULL};
   pass_builder b;
   int top = lua_gettop(L);
-  begin_pass(L, &b, LM_PASS_CPU, "cpu");
-  static const char *const fields[] = {"fn", "inputs", "params", "out", NULL};
-  check_fields(L, 1, b.what, fields);
-  b.desc.shader = opt_string(L, 1, "fn", b.what);
-  if (!b.desc.shader) return luaL_error(L, "%s: field 'fn' is missing (an engine function: trace)", b.what);
-  read_outputs(L, 1, &b);
-  if (b.desc.output_count == 0) return luaL_error(L, "%s: field 'out' is missing", b.what);
-  read_inputs(L, 1, &b);
-  read_params(L, 1, &b);
+  lm_pipeline *p = begin_output_pass(L, &b, LM_PASS_CPU, "cpu", fields, "fn", "an engine function: trace");
   return add_pass_returning_output(L, p, &b, top);
 }
 
