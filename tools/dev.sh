@@ -5,7 +5,7 @@
 #                       default against POV-Ray references (data/jobs/quick.lua, cached)
 #   tools/dev.sh test   install what is missing, build, run the whole test suite
 #   tools/dev.sh build  install what is missing and build
-# BUILD_DIR (default build) and CMAKE_ARGS pass through to CMake.
+# BUILD_DIR (default build) and CMAKE_ARGS pass through to CMake, CTEST_ARGS to ctest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -61,7 +61,8 @@ case "${1:-run}" in
     ;;
   test)
     deps; build
-    ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure
+    # shellcheck disable=SC2086
+    ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure ${CTEST_ARGS:-}
     ;;
   *) echo "usage: tools/dev.sh run|test|build|deps" >&2; exit 2 ;;
 esac
