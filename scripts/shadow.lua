@@ -12,8 +12,11 @@ shadow.defaults = {
   technique = "esm",  -- "esm" (seed 000 eq 30), "pcf" (3x3), "poisson" (16 taps), "hard",
                       -- "pcss" (soft shadows whose penumbra grows with the blocker's distance, seed 003)
   resolution = 512,   -- tile size in texels, 16..8192 (the seed: 512)
-  c = 90,             -- ESM exponent on depth normalized to the light's range (the seed: 90)
-  blur = 2,           -- ESM Gaussian radius in texels, 0..32
+  c = 16,             -- ESM exponent per texel of depth: exp(-c d), d in texels' world size where
+                      -- the receiver is (the seed's 90 on the light's range is ~0.2 a texel at 512:
+                      -- light leaks over tens of texels behind every occluder)
+  blur = 0,           -- ESM log-space Gaussian radius in texels, 0..32 (the seed: 2); at large c a
+                      -- blur lights a band of its radius beside every occluder's edge
   cascades = 3,       -- directional lights, 1..4
   lambda = 0.75,      -- cascade splits: 0 uniform .. 1 logarithmic
   bias = 1,           -- depth bias in texels: the world size of a shadow-map texel where the
@@ -70,7 +73,7 @@ function shadow.render(o, G)
   if plan.technique ~= "esm" or plan.blur == 0 then return map end
   local blurred = map
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
-    blurred = pass{ "shadow.blur_" .. axis[1], shader = "esm_blur.frag", inputs = { src = blurred },
+    blurred = pass{ "shadow.blur_" .. axis[1], shader = "esm_blur.frag", inputs = { shadow_atlas = blurred },
                     params = { direction = axis[2], radius = plan.blur, c = plan.c, tile = plan.tile,
                                views = plan.views },
                     out = target{ "shadow.esm_" .. axis[1], format = "r32f", size = size } }

@@ -32,6 +32,13 @@ const vec2 POISSON[16] = vec2[](
 
 float shadow_texel(ivec2 t, ivec2 lo, ivec2 hi) { return texelFetch(shadow_atlas, clamp(t, lo, hi), 0).r; }
 
+// A texel's world size, where a point at stored depth r is, in stored depth
+// (the tile's 0..1): the unit of the bias and of ESM's c, so both mean the
+// same in any scene unit, tile size and depth range.
+float shadow_texel_depth(ShadowView sv, float r) {
+  return max(sv.depth.w > 0.0 ? sv.texel.x * r : sv.texel.x / max(sv.texel.y, 1e-30), 1e-30);
+}
+
 // PCSS penumbra width in texels for a blocker at normalized depth zb over a
 // receiver at r (similar triangles, as ratios: no world unit). Orthographic:
 // the world depth between them times the light's angular size, over the
@@ -91,21 +98,20 @@ float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
   vec2 texel = (sv.rect.xy + tuv * sv.rect.zw) * size - 0.5;
   ivec2 base = ivec2(floor(texel));
   vec2 f = texel - vec2(base);
-  // The bias is given in texels: the world size of one where p is, as a
-  // share of the world depth the tile's 0..1 spans (any unit, any tile).
-  float world_texel = sv.texel.x * (sv.depth.w > 0.0 ? length(p - sv.depth.xyz) : 1.0);
-  float bias = s.params.y * world_texel / max(sv.texel.y, 1e-30);
+  float texel_depth = shadow_texel_depth(sv, r);
+  float bias = s.params.y * texel_depth;
   int technique = s.info.w;
   // Filters reach `spread` texels away, where a tilted receiver is deeper:
   // scale the bias by the tilt (tan of the light's angle, capped).
-  float spread = technique == 1 ? 1.5 : technique == 2 ? s.params.w : 0.0;
+  float spread = technique == 0 ? 1.0 : technique == 1 ? 1.5 : technique == 2 ? s.params.w : 0.0;
   float c = saturate(ndl), tan_tilt = min(sqrt(max(1.0 - c * c, 0.0)) / max(c, 0.1), 10.0);
   if (technique == 4) return pcss_lookup(s, sv, texel, r, bias, tan_tilt, lo, hi);
   bias *= 1.0 + spread * tan_tilt;
   if (technique == 0) {
     // ESM with the seed's 4-tap bilinear combination (seed 000, Listing 8):
-    // the depth difference is clamped at 0 and scaled by n.l, then exp(-c d).
-    float k = s.params.x, scale = saturate(ndl);
+    // the depth difference is clamped at 0 and scaled by n.l, then exp(-k d)
+    // with k = c per texel of depth (a scale-free c; leaks within a texel).
+    float k = s.params.x / texel_depth, scale = saturate(ndl);
     vec4 z = vec4(shadow_texel(base, lo, hi), shadow_texel(base + ivec2(1, 0), lo, hi),
                   shadow_texel(base + ivec2(0, 1), lo, hi), shadow_texel(base + ivec2(1, 1), lo, hi));
     vec4 vis = exp(-k * max(vec4(r) - z - bias, 0.0) * scale);

@@ -16,7 +16,7 @@ int lm_shadow_technique_parse(const char *name) {
 }
 
 void lm_shadow_settings_default(lm_shadow_settings *s) {
-  *s = (lm_shadow_settings){.technique = LM_SHADOW_ESM, .resolution = 512, .c = 90.0f, .blur = 2,
+  *s = (lm_shadow_settings){.technique = LM_SHADOW_ESM, .resolution = 512, .c = 16.0f, .blur = 0,
                             .cascades = 3, .lambda = 0.75f, .distance = 0.0f,
                             .blend = 0.1f, .radius = 2.5f, .stabilize = true,
                             .size = -1.0f, .penumbra = 16.0f};
