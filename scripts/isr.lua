@@ -71,8 +71,8 @@ local rules = {
   seed = function(v) if type(v) ~= "table" then return "a table of the seed mode's options" end end,
 }
 
--- The coarse G-buffer and direct light: G itself at factor 1.
-local function coarse_gbuffer(G, direct, f)
+-- The coarse G-buffer and direct light: G itself at factor 1 (rsm.lua shares it).
+function isr.coarse_gbuffer(G, direct, f)
   if f == 1 then
     local C = gbuffer.inputs(G)
     C.direct = direct
@@ -99,13 +99,15 @@ end
 -- Records ISR lighting of G given its direct light `direct` (lights only, no
 -- ambient term: a target from direct.frag with ambient 0), with options o
 -- (see isr.defaults) and light = { ambient = {r, g, b}, background = {r, g, b} }.
+-- extra (optional), a function (C, E, f) -> E', adds to the transport's coarse
+-- result before the blur (the combined technique's off-screen light).
 -- Returns the lit target.
-function isr.render(G, direct, o, light)
+function isr.render(G, direct, o, light, extra)
   o = options.check("isr", isr.defaults, o, rules, 2)
   local seed = options.check("isr.seed", isr.defaults.seed, o.seed, seed_rules, 2) -- checked in either mode
   if o.mode ~= "seed" then seed = nil end
   local f = o.coarse
-  local C = coarse_gbuffer(G, direct, f)
+  local C = isr.coarse_gbuffer(G, direct, f)
   local E
   for b = 1, seed and seed.bounces or o.bounces do
     local inputs = gbuffer.inputs(C)
@@ -124,22 +126,36 @@ function isr.render(G, direct, o, light)
                 defines = { BOUNCE = E ~= nil }, out = coarse_target("isr.e" .. b, f) }
     end
   end
-  if o.blur > 0 then
-    for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
-      E = pass{ "isr.blur_" .. axis[1], shader = "blur.frag",
-                inputs = { src = E, mask = C.mat, depth = C.dpt },
-                params = { axis = axis[2], radius = o.blur }, defines = { MASK = true, DEPTH = true },
-                out = coarse_target("isr.blur_" .. axis[1], f) }
-    end
-  end
+  if extra then E = extra(C, E, f) end
+  E = isr.blur(E, C, f, o.blur)
   local params = { ambient = light.ambient, background = light.background, view = views[o.view] }
   if seed then
     params.k_isr, params.k_ssao = seed.k_isr, seed.k_ssao
   else
     params.k = o.k
   end
-  local defines = { SEED = seed ~= nil }
-  sky.bind(light.sky, params, defines)
+  return isr.composite(G, direct, C, E, params, seed ~= nil, light.sky)
+end
+
+-- A separable Gaussian blur of the coarse result E over the coarse
+-- G-buffer C that skips background and does not cross depth edges.
+function isr.blur(E, C, f, radius)
+  if radius == 0 then return E end
+  for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
+    E = pass{ "isr.blur_" .. axis[1], shader = "blur.frag",
+              inputs = { src = E, mask = C.mat, depth = C.dpt },
+              params = { axis = axis[2], radius = radius }, defines = { MASK = true, DEPTH = true },
+              out = coarse_target("isr.blur_" .. axis[1], f) }
+  end
+  return E
+end
+
+-- Bilateral upsampling of the coarse E (rgb E, a A) and the composite with
+-- the direct light (isr_light.frag), to the target "lit"; skylight (from
+-- sky.light, may be nil) joins the ambient term.
+function isr.composite(G, direct, C, E, params, seed, skylight)
+  local defines = { SEED = seed }
+  sky.bind(skylight, params, defines)
   return pass{ "isr.light", shader = "isr_light.frag",
                inputs = { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat, direct = direct,
                           isr = E, coarse_dpt = C.dpt, coarse_mat = C.mat },

@@ -2,6 +2,9 @@
 -- one listed is the default. Options are what `limn capture --set` can change.
 local gbuffer = require "gbuffer"
 local isr = require "isr"
+local rsm = require "rsm"
+local vpl = require "vpl"
+local temporal = require "temporal"
 local shadow = require "shadow"
 local sky = require "sky"
 local ssdo = require "ssdo"
@@ -11,20 +14,29 @@ local options = require "options"
 
 -- The seed's viewer modes: isr+esm (F2, the default), isr (F3), dl+esm (F4),
 -- dl (F5); then screen-space directional and ambient occlusion (seed 001).
--- "+esm" turns shadows on; shadow.technique picks their filter.
-Techniques = { "isr+esm", "isr", "dl+esm", "dl", "ssdo+esm", "ssdo", "ssao+esm", "ssao" }
+-- "+esm" turns shadows on; shadow.technique picks their filter. rsm+esm:
+-- indirect light from reflective shadow maps (seed 004, scripts/rsm.lua);
+-- vpl+esm: indirect point lights and negative lights in them (seed 002,
+-- scripts/vpl.lua); isr+rsm+esm: RSM and ISR together, each sender counted
+-- once (docs/gi-combined.md).
+Techniques = { "isr+esm", "isr", "dl+esm", "dl", "ssdo+esm", "ssdo", "ssao+esm", "ssao", "rsm+esm",
+               "vpl+esm", "isr+rsm+esm" }
 
 Options = {
   ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
   background = 0.0,        -- radiance where no geometry is
   materials = "phong",     -- "phong" (the std technique) or "pbr" (glTF metallic-roughness, GGX)
   isr = {},                -- see isr.defaults in scripts/isr.lua
+  rsm = {},                -- see rsm.defaults in scripts/rsm.lua
+  vpl = {},                -- see vpl.defaults in scripts/vpl.lua
   shadow = {},             -- see shadow.defaults in scripts/shadow.lua
   sky = {},                -- see sky.defaults in scripts/sky.lua (off by default)
   ssdo = {},               -- see ssdo.defaults in scripts/ssdo.lua
   ssao = {},               -- see ssao.defaults in scripts/ssao.lua
 }
 for k, v in pairs(isr.defaults) do Options.isr[k] = v end
+for k, v in pairs(rsm.defaults) do Options.rsm[k] = v end
+for k, v in pairs(vpl.defaults) do Options.vpl[k] = v end
 for k, v in pairs(shadow.defaults) do Options.shadow[k] = v end
 for k, v in pairs(sky.defaults) do Options.sky[k] = v end
 for k, v in pairs(ssdo.defaults) do Options.ssdo[k] = v end
@@ -54,6 +66,7 @@ local rules = { ambient = options.number(0, 1e6), background = options.number(0,
 
 function OnCreate()
   post.create()
+  temporal.create("rsm", 1 / rsm.defaults.coarse) -- rsm.temporal's history
 end
 
 function OnRender(tech)
@@ -69,17 +82,24 @@ function OnRender(tech)
   if not materials then error('materials must be "phong" or "pbr" (got "' .. tostring(tech.materials) .. '")') end
   local G = gbuffer.render(gbuffer.targets(1, materials), materials)
   -- Shadows after the G-buffer: their cascades fit the depths it sees.
-  local shadows = tech.name:find("+esm", 1, true) and shadow.render(tech.shadow, G) or nil
+  -- The RSM's options, when the technique reads one (the shadow pass then writes it).
+  local o_rsm = lighting == "vpl" and vpl.check(tech.vpl) or tech.name:find("rsm+", 1, true) and rsm.check(tech.rsm)
+  local shadows, R
+  if tech.name:find("+esm", 1, true) then shadows, R = shadow.render(tech.shadow, G, o_rsm and o_rsm.reach) end
   if shadows and tech.shadow.debug then return present(shadow.debug(shadows)) end
   local lit
   local skylight = sky.light(tech.sky) -- nil when off: then nothing of it is recorded
-  if lighting == "dl" then
+  if lighting == "dl" or (lighting == "rsm" or lighting == "vpl") and not R then -- no caster: no RSM
     lit = direct(G, tech, shadows, tech.ambient, "lit", skylight)
   else
     local d = direct(G, tech, shadows, 0, "direct")
     local light = { ambient = grey(tech.ambient), background = grey(tech.background), sky = skylight }
-    if lighting == "isr" then
-      lit = isr.render(G, d, tech.isr, light)
+    if lighting == "rsm" then
+      lit = rsm.render(G, d, shadows, R, o_rsm, light)
+    elseif lighting == "vpl" then
+      lit = vpl.render(G, d, shadows, R, o_rsm, light)
+    elseif lighting == "isr" then
+      lit = isr.render(G, d, tech.isr, light, R and function(C, E, f) return rsm.gather(C, f, R, shadows, o_rsm, E) end)
     elseif lighting == "ssdo" then
       lit = ssdo.render(G, d, tech.ssdo, light)
     else

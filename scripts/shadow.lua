@@ -57,28 +57,37 @@ end
 -- `shadow_atlas`, or nil when no light casts shadows (nothing is recorded).
 -- With the G-buffer G (recorded before), cascades fit the depths it sees
 -- (shadow.depth_range); without, the depths of the meshes in view.
-function shadow.render(o, G)
+-- With rsm (a number >= 1), the same pass also writes reflective shadow maps
+-- (seed 004; shadow.frag), returned second as { flux =, nrm =, pos = }
+-- (atlas-sized, rsm.frag reads them); a directional light gets one more tile
+-- for them, over the sphere around all that is seen, its radius times rsm.
+-- Without, no RSM target or tile exists.
+function shadow.render(o, G, rsm)
   o = options.check("shadow", shadow.defaults, o, rules, 2)
   local settings = {}
   for k, v in pairs(o) do
     if k ~= "debug" then settings[k] = v end
   end
+  settings.rsm = rsm
   local plan = shadow_plan(settings)
   if not plan then return nil end
   local size = { plan.width, plan.height }
   local map = target{ "shadow.map", format = "r32f", size = size }
+  local R = rsm and { flux = target{ "shadow.rsm_flux", format = "rgba16f", size = size },
+                      nrm = target{ "shadow.rsm_nrm", format = "rgba16f", size = size },
+                      pos = target{ "shadow.rsm_pos", format = "rgba32f", size = size } } or nil
   scene{ "shadow.depth", technique = "shadow", views = plan, fit = G and shadow.depth_range(G) or nil,
-         out = map, clear = { 1, 1, 1, 1 },
+         out = R and { map, R.flux, R.nrm, R.pos } or map, clear = { 1, 1, 1, 1 }, defines = { RSM = R ~= nil },
          depth = target{ "shadow.zbuffer", format = "depth32f", size = size } }
-  if plan.technique ~= "esm" or plan.blur == 0 then return map end
+  if plan.technique ~= "esm" or plan.blur == 0 then return map, R end
   local blurred = map
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
     blurred = pass{ "shadow.blur_" .. axis[1], shader = "esm_blur.frag", inputs = { shadow_atlas = blurred },
                     params = { direction = axis[2], radius = plan.blur, c = plan.c, tile = plan.tile,
-                               views = plan.views },
+                               views = plan.shadow_views }, -- not the RSM's wide tiles after them
                     out = target{ "shadow.esm_" .. axis[1], format = "r32f", size = size } }
   end
-  return blurred
+  return blurred, R
 end
 
 -- Adds the atlas to a lighting pass's inputs and defines (no-op without one).

@@ -1,15 +1,43 @@
 // Stores depth normalized to the light's range (not exp(c d): filtering in
-// log space keeps large c finite, see esm_blur.frag).
+// log space keeps large c finite, see esm_blur.frag). With RSM, the
+// reflective shadow map of seed 004 (lines 858-904) as well: the sender's
+// reflectance k_d albedo (its flux is the light's radiance there times this
+// and the texel's area, rsm.glsl), its world normal turned toward the light
+// and its world position. The pass clears every target to 1: a normal of
+// length above 1 marks an empty texel.
 #include "common.glsl"
 
 in vec3 world_pos;
 uniform vec4 pass_depth;
+#ifdef RSM
+in vec3 world_normal;
+in vec2 tex_uv;
+uniform vec3 material_color;
+uniform vec4 material_k; // k_a, k_d, k_s, shininess
+#ifdef BASE_COLOR_TEXTURE
+uniform sampler2D base_color_tex;
+#endif
+layout(location = 1) out vec4 rsm_flux;
+layout(location = 2) out vec4 rsm_nrm;
+layout(location = 3) out vec4 rsm_pos;
+#endif
 
-out float depth01;
+layout(location = 0) out float depth01;
 
 void main() {
   if (pass_depth.w > 0.0) // perspective: distance from the light / range
     depth01 = saturate(length(world_pos - pass_depth.xyz) * pass_depth.w);
   else                    // orthographic: window depth is already linear
     depth01 = saturate(gl_FragCoord.z); // casters before the near plane are clamped onto it
+#ifdef RSM
+  vec3 albedo = material_color;
+#ifdef BASE_COLOR_TEXTURE
+  albedo *= texture(base_color_tex, tex_uv).rgb;
+#endif
+  vec3 n = safe_normalize(world_normal, vec3(0.0, 1.0, 0.0));
+  if (!gl_FrontFacing) n = -n; // two-sided, as the G-buffer
+  rsm_flux = vec4(saturate(material_k.y) * saturate(albedo), 1.0);
+  rsm_nrm = vec4(n, 0.0);
+  rsm_pos = vec4(world_pos, 0.0);
+#endif
 }

@@ -10,7 +10,7 @@ struct ShadowLight {
   ivec4 info;  // first view, view count, kind (0 none, 1 cascades, 2 spot, 3 point), technique
   vec4 splits; // cascades: camera depth where each ends
   vec4 params; // c, bias (texels), blend, Poisson radius
-  ivec4 cube;  // point lights: x = the cube faces drawn (bit f: face f), their views in face order
+  ivec4 cube;  // x: point lights' cube faces drawn (bit f: face f), in order; y, z: the RSM views
   vec4 soft;   // PCSS: light size (radians for cascades, world units else), widest penumbra (texels)
 };
 struct ShadowView {

@@ -1,8 +1,16 @@
 // The "shadow" material technique: depth from a light's point of view, one
 // shadow-map tile per draw (the engine sets pass_view_proj and pass_depth).
+// With RSM, also what a reflective shadow map stores (shadow.frag).
 #include "common.glsl"
 
 layout(location = 0) in vec3 in_position;
+#ifdef RSM
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+uniform mat3 normal_matrix;
+out vec3 world_normal;
+out vec2 tex_uv;
+#endif
 
 uniform mat4 model;
 uniform mat4 pass_view_proj;
@@ -13,5 +21,9 @@ out vec3 world_pos;
 void main() {
   vec4 world = model * vec4(in_position, 1.0);
   world_pos = world.xyz;
+#ifdef RSM
+  world_normal = normal_matrix * in_normal;
+  tex_uv = in_uv;
+#endif
   gl_Position = pass_view_proj * world;
 }

@@ -34,7 +34,8 @@ static float mean_luminance(const gl_result *r) {
   return gl_luminance(all);
 }
 
-static const char *const every_technique[] = {"isr+esm", "isr", "dl+esm", "dl", "ssdo+esm", "ssdo", "ssao+esm", "ssao"};
+static const char *const every_technique[] = {"isr+esm", "isr",     "dl+esm",  "dl",      "ssdo+esm",    "ssdo",
+                                              "ssao+esm", "ssao", "rsm+esm", "vpl+esm", "isr+rsm+esm"};
 enum { TECHNIQUES = sizeof every_technique / sizeof *every_technique };
 
 /* Radiance from 1e-8 to 1e6 in one image: a blinding light, a faint background. */

@@ -168,7 +168,7 @@ static float opt_number(lua_State *L, int idx, const char *field, float def, flo
 }
 
 /* shadow_plan{ technique, resolution, c, blur, cascades, lambda, bias, distance,
- * blend, radius, stabilize, size, penumbra }: tiles for every light that casts shadows, or nil
+ * blend, radius, stabilize, size, penumbra, rsm }: tiles for every light that casts shadows, or nil
  * when none does. scene{ views = plan } draws them; scene{ views = plan, fit =
  * T } first fits them to the camera depths T's first texel holds (min in r,
  * max in g, as depth / far). */
@@ -180,7 +180,7 @@ static int l_shadow_plan(lua_State *L) {
   luaL_checktype(L, 1, LUA_TTABLE);
   static const char *const fields[] = {"technique", "resolution", "c", "blur", "cascades", "lambda",
                                        "bias", "distance", "blend", "radius", "stabilize", "size",
-                                       "penumbra", NULL};
+                                       "penumbra", "rsm", NULL};
   check_fields(L, 1, "shadow_plan", fields);
   lm_shadow_settings st;
   lm_shadow_settings_default(&st);
@@ -205,6 +205,7 @@ static int l_shadow_plan(lua_State *L) {
   lua_getfield(L, 1, "stabilize");
   if (!lua_isnil(L, -1)) st.stabilize = lua_toboolean(L, -1);
   lua_pop(L, 1);
+  st.rsm = opt_number(L, 1, "rsm", 0, 0, 64, what);
   lm_shadow_plan_free(p->shadows);
   lm_error err;
   if (!lm_shadow_plan_make(p->shadows, p->scene, p->camera, &st, &err)) return luaL_error(L, "shadow_plan: %s", err.msg);
@@ -236,10 +237,12 @@ static int l_plan_index(lua_State *L) {
   else if (!strcmp(k, "height")) lua_pushinteger(L, plan->atlas_height);
   else if (!strcmp(k, "tile")) lua_pushinteger(L, plan->tile);
   else if (!strcmp(k, "views")) lua_pushinteger(L, plan->view_count);
+  else if (!strcmp(k, "shadow_views")) lua_pushinteger(L, plan->shadow_views);
   else if (!strcmp(k, "c")) lua_pushnumber(L, plan->settings.c);
   else if (!strcmp(k, "blur")) lua_pushinteger(L, plan->settings.blur);
   else if (!strcmp(k, "technique")) lua_pushstring(L, (const char *[]){"esm", "pcf", "poisson", "hard", "pcss"}[plan->settings.technique]);
-  else return luaL_error(L, "shadow plan has no field '%s' (width, height, tile, views, c, blur, technique)", k);
+  else return luaL_error(L, "shadow plan has no field '%s' (width, height, tile, views, shadow_views, c, blur, "
+                         "technique)", k);
   return 1;
 }
 

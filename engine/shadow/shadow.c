@@ -107,16 +107,89 @@ static void caster_depth(const lm_scene *s, mat4 view, float l, float r, float b
   *zn = fmaxf(*zn, cmin), *zf = fminf(*zf, cmax);
 }
 
+/* One orthographic tile along dir over the camera's slice z0 .. z1: a
+ * cascade (grow 0), or the RSM's wide tile over the slice's bounding sphere
+ * with its radius times grow. */
+static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam, vec3 dir,
+                           float z0, float z1, float grow) {
+  const lm_shadow_settings *st = &plan->settings;
+  vec3 corners[8], center = {0, 0, 0};
+  slice_corners(cam, z0, z1, corners);
+  for (int c = 0; c < 8; c++) glm_vec3_muladds(corners[c], 1.0f / 8.0f, center);
+  float l, r, b, t, extent = 0;
+  for (int c = 0; c < 8; c++) extent = fmaxf(extent, glm_vec3_distance(corners[c], center));
+  extent = round_relative(extent * fmaxf(grow, 1.0f) * 1.0001f, true);
+  /* The eye sits on a plane across the light snapped to steps of extent/16,
+   * so a small camera move changes no stored depth. */
+  float step = extent / 16.0f, along = glm_vec3_dot(center, dir);
+  float behind = along - floorf(along / step) * step; /* in [0, step) */
+  vec3 up, eye;
+  up_for(dir, up);
+  glm_vec3_copy(center, eye);
+  glm_vec3_muladds(dir, -(behind + extent), eye);
+  mat4 view, proj, vp;
+  glm_lookat(eye, center, up, view);
+  if (st->stabilize) {
+    /* A sphere around the slice does not change as the camera turns
+     * (seed 003); rounding its radius keeps float noise from resizing it. */
+    l = b = -extent, r = t = extent;
+  } else {
+    l = b = FLT_MAX, r = t = -FLT_MAX;
+    for (int c = 0; c < 8; c++) {
+      vec4 p = {corners[c][0], corners[c][1], corners[c][2], 1}, q;
+      glm_mat4_mulv(view, p, q);
+      l = fminf(l, q[0]), r = fmaxf(r, q[0]), b = fminf(b, q[1]), t = fmaxf(t, q[1]);
+    }
+  }
+  /* Depth spans the slice's sphere (whatever `behind` is), narrowed to the
+   * meshes inside the tile and snapped to steps, so ESM's c acts on a short
+   * range and no light leaks across a big scene. Casters nearer the light
+   * than the near plane are clamped onto it by depth clamping in the
+   * shadow pass ("pancaking"). */
+  float zn = 0, zf = 2.0f * extent + step;
+  if (grow > 0) {
+    /* The RSM's tile: every mesh in the rectangle, however deep (a sender
+     * below the slice's sphere still lights it), a step to spare at either
+     * end so that none lies on a clip plane. */
+    zf = FLT_MAX;
+    caster_depth(s, view, l, r, b, t, &zn, &zf);
+    zn = fmaxf(floorf(zn / step) * step - step, 0.0f), zf = ceilf(zf / step) * step + step;
+  } else {
+    caster_depth(s, view, l, r, b, t, &zn, &zf);
+    zn = fmaxf(floorf(zn / step) * step, 0.0f), zf = fminf(ceilf(zf / step) * step, 2.0f * extent + step);
+  }
+  if (!(zf > zn) || !isfinite(zf)) zn = 0, zf = 2.0f * extent + step;
+  glm_ortho(l, r, b, t, zn, zf, proj);
+  glm_mat4_mul(proj, view, vp);
+  if (st->stabilize) {
+    /* Texel snapping: move the projection so the world origin falls on a
+     * texel corner; a camera moving by less than a texel moves no edge. */
+    vec4 origin = {0, 0, 0, 1}, o;
+    glm_mat4_mulv(vp, origin, o);
+    float half = (float)plan->tile * 0.5f;
+    float dx = (roundf(o[0] * half) - o[0] * half) / half, dy = (roundf(o[1] * half) - o[1] * half) / half;
+    proj[3][0] += dx, proj[3][1] += dy;
+    glm_mat4_mul(proj, view, vp);
+  }
+  /* A texel's world size and the world depth the tile's 0..1 spans. */
+  add_view(plan, vp, (float[4]){0, 0, 0, 0}, (float[4]){(r - l) / (float)plan->tile, zf - zn, 0, 0});
+}
+
+/* Cascades cover the depths where receivers are seen (plan->seen), snapped
+ * outwards to a relative grid so that a small camera move keeps them. */
+static void cascade_range(const lm_shadow_plan *plan, float *n, float *reach) {
+  *n = round_relative(plan->seen[0], false), *reach = round_relative(plan->seen[1], true);
+  if (plan->settings.distance > 0) *reach = fminf(plan->settings.distance, *reach);
+  if (!(*reach > *n)) *reach = *n * 1.001f;
+}
+
 static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
                           const lm_light_data *light, lm_shadow_light_data *out) {
   const lm_shadow_settings *st = &plan->settings;
   vec3 dir;
   glm_vec3_normalize_to((float *)light->direction, dir);
-  /* Cascades cover the depths where receivers are seen (plan->seen), snapped
-   * outwards to a relative grid so that a small camera move keeps them. */
-  float n = round_relative(plan->seen[0], false), reach = round_relative(plan->seen[1], true);
-  if (st->distance > 0) reach = fminf(st->distance, reach);
-  if (!(reach > n)) reach = n * 1.001f;
+  float n, reach;
+  cascade_range(plan, &n, &reach);
   out->info[0] = plan->view_count;
   out->info[1] = st->cascades;
   out->info[2] = KIND_CASCADES;
@@ -124,58 +197,21 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_fram
     float z0 = split_depth(n, reach, k, st->cascades, st->lambda);
     float z1 = split_depth(n, reach, k + 1, st->cascades, st->lambda);
     out->splits[k] = z1;
-    vec3 corners[8], center = {0, 0, 0};
-    slice_corners(cam, z0, z1, corners);
-    for (int c = 0; c < 8; c++) glm_vec3_muladds(corners[c], 1.0f / 8.0f, center);
-    float l, r, b, t, extent = 0;
-    for (int c = 0; c < 8; c++) extent = fmaxf(extent, glm_vec3_distance(corners[c], center));
-    extent = round_relative(extent * 1.0001f, true);
-    /* The eye sits on a plane across the light snapped to steps of extent/16,
-     * so a small camera move changes no stored depth. */
-    float step = extent / 16.0f, along = glm_vec3_dot(center, dir);
-    float behind = along - floorf(along / step) * step; /* in [0, step) */
-    vec3 up, eye;
-    up_for(dir, up);
-    glm_vec3_copy(center, eye);
-    glm_vec3_muladds(dir, -(behind + extent), eye);
-    mat4 view, proj, vp;
-    glm_lookat(eye, center, up, view);
-    if (st->stabilize) {
-      /* A sphere around the slice does not change as the camera turns
-       * (seed 003); rounding its radius keeps float noise from resizing it. */
-      l = b = -extent, r = t = extent;
-    } else {
-      l = b = FLT_MAX, r = t = -FLT_MAX;
-      for (int c = 0; c < 8; c++) {
-        vec4 p = {corners[c][0], corners[c][1], corners[c][2], 1}, q;
-        glm_mat4_mulv(view, p, q);
-        l = fminf(l, q[0]), r = fmaxf(r, q[0]), b = fminf(b, q[1]), t = fmaxf(t, q[1]);
-      }
-    }
-    /* Depth spans the slice's sphere (whatever `behind` is), narrowed to the
-     * meshes inside the tile and snapped to steps, so ESM's c acts on a short
-     * range and no light leaks across a big scene. Casters nearer the light
-     * than the near plane are clamped onto it by depth clamping in the
-     * shadow pass ("pancaking"). */
-    float zn = 0, zf = 2.0f * extent + step;
-    caster_depth(s, view, l, r, b, t, &zn, &zf);
-    zn = fmaxf(floorf(zn / step) * step, 0.0f), zf = fminf(ceilf(zf / step) * step, 2.0f * extent + step);
-    if (!(zf > zn)) zn = 0, zf = 2.0f * extent + step;
-    glm_ortho(l, r, b, t, zn, zf, proj);
-    glm_mat4_mul(proj, view, vp);
-    if (st->stabilize) {
-      /* Texel snapping: move the projection so the world origin falls on a
-       * texel corner; a camera moving by less than a texel moves no edge. */
-      vec4 origin = {0, 0, 0, 1}, o;
-      glm_mat4_mulv(vp, origin, o);
-      float half = (float)plan->tile * 0.5f;
-      float dx = (roundf(o[0] * half) - o[0] * half) / half, dy = (roundf(o[1] * half) - o[1] * half) / half;
-      proj[3][0] += dx, proj[3][1] += dy;
-      glm_mat4_mul(proj, view, vp);
-    }
-    /* A texel's world size and the world depth the tile's 0..1 spans. */
-    add_view(plan, vp, (float[4]){0, 0, 0, 0}, (float[4]){(r - l) / (float)plan->tile, zf - zn, 0, 0});
+    add_slice_view(plan, s, cam, dir, z0, z1, 0.0f);
   }
+}
+
+/* The RSM's wide tile of a directional light: what its cascades cover and
+ * around it, in one; after every shadow view, so that the ESM blur, which
+ * it does not need, stops before it (plan->shadow_views). */
+static void plan_wide_tile(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
+                           const lm_light_data *light, lm_shadow_light_data *out) {
+  vec3 dir;
+  glm_vec3_normalize_to((float *)light->direction, dir);
+  float n, reach;
+  cascade_range(plan, &n, &reach);
+  out->cube[1] = plan->view_count, out->cube[2] = 1;
+  add_slice_view(plan, s, cam, dir, n, reach, plan->settings.rsm);
 }
 
 /* Range of a point or spot light: where its light ends (lm_light_reach: the
@@ -274,6 +310,7 @@ static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
   if (l->type == LM_LIGHT_SPOT) {
     out->info[1] = 1;
     out->info[2] = KIND_SPOT;
+    if (plan->settings.rsm > 0) out->cube[1] = plan->view_count, out->cube[2] = 1;
     float fov = fminf(2.0f * l->outer_cone * 1.05f + 0.02f, glm_rad(170.0f));
     plan_perspective(plan, pos, dir, fov, range);
     return;
@@ -282,6 +319,7 @@ static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
   out->info[1] = __builtin_popcount((unsigned)faces);
   out->info[2] = KIND_POINT;
   out->cube[0] = faces;
+  if (plan->settings.rsm > 0) out->cube[1] = plan->view_count, out->cube[2] = out->info[1];
   for (int f = 0; f < 6; f++)
     if (faces & 1 << f) plan_perspective(plan, pos, cube_faces[f], GLM_PI_2f, range);
 }
@@ -292,6 +330,10 @@ static void plan_views(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
   lm_light_data *ld = lm_alloc(sizeof *ld * (size_t)(s->light_count + 1));
   lm_scene_light_data(s, ld, s->light_count);
   for (int i = 0; i < s->light_count; i++) plan_light(plan, s, cam, i, &ld[i]);
+  plan->shadow_views = plan->view_count;
+  for (int i = 0; i < s->light_count; i++)
+    if (plan->settings.rsm > 0 && s->lights[i].casts_shadows && s->lights[i].type == LM_LIGHT_DIRECTIONAL)
+      plan_wide_tile(plan, s, cam, &ld[i], &plan->lights[i]);
   free(ld);
   for (int v = 0; v < plan->view_count; v++) {
     int cx = v % plan->columns, cy = v / plan->columns;
@@ -313,7 +355,8 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
   if (st->resolution < 16 || st->resolution > 8192 || st->cascades < 1 || st->cascades > 4 ||
       !(st->c > 0 && st->c <= 10000) || st->blur < 0 || st->blur > 32 || !(st->lambda >= 0 && st->lambda <= 1) ||
       !(st->bias >= 0 && st->bias <= 64) || !(st->distance >= 0) || !(st->blend >= 0 && st->blend <= 1) ||
-      !(st->radius >= 0 && st->radius <= 32) || (unsigned)st->technique > LM_SHADOW_PCSS ||
+      !(st->radius >= 0 && st->radius <= 32) || !(st->rsm >= 0 && st->rsm <= 64) ||
+      (unsigned)st->technique > LM_SHADOW_PCSS ||
       !(st->size < 0 || st->size <= 1e30f) || !(st->penumbra >= 1 && st->penumbra <= 64)) {
     lm_error_set(err, "shadow settings out of range");
     return false;
@@ -332,9 +375,10 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
     if (!l->casts_shadows) continue;
     if (l->type == LM_LIGHT_POINT) {
       vec3 pos = {ld[i].position[0], ld[i].position[1], ld[i].position[2]};
-      plan->lights[i].cube[0] = cube_faces_seen(plan, s, cam, pos, light_range(s, l, pos));
+      /* An RSM needs every face: a sender off screen lights what is seen. */
+      plan->lights[i].cube[0] = st->rsm > 0 ? 63 : cube_faces_seen(plan, s, cam, pos, light_range(s, l, pos));
     }
-    count += l->type == LM_LIGHT_DIRECTIONAL ? st->cascades
+    count += l->type == LM_LIGHT_DIRECTIONAL ? st->cascades + (st->rsm > 0)
              : l->type == LM_LIGHT_SPOT      ? 1
                                              : __builtin_popcount((unsigned)plan->lights[i].cube[0]);
   }

@@ -3,7 +3,9 @@
  * scheme, stabilized as seed 003), one perspective tile for a spot light, six
  * cube faces for a point light. The plan becomes one scene pass drawn once
  * per tile, and two storage blocks the lighting shaders read through
- * shaders/shadow.glsl. A frame that plans nothing renders no shadow map. */
+ * shaders/shadow.glsl. A frame that plans nothing renders no shadow map.
+ * With settings.rsm the same pass also writes reflective shadow maps
+ * (scripts/shadow.lua, shaders/rsm.glsl). */
 #ifndef LIMN_SHADOW_H
 #define LIMN_SHADOW_H
 
@@ -23,7 +25,7 @@ int lm_shadow_technique_parse(const char *name);
 typedef struct lm_shadow_settings {
   lm_shadow_technique technique;
   int resolution;  /* tile size in texels (16 .. 8192) */
-  float c;         /* ESM exponent on depth normalized to the light's range */
+  float c;         /* ESM exponent per texel of depth (shadow.glsl: shadow_texel_depth) */
   int blur;        /* ESM Gaussian radius in texels (0: none) */
   int cascades;    /* directional lights: 1 .. 4 */
   float lambda;    /* split scheme: 0 uniform, 1 logarithmic */
@@ -34,6 +36,9 @@ typedef struct lm_shadow_settings {
   bool stabilize;  /* bounding spheres and texel snapping (seed 003) */
   float size;      /* PCSS: every light's size (see lm_light.size); <= 0: each light's own */
   float penumbra;  /* PCSS: the widest penumbra radius and blocker search, texels */
+  float rsm;       /* > 0: a frame reads reflective shadow maps (seed 004's senders); each
+                    * directional light gets one more tile, over the sphere around all
+                    * that is seen with its radius times rsm (senders off screen), 0..64 */
 } lm_shadow_settings;
 void lm_shadow_settings_default(lm_shadow_settings *s);
 
@@ -42,7 +47,9 @@ typedef struct lm_shadow_light_data {
   int32_t info[4]; /* first view, view count, kind (0 none, 1 cascades, 2 spot, 3 point), technique */
   float splits[4]; /* cascades: camera depth where each ends */
   float params[4]; /* c, bias (texels), blend, Poisson radius */
-  int32_t cube[4]; /* point lights: x = the cube faces drawn (bit f: face f, +X -X +Y -Y +Z -Z), in order */
+  int32_t cube[4]; /* x: point lights' cube faces drawn (bit f: face f, +X -X +Y -Y +Z -Z), in order;
+                    * y, z: the light's RSM views (first, count; count 0 without RSM): the
+                    * wide tile of a directional light, else its shadow views */
   float soft[4];   /* PCSS: light size (radians for cascades, world units else), widest penumbra (texels) */
 } lm_shadow_light_data;
 typedef struct lm_shadow_view_data {
@@ -58,6 +65,7 @@ typedef struct lm_shadow_plan {
   lm_pass_view *views; /* for the scene pass, one per tile */
   lm_shadow_view_data *view_data;
   int view_count;
+  int shadow_views; /* the first views, those shadow lookups read (the RSM's wide tiles follow) */
   lm_shadow_light_data *lights; /* one per scene light */
   int light_count;
   float seen[2]; /* camera depths cascades cover: where receivers are seen */

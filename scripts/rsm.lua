@@ -1,0 +1,81 @@
+-- Indirect light from reflective shadow maps (seed 004, lines 858-958), on
+-- POV-Ray's scale (/work/shared/design/gi-scale.md). The shadow pass writes
+-- the maps when this module asks (shadow.render(o, G, reach)); the gather
+-- runs at a coarse size over isr.lua's coarse G-buffer (rsm.frag), then the
+-- same geometry-aware blur, bilateral upsampling and composite as ISR
+-- (isr.blur, isr.composite: L = D + k_a L_a albedo + k k_d albedo E).
+local gbuffer = require "gbuffer"
+local isr = require "isr"
+local options = require "options"
+local shadow = require "shadow"
+local temporal = require "temporal"
+
+local rsm = {}
+
+-- The options a pipeline exposes (pp.lua's Options.rsm), with defaults.
+rsm.defaults = {
+  samples = 64,      -- RSM samples a coarse pixel and light, 1..4096 (the seed: 512 at half size)
+  radius = 1.0,      -- sampling disc radius in tiles of the RSM, (0, 2]
+  reach = 3,         -- a directional light's RSM tile covers the sphere around what is seen,
+                     -- its radius times reach, 1..64 (senders off screen; no world unit)
+  steps = 0,         -- screen-space visibility march a sample, 0..32 (0: none; the seed's
+                     -- test, which about halves its frame rate)
+  rotate = 10,       -- pattern turn a frame in degrees with temporal reuse, 0..180 (the seed: 10);
+                     -- without, the pattern stays (a still camera, a still image)
+  k = 1.0,           -- indirect light factor, 0..16 (1: physical)
+  coarse = 2,        -- coarse factor a side: 1, 2 or 4 (the seed: half resolution)
+  blur = 4,          -- Gaussian taps each side at coarse size, 0..32
+  temporal = {},     -- temporal reuse (scripts/temporal.lua): enabled, frames, epsilon, bias;
+                     -- its history is at coarse 2 (pp.lua's OnCreate)
+}
+for k, v in pairs(temporal.defaults) do rsm.defaults.temporal[k] = v end
+
+local rules = {
+  samples = options.whole(1, 4096),
+  radius = options.positive(2),
+  reach = options.number(1, 64),
+  steps = options.whole(0, 32),
+  rotate = options.number(0, 180),
+  k = options.number(0, 16),
+  coarse = options.one_of(1, 2, 4),
+  blur = options.whole(0, 32),
+  temporal = function(v) if type(v) ~= "table" then return "a table of temporal reuse options" end end,
+}
+
+-- Checked options (errors name the option, pointing at the caller's caller);
+-- shadow.render(..., o.reach) then writes the maps.
+function rsm.check(o)
+  o = options.check("rsm", rsm.defaults, o, rules, 3)
+  o.temporal = temporal.check("rsm.temporal", o.temporal)
+  return o
+end
+
+-- Records the gather over the coarse G-buffer C (isr.coarse_gbuffer) from
+-- the RSM targets R (shadow.render's second result) and the atlas `shadows`.
+-- base (optional): a coarse result to add to (the screen-space pass's), in
+-- which case senders the camera sees are left to it. Returns the coarse E.
+function rsm.gather(C, f, R, shadows, o, base)
+  local inputs, defines = shadow.bind(shadows, gbuffer.inputs(C),
+                                      { VISIBILITY = o.steps > 0, BASE = base ~= nil, EXCLUDE_SEEN = base ~= nil })
+  inputs.rsm_flux, inputs.rsm_nrm, inputs.rsm_pos, inputs.base = R.flux, R.nrm, R.pos, base
+  return pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines,
+               params = { samples = o.samples, radius = o.radius, steps = o.steps,
+                          rotate = o.temporal.enabled and o.rotate / 360 or 0 },
+               fetches = 4 + o.samples * (3 + o.steps * 2 + (base and 3 or 0)),
+               out = target{ "rsm.e", format = "rgba16f", scale = 1 / f } }
+end
+
+-- Records RSM lighting of G given its direct light `direct` (no ambient
+-- term), the shadow atlas and RSM targets (shadow.render(..., o.reach)), with
+-- checked options o and light = { ambient = {r, g, b}, background = {r, g, b}, sky }.
+-- Returns the lit target.
+function rsm.render(G, direct, shadows, R, o, light)
+  local f = o.coarse
+  local C = isr.coarse_gbuffer(G, direct, f)
+  local E = temporal.apply("rsm", rsm.gather(C, f, R, shadows, o), C, o.temporal, 1 / f)
+  E = isr.blur(E, C, f, o.blur)
+  return isr.composite(G, direct, C, E, { ambient = light.ambient, background = light.background, k = o.k }, false,
+                       light.sky)
+end
+
+return rsm

@@ -1,0 +1,80 @@
+-- Indirect point lights with negative lights (seed 002), on POV-Ray's scale
+-- (/work/shared/design/gi-scale.md), over the reflective shadow maps the
+-- shadow pass writes (shadow.render(o, G, reach), as rsm.lua). vpl.frag:
+--   1. gather at a coarse size: N indirect lights a light, fixed Halton
+--      points in its RSM, each pixel lit by all of them without visibility
+--      (E+), and the light arriving from behind each pixel's tangent plane
+--      (the seed's S_neg) with its mean direction
+--   2. subtract M negative lights taken at Halton pixels of S_neg
+--   3. at full size, the coarse result where the coarse texels around a
+--      pixel agree with it (the seed's discontinuity threshold), else all
+--      lights again for that pixel
+--   4. ISR's composite (isr.composite: L = D + k_a L_a albedo + k k_d albedo E)
+local gbuffer = require "gbuffer"
+local isr = require "isr"
+local options = require "options"
+local shadow = require "shadow"
+
+local vpl = {}
+
+-- The options a pipeline exposes (pp.lua's Options.vpl), with defaults.
+vpl.defaults = {
+  lights = 100,      -- N indirect lights a light, 0..4096 (the seed: 100 with 50 negative)
+  negative = 50,     -- M negative lights, 0..4096 (0: no occlusion)
+  threshold = 0.1,   -- discontinuity threshold: relative depth and 1 - cos between normals, 0..2
+  coarse = 2,        -- coarse factor a side: 1, 2 or 4 (the seed: 2)
+  reach = 3,         -- a directional light's RSM tile, as rsm.reach, 1..64
+  focus = 1,         -- the indirect lights of a directional light's tile lie in its central part
+                     -- of this side, times reach (1: the sphere around what is seen), 0.05..64
+  k = 1.0,           -- indirect light factor, 0..16 (1: physical)
+}
+
+local rules = {
+  lights = options.whole(0, 4096),
+  negative = options.whole(0, 4096),
+  threshold = options.number(0, 2),
+  coarse = options.one_of(1, 2, 4),
+  reach = options.number(1, 64),
+  focus = options.number(0.05, 64),
+  k = options.number(0, 16),
+}
+
+-- Checked options (errors point at the caller's caller).
+function vpl.check(o) return options.check("vpl", vpl.defaults, o, rules, 3) end
+
+-- Records VPL lighting of G given its direct light `direct` (no ambient
+-- term), the shadow atlas and RSM targets R, checked options o and light =
+-- { ambient = {r, g, b}, background = {r, g, b} }. Returns the lit target.
+function vpl.render(G, direct, shadows, R, o, light)
+  local f = o.coarse
+  local C = isr.coarse_gbuffer(G, direct, f)
+  local function inputs(g)
+    local t, defines = shadow.bind(shadows, gbuffer.inputs(g), {})
+    t.rsm_flux, t.rsm_nrm, t.rsm_pos = R.flux, R.nrm, R.pos
+    return t, defines
+  end
+  local params = { indirect_count = o.lights, negative = o.negative, threshold = o.threshold,
+                   focus = math.min(o.focus / o.reach, 1) }
+  local coarse = function(name) return target{ name, format = "rgba16f", scale = 1 / f } end
+  local t, defines = inputs(C)
+  defines.GATHER = true
+  local E, N, D = coarse("vpl.e_plus"), coarse("vpl.neg"), coarse("vpl.neg_dir")
+  pass{ "vpl.gather", shader = "vpl.frag", inputs = t, defines = defines, params = params,
+        fetches = 4 + o.lights * 3, out = { E, N, D } }
+  t, defines = inputs(C)
+  t.positive, t.neg, t.neg_dir, t.cdpt, t.cnrm = E, N, D, C.dpt, C.nrm
+  defines.NEGATIVE = true
+  E = pass{ "vpl.negative", shader = "vpl.frag", inputs = t, defines = defines, params = params,
+            fetches = 5 + o.negative * 3, out = coarse("vpl.e") }
+  t, defines = inputs(G)
+  t.coarse, t.neg, t.neg_dir, t.cdpt, t.cnrm = E, N, D, C.dpt, C.nrm
+  defines.REFINE = true
+  E = pass{ "vpl.refine", shader = "vpl.frag", inputs = t, defines = defines, params = params,
+            fetches = 4 + 12, -- where coarse texels agree; a discontinuity costs all lights again
+            out = target{ "vpl.full", format = "rgba16f" } }
+  return isr.composite(G, direct, { dpt = G.dpt, mat = G.mat }, E,
+                       { ambient = light.ambient, background = light.background, k = o.k }, false,
+                       light.sky)
+end
+
+return vpl

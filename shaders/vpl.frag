@@ -1,0 +1,171 @@
+// Indirect point lights with negative lights (seed 002, sections 3.1-3.4),
+// on POV-Ray's scale (/work/shared/design/gi-scale.md), over the reflective
+// shadow maps of shadow.frag. Three passes (scripts/vpl.lua), by define:
+//   GATHER   coarse: E+ from the N indirect lights, and the seed's S_neg:
+//            the light that would arrive from behind p's tangent plane
+//            (n_p.t negated) and its intensity-weighted mean direction
+//   NEGATIVE coarse: E = E+ minus M negative lights taken at Halton pixels
+//            of S_neg
+//   REFINE   full size: the coarse E where the 2 x 2 coarse texels around a
+//            pixel agree with it in normal and depth (the seed's
+//            discontinuity threshold), else E recomputed at full size
+// Indirect lights: the i-th of N lies where the Halton point
+// (Phi_2(i), Phi_3(i)) falls in the light's RSM view (fixed: nothing
+// flickers); the seed's points are directions in a spotlight's cone, which
+// a directional light has none of: points uniform over the tile stand for
+// the same thing, each weighing its share of the tile's area (seen from the
+// light: orthographic T^2 texel areas / N; perspective its texel's area
+// r^2 cos(a) tan-step^2 times T^2 / N). A light at q sends
+//   E(p) += (1/pi) Phi max(0, n_p.t) max(0, n_q.-t) / max(|q - p|^2, A)
+// (seed 002's gather, t = (q - p)/|q - p|), A the area the light stands
+// for: its own size caps 1/d^2. Output of GATHER: E+ (rgb), S_neg (rgb) and
+// its mean direction (xyz); NEGATIVE and REFINE: rgb = E, a = 1.
+#include "gbuffer.glsl"
+#include "halton.glsl"
+
+in vec2 uv;
+uniform sampler2D clr, nrm, dpt, mat;          // G-buffer (coarse, or full for REFINE)
+uniform sampler2D rsm_flux, rsm_nrm, rsm_pos;  // shadow.lua's RSM targets
+uniform int indirect_count = 100;              // N indirect lights a light
+uniform int negative = 50;                     // M negative lights
+uniform float focus = 1.0;                     // orthographic tiles: the central share of a side they fill
+#if defined(NEGATIVE) || defined(REFINE)
+uniform sampler2D neg, neg_dir;                // GATHER's S_neg, coarse
+uniform sampler2D cdpt, cnrm;                  // the coarse G-buffer's depth and normal
+#endif
+#ifdef NEGATIVE
+uniform sampler2D positive;                    // GATHER's E+
+#endif
+#ifdef REFINE
+uniform sampler2D coarse;                      // NEGATIVE's E
+uniform float threshold = 0.1;                 // relative depth and 1 - cos of the normals
+#endif
+
+#ifdef GATHER
+layout(location = 0) out vec4 result;
+layout(location = 1) out vec4 out_neg;
+layout(location = 2) out vec4 out_neg_dir;
+#else
+out vec4 result;
+#endif
+
+// E+ at (p, n) from every indirect light; S_neg and its direction when asked.
+vec3 indirect(vec3 p, vec3 n, out vec3 s_neg, out vec3 neg_d) {
+  vec2 atlas = vec2(textureSize(rsm_pos, 0));
+  vec3 e = vec3(0.0);
+  s_neg = vec3(0.0);
+  neg_d = vec3(0.0);
+  for (int i = 0; i < frame.counts.x; i++) {
+    ShadowLight sl = shadow_lights[i];
+    int first = sl.cube.y, count = sl.cube.z;
+    int per_view = count > 0 ? max(indirect_count / count, 1) : 0;
+    if (indirect_count == 0) per_view = 0;
+    for (int v = first; v < first + count; v++) {
+      ShadowView sv = shadow_views[v];
+      float tile = sv.rect.z * atlas.x;
+      for (int k = 0; k < per_view; k++) {
+        vec2 t = vec2(radical_inverse(uint(k + 1), 2u), radical_inverse(uint(k + 1), 3u));
+        float side = sv.depth.w > 0.0 ? 1.0 : clamp(focus, 1e-3, 1.0);
+        t = 0.5 + (t - 0.5) * side;
+        ivec2 a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
+        vec3 nq = texelFetch(rsm_nrm, a, 0).xyz;
+        if (dot(nq, nq) > 1.5) continue; // empty
+        vec3 q = texelFetch(rsm_pos, a, 0).xyz;
+        vec3 l;
+        vec3 radiance = light_incident(i, q, l);
+        float area = sv.texel.x * sv.texel.x;
+        if (sv.depth.w > 0.0) {
+          vec2 tn = (t * 2.0 - 1.0) * sv.texel.x * tile * 0.5;
+          area *= dot(q - sv.depth.xyz, q - sv.depth.xyz) * inversesqrt(1.0 + dot(tn, tn));
+        }
+        area *= tile * tile * side * side / float(per_view);
+        vec3 flux = texelFetch(rsm_flux, a, 0).rgb * radiance * area;
+        vec3 d = q - p;
+        float d2 = dot(d, d);
+        vec3 dir = d * inversesqrt(max(d2, 1e-30));
+        float g = max(dot(nq, -dir), 0.0) / max(d2, area);
+        float ndt = dot(n, dir);
+        e += flux * max(ndt, 0.0) * g;
+        vec3 behind = flux * max(-ndt, 0.0) * g;
+        s_neg += behind;
+        neg_d += luminance(behind) * dir;
+      }
+    }
+  }
+  return e / PI;
+}
+
+#if defined(NEGATIVE) || defined(REFINE)
+// The M negative lights: Halton pixels of S_neg, each a point light at the
+// pixel's surface, standing for its share of the coarse image's surface
+// (the pixel's world footprint squared times the pixels it stands for):
+// the light it blocks (pi S_neg times that area) sent on as a Lambertian
+// emitter facing away from the indirect lights' mean direction.
+vec3 negative_light(vec3 p, vec3 n) {
+  ivec2 size = textureSize(neg, 0);
+  vec3 e = vec3(0.0);
+  float share = float(size.x * size.y) / float(max(negative, 1));
+  for (int m = 0; m < negative; m++) {
+    vec2 h = vec2(radical_inverse(uint(m + 1), 2u), radical_inverse(uint(m + 1), 3u));
+    ivec2 x = ivec2(h * vec2(size));
+    vec3 s = texelFetch(neg, x, 0).rgb;
+    if (luminance(s) <= 0.0) continue;
+    vec2 xuv = (vec2(x) + 0.5) / vec2(size);
+    float z = texelFetch(cdpt, x, 0).r;
+    vec3 q = position_from_depth(xuv, z);
+    vec3 dir_l = safe_normalize(texelFetch(neg_dir, x, 0).xyz, vec3(0.0));
+    float foot = 2.0 * dpt_view_depth(z) * frame.clip.w / float(size.y); // a pixel's world size
+    float area = foot * foot * share;
+    // q blocks the light that arrives at its back from the indirect lights
+    // (toward dir_l): the negative light leaves q away from them, onto what
+    // lies in q's shadow facing back toward q.
+    vec3 d = p - q;
+    float d2 = dot(d, d);
+    vec3 t = d * inversesqrt(max(d2, 1e-30));
+    e += s * area * max(dot(-dir_l, t), 0.0) * max(dot(n, -t), 0.0) / max(d2, area);
+  }
+  return e / PI;
+}
+#endif
+
+void main() {
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  Surface s = gbuffer_fetch(clr, nrm, dpt, mat, px);
+  vec3 s_neg, neg_d;
+#ifdef GATHER
+  if (!s.covered) {
+    result = vec4(0.0, 0.0, 0.0, 1.0);
+    out_neg = out_neg_dir = vec4(0.0);
+    return;
+  }
+  vec3 e = indirect(s.p, s.n, s_neg, neg_d);
+  result = vec4(finite_or_zero(e), 1.0);
+  out_neg = vec4(finite_or_zero(s_neg / PI), 1.0);
+  out_neg_dir = vec4(finite_or_zero(neg_d), 0.0);
+#elif defined(NEGATIVE)
+  vec3 e = texelFetch(positive, px, 0).rgb;
+  if (s.covered) e = max(e - negative_light(s.p, s.n), vec3(0.0));
+  result = vec4(finite_or_zero(e), 1.0);
+#else // REFINE
+  if (!s.covered) {
+    result = vec4(0.0, 0.0, 0.0, 1.0);
+    return;
+  }
+  ivec2 csize = textureSize(coarse, 0);
+  vec2 tc = uv * vec2(csize) - 0.5;
+  ivec2 base = ivec2(floor(tc));
+  vec2 f = tc - floor(tc);
+  vec3 sum = vec3(0.0);
+  bool agree = true;
+  for (int i = 0; i < 4; i++) {
+    ivec2 o = ivec2(i & 1, i >> 1), q = clamp(base + o, ivec2(0), csize - 1);
+    float zc = texelFetch(cdpt, q, 0).r;
+    vec3 nc = texelFetch(cnrm, q, 0).xyz;
+    agree = agree && abs(zc - s.depth01) <= threshold * max(s.depth01, 1e-12) && dot(nc, s.n) >= 1.0 - threshold;
+    vec2 w = mix(1.0 - f, f, vec2(o));
+    sum += w.x * w.y * texelFetch(coarse, q, 0).rgb;
+  }
+  vec3 e = agree ? sum : max(indirect(s.p, s.n, s_neg, neg_d) - negative_light(s.p, s.n), vec3(0.0));
+  result = vec4(finite_or_zero(e), 1.0);
+#endif
+}

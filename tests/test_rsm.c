@@ -1,0 +1,359 @@
+/* Reflective shadow maps (scripts/rsm.lua, shaders/rsm.frag) and indirect
+ * point lights in them (scripts/vpl.lua) through pp.lua: colour bleeding from a sunlit floor onto a ceiling the sun cannot
+ * reach and the camera sees alone (present with rsm, absent with isr), on
+ * POV-Ray's scale; a closed room lit by one spot patch lights its ceiling;
+ * a frame that reads no RSM renders none; extremes stay finite. Needs a GL
+ * context (llvmpipe will do). */
+#include <cglm/cglm.h>
+#define _POSIX_C_SOURCE 200809L
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl_test.h"
+#include "shadow/shadow.h"
+
+enum { W = 160, H = 120 };
+
+/* A quad a b c d (counter-clockwise seen from its normal n). */
+static void quad(lm_scene *s, const char *name, int material, const float c[4][3], const float n[3]) {
+  static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+  float v[4 * 8];
+  for (int i = 0; i < 4; i++) {
+    float *o = v + 8 * i;
+    o[0] = c[i][0], o[1] = c[i][1], o[2] = c[i][2], o[3] = n[0], o[4] = n[1], o[5] = n[2];
+    o[6] = (float)(i == 1 || i == 2), o[7] = (float)(i >= 2);
+  }
+  mat4 id = GLM_MAT4_IDENTITY_INIT;
+  lm_scene_add_node(s, name, -1, (float *)id, lm_scene_add_mesh(s, name, v, 4, idx, 6), material);
+}
+
+static int material(lm_scene *s, const char *name, float r, float g, float b) {
+  lm_material m = {.color = {r, g, b}, .rho = 0.5f, .ka = 1, .kd = 1, .shininess = 1};
+  snprintf(m.name, sizeof m.name, "%s", name);
+  return lm_scene_add_material(s, &m);
+}
+
+/* A camera at (0, y, 0) looking straight up. */
+static void camera_up(lm_scene *s, float y) {
+  mat4 m;
+  glm_translate_make(m, (vec3){0, y, 0});
+  glm_rotate(m, glm_rad(90.0f), (vec3){1, 0, 0}); /* -Z of the node points up */
+  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "up", .fov_y = glm_rad(45.0f), .znear = 0.01f, .zfar = 100, .node = cam});
+}
+
+/* A red floor (albedo 0.8, 0.1, 0.1) over [-F, F]^2 at y = 0 under a
+ * canopy, grey 0.8 over [-2, 2]^2 at y = 1, facing down; a sun straight
+ * down (power 1) shadows the floor under the canopy. The camera under the
+ * canopy sees the canopy alone. */
+enum { F = 4 };
+static lm_scene *canopy_scene(void) {
+  lm_scene *s = lm_scene_create("canopy");
+  int red = material(s, "red", 0.8f, 0.1f, 0.1f), grey = material(s, "grey", 0.8f, 0.8f, 0.8f);
+  quad(s, "floor", red, (const float[4][3]){{-F, 0, F}, {F, 0, F}, {F, 0, -F}, {-F, 0, -F}}, (const float[3]){0, 1, 0});
+  quad(s, "canopy", grey, (const float[4][3]){{-2, 1, -2}, {2, 1, -2}, {2, 1, 2}, {-2, 1, 2}}, (const float[3]){0, -1, 0});
+  mat4 m;
+  glm_rotate_make(m, glm_rad(-90.0f), (vec3){1, 0, 0}); /* -Z of the node points down */
+  int sun = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 1,
+                                     .casts_shadows = true, .node = sun});
+  camera_up(s, 0.5f);
+  lm_scene_update(s);
+  return s;
+}
+
+static gl_result render_ok(lm_scene *s, const char *tech, const char *const *sets) {
+  gl_result r = gl_render(&(gl_run){.scene = s, .tech = tech, .sets = sets, .width = W, .height = H});
+  if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
+  if (!gl_all_finite(&r)) fail_msg("%s: a pixel is NaN, Inf or negative", tech);
+  return r;
+}
+
+/* The canopy's centre receives k_d albedo (1/pi) int L cos cos / d^2 dA
+ * over the lit floor (L = 0.8 red, 0.1 green: POV-Ray's diffuse 1 under a
+ * sun of 1); cos = h / d at height h = 1. */
+static double canopy_expected(double albedo, double floor_l) {
+  const int n = 800;
+  double sum = 0, da = (2.0 * F / n) * (2.0 * F / n);
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++) {
+      double x = -F + (i + 0.5) * 2.0 * F / n, z = -F + (j + 0.5) * 2.0 * F / n;
+      if (fabs(x) < 2 && fabs(z) < 2) continue; /* in the canopy's shadow */
+      double d2 = x * x + z * z + 1;
+      sum += da / (d2 * d2);
+    }
+  return albedo * floor_l * sum / GLM_PI;
+}
+
+/* The sun cannot reach the canopy's underside and the camera sees nothing
+ * else: rsm+esm lights it red from the floor, within 10% of the integral (measured 3%)
+ * (the RSM's texels, the pattern's noise and the soft shadow edge), and
+ * isr+esm, seeing no sender, leaves it dark. rsm.reach = 16: what the
+ * camera sees is a small patch, the lit floor lies around it. */
+static void sunlit_floor_bleeds_onto_a_ceiling_the_sun_cannot_reach(void **state) {
+  (void)state;
+  static const char *const sets[] = {"ambient=0", "rsm.reach=16", NULL};
+  lm_scene *s = canopy_scene();
+  static const char *const vpl_sets[] = {"ambient=0", "vpl.reach=16", "vpl.focus=16", "vpl.lights=400", NULL};
+  gl_result rsm = render_ok(s, "rsm+esm", sets), isr = render_ok(s, "isr+esm", sets),
+            both = render_ok(s, "isr+rsm+esm", sets), vpl = render_ok(s, "vpl+esm", vpl_sets);
+  float a[3], b[3], c[3], v[3];
+  gl_region(&vpl, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, v);
+  gl_region(&rsm, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, a);
+  gl_region(&isr, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, b);
+  gl_region(&both, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, c);
+  double red = canopy_expected(0.8, 0.8), green = canopy_expected(0.8, 0.1);
+  print_message("canopy: rsm %.4f %.4f %.4f (expected %.4f %.4f), isr %.5f, combined %.4f, vpl %.4f %.4f\n", a[0],
+                a[1], a[2], red, green, b[0], c[0], v[0], v[1]);
+  assert_true(fabs(v[0] - red) < 0.15 * red); /* 400 lights over the tile, about 150 on the lit floor: 7% */
+  assert_true(v[0] > 4 * v[1]);
+  assert_true(fabs(a[0] - red) < 0.1 * red);
+  assert_true(fabs(a[1] - green) < 0.1 * green + 0.002);
+  assert_true(a[0] > 4 * a[1]); /* red, from the floor */
+  assert_true(b[0] < 0.01 * a[0] && b[1] < 0.01 * a[0]);
+  assert_true(fabsf(c[0] - a[0]) < 0.05f * a[0]); /* combined: ISR sees no sender, RSM counts them all */
+  gl_result_free(&rsm);
+  gl_result_free(&isr);
+  gl_result_free(&both);
+  gl_result_free(&vpl);
+  lm_scene_destroy(s);
+}
+
+/* A closed room [-1, 1]^3 (grey 0.5 inside) with a spot light under its
+ * ceiling pointing down, a narrow cone: one lit patch on the floor. The
+ * camera on the floor looks up at the ceiling, which only the patch lights:
+ * dl+esm leaves it black, rsm+esm lights it. point: a point light on the
+ * floor instead (its six cube faces as RSM), which lights the ceiling
+ * directly too, more with rsm. */
+static lm_scene *closed_room(lm_light_type type) {
+  lm_scene *s = lm_scene_create("room");
+  int grey = material(s, "grey", 0.5f, 0.5f, 0.5f);
+  static const float walls[6][4][3] = {
+      {{-1, -1, 1}, {1, -1, 1}, {1, -1, -1}, {-1, -1, -1}}, /* floor, up */
+      {{-1, 1, -1}, {1, 1, -1}, {1, 1, 1}, {-1, 1, 1}},     /* ceiling, down */
+      {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}}, /* back, +z */
+      {{1, -1, 1}, {-1, -1, 1}, {-1, 1, 1}, {1, 1, 1}},     /* front, -z */
+      {{-1, -1, 1}, {-1, -1, -1}, {-1, 1, -1}, {-1, 1, 1}}, /* left, +x */
+      {{1, -1, -1}, {1, -1, 1}, {1, 1, 1}, {1, 1, -1}},     /* right, -x */
+  };
+  static const float normals[6][3] = {{0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0, 0}};
+  for (int i = 0; i < 6; i++) quad(s, "wall", grey, walls[i], normals[i]);
+  mat4 m;
+  glm_translate_make(m, (vec3){0, type == LM_LIGHT_SPOT ? 0.9f : -0.8f, 0});
+  glm_rotate(m, glm_rad(-90.0f), (vec3){1, 0, 0});
+  int node = lm_scene_add_node(s, "light", -1, (float *)m, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "lamp", .type = type, .color = {1, 1, 1}, .power = 1,
+                                     .inner_cone = glm_rad(10.0f), .outer_cone = glm_rad(15.0f),
+                                     .falloff = LM_FALLOFF_INVERSE_SQUARE, .casts_shadows = true, .node = node});
+  camera_up(s, -0.95f);
+  lm_scene_update(s);
+  return s;
+}
+
+static void a_closed_room_with_one_lit_patch_lights_its_ceiling(void **state) {
+  (void)state;
+  static const char *const sets[] = {"ambient=0", NULL};
+  for (int k = 0; k < 2; k++) {
+    lm_scene *s = closed_room(k ? LM_LIGHT_POINT : LM_LIGHT_SPOT);
+    gl_result dl = render_ok(s, "dl+esm", sets), rsm = render_ok(s, "rsm+esm", sets),
+              vpl = render_ok(s, "vpl+esm", sets);
+    float a[3], b[3], c[3];
+    gl_region(&dl, W / 4, H / 4, 3 * W / 4, 3 * H / 4, a);
+    gl_region(&rsm, W / 4, H / 4, 3 * W / 4, 3 * H / 4, b);
+    gl_region(&vpl, W / 4, H / 4, 3 * W / 4, 3 * H / 4, c);
+    print_message("%s: ceiling dl %.5f, rsm %.5f, vpl %.5f\n", k ? "point" : "spot", gl_luminance(a), gl_luminance(b),
+                  gl_luminance(c));
+    if (k == 0) {
+      assert_true(gl_luminance(a) < 1e-4f);
+      assert_true(gl_luminance(b) > 0.002f && gl_luminance(c) > 0.002f);
+    } else {
+      assert_true(gl_luminance(b) > 1.05f * gl_luminance(a) && gl_luminance(c) > 1.05f * gl_luminance(a));
+    }
+    gl_result_free(&dl);
+    gl_result_free(&rsm);
+    gl_result_free(&vpl);
+    lm_scene_destroy(s);
+  }
+}
+
+/* RSM targets, the gather and a directional light's wide tile exist only
+ * in a frame that reads them. */
+static void a_frame_that_reads_no_rsm_renders_none(void **state) {
+  (void)state;
+  const char *const techs[] = {"dl+esm", "isr+esm", "rsm+esm", "isr+rsm+esm", "vpl+esm"};
+  lm_scene *s = canopy_scene();
+  for (int t = 0; t < 5; t++) {
+    gl_result r = render_ok(s, techs[t], NULL);
+    bool reads = t >= 2;
+    lm_graph *g = lm_renderer_graph(r.renderer);
+    assert_int_equal(lm_graph_find_target(g, "shadow.rsm_flux") >= 0, reads);
+    assert_int_equal(lm_graph_find_target(g, "shadow.rsm_pos") >= 0, reads);
+    assert_int_equal(gl_has_pass(&r, "rsm.") || gl_has_pass(&r, "vpl."), reads);
+    assert_int_equal(lm_renderer_shadows(r.renderer)->view_count, 3 + reads); /* cascades (+ the wide tile) */
+    assert_int_equal(gl_culled(&r, ""), 0);
+    gl_result_free(&r);
+  }
+  lm_scene_destroy(s);
+}
+
+/* A light inside geometry (a point light in a closed box the camera looks
+ * at from outside), a spot whose cone is nearly closed (a tile seeing next
+ * to nothing), one sample, 4096 samples and the visibility march: finite. */
+static void extremes_stay_finite(void **state) {
+  (void)state;
+  static const char *const cases[][4] = {
+      {"rsm.samples=1", NULL}, {"rsm.samples=4096", "rsm.coarse=4", NULL}, {"rsm.steps=32", NULL},
+      {"rsm.radius=2", "rsm.reach=64", NULL}, {"rsm.coarse=1", "rsm.blur=0", NULL},
+  };
+  static const char *const vpl_cases[][4] = {
+      {"vpl.lights=0", NULL}, {"vpl.lights=4096", "vpl.negative=4096", "vpl.coarse=4", NULL},
+      {"vpl.negative=0", "vpl.threshold=0", NULL}, {"vpl.threshold=2", "vpl.focus=0.05", NULL},
+  };
+  lm_scene *room = closed_room(LM_LIGHT_POINT);
+  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+    gl_result r = render_ok(room, "isr+rsm+esm", cases[i]);
+    gl_result_free(&r);
+  }
+  for (size_t i = 0; i < sizeof vpl_cases / sizeof *vpl_cases; i++) {
+    gl_result r = render_ok(room, "vpl+esm", vpl_cases[i]);
+    gl_result_free(&r);
+  }
+  lm_scene_destroy(room);
+  lm_scene *closed = closed_room(LM_LIGHT_SPOT);
+  closed->lights[0].outer_cone = closed->lights[0].inner_cone = 1e-6f;
+  gl_result r = render_ok(closed, "rsm+esm", NULL);
+  gl_result_free(&r);
+  r = render_ok(closed, "vpl+esm", NULL);
+  gl_result_free(&r);
+  lm_scene_destroy(closed);
+  /* The camera outside the box, the point light inside it. */
+  lm_scene *outside = closed_room(LM_LIGHT_POINT);
+  mat4 m;
+  glm_translate_make(m, (vec3){0, 0, 3});
+  outside->cameras[0].node = lm_scene_add_node(outside, "outside", -1, (float *)m, -1, -1);
+  lm_scene_update(outside);
+  r = render_ok(outside, "rsm+esm", NULL);
+  gl_result_free(&r);
+  r = render_ok(outside, "vpl+esm", NULL);
+  gl_result_free(&r);
+  lm_scene_destroy(outside);
+}
+
+
+static double mean_abs_diff(const float *a, const float *b, int n) {
+  double sum = 0;
+  for (int i = 0; i < n; i++) sum += fabs(a[i] - b[i]);
+  return sum / n;
+}
+
+/* A still camera with temporal reuse (16 samples a frame, the pattern
+ * turning 10 degrees a frame): the change from one frame to the next falls
+ * from frame 2 to frame 40 by more than 5x and ends below 1e-3 of the
+ * image's mean (mean over the linear RGB values), and the result lies nearer
+ * a 1024-sample frame than one frame of 16 samples does. */
+static void still_frames_with_temporal_reuse_converge(void **state) {
+  (void)state;
+  static const char *const on[] = {"ambient=0", "rsm.samples=16", "rsm.temporal.enabled=true", NULL};
+  static const char *const off[] = {"ambient=0", "rsm.samples=16", NULL};
+  static const char *const ref[] = {"ambient=0", "rsm.samples=1024", NULL};
+  lm_scene *s = closed_room(LM_LIGHT_POINT);
+  int n = W * H * 3;
+  float *last = malloc(sizeof(float) * (size_t)n);
+  gl_result r = gl_render(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = on, .width = W, .height = H, .frames = 2});
+  assert_true(r.ok);
+  memcpy(last, r.rgb, sizeof(float) * (size_t)n);
+  assert_true(gl_render_again(&r));
+  double early = mean_abs_diff(last, r.rgb, n), late = 0;
+  for (int f = 3; f < 40; f++) {
+    memcpy(last, r.rgb, sizeof(float) * (size_t)n);
+    assert_true(gl_render_again(&r));
+    late = mean_abs_diff(last, r.rgb, n);
+  }
+  gl_result one = render_ok(s, "rsm+esm", off), best = render_ok(s, "rsm+esm", ref);
+  double e_acc = mean_abs_diff(r.rgb, best.rgb, n), e_one = mean_abs_diff(one.rgb, best.rgb, n);
+  float all[3];
+  gl_region(&r, 0, 0, W - 1, H - 1, all);
+  double mean = (all[0] + all[1] + all[2]) / 3.0;
+  print_message("temporal: change %.2e (frame 3) -> %.2e (frame 40) of a mean %.3f; error to 1024 samples %.2e "
+                "(one frame %.2e)\n", early, late, mean, e_acc, e_one);
+  assert_true(gl_all_finite(&r));
+  assert_true(late < 1e-3 * mean && late * 5 < early);
+  assert_true(e_acc < e_one);
+  free(last);
+  gl_result_free(&r);
+  gl_result_free(&one);
+  gl_result_free(&best);
+  lm_scene_destroy(s);
+}
+
+/* A camera move with temporal reuse: after 20 still frames the camera
+ * slides sideways by a tenth of the room; the first frame after the move
+ * differs from a frame of 1024 samples without reuse at the new place by
+ * less than 1% of
+ * the image's mean, edges (ceiling and walls, the lit patch) included,
+ * where a ghost trail would show the old ones: reprojection keeps what is
+ * still seen, the disocclusion test drops what was not. */
+static void a_camera_move_leaves_no_ghost_edge(void **state) {
+  (void)state;
+  static const char *const on[] = {"ambient=0", "rsm.temporal.enabled=true", NULL};
+  static const char *const off[] = {"ambient=0", "rsm.samples=1024", NULL};
+  lm_scene *s = closed_room(LM_LIGHT_POINT);
+  /* Look along the room at the far wall, ceiling in the upper half. */
+  int cam = s->cameras[0].node;
+  mat4 m;
+  glm_translate_make(m, (vec3){0, -0.5f, 0.9f});
+  glm_rotate(m, glm_rad(20.0f), (vec3){1, 0, 0});
+  memcpy(s->nodes[cam].local, m, sizeof m);
+  lm_scene_update(s);
+  gl_result r = gl_render(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = on, .width = W, .height = H, .frames = 20});
+  assert_true(r.ok);
+  glm_translate_make(m, (vec3){0.2f, -0.5f, 0.9f});
+  glm_rotate(m, glm_rad(20.0f), (vec3){1, 0, 0});
+  memcpy(s->nodes[cam].local, m, sizeof m);
+  lm_scene_update(s);
+  assert_true(gl_render_again(&r));
+  gl_result plain = render_ok(s, "rsm+esm", off);
+  double diff = mean_abs_diff(r.rgb, plain.rgb, W * H * 3);
+  float all[3];
+  gl_region(&plain, 0, 0, W - 1, H - 1, all);
+  double mean = (all[0] + all[1] + all[2]) / 3.0;
+  print_message("after the move: mean difference to no reuse %.2e of a mean %.3f\n", diff, mean);
+  assert_true(gl_all_finite(&r));
+  assert_true(diff < 0.01 * mean);
+  gl_result_free(&r);
+  gl_result_free(&plain);
+  lm_scene_destroy(s);
+}
+
+static void bad_options_name_themselves(void **state) {
+  (void)state;
+  static const gl_bad_option cases[] = {
+      {"rsm+esm", "rsm.samples=0", "rsm.samples"},    {"rsm+esm", "rsm.samples=4097", "rsm.samples"},
+      {"rsm+esm", "rsm.radius=0", "rsm.radius"},      {"rsm+esm", "rsm.reach=0.5", "rsm.reach"},
+      {"isr+rsm+esm", "rsm.steps=33", "rsm.steps"},   {"rsm+esm", "rsm.coarse=3", "rsm.coarse"},
+      {"vpl+esm", "vpl.lights=-1", "vpl.lights"},     {"vpl+esm", "vpl.negative=4097", "vpl.negative"},
+      {"vpl+esm", "vpl.threshold=3", "vpl.threshold"}, {"vpl+esm", "vpl.focus=0", "vpl.focus"},
+      {"rsm+esm", "rsm.temporal.frames=0", "rsm.temporal.frames"},
+  };
+  gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(sunlit_floor_bleeds_onto_a_ceiling_the_sun_cannot_reach),
+      cmocka_unit_test(a_closed_room_with_one_lit_patch_lights_its_ceiling),
+      cmocka_unit_test(a_frame_that_reads_no_rsm_renders_none),
+      cmocka_unit_test(still_frames_with_temporal_reuse_converge),
+      cmocka_unit_test(a_camera_move_leaves_no_ghost_edge),
+      cmocka_unit_test(extremes_stay_finite),
+      cmocka_unit_test(bad_options_name_themselves),
+  };
+  return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
+}
