@@ -11,6 +11,7 @@ local ssdo = require "ssdo"
 local ssao = require "ssao"
 local post = require "post"
 local options = require "options"
+local reflections = require "reflections"
 
 -- The seed's viewer modes: isr+esm (F2, the default), isr (F3), dl+esm (F4),
 -- dl (F5); then screen-space directional and ambient occlusion (seed 001).
@@ -33,6 +34,7 @@ Options = {
   sky = {},                -- see sky.defaults in scripts/sky.lua (off by default)
   ssdo = {},               -- see ssdo.defaults in scripts/ssdo.lua
   ssao = {},               -- see ssao.defaults in scripts/ssao.lua
+  reflections = {},        -- see reflections.defaults in scripts/reflections.lua
 }
 for k, v in pairs(isr.defaults) do Options.isr[k] = v end
 for k, v in pairs(rsm.defaults) do Options.rsm[k] = v end
@@ -41,6 +43,7 @@ for k, v in pairs(shadow.defaults) do Options.shadow[k] = v end
 for k, v in pairs(sky.defaults) do Options.sky[k] = v end
 for k, v in pairs(ssdo.defaults) do Options.ssdo[k] = v end
 for k, v in pairs(ssao.defaults) do Options.ssao[k] = v end
+for k, v in pairs(reflections.defaults) do Options.reflections[k] = v end
 -- Post effects, each off by default (the seed viewer's F6 bloom, F7 dof, F8
 -- glass, F9 radial_blur, F11 sepia, F12 tiles; and hdr, motion_blur): a
 -- table per effect, `--set bloom=true` turns one on (bloom.enabled), and
@@ -109,6 +112,11 @@ function OnRender(tech)
   if G.emi then -- emitted light, after the lighting that never sees it
     lit = pass{ "emissive", shader = "bloom_add.frag", inputs = { src = lit, bloom = G.emi },
                 out = target{ "lit.emissive", format = "rgba16f" } }
+  end
+  -- Ray-traced reflections on every technique, left out where no material reflects.
+  if tech.reflections.enabled and scene_reflective() then
+    lit = reflections.render(G, lit, tech.reflections, { ambient = grey(tech.ambient),
+                             background = grey(tech.background), shadows = shadows })
   end
   present(post.render(lit, tech, G))
 end

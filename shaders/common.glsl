@@ -56,6 +56,16 @@ float luminance(vec3 c) { return dot(c, vec3(0.27, 0.67, 0.06)); }
 // from reversed float depth (lm_scene_frame_data). Shaders encode and decode
 // it through these and position_from_depth only.
 float dpt_encode(float view_depth) { return max(view_depth, 0.0) * frame.clip.z; }
+// The G-buffer's mat.a: coverage (>= 0.5: geometry), the material model and
+// reflectivity r in [0, 1]: std (Phong) 1 - 0.22 r in [0.78, 1], pbr 0.74 -
+// 0.22 r in [0.52, 0.74], apart from each other and from 0.5 in 8 bits.
+float mat_alpha_encode(float reflectivity, bool pbr) {
+  return (pbr ? 0.74 : 1.0) - 0.22 * clamp(reflectivity, 0.0, 1.0);
+}
+bool mat_alpha_pbr(float a) { return a >= 0.5 && a < 0.76; }
+float mat_alpha_reflectivity(float a) {
+  return a >= 0.5 ? clamp(((mat_alpha_pbr(a) ? 0.74 : 1.0) - a) / 0.22, 0.0, 1.0) : 0.0;
+}
 float dpt_view_depth(float dpt) { return max(dpt, 0.0) * frame.clip.y; }
 
 // World position from dpt (linear depth / far) and the far-plane rays (seed 000, eq 23-24).

@@ -5,9 +5,6 @@
 #include "lighting.glsl"
 #include "sky.glsl"
 
-// The pbr technique (pbr.frag) writes this in mat.a: covered (>= 0.5) and
-// told apart from std's 1.
-const float PBR_MARK = 0.75;
 const float PBR_MIN_ROUGHNESS = 0.08; // keeps pbr_shininess within rgba16f
 
 // The Blinn-Phong exponent whose lobe matches GGX of alpha = roughness^2
@@ -26,6 +23,7 @@ struct Surface {
   float depth01;   // dpt: linear depth / far
   vec3 k;          // mat.xyz: k_a, k_d, k_s
   bool covered;    // mat.a >= 0.5: geometry, not background
+  float reflectivity; // mat.a (mat_alpha_reflectivity): mirror share, 0 .. 1
   vec3 p;          // world position (eq 23-24)
   bool pbr;        // written by the pbr technique: k = (occlusion, 1 - metallic, max F0)
   float roughness; // pbr: from the shininess
@@ -41,8 +39,9 @@ Surface gbuffer_decode(vec4 c, vec4 nn, float d, vec4 m, vec2 uv) {
   s.depth01 = max(d, 0.0);
   s.k = m.xyz;
   s.covered = m.a >= 0.5;
+  s.reflectivity = mat_alpha_reflectivity(m.a);
   s.p = position_from_depth(uv, s.depth01);
-  s.pbr = s.covered && m.a < 0.5 * (PBR_MARK + 1.0);
+  s.pbr = mat_alpha_pbr(m.a);
   s.roughness = pbr_roughness(s.shininess);
   s.f0 = mix(vec3(0.04), s.albedo, 1.0 - s.k.y);
   return s;

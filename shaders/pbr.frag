@@ -2,7 +2,7 @@
 // in std's channels so that every pass reads it (gbuffer.glsl):
 //   clr = base colour, rho            nrm = shading normal, shininess whose
 //   dpt = linear depth / far                Blinn-Phong lobe matches GGX's
-//   mat = k_a = occlusion, k_d = 1 - metallic, k_s = max(F0), PBR_MARK
+//   mat = k_a = occlusion, k_d = 1 - metallic, k_s = max(F0), mat_alpha_encode(reflectivity, true)
 // so k_d * clr is the diffuse albedo GI passes use, and lighting.glsl's
 // pbr_light gets roughness and F0 = mix(0.04, clr, metallic) back.
 // Location 4 (when the pass gives it) takes the emitted radiance.
@@ -17,6 +17,7 @@ uniform vec3 material_color;   // base colour factor
 uniform vec4 material_pbr;     // metallic, roughness, normal scale, occlusion strength
 uniform vec3 material_emissive;
 uniform vec2 material_alpha;   // alpha, mask cutoff (< 0: opaque)
+uniform float material_reflectivity;
 #ifdef BASE_COLOR_TEXTURE
 uniform sampler2D base_color_tex; // sRGB: texture() returns linear colour
 uniform mat3 base_color_xform;    // KHR_texture_transform
@@ -94,6 +95,7 @@ void main() {
   out_clr = vec4(albedo, max(max(albedo.r, albedo.g), albedo.b) * (1.0 - metallic));
   out_nrm = vec4(n, pbr_shininess(roughness));
   out_dpt = max(view_depth, 0.0) * frame.clip.z;
-  out_mat = vec4(saturate(occlusion), 1.0 - metallic, max(max(f0.r, f0.g), f0.b), PBR_MARK);
+  out_mat = vec4(saturate(occlusion), 1.0 - metallic, max(max(f0.r, f0.g), f0.b),
+                 mat_alpha_encode(material_reflectivity, true));
   out_emi = vec4(finite_or_zero(emissive), 1.0);
 }

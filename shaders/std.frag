@@ -1,6 +1,7 @@
 // G-buffer as seed 000 (lines 1229-1259), plus the Phong factors:
 //   clr = albedo, rho     nrm = world normal, shininess
-//   dpt = linear depth / far    mat = k_a, k_d, k_s, coverage (1 = geometry)
+//   dpt = linear depth / far    mat = k_a, k_d, k_s, coverage and reflectivity
+//   (mat_alpha_encode: >= 0.5 = geometry)
 #include "common.glsl"
 
 in vec3 world_normal;
@@ -10,6 +11,7 @@ in vec2 tex_uv;
 uniform vec3 material_color;
 uniform float material_rho;
 uniform vec4 material_k; // k_a, k_d, k_s, shininess
+uniform float material_reflectivity;
 #ifdef BASE_COLOR_TEXTURE
 // The material's base-colour image, stored sRGB: texture() returns linear values.
 uniform sampler2D base_color_tex;
@@ -31,5 +33,5 @@ void main() {
   out_clr = vec4(saturate(albedo), saturate(material_rho));
   out_nrm = vec4(n, max(material_k.w, 0.0));
   out_dpt = dpt_encode(view_depth);
-  out_mat = vec4(saturate(material_k.xyz), 1.0);
+  out_mat = vec4(saturate(material_k.xyz), mat_alpha_encode(material_reflectivity, false));
 }

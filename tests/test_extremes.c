@@ -13,6 +13,7 @@
 
 #include "gl_test.h"
 #include "scene/gltf.h"
+#include "trace/trace.h"
 
 static lm_scene *builtin(const char *name) {
   lm_error err;
@@ -146,7 +147,7 @@ static void degenerate_and_nan_geometry(void **state) {
     if (kind == 1) v[8] = NAN, v[9] = 1, v[16] = 1; /* a real triangle with a NaN corner */
     uint32_t idx[3] = {0, 1, 2};
     mat4 id = GLM_MAT4_IDENTITY_INIT;
-    lm_material m = {"m", {0.5f, 0.5f, 0.5f}, 0.5f, 1, 1, 0, 1, 0};
+    lm_material m = {"m", {0.5f, 0.5f, 0.5f}, 0.5f, 1, 1, 0, 1, 0, 0};
     lm_scene_add_node(s, "tri", -1, (float *)id, lm_scene_add_mesh(s, "tri", v, 3, idx, 3),
                       lm_scene_add_material(s, &m));
     int ln = lm_scene_add_node(s, "light", -1, (float *)id, -1, -1);
@@ -192,6 +193,63 @@ static void pcss_sizes_and_depth_ranges_at_both_ends(void **state) {
     }
     lm_scene_destroy(s);
   }
+}
+
+/* The ray tracer over the box at unit scales 1e-6 .. 1e6 (a scaled root,
+ * cameras with it), and over corners at +-1e9 (the largest glTF coordinate)
+ * beside a 1e-9 triangle: every hit finite, the same pixels hit at every scale. */
+static void ray_tracing_at_extreme_scales(void **state) {
+  (void)state;
+  enum { W = 32, H = 24 };
+  const float scales[] = {1e-6f, 1, 1e6f};
+  int hits_at_1 = -1, hits[3];
+  for (int si = 0; si < 3; si++) {
+    lm_scene *s = builtin("cornell");
+    mat4 m = GLM_MAT4_IDENTITY_INIT;
+    glm_scale_uni(m, scales[si]);
+    lm_scene_add_root(s, "unit", (float *)m);
+    lm_scene_update(s);
+    lm_trace *t = lm_trace_create(s, NULL);
+    lm_frame_data f;
+    lm_scene_frame_data(s, 0, W, H, &f);
+    hits[si] = 0;
+    for (int y = 0; y < H; y++)
+      for (int x = 0; x < W; x++) {
+        lm_trace_ray r = {.tmax = INFINITY};
+        for (int k = 0; k < 3; k++)
+          r.origin[k] = f.camera_pos[k],
+          r.dir[k] = f.frustum_o[k] + f.frustum_u[k] * (x + 0.5f) / W + f.frustum_v[k] * (y + 0.5f) / H;
+        lm_trace_hit h;
+        if (!lm_trace_intersect(t, &r, &h)) continue;
+        hits[si]++;
+        lm_trace_surface sf;
+        lm_trace_surface_at(t, &r, &h, &sf);
+        assert_true(isfinite(h.t) && h.t > 0);
+        for (int k = 0; k < 3; k++) assert_true(isfinite(sf.position[k]) && isfinite(sf.normal[k]));
+      }
+    if (scales[si] == 1) hits_at_1 = hits[si];
+    lm_trace_destroy(t);
+    lm_scene_destroy(s);
+  }
+  assert_true(hits_at_1 > W * H / 2);
+  for (int si = 0; si < 3; si++) assert_true(abs(hits[si] - hits_at_1) <= 2);
+
+  const float far_tris[2][9] = {{-1e9f, -1e9f, -1e9f, 1e9f, -1e9f, -1e9f, 0, 1e9f, -1e9f},
+                                {0, 0, 0, 1e-9f, 0, 0, 0, 1e-9f, 0}};
+  lm_trace_stats st;
+  lm_trace *t = lm_trace_create_triangles(&far_tris[0][0], 2, &st);
+  assert_int_equal(st.triangles, 2);
+  lm_trace_hit h;
+  lm_trace_ray tiny = {{2.5e-10f, 2.5e-10f, 1}, 0, {0, 0, -1}, INFINITY};
+  assert_true(lm_trace_intersect(t, &tiny, &h));
+  assert_float_equal(h.t, 1, 1e-6);
+  lm_trace_ray huge = {{1e8f, -5e8f, 1e9f}, 0, {0, 0, -1}, INFINITY};
+  assert_true(lm_trace_intersect(t, &huge, &h));
+  assert_float_equal(h.t, 2e9f, 1e3);
+  lm_trace_surface sf;
+  lm_trace_surface_at(t, &huge, &h, &sf);
+  for (int k = 0; k < 3; k++) assert_true(isfinite(sf.position[k]) && isfinite(sf.normal[k]));
+  lm_trace_destroy(t);
 }
 
 /* A target larger than the GL limit is refused, naming it and its size. */
@@ -248,6 +306,7 @@ int main(void) {
       cmocka_unit_test(zero_lights_and_64_lights),
       cmocka_unit_test(degenerate_and_nan_geometry),
       cmocka_unit_test(pcss_sizes_and_depth_ranges_at_both_ends),
+      cmocka_unit_test(ray_tracing_at_extreme_scales),
       cmocka_unit_test(oversize_targets_are_refused),
       cmocka_unit_test(every_effect_on_every_test_scene),
   };

@@ -776,6 +776,34 @@ static void malformed_files_name_the_element(void **state) {
          "light 0: extras.size must be a finite number >= 0");
   EXPECT("color.gltf", "[0.5,0.25,1,1]", "[0.5,0.25]", "baseColorFactor");
   EXPECT("metal.gltf", "\"metallicFactor\":0", "\"metallicFactor\":1e999", "");
+  EXPECT("reflect.gltf", "\"materials\":[{", "\"materials\":[{\"extras\":{\"reflectivity\":1.5},",
+         "material 0 ('material'): extras.reflectivity must be a number in [0, 1]");
+  EXPECT("reflect_text.gltf", "\"materials\":[{", "\"materials\":[{\"extras\":{\"reflectivity\":\"yes\"},",
+         "extras.reflectivity");
+}
+
+/* A material's extras.reflectivity comes over; without it a material is not reflective. */
+static void reflectivity_comes_from_extras(void **state) {
+  (void)state;
+  const char *path = write_triangle("mirror.gltf", 5123);
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(path, &err);
+  assert_non_null(s);
+  assert_float_equal(s->materials[0].reflectivity, 0, 0);
+  lm_scene_destroy(s);
+  FILE *f = fopen(path, "rb");
+  char text[4096], out[4200];
+  size_t n = fread(text, 1, sizeof text - 1, f);
+  fclose(f);
+  text[n] = '\0';
+  const char *from = "\"materials\":[{", *at = strstr(text, from);
+  assert_non_null(at);
+  snprintf(out, sizeof out, "%.*s%s\"extras\":{\"reflectivity\":0.8},%s", (int)(at - text), text, from, at + strlen(from));
+  write_bytes("mirror.gltf", out, strlen(out));
+  s = lm_scene_load_gltf(path, &err);
+  if (!s) fail_msg("%s", err.msg);
+  assert_float_equal(s->materials[0].reflectivity, 0.8, 1e-6);
+  lm_scene_destroy(s);
 }
 
 /* One indexed triangle: 36 bytes of positions, then 3 uint16 indices; the
@@ -1002,6 +1030,7 @@ int main(void) {
       cmocka_unit_test(zero_area_triangles_keep_finite_normals),
       cmocka_unit_test(external_buffer_resolves_next_to_the_file),
       cmocka_unit_test(malformed_files_name_the_element),
+      cmocka_unit_test(reflectivity_comes_from_extras),
       cmocka_unit_test(bad_vertex_values_are_refused),
       cmocka_unit_test(truncated_and_missing_files_are_refused),
       cmocka_unit_test(mutated_glb_never_crashes),

@@ -83,6 +83,47 @@ static void unread_passes_are_left_out(void **state) {
   lm_graph_destroy(g);
 }
 
+/* A CPU pass is culled and ordered by its edges like any pass; it takes no depth target. */
+static void cpu_passes_follow_their_edges(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_graph_begin(g, 64, 48);
+  int rays = target(g, "rays", LM_FORMAT_RGBA32F, 0.5f), hits = target(g, "hits", LM_FORMAT_RGBA32F, 0.5f);
+  int spare = target(g, "spare", LM_FORMAT_RGBA32F, 0.5f), out = target(g, "out", LM_FORMAT_RGBA8, 1);
+  int depth = target(g, "depth", LM_FORMAT_DEPTH32F, 0.5f);
+  fs(g, "make_rays", -1, rays);
+  lm_error err;
+  lm_pass_input in = {"rays", rays};
+  lm_pass_desc d = {.kind = LM_PASS_CPU, .name = "trace", .where = "test.lua:2", .shader = "trace",
+                    .inputs = &in, .input_count = 1, .outputs = &hits, .output_count = 1, .depth = -1};
+  assert_int_equal(lm_graph_add_pass(g, &d, &err), 1);
+  d.name = "unread", d.outputs = &spare;
+  assert_int_equal(lm_graph_add_pass(g, &d, &err), 2);
+  fs(g, "light_hits", hits, out);
+  lm_graph_mark_output(g, out);
+  assert_true(lm_graph_compile(g, &err));
+  assert_false(lm_graph_pass(g, 1).culled);
+  assert_true(lm_graph_pass(g, 2).culled);
+  d.shader = "";
+  assert_int_equal(lm_graph_add_pass(g, &d, &err), -1);
+  assert_non_null(strstr(err.msg, "pass 'unread': no function"));
+  lm_graph_destroy(g);
+
+  g = lm_graph_create();
+  lm_graph_begin(g, 64, 48);
+  rays = target(g, "rays", LM_FORMAT_RGBA32F, 0.5f), hits = target(g, "hits", LM_FORMAT_RGBA32F, 0.5f);
+  depth = target(g, "depth", LM_FORMAT_DEPTH32F, 0.5f);
+  fs(g, "make_rays", -1, rays);
+  d = (lm_pass_desc){.kind = LM_PASS_CPU, .name = "trace", .where = "test.lua:2", .shader = "trace",
+                     .inputs = &in, .input_count = 1, .outputs = &hits, .output_count = 1, .depth = depth};
+  in.target = rays;
+  lm_graph_add_pass(g, &d, &err);
+  lm_graph_mark_output(g, hits);
+  assert_false(lm_graph_compile(g, &err));
+  assert_non_null(strstr(err.msg, "test.lua:2: pass 'trace': CPU passes take no depth target"));
+  lm_graph_destroy(g);
+}
+
 static void reading_an_unwritten_target_names_the_pass(void **state) {
   (void)state;
   lm_graph *g = lm_graph_create();
@@ -219,6 +260,7 @@ int main(void) {
       cmocka_unit_test(target_sizes_follow_output_and_never_vanish),
       cmocka_unit_test(bad_targets_are_refused),
       cmocka_unit_test(unread_passes_are_left_out),
+      cmocka_unit_test(cpu_passes_follow_their_edges),
       cmocka_unit_test(reading_an_unwritten_target_names_the_pass),
       cmocka_unit_test(feedback_loops_are_refused),
       cmocka_unit_test(formats_and_sizes_are_checked),

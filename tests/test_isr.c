@@ -151,8 +151,8 @@ static void bad_options_name_themselves(void **state) {
  * (a scene in other units). */
 static lm_scene *gap_scene(float unit) {
   lm_scene *s = lm_scene_create("gap");
-  int floor_m = lm_scene_add_material(s, &(lm_material){"floor", {0.5f, 0.5f, 0.5f}, 0.5f, 1, 1, 0, 1, 0});
-  int ceiling_m = lm_scene_add_material(s, &(lm_material){"ceiling", {0.8f, 0.8f, 0.8f}, 0.8f, 1, 1, 0, 1, 0});
+  int floor_m = lm_scene_add_material(s, &(lm_material){"floor", {0.5f, 0.5f, 0.5f}, 0.5f, 1, 1, 0, 1, 0, 0});
+  int ceiling_m = lm_scene_add_material(s, &(lm_material){"ceiling", {0.8f, 0.8f, 0.8f}, 0.8f, 1, 1, 0, 1, 0, 0});
   const float w = 200 * unit, g = 1 * unit, z0 = 10 * unit, z1 = -400 * unit;
   static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
   const float floor_v[4 * 8] = {-w, 0, z0, 0, 1, 0, 0, 0, w, 0, z0, 0, 1, 0, 1, 0,

@@ -157,7 +157,7 @@ static void scripts_override_materials_by_name(void **state) {
     const char *materials, *expect;
   } bad[] = {
       {"{ nosuch = { ks = 1 } }", "material 'nosuch': scene 'primitives.glb' has no material of that name (it has: ground,"},
-      {"{ ground = { shine = 1 } }", "material 'ground': unknown parameter 'shine' (known: color, rho, ka, kd, ks, shininess)"},
+      {"{ ground = { shine = 1 } }", "material 'ground': unknown parameter 'shine' (known: color, rho, ka, kd, ks, shininess, reflectivity)"},
       {"{ ground = { color = 1 } }", "material 'ground': parameter 'color' takes 3 numbers, not 1"},
       {"{ ground = { color = { 1, 'x', 0 } } }", "material 'ground': parameter 'color': element 2 is a string"},
       {"{ ground = 3 }", "materials are named tables"},

@@ -105,6 +105,38 @@ static void camera_lights_and_materials_match(void **state) {
   lm_scene_destroy(s);
 }
 
+/* A reflective material becomes POV-Ray's finish reflection; an override past 1 is clamped, with a warning. */
+static void reflective_materials_write_reflection(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *s = lm_scene_builtin("cornell_pov", &err); /* lights POV-Ray matches: no other warning */
+  assert_non_null(s);
+  int red = lm_scene_find_material(s, "red");
+  s->materials[red].reflectivity = 0.75f;
+  lm_pov_desc d = {.camera = 0, .width = 64, .height = 48, .shadows = true};
+  lm_buf out = {0}, warn = {0};
+  assert_true(lm_pov_export(s, &d, &out, &warn, &err));
+  assert_non_null(strstr(out.data, "  finish { ambient 0 emission 0 diffuse 1 brilliance 1 phong 0 phong_size 1 "
+                                   "reflection 0.75 }"));
+  int count = 0;
+  for (const char *p = out.data; (p = strstr(p, "reflection")); p++) count++;
+  assert_int_equal(count, 1); /* only the reflective material */
+  assert_null(warn.data);
+  lm_buf_free(&out);
+  lm_buf_free(&warn);
+  s->materials[red].reflectivity = 2;
+  assert_true(lm_pov_export(s, &d, &out, &warn, &err));
+  assert_non_null(strstr(out.data, "reflection 1 }"));
+  assert_non_null(strstr(warn.data, "material 'red': reflectivity outside [0, 1]"));
+  d.strict = true;
+  lm_buf_free(&out);
+  assert_false(lm_pov_export(s, &d, &out, NULL, &err));
+  assert_non_null(strstr(err.msg, "reflectivity"));
+  lm_buf_free(&out);
+  lm_buf_free(&warn);
+  lm_scene_destroy(s);
+}
+
 /* The box's vertex (0.5, 0.5, 0.5) of tall_box lands at T * R * S of it. */
 static void mesh_vertices_are_in_world_space(void **state) {
   (void)state;
@@ -315,6 +347,7 @@ static void bad_views_are_refused(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(camera_lights_and_materials_match),
+      cmocka_unit_test(reflective_materials_write_reflection),
       cmocka_unit_test(mesh_vertices_are_in_world_space),
       cmocka_unit_test(window_falloff_is_refused_or_warned_by_name),
       cmocka_unit_test(builtin_cornell_exports_exactly),

@@ -199,6 +199,88 @@ static void textures_are_pooled_across_frames(void **state) {
   lm_pipeline_destroy(p);
 }
 
+/* The CPU step of a hybrid technique: "fill" writes (x, y, 0.5, 1) per
+ * texel, "invert" reads it back and writes 1 - it; what reaches the GPU is
+ * what the functions wrote, top row first. An unread CPU pass does not run. */
+typedef struct cpu_calls {
+  int fill, invert;
+} cpu_calls;
+
+static bool run_cpu(void *user, const lm_cpu_pass *cp, lm_error *err) {
+  cpu_calls *calls = user;
+  if (!strcmp(cp->desc->shader, "fill")) {
+    calls->fill++;
+    lm_cpu_image *o = &cp->outputs[0];
+    for (int y = 0; y < o->height; y++)
+      for (int x = 0; x < o->width; x++) {
+        float *px = o->rgba + ((size_t)y * o->width + x) * 4;
+        px[0] = (float)x, px[1] = (float)y, px[2] = 0.5f, px[3] = 1;
+      }
+    return true;
+  }
+  if (!strcmp(cp->desc->shader, "invert")) {
+    calls->invert++;
+    const lm_cpu_image *i = &cp->inputs[0];
+    assert_string_equal(i->name, "src");
+    for (size_t k = 0; k < (size_t)i->width * i->height * 4; k++) cp->outputs[0].rgba[k] = 1 - i->rgba[k];
+    return true;
+  }
+  lm_error_set(err, "no CPU function '%s'", cp->desc->shader);
+  return false;
+}
+
+static void cpu_passes_read_back_and_upload(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_error err;
+  for (int frame = 0; frame < 2; frame++) {
+    lm_graph_begin(g, 16, 12);
+    int a = lm_graph_add_target(g, &(lm_target_desc){.name = "a", .format = LM_FORMAT_RGBA32F, .scale = 0.5f}, &err);
+    int b = lm_graph_add_target(g, &(lm_target_desc){.name = "b", .format = LM_FORMAT_RGBA16F, .scale = 0.5f}, &err);
+    int c = lm_graph_add_target(g, &(lm_target_desc){.name = "c", .format = LM_FORMAT_RGBA32F, .scale = 0.5f}, &err);
+    lm_pass_input in = {"src", a};
+    lm_pass_desc fill = {.kind = LM_PASS_CPU, .name = "fill", .where = "test:1", .shader = "fill",
+                         .outputs = &a, .output_count = 1, .depth = -1};
+    lm_pass_desc inv = {.kind = LM_PASS_CPU, .name = "invert", .where = "test:2", .shader = "invert",
+                        .inputs = &in, .input_count = 1, .outputs = &b, .output_count = 1, .depth = -1};
+    lm_pass_desc unread = inv;
+    unread.name = "unread", unread.outputs = &c;
+    assert_true(lm_graph_add_pass(g, &fill, &err) >= 0 && lm_graph_add_pass(g, &inv, &err) >= 0 &&
+                lm_graph_add_pass(g, &unread, &err) >= 0);
+    lm_graph_mark_output(g, b);
+    assert_true(lm_graph_compile(g, &err));
+    cpu_calls calls = {0};
+    lm_graph_exec_desc x = {.run_cpu = run_cpu, .user = &calls, .check_finite = true};
+    if (!lm_graph_execute(g, &x, &err)) fail_msg("%s", err.msg);
+    assert_int_equal(calls.fill, 1);
+    assert_int_equal(calls.invert, 1);
+    assert_true(lm_graph_pass(g, 1).ms >= 0);
+    float px[8 * 6 * 4];
+    lm_texture_read(lm_graph_target(g, b).texture, 8, 6, true, px);
+    for (int y = 0; y < 6; y++)
+      for (int xx = 0; xx < 8; xx++) {
+        const float *p = px + (y * 8 + xx) * 4;
+        assert_float_equal(p[0], 1 - xx, 1e-3);
+        assert_float_equal(p[1], 1 - y, 1e-3);
+        assert_float_equal(p[2], 0.5, 1e-3);
+      }
+  }
+  /* a failing function names the pass; with none given, the pass is named too */
+  lm_graph_begin(g, 16, 12);
+  int a = lm_graph_add_target(g, &(lm_target_desc){.name = "a", .format = LM_FORMAT_RGBA32F}, &err);
+  lm_pass_desc bad = {.kind = LM_PASS_CPU, .name = "odd", .where = "test:3", .shader = "nosuch",
+                      .outputs = &a, .output_count = 1, .depth = -1};
+  lm_graph_add_pass(g, &bad, &err);
+  lm_graph_mark_output(g, a);
+  assert_true(lm_graph_compile(g, &err));
+  cpu_calls calls = {0};
+  assert_false(lm_graph_execute(g, &(lm_graph_exec_desc){.run_cpu = run_cpu, .user = &calls}, &err));
+  assert_non_null(strstr(err.msg, "test:3: pass 'odd': no CPU function 'nosuch'"));
+  assert_false(lm_graph_execute(g, &(lm_graph_exec_desc){0}, &err));
+  assert_non_null(strstr(err.msg, "test:3: pass 'odd': CPU function 'nosuch' is not available here"));
+  lm_graph_destroy(g);
+}
+
 int main(void) {
   snprintf(pp_lua, sizeof pp_lua, "%s/scripts/pp.lua", lm_root_dir());
   const struct CMUnitTest tests[] = {
@@ -208,6 +290,7 @@ int main(void) {
       cmocka_unit_test(wrong_uniforms_and_inputs_name_the_pass_and_parameter),
       cmocka_unit_test(no_nan_or_inf_leaves_the_output_stage),
       cmocka_unit_test(textures_are_pooled_across_frames),
+      cmocka_unit_test(cpu_passes_read_back_and_upload),
   };
   return cmocka_run_group_tests(tests, setup, gl_test_teardown);
 }

@@ -200,10 +200,26 @@ static void sky_harmonics_match_the_sky(void **state) {
   assert_non_null(strstr(err.msg, "limn-no-such-sky.exr"));
 }
 
+/* Scripts set a material's reflectivity per pass like any other parameter. */
+static void reflectivity_is_a_material_parameter(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *s = lm_scene_builtin("cornell", &err);
+  assert_non_null(s);
+  lm_material_param ok = {"red", "reflectivity", 1, {0.5f}};
+  assert_true(lm_scene_check_params(s, &ok, 1, &err));
+  lm_material_param bad = {"red", "reflectivity", 3, {0.5f, 0, 0}};
+  assert_false(lm_scene_check_params(s, &bad, 1, &err));
+  assert_non_null(strstr(err.msg, "material 'red': parameter 'reflectivity' takes 1 number, not 3"));
+  assert_float_equal(s->materials[lm_scene_find_material(s, "red")].reflectivity, 0, 0); /* built-ins: none */
+  lm_scene_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(positions_rebuild_from_linear_depth),
       cmocka_unit_test(sky_harmonics_match_the_sky),
+      cmocka_unit_test(reflectivity_is_a_material_parameter),
       cmocka_unit_test(extreme_cameras_stay_finite),
       cmocka_unit_test(children_follow_their_parents),
       cmocka_unit_test(nodes_move_to_a_world_transform),

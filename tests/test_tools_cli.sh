@@ -92,6 +92,10 @@ check "bench fits the direct pass" out_has '{"name": "direct", "ms": ['
 check "bench fit per pixel" out_has '"ns_per_pixel": '
 check "bench table" run 0 bench --sizes 32x24,64x48 --frames 1 --warmup 0
 check "bench table names the fit" out_has "fit: a ms + b ns/pixel"
+check "bench cpu pass" run 0 bench --scene cornell_mirror --tech dl --set reflections=true --sizes 32x24 --frames 1 --warmup 0
+check "bench cpu pass ratio" out_has "CPU passes at 32x24: "
+check "bench bad set" run 2 bench --set reflections
+check "bench bad set message" err_has "--set wants NAME=VALUE"
 check "bench bad vary" run 2 bench --vary isr.samples
 check "bench bad vary message" err_has "--vary wants NAME=V1,V2,..."
 check "bench vary" run 0 bench --tech isr --sizes 32x24,64x48 --frames 1 --warmup 0 --json --vary isr.samples=4,32

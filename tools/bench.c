@@ -11,6 +11,7 @@
 
 #include "render/render.h"
 #include "scene/gltf.h"
+#include "trace/trace.h"
 #include "tools.h"
 
 static const char bench_usage[] =
@@ -27,6 +28,12 @@ static const char bench_usage[] =
     "as the fetches a pixel its time would allow. With shadows fitted to the\n"
     "depths the frame sees, the cost of that fit (the depth-range reduction\n"
     "passes plus reading their result back) is shown as a share of the frame.\n"
+    "CPU passes (cpu{}, e.g. reflections' ray tracing, with their read-back and\n"
+    "upload) are shown against the rest of the frame as a ratio.\n"
+    "With --trace, the CPU ray tracer (engine/trace) on the scene: its build, its\n"
+    "rate on the reflection rays of a view where every surface is a mirror at\n"
+    "800x450 (the seed's quarter of 1600x900), and the same at a quarter of the\n"
+    "largest size against that size's frame time, as a ratio.\n"
     "\n"
     "options:\n"
     "  --scene NAME|FILE   (default cornell)\n"
@@ -48,6 +55,8 @@ static const char bench_usage[] =
     "  --light-reach F     those lights' range, a fraction of the scene's\n"
     "                      bounding-box diagonal (default 0.08)\n"
     "  --clock auto|gpu|cpu\n"
+    "  --trace             also measure the ray tracer (see above)\n"
+    "  --trace-threads N   its threads (default 2)\n"
     "  --json              one JSON object on stdout instead of the tables\n"
     "  --help              this text\n";
 
@@ -59,6 +68,7 @@ typedef struct bench_pass {
   double vary_ms[MAX_SIZES]; /* median per --vary value at the largest size */
   double lights_ms[2][MAX_SIZES]; /* median per --lights count: culled, every light everywhere */
   double fetches;           /* declared fetches a pixel (0: not said) */
+  bool cpu;                 /* a CPU pass (cpu{}: the ray tracer's step) */
   int width, height;        /* its output at the largest size */
 } bench_pass;
 
@@ -82,6 +92,12 @@ typedef struct bench {
   double readback_ms[MAX_SIZES]; /* the shadow fit's read-back and refit (wall clock) */
   bench_pass passes[MAX_PASSES];
   int pass_count;
+  bool trace;
+  int trace_threads;
+  lm_trace_stats trace_stats;
+  int trace_rays, frame_rays;  /* reflection rays at 800x450, and at a quarter of the largest size */
+  double trace_ms, frame_trace_ms; /* medians of tracing them (wall clock) */
+  double trace_cpu_ms;         /* median CPU time (all threads) of the 800x450 rays */
 } bench;
 
 static int usage_error(const char *fmt, const char *arg) {
@@ -92,7 +108,7 @@ static int usage_error(const char *fmt, const char *arg) {
 }
 
 static int parse_args(int argc, char **argv, bench *b) {
-  *b = (bench){.frames = 5, .warmup = 2, .scene = "cornell", .light_reach = 0.08};
+  *b = (bench){.frames = 5, .warmup = 2, .scene = "cornell", .light_reach = 0.08, .trace_threads = 2};
   const char *sizes = "64x48,128x96,256x192";
   static const struct option opts[] = {
       {"scene", required_argument, 0, 's'}, {"script", required_argument, 0, 'p'},
@@ -101,6 +117,7 @@ static int parse_args(int argc, char **argv, bench *b) {
       {"clock", required_argument, 0, 'k'}, {"json", no_argument, 0, 'j'},
       {"vary", required_argument, 0, 'V'},  {"help", no_argument, 0, 'h'},
       {"set", required_argument, 0, 'S'},   {"lights", required_argument, 0, 'L'}, {"light-reach", required_argument, 0, 'R'},
+      {"trace", no_argument, 0, 'r'},       {"trace-threads", required_argument, 0, 'T'},
       {0, 0, 0, 0}};
   opterr = 0;
   optind = 1;
@@ -124,6 +141,11 @@ static int parse_args(int argc, char **argv, bench *b) {
       else return usage_error("--clock wants auto, gpu or cpu, not '%s'", optarg);
       break;
     case 'j': b->json = true; break;
+    case 'r': b->trace = true; break;
+    case 'T':
+      if (!limn_parse_int(optarg, 1, 256, &b->trace_threads))
+        return usage_error("--trace-threads wants 1..256, not '%s'", optarg);
+      break;
     case 'V': {
       const char *eq = strchr(optarg, '=');
       if (!eq || eq == optarg || !eq[1]) return usage_error("--vary wants NAME=V1,V2,..., not '%s'", optarg);
@@ -274,6 +296,7 @@ static bool run_size(bench *b, int si, int series, lm_scene *scene, lm_pipeline 
       bench_pass *bp = find_pass(b, p.name);
       if (!bp) continue;
       if (!vary && size == b->largest) bp->fetches = p.fetches, bp->width = p.width, bp->height = p.height;
+      bp->cpu = p.kind == LM_PASS_CPU;
       int slot = (int)(bp - b->passes);
       if (pass_n[slot] < b->frames) pass_ms[slot * b->frames + pass_n[slot]++] = p.ms;
     }
@@ -345,6 +368,106 @@ static bool shadow_fit_ms(const bench *b, int s, double *passes, double *readbac
   return any;
 }
 
+/* Reflection rays as the GPU's ray pass writes them for a view in which every
+ * surface is a mirror (the seed's worst case, 003 Table 7.2): a primary ray a
+ * pixel finds the surface, the reflected ray leaves it, nudged off along the
+ * normal by a fraction of the scene's size (scale-free). Returns the count. */
+static int mirror_rays(const lm_trace *t, const lm_scene *s, int threads, int w, int h, lm_trace_ray *out) {
+  lm_frame_data f;
+  lm_scene_frame_data(s, 0, w, h, &f);
+  float lo[3], hi[3];
+  lm_scene_bounds(s, lo, hi);
+  float eps = 1e-5f * sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                            (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  int n = w * h;
+  lm_trace_ray *prim = lm_alloc(sizeof *prim * (size_t)n);
+  lm_trace_hit *hits = lm_alloc(sizeof *hits * (size_t)n);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      float u = (x + 0.5f) / w, v = (y + 0.5f) / h;
+      lm_trace_ray *r = &prim[y * w + x];
+      *r = (lm_trace_ray){.tmax = INFINITY};
+      for (int k = 0; k < 3; k++)
+        r->origin[k] = f.camera_pos[k], r->dir[k] = f.frustum_o[k] + f.frustum_u[k] * u + f.frustum_v[k] * v;
+    }
+  lm_trace_rays(t, prim, hits, n, threads);
+  int count = 0;
+  for (int i = 0; i < n; i++) {
+    if (hits[i].tri < 0) continue;
+    lm_trace_surface sf;
+    lm_trace_surface_at(t, &prim[i], &hits[i], &sf);
+    const float *d = prim[i].dir, *nn = sf.normal;
+    float dn = d[0] * nn[0] + d[1] * nn[1] + d[2] * nn[2];
+    lm_trace_ray *r = &out[count++];
+    *r = (lm_trace_ray){.tmax = INFINITY};
+    for (int k = 0; k < 3; k++) r->origin[k] = sf.position[k] + eps * nn[k], r->dir[k] = d[k] - 2 * dn * nn[k];
+  }
+  free(prim);
+  free(hits);
+  return count;
+}
+
+/* Median wall time of tracing `n` rays over the bench's frames, and of the
+ * process's CPU time (every thread's) in *cpu_ms. */
+static double trace_median_ms(const bench *b, const lm_trace *t, const lm_trace_ray *rays, int n, double *cpu_ms) {
+  lm_trace_hit *hits = lm_alloc(sizeof *hits * (size_t)(n ? n : 1));
+  double *ms = lm_alloc(sizeof(double) * 2 * (size_t)(b->warmup + b->frames)), *cpu = ms + b->warmup + b->frames;
+  for (int f = 0; f < b->warmup + b->frames; f++) {
+    double t0 = lm_now_ms(), c0 = lm_cpu_ms();
+    lm_trace_rays(t, rays, hits, n, b->trace_threads);
+    ms[f] = lm_now_ms() - t0;
+    cpu[f] = lm_cpu_ms() - c0;
+  }
+  double m = median(ms + b->warmup, b->frames);
+  *cpu_ms = median(cpu + b->warmup, b->frames);
+  free(ms);
+  free(hits);
+  return m;
+}
+
+static void trace_figures(bench *b, const lm_scene *s) {
+  lm_trace *t = lm_trace_create(s, &b->trace_stats);
+  lm_trace_ray *rays = lm_alloc(sizeof *rays * 800 * 450);
+  b->trace_rays = mirror_rays(t, s, b->trace_threads, 800, 450, rays);
+  b->trace_ms = trace_median_ms(b, t, rays, b->trace_rays, &b->trace_cpu_ms);
+  int w = b->sizes[b->largest][0] / 2, h = b->sizes[b->largest][1] / 2;
+  w = w > 1 ? w : 1, h = h > 1 ? h : 1;
+  lm_trace_ray *frame = lm_alloc(sizeof *frame * (size_t)w * (size_t)h);
+  b->frame_rays = mirror_rays(t, s, b->trace_threads, w, h, frame);
+  double cpu;
+  b->frame_trace_ms = trace_median_ms(b, t, frame, b->frame_rays, &cpu);
+  free(frame);
+  free(rays);
+  lm_trace_destroy(t);
+}
+
+static double rays_per_s(int rays, double ms) { return ms > 0 ? rays / (ms * 1e-3) : 0; }
+
+static void print_trace(const bench *b) {
+  const lm_trace_stats *st = &b->trace_stats;
+  double frame = b->frame_ms[b->largest];
+  printf("ray tracer (engine/trace, %d threads): %d triangles (%d skipped), BVH of %d nodes, depth %d, "
+         "built in %.1f ms\n", b->trace_threads, st->triangles, st->skipped, st->nodes, st->depth, st->build_ms);
+  printf("  every surface a mirror, 800x450: %d reflection rays in %.3f ms = %.2f million rays/s (wall clock)\n",
+         b->trace_rays, b->trace_ms, rays_per_s(b->trace_rays, b->trace_ms) * 1e-6);
+  /* on a shared machine the wall clock counts other processes' time too */
+  printf("  CPU time %.3f ms: %.2f million rays/s a core, %.2f on %d dedicated cores\n", b->trace_cpu_ms,
+         rays_per_s(b->trace_rays, b->trace_cpu_ms) * 1e-6,
+         rays_per_s(b->trace_rays, b->trace_cpu_ms) * 1e-6 * b->trace_threads, b->trace_threads);
+  printf("  at %dx%d (rays at %dx%d): %d rays in %.3f ms against the frame's %.3f ms: ratio %.3f\n",
+         b->sizes[b->largest][0], b->sizes[b->largest][1], b->sizes[b->largest][0] / 2, b->sizes[b->largest][1] / 2,
+         b->frame_rays, b->frame_trace_ms, frame, frame > 0 ? b->frame_trace_ms / frame : 0);
+}
+
+/* CPU passes' time at size s; false when the frame has none. */
+static bool cpu_pass_ms(const bench *b, int s, double *ms) {
+  *ms = 0;
+  bool any = false;
+  for (int i = 0; i < b->pass_count; i++)
+    if (b->passes[i].cpu && b->passes[i].ms[s] >= 0) *ms += b->passes[i].ms[s], any = true;
+  return any;
+}
+
 static void print_tables(const bench *b, lm_clock clock) {
   printf("frame (wall clock, glFinish before and after) and compositor overhead (CPU: Lua + graph compile);\n"
          "passes: clock %s; medians of %d frames after %d warm-up\n", lm_clock_name(clock), b->frames, b->warmup);
@@ -357,6 +480,11 @@ static void print_tables(const bench *b, lm_clock clock) {
     if (shadow_fit_ms(b, s, &fp, &fr))
       printf("  shadow fit at %dx%d: reduction %.3f ms + read-back %.3f ms = %.1f%% of the frame\n", b->sizes[s][0],
              b->sizes[s][1], fp, fr, b->frame_ms[s] > 0 ? 100 * (fp + fr) / b->frame_ms[s] : 0);
+  double cpu;
+  for (int s = 0; s < b->size_count; s++)
+    if (cpu_pass_ms(b, s, &cpu))
+      printf("  CPU passes at %dx%d: %.3f ms against the rest of the frame's %.3f ms: ratio %.3f\n", b->sizes[s][0],
+             b->sizes[s][1], cpu, b->frame_ms[s] - cpu, b->frame_ms[s] > cpu ? cpu / (b->frame_ms[s] - cpu) : 0);
   printf("  %-24s", "pass (ms)");
   for (int s = 0; s < b->size_count; s++) printf(" %9dx%-4d", b->sizes[s][0], b->sizes[s][1]);
   printf("  fit: a ms + b ns/pixel (r^2)\n");
@@ -408,6 +536,8 @@ static void print_json(const bench *b, lm_clock clock) {
            b->sizes[s][0], b->sizes[s][1], b->frame_ms[s], b->overhead_ms[s]);
     double fp, fr;
     if (shadow_fit_ms(b, s, &fp, &fr)) printf(", \"shadow_fit_ms\": %.6g, \"shadow_readback_ms\": %.6g", fp + fr, fr);
+    double cpu;
+    if (cpu_pass_ms(b, s, &cpu)) printf(", \"cpu_pass_ms\": %.6g", cpu);
     printf("}");
   }
   printf("], \"passes\": [");
@@ -446,6 +576,15 @@ static void print_json(const bench *b, lm_clock clock) {
     printf(", \"values\": [");
     for (int v = 0; v < b->vary_count; v++) printf("%s%.6g", v ? ", " : "", b->vary[v]);
     printf("]}");
+  }
+  if (b->trace) {
+    double frame = b->frame_ms[b->largest];
+    printf(", \"trace\": {\"threads\": %d, \"triangles\": %d, \"skipped\": %d, \"nodes\": %d, \"build_ms\": %.6g, "
+           "\"rays\": %d, \"ms\": %.6g, \"cpu_ms\": %.6g, \"rays_per_second\": %.6g, \"frame_rays\": %d, \"frame_trace_ms\": %.6g, "
+           "\"ratio_to_frame\": %.6g}",
+           b->trace_threads, b->trace_stats.triangles, b->trace_stats.skipped, b->trace_stats.nodes,
+           b->trace_stats.build_ms, b->trace_rays, b->trace_ms, b->trace_cpu_ms, rays_per_s(b->trace_rays, b->trace_ms), b->frame_rays,
+           b->frame_trace_ms, frame > 0 ? b->frame_trace_ms / frame : 0);
   }
   if (b->ns_per_fetch > 0) printf(", \"calibration\": {\"ns_per_fetch\": %.6g}", b->ns_per_fetch);
   else printf(", \"calibration\": null");
@@ -553,20 +692,17 @@ int limn_bench(int argc, char **argv) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 1;
   }
-  if (b.tech && !lm_pipeline_set_technique(pipe, b.tech, &err)) {
-    lm_log(LM_LOG_ERROR, "%s", err.msg);
-    lm_pipeline_destroy(pipe);
-    return 2;
-  }
-  for (int i = 0; i < b.set_count; i++) {
+  bool set_ok = true;
+  for (int i = 0; i < b.set_count && set_ok; i++) {
     char name[256];
     const char *eq = strchr(b.sets[i], '=');
     snprintf(name, sizeof name, "%.*s", (int)(eq - b.sets[i]), b.sets[i]);
-    if (!lm_pipeline_set_option(pipe, name, eq + 1, &err)) {
-      lm_log(LM_LOG_ERROR, "%s", err.msg);
-      lm_pipeline_destroy(pipe);
-      return 2;
-    }
+    set_ok = lm_pipeline_set_option(pipe, name, eq + 1, &err);
+  }
+  if (!set_ok || (b.tech && !lm_pipeline_set_technique(pipe, b.tech, &err))) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    lm_pipeline_destroy(pipe);
+    return 2;
   }
   lm_scene *scene = lm_scene_load(b.scene, &err);
   if (!scene) {
@@ -588,10 +724,12 @@ int limn_bench(int argc, char **argv) {
          run_size(&b, v, SERIES_LIGHTS_ALL, scene, pipe, &used, &err);
   }
   if (ok) ok = calibrate(&b, scene, &err);
+  if (ok && b.trace) trace_figures(&b, scene);
   if (ok) {
     if (b.json) print_json(&b, used);
     else print_tables(&b, used);
     if (b.lights_count && !b.json) print_lights(&b); /* tables only */
+    if (b.trace && !b.json) print_trace(&b);
   } else {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
   }

@@ -378,6 +378,16 @@ void lm_texture_upload(lm_texture tex, int width, int height, const uint8_t *rgb
   free(flipped);
 }
 
+void lm_texture_upload_floats(lm_texture tex, int width, int height, const float *rgba) {
+  size_t row = (size_t)width * 4;
+  float *flipped = lm_alloc(row * (size_t)height * sizeof(float));
+  for (int y = 0; y < height; y++)
+    memcpy(flipped + (size_t)y * row, rgba + (size_t)(height - 1 - y) * row, row * sizeof(float));
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(tex.id, 0, 0, 0, width, height, GL_RGBA, GL_FLOAT, flipped);
+  free(flipped);
+}
+
 void lm_texture_copy(lm_texture dst, lm_texture src, int width, int height) {
   glCopyImageSubData(src.id, GL_TEXTURE_2D, 0, 0, 0, 0, dst.id, GL_TEXTURE_2D, 0, 0, 0, 0, width, height, 1);
 }

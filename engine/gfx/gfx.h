@@ -197,6 +197,8 @@ void lm_texture_read(lm_texture tex, int width, int height, bool floats, void *o
 /* ---- uploads, copies and the window's framebuffer ---------------------- */
 /* Replaces level 0 of an rgba8 texture with RGBA bytes, top row first. */
 void lm_texture_upload(lm_texture tex, int width, int height, const uint8_t *rgba);
+/* Replaces level 0 of a colour texture (any format) with RGBA floats, top row first. */
+void lm_texture_upload_floats(lm_texture tex, int width, int height, const float *rgba);
 /* Copies level 0 of src into dst (same format and size). */
 void lm_texture_copy(lm_texture dst, lm_texture src, int width, int height);
 /* Binds the window's (default) framebuffer and sets the viewport. */

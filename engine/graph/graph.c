@@ -99,7 +99,7 @@ int lm_graph_add_pass(lm_graph *g, const lm_pass_desc *d, lm_error *err) {
   const char *where = d->where ? d->where : "?";
   if (!d->shader || !d->shader[0]) {
     lm_error_set(err, "%s: pass '%s': no %s", where, name,
-                 d->kind == LM_PASS_SCENE ? "technique" : "shader");
+                 d->kind == LM_PASS_SCENE ? "technique" : d->kind == LM_PASS_CPU ? "function" : "shader");
     return -1;
   }
   if (d->output_count > LM_MAX_COLOR_OUTPUTS || d->input_count > LM_MAX_PASS_INPUTS ||
@@ -210,8 +210,9 @@ static bool validate_pass(lm_graph *g, int pi, lm_error *err) {
     }
     w = gt->width, h = gt->height;
   }
-  if (d->kind == LM_PASS_FULLSCREEN && d->depth >= 0) {
-    lm_error_set(err, "%s: pass '%s': full-screen passes take no depth target", where, name);
+  if (d->kind != LM_PASS_SCENE && d->depth >= 0) {
+    lm_error_set(err, "%s: pass '%s': %s passes take no depth target", where, name,
+                 d->kind == LM_PASS_CPU ? "CPU" : "full-screen");
     return false;
   }
   if (d->fits_views && !g->targets[d->fit_target].desc.persistent && last_writer(g, d->fit_target, pi) < 0) {

@@ -23,7 +23,12 @@ typedef struct lm_target_desc {
 /* A target's size for an output of out_w x out_h: never below 1x1. */
 void lm_target_size(const lm_target_desc *d, int out_w, int out_h, int *w, int *h);
 
-typedef enum lm_pass_kind { LM_PASS_FULLSCREEN, LM_PASS_SCENE } lm_pass_kind;
+/* A CPU pass runs C code between GPU passes (seed 003's hybrid tracer: rays
+ * read back, traced, hit records uploaded): `shader` names the function
+ * (lm_graph_exec_desc.run_cpu), which gets its inputs' texels and fills its
+ * outputs'. It takes no depth target and no views; its parameters go to the
+ * function in the description. */
+typedef enum lm_pass_kind { LM_PASS_FULLSCREEN, LM_PASS_SCENE, LM_PASS_CPU } lm_pass_kind;
 
 typedef struct lm_pass_input {
   const char *name; /* sampler uniform */
@@ -141,6 +146,21 @@ typedef struct lm_scene_pass {
  * parameters applied. NULL with a message naming the pass and shader file. */
 const lm_program *lm_scene_pass_variant(const lm_scene_pass *sp, const char *defines, lm_error *err);
 
+/* A CPU pass's images: RGBA floats, rows top first (any target format; an
+ * rgba8 output's values are clamped to [0, 1] on upload). */
+typedef struct lm_cpu_image {
+  const char *name; /* the input's sampler name, or the output target's name */
+  int width, height;
+  float *rgba;
+} lm_cpu_image;
+typedef struct lm_cpu_pass {
+  const lm_pass_desc *desc;
+  const lm_cpu_image *inputs; /* read back, in desc->inputs' order */
+  int input_count;
+  lm_cpu_image *outputs;      /* zeroed; uploaded after the call; in desc->outputs' order */
+  int output_count;
+} lm_cpu_pass;
+
 typedef struct lm_graph_exec_desc {
   lm_clock clock;
   /* Draws the scene for a scene pass (once per view); false with a message
@@ -151,6 +171,10 @@ typedef struct lm_graph_exec_desc {
    * views' matrices. NULL: the views stay as recorded. */
   bool (*fit_views)(void *user, const lm_pass_desc *d, lm_texture fit, int w, int h, lm_pass_view *views,
                     lm_error *err);
+  /* Runs a CPU pass (desc->shader names the function); false with a message
+   * stops the frame. NULL: a CPU pass is an error naming it. Its time, with
+   * the read-back and upload, is the pass's time (wall clock). */
+  bool (*run_cpu)(void *user, const lm_cpu_pass *cp, lm_error *err);
   /* Uniforms the scene sets on each draw (not bindable from a script). */
   bool (*scene_owns_uniform)(const char *name);
   void *user;

@@ -252,9 +252,44 @@ const lm_program *lm_scene_pass_variant(const lm_scene_pass *sp, const char *def
   return p;
 }
 
+/* Reads the inputs back, calls the function, uploads what it wrote; timed whole. */
+static bool run_cpu_pass(lm_graph *g, const lm_pass_desc *d, lm_timer *timer, const lm_graph_exec_desc *x,
+                         lm_error *err) {
+  if (!x->run_cpu) {
+    lm_error_set(err, "%s: pass '%s': CPU function '%s' is not available here", d->where, d->name, d->shader);
+    return false;
+  }
+  lm_cpu_image in[LM_MAX_PASS_INPUTS], out[LM_MAX_COLOR_OUTPUTS];
+  lm_timer_begin(timer, LM_CLOCK_CPU);
+  for (int i = 0; i < d->input_count; i++) {
+    const graph_target *t = &g->targets[d->inputs[i].target];
+    in[i] = (lm_cpu_image){d->inputs[i].name, t->width, t->height,
+                           lm_alloc(sizeof(float) * 4 * (size_t)t->width * (size_t)t->height)};
+    lm_texture_read(t->texture, t->width, t->height, true, in[i].rgba);
+  }
+  for (int i = 0; i < d->output_count; i++) {
+    const graph_target *t = &g->targets[d->outputs[i]];
+    size_t bytes = sizeof(float) * 4 * (size_t)t->width * (size_t)t->height;
+    out[i] = (lm_cpu_image){t->desc.name, t->width, t->height, memset(lm_alloc(bytes), 0, bytes)};
+  }
+  lm_cpu_pass cp = {d, in, d->input_count, out, d->output_count};
+  bool ok = x->run_cpu(x->user, &cp, err);
+  if (!ok) lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
+  for (int i = 0; i < d->output_count && ok; i++) {
+    const graph_target *t = &g->targets[d->outputs[i]];
+    lm_texture_upload_floats(t->texture, t->width, t->height, out[i].rgba);
+    if (t->desc.mips) lm_texture_generate_mips(t->texture);
+  }
+  lm_timer_end(timer);
+  for (int i = 0; i < d->input_count; i++) free(in[i].rgba);
+  for (int i = 0; i < d->output_count; i++) free(out[i].rgba);
+  return ok && (!x->check_finite || check_outputs_finite(g, d, err));
+}
+
 static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_graph_exec_desc *x,
                      lm_error *err) {
   const lm_pass_desc *d = &gp->desc;
+  if (d->kind == LM_PASS_CPU) return run_cpu_pass(g, d, timer, x, err);
   const graph_target *fit = d->fits_views ? &g->targets[d->fit_target] : NULL;
   /* The views live in the graph's arena: the callback may rewrite them. */
   if (fit && x->fit_views &&

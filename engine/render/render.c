@@ -1,7 +1,10 @@
 #include "render/render.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "trace/trace.h"
 
 enum { MAX_LIGHTS = 256 };
 
@@ -19,6 +22,8 @@ struct lm_renderer {
   lm_scene_draw_stats stats;  /* this frame's camera draws */
   lm_scene_draw_stats shadow_stats; /* and its shadow tiles' */
   bool sharing;
+  lm_trace *trace; /* the scene's BVH, built by the first CPU "trace" pass */
+  uint64_t trace_hash; /* geometry_hash when it was built or refitted */
 };
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
@@ -38,6 +43,7 @@ void lm_renderer_destroy(lm_renderer *r) {
   lm_graph_destroy(r->graph);
   lm_shadow_plan_free(&r->shadows);
   lm_light_grid_free(&r->light_grid);
+  lm_trace_destroy(r->trace);
   free(r);
 }
 
@@ -103,7 +109,102 @@ bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
   if (!lm_scene_upload(scene, err)) return false;
   r->desc.scene = scene;
   r->frame = 0;
+  lm_trace_destroy(r->trace);
+  r->trace = NULL;
   return true;
+}
+
+/* A hash of what the BVH is built from: mesh nodes, their meshes and world transforms. */
+static uint64_t geometry_hash(const lm_scene *s) {
+  uint64_t h = lm_hash(&s->node_count, sizeof s->node_count, 0);
+  for (int i = 0; i < s->node_count; i++) {
+    const lm_node *n = &s->nodes[i];
+    if (n->mesh < 0) continue;
+    h = lm_hash(&n->mesh, sizeof n->mesh, h);
+    h = lm_hash(n->world, sizeof n->world, h);
+  }
+  return h;
+}
+
+static float srgb_to_linear(unsigned char c) {
+  float v = c / 255.0f;
+  return v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
+}
+
+/* The hit's albedo: the material's colour times its base-colour texel
+ * (nearest, repeating, decoded from sRGB as the GPU's sampler does). */
+static void hit_albedo(const lm_scene *s, const lm_material *m, const float uv[2], float out[3]) {
+  memcpy(out, m->color, sizeof m->color);
+  int t = m->base_color_texture - 1;
+  if (t < 0 || t >= s->texture_count || !s->textures[t].rgba) return;
+  const lm_scene_texture *tx = &s->textures[t];
+  float u = uv[0] - floorf(uv[0]), v = uv[1] - floorf(uv[1]);
+  if (!isfinite(u) || !isfinite(v)) return;
+  int x = (int)(u * tx->width), y = (int)(v * tx->height);
+  x = x < tx->width ? x : tx->width - 1, y = y < tx->height ? y : tx->height - 1;
+  const unsigned char *px = tx->rgba + ((size_t)y * tx->width + x) * 4;
+  for (int k = 0; k < 3; k++) out[k] *= srgb_to_linear(px[k]);
+}
+
+static const lm_cpu_image *cpu_input(const lm_cpu_pass *cp, const char *name) {
+  for (int i = 0; i < cp->input_count; i++)
+    if (!strcmp(cp->inputs[i].name, name)) return &cp->inputs[i];
+  return NULL;
+}
+
+/* The CPU step of ray-traced reflections (seed 003 section 6.2): rays from
+ * rays_o (origin, w > 0.5: a ray) and rays_d (direction, w: the longest
+ * distance, 0 for none), traced on every core; out: a G-buffer of the hits
+ * as std.frag lays it out (albedo and rho; normal and shininess; position
+ * and 1; k_a, k_d, k_s and coverage), zero for a miss. The materials are the
+ * scene's own: a pass's material overrides do not reach the hits. */
+static bool run_trace(lm_renderer *r, const lm_cpu_pass *cp, lm_error *err) {
+  const lm_cpu_image *ro = cpu_input(cp, "rays_o"), *rd = cpu_input(cp, "rays_d");
+  if (!ro || !rd || cp->output_count != 4 || rd->width != ro->width || rd->height != ro->height ||
+      cp->outputs[0].width != ro->width || cp->outputs[0].height != ro->height) {
+    lm_error_set(err, "function 'trace' takes inputs rays_o and rays_d and 4 outputs of their size "
+                      "(hit colour, normal, position, material)");
+    return false;
+  }
+  const lm_scene *s = r->desc.scene;
+  uint64_t h = geometry_hash(s);
+  if (!r->trace) r->trace = lm_trace_create(s, NULL);
+  else if (h != r->trace_hash) lm_trace_update(r->trace, s, NULL); /* nodes moved: refit (or rebuild) */
+  r->trace_hash = h;
+  int n = ro->width * ro->height, count = 0;
+  lm_trace_ray *rays = lm_alloc(sizeof *rays * (size_t)n);
+  int *pixel = lm_alloc(sizeof *pixel * (size_t)n);
+  for (int i = 0; i < n; i++) {
+    const float *o = ro->rgba + (size_t)i * 4, *d = rd->rgba + (size_t)i * 4;
+    if (!(o[3] > 0.5f)) continue;
+    rays[count] = (lm_trace_ray){{o[0], o[1], o[2]}, 0, {d[0], d[1], d[2]}, d[3] > 0 ? d[3] : INFINITY};
+    pixel[count++] = i;
+  }
+  lm_trace_hit *hits = lm_alloc(sizeof *hits * (size_t)(count ? count : 1));
+  lm_trace_rays(r->trace, rays, hits, count, 0);
+  for (int k = 0; k < count; k++) {
+    if (hits[k].tri < 0) continue;
+    lm_trace_surface sf;
+    lm_trace_surface_at(r->trace, &rays[k], &hits[k], &sf);
+    const lm_material *m = lm_scene_node_material(s, &s->nodes[sf.node]);
+    float *clr = cp->outputs[0].rgba + (size_t)pixel[k] * 4, *nrm = cp->outputs[1].rgba + (size_t)pixel[k] * 4;
+    float *pos = cp->outputs[2].rgba + (size_t)pixel[k] * 4, *mat = cp->outputs[3].rgba + (size_t)pixel[k] * 4;
+    hit_albedo(s, m, sf.uv, clr);
+    clr[3] = m->rho;
+    memcpy(nrm, sf.normal, sizeof sf.normal);
+    nrm[3] = m->shininess > 0 ? m->shininess : 0;
+    memcpy(pos, sf.position, sizeof sf.position);
+    pos[3] = 1;
+    mat[0] = m->ka, mat[1] = m->kd, mat[2] = m->ks, mat[3] = 1;
+  }
+  free(rays), free(pixel), free(hits);
+  return true;
+}
+
+static bool run_cpu(void *user, const lm_cpu_pass *cp, lm_error *err) {
+  if (!strcmp(cp->desc->shader, "trace")) return run_trace(user, cp, err);
+  lm_error_set(err, "no CPU function '%s' (the engine has: trace)", cp->desc->shader);
+  return false;
 }
 
 void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height) {
@@ -169,7 +270,7 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_storage_upload(4, r->light_grid.data, r->light_grid.count * sizeof *r->light_grid.data);
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
   r->fit_ms = 0;
-  lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene, .fit_views = fit_views,
+  lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene, .fit_views = fit_views, .run_cpu = run_cpu,
                           .scene_owns_uniform = lm_scene_owns_uniform, .user = r,
                           .check_finite = r->desc.check_finite};
   return lm_graph_execute(g, &x, err);

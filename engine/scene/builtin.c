@@ -66,15 +66,20 @@ static void trs(vec3 t, float yaw_deg, vec3 scale, mat4 out) {
  * parallel light through the open side and a spot (no falloff) on the tall
  * box, so that every light model the export claims is exercised
  * (test_pov_faithful); it stays apart so that the box itself keeps the
- * seed's one light, which the tests' images and shadow maps assume. */
-static lm_scene *cornell(bool pov) {
-  lm_scene *s = lm_scene_create(pov ? "cornell_pov" : "cornell");
-  lm_material white = {"white", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.0f, 1.0f, 0};
-  lm_material red = {"red", {0.63f, 0.065f, 0.05f}, 0.63f, 1.0f, 1.0f, 0.0f, 1.0f, 0};
-  lm_material green = {"green", {0.14f, 0.45f, 0.091f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f, 0};
-  lm_material box = {"box", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.15f, 24.0f, 0};
+ * seed's one light, which the tests' images and shadow maps assume.
+ * mirror: the pov box with its left wall a perfect mirror (black, no
+ * diffuse or specular, reflectivity 1): ray-traced reflections against
+ * POV-Ray's reflection of the same finish. */
+static lm_scene *cornell(bool pov, bool mirror) {
+  lm_scene *s = lm_scene_create(mirror ? "cornell_mirror" : pov ? "cornell_pov" : "cornell");
+  lm_material white = {"white", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.0f, 1.0f, 0, 0};
+  lm_material red = {"red", {0.63f, 0.065f, 0.05f}, 0.63f, 1.0f, 1.0f, 0.0f, 1.0f, 0, 0};
+  lm_material green = {"green", {0.14f, 0.45f, 0.091f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f, 0, 0};
+  lm_material box = {"box", {0.73f, 0.73f, 0.73f}, 0.73f, 1.0f, 1.0f, 0.15f, 24.0f, 0, 0};
   int m_white = lm_scene_add_material(s, &white), m_red = lm_scene_add_material(s, &red);
   int m_green = lm_scene_add_material(s, &green), m_box = lm_scene_add_material(s, &box);
+  if (mirror)
+    m_red = lm_scene_add_material(s, &(lm_material){.name = "mirror", .ka = 1, .shininess = 1, .reflectivity = 1});
 
   const struct {
     const char *name;
@@ -137,8 +142,8 @@ static lm_scene *cornell(bool pov) {
  * ground, rows of posts reaching far from the camera, a low sun. */
 static lm_scene *field(void) {
   lm_scene *s = lm_scene_create("field");
-  lm_material ground = {"ground", {0.45f, 0.5f, 0.35f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f, 0};
-  lm_material post = {"post", {0.7f, 0.6f, 0.5f}, 0.6f, 1.0f, 1.0f, 0.1f, 16.0f, 0};
+  lm_material ground = {"ground", {0.45f, 0.5f, 0.35f}, 0.45f, 1.0f, 1.0f, 0.0f, 1.0f, 0, 0};
+  lm_material post = {"post", {0.7f, 0.6f, 0.5f}, 0.6f, 1.0f, 1.0f, 0.1f, 16.0f, 0, 0};
   int m_ground = lm_scene_add_material(s, &ground), m_post = lm_scene_add_material(s, &post);
   const float g[4][3] = {{-100, 0, 100}, {100, 0, 100}, {100, 0, -100}, {-100, 0, -100}};
   mat4 id = GLM_MAT4_IDENTITY_INIT, m;
@@ -167,11 +172,12 @@ static lm_scene *field(void) {
   return s;
 }
 
-const char *lm_scene_builtin_list(void) { return "cornell, cornell_pov, field"; }
+const char *lm_scene_builtin_list(void) { return "cornell, cornell_pov, cornell_mirror, field"; }
 
 lm_scene *lm_scene_builtin(const char *name, lm_error *err) {
-  if (!strcmp(name, "cornell")) return cornell(false);
-  if (!strcmp(name, "cornell_pov")) return cornell(true);
+  if (!strcmp(name, "cornell")) return cornell(false, false);
+  if (!strcmp(name, "cornell_pov")) return cornell(true, false);
+  if (!strcmp(name, "cornell_mirror")) return cornell(true, true);
   if (!strcmp(name, "field")) return field();
   lm_error_set(err, "unknown scene '%s' (built in: %s)", name, lm_scene_builtin_list());
   return NULL;

@@ -32,6 +32,11 @@
  *     shininess = 2 / roughness^4 - 2, clamped to [1, 1024] (the Blinn-Phong
  *                 exponent whose lobe matches GGX of alpha = roughness^2)
  *     ka        = 1; rho = max(color) * kd   (what diffuse bounce returns)
+ *     reflectivity = extras.reflectivity, a number in [0, 1] (absent: 0).
+ *                 Mirror reflection is the artist's choice, not derived
+ *                 from metallic/roughness: a rough metal is no mirror, and
+ *                 existing files keep their look. A script overrides it per
+ *                 material (scene{ materials = ... }).
  *   A primitive without a material gets material -1, the engine's default.
  *   Beside it (lm_scene.material_pbr) the metallic-roughness model whole,
  *   for the pbr technique: factors, alphaMode and alphaCutoff, normal scale,

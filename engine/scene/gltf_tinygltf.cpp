@@ -481,6 +481,13 @@ int material_for(Loader &L, const char *where, int index) {
       !material_texture(L, index, "emissiveTexture", LM_TEX_EMISSIVE, gm.emissiveTexture.index,
                         gm.emissiveTexture.texCoord, gm.emissiveTexture.extensions, &m, &p))
     return -1;
+  if (gm.extras.IsObject() && gm.extras.Has("reflectivity")) {
+    const tinygltf::Value &r = gm.extras.Get("reflectivity");
+    double v = r.IsNumber() ? r.GetNumberAsDouble() : -1;
+    if (!(v >= 0 && v <= 1))
+      return fail(L, "material %d ('%s'): extras.reflectivity must be a number in [0, 1]", index, m.name), -1;
+    m.reflectivity = (float)v;
+  }
   L.materials[index] = lm_scene_add_material(L.s, &m);
   L.s->material_pbr[L.materials[index]] = p;
   return L.materials[index];

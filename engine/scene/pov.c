@@ -276,12 +276,18 @@ static bool write_material(pov_ctx *c, const lm_material *m, const char *id) {
                               "and so does the export", m->name))
     return false;
   double size = m->shininess >= 1 ? m->shininess : 1; /* the engine's max(shininess, 1) */
+  double refl = clamp01(m->reflectivity);
+  if (refl != m->reflectivity &&
+      !mismatch(c, "material '%s': reflectivity outside [0, 1]; the export clamps it", m->name))
+    return false;
+  char reflection[64] = "";
+  if (refl > 0) snprintf(reflection, sizeof reflection, " reflection %.9g", refl);
   lm_buf_printf(c->out,
                 "// material '%s'\n#declare %s = texture {\n"
                 "  pigment { rgb <%.9g, %.9g, %.9g> }\n"
-                "  finish { ambient 0 emission 0 diffuse %.9g brilliance 1 phong %.9g phong_size %.9g }\n"
+                "  finish { ambient 0 emission 0 diffuse %.9g brilliance 1 phong %.9g phong_size %.9g%s }\n"
                 "}\n\n",
-                m->name, id, col[0], col[1], col[2], kd, ks, size);
+                m->name, id, col[0], col[1], col[2], kd, ks, size, reflection);
   return true;
 }
 

@@ -34,8 +34,11 @@
  *   s = 2 / roughness^4 - 2 whose lobe matches GGX's and the normalized
  *   amplitude max(F0) (s + 2) / 8, metallic tinting it with the pigment,
  *   emission the emissive colour; Fresnel's rise at grazing angles, Smith
- *   shadowing, the 1 - F diffuse weight and textures are not carried. The
- *   engine's
+ *   shadowing, the 1 - F diffuse weight and textures are not carried. A
+ *   reflective material (reflectivity r > 0) adds "reflection r": POV-Ray
+ *   adds r times the colour seen along the mirror direction on top of
+ *   diffuse and phong (no conserve_energy, no fresnel), one bounce deep as
+ *   the engine's ray-traced reflections (engine/trace). The engine's
  *   ambient term (k_a * ambient) has no counterpart: render the engine with
  *   the option ambient = 0 when comparing.
  * - Lights, colour = color * power:

@@ -410,7 +410,7 @@ static const char *const slot_define[LM_TEX_SLOTS] = {"BASE_COLOR_TEXTURE", "MR_
                                                        "OCCLUSION_TEXTURE", "EMISSIVE_TEXTURE"};
 
 static const char *scene_uniforms[] = {"model", "normal_matrix", "material_color", "material_rho", "material_k",
-                                       "material_pbr", "material_emissive", "material_alpha", "base_color_tex",
+                                       "material_reflectivity", "material_pbr", "material_emissive", "material_alpha", "base_color_tex",
                                        "mr_tex", "normal_tex", "occlusion_tex", "emissive_tex", "base_color_xform",
                                        "mr_xform", "normal_xform", "occlusion_xform", "emissive_xform"};
 
@@ -420,8 +420,14 @@ bool lm_scene_owns_uniform(const char *name) {
   return false;
 }
 
+bool lm_scene_reflective(const lm_scene *s) {
+  for (int i = 0; i < s->node_count; i++)
+    if (s->nodes[i].mesh >= 0 && lm_scene_node_material(s, &s->nodes[i])->reflectivity > 0) return true;
+  return false;
+}
+
 const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n) {
-  static const lm_material fallback = {"default", {0.8f, 0.8f, 0.8f}, 0.8f, 0.1f, 0.9f, 0.0f, 16.0f, 0};
+  static const lm_material fallback = {"default", {0.8f, 0.8f, 0.8f}, 0.8f, 0.1f, 0.9f, 0.0f, 16.0f, 0, 0};
   return n->material >= 0 && n->material < s->material_count ? &s->materials[n->material] : &fallback;
 }
 
@@ -429,10 +435,11 @@ const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n) {
 static const struct {
   const char *name;
   int count;
-} material_params[] = {{"color", 3}, {"rho", 1}, {"ka", 1}, {"kd", 1}, {"ks", 1}, {"shininess", 1}};
+} material_params[] = {{"color", 3}, {"rho", 1}, {"ka", 1}, {"kd", 1}, {"ks", 1}, {"shininess", 1},
+                       {"reflectivity", 1}};
 enum { MATERIAL_PARAM_COUNT = sizeof material_params / sizeof *material_params };
 
-const char *lm_material_param_list(void) { return "color, rho, ka, kd, ks, shininess"; }
+const char *lm_material_param_list(void) { return "color, rho, ka, kd, ks, shininess, reflectivity"; }
 
 static int material_param_index(const char *name) {
   for (int i = 0; i < MATERIAL_PARAM_COUNT; i++)
@@ -481,6 +488,7 @@ static void apply_param(lm_material *m, const lm_material_param *p) {
   case 3: m->kd = p->v[0]; break;
   case 4: m->ks = p->v[0]; break;
   case 5: m->shininess = p->v[0]; break;
+  case 6: m->reflectivity = p->v[0]; break;
   default: break;
   }
 }
@@ -615,6 +623,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     if ((u = lm_program_uniform(p, "material_color"))) lm_program_set(p, u, m.color);
     if ((u = lm_program_uniform(p, "material_rho"))) lm_program_set(p, u, &m.rho);
     if ((u = lm_program_uniform(p, "material_k"))) lm_program_set(p, u, k);
+    if ((u = lm_program_uniform(p, "material_reflectivity"))) lm_program_set(p, u, &m.reflectivity);
     if ((u = lm_program_uniform(p, "material_pbr"))) lm_program_set(p, u, params);
     if ((u = lm_program_uniform(p, "material_emissive"))) lm_program_set(p, u, mp.emissive);
     if ((u = lm_program_uniform(p, "material_alpha"))) lm_program_set(p, u, alpha);

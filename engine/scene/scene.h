@@ -26,6 +26,10 @@ typedef struct lm_material {
   float rho;       /* reflectance, the G-buffer's "radiation mask" */
   float ka, kd, ks, shininess;
   int base_color_texture; /* 1 + index into the scene's textures; 0: none */
+  /* Mirror reflection in [0, 1] (seed 003 chapter 6): the share of the
+   * reflected view added on top of the surface's own light, as POV-Ray's
+   * finish { reflection r } does. 0: not reflective. */
+  float reflectivity;
 } lm_material;
 
 /* glTF's metallic-roughness data of a material, beside it (lm_scene's
@@ -155,6 +159,8 @@ int lm_scene_add_node(lm_scene *s, const char *name, int parent, const float loc
 int lm_scene_add_light(lm_scene *s, const lm_light *l);
 /* Takes ownership of `rgba` (malloc'd). Returns the texture's index. */
 int lm_scene_add_texture(lm_scene *s, const char *name, int width, int height, unsigned char *rgba);
+/* True when a mesh node's material has a reflectivity above 0. */
+bool lm_scene_reflective(const lm_scene *s);
 /* Index of the material called `name`, or -1. */
 int lm_scene_find_material(const lm_scene *s, const char *name);
 int lm_scene_add_camera(lm_scene *s, const lm_camera *c);
@@ -196,7 +202,8 @@ int lm_scene_add_camera_list(lm_scene *s, const char *path, int *count, lm_error
 const lm_material *lm_scene_node_material(const lm_scene *s, const lm_node *n);
 
 /* A scene built in code: "cornell"; "cornell_pov" (the box lit only by
- * lights POV-Ray matches exactly, engine/scene/pov.h); "field" (open ground
+ * lights POV-Ray matches exactly, engine/scene/pov.h); "cornell_mirror"
+ * (cornell_pov with a mirror for its left wall); "field" (open ground
  * under a sun, for cascaded shadows). NULL with a message listing the names. */
 lm_scene *lm_scene_builtin(const char *name, lm_error *err);
 const char *lm_scene_builtin_list(void);
@@ -243,7 +250,7 @@ bool lm_light_grid_has(const lm_light_grid *g, int cluster, int light);
 void lm_light_grid_free(lm_light_grid *g);
 
 /* A parameter override: material `material`'s parameter `name` ("color",
- * "rho", "ka", "kd", "ks", "shininess") takes v[0 .. count) for one draw.
+ * "rho", "ka", "kd", "ks", "shininess", "reflectivity") takes v[0 .. count) for one draw.
  * (The frame graph carries these as lm_pass_material_param; the renderer
  * copies them over, as scene and graph do not include each other.) */
 typedef struct lm_material_param {
@@ -277,9 +284,9 @@ typedef struct lm_scene_draw_stats {
 } lm_scene_draw_stats;
 /* Draws every mesh node whose bounds reach into the frustum, setting model,
  * normal_matrix, the material uniforms (material_color, material_rho,
- * material_k; material_pbr, material_emissive, material_alpha) and the
- * textures with their transforms (base_color_tex, base_color_xform, mr_tex,
- * ...). With a technique that declares material_pbr, a material whose
+ * material_k, material_reflectivity; material_pbr, material_emissive,
+ * material_alpha) and the textures with their transforms (base_color_tex,
+ * base_color_xform, mr_tex, ...). With a technique that declares material_pbr, a material whose
  * alphaMode is BLEND is an error naming it. Adds to *stats (may be NULL). */
 bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err);
 /* True when the world-space box lo..hi lies wholly outside one clip plane of view_proj. */

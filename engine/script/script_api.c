@@ -521,6 +521,15 @@ static void add_pass(lua_State *L, lm_pipeline *p, pass_builder *b) {
   if (lm_graph_add_pass(p->graph, &b->desc, &err) < 0) luaL_error(L, "%s", err.msg);
 }
 
+/* Adds the pass and returns its first output (pass{} and cpu{} chain). */
+static int add_pass_returning_output(lua_State *L, lm_pipeline *p, pass_builder *b, int top) {
+  add_pass(L, p, b);
+  lua_settop(L, top);
+  lua_getfield(L, 1, "out");
+  if (lua_istable(L, -1)) lua_rawgeti(L, -1, 1);
+  return 1;
+}
+
 /* scene{ "name", technique = "std", out = {...}, depth = T, clear = bool | {r,g,b,a}, ...,
  * views = plan, fit = T } */
 static int l_scene(lua_State *L) {
@@ -574,28 +583,49 @@ static int l_scene(lua_State *L) {
   return 0;
 }
 
+/* What pass{} and cpu{} share: the program (field `field`: a shader or a CPU
+ * function), outputs, inputs and parameters. */
+static lm_pipeline *begin_output_pass(lua_State *L, pass_builder *b, lm_pass_kind kind, const char *fn,
+                                      const char *const *fields, const char *field, const char *hint) {
+  lm_pipeline *p = recording(L, fn);
+  if (p->in_create) luaL_error(L, "%s() records a pass: call it from OnRender", fn);
+  begin_pass(L, b, kind, fn);
+  check_fields(L, 1, b->what, fields);
+  b->desc.shader = opt_string(L, 1, field, b->what);
+  if (!b->desc.shader) luaL_error(L, "%s: field '%s' is missing (%s)", b->what, field, hint);
+  read_outputs(L, 1, b);
+  if (b->desc.output_count == 0) luaL_error(L, "%s: field 'out' is missing", b->what);
+  read_inputs(L, 1, b);
+  read_params(L, 1, b);
+  return p;
+}
+
 /* pass{ "name", shader = "x.frag", inputs = {...}, params = {...}, out = T | {...}, defines = {...} }
  * returns its first output, so passes chain. */
 static int l_pass(lua_State *L) {
-  lm_pipeline *p = recording(L, "pass");
-  if (p->in_create) return luaL_error(L, "pass() records a pass: call it from OnRender");
+  static const char *const fields[] = {"shader", "inputs", "params", "out", "defines", "fetches", NULL};
   pass_builder b;
   int top = lua_gettop(L);
-  begin_pass(L, &b, LM_PASS_FULLSCREEN, "pass");
-  static const char *const fields[] = {"shader", "inputs", "params", "out", "defines", "fetches", NULL};
-  check_fields(L, 1, b.what, fields);
-  b.desc.shader = opt_string(L, 1, "shader", b.what);
-  if (!b.desc.shader) return luaL_error(L, "%s: field 'shader' is missing (a file in shaders/)", b.what);
-  read_outputs(L, 1, &b);
-  if (b.desc.output_count == 0) return luaL_error(L, "%s: field 'out' is missing", b.what);
-  read_inputs(L, 1, &b);
-  read_params(L, 1, &b);
+  lm_pipeline *p = begin_output_pass(L, &b, LM_PASS_FULLSCREEN, "pass", fields, "shader", "a file in shaders/");
   read_defines(L, 1, &b);
   b.desc.fetches = opt_number(L, 1, "fetches", 0, 0, 1e6f, b.what);
-  add_pass(L, p, &b);
-  lua_settop(L, top);
-  lua_getfield(L, 1, "out");
-  if (lua_istable(L, -1)) lua_rawgeti(L, -1, 1);
+  return add_pass_returning_output(L, p, &b, top);
+}
+
+/* cpu{ "name", fn = "trace", inputs = {...}, params = {...}, out = T | {...} }: a
+ * CPU pass (the engine's function `fn` between GPU passes); returns its first output. */
+static int l_cpu(lua_State *L) {
+  static const char *const fields[] = {"fn", "inputs", "params", "out", NULL};
+  pass_builder b;
+  int top = lua_gettop(L);
+  lm_pipeline *p = begin_output_pass(L, &b, LM_PASS_CPU, "cpu", fields, "fn", "an engine function: trace");
+  return add_pass_returning_output(L, p, &b, top);
+}
+
+/* scene_reflective(): whether a material the scene draws is reflective. */
+static int l_scene_reflective(lua_State *L) {
+  lm_pipeline *p = recording(L, "scene_reflective");
+  lua_pushboolean(L, p->scene && lm_scene_reflective(p->scene));
   return 1;
 }
 
@@ -629,8 +659,8 @@ void lm_script_open_api(lua_State *L) {
   lua_pop(L, 1);
   static const luaL_Reg api[] = {{"target", l_target}, {"scene", l_scene}, {"pass", l_pass},
                                  {"present", l_present}, {"output_size", l_output_size},
-                                 {"shadow_plan", l_shadow_plan}, {"sky_sh", l_sky_sh},
-                                 {NULL, NULL}};
+                                 {"shadow_plan", l_shadow_plan}, {"sky_sh", l_sky_sh}, {"cpu", l_cpu},
+                                 {"scene_reflective", l_scene_reflective}, {NULL, NULL}};
   lua_pushglobaltable(L);
   luaL_setfuncs(L, api, 0);
   lua_pop(L, 1);

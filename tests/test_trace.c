@@ -1,0 +1,307 @@
+/* The CPU ray tracer (engine/trace): the BVH finds what brute force finds,
+ * bad geometry and bad rays are skipped, a mirror shows the object its
+ * mirror image predicts, and a moved node is refitted. No GL needed. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "trace/trace.h"
+
+/* A small deterministic generator, so that failures reproduce. */
+static uint32_t rng_state = 12345;
+static float rnd(void) {
+  rng_state = rng_state * 1664525u + 1013904223u;
+  return (float)(rng_state >> 8) / 16777216.0f;
+}
+
+/* Nearest hit over every triangle, in double precision: the reference. */
+static double brute_nearest(const float *xyz, int count, const lm_trace_ray *r, int *which) {
+  double best = r->tmax;
+  *which = -1;
+  for (int i = 0; i < count; i++) {
+    const float *c = xyz + i * 9;
+    double e1[3], e2[3], s[3], p[3], q[3], d[3];
+    for (int k = 0; k < 3; k++)
+      e1[k] = c[3 + k] - c[k], e2[k] = c[6 + k] - c[k], s[k] = r->origin[k] - c[k], d[k] = r->dir[k];
+    p[0] = d[1] * e2[2] - d[2] * e2[1], p[1] = d[2] * e2[0] - d[0] * e2[2], p[2] = d[0] * e2[1] - d[1] * e2[0];
+    double det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
+    if (fabs(det) < 1e-300) continue;
+    double u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) / det;
+    q[0] = s[1] * e1[2] - s[2] * e1[1], q[1] = s[2] * e1[0] - s[0] * e1[2], q[2] = s[0] * e1[1] - s[1] * e1[0];
+    double v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
+    double t = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det;
+    if (u < 0 || v < 0 || u + v > 1 || t <= r->tmin || t >= best) continue;
+    best = t, *which = i;
+  }
+  return best;
+}
+
+static void bvh_agrees_with_brute_force(void **state) {
+  (void)state;
+  enum { TRIS = 3000, RAYS = 4000 };
+  float *xyz = malloc(TRIS * 9 * sizeof(float));
+  for (int i = 0; i < TRIS; i++) { /* small triangles in a unit cube, some long slivers */
+    float c[3] = {rnd(), rnd(), rnd()}, size = i % 10 == 0 ? 0.5f : 0.04f;
+    for (int v = 0; v < 3; v++)
+      for (int k = 0; k < 3; k++) xyz[i * 9 + v * 3 + k] = c[k] + (rnd() - 0.5f) * size;
+  }
+  lm_trace_stats st;
+  lm_trace *t = lm_trace_create_triangles(xyz, TRIS, &st);
+  assert_int_equal(st.triangles, TRIS);
+  assert_int_equal(st.skipped, 0);
+  assert_true(st.depth <= LM_TRACE_MAX_DEPTH);
+  assert_true(st.leaves > TRIS / 8); /* a real hierarchy, not one leaf */
+  lm_trace_ray *rays = malloc(RAYS * sizeof *rays);
+  lm_trace_hit *hits = malloc(RAYS * sizeof *hits);
+  for (int i = 0; i < RAYS; i++) {
+    float o[3] = {rnd() * 1.2f - 0.1f, rnd() * 1.2f - 0.1f, rnd() * 1.2f - 0.1f};
+    float d[3] = {rnd() - 0.5f, rnd() - 0.5f, rnd() - 0.5f};
+    if (i % 7 == 0) d[i % 3] = 0, d[(i + 1) % 3] = 0, d[(i + 2) % 3] = 1; /* axis-aligned: zero components */
+    rays[i] = (lm_trace_ray){{o[0], o[1], o[2]}, 0, {d[0], d[1], d[2]}, i % 5 == 0 ? 0.3f : INFINITY};
+  }
+  lm_trace_rays(t, rays, hits, RAYS, 2);
+  int hit_count = 0;
+  for (int i = 0; i < RAYS; i++) {
+    int which;
+    double want = brute_nearest(xyz, TRIS, &rays[i], &which);
+    lm_trace_hit one;
+    bool hit = lm_trace_intersect(t, &rays[i], &one);
+    assert_int_equal(hit, which >= 0);
+    assert_int_equal(one.tri, hits[i].tri); /* threads find what one ray alone finds */
+    if (!hit) continue;
+    hit_count++;
+    /* the same distance (a different triangle only where two lie as near) */
+    assert_true(fabs(one.t - want) <= 1e-4 * (1 + want));
+    lm_trace_surface s;
+    lm_trace_surface_at(t, &rays[i], &one, &s);
+    if (s.prim != which) {
+      int other;
+      lm_trace_ray only = rays[i];
+      only.tmax = (float)want * 1.001f + 1e-6f;
+      brute_nearest(xyz + s.prim * 9, 1, &only, &other);
+      assert_int_equal(other, 0);
+    }
+    assert_true(fabsf(s.normal[0] * s.normal[0] + s.normal[1] * s.normal[1] + s.normal[2] * s.normal[2] - 1) < 1e-4f);
+  }
+  print_message("%d of %d rays hit\n", hit_count, RAYS);
+  assert_true(hit_count > RAYS / 4); /* the comparison covered hits, not only misses */
+  free(rays), free(hits), free(xyz);
+  lm_trace_destroy(t);
+}
+
+static void empty_scenes_trace(void **state) {
+  (void)state;
+  lm_trace_stats st;
+  lm_trace *t = lm_trace_create_triangles(NULL, 0, &st);
+  assert_int_equal(st.triangles, 0);
+  lm_trace_ray r = {{0, 0, 0}, 0, {0, 0, -1}, INFINITY};
+  lm_trace_hit h;
+  assert_false(lm_trace_intersect(t, &r, &h));
+  assert_int_equal(h.tri, -1);
+  lm_trace_hit hs[600];
+  lm_trace_ray rs[600];
+  for (int i = 0; i < 600; i++) rs[i] = r;
+  lm_trace_rays(t, rs, hs, 600, 0);
+  for (int i = 0; i < 600; i++) assert_int_equal(hs[i].tri, -1);
+  lm_trace_destroy(t);
+
+  lm_scene *s = lm_scene_create("empty");
+  lm_scene_update(s);
+  t = lm_trace_create(s, &st);
+  assert_int_equal(st.triangles, 0);
+  assert_false(lm_trace_intersect(t, &r, &h));
+  lm_trace_update(t, s, &st);
+  assert_true(st.refitted);
+  assert_false(lm_trace_intersect(t, &r, &h));
+  lm_trace_destroy(t);
+  lm_scene_destroy(s);
+}
+
+static void degenerate_triangles_are_skipped(void **state) {
+  (void)state;
+  const float nan = NAN, inf = INFINITY;
+  const float bad[][9] = {
+      {0, 0, 0, 0, 0, 0, 0, 0, 0},        /* a point */
+      {0, 0, 0, 1, 1, 1, 2, 2, 2},        /* collinear */
+      {0, 0, 0, 1, 0, 0, 1, 0, 0},        /* two corners the same */
+      {nan, 0, 0, 1, 0, 0, 0, 1, 0},      /* NaN */
+      {0, 0, 0, inf, 0, 0, 0, 1, 0},      /* Inf */
+      {0, 0, 0, 3e38f, 0, 0, 0, 3e38f, 0}, /* finite corners, area overflows */
+      {-3e38f, 0, 0, 3e38f, 0, 0, 0, 1, 0}, /* an edge overflows */
+  };
+  int n = sizeof bad / sizeof bad[0];
+  lm_trace_stats st;
+  lm_trace *t = lm_trace_create_triangles(&bad[0][0], n, &st);
+  assert_int_equal(st.triangles, 0);
+  assert_int_equal(st.skipped, n);
+  lm_trace_ray r = {{0.2f, 0.2f, 1}, 0, {0, 0, -1}, INFINITY};
+  lm_trace_hit h;
+  assert_false(lm_trace_intersect(t, &r, &h));
+  lm_trace_destroy(t);
+
+  /* the same with one good triangle among them: it alone is hit */
+  float mixed[8][9];
+  memcpy(mixed, bad, sizeof bad);
+  const float good[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  memcpy(mixed[n], good, sizeof good);
+  t = lm_trace_create_triangles(&mixed[0][0], n + 1, &st);
+  assert_int_equal(st.triangles, 1);
+  assert_true(lm_trace_intersect(t, &r, &h));
+  assert_float_equal(h.t, 1, 1e-6);
+  lm_trace_surface s;
+  lm_trace_surface_at(t, &r, &h, &s);
+  assert_int_equal(s.prim, n);
+  assert_float_equal(s.normal[2], 1, 1e-6); /* facing the ray */
+
+  /* bad rays miss without a fault */
+  const lm_trace_ray rays[] = {
+      {{nan, 0, 1}, 0, {0, 0, -1}, INFINITY}, {{0.2f, 0.2f, 1}, 0, {0, 0, 0}, INFINITY},
+      {{0.2f, 0.2f, 1}, 0, {0, 0, inf}, INFINITY}, {{0.2f, 0.2f, 1}, 2, {0, 0, -1}, 1},
+      {{0.2f, 0.2f, 1}, nan, {0, 0, -1}, INFINITY}, {{0.2f, 0.2f, 1}, 0, {0, 0, -1}, nan},
+      {{0.2f, 0.2f, 1}, 0, {0, 0, -1e-38f}, INFINITY}, /* tiny but fine: still hits */
+  };
+  for (int i = 0; i < 7; i++) assert_int_equal(lm_trace_intersect(t, &rays[i], &h), i == 6);
+  lm_trace_destroy(t);
+}
+
+/* A box mesh of half-size 1 about the origin, normals per face. */
+static int add_box(lm_scene *s) {
+  float v[24 * 8];
+  uint32_t idx[36];
+  for (int f = 0; f < 6; f++) {
+    int ax = f / 2;
+    float sg = f % 2 ? -1.0f : 1.0f;
+    int a = (ax + 1) % 3, b = (ax + 2) % 3;
+    static const float corner[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    for (int c = 0; c < 4; c++) {
+      float *p = v + (f * 4 + c) * 8;
+      memset(p, 0, 8 * sizeof(float));
+      p[ax] = sg, p[a] = corner[c][0], p[b] = corner[c][1] * sg;
+      p[3 + ax] = sg;
+    }
+    static const int tri[6] = {0, 1, 2, 0, 2, 3};
+    for (int k = 0; k < 6; k++) idx[f * 6 + k] = (uint32_t)(f * 4 + tri[k]);
+  }
+  return lm_scene_add_mesh(s, "box", v, 24, idx, 36);
+}
+
+static void translate_scale(float m[16], float x, float y, float z, float sx, float sy, float sz) {
+  memset(m, 0, 16 * sizeof(float));
+  m[0] = sx, m[5] = sy, m[10] = sz, m[15] = 1;
+  m[12] = x, m[13] = y, m[14] = z;
+}
+
+/* Where the segment from `o` along `d` enters the box lo..hi; -1 when it misses. */
+static float slab(const float o[3], const float d[3], const float lo[3], const float hi[3]) {
+  float t0 = 0, t1 = INFINITY;
+  for (int k = 0; k < 3; k++) {
+    if (fabsf(d[k]) < 1e-12f) {
+      if (o[k] < lo[k] || o[k] > hi[k]) return -1;
+      continue;
+    }
+    float a = (lo[k] - o[k]) / d[k], b = (hi[k] - o[k]) / d[k];
+    t0 = fmaxf(t0, fminf(a, b)), t1 = fminf(t1, fmaxf(a, b));
+  }
+  return t0 <= t1 ? t0 : -1;
+}
+
+/* A mirror (a flat box, top face at y = 0) under a red cube: an eye above
+ * looks down at the mirror; each reflected ray must hit the cube exactly where
+ * the straight ray from the eye meets the cube's mirror image (y -> -y). */
+static void mirror_shows_the_known_object(void **state) {
+  (void)state;
+  lm_scene *s = lm_scene_create("mirror");
+  int box = add_box(s);
+  int mirror_mat = lm_scene_add_material(s, &(lm_material){.name = "mirror", .color = {1, 1, 1}, .kd = 1});
+  int red = lm_scene_add_material(s, &(lm_material){.name = "red", .color = {1, 0, 0}, .kd = 1});
+  float m[16];
+  translate_scale(m, 0, -0.05f, 0, 4, 0.05f, 4); /* top face at y = 0 */
+  int mirror_node = lm_scene_add_node(s, "mirror", -1, m, box, mirror_mat);
+  const float c[3] = {1.0f, 1.0f, -0.5f}, half[3] = {0.3f, 0.4f, 0.5f};
+  translate_scale(m, c[0], c[1], c[2], half[0], half[1], half[2]);
+  int cube = lm_scene_add_node(s, "cube", -1, m, box, red);
+  lm_scene_update(s);
+  lm_trace_stats st;
+  lm_trace *t = lm_trace_create(s, &st);
+  assert_int_equal(st.triangles, 24);
+
+  const float eye[3] = {-1.5f, 2.0f, 0.5f};
+  const float lo[3] = {c[0] - half[0], -c[1] - half[1], c[2] - half[2]};
+  const float hi[3] = {c[0] + half[0], -c[1] + half[1], c[2] + half[2]}; /* the mirror image */
+  int shown = 0, agree = 0, total = 0;
+  for (int j = 0; j < 24; j++)
+    for (int i = 0; i < 32; i++) {
+      float p[3] = {-2.0f + 4.0f * (i + 0.5f) / 32, 0, -2.0f + 4.0f * (j + 0.5f) / 24};
+      float d[3] = {p[0] - eye[0], p[1] - eye[1], p[2] - eye[2]};
+      /* the primary ray must find the mirror first (the cube may hide it) */
+      lm_trace_ray pr = {{eye[0], eye[1], eye[2]}, 0, {d[0], d[1], d[2]}, INFINITY};
+      lm_trace_hit ph;
+      assert_true(lm_trace_intersect(t, &pr, &ph));
+      lm_trace_surface ps;
+      lm_trace_surface_at(t, &pr, &ph, &ps);
+      if (ps.node != mirror_node) continue;
+      total++;
+      assert_float_equal(ps.normal[1], 1, 1e-5);
+      /* reflect about the normal, as the GPU's ray pass does */
+      lm_trace_ray rr = {{ps.position[0], ps.position[1], ps.position[2]}, 1e-4f, {d[0], -d[1], d[2]}, INFINITY};
+      lm_trace_hit rh;
+      bool hit = lm_trace_intersect(t, &rr, &rh);
+      float te = slab(eye, d, lo, hi);
+      bool want = te >= 0;
+      if (!hit) {
+        agree += !want;
+        continue;
+      }
+      lm_trace_surface rs;
+      lm_trace_surface_at(t, &rr, &rh, &rs);
+      bool on_cube = rs.node == cube;
+      agree += on_cube == want;
+      if (!on_cube || !want) continue;
+      shown++;
+      assert_int_equal(s->nodes[rs.node].material, red);
+      /* eye + te d is the image point; its mirror (y -> -y) is where the reflected ray lands */
+      float img[3] = {eye[0] + te * d[0], -(eye[1] + te * d[1]), eye[2] + te * d[2]};
+      for (int k = 0; k < 3; k++) assert_float_equal(rs.position[k], img[k], 1e-4);
+    }
+  assert_true(total > 500);
+  assert_true(shown > 20);          /* the cube is seen in the mirror */
+  assert_true(agree >= total - 2);  /* and only where its image is (grazing edges aside) */
+
+  /* the cube moves: a refit, and the reflection follows it */
+  translate_scale(m, -1.0f, 1.0f, -0.5f, half[0], half[1], half[2]);
+  memcpy(s->nodes[cube].local, m, sizeof m);
+  lm_scene_update(s);
+  lm_trace_update(t, s, &st);
+  assert_true(st.refitted);
+  lm_trace_ray down = {{-1.0f, 5, -0.5f}, 0, {0, -1, 0}, INFINITY};
+  lm_trace_hit h;
+  assert_true(lm_trace_intersect(t, &down, &h));
+  assert_float_equal(h.t, 5 - 1.4f, 1e-5);
+  down.origin[0] = 1.0f;
+  assert_true(lm_trace_intersect(t, &down, &h));
+  assert_float_equal(h.t, 5, 1e-5); /* where the cube was: the mirror */
+
+  /* a node gains no mesh but loses one: a rebuild */
+  s->nodes[cube].mesh = -1;
+  lm_scene_update(s);
+  lm_trace_update(t, s, &st);
+  assert_false(st.refitted);
+  assert_int_equal(st.triangles, 12);
+  lm_trace_destroy(t);
+  lm_scene_destroy(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(bvh_agrees_with_brute_force),
+      cmocka_unit_test(empty_scenes_trace),
+      cmocka_unit_test(degenerate_triangles_are_skipped),
+      cmocka_unit_test(mirror_shows_the_known_object),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
