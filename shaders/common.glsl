@@ -80,4 +80,13 @@ vec3 finite_or_zero(vec3 c) {
   return max(mix(c, vec3(0.0), bad), vec3(0.0));
 }
 
+// glTF alphaMode MASK (a material variant's ALPHA_MASK, lm_scene_draw): a
+// fragment whose alpha, material_alpha.x times the base colour texel's, is
+// below the cutoff material_alpha.y is no surface, in the G-buffer and in
+// shadow maps alike.
+#ifdef ALPHA_MASK
+uniform vec2 material_alpha;
+bool alpha_masked(float texel_alpha) { return material_alpha.x * texel_alpha < material_alpha.y; }
+#endif
+
 #endif

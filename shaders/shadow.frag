@@ -9,14 +9,17 @@
 
 in vec3 world_pos;
 uniform vec4 pass_depth;
-#ifdef RSM
-in vec3 world_normal;
+#if defined(RSM) || defined(ALPHA_MASK)
 in vec2 tex_uv;
-uniform vec3 material_color;
-uniform vec4 material_k; // k_a, k_d, k_s, shininess
 #ifdef BASE_COLOR_TEXTURE
 uniform sampler2D base_color_tex;
+uniform mat3 base_color_xform; // KHR_texture_transform
 #endif
+#endif
+#ifdef RSM
+in vec3 world_normal;
+uniform vec3 material_color;
+uniform vec4 material_k; // k_a, k_d, k_s, shininess
 layout(location = 1) out vec4 rsm_flux;
 layout(location = 2) out vec4 rsm_nrm;
 layout(location = 3) out vec4 rsm_pos;
@@ -25,15 +28,20 @@ layout(location = 3) out vec4 rsm_pos;
 layout(location = 0) out float depth01;
 
 void main() {
+#if defined(BASE_COLOR_TEXTURE) && (defined(RSM) || defined(ALPHA_MASK))
+  vec4 texel = texture(base_color_tex, (base_color_xform * vec3(tex_uv, 1.0)).xy);
+#else
+  vec4 texel = vec4(1.0);
+#endif
+#ifdef ALPHA_MASK
+  if (alpha_masked(texel.a)) discard;
+#endif
   if (pass_depth.w > 0.0) // perspective: distance from the light / range
     depth01 = saturate(length(world_pos - pass_depth.xyz) * pass_depth.w);
   else                    // orthographic: window depth is already linear
     depth01 = saturate(gl_FragCoord.z); // casters before the near plane are clamped onto it
 #ifdef RSM
-  vec3 albedo = material_color;
-#ifdef BASE_COLOR_TEXTURE
-  albedo *= texture(base_color_tex, tex_uv).rgb;
-#endif
+  vec3 albedo = material_color * texel.rgb;
   vec3 n = safe_normalize(world_normal, vec3(0.0, 1.0, 0.0));
   if (!gl_FrontFacing) n = -n; // two-sided, as the G-buffer
   rsm_flux = vec4(saturate(material_k.y) * saturate(albedo), 1.0);

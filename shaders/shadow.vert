@@ -4,12 +4,14 @@
 #include "common.glsl"
 
 layout(location = 0) in vec3 in_position;
+#if defined(RSM) || defined(ALPHA_MASK)
+layout(location = 2) in vec2 in_uv;
+out vec2 tex_uv;
+#endif
 #ifdef RSM
 layout(location = 1) in vec3 in_normal;
-layout(location = 2) in vec2 in_uv;
 uniform mat3 normal_matrix;
 out vec3 world_normal;
-out vec2 tex_uv;
 #endif
 
 uniform mat4 model;
@@ -21,9 +23,11 @@ out vec3 world_pos;
 void main() {
   vec4 world = model * vec4(in_position, 1.0);
   world_pos = world.xyz;
+#if defined(RSM) || defined(ALPHA_MASK)
+  tex_uv = in_uv;
+#endif
 #ifdef RSM
   world_normal = normal_matrix * in_normal;
-  tex_uv = in_uv;
 #endif
   gl_Position = pass_view_proj * world;
 }

@@ -26,10 +26,14 @@ layout(location = 3) out vec4 out_mat;
 void main() {
   vec3 n = safe_normalize(world_normal, vec3(0.0, 1.0, 0.0));
   if (!gl_FrontFacing) n = -n; // two-sided: a wall seen from behind still lights
-  vec3 albedo = material_color;
+  vec4 base = vec4(material_color, 1.0);
 #ifdef BASE_COLOR_TEXTURE
-  albedo *= texture(base_color_tex, (base_color_xform * vec3(tex_uv, 1.0)).xy).rgb; // glTF: factor * texture
+  base *= texture(base_color_tex, (base_color_xform * vec3(tex_uv, 1.0)).xy); // glTF: factor * texture
 #endif
+#ifdef ALPHA_MASK
+  if (alpha_masked(base.a)) discard;
+#endif
+  vec3 albedo = base.rgb;
   out_clr = vec4(saturate(albedo), saturate(material_rho));
   out_nrm = vec4(n, max(material_k.w, 0.0));
   out_dpt = dpt_encode(view_depth);

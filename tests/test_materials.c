@@ -445,6 +445,61 @@ static void pbr_sphere_grid_is_finite_and_monotonic(void **state) {
   lm_scene_destroy(s);
 }
 
+/* glTF alphaMode MASK in both material techniques: a sphere whose alpha is
+ * under its cutoff is no surface in the G-buffer and casts no shadow, so the
+ * floor below it is lit as if it were not there; opaque, the same sphere
+ * shadows the floor. */
+static void alpha_masked_casters_cast_no_shadow(void **state) {
+  (void)state;
+  enum { W = 96, H = 72 };
+  lm_scene *s = lm_scene_create("mask");
+  int sphere = add_sphere(s, 0.5f);
+  static const float floor_v[4 * 8] = {-4, 0, -4, 0, 1, 0, 0, 0, 4, 0, -4, 0, 1, 0, 1, 0,
+                                       4, 0, 4,  0, 1, 0, 1, 1, -4, 0, 4, 0, 1, 0, 0, 1};
+  static const uint32_t floor_i[6] = {0, 2, 1, 0, 3, 2};
+  int floor_mesh = lm_scene_add_mesh(s, "floor", floor_v, 4, floor_i, 6);
+  lm_material white = {.name = "white", .color = {0.8f, 0.8f, 0.8f}, .rho = 0.8f, .ka = 1, .kd = 1, .shininess = 1};
+  lm_material ball = white;
+  snprintf(ball.name, sizeof ball.name, "ball");
+  int m_white = lm_scene_add_material(s, &white), m_ball = lm_scene_add_material(s, &ball);
+  float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  lm_scene_add_node(s, "floor", -1, m, floor_mesh, m_white);
+  m[13] = 1.5f;
+  lm_scene_add_node(s, "ball", -1, m, sphere, m_ball);
+  /* the eye straight above, looking down; the sun at 45 degrees, its light
+   * toward +x: the ball's shadow lies 1.5 to the right of it (16 pixels) */
+  float down[16] = {1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, 0, 6, 0, 1};
+  const float c = 0.70710678f;
+  float slant[16] = {c, c, 0, 0, 0, 0, -1, 0, -c, c, 0, 0, 0, 0, 0, 1};
+  int eye = lm_scene_add_node(s, "eye", -1, down, -1, -1), sun = lm_scene_add_node(s, "sun", -1, slant, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "eye", .fov_y = 1.0f, .znear = 0.5f, .zfar = 20, .node = eye});
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 1,
+                                     .outer_cone = 1.5707964f, .casts_shadows = true, .node = sun});
+  lm_scene_update(s);
+  static const char *const materials[] = {"materials=phong", "materials=pbr"};
+  for (int k = 0; k < 2; k++) {
+    const char *sets[] = {materials[k], "ambient=0", NULL};
+    float lit[2][3], ring[2][3];
+    for (int masked = 0; masked < 2; masked++) {
+      s->material_pbr[m_ball] = (lm_material_pbr){.set = true, .roughness = 1, .normal_scale = 1,
+                                                  .occlusion_strength = 1, .alpha = masked ? 0.3f : 1.0f,
+                                                  .alpha_mode = LM_ALPHA_MASK, .alpha_cutoff = 0.5f};
+      gl_result g = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = sets, .width = W, .height = H,
+                                        .check_finite = true});
+      if (!g.ok) fail_msg("%s: %s", materials[k], g.err.msg);
+      gl_region(&g, W / 2 + 14, H / 2 - 2, W / 2 + 18, H / 2 + 2, lit[masked]);  /* the ball's shadow */
+      gl_region(&g, W / 2 + 30, H / 2 - 2, W / 2 + 34, H / 2 + 2, ring[masked]); /* open floor */
+      gl_result_free(&g);
+    }
+    printf("%s: where the ball's shadow falls %.4f opaque, %.4f masked; open floor %.4f\n", materials[k],
+           (double)gl_luminance(lit[0]), (double)gl_luminance(lit[1]), (double)gl_luminance(ring[1]));
+    assert_true(gl_luminance(ring[1]) > 0.1f);
+    assert_true(gl_luminance(lit[0]) < 0.1f * gl_luminance(ring[1]));               /* opaque: its shadow */
+    assert_float_equal(gl_luminance(lit[1]), gl_luminance(ring[1]), 0.02f * gl_luminance(ring[1])); /* masked: none */
+  }
+  lm_scene_destroy(s);
+}
+
 /* A file drawing `n` float3 vertices (`b64`, then `ni` u16 indices when ni >
  * 0) as primitive `mode`, seen by one camera. */
 static lm_scene *topology_scene(const char *b64, int n, int ni, int mode) {
@@ -526,6 +581,7 @@ int main(void) {
       cmocka_unit_test(materials_reload_without_a_restart),
       cmocka_unit_test(bad_textures_name_material_texture_and_image),
       cmocka_unit_test(pbr_sphere_grid_is_finite_and_monotonic),
+      cmocka_unit_test(alpha_masked_casters_cast_no_shadow),
       cmocka_unit_test(strips_and_fans_render_as_their_triangle_lists),
       cmocka_unit_test(mutated_scene_files_never_crash),
   };

@@ -544,7 +544,10 @@ static int slot_texture(const lm_scene *s, const lm_material *m, const lm_materi
 }
 
 /* The variant's defines: a define per texture the technique reads (every
- * slot for a pbr one, the base colour for the others). */
+ * slot for a pbr one, the base colour for the others), and ALPHA_MASK for a
+ * glTF alphaMode MASK material in the others (std.frag, shadow.frag: a masked
+ * hole is no surface and casts no shadow; pbr.frag reads material_alpha
+ * always). */
 static void material_defines(const lm_scene *s, const lm_material *m, const lm_material_pbr *p, bool pbr,
                              char *out, size_t cap) {
   out[0] = '\0';
@@ -552,6 +555,10 @@ static void material_defines(const lm_scene *s, const lm_material *m, const lm_m
     if (slot_texture(s, m, p, slot) < 0 || (slot != LM_TEX_BASE_COLOR && !pbr)) continue;
     size_t len = strlen(out);
     snprintf(out + len, cap - len, "%s%s", len ? ";" : "", slot_define[slot]);
+  }
+  if (!pbr && p->alpha_mode == LM_ALPHA_MASK) {
+    size_t len = strlen(out);
+    snprintf(out + len, cap - len, "%sALPHA_MASK", len ? ";" : "");
   }
 }
 
