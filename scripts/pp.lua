@@ -116,7 +116,7 @@ function OnRender(tech)
   -- Ray-traced reflections on every technique, left out where no material reflects.
   if tech.reflections.enabled and scene_reflective() then
     lit = reflections.render(G, lit, tech.reflections, { ambient = grey(tech.ambient),
-                             background = grey(tech.background), shadows = shadows })
+                             background = grey(tech.background), shadows = shadows, sky = skylight })
   end
   present(post.render(lit, tech, G))
 end

@@ -9,6 +9,7 @@
 local filters = require "filters"
 local options = require "options"
 local shadow = require "shadow"
+local sky = require "sky"
 
 local reflections = {}
 
@@ -29,7 +30,7 @@ local rules = {
 }
 
 -- Adds reflections to `lit` (full size) for G-buffer G with options o;
--- light = { ambient =, background =, shadows = } as the camera's lighting.
+-- light = { ambient =, background =, shadows =, sky = } as the camera's lighting.
 -- Returns a full-size rgba16f target "reflect.out".
 function reflections.render(G, lit, o, light)
   o = options.check("reflections", reflections.defaults, o, rules, 2)
@@ -44,8 +45,9 @@ function reflections.render(G, lit, o, light)
        out = { H.clr, H.nrm, H.pos, H.mat } }
   local inputs, defines = shadow.bind(light.shadows, { hit_clr = H.clr, hit_nrm = H.nrm, hit_pos = H.pos,
                                                        hit_mat = H.mat, rays_o = rays_o, rays_d = rays_d }, {})
+  local params = sky.bind(light.sky, { ambient = light.ambient, background = light.background }, defines)
   local refl = pass{ "reflect.light", shader = "reflect_light.frag", inputs = inputs, defines = defines,
-                     params = { ambient = light.ambient, background = light.background },
+                     params = params,
                      out = half("reflect.lit", "rgba16f") }
   refl = filters.upsample(refl, G, { name = "reflect.upsample", format = "rgba16f", factor = f,
                                      sigma_depth = o.sigma_depth, sigma_normal = o.sigma_normal })

@@ -10,5 +10,5 @@ out vec4 lit;
 
 void main() {
   Surface s = gbuffer_read(clr, nrm, dpt, mat, uv);
-  lit = vec4(s.covered ? direct_light(s, ambient) : background, 1.0);
+  lit = vec4(s.covered ? direct_light(s, ambient) : background + sky_seen(uv), 1.0);
 }

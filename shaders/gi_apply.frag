@@ -2,7 +2,7 @@
 // direct light `lit` (lights and shadows, no ambient term; seed 001, lines
 // 1301-1313). sky = k_a L_a albedo is the ambient term, the light of the sky
 // in the physical variants, the only light occlusion may take away.
-// Background keeps the lit colour. One of:
+// Background keeps the lit colour, plus the sky seen there. One of:
 //  PHYSICAL  out = lit + A sky + B     SSDO: accessibility and bounce
 //  MERGED    out = M (lit + sky + B)   SSDO modulation factor and bounce (the seed's)
 //  TWO_STEP  out = L_dir + L_ind       the original SSDO's two results
@@ -28,8 +28,8 @@ void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   vec3 l = texelFetch(lit, p, 0).rgb;
   vec4 m = texelFetch(mat, p, 0);
-  if (m.a < 0.5) {
-    result = vec4(l, 1.0);
+  if (m.a < 0.5) { // the lit colour (background) and the sky, which the direct pass leaves out
+    result = vec4(l + sky_seen(uv), 1.0);
     return;
   }
 #ifdef SKY

@@ -59,7 +59,7 @@ vec4 upsample(float z) {
 void main() {
   Surface s = gbuffer_read(clr, nrm, dpt, mat, uv);
   if (!s.covered) {
-    lit = vec4(background, 1.0);
+    lit = vec4(background + sky_seen(uv), 1.0);
     return;
   }
   vec4 e = upsample(s.depth01);

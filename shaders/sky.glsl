@@ -5,6 +5,7 @@
 // albedo it is the ambient term, which occlusion alone may take away.
 #ifndef LIMN_SKY_GLSL
 #define LIMN_SKY_GLSL
+#include "common.glsl"
 #ifdef SKY
 uniform mat3 sky_r, sky_g, sky_b;
 
@@ -14,6 +15,29 @@ float sky_sh(mat3 c, vec3 n) {
          0.315391565 * c[2][0] * (3.0 * n.z * n.z - 1.0) + 0.546274215 * c[2][2] * (n.x * n.x - n.y * n.y);
 }
 #endif
+
+// The sky's radiance along unit direction d (black without SKY): the 3
+// bands of radiance, each band's irradiance coefficients over A_l / pi (1,
+// 2/3, 1/4), clamped as above. What background pixels and rays that miss
+// see, as POV-Ray's camera sees its sky_sphere (a smooth 3-band sky).
+vec3 sky_radiance(vec3 d) {
+#ifdef SKY
+  const mat3 band = mat3(1.0, 1.5, 1.5, 1.5, 4.0, 4.0, 4.0, 4.0, 4.0); // sky_sh's layout
+  return max(vec3(sky_sh(matrixCompMult(sky_r, band), d), sky_sh(matrixCompMult(sky_g, band), d),
+                  sky_sh(matrixCompMult(sky_b, band), d)), 0.0);
+#else
+  return vec3(0.0);
+#endif
+}
+
+// The sky seen through the output's uv (0..1), on the camera's ray there.
+vec3 sky_seen(vec2 uv) {
+#ifdef SKY
+  return sky_radiance(safe_normalize(position_from_depth(uv, 1.0) - frame.camera_pos.xyz, vec3(0.0, 0.0, -1.0)));
+#else
+  return vec3(0.0);
+#endif
+}
 
 vec3 sky_ambient(vec3 ambient, vec3 n) {
 #ifdef SKY

@@ -50,6 +50,33 @@ static void a_uniform_sky_gives_albedo_times_radiance(void **state) {
   lm_scene_destroy(s);
 }
 
+/* Background pixels show the sky, as POV-Ray's camera sees its sky_sphere:
+ * a uniform sky of 0.5 in the sky above the field under every technique, and
+ * a sky brighter at the zenith brighter toward the image's top. */
+static void the_sky_is_seen_where_no_geometry_is(void **state) {
+  (void)state;
+  lm_scene *s = shaded_field();
+  static const char *const uniform[] = {"ambient=0", "sky=true", "sky.zenith=0.5", "sky.horizon=0.5", NULL};
+  static const char *const techs[] = {"dl", "isr", "ssao", "ssdo", "isr+esm"};
+  for (int t = 0; t < 5; t++) {
+    gl_result r = render_ok(s, techs[t], uniform);
+    float top[3];
+    gl_region(&r, 0, 0, 95, 3, top);
+    printf("%s: the sky above the field: %.4f %.4f %.4f (0.5)\n", techs[t], top[0], top[1], top[2]);
+    for (int k = 0; k < 3; k++) assert_float_equal(top[k], 0.5f, 0.01f);
+    gl_result_free(&r);
+  }
+  static const char *const gradient[] = {"ambient=0", "sky=true", "sky.zenith=1", "sky.horizon=0.1", NULL};
+  gl_result r = render_ok(s, "dl", gradient);
+  float high[3], low[3];
+  gl_region(&r, 0, 0, 95, 1, high);
+  gl_region(&r, 0, 12, 95, 13, low);
+  printf("gradient sky: %.4f at the top, %.4f lower\n", gl_luminance(high), gl_luminance(low));
+  assert_true(gl_luminance(high) > gl_luminance(low) + 0.02f);
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+}
+
 /* Mean of the 3 x 3 pixels around world point p seen through vp. */
 static float luminance_at(const gl_result *r, mat4 vp, float x, float y, float z) {
   vec4 q;
@@ -118,6 +145,7 @@ static void bad_sky_options_are_refused(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(a_uniform_sky_gives_albedo_times_radiance),
+      cmocka_unit_test(the_sky_is_seen_where_no_geometry_is),
       cmocka_unit_test(gi_occludes_the_sky_beside_an_obstacle),
       cmocka_unit_test(a_sky_of_intensity_0_changes_nothing),
       cmocka_unit_test(bad_sky_options_are_refused),
