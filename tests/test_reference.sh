@@ -10,7 +10,8 @@
 # - a two-setting sweep writes the CSV, the JSON, the SVG (it parses as XML)
 #   and the Markdown summary, with consistent numbers; it renders (once) the
 #   direct-only reference of the view, whose error against the baseline is
-#   the floor of the share of indirect error removed.
+#   the floor of the share of indirect error removed;
+# - each setting starts from the job's options, inheriting none from the one before.
 # Skipped (77) where povray is not installed (tools/dev.sh installs it).
 set -u
 limn=$1
@@ -161,6 +162,17 @@ low=$(grep -o 'text-anchor="end">[-0-9.e+]*<' rep/report.svg | head -1 | tr -dc 
 awk -v l="$low" 'BEGIN { exit !(l > 0) }' || fail "the error axis starts at $low, not at the data"
 # The images are there to look at.
 [ "$(ls rep/images/*.exr | wc -l)" = 3 ] || fail "not three images"
+
+# Every setting starts from the job's options: "isr" after "isr:isr.mode=seed" renders the default
+# mode, not the seed's it would inherit.
+"$limn" report --job job.lua "${fast[@]}" --out rep4 --frames 1 --warmup 0 \
+  --sweep "isr:isr.mode=seed" --sweep isr >log11 2>&1 || { cat log11; fail "report seed then default"; }
+sed -e 's/sizes = /techniques = { "isr" }, sizes = /' -e 's|out/{camera}_{technique}.png|isr/{camera}.exr|' job.lua >isr.lua
+"$limn" capture --job isr.lua >/dev/null 2>&1 || fail "capture isr"
+"$limn" compare rep4/images/ball_front_48x36_2.exr isr/front.exr --json >c2.json || fail "compare setting 2"
+grep -q '"mean_error": 0[,}]' c2.json || { cat c2.json; fail "isr after isr.mode=seed is not isr's default"; }
+"$limn" compare rep4/images/ball_front_48x36_1.exr isr/front.exr --json >c1.json || fail "compare setting 1"
+grep -q '"mean_error": 0[,}]' c1.json && fail "isr.mode=seed rendered the default"
 
 # 4. --require-refs names the command when a reference is missing
 "$limn" report --job job.lua "${fast[@]}" --refs refs-none --require-refs --out rep2 --sweep dl >log7 2>&1

@@ -390,8 +390,50 @@ static bool write_file(const report_args *a, const char *name, lm_buf *b, lm_err
   return ok;
 }
 
-static bool set_setting(lm_pipeline *p, const report_setting *s, lm_error *err) {
+/* The value each swept option has before any setting (the script's default
+ * with the job's `set`), so that every setting starts from the same options
+ * and none inherits the one before it. */
+typedef struct report_base {
+  char (*names)[128], (*values)[64];
+  int count;
+} report_base;
+
+static bool base_has(const report_base *b, const char *name) {
+  for (int i = 0; i < b->count; i++)
+    if (!strcmp(b->names[i], name)) return true;
+  return false;
+}
+
+static void base_take(report_base *b, const lm_pipeline *p, const report_setting *settings, int n) {
+  int cap = n * REPORT_MAX_OPTIONS;
+  b->names = lm_alloc(sizeof *b->names * (size_t)(cap + 1));
+  b->values = lm_alloc(sizeof *b->values * (size_t)(cap + 1));
+  b->count = 0;
+  for (int s = 0; s < n; s++)
+    for (int i = 0; i < settings[s].option_count; i++) {
+      char name[128], value[64];
+      snprintf(name, sizeof name, "%s", settings[s].names[i]);
+      if (!lm_pipeline_get_option(p, name, value, sizeof value)) continue; /* set_setting names it */
+      if (!strcmp(value, "table")) { /* "bloom=true" sets bloom.enabled */
+        snprintf(name, sizeof name, "%.119s.enabled", settings[s].names[i]);
+        if (!lm_pipeline_get_option(p, name, value, sizeof value)) continue;
+      }
+      if (base_has(b, name)) continue;
+      memcpy(b->names[b->count], name, sizeof name);
+      memcpy(b->values[b->count], value, sizeof value);
+      b->count++;
+    }
+}
+
+static void base_free(report_base *b) {
+  free(b->names);
+  free(b->values);
+}
+
+static bool set_setting(lm_pipeline *p, const report_base *base, const report_setting *s, lm_error *err) {
   if (!lm_pipeline_set_technique(p, s->technique, err)) return false;
+  for (int i = 0; i < base->count; i++)
+    if (!lm_pipeline_set_option(p, base->names[i], base->values[i], err)) return false;
   for (int i = 0; i < s->option_count; i++)
     if (!lm_pipeline_set_option(p, s->names[i], s->values[i], err)) {
       lm_error_prefix(err, "%s=%s", s->names[i], s->values[i]);
@@ -432,9 +474,12 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
     return 2;
   }
   /* Every setting is checked before anything renders. */
+  report_base base_options;
+  base_take(&base_options, pipeline, a->settings, a->setting_count);
   for (int s = 0; s < a->setting_count; s++)
-    if (!set_setting(pipeline, &a->settings[s], &err)) {
+    if (!set_setting(pipeline, &base_options, &a->settings[s], &err)) {
       lm_log(LM_LOG_ERROR, "--sweep %s: %s", a->settings[s].label, err.msg);
+      base_free(&base_options);
       free(places);
       return 2;
     }
@@ -448,6 +493,7 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
   if (rc) {
     free(refs);
     free(places);
+    base_free(&base_options);
     return rc;
   }
 
@@ -455,6 +501,7 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     free(refs);
     free(places);
+    base_free(&base_options);
     return 1;
   }
   lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = j->scenes[0].scene, .pipeline = pipeline,
@@ -495,7 +542,7 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
       capture_view cv = {.camera = v->camera, .width = w, .height = h, .frames = a->frames, .outputs = outs,
                          .output_count = 1, .quiet = true};
       capture_result scratch = {0};
-      ok = set_setting(pipeline, &a->settings[s], &err) && job_make_parent(out, &err) &&
+      ok = set_setting(pipeline, &base_options, &a->settings[s], &err) && job_make_parent(out, &err) &&
            (a->warmup == 0 || capture_render_write(r, &warm, &scratch, &err)) &&
            capture_render_write(r, &cv, &row->res, &err);
       capture_result_free(&scratch);
@@ -576,6 +623,7 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
   lm_context_destroy();
   free(refs);
   free(places);
+  base_free(&base_options);
   return rc;
 }
 

@@ -19,8 +19,7 @@ limn_option_default() {
   "$LIMN" capture --list-options | sed -n 's/^options: //p' | tr ',' '\n' | sed -n "s/^ *$1=//p"
 }
 
-# Sweep specs (limn report --sweep). Options stay set from one setting to the
-# next in a report, so a spec that depends on isr.mode sets it.
+# Sweep specs (limn report --sweep); each setting starts from the defaults.
 # The seed's image-space radiosity (isr.mode = "seed" once the pipeline has
 # the option; before that isr+esm is the seed's).
 limn_seed_isr_spec() {
