@@ -102,6 +102,19 @@ scenes=$(ls refs-set | wc -l)
 echo "reference set: $views views of $scenes scenes"
 [ "${views:-0}" -ge 12 ] && [ "$scenes" -ge 4 ] || fail "the reference set has $views views of $scenes scenes"
 
+# POV-Ray gets the cores this process may run on, not the machine's: under taskset -c 0, one thread.
+cat > povargs <<'STUB'
+#!/bin/sh
+echo "$@" >> "$(dirname "$0")/povargs.log"
+for a; do case $a in +O*) : > "${a#+O}" ;; esac; done
+STUB
+chmod +x povargs
+if command -v taskset >/dev/null; then
+  taskset -c 0 "$limn" reference --job job.lua --refs refs-one --jobs 1 --povray "$tmp/povargs" >log12 2>&1 \
+    || { cat log12; fail "reference under taskset"; }
+  grep -qw -- "+WT1" povargs.log || { cat povargs.log; fail "POV-Ray was not given the one core of the affinity mask"; }
+fi
+
 # 3. a two-setting sweep on the one view: the reference is cached
 "$limn" report --job job.lua "${fast[@]}" --out rep --frames 2 --warmup 1 --sweep "isr:isr.samples=8,16" \
   >log6 2>&1 || { cat log6; fail "report"; }

@@ -44,8 +44,7 @@ static const char reference_usage[] =
 void reference_defaults(reference_args *a) {
   *a = (reference_args){.refs = "out/reference", .povray = "povray", .shards = 1};
   limn_pov_defaults(&a->pov);
-  long cores = sysconf(_SC_NPROCESSORS_ONLN);
-  a->jobs = cores > 0 ? (int)cores : 1;
+  a->jobs = lm_cpu_count();
 }
 
 /* A name part without slashes or spaces. */
@@ -156,8 +155,7 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
   lm_error err;
   int rc = 0, done = 0, rendered = 0, cached = 0, running = 0, mine = 0;
   int jobs = a->jobs > 0 ? a->jobs : 1;
-  long cores = sysconf(_SC_NPROCESSORS_ONLN);
-  int threads = cores > jobs ? (int)(cores / jobs) : 1;
+  int cores = lm_cpu_count(), threads = cores > jobs ? cores / jobs : 1;
   bool tty = isatty(STDOUT_FILENO);
   pov_run *runs = lm_alloc(sizeof *runs * (size_t)jobs);
   char what[1200];

@@ -1,12 +1,14 @@
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* sched_getaffinity */
 #include "core/core.h"
 
 #include <errno.h>
+#include <sched.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 void lm_error_set(lm_error *err, const char *fmt, ...) {
   if (!err) return;
@@ -50,6 +52,15 @@ static double clock_ms(clockid_t id) {
 }
 double lm_now_ms(void) { return clock_ms(CLOCK_MONOTONIC); }
 double lm_cpu_ms(void) { return clock_ms(CLOCK_PROCESS_CPUTIME_ID); }
+
+int lm_cpu_count(void) {
+  /* The affinity mask, not the machine's online count: a Slurm task, a
+   * container or taskset may give this process fewer cores than exist. */
+  cpu_set_t set;
+  if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0) return CPU_COUNT(&set);
+  long n = sysconf(_SC_NPROCESSORS_ONLN);
+  return n > 0 ? (int)n : 1;
+}
 
 char *lm_read_file(const char *path, size_t *len, lm_error *err) {
   FILE *f = fopen(path, "rb");

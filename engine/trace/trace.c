@@ -9,7 +9,6 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 enum {
   BINS = 16,     /* SAH candidate planes per axis: 15 */
@@ -375,12 +374,6 @@ void lm_trace_destroy(lm_trace *t) {
   free(t);
 }
 
-/* Online cores (at least 1). */
-static int online_cores(void) {
-  long n = sysconf(_SC_NPROCESSORS_ONLN);
-  return n > 0 ? (int)n : 1;
-}
-
 /* ---- traversal ---------------------------------------------------------- */
 /* Plain comparisons, not fminf/fmaxf (library calls for their NaN rules):
  * slab distances are never NaN, since corners and origins are finite and the
@@ -494,7 +487,7 @@ static void *trace_worker(void *arg) {
 
 void lm_trace_rays(const lm_trace *t, const lm_trace_ray *rays, lm_trace_hit *hits, int count, int threads) {
   if (count <= 0) return;
-  if (threads <= 0) threads = online_cores();
+  if (threads <= 0) threads = lm_cpu_count();
   int chunks = (count + CHUNK - 1) / CHUNK;
   if (threads > chunks) threads = chunks;
   if (threads > 256) threads = 256;
