@@ -65,7 +65,10 @@ Surface gbuffer_fetch(sampler2D clr, sampler2D nrm, sampler2D dpt, sampler2D mat
 vec3 direct_light(Surface s, vec3 ambient) {
   vec3 v = safe_normalize(frame.camera_pos.xyz - s.p, s.n);
   vec3 a = sky_ambient(ambient, s.n);
-  if (s.pbr) return pbr_light(s.k.y * s.albedo, s.f0, s.roughness, s.k.x, s.n, v, s.p, a);
-  return phong(s.albedo, s.k, s.shininess, s.n, v, s.p, a);
+  // pbr: k = (occlusion, 1 - metallic, max F0), the diffuse colour k_d albedo;
+  // ambient light reaches it times occlusion, as k_a times the albedo in Phong.
+  vec3 diffuse = s.pbr ? s.k.y * s.albedo : s.albedo;
+  Reflector m = Reflector(s.pbr, diffuse, s.k, s.shininess, s.f0, s.roughness);
+  return s.k.x * a * diffuse + reflected_light(m, s.n, v, s.p);
 }
 #endif
