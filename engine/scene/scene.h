@@ -280,10 +280,13 @@ typedef struct lm_scene_draw_desc {
 } lm_scene_draw_desc;
 typedef struct lm_scene_draw_stats {
   int drawn, culled; /* mesh nodes drawn, and left out by the frustum test */
+  int calls;         /* draw calls: one for the nodes of a mesh and material in view */
   long triangles;    /* triangles drawn */
 } lm_scene_draw_stats;
-/* Draws every mesh node whose bounds reach into the frustum, setting model,
- * normal_matrix, the material uniforms (material_color, material_rho,
+/* Draws every mesh node whose bounds reach into the frustum, the nodes of one
+ * mesh and material in one instanced draw (each node's matrices in the
+ * instance attributes of lm_instance; a technique declaring the uniforms
+ * model or normal_matrix is an error), setting the material uniforms (material_color, material_rho,
  * material_k, material_reflectivity; material_pbr, material_emissive,
  * material_alpha) and the textures with their transforms (base_color_tex,
  * base_color_xform, mr_tex, ...). With a technique that declares material_pbr, a material whose
