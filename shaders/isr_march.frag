@@ -90,17 +90,25 @@ void main() {
     vec4 b = frame.view_proj * vec4(w, 0.0);
     float t_end = exit_distance(a, b);
     bool seen = false;
-    float t_prev = 0.0;
+    float t_prev = 0.0, t = 0.0;
     ivec2 q = px;
-    for (int j = 0; j < m && t_end > foot; j++) {
-      // The last sample lies on t_end: a surface where the ray leaves the view is met too.
-      float t = foot * pow(t_end / foot, (float(j) + u.z) / max(float(m) - 1.0 + u.z, 1e-6));
-      vec4 c = a + t * b;
-      float zq = buffer_depth(c, size, q);
-      if (zq <= 0.0 || c.w <= zq) { // background or in front of the surface there
+    // The march goes on to the next sample behind the depth buffer in a loop
+    // of its own, and only there refines and tests for a hit: a software
+    // rasterizer runs an if's body for every pixel of its group, so the
+    // refinement inside the march's loop would cost as much at every step.
+    int j = 0;
+    while (j < m && t_end > foot) {
+      float zq = 0.0;
+      vec4 c;
+      for (; j < m; j++) {
+        // The last sample lies on t_end: a surface where the ray leaves the view is met too.
+        t = foot * pow(t_end / foot, (float(j) + u.z) / max(float(m) - 1.0 + u.z, 1e-6));
+        c = a + t * b;
+        zq = buffer_depth(c, size, q);
+        if (zq > 0.0 && c.w > zq) break; // behind the surface there
         t_prev = t;
-        continue;
       }
+      if (j >= m) break;
       // Behind a surface: bisect [t_prev, t] for where the ray passed it.
       float lo = t_prev, hi = t;
       for (int k = 0; k < 4; k++) {
@@ -129,6 +137,7 @@ void main() {
         break;
       }
       t_prev = t;
+      j++;
     }
     if (!seen) open += 1.0;
   }
