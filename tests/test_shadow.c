@@ -562,6 +562,33 @@ static void a_filter_variant_compiles_its_filter_alone(void **state) {
   }
 }
 
+/* A cascade's tile is the square around its camera slice's sphere, but its
+ * lookups serve the slice alone, where it meets the scene's bounds: it draws
+ * the casters over that part's light-space rectangle (widened by the
+ * filter's reach), no farther from the light than it. The field's casters
+ * are drawn 62% (esm) and 69% (pcss, wider) as often as drawing every caster
+ * in every cascade, and the image is the same. */
+static void cascades_draw_the_casters_of_their_slice(void **state) {
+  (void)state;
+  lm_scene *s = builtin("field");
+  static const char *const techniques[] = {"shadow.technique=esm", "shadow.technique=pcss"};
+  for (int i = 0; i < 2; i++) {
+    const char *const sets[] = {techniques[i], NULL};
+    gl_result culled = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = sets});
+    gl_result all = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = sets, .no_culling = true});
+    assert_true(culled.ok && all.ok);
+    lm_scene_draw_stats a = lm_renderer_shadow_draw_stats(culled.renderer), b = lm_renderer_shadow_draw_stats(all.renderer);
+    float d = share_different(&culled, &all);
+    printf("field, %s: cascades draw %d casters (%d culled) against %d; %.3f%% of the pixels differ\n", techniques[i],
+           a.drawn, a.culled, b.drawn, 100.0 * d);
+    assert_true(d == 0.0f);
+    assert_true(a.drawn < 0.75 * b.drawn);
+    gl_result_free(&culled);
+    gl_result_free(&all);
+  }
+  lm_scene_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(plans_cover_every_caster),
@@ -577,6 +604,7 @@ int main(void) {
       cmocka_unit_test(the_atlas_can_be_viewed),
       cmocka_unit_test(esm_keeps_the_rooms_sun_patch_and_does_not_leak),
       cmocka_unit_test(a_filter_variant_compiles_its_filter_alone),
+      cmocka_unit_test(cascades_draw_the_casters_of_their_slice),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

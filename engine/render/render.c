@@ -95,9 +95,10 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
     params[i] = (lm_material_param){q->material, q->name, q->count, {q->v[0], q->v[1], q->v[2], q->v[3]}};
   }
   if (!lm_scene_check_params(r->desc.scene, params, n, err)) return false;
-  /* Cull against the camera or the tile; a cascade tile keeps casters before
-   * its near plane, which its depth clamp flattens onto it (pancaking). */
-  const float *view_proj = sp->view ? sp->view->view_proj : r->camera.view_proj;
+  /* Cull against the camera or the tile's cull volume (a cascade's: the
+   * slice it serves); a cascade tile keeps casters before its near plane,
+   * which its depth clamp flattens onto it (pancaking). */
+  const float *view_proj = sp->view ? sp->view->cull : r->camera.view_proj;
   lm_scene_draw_desc d = {.program = sp->program, .variant = scene_variant, .ctx = (void *)sp,
                           .view_proj = r->desc.no_culling ? NULL : view_proj,
                           .pancake = sp->view && sp->view->depth[3] == 0,
