@@ -227,12 +227,13 @@ float lm_light_data_reach(const lm_light_data *d);
 
 /* Clustered light culling (engine/scene/lightgrid.c): the frustum cut into
  * screen tiles and exponential depth slices, each listing the lights whose
- * reach (and cone) touches it; lights of infinite reach are listed once for
- * all. `data` is the LimnLightGrid storage block (shaders/common.glsl). */
+ * reach (and cone) touches it; lights of infinite reach and no cone (a
+ * spot's, under 90 degrees, culls it at any reach) are listed once for all.
+ * `data` is the LimnLightGrid storage block (shaders/common.glsl). */
 typedef struct lm_light_grid {
   int tiles_x, tiles_y, slices, tile_px; /* tile_px 0: no culling, every light everywhere */
   float near, far, slice_scale;          /* slice = floor(log(z / near) * slice_scale) */
-  int global;                            /* lights of infinite reach */
+  int global;                            /* lights of infinite reach and no cone */
   long listed;                           /* entries of all cluster lists */
   uint32_t *data;
   size_t count, cap;                     /* words */
