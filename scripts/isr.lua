@@ -107,7 +107,7 @@ end
 local function hit_targets(o, f)
   local w, h = output_size()
   local n = (o.samples + 3) // 4
-  if not o.reuse or o.bounces < 2 or n > 7 or (w // f + 1) * (h // f + 1) > 1 << 24 then return 0 end
+  if not o.reuse or o.bounces < 2 or n > 7 or (w // f + 1) * (h // f + 1) >= 1 << 24 then return 0 end
   return n
 end
 

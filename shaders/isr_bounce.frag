@@ -1,6 +1,6 @@
 // A later bounce of the physical ISR transport (isr_march.frag) from the hits
-// its first march recorded (HITS targets, four rays each: the coarse texel a
-// ray's sender lies on, -1 for none). Every bounce marches the same rays
+// its first march recorded (HITS targets, four rays each: 1 + the index of
+// the coarse texel a ray's sender lies on, 0 for none). Every bounce marches the same rays
 // through the same depth buffer and meets the same senders, so this sums over
 // them what the march with BOUNCE would:
 //   E(p) = 1/n sum over sending rays of sender(q) + k_d albedo(q) previous(q)
@@ -34,10 +34,10 @@ uniform int samples = 12;
 
 out vec4 isr;
 
-// What ray hits sends (none for -1), from hit target h's texel px.
-vec3 sent(float index, int width) {
-  if (index < 0.0) return vec3(0.0);
-  int k = int(index + 0.5);
+// What a ray whose recorded hit is `hit` sends (nothing for 0).
+vec3 sent(float hit, int width) {
+  if (hit < 0.5) return vec3(0.0);
+  int k = int(hit - 0.5);
   ivec2 q = ivec2(k % width, k / width);
   vec4 c = texelFetch(clr, q, 0);
   return texelFetch(sender, q, 0).rgb + texelFetch(mat, q, 0).y * c.rgb * texelFetch(previous, q, 0).rgb;

@@ -33,10 +33,10 @@
 // Output: rgb = E, a = A, the share of rays (cosine-weighted) that meet no
 // surface. Background texels: (0, 0, 0, 1).
 // With HITS (1..7, the first bounce of several), also the sending hit of each
-// ray, four rays a target in hits[k] (k < HITS): the coarse texel's index
-// y * width + x (exact in a float up to 2^24 texels; isr.lua keeps within),
-// or -1 when the ray sends nothing; isr_bounce.frag takes the later bounces
-// from them instead of marching the same rays again.
+// ray, four rays a target in hits0.. (HITS targets): 1 + the coarse texel's
+// index y * width + x (exact in a float below 2^24 texels; isr.lua keeps
+// within), or 0 when the ray sends nothing; isr_bounce.frag takes the later
+// bounces from them instead of marching the same rays again.
 #include "gbuffer.glsl"
 #include "halton.glsl"
 
@@ -72,7 +72,7 @@ layout(location = 6) out vec4 hits5;
 layout(location = 7) out vec4 hits6;
 #endif
 
-// Writes the recorded hits (-1 for none) to the HITS targets, four a target.
+// Writes the recorded hits (0 for none) to the HITS targets, four a target.
 void write_hits(float hit[4 * HITS]) {
   hits0 = vec4(hit[0], hit[1], hit[2], hit[3]);
 #if HITS > 1
@@ -122,7 +122,7 @@ void main() {
   Surface s = gbuffer_fetch(clr, nrm, dpt, mat, px);
 #ifdef HITS
   float hit[4 * HITS];
-  for (int k = 0; k < 4 * HITS; k++) hit[k] = -1.0;
+  for (int k = 0; k < 4 * HITS; k++) hit[k] = 0.0;
 #endif
   if (!s.covered) {
     isr = vec4(0.0, 0.0, 0.0, 1.0);
@@ -194,7 +194,7 @@ void main() {
 #endif
           gathered += radiance;
 #ifdef HITS
-          if (i < 4 * HITS) hit[i] = float(q.y * size.x + q.x);
+          if (i < 4 * HITS) hit[i] = float(q.y * size.x + q.x + 1);
 #endif
         }
         break;
