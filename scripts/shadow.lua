@@ -27,6 +27,8 @@ shadow.defaults = {
   blend = 0.1,        -- share of a cascade blended into the next one
   radius = 2.5,       -- Poisson disc radius in texels
   stabilize = true,   -- bounding spheres and texel snapping (seed 003)
+  cache = true,       -- a tile whose view and casters are unchanged since the last frame keeps its
+                      -- texels instead of being drawn again (a still camera; spot and point lights)
   size = -1,          -- PCSS: every light's size (its diameter in the scene's unit; for the sun its
                       -- angular diameter, radians); <= 0: each light's own (glTF extras.size, else
                       -- 0.0093 rad for directional lights, 1% of the shadow map's range for others)

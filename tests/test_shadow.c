@@ -211,7 +211,8 @@ static void the_sun_casts_cascaded_shadows_at_any_depth_range(void **state) {
 static void cascades_fit_the_depths_the_frame_sees(void **state) {
   (void)state;
   lm_scene *s = builtin("field");
-  gl_result r = render_ok(s, "dl+esm", NULL);
+  static const char *const drawn[] = {"shadow.cache=false", NULL}; /* the second frame draws its tiles too */
+  gl_result r = render_ok(s, "dl+esm", drawn);
   lm_renderer_set_sharing(r.renderer, false); /* keep gbuffer.dpt readable */
   assert_true(gl_render_again(&r));
   int w, h;
@@ -231,8 +232,8 @@ static void cascades_fit_the_depths_the_frame_sees(void **state) {
   assert_true(plan->seen[0] > 10 * cam.clip[0] && plan->seen[1] < 0.8f * cam.clip[1]);
   float last = plan->lights[0].splits[2];
   assert_true(last >= plan->seen[1] && last <= plan->seen[1] * 1.0625f);
-  /* Each cascade draws only the casters over its tile (keeping those before
-   * its near plane): of 3 x 61 meshes, 35 are left out (none were before). */
+  /* Each cascade draws only the casters over the slice it serves (keeping
+   * those before its near plane): of 3 x 61 meshes, 69 are left out. */
   lm_scene_draw_stats st = lm_renderer_shadow_draw_stats(r.renderer);
   printf("cascade tiles: %d meshes drawn, %d culled\n", st.drawn, st.culled);
   assert_true(st.drawn + st.culled == 3 * 61 && st.culled >= 25 && st.drawn >= 3);
@@ -589,6 +590,45 @@ static void cascades_draw_the_casters_of_their_slice(void **state) {
   lm_scene_destroy(s);
 }
 
+/* A shadow tile whose view and casters are those of the last frame's tile in
+ * its place keeps its texels (copied, not drawn): the box's second frame
+ * draws no tile and looks as every tile drawn does; moving a caster redraws
+ * them all, and the frame is the one an uncached renderer gives; with
+ * shadow.cache=false every frame draws. */
+static void unchanged_tiles_are_kept_and_changed_ones_drawn(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  static const char *const off[] = {"shadow.cache=false", NULL};
+  gl_result c = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .frames = 2});
+  gl_result u = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .frames = 2, .sets = off});
+  assert_true(c.ok && u.ok);
+  int views = lm_renderer_shadows(c.renderer)->view_count;
+  lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(c.renderer), drawn = lm_renderer_shadow_draw_stats(u.renderer);
+  printf("second frame: %d of %d tiles kept, %d nodes drawn; without the cache %d kept, %d drawn\n", kept.kept, views,
+         kept.drawn, drawn.kept, drawn.drawn);
+  assert_true(views > 0 && kept.kept == views && kept.drawn == 0 && drawn.kept == 0 && drawn.drawn > 0);
+  assert_true(share_different(&c, &u) == 0.0f);
+  int box = -1;
+  for (int i = 0; i < s->node_count; i++)
+    if (!strcmp(s->nodes[i].name, "tall_box")) box = i;
+  assert_true(box >= 0);
+  mat4 w;
+  memcpy(w, s->nodes[box].world, sizeof w);
+  w[3][0] += 0.05f;
+  lm_scene_node_set_world(s, box, (float *)w);
+  assert_true(gl_render_again(&c));
+  gl_result fresh = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = off});
+  assert_true(fresh.ok);
+  kept = lm_renderer_shadow_draw_stats(c.renderer);
+  printf("after moving the tall box: %d tiles kept, %d nodes drawn; %.3f%% of pixels differ from a fresh frame\n",
+         kept.kept, kept.drawn, 100.0 * share_different(&c, &fresh));
+  assert_true(kept.kept == 0 && kept.drawn > 0 && share_different(&c, &fresh) == 0.0f);
+  gl_result_free(&c);
+  gl_result_free(&u);
+  gl_result_free(&fresh);
+  lm_scene_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(plans_cover_every_caster),
@@ -605,6 +645,7 @@ int main(void) {
       cmocka_unit_test(esm_keeps_the_rooms_sun_patch_and_does_not_leak),
       cmocka_unit_test(a_filter_variant_compiles_its_filter_alone),
       cmocka_unit_test(cascades_draw_the_casters_of_their_slice),
+      cmocka_unit_test(unchanged_tiles_are_kept_and_changed_ones_drawn),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

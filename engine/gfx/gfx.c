@@ -417,6 +417,10 @@ void lm_texture_copy(lm_texture dst, lm_texture src, int width, int height) {
   glCopyImageSubData(src.id, GL_TEXTURE_2D, 0, 0, 0, 0, dst.id, GL_TEXTURE_2D, 0, 0, 0, 0, width, height, 1);
 }
 
+void lm_texture_copy_rect(lm_texture dst, lm_texture src, int x, int y, int width, int height) {
+  glCopyImageSubData(src.id, GL_TEXTURE_2D, 0, x, y, 0, dst.id, GL_TEXTURE_2D, 0, x, y, 0, width, height, 1);
+}
+
 void lm_screen_bind(int width, int height) {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glViewport(0, 0, width, height);

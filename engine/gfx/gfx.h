@@ -209,6 +209,8 @@ void lm_texture_upload(lm_texture tex, int width, int height, const uint8_t *rgb
 void lm_texture_upload_floats(lm_texture tex, int width, int height, const float *rgba);
 /* Copies level 0 of src into dst (same format and size). */
 void lm_texture_copy(lm_texture dst, lm_texture src, int width, int height);
+/* Copies the rectangle x, y, width, height of src's level 0 to the same place in dst (same format). */
+void lm_texture_copy_rect(lm_texture dst, lm_texture src, int x, int y, int width, int height);
 /* Binds the window's (default) framebuffer and sets the viewport. */
 void lm_screen_bind(int width, int height);
 /* The default framebuffer's back buffer as RGB bytes, top row first. */

@@ -282,6 +282,7 @@ typedef struct lm_scene_draw_desc {
 typedef struct lm_scene_draw_stats {
   int drawn, culled; /* mesh nodes drawn, and left out by the frustum test */
   int calls;         /* draw calls: one for the nodes of a mesh and material in view */
+  int kept;          /* views (shadow tiles) kept from the last frame instead of drawn */
   long triangles;    /* triangles drawn */
 } lm_scene_draw_stats;
 /* Draws every mesh node whose bounds reach into the frustum, the nodes of one
