@@ -38,7 +38,9 @@ isr.defaults = {
   bounces = 2,       -- transport steps, 1..4 (POV-Ray's recursion_limit 2: two bounces)
   reuse = true,      -- later bounces sum over the senders the first march met (the same rays meet
                      -- the same senders every bounce); false: march again every bounce
-  coarse = 2,        -- coarse factor a side: 1, 2 or 4
+  coarse = 0,        -- coarse factor a side: 1, 2 or 4; 0 (auto): 2, or 4 where the coarse grid
+                     -- is still at least 128 texels wide (from 512 pixels wide), a grid as fine
+                     -- relative to the view as 256 pixels wide at 2
   blur = 4,          -- Gaussian taps each side at coarse size, 0..32 (0: no blur)
   view = "lit",      -- "lit"; "indirect" (the indirect light) or "ao" (accessibility) to inspect
   seed = {           -- mode "seed": the dissertation's parameters
@@ -70,7 +72,7 @@ local rules = {
   k = options.number(0, 16),
   bounces = options.whole(1, 4),
   reuse = options.boolean,
-  coarse = options.one_of(1, 2, 4),
+  coarse = options.one_of(0, 1, 2, 4),
   blur = options.whole(0, 32),
   view = options.one_of("lit", "indirect", "ao"),
   seed = function(v) if type(v) ~= "table" then return "a table of the seed mode's options" end end,
@@ -97,6 +99,12 @@ function isr.coarse_gbuffer(G, direct, f)
   return C
 end
 
+-- The coarse factor: o.coarse, or for 0 the auto factor at this output size.
+local function factor(o)
+  if o.coarse > 0 then return o.coarse end
+  return output_size() // 4 >= 128 and 4 or 2
+end
+
 local function coarse_target(name, f)
   return target{ name, format = "rgba16f", scale = 1 / f }
 end
@@ -121,7 +129,7 @@ function isr.render(G, direct, o, light, extra)
   o = options.check("isr", isr.defaults, o, rules, 2)
   local seed = options.check("isr.seed", isr.defaults.seed, o.seed, seed_rules, 2) -- checked in either mode
   if o.mode ~= "seed" then seed = nil end
-  local f = o.coarse
+  local f = factor(o)
   local C = isr.coarse_gbuffer(G, direct, f)
   local E, H
   local hits = seed and 0 or hit_targets(o, f)
