@@ -41,7 +41,11 @@ Surface gbuffer_decode(vec4 c, vec4 nn, float d, vec4 m, vec2 uv) {
   s.covered = m.a >= 0.5;
   s.reflectivity = mat_alpha_reflectivity(m.a);
   s.p = position_from_depth(uv, s.depth01);
+#ifdef PHONG_ONLY
+  s.pbr = false; // the std technique drew every pixel (gbuffer.defines): no GGX compiled
+#else
   s.pbr = mat_alpha_pbr(m.a);
+#endif
   s.roughness = pbr_roughness(s.shininess);
   s.f0 = mix(vec3(0.04), s.albedo, 1.0 - s.k.y);
   return s;
