@@ -547,11 +547,13 @@ static void a_filter_variant_compiles_its_filter_alone(void **state) {
       float d = share_different(&one, &all);
       printf("%s, %s: its filter alone against every filter compiled: %.3f%% of pixels differ\n", scenes[k],
              plans[i], 100.0 * d);
-      if (!(d <= 0.002f)) fail_msg("%s, %s: the variant differs in %.3f%% of the pixels", scenes[k], plans[i], 100.0 * d);
+      if (!(d <= 0.002f))
+        fail_msg("%s, %s: the variant differs in %.3f%% of the pixels", scenes[k], plans[i], 100.0 * d);
       gl_result_free(&one);
       gl_result_free(&all);
     }
-    gl_result esm = render_filter(s, "esm", -1), forced = render_filter(s, "esm", 3), hard = render_filter(s, "hard", -1);
+    gl_result esm = render_filter(s, "esm", -1), forced = render_filter(s, "esm", 3);
+    gl_result hard = render_filter(s, "hard", -1);
     float to_hard = share_different(&forced, &hard), to_esm = share_different(&forced, &esm);
     printf("%s: esm plan, hard filter defined: differs from hard in %.3f%%, from esm in %.3f%% of the pixels\n",
            scenes[k], 100.0 * to_hard, 100.0 * to_esm);
@@ -578,7 +580,8 @@ static void cascades_draw_the_casters_of_their_slice(void **state) {
     gl_result culled = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = sets});
     gl_result all = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = sets, .no_culling = true});
     assert_true(culled.ok && all.ok);
-    lm_scene_draw_stats a = lm_renderer_shadow_draw_stats(culled.renderer), b = lm_renderer_shadow_draw_stats(all.renderer);
+    lm_scene_draw_stats a = lm_renderer_shadow_draw_stats(culled.renderer);
+    lm_scene_draw_stats b = lm_renderer_shadow_draw_stats(all.renderer);
     float d = share_different(&culled, &all);
     printf("field, %s: cascades draw %d casters (%d culled) against %d; %.3f%% of the pixels differ\n", techniques[i],
            a.drawn, a.culled, b.drawn, 100.0 * d);
@@ -603,7 +606,8 @@ static void unchanged_tiles_are_kept_and_changed_ones_drawn(void **state) {
   gl_result u = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .frames = 2, .sets = off});
   assert_true(c.ok && u.ok);
   int views = lm_renderer_shadows(c.renderer)->view_count;
-  lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(c.renderer), drawn = lm_renderer_shadow_draw_stats(u.renderer);
+  lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(c.renderer);
+  lm_scene_draw_stats drawn = lm_renderer_shadow_draw_stats(u.renderer);
   printf("second frame: %d of %d tiles kept, %d nodes drawn; without the cache %d kept, %d drawn\n", kept.kept, views,
          kept.drawn, drawn.kept, drawn.drawn);
   assert_true(views > 0 && kept.kept == views && kept.drawn == 0 && drawn.kept == 0 && drawn.drawn > 0);

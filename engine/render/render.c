@@ -16,7 +16,7 @@ typedef struct tile_cache {
   lm_texture tex[LM_MAX_COLOR_OUTPUTS + 1];
   lm_format format[LM_MAX_COLOR_OUTPUTS + 1];
   int count, width, height;
-  struct cached_tile { int x, y, width, height; uint64_t key; } *tiles;
+  struct cached_tile { int x, y, width, height; bool drawn; uint64_t key; } *tiles;
   int tile_count, tile_cap;
 } tile_cache;
 
@@ -165,7 +165,8 @@ static uint64_t tile_key(const lm_renderer *r, const lm_scene_pass *sp) {
  * they change); false when a texture cannot be made. */
 static bool tile_cache_fit(tile_cache *c, const lm_graph_target_info *t, int n, lm_error *err) {
   bool same = c->count == n && n > 0 && c->width == t[0].width && c->height == t[0].height;
-  for (int i = 0; same && i < n; i++) same = c->format[i] == t[i].format && t[i].width == c->width && t[i].height == c->height;
+  for (int i = 0; same && i < n; i++)
+    same = c->format[i] == t[i].format && t[i].width == c->width && t[i].height == c->height;
   if (same) return true;
   tile_cache_free(c);
   for (int i = 0; i < n; i++) {
@@ -189,7 +190,7 @@ static struct cached_tile *tile_at(tile_cache *c, const lm_pass_view *v) {
     if (t->x == v->x && t->y == v->y && t->width == v->width && t->height == v->height) return t;
   }
   struct cached_tile *t = LM_PUSH(c->tiles, c->tile_count, c->tile_cap);
-  *t = (struct cached_tile){v->x, v->y, v->width, v->height, 0};
+  *t = (struct cached_tile){v->x, v->y, v->width, v->height, false, 0};
   return t;
 }
 
@@ -204,7 +205,7 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
     if (!tile_cache_fit(&r->tiles, t, nt, err)) return false;
     key = tile_key(r, sp);
     cached = tile_at(&r->tiles, sp->view);
-    if (cached->key == key) {
+    if (cached->drawn && cached->key == key) {
       for (int i = 0; i < nt; i++)
         lm_texture_copy_rect(t[i].texture, r->tiles.tex[i], cached->x, cached->y, cached->width, cached->height);
       r->shadow_stats.kept++;
@@ -215,15 +216,15 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   if (cached) {
     for (int i = 0; i < nt; i++)
       lm_texture_copy_rect(r->tiles.tex[i], t[i].texture, cached->x, cached->y, cached->width, cached->height);
-    cached->key = key;
+    cached->drawn = true, cached->key = key;
   }
   return true;
 }
 
-
 bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
   if (!lm_scene_upload(scene, err)) return false;
   r->desc.scene = scene;
+  r->tiles.tile_count = 0; /* another scene's textures are not hashed: draw every tile again */
   r->frame = 0;
   lm_trace_destroy(r->trace);
   r->trace = NULL;

@@ -690,7 +690,8 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     }
     bind_material(s, p, &m, &mp, defines);
     lm_mesh_draw_instances(&mesh->gpu, first, last - first);
-    if (stats) stats->calls++, stats->drawn += last - first, stats->triangles += (long)(last - first) * (mesh->index_count / 3);
+    if (stats)
+      stats->calls++, stats->drawn += last - first, stats->triangles += (long)(last - first) * (mesh->index_count / 3);
   }
   free(nodes);
   return ok;
