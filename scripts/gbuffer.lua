@@ -24,7 +24,15 @@ end
 function gbuffer.render(G, technique, materials)
   scene{ "gbuffer", technique = technique or "std", out = { G.clr, G.nrm, G.dpt, G.mat, G.emi },
          depth = G.depth, clear = { 0, 0, 0, 0 }, materials = materials }
+  G.phong_only = (technique or "std") == "std" -- no pixel carries the pbr technique's mark
   return G
+end
+
+-- Adds to a lighting pass's defines what G says of its pixels: PHONG_ONLY when
+-- the std technique drew them all (gbuffer.glsl then compiles no GGX).
+function gbuffer.defines(G, defines)
+  defines.PHONG_ONLY = G.phong_only
+  return defines
 end
 
 -- The inputs table a lighting pass takes.

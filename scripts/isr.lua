@@ -15,7 +15,9 @@
 --   1. coarse CLR, NRM, DPT, MAT and direct light (isr_downsample.frag;
 --      skipped at coarse 1)
 --   2. the transport step, repeated for more bounces with the last step's
---      indirect light added to the senders' radiance
+--      indirect light added to the senders' radiance (physical: the first
+--      march records each ray's sender and the later bounces sum over those,
+--      isr_bounce.frag, rather than march the same rays again)
 --   3. a separable Gaussian blur of the coarse result that skips background
 --      and does not cross depth edges (blur.frag)
 --   4. bilateral upsampling and the composite (isr_light.frag)
@@ -34,7 +36,11 @@ isr.defaults = {
   thickness = 0.02,  -- a surface hides what lies this fraction of its depth behind it, 0..1
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
   bounces = 2,       -- transport steps, 1..4 (POV-Ray's recursion_limit 2: two bounces)
-  coarse = 2,        -- coarse factor a side: 1, 2 or 4
+  reuse = true,      -- later bounces sum over the senders the first march met (the same rays meet
+                     -- the same senders every bounce); false: march again every bounce
+  coarse = 0,        -- coarse factor a side: 1, 2 or 4; 0 (auto): 2, or 4 where the coarse grid
+                     -- is still at least 128 texels wide (from 512 pixels wide), a grid as fine
+                     -- relative to the view as 256 pixels wide at 2
   blur = 4,          -- Gaussian taps each side at coarse size, 0..32 (0: no blur)
   view = "lit",      -- "lit"; "indirect" (the indirect light) or "ao" (accessibility) to inspect
   seed = {           -- mode "seed": the dissertation's parameters
@@ -65,7 +71,8 @@ local rules = {
   thickness = options.number(0, 1),
   k = options.number(0, 16),
   bounces = options.whole(1, 4),
-  coarse = options.one_of(1, 2, 4),
+  reuse = options.boolean,
+  coarse = options.one_of(0, 1, 2, 4),
   blur = options.whole(0, 32),
   view = options.one_of("lit", "indirect", "ao"),
   seed = function(v) if type(v) ~= "table" then return "a table of the seed mode's options" end end,
@@ -92,8 +99,24 @@ function isr.coarse_gbuffer(G, direct, f)
   return C
 end
 
+-- The coarse factor: o.coarse, or for 0 the auto factor at this output size.
+local function factor(o)
+  if o.coarse > 0 then return o.coarse end
+  return output_size() // 4 >= 128 and 4 or 2
+end
+
 local function coarse_target(name, f)
   return target{ name, format = "rgba16f", scale = 1 / f }
+end
+
+-- How many targets of four rays' hits the first march records for the later
+-- bounces (isr_march.frag's HITS): none for one bounce, or when they would
+-- not fit in the 7 colour outputs beside E or a texel's index in a float.
+local function hit_targets(o, f)
+  local w, h = output_size()
+  local n = (o.samples + 3) // 4
+  if not o.reuse or o.bounces < 2 or n > 7 or (w // f + 1) * (h // f + 1) >= 1 << 24 then return 0 end
+  return n
 end
 
 -- Records ISR lighting of G given its direct light `direct` (lights only, no
@@ -106,9 +129,10 @@ function isr.render(G, direct, o, light, extra)
   o = options.check("isr", isr.defaults, o, rules, 2)
   local seed = options.check("isr.seed", isr.defaults.seed, o.seed, seed_rules, 2) -- checked in either mode
   if o.mode ~= "seed" then seed = nil end
-  local f = o.coarse
+  local f = factor(o)
   local C = isr.coarse_gbuffer(G, direct, f)
-  local E
+  local E, H
+  local hits = seed and 0 or hit_targets(o, f)
   for b = 1, seed and seed.bounces or o.bounces do
     local inputs = gbuffer.inputs(C)
     inputs.previous = E
@@ -118,12 +142,27 @@ function isr.render(G, direct, o, light, extra)
       E = pass{ name, shader = "isr.frag", inputs = inputs, params = { samples = seed.samples, radius = seed.radius },
                 fetches = 4 + seed.samples * (E and 6 or 5), -- at most: G-buffer and sender (and bounce) a sample
                 defines = { BOUNCE = E ~= nil }, out = coarse_target("isr.e" .. b, f) }
+    elseif H then
+      local from = { clr = C.clr, mat = C.mat, sender = C.direct, previous = E }
+      for k = 1, hits do from["hits" .. (k - 1)] = H[k] end
+      E = pass{ name, shader = "isr_bounce.frag", inputs = from, params = { samples = o.samples },
+                fetches = 1 + hits + 4 * o.samples, -- the hits, and four fetches a sending ray
+                defines = { HITS = hits }, out = coarse_target("isr.e" .. b, f) }
     else
       inputs.sender = C.direct
-      E = pass{ name, shader = "isr_march.frag", inputs = inputs,
-                params = { samples = o.samples, steps = o.steps, thickness = o.thickness },
-                fetches = 4 + o.samples * (o.steps + (E and 11 or 10)), -- march, one bisection, the hit
-                defines = { BOUNCE = E ~= nil }, out = coarse_target("isr.e" .. b, f) }
+      E = coarse_target("isr.e" .. b, f)
+      local out = { E }
+      if b == 1 and hits > 0 then
+        H = {}
+        for k = 1, hits do
+          H[k] = target{ "isr.hits" .. k, format = "rgba32f", scale = 1 / f }
+          out[k + 1] = H[k]
+        end
+      end
+      pass{ name, shader = "isr_march.frag", inputs = inputs,
+            params = { samples = o.samples, steps = o.steps, thickness = o.thickness },
+            fetches = 4 + o.samples * (o.steps + (b > 1 and 11 or 10)), -- march, one bisection, the hit
+            defines = { BOUNCE = b > 1, HITS = H and hits or nil }, out = out }
     end
   end
   if extra then E = extra(C, E, f) end

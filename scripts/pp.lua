@@ -57,7 +57,7 @@ local function grey(x) return { x, x, x } end
 -- the GI composite adds the ambient term, occluded, and the indirect light),
 -- which also serves as the GI senders' radiance.
 local function direct(G, tech, shadows, ambient, name, skylight)
-  local inputs, defines = shadow.bind(shadows, gbuffer.inputs(G), {})
+  local inputs, defines = shadow.bind(shadows, gbuffer.inputs(G), gbuffer.defines(G, {}))
   local params = sky.bind(skylight, { ambient = grey(ambient), background = grey(tech.background) }, defines)
   return pass{ "direct", shader = "direct.frag", inputs = inputs, defines = defines,
                fetches = not shadows and 4 or nil, -- the G-buffer; shadow lookups vary with the lights

@@ -27,6 +27,8 @@ shadow.defaults = {
   blend = 0.1,        -- share of a cascade blended into the next one
   radius = 2.5,       -- Poisson disc radius in texels
   stabilize = true,   -- bounding spheres and texel snapping (seed 003)
+  cache = true,       -- a tile whose view and casters are unchanged since the last frame keeps its
+                      -- texels instead of being drawn again (a still camera; spot and point lights)
   size = -1,          -- PCSS: every light's size (its diameter in the scene's unit; for the sun its
                       -- angular diameter, radians); <= 0: each light's own (glTF extras.size, else
                       -- 0.0093 rad for directional lights, 1% of the shadow map's range for others)
@@ -38,6 +40,11 @@ shadow.defaults = {
 local rules = { technique = options.one_of("esm", "pcf", "poisson", "hard", "pcss") }
 
 local BLOCK = 8
+
+-- Each atlas's filter as shaders/shadow.glsl numbers them (SHADOW_FILTER:
+-- lm_shadow_technique), kept for shadow.bind; weak keys: atlases are per frame.
+local FILTERS = { esm = 0, pcf = 1, poisson = 2, hard = 3, pcss = 4 }
+local filter_of = setmetatable({}, { __mode = "k" })
 
 -- The least and greatest camera depth the G-buffer G sees (depth / far in r
 -- and g of a 1x1 target), by BLOCK x BLOCK min/max reduction passes.
@@ -79,6 +86,7 @@ function shadow.render(o, G, rsm)
   scene{ "shadow.depth", technique = "shadow", views = plan, fit = G and shadow.depth_range(G) or nil,
          out = R and { map, R.flux, R.nrm, R.pos } or map, clear = { 1, 1, 1, 1 }, defines = { RSM = R ~= nil },
          depth = target{ "shadow.zbuffer", format = "depth32f", size = size } }
+  filter_of[map] = FILTERS[plan.technique]
   if plan.technique ~= "esm" or plan.blur == 0 then return map, R end
   local blurred = map
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
@@ -87,14 +95,17 @@ function shadow.render(o, G, rsm)
                                views = plan.shadow_views }, -- not the RSM's wide tiles after them
                     out = target{ "shadow.esm_" .. axis[1], format = "r32f", size = size } }
   end
+  filter_of[blurred] = filter_of[map]
   return blurred, R
 end
 
--- Adds the atlas to a lighting pass's inputs and defines (no-op without one).
+-- Adds the atlas to a lighting pass's inputs and defines (no-op without one):
+-- SHADOWS, and SHADOW_FILTER, so that the pass compiles the atlas's filter alone.
 function shadow.bind(atlas, inputs, defines)
   if atlas then
     inputs.shadow_atlas = atlas
     defines.SHADOWS = true
+    defines.SHADOW_FILTER = filter_of[atlas]
   end
   return inputs, defines
 end

@@ -41,7 +41,11 @@ Surface gbuffer_decode(vec4 c, vec4 nn, float d, vec4 m, vec2 uv) {
   s.covered = m.a >= 0.5;
   s.reflectivity = mat_alpha_reflectivity(m.a);
   s.p = position_from_depth(uv, s.depth01);
+#ifdef PHONG_ONLY
+  s.pbr = false; // the std technique drew every pixel (gbuffer.defines): no GGX compiled
+#else
   s.pbr = mat_alpha_pbr(m.a);
+#endif
   s.roughness = pbr_roughness(s.shininess);
   s.f0 = mix(vec3(0.04), s.albedo, 1.0 - s.k.y);
   return s;
@@ -65,7 +69,10 @@ Surface gbuffer_fetch(sampler2D clr, sampler2D nrm, sampler2D dpt, sampler2D mat
 vec3 direct_light(Surface s, vec3 ambient) {
   vec3 v = safe_normalize(frame.camera_pos.xyz - s.p, s.n);
   vec3 a = sky_ambient(ambient, s.n);
-  if (s.pbr) return pbr_light(s.k.y * s.albedo, s.f0, s.roughness, s.k.x, s.n, v, s.p, a);
-  return phong(s.albedo, s.k, s.shininess, s.n, v, s.p, a);
+  // pbr: k = (occlusion, 1 - metallic, max F0), the diffuse colour k_d albedo;
+  // ambient light reaches it times occlusion, as k_a times the albedo in Phong.
+  vec3 diffuse = s.pbr ? s.k.y * s.albedo : s.albedo;
+  Reflector m = Reflector(s.pbr, diffuse, s.k, s.shininess, s.f0, s.roughness);
+  return s.k.x * a * diffuse + reflected_light(m, s.n, v, s.p);
 }
 #endif

@@ -32,6 +32,11 @@
 //
 // Output: rgb = E, a = A, the share of rays (cosine-weighted) that meet no
 // surface. Background texels: (0, 0, 0, 1).
+// With HITS (1..7, the first bounce of several), also the sending hit of each
+// ray, four rays a target in hits0.. (HITS targets): 1 + the coarse texel's
+// index y * width + x (exact in a float below 2^24 texels; isr.lua keeps
+// within), or 0 when the ray sends nothing; isr_bounce.frag takes the later
+// bounces from them instead of marching the same rays again.
 #include "gbuffer.glsl"
 #include "halton.glsl"
 
@@ -45,7 +50,51 @@ uniform int samples = 12;
 uniform int steps = 10;
 uniform float thickness = 0.02; // fraction of a surface's depth
 
-out vec4 isr;
+layout(location = 0) out vec4 isr;
+#ifdef HITS
+layout(location = 1) out vec4 hits0;
+#if HITS > 1
+layout(location = 2) out vec4 hits1;
+#endif
+#if HITS > 2
+layout(location = 3) out vec4 hits2;
+#endif
+#if HITS > 3
+layout(location = 4) out vec4 hits3;
+#endif
+#if HITS > 4
+layout(location = 5) out vec4 hits4;
+#endif
+#if HITS > 5
+layout(location = 6) out vec4 hits5;
+#endif
+#if HITS > 6
+layout(location = 7) out vec4 hits6;
+#endif
+
+// Writes the recorded hits (0 for none) to the HITS targets, four a target.
+void write_hits(float hit[4 * HITS]) {
+  hits0 = vec4(hit[0], hit[1], hit[2], hit[3]);
+#if HITS > 1
+  hits1 = vec4(hit[4], hit[5], hit[6], hit[7]);
+#endif
+#if HITS > 2
+  hits2 = vec4(hit[8], hit[9], hit[10], hit[11]);
+#endif
+#if HITS > 3
+  hits3 = vec4(hit[12], hit[13], hit[14], hit[15]);
+#endif
+#if HITS > 4
+  hits4 = vec4(hit[16], hit[17], hit[18], hit[19]);
+#endif
+#if HITS > 5
+  hits5 = vec4(hit[20], hit[21], hit[22], hit[23]);
+#endif
+#if HITS > 6
+  hits6 = vec4(hit[24], hit[25], hit[26], hit[27]);
+#endif
+}
+#endif
 
 // Tightens t so that the constraint g0 + g1 t >= 0 holds on [0, t].
 float limit(float g0, float g1, float t) { return g1 < 0.0 ? min(t, max(g0, 0.0) / -g1) : t; }
@@ -71,8 +120,15 @@ float buffer_depth(vec4 c, ivec2 size, out ivec2 q) {
 void main() {
   ivec2 size = textureSize(dpt, 0), px = ivec2(gl_FragCoord.xy);
   Surface s = gbuffer_fetch(clr, nrm, dpt, mat, px);
+#ifdef HITS
+  float hit[4 * HITS];
+  for (int k = 0; k < 4 * HITS; k++) hit[k] = 0.0;
+#endif
   if (!s.covered) {
     isr = vec4(0.0, 0.0, 0.0, 1.0);
+#ifdef HITS
+    write_hits(hit);
+#endif
     return;
   }
   int n = clamp(samples, 1, 256), m = clamp(steps, 1, 64);
@@ -90,17 +146,29 @@ void main() {
     vec4 b = frame.view_proj * vec4(w, 0.0);
     float t_end = exit_distance(a, b);
     bool seen = false;
-    float t_prev = 0.0;
+    float t_prev = 0.0, t = 0.0;
     ivec2 q = px;
-    for (int j = 0; j < m && t_end > foot; j++) {
-      // The last sample lies on t_end: a surface where the ray leaves the view is met too.
-      float t = foot * pow(t_end / foot, (float(j) + u.z) / max(float(m) - 1.0 + u.z, 1e-6));
-      vec4 c = a + t * b;
-      float zq = buffer_depth(c, size, q);
-      if (zq <= 0.0 || c.w <= zq) { // background or in front of the surface there
+    // The march goes on to the next sample behind the depth buffer in a loop
+    // of its own, and only there refines and tests for a hit: a software
+    // rasterizer runs an if's body for every pixel of its group, so the
+    // refinement inside the march's loop would cost as much at every step.
+    // Sample j lies at foot (t_end / foot)^((j + u.z) e): each the last times
+    // a ratio. The last lies on t_end: a surface where the ray leaves the view is met too.
+    float e = 1.0 / max(float(m) - 1.0 + u.z, 1e-6), span = max(t_end / foot, 1.0); // > 1 where it marches
+    float ratio = pow(span, e), t_next = foot * pow(span, u.z * e);
+    int j = 0;
+    while (j < m && t_end > foot) {
+      float zq = 0.0;
+      vec4 c;
+      for (; j < m; j++) {
+        t = t_next;
+        t_next *= ratio;
+        c = a + t * b;
+        zq = buffer_depth(c, size, q);
+        if (zq > 0.0 && c.w > zq) break; // behind the surface there
         t_prev = t;
-        continue;
       }
+      if (j >= m) break;
       // Behind a surface: bisect [t_prev, t] for where the ray passed it.
       float lo = t_prev, hi = t;
       for (int k = 0; k < 4; k++) {
@@ -125,12 +193,19 @@ void main() {
           radiance += x.k.y * x.albedo * texelFetch(previous, q, 0).rgb;
 #endif
           gathered += radiance;
+#ifdef HITS
+          if (i < 4 * HITS) hit[i] = float(q.y * size.x + q.x + 1);
+#endif
         }
         break;
       }
       t_prev = t;
+      j++;
     }
     if (!seen) open += 1.0;
   }
   isr = vec4(gathered / float(n), open / float(n));
+#ifdef HITS
+  write_hits(hit);
+#endif
 }

@@ -81,46 +81,62 @@ int light_index(LightList r, int j) {
   return int(cells[j < r.global ? grid_global.y + uint(j) : r.offset + uint(j - r.global)]);
 }
 
-// k = (k_a, k_d, k_s), shininess >= 0; n and v unit vectors (v toward the eye).
-vec3 phong(vec3 albedo, vec3 k, float shininess, vec3 n, vec3 v, vec3 p, vec3 ambient) {
-  vec3 sum = k.x * ambient * albedo;
+// A surface's reflection: Phong (seed 000) or glTF's metallic-roughness BRDF.
+struct Reflector {
+  bool pbr;
+  vec3 albedo;     // Phong: the albedo; pbr: the diffuse colour
+  vec3 k;          // Phong: k_d, k_s in y, z (k_a is the caller's)
+  float shininess; // Phong, >= 0
+  vec3 f0;         // pbr
+  float roughness; // pbr
+};
+
+// glTF's metallic-roughness BRDF times n.l: Lambert diffuse weighted by 1 - F,
+// GGX (Trowbridge-Reitz) specular with Smith's height-correlated visibility
+// and Schlick's Fresnel from f0. The engine's lights carry Lambert's 1 / pi
+// already (Phong has none; engine/scene/gltf.h), so the specular term is
+// pi times the BRDF.
+vec3 pbr_reflect(Reflector m, vec3 n, vec3 v, vec3 l, float ndl) {
+  float a = max(m.roughness * m.roughness, 1e-3), a2 = a * a;
+  float ndv = max(dot(n, v), 1e-4);
+  vec3 h = safe_normalize(l + v, n);
+  float ndh = saturate(dot(n, h)), vdh = saturate(dot(v, h));
+  float dd = ndh * ndh * (a2 - 1.0) + 1.0;
+  float d = a2 / max(PI * dd * dd, 1e-12);
+  float vis = 0.5 / max(ndl * sqrt(ndv * ndv * (1.0 - a2) + a2) + ndv * sqrt(ndl * ndl * (1.0 - a2) + a2), 1e-8);
+  vec3 f = m.f0 + (1.0 - m.f0) * pow(1.0 - vdh, 5.0);
+  return ndl * ((1.0 - f) * m.albedo + PI * f * d * vis);
+}
+
+// Phong's diffuse and specular terms (k_d n.l + k_s (r.v)^shininess).
+vec3 phong_reflect(Reflector m, vec3 n, vec3 v, vec3 l, float ndl) {
+  vec3 r = reflect(-l, n);
+  // pow(0, 0) is undefined in GLSL: keep the base strictly positive.
+  float spec = m.k.z > 0.0 ? pow(max(dot(r, v), 1e-8), max(m.shininess, 1.0)) : 0.0;
+  return m.k.y * m.albedo * ndl + m.k.z * spec;
+}
+
+// The light of every light that may reach p reflected toward v (unit n and v),
+// one loop for both models. The loop tests at its end: a software rasterizer
+// would run a head-tested loop's body once more for its last test.
+vec3 reflected_light(Reflector m, vec3 n, vec3 v, vec3 p) {
+  vec3 sum = vec3(0.0);
   LightList near = lights_near(p);
-  for (int j = 0; j < near.count; j++) {
-    int i = light_index(near, j);
+  if (near.count <= 0) return sum;
+  int j = 0;
+  do {
     vec3 l, radiance;
     float ndl;
-    if (!light_on_surface(i, p, n, l, ndl, radiance)) continue;
-    vec3 r = reflect(-l, n);
-    // pow(0, 0) is undefined in GLSL: keep the base strictly positive.
-    float spec = k.z > 0.0 ? pow(max(dot(r, v), 1e-8), max(shininess, 1.0)) : 0.0;
-    sum += radiance * (k.y * albedo * ndl + k.z * spec);
-  }
+    if (light_on_surface(light_index(near, j), p, n, l, ndl, radiance))
+      sum += radiance * (m.pbr ? pbr_reflect(m, n, v, l, ndl) : phong_reflect(m, n, v, l, ndl));
+  } while (++j < near.count);
   return sum;
 }
 
-// glTF's metallic-roughness BRDF: Lambert diffuse weighted by 1 - F, GGX
-// (Trowbridge-Reitz) specular with Smith's height-correlated visibility and
-// Schlick's Fresnel from f0. The engine's lights carry Lambert's 1 / pi
-// already (Phong has none; engine/scene/gltf.h), so the specular term is
-// pi times the BRDF. Ambient light reaches the diffuse part times occlusion.
-vec3 pbr_light(vec3 diffuse, vec3 f0, float roughness, float occlusion, vec3 n, vec3 v, vec3 p, vec3 ambient) {
-  float a = max(roughness * roughness, 1e-3), a2 = a * a;
-  float ndv = max(dot(n, v), 1e-4);
-  vec3 sum = occlusion * ambient * diffuse;
-  LightList near = lights_near(p);
-  for (int j = 0; j < near.count; j++) {
-    int i = light_index(near, j);
-    vec3 l, radiance;
-    float ndl;
-    if (!light_on_surface(i, p, n, l, ndl, radiance)) continue;
-    vec3 h = safe_normalize(l + v, n);
-    float ndh = saturate(dot(n, h)), vdh = saturate(dot(v, h));
-    float dd = ndh * ndh * (a2 - 1.0) + 1.0;
-    float d = a2 / max(PI * dd * dd, 1e-12);
-    float vis = 0.5 / max(ndl * sqrt(ndv * ndv * (1.0 - a2) + a2) + ndv * sqrt(ndl * ndl * (1.0 - a2) + a2), 1e-8);
-    vec3 f = f0 + (1.0 - f0) * pow(1.0 - vdh, 5.0);
-    sum += radiance * ndl * ((1.0 - f) * diffuse + PI * f * d * vis);
-  }
-  return sum;
+// k = (k_a, k_d, k_s), shininess >= 0; n and v unit vectors (v toward the eye).
+vec3 phong(vec3 albedo, vec3 k, float shininess, vec3 n, vec3 v, vec3 p, vec3 ambient) {
+  Reflector m = Reflector(false, albedo, k, shininess, vec3(0.0), 1.0);
+  return k.x * ambient * albedo + reflected_light(m, n, v, p);
 }
+
 #endif

@@ -4,7 +4,7 @@
 //   dpt = linear depth / far                Blinn-Phong lobe matches GGX's
 //   mat = k_a = occlusion, k_d = 1 - metallic, k_s = max(F0), mat_alpha_encode(reflectivity, true)
 // so k_d * clr is the diffuse albedo GI passes use, and lighting.glsl's
-// pbr_light gets roughness and F0 = mix(0.04, clr, metallic) back.
+// pbr_reflect gets roughness and F0 = mix(0.04, clr, metallic) back.
 // Location 4 (when the pass gives it) takes the emitted radiance.
 #include "gbuffer.glsl"
 

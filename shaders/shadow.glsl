@@ -2,9 +2,18 @@
 // shaders read shadows (ESM, PCF, Poisson or hard compares, cascades for
 // directional lights, cube faces for point lights; PCSS). Needs `#define SHADOWS`
 // and a pass input `shadow_atlas` (what scripts/shadow.lua returns).
+// SHADOW_FILTER (0 esm, 1 pcf, 2 poisson, 3 hard, 4 pcss: lm_shadow_technique),
+// which shadow.bind defines from the plan, compiles in that filter alone:
+// without it every filter is compiled and each light's info.w picks one,
+// and a software rasterizer runs every branch (all five filters a lookup).
 #ifndef LIMN_SHADOW_GLSL
 #define LIMN_SHADOW_GLSL
 #include "common.glsl"
+#ifdef SHADOW_FILTER
+#define SHADOW_FILTER_OF(s) SHADOW_FILTER
+#else
+#define SHADOW_FILTER_OF(s) ((s).info.w)
+#endif
 
 struct ShadowLight {
   ivec4 info;  // first view, view count, kind (0 none, 1 cascades, 2 spot, 3 point), technique
@@ -100,7 +109,7 @@ float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
   vec2 f = texel - vec2(base);
   float texel_depth = shadow_texel_depth(sv, r);
   float bias = s.params.y * texel_depth;
-  int technique = s.info.w;
+  int technique = SHADOW_FILTER_OF(s);
   // Filters reach `spread` texels away, where a tilted receiver is deeper:
   // scale the bias by the tilt (tan of the light's angle, capped).
   float spread = technique == 0 ? 1.0 : technique == 1 ? 1.5 : technique == 2 ? s.params.w : 0.0;
@@ -136,27 +145,33 @@ float shadow_factor(int light, vec3 p, vec3 n, vec3 l) {
   ShadowLight s = shadow_lights[light];
   int first = s.info.x, count = s.info.y, kind = s.info.z;
   if (count <= 0) return 1.0;
-  float ndl = dot(n, l);
+  // The view to read, and for cascades the next one's weight t: one lookup
+  // whatever the kind (a software rasterizer runs every kind's branch).
+  int v = first;
+  float t = 0.0;
   if (kind == 3) { // point light: the cube face of the major axis
     vec3 d = p - shadow_views[first].depth.xyz;
     vec3 a = abs(d);
     int face = a.x >= a.y && a.x >= a.z ? (d.x >= 0.0 ? 0 : 1) : a.y >= a.z ? (d.y >= 0.0 ? 2 : 3) : (d.z >= 0.0 ? 4 : 5);
     if ((s.cube.x & (1 << face)) == 0) return 1.0; // no visible pixel was to sample it
-    return shadow_view_lookup(first + bitCount(s.cube.x & ((1 << face) - 1)), s, p, ndl);
+    v = first + bitCount(s.cube.x & ((1 << face) - 1));
+  } else if (kind == 1) { // cascades: by camera depth, blended over the last `blend` share of each
+    float z = -(frame.view * vec4(p, 1.0)).z;
+    int k = 0;
+    while (k < count - 1 && z > s.splits[k]) k++;
+    if (z > s.splits[count - 1]) return 1.0; // beyond the shadowed distance
+    v = first + k;
+    float start = k > 0 ? s.splits[k - 1] : frame.clip.x;
+    float band = (s.splits[k] - start) * s.params.z;
+    if (k < count - 1 && band > 0.0 && z > s.splits[k] - band) t = saturate((z - (s.splits[k] - band)) / band);
   }
-  if (kind == 2) return shadow_view_lookup(first, s, p, ndl);
-  // Cascades: by camera depth, blended over the last `blend` share of each.
-  float z = -(frame.view * vec4(p, 1.0)).z;
-  int k = 0;
-  while (k < count - 1 && z > s.splits[k]) k++;
-  if (z > s.splits[count - 1]) return 1.0; // beyond the shadowed distance
-  float vis = shadow_view_lookup(first + k, s, p, ndl);
-  float start = k > 0 ? s.splits[k - 1] : frame.clip.x;
-  float band = (s.splits[k] - start) * s.params.z;
-  if (k < count - 1 && band > 0.0 && z > s.splits[k] - band) {
-    float t = saturate((z - (s.splits[k] - band)) / band);
-    vis = mix(vis, shadow_view_lookup(first + k + 1, s, p, ndl), t);
-  }
+  float ndl = dot(n, l), vis = 1.0;
+  // Both lookups in a loop that tests at its end, not the second in an if: a
+  // software rasterizer leaves such a loop once no pixel of its group goes on,
+  // but runs both sides of every if.
+  int j = 0;
+  do vis = mix(vis, shadow_view_lookup(v + j, s, p, ndl), j == 0 ? 1.0 : t);
+  while (++j < (t > 0.0 ? 2 : 1));
   return vis;
 }
 #endif

@@ -10,24 +10,24 @@ out vec2 tex_uv;
 #endif
 #ifdef RSM
 layout(location = 1) in vec3 in_normal;
-uniform mat3 normal_matrix;
+layout(location = 7) in mat3 instance_normal; // the model matrix's inverse transpose
 out vec3 world_normal;
 #endif
 
-uniform mat4 model;
+layout(location = 3) in mat4 instance_model; // the node's (lm_instance: one draw, many nodes)
 uniform mat4 pass_view_proj;
 uniform vec4 pass_depth; // light position, 1 / range; w = 0: orthographic
 
 out vec3 world_pos;
 
 void main() {
-  vec4 world = model * vec4(in_position, 1.0);
+  vec4 world = instance_model * vec4(in_position, 1.0);
   world_pos = world.xyz;
 #if defined(RSM) || defined(ALPHA_MASK)
   tex_uv = in_uv;
 #endif
 #ifdef RSM
-  world_normal = normal_matrix * in_normal;
+  world_normal = instance_normal * in_normal;
 #endif
   gl_Position = pass_view_proj * world;
 }

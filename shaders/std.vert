@@ -4,9 +4,8 @@
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv;
-
-uniform mat4 model;
-uniform mat3 normal_matrix;
+layout(location = 3) in mat4 instance_model;  // the node's (lm_instance: one draw, many nodes)
+layout(location = 7) in mat3 instance_normal; // its inverse transpose
 
 out vec3 world_normal;
 out vec3 world_pos; // for derivative tangent frames (pbr.frag)
@@ -14,8 +13,8 @@ out float view_depth;
 out vec2 tex_uv;
 
 void main() {
-  vec4 world = model * vec4(in_position, 1.0);
-  world_normal = normal_matrix * in_normal;
+  vec4 world = instance_model * vec4(in_position, 1.0);
+  world_normal = instance_normal * in_normal;
   world_pos = world.xyz;
   view_depth = -(frame.view * world).z; // OpenGL looks down -z
   tex_uv = in_uv;

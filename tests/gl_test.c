@@ -99,7 +99,8 @@ gl_result gl_render(const gl_run *run) {
                                                       .pipeline = r.pipeline, .width = r.width,
                                                       .height = r.height, .linear_output = true,
                                                       .check_finite = run->check_finite,
-                                                      .no_light_culling = run->no_light_culling}, &r.err);
+                                                      .no_light_culling = run->no_light_culling,
+                                                      .no_culling = run->no_culling}, &r.err);
   if (!r.renderer) return r;
   r.rgb = malloc(sizeof(float) * 3 * (size_t)r.width * (size_t)r.height);
   r.srgb = malloc(3 * (size_t)r.width * (size_t)r.height);

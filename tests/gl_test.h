@@ -16,6 +16,7 @@ typedef struct gl_run {
   int frames;               /* 0: 1 */
   bool check_finite;        /* the renderer's NaN/Inf attribution */
   bool no_light_culling;    /* every pixel evaluates every light */
+  bool no_culling;          /* every node drawn in every view (lm_renderer_desc.no_culling) */
 } gl_run;
 
 typedef struct gl_result {

@@ -1,7 +1,8 @@
 /* Light culling (engine/scene/lightgrid.c): no cluster leaves out a light
  * that reaches a point of it, checked on the CPU at points just inside each
  * light's range and cone; and the Cornell box lit by many lights whose ranges
- * end on its walls renders as it does with every light evaluated everywhere. */
+ * end on its walls renders as it does with every light evaluated everywhere;
+ * spots of unbounded reach are culled by their cones. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -179,10 +180,88 @@ static void culled_frame_matches_every_light_evaluated(void **state) {
   lm_scene_destroy(plain);
 }
 
+/* Spots whose falloff has no range (1 / d^2) reach every distance but only
+ * their cone: the grid lists them where the cone reaches (at points inside
+ * it, near and far, in their clusters), not in every cluster, and the frame
+ * is the one every light evaluated everywhere gives. */
+static void spots_of_unbounded_reach_are_culled_by_their_cone(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *s = lm_scene_builtin("cornell", &err);
+  assert_non_null(s);
+  s->lights[0].casts_shadows = false;
+  enum { SPOTS = 6, W = 96, H = 72 };
+  for (int i = 0; i < SPOTS; i++) {
+    mat4 m;
+    glm_translate_make(m, (vec3){-0.8f + 0.32f * (float)i, 1.9f, -0.5f + 0.2f * (float)(i % 3)});
+    glm_rotate_x(m, glm_rad(-90.0f + 10.0f * (float)(i % 3)), m); /* down, some tilted forward */
+    char name[16];
+    snprintf(name, sizeof name, "spot_%d", i);
+    lm_scene_add_light(s, &(lm_light){.name = "", .type = LM_LIGHT_SPOT, .color = {1, 0.9f, 0.8f}, .power = 50.0f,
+                                      .falloff = LM_FALLOFF_INVERSE_SQUARE, .inner_cone = 0.15f, .outer_cone = 0.25f,
+                                      .node = lm_scene_add_node(s, name, -1, (float *)m, -1, -1)});
+  }
+  lm_scene_update(s);
+  lm_frame_data f;
+  lm_scene_frame_data(s, 0, W, H, &f);
+  lm_light_data lights[8];
+  int n = lm_scene_light_data(s, lights, 8);
+  lm_light_grid g = {0};
+  lm_light_grid_build(&g, &f, lights, n, true);
+  assert_true(g.tile_px > 0 && isinf(lm_light_data_reach(&lights[1])));
+  assert_int_equal(g.global, 1); /* the box's own light */
+  double mean = (double)g.listed / (g.tiles_x * g.tiles_y * g.slices);
+  printf("spots of unbounded reach: a cluster lists %.2f of %d on average\n", mean, SPOTS);
+  assert_true(mean < SPOTS / 2.0);
+  long checked = 0;
+  for (int i = 1; i < n; i++)
+    for (int k = 0; k < 4000; k++) {
+      /* A point in the cone: along the axis up to 3 units, at most 0.99 of the cone's radius off it. */
+      float t = 3.0f * uniform01(), a = 2 * GLM_PIf * uniform01(), off = 0.99f * sqrtf(uniform01()) * t * tanf(0.25f);
+      vec3 d = {lights[i].direction[0], lights[i].direction[1], lights[i].direction[2]}, u, v;
+      glm_vec3_crossn(d, fabsf(d[0]) < 0.9f ? (vec3){1, 0, 0} : (vec3){0, 1, 0}, u);
+      glm_vec3_crossn(d, u, v);
+      float p[3];
+      for (int c = 0; c < 3; c++)
+        p[c] = lights[i].position[c] + t * d[c] + off * (cosf(a) * u[c] + sinf(a) * v[c]);
+      vec4 c, wp = {p[0], p[1], p[2], 1};
+      glm_mat4_mulv((vec4 *)f.view_proj, wp, c);
+      if (!(c[3] > 0)) continue;
+      float x = (c[0] / c[3] * 0.5f + 0.5f) * W, y = (c[1] / c[3] * 0.5f + 0.5f) * H;
+      int cluster = x < 0 || y < 0 || x >= W || y >= H ? -1 : lm_light_grid_cluster(&g, x, y, c[3] / f.clip[1]);
+      if (cluster < 0) continue;
+      checked++;
+      if (!lm_light_grid_has(&g, cluster, i)) fail_msg("spot %d left out of cluster %d", i, cluster);
+    }
+  printf("points inside the cones checked in their clusters: %ld\n", checked);
+  assert_true(checked > 5000);
+  lm_light_grid_free(&g);
+  const char *sets[] = {"ambient=0", NULL};
+  gl_result on = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = sets, .width = W, .height = H});
+  gl_result off = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = sets, .width = W, .height = H,
+                                      .no_light_culling = true});
+  s->light_count = 1; /* the box alone: the spots must add light */
+  gl_result box = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = sets, .width = W, .height = H});
+  assert_true(on.ok && off.ok && box.ok);
+  double worst = 0, sum = 0, sum_box = 0;
+  for (int i = 0; i < 3 * W * H; i++) {
+    worst = fmax(worst, fabs(on.rgb[i] - off.rgb[i]) / fmax(off.rgb[i], 0.05));
+    sum += off.rgb[i], sum_box += box.rgb[i];
+  }
+  printf("culled against unculled: largest relative difference %.2e; radiance %.1f, %.1f without the spots\n",
+         worst, sum, sum_box);
+  assert_true(worst < 4e-3 && sum > 1.2 * sum_box);
+  gl_result_free(&on);
+  gl_result_free(&off);
+  gl_result_free(&box);
+  lm_scene_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(every_reaching_light_is_listed),
       cmocka_unit_test(culled_frame_matches_every_light_evaluated),
+      cmocka_unit_test(spots_of_unbounded_reach_are_culled_by_their_cone),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

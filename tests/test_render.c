@@ -281,11 +281,68 @@ static void cpu_passes_read_back_and_upload(void **state) {
   lm_graph_destroy(g);
 }
 
+/* The field's 60 posts share a mesh and a material: the camera draws them in
+ * one instanced call (and the ground in another), each where its own
+ * matrices put it. Given a copy of the mesh each, they draw one call a post,
+ * and the image, shadows included (shadow.vert reads the same instances), is
+ * the same. */
+static void copies_of_a_mesh_draw_in_one_call_and_look_the_same(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *shared = lm_scene_builtin("field", &err), *own = lm_scene_builtin("field", &err);
+  assert_true(shared && own);
+  int posts = 0;
+  for (int i = 0; i < own->node_count; i++) {
+    lm_node *n = &own->nodes[i];
+    if (strncmp(n->name, "post_", 5)) continue;
+    const lm_scene_mesh *m = &own->meshes[n->mesh];
+    float *v = malloc(sizeof(float) * 8 * (size_t)m->vertex_count);
+    uint32_t *idx = malloc(sizeof(uint32_t) * (size_t)m->index_count);
+    memcpy(v, m->vertices, sizeof(float) * 8 * (size_t)m->vertex_count);
+    memcpy(idx, m->indices, sizeof(uint32_t) * (size_t)m->index_count);
+    n->mesh = lm_scene_add_mesh(own, n->name, v, m->vertex_count, idx, m->index_count); /* may move meshes */
+    free(v);
+    free(idx);
+    posts++;
+  }
+  assert_int_equal(posts, 60);
+  gl_result a = gl_render(&(gl_run){.scene = shared, .tech = "dl+esm", .width = W, .height = H});
+  gl_result b = gl_render(&(gl_run){.scene = own, .tech = "dl+esm", .width = W, .height = H});
+  assert_true(a.ok && b.ok);
+  lm_scene_draw_stats sa = lm_renderer_draw_stats(a.renderer), sb = lm_renderer_draw_stats(b.renderer);
+  printf("field: %d nodes drawn in %d calls shared, %d in %d calls with a mesh each\n", sa.drawn, sa.calls, sb.drawn,
+         sb.calls);
+  assert_int_equal(sa.drawn, sb.drawn);
+  assert_int_equal(sa.calls, 2);
+  assert_int_equal(sb.calls, sb.drawn);
+  float worst = 0;
+  for (int i = 0; i < W * H * 3; i++) worst = fmaxf(worst, fabsf(a.rgb[i] - b.rgb[i]));
+  printf("largest difference between the images: %g\n", worst);
+  assert_true(worst <= 1e-5f);
+  gl_result_free(&a);
+  gl_result_free(&b);
+  lm_scene_destroy(shared);
+  lm_scene_destroy(own);
+  /* A technique still reading the per-node uniform `model` is told what to read instead. */
+  assert_true(gl_write_file("shaders/oldtech.vert", "#include \"common.glsl\"\nlayout(location = 0) in vec3 p;\n"
+                                                    "uniform mat4 model;\nvoid main() { gl_Position = frame.view_proj "
+                                                    "* model * vec4(p, 1.0); }\n"));
+  assert_true(gl_write_file("shaders/oldtech.frag", "out vec4 o;\nvoid main() { o = vec4(1.0); }\n"));
+  assert_true(gl_write_file("oldtech.lua", "Techniques = { 'x' }\nfunction OnRender()\n  local t = target{ 't', "
+                                           "format = 'rgba8' }\n  scene{ 'old', technique = 'oldtech', out = t }\n"
+                                           "  present(t)\nend\n"));
+  gl_result r = render("oldtech.lua", NULL, 1);
+  assert_false(r.ok);
+  if (!strstr(r.err.msg, "oldtech") || !strstr(r.err.msg, "instance_model")) fail_msg("%s", r.err.msg);
+  gl_result_free(&r);
+}
+
 int main(void) {
   snprintf(pp_lua, sizeof pp_lua, "%s/scripts/pp.lua", lm_root_dir());
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(cornell_box_has_light_and_colour_where_it_must),
       cmocka_unit_test(cornell_box_matches_the_golden_image),
+      cmocka_unit_test(copies_of_a_mesh_draw_in_one_call_and_look_the_same),
       cmocka_unit_test(shader_errors_name_the_original_file_and_line),
       cmocka_unit_test(wrong_uniforms_and_inputs_name_the_pass_and_parameter),
       cmocka_unit_test(no_nan_or_inf_leaves_the_output_stage),

@@ -2,6 +2,7 @@
 """Times this checkout against another revision in one run.
 
     tools/bench_compare.py REV [--case SCENE[:TECH[:NAME=VALUE,...]]] ... [options]
+    (--set-this NAME=VALUE: an option for this checkout alone, one REV lacks)
 
 Builds REV's `limn` in a scratch git worktree (under /tmp, removed at the end
 unless --keep), then renders every case with both builds in turn, round after
@@ -60,12 +61,12 @@ def parse_case(text):
     return {"label": text, "scene": scene, "tech": tech, "sets": sets}
 
 
-def capture(limn, case, args, image):
+def capture(limn, case, args, image, sets):
     cmd = [limn, "capture", "--scene", case["scene"], "--size", args.size, "--frames", str(args.frames),
            "--output", image]
     if case["tech"]:
         cmd += ["--tech", case["tech"]]
-    for s in case["sets"] + args.set:
+    for s in case["sets"] + sets:
         cmd += ["--set", s]
     p = subprocess.run(cmd, text=True, capture_output=True)
     if p.returncode != 0:
@@ -98,6 +99,8 @@ def main():
                     help="SCENE[:TECH[:NAME=VALUE,...]]: a scene of data/scenes or a built-in, a technique and\n"
                          "options (repeatable; default: garage, office and outdoor with isr+esm)")
     ap.add_argument("--set", action="append", default=[], help="NAME=VALUE for every case (repeatable)")
+    ap.add_argument("--set-this", action="append", default=[], metavar="NAME=VALUE",
+                    help="for this checkout only, every case: an option REV lacks (repeatable)")
     ap.add_argument("--size", default="512x384")
     ap.add_argument("--frames", type=int, default=3, help="frames a run (the median is taken)")
     ap.add_argument("--rounds", type=int, default=3, help="runs of each revision per case, alternated")
@@ -136,7 +139,8 @@ def main():
                 for who in order:
                     print(f"  {case['label']}: round {r + 1}/{args.rounds}, {who}", file=log)
                     img = os.path.join(images, f"{len(results)}-{who}.exr")
-                    times[who].append(capture(limn[who], case, args, img))
+                    times[who].append(capture(limn[who], case, args, img,
+                                              args.set + (args.set_this if who == "this" else [])))
             err = mean_error(limn["this"], os.path.join(images, f"{len(results)}-base.exr"),
                              os.path.join(images, f"{len(results)}-this.exr"))
             names = [n for n in times["base"][0] if n != "total"]
@@ -159,10 +163,13 @@ def main():
     label = here + (" (uncommitted changes)" if dirty else "")
     if args.json:
         print(json.dumps({"base": sha, "this": label, "size": args.size, "frames": args.frames,
-                          "rounds": args.rounds, "sets": args.set, "cases": results}, indent=1))
+                          "rounds": args.rounds, "sets": args.set, "sets_this": args.set_this, "cases": results},
+                         indent=1))
         return
     print(f"base {args.rev} ({sha[:10]}) against this checkout {label}; {args.size}, medians of "
           f"{args.rounds} alternated runs of {args.frames} frames; ratio = base / this (> 1: faster now)")
+    if args.set_this:
+        print(f"this checkout only: {', '.join(args.set_this)}")
     fmt = "  {:<26} {:>10} {:>10} {:>8}"
     for res in results:
         err = res["mean_error"]

@@ -2,6 +2,7 @@
 #include "gfx/gfx.h"
 
 #include <epoxy/gl.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -285,6 +286,16 @@ void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const u
     glVertexArrayAttribFormat(m->vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a] * sizeof(float));
     glVertexArrayAttribBinding(m->vao, a, 0);
   }
+  /* Binding 1: lm_instance, one an instance (its buffer is bound at draw time). */
+  for (int a = 3; a < 10; a++) {
+    bool model = a < 7;
+    size_t offset = model ? offsetof(lm_instance, model) + (size_t)(a - 3) * 4 * sizeof(float)
+                          : offsetof(lm_instance, normal) + (size_t)(a - 7) * 3 * sizeof(float);
+    glEnableVertexArrayAttrib(m->vao, (GLuint)a);
+    glVertexArrayAttribFormat(m->vao, (GLuint)a, model ? 4 : 3, GL_FLOAT, GL_FALSE, (GLuint)offset);
+    glVertexArrayAttribBinding(m->vao, (GLuint)a, 1);
+  }
+  glVertexArrayBindingDivisor(m->vao, 1, 1);
   m->index_count = index_count;
 }
 
@@ -295,9 +306,23 @@ void lm_mesh_destroy(lm_mesh *m) {
   *m = (lm_mesh){0};
 }
 
-void lm_mesh_draw(const lm_mesh *m) {
+static GLuint instance_vbo;
+static size_t instance_capacity; /* instances */
+
+void lm_instances_upload(const lm_instance *instances, int count) {
+  if (count <= 0) return;
+  if (!instance_vbo) glCreateBuffers(1, &instance_vbo);
+  if ((size_t)count > instance_capacity) instance_capacity = (size_t)count + (size_t)count / 2;
+  /* New storage each time (orphaning): draws already queued keep reading the old. */
+  glNamedBufferData(instance_vbo, (GLsizeiptr)(instance_capacity * sizeof(lm_instance)), NULL, GL_STREAM_DRAW);
+  glNamedBufferSubData(instance_vbo, 0, (GLsizeiptr)((size_t)count * sizeof(lm_instance)), instances);
+}
+
+void lm_mesh_draw_instances(const lm_mesh *m, int first, int count) {
+  if (count <= 0 || !instance_vbo) return;
+  glVertexArrayVertexBuffer(m->vao, 1, instance_vbo, 0, sizeof(lm_instance));
   glBindVertexArray(m->vao);
-  glDrawElements(GL_TRIANGLES, m->index_count, GL_UNSIGNED_INT, NULL);
+  glDrawElementsInstancedBaseInstance(GL_TRIANGLES, m->index_count, GL_UNSIGNED_INT, NULL, count, (GLuint)first);
 }
 
 /* ---- timers ------------------------------------------------------------ */
@@ -390,6 +415,10 @@ void lm_texture_upload_floats(lm_texture tex, int width, int height, const float
 
 void lm_texture_copy(lm_texture dst, lm_texture src, int width, int height) {
   glCopyImageSubData(src.id, GL_TEXTURE_2D, 0, 0, 0, 0, dst.id, GL_TEXTURE_2D, 0, 0, 0, 0, width, height, 1);
+}
+
+void lm_texture_copy_rect(lm_texture dst, lm_texture src, int x, int y, int width, int height) {
+  glCopyImageSubData(src.id, GL_TEXTURE_2D, 0, x, y, 0, dst.id, GL_TEXTURE_2D, 0, x, y, 0, width, height, 1);
 }
 
 void lm_screen_bind(int width, int height) {

@@ -170,11 +170,19 @@ void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, in
 
 /* ---- meshes ------------------------------------------------------------ */
 typedef struct lm_mesh { uint32_t vao, vbo, ibo; int index_count; } lm_mesh;
-/* Interleaved position(3) normal(3) uv(2) floats; 32-bit indices. */
+/* Interleaved position(3) normal(3) uv(2) floats (attributes 0, 1, 2); 32-bit indices. */
 void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const uint32_t *indices,
                     int index_count);
 void lm_mesh_destroy(lm_mesh *m);
-void lm_mesh_draw(const lm_mesh *m);
+/* One instance of a drawn mesh: attributes 3-6 (mat4 instance_model, the
+ * columns) and 7-9 (mat3 instance_normal, the model matrix's inverse
+ * transpose), stepping once an instance. */
+typedef struct lm_instance { float model[16]; float normal[9]; } lm_instance;
+/* Replaces the instances the next draws read (grows the buffer as needed). */
+void lm_instances_upload(const lm_instance *instances, int count);
+/* Draws m once for each of the uploaded instances first .. first + count - 1:
+ * one draw call however many there are. */
+void lm_mesh_draw_instances(const lm_mesh *m, int first, int count);
 
 /* ---- timers ------------------------------------------------------------ */
 typedef enum lm_clock { LM_CLOCK_AUTO, LM_CLOCK_GPU, LM_CLOCK_CPU } lm_clock;
@@ -201,6 +209,8 @@ void lm_texture_upload(lm_texture tex, int width, int height, const uint8_t *rgb
 void lm_texture_upload_floats(lm_texture tex, int width, int height, const float *rgba);
 /* Copies level 0 of src into dst (same format and size). */
 void lm_texture_copy(lm_texture dst, lm_texture src, int width, int height);
+/* Copies the rectangle x, y, width, height of src's level 0 to the same place in dst (same format). */
+void lm_texture_copy_rect(lm_texture dst, lm_texture src, int x, int y, int width, int height);
 /* Binds the window's (default) framebuffer and sets the viewport. */
 void lm_screen_bind(int width, int height);
 /* The default framebuffer's back buffer as RGB bytes, top row first. */

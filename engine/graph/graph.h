@@ -50,6 +50,7 @@ typedef struct lm_pass_view {
   int x, y, width, height; /* viewport, pixels */
   float view_proj[16];
   float depth[4];
+  float cull[16]; /* nodes wholly outside this clip volume are not drawn (view_proj, or a tighter one) */
 } lm_pass_view;
 /* A scene pass's override of a material parameter (scene{ materials = ...}):
  * the scene checks the names when it draws. */

@@ -8,6 +8,18 @@
 
 enum { MAX_LIGHTS = 256 };
 
+/* Shadow tiles kept from frame to frame: a copy of every output of the
+ * shadow pass (and its depth), and per tile drawn the key of what drew it.
+ * A view whose key matches the tile in its place copies the texels back
+ * instead of drawing (lm_shadow_settings.cache). */
+typedef struct tile_cache {
+  lm_texture tex[LM_MAX_COLOR_OUTPUTS + 1];
+  lm_format format[LM_MAX_COLOR_OUTPUTS + 1];
+  int count, width, height;
+  struct cached_tile { int x, y, width, height; bool drawn; uint64_t key; } *tiles;
+  int tile_count, tile_cap;
+} tile_cache;
+
 struct lm_renderer {
   lm_renderer_desc desc;
   lm_graph *graph;
@@ -24,6 +36,8 @@ struct lm_renderer {
   bool sharing;
   lm_trace *trace; /* the scene's BVH, built by the first CPU "trace" pass */
   uint64_t trace_hash; /* geometry_hash when it was built or refitted */
+  tile_cache tiles;
+  uint64_t casters_hash; /* this frame's caster_hash */
 };
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
@@ -38,8 +52,15 @@ lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
   return r;
 }
 
+static void tile_cache_free(tile_cache *c) {
+  for (int i = 0; i < c->count; i++) lm_texture_destroy(&c->tex[i]);
+  free(c->tiles);
+  *c = (tile_cache){0};
+}
+
 void lm_renderer_destroy(lm_renderer *r) {
   if (!r) return;
+  tile_cache_free(&r->tiles);
   lm_graph_destroy(r->graph);
   lm_shadow_plan_free(&r->shadows);
   lm_light_grid_free(&r->light_grid);
@@ -85,8 +106,8 @@ static const lm_program *scene_variant(void *ctx, const char *defines, lm_error 
   return lm_scene_pass_variant(ctx, defines, err);
 }
 
-static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
-  lm_renderer *r = user;
+/* Draws the scene for a scene pass: the camera's, or one shadow tile's. */
+static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, lm_error *err) {
   enum { MAX_PARAMS = 256 };
   lm_material_param params[MAX_PARAMS];
   int n = sp->desc->material_param_count < MAX_PARAMS ? sp->desc->material_param_count : MAX_PARAMS;
@@ -95,9 +116,10 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
     params[i] = (lm_material_param){q->material, q->name, q->count, {q->v[0], q->v[1], q->v[2], q->v[3]}};
   }
   if (!lm_scene_check_params(r->desc.scene, params, n, err)) return false;
-  /* Cull against the camera or the tile; a cascade tile keeps casters before
-   * its near plane, which its depth clamp flattens onto it (pancaking). */
-  const float *view_proj = sp->view ? sp->view->view_proj : r->camera.view_proj;
+  /* Cull against the camera or the tile's cull volume (a cascade's: the
+   * slice it serves); a cascade tile keeps casters before its near plane,
+   * which its depth clamp flattens onto it (pancaking). */
+  const float *view_proj = sp->view ? sp->view->cull : r->camera.view_proj;
   lm_scene_draw_desc d = {.program = sp->program, .variant = scene_variant, .ctx = (void *)sp,
                           .view_proj = r->desc.no_culling ? NULL : view_proj,
                           .pancake = sp->view && sp->view->depth[3] == 0,
@@ -105,9 +127,104 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   return lm_scene_draw(r->desc.scene, &d, sp->view ? &r->shadow_stats : &r->stats, err);
 }
 
+/* The textures a scene pass draws: its colour outputs, then its depth target
+ * if it has one. Returns how many. */
+static int pass_textures(const lm_scene_pass *sp, lm_graph_target_info out[LM_MAX_COLOR_OUTPUTS + 1]) {
+  int n = 0;
+  for (int i = 0; i < sp->desc->output_count && n < LM_MAX_COLOR_OUTPUTS; i++)
+    out[n++] = lm_graph_target(sp->graph, sp->desc->outputs[i]);
+  if (sp->desc->depth >= 0) out[n++] = lm_graph_target(sp->graph, sp->desc->depth);
+  return n;
+}
+
+/* What a shadow tile's texels follow from: the view (place, matrices, cull
+ * volume), the pass (technique's program, defines, clear colour, material
+ * overrides) and the casters (caster_hash). */
+static uint64_t tile_key(const lm_renderer *r, const lm_scene_pass *sp) {
+  const lm_pass_view *v = sp->view;
+  const lm_pass_desc *d = sp->desc;
+  int place[4] = {v->x, v->y, v->width, v->height};
+  uint64_t h = lm_hash(place, sizeof place, r->casters_hash);
+  h = lm_hash(v->view_proj, sizeof v->view_proj, h);
+  h = lm_hash(v->depth, sizeof v->depth, h);
+  h = lm_hash(v->cull, sizeof v->cull, h);
+  h = lm_hash(&sp->program->id, sizeof sp->program->id, h);
+  h = lm_hash(d->shader, strlen(d->shader), h);
+  h = lm_hash(d->defines, strlen(d->defines), h);
+  h = lm_hash(d->clear_color, sizeof d->clear_color, h);
+  for (int i = 0; i < d->material_param_count; i++) {
+    const lm_pass_material_param *q = &d->material_params[i];
+    h = lm_hash(q->material, strlen(q->material), h);
+    h = lm_hash(q->name, strlen(q->name), h);
+    h = lm_hash(q->v, sizeof(float) * (size_t)q->count, h);
+  }
+  return h;
+}
+
+/* Makes the cache hold textures like the pass's (forgetting every tile when
+ * they change); false when a texture cannot be made. */
+static bool tile_cache_fit(tile_cache *c, const lm_graph_target_info *t, int n, lm_error *err) {
+  bool same = c->count == n && n > 0 && c->width == t[0].width && c->height == t[0].height;
+  for (int i = 0; same && i < n; i++)
+    same = c->format[i] == t[i].format && t[i].width == c->width && t[i].height == c->height;
+  if (same) return true;
+  tile_cache_free(c);
+  for (int i = 0; i < n; i++) {
+    if (!lm_texture_create(&c->tex[i], &(lm_texture_desc){t[i].format, t[i].width, t[i].height, false},
+                           "shadow tile cache", err)) {
+      c->count = i;
+      tile_cache_free(c);
+      return false;
+    }
+    c->format[i] = t[i].format;
+    c->count = i + 1;
+  }
+  c->width = t[0].width, c->height = t[0].height;
+  return true;
+}
+
+/* The cached tile at view v's place (a new, empty one when none is). */
+static struct cached_tile *tile_at(tile_cache *c, const lm_pass_view *v) {
+  for (int i = 0; i < c->tile_count; i++) {
+    struct cached_tile *t = &c->tiles[i];
+    if (t->x == v->x && t->y == v->y && t->width == v->width && t->height == v->height) return t;
+  }
+  struct cached_tile *t = LM_PUSH(c->tiles, c->tile_count, c->tile_cap);
+  *t = (struct cached_tile){v->x, v->y, v->width, v->height, false, 0};
+  return t;
+}
+
+static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
+  lm_renderer *r = user;
+  /* A shadow tile drawn last frame from the same view and casters: copy it back. */
+  struct cached_tile *cached = NULL;
+  lm_graph_target_info t[LM_MAX_COLOR_OUTPUTS + 1];
+  int nt = sp->view && r->shadows.settings.cache ? pass_textures(sp, t) : 0;
+  uint64_t key = 0;
+  if (nt > 0) {
+    if (!tile_cache_fit(&r->tiles, t, nt, err)) return false;
+    key = tile_key(r, sp);
+    cached = tile_at(&r->tiles, sp->view);
+    if (cached->drawn && cached->key == key) {
+      for (int i = 0; i < nt; i++)
+        lm_texture_copy_rect(t[i].texture, r->tiles.tex[i], cached->x, cached->y, cached->width, cached->height);
+      r->shadow_stats.kept++;
+      return true;
+    }
+  }
+  if (!draw_pass(r, sp, err)) return false;
+  if (cached) {
+    for (int i = 0; i < nt; i++)
+      lm_texture_copy_rect(r->tiles.tex[i], t[i].texture, cached->x, cached->y, cached->width, cached->height);
+    cached->drawn = true, cached->key = key;
+  }
+  return true;
+}
+
 bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
   if (!lm_scene_upload(scene, err)) return false;
   r->desc.scene = scene;
+  r->tiles.tile_count = 0; /* another scene's textures are not hashed: draw every tile again */
   r->frame = 0;
   lm_trace_destroy(r->trace);
   r->trace = NULL;
@@ -122,6 +239,29 @@ static uint64_t geometry_hash(const lm_scene *s) {
     if (n->mesh < 0) continue;
     h = lm_hash(&n->mesh, sizeof n->mesh, h);
     h = lm_hash(n->world, sizeof n->world, h);
+  }
+  return h;
+}
+
+/* A hash of what shadow tiles are drawn from beside their views: the scene,
+ * its mesh nodes (mesh, material, world transform) and what the shadow and
+ * RSM shaders read of the materials (colour, factors, base-colour texture,
+ * alpha mask and texture transforms). */
+static uint64_t caster_hash(const lm_scene *s) {
+  uint64_t h = lm_hash(&s, sizeof s, geometry_hash(s));
+  for (int i = 0; i < s->node_count; i++)
+    if (s->nodes[i].mesh >= 0) h = lm_hash(&s->nodes[i].material, sizeof s->nodes[i].material, h);
+  for (int i = 0; i < s->material_count; i++) {
+    const lm_material *m = &s->materials[i];
+    const lm_material_pbr *p = &s->material_pbr[i];
+    float f[9] = {m->color[0], m->color[1], m->color[2], m->rho, m->ka, m->kd, m->ks, m->shininess, m->reflectivity};
+    float a[2] = {p->alpha, p->alpha_cutoff};
+    int k[3] = {m->base_color_texture, (int)p->alpha_mode, p->set};
+    h = lm_hash(f, sizeof f, h);
+    h = lm_hash(a, sizeof a, h);
+    h = lm_hash(k, sizeof k, h);
+    h = lm_hash(p->textures, sizeof p->textures, h);
+    h = lm_hash(p->uv_transform, sizeof p->uv_transform, h);
   }
   return h;
 }
@@ -269,6 +409,7 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_light_grid_build(&r->light_grid, frame, lights, n, !r->desc.no_light_culling);
   lm_storage_upload(4, r->light_grid.data, r->light_grid.count * sizeof *r->light_grid.data);
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
+  if (r->shadows.view_count > 0 && r->shadows.settings.cache) r->casters_hash = caster_hash(r->desc.scene);
   r->fit_ms = 0;
   lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene, .fit_views = fit_views, .run_cpu = run_cpu,
                           .scene_owns_uniform = lm_scene_owns_uniform, .user = r,

@@ -64,8 +64,9 @@ static void cluster_box(const lm_light_grid *g, const lm_frame_data *f, int tx, 
   for (int i = 0; i < 3; i++) lo[i] -= pad, hi[i] += pad;
 }
 
-/* Whether a light at view-space c with reach r (and, for a spot under 90
- * degrees, axis `axis` and cone cosine cos_outer) can touch the box. */
+/* Whether a light at view-space c with reach r (infinite for a spot of
+ * unbounded falloff; and, for a spot under 90 degrees, axis `axis` and cone
+ * cosine cos_outer) can touch the box. */
 static bool touches(const float c[3], float r, const float *axis, float cos_outer, const float lo[3],
                     const float hi[3]) {
   float d2 = 0;
@@ -73,7 +74,7 @@ static bool touches(const float c[3], float r, const float *axis, float cos_oute
     float e = c[i] < lo[i] ? lo[i] - c[i] : c[i] > hi[i] ? c[i] - hi[i] : 0;
     d2 += e * e;
   }
-  if (d2 > r * r) return false;
+  if (!isinf(r) && d2 > r * r) return false;
   if (!axis) return true;
   /* The cone against the box's bounding sphere: the sphere's distance from
    * the cone's surface, and its extent along the axis. */
@@ -90,6 +91,14 @@ static bool touches(const float c[3], float r, const float *axis, float cos_oute
   float gap = cos_outer * across - along * sin_outer;
   return !(gap > rad || along < -rad);
 }
+
+/* A spot whose cone is under 90 degrees: culled by its cone, whatever its reach. */
+static bool is_cone(const lm_light_data *l) {
+  return (int)(l->position[3] + 0.5f) == LM_LIGHT_SPOT && l->direction[3] > 0;
+}
+
+/* Does the light reach every cluster (infinite reach and no cone)? */
+static bool everywhere(const lm_light_data *l) { return isinf(lm_light_data_reach(l)) && !is_cone(l); }
 
 typedef struct near_light {
   float pos[3], axis[3], reach, cos_outer;
@@ -110,18 +119,18 @@ void lm_light_grid_build(lm_light_grid *g, const lm_frame_data *f, const lm_ligh
   g->near = f->clip[0], g->far = f->clip[1];
   float ratio = f->clip[1] / f->clip[0];
   g->slice_scale = ratio > 1.0001f ? (float)SLICES / logf(ratio) : 0;
-  /* Lights with a finite reach, in view space. */
+  /* Lights with a finite reach or a cone, in view space; the others reach
+   * every cluster. */
   near_light *near = lm_alloc(sizeof *near * (size_t)(n > 0 ? n : 1));
   int near_count = 0;
   for (int i = 0; i < n; i++) {
     const lm_light_data *l = &lights[i];
-    float r = lm_light_data_reach(l);
-    if (isinf(r)) continue;
+    if (everywhere(l)) continue;
     near_light *q = &near[near_count++];
     to_view(f->view, l->position, 1, q->pos);
     to_view(f->view, l->direction, 0, q->axis);
-    q->reach = r, q->cos_outer = l->direction[3], q->index = i;
-    q->spot = (int)(l->position[3] + 0.5f) == LM_LIGHT_SPOT && q->cos_outer > 0;
+    q->reach = lm_light_data_reach(l), q->cos_outer = l->direction[3], q->index = i;
+    q->spot = is_cone(l);
   }
   /* No grid (every light everywhere) when asked, when the camera gives no
    * slices, or when no light has a finite reach: nothing to cull. */
@@ -135,7 +144,7 @@ void lm_light_grid_build(lm_light_grid *g, const lm_frame_data *f, const lm_ligh
   for (int c = 0; c < 2 * clusters; c++) push(g, 0);
   uint32_t global_offset = (uint32_t)(g->count - HEADER), global = 0;
   for (int i = 0; i < n; i++)
-    if (clusters && isinf(lm_light_data_reach(&lights[i]))) push(g, (uint32_t)i), global++;
+    if (clusters && everywhere(&lights[i])) push(g, (uint32_t)i), global++;
   g->data[8] = global, g->data[9] = global_offset;
   g->listed = 0;
   for (int c = 0; c < clusters; c++) {

@@ -409,7 +409,7 @@ static const char *const slot_xform[LM_TEX_SLOTS] = {"base_color_xform", "mr_xfo
 static const char *const slot_define[LM_TEX_SLOTS] = {"BASE_COLOR_TEXTURE", "MR_TEXTURE", "NORMAL_TEXTURE",
                                                        "OCCLUSION_TEXTURE", "EMISSIVE_TEXTURE"};
 
-static const char *scene_uniforms[] = {"model", "normal_matrix", "material_color", "material_rho", "material_k",
+static const char *scene_uniforms[] = {"material_color", "material_rho", "material_k",
                                        "material_reflectivity", "material_pbr", "material_emissive", "material_alpha", "base_color_tex",
                                        "mr_tex", "normal_tex", "occlusion_tex", "emissive_tex", "base_color_xform",
                                        "mr_xform", "normal_xform", "occlusion_xform", "emissive_xform"};
@@ -581,23 +581,92 @@ bool lm_scene_node_bounds(const lm_scene *s, int node, float lo[3], float hi[3])
   return isfinite(lo[0] + lo[1] + lo[2] + hi[0] + hi[1] + hi[2]);
 }
 
+/* A visible mesh node, sorted so that nodes of one mesh and material lie together. */
+typedef struct drawn_node { int material, mesh, node; } drawn_node;
+
+static int drawn_node_order(const void *pa, const void *pb) {
+  const drawn_node *a = pa, *b = pb;
+  if (a->material != b->material) return a->material < b->material ? -1 : 1;
+  if (a->mesh != b->mesh) return a->mesh < b->mesh ? -1 : 1;
+  return (a->node > b->node) - (a->node < b->node);
+}
+
+/* Sets the material uniforms and textures of material m for program p. */
+static void bind_material(const lm_scene *s, const lm_program *p, const lm_material *m, const lm_material_pbr *mp,
+                          const char *defines) {
+  float k[4] = {m->ka, m->kd, m->ks, m->shininess};
+  float params[4] = {mp->metallic, mp->roughness, mp->normal_scale, mp->occlusion_strength};
+  float alpha[2] = {mp->alpha, mp->alpha_mode == LM_ALPHA_MASK ? mp->alpha_cutoff : -1.0f};
+  const lm_uniform *u;
+  if ((u = lm_program_uniform(p, "material_color"))) lm_program_set(p, u, m->color);
+  if ((u = lm_program_uniform(p, "material_rho"))) lm_program_set(p, u, &m->rho);
+  if ((u = lm_program_uniform(p, "material_k"))) lm_program_set(p, u, k);
+  if ((u = lm_program_uniform(p, "material_reflectivity"))) lm_program_set(p, u, &m->reflectivity);
+  if ((u = lm_program_uniform(p, "material_pbr"))) lm_program_set(p, u, params);
+  if ((u = lm_program_uniform(p, "material_emissive"))) lm_program_set(p, u, mp->emissive);
+  if ((u = lm_program_uniform(p, "material_alpha"))) lm_program_set(p, u, alpha);
+  for (int slot = 0; slot < LM_TEX_SLOTS && defines[0]; slot++) {
+    if (!strstr(defines, slot_define[slot])) continue;
+    if ((u = lm_program_uniform(p, slot_sampler[slot])))
+      lm_program_bind_texture(u, s->textures[slot_texture(s, m, mp, slot)].gpu);
+    float xf[9];
+    uv_matrix(mp->uv_transform[slot], xf);
+    if ((u = lm_program_uniform(p, slot_xform[slot]))) lm_program_set(p, u, xf);
+  }
+}
+
+/* A node's model matrix and normal matrix (the inverse transpose's 3x3). */
+static void node_instance(const lm_node *n, lm_instance *out) {
+  mat4 model, inv;
+  mat3 normal;
+  memcpy(model, n->world, sizeof model);
+  glm_mat4_inv(model, inv);
+  glm_mat4_transpose(inv);
+  glm_mat4_pick3(inv, normal);
+  memcpy(out->model, model, sizeof out->model);
+  memcpy(out->normal, normal, sizeof out->normal);
+}
+
 bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err) {
   const lm_program *p = d->program;
+  if (lm_program_uniform(p, "model") || lm_program_uniform(p, "normal_matrix")) {
+    lm_error_set(err, "technique %s: the uniforms model and normal_matrix are no longer set; its vertex shader "
+                 "reads the instance attributes instance_model (location 3) and instance_normal (7), as std.vert does",
+                 p->label);
+    return false;
+  }
   /* A technique that reads material_pbr (shaders/pbr.frag) takes every texture slot. */
   bool pbr = lm_program_uniform(d->program, "material_pbr") != NULL;
-  char bound[160] = ""; /* the defines of the variant that is bound */
+  /* The nodes in view, then one instanced draw for each run of one mesh and
+   * material: a scene of many copies costs a few draw calls, not one a copy. */
+  drawn_node *nodes = lm_alloc(sizeof *nodes * (size_t)(s->node_count > 0 ? s->node_count : 1));
+  int count = 0;
   for (int i = 0; i < s->node_count; i++) {
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
-    const lm_scene_mesh *mesh = &s->meshes[n->mesh];
     if (d->view_proj) {
       float lo[3], hi[3];
-      world_bounds(n->world, mesh->bounds, lo, hi);
+      world_bounds(n->world, s->meshes[n->mesh].bounds, lo, hi);
       if (box_outside(d->view_proj, lo, hi, d->pancake)) {
         if (stats) stats->culled++;
         continue;
       }
     }
+    nodes[count++] = (drawn_node){n->material, n->mesh, i};
+  }
+  qsort(nodes, (size_t)count, sizeof *nodes, drawn_node_order);
+  lm_instance *instances = lm_alloc(sizeof *instances * (size_t)(count > 0 ? count : 1));
+  for (int i = 0; i < count; i++) node_instance(&s->nodes[nodes[i].node], &instances[i]);
+  lm_instances_upload(instances, count);
+  free(instances);
+  char bound[160] = ""; /* the defines of the variant that is bound */
+  bool ok = true;
+  for (int first = 0, last; first < count && ok; first = last) {
+    for (last = first + 1; last < count && nodes[last].material == nodes[first].material &&
+                           nodes[last].mesh == nodes[first].mesh;)
+      last++;
+    const lm_node *n = &s->nodes[nodes[first].node];
+    const lm_scene_mesh *mesh = &s->meshes[n->mesh];
     lm_material m = *lm_scene_node_material(s, n);
     for (int k = 0; k < d->param_count; k++)
       if (!strcmp(d->params[k].material, m.name)) apply_param(&m, &d->params[k]);
@@ -606,44 +675,24 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
       lm_error_set(err, "material '%s' (node '%s'): alphaMode BLEND is not drawn by this technique (the "
                    "G-buffer keeps one opaque surface a pixel); make it OPAQUE or MASK, or draw with std",
                    m.name, n->name);
-      return false;
+      ok = false;
+      break;
     }
     char defines[160] = "";
     if (d->variant) material_defines(s, &m, &mp, pbr, defines, sizeof defines);
     if (strcmp(defines, bound)) { /* switch programs only when the variant changes */
       p = d->variant(d->ctx, defines, err);
-      if (!p) return false;
+      if (!p) {
+        ok = false;
+        break;
+      }
       snprintf(bound, sizeof bound, "%s", defines);
     }
-    mat4 model, inv;
-    mat3 normal;
-    memcpy(model, n->world, sizeof model);
-    glm_mat4_inv(model, inv);
-    glm_mat4_transpose(inv);
-    glm_mat4_pick3(inv, normal);
-    float k[4] = {m.ka, m.kd, m.ks, m.shininess};
-    float params[4] = {mp.metallic, mp.roughness, mp.normal_scale, mp.occlusion_strength};
-    float alpha[2] = {mp.alpha, mp.alpha_mode == LM_ALPHA_MASK ? mp.alpha_cutoff : -1.0f};
-    const lm_uniform *u;
-    if ((u = lm_program_uniform(p, "model"))) lm_program_set(p, u, (float *)model);
-    if ((u = lm_program_uniform(p, "normal_matrix"))) lm_program_set(p, u, (float *)normal);
-    if ((u = lm_program_uniform(p, "material_color"))) lm_program_set(p, u, m.color);
-    if ((u = lm_program_uniform(p, "material_rho"))) lm_program_set(p, u, &m.rho);
-    if ((u = lm_program_uniform(p, "material_k"))) lm_program_set(p, u, k);
-    if ((u = lm_program_uniform(p, "material_reflectivity"))) lm_program_set(p, u, &m.reflectivity);
-    if ((u = lm_program_uniform(p, "material_pbr"))) lm_program_set(p, u, params);
-    if ((u = lm_program_uniform(p, "material_emissive"))) lm_program_set(p, u, mp.emissive);
-    if ((u = lm_program_uniform(p, "material_alpha"))) lm_program_set(p, u, alpha);
-    for (int slot = 0; slot < LM_TEX_SLOTS && defines[0]; slot++) {
-      if (!strstr(defines, slot_define[slot])) continue;
-      if ((u = lm_program_uniform(p, slot_sampler[slot])))
-        lm_program_bind_texture(u, s->textures[slot_texture(s, &m, &mp, slot)].gpu);
-      float xf[9];
-      uv_matrix(mp.uv_transform[slot], xf);
-      if ((u = lm_program_uniform(p, slot_xform[slot]))) lm_program_set(p, u, xf);
-    }
-    lm_mesh_draw(&mesh->gpu);
-    if (stats) stats->drawn++, stats->triangles += mesh->index_count / 3;
+    bind_material(s, p, &m, &mp, defines);
+    lm_mesh_draw_instances(&mesh->gpu, first, last - first);
+    if (stats)
+      stats->calls++, stats->drawn += last - first, stats->triangles += (long)(last - first) * (mesh->index_count / 3);
   }
-  return true;
+  free(nodes);
+  return ok;
 }

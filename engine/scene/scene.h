@@ -227,12 +227,13 @@ float lm_light_data_reach(const lm_light_data *d);
 
 /* Clustered light culling (engine/scene/lightgrid.c): the frustum cut into
  * screen tiles and exponential depth slices, each listing the lights whose
- * reach (and cone) touches it; lights of infinite reach are listed once for
- * all. `data` is the LimnLightGrid storage block (shaders/common.glsl). */
+ * reach (and cone) touches it; lights of infinite reach and no cone (a
+ * spot's, under 90 degrees, culls it at any reach) are listed once for all.
+ * `data` is the LimnLightGrid storage block (shaders/common.glsl). */
 typedef struct lm_light_grid {
   int tiles_x, tiles_y, slices, tile_px; /* tile_px 0: no culling, every light everywhere */
   float near, far, slice_scale;          /* slice = floor(log(z / near) * slice_scale) */
-  int global;                            /* lights of infinite reach */
+  int global;                            /* lights of infinite reach and no cone */
   long listed;                           /* entries of all cluster lists */
   uint32_t *data;
   size_t count, cap;                     /* words */
@@ -280,10 +281,14 @@ typedef struct lm_scene_draw_desc {
 } lm_scene_draw_desc;
 typedef struct lm_scene_draw_stats {
   int drawn, culled; /* mesh nodes drawn, and left out by the frustum test */
+  int calls;         /* draw calls: one for the nodes of a mesh and material in view */
+  int kept;          /* views (shadow tiles) kept from the last frame instead of drawn */
   long triangles;    /* triangles drawn */
 } lm_scene_draw_stats;
-/* Draws every mesh node whose bounds reach into the frustum, setting model,
- * normal_matrix, the material uniforms (material_color, material_rho,
+/* Draws every mesh node whose bounds reach into the frustum, the nodes of one
+ * mesh and material in one instanced draw (each node's matrices in the
+ * instance attributes of lm_instance; a technique declaring the uniforms
+ * model or normal_matrix is an error), setting the material uniforms (material_color, material_rho,
  * material_k, material_reflectivity; material_pbr, material_emissive,
  * material_alpha) and the textures with their transforms (base_color_tex,
  * base_color_xform, mr_tex, ...). With a technique that declares material_pbr, a material whose

@@ -168,7 +168,7 @@ static float opt_number(lua_State *L, int idx, const char *field, float def, flo
 }
 
 /* shadow_plan{ technique, resolution, c, blur, cascades, lambda, bias, distance,
- * blend, radius, stabilize, size, penumbra, rsm }: tiles for every light that casts shadows, or nil
+ * blend, radius, stabilize, size, penumbra, rsm, cache }: tiles for every light that casts shadows, or nil
  * when none does. scene{ views = plan } draws them; scene{ views = plan, fit =
  * T } first fits them to the camera depths T's first texel holds (min in r,
  * max in g, as depth / far). */
@@ -180,7 +180,7 @@ static int l_shadow_plan(lua_State *L) {
   luaL_checktype(L, 1, LUA_TTABLE);
   static const char *const fields[] = {"technique", "resolution", "c", "blur", "cascades", "lambda",
                                        "bias", "distance", "blend", "radius", "stabilize", "size",
-                                       "penumbra", "rsm", NULL};
+                                       "penumbra", "rsm", "cache", NULL};
   check_fields(L, 1, "shadow_plan", fields);
   lm_shadow_settings st;
   lm_shadow_settings_default(&st);
@@ -204,6 +204,9 @@ static int l_shadow_plan(lua_State *L) {
   st.penumbra = opt_number(L, 1, "penumbra", st.penumbra, 1, 64, what);
   lua_getfield(L, 1, "stabilize");
   if (!lua_isnil(L, -1)) st.stabilize = lua_toboolean(L, -1);
+  lua_pop(L, 1);
+  lua_getfield(L, 1, "cache");
+  if (!lua_isnil(L, -1)) st.cache = lua_toboolean(L, -1);
   lua_pop(L, 1);
   st.rsm = opt_number(L, 1, "rsm", 0, 0, 64, what);
   lm_shadow_plan_free(p->shadows);

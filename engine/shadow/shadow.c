@@ -18,7 +18,7 @@ int lm_shadow_technique_parse(const char *name) {
 void lm_shadow_settings_default(lm_shadow_settings *s) {
   *s = (lm_shadow_settings){.technique = LM_SHADOW_ESM, .resolution = 512, .c = 16.0f, .blur = 0,
                             .cascades = 3, .lambda = 0.75f, .distance = 0.0f,
-                            .blend = 0.1f, .radius = 2.5f, .stabilize = true,
+                            .blend = 0.1f, .radius = 2.5f, .stabilize = true, .cache = true,
                             .size = -1.0f, .penumbra = 16.0f};
   s->bias = 1.0f; /* texels; the seed has 0: lit slanted surfaces then lose 1-2% to ESM */
 }
@@ -31,7 +31,9 @@ static void up_for(const vec3 dir, vec3 up) {
     glm_vec3_copy((vec3){1, 0, 0}, up);
 }
 
-static int add_view(lm_shadow_plan *plan, mat4 view_proj, const float depth[4], const float texel[4]) {
+/* A tile's view; its casters are culled against `cull` (NULL: view_proj). */
+static int add_view(lm_shadow_plan *plan, mat4 view_proj, const float depth[4], const float texel[4],
+                    mat4 cull) {
   int i = plan->view_count++;
   plan->views = lm_realloc(plan->views, sizeof *plan->views * (size_t)plan->view_count);
   plan->view_data = lm_realloc(plan->view_data, sizeof *plan->view_data * (size_t)plan->view_count);
@@ -40,6 +42,7 @@ static int add_view(lm_shadow_plan *plan, mat4 view_proj, const float depth[4], 
   memcpy(plan->view_data[i].texel, texel, 16);
   memcpy(plan->views[i].view_proj, view_proj, 64);
   memcpy(plan->views[i].depth, depth, 16);
+  memcpy(plan->views[i].cull, cull ? cull : view_proj, 64);
   return i;
 }
 
@@ -107,11 +110,91 @@ static void caster_depth(const lm_scene *s, mat4 view, float l, float r, float b
   *zn = fmaxf(*zn, cmin), *zf = fminf(*zf, cmax);
 }
 
+/* How far from a receiver's texel a lookup reads, in texels: the filter's
+ * reach, the ESM blur's, and one for texel snapping. */
+static float filter_reach(const lm_shadow_settings *st) {
+  float r = st->technique == LM_SHADOW_PCSS ? st->penumbra : st->technique == LM_SHADOW_POISSON ? st->radius : 1.5f;
+  return r + (float)st->blur + 1.0f;
+}
+
+/* Clips the convex polygon p (n vertices) to the half-space where
+ * sign * (v[axis] - at) >= 0; returns the new count (at most n + 1). */
+static int clip_polygon(vec3 *p, int n, int axis, float at, float sign) {
+  vec3 out[16];
+  int m = 0;
+  for (int i = 0; i < n && m < 15; i++) {
+    const float *a = p[i], *b = p[(i + 1) % n];
+    float da = sign * (a[axis] - at), db = sign * (b[axis] - at);
+    if (da >= 0) glm_vec3_copy((float *)a, out[m++]);
+    if ((da < 0) != (db < 0)) glm_vec3_lerp((float *)a, (float *)b, da / (da - db), out[m++]);
+  }
+  memcpy(p, out, sizeof *out * (size_t)m);
+  return m;
+}
+
+/* The vertices of the camera slice z0 .. z1 within the box lo..hi (both
+ * convex): each face of the slice clipped to the box, and the box's corners
+ * inside the slice. At most 6 * 10 + 8 into out; 0 when they do not meet. */
+static int slice_in_box(const lm_frame_data *cam, float z0, float z1, const float lo[3], const float hi[3],
+                        vec3 out[68]) {
+  vec3 corners[8];
+  slice_corners(cam, z0, z1, corners);
+  /* Corner c has bit 1 for u, 2 for v, 4 for far: a face holds one bit fixed. */
+  static const int cycle[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  int n = 0;
+  for (int face = 0; face < 6; face++) {
+    int fixed = face / 2, a = (fixed + 1) % 3, b = (fixed + 2) % 3;
+    vec3 poly[16];
+    for (int i = 0; i < 4; i++)
+      glm_vec3_copy(corners[(face % 2) << fixed | cycle[i][0] << a | cycle[i][1] << b], poly[i]);
+    int m = 4;
+    for (int k = 0; k < 3 && m > 0; k++) {
+      m = clip_polygon(poly, m, k, lo[k], 1.0f);
+      if (m > 0) m = clip_polygon(poly, m, k, hi[k], -1.0f);
+    }
+    for (int i = 0; i < m && i < 10; i++) glm_vec3_copy(poly[i], out[n++]);
+  }
+  for (int c = 0; c < 8; c++) {
+    vec4 p = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2], 1}, q;
+    glm_mat4_mulv((vec4 *)cam->view_proj, p, q);
+    float z = -(cam->view[2] * p[0] + cam->view[6] * p[1] + cam->view[10] * p[2] + cam->view[14]);
+    if (z >= z0 && z <= z1 && fabsf(q[0]) <= q[3] && fabsf(q[1]) <= q[3]) glm_vec3_copy(p, out[n++]);
+  }
+  return n;
+}
+
+/* A cascade's casters: its tile's square holds the sphere around the camera
+ * slice, but lookups read it only for receivers in the slice (camera depths
+ * zr .. z1, zr where the last cascade's blend begins) and within the scene's
+ * bounds. A caster matters when it lies over their light-space rectangle
+ * (widened by the filter's reach of `texel`-sized texels) and not beyond the
+ * farthest of them: cull against that box, within the tile's (l, r, b, t,
+ * zn, zf). */
+static void cascade_cull(const lm_frame_data *cam, mat4 view, float zr, float z1, const float bounds[2][3],
+                         float texel, float reach, const float tile[6], mat4 cull) {
+  vec3 p[68];
+  int n = slice_in_box(cam, zr, z1, bounds[0], bounds[1], p);
+  float l = FLT_MAX, r = -FLT_MAX, b = FLT_MAX, t = -FLT_MAX, far = -FLT_MAX;
+  for (int i = 0; i < n; i++) {
+    vec4 w = {p[i][0], p[i][1], p[i][2], 1}, q;
+    glm_mat4_mulv(view, w, q);
+    l = fminf(l, q[0]), r = fmaxf(r, q[0]), b = fminf(b, q[1]), t = fmaxf(t, q[1]);
+    far = fmaxf(far, -q[2]); /* the light looks down -z */
+  }
+  float pad = texel * reach;
+  l = fmaxf(l - pad, tile[0]), r = fminf(r + pad, tile[1]), b = fmaxf(b - pad, tile[2]), t = fminf(t + pad, tile[3]);
+  far = fminf(far + pad, tile[5]);
+  if (!(l < r && b < t && far > tile[4])) l = tile[0], r = tile[1], b = tile[2], t = tile[3], far = tile[5];
+  mat4 proj;
+  glm_ortho(l, r, b, t, tile[4], far, proj);
+  glm_mat4_mul(proj, view, cull);
+}
+
 /* One orthographic tile along dir over the camera's slice z0 .. z1: a
- * cascade (grow 0), or the RSM's wide tile over the slice's bounding sphere
- * with its radius times grow. */
+ * cascade (grow 0; its receivers from camera depth zr), or the RSM's wide
+ * tile over the slice's bounding sphere with its radius times grow. */
 static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam, vec3 dir,
-                           float z0, float z1, float grow) {
+                           float z0, float z1, float zr, const float bounds[2][3], float grow) {
   const lm_shadow_settings *st = &plan->settings;
   vec3 corners[8], center = {0, 0, 0};
   slice_corners(cam, z0, z1, corners);
@@ -171,8 +254,11 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
     proj[3][0] += dx, proj[3][1] += dy;
     glm_mat4_mul(proj, view, vp);
   }
+  float texel = (r - l) / (float)plan->tile;
+  mat4 cull;
+  if (grow <= 0) cascade_cull(cam, view, zr, z1, bounds, texel, filter_reach(st), (float[6]){l, r, b, t, zn, zf}, cull);
   /* A texel's world size and the world depth the tile's 0..1 spans. */
-  add_view(plan, vp, (float[4]){0, 0, 0, 0}, (float[4]){(r - l) / (float)plan->tile, zf - zn, 0, 0});
+  add_view(plan, vp, (float[4]){0, 0, 0, 0}, (float[4]){texel, zf - zn, 0, 0}, grow <= 0 ? cull : NULL);
 }
 
 /* Cascades cover the depths where receivers are seen (plan->seen), snapped
@@ -193,11 +279,15 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_fram
   out->info[0] = plan->view_count;
   out->info[1] = st->cascades;
   out->info[2] = KIND_CASCADES;
+  float bounds[2][3];
+  lm_scene_bounds(s, bounds[0], bounds[1]);
   for (int k = 0; k < st->cascades; k++) {
     float z0 = split_depth(n, reach, k, st->cascades, st->lambda);
     float z1 = split_depth(n, reach, k + 1, st->cascades, st->lambda);
+    /* shadow.glsl blends the last `blend` share of cascade k - 1 into this one. */
+    float zr = k > 0 ? z0 - (z0 - split_depth(n, reach, k - 1, st->cascades, st->lambda)) * st->blend : z0;
     out->splits[k] = z1;
-    add_slice_view(plan, s, cam, dir, z0, z1, 0.0f);
+    add_slice_view(plan, s, cam, dir, z0, z1, zr, (const float(*)[3])bounds, 0.0f);
   }
 }
 
@@ -211,7 +301,7 @@ static void plan_wide_tile(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
   float n, reach;
   cascade_range(plan, &n, &reach);
   out->cube[1] = plan->view_count, out->cube[2] = 1;
-  add_slice_view(plan, s, cam, dir, n, reach, plan->settings.rsm);
+  add_slice_view(plan, s, cam, dir, n, reach, n, NULL, plan->settings.rsm);
 }
 
 /* Range of a point or spot light: where its light ends (lm_light_reach: the
@@ -244,7 +334,7 @@ static void plan_perspective(lm_shadow_plan *plan, const vec3 pos, const vec3 di
   perspective_view_proj(pos, dir, fov, range, vp);
   /* A texel's world size per unit of distance, and the world depth 0..1 spans. */
   add_view(plan, vp, (float[4]){pos[0], pos[1], pos[2], 1.0f / range},
-           (float[4]){2.0f * tanf(fov * 0.5f) / (float)plan->tile, range, 0, 0});
+           (float[4]){2.0f * tanf(fov * 0.5f) / (float)plan->tile, range, 0, 0}, NULL);
 }
 
 /* Point light: cube faces +X -X +Y -Y +Z -Z (shadow.glsl picks by major axis). */

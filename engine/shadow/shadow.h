@@ -36,6 +36,8 @@ typedef struct lm_shadow_settings {
   bool stabilize;  /* bounding spheres and texel snapping (seed 003) */
   float size;      /* PCSS: every light's size (see lm_light.size); <= 0: each light's own */
   float penumbra;  /* PCSS: the widest penumbra radius and blocker search, texels */
+  bool cache;      /* a tile whose view and casters are those of the last frame's tile in its
+                    * place keeps that tile's texels (engine/render: copied, not drawn) */
   float rsm;       /* > 0: a frame reads reflective shadow maps (seed 004's senders); each
                     * directional light gets one more tile, over the sphere around all
                     * that is seen with its radius times rsm (senders off screen), 0..64 */

@@ -1,0 +1,71 @@
+// A later bounce of the physical ISR transport (isr_march.frag) from the hits
+// its first march recorded (HITS targets, four rays each: 1 + the index of
+// the coarse texel a ray's sender lies on, 0 for none). Every bounce marches the same rays
+// through the same depth buffer and meets the same senders, so this sums over
+// them what the march with BOUNCE would:
+//   E(p) = 1/n sum over sending rays of sender(q) + k_d albedo(q) previous(q)
+// with previous the last step's E; A, the share of open rays, is previous's.
+#include "gbuffer.glsl"
+
+in vec2 uv;
+uniform sampler2D clr, mat;  // coarse G-buffer
+uniform sampler2D sender;    // coarse direct light
+uniform sampler2D previous;  // the last step's E (rgb), A (a)
+uniform sampler2D hits0;
+#if HITS > 1
+uniform sampler2D hits1;
+#endif
+#if HITS > 2
+uniform sampler2D hits2;
+#endif
+#if HITS > 3
+uniform sampler2D hits3;
+#endif
+#if HITS > 4
+uniform sampler2D hits4;
+#endif
+#if HITS > 5
+uniform sampler2D hits5;
+#endif
+#if HITS > 6
+uniform sampler2D hits6;
+#endif
+uniform int samples = 12;
+
+out vec4 isr;
+
+// What a ray whose recorded hit is `hit` sends (nothing for 0).
+vec3 sent(float hit, int width) {
+  if (hit < 0.5) return vec3(0.0);
+  int k = int(hit - 0.5);
+  ivec2 q = ivec2(k % width, k / width);
+  vec4 c = texelFetch(clr, q, 0);
+  return texelFetch(sender, q, 0).rgb + texelFetch(mat, q, 0).y * c.rgb * texelFetch(previous, q, 0).rgb;
+}
+
+vec3 sent4(vec4 h, int width) { return sent(h.x, width) + sent(h.y, width) + sent(h.z, width) + sent(h.w, width); }
+
+void main() {
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  int width = textureSize(clr, 0).x, n = clamp(samples, 1, 4 * HITS);
+  vec3 gathered = sent4(texelFetch(hits0, px, 0), width);
+#if HITS > 1
+  gathered += sent4(texelFetch(hits1, px, 0), width);
+#endif
+#if HITS > 2
+  gathered += sent4(texelFetch(hits2, px, 0), width);
+#endif
+#if HITS > 3
+  gathered += sent4(texelFetch(hits3, px, 0), width);
+#endif
+#if HITS > 4
+  gathered += sent4(texelFetch(hits4, px, 0), width);
+#endif
+#if HITS > 5
+  gathered += sent4(texelFetch(hits5, px, 0), width);
+#endif
+#if HITS > 6
+  gathered += sent4(texelFetch(hits6, px, 0), width);
+#endif
+  isr = vec4(gathered / float(n), texelFetch(previous, px, 0).a);
+}
