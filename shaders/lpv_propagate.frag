@@ -8,8 +8,9 @@
 // face's solid angle, re-sent from the destination as a lobe facing out of
 // that face). That step turns light that crosses a cell obliquely into light
 // facing a side face, so a wave loses its direction within a few steps and
-// spreads as a diffusion: light from a lit floor fades within 3 cells
-// above it (checked against the integral for an infinite plane). Here each
+// spreads as a diffusion: after 8 steps the light three cells above a lit
+// infinite plane is a tenth of the exact irradiance (a CPU model of both
+// steps; this one keeps 40% there, 90% in the first cell). Here each
 // direction's light moves to a neighbour as a cube's faces see it: light
 // travelling in w leaves through face k in the share
 //   w_k(w) = max(0, w.e_k) / (|w_x| + |w_y| + |w_z|)
