@@ -31,7 +31,8 @@ uniform float lpv_cell = 1.0;
 uniform float lpv_shift = 1.0;
 uniform sampler2D lpv_seen; // 1 x 1: least and greatest depth / far seen (shadow.depth_range)
 
-float lpv_cell_size(int c) { return lpv_cell * exp2(float(c)); }
+// Never 0: positions are divided by it.
+float lpv_cell_size(int c) { return max(lpv_cell * exp2(float(c)), 1e-30); }
 
 // World position of the least corner of cascade c's grid.
 vec3 lpv_origin(int c) {

@@ -54,7 +54,7 @@ bool cascade_rect(ShadowView sv, int c, out vec2 lo, out vec2 hi) {
 
 // VPL k of cascade c: position, normal and radiance times area; false when it stands for nothing.
 bool vpl(int k, int c, out vec3 q, out vec3 n, out vec3 flux) {
-  int per_view = vpl_side * vpl_side, v = k / per_view, b = k % per_view;
+  int side = max(vpl_side, 1), per_view = side * side, v = k / per_view, b = k % per_view;
   int light = -1;
   for (int i = 0; i < frame.counts.x && light < 0; i++) { // the v-th RSM view, light by light
     ivec4 cube = shadow_lights[i].cube;
@@ -68,7 +68,7 @@ bool vpl(int k, int c, out vec3 q, out vec3 n, out vec3 flux) {
   if (!cascade_rect(sv, c, lo, hi)) return false;
   vec2 atlas = vec2(textureSize(rsm_pos, 0));
   float tile = sv.rect.z * atlas.x;
-  vec2 t = lo + (vec2(b % vpl_side, b / vpl_side) + 0.5) / float(vpl_side) * (hi - lo);
+  vec2 t = lo + (vec2(b % side, b / side) + 0.5) / float(side) * (hi - lo);
   ivec2 a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
   n = texelFetch(rsm_nrm, a, 0).xyz;
   if (dot(n, n) > 1.5) return false; // empty
@@ -86,8 +86,9 @@ bool vpl(int k, int c, out vec3 q, out vec3 n, out vec3 flux) {
 // over the cosine to the camera, capped); false on background.
 bool surfel(int k, out vec3 p, out vec3 n, out float area) {
   ivec2 size = textureSize(dpt, 0);
+  int columns = max(surfel_grid.x, 1);
   vec2 step = vec2(size) / vec2(max(surfel_grid, ivec2(1)));
-  vec2 uv = (vec2(k % surfel_grid.x, k / surfel_grid.x) + 0.5) * step / vec2(size);
+  vec2 uv = (vec2(k % columns, k / columns) + 0.5) * step / vec2(size);
   ivec2 px = ivec2(uv * vec2(size));
   if (texelFetch(mat, px, 0).a < 0.5) return false; // background
   float z = texelFetch(dpt, px, 0).r;
@@ -124,7 +125,7 @@ void main() {
   vec2 size = vec2(lpv_cells * lpv_cells, lpv_cells * lpv_cascades);
   gl_Position = vec4((vec2(lpv_texel(cell, c)) + 0.5) / size * 2.0 - 1.0, 0.0, 1.0);
 #ifdef GEOMETRY
-  v_r = lpv_finite(lpv_lobe(area / max(h * h, 1e-30), -n));
+  v_r = lpv_finite(lpv_lobe(area / max(h * h, 1e-30), -n)); // h^2 may underflow
 #else
   v_r = lpv_finite(lpv_lobe(flux.r, n));
   v_g = lpv_finite(lpv_lobe(flux.g, n));
