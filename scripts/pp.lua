@@ -4,6 +4,7 @@ local gbuffer = require "gbuffer"
 local isr = require "isr"
 local rsm = require "rsm"
 local vpl = require "vpl"
+local lpv = require "lpv"
 local temporal = require "temporal"
 local shadow = require "shadow"
 local sky = require "sky"
@@ -19,9 +20,10 @@ local reflections = require "reflections"
 -- indirect light from reflective shadow maps (seed 004, scripts/rsm.lua);
 -- vpl+esm: indirect point lights and negative lights in them (seed 002,
 -- scripts/vpl.lua); isr+rsm+esm: RSM and ISR together, each sender counted
--- once (docs/gi-combined.md).
+-- once (docs/gi-combined.md); lpv+esm: light propagation volumes (seed 003,
+-- scripts/lpv.lua); isr+lpv+esm: LPV and ISR together, as isr+rsm+esm.
 Techniques = { "isr+esm", "isr", "dl+esm", "dl", "ssdo+esm", "ssdo", "ssao+esm", "ssao", "rsm+esm",
-               "vpl+esm", "isr+rsm+esm" }
+               "vpl+esm", "isr+rsm+esm", "lpv+esm", "isr+lpv+esm" }
 
 Options = {
   ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
@@ -30,6 +32,7 @@ Options = {
   isr = {},                -- see isr.defaults in scripts/isr.lua
   rsm = {},                -- see rsm.defaults in scripts/rsm.lua
   vpl = {},                -- see vpl.defaults in scripts/vpl.lua
+  lpv = {},                -- see lpv.defaults in scripts/lpv.lua
   shadow = {},             -- see shadow.defaults in scripts/shadow.lua
   sky = {},                -- see sky.defaults in scripts/sky.lua (off by default)
   ssdo = {},               -- see ssdo.defaults in scripts/ssdo.lua
@@ -39,6 +42,7 @@ Options = {
 for k, v in pairs(isr.defaults) do Options.isr[k] = v end
 for k, v in pairs(rsm.defaults) do Options.rsm[k] = v end
 for k, v in pairs(vpl.defaults) do Options.vpl[k] = v end
+for k, v in pairs(lpv.defaults) do Options.lpv[k] = v end
 for k, v in pairs(shadow.defaults) do Options.shadow[k] = v end
 for k, v in pairs(sky.defaults) do Options.sky[k] = v end
 for k, v in pairs(ssdo.defaults) do Options.ssdo[k] = v end
@@ -87,12 +91,13 @@ function OnRender(tech)
   -- Shadows after the G-buffer: their cascades fit the depths it sees.
   -- The RSM's options, when the technique reads one (the shadow pass then writes it).
   local o_rsm = lighting == "vpl" and vpl.check(tech.vpl) or tech.name:find("rsm+", 1, true) and rsm.check(tech.rsm)
+                or tech.name:find("lpv+", 1, true) and lpv.check(tech.lpv)
   local shadows, R
   if tech.name:find("+esm", 1, true) then shadows, R = shadow.render(tech.shadow, G, o_rsm and o_rsm.reach) end
   if shadows and tech.shadow.debug then return present(shadow.debug(shadows)) end
   local lit
   local skylight = sky.light(tech.sky) -- nil when off: then nothing of it is recorded
-  if lighting == "dl" or (lighting == "rsm" or lighting == "vpl") and not R then -- no caster: no RSM
+  if lighting == "dl" or (lighting == "rsm" or lighting == "vpl" or lighting == "lpv") and not R then -- no caster: no RSM
     lit = direct(G, tech, shadows, tech.ambient, "lit", skylight)
   else
     local d = direct(G, tech, shadows, 0, "direct")
@@ -101,8 +106,14 @@ function OnRender(tech)
       lit = rsm.render(G, d, shadows, R, o_rsm, light)
     elseif lighting == "vpl" then
       lit = vpl.render(G, d, shadows, R, o_rsm, light)
+    elseif lighting == "lpv" then
+      lit = lpv.render(G, d, R, o_rsm, light)
     elseif lighting == "isr" then
-      lit = isr.render(G, d, tech.isr, light, R and function(C, E, f) return rsm.gather(C, f, R, shadows, o_rsm, E) end)
+      -- The combined techniques add the off-screen senders to ISR's coarse result.
+      local extra = R and tech.name:find("lpv+", 1, true) and function(C, E, f)
+        return lpv.gather(C, f, lpv.volume(G, R, o_rsm, true), o_rsm, E)
+      end or R and function(C, E, f) return rsm.gather(C, f, R, shadows, o_rsm, E) end
+      lit = isr.render(G, d, tech.isr, light, extra)
     elseif lighting == "ssdo" then
       lit = ssdo.render(G, d, tech.ssdo, light)
     else

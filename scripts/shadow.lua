@@ -65,8 +65,9 @@ end
 -- With the G-buffer G (recorded before), cascades fit the depths it sees
 -- (shadow.depth_range); without, the depths of the meshes in view.
 -- With rsm (a number >= 1), the same pass also writes reflective shadow maps
--- (seed 004; shadow.frag), returned second as { flux =, nrm =, pos = }
--- (atlas-sized, rsm.frag reads them); a directional light gets one more tile
+-- (seed 004; shadow.frag), returned second as { flux =, nrm =, pos =, views =, seen = }
+-- (atlas-sized, rsm.frag reads them; views: how many tiles are the lights' RSM views; seen: the
+-- depth range G sees, shadow.depth_range, nil without G); a directional light gets one more tile
 -- for them, over the sphere around all that is seen, its radius times rsm.
 -- Without, no RSM target or tile exists.
 function shadow.render(o, G, rsm)
@@ -80,10 +81,12 @@ function shadow.render(o, G, rsm)
   if not plan then return nil end
   local size = { plan.width, plan.height }
   local map = target{ "shadow.map", format = "r32f", size = size }
+  local seen = G and shadow.depth_range(G) or nil
   local R = rsm and { flux = target{ "shadow.rsm_flux", format = "rgba16f", size = size },
                       nrm = target{ "shadow.rsm_nrm", format = "rgba16f", size = size },
-                      pos = target{ "shadow.rsm_pos", format = "rgba32f", size = size } } or nil
-  scene{ "shadow.depth", technique = "shadow", views = plan, fit = G and shadow.depth_range(G) or nil,
+                      pos = target{ "shadow.rsm_pos", format = "rgba32f", size = size },
+                      views = plan.rsm_views, seen = seen } or nil
+  scene{ "shadow.depth", technique = "shadow", views = plan, fit = seen,
          out = R and { map, R.flux, R.nrm, R.pos } or map, clear = { 1, 1, 1, 1 }, defines = { RSM = R ~= nil },
          depth = target{ "shadow.zbuffer", format = "depth32f", size = size } }
   filter_of[map] = FILTERS[plan.technique]

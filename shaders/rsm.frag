@@ -24,7 +24,7 @@
 // buffer's) is left to the screen-space pass the combined technique adds.
 // Output: rgb = E, a = 1 (RSM light occludes no ambient term); with BASE,
 // the coarse result `base` of the screen-space pass plus E (its a kept).
-#include "gbuffer.glsl"
+#include "rsm.glsl"
 #include "halton.glsl"
 
 in vec2 uv;
@@ -39,15 +39,6 @@ uniform sampler2D base;
 #endif
 
 out vec4 result;
-
-bool seen(vec3 q) {
-  vec4 c = frame.view_proj * vec4(q, 1.0);
-  if (c.w <= 1e-12) return false;
-  vec2 s = c.xy / c.w * 0.5 + 0.5;
-  if (any(lessThan(s, vec2(0.0))) || any(greaterThan(s, vec2(1.0)))) return false;
-  float z = -(frame.view * vec4(q, 1.0)).z * frame.clip.z, zb = texture(dpt, s).r;
-  return abs(z - zb) <= 0.02 * max(zb, 1e-12);
-}
 
 bool blocked(vec3 p, vec3 q) {
   for (int j = 1; j <= steps; j++) {
@@ -100,19 +91,14 @@ void main() {
         vec3 rho = texelFetch(rsm_flux, a, 0).rgb;
         vec3 l;
         vec3 radiance = light_incident(i, q, l);
-        float area = sv.texel.x * sv.texel.x;
-        if (sv.depth.w > 0.0) { // perspective: r^2 cos(a) per unit of solid angle at the axis
-          vec2 tn = (t * 2.0 - 1.0) * sv.texel.x * tile * 0.5; // tan of the off-axis angles
-          float r2 = dot(q - sv.depth.xyz, q - sv.depth.xyz);
-          area *= r2 * inversesqrt(1.0 + dot(tn, tn));
-        }
+        float area = rsm_texel_area(sv, t, q, tile);
         vec3 d = q - s.p;
         float d2 = dot(d, d);
         vec3 dir = d * inversesqrt(max(d2, 1e-30));
         float g = max(dot(s.n, dir), 0.0) * max(dot(nq, -dir), 0.0) / max(d2, area);
         if (g <= 0.0) continue;
 #ifdef EXCLUDE_SEEN
-        if (seen(q)) continue;
+        if (rsm_seen(dpt, q)) continue;
 #endif
 #ifdef VISIBILITY
         if (blocked(s.p, q)) continue;

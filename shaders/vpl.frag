@@ -20,7 +20,7 @@
 // (seed 002's gather, t = (q - p)/|q - p|), A the area the light stands
 // for: its own size caps 1/d^2. Output of GATHER: E+ (rgb), S_neg (rgb) and
 // its mean direction (xyz); NEGATIVE and REFINE: rgb = E, a = 1.
-#include "gbuffer.glsl"
+#include "rsm.glsl"
 #include "halton.glsl"
 
 in vec2 uv;
@@ -73,12 +73,7 @@ vec3 indirect(vec3 p, vec3 n, out vec3 s_neg, out vec3 neg_d) {
         vec3 q = texelFetch(rsm_pos, a, 0).xyz;
         vec3 l;
         vec3 radiance = light_incident(i, q, l);
-        float area = sv.texel.x * sv.texel.x;
-        if (sv.depth.w > 0.0) {
-          vec2 tn = (t * 2.0 - 1.0) * sv.texel.x * tile * 0.5;
-          area *= dot(q - sv.depth.xyz, q - sv.depth.xyz) * inversesqrt(1.0 + dot(tn, tn));
-        }
-        area *= tile * tile * side * side / float(per_view);
+        float area = rsm_texel_area(sv, t, q, tile) * tile * tile * side * side / float(per_view);
         vec3 flux = texelFetch(rsm_flux, a, 0).rgb * radiance * area;
         vec3 d = q - p;
         float d2 = dot(d, d);

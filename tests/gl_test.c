@@ -1,4 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
+#include <cglm/cglm.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -188,6 +189,32 @@ bool gl_target_finite(gl_result *r, const char *name) {
   bool ok = px && finite_not_negative(px, (size_t)w * h * 4);
   free(px);
   return ok;
+}
+
+void gl_quad(lm_scene *s, const char *name, int material, const float c[4][3], const float n[3]) {
+  static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+  float v[4 * 8];
+  for (int i = 0; i < 4; i++) {
+    float *o = v + 8 * i;
+    o[0] = c[i][0], o[1] = c[i][1], o[2] = c[i][2], o[3] = n[0], o[4] = n[1], o[5] = n[2];
+    o[6] = (float)(i == 1 || i == 2), o[7] = (float)(i >= 2);
+  }
+  mat4 id = GLM_MAT4_IDENTITY_INIT;
+  lm_scene_add_node(s, name, -1, (float *)id, lm_scene_add_mesh(s, name, v, 4, idx, 6), material);
+}
+
+int gl_material(lm_scene *s, const char *name, float r, float g, float b) {
+  lm_material m = {.color = {r, g, b}, .rho = 0.5f, .ka = 1, .kd = 1, .shininess = 1};
+  snprintf(m.name, sizeof m.name, "%s", name);
+  return lm_scene_add_material(s, &m);
+}
+
+void gl_camera_up(lm_scene *s, float y) {
+  mat4 m;
+  glm_translate_make(m, (vec3){0, y, 0});
+  glm_rotate(m, glm_rad(90.0f), (vec3){1, 0, 0}); /* -Z of the node points up */
+  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "up", .fov_y = glm_rad(45.0f), .znear = 0.01f, .zfar = 100, .node = cam});
 }
 
 void gl_rescale(lm_scene *s, float unit) {

@@ -66,6 +66,14 @@ float *gl_read_target(gl_result *r, const char *name, int *width, int *height);
  * read before the output stage, which would hide a NaN.) */
 bool gl_target_finite(gl_result *r, const char *name);
 
+/* Scenes built in code: a quad a b c d (counter-clockwise seen from its
+ * normal n) as a mesh node of material `material`; a Lambertian material
+ * (rho 0.5, k_a = k_d = 1, no specular) of colour r g b, returning its
+ * index; a camera at (0, y, 0) looking straight up. */
+void gl_quad(lm_scene *s, const char *name, int material, const float c[4][3], const float n[3]);
+int gl_material(lm_scene *s, const char *name, float r, float g, float b);
+void gl_camera_up(lm_scene *s, float y);
+
 /* The same scene in a unit `unit` times smaller: a root node scaled by unit
  * above everything (cameras under it scale near and far with it), and the
  * lights' ranges and inverse-square intensities, which glTF keeps out of node

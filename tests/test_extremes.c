@@ -36,7 +36,8 @@ static float mean_luminance(const gl_result *r) {
 }
 
 static const char *const every_technique[] = {"isr+esm", "isr",     "dl+esm",  "dl",      "ssdo+esm",    "ssdo",
-                                              "ssao+esm", "ssao", "rsm+esm", "vpl+esm", "isr+rsm+esm"};
+                                              "ssao+esm", "ssao", "rsm+esm", "vpl+esm", "isr+rsm+esm",
+                                              "lpv+esm", "isr+lpv+esm"};
 enum { TECHNIQUES = sizeof every_technique / sizeof *every_technique };
 
 /* Radiance from 1e-8 to 1e6 in one image: a blinding light, a faint background. */

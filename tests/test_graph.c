@@ -124,6 +124,42 @@ static void cpu_passes_follow_their_edges(void **state) {
   lm_graph_destroy(g);
 }
 
+/* A points pass needs a vertex shader and a count in range, takes no depth
+ * target, and is culled by its edges like any pass. */
+static void points_passes_are_checked_and_culled(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_graph_begin(g, 64, 48);
+  int volume = target(g, "volume", LM_FORMAT_RGBA32F, 0.5f), spare = target(g, "spare", LM_FORMAT_RGBA32F, 0.5f);
+  int out = target(g, "out", LM_FORMAT_RGBA8, 1), depth = target(g, "depth", LM_FORMAT_DEPTH32F, 0.5f);
+  lm_error err;
+  lm_pass_desc d = {.kind = LM_PASS_POINTS, .name = "inject", .where = "test.lua:4", .shader = "x.frag",
+                    .vertex = "x.vert", .count = 100, .outputs = &volume, .output_count = 1, .depth = -1};
+  assert_int_equal(lm_graph_add_pass(g, &d, &err), 0);
+  d.name = "unread", d.outputs = &spare;
+  assert_int_equal(lm_graph_add_pass(g, &d, &err), 1);
+  fs(g, "lookup", volume, out);
+  lm_graph_mark_output(g, out);
+  assert_true(lm_graph_compile(g, &err));
+  assert_false(lm_graph_pass(g, 0).culled);
+  assert_true(lm_graph_pass(g, 1).culled);
+  assert_string_equal(lm_pass_kind_name(lm_graph_pass(g, 0).kind), "points");
+  d.vertex = NULL;
+  assert_int_equal(lm_graph_add_pass(g, &d, &err), -1);
+  assert_string_equal(err.msg, "test.lua:4: pass 'unread': no vertex shader");
+  d.vertex = "x.vert", d.count = -1;
+  assert_int_equal(lm_graph_add_pass(g, &d, &err), -1);
+  assert_non_null(strstr(err.msg, "pass 'unread': count must be a whole number in 0 .. 67108864 (got -1)"));
+  d.count = LM_MAX_POINTS + 1;
+  assert_int_equal(lm_graph_add_pass(g, &d, &err), -1);
+  d.count = 0, d.depth = depth;
+  assert_true(lm_graph_add_pass(g, &d, &err) >= 0);
+  lm_graph_mark_output(g, spare);
+  assert_false(lm_graph_compile(g, &err));
+  assert_non_null(strstr(err.msg, "test.lua:4: pass 'unread': points passes take no depth target"));
+  lm_graph_destroy(g);
+}
+
 static void reading_an_unwritten_target_names_the_pass(void **state) {
   (void)state;
   lm_graph *g = lm_graph_create();
@@ -261,6 +297,7 @@ int main(void) {
       cmocka_unit_test(bad_targets_are_refused),
       cmocka_unit_test(unread_passes_are_left_out),
       cmocka_unit_test(cpu_passes_follow_their_edges),
+      cmocka_unit_test(points_passes_are_checked_and_culled),
       cmocka_unit_test(reading_an_unwritten_target_names_the_pass),
       cmocka_unit_test(feedback_loops_are_refused),
       cmocka_unit_test(formats_and_sizes_are_checked),

@@ -337,6 +337,64 @@ static void copies_of_a_mesh_draw_in_one_call_and_look_the_same(void **state) {
   gl_result_free(&r);
 }
 
+/* A points pass scatters: 1000 points, point i on texel i % 4 of a 4 x 2
+ * target's top row, each adding (1, i, 0, 0), sum exactly what each texel
+ * gets; the target starts from zero every frame, so a second frame gives
+ * the same sums; the other row stays 0. Bad fields are named. */
+static void points_passes_scatter_and_add(void **state) {
+  (void)state;
+  assert_true(gl_write_file("shaders/scatter.vert",
+                            "uniform int columns = 4;\nflat out vec4 v;\nvoid main() {\n"
+                            "  int x = gl_VertexID % columns;\n"
+                            "  gl_Position = vec4((float(x) + 0.5) / float(columns) * 2.0 - 1.0, 0.5, 0.0, 1.0);\n"
+                            "  v = vec4(1.0, float(gl_VertexID), 0.0, 0.0);\n}\n"));
+  assert_true(gl_write_file("shaders/scatter.frag", "flat in vec4 v;\nout vec4 o;\nvoid main() { o = v; }\n"));
+  static const char *const good =
+      "Techniques = { 'x' }\nfunction OnRender(tech)\n"
+      "  present(points{ 'scatter', vertex = 'scatter.vert', shader = 'scatter.frag', count = 1000,\n"
+      "                  out = target{ 'scatter', format = 'rgba32f', size = { 4, 2 } } })\nend\n";
+  assert_true(gl_write_file("points.lua", good));
+  gl_result r = gl_render(&(gl_run){.script = "points.lua", .width = 8, .height = 4, .frames = 2});
+  if (!r.ok) fail_msg("%s", r.err.msg);
+  int w, h;
+  float *px = gl_read_target(&r, "scatter", &w, &h);
+  assert_non_null(px);
+  assert_int_equal(w, 4), assert_int_equal(h, 2);
+  for (int x = 0; x < 4; x++) {
+    double sum = 0; /* i = x, x + 4, ... < 1000 */
+    for (int i = x; i < 1000; i += 4) sum += i;
+    assert_float_equal(px[x * 4 + 0], 250, 1e-3);          /* rows top first: the top row */
+    assert_float_equal(px[x * 4 + 1], sum, 1e-6 * sum);
+    assert_float_equal(px[(4 + x) * 4 + 0], 0, 0);         /* the bottom row, untouched */
+  }
+  free(px);
+  assert_true(gl_has_pass(&r, "scatter"));
+  gl_result_free(&r);
+  static const struct {
+    const char *fields, *expect;
+  } cases[] = {
+      {"count = -1", "points.lua:3: pass 'scatter': count must be a whole number in 0 .. 67108864 (got -1)"},
+      {"count = 1.5", "pass 'scatter': count must be a whole number"},
+      {"count = 'many'", "pass 'scatter': count must be a whole number"},
+      {"count = 1e9", "pass 'scatter': count must be a whole number"},
+      {"count = 4, vertex = nil", "pass 'scatter': field 'vertex' is missing"},
+      {"count = 4, depth = 1", "pass 'scatter': unknown field 'depth'"},
+      {"count = 4, vertex = 'nope.vert'", "pass 'scatter'"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+    char text[1024];
+    snprintf(text, sizeof text,
+             "Techniques = { 'x' }\nfunction OnRender(tech)\n"
+             "  present(points{ 'scatter', vertex = 'scatter.vert', shader = 'scatter.frag', %s,\n"
+             "                  out = target{ 'scatter', format = 'rgba32f', size = { 4, 2 } } })\nend\n",
+             cases[i].fields);
+    assert_true(gl_write_file("points.lua", text));
+    gl_result fr = gl_render(&(gl_run){.script = "points.lua", .width = 8, .height = 4});
+    if (fr.ok || !strstr(fr.err.msg, cases[i].expect)) fail_msg("case %zu: %s", i, fr.ok ? "rendered" : fr.err.msg);
+    gl_result_free(&fr);
+  }
+}
+
 int main(void) {
   snprintf(pp_lua, sizeof pp_lua, "%s/scripts/pp.lua", lm_root_dir());
   const struct CMUnitTest tests[] = {
@@ -348,6 +406,7 @@ int main(void) {
       cmocka_unit_test(no_nan_or_inf_leaves_the_output_stage),
       cmocka_unit_test(textures_are_pooled_across_frames),
       cmocka_unit_test(cpu_passes_read_back_and_upload),
+      cmocka_unit_test(points_passes_scatter_and_add),
   };
   return cmocka_run_group_tests(tests, setup, gl_test_teardown);
 }

@@ -21,34 +21,6 @@
 
 enum { W = 160, H = 120 };
 
-/* A quad a b c d (counter-clockwise seen from its normal n). */
-static void quad(lm_scene *s, const char *name, int material, const float c[4][3], const float n[3]) {
-  static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-  float v[4 * 8];
-  for (int i = 0; i < 4; i++) {
-    float *o = v + 8 * i;
-    o[0] = c[i][0], o[1] = c[i][1], o[2] = c[i][2], o[3] = n[0], o[4] = n[1], o[5] = n[2];
-    o[6] = (float)(i == 1 || i == 2), o[7] = (float)(i >= 2);
-  }
-  mat4 id = GLM_MAT4_IDENTITY_INIT;
-  lm_scene_add_node(s, name, -1, (float *)id, lm_scene_add_mesh(s, name, v, 4, idx, 6), material);
-}
-
-static int material(lm_scene *s, const char *name, float r, float g, float b) {
-  lm_material m = {.color = {r, g, b}, .rho = 0.5f, .ka = 1, .kd = 1, .shininess = 1};
-  snprintf(m.name, sizeof m.name, "%s", name);
-  return lm_scene_add_material(s, &m);
-}
-
-/* A camera at (0, y, 0) looking straight up. */
-static void camera_up(lm_scene *s, float y) {
-  mat4 m;
-  glm_translate_make(m, (vec3){0, y, 0});
-  glm_rotate(m, glm_rad(90.0f), (vec3){1, 0, 0}); /* -Z of the node points up */
-  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
-  lm_scene_add_camera(s, &(lm_camera){.name = "up", .fov_y = glm_rad(45.0f), .znear = 0.01f, .zfar = 100, .node = cam});
-}
-
 /* A red floor (albedo 0.8, 0.1, 0.1) over [-F, F]^2 at y = 0 under a
  * canopy, grey 0.8 over [-2, 2]^2 at y = 1, facing down; a sun straight
  * down (power 1) shadows the floor under the canopy. The camera under the
@@ -56,15 +28,15 @@ static void camera_up(lm_scene *s, float y) {
 enum { F = 4 };
 static lm_scene *canopy_scene(void) {
   lm_scene *s = lm_scene_create("canopy");
-  int red = material(s, "red", 0.8f, 0.1f, 0.1f), grey = material(s, "grey", 0.8f, 0.8f, 0.8f);
-  quad(s, "floor", red, (const float[4][3]){{-F, 0, F}, {F, 0, F}, {F, 0, -F}, {-F, 0, -F}}, (const float[3]){0, 1, 0});
-  quad(s, "canopy", grey, (const float[4][3]){{-2, 1, -2}, {2, 1, -2}, {2, 1, 2}, {-2, 1, 2}}, (const float[3]){0, -1, 0});
+  int red = gl_material(s, "red", 0.8f, 0.1f, 0.1f), grey = gl_material(s, "grey", 0.8f, 0.8f, 0.8f);
+  gl_quad(s, "floor", red, (const float[4][3]){{-F, 0, F}, {F, 0, F}, {F, 0, -F}, {-F, 0, -F}}, (const float[3]){0, 1, 0});
+  gl_quad(s, "canopy", grey, (const float[4][3]){{-2, 1, -2}, {2, 1, -2}, {2, 1, 2}, {-2, 1, 2}}, (const float[3]){0, -1, 0});
   mat4 m;
   glm_rotate_make(m, glm_rad(-90.0f), (vec3){1, 0, 0}); /* -Z of the node points down */
   int sun = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
   lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 1,
                                      .casts_shadows = true, .node = sun});
-  camera_up(s, 0.5f);
+  gl_camera_up(s, 0.5f);
   lm_scene_update(s);
   return s;
 }
@@ -134,7 +106,7 @@ static void sunlit_floor_bleeds_onto_a_ceiling_the_sun_cannot_reach(void **state
  * directly too, more with rsm. */
 static lm_scene *closed_room(lm_light_type type) {
   lm_scene *s = lm_scene_create("room");
-  int grey = material(s, "grey", 0.5f, 0.5f, 0.5f);
+  int grey = gl_material(s, "grey", 0.5f, 0.5f, 0.5f);
   static const float walls[6][4][3] = {
       {{-1, -1, 1}, {1, -1, 1}, {1, -1, -1}, {-1, -1, -1}}, /* floor, up */
       {{-1, 1, -1}, {1, 1, -1}, {1, 1, 1}, {-1, 1, 1}},     /* ceiling, down */
@@ -144,7 +116,7 @@ static lm_scene *closed_room(lm_light_type type) {
       {{1, -1, -1}, {1, -1, 1}, {1, 1, 1}, {1, 1, -1}},     /* right, -x */
   };
   static const float normals[6][3] = {{0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0, 0}};
-  for (int i = 0; i < 6; i++) quad(s, "wall", grey, walls[i], normals[i]);
+  for (int i = 0; i < 6; i++) gl_quad(s, "wall", grey, walls[i], normals[i]);
   mat4 m;
   glm_translate_make(m, (vec3){0, type == LM_LIGHT_SPOT ? 0.9f : -0.8f, 0});
   glm_rotate(m, glm_rad(-90.0f), (vec3){1, 0, 0});
@@ -152,7 +124,7 @@ static lm_scene *closed_room(lm_light_type type) {
   lm_scene_add_light(s, &(lm_light){.name = "lamp", .type = type, .color = {1, 1, 1}, .power = 1,
                                      .inner_cone = glm_rad(10.0f), .outer_cone = glm_rad(15.0f),
                                      .falloff = LM_FALLOFF_INVERSE_SQUARE, .casts_shadows = true, .node = node});
-  camera_up(s, -0.95f);
+  gl_camera_up(s, -0.95f);
   lm_scene_update(s);
   return s;
 }

@@ -204,7 +204,7 @@ static void collect_times(lm_graph *g, pass_samples **times, int *count, int fra
     if (!t) {
       *times = lm_realloc(*times, sizeof **times * (size_t)(*count + 1));
       t = &(*times)[(*count)++];
-      *t = (pass_samples){lm_strdup(p.name), p.kind == LM_PASS_SCENE ? "scene" : p.kind == LM_PASS_CPU ? "cpu" : "fullscreen",
+      *t = (pass_samples){lm_strdup(p.name), lm_pass_kind_name(p.kind),
                           lm_alloc(sizeof(double) * (size_t)frames), 0};
     }
     if (t->count < frames) t->ms[t->count++] = p.ms;

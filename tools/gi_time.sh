@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 LIMN=${BUILD_DIR:-build}/limn
 [ -x "$LIMN" ] || { echo "gi_time: no $LIMN (build first: tools/dev.sh build)" >&2; exit 2; }
 SIZE=${SIZE:-256x192} FRAMES=${FRAMES:-5}
-read -r -a techs <<< "${TECHS:-dl+esm rsm+esm vpl+esm isr+rsm+esm isr+esm}"
+read -r -a techs <<< "${TECHS:-dl+esm rsm+esm vpl+esm isr+rsm+esm isr+esm lpv+esm isr+lpv+esm}"
 scenes=(data/scenes/reference/room.glb data/scenes/reference/street.glb data/scenes/reference/blocks.glb
         data/scenes/cornell.glb)
 declare -A sum

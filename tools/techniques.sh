@@ -39,7 +39,7 @@ limn_default_spec() {
 # mean error, mean ms, share of the baseline's indirect error removed (mean
 # over views), views improved, views whose Pearson rose, time over the
 # baseline's (same run). --targets adds the GI targets with PASS or FAIL
-# (for the NAMEs default, ssdo+esm and ssao+esm; rsm+esm, vpl+esm and combined when given).
+# (for the NAMEs default, ssdo+esm and ssao+esm; rsm+esm, vpl+esm, combined and lpv+esm when given).
 limn_gi_report() {
   local targets=0
   [ "$1" = --targets ] && targets=1 && shift
@@ -87,7 +87,7 @@ limn_gi_report() {
     }
     if (!targets) exit
     for (i = 1; i <= n; i++) if (nm[i] == "default") d = ix[i]; else if (nm[i] == "ssdo+esm") so = ix[i]; else if (nm[i] == "ssao+esm") sa = ix[i]
-    for (i = 1; i <= n; i++) if (nm[i] == "rsm+esm") rs = ix[i]; else if (nm[i] == "vpl+esm") vp = ix[i]; else if (nm[i] == "combined") co = ix[i]
+    for (i = 1; i <= n; i++) if (nm[i] == "rsm+esm") rs = ix[i]; else if (nm[i] == "vpl+esm") vp = ix[i]; else if (nm[i] == "combined") co = ix[i]; else if (nm[i] == "lpv+esm") lp = ix[i]
     b = nm[1]
     printf "\ntargets:\n"
     printf "  %s  the default removes at least 40%% of %s'"'"'s indirect error (mean over views): %s\n",
@@ -109,6 +109,8 @@ limn_gi_report() {
                    (SN[rs] ? sprintf("%.1f%%", SH[rs]) : "n/a")
     if (vp) printf "  %s  vpl+esm removes at least 30%%: %s\n", (SN[vp] && SH[vp] >= 30 ? "PASS" : "FAIL"),
                    (SN[vp] ? sprintf("%.1f%%", SH[vp]) : "n/a")
+    if (lp) printf "  %s  lpv+esm removes at least 30%%: %s\n", (SN[lp] && SH[lp] >= 30 ? "PASS" : "FAIL"),
+                   (SN[lp] ? sprintf("%.1f%%", SH[lp]) : "n/a")
   }' "$out/report.csv"
   echo
   echo "mean err: seed eq 19, mean over the views; ms: mean time per frame; indir.%: share of ${names[0]}'s"

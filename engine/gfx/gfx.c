@@ -208,6 +208,18 @@ void lm_draw_fullscreen(void) {
   glDrawArrays(GL_TRIANGLES, 0, 3); /* one triangle covering the viewport */
 }
 
+void lm_draw_points(int count) {
+  if (count <= 0) return;
+  if (!empty_vao) glCreateVertexArrays(1, &empty_vao);
+  glBindVertexArray(empty_vao);
+  glEnable(GL_BLEND);
+  glBlendEquation(GL_FUNC_ADD);
+  glBlendFunc(GL_ONE, GL_ONE);
+  glPointSize(1.0f);
+  glDrawArrays(GL_POINTS, 0, count);
+  glDisable(GL_BLEND);
+}
+
 void lm_set_viewport(int x, int y, int width, int height) { glViewport(x, y, width, height); }
 
 enum { STORAGE_BINDINGS = 8 };

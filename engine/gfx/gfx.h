@@ -74,6 +74,10 @@ typedef struct lm_attachments {
 bool lm_attachments_bind(const lm_attachments *att, lm_error *err);
 void lm_clear(int color_count, const float rgba[4], bool clear_depth, float depth);
 void lm_draw_fullscreen(void);
+/* Draws `count` points from no vertex data (the vertex shader numbers them by
+ * gl_VertexID), each one pixel, added to what the outputs hold (additive
+ * blending, on for this draw only). */
+void lm_draw_points(int count);
 void lm_set_viewport(int x, int y, int width, int height);
 /* Uploads a shader storage block to `binding` (grows its buffer as needed). */
 void lm_storage_upload(int binding, const void *data, size_t bytes);

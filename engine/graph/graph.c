@@ -18,6 +18,10 @@ void lm_target_size(const lm_target_desc *d, int out_w, int out_h, int *w, int *
   *h = fh < 1 ? 1 : fh > 1e6 ? 1000000 : (int)fh;
 }
 
+const char *lm_pass_kind_name(lm_pass_kind k) {
+  return k == LM_PASS_SCENE ? "scene" : k == LM_PASS_CPU ? "cpu" : k == LM_PASS_POINTS ? "points" : "fullscreen";
+}
+
 lm_graph *lm_graph_create(void) { return lm_alloc(sizeof(lm_graph)); }
 
 void lm_graph_destroy(lm_graph *g) {
@@ -102,6 +106,15 @@ int lm_graph_add_pass(lm_graph *g, const lm_pass_desc *d, lm_error *err) {
                  d->kind == LM_PASS_SCENE ? "technique" : d->kind == LM_PASS_CPU ? "function" : "shader");
     return -1;
   }
+  if (d->kind == LM_PASS_POINTS && (!d->vertex || !d->vertex[0])) {
+    lm_error_set(err, "%s: pass '%s': no vertex shader", where, name);
+    return -1;
+  }
+  if (d->kind == LM_PASS_POINTS && (d->count < 0 || d->count > LM_MAX_POINTS)) {
+    lm_error_set(err, "%s: pass '%s': count must be a whole number in 0 .. %d (got %d)", where, name,
+                 LM_MAX_POINTS, d->count);
+    return -1;
+  }
   if (d->output_count > LM_MAX_COLOR_OUTPUTS || d->input_count > LM_MAX_PASS_INPUTS ||
       d->param_count > LM_MAX_PASS_PARAMS) {
     lm_error_set(err, "%s: pass '%s': too many outputs, inputs or parameters (at most %d, %d, %d)",
@@ -139,6 +152,7 @@ int lm_graph_add_pass(lm_graph *g, const lm_pass_desc *d, lm_error *err) {
   c->name = arena_str(g, name);
   c->where = arena_str(g, where);
   c->shader = arena_str(g, d->shader);
+  c->vertex = arena_str(g, d->vertex);
   c->defines = arena_str(g, d->defines ? d->defines : "");
   lm_pass_input *in = lm_arena_alloc(&g->arena, sizeof *in * (size_t)(d->input_count + 1));
   for (int i = 0; i < d->input_count; i++)
@@ -212,7 +226,7 @@ static bool validate_pass(lm_graph *g, int pi, lm_error *err) {
   }
   if (d->kind != LM_PASS_SCENE && d->depth >= 0) {
     lm_error_set(err, "%s: pass '%s': %s passes take no depth target", where, name,
-                 d->kind == LM_PASS_CPU ? "CPU" : "full-screen");
+                 d->kind == LM_PASS_CPU ? "CPU" : d->kind == LM_PASS_POINTS ? "points" : "full-screen");
     return false;
   }
   if (d->fits_views && !g->targets[d->fit_target].desc.persistent && last_writer(g, d->fit_target, pi) < 0) {

@@ -27,8 +27,15 @@ void lm_target_size(const lm_target_desc *d, int out_w, int out_h, int *w, int *
  * read back, traced, hit records uploaded): `shader` names the function
  * (lm_graph_exec_desc.run_cpu), which gets its inputs' texels and fills its
  * outputs'. It takes no depth target and no views; its parameters go to the
- * function in the description. */
-typedef enum lm_pass_kind { LM_PASS_FULLSCREEN, LM_PASS_SCENE, LM_PASS_CPU } lm_pass_kind;
+ * function in the description.
+ * A points pass scatters: `count` points from no vertex data, each placed by
+ * the `vertex` shader (which reads its inputs by gl_VertexID) on one texel
+ * of the outputs and coloured by `shader`, into outputs cleared to zero and
+ * blended additively (seed 003's injection of light into a volume). It
+ * takes no depth target and no views. */
+typedef enum lm_pass_kind { LM_PASS_FULLSCREEN, LM_PASS_SCENE, LM_PASS_CPU, LM_PASS_POINTS } lm_pass_kind;
+/* "fullscreen", "scene", "cpu", "points" (timing tables). */
+const char *lm_pass_kind_name(lm_pass_kind k);
 
 typedef struct lm_pass_input {
   const char *name; /* sampler uniform */
@@ -62,12 +69,15 @@ typedef struct lm_pass_material_param {
 
 #define LM_MAX_PASS_INPUTS 16
 #define LM_MAX_PASS_PARAMS 64
+#define LM_MAX_POINTS (1 << 26)
 
 typedef struct lm_pass_desc {
   lm_pass_kind kind;
   const char *name;
   const char *where;   /* where it was recorded ("scripts/pp.lua:12"), for messages */
-  const char *shader;  /* full-screen: fragment shader file; scene: material technique */
+  const char *shader;  /* full-screen, points: fragment shader file; scene: material technique */
+  const char *vertex;  /* points: vertex shader file */
+  int count;           /* points: how many, 0 .. LM_MAX_POINTS */
   const char *defines; /* "NAME=VALUE;NAME2" */
   const lm_pass_input *inputs;
   int input_count;

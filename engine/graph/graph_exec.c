@@ -188,7 +188,7 @@ static lm_program *pass_program(const lm_pass_desc *d, const char *extra, lm_err
     snprintf(defines, sizeof defines, "%s%s%s", d->defines, d->defines[0] && extra[0] ? ";" : "", extra);
     p = lm_program_get(vert, frag, defines, err);
   } else {
-    p = lm_program_get("fullscreen.vert", d->shader, d->defines, err);
+    p = lm_program_get(d->kind == LM_PASS_POINTS ? d->vertex : "fullscreen.vert", d->shader, d->defines, err);
   }
   if (!p) lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
   return p;
@@ -329,6 +329,10 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
     }
     lm_set_scene_state(false, false);
     if (!ok) lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
+  } else if (d->kind == LM_PASS_POINTS) {
+    static const float zero[4] = {0, 0, 0, 0};
+    lm_clear(d->output_count, zero, false, 0);
+    lm_draw_points(d->count);
   } else {
     lm_draw_fullscreen();
   }

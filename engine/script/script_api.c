@@ -1,5 +1,6 @@
-/* What pipeline scripts call: target{}, scene{}, pass{}, present(),
- * output_size(). Each validates its table and names the field at fault. */
+/* What pipeline scripts call: target{}, scene{}, pass{}, cpu{}, points{},
+ * present(), output_size(), shadow_plan{}, sky_sh{}, scene_reflective(),
+ * scene_bounds(). Each validates its table and names the field at fault. */
 #include "script/script_internal.h"
 
 #include <math.h>
@@ -241,11 +242,16 @@ static int l_plan_index(lua_State *L) {
   else if (!strcmp(k, "tile")) lua_pushinteger(L, plan->tile);
   else if (!strcmp(k, "views")) lua_pushinteger(L, plan->view_count);
   else if (!strcmp(k, "shadow_views")) lua_pushinteger(L, plan->shadow_views);
+  else if (!strcmp(k, "rsm_views")) {
+    int n = 0; /* the lights' RSM views (lm_shadow_light_data.cube z) */
+    for (int i = 0; i < plan->light_count; i++) n += plan->lights[i].cube[2];
+    lua_pushinteger(L, n);
+  }
   else if (!strcmp(k, "c")) lua_pushnumber(L, plan->settings.c);
   else if (!strcmp(k, "blur")) lua_pushinteger(L, plan->settings.blur);
   else if (!strcmp(k, "technique")) lua_pushstring(L, (const char *[]){"esm", "pcf", "poisson", "hard", "pcss"}[plan->settings.technique]);
-  else return luaL_error(L, "shadow plan has no field '%s' (width, height, tile, views, shadow_views, c, blur, "
-                         "technique)", k);
+  else return luaL_error(L, "shadow plan has no field '%s' (width, height, tile, views, shadow_views, rsm_views, c, "
+                         "blur, technique)", k);
   return 1;
 }
 
@@ -625,6 +631,48 @@ static int l_cpu(lua_State *L) {
   return add_pass_returning_output(L, p, &b, top);
 }
 
+/* points{ "name", vertex = "x.vert", shader = "x.frag", count = N, inputs = {...}, params = {...},
+ * out = T | {...}, defines = {...}, fetches = F }: N points, each placed on one texel by the vertex
+ * shader, added into outputs cleared to zero (a scatter); returns its first output. */
+static int l_points(lua_State *L) {
+  static const char *const fields[] = {"vertex", "shader", "count", "inputs", "params", "out", "defines",
+                                       "fetches", NULL};
+  pass_builder b;
+  int top = lua_gettop(L);
+  lm_pipeline *p = begin_output_pass(L, &b, LM_PASS_POINTS, "points", fields, "shader", "a file in shaders/");
+  b.desc.vertex = opt_string(L, 1, "vertex", b.what);
+  if (!b.desc.vertex) return luaL_error(L, "%s: field 'vertex' is missing (a vertex shader in shaders/)", b.what);
+  lua_getfield(L, 1, "count");
+  lua_Number n = lua_tonumber(L, -1);
+  if (!lua_isnumber(L, -1) || !(n >= 0 && n <= LM_MAX_POINTS) || n != floor(n))
+    return luaL_error(L, "%s: count must be a whole number in 0 .. %d (got %s)", b.what, LM_MAX_POINTS,
+                      luaL_tolstring(L, -1, NULL));
+  b.desc.count = (int)n;
+  lua_pop(L, 1);
+  read_defines(L, 1, &b);
+  b.desc.fetches = opt_number(L, 1, "fetches", 0, 0, 1e6f, b.what);
+  return add_pass_returning_output(L, p, &b, top);
+}
+
+/* scene_bounds(): the world box of the scene's meshes as two lists {x, y, z}
+ * (least, greatest), or nil for a scene without finite geometry. */
+static int l_scene_bounds(lua_State *L) {
+  lm_pipeline *p = recording(L, "scene_bounds");
+  float lo[3], hi[3];
+  if (!p->scene || !lm_scene_bounds(p->scene, lo, hi)) {
+    lua_pushnil(L);
+    return 1;
+  }
+  for (int k = 0; k < 2; k++) {
+    lua_createtable(L, 3, 0);
+    for (int i = 0; i < 3; i++) {
+      lua_pushnumber(L, (k ? hi : lo)[i]);
+      lua_rawseti(L, -2, i + 1);
+    }
+  }
+  return 2;
+}
+
 /* scene_reflective(): whether a material the scene draws is reflective. */
 static int l_scene_reflective(lua_State *L) {
   lm_pipeline *p = recording(L, "scene_reflective");
@@ -663,7 +711,8 @@ void lm_script_open_api(lua_State *L) {
   static const luaL_Reg api[] = {{"target", l_target}, {"scene", l_scene}, {"pass", l_pass},
                                  {"present", l_present}, {"output_size", l_output_size},
                                  {"shadow_plan", l_shadow_plan}, {"sky_sh", l_sky_sh}, {"cpu", l_cpu},
-                                 {"scene_reflective", l_scene_reflective}, {NULL, NULL}};
+                                 {"scene_reflective", l_scene_reflective}, {"points", l_points},
+                                 {"scene_bounds", l_scene_bounds}, {NULL, NULL}};
   lua_pushglobaltable(L);
   luaL_setfuncs(L, api, 0);
   lua_pop(L, 1);

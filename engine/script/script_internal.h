@@ -29,8 +29,8 @@ struct lm_pipeline {
   float sky_map_sh[LM_SKY_SH];
 };
 
-/* Registers target, scene, pass, cpu, present, output_size, shadow_plan, sky_sh and scene_reflective in
- * the global table. */
+/* Registers target, scene, pass, cpu, points, present, output_size, shadow_plan, sky_sh, scene_reflective
+ * and scene_bounds in the global table. */
 void lm_script_open_api(lua_State *L);
 /* The pipeline that owns L. */
 lm_pipeline *lm_script_pipeline(lua_State *L);

@@ -1,0 +1,148 @@
+-- Light propagation volumes (seed 003, section 5.2), on POV-Ray's scale
+-- (/work/shared/design/gi-scale.md), over the reflective shadow maps the
+-- shadow pass writes (shadow.render(o, G, reach), as rsm.lua). Each frame:
+--   1. injection (points passes, lpv_inject.vert): VPLs from every light's
+--      RSM views, each a Lambertian lobe in 2-band spherical harmonics per
+--      colour channel, and surfels of the G-buffer as the geometry volume's
+--      blocking, into `cascades` grids of `cells`^3 cells
+--      (unwrapped into cells^2 x cells*cascades textures, the seed's 1024 x
+--      32 for one 32^3 grid) that follow the camera, snapped to whole cells
+--   2. `steps` propagation steps to the six neighbours, blocked by the
+--      geometry volume, with running sums (lpv_propagate.frag)
+--   3. the lookup at each coarse pixel (lpv_lookup.frag), cascades as
+--      distance bands, then ISR's blur, bilateral upsampling and composite
+--      (isr.blur, isr.composite: L = D + k_a L_a albedo + k k_d albedo E)
+-- The combined technique (isr+lpv+esm) leaves the VPLs the camera sees to
+-- ISR's screen-space march (docs/gi-combined.md).
+local gbuffer = require "gbuffer"
+local isr = require "isr"
+local options = require "options"
+
+local lpv = {}
+
+-- The options a pipeline exposes (pp.lua's Options.lpv), with defaults.
+-- No default is a world length: cells follow from the scene's size.
+lpv.defaults = {
+  cells = 32,        -- cells a side of each cascade, 4..64 (the seed: 32)
+  cascades = 3,      -- grids following the camera, each cell twice the last's, 1..4 (the seed: 3)
+  steps = 8,         -- propagation steps, 0..256 (light moves up to a cell a step)
+  extent = 3.0,      -- the coarsest cascade's side over the scene's bounding-box diagonal, 1e-3..64
+  cell = 0,          -- cascade 0's cell side in world units, 0..1e30 (0: from extent)
+  shift = 1.0,       -- the cascades' centre lies this share of the seen distance ahead of the camera, 0..1
+  vpls = 48,         -- VPLs a side a cascade, 1..1024: vpls^2 over all RSM views (a point light's six faces
+                     -- share them), the injection's cost
+  surfels = 32,      -- G-buffer surfels a row for the geometry volume, 0..1024 (0: nothing blocks)
+  occlusion = 1.0,   -- how much the geometry volume blocks, 0..1 (0: light passes through walls)
+  reach = 3,         -- a directional light's RSM tile, as rsm.reach, 1..64
+  k = 1.0,           -- indirect light factor, 0..16 (1: physical)
+  coarse = 2,        -- the lookup's coarse factor a side: 1, 2 or 4
+  blur = 2,          -- Gaussian taps each side at coarse size, 0..32
+}
+
+local rules = {
+  cells = options.whole(4, 64),
+  cascades = options.whole(1, 4),
+  steps = options.whole(0, 256),
+  extent = options.number(1e-3, 64),
+  cell = options.number(0, 1e30),
+  shift = options.number(0, 1),
+  vpls = options.whole(1, 1024),
+  surfels = options.whole(0, 1024),
+  occlusion = options.number(0, 1),
+  reach = options.number(1, 64),
+  k = options.number(0, 16),
+  coarse = options.one_of(1, 2, 4),
+  blur = options.whole(0, 32),
+}
+
+-- Checked options (errors name the option, pointing at the caller's caller);
+-- shadow.render(..., o.reach) then writes the maps.
+function lpv.check(o) return options.check("lpv", lpv.defaults, o, rules, 3) end
+
+-- Cascade 0's cell side: o.cell, or the coarsest cascade spanning extent
+-- times the scene's diagonal (a scene without extent: a unit, as the
+-- engine's bounds of an empty scene).
+local function cell_size(o)
+  if o.cell > 0 then return o.cell end
+  local lo, hi = scene_bounds()
+  local d = lo and math.sqrt((hi[1] - lo[1]) ^ 2 + (hi[2] - lo[2]) ^ 2 + (hi[3] - lo[3]) ^ 2) or 1
+  if not (d > 0 and d < math.huge) then d = 1 end
+  return o.extent * d / (o.cells * 2 ^ (o.cascades - 1))
+end
+
+-- The uniforms of lpv.glsl.
+local function grid(o, h, params)
+  params.lpv_cells, params.lpv_cascades, params.lpv_cell, params.lpv_shift = o.cells, o.cascades, h, o.shift
+  return params
+end
+
+-- Records injection and propagation from the RSM targets R (shadow.render's
+-- second result) and the G-buffer G. exclude_seen: VPLs the camera sees are
+-- left out (the combined technique). Returns the volumes: { early = {r, g,
+-- b}, late = {r, g, b} (sums of steps 1 .. steps // 2 and the rest, nil when
+-- none), cell = cascade 0's cell side, seen = R.seen }.
+function lpv.volume(G, R, o, exclude_seen)
+  local h = cell_size(o)
+  local size = { o.cells * o.cells, o.cells * o.cascades }
+  local function volume(name) return target{ name, format = "rgba32f", size = size } end
+  local w, ht = output_size()
+  local rows = o.surfels > 0 and math.max(1, (o.surfels * ht + w // 2) // w) or 0
+  local side = math.max(1, math.floor(o.vpls / math.sqrt(math.max(R.views, 1)) + 0.5))
+  local params = grid(o, h, { vpl_side = side, rsm_views = R.views, surfel_grid = { o.surfels, rows } })
+  local inputs = { rsm_flux = R.flux, rsm_nrm = R.nrm, rsm_pos = R.pos, nrm = G.nrm, dpt = G.dpt, mat = G.mat,
+                   lpv_seen = R.seen }
+  local inj = { volume("lpv.inject_r"), volume("lpv.inject_g"), volume("lpv.inject_b") }
+  points{ "lpv.inject", vertex = "lpv_inject.vert", shader = "lpv_inject.frag",
+          count = R.views * side * side * o.cascades, inputs = inputs, params = params,
+          defines = { SHADOWS = true, EXCLUDE_SEEN = exclude_seen == true }, fetches = 4, out = inj }
+  local geometry = points{ "lpv.geometry", vertex = "lpv_inject.vert", shader = "lpv_inject.frag",
+                           count = o.surfels * rows * o.cascades, inputs = inputs, params = params,
+                           defines = { SHADOWS = true, GEOMETRY = true }, fetches = 3,
+                           out = volume("lpv.geometry") }
+  -- The injected light itself (step 0) is in no sum: it sits in its VPL's own cell, which a thin
+  -- wall shares with the other side, and would light that side too.
+  local wave, early, late = { inj[1], inj[2], inj[3] }, nil, nil
+  local half = o.steps // 2
+  for k = 1, o.steps do
+    local sum = k <= half and early or k > half and late or nil
+    local out = {}
+    for i, ch in ipairs{ "r", "g", "b" } do
+      out[i] = volume("lpv.wave_" .. ch .. k)
+      out[i + 3] = volume("lpv.sum_" .. ch .. k)
+    end
+    local inputs = { wave_r = wave[1], wave_g = wave[2], wave_b = wave[3], geometry = geometry }
+    if sum then inputs.sum_r, inputs.sum_g, inputs.sum_b = sum[1], sum[2], sum[3] end
+    pass{ "lpv.propagate" .. k, shader = "lpv_propagate.frag", inputs = inputs, defines = { SUM = sum ~= nil, FIRST = k == 1 },
+          params = grid(o, h, { occlusion = o.occlusion }), fetches = sum and 22 or 19, out = out }
+    wave = { out[1], out[2], out[3] }
+    if k <= half then early = { out[4], out[5], out[6] } else late = { out[4], out[5], out[6] } end
+  end
+  return { early = early, late = late, cell = h, seen = R.seen }
+end
+
+-- Records the lookup over the coarse G-buffer C (isr.coarse_gbuffer, factor
+-- f) in the volumes V (lpv.volume). base (optional): a coarse result to add
+-- to (the screen-space pass's). Returns the coarse E.
+function lpv.gather(C, f, V, o, base)
+  local inputs = gbuffer.inputs(C)
+  if V.early then inputs.early_r, inputs.early_g, inputs.early_b = V.early[1], V.early[2], V.early[3] end
+  if V.late then inputs.late_r, inputs.late_g, inputs.late_b = V.late[1], V.late[2], V.late[3] end
+  inputs.base, inputs.lpv_seen = base, V.seen
+  return pass{ "lpv.lookup", shader = "lpv_lookup.frag", inputs = inputs,
+               defines = { EARLY = V.early ~= nil, LATE = V.late ~= nil, BASE = base ~= nil },
+               params = grid(o, V.cell, { lpv_steps = o.steps }),
+               fetches = 4 + o.cascades * 24, out = target{ "lpv.e", format = "rgba16f", scale = 1 / f } }
+end
+
+-- Records LPV lighting of G given its direct light `direct` (no ambient
+-- term), the RSM targets R, checked options o and light = { ambient = {r, g,
+-- b}, background = {r, g, b}, sky }. Returns the lit target.
+function lpv.render(G, direct, R, o, light)
+  local f = o.coarse
+  local C = isr.coarse_gbuffer(G, direct, f)
+  local E = isr.blur(lpv.gather(C, f, lpv.volume(G, R, o), o), C, f, o.blur)
+  return isr.composite(G, direct, C, E, { ambient = light.ambient, background = light.background, k = o.k }, false,
+                       light.sky)
+end
+
+return lpv

@@ -1,0 +1,134 @@
+// Injection into the light propagation volumes (seed 003, sections 5.2.3 and
+// 5.2.5; scripts/lpv.lua): points passes, one point a cell write, added up.
+// Each cascade takes the same points, cascade after cascade:
+//   - VPLs: `vpl_side`^2 points in each of the lights' `rsm_views` RSM views
+//     (light by light; lpv.lua shares lpv.vpls^2 among them), the centre
+//     texels of a grid over the part of the
+//     view's RSM that the cascade's grid covers (so every cascade gets as
+//     many VPLs a cell; empty texels are dropped), each standing for its
+//     share of that part's texels. A VPL is the sender's Lambertian lobe, its
+//     radiance (k_d albedo times light_incident) times the area it stands for
+//     (rsm_texel_area), put in the cell half a cell in front of the sender
+//     (the seed's VPLs "placed above their surfaces");
+//   - GEOMETRY: surfels, a `surfel_grid` of G-buffer pixels (the surfaces the
+//     camera sees), into the geometry volume: the share of a cell's
+//     cross-section a surfel covers for light travelling in w, its area over
+//     h^2 times max(0, -n.w) (2 bands), in the cell half a cell behind the
+//     surface (light reaching the surface fills the cell in front of it,
+//     where the lookup reads, and stops at the next). Surfaces the camera
+//     does not see block nothing: the RSM's surfels (as the second LPV
+//     version takes) measured no better on the reference set and doubled
+//     the points, which cost llvmpipe most of the injection's time.
+// EXCLUDE_SEEN (the combined technique): a VPL the camera sees is left to the
+// screen-space pass, as rsm.frag does.
+// Output, flat: the VPL's lobe per colour channel (or the blocking lobe); a
+// point that adds nothing is placed off the target.
+#include "rsm.glsl"
+#include "lpv.glsl"
+
+uniform sampler2D rsm_flux, rsm_nrm, rsm_pos; // shadow.lua's RSM targets
+uniform sampler2D nrm, dpt, mat;              // the G-buffer
+uniform int vpl_side = 64;
+uniform int rsm_views = 0;
+uniform ivec2 surfel_grid = ivec2(0);
+
+flat out vec4 v_r, v_g, v_b; // GEOMETRY: v_r, the blocking lobe
+
+const float MIN_COS = 0.2; // caps a surfel's area at 5 times its projection (grazing views)
+
+// The part of view sv's tile (lo, hi in 0..1) that cascade c's grid covers:
+// for an orthographic view (a directional light's), the box's projection, its
+// centre's plus the sum of its half axes' (the projection is affine); for a
+// perspective one, the whole tile (a box may lie around its light).
+bool cascade_rect(ShadowView sv, int c, out vec2 lo, out vec2 hi) {
+  lo = vec2(0.0);
+  hi = vec2(1.0);
+  if (sv.depth.w > 0.0) return true;
+  float half_side = 0.5 * float(lpv_cells) * lpv_cell_size(c);
+  vec2 centre = (sv.view_proj * vec4(lpv_origin(c) + half_side, 1.0)).xy * 0.5 + 0.5;
+  vec2 reach = half_side * 0.5 * (abs(sv.view_proj[0].xy) + abs(sv.view_proj[1].xy) + abs(sv.view_proj[2].xy));
+  lo = clamp(centre - reach, 0.0, 1.0);
+  hi = clamp(centre + reach, 0.0, 1.0);
+  return all(greaterThan(hi, lo));
+}
+
+// VPL k of cascade c: position, normal and radiance times area; false when it stands for nothing.
+bool vpl(int k, int c, out vec3 q, out vec3 n, out vec3 flux) {
+  int side = max(vpl_side, 1), per_view = side * side, v = k / per_view, b = k % per_view;
+  int light = -1;
+  for (int i = 0; i < frame.counts.x && light < 0; i++) { // the v-th RSM view, light by light
+    ivec4 cube = shadow_lights[i].cube;
+    if (v < cube.z) light = i;
+    else v -= cube.z;
+  }
+  if (light < 0) return false;
+  v += shadow_lights[light].cube.y;
+  ShadowView sv = shadow_views[v];
+  vec2 lo, hi;
+  if (!cascade_rect(sv, c, lo, hi)) return false;
+  vec2 atlas = vec2(textureSize(rsm_pos, 0));
+  float tile = sv.rect.z * atlas.x;
+  vec2 t = lo + (vec2(b % side, b / side) + 0.5) / float(side) * (hi - lo);
+  ivec2 a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
+  n = texelFetch(rsm_nrm, a, 0).xyz;
+  if (dot(n, n) > 1.5) return false; // empty
+  q = texelFetch(rsm_pos, a, 0).xyz;
+#ifdef EXCLUDE_SEEN
+  if (rsm_seen(dpt, q)) return false;
+#endif
+  vec3 l, radiance = light_incident(light, q, l);
+  float texels = tile * tile * (hi.x - lo.x) * (hi.y - lo.y) / float(per_view); // the RSM texels a point stands for
+  flux = texelFetch(rsm_flux, a, 0).rgb * radiance * rsm_texel_area(sv, t, q, tile) * texels;
+  return true;
+}
+
+// Surfel k: the G-buffer pixel's position, normal and area (its footprint
+// over the cosine to the camera, capped); false on background.
+bool surfel(int k, out vec3 p, out vec3 n, out float area) {
+  ivec2 size = textureSize(dpt, 0);
+  int columns = max(surfel_grid.x, 1);
+  vec2 step = vec2(size) / vec2(max(surfel_grid, ivec2(1)));
+  vec2 uv = (vec2(k % columns, k / columns) + 0.5) * step / vec2(size);
+  ivec2 px = ivec2(uv * vec2(size));
+  if (texelFetch(mat, px, 0).a < 0.5) return false; // background
+  float z = texelFetch(dpt, px, 0).r;
+  p = position_from_depth(uv, z);
+  n = safe_normalize(texelFetch(nrm, px, 0).xyz, vec3(0.0, 1.0, 0.0));
+  float foot = 2.0 * dpt_view_depth(z) * frame.clip.w / float(size.y); // a pixel's world size
+  vec3 v = safe_normalize(frame.camera_pos.xyz - p, n);
+  area = foot * foot * step.x * step.y / max(abs(dot(n, v)), MIN_COS);
+  return true;
+}
+
+void main() {
+  gl_Position = vec4(2.0, 2.0, 0.0, 1.0); // off the target
+  v_r = v_g = v_b = vec4(0.0);
+#ifdef GEOMETRY
+  int per_cascade = surfel_grid.x * surfel_grid.y;
+#else
+  int per_cascade = rsm_views * vpl_side * vpl_side;
+#endif
+  int c = gl_VertexID / max(per_cascade, 1), k = gl_VertexID % max(per_cascade, 1);
+  if (c >= lpv_cascades) return;
+  vec3 p, n, flux;
+  float area;
+#ifdef GEOMETRY
+  if (!surfel(k, p, n, area)) return;
+  float side = -0.5;
+#else
+  if (!vpl(k, c, p, n, flux)) return;
+  float side = 0.5;
+#endif
+  float h = lpv_cell_size(c);
+  ivec3 cell = ivec3(floor((p + side * h * n - lpv_origin(c)) / h));
+  if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, ivec3(lpv_cells)))) return;
+  vec2 size = vec2(lpv_cells * lpv_cells, lpv_cells * lpv_cascades);
+  gl_Position = vec4((vec2(lpv_texel(cell, c)) + 0.5) / size * 2.0 - 1.0, 0.0, 1.0);
+#ifdef GEOMETRY
+  v_r = lpv_finite(lpv_lobe(area / max(h * h, 1e-30), -n)); // h^2 may underflow
+#else
+  v_r = lpv_finite(lpv_lobe(flux.r, n));
+  v_g = lpv_finite(lpv_lobe(flux.g, n));
+  v_b = lpv_finite(lpv_lobe(flux.b, n));
+#endif
+}

@@ -1,0 +1,123 @@
+// The light propagation volumes' light at each pixel of the (coarse)
+// G-buffer (seed 003, section 5.3.6's lookup; scripts/lpv.lua), on POV-Ray's
+// scale (/work/shared/design/gi-scale.md): E / pi, what the composite
+// (isr_light.frag) multiplies by k_d albedo.
+//
+// A cell's summed intensity I over the steps is the radiance through it
+// times its cross-section h^2, times the steps light spends crossing it: a
+// step moves light in w by w / (|w_x| + |w_y| + |w_z|) cells
+// (lpv_propagate.frag), so it lingers |w|_1 steps a cell. Hence
+//   E / pi = (1 / pi) int I(-w) / h^2 / |w|_1 max(0, n.w) dw
+//          ~ D max(0, A - 2/3 B.n) / h^2,  D = mean of 1 / |w|_1 = 0.674213
+// (int (A + B.w) max(0, -n.w) dw = pi A - 2 pi / 3 B.n), read trilinearly
+// 1.5 cells in front of the surface: the first layer of cells in front of a
+// lit surface holds its own VPLs' light going sideways (2 bands cannot
+// represent a Lambertian lobe's zero at grazing angles), which read there
+// would light a lit plane by itself; measured on the reference set
+// (tools/fidelity.sh), 1.5 cells took out the bright ground of the blocks
+// views that 0.5 and 1 cell left (56% of dl+esm's indirect error removed,
+// every view improved, against 55% and 14 of 15 at 1 cell).
+//
+// Cascades as distance bands: a step of cascade c carries light as far as
+// two of cascade c - 1, so cascade c's steps after the first half
+// (`late`: steps floor(S / 2) + 1 .. S) carry light from beyond what cascade
+// c - 1's S steps reach, and each path is counted once:
+//   E = all steps of the finest cascade c0 that holds p + late steps of each coarser one
+// (`early` holds steps 1 .. floor(S / 2); step 0, the injected VPLs in their
+// own cells, is in neither, see lpv.lua). A grid holds only the VPLs inside
+// it: a point less than S cells from c0's border would miss the light from
+// beyond it, so over those S cells the sum blends into the same sum from
+// c0 + 1 (no seam shows either); past the coarsest cascade's border the
+// light fades to nothing.
+// Output: rgb = E / pi, a = 1 (it occludes no ambient term); with BASE, the
+// screen-space pass's coarse result `base` plus it (its a kept).
+#include "gbuffer.glsl"
+#include "lpv.glsl"
+
+in vec2 uv;
+uniform sampler2D clr, nrm, dpt, mat;         // (coarse) G-buffer
+#ifdef EARLY
+uniform sampler2D early_r, early_g, early_b;  // sums of steps 1 .. floor(S / 2)
+#endif
+#ifdef LATE
+uniform sampler2D late_r, late_g, late_b;     // sums of steps floor(S / 2) + 1 .. S
+#endif
+#ifdef BASE
+uniform sampler2D base;
+#endif
+uniform int lpv_steps = 8;
+
+out vec4 result;
+
+const float D = 0.674213;
+
+vec3 irradiance(vec4 r, vec4 g, vec4 b, vec3 n) {
+  vec3 a = vec3(r.x, g.x, b.x), bn = vec3(dot(r.yzw, n), dot(g.yzw, n), dot(b.yzw, n));
+  return D * max(a - (2.0 / 3.0) * bn, 0.0);
+}
+
+vec4 volume(sampler2D v, vec2 uv0, vec2 uv1, float f) { return mix(texture(v, uv0), texture(v, uv1), f); }
+
+// Where p facing n is read in cascade c, in cell centres (1.5 cells in front of it).
+vec3 cell_coords(int c, vec3 p, vec3 n) {
+  float h = lpv_cell_size(c);
+  return (p + 1.5 * h * n - lpv_origin(c)) / h - 0.5;
+}
+
+// How many cells u lies within the grid's sampled range (negative: outside).
+float inside(vec3 u) {
+  float last = float(lpv_cells - 1);
+  return min(min(u.x, u.y), min(u.z, min(last - u.x, min(last - u.y, last - u.z))));
+}
+
+// Cascade c's E / pi at p facing n from its late sum, and its early sum too when asked.
+vec3 cascade(int c, vec3 p, vec3 n, bool early) {
+  float last = float(lpv_cells - 1);
+  vec3 u = clamp(cell_coords(c, p, n), vec3(0.0), vec3(last));
+  float z0 = floor(u.z), f = u.z - z0, z1 = min(z0 + 1.0, last);
+  vec2 size = vec2(lpv_cells * lpv_cells, lpv_cells * lpv_cascades), row = vec2(u.x, float(c * lpv_cells) + u.y);
+  vec2 uv0 = (row + vec2(z0 * float(lpv_cells), 0.0) + 0.5) / size, uv1 = (row + vec2(z1 * float(lpv_cells), 0.0) + 0.5) / size;
+  vec3 e = vec3(0.0);
+#ifdef EARLY
+  if (early) e += irradiance(volume(early_r, uv0, uv1, f), volume(early_g, uv0, uv1, f), volume(early_b, uv0, uv1, f), n);
+#endif
+#ifdef LATE
+  e += irradiance(volume(late_r, uv0, uv1, f), volume(late_g, uv0, uv1, f), volume(late_b, uv0, uv1, f), n);
+#endif
+  float h = lpv_cell_size(c);
+  return e / max(h * h, 1e-30);
+}
+
+// All steps of cascade c0 and the late ones of every coarser cascade.
+vec3 bands(int c0, vec3 p, vec3 n) {
+  vec3 e = vec3(0.0);
+  for (int c = c0; c < lpv_cascades; c++) e += cascade(c, p, n, c == c0);
+  return e;
+}
+
+void main() {
+  ivec2 px = ivec2(gl_FragCoord.xy);
+#ifdef BASE
+  vec4 b = texelFetch(base, px, 0);
+#else
+  vec4 b = vec4(0.0, 0.0, 0.0, 1.0);
+#endif
+  Surface s = gbuffer_fetch(clr, nrm, dpt, mat, px);
+  if (!s.covered) {
+    result = b;
+    return;
+  }
+  int c0 = lpv_cascades;
+  float margin = -1.0;
+  for (int c = 0; c < lpv_cascades && c0 == lpv_cascades; c++) {
+    margin = inside(cell_coords(c, s.p, s.n));
+    if (margin >= 0.0) c0 = c;
+  }
+  vec3 e = vec3(0.0);
+  if (c0 < lpv_cascades) {
+    float w = clamp(margin / float(max(lpv_steps, 1)), 0.0, 1.0);
+    e = bands(c0, s.p, s.n);
+    if (w < 1.0) e = mix(bands(c0 + 1, s.p, s.n), e, w);
+  }
+  result = vec4(b.rgb + finite_or_zero(e), b.a);
+}

@@ -1,0 +1,356 @@
+/* Light propagation volumes (scripts/lpv.lua, shaders/lpv_*.{vert,frag})
+ * through pp.lua: a sunlit red wall tints the white wall beside it, on the
+ * scale of the RSM gather; propagation never adds energy; a sub-cell camera
+ * move leaves the volumes where they were; a frame that reads no LPV records
+ * none of its passes; any unit gives the same image; extremes stay finite;
+ * bad options name themselves. Needs a GL context (llvmpipe will do). */
+#define _POSIX_C_SOURCE 200809L
+#include <cglm/cglm.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl_test.h"
+
+enum { W = 96, H = 72 };
+
+/* A red wall (0.8, 0.1, 0.1) at x = -1 facing +x and a white wall (0.8) at
+ * z = -1 facing +z, both 1.5 high, over [-1, 1]; a grey floor under them.
+ * The sun (or a spot light at (1, 1.2, 0.5)) shines along -x and down onto
+ * the red wall: the white wall, parallel to the light, gets none. The camera
+ * at (0, 0.75, 2) looks along -z at the white wall, the red wall to its left. */
+static lm_scene *corner_scene(lm_light_type type) {
+  lm_scene *s = lm_scene_create("corner");
+  int red = gl_material(s, "red", 0.8f, 0.1f, 0.1f), white = gl_material(s, "white", 0.8f, 0.8f, 0.8f);
+  int grey = gl_material(s, "grey", 0.3f, 0.3f, 0.3f);
+  gl_quad(s, "red", red, (const float[4][3]){{-1, 0, 1}, {-1, 0, -1}, {-1, 1.5f, -1}, {-1, 1.5f, 1}},
+          (const float[3]){1, 0, 0});
+  gl_quad(s, "white", white, (const float[4][3]){{-1, 0, -1}, {1, 0, -1}, {1, 1.5f, -1}, {-1, 1.5f, -1}},
+          (const float[3]){0, 0, 1});
+  gl_quad(s, "floor", grey, (const float[4][3]){{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}},
+          (const float[3]){0, 1, 0});
+  mat4 m;
+  if (type == LM_LIGHT_DIRECTIONAL) {
+    glm_rotate_make(m, glm_rad(90.0f), (vec3){0, 1, 0}); /* -Z of the node along -x */
+    glm_rotate(m, glm_rad(-15.0f), (vec3){1, 0, 0});    /* and down */
+  } else {
+    glm_translate_make(m, (vec3){1, 1.2f, 0.5f});
+    glm_rotate(m, glm_rad(90.0f), (vec3){0, 1, 0});
+    glm_rotate(m, glm_rad(-20.0f), (vec3){1, 0, 0});
+  }
+  int light = lm_scene_add_node(s, "light", -1, (float *)m, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "light", .type = type, .color = {1, 1, 1},
+                                     .power = type == LM_LIGHT_DIRECTIONAL ? 1.0f : 3.0f,
+                                     .inner_cone = glm_rad(50.0f), .outer_cone = glm_rad(60.0f),
+                                     .falloff = LM_FALLOFF_INVERSE_SQUARE, .casts_shadows = true, .node = light});
+  glm_translate_make(m, (vec3){0, 0.75f, 2});
+  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "front", .fov_y = glm_rad(60.0f), .znear = 0.01f, .zfar = 100,
+                                      .node = cam});
+  lm_scene_update(s);
+  return s;
+}
+
+static gl_result render_ok(lm_scene *s, const char *tech, const char *const *sets, int w, int h) {
+  gl_result r = gl_render(&(gl_run){.scene = s, .tech = tech, .sets = sets, .width = w, .height = h});
+  if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
+  if (!gl_all_finite(&r)) fail_msg("%s: a pixel is NaN, Inf or negative", tech);
+  return r;
+}
+
+/* Mean linear RGB of the white wall between x0 and x1 (world), at heights
+ * 0.45 .. 1.05, for the corner scene's camera. */
+static void white_wall(const gl_result *r, float x0, float x1, float out[3]) {
+  float half_w = 3 * tanf(glm_rad(30.0f)) * r->width / r->height, half_h = 3 * tanf(glm_rad(30.0f));
+  int c0 = (int)((x0 / half_w + 1) * 0.5f * r->width), c1 = (int)((x1 / half_w + 1) * 0.5f * r->width);
+  int r0 = (int)((1 - 0.3f / half_h) * 0.5f * r->height), r1 = (int)((1 + 0.3f / half_h) * 0.5f * r->height);
+  gl_region(r, c0, r0, c1, r1, out);
+}
+
+/* The sunlit red wall lights the white wall red, most near the corner;
+ * dl+esm leaves the white wall black. The LPV's light there is within a
+ * factor 2 of the RSM gather's (which holds to the integral within 3%,
+ * test_rsm). */
+static void a_lit_coloured_wall_tints_a_neighbouring_white_one(void **state) {
+  (void)state;
+  static const char *const sets[] = {"ambient=0", NULL};
+  lm_scene *s = corner_scene(LM_LIGHT_DIRECTIONAL);
+  gl_result lpv = render_ok(s, "lpv+esm", sets, W, H), dl = render_ok(s, "dl+esm", sets, W, H),
+            rsm = render_ok(s, "rsm+esm", sets, W, H);
+  float near[3], far[3], dark[3], ref[3];
+  white_wall(&lpv, -0.9f, -0.5f, near);
+  white_wall(&lpv, 0.5f, 0.9f, far);
+  white_wall(&dl, -0.9f, -0.5f, dark);
+  white_wall(&rsm, -0.9f, -0.5f, ref);
+  print_message("white wall near the red one: lpv %.4f %.4f %.4f, rsm %.4f %.4f %.4f, dl %.5f; far: lpv %.4f\n",
+                near[0], near[1], near[2], ref[0], ref[1], ref[2], dark[0], far[0]);
+  assert_true(dark[0] < 1e-4f);
+  assert_true(near[0] > 0.005f && near[0] > 3 * near[1] && near[0] > 3 * near[2]);
+  assert_true(near[0] > 1.5f * far[0]);
+  assert_true(near[0] > 0.5f * ref[0] && near[0] < 2 * ref[0]);
+  gl_result_free(&lpv);
+  gl_result_free(&dl);
+  gl_result_free(&rsm);
+  lm_scene_destroy(s);
+}
+
+/* The power 4 pi A summed over the cells of each colour channel's volume. */
+static void volume_power(gl_result *r, const char *prefix, int step, double out[3]) {
+  for (int ch = 0; ch < 3; ch++) {
+    char name[64];
+    snprintf(name, sizeof name, "%s%c%d", prefix, "rgb"[ch], step);
+    int w, h;
+    float *px = gl_read_target(r, name, &w, &h);
+    if (!px) fail_msg("no target %s", name);
+    double sum = 0;
+    for (int i = 0; i < w * h; i++) {
+      if (!isfinite(px[4 * i]) || px[4 * i] < 0) fail_msg("%s: texel %d holds %g", name, i, px[4 * i]);
+      sum += px[4 * i];
+    }
+    out[ch] = 4 * GLM_PI * sum;
+    free(px);
+  }
+}
+
+/* Each step's wave holds at most the power of the last one, in every
+ * channel (nothing is made; blocking and the grids' borders take some), and
+ * after 12 steps less than after 1. The waves are read as stored, scaled by
+ * what each cell may send (lpv_propagate.frag), which lies between a wave's
+ * power and the next one's, so the stored sequence falling is the waves'. */
+static void energy_does_not_grow_with_propagation_steps(void **state) {
+  (void)state;
+  lm_scene *s = corner_scene(LM_LIGHT_DIRECTIONAL);
+  double last[3] = {0}, first[3] = {0};
+  for (int steps = 1; steps <= 12; steps++) {
+    char set[32];
+    snprintf(set, sizeof set, "lpv.steps=%d", steps);
+    const char *const sets[] = {"ambient=0", set, NULL};
+    gl_result r = render_ok(s, "lpv+esm", sets, 48, 36);
+    double p[3];
+    volume_power(&r, "lpv.wave_", steps, p);
+    if (steps == 1) memcpy(first, p, sizeof p);
+    print_message("steps %2d: wave power %.5g %.5g %.5g\n", steps, p[0], p[1], p[2]);
+    for (int ch = 0; ch < 3 && steps > 1; ch++)
+      if (p[ch] > last[ch] * (1 + 1e-5)) fail_msg("step %d, channel %d: %.9g after %.9g", steps, ch, p[ch], last[ch]);
+    assert_true(p[0] > 0);
+    memcpy(last, p, sizeof p);
+    gl_result_free(&r);
+  }
+  for (int ch = 0; ch < 3; ch++) assert_true(last[ch] < first[ch]);
+  lm_scene_destroy(s);
+}
+
+/* Mean absolute difference of two cascades' volumes (N^2 x N per cascade),
+ * b's cells shifted by the whole cells that match best (a grid that moves
+ * whole cells leaves its light where it was), over cells two from the
+ * borders, relative to a's mean magnitude; per cascade, the worst. */
+static double aligned_difference(const float *a, const float *b, int n, int cascades) {
+  double worst = 0;
+  for (int c = 0; c < cascades; c++) {
+    double best = INFINITY, mag = 0;
+    for (int shift = 0; shift < 27; shift++) {
+      int dx = shift % 3 - 1, dy = shift / 3 % 3 - 1, dz = shift / 9 - 1;
+      double diff = 0;
+      mag = 0;
+      for (int z = 2; z < n - 2; z++)
+        for (int y = 2; y < n - 2; y++)
+          for (int x = 2; x < n - 2; x++)
+            for (int k = 0; k < 4; k++) {
+              /* rows top first: texel (z n + x, c n + y) is row (cascades n - 1 - (c n + y)) */
+              size_t ia = ((size_t)(cascades * n - 1 - (c * n + y)) * n * n + z * n + x) * 4 + k;
+              size_t ib = ((size_t)(cascades * n - 1 - (c * n + y + dy)) * n * n + (z + dz) * n + x + dx) * 4 + k;
+              diff += fabs(a[ia] - b[ib]);
+              mag += fabs(a[ia]);
+            }
+      if (diff < best) best = diff;
+    }
+    if (mag > 0 && best / mag > worst) worst = best / mag;
+  }
+  return worst;
+}
+
+/* A camera move of a tenth of the finest cell, under a spot light and under
+ * the sun (whose RSM tile follows what the camera sees, in whole texels):
+ * without the geometry volume's surfels (which sample the G-buffer, so move
+ * with the camera) every cascade's light stays exactly where it was (no grid
+ * moved, and the VPLs sit on the same world points); with them, within 2%;
+ * the image's indirect light on the white wall within 2% (its pixels see
+ * the wall shifted). */
+static void cascades_do_not_shimmer_under_sub_cell_motion(void **state) {
+  (void)state;
+  const lm_light_type types[] = {LM_LIGHT_SPOT, LM_LIGHT_DIRECTIONAL};
+  for (int k = 0; k < 4; k++) {
+    bool surfels = k & 1;
+    const char *const sets[] = {"ambient=0", surfels ? NULL : "lpv.surfels=0", NULL};
+    lm_scene *s = corner_scene(types[k / 2]);
+    gl_result r = render_ok(s, "lpv+esm", sets, W, H);
+    int w, h;
+    float *before = gl_read_target(&r, "lpv.sum_r8", &w, &h), lit0[3];
+    assert_non_null(before);
+    white_wall(&r, -0.9f, 0.9f, lit0);
+    /* cascade 0's cell: extent 3 times the diagonal of [-1, 1] x [0, 1.5] x [-1, 1], over 32 x 4 cells */
+    float cell = 3 * sqrtf(4 + 2.25f + 4) / 128;
+    int cam = s->cameras[0].node;
+    mat4 m;
+    glm_translate_make(m, (vec3){0.1f * cell, 0.75f, 2});
+    memcpy(s->nodes[cam].local, m, sizeof m);
+    lm_scene_update(s);
+    assert_true(gl_render_again(&r));
+    float *after = gl_read_target(&r, "lpv.sum_r8", &w, &h), lit1[3];
+    assert_non_null(after);
+    white_wall(&r, -0.9f, 0.9f, lit1);
+    double volume = aligned_difference(before, after, 32, 3);
+    print_message("%s%s, sub-cell move: volume change %.2e, white wall %.5f -> %.5f\n", k / 2 ? "sun" : "spot",
+                  surfels ? "" : " (no surfels)", volume, lit0[0], lit1[0]);
+    assert_true(volume < (surfels ? 0.02 : 1e-5));
+    assert_true(fabsf(lit1[0] - lit0[0]) < 0.02f * lit0[0]);
+    free(before);
+    free(after);
+    gl_result_free(&r);
+    lm_scene_destroy(s);
+  }
+}
+
+/* The LPV's passes and volumes exist only in a frame whose technique reads
+ * them, and then none is left out; without a light that casts shadows (no
+ * RSM) lpv+esm is direct light alone. */
+static void a_frame_that_reads_no_lpv_records_none_of_its_passes(void **state) {
+  (void)state;
+  const char *const techs[] = {"dl+esm", "isr+esm", "rsm+esm", "vpl+esm", "isr+rsm+esm", "lpv+esm", "isr+lpv+esm"};
+  lm_scene *s = corner_scene(LM_LIGHT_DIRECTIONAL);
+  for (int t = 0; t < 7; t++) {
+    gl_result r = render_ok(s, techs[t], NULL, 48, 36);
+    bool reads = t >= 5;
+    lm_graph *g = lm_renderer_graph(r.renderer);
+    assert_int_equal(gl_has_pass(&r, "lpv."), reads);
+    assert_int_equal(lm_graph_find_target(g, "lpv.inject_r") >= 0, reads);
+    assert_int_equal(lm_graph_find_target(g, "lpv.geometry") >= 0, reads);
+    assert_int_equal(gl_culled(&r, "lpv."), 0);
+    gl_result_free(&r);
+  }
+  s->lights[0].casts_shadows = false;
+  gl_result r = render_ok(s, "lpv+esm", NULL, 48, 36);
+  assert_false(gl_has_pass(&r, "lpv."));
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+}
+
+/* The corner in other units (cameras and lights scaled with it): in units
+ * that floats scale exactly (1/1024, 65536) the white wall's light is the
+ * same within 0.5% (nothing in the LPV has a unit); in units 1e-3 and 1e5
+ * within 10%: the shadow manager snaps the RSM's tiles on grids relative to
+ * the scene's magnitude, so there the VPLs (one texel each) fall on other
+ * texels, and the cells they land in change (measured: 6% at 1e-3, under
+ * 0.1% at 1e5; rsm+esm, which takes many texels a pixel, 1%). */
+static void any_unit_gives_the_same_light(void **state) {
+  (void)state;
+  static const char *const sets[] = {"ambient=0", NULL};
+  float base[3];
+  lm_scene *s = corner_scene(LM_LIGHT_DIRECTIONAL);
+  gl_result r = render_ok(s, "lpv+esm", sets, W, H);
+  white_wall(&r, -0.9f, 0.9f, base);
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+  const float units[] = {1.0f / 1024, 65536, 1e-3f, 1e5f}, bound[] = {0.005f, 0.005f, 0.1f, 0.1f};
+  for (int i = 0; i < 4; i++) {
+    s = corner_scene(LM_LIGHT_DIRECTIONAL);
+    gl_rescale(s, units[i]);
+    lm_scene_update(s);
+    r = render_ok(s, "lpv+esm", sets, W, H);
+    float v[3];
+    white_wall(&r, -0.9f, 0.9f, v);
+    print_message("unit %g: white wall %.5f (unit 1: %.5f)\n", units[i], v[0], base[0]);
+    assert_true(fabsf(v[0] - base[0]) < bound[i] * base[0]);
+    gl_result_free(&r);
+    lm_scene_destroy(s);
+  }
+}
+
+/* Every option at both ends, a point light inside a closed box seen from
+ * outside, and the combined technique: finite images and volumes. */
+static void extremes_stay_finite(void **state) {
+  (void)state;
+  static const char *const cases[][5] = {
+      {"lpv.steps=0", NULL},
+      {"lpv.steps=256", "lpv.cells=4", NULL},
+      {"lpv.cells=64", "lpv.steps=1", "lpv.cascades=1", NULL},
+      {"lpv.cascades=4", "lpv.cells=8", NULL},
+      {"lpv.vpls=1", NULL},
+      {"lpv.vpls=1024", "lpv.cascades=1", "lpv.steps=1", NULL},
+      {"lpv.surfels=0", NULL},
+      {"lpv.surfels=1024", "lpv.cascades=1", "lpv.steps=1", NULL},
+      {"lpv.extent=1e-3", NULL},
+      {"lpv.extent=64", NULL},
+      {"lpv.cell=1e-30", NULL},
+      {"lpv.cell=1e30", NULL},
+      {"lpv.occlusion=0", "lpv.shift=0", NULL},
+      {"lpv.coarse=4", "lpv.blur=32", "lpv.k=16", NULL},
+      {"lpv.coarse=1", "lpv.blur=0", "lpv.reach=64", NULL},
+  };
+  lm_scene *s = corner_scene(LM_LIGHT_DIRECTIONAL);
+  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+    gl_result r = render_ok(s, "lpv+esm", cases[i], 48, 36);
+    if (gl_has_pass(&r, "lpv.lookup") && !gl_target_finite(&r, "lpv.e")) fail_msg("case %zu: lpv.e", i);
+    gl_result_free(&r);
+  }
+  gl_result r = render_ok(s, "isr+lpv+esm", NULL, 48, 36);
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+  /* A point light inside a closed box, the camera outside it. */
+  s = lm_scene_create("box");
+  int grey = gl_material(s, "grey", 0.5f, 0.5f, 0.5f);
+  static const float walls[6][4][3] = {
+      {{-1, -1, 1}, {1, -1, 1}, {1, -1, -1}, {-1, -1, -1}}, {{-1, 1, -1}, {1, 1, -1}, {1, 1, 1}, {-1, 1, 1}},
+      {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}}, {{1, -1, 1}, {-1, -1, 1}, {-1, 1, 1}, {1, 1, 1}},
+      {{-1, -1, 1}, {-1, -1, -1}, {-1, 1, -1}, {-1, 1, 1}}, {{1, -1, -1}, {1, -1, 1}, {1, 1, 1}, {1, 1, -1}},
+  };
+  static const float normals[6][3] = {{0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0, 0}};
+  for (int i = 0; i < 6; i++) gl_quad(s, "wall", grey, walls[i], normals[i]);
+  mat4 m = GLM_MAT4_IDENTITY_INIT;
+  int node = lm_scene_add_node(s, "lamp", -1, (float *)m, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "lamp", .type = LM_LIGHT_POINT, .color = {1, 1, 1}, .power = 1,
+                                     .falloff = LM_FALLOFF_INVERSE_SQUARE, .casts_shadows = true, .node = node});
+  glm_translate_make(m, (vec3){0, 0, 4});
+  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "outside", .fov_y = glm_rad(45.0f), .znear = 0.01f, .zfar = 100,
+                                      .node = cam});
+  lm_scene_update(s);
+  r = render_ok(s, "lpv+esm", NULL, 48, 36);
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+}
+
+static void bad_options_name_themselves(void **state) {
+  (void)state;
+  static const gl_bad_option cases[] = {
+      {"lpv+esm", "lpv.cells=3", "lpv.cells"},         {"lpv+esm", "lpv.cells=65", "lpv.cells"},
+      {"lpv+esm", "lpv.cells=8.5", "lpv.cells"},       {"lpv+esm", "lpv.steps=-1", "lpv.steps"},
+      {"lpv+esm", "lpv.steps=257", "lpv.steps"},       {"lpv+esm", "lpv.cascades=0", "lpv.cascades"},
+      {"lpv+esm", "lpv.cascades=5", "lpv.cascades"},   {"lpv+esm", "lpv.extent=0", "lpv.extent"},
+      {"lpv+esm", "lpv.cell=-1", "lpv.cell"},          {"lpv+esm", "lpv.shift=2", "lpv.shift"},
+      {"lpv+esm", "lpv.vpls=0", "lpv.vpls"},           {"lpv+esm", "lpv.surfels=-1", "lpv.surfels"},
+      {"lpv+esm", "lpv.occlusion=2", "lpv.occlusion"}, {"lpv+esm", "lpv.reach=0.5", "lpv.reach"},
+      {"lpv+esm", "lpv.coarse=3", "lpv.coarse"},       {"isr+lpv+esm", "lpv.blur=33", "lpv.blur"},
+      {"isr+lpv+esm", "lpv.k=17", "lpv.k"},
+  };
+  gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(a_lit_coloured_wall_tints_a_neighbouring_white_one),
+      cmocka_unit_test(energy_does_not_grow_with_propagation_steps),
+      cmocka_unit_test(cascades_do_not_shimmer_under_sub_cell_motion),
+      cmocka_unit_test(a_frame_that_reads_no_lpv_records_none_of_its_passes),
+      cmocka_unit_test(any_unit_gives_the_same_light),
+      cmocka_unit_test(extremes_stay_finite),
+      cmocka_unit_test(bad_options_name_themselves),
+  };
+  return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
+}
