@@ -395,6 +395,39 @@ static void points_passes_scatter_and_add(void **state) {
   }
 }
 
+/* Two passes of one shader (one cached program): the first sets `gain`, the
+ * second does not and gets the shader's initializer, not the first's value;
+ * an int keeps its initializer alike. */
+static void a_uniform_a_pass_leaves_unset_keeps_its_initializer(void **state) {
+  (void)state;
+  assert_true(gl_write_file("gain.lua",
+                            "Techniques = { 'x' }\nfunction OnRender(tech)\n"
+                            "  local a = target{ 'a', format = 'rgba32f', size = { 2, 2 } }\n"
+                            "  local b = target{ 'b', format = 'rgba32f', size = { 2, 2 } }\n"
+                            "  local z = target{ 'z', format = 'rgba32f', size = { 2, 2 } }\n"
+                            "  pass{ 'zero', shader = 'zero.frag', out = z }\n"
+                            "  pass{ 'set', shader = 'gain.frag', inputs = { x = z }, params = { gain = 1.0, step = 7 },"
+                            " out = a }\n"
+                            "  pass{ 'unset', shader = 'gain.frag', inputs = { x = a }, out = b }\n"
+                            "  present(b)\nend\n"));
+  /* Each pass reads the one before, so all run, in order. */
+  assert_true(gl_write_file("shaders/zero.frag", "out vec4 o;\nvoid main() { o = vec4(0.0); }\n"));
+  assert_true(gl_write_file("shaders/gain.frag", "uniform sampler2D x;\nuniform float gain = 0.25;\n"
+                                                 "uniform int step = 3;\nout vec4 o;\n"
+                                                 "void main() { o = vec4(gain, float(step), texelFetch(x, ivec2(0), 0).x, 1.0); }\n"));
+  gl_result r = gl_render(&(gl_run){.script = "gain.lua", .width = 2, .height = 2, .frames = 2});
+  if (!r.ok) fail_msg("%s", r.err.msg);
+  int w, h;
+  float *px = gl_read_target(&r, "b", &w, &h);
+  assert_non_null(px);
+  printf("unset pass after a set one: gain %g, step %g (set pass wrote gain %g)\n", px[0], px[1], px[2]);
+  assert_float_equal(px[0], 0.25, 1e-6);
+  assert_float_equal(px[1], 3, 0);
+  assert_float_equal(px[2], 1.0, 1e-6);
+  free(px);
+  gl_result_free(&r);
+}
+
 int main(void) {
   snprintf(pp_lua, sizeof pp_lua, "%s/scripts/pp.lua", lm_root_dir());
   const struct CMUnitTest tests[] = {
@@ -407,6 +440,7 @@ int main(void) {
       cmocka_unit_test(textures_are_pooled_across_frames),
       cmocka_unit_test(cpu_passes_read_back_and_upload),
       cmocka_unit_test(points_passes_scatter_and_add),
+      cmocka_unit_test(a_uniform_a_pass_leaves_unset_keeps_its_initializer),
   };
   return cmocka_run_group_tests(tests, setup, gl_test_teardown);
 }

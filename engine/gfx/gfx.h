@@ -123,6 +123,10 @@ typedef struct lm_uniform {
   lm_uniform_type type;
   int location; /* -1: declared in the source but not active */
   int unit;     /* texture unit, for samplers */
+  union {       /* its value after linking (the GLSL initializer, else 0) */
+    float f[16];
+    int i[4];
+  } initial;
 } lm_uniform;
 
 typedef struct lm_program {
@@ -141,6 +145,9 @@ void lm_program_use(const lm_program *p);
 void lm_program_set(const lm_program *p, const lm_uniform *u, const float *values);
 void lm_program_set_int(const lm_program *p, const lm_uniform *u, const int *values);
 void lm_program_bind_texture(const lm_uniform *u, lm_texture tex);
+/* Every value uniform back to its initial value: a cached program serves many
+ * passes, and one pass's parameters must not leak into the next. */
+void lm_program_reset(const lm_program *p);
 /* Forget every compiled program (shader files changed). */
 void lm_programs_clear(void);
 /* Shader files changed, keeping what runs: each cached program is rebuilt on

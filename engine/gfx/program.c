@@ -74,6 +74,10 @@ static int read_word(const char *p, char *out, int cap) {
   return n;
 }
 
+static bool is_int_type(lm_uniform_type t) {
+  return t == LM_UNIFORM_INT || t == LM_UNIFORM_BOOL || (t >= LM_UNIFORM_IVEC2 && t <= LM_UNIFORM_IVEC4);
+}
+
 static void add_uniform(lm_program *prog, const char *name, lm_uniform_type type) {
   for (int i = 0; i < prog->uniform_count; i++)
     if (!strcmp(prog->uniforms[i].name, name)) return;
@@ -82,6 +86,7 @@ static void add_uniform(lm_program *prog, const char *name, lm_uniform_type type
   u->type = type;
   u->location = -1;
   u->unit = -1;
+  memset(&u->initial, 0, sizeof u->initial);
 }
 
 /* Every `uniform TYPE NAME` declared in the text (blocks are skipped). The
@@ -193,9 +198,14 @@ static lm_program *build(const char *vert, const char *frag, const char *defines
   for (int i = 0; i < prog->uniform_count; i++) {
     lm_uniform *u = &prog->uniforms[i];
     u->location = glGetUniformLocation(prog->id, u->name);
-    if (u->location >= 0 && (u->type == LM_UNIFORM_SAMPLER || u->type == LM_UNIFORM_SAMPLER_SHADOW)) {
+    if (u->location < 0) continue;
+    if (u->type == LM_UNIFORM_SAMPLER || u->type == LM_UNIFORM_SAMPLER_SHADOW) {
       u->unit = unit++;
       glProgramUniform1i(prog->id, u->location, u->unit);
+    } else if (is_int_type(u->type)) {
+      glGetUniformiv(prog->id, u->location, u->initial.i);
+    } else if (u->type != LM_UNIFORM_OTHER) {
+      glGetUniformfv(prog->id, u->location, u->initial.f);
     }
   }
   GLint outputs = 0;
@@ -278,6 +288,14 @@ void lm_program_set_int(const lm_program *p, const lm_uniform *u, const int *v) 
   case LM_UNIFORM_IVEC3: glProgramUniform3iv(p->id, u->location, 1, v); break;
   case LM_UNIFORM_IVEC4: glProgramUniform4iv(p->id, u->location, 1, v); break;
   default: break;
+  }
+}
+
+void lm_program_reset(const lm_program *p) {
+  for (int i = 0; i < p->uniform_count; i++) {
+    const lm_uniform *u = &p->uniforms[i];
+    if (is_int_type(u->type)) lm_program_set_int(p, u, u->initial.i);
+    else lm_program_set(p, u, u->initial.f); /* samplers and others: nothing */
   }
 }
 

@@ -223,6 +223,7 @@ static bool check_outputs_finite(const lm_graph *g, const lm_pass_desc *d, lm_er
 /* Binds p with the pass's inputs and parameters. */
 static void bind_pass(const lm_graph *g, const lm_pass_desc *d, const lm_program *p) {
   lm_program_use(p);
+  lm_program_reset(p);
   for (int i = 0; i < d->input_count; i++)
     lm_program_bind_texture(lm_program_uniform(p, d->inputs[i].name), g->targets[d->inputs[i].target].texture);
   apply_params(d, p);
