@@ -175,6 +175,53 @@ static void a_frame_that_reads_no_rsm_renders_none(void **state) {
   lm_scene_destroy(s);
 }
 
+/* The shadow pass's RSM targets are kept across frames as its depth is
+ * (shadow.cache): a still frame keeps every tile, the RSM's wide tile too,
+ * in place, and gives the image of a renderer that draws them all; after
+ * the canopy moves every tile is drawn again (each cleared alone) and the
+ * frame is the one a fresh renderer gives. rsm+esm reads them all; vpl+esm
+ * through its lights. */
+static void rsm_tiles_are_kept_and_give_the_drawn_image(void **state) {
+  (void)state;
+  const char *const techs[] = {"rsm+esm", "vpl+esm"};
+  for (int t = 0; t < 2; t++) {
+    lm_scene *s = canopy_scene();
+    static const char *const on[] = {"ambient=0", "rsm.reach=16", "vpl.reach=16", NULL},
+                             *const off[] = {"ambient=0", "rsm.reach=16", "vpl.reach=16", "shadow.cache=false", NULL};
+    gl_result c = gl_render(&(gl_run){.scene = s, .tech = techs[t], .sets = on, .width = W, .height = H, .frames = 2});
+    gl_result u = gl_render(&(gl_run){.scene = s, .tech = techs[t], .sets = off, .width = W, .height = H, .frames = 2});
+    assert_true(c.ok && u.ok);
+    int views = lm_renderer_shadows(c.renderer)->view_count;
+    lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(c.renderer);
+    size_t bytes = sizeof(float) * 3 * W * H;
+    printf("%s: %d of %d tiles kept, %d in place; %s the image every tile drawn gives\n", techs[t], kept.kept, views,
+           kept.in_place, memcmp(c.rgb, u.rgb, bytes) ? "not" : "exactly");
+    assert_true(views == 4 && kept.kept == views && kept.in_place == views && kept.drawn == 0);
+    assert_memory_equal(c.rgb, u.rgb, bytes);
+    int canopy = -1;
+    for (int i = 0; i < s->node_count; i++)
+      if (!strcmp(s->nodes[i].name, "canopy")) canopy = i;
+    assert_true(canopy >= 0);
+    mat4 w;
+    memcpy(w, s->nodes[canopy].world, sizeof w);
+    w[3][0] += 0.25f;
+    lm_scene_node_set_world(s, canopy, (float *)w);
+    lm_scene_update(s);
+    assert_true(gl_render_again(&c));
+    gl_result fresh = gl_render(&(gl_run){.scene = s, .tech = techs[t], .sets = off, .width = W, .height = H});
+    assert_true(fresh.ok);
+    kept = lm_renderer_shadow_draw_stats(c.renderer);
+    printf("%s after the canopy moved: %d tiles kept; %s the image of a fresh renderer\n", techs[t], kept.kept,
+           memcmp(c.rgb, fresh.rgb, bytes) ? "not" : "exactly");
+    assert_true(kept.kept == 0 && kept.drawn > 0);
+    assert_memory_equal(c.rgb, fresh.rgb, bytes);
+    gl_result_free(&c);
+    gl_result_free(&u);
+    gl_result_free(&fresh);
+    lm_scene_destroy(s);
+  }
+}
+
 /* A light inside geometry (a point light in a closed box the camera looks
  * at from outside), a spot whose cone is nearly closed (a tile seeing next
  * to nothing), one sample, 4096 samples and the visibility march: finite. */
@@ -322,6 +369,7 @@ int main(void) {
       cmocka_unit_test(sunlit_floor_bleeds_onto_a_ceiling_the_sun_cannot_reach),
       cmocka_unit_test(a_closed_room_with_one_lit_patch_lights_its_ceiling),
       cmocka_unit_test(a_frame_that_reads_no_rsm_renders_none),
+      cmocka_unit_test(rsm_tiles_are_kept_and_give_the_drawn_image),
       cmocka_unit_test(still_frames_with_temporal_reuse_converge),
       cmocka_unit_test(a_camera_move_leaves_no_ghost_edge),
       cmocka_unit_test(extremes_stay_finite),

@@ -594,10 +594,13 @@ static void cascades_draw_the_casters_of_their_slice(void **state) {
 }
 
 /* A shadow tile whose view and casters are those of the last frame's tile in
- * its place keeps its texels (copied, not drawn): the box's second frame
- * draws no tile and looks as every tile drawn does; moving a caster redraws
- * them all, and the frame is the one an uncached renderer gives; with
- * shadow.cache=false every frame draws. */
+ * its place keeps its texels: the box's second frame draws no tile, and as
+ * the pass's outputs are the textures it left last frame, which nothing
+ * else writes, every tile is still in place (neither cleared nor copied);
+ * the image is the one every tile drawn gives. Moving a caster redraws them
+ * all, each cleared alone in the outputs in place, and the frame is the one
+ * an uncached renderer gives; the next frame keeps them all in place again.
+ * With shadow.cache=false every frame draws. */
 static void unchanged_tiles_are_kept_and_changed_ones_drawn(void **state) {
   (void)state;
   lm_scene *s = builtin("cornell");
@@ -608,9 +611,10 @@ static void unchanged_tiles_are_kept_and_changed_ones_drawn(void **state) {
   int views = lm_renderer_shadows(c.renderer)->view_count;
   lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(c.renderer);
   lm_scene_draw_stats drawn = lm_renderer_shadow_draw_stats(u.renderer);
-  printf("second frame: %d of %d tiles kept, %d nodes drawn; without the cache %d kept, %d drawn\n", kept.kept, views,
-         kept.drawn, drawn.kept, drawn.drawn);
-  assert_true(views > 0 && kept.kept == views && kept.drawn == 0 && drawn.kept == 0 && drawn.drawn > 0);
+  printf("second frame: %d of %d tiles kept (%d in place), %d nodes drawn; without the cache %d kept, %d drawn\n",
+         kept.kept, views, kept.in_place, kept.drawn, drawn.kept, drawn.drawn);
+  assert_true(views > 0 && kept.kept == views && kept.in_place == views && kept.drawn == 0 && drawn.kept == 0 &&
+              drawn.drawn > 0);
   assert_true(share_different(&c, &u) == 0.0f);
   int box = -1;
   for (int i = 0; i < s->node_count; i++)
@@ -627,9 +631,39 @@ static void unchanged_tiles_are_kept_and_changed_ones_drawn(void **state) {
   printf("after moving the tall box: %d tiles kept, %d nodes drawn; %.3f%% of pixels differ from a fresh frame\n",
          kept.kept, kept.drawn, 100.0 * share_different(&c, &fresh));
   assert_true(kept.kept == 0 && kept.drawn > 0 && share_different(&c, &fresh) == 0.0f);
+  assert_true(gl_render_again(&c));
+  kept = lm_renderer_shadow_draw_stats(c.renderer);
+  printf("the frame after: %d tiles kept, %d in place; %.3f%% of pixels differ from a fresh frame\n", kept.kept,
+         kept.in_place, 100.0 * share_different(&c, &fresh));
+  assert_true(kept.kept == views && kept.in_place == views && share_different(&c, &fresh) == 0.0f);
   gl_result_free(&c);
   gl_result_free(&u);
   gl_result_free(&fresh);
+  lm_scene_destroy(s);
+}
+
+/* Kept tiles are copied back from the renderer's cache where the pass's
+ * outputs cannot hold them from one frame to the next: the shadow map of
+ * ESM's log-space blur, whose texture a later blur pass takes over once it
+ * is read (lm_graph_target_info.alone is false), or a frame whose texture
+ * for it is another. Either way the frame is the one every tile drawn gives. */
+static void tiles_whose_texture_another_target_shares_are_copied_back(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  static const char *const blur[] = {"shadow.blur=2", NULL}, *const off[] = {"shadow.blur=2", "shadow.cache=false", NULL};
+  gl_result c = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .frames = 2, .sets = blur});
+  gl_result u = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .frames = 2, .sets = off});
+  assert_true(c.ok && u.ok);
+  lm_graph *g = lm_renderer_graph(c.renderer);
+  bool alone = lm_graph_target(g, lm_graph_find_target(g, "shadow.map")).alone;
+  int views = lm_renderer_shadows(c.renderer)->view_count;
+  lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(c.renderer);
+  printf("ESM blur: shadow.map %s; %d of %d tiles kept, %d in place; %.3f%% of pixels differ from every tile drawn\n",
+         alone ? "alone" : "shared", kept.kept, views, kept.in_place, 100.0 * share_different(&c, &u));
+  assert_false(alone); /* shadow.esm_y takes its texture over */
+  assert_true(kept.kept == views && kept.in_place == 0 && share_different(&c, &u) == 0.0f);
+  gl_result_free(&c);
+  gl_result_free(&u);
   lm_scene_destroy(s);
 }
 
@@ -650,6 +684,7 @@ int main(void) {
       cmocka_unit_test(a_filter_variant_compiles_its_filter_alone),
       cmocka_unit_test(cascades_draw_the_casters_of_their_slice),
       cmocka_unit_test(unchanged_tiles_are_kept_and_changed_ones_drawn),
+      cmocka_unit_test(tiles_whose_texture_another_target_shares_are_copied_back),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

@@ -201,6 +201,14 @@ void lm_clear(int color_count, const float rgba[4], bool clear_depth, float dept
   }
 }
 
+void lm_clear_rect(int x, int y, int width, int height, int color_count, const float rgba[4], bool clear_depth,
+                   float depth) {
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(x, y, width, height);
+  lm_clear(color_count, rgba, clear_depth, depth);
+  glDisable(GL_SCISSOR_TEST);
+}
+
 static GLuint empty_vao;
 void lm_draw_fullscreen(void) {
   if (!empty_vao) glCreateVertexArrays(1, &empty_vao);

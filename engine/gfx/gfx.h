@@ -73,6 +73,9 @@ typedef struct lm_attachments {
 /* Binds (a cached) framebuffer for these attachments and sets the viewport. */
 bool lm_attachments_bind(const lm_attachments *att, lm_error *err);
 void lm_clear(int color_count, const float rgba[4], bool clear_depth, float depth);
+/* lm_clear within the rectangle x, y, width, height alone. */
+void lm_clear_rect(int x, int y, int width, int height, int color_count, const float rgba[4], bool clear_depth,
+                   float depth);
 void lm_draw_fullscreen(void);
 /* Draws `count` points from no vertex data (the vertex shader numbers them by
  * gl_VertexID), each one pixel, added to what the outputs hold (additive

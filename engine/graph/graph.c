@@ -295,12 +295,29 @@ static void plan_slots(lm_graph *g) {
   }
 }
 
+/* lm_graph_target_info.alone: one pass that runs writes the target, and it
+ * is persistent or no other target holds its slot. */
+static void mark_alone(lm_graph *g) {
+  for (int t = 0; t < g->target_count; t++) {
+    graph_target *gt = &g->targets[t];
+    if (!gt->used) continue;
+    int writers = 0;
+    for (int pi = 0; pi < g->pass_count; pi++)
+      if (!g->passes[pi].culled) writers += pass_writes(&g->passes[pi].desc, t);
+    bool shared = false;
+    for (int k = g->persistent_count; k < g->target_count && !shared && gt->slot >= 0; k++)
+      shared = k != t && g->targets[k].used && g->targets[k].slot == gt->slot;
+    gt->alone = writers == 1 && !shared;
+  }
+}
+
 bool lm_graph_compile(lm_graph *g, lm_error *err) {
   for (int t = 0; t < g->target_count; t++) {
     graph_target *gt = &g->targets[t];
     lm_target_size(&gt->desc, g->width, g->height, &gt->width, &gt->height);
     gt->used = false;
     gt->slot = -1;
+    gt->alone = false;
     gt->first = gt->last = -1;
   }
   for (int pi = 0; pi < g->pass_count; pi++)
@@ -339,6 +356,7 @@ bool lm_graph_compile(lm_graph *g, lm_error *err) {
     if (!g->targets[t].used)
       lm_log(LM_LOG_DEBUG, "left out: target '%s' (no pass that runs uses it)", g->targets[t].desc.name);
   plan_slots(g);
+  mark_alone(g);
   g->compiled = true;
   return true;
 }
@@ -358,7 +376,7 @@ int lm_graph_target_count(const lm_graph *g) { return g->target_count; }
 lm_graph_target_info lm_graph_target(const lm_graph *g, int i) {
   const graph_target *t = &g->targets[i];
   return (lm_graph_target_info){t->desc.name, t->desc.format, t->width, t->height,
-                                t->desc.persistent, t->used, t->slot, t->texture};
+                                t->desc.persistent, t->used, t->slot, t->alone, t->texture};
 }
 
 int lm_graph_slot_count(const lm_graph *g) { return g->slot_count; }

@@ -136,6 +136,8 @@ typedef struct lm_graph_target_info {
   int width, height;
   bool persistent, used;
   int slot;         /* shared texture slot (transient, used targets), else -1 */
+  bool alone;       /* one pass that runs writes it and no other target shares its texture: what
+                     * that pass leaves stays until it runs again (if it gets the same texture) */
   lm_texture texture; /* after execution */
 } lm_graph_target_info;
 int lm_graph_target_count(const lm_graph *g);
@@ -182,6 +184,11 @@ typedef struct lm_graph_exec_desc {
    * views' matrices. NULL: the views stay as recorded. */
   bool (*fit_views)(void *user, const lm_pass_desc *d, lm_texture fit, int w, int h, lm_pass_view *views,
                     lm_error *err);
+  /* Before a scene pass with views that clears (after fit_views): true when
+   * the callback keeps what the outputs hold, so that the pass clears
+   * nothing and draw_scene clears each tile it draws itself. NULL or false:
+   * the outputs are cleared whole first. */
+  bool (*keeps_views)(void *user, const lm_scene_pass *sp);
   /* Runs a CPU pass (desc->shader names the function); false with a message
    * stops the frame. NULL: a CPU pass is an error naming it. Its time, with
    * the read-back and upload, is the pass's time (wall clock). */

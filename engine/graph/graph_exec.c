@@ -319,8 +319,10 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
   bool ok = true;
   if (d->kind == LM_PASS_SCENE) {
     lm_set_scene_state(true, d->view_count > 0); /* tiles are shadow maps */
-    if (d->clear) lm_clear(d->output_count, d->clear_color, d->depth >= 0, lm_scene_clear_depth(d->view_count > 0));
     scene_pass_ctx c = {{d, p, g, NULL}, x};
+    bool kept = d->view_count > 0 && x->keeps_views && x->keeps_views(x->user, &c.pub);
+    if (d->clear && !kept)
+      lm_clear(d->output_count, d->clear_color, d->depth >= 0, lm_scene_clear_depth(d->view_count > 0));
     if (d->view_count == 0 && x->draw_scene) ok = x->draw_scene(x->user, &c.pub, err);
     for (int v = 0; v < d->view_count && ok; v++) {
       c.pub.view = &d->views[v];

@@ -10,6 +10,7 @@ typedef struct graph_target {
   bool used;           /* read or written by a pass that runs */
   int first, last;     /* live pass indices that touch it */
   int slot;
+  bool alone;          /* lm_graph_target_info.alone */
   lm_texture texture;  /* persistent: owned; transient: borrowed from the pool */
   int alloc_w, alloc_h; /* persistent: the size its texture was made at */
 } graph_target;

@@ -11,13 +11,21 @@ enum { MAX_LIGHTS = 256 };
 /* Shadow tiles kept from frame to frame: a copy of every output of the
  * shadow pass (and its depth), and per tile drawn the key of what drew it.
  * A view whose key matches the tile in its place copies the texels back
- * instead of drawing (lm_shadow_settings.cache). */
+ * instead of drawing (lm_shadow_settings.cache). When the pass's outputs
+ * are the very textures it left last frame, which nothing else wrote since
+ * (lm_graph_target_info.alone), and the tiles lie where they lay, the texels
+ * are still there: the pass clears nothing, a kept tile costs nothing, and a
+ * drawn one is cleared alone (keeps_views). */
 typedef struct tile_cache {
   lm_texture tex[LM_MAX_COLOR_OUTPUTS + 1];
   lm_format format[LM_MAX_COLOR_OUTPUTS + 1];
   int count, width, height;
   struct cached_tile { int x, y, width, height; bool drawn; uint64_t key; } *tiles;
   int tile_count, tile_cap;
+  uint32_t left[LM_MAX_COLOR_OUTPUTS + 1]; /* the textures the pass left, 0 where another may write */
+  long execution;  /* lm_renderer.executions when it left them */
+  uint64_t layout; /* the views' places then (view_layout) */
+  bool in_place;   /* this frame's pass: they hold the tiles still */
 } tile_cache;
 
 struct lm_renderer {
@@ -38,6 +46,7 @@ struct lm_renderer {
   uint64_t trace_hash; /* geometry_hash when it was built or refitted */
   tile_cache tiles;
   uint64_t casters_hash; /* this frame's caster_hash */
+  long executions; /* frames executed, never reset (tile_cache.execution) */
 };
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
@@ -47,6 +56,7 @@ lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
   r->graph = lm_graph_create();
   r->sharing = true;
   r->output_srgb = r->output_linear = -1;
+  r->tiles.execution = -1;
   lm_renderer_resize(r, desc->width, desc->height);
   r->clock = lm_clock_choose(desc->clock);
   return r;
@@ -55,7 +65,7 @@ lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
 static void tile_cache_free(tile_cache *c) {
   for (int i = 0; i < c->count; i++) lm_texture_destroy(&c->tex[i]);
   free(c->tiles);
-  *c = (tile_cache){0};
+  *c = (tile_cache){.execution = -1};
 }
 
 void lm_renderer_destroy(lm_renderer *r) {
@@ -194,6 +204,31 @@ static struct cached_tile *tile_at(tile_cache *c, const lm_pass_view *v) {
   return t;
 }
 
+/* Where a pass's views lie in its outputs, and the outputs' size. */
+static uint64_t view_layout(const lm_scene_pass *sp, const lm_graph_target_info *t) {
+  uint64_t h = lm_hash(&t[0].width, sizeof t[0].width, lm_hash(&t[0].height, sizeof t[0].height, 0));
+  for (int v = 0; v < sp->desc->view_count; v++) {
+    const lm_pass_view *w = &sp->desc->views[v];
+    int place[4] = {w->x, w->y, w->width, w->height};
+    h = lm_hash(place, sizeof place, h);
+  }
+  return h;
+}
+
+/* lm_graph_exec_desc.keeps_views: the shadow pass's outputs still hold last
+ * frame's tiles (its textures, which only it writes, in the last frame
+ * executed, the views in the same places). */
+static bool keeps_views(void *user, const lm_scene_pass *sp) {
+  lm_renderer *r = user;
+  tile_cache *c = &r->tiles;
+  lm_graph_target_info t[LM_MAX_COLOR_OUTPUTS + 1];
+  int nt = r->shadows.settings.cache ? pass_textures(sp, t) : 0;
+  bool same = nt > 0 && nt == c->count && c->execution == r->executions - 1 && view_layout(sp, t) == c->layout;
+  for (int i = 0; i < nt && same; i++) same = t[i].alone && t[i].texture.id == c->left[i];
+  c->in_place = same;
+  return same;
+}
+
 static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   lm_renderer *r = user;
   /* A shadow tile drawn last frame from the same view and casters: copy it back. */
@@ -201,21 +236,31 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   lm_graph_target_info t[LM_MAX_COLOR_OUTPUTS + 1];
   int nt = sp->view && r->shadows.settings.cache ? pass_textures(sp, t) : 0;
   uint64_t key = 0;
+  tile_cache *c = &r->tiles;
   if (nt > 0) {
-    if (!tile_cache_fit(&r->tiles, t, nt, err)) return false;
+    bool in_place = c->in_place;
+    if (!tile_cache_fit(c, t, nt, err)) return false;
     key = tile_key(r, sp);
-    cached = tile_at(&r->tiles, sp->view);
+    cached = tile_at(c, sp->view);
+    /* What the pass leaves for the next frame (whether or not it was in place). */
+    for (int i = 0; i < nt; i++) c->left[i] = t[i].alone ? t[i].texture.id : 0;
+    c->execution = r->executions;
+    c->layout = view_layout(sp, t);
     if (cached->drawn && cached->key == key) {
-      for (int i = 0; i < nt; i++)
-        lm_texture_copy_rect(t[i].texture, r->tiles.tex[i], cached->x, cached->y, cached->width, cached->height);
+      for (int i = 0; i < nt && !in_place; i++)
+        lm_texture_copy_rect(t[i].texture, c->tex[i], cached->x, cached->y, cached->width, cached->height);
       r->shadow_stats.kept++;
+      r->shadow_stats.in_place += in_place;
       return true;
     }
+    if (in_place) /* the pass cleared nothing: this tile alone */
+      lm_clear_rect(cached->x, cached->y, cached->width, cached->height, sp->desc->output_count,
+                    sp->desc->clear_color, sp->desc->depth >= 0, lm_scene_clear_depth(true));
   }
   if (!draw_pass(r, sp, err)) return false;
   if (cached) {
     for (int i = 0; i < nt; i++)
-      lm_texture_copy_rect(r->tiles.tex[i], t[i].texture, cached->x, cached->y, cached->width, cached->height);
+      lm_texture_copy_rect(c->tex[i], t[i].texture, cached->x, cached->y, cached->width, cached->height);
     cached->drawn = true, cached->key = key;
   }
   return true;
@@ -399,6 +444,8 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
 static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_frame_data *frame = &r->camera;
   r->stats = r->shadow_stats = (lm_scene_draw_stats){0};
+  r->executions++;
+  r->tiles.in_place = false;
   memcpy(frame->prev_view_proj, r->frame ? r->prev_view_proj : frame->view_proj, sizeof frame->prev_view_proj);
   memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
   frame->time[1] = (float)r->frame++;
@@ -411,7 +458,8 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
   if (r->shadows.view_count > 0 && r->shadows.settings.cache) r->casters_hash = caster_hash(r->desc.scene);
   r->fit_ms = 0;
-  lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene, .fit_views = fit_views, .run_cpu = run_cpu,
+  lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene, .fit_views = fit_views,
+                          .keeps_views = keeps_views, .run_cpu = run_cpu,
                           .scene_owns_uniform = lm_scene_owns_uniform, .user = r,
                           .check_finite = r->desc.check_finite};
   return lm_graph_execute(g, &x, err);

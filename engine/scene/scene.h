@@ -283,6 +283,7 @@ typedef struct lm_scene_draw_stats {
   int drawn, culled; /* mesh nodes drawn, and left out by the frustum test */
   int calls;         /* draw calls: one for the nodes of a mesh and material in view */
   int kept;          /* views (shadow tiles) kept from the last frame instead of drawn */
+  int in_place;      /* of those, the ones still in the pass's outputs: neither cleared nor copied */
   long triangles;    /* triangles drawn */
 } lm_scene_draw_stats;
 /* Draws every mesh node whose bounds reach into the frustum, the nodes of one
