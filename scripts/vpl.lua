@@ -1,15 +1,17 @@
 -- Indirect point lights with negative lights (seed 002), on POV-Ray's scale
 -- (/work/shared/design/gi-scale.md), over the reflective shadow maps the
 -- shadow pass writes (shadow.render(o, G, reach), as rsm.lua). vpl.frag:
---   1. gather at a coarse size: N indirect lights a light, fixed Halton
---      points in its RSM, each pixel lit by all of them without visibility
---      (E+), and the light arriving from behind each pixel's tangent plane
---      (the seed's S_neg) with its mean direction
---   2. subtract M negative lights taken at Halton pixels of S_neg
---   3. at full size, the coarse result where the coarse texels around a
+--   1. the indirect lights: N fixed Halton points in each light's RSM, one
+--      texel each (position, normal, radiance times area), worked out once
+--   2. gather at a coarse size: each pixel lit by all of them without
+--      visibility (E+), and the light arriving from behind each pixel's
+--      tangent plane (the seed's S_neg) with its mean direction
+--   3. the M negative lights at Halton pixels of S_neg, one texel each
+--   4. subtract them, at the coarse size
+--   5. at full size, the coarse result where the coarse texels around a
 --      pixel agree with it (the seed's discontinuity threshold), else all
 --      lights again for that pixel
---   4. ISR's composite (isr.composite: L = D + k_a L_a albedo + k k_d albedo E)
+--   6. ISR's composite (isr.composite: L = D + k_a L_a albedo + k k_d albedo E)
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local options = require "options"
@@ -48,28 +50,40 @@ function vpl.check(o) return options.check("vpl", vpl.defaults, o, rules, 3) end
 function vpl.render(G, direct, shadows, R, o, light)
   local f = o.coarse
   local C = isr.coarse_gbuffer(G, direct, f)
-  local function inputs(g)
-    local t, defines = shadow.bind(shadows, gbuffer.inputs(g), {})
-    t.rsm_flux, t.rsm_nrm, t.rsm_pos = R.flux, R.nrm, R.pos
-    return t, defines
-  end
   local params = { indirect_count = o.lights, negative = o.negative, threshold = o.threshold,
                    focus = math.min(o.focus / o.reach, 1) }
   local coarse = function(name) return target{ name, format = "rgba16f", scale = 1 / f } end
-  local t, defines = inputs(C)
-  defines.GATHER = true
+  -- Lists of lights, a texel each: (N, RSM views) and (M, 1); at least one texel.
+  local function list(name, format, w, h) return target{ name, format = format, size = { math.max(w, 1), math.max(h, 1) } } end
+  local L = { pos = list("vpl.light_pos", "rgba32f", o.lights, R.views), nrm = list("vpl.light_nrm", "rgba16f", o.lights, R.views),
+              flux = list("vpl.light_flux", "rgba32f", o.lights, R.views) }
+  local inputs, defines = shadow.bind(shadows, { rsm_flux = R.flux, rsm_nrm = R.nrm, rsm_pos = R.pos }, { LIGHTS = true })
+  pass{ "vpl.lights", shader = "vpl.frag", inputs = inputs, defines = defines, params = params, fetches = 3,
+        out = { L.pos, L.nrm, L.flux } }
+  local function gbuffer_pass(g, define)
+    local t, d = shadow.bind(shadows, gbuffer.inputs(g), { [define] = true })
+    t.vpl_pos, t.vpl_nrm, t.vpl_flux = L.pos, L.nrm, L.flux
+    return t, d
+  end
+  local t, d = gbuffer_pass(C, "GATHER")
   local E, N, D = coarse("vpl.e_plus"), coarse("vpl.neg"), coarse("vpl.neg_dir")
-  pass{ "vpl.gather", shader = "vpl.frag", inputs = t, defines = defines, params = params,
+  pass{ "vpl.gather", shader = "vpl.frag", inputs = t, defines = d, params = params,
         fetches = 4 + o.lights * 3, out = { E, N, D } }
-  t, defines = inputs(C)
-  t.positive, t.neg, t.neg_dir, t.cdpt, t.cnrm = E, N, D, C.dpt, C.nrm
-  defines.NEGATIVE = true
-  E = pass{ "vpl.negative", shader = "vpl.frag", inputs = t, defines = defines, params = params,
+  local M = { pos = list("vpl.neg_pos", "rgba32f", o.negative, 1), toward = list("vpl.neg_toward", "rgba32f", o.negative, 1),
+              s = list("vpl.neg_s", "rgba32f", o.negative, 1) }
+  inputs, defines = shadow.bind(shadows, { neg = N, neg_dir = D, cdpt = C.dpt }, { NEGATIVES = true })
+  pass{ "vpl.negatives", shader = "vpl.frag", inputs = inputs, defines = defines, params = params, fetches = 3,
+        out = { M.pos, M.toward, M.s } }
+  local function negatives(t) t.neg_pos, t.neg_toward, t.neg_s = M.pos, M.toward, M.s end
+  t, d = gbuffer_pass(C, "NEGATIVE")
+  t.positive = E
+  negatives(t)
+  E = pass{ "vpl.negative", shader = "vpl.frag", inputs = t, defines = d, params = params,
             fetches = 5 + o.negative * 3, out = coarse("vpl.e") }
-  t, defines = inputs(G)
-  t.coarse, t.neg, t.neg_dir, t.cdpt, t.cnrm = E, N, D, C.dpt, C.nrm
-  defines.REFINE = true
-  E = pass{ "vpl.refine", shader = "vpl.frag", inputs = t, defines = defines, params = params,
+  t, d = gbuffer_pass(G, "REFINE")
+  t.coarse, t.cdpt, t.cnrm = E, C.dpt, C.nrm
+  negatives(t)
+  E = pass{ "vpl.refine", shader = "vpl.frag", inputs = t, defines = d, params = params,
             fetches = 4 + 12, -- where coarse texels agree; a discontinuity costs all lights again
             out = target{ "vpl.full", format = "rgba16f" } }
   return isr.composite(G, direct, { dpt = G.dpt, mat = G.mat }, E,

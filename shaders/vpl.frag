@@ -1,14 +1,23 @@
 // Indirect point lights with negative lights (seed 002, sections 3.1-3.4),
 // on POV-Ray's scale (/work/shared/design/gi-scale.md), over the reflective
-// shadow maps of shadow.frag. Three passes (scripts/vpl.lua), by define:
-//   GATHER   coarse: E+ from the N indirect lights, and the seed's S_neg:
-//            the light that would arrive from behind p's tangent plane
-//            (n_p.t negated) and its intensity-weighted mean direction
-//   NEGATIVE coarse: E = E+ minus M negative lights taken at Halton pixels
-//            of S_neg
-//   REFINE   full size: the coarse E where the 2 x 2 coarse texels around a
-//            pixel agree with it in normal and depth (the seed's
-//            discontinuity threshold), else E recomputed at full size
+// shadow maps of shadow.frag. Five passes (scripts/vpl.lua), by define:
+//   LIGHTS    the indirect lights, one texel each: texel (k, r) is light k
+//             of the r-th RSM view (light by light, as shadow.render's
+//             `views` counts them): position and the area it stands for,
+//             normal, radiance times area (0 area: it stands for nothing)
+//   GATHER    coarse: E+ from the N indirect lights, and the seed's S_neg:
+//             the light that would arrive from behind p's tangent plane
+//             (n_p.t negated) and its intensity-weighted mean direction
+//   NEGATIVES the M negative lights, one texel each, from S_neg at Halton
+//             pixels: position and area, the direction they block, S_neg
+//   NEGATIVE  coarse: E = E+ minus the M negative lights
+//   REFINE    full size: the coarse E where the 2 x 2 coarse texels around a
+//             pixel agree with it in normal and depth (the seed's
+//             discontinuity threshold), else E recomputed at full size
+// Every pixel meets the same lights, so what each light is (its RSM texel,
+// the light there, its area) is worked out once in LIGHTS and NEGATIVES, not
+// per pixel: the per-pixel loops read one small texture at one place for
+// all pixels, and compute the geometry alone.
 // Indirect lights: the i-th of N lies where the Halton point
 // (Phi_2(i), Phi_3(i)) falls in the light's RSM view (fixed: nothing
 // flickers); the seed's points are directions in a spotlight's cone, which
@@ -24,20 +33,34 @@
 #include "halton.glsl"
 
 in vec2 uv;
-uniform sampler2D clr, nrm, dpt, mat;          // G-buffer (coarse, or full for REFINE)
-uniform sampler2D rsm_flux, rsm_nrm, rsm_pos;  // shadow.lua's RSM targets
 uniform int indirect_count = 100;              // N indirect lights a light
 uniform int negative = 50;                     // M negative lights
+#ifdef LIGHTS
+uniform sampler2D rsm_flux, rsm_nrm, rsm_pos;  // shadow.lua's RSM targets
 uniform float focus = 1.0;                     // orthographic tiles: the central share of a side they fill
-#if defined(NEGATIVE) || defined(REFINE)
+layout(location = 0) out vec4 out_pos;         // position, area (0: none)
+layout(location = 1) out vec4 out_nrm;
+layout(location = 2) out vec4 out_flux;        // radiance times area
+#else
+uniform sampler2D clr, nrm, dpt, mat;          // G-buffer (coarse, or full for REFINE)
+uniform sampler2D vpl_pos, vpl_nrm, vpl_flux;  // LIGHTS
+#endif
+#ifdef NEGATIVES
 uniform sampler2D neg, neg_dir;                // GATHER's S_neg, coarse
-uniform sampler2D cdpt, cnrm;                  // the coarse G-buffer's depth and normal
+uniform sampler2D cdpt;                        // the coarse G-buffer's depth
+layout(location = 0) out vec4 out_pos;         // position, area (0: none)
+layout(location = 1) out vec4 out_dir;         // the indirect lights' mean direction there
+layout(location = 2) out vec4 out_neg;         // S_neg
+#endif
+#if defined(NEGATIVE) || defined(REFINE)
+uniform sampler2D neg_pos, neg_toward, neg_s;  // NEGATIVES
 #endif
 #ifdef NEGATIVE
 uniform sampler2D positive;                    // GATHER's E+
 #endif
 #ifdef REFINE
 uniform sampler2D coarse;                      // NEGATIVE's E
+uniform sampler2D cdpt, cnrm;                  // the coarse G-buffer's depth and normal
 uniform float threshold = 0.1;                 // relative depth and 1 - cos of the normals
 #endif
 
@@ -45,40 +68,64 @@ uniform float threshold = 0.1;                 // relative depth and 1 - cos of 
 layout(location = 0) out vec4 result;
 layout(location = 1) out vec4 out_neg;
 layout(location = 2) out vec4 out_neg_dir;
-#else
+#elif defined(NEGATIVE) || defined(REFINE)
 out vec4 result;
 #endif
 
+// Indirect lights a view of light i holds (its share of N).
+int lights_per_view(int i) {
+  int count = shadow_lights[i].cube.z;
+  return count > 0 && indirect_count > 0 ? max(indirect_count / count, 1) : 0;
+}
+
+#ifdef LIGHTS
+// Indirect light k of the r-th RSM view: false when it stands for nothing.
+bool indirect_light(int k, int r, out vec3 q, out vec3 nq, out vec3 flux, out float area) {
+  int light = -1;
+  for (int i = 0; i < frame.counts.x && light < 0; i++) { // the r-th RSM view, light by light
+    if (r < shadow_lights[i].cube.z) light = i;
+    else r -= shadow_lights[i].cube.z;
+  }
+  if (light < 0) return false;
+  int per_view = lights_per_view(light);
+  if (k >= per_view) return false;
+  ShadowView sv = shadow_views[shadow_lights[light].cube.y + r];
+  vec2 atlas = vec2(textureSize(rsm_pos, 0));
+  float tile = sv.rect.z * atlas.x;
+  vec2 t = vec2(radical_inverse(uint(k + 1), 2u), radical_inverse(uint(k + 1), 3u));
+  float side = sv.depth.w > 0.0 ? 1.0 : clamp(focus, 1e-3, 1.0);
+  t = 0.5 + (t - 0.5) * side;
+  ivec2 a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
+  nq = texelFetch(rsm_nrm, a, 0).xyz;
+  if (dot(nq, nq) > 1.5) return false; // empty
+  q = texelFetch(rsm_pos, a, 0).xyz;
+  vec3 l;
+  vec3 radiance = light_incident(light, q, l);
+  area = rsm_texel_area(sv, t, q, tile) * tile * tile * side * side / float(per_view);
+  flux = texelFetch(rsm_flux, a, 0).rgb * radiance * area;
+  return area > 0.0;
+}
+#endif
+
+#ifndef LIGHTS
 // E+ at (p, n) from every indirect light; S_neg and its direction when asked.
 vec3 indirect(vec3 p, vec3 n, out vec3 s_neg, out vec3 neg_d) {
-  vec2 atlas = vec2(textureSize(rsm_pos, 0));
   vec3 e = vec3(0.0);
   s_neg = vec3(0.0);
   neg_d = vec3(0.0);
+  int r = 0; // row of the lights' texture: RSM views light by light
   for (int i = 0; i < frame.counts.x; i++) {
-    ShadowLight sl = shadow_lights[i];
-    int first = sl.cube.y, count = sl.cube.z;
-    int per_view = count > 0 ? max(indirect_count / count, 1) : 0;
-    if (indirect_count == 0) per_view = 0;
-    for (int v = first; v < first + count; v++) {
-      ShadowView sv = shadow_views[v];
-      float tile = sv.rect.z * atlas.x;
+    int per_view = lights_per_view(i);
+    for (int v = 0; v < shadow_lights[i].cube.z; v++, r++) {
       for (int k = 0; k < per_view; k++) {
-        vec2 t = vec2(radical_inverse(uint(k + 1), 2u), radical_inverse(uint(k + 1), 3u));
-        float side = sv.depth.w > 0.0 ? 1.0 : clamp(focus, 1e-3, 1.0);
-        t = 0.5 + (t - 0.5) * side;
-        ivec2 a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
-        vec3 nq = texelFetch(rsm_nrm, a, 0).xyz;
-        if (dot(nq, nq) > 1.5) continue; // empty
-        vec3 q = texelFetch(rsm_pos, a, 0).xyz;
-        vec3 l;
-        vec3 radiance = light_incident(i, q, l);
-        float area = rsm_texel_area(sv, t, q, tile) * tile * tile * side * side / float(per_view);
-        vec3 flux = texelFetch(rsm_flux, a, 0).rgb * radiance * area;
+        vec4 qa = texelFetch(vpl_pos, ivec2(k, r), 0);
+        if (qa.w <= 0.0) continue; // the same light for every pixel: a branch all take alike
+        vec3 q = qa.xyz, nq = texelFetch(vpl_nrm, ivec2(k, r), 0).xyz;
+        vec3 flux = texelFetch(vpl_flux, ivec2(k, r), 0).rgb;
         vec3 d = q - p;
         float d2 = dot(d, d);
         vec3 dir = d * inversesqrt(max(d2, 1e-30));
-        float g = max(dot(nq, -dir), 0.0) / max(d2, area);
+        float g = max(dot(nq, -dir), 0.0) / max(d2, qa.w);
         float ndt = dot(n, dir);
         e += flux * max(ndt, 0.0) * g;
         vec3 behind = flux * max(-ndt, 0.0) * g;
@@ -89,35 +136,45 @@ vec3 indirect(vec3 p, vec3 n, out vec3 s_neg, out vec3 neg_d) {
   }
   return e / PI;
 }
+#endif
+
+#ifdef NEGATIVES
+// The m-th negative light: the Halton pixel of S_neg, a point light at the
+// pixel's surface, standing for its share of the coarse image's surface
+// (the pixel's world footprint squared times the pixels it stands for);
+// false when it blocks nothing.
+bool negative_light_at(int m, out vec3 q, out vec3 dir_l, out vec3 s, out float area) {
+  ivec2 size = textureSize(neg, 0);
+  float share = float(size.x * size.y) / float(max(negative, 1));
+  vec2 h = vec2(radical_inverse(uint(m + 1), 2u), radical_inverse(uint(m + 1), 3u));
+  ivec2 x = ivec2(h * vec2(size));
+  s = texelFetch(neg, x, 0).rgb;
+  if (luminance(s) <= 0.0) return false;
+  vec2 xuv = (vec2(x) + 0.5) / vec2(size);
+  float z = texelFetch(cdpt, x, 0).r;
+  q = position_from_depth(xuv, z);
+  dir_l = safe_normalize(texelFetch(neg_dir, x, 0).xyz, vec3(0.0));
+  float foot = 2.0 * dpt_view_depth(z) * frame.clip.w / float(size.y); // a pixel's world size
+  area = foot * foot * share;
+  return area > 0.0;
+}
+#endif
 
 #if defined(NEGATIVE) || defined(REFINE)
-// The M negative lights: Halton pixels of S_neg, each a point light at the
-// pixel's surface, standing for its share of the coarse image's surface
-// (the pixel's world footprint squared times the pixels it stands for):
-// the light it blocks (pi S_neg times that area) sent on as a Lambertian
-// emitter facing away from the indirect lights' mean direction.
+// The light the M negative lights take from p: each blocks the light that
+// arrives at its back from the indirect lights (pi S_neg times its area) and
+// sends it on as a Lambertian emitter facing away from them (toward -dir_l),
+// onto what lies in its shadow facing back toward it.
 vec3 negative_light(vec3 p, vec3 n) {
-  ivec2 size = textureSize(neg, 0);
   vec3 e = vec3(0.0);
-  float share = float(size.x * size.y) / float(max(negative, 1));
   for (int m = 0; m < negative; m++) {
-    vec2 h = vec2(radical_inverse(uint(m + 1), 2u), radical_inverse(uint(m + 1), 3u));
-    ivec2 x = ivec2(h * vec2(size));
-    vec3 s = texelFetch(neg, x, 0).rgb;
-    if (luminance(s) <= 0.0) continue;
-    vec2 xuv = (vec2(x) + 0.5) / vec2(size);
-    float z = texelFetch(cdpt, x, 0).r;
-    vec3 q = position_from_depth(xuv, z);
-    vec3 dir_l = safe_normalize(texelFetch(neg_dir, x, 0).xyz, vec3(0.0));
-    float foot = 2.0 * dpt_view_depth(z) * frame.clip.w / float(size.y); // a pixel's world size
-    float area = foot * foot * share;
-    // q blocks the light that arrives at its back from the indirect lights
-    // (toward dir_l): the negative light leaves q away from them, onto what
-    // lies in q's shadow facing back toward q.
-    vec3 d = p - q;
+    vec4 qa = texelFetch(neg_pos, ivec2(m, 0), 0);
+    if (qa.w <= 0.0) continue; // the same for every pixel
+    vec3 dir_l = texelFetch(neg_toward, ivec2(m, 0), 0).xyz, s = texelFetch(neg_s, ivec2(m, 0), 0).rgb;
+    vec3 d = p - qa.xyz;
     float d2 = dot(d, d);
     vec3 t = d * inversesqrt(max(d2, 1e-30));
-    e += s * area * max(dot(-dir_l, t), 0.0) * max(dot(n, -t), 0.0) / max(d2, area);
+    e += s * qa.w * max(dot(-dir_l, t), 0.0) * max(dot(n, -t), 0.0) / max(d2, qa.w);
   }
   return e / PI;
 }
@@ -125,8 +182,30 @@ vec3 negative_light(vec3 p, vec3 n) {
 
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
+#ifdef LIGHTS
+  vec3 q, nq, flux;
+  float area;
+  if (indirect_light(px.x, px.y, q, nq, flux, area)) {
+    out_pos = vec4(q, area);
+    out_nrm = vec4(nq, 0.0);
+    out_flux = vec4(finite_or_zero(flux), 0.0);
+  } else {
+    out_pos = out_nrm = out_flux = vec4(0.0);
+  }
+#elif defined(NEGATIVES)
+  vec3 q, dir_l, s;
+  float area;
+  if (px.x < negative && negative_light_at(px.x, q, dir_l, s, area)) {
+    out_pos = vec4(q, area);
+    out_dir = vec4(dir_l, 0.0);
+    out_neg = vec4(s, 0.0);
+  } else {
+    out_pos = out_dir = out_neg = vec4(0.0);
+  }
+#else
   Surface s = gbuffer_fetch(clr, nrm, dpt, mat, px);
   vec3 s_neg, neg_d;
+#endif
 #ifdef GATHER
   if (!s.covered) {
     result = vec4(0.0, 0.0, 0.0, 1.0);
@@ -141,7 +220,7 @@ void main() {
   vec3 e = texelFetch(positive, px, 0).rgb;
   if (s.covered) e = max(e - negative_light(s.p, s.n), vec3(0.0));
   result = vec4(finite_or_zero(e), 1.0);
-#else // REFINE
+#elif defined(REFINE)
   if (!s.covered) {
     result = vec4(0.0, 0.0, 0.0, 1.0);
     return;
