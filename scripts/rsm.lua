@@ -14,14 +14,15 @@ local rsm = {}
 
 -- The options a pipeline exposes (pp.lua's Options.rsm), with defaults.
 rsm.defaults = {
-  samples = 64,      -- RSM samples a coarse pixel and light, 1..4096 (the seed: 512 at half size)
+  samples = 64,      -- RSM samples a coarse pixel and light, 1..4096 (the seed: 512 at half size);
+                     -- each pixel of a 4 x 4 tile takes its own block of one pattern (rsm.frag)
   radius = 1.0,      -- sampling disc radius in tiles of the RSM, (0, 2]
   reach = 3,         -- a directional light's RSM tile covers the sphere around what is seen,
                      -- its radius times reach, 1..64 (senders off screen; no world unit)
   steps = 0,         -- screen-space visibility march a sample, 0..32 (0: none; the seed's
                      -- test, which about halves its frame rate)
-  rotate = 10,       -- pattern turn a frame in degrees with temporal reuse, 0..180 (the seed: 10);
-                     -- without, the pattern stays (a still camera, a still image)
+  rotate = 10,       -- pattern turn a frame in degrees with temporal reuse, 0..180 (the seed: 10;
+                     -- its radii shift too); without, the pattern stays (a still camera, a still image)
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
   coarse = 2,        -- coarse factor a side: 1, 2 or 4 (the seed: half resolution)
   blur = 4,          -- Gaussian taps each side at coarse size, 0..32
@@ -57,11 +58,11 @@ end
 function rsm.gather(C, f, R, shadows, o, base)
   local inputs, defines = shadow.bind(shadows, gbuffer.inputs(C),
                                       { VISIBILITY = o.steps > 0, BASE = base ~= nil, EXCLUDE_SEEN = base ~= nil })
-  inputs.rsm_flux, inputs.rsm_nrm, inputs.rsm_pos, inputs.base = R.flux, R.nrm, R.pos, base
-  return pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines,
-               params = { samples = o.samples, radius = o.radius, steps = o.steps,
-                          rotate = o.temporal.enabled and o.rotate / 360 or 0 },
-               fetches = 4 + o.samples * (3 + o.steps * 2 + (base and 3 or 0)),
+  inputs.rsm_flux, inputs.rsm_pos, inputs.base = R.flux, R.pos, base
+  local params = { samples = o.samples, radius = o.radius, steps = o.steps,
+                   rotate = o.temporal.enabled and o.rotate / 360 or 0 }
+  return pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines, params = params,
+               fetches = 4 + o.samples * (2 + o.steps * 2 + (base and 3 or 0)),
                out = target{ "rsm.e", format = "rgba16f", scale = 1 / f } }
 end
 

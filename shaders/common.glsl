@@ -74,6 +74,25 @@ vec3 position_from_depth(vec2 uv, float depth01) {
   return frame.camera_pos.xyz + ray * depth01;
 }
 
+// A unit normal as one float, held exactly: octahedral coordinates of 12
+// bits each make an integer below 2^24, which a float holds exactly, stored
+// as -1 - that integer so that a value above 0 can mean "none" (the RSM's
+// position target carries its texel's normal in w this way: one fetch for
+// both). normal_unpack(normal_pack(n)) is within 0.05 degrees of n.
+float normal_pack(vec3 n) {
+  vec2 o = n.xy / max(abs(n.x) + abs(n.y) + abs(n.z), 1e-30);
+  if (n.z < 0.0) o = (1.0 - abs(o.yx)) * vec2(o.x >= 0.0 ? 1.0 : -1.0, o.y >= 0.0 ? 1.0 : -1.0);
+  uvec2 q = uvec2(round(clamp(o * 0.5 + 0.5, 0.0, 1.0) * 4095.0));
+  return -1.0 - float(q.x * 4096u + q.y);
+}
+vec3 normal_unpack(float w) {
+  uint c = uint(clamp(-1.0 - w, 0.0, 16777215.0));
+  vec2 o = vec2(uvec2(c >> 12, c & 4095u)) / 4095.0 * 2.0 - 1.0;
+  vec3 n = vec3(o, 1.0 - abs(o.x) - abs(o.y));
+  if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+  return safe_normalize(n, vec3(0.0, 0.0, 1.0));
+}
+
 // Replaces NaN and Inf by zero, negatives by zero.
 vec3 finite_or_zero(vec3 c) {
   bvec3 bad = bvec3(isnan(c.x) || isinf(c.x), isnan(c.y) || isinf(c.y), isnan(c.z) || isinf(c.z));

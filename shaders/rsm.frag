@@ -15,8 +15,15 @@
 // 1 / (2 pi R^2 xi_1), so each sample weighs 2 pi R^2 xi_1 T^2 / N texels
 // (T the tile's side): the seed's "samples weighed by their squared
 // distance" (line 917) made exact for this pattern. Samples outside the tile
-// or on an empty texel add nothing. Halton points rotated per pixel in a 4 x 4
-// tile (the blur averages them) and per frame by `rotate`.
+// or on an empty texel add nothing.
+// Interleaved sampling: the pattern is one sequence, xi_1 = Phi_2(k) (van der
+// Corput) and xi_2 = k phi (golden ratio, mod 1), of which pixel j of a 4 x 4
+// tile (Bayer order, halton.glsl) takes the block k = j n .. j n + n - 1: each
+// pixel's n samples are stratified in xi_1 and spread in angle, and the 16
+// blocks together are the sequence's first 16 n points, which the
+// geometry-aware blur averages. Each sample still weighs its own density, so
+// one pixel alone is exact too, only noisier. The angle steps by a fixed
+// rotation (no sin or cos a sample); the pattern turns per frame by `rotate`.
 // 1/d^2 is capped at the texel's own area, so a sender next to p stays finite.
 // VISIBILITY: the seed's screen-space test (lines 930-958): `steps` points
 // on p -> q; one behind the depth buffer rejects q.
@@ -29,7 +36,7 @@
 
 in vec2 uv;
 uniform sampler2D clr, nrm, dpt, mat;          // coarse G-buffer
-uniform sampler2D rsm_flux, rsm_nrm, rsm_pos;  // shadow.lua's RSM targets (atlas-sized)
+uniform sampler2D rsm_flux, rsm_pos;  // shadow.lua's RSM targets (atlas-sized; the normal in rsm_pos.w)
 uniform int samples = 64;
 uniform float radius = 1.0;
 uniform float rotate = 0.0; // turn of the pattern a frame, in turns (seed 004: 10 degrees)
@@ -39,6 +46,11 @@ uniform sampler2D base;
 #endif
 
 out vec4 result;
+
+const int INTERLEAVE = 4;                          // tile side of the interleaved pattern
+const float GOLDEN = 0.61803398874989;             // the angle's step, in turns
+const vec2 TURN = vec2(-0.73736887807832, -0.67549029426152); // cos, sin of 2 pi GOLDEN
+const float PLASTIC = 0.75487766624669;            // 1 / the plastic number
 
 bool blocked(vec3 p, vec3 q) {
   for (int j = 1; j <= steps; j++) {
@@ -65,14 +77,23 @@ void main() {
     result = b;
     return;
   }
-  vec3 offset = halton_offset(px, 4);
-  offset.x = fract(offset.x + fract(frame.time.y * rotate));
+
+  int j = interleave_index(px, INTERLEAVE);
+  float turn = fract(frame.time.y * rotate);
+  // With temporal reuse the radii move too (by the plastic number's step, unrelated to the angle's), so
+  // that the frames a pixel accumulates cover other distances, not only other angles.
+  float shift = rotate > 0.0 ? fract(frame.time.y * PLASTIC) : 0.0;
   vec2 atlas = vec2(textureSize(rsm_pos, 0));
   vec3 e = vec3(0.0);
   for (int i = 0; i < frame.counts.x; i++) {
     ShadowLight sl = shadow_lights[i];
     int first = sl.cube.y, count = sl.cube.z;
     int n = count > 0 ? max(samples / count, 1) : 0;
+    // The block's first angle: j n phi turns (j integer: fract(j fract(n phi)) = fract(j n phi),
+    // without the rounding of the large product).
+    float a0 = 2.0 * PI * fract(float(j) * fract(float(n) * GOLDEN) + turn);
+    uint k0 = uint(j * n);
+    float centred = 0.5 / float(max(n * INTERLEAVE * INTERLEAVE, 1)) + shift; // half the union's radial stratum
     for (int v = first; v < first + count; v++) {
       ShadowView sv = shadow_views[v];
       vec4 c = sv.view_proj * vec4(s.p, 1.0);
@@ -80,30 +101,30 @@ void main() {
       centre = clamp(centre, vec2(0.0), vec2(1.0)); // behind a cube face: its nearest edge
       float tile = sv.rect.z * atlas.x;
       float texels = 2.0 * PI * radius * radius * tile * tile / float(max(n, 1));
-      for (int k = 0; k < n; k++) {
-        vec3 h = halton_sample(k, offset);
-        vec2 t = centre + h.y * radius * vec2(cos(2.0 * PI * h.x), sin(2.0 * PI * h.x));
+      vec2 dir = vec2(cos(a0), sin(a0));
+      for (int k = 0; k < n; k++, dir = vec2(dir.x * TURN.x - dir.y * TURN.y, dir.x * TURN.y + dir.y * TURN.x)) {
+        float xi = fract(radical_inverse(k0 + uint(k), 2u) + centred);
+        vec2 t = centre + xi * radius * dir;
         if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
         ivec2 a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
-        vec3 nq = texelFetch(rsm_nrm, a, 0).xyz;
-        if (dot(nq, nq) > 1.5) continue; // empty
-        vec3 q = texelFetch(rsm_pos, a, 0).xyz;
-        vec3 rho = texelFetch(rsm_flux, a, 0).rgb;
-        vec3 l;
-        vec3 radiance = light_incident(i, q, l);
+        vec4 qn = texelFetch(rsm_pos, a, 0); // position, normal (normal_pack)
+        if (qn.w > 0.0) continue; // empty
+        vec3 q = qn.xyz, nq = normal_unpack(qn.w);
         float area = rsm_texel_area(sv, t, q, tile);
         vec3 d = q - s.p;
         float d2 = dot(d, d);
-        vec3 dir = d * inversesqrt(max(d2, 1e-30));
-        float g = max(dot(s.n, dir), 0.0) * max(dot(nq, -dir), 0.0) / max(d2, area);
-        if (g <= 0.0) continue;
+        vec3 towards = d * inversesqrt(max(d2, 1e-30));
+        float g = max(dot(s.n, towards), 0.0) * max(dot(nq, -towards), 0.0) / max(d2, area);
+        if (g <= 0.0) continue; // before the flux and the light: coplanar and facing-away senders are common
 #ifdef EXCLUDE_SEEN
         if (rsm_seen(dpt, q)) continue;
 #endif
 #ifdef VISIBILITY
         if (blocked(s.p, q)) continue;
 #endif
-        e += rho * radiance * area * g * texels * h.y;
+        vec3 l;
+        vec3 radiance = light_incident(i, q, l);
+        e += texelFetch(rsm_flux, a, 0).rgb * radiance * area * g * texels * xi;
       }
     }
   }

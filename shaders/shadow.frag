@@ -3,8 +3,9 @@
 // reflective shadow map of seed 004 (lines 858-904) as well: the sender's
 // reflectance k_d albedo (its flux is the light's radiance there times this
 // and the texel's area, rsm.glsl), its world normal turned toward the light
-// and its world position. The pass clears every target to 1: a normal of
-// length above 1 marks an empty texel.
+// and its world position, with the normal again in w (normal_pack: the
+// gather reads both in one fetch). The pass clears every target to 1: a
+// normal of length above 1, or a w above 0, marks an empty texel.
 #include "common.glsl"
 
 in vec3 world_pos;
@@ -46,6 +47,6 @@ void main() {
   if (!gl_FrontFacing) n = -n; // two-sided, as the G-buffer
   rsm_flux = vec4(saturate(material_k.y) * saturate(albedo), 1.0);
   rsm_nrm = vec4(n, 0.0);
-  rsm_pos = vec4(world_pos, 0.0);
+  rsm_pos = vec4(world_pos, normal_pack(n));
 #endif
 }
