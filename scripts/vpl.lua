@@ -54,32 +54,33 @@ function vpl.render(G, direct, shadows, R, o, light)
                    focus = math.min(o.focus / o.reach, 1) }
   local coarse = function(name) return target{ name, format = "rgba16f", scale = 1 / f } end
   -- Lists of lights, a texel each: (N, RSM views) and (M, 1); at least one texel.
-  local function list(name, format, w, h) return target{ name, format = format, size = { math.max(w, 1), math.max(h, 1) } } end
-  local L = { pos = list("vpl.light_pos", "rgba32f", o.lights, R.views), nrm = list("vpl.light_nrm", "rgba16f", o.lights, R.views),
-              flux = list("vpl.light_flux", "rgba32f", o.lights, R.views) }
-  local inputs, defines = shadow.bind(shadows, { rsm_flux = R.flux, rsm_nrm = R.nrm, rsm_pos = R.pos }, { LIGHTS = true })
+  local function list(name, w, h)
+    return target{ name, format = "rgba32f", size = { math.max(w, 1), math.max(h, 1) } }
+  end
+  local L = { pos = list("vpl.light_pos", o.lights, R.views), flux = list("vpl.light_flux", o.lights, R.views) }
+  local inputs, defines = shadow.bind(shadows, { rsm_flux = R.flux, rsm_nrm = R.nrm, rsm_pos = R.pos },
+                                      { LIGHTS = true })
   pass{ "vpl.lights", shader = "vpl.frag", inputs = inputs, defines = defines, params = params, fetches = 3,
-        out = { L.pos, L.nrm, L.flux } }
+        out = { L.pos, L.flux } }
   local function gbuffer_pass(g, define)
     local t, d = shadow.bind(shadows, gbuffer.inputs(g), { [define] = true })
-    t.vpl_pos, t.vpl_nrm, t.vpl_flux = L.pos, L.nrm, L.flux
+    t.vpl_pos, t.vpl_flux = L.pos, L.flux
     return t, d
   end
   local t, d = gbuffer_pass(C, "GATHER")
   local E, N, D = coarse("vpl.e_plus"), coarse("vpl.neg"), coarse("vpl.neg_dir")
   pass{ "vpl.gather", shader = "vpl.frag", inputs = t, defines = d, params = params,
-        fetches = 4 + o.lights * 3, out = { E, N, D } }
-  local M = { pos = list("vpl.neg_pos", "rgba32f", o.negative, 1), toward = list("vpl.neg_toward", "rgba32f", o.negative, 1),
-              s = list("vpl.neg_s", "rgba32f", o.negative, 1) }
+        fetches = 4 + o.lights * 2, out = { E, N, D } }
+  local M = { pos = list("vpl.neg_pos", o.negative, 1), s = list("vpl.neg_s", o.negative, 1) }
   inputs, defines = shadow.bind(shadows, { neg = N, neg_dir = D, cdpt = C.dpt }, { NEGATIVES = true })
   pass{ "vpl.negatives", shader = "vpl.frag", inputs = inputs, defines = defines, params = params, fetches = 3,
-        out = { M.pos, M.toward, M.s } }
-  local function negatives(t) t.neg_pos, t.neg_toward, t.neg_s = M.pos, M.toward, M.s end
+        out = { M.pos, M.s } }
+  local function negatives(t) t.neg_pos, t.neg_s = M.pos, M.s end
   t, d = gbuffer_pass(C, "NEGATIVE")
   t.positive = E
   negatives(t)
   E = pass{ "vpl.negative", shader = "vpl.frag", inputs = t, defines = d, params = params,
-            fetches = 5 + o.negative * 3, out = coarse("vpl.e") }
+            fetches = 5 + o.negative * 2, out = coarse("vpl.e") }
   t, d = gbuffer_pass(G, "REFINE")
   t.coarse, t.cdpt, t.cnrm = E, C.dpt, C.nrm
   negatives(t)

@@ -3,13 +3,14 @@
 // shadow maps of shadow.frag. Five passes (scripts/vpl.lua), by define:
 //   LIGHTS    the indirect lights, one texel each: texel (k, r) is light k
 //             of the r-th RSM view (light by light, as shadow.render's
-//             `views` counts them): position and the area it stands for,
-//             normal, radiance times area (0 area: it stands for nothing)
+//             `views` counts them): position and normal (normal_pack; w > 0:
+//             it stands for nothing), radiance times area and the area
 //   GATHER    coarse: E+ from the N indirect lights, and the seed's S_neg:
 //             the light that would arrive from behind p's tangent plane
 //             (n_p.t negated) and its intensity-weighted mean direction
 //   NEGATIVES the M negative lights, one texel each, from S_neg at Halton
-//             pixels: position and area, the direction they block, S_neg
+//             pixels: position and the direction they block (normal_pack;
+//             w > 0: none), S_neg and the area
 //   NEGATIVE  coarse: E = E+ minus the M negative lights
 //   REFINE    full size: the coarse E where the 2 x 2 coarse texels around a
 //             pixel agree with it in normal and depth (the seed's
@@ -38,22 +39,21 @@ uniform int negative = 50;                     // M negative lights
 #ifdef LIGHTS
 uniform sampler2D rsm_flux, rsm_nrm, rsm_pos;  // shadow.lua's RSM targets
 uniform float focus = 1.0;                     // orthographic tiles: the central share of a side they fill
-layout(location = 0) out vec4 out_pos;         // position, area (0: none)
-layout(location = 1) out vec4 out_nrm;
-layout(location = 2) out vec4 out_flux;        // radiance times area
+layout(location = 0) out vec4 out_pos;         // position, normal (normal_pack; w > 0: none)
+layout(location = 1) out vec4 out_flux;        // radiance times area, area
 #else
 uniform sampler2D clr, nrm, dpt, mat;          // G-buffer (coarse, or full for REFINE)
-uniform sampler2D vpl_pos, vpl_nrm, vpl_flux;  // LIGHTS
+uniform sampler2D vpl_pos, vpl_flux;           // LIGHTS
 #endif
 #ifdef NEGATIVES
 uniform sampler2D neg, neg_dir;                // GATHER's S_neg, coarse
 uniform sampler2D cdpt;                        // the coarse G-buffer's depth
-layout(location = 0) out vec4 out_pos;         // position, area (0: none)
-layout(location = 1) out vec4 out_dir;         // the indirect lights' mean direction there
-layout(location = 2) out vec4 out_neg;         // S_neg
+layout(location = 0) out vec4 out_pos;         // position, the indirect lights' mean direction there
+                                               // (normal_pack; w > 0: none)
+layout(location = 1) out vec4 out_neg;         // S_neg, area
 #endif
 #if defined(NEGATIVE) || defined(REFINE)
-uniform sampler2D neg_pos, neg_toward, neg_s;  // NEGATIVES
+uniform sampler2D neg_pos, neg_s;              // NEGATIVES
 #endif
 #ifdef NEGATIVE
 uniform sampler2D positive;                    // GATHER's E+
@@ -118,14 +118,14 @@ vec3 indirect(vec3 p, vec3 n, out vec3 s_neg, out vec3 neg_d) {
     int per_view = lights_per_view(i);
     for (int v = 0; v < shadow_lights[i].cube.z; v++, r++) {
       for (int k = 0; k < per_view; k++) {
-        vec4 qa = texelFetch(vpl_pos, ivec2(k, r), 0);
-        if (qa.w <= 0.0) continue; // the same light for every pixel: a branch all take alike
-        vec3 q = qa.xyz, nq = texelFetch(vpl_nrm, ivec2(k, r), 0).xyz;
-        vec3 flux = texelFetch(vpl_flux, ivec2(k, r), 0).rgb;
+        vec4 qn = texelFetch(vpl_pos, ivec2(k, r), 0);
+        if (qn.w > 0.0) continue; // the same light for every pixel: a branch all take alike
+        vec4 fa = texelFetch(vpl_flux, ivec2(k, r), 0);
+        vec3 q = qn.xyz, nq = normal_unpack(qn.w), flux = fa.rgb;
         vec3 d = q - p;
         float d2 = dot(d, d);
         vec3 dir = d * inversesqrt(max(d2, 1e-30));
-        float g = max(dot(nq, -dir), 0.0) / max(d2, qa.w);
+        float g = max(dot(nq, -dir), 0.0) / max(d2, fa.a);
         float ndt = dot(n, dir);
         e += flux * max(ndt, 0.0) * g;
         vec3 behind = flux * max(-ndt, 0.0) * g;
@@ -156,7 +156,8 @@ bool negative_light_at(int m, out vec3 q, out vec3 dir_l, out vec3 s, out float 
   dir_l = safe_normalize(texelFetch(neg_dir, x, 0).xyz, vec3(0.0));
   float foot = 2.0 * dpt_view_depth(z) * frame.clip.w / float(size.y); // a pixel's world size
   area = foot * foot * share;
-  return area > 0.0;
+  return area > 0.0 && dot(dir_l, dir_l) > 0.5; // without a direction it blocks nothing
+
 }
 #endif
 
@@ -168,13 +169,14 @@ bool negative_light_at(int m, out vec3 q, out vec3 dir_l, out vec3 s, out float 
 vec3 negative_light(vec3 p, vec3 n) {
   vec3 e = vec3(0.0);
   for (int m = 0; m < negative; m++) {
-    vec4 qa = texelFetch(neg_pos, ivec2(m, 0), 0);
-    if (qa.w <= 0.0) continue; // the same for every pixel
-    vec3 dir_l = texelFetch(neg_toward, ivec2(m, 0), 0).xyz, s = texelFetch(neg_s, ivec2(m, 0), 0).rgb;
-    vec3 d = p - qa.xyz;
+    vec4 qd = texelFetch(neg_pos, ivec2(m, 0), 0);
+    if (qd.w > 0.0) continue; // the same for every pixel
+    vec4 sa = texelFetch(neg_s, ivec2(m, 0), 0);
+    vec3 dir_l = normal_unpack(qd.w);
+    vec3 d = p - qd.xyz;
     float d2 = dot(d, d);
     vec3 t = d * inversesqrt(max(d2, 1e-30));
-    e += s * qa.w * max(dot(-dir_l, t), 0.0) * max(dot(n, -t), 0.0) / max(d2, qa.w);
+    e += sa.rgb * sa.a * max(dot(-dir_l, t), 0.0) * max(dot(n, -t), 0.0) / max(d2, sa.a);
   }
   return e / PI;
 }
@@ -186,21 +188,21 @@ void main() {
   vec3 q, nq, flux;
   float area;
   if (indirect_light(px.x, px.y, q, nq, flux, area)) {
-    out_pos = vec4(q, area);
-    out_nrm = vec4(nq, 0.0);
-    out_flux = vec4(finite_or_zero(flux), 0.0);
+    out_pos = vec4(q, normal_pack(nq));
+    out_flux = vec4(finite_or_zero(flux), area);
   } else {
-    out_pos = out_nrm = out_flux = vec4(0.0);
+    out_pos = vec4(0.0, 0.0, 0.0, 1.0);
+    out_flux = vec4(0.0);
   }
 #elif defined(NEGATIVES)
   vec3 q, dir_l, s;
   float area;
   if (px.x < negative && negative_light_at(px.x, q, dir_l, s, area)) {
-    out_pos = vec4(q, area);
-    out_dir = vec4(dir_l, 0.0);
-    out_neg = vec4(s, 0.0);
+    out_pos = vec4(q, normal_pack(dir_l));
+    out_neg = vec4(s, area);
   } else {
-    out_pos = out_dir = out_neg = vec4(0.0);
+    out_pos = vec4(0.0, 0.0, 0.0, 1.0);
+    out_neg = vec4(0.0);
   }
 #else
   Surface s = gbuffer_fetch(clr, nrm, dpt, mat, px);
