@@ -61,6 +61,7 @@ function rsm.gather(C, f, R, shadows, o, base)
   inputs.rsm_flux, inputs.rsm_pos, inputs.base = R.flux, R.pos, base
   local params = { samples = o.samples, radius = o.radius, steps = o.steps,
                    rotate = o.temporal.enabled and o.rotate / 360 or 0 }
+  if not base then temporal.skip("rsm", inputs, defines, params, o.temporal, 1 / f) end
   return pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines, params = params,
                fetches = 4 + o.samples * (2 + o.steps * 2 + (base and 3 or 0)),
                out = target{ "rsm.e", format = "rgba16f", scale = 1 / f } }

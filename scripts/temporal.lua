@@ -6,7 +6,9 @@
 -- OnCreate at its coarse scale, taking turns (a pass cannot read and write
 -- one target); the viewer's reload keeps them by name, format and size.
 -- The GI pass turns its sampling pattern each frame (rsm.rotate) so the
--- accumulation averages different samples.
+-- accumulation averages different samples, and skips the pixels that have
+-- converged (temporal.skip): on a still camera it then costs the
+-- reprojection and the refreshed tiles.
 local options = require "options"
 
 local temporal = {}
@@ -19,6 +21,8 @@ temporal.defaults = {
   bias = 0.1,       -- the seed's confidence bias, 0..16
   confidence = 0.25, -- a pixel whose confidence falls below this starts again, 0..1 (above
                      -- about 0.5 the noise of a few samples restarts pixels that should not)
+  refresh = 8,      -- a converged pixel's 4 x 4 tile takes fresh samples one frame in this many,
+                    -- so that a change of its light shows within as many frames, 0..1024 (0: never)
 }
 
 local rules = {
@@ -27,6 +31,7 @@ local rules = {
   epsilon = options.positive(1),
   bias = options.number(0, 16),
   confidence = options.number(0, 1),
+  refresh = options.whole(0, 1024),
 }
 
 local histories = {} -- user -> { targets = {a, b}, turn = 0, scale = s }
@@ -43,22 +48,41 @@ end
 -- Checked options under `name` (errors point at the caller's caller).
 function temporal.check(name, o) return options.check(name, temporal.defaults, o, rules, 3) end
 
+-- The history of `user` at `scale`, checked (errors point at the caller's caller).
+local function history_of(user, scale)
+  local h = histories[user]
+  if not h then error("temporal: call temporal.create(\"" .. user .. "\", scale) from OnCreate", 3) end
+  if h.scale ~= scale then
+    error(string.format("temporal: the history of %s is at scale %g, the result at %g", user, h.scale, scale), 3)
+  end
+  return h
+end
+
+-- Adds to a GI pass's inputs, defines and params what it needs to skip the
+-- pixels whose accumulation has converged (TEMPORAL_SKIP, temporal.glsl):
+-- the history temporal.apply will read this frame. Nothing when off. The
+-- pass also needs the coarse G-buffer's dpt as `dpt`.
+function temporal.skip(user, inputs, defines, params, o, scale)
+  if not o.enabled then return end
+  local previous = history_of(user, scale).targets[histories[user].turn + 1]
+  inputs.history, inputs.history_depth = previous.value, previous.depth
+  defines.TEMPORAL_SKIP = true
+  params.frames, params.epsilon, params.refresh = o.frames, o.epsilon, o.refresh
+end
+
 -- The accumulated result of `src`, a coarse result at the scale the history
 -- was declared with (C: the coarse G-buffer with dpt and mat), or src
 -- itself when off.
 function temporal.apply(user, src, C, o, scale)
   if not o.enabled then return src end
-  local h = histories[user]
-  if not h then error("temporal: call temporal.create(\"" .. user .. "\", scale) from OnCreate", 2) end
-  if h.scale ~= scale then
-    error(string.format("temporal: the history of %s is at scale %g, the result at %g", user, h.scale, scale), 2)
-  end
+  local h = history_of(user, scale)
   local previous, next = h.targets[h.turn + 1], h.targets[2 - h.turn]
   h.turn = 1 - h.turn
   local out = target{ "temporal." .. user, format = "rgba16f", scale = scale }
   pass{ "temporal." .. user, shader = "temporal.frag",
         inputs = { src = src, history = previous.value, history_depth = previous.depth, dpt = C.dpt, mat = C.mat },
-        params = { epsilon = o.epsilon, bias = o.bias, frames = o.frames, confidence = o.confidence },
+        params = { epsilon = o.epsilon, bias = o.bias, frames = o.frames, confidence = o.confidence,
+                   refresh = o.refresh },
         fetches = 6, out = { out, next.value, next.depth } }
   return out
 end

@@ -29,10 +29,15 @@
 // on p -> q; one behind the depth buffer rejects q.
 // EXCLUDE_SEEN: a sender the camera sees (on screen, depth within 2% of the
 // buffer's) is left to the screen-space pass the combined technique adds.
+// TEMPORAL_SKIP: a pixel whose temporal accumulation has converged
+// (temporal.glsl) takes no samples; the accumulation keeps its history.
 // Output: rgb = E, a = 1 (RSM light occludes no ambient term); with BASE,
 // the coarse result `base` of the screen-space pass plus E (its a kept).
 #include "rsm.glsl"
 #include "halton.glsl"
+#ifdef TEMPORAL_SKIP
+#include "temporal.glsl"
+#endif
 
 in vec2 uv;
 uniform sampler2D clr, nrm, dpt, mat;          // coarse G-buffer
@@ -77,6 +82,13 @@ void main() {
     result = b;
     return;
   }
+#ifdef TEMPORAL_SKIP
+  vec4 h;
+  if (temporal_converged(uv, texelFetch(dpt, px, 0).r, px, h)) { // the accumulation keeps its history
+    result = b;
+    return;
+  }
+#endif
 
   int j = interleave_index(px, INTERLEAVE);
   float turn = fract(frame.time.y * rotate);

@@ -28,7 +28,7 @@ check "no command" run 2
 check "help" run 0 --help
 check "help lists capture" out_has "capture"
 check "capture help" run 0 capture --help
-for flag in --scene --script --tech --set --size --frames --camera --output --clock --egl --list-options; do
+for flag in --scene --script --tech --set --size --frames --warmup --camera --output --clock --egl --list-options; do
   check "capture help names $flag" out_has "$flag"
 done
 check "unknown command" run 2 frobnicate

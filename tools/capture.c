@@ -28,6 +28,8 @@ static const char capture_usage[] =
     "                       (repeatable; dotted names reach nested options)\n"
     "  --size WxH           output size (default 256x192)\n"
     "  --frames N           frames to render (default 1); times are medians\n"
+    "  --warmup N           frames to render before those, untimed (default 0;\n"
+    "                       say a temporal accumulation's convergence)\n"
     "  --camera N           camera index of the scene (default 0), or auto:\n"
     "                       one framing the scene's bounds\n"
     "  --output FILE        image to write, .png or .exr (repeatable)\n"
@@ -59,7 +61,7 @@ typedef struct capture_args {
   int output_count;
   const char *sets[64];
   int set_count;
-  int width, height, frames, camera;
+  int width, height, frames, warmup, camera;
   lm_clock clock;
   bool list_options, quiet, verbose, check_nan;
 } capture_args;
@@ -87,6 +89,7 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       {"scene", required_argument, 0, 's'},  {"script", required_argument, 0, 'p'},
       {"tech", required_argument, 0, 't'},   {"set", required_argument, 0, 'D'},
       {"size", required_argument, 0, 'z'},   {"frames", required_argument, 0, 'n'},
+      {"warmup", required_argument, 0, 'w'},
       {"camera", required_argument, 0, 'c'}, {"output", required_argument, 0, 'o'},
       {"clock", required_argument, 0, 'k'},  {"egl", required_argument, 0, 'e'},
       {"list-options", no_argument, 0, 'l'}, {"quiet", no_argument, 0, 'q'},
@@ -99,7 +102,7 @@ static int parse_args(int argc, char **argv, capture_args *a) {
   optind = 1;
   int c;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
-    for (const struct option *o = opts; o->name && c && strchr("sptznc", c); o++)
+    for (const struct option *o = opts; o->name && c && strchr("sptznwc", c); o++)
       if (o->val == c) a->single_flag = o->name;
     switch (c) {
     case 's': a->scene = optarg; break;
@@ -116,6 +119,9 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       break;
     case 'n':
       if (!limn_parse_int(optarg, 1, 100000, &a->frames)) return usage_error("--frames wants 1..100000, not '%s'", optarg);
+      break;
+    case 'w':
+      if (!limn_parse_int(optarg, 0, 100000, &a->warmup)) return usage_error("--warmup wants 0..100000, not '%s'", optarg);
       break;
     case 'c':
       if (!limn_parse_camera(optarg, &a->camera)) return usage_error("--camera wants an index or auto, not '%s'", optarg);
@@ -243,9 +249,9 @@ bool capture_render_write(lm_renderer *r, const capture_view *v, capture_result 
   int n = 0;
   lm_renderer_set_view(r, v->camera, v->width, v->height);
   bool ok = true;
-  for (int f = 0; f < v->frames && ok; f++) {
+  for (int f = 0; f < v->warmup + v->frames && ok; f++) {
     ok = lm_renderer_frame(r, err);
-    if (ok) collect_times(lm_renderer_graph(r), &samples, &n, v->frames);
+    if (ok && f >= v->warmup) collect_times(lm_renderer_graph(r), &samples, &n, v->frames);
   }
   if (ok) ok = write_outputs(r, v->width, v->height, v->outputs, v->output_count, v->quiet, err);
   res->passes = lm_alloc(sizeof *res->passes * (size_t)(n + 1));
@@ -266,9 +272,10 @@ void capture_result_free(capture_result *res) {
   *res = (capture_result){0};
 }
 
-static void print_times(const capture_result *res, int frames, lm_clock clock) {
-  printf("pass times (median of %d frame%s; clock: %s)\n", frames, frames == 1 ? "" : "s",
-         lm_clock_name(clock));
+static void print_times(const capture_result *res, int frames, int warmup, lm_clock clock) {
+  printf("pass times (median of %d frame%s", frames, frames == 1 ? "" : "s");
+  if (warmup > 0) printf(" after %d untimed", warmup);
+  printf("; clock: %s)\n", lm_clock_name(clock));
   for (int i = 0; i < res->pass_count; i++)
     printf("  %-24s %-10s %9.3f ms\n", res->passes[i].name, res->passes[i].kind, res->passes[i].ms);
   printf("  %-24s %-10s %9.3f ms\n", "total", "", res->total_ms);
@@ -357,11 +364,11 @@ int limn_capture(int argc, char **argv) {
             a.width, a.height);
   capture_result res = {0};
   if (ok) {
-    capture_view v = {.camera = a.camera, .width = a.width, .height = a.height, .frames = a.frames,
+    capture_view v = {.camera = a.camera, .width = a.width, .height = a.height, .frames = a.frames, .warmup = a.warmup,
                       .outputs = a.outputs, .output_count = a.output_count, .quiet = a.quiet};
     ok = capture_render_write(r, &v, &res, &err);
   }
-  if (ok && !a.quiet) print_times(&res, a.frames, lm_renderer_clock(r));
+  if (ok && !a.quiet) print_times(&res, a.frames, a.warmup, lm_renderer_clock(r));
   if (!ok) lm_log(LM_LOG_ERROR, "%s", err.msg);
   capture_result_free(&res);
   lm_renderer_destroy(r);

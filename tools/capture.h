@@ -7,6 +7,7 @@
 
 typedef struct capture_view {
   int camera, width, height, frames;
+  int warmup; /* frames rendered first, untimed */
   const char *const *outputs; /* .png (sRGB), .exr (linear), ... */
   int output_count;
   bool quiet;

@@ -2,16 +2,18 @@
 # tools/gi_time.sh: frame time of GI techniques against dl+esm, as ratios
 # measured in one run: each technique renders every scene of the reference
 # set (data/jobs/reference.lua's scenes, camera 0) at SIZE, FRAMES timed
-# frames after one warm-up (capture's median "total"), interleaved scene by
-# scene so that load on the machine falls on all alike. A benchmark, not a
-# test: it prints figures and exits 0 when the run completes.
+# frames after WARMUP untimed ones (capture's median "total"), interleaved
+# scene by scene so that load on the machine falls on all alike. A
+# benchmark, not a test: it prints figures and exits 0 when the run completes.
 #   BUILD_DIR  the build (default build)   SIZE  (default 256x192)
 #   FRAMES     timed frames (default 5)    TECHS (default below; "tech:opt=v,opt=v" sets options)
+#   WARMUP     untimed frames first (default 1; with temporal reuse, more than rsm.temporal.frames
+#              times the converged frame)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 LIMN=${BUILD_DIR:-build}/limn
 [ -x "$LIMN" ] || { echo "gi_time: no $LIMN (build first: tools/dev.sh build)" >&2; exit 2; }
-SIZE=${SIZE:-256x192} FRAMES=${FRAMES:-5}
+SIZE=${SIZE:-256x192} FRAMES=${FRAMES:-5} WARMUP=${WARMUP:-1}
 read -r -a techs <<< "${TECHS:-dl+esm rsm+esm vpl+esm isr+rsm+esm isr+esm lpv+esm isr+lpv+esm}"
 scenes=(data/scenes/reference/room.glb data/scenes/reference/street.glb data/scenes/reference/blocks.glb
         data/scenes/cornell.glb)
@@ -23,13 +25,14 @@ for scene in "${scenes[@]}"; do
       IFS=, read -r -a sets <<< "${spec#*:}"
       for s in "${sets[@]}"; do args+=(--set "$s"); done
     fi
-    ms=$("$LIMN" capture --scene "$scene" "${args[@]}" --size "$SIZE" --frames $((FRAMES + 1)) --set ambient=0 \
+    ms=$("$LIMN" capture --scene "$scene" "${args[@]}" --size "$SIZE" --warmup "$WARMUP" --frames "$FRAMES" --set ambient=0 \
            --output /tmp/gi_time_$$.png 2>&1 | awk '$1 == "total" { print $2 }')
     sum[$spec]=$(awk -v a="${sum[$spec]:-0}" -v b="$ms" 'BEGIN { print a + b }')
   done
 done
 rm -f /tmp/gi_time_$$.png
 base=${techs[0]}
+echo "frame time: median of $FRAMES frames after $WARMUP untimed; clock: capture's (glFinish + CLOCK_MONOTONIC on llvmpipe)"
 printf "%-40s %10s %8s\n" "technique ($SIZE, ${#scenes[@]} scenes)" "ms/frame" "time x"
 for spec in "${techs[@]}"; do
   awk -v n="${#scenes[@]}" -v s="${sum[$spec]}" -v b="${sum[$base]}" -v t="$spec" \

@@ -1,0 +1,53 @@
+// Temporal reuse's reprojection (seed 004, chapter 3.3), shared by the
+// accumulation (temporal.frag) and the GI passes that skip their work where
+// it has converged (TEMPORAL_SKIP in rsm.frag): both must take the same
+// history texel and make the same decision. The history is last frame's
+// accumulation: value (rgb V, a frames seen) and depth (r: view depth, 0
+// none), at the coarse size of the pass.
+#ifndef LIMN_TEMPORAL_GLSL
+#define LIMN_TEMPORAL_GLSL
+#include "common.glsl"
+#include "halton.glsl"
+
+uniform sampler2D history, history_depth;
+uniform float epsilon = 0.02, frames = 36.0;
+uniform int refresh = 8;
+
+// The history of the pixel at uv whose coarse depth is d (dpt): the
+// pixel's world position through the previous frame's view-projection; kept
+// where the previous frame stored a depth that matches the reprojected
+// clip w (the view depth there) within `epsilon` of it (relative: any
+// unit), else dropped (off the last frame, disoccluded). False: none.
+bool temporal_history(vec2 uv, float d, out vec4 h) {
+  h = vec4(0.0);
+  vec4 c = frame.prev_view_proj * vec4(position_from_depth(uv, d), 1.0);
+  if (c.w <= 1e-12) return false;
+  vec2 q = c.xy / c.w * 0.5 + 0.5;
+  if (any(lessThan(q, vec2(0.0))) || any(greaterThan(q, vec2(1.0)))) return false;
+  ivec2 size = textureSize(history, 0), t = clamp(ivec2(q * vec2(size)), ivec2(0), size - 1);
+  h = texelFetch(history, t, 0);
+  float hd = texelFetch(history_depth, t, 0).r;
+  return hd > 0.0 && abs(hd - c.w) <= epsilon * hd && h.a >= 1.0;
+}
+
+// Does pixel px take fresh samples this frame although it has converged?
+// Tiles of 4 x 4 pixels (the interleaved pattern's) take turns, one frame
+// in `refresh` each (the seed's refreshed tiles), so that a converged pixel
+// whose light changed finds out (its confidence drops) within `refresh`
+// frames. A tile's turn is its Bayer index among 4 x 4 tiles and of its
+// block among 4 x 4 blocks (256 turns): each frame refreshes the same share
+// of the image, scattered over it. 0: never.
+bool temporal_refresh(ivec2 px) {
+  if (refresh <= 0) return false;
+  ivec2 tile = px >> 2;
+  int turn = interleave_index(tile, 4) + 16 * interleave_index(tile >> 2, 4);
+  return (turn + int(frame.time.y)) % refresh == 0;
+}
+
+// Has the pixel's accumulation converged, so that this frame's samples
+// would not change it? Its history holds `frames` frames and it is not
+// being refreshed. The accumulation then keeps the history as it is.
+bool temporal_converged(vec2 uv, float d, ivec2 px, out vec4 h) {
+  return temporal_history(uv, d, h) && h.a >= max(frames, 1.0) && !temporal_refresh(px);
+}
+#endif
