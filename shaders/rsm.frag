@@ -15,7 +15,8 @@
 // 1 / (2 pi R^2 xi_1), so each sample weighs 2 pi R^2 xi_1 T^2 / N texels
 // (T the tile's side): the seed's "samples weighed by their squared
 // distance" (line 917) made exact for this pattern. Samples outside the tile
-// or on an empty texel add nothing.
+// or on an empty texel add nothing; so R is at most the distance to the
+// tile's farthest corner, where the disc covers the whole tile already.
 // Interleaved sampling: the pattern is one sequence, xi_1 = Phi_2(k) (van der
 // Corput) and xi_2 = k phi (golden ratio, mod 1), of which pixel j of a 4 x 4
 // tile (Bayer order, halton.glsl) takes the block k = j n .. j n + n - 1: each
@@ -112,11 +113,14 @@ void main() {
       vec2 centre = c.w > 1e-12 ? c.xy / c.w * 0.5 + 0.5 : vec2(0.5);
       centre = clamp(centre, vec2(0.0), vec2(1.0)); // behind a cube face: its nearest edge
       float tile = sv.rect.z * atlas.x;
-      float texels = 2.0 * PI * radius * radius * tile * tile / float(max(n, 1));
+      // The disc reaches no farther than the tile's farthest corner: beyond it every sample would fall
+      // outside and add nothing, so the pattern keeps its samples where texels are.
+      float reach = min(radius, length(max(centre, 1.0 - centre)));
+      float texels = 2.0 * PI * reach * reach * tile * tile / float(max(n, 1));
       vec2 dir = vec2(cos(a0), sin(a0));
       for (int k = 0; k < n; k++, dir = vec2(dir.x * TURN.x - dir.y * TURN.y, dir.x * TURN.y + dir.y * TURN.x)) {
         float xi = fract(radical_inverse(k0 + uint(k), 2u) + centred);
-        vec2 t = centre + xi * radius * dir;
+        vec2 t = centre + xi * reach * dir;
         if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
         ivec2 a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
         vec4 qn = texelFetch(rsm_pos, a, 0); // position, normal (normal_pack)
