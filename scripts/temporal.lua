@@ -21,8 +21,9 @@ temporal.defaults = {
   bias = 0.1,       -- the seed's confidence bias, 0..16
   confidence = 0.25, -- a pixel whose confidence falls below this starts again, 0..1 (above
                      -- about 0.5 the noise of a few samples restarts pixels that should not)
-  refresh = 8,      -- a converged pixel's 4 x 4 tile takes fresh samples one frame in this many,
-                    -- so that a change of its light shows within as many frames, 0..1024 (0: never)
+  refresh = 32,     -- a converged pixel's 4 x 4 tile takes fresh samples one frame in this many,
+                    -- so that a change of its light shows within as many frames, 0..1024 (0: never;
+                    -- the seed: one 16 x 16 tile a frame, 1 in 256 at its half of 512 x 512)
 }
 
 local rules = {

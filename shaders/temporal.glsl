@@ -11,7 +11,7 @@
 
 uniform sampler2D history, history_depth;
 uniform float epsilon = 0.02, frames = 36.0;
-uniform int refresh = 8;
+uniform int refresh = 32;
 
 // The history of the pixel at uv whose coarse depth is d (dpt): the
 // pixel's world position through the previous frame's view-projection; kept

@@ -314,7 +314,7 @@ static void still_frames_with_temporal_reuse_converge(void **state) {
 
 /* Temporal reuse stops gathering where it has converged: on a still camera
  * after `frames` (36) frames the gather writes light only in the tiles it
- * refreshes (one 4 x 4 tile in rsm.temporal.refresh = 8 a frame), against
+ * refreshes (one 4 x 4 tile in rsm.temporal.refresh = 32 a frame), against
  * every lit pixel in the second frame. A light that then grows 10^4 times
  * (so that the seed's confidence drops below 0.25 and its pixels restart)
  * shows on the ceiling the spot's patch alone lights within `refresh` frames
@@ -344,17 +344,17 @@ static void converged_pixels_skip_the_gather_and_refreshed_tiles_see_changes(voi
     float before[3];
     gl_region(&r, W / 4, H / 4, 3 * W / 4, 3 * H / 4, before);
     s->lights[0].power *= 1e4f;
-    for (int f = 0; f < 8; f++) assert_true(gl_render_again(&r));
+    for (int f = 0; f < 32; f++) assert_true(gl_render_again(&r));
     gl_result fresh = render_ok(s, "rsm+esm", fresh_sets);
     float after[3], want[3];
     gl_region(&r, W / 4, H / 4, 3 * W / 4, 3 * H / 4, after);
     gl_region(&fresh, W / 4, H / 4, 3 * W / 4, 3 * H / 4, want);
     print_message("refresh %s: gathered %d texels in frame 2, %d in frame 40; ceiling %.4f, light 10^4 x: %.2f after "
-                  "8 frames (fresh %.2f)\n", k ? "0" : "8", lit_early, lit_late, gl_luminance(before),
+                  "32 frames (fresh %.2f)\n", k ? "0" : "32", lit_early, lit_late, gl_luminance(before),
                   gl_luminance(after), gl_luminance(want));
     assert_true(lit_early > 0);
     if (k == 0) {
-      assert_true(lit_late < 0.25 * lit_early && lit_late > 0);
+      assert_true(lit_late < 0.1 * lit_early && lit_late > 0);
       assert_true(gl_luminance(after) > 0.5f * gl_luminance(want));
     } else {
       assert_true(lit_late == 0);
