@@ -650,7 +650,8 @@ static void unchanged_tiles_are_kept_and_changed_ones_drawn(void **state) {
 static void tiles_whose_texture_another_target_shares_are_copied_back(void **state) {
   (void)state;
   lm_scene *s = builtin("cornell");
-  static const char *const blur[] = {"shadow.blur=2", NULL}, *const off[] = {"shadow.blur=2", "shadow.cache=false", NULL};
+  static const char *const blur[] = {"shadow.blur=2", NULL},
+                           *const off[] = {"shadow.blur=2", "shadow.cache=false", NULL};
   gl_result c = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .frames = 2, .sets = blur});
   gl_result u = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .frames = 2, .sets = off});
   assert_true(c.ok && u.ok);
