@@ -120,18 +120,22 @@ function lpv.volume(G, R, o, exclude_seen)
   return { early = early, late = late, cell = h, seen = R.seen }
 end
 
--- Records the lookup over the coarse G-buffer C (isr.coarse_gbuffer, factor
--- f) in the volumes V (lpv.volume). base (optional): a coarse result to add
--- to (the screen-space pass's). Returns the coarse E.
+-- Records the lookup over the coarse G-buffer C (isr.coarse_view or
+-- isr.coarse_gbuffer, factor f) in the volumes V (lpv.volume). base
+-- (optional): a coarse result to add to (the screen-space pass's). Returns
+-- the coarse E.
 function lpv.gather(C, f, V, o, base)
   local inputs = gbuffer.inputs(C)
   if V.early then inputs.early_r, inputs.early_g, inputs.early_b = V.early[1], V.early[2], V.early[3] end
   if V.late then inputs.late_r, inputs.late_g, inputs.late_b = V.late[1], V.late[2], V.late[3] end
   inputs.base, inputs.lpv_seen = base, V.seen
-  return pass{ "lpv.lookup", shader = "lpv_lookup.frag", inputs = inputs,
-               defines = { EARLY = V.early ~= nil, LATE = V.late ~= nil, BASE = base ~= nil },
-               params = grid(o, V.cell, { lpv_steps = o.steps }),
-               fetches = 4 + o.cascades * 24, out = target{ "lpv.e", format = "rgba16f", scale = 1 / f } }
+  local z = C.z and not base -- the first pass over a view writes its depth (isr.coarse_view)
+  local E = target{ "lpv.e", format = "rgba16f", scale = 1 / f }
+  pass{ "lpv.lookup", shader = "lpv_lookup.frag", inputs = inputs,
+        defines = { EARLY = V.early ~= nil, LATE = V.late ~= nil, BASE = base ~= nil, STRIDE = C.stride, Z = z },
+        params = grid(o, V.cell, { lpv_steps = o.steps }),
+        fetches = 4 + o.cascades * 24, out = { E, z and C.z or nil } }
+  return E
 end
 
 -- Records LPV lighting of G given its direct light `direct` (no ambient
@@ -139,7 +143,7 @@ end
 -- b}, background = {r, g, b}, sky }. Returns the lit target.
 function lpv.render(G, direct, R, o, light)
   local f = o.coarse
-  local C = isr.coarse_gbuffer(G, direct, f)
+  local C = isr.coarse_view(G, direct, f)
   local E = isr.blur(lpv.gather(C, f, lpv.volume(G, R, o), o), C, f, o.blur)
   return isr.composite(G, direct, C, E, { ambient = light.ambient, background = light.background, k = o.k }, false,
                        light.sky)

@@ -1,16 +1,21 @@
 // A later bounce of the physical ISR transport (isr_march.frag) from the hits
 // its first march recorded (HITS targets, four rays each: 1 + the index of
-// the coarse texel a ray's sender lies on, 0 for none). Every bounce marches the same rays
+// the G-buffer texel a ray's sender lies on, 0 for none). Every bounce marches the same rays
 // through the same depth buffer and meets the same senders, so this sums over
 // them what the march with BOUNCE would:
 //   E(p) = 1/n sum over sending rays of sender(q) + k_d albedo(q) previous(q)
-// with previous the last step's E; A, the share of open rays, is previous's.
+// with previous the last step's E (at the coarse texel over q, the G-buffer
+// being STRIDE times finer); A, the share of open rays, is previous's.
 #include "gbuffer.glsl"
 
+#ifndef STRIDE
+#define STRIDE 1
+#endif
+
 in vec2 uv;
-uniform sampler2D clr, mat;  // coarse G-buffer
-uniform sampler2D sender;    // coarse direct light
-uniform sampler2D previous;  // the last step's E (rgb), A (a)
+uniform sampler2D clr, mat;  // the G-buffer the march read
+uniform sampler2D sender;    // direct light, the G-buffer's size
+uniform sampler2D previous;  // the last step's E (rgb), A (a), the output's size
 uniform sampler2D hits0;
 #if HITS > 1
 uniform sampler2D hits1;
@@ -27,9 +32,6 @@ uniform sampler2D hits4;
 #if HITS > 5
 uniform sampler2D hits5;
 #endif
-#if HITS > 6
-uniform sampler2D hits6;
-#endif
 uniform int samples = 12;
 
 out vec4 isr;
@@ -40,7 +42,8 @@ vec3 sent(float hit, int width) {
   int k = int(hit - 0.5);
   ivec2 q = ivec2(k % width, k / width);
   vec4 c = texelFetch(clr, q, 0);
-  return texelFetch(sender, q, 0).rgb + texelFetch(mat, q, 0).y * c.rgb * texelFetch(previous, q, 0).rgb;
+  vec3 e = texelFetch(previous, min(q / STRIDE, textureSize(previous, 0) - 1), 0).rgb;
+  return texelFetch(sender, q, 0).rgb + texelFetch(mat, q, 0).y * c.rgb * e;
 }
 
 vec3 sent4(vec4 h, int width) { return sent(h.x, width) + sent(h.y, width) + sent(h.z, width) + sent(h.w, width); }
@@ -63,9 +66,6 @@ void main() {
 #endif
 #if HITS > 5
   gathered += sent4(texelFetch(hits5, px, 0), width);
-#endif
-#if HITS > 6
-  gathered += sent4(texelFetch(hits6, px, 0), width);
 #endif
   isr = vec4(gathered / float(n), texelFetch(previous, px, 0).a);
 }

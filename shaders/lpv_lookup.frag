@@ -31,8 +31,15 @@
 // light fades to nothing.
 // Output: rgb = E / pi, a = 1 (it occludes no ambient term); with BASE, the
 // screen-space pass's coarse result `base` plus it (its a kept).
+// With STRIDE, each texel reads the G-buffer, STRIDE times finer, at its
+// block's centre (isr.coarse_view); with Z it also writes that depth / far,
+// 0 where nothing is drawn, into z (the view's depth).
 #include "gbuffer.glsl"
 #include "lpv.glsl"
+
+#ifndef STRIDE
+#define STRIDE 1
+#endif
 
 in vec2 uv;
 uniform sampler2D clr, nrm, dpt, mat;         // (coarse) G-buffer
@@ -47,7 +54,10 @@ uniform sampler2D base;
 #endif
 uniform int lpv_steps = 8;
 
-out vec4 result;
+layout(location = 0) out vec4 result;
+#ifdef Z
+layout(location = 1) out float z;
+#endif
 
 const float D = 0.674213;
 
@@ -102,7 +112,10 @@ void main() {
 #else
   vec4 b = vec4(0.0, 0.0, 0.0, 1.0);
 #endif
-  Surface s = gbuffer_fetch(clr, nrm, dpt, mat, px);
+  Surface s = gbuffer_fetch(clr, nrm, dpt, mat, block_centre(px, STRIDE, textureSize(dpt, 0)));
+#ifdef Z
+  z = s.covered ? s.depth01 : 0.0;
+#endif
   if (!s.covered) {
     result = b;
     return;
