@@ -44,9 +44,10 @@ bool cascade_rect(ShadowView sv, int c, out vec2 lo, out vec2 hi) {
   lo = vec2(0.0);
   hi = vec2(1.0);
   if (sv.depth.w > 0.0) return true;
-  float half_side = 0.5 * float(lpv_cells) * lpv_cell_size(c);
+  vec3 half_side = 0.5 * vec3(lpv_dims(c)) * lpv_cell_size(c);
   vec2 centre = (sv.view_proj * vec4(lpv_origin(c) + half_side, 1.0)).xy * 0.5 + 0.5;
-  vec2 reach = half_side * 0.5 * (abs(sv.view_proj[0].xy) + abs(sv.view_proj[1].xy) + abs(sv.view_proj[2].xy));
+  vec2 reach = 0.5 * (abs(sv.view_proj[0].xy) * half_side.x + abs(sv.view_proj[1].xy) * half_side.y +
+                      abs(sv.view_proj[2].xy) * half_side.z);
   lo = clamp(centre - reach, 0.0, 1.0);
   hi = clamp(centre + reach, 0.0, 1.0);
   return all(greaterThan(hi, lo));
@@ -121,9 +122,8 @@ void main() {
 #endif
   float h = lpv_cell_size(c);
   ivec3 cell = ivec3(floor((p + side * h * n - lpv_origin(c)) / h));
-  if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, ivec3(lpv_cells)))) return;
-  vec2 size = vec2(lpv_cells * lpv_cells, lpv_cells * lpv_cascades);
-  gl_Position = vec4((vec2(lpv_texel(cell, c)) + 0.5) / size * 2.0 - 1.0, 0.0, 1.0);
+  if (!lpv_inside(cell, c)) return;
+  gl_Position = vec4((vec2(lpv_texel(cell, c)) + 0.5) / vec2(lpv_size) * 2.0 - 1.0, 0.0, 1.0);
 #ifdef GEOMETRY
   v_r = lpv_finite(lpv_lobe(area / max(h * h, 1e-30), -n)); // h^2 may underflow
 #else
