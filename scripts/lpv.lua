@@ -119,18 +119,30 @@ end
 function lpv.volume(G, R, o, exclude_seen)
   local grids = layout(o, cell_size(o))
   local function volume(name) return target{ name, format = "rgba32f", size = grids.size } end
+  -- Points a cascade: vpls^2 VPLs shared among the RSM views and a grid of surfels `surfels` a row. The
+  -- cascades that hold the whole scene (the coarser ones from the first that does) take the same part of
+  -- each RSM view and of the screen: each then takes half as many a side as the last, as many for each of
+  -- its cells (the points cost about a microsecond each, and three cascades drew three times as many).
   local w, ht = output_size()
-  local rows = o.surfels > 0 and math.max(1, (o.surfels * ht + w // 2) // w) or 0
   local side = math.max(1, math.floor(o.vpls / math.sqrt(math.max(R.views, 1)) + 0.5))
-  local params = grid(o, grids, { vpl_side = side, rsm_views = R.views, surfel_grid = { o.surfels, rows } })
+  local sides, cols, rows, vpls, surfels, whole = {}, {}, {}, 0, 0, nil
+  for c = 1, 4 do
+    whole = whole or grids.follow[c] == 0 and c
+    local thin = whole and 2 ^ (c - whole) or 1
+    sides[c] = math.max(1, math.floor(side / thin + 0.5))
+    cols[c] = o.surfels > 0 and math.max(1, math.floor(o.surfels / thin + 0.5)) or 0
+    rows[c] = o.surfels > 0 and math.max(1, (cols[c] * ht + w // 2) // w) or 0
+    if c <= o.cascades then vpls, surfels = vpls + R.views * sides[c] ^ 2, surfels + cols[c] * rows[c] end
+  end
+  local params = grid(o, grids, { vpl_sides = sides, rsm_views = R.views, surfel_cols = cols, surfel_rows = rows })
   local inputs = { rsm_flux = R.flux, rsm_nrm = R.nrm, rsm_pos = R.pos, nrm = G.nrm, dpt = G.dpt, mat = G.mat,
                    lpv_seen = R.seen }
   local inj = { volume("lpv.inject_r"), volume("lpv.inject_g"), volume("lpv.inject_b") }
   points{ "lpv.inject", vertex = "lpv_inject.vert", shader = "lpv_inject.frag",
-          count = R.views * side * side * o.cascades, inputs = inputs, params = params,
+          count = vpls, inputs = inputs, params = params,
           defines = { SHADOWS = true, EXCLUDE_SEEN = exclude_seen == true }, fetches = 4, out = inj }
   local geometry = points{ "lpv.geometry", vertex = "lpv_inject.vert", shader = "lpv_inject.frag",
-                           count = o.surfels * rows * o.cascades, inputs = inputs, params = params,
+                           count = surfels, inputs = inputs, params = params,
                            defines = { SHADOWS = true, GEOMETRY = true }, fetches = 3,
                            out = volume("lpv.geometry") }
   -- The injected light itself (step 0) is in no sum: it sits in its VPL's own cell, which a thin
