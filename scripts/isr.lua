@@ -163,7 +163,7 @@ function isr.render(G, direct, o, light, extra)
   if o.mode ~= "seed" then seed = nil end
   local f = factor(o)
   local C = seed and isr.coarse_gbuffer(G, direct, f) or isr.coarse_view(G, direct, f)
-  local E, H
+  local E, E1, H
   local hits = seed and 0 or hit_targets(o)
   for b = 1, seed and seed.bounces or o.bounces do
     local inputs = gbuffer.inputs(C)
@@ -175,17 +175,20 @@ function isr.render(G, direct, o, light, extra)
                 fetches = 4 + seed.samples * (E and 6 or 5), -- at most: G-buffer and sender (and bounce) a sample
                 defines = { BOUNCE = E ~= nil }, out = coarse_target("isr.e" .. b, f) }
     elseif H then
-      local from = { clr = C.clr, mat = C.mat, sender = C.direct, previous = E }
+      local from = { clr = C.clr, mat = C.mat, first = E1, previous = E }
       for k = 1, hits do from["hits" .. (k - 1)] = H[k] end
       E = pass{ name, shader = "isr_bounce.frag", inputs = from, params = { samples = o.samples },
-                fetches = 1 + hits + 4 * o.samples, -- the hits, and four fetches a sending ray
+                fetches = 2 + hits + 3 * o.samples, -- first, the hits, and three fetches a sending ray
                 defines = { HITS = hits, STRIDE = C.stride }, out = coarse_target("isr.e" .. b, f) }
     else
       inputs.sender = C.direct
-      E = coarse_target("isr.e" .. b, f)
+      -- The later bounces add to the first E (isr_bounce.frag), or march from it: 32-bit floats in
+      -- either case, so that both give the same sum.
+      E = b == 1 and o.bounces > 1 and target{ "isr.e1", format = "rgba32f", scale = 1 / f }
+          or coarse_target("isr.e" .. b, f)
       local out = { E, b == 1 and C.z or nil }
       if b == 1 and hits > 0 then
-        H = {}
+        E1, H = E, {}
         for k = 1, hits do
           H[k] = target{ "isr.hits" .. k, format = "rgba32f", scale = 1 / f }
           out[k + 2] = H[k]

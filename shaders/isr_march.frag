@@ -66,7 +66,7 @@ uniform sampler2D sender;             // direct light, the G-buffer's size
 #ifdef BOUNCE
 uniform sampler2D previous;           // the last step's E, the output's size
 #endif
-uniform int samples = 12;
+uniform int samples = 4;
 uniform int steps = 10;
 uniform float thickness = 0.02; // fraction of a surface's depth
 uniform vec3 scene_lo = vec3(-1e30), scene_hi = vec3(1e30); // the scene's box, a little wider (isr.lua)
