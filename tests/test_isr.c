@@ -126,7 +126,7 @@ static void bad_options_name_themselves(void **state) {
   static const gl_bad_option cases[] = {
       {"isr", "isr.samples=0", "isr.samples must be a whole number in 1..256 (got 0)"},
       {"isr", "isr.samples=2.5", "isr.samples must be"},
-      {"isr", "isr.coarse=3", "isr.coarse must be one of 0, 1, 2, 4"},
+      {"isr", "isr.coarse=5", "isr.coarse must be one of 0, 1, 2, 3, 4"},
       {"isr", "isr.seed.radius=0", "isr.seed.radius must be a positive"},
       {"isr", "isr.seed.k_ssao=-1", "isr.seed.k_ssao must be a finite number in 0..1"},
       {"isr", "isr.seed.sender=sun", "isr.seed.sender must be one of albedo, lit (got sun)"},
@@ -277,12 +277,13 @@ static void later_bounces_from_the_recorded_senders_are_the_marched_ones(void **
 
 /* isr.coarse 0 (the default) gathers over a grid at least 128 texels wide:
  * coarse 2 up to 511 pixels wide, 4 from 512 (the same 128 x 96 grid at
- * 256 x 192 and 512 x 384); a coarse factor given is kept. */
+ * 256 x 192 and 512 x 384); below 256 pixels wide, 3; a coarse factor
+ * given is kept. */
 static void the_auto_coarse_grid_keeps_its_size_relative_to_the_view(void **state) {
   (void)state;
   static const struct { int w, h; const char *set; int grid_w; } cases[] = {
-      {256, 192, NULL, 128}, {510, 384, NULL, 255}, {512, 384, NULL, 128}, {1024, 768, NULL, 256},
-      {512, 384, "isr.coarse=2", 256}};
+      {160, 120, NULL, 53},  {255, 192, NULL, 85},  {256, 192, NULL, 128}, {510, 384, NULL, 255},
+      {512, 384, NULL, 128}, {1024, 768, NULL, 256}, {512, 384, "isr.coarse=2", 256}};
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
     const char *const sets[] = {cases[i].set, NULL};
     gl_result r = gl_render(&(gl_run){.tech = "isr", .sets = cases[i].set ? sets : NULL, .width = cases[i].w,
