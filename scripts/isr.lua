@@ -12,8 +12,10 @@
 --            defaults in isr.seed): albedo or lit senders in a disc of world
 --            radius, no visibility, k_ISR and k_SSAO (isr.frag)
 -- Steps:
---   1. coarse CLR, NRM, DPT, MAT and direct light (isr_downsample.frag;
---      skipped at coarse 1)
+--   1. seed: coarse CLR, NRM, DPT, MAT and direct light (isr_downsample.frag;
+--      skipped at coarse 1); physical: none, its passes read the G-buffer at
+--      each coarse texel's block centre and march through the full depth
+--      buffer (isr.coarse_view)
 --   2. the transport step, repeated for more bounces with the last step's
 --      indirect light added to the senders' radiance (physical: the first
 --      march records each ray's sender and the later bounces sum over those,
@@ -30,7 +32,8 @@ local isr = {}
 -- The options a pipeline exposes (pp.lua's Options.isr), with their defaults.
 isr.defaults = {
   mode = "physical", -- "physical" (gi-scale.md) or "seed" (seed 000's eq 25-29, options in isr.seed)
-  samples = 12,      -- rays a coarse pixel, 1..256
+  samples = 4,       -- rays a coarse pixel, 1..256; a 4 x 4 tile of pixels takes 16 times as many
+                     -- directions, which the blur averages
   steps = 10,        -- depth-march steps a ray, 1..64, spread geometrically from one coarse
                      -- pixel's footprint to where the ray leaves the view (no world unit)
   thickness = 0.02,  -- a surface hides what lies this fraction of its depth behind it, 0..1
@@ -38,9 +41,9 @@ isr.defaults = {
   bounces = 2,       -- transport steps, 1..4 (POV-Ray's recursion_limit 2: two bounces)
   reuse = true,      -- later bounces sum over the senders the first march met (the same rays meet
                      -- the same senders every bounce); false: march again every bounce
-  coarse = 0,        -- coarse factor a side: 1, 2 or 4; 0 (auto): 2, or 4 where the coarse grid
-                     -- is still at least 128 texels wide (from 512 pixels wide), a grid as fine
-                     -- relative to the view as 256 pixels wide at 2
+  coarse = 0,        -- coarse factor a side: 1, 2, 3 or 4; 0 (auto): 3 below 256 pixels wide, 2,
+                     -- and 4 where the coarse grid is still at least 128 texels wide (from 512
+                     -- pixels wide), a grid as fine relative to the view as 256 pixels wide at 2
   blur = 4,          -- Gaussian taps each side at coarse size, 0..32 (0: no blur)
   view = "lit",      -- "lit"; "indirect" (the indirect light) or "ao" (accessibility) to inspect
   seed = {           -- mode "seed": the dissertation's parameters
@@ -72,13 +75,14 @@ local rules = {
   k = options.number(0, 16),
   bounces = options.whole(1, 4),
   reuse = options.boolean,
-  coarse = options.one_of(0, 1, 2, 4),
+  coarse = options.one_of(0, 1, 2, 3, 4),
   blur = options.whole(0, 32),
   view = options.one_of("lit", "indirect", "ao"),
   seed = function(v) if type(v) ~= "table" then return "a table of the seed mode's options" end end,
 }
 
--- The coarse G-buffer and direct light: G itself at factor 1 (rsm.lua shares it).
+-- The coarse G-buffer and direct light, each texel its block's average: G
+-- itself at factor 1 (rsm.lua and vpl.lua share it).
 function isr.coarse_gbuffer(G, direct, f)
   if f == 1 then
     local C = gbuffer.inputs(G)
@@ -99,10 +103,27 @@ function isr.coarse_gbuffer(G, direct, f)
   return C
 end
 
+-- A coarse grid over G without a pass of its own: the passes over it
+-- (isr_march, isr_bounce and lpv_lookup with STRIDE = stride) read G's texel
+-- at each coarse texel's block centre (block_centre), where a coarse copy
+-- would average the block, and the march steps through G's full depth. The
+-- first of them (the march, or the LPV's lookup alone) writes the grid's
+-- depth into z (0 where nothing is drawn), which the blur and the composite
+-- read. Against the copy (isr.downsample), at 160 x 120 on the room: 0.45 ms
+-- a frame less, the march 0.25 ms more (its depth and senders at full size).
+function isr.coarse_view(G, direct, f)
+  return { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat, direct = direct, stride = f,
+           z = target{ "isr.z", format = "r32f", scale = 1 / f } }
+end
+
 -- The coarse factor: o.coarse, or for 0 the auto factor at this output size.
+-- Below 256 pixels wide, 3: on the reference set at 160 x 120 (tools/fidelity.sh)
+-- it removes 42.1% of dl+esm's indirect error against 42.9% at 2, in 80% of the
+-- frame time, where the passes' costs per frame weigh most against dl+esm's.
 local function factor(o)
   if o.coarse > 0 then return o.coarse end
-  return output_size() // 4 >= 128 and 4 or 2
+  local w = output_size()
+  return w // 4 >= 128 and 4 or w < 256 and o.mode == "physical" and 3 or 2
 end
 
 local function coarse_target(name, f)
@@ -111,12 +132,27 @@ end
 
 -- How many targets of four rays' hits the first march records for the later
 -- bounces (isr_march.frag's HITS): none for one bounce, or when they would
--- not fit in the 7 colour outputs beside E or a texel's index in a float.
-local function hit_targets(o, f)
+-- not fit in the 6 colour outputs beside E and z or an index of the
+-- G-buffer's texels in a float.
+local function hit_targets(o)
   local w, h = output_size()
   local n = (o.samples + 3) // 4
-  if not o.reuse or o.bounces < 2 or n > 7 or (w // f + 1) * (h // f + 1) >= 1 << 24 then return 0 end
+  if not o.reuse or o.bounces < 2 or n > 6 or (w + 1) * (h + 1) >= 1 << 24 then return 0 end
   return n
+end
+
+-- The march's params: the scene's box (scene_bounds), wider by a hundredth
+-- of its diagonal a side so that a point the depth buffer places on its
+-- surface lies inside; none for a scene without geometry.
+local function march_params(o)
+  local params = { samples = o.samples, steps = o.steps, thickness = o.thickness }
+  local lo, hi = scene_bounds()
+  if lo then
+    local d = math.sqrt((hi[1] - lo[1]) ^ 2 + (hi[2] - lo[2]) ^ 2 + (hi[3] - lo[3]) ^ 2) * 0.01
+    params.scene_lo = { lo[1] - d, lo[2] - d, lo[3] - d }
+    params.scene_hi = { hi[1] + d, hi[2] + d, hi[3] + d }
+  end
+  return params
 end
 
 -- Records ISR lighting of G given its direct light `direct` (lights only, no
@@ -130,9 +166,9 @@ function isr.render(G, direct, o, light, extra)
   local seed = options.check("isr.seed", isr.defaults.seed, o.seed, seed_rules, 2) -- checked in either mode
   if o.mode ~= "seed" then seed = nil end
   local f = factor(o)
-  local C = isr.coarse_gbuffer(G, direct, f)
-  local E, H
-  local hits = seed and 0 or hit_targets(o, f)
+  local C = seed and isr.coarse_gbuffer(G, direct, f) or isr.coarse_view(G, direct, f)
+  local E, E1, H
+  local hits = seed and 0 or hit_targets(o)
   for b = 1, seed and seed.bounces or o.bounces do
     local inputs = gbuffer.inputs(C)
     inputs.previous = E
@@ -143,26 +179,28 @@ function isr.render(G, direct, o, light, extra)
                 fetches = 4 + seed.samples * (E and 6 or 5), -- at most: G-buffer and sender (and bounce) a sample
                 defines = { BOUNCE = E ~= nil }, out = coarse_target("isr.e" .. b, f) }
     elseif H then
-      local from = { clr = C.clr, mat = C.mat, sender = C.direct, previous = E }
+      local from = { clr = C.clr, mat = C.mat, first = E1, previous = E }
       for k = 1, hits do from["hits" .. (k - 1)] = H[k] end
       E = pass{ name, shader = "isr_bounce.frag", inputs = from, params = { samples = o.samples },
-                fetches = 1 + hits + 4 * o.samples, -- the hits, and four fetches a sending ray
-                defines = { HITS = hits }, out = coarse_target("isr.e" .. b, f) }
+                fetches = 2 + hits + 3 * o.samples, -- first, the hits, and three fetches a sending ray
+                defines = { HITS = hits, STRIDE = C.stride }, out = coarse_target("isr.e" .. b, f) }
     else
       inputs.sender = C.direct
-      E = coarse_target("isr.e" .. b, f)
-      local out = { E }
+      -- The later bounces add to the first E (isr_bounce.frag), or march from it: 32-bit floats in
+      -- either case, so that both give the same sum.
+      E = b == 1 and o.bounces > 1 and target{ "isr.e1", format = "rgba32f", scale = 1 / f }
+          or coarse_target("isr.e" .. b, f)
+      local out = { E, b == 1 and C.z or nil }
       if b == 1 and hits > 0 then
-        H = {}
+        E1, H = E, {}
         for k = 1, hits do
           H[k] = target{ "isr.hits" .. k, format = "rgba32f", scale = 1 / f }
-          out[k + 1] = H[k]
+          out[k + 2] = H[k]
         end
       end
-      pass{ name, shader = "isr_march.frag", inputs = inputs,
-            params = { samples = o.samples, steps = o.steps, thickness = o.thickness },
-            fetches = 4 + o.samples * (o.steps + (b > 1 and 11 or 10)), -- march, one bisection, the hit
-            defines = { BOUNCE = b > 1, HITS = H and hits or nil }, out = out }
+      pass{ name, shader = "isr_march.frag", inputs = inputs, params = march_params(o),
+            fetches = 4 + o.samples * (o.steps + (b > 1 and 6 or 5)), -- the march, and the hit's G-buffer and light
+            defines = { BOUNCE = b > 1, Z = b == 1, HITS = H and hits or nil, STRIDE = C.stride }, out = out }
     end
   end
   if extra then E = extra(C, E, f) end
@@ -177,13 +215,15 @@ function isr.render(G, direct, o, light, extra)
 end
 
 -- A separable Gaussian blur of the coarse result E over the coarse
--- G-buffer C that skips background and does not cross depth edges.
+-- G-buffer C (a copy, or a view with its depth z) that skips background and
+-- does not cross depth edges.
 function isr.blur(E, C, f, radius)
   if radius == 0 then return E end
+  local mask = not C.z and C.mat or nil -- a view's depth is its mask too
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
     E = pass{ "isr.blur_" .. axis[1], shader = "blur.frag",
-              inputs = { src = E, mask = C.mat, depth = C.dpt },
-              params = { axis = axis[2], radius = radius }, defines = { MASK = true, DEPTH = true },
+              inputs = { src = E, mask = mask, depth = C.z or C.dpt },
+              params = { axis = axis[2], radius = radius }, defines = { MASK = mask ~= nil, DEPTH = true },
               out = coarse_target("isr.blur_" .. axis[1], f) }
   end
   return E
@@ -193,11 +233,11 @@ end
 -- the direct light (isr_light.frag), to the target "lit"; skylight (from
 -- sky.light, may be nil) joins the ambient term.
 function isr.composite(G, direct, C, E, params, seed, skylight)
-  local defines = { SEED = seed }
+  local defines = { SEED = seed, Z_MASK = C.z ~= nil }
   sky.bind(skylight, params, defines)
   return pass{ "isr.light", shader = "isr_light.frag",
                inputs = { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat, direct = direct,
-                          isr = E, coarse_dpt = C.dpt, coarse_mat = C.mat },
+                          isr = E, coarse_dpt = C.z or C.dpt, coarse_mat = not C.z and C.mat or nil },
                defines = defines, params = params,
                out = target{ "lit", format = "rgba16f" } }
 end

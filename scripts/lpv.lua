@@ -70,9 +70,44 @@ local function cell_size(o)
   return o.extent * d / (o.cells * 2 ^ (o.cascades - 1))
 end
 
--- The uniforms of lpv.glsl.
-local function grid(o, h, params)
-  params.lpv_cells, params.lpv_cascades, params.lpv_cell, params.lpv_shift = o.cells, o.cascades, h, o.shift
+-- The cascades' grids (lpv.glsl) for cascade 0's cell side h: per cascade
+-- and axis, where the scene's box and a cell either side fit in o.cells
+-- cells, just those cells and their least corner (the grid stays put), else
+-- o.cells cells that follow the camera; the blocks' first columns and the
+-- volumes' size. Cascades past o.cascades (up to the uniforms' 4) are empty.
+local function layout(o, h)
+  local lo, hi = scene_bounds()
+  local G = { h = h, n = { {}, {}, {} }, corner = { {}, {}, {} }, follow = {}, col = {} }
+  local width, rows = 0, 1
+  for c = 1, 4 do
+    local hc, follow = h * 2 ^ (c - 1), 0
+    for k = 1, 3 do
+      local n, corner = o.cells, 0
+      local first = lo and math.floor(lo[k] / hc) - 1
+      local cells = lo and math.ceil(hi[k] / hc) + 1 - first
+      if cells and cells <= o.cells then
+        n, corner = cells, first * hc
+      else
+        follow = follow | 1 << (k - 1)
+      end
+      G.n[k][c], G.corner[k][c] = c <= o.cascades and n or 1, corner
+    end
+    G.follow[c], G.col[c] = follow, width
+    if c <= o.cascades then
+      width = width + G.n[1][c] * G.n[3][c]
+      rows = math.max(rows, G.n[2][c])
+    end
+  end
+  G.size = { width, rows }
+  return G
+end
+
+-- The uniforms of lpv.glsl for the grids G (layout).
+local function grid(o, G, params)
+  params.lpv_cascades, params.lpv_cell, params.lpv_shift = o.cascades, G.h, o.shift
+  params.lpv_nx, params.lpv_ny, params.lpv_nz = G.n[1], G.n[2], G.n[3]
+  params.lpv_ax, params.lpv_ay, params.lpv_az = G.corner[1], G.corner[2], G.corner[3]
+  params.lpv_follow, params.lpv_col, params.lpv_size = G.follow, G.col, G.size
   return params
 end
 
@@ -80,23 +115,34 @@ end
 -- second result) and the G-buffer G. exclude_seen: VPLs the camera sees are
 -- left out (the combined technique). Returns the volumes: { early = {r, g,
 -- b}, late = {r, g, b} (sums of steps 1 .. steps // 2 and the rest, nil when
--- none), cell = cascade 0's cell side, seen = R.seen }.
+-- none), grids = their layout, seen = R.seen }.
 function lpv.volume(G, R, o, exclude_seen)
-  local h = cell_size(o)
-  local size = { o.cells * o.cells, o.cells * o.cascades }
-  local function volume(name) return target{ name, format = "rgba32f", size = size } end
+  local grids = layout(o, cell_size(o))
+  local function volume(name) return target{ name, format = "rgba32f", size = grids.size } end
+  -- Points a cascade: vpls^2 VPLs shared among the RSM views and a grid of surfels `surfels` a row. The
+  -- cascades that hold the whole scene (the coarser ones from the first that does) take the same part of
+  -- each RSM view and of the screen: each then takes half as many a side as the last, as many for each of
+  -- its cells (the points cost about a microsecond each, and three cascades drew three times as many).
   local w, ht = output_size()
-  local rows = o.surfels > 0 and math.max(1, (o.surfels * ht + w // 2) // w) or 0
   local side = math.max(1, math.floor(o.vpls / math.sqrt(math.max(R.views, 1)) + 0.5))
-  local params = grid(o, h, { vpl_side = side, rsm_views = R.views, surfel_grid = { o.surfels, rows } })
+  local sides, cols, rows, vpls, surfels, whole = {}, {}, {}, 0, 0, nil
+  for c = 1, 4 do
+    whole = whole or grids.follow[c] == 0 and c
+    local thin = whole and 2 ^ (c - whole) or 1
+    sides[c] = math.max(1, math.floor(side / thin + 0.5))
+    cols[c] = o.surfels > 0 and math.max(1, math.floor(o.surfels / thin + 0.5)) or 0
+    rows[c] = o.surfels > 0 and math.max(1, (cols[c] * ht + w // 2) // w) or 0
+    if c <= o.cascades then vpls, surfels = vpls + R.views * sides[c] ^ 2, surfels + cols[c] * rows[c] end
+  end
+  local params = grid(o, grids, { vpl_sides = sides, rsm_views = R.views, surfel_cols = cols, surfel_rows = rows })
   local inputs = { rsm_flux = R.flux, rsm_nrm = R.nrm, rsm_pos = R.pos, nrm = G.nrm, dpt = G.dpt, mat = G.mat,
                    lpv_seen = R.seen }
   local inj = { volume("lpv.inject_r"), volume("lpv.inject_g"), volume("lpv.inject_b") }
   points{ "lpv.inject", vertex = "lpv_inject.vert", shader = "lpv_inject.frag",
-          count = R.views * side * side * o.cascades, inputs = inputs, params = params,
+          count = vpls, inputs = inputs, params = params,
           defines = { SHADOWS = true, EXCLUDE_SEEN = exclude_seen == true }, fetches = 4, out = inj }
   local geometry = points{ "lpv.geometry", vertex = "lpv_inject.vert", shader = "lpv_inject.frag",
-                           count = o.surfels * rows * o.cascades, inputs = inputs, params = params,
+                           count = surfels, inputs = inputs, params = params,
                            defines = { SHADOWS = true, GEOMETRY = true }, fetches = 3,
                            out = volume("lpv.geometry") }
   -- The injected light itself (step 0) is in no sum: it sits in its VPL's own cell, which a thin
@@ -113,25 +159,29 @@ function lpv.volume(G, R, o, exclude_seen)
     local inputs = { wave_r = wave[1], wave_g = wave[2], wave_b = wave[3], geometry = geometry }
     if sum then inputs.sum_r, inputs.sum_g, inputs.sum_b = sum[1], sum[2], sum[3] end
     pass{ "lpv.propagate" .. k, shader = "lpv_propagate.frag", inputs = inputs, defines = { SUM = sum ~= nil, FIRST = k == 1 },
-          params = grid(o, h, { occlusion = o.occlusion }), fetches = sum and 22 or 19, out = out }
+          params = grid(o, grids, { occlusion = o.occlusion }), fetches = sum and 22 or 19, out = out }
     wave = { out[1], out[2], out[3] }
     if k <= half then early = { out[4], out[5], out[6] } else late = { out[4], out[5], out[6] } end
   end
-  return { early = early, late = late, cell = h, seen = R.seen }
+  return { early = early, late = late, grids = grids, seen = R.seen }
 end
 
--- Records the lookup over the coarse G-buffer C (isr.coarse_gbuffer, factor
--- f) in the volumes V (lpv.volume). base (optional): a coarse result to add
--- to (the screen-space pass's). Returns the coarse E.
+-- Records the lookup over the coarse G-buffer C (isr.coarse_view or
+-- isr.coarse_gbuffer, factor f) in the volumes V (lpv.volume). base
+-- (optional): a coarse result to add to (the screen-space pass's). Returns
+-- the coarse E.
 function lpv.gather(C, f, V, o, base)
   local inputs = gbuffer.inputs(C)
   if V.early then inputs.early_r, inputs.early_g, inputs.early_b = V.early[1], V.early[2], V.early[3] end
   if V.late then inputs.late_r, inputs.late_g, inputs.late_b = V.late[1], V.late[2], V.late[3] end
   inputs.base, inputs.lpv_seen = base, V.seen
-  return pass{ "lpv.lookup", shader = "lpv_lookup.frag", inputs = inputs,
-               defines = { EARLY = V.early ~= nil, LATE = V.late ~= nil, BASE = base ~= nil },
-               params = grid(o, V.cell, { lpv_steps = o.steps }),
-               fetches = 4 + o.cascades * 24, out = target{ "lpv.e", format = "rgba16f", scale = 1 / f } }
+  local z = C.z and not base -- the first pass over a view writes its depth (isr.coarse_view)
+  local E = target{ "lpv.e", format = "rgba16f", scale = 1 / f }
+  pass{ "lpv.lookup", shader = "lpv_lookup.frag", inputs = inputs,
+        defines = { EARLY = V.early ~= nil, LATE = V.late ~= nil, BASE = base ~= nil, STRIDE = C.stride, Z = z },
+        params = grid(o, V.grids, { lpv_steps = o.steps }),
+        fetches = 4 + o.cascades * 24, out = { E, z and C.z or nil } }
+  return E
 end
 
 -- Records LPV lighting of G given its direct light `direct` (no ambient
@@ -139,7 +189,7 @@ end
 -- b}, background = {r, g, b}, sky }. Returns the lit target.
 function lpv.render(G, direct, R, o, light)
   local f = o.coarse
-  local C = isr.coarse_gbuffer(G, direct, f)
+  local C = isr.coarse_view(G, direct, f)
   local E = isr.blur(lpv.gather(C, f, lpv.volume(G, R, o), o), C, f, o.blur)
   return isr.composite(G, direct, C, E, { ambient = light.ambient, background = light.background, k = o.k }, false,
                        light.sky)

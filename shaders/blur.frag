@@ -5,7 +5,8 @@
 // weighs less, so the blur does not carry light across silhouettes (the
 // halos the seed names as a weakness, lines 2592-2688). The plane's slope
 // is the smaller one-sided difference, which does not straddle an edge, so
-// a floor seen at a grazing angle still blurs along its length.
+// a floor seen at a grazing angle still blurs along its length. With DEPTH
+// and no MASK, a depth of 0 (nothing drawn) is the mask.
 #include "common.glsl"
 
 in vec2 uv;
@@ -28,8 +29,11 @@ float weight_at(ivec2 q, float z, float expected) {
   w *= step(0.5, texelFetch(mask, q, 0).a);
 #endif
 #ifdef DEPTH
-  float dz = (texelFetch(depth, q, 0).r - expected) / (max(z, 1e-12) * DEPTH_TOLERANCE);
+  float d = texelFetch(depth, q, 0).r, dz = (d - expected) / (max(z, 1e-12) * DEPTH_TOLERANCE);
   w *= exp(-dz * dz);
+#ifndef MASK
+  w *= d > 0.0 ? 1.0 : 0.0;
+#endif
 #endif
   return w;
 }
@@ -44,14 +48,15 @@ void main() {
   float behind = z - texelFetch(depth, clamp(p - axis, ivec2(0), last), 0).r;
   slope = abs(ahead) < abs(behind) ? ahead : behind;
 #endif
-  if (weight_at(p, z, z) == 0.0 || radius < 1) {
+  float wsum = weight_at(p, z, z); // the centre's tap, fetched once
+  if (wsum == 0.0 || radius < 1) {
     dst = centre;
     return;
   }
   float sigma = 0.5 * float(radius), inv2s2 = 0.5 / (sigma * sigma);
-  vec4 sum = vec4(0.0);
-  float wsum = 0.0;
+  vec4 sum = wsum * centre;
   for (int i = -radius; i <= radius; i++) {
+    if (i == 0) continue;
     ivec2 q = clamp(p + axis * i, ivec2(0), last);
     float w = exp(-float(i * i) * inv2s2) * weight_at(q, z, z + float(i) * slope);
     sum += w * texelFetch(src, q, 0);

@@ -68,6 +68,11 @@ float mat_alpha_reflectivity(float a) {
 }
 float dpt_view_depth(float dpt) { return max(dpt, 0.0) * frame.clip.y; }
 
+// The texel of an image of `size`, `factor` times finer than a coarse one,
+// that stands for coarse texel q: its block's centre, clamped to the image
+// (a coarse pass reads the G-buffer there instead of an averaged copy).
+ivec2 block_centre(ivec2 q, int factor, ivec2 size) { return clamp(q * factor + factor / 2, ivec2(0), size - 1); }
+
 // World position from dpt (linear depth / far) and the far-plane rays (seed 000, eq 23-24).
 vec3 position_from_depth(vec2 uv, float depth01) {
   vec3 ray = frame.frustum_o.xyz + frame.frustum_u.xyz * uv.x + frame.frustum_v.xyz * uv.y;

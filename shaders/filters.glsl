@@ -18,7 +18,7 @@ struct Geometry {
 // coarser than the G-buffer takes the G-buffer texel at its block's centre.
 Geometry geometry_at(sampler2D nrm, sampler2D dpt, sampler2D mat, ivec2 q, int factor) {
   ivec2 size = textureSize(dpt, 0);
-  ivec2 g = clamp(q * factor + factor / 2, ivec2(0), size - 1);
+  ivec2 g = block_centre(q, factor, size);
   Geometry o;
   o.n = safe_normalize(texelFetch(nrm, g, 0).xyz, vec3(0.0, 1.0, 0.0));
   o.z = max(texelFetch(dpt, g, 0).r, 0.0);

@@ -1,16 +1,24 @@
 // A later bounce of the physical ISR transport (isr_march.frag) from the hits
 // its first march recorded (HITS targets, four rays each: 1 + the index of
-// the coarse texel a ray's sender lies on, 0 for none). Every bounce marches the same rays
+// the G-buffer texel a ray's sender lies on, 0 for none). Every bounce marches the same rays
 // through the same depth buffer and meets the same senders, so this sums over
 // them what the march with BOUNCE would:
 //   E(p) = 1/n sum over sending rays of sender(q) + k_d albedo(q) previous(q)
-// with previous the last step's E; A, the share of open rays, is previous's.
+//        = first(p) + 1/n sum over sending rays of k_d albedo(q) previous(q)
+// with first the first march's E (the senders' own light, kept in 32-bit
+// floats so that the sum is the march's), previous the last step's E (at the
+// coarse texel over q, the G-buffer being STRIDE times finer); A, the share
+// of open rays, is first's.
 #include "gbuffer.glsl"
 
+#ifndef STRIDE
+#define STRIDE 1
+#endif
+
 in vec2 uv;
-uniform sampler2D clr, mat;  // coarse G-buffer
-uniform sampler2D sender;    // coarse direct light
-uniform sampler2D previous;  // the last step's E (rgb), A (a)
+uniform sampler2D clr, mat;  // the G-buffer the march read
+uniform sampler2D first;     // the first march's E (rgb), A (a), the output's size
+uniform sampler2D previous;  // the last step's E, the output's size
 uniform sampler2D hits0;
 #if HITS > 1
 uniform sampler2D hits1;
@@ -27,20 +35,17 @@ uniform sampler2D hits4;
 #if HITS > 5
 uniform sampler2D hits5;
 #endif
-#if HITS > 6
-uniform sampler2D hits6;
-#endif
-uniform int samples = 12;
+uniform int samples = 4;
 
 out vec4 isr;
 
-// What a ray whose recorded hit is `hit` sends (nothing for 0).
+// What a ray whose recorded hit is `hit` sends of the last step's light (nothing for 0).
 vec3 sent(float hit, int width) {
   if (hit < 0.5) return vec3(0.0);
   int k = int(hit - 0.5);
   ivec2 q = ivec2(k % width, k / width);
-  vec4 c = texelFetch(clr, q, 0);
-  return texelFetch(sender, q, 0).rgb + texelFetch(mat, q, 0).y * c.rgb * texelFetch(previous, q, 0).rgb;
+  vec3 e = texelFetch(previous, min(q / STRIDE, textureSize(previous, 0) - 1), 0).rgb;
+  return texelFetch(mat, q, 0).y * texelFetch(clr, q, 0).rgb * e;
 }
 
 vec3 sent4(vec4 h, int width) { return sent(h.x, width) + sent(h.y, width) + sent(h.z, width) + sent(h.w, width); }
@@ -64,8 +69,6 @@ void main() {
 #if HITS > 5
   gathered += sent4(texelFetch(hits5, px, 0), width);
 #endif
-#if HITS > 6
-  gathered += sent4(texelFetch(hits6, px, 0), width);
-#endif
-  isr = vec4(gathered / float(n), texelFetch(previous, px, 0).a);
+  vec4 e = texelFetch(first, px, 0);
+  isr = vec4(e.rgb + gathered / float(n), e.a);
 }

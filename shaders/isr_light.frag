@@ -10,11 +10,17 @@
 //   SEED      L = (D + k_a L_a albedo) saturate(A + 1 - k_SSAO) + k_ISR rho E
 //             (isr.frag; C0 k_dl of eq 29 is the direct light with its
 //             ambient term, A the accessibility: 1 open, 0 occluded)
+// The coarse texels' coverage is coarse_mat's (a coarse copy of the
+// G-buffer) or with Z_MASK their depth's, 0 where nothing was drawn (a
+// coarse view's depth, isr.coarse_view).
 #include "gbuffer.glsl"
 
 in vec2 uv;
 uniform sampler2D clr, nrm, dpt, mat, direct;  // full-size G-buffer and direct light
-uniform sampler2D isr, coarse_dpt, coarse_mat; // coarse ISR (rgb E, a A) and its depth
+uniform sampler2D isr, coarse_dpt;             // coarse ISR (rgb E, a A) and its depth
+#ifndef Z_MASK
+uniform sampler2D coarse_mat;                  // its coverage (a)
+#endif
 uniform vec3 ambient = vec3(0.0);
 uniform vec3 background = vec3(0.0);
 #ifdef SEED
@@ -39,12 +45,21 @@ vec4 upsample(float z) {
   vec2 f = t - floor(t);
   vec4 sum = vec4(0.0), nearest = vec4(0.0, 0.0, 0.0, 1.0);
   float wsum = 0.0, nearest_dz = 1e30;
+  // The four texels' depths (and coverage) in one gather each, at their
+  // shared corner (clamped at the border, as q is): x (0, 1), y (1, 1),
+  // z (1, 0), w (0, 0) from base.
+  vec2 corner = (vec2(base) + 1.0) / vec2(textureSize(isr, 0));
+  vec4 zs = textureGather(coarse_dpt, corner, 0).wzxy;
+#ifdef Z_MASK
+  vec4 cover = vec4(greaterThan(zs, vec4(0.0)));
+#else
+  vec4 cover = step(0.5, textureGather(coarse_mat, corner, 3).wzxy);
+#endif
   for (int i = 0; i < 4; i++) {
     ivec2 o = ivec2(i & 1, i >> 1), q = clamp(base + o, ivec2(0), last);
     vec2 wb2 = mix(1.0 - f, f, vec2(o));
     vec4 v = texelFetch(isr, q, 0);
-    float dz = abs(z - texelFetch(coarse_dpt, q, 0).r) / max(z, 1e-12);
-    float covered = step(0.5, texelFetch(coarse_mat, q, 0).a);
+    float covered = cover[i], dz = abs(z - zs[i]) / max(z, 1e-12);
     float w = wb2.x * wb2.y * covered / (EPS_Z + dz);
     sum += w * v;
     wsum += w;
@@ -57,7 +72,7 @@ vec4 upsample(float z) {
 }
 
 void main() {
-  Surface s = gbuffer_read(clr, nrm, dpt, mat, uv);
+  Surface s = gbuffer_fetch(clr, nrm, dpt, mat, ivec2(gl_FragCoord.xy)); // unfiltered: a pass at the G-buffer's size
   if (!s.covered) {
     lit = vec4(background + sky_seen(uv), 1.0);
     return;

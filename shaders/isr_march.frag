@@ -1,28 +1,41 @@
 // Physically scaled image-space radiosity (/work/shared/design/gi-scale.md),
-// the transport step of isr.lua's default mode, over the coarse G-buffer:
+// the transport step of isr.lua's default mode, at each texel of a coarse
+// grid over the G-buffer:
 //   E(p) = (1/pi) int over the hemisphere of L(x(w)) cos(theta) dw
 // where x(w) is the first surface seen from p in direction w and L(x) its
 // lit radiance (`sender`: the frame's direct light, shadows included; with
 // BOUNCE also k_d albedo E of the last step, the next bounce). The composite
 // (isr_light.frag) multiplies by k_d albedo, POV-Ray's radiosity convention.
+// The G-buffer is read at STRIDE texels a side per coarse texel: p is the
+// surface at its block's centre (block_centre) and the rays march through
+// the full buffer's depth (STRIDE 1: a coarse copy, isr_downsample.frag).
 //
-// Estimator: `samples` cosine-weighted directions (pdf cos / pi, so each ray
-// weighs 1 / samples and the cosines cancel), Halton points (halton.glsl)
-// turned per pixel in a 4 x 4 tile that the blur averages. A ray counts a
+// Estimator: `samples` cosine-weighted directions a texel (pdf cos / pi, so
+// each ray weighs 1 / samples and the cosines cancel), interleaved: the 16
+// texels of a 4 x 4 tile take consecutive runs of one low-discrepancy
+// sequence (R3, halton.glsl), texel k of the tile (in Bayer order) points
+// k n .. k n + n - 1, so that the tile holds 16 n directions that fill the
+// hemisphere evenly and the blur, at least 4 wide, averages them. Every
+// tile takes the same directions: turning them per tile made the error
+// vary from tile to tile, blotches the blur spreads (4 rays a texel then
+// came as close to 64 as 12 a texel, each turned per texel, did before).
+// A ray counts a
 // sender only when the depth buffer says it is seen: the ray is marched in
 // `steps` samples at distances t_j = t_0 (t_end / t_0)^((j + u) / (steps - 1 + u)),
 // j = 0 .. steps - 1, u in (0, 1) a per-ray jitter, from about t_0 = one
 // coarse texel's footprint at p's depth to t_end, where the ray leaves the
-// view frustum. The spacing is geometric,
+// view frustum or the scene's box. The spacing is geometric,
 // so the march reaches across the whole visible scene with a few samples and
 // has no length in world units (a scene in millimetres or kilometres gives
 // the same image). A sample behind the depth buffer ends the coarse march;
-// four bisections between it and the last sample in front find the surface
-// it passed, which is a hit when the refined step reaches that surface's
-// plane (or comes within `thickness` of its depth of it; measured off the
-// plane, not along the view ray, so that a surface seen at a grazing angle
-// is not missed); otherwise the ray passed behind a nearer object and goes
-// on. A hit on a
+// the secant through the depths off the buffer at it and at the last sample
+// in front finds where the ray passed the surface (one fetch where four
+// bisections took five, as close to the POV-Ray references in
+// tools/fidelity.sh), a hit when that point lies on the plane
+// of the surface seen there (within half the step, or `thickness` of its
+// depth; measured off the plane, not along the view ray, so that a surface
+// seen at a grazing angle is not missed); otherwise the ray passed behind a
+// nearer object and goes on. A hit on a
 // surface facing away, or not above p's tangent plane, sends nothing: the
 // first blocks (it is seen, only its back), the second is p's own plane met
 // through the depth buffer's steps and is passed.
@@ -31,67 +44,76 @@
 // sky: the ambient term, occluded by the returned accessibility.
 //
 // Output: rgb = E, a = A, the share of rays (cosine-weighted) that meet no
-// surface. Background texels: (0, 0, 0, 1).
-// With HITS (1..7, the first bounce of several), also the sending hit of each
-// ray, four rays a target in hits0.. (HITS targets): 1 + the coarse texel's
-// index y * width + x (exact in a float below 2^24 texels; isr.lua keeps
-// within), or 0 when the ray sends nothing; isr_bounce.frag takes the later
-// bounces from them instead of marching the same rays again.
+// surface. Background texels: (0, 0, 0, 1). With Z, also z: p's depth / far,
+// 0 where nothing is drawn (the view's depth that the blur and composite
+// read, isr.coarse_view).
+// With HITS (1..6, the first bounce of several), also the sending hit of each
+// ray, four rays a target in hits0.. (HITS targets): 1 + the index y * width
+// + x of the depth buffer's texel the ray met (exact in a float below 2^24
+// texels; isr.lua keeps within), or 0 when the ray sends nothing;
+// isr_bounce.frag takes the later bounces from them instead of marching the
+// same rays again.
 #include "gbuffer.glsl"
 #include "halton.glsl"
 
-in vec2 uv;
-uniform sampler2D clr, nrm, dpt, mat; // coarse G-buffer
-uniform sampler2D sender;             // coarse direct light
-#ifdef BOUNCE
-uniform sampler2D previous;           // the last step's E
+#ifndef STRIDE
+#define STRIDE 1
 #endif
-uniform int samples = 12;
+
+in vec2 uv;
+uniform sampler2D clr, nrm, dpt, mat; // the G-buffer, STRIDE times finer than the output
+uniform sampler2D sender;             // direct light, the G-buffer's size
+#ifdef BOUNCE
+uniform sampler2D previous;           // the last step's E, the output's size
+#endif
+uniform int samples = 4;
 uniform int steps = 10;
 uniform float thickness = 0.02; // fraction of a surface's depth
+uniform vec3 scene_lo = vec3(-1e30), scene_hi = vec3(1e30); // the scene's box, a little wider (isr.lua)
 
 layout(location = 0) out vec4 isr;
+#ifdef Z
+layout(location = 1) out float z;
+#endif
 #ifdef HITS
-layout(location = 1) out vec4 hits0;
+layout(location = 2) out vec4 hits0;
 #if HITS > 1
-layout(location = 2) out vec4 hits1;
+layout(location = 3) out vec4 hits1;
 #endif
 #if HITS > 2
-layout(location = 3) out vec4 hits2;
+layout(location = 4) out vec4 hits2;
 #endif
 #if HITS > 3
-layout(location = 4) out vec4 hits3;
+layout(location = 5) out vec4 hits3;
 #endif
 #if HITS > 4
-layout(location = 5) out vec4 hits4;
+layout(location = 6) out vec4 hits4;
 #endif
 #if HITS > 5
-layout(location = 6) out vec4 hits5;
-#endif
-#if HITS > 6
-layout(location = 7) out vec4 hits6;
+layout(location = 7) out vec4 hits5;
 #endif
 
-// Writes the recorded hits (0 for none) to the HITS targets, four a target.
-void write_hits(float hit[4 * HITS]) {
-  hits0 = vec4(hit[0], hit[1], hit[2], hit[3]);
+// Records ray i's hit h into component i % 4 of target i / 4. The outputs
+// themselves hold the hits (cleared first): an array indexed by i, which
+// varies at run time, went through memory and cost the march 4-7%.
+void record_hit(int i, float h) {
+  vec4 add = h * vec4(equal(ivec4(i & 3), ivec4(0, 1, 2, 3)));
+  int k = i >> 2;
+  hits0 += k == 0 ? add : vec4(0.0);
 #if HITS > 1
-  hits1 = vec4(hit[4], hit[5], hit[6], hit[7]);
+  hits1 += k == 1 ? add : vec4(0.0);
 #endif
 #if HITS > 2
-  hits2 = vec4(hit[8], hit[9], hit[10], hit[11]);
+  hits2 += k == 2 ? add : vec4(0.0);
 #endif
 #if HITS > 3
-  hits3 = vec4(hit[12], hit[13], hit[14], hit[15]);
+  hits3 += k == 3 ? add : vec4(0.0);
 #endif
 #if HITS > 4
-  hits4 = vec4(hit[16], hit[17], hit[18], hit[19]);
+  hits4 += k == 4 ? add : vec4(0.0);
 #endif
 #if HITS > 5
-  hits5 = vec4(hit[20], hit[21], hit[22], hit[23]);
-#endif
-#if HITS > 6
-  hits6 = vec4(hit[24], hit[25], hit[26], hit[27]);
+  hits5 += k == 5 ? add : vec4(0.0);
 #endif
 }
 #endif
@@ -99,15 +121,23 @@ void write_hits(float hit[4 * HITS]) {
 // Tightens t so that the constraint g0 + g1 t >= 0 holds on [0, t].
 float limit(float g0, float g1, float t) { return g1 < 0.0 ? min(t, max(g0, 0.0) / -g1) : t; }
 
-// How far the ray a + t b (clip space) stays in the view frustum, t >= 0.
-float exit_distance(vec4 a, vec4 b) {
+// How far the ray a + t b (clip space; p + t w in the world) stays in the
+// view frustum and in the scene's box, t >= 0. Past the box nothing is met,
+// and a ray that only the far plane stops would spread its steps that far:
+// the image would depend on where the far plane lies (test_scale).
+float exit_distance(vec4 a, vec4 b, vec3 p, vec3 w) {
   float t = 4.0 * frame.clip.y; // a bound for rays the planes do not stop
   t = limit(a.w - a.x, b.w - b.x, t);
   t = limit(a.w + a.x, b.w + b.x, t);
   t = limit(a.w - a.y, b.w - b.y, t);
   t = limit(a.w + a.y, b.w + b.y, t);
   t = limit(a.w - frame.clip.x, b.w, t);
-  return limit(frame.clip.y - a.w, -b.w, t);
+  t = limit(frame.clip.y - a.w, -b.w, t);
+  for (int k = 0; k < 3; k++) {
+    t = limit(p[k] - scene_lo[k], w[k], t);
+    t = limit(scene_hi[k] - p[k], -w[k], t);
+  }
+  return t;
 }
 
 // The texel a clip-space point falls on, and that texel's view depth (0: background).
@@ -119,93 +149,102 @@ float buffer_depth(vec4 c, ivec2 size, out ivec2 q) {
 
 void main() {
   ivec2 size = textureSize(dpt, 0), px = ivec2(gl_FragCoord.xy);
-  Surface s = gbuffer_fetch(clr, nrm, dpt, mat, px);
+  Surface s = gbuffer_fetch(clr, nrm, dpt, mat, block_centre(px, STRIDE, size));
+#ifdef Z
+  z = s.covered ? s.depth01 : 0.0;
+#endif
 #ifdef HITS
-  float hit[4 * HITS];
-  for (int k = 0; k < 4 * HITS; k++) hit[k] = 0.0;
+  hits0 = vec4(0.0); // 0: no hit
+#if HITS > 1
+  hits1 = vec4(0.0);
+#endif
+#if HITS > 2
+  hits2 = vec4(0.0);
+#endif
+#if HITS > 3
+  hits3 = vec4(0.0);
+#endif
+#if HITS > 4
+  hits4 = vec4(0.0);
+#endif
+#if HITS > 5
+  hits5 = vec4(0.0);
+#endif
 #endif
   if (!s.covered) {
     isr = vec4(0.0, 0.0, 0.0, 1.0);
-#ifdef HITS
-    write_hits(hit);
-#endif
     return;
   }
   int n = clamp(samples, 1, 256), m = clamp(steps, 1, 64);
   float far = frame.clip.y, thick = max(thickness, 0.0);
   // World size of one coarse texel at p: 2 z tan(fov / 2) / height.
-  float foot = max(2.0 * s.depth01 * far * frame.clip.w / float(size.y), 1e-7 * far);
+  float foot = max(2.0 * s.depth01 * far * frame.clip.w * float(STRIDE) / float(size.y), 1e-12 * far); // never 0
   mat3 basis = tangent_frame(s.n);
-  vec3 offset = halton_offset(px, 4);
+  int first = interleave_index(px, 4) * n;
   vec4 a = frame.view_proj * vec4(s.p, 1.0);
   vec3 gathered = vec3(0.0);
   float open = 0.0;
   for (int i = 0; i < n; i++) {
-    vec3 u = halton_sample(i, offset);
+    vec3 u = r3_sample(first + i, vec3(0.0)); // no turn: every tile the same
     vec3 w = basis * hemisphere_cosine(u.xy);
     vec4 b = frame.view_proj * vec4(w, 0.0);
-    float t_end = exit_distance(a, b);
+    float t_end = exit_distance(a, b, s.p, w);
     bool seen = false;
-    float t_prev = 0.0, t = 0.0;
+    float t_prev = 0.0, t = 0.0, ahead = -1.0;
     ivec2 q = px;
     // The march goes on to the next sample behind the depth buffer in a loop
-    // of its own, and only there refines and tests for a hit: a software
-    // rasterizer runs an if's body for every pixel of its group, so the
-    // refinement inside the march's loop would cost as much at every step.
+    // of its own, and only there tests for a hit: a software rasterizer runs
+    // an if's body for every pixel of its group, so the test inside the
+    // march's loop would cost as much at every step.
     // Sample j lies at foot (t_end / foot)^((j + u.z) e): each the last times
     // a ratio. The last lies on t_end: a surface where the ray leaves the view is met too.
     float e = 1.0 / max(float(m) - 1.0 + u.z, 1e-6), span = max(t_end / foot, 1.0); // > 1 where it marches
     float ratio = pow(span, e), t_next = foot * pow(span, u.z * e);
     int j = 0;
     while (j < m && t_end > foot) {
-      float zq = 0.0;
-      vec4 c;
+      float zq = 0.0, behind = 0.0;
       for (; j < m; j++) {
         t = t_next;
         t_next *= ratio;
-        c = a + t * b;
+        vec4 c = a + t * b;
         zq = buffer_depth(c, size, q);
-        if (zq > 0.0 && c.w > zq) break; // behind the surface there
+        behind = c.w - zq;
+        if (zq > 0.0 && behind > 0.0) break; // behind the surface there
         t_prev = t;
+        ahead = zq > 0.0 ? -behind : -1.0;
       }
       if (j >= m) break;
-      // Behind a surface: bisect [t_prev, t] for where the ray passed it.
-      float lo = t_prev, hi = t;
-      for (int k = 0; k < 4; k++) {
-        float mid = 0.5 * (lo + hi);
-        vec4 cm = a + mid * b;
-        ivec2 qm;
-        float zm = buffer_depth(cm, size, qm);
-        if (zm > 0.0 && cm.w > zm) hi = mid;
-        else lo = mid;
-      }
-      zq = buffer_depth(a + hi * b, size, q);
+      // Behind a surface: where the ray passed it, by the secant through the
+      // depths off the buffer at t_prev (in front, `ahead`) and t (behind),
+      // or halfway where t_prev's is unknown (p itself, or nothing drawn).
+      float t_hit = ahead >= 0.0 ? mix(t_prev, t, ahead / max(ahead + behind, 1e-30 * far)) : 0.5 * (t_prev + t);
+      zq = buffer_depth(a + t_hit * b, size, q);
       Surface x = gbuffer_fetch(clr, nrm, dpt, mat, q);
       vec3 to_x = x.p - s.p;
-      // A hit when the refined step reaches the seen surface's plane.
-      if (zq > 0.0 && abs(dot(x.n, s.p + hi * w - x.p)) <= max(thick * zq, hi - lo) &&
+      // A hit when that point lies on the plane of the surface seen there,
+      // within `thickness` of its depth or half the step (the secant's
+      // uncertainty: it assumes the buffer's depth linear over the step).
+      if (zq > 0.0 && abs(dot(x.n, s.p + t_hit * w - x.p)) <= max(thick * zq, 0.5 * (t - t_prev)) &&
           dot(s.n, to_x) > 0.25 * foot) { // above p's tangent plane: not p's own surface
         seen = true;
         float cos_x = dot(x.n, -safe_normalize(to_x, w));
         if (cos_x > 0.0) {
           vec3 radiance = texelFetch(sender, q, 0).rgb;
 #ifdef BOUNCE
-          radiance += x.k.y * x.albedo * texelFetch(previous, q, 0).rgb;
+          radiance += x.k.y * x.albedo * texelFetch(previous, min(q / STRIDE, textureSize(previous, 0) - 1), 0).rgb;
 #endif
           gathered += radiance;
 #ifdef HITS
-          if (i < 4 * HITS) hit[i] = float(q.y * size.x + q.x + 1);
+          if (i < 4 * HITS) record_hit(i, float(q.y * size.x + q.x + 1));
 #endif
         }
         break;
       }
       t_prev = t;
+      ahead = -1.0;
       j++;
     }
     if (!seen) open += 1.0;
   }
   isr = vec4(gathered / float(n), open / float(n));
-#ifdef HITS
-  write_hits(hit);
-#endif
 }

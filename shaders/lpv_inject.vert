@@ -1,16 +1,17 @@
 // Injection into the light propagation volumes (seed 003, sections 5.2.3 and
 // 5.2.5; scripts/lpv.lua): points passes, one point a cell write, added up.
-// Each cascade takes the same points, cascade after cascade:
-//   - VPLs: `vpl_side`^2 points in each of the lights' `rsm_views` RSM views
-//     (light by light; lpv.lua shares lpv.vpls^2 among them), the centre
-//     texels of a grid over the part of the
-//     view's RSM that the cascade's grid covers (so every cascade gets as
-//     many VPLs a cell; empty texels are dropped), each standing for its
-//     share of that part's texels. A VPL is the sender's Lambertian lobe, its
+// The cascades take their points one after the other, cascade c
+// `vpl_sides`[c]^2 VPLs a view, a grid of `surfel_cols`[c] x
+// `surfel_rows`[c] surfels (as many a cell in each; lpv.lua):
+//   - VPLs: `vpl_sides`[c]^2 points in each of the lights' `rsm_views` RSM
+//     views (light by light; lpv.lua shares lpv.vpls^2 among them), the
+//     centre texels of a grid over the part of the view's RSM that the
+//     cascade's grid covers (empty texels are dropped), each standing for
+//     its share of that part's texels. A VPL is the sender's Lambertian lobe, its
 //     radiance (k_d albedo times light_incident) times the area it stands for
 //     (rsm_texel_area), put in the cell half a cell in front of the sender
 //     (the seed's VPLs "placed above their surfaces");
-//   - GEOMETRY: surfels, a `surfel_grid` of G-buffer pixels (the surfaces the
+//   - GEOMETRY: surfels, a grid of G-buffer pixels (the surfaces the
 //     camera sees), into the geometry volume: the share of a cell's
 //     cross-section a surfel covers for light travelling in w, its area over
 //     h^2 times max(0, -n.w) (2 bands), in the cell half a cell behind the
@@ -28,9 +29,9 @@
 
 uniform sampler2D rsm_flux, rsm_nrm, rsm_pos; // shadow.lua's RSM targets
 uniform sampler2D nrm, dpt, mat;              // the G-buffer
-uniform int vpl_side = 64;
+uniform ivec4 vpl_sides = ivec4(64); // per cascade
 uniform int rsm_views = 0;
-uniform ivec2 surfel_grid = ivec2(0);
+uniform ivec4 surfel_cols = ivec4(0), surfel_rows = ivec4(0); // per cascade
 
 flat out vec4 v_r, v_g, v_b; // GEOMETRY: v_r, the blocking lobe
 
@@ -44,9 +45,10 @@ bool cascade_rect(ShadowView sv, int c, out vec2 lo, out vec2 hi) {
   lo = vec2(0.0);
   hi = vec2(1.0);
   if (sv.depth.w > 0.0) return true;
-  float half_side = 0.5 * float(lpv_cells) * lpv_cell_size(c);
+  vec3 half_side = 0.5 * vec3(lpv_dims(c)) * lpv_cell_size(c);
   vec2 centre = (sv.view_proj * vec4(lpv_origin(c) + half_side, 1.0)).xy * 0.5 + 0.5;
-  vec2 reach = half_side * 0.5 * (abs(sv.view_proj[0].xy) + abs(sv.view_proj[1].xy) + abs(sv.view_proj[2].xy));
+  vec2 reach = 0.5 * (abs(sv.view_proj[0].xy) * half_side.x + abs(sv.view_proj[1].xy) * half_side.y +
+                      abs(sv.view_proj[2].xy) * half_side.z);
   lo = clamp(centre - reach, 0.0, 1.0);
   hi = clamp(centre + reach, 0.0, 1.0);
   return all(greaterThan(hi, lo));
@@ -54,7 +56,7 @@ bool cascade_rect(ShadowView sv, int c, out vec2 lo, out vec2 hi) {
 
 // VPL k of cascade c: position, normal and radiance times area; false when it stands for nothing.
 bool vpl(int k, int c, out vec3 q, out vec3 n, out vec3 flux) {
-  int side = max(vpl_side, 1), per_view = side * side, v = k / per_view, b = k % per_view;
+  int side = max(vpl_sides[c], 1), per_view = side * side, v = k / per_view, b = k % per_view;
   int light = -1;
   for (int i = 0; i < frame.counts.x && light < 0; i++) { // the v-th RSM view, light by light
     ivec4 cube = shadow_lights[i].cube;
@@ -82,12 +84,12 @@ bool vpl(int k, int c, out vec3 q, out vec3 n, out vec3 flux) {
   return true;
 }
 
-// Surfel k: the G-buffer pixel's position, normal and area (its footprint
-// over the cosine to the camera, capped); false on background.
-bool surfel(int k, out vec3 p, out vec3 n, out float area) {
-  ivec2 size = textureSize(dpt, 0);
-  int columns = max(surfel_grid.x, 1);
-  vec2 step = vec2(size) / vec2(max(surfel_grid, ivec2(1)));
+// Surfel k of cascade c: the G-buffer pixel's position, normal and area (its
+// footprint over the cosine to the camera, capped); false on background.
+bool surfel(int k, int c, out vec3 p, out vec3 n, out float area) {
+  ivec2 size = textureSize(dpt, 0), grid = max(ivec2(surfel_cols[c], surfel_rows[c]), ivec2(1));
+  int columns = grid.x;
+  vec2 step = vec2(size) / vec2(grid);
   vec2 uv = (vec2(k % columns, k / columns) + 0.5) * step / vec2(size);
   ivec2 px = ivec2(uv * vec2(size));
   if (texelFetch(mat, px, 0).a < 0.5) return false; // background
@@ -103,17 +105,21 @@ bool surfel(int k, out vec3 p, out vec3 n, out float area) {
 void main() {
   gl_Position = vec4(2.0, 2.0, 0.0, 1.0); // off the target
   v_r = v_g = v_b = vec4(0.0);
+  int c = 0, k = gl_VertexID;
+  for (; c < lpv_cascades; c++) { // the cascade's points, and the point's index among them
 #ifdef GEOMETRY
-  int per_cascade = surfel_grid.x * surfel_grid.y;
+    int points = surfel_cols[c] * surfel_rows[c];
 #else
-  int per_cascade = rsm_views * vpl_side * vpl_side;
+    int points = rsm_views * vpl_sides[c] * vpl_sides[c];
 #endif
-  int c = gl_VertexID / max(per_cascade, 1), k = gl_VertexID % max(per_cascade, 1);
+    if (k < points) break;
+    k -= points;
+  }
   if (c >= lpv_cascades) return;
   vec3 p, n, flux;
   float area;
 #ifdef GEOMETRY
-  if (!surfel(k, p, n, area)) return;
+  if (!surfel(k, c, p, n, area)) return;
   float side = -0.5;
 #else
   if (!vpl(k, c, p, n, flux)) return;
@@ -121,9 +127,8 @@ void main() {
 #endif
   float h = lpv_cell_size(c);
   ivec3 cell = ivec3(floor((p + side * h * n - lpv_origin(c)) / h));
-  if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, ivec3(lpv_cells)))) return;
-  vec2 size = vec2(lpv_cells * lpv_cells, lpv_cells * lpv_cascades);
-  gl_Position = vec4((vec2(lpv_texel(cell, c)) + 0.5) / size * 2.0 - 1.0, 0.0, 1.0);
+  if (!lpv_inside(cell, c)) return;
+  gl_Position = vec4((vec2(lpv_texel(cell, c)) + 0.5) / vec2(lpv_size) * 2.0 - 1.0, 0.0, 1.0);
 #ifdef GEOMETRY
   v_r = lpv_finite(lpv_lobe(area / max(h * h, 1e-30), -n)); // h^2 may underflow
 #else

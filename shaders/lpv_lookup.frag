@@ -31,8 +31,15 @@
 // light fades to nothing.
 // Output: rgb = E / pi, a = 1 (it occludes no ambient term); with BASE, the
 // screen-space pass's coarse result `base` plus it (its a kept).
+// With STRIDE, each texel reads the G-buffer, STRIDE times finer, at its
+// block's centre (isr.coarse_view); with Z it also writes that depth / far,
+// 0 where nothing is drawn, into z (the view's depth).
 #include "gbuffer.glsl"
 #include "lpv.glsl"
+
+#ifndef STRIDE
+#define STRIDE 1
+#endif
 
 in vec2 uv;
 uniform sampler2D clr, nrm, dpt, mat;         // (coarse) G-buffer
@@ -47,7 +54,10 @@ uniform sampler2D base;
 #endif
 uniform int lpv_steps = 8;
 
-out vec4 result;
+layout(location = 0) out vec4 result;
+#ifdef Z
+layout(location = 1) out float z;
+#endif
 
 const float D = 0.674213;
 
@@ -64,19 +74,24 @@ vec3 cell_coords(int c, vec3 p, vec3 n) {
   return (p + 1.5 * h * n - lpv_origin(c)) / h - 0.5;
 }
 
-// How many cells u lies within the grid's sampled range (negative: outside).
-float inside(vec3 u) {
-  float last = float(lpv_cells - 1);
-  return min(min(u.x, u.y), min(u.z, min(last - u.x, min(last - u.y, last - u.z))));
+// How many cells u lies within cascade c's sampled range (negative:
+// outside), along the axes that follow the camera: along the others the
+// grid holds the whole scene, and no light comes from beyond it.
+float inside(vec3 u, int c) {
+  vec3 last = vec3(lpv_dims(c) - 1);
+  vec3 m = min(u, last - u);
+  bvec3 moves = bvec3((lpv_follow[c] & 1) != 0, (lpv_follow[c] & 2) != 0, (lpv_follow[c] & 4) != 0);
+  m = mix(vec3(1e30), m, moves);
+  return min(m.x, min(m.y, m.z));
 }
 
 // Cascade c's E / pi at p facing n from its late sum, and its early sum too when asked.
 vec3 cascade(int c, vec3 p, vec3 n, bool early) {
-  float last = float(lpv_cells - 1);
-  vec3 u = clamp(cell_coords(c, p, n), vec3(0.0), vec3(last));
-  float z0 = floor(u.z), f = u.z - z0, z1 = min(z0 + 1.0, last);
-  vec2 size = vec2(lpv_cells * lpv_cells, lpv_cells * lpv_cascades), row = vec2(u.x, float(c * lpv_cells) + u.y);
-  vec2 uv0 = (row + vec2(z0 * float(lpv_cells), 0.0) + 0.5) / size, uv1 = (row + vec2(z1 * float(lpv_cells), 0.0) + 0.5) / size;
+  vec3 last = vec3(lpv_dims(c) - 1);
+  vec3 u = clamp(cell_coords(c, p, n), vec3(0.0), last);
+  float z0 = floor(u.z), f = u.z - z0, z1 = min(z0 + 1.0, last.z), nx = float(lpv_nx[c]);
+  vec2 size = vec2(lpv_size), row = vec2(float(lpv_col[c]) + u.x, u.y);
+  vec2 uv0 = (row + vec2(z0 * nx, 0.0) + 0.5) / size, uv1 = (row + vec2(z1 * nx, 0.0) + 0.5) / size;
   vec3 e = vec3(0.0);
 #ifdef EARLY
   if (early) e += irradiance(volume(early_r, uv0, uv1, f), volume(early_g, uv0, uv1, f), volume(early_b, uv0, uv1, f), n);
@@ -102,7 +117,10 @@ void main() {
 #else
   vec4 b = vec4(0.0, 0.0, 0.0, 1.0);
 #endif
-  Surface s = gbuffer_fetch(clr, nrm, dpt, mat, px);
+  Surface s = gbuffer_fetch(clr, nrm, dpt, mat, block_centre(px, STRIDE, textureSize(dpt, 0)));
+#ifdef Z
+  z = s.covered ? s.depth01 : 0.0;
+#endif
   if (!s.covered) {
     result = b;
     return;
@@ -110,7 +128,7 @@ void main() {
   int c0 = lpv_cascades;
   float margin = -1.0;
   for (int c = 0; c < lpv_cascades && c0 == lpv_cascades; c++) {
-    margin = inside(cell_coords(c, s.p, s.n));
+    margin = inside(cell_coords(c, s.p, s.n), c);
     if (margin >= 0.0) c0 = c;
   }
   vec3 e = vec3(0.0);

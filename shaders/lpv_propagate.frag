@@ -1,7 +1,8 @@
 // One propagation step of the light propagation volumes (seed 003, section
 // 5.2.6; scripts/lpv.lua): every cell of every cascade gathers what its six
 // neighbours send it, in one pass over the unwrapped volume (a neighbour
-// across a layer's or cascade's edge is no neighbour: nothing wraps).
+// across a layer's or cascade's edge is no neighbour: nothing wraps; a texel
+// no cell uses holds nothing).
 //
 // The transfer. The seed takes the second LPV version's cell-to-cell step
 // (the source's intensity towards each face of the destination times the
@@ -85,7 +86,7 @@ vec4 r = vec4(0.0), gr = vec4(0.0), b = vec4(0.0);
 void gather(ivec3 cell, int c, vec4 g, int axis, float sign) {
   ivec3 s = cell;
   s[axis] -= int(sign);
-  if (s[axis] < 0 || s[axis] >= lpv_cells) return;
+  if (s[axis] < 0 || s[axis] >= lpv_dims(c)[axis]) return;
   ivec2 ts = lpv_texel(s, c);
   float open = 1.0 - occlusion * clamp(g.x + sign * g[axis + 1], 0.0, 1.0);
   r += open * transfer(texelFetch(wave_r, ts, 0), axis, sign);
@@ -95,8 +96,12 @@ void gather(ivec3 cell, int c, vec4 g, int axis, float sign) {
 
 void main() {
   ivec2 t = ivec2(gl_FragCoord.xy);
-  int n = lpv_cells, c = t.y / n;
-  ivec3 cell = ivec3(t.x % n, t.y % n, t.x / n);
+  int c;
+  ivec3 cell;
+  if (!lpv_cell_at(t, c, cell)) {
+    out_r = out_g = out_b = out_sum_r = out_sum_g = out_sum_b = vec4(0.0);
+    return;
+  }
   vec4 g = texelFetch(geometry, t, 0);
   gather(cell, c, g, 0, 1.0);
   gather(cell, c, g, 0, -1.0);

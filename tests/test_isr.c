@@ -126,7 +126,7 @@ static void bad_options_name_themselves(void **state) {
   static const gl_bad_option cases[] = {
       {"isr", "isr.samples=0", "isr.samples must be a whole number in 1..256 (got 0)"},
       {"isr", "isr.samples=2.5", "isr.samples must be"},
-      {"isr", "isr.coarse=3", "isr.coarse must be one of 0, 1, 2, 4"},
+      {"isr", "isr.coarse=5", "isr.coarse must be one of 0, 1, 2, 3, 4"},
       {"isr", "isr.seed.radius=0", "isr.seed.radius must be a positive"},
       {"isr", "isr.seed.k_ssao=-1", "isr.seed.k_ssao must be a finite number in 0..1"},
       {"isr", "isr.seed.sender=sun", "isr.seed.sender must be one of albedo, lit (got sun)"},
@@ -245,11 +245,12 @@ static void an_open_floor_keeps_its_direct_light(void **state) {
 /* The later bounces sum over the senders the first march recorded
  * (isr_bounce.frag) instead of marching the same rays again: the indirect
  * light is the marched one, for 2 and 4 bounces, 12 rays (3 hit targets) and
- * 28 (7, the most); 32 rays do not fit and march every bounce. */
+ * 24 (6, the most beside E and the grid's depth); 28 rays do not fit and
+ * march every bounce. */
 static void later_bounces_from_the_recorded_senders_are_the_marched_ones(void **state) {
   (void)state;
   static const char *const cases[][2] = {{"isr.bounces=2", "isr.samples=12"}, {"isr.bounces=4", "isr.samples=12"},
-                                         {"isr.bounces=2", "isr.samples=28"}};
+                                         {"isr.bounces=2", "isr.samples=24"}};
   for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
     const char *const reused[] = {"isr.view=indirect", cases[c][0], cases[c][1], NULL};
     const char *const marched[] = {"isr.view=indirect", cases[c][0], cases[c][1], "isr.reuse=false", NULL};
@@ -267,7 +268,7 @@ static void later_bounces_from_the_recorded_senders_are_the_marched_ones(void **
     gl_result_free(&a);
     gl_result_free(&b);
   }
-  static const char *const many[] = {"isr.samples=32", NULL};
+  static const char *const many[] = {"isr.samples=28", NULL};
   gl_result r = render_ok("isr", many);
   lm_graph *g = lm_renderer_graph(r.renderer);
   assert_int_equal(lm_graph_find_target(g, "isr.hits1"), -1);
@@ -276,19 +277,20 @@ static void later_bounces_from_the_recorded_senders_are_the_marched_ones(void **
 
 /* isr.coarse 0 (the default) gathers over a grid at least 128 texels wide:
  * coarse 2 up to 511 pixels wide, 4 from 512 (the same 128 x 96 grid at
- * 256 x 192 and 512 x 384); a coarse factor given is kept. */
+ * 256 x 192 and 512 x 384); below 256 pixels wide, 3; a coarse factor
+ * given is kept. */
 static void the_auto_coarse_grid_keeps_its_size_relative_to_the_view(void **state) {
   (void)state;
   static const struct { int w, h; const char *set; int grid_w; } cases[] = {
-      {256, 192, NULL, 128}, {510, 384, NULL, 255}, {512, 384, NULL, 128}, {1024, 768, NULL, 256},
-      {512, 384, "isr.coarse=2", 256}};
+      {160, 120, NULL, 53},  {255, 192, NULL, 85},  {256, 192, NULL, 128}, {510, 384, NULL, 255},
+      {512, 384, NULL, 128}, {1024, 768, NULL, 256}, {512, 384, "isr.coarse=2", 256}};
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
     const char *const sets[] = {cases[i].set, NULL};
     gl_result r = gl_render(&(gl_run){.tech = "isr", .sets = cases[i].set ? sets : NULL, .width = cases[i].w,
                                       .height = cases[i].h});
     assert_true(r.ok);
     lm_graph *g = lm_renderer_graph(r.renderer);
-    lm_graph_target_info t = lm_graph_target(g, lm_graph_find_target(g, "isr.clr"));
+    lm_graph_target_info t = lm_graph_target(g, lm_graph_find_target(g, "isr.e1"));
     printf("%dx%d %s: coarse grid %dx%d\n", cases[i].w, cases[i].h, cases[i].set ? cases[i].set : "", t.width,
            t.height);
     assert_int_equal(t.width, cases[i].grid_w);

@@ -102,7 +102,7 @@ check "bench vary" run 0 bench --tech isr --sizes 32x24,64x48 --frames 1 --warmu
 check "bench vary values" out_has '"vary": {"option": "isr.samples", "values": [4, 32]}'
 check "bench vary fit" out_has '"vary_fit": {"ms": '
 check "bench calibrates fetches" out_has '"calibration": {"ns_per_fetch": '
-check "bench declared fetches" out_has '"fetches_per_pixel": 244, "fetches_per_second": '  # 4 + 5 * 48 samples (isr.lua)
+check "bench declared fetches" out_has '"fetches_per_pixel": 64, "fetches_per_second": '  # 4 + 4 samples * (10 steps + 5) (isr.lua)
 check "bench vary unknown option" run 1 bench --tech isr --sizes 32x24 --frames 1 --warmup 0 --vary isr.nope=1,2
 check "bench vary unknown option message" err_has "unknown option 'isr.nope'"
 check "bench set" run 0 bench --tech dl --sizes 32x24 --frames 1 --warmup 0 --json --set dof=true
