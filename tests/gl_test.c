@@ -74,6 +74,14 @@ static bool read_output(gl_result *r) {
          lm_renderer_read(r->renderer, false, r->srgb, &r->err);
 }
 
+gl_result gl_render_ok(const gl_run *run) {
+  gl_result r = gl_render(run);
+  const char *tech = run->tech ? run->tech : "(default)";
+  if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
+  if (!gl_all_finite(&r)) fail_msg("%s: a pixel is NaN, Inf or negative", tech);
+  return r;
+}
+
 bool gl_set(gl_result *r, const char *assignment) {
   char name[128];
   const char *eq = strchr(assignment, '=');

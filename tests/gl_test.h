@@ -43,6 +43,9 @@ lm_scene *gl_cornell(void);
 /* Writes text to the file `rel` under the scratch root; false when it cannot. */
 bool gl_write_file(const char *rel, const char *text);
 gl_result gl_render(const gl_run *run);
+/* gl_render that fails the test, naming the technique, when the frame fails
+ * or a pixel is NaN, Inf or negative. */
+gl_result gl_render_ok(const gl_run *run);
 /* Sets a "name=value" option for the next frame; false with the message in r->err. */
 bool gl_set(gl_result *r, const char *assignment);
 /* Renders one more frame with the same pipeline (after moving a camera, say). */

@@ -58,10 +58,7 @@ static lm_scene *corner_scene(lm_light_type type) {
 }
 
 static gl_result render_ok(lm_scene *s, const char *tech, const char *const *sets, int w, int h) {
-  gl_result r = gl_render(&(gl_run){.scene = s, .tech = tech, .sets = sets, .width = w, .height = h});
-  if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
-  if (!gl_all_finite(&r)) fail_msg("%s: a pixel is NaN, Inf or negative", tech);
-  return r;
+  return gl_render_ok(&(gl_run){.scene = s, .tech = tech, .sets = sets, .width = w, .height = h});
 }
 
 /* Mean linear RGB of the white wall between x0 and x1 (world), at heights

@@ -42,10 +42,7 @@ static lm_scene *canopy_scene(void) {
 }
 
 static gl_result render_ok(lm_scene *s, const char *tech, const char *const *sets) {
-  gl_result r = gl_render(&(gl_run){.scene = s, .tech = tech, .sets = sets, .width = W, .height = H});
-  if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
-  if (!gl_all_finite(&r)) fail_msg("%s: a pixel is NaN, Inf or negative", tech);
-  return r;
+  return gl_render_ok(&(gl_run){.scene = s, .tech = tech, .sets = sets, .width = W, .height = H});
 }
 
 /* The canopy's centre receives k_d albedo (1/pi) int L cos cos / d^2 dA

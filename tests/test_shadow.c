@@ -89,10 +89,7 @@ static float shadow_ratio(const gl_result *lit, const gl_result *shadowed, int x
 }
 
 static gl_result render_ok(lm_scene *s, const char *tech, const char *const *sets) {
-  gl_result r = gl_render(&(gl_run){.scene = s, .tech = tech, .sets = sets});
-  if (!r.ok) fail_msg("%s: %s", tech, r.err.msg);
-  if (!gl_all_finite(&r)) fail_msg("%s: a pixel is NaN, Inf or negative", tech);
-  return r;
+  return gl_render_ok(&(gl_run){.scene = s, .tech = tech, .sets = sets});
 }
 
 /* In the Cornell box the tall box shades the lower left wall (pixels 66..78 x
