@@ -61,8 +61,10 @@ case "${1:-run}" in
     ;;
   test)
     deps; build
+    # Tests in parallel, one a core: each renders on llvmpipe, whose threads
+    # mostly wait on a single draw thread, so two at once fill two cores.
     # shellcheck disable=SC2086
-    ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure ${CTEST_ARGS:-}
+    ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure -j "$(nproc)" ${CTEST_ARGS:-}
     ;;
   *) echo "usage: tools/dev.sh run|test|build|deps" >&2; exit 2 ;;
 esac
