@@ -18,6 +18,7 @@ size_t __sanitizer_get_current_allocated_bytes(void);
 #include <strings.h>
 #include <unistd.h>
 
+#include "capture.h"
 #include "image/image.h"
 #include "render/render.h"
 #include "scene/gltf.h"
@@ -157,17 +158,6 @@ static int parse_args(int argc, char **argv, view_args *a) {
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
   return 0;
-}
-
-static void resolve_script(const char *given, char *out, size_t cap) {
-  if (!given) {
-    snprintf(out, cap, "%s/scripts/pp.lua", lm_root_dir());
-  } else if (given[0] != '/' && !lm_file_exists(given)) {
-    snprintf(out, cap, "%s/%s", lm_root_dir(), given);
-    if (!lm_file_exists(out)) snprintf(out, cap, "%s", given);
-  } else {
-    snprintf(out, cap, "%s", given);
-  }
 }
 
 static volatile sig_atomic_t stop_requested;
@@ -653,7 +643,7 @@ int limn_view(int argc, char **argv) {
   signal(SIGINT, on_signal);
   signal(SIGTERM, on_signal);
   viewer v = {.args = &a, .inspect = -1, .channel = 4, .overlay_on = a.overlay, .range = {0, 1}};
-  resolve_script(a.script, v.script, sizeof v.script);
+  capture_resolve(a.script, v.script, sizeof v.script);
   rc = run(&v);
   viewer_free(&v);
   free_args(&a);
