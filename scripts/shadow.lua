@@ -29,6 +29,9 @@ shadow.defaults = {
   stabilize = true,   -- bounding spheres and texel snapping (seed 003)
   cache = true,       -- a tile whose view and casters are unchanged since the last frame keeps its
                       -- texels instead of being drawn again (a still camera; spot and point lights)
+  coverage = true,    -- spot and point lights' tiles about as fine as the screen needs: a texel a pixel
+                      -- over the disc their reach covers on screen, from resolution down to 32 texels
+                      -- (false: every tile at resolution)
   size = -1,          -- PCSS: every light's size (its diameter in the scene's unit; for the sun its
                       -- angular diameter, radians); <= 0: each light's own (glTF extras.size, else
                       -- 0.0093 rad for directional lights, 1% of the shadow map's range for others)
@@ -94,8 +97,7 @@ function shadow.render(o, G, rsm)
   local blurred = map
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
     blurred = pass{ "shadow.blur_" .. axis[1], shader = "esm_blur.frag", inputs = { shadow_atlas = blurred },
-                    params = { direction = axis[2], radius = plan.blur, c = plan.c, tile = plan.tile,
-                               views = plan.shadow_views }, -- not the RSM's wide tiles after them
+                    params = { direction = axis[2], radius = plan.blur, c = plan.c, views = plan.shadow_views }, -- not the RSM's wide tiles after them
                     out = target{ "shadow.esm_" .. axis[1], format = "r32f", size = size } }
   end
   filter_of[blurred] = filter_of[map]

@@ -8,22 +8,28 @@ in vec2 uv;
 uniform vec2 direction = vec2(1.0, 0.0); // in texels
 uniform int radius = 2;
 uniform float c = 16.0;
-uniform float tile = 512.0;
-uniform int views = 1 << 30; // tiles in use, row by row; the grid's spare cells stay clear
+uniform int views = 1 << 30; // the shadow tiles, the first views; texels of no tile stay clear
 
 out float blurred;
 
 void main() {
   ivec2 size = textureSize(shadow_atlas, 0);
   ivec2 p = ivec2(gl_FragCoord.xy);
-  ivec2 cell = ivec2(vec2(p) / tile);
-  int view = cell.x + cell.y * int(float(size.x) / tile);
-  if (view >= views) {
+  // The tile holding p: tiles differ in size (a local light's are as fine as
+  // the screen needs, engine/shadow), so each texel looks its tile up among
+  // the views, a loop the default (no blur) never runs.
+  int view = -1;
+  ivec2 lo, hi;
+  for (int v = 0; v < min(views, shadow_views.length()) && view < 0; v++) {
+    vec4 rect = shadow_views[v].rect;
+    lo = ivec2(floor(rect.xy * vec2(size) + 0.5));
+    hi = lo + ivec2(floor(rect.zw * vec2(size) + 0.5)) - 1;
+    if (all(greaterThanEqual(p, lo)) && all(lessThanEqual(p, hi))) view = v;
+  }
+  if (view < 0) {
     blurred = 1.0; // no tile here: what the shadow pass clears to
     return;
   }
-  ivec2 lo = ivec2(floor(vec2(p) / tile) * tile);
-  ivec2 hi = min(lo + ivec2(tile) - 1, size - 1);
   int r = clamp(radius, 0, 32);
   float inv_two_sigma2 = 1.0 / (2.0 * max(float(r) * 0.5, 0.5) * max(float(r) * 0.5, 0.5));
   // One pass of a running log-sum-exp: z0 is the largest depth so far and

@@ -417,6 +417,106 @@ static void cube_faces_no_pixel_samples_are_not_drawn(void **state) {
   lm_scene_destroy(s);
 }
 
+/* A local light's tiles are as fine as the screen needs: the box's light
+ * given a reach of 1.6 (the camera 3.5 away, outside it) covers a disc of
+ * about 240 pixels at 256x192, so its cube faces get 128 texels, not 512;
+ * twice the output doubles them; a camera inside the reach gets the full
+ * resolution; the atlas packs tiles of mixed sizes without overlap; and the
+ * image stays that of full-size tiles. */
+static bool rects_overlap(const float *a, const float *b) {
+  return a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3];
+}
+
+static void check_packing(const lm_shadow_plan *plan) {
+  for (int v = 0; v < plan->view_count; v++) {
+    const float *r = plan->view_data[v].rect;
+    const lm_pass_view *w = &plan->views[v];
+    assert_true(w->x >= 0 && w->y >= 0 && w->x + w->width <= plan->atlas_width && w->y + w->height <= plan->atlas_height);
+    assert_float_equal(r[2] * (float)plan->atlas_width, (float)w->width, 1e-3);
+    for (int u = 0; u < v; u++) assert_false(rects_overlap(r, plan->view_data[u].rect));
+  }
+}
+
+static void local_tiles_follow_their_screen_coverage(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  s->lights[0].falloff = LM_FALLOFF_WINDOW;
+  s->lights[0].radius = 1.6f;
+  lm_shadow_settings st;
+  lm_shadow_settings_default(&st);
+  lm_shadow_plan plan;
+  lm_error err;
+  int sizes[2][2] = {{256, 192}, {512, 384}}, tiles[2];
+  for (int k = 0; k < 2; k++) {
+    lm_frame_data cam;
+    lm_scene_frame_data(s, 0, sizes[k][0], sizes[k][1], &cam);
+    assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+    tiles[k] = plan.views[0].width;
+    for (int v = 1; v < plan.view_count; v++) assert_int_equal(plan.views[v].width, tiles[k]);
+    check_packing(&plan);
+    lm_shadow_plan_free(&plan);
+  }
+  printf("reach 1.6 at 256x192: %d-texel faces; at 512x384: %d\n", tiles[0], tiles[1]);
+  assert_int_equal(tiles[0], 128);
+  assert_int_equal(tiles[1], 256);
+  lm_frame_data cam;
+  lm_scene_frame_data(s, 0, 256, 192, &cam);
+  st.coverage = false;
+  assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+  assert_int_equal(plan.views[0].width, 512);
+  lm_shadow_plan_free(&plan);
+  st.coverage = true;
+  s->lights[0].radius = 4.0f; /* the camera inside its reach */
+  assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+  assert_int_equal(plan.views[0].width, 512);
+  lm_shadow_plan_free(&plan);
+
+  /* Mixed sizes: the sun's cascades, the box's light and small lights far off. */
+  s->lights[0].radius = 1.6f;
+  mat4 m;
+  glm_mat4_identity(m);
+  glm_rotate_x(m, glm_rad(-60.0f), m);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 0.2f,
+                                    .casts_shadows = true, .node = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1)});
+  for (int i = 0; i < 5; i++) {
+    glm_translate_make(m, (vec3){-0.8f + 0.4f * (float)i, 0.5f + 0.2f * (float)i, -0.5f});
+    char name[16];
+    snprintf(name, sizeof name, "lamp%d", i);
+    lm_scene_add_light(s, &(lm_light){.type = LM_LIGHT_POINT, .color = {1, 1, 1}, .power = 0.05f,
+                                      .radius = 0.05f + 0.1f * (float)i, .falloff = LM_FALLOFF_WINDOW,
+                                      .casts_shadows = true, .node = lm_scene_add_node(s, name, -1, (float *)m, -1, -1)});
+  }
+  lm_scene_update(s);
+  assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+  check_packing(&plan);
+  int area = plan.atlas_width * plan.atlas_height;
+  printf("mixed: %d tiles in %dx%d texels\n", plan.view_count, plan.atlas_width, plan.atlas_height);
+  lm_shadow_plan_free(&plan);
+  st.coverage = false;
+  assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+  printf("every tile at 512: %d tiles in %dx%d texels\n", plan.view_count, plan.atlas_width, plan.atlas_height);
+  assert_true(area * 4 <= plan.atlas_width * plan.atlas_height);
+  lm_shadow_plan_free(&plan);
+
+  /* The image: the same shadows as with every tile at full size, with the
+   * ESM blur (which finds each texel's tile among tiles of mixed sizes) too. */
+  static const char *const sets[2][2][3] = {{{"shadow.coverage=false", NULL}, {NULL}},
+                                            {{"shadow.coverage=false", "shadow.blur=2", NULL}, {"shadow.blur=2", NULL}}};
+  for (int k = 0; k < 2; k++) {
+    gl_result fine = render_ok(s, "dl+esm", sets[k][0]), fitted = render_ok(s, "dl+esm", sets[k][1]);
+    int n = fitted.width * fitted.height, differ = 0;
+    for (int i = 0; i < n; i++) {
+      float a = gl_luminance(fine.rgb + (size_t)i * 3), b = gl_luminance(fitted.rgb + (size_t)i * 3);
+      differ += fabsf(a - b) > 0.1f * fmaxf(a, 0.02f);
+    }
+    printf("%s: pixels off by more than 10%%: %.2f%%\n", k ? "blur 2" : "no blur", 100.0 * differ / n);
+    assert_true(differ < n / 100);
+    gl_result_free(&fine);
+    gl_result_free(&fitted);
+  }
+  lm_scene_destroy(s);
+}
+
 static void nothing_casts_or_nothing_reads_means_no_shadow_pass(void **state) {
   (void)state;
   lm_scene *s = builtin("cornell");
@@ -676,6 +776,7 @@ int main(void) {
       cmocka_unit_test(stabilized_cascades_do_not_shimmer),
       cmocka_unit_test(pcss_penumbra_widens_with_blocker_distance),
       cmocka_unit_test(cube_faces_no_pixel_samples_are_not_drawn),
+      cmocka_unit_test(local_tiles_follow_their_screen_coverage),
       cmocka_unit_test(nothing_casts_or_nothing_reads_means_no_shadow_pass),
       cmocka_unit_test(the_atlas_can_be_viewed),
       cmocka_unit_test(esm_keeps_the_rooms_sun_patch_and_does_not_leak),

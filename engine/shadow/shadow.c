@@ -18,7 +18,7 @@ int lm_shadow_technique_parse(const char *name) {
 void lm_shadow_settings_default(lm_shadow_settings *s) {
   *s = (lm_shadow_settings){.technique = LM_SHADOW_ESM, .resolution = 512, .c = 16.0f, .blur = 0,
                             .cascades = 3, .lambda = 0.75f, .distance = 0.0f,
-                            .blend = 0.1f, .radius = 2.5f, .stabilize = true, .cache = true,
+                            .blend = 0.1f, .radius = 2.5f, .stabilize = true, .cache = true, .coverage = true,
                             .size = -1.0f, .penumbra = 16.0f};
   s->bias = 1.0f; /* texels; the seed has 0: lit slanted surfaces then lose 1-2% to ESM */
 }
@@ -31,8 +31,9 @@ static void up_for(const vec3 dir, vec3 up) {
     glm_vec3_copy((vec3){1, 0, 0}, up);
 }
 
-/* A tile's view; its casters are culled against `cull` (NULL: view_proj). */
-static int add_view(lm_shadow_plan *plan, mat4 view_proj, const float depth[4], const float texel[4],
+/* A tile of `size` texels a side (placed by pack_tiles); its casters are
+ * culled against `cull` (NULL: view_proj). */
+static int add_view(lm_shadow_plan *plan, int size, mat4 view_proj, const float depth[4], const float texel[4],
                     mat4 cull) {
   int i = plan->view_count++;
   plan->views = lm_realloc(plan->views, sizeof *plan->views * (size_t)plan->view_count);
@@ -43,6 +44,7 @@ static int add_view(lm_shadow_plan *plan, mat4 view_proj, const float depth[4], 
   memcpy(plan->views[i].view_proj, view_proj, 64);
   memcpy(plan->views[i].depth, depth, 16);
   memcpy(plan->views[i].cull, cull ? cull : view_proj, 64);
+  plan->views[i].width = plan->views[i].height = size;
   return i;
 }
 
@@ -258,7 +260,7 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
   mat4 cull;
   if (grow <= 0) cascade_cull(cam, view, zr, z1, bounds, texel, filter_reach(st), (float[6]){l, r, b, t, zn, zf}, cull);
   /* A texel's world size and the world depth the tile's 0..1 spans. */
-  add_view(plan, vp, (float[4]){0, 0, 0, 0}, (float[4]){texel, zf - zn, 0, 0}, grow <= 0 ? cull : NULL);
+  add_view(plan, plan->tile, vp, (float[4]){0, 0, 0, 0}, (float[4]){texel, zf - zn, 0, 0}, grow <= 0 ? cull : NULL);
 }
 
 /* Cascades cover the depths where receivers are seen (plan->seen), snapped
@@ -329,12 +331,13 @@ static void perspective_view_proj(const vec3 pos, const vec3 dir, float fov, flo
   glm_mat4_mul(proj, view, vp);
 }
 
-static void plan_perspective(lm_shadow_plan *plan, const vec3 pos, const vec3 dir, float fov, float range) {
+static void plan_perspective(lm_shadow_plan *plan, int size, const vec3 pos, const vec3 dir, float fov,
+                             float range) {
   mat4 vp;
   perspective_view_proj(pos, dir, fov, range, vp);
   /* A texel's world size per unit of distance, and the world depth 0..1 spans. */
-  add_view(plan, vp, (float[4]){pos[0], pos[1], pos[2], 1.0f / range},
-           (float[4]){2.0f * tanf(fov * 0.5f) / (float)plan->tile, range, 0, 0}, NULL);
+  add_view(plan, size, vp, (float[4]){pos[0], pos[1], pos[2], 1.0f / range},
+           (float[4]){2.0f * tanf(fov * 0.5f) / (float)size, range, 0, 0}, NULL);
 }
 
 /* Point light: cube faces +X -X +Y -Y +Z -Z (shadow.glsl picks by major axis). */
@@ -373,6 +376,34 @@ static int cube_faces_seen(const lm_shadow_plan *plan, const lm_scene *s, const 
   return mask;
 }
 
+/* A tile of the cell's `tile` texels halved `level` times (never empty). */
+static int tile_size(int tile, int level) { return tile >> level > 0 ? tile >> level : 1; }
+
+enum { MIN_TILE = 32 };
+
+/* How many times a local light's tiles halve the resolution: about one
+ * texel a pixel over the disc that its reach (a sphere of `range` around
+ * pos) covers on screen, a cube face about half of it, never below
+ * MIN_TILE texels; a light whose reach holds the camera keeps the full
+ * resolution, one whose reach lies outside the view gets the least. The
+ * measure is in pixels, so a scene's unit changes nothing. */
+static int coverage_level(const lm_shadow_plan *plan, const lm_frame_data *cam, const vec3 pos, float range,
+                          bool cube) {
+  if (!plan->settings.coverage) return 0;
+  float d = glm_vec3_distance((float *)cam->camera_pos, (float *)pos), pixels = 0;
+  if (!(d > range)) return 0; /* inside, or not a number */
+  vec3 lo = {pos[0] - range, pos[1] - range, pos[2] - range}, hi = {pos[0] + range, pos[1] + range, pos[2] + range};
+  if (!lm_box_outside_frustum(cam->view_proj, lo, hi)) {
+    /* The disc's diameter: 2 tan(angular radius) over 2 tan(fov_y / 2), in pixels of the height. */
+    float sin_a = range / d;
+    pixels = cam->output_size[1] * sin_a / sqrtf(fmaxf(1.0f - sin_a * sin_a, 1e-12f)) / fmaxf(cam->clip[3], 1e-6f);
+    if (cube) pixels *= 0.5f;
+  }
+  int level = 0;
+  while (tile_size(plan->tile, level + 1) >= MIN_TILE && (float)tile_size(plan->tile, level + 1) >= pixels) level++;
+  return level;
+}
+
 static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam, int i,
                        const lm_light_data *ld) {
   const lm_light *l = &s->lights[i];
@@ -397,12 +428,13 @@ static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
   float range = light_range(s, l, pos);
   out->soft[0] = size > 0 ? size : LM_LIGHT_SIZE_SHARE * range;
   out->info[0] = plan->view_count;
+  int tile = tile_size(plan->tile, plan->levels[i]);
   if (l->type == LM_LIGHT_SPOT) {
     out->info[1] = 1;
     out->info[2] = KIND_SPOT;
     if (plan->settings.rsm > 0) out->cube[1] = plan->view_count, out->cube[2] = 1;
     float fov = fminf(2.0f * l->outer_cone * 1.05f + 0.02f, glm_rad(170.0f));
-    plan_perspective(plan, pos, dir, fov, range);
+    plan_perspective(plan, tile, pos, dir, fov, range);
     return;
   }
   /* Point light: the faces a visible pixel may sample, in face order. */
@@ -411,7 +443,43 @@ static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
   out->cube[0] = faces;
   if (plan->settings.rsm > 0) out->cube[1] = plan->view_count, out->cube[2] = out->info[1];
   for (int f = 0; f < 6; f++)
-    if (faces & 1 << f) plan_perspective(plan, pos, cube_faces[f], GLM_PI_2f, range);
+    if (faces & 1 << f) plan_perspective(plan, tile, pos, cube_faces[f], GLM_PI_2f, range);
+}
+
+/* Places n tiles of size[v] texels a side in cells of `tile` texels: largest first, each in a free square of its size, else in the
+ * smallest larger one split into quadrants (the three it does not take stay
+ * free), else in a new cell. Sizes are the cell halved whole times, so the
+ * quadrants fit exactly and only the last cell has room to spare. Writes
+ * cell[v] and the place x, y in it; returns the cells used. */
+static int pack_tiles(int tile, const int *size, int n, int *cell, int *x, int *y) {
+  typedef struct { int cell, x, y, size; } square;
+  int cells = 0, nfree = 0;
+  int *order = lm_alloc(sizeof *order * (size_t)(n + 1));
+  square *free_squares = lm_alloc(sizeof *free_squares * (size_t)(3 * 16 * n + 1)); /* 3 a halving, <= 13 halvings */
+  for (int v = 0; v < n; v++) { /* insertion sort, largest first, views in order among equals */
+    int k = v;
+    for (; k > 0 && size[order[k - 1]] < size[v]; k--) order[k] = order[k - 1];
+    order[k] = v;
+  }
+  for (int i = 0; i < n; i++) {
+    int v = order[i], best = -1;
+    for (int f = 0; f < nfree; f++)
+      if (free_squares[f].size >= size[v] && (best < 0 || free_squares[f].size < free_squares[best].size)) best = f;
+    square q = {cells, 0, 0, tile};
+    if (best >= 0) q = free_squares[best], free_squares[best] = free_squares[--nfree];
+    else cells++;
+    while (q.size / 2 >= size[v]) {
+      int h = q.size / 2;
+      free_squares[nfree++] = (square){q.cell, q.x + h, q.y, h};
+      free_squares[nfree++] = (square){q.cell, q.x, q.y + h, h};
+      free_squares[nfree++] = (square){q.cell, q.x + h, q.y + h, h};
+      q.size = h;
+    }
+    cell[v] = q.cell, x[v] = q.x, y[v] = q.y;
+  }
+  free(order);
+  free(free_squares);
+  return cells;
 }
 
 /* Every light's views for the camera; then the tiles' places in the atlas. */
@@ -425,17 +493,21 @@ static void plan_views(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
     if (plan->settings.rsm > 0 && s->lights[i].casts_shadows && s->lights[i].type == LM_LIGHT_DIRECTIONAL)
       plan_wide_tile(plan, s, cam, &ld[i], &plan->lights[i]);
   free(ld);
-  for (int v = 0; v < plan->view_count; v++) {
-    int cx = v % plan->columns, cy = v / plan->columns;
-    plan->views[v].x = cx * plan->tile;
-    plan->views[v].y = cy * plan->tile;
-    plan->views[v].width = plan->views[v].height = plan->tile;
+  int n = plan->view_count, *cell = lm_alloc(sizeof *cell * (size_t)(4 * n + 1)), *x = cell + n, *y = x + n;
+  int *size = y + n;
+  for (int v = 0; v < n; v++) size[v] = plan->views[v].width;
+  pack_tiles(plan->tile, size, n, cell, x, y);
+  for (int v = 0; v < n; v++) {
+    lm_pass_view *w = &plan->views[v];
+    w->x = cell[v] % plan->columns * plan->tile + x[v];
+    w->y = cell[v] / plan->columns * plan->tile + y[v];
     float *rect = plan->view_data[v].rect;
-    rect[0] = (float)cx / (float)plan->columns;
-    rect[1] = (float)cy / (float)plan->rows;
-    rect[2] = 1.0f / (float)plan->columns;
-    rect[3] = 1.0f / (float)plan->rows;
+    rect[0] = (float)w->x / (float)plan->atlas_width;
+    rect[1] = (float)w->y / (float)plan->atlas_height;
+    rect[2] = (float)w->width / (float)plan->atlas_width;
+    rect[3] = (float)w->height / (float)plan->atlas_height;
   }
+  free(cell);
 }
 
 bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
@@ -454,30 +526,39 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
   plan->light_count = s->light_count;
   plan->lights = lm_alloc(sizeof *plan->lights * (size_t)(s->light_count + 1));
   visible_depth(s, cam, plan->seen);
-  /* How many views (a point light's faces chosen now, for the whole frame),
-   * then tiles in a near-square grid, shrunk to fit the GL limit if needed;
-   * the views depend on the tile size (texel snapping). */
+  /* Each light's tiles and their sizes (a point light's faces chosen now,
+   * for the whole frame), then a near-square grid of cells that holds them,
+   * shrunk to fit the GL limit if needed; the views depend on the tile size
+   * (texel snapping). */
+  plan->levels = lm_alloc(sizeof *plan->levels * (size_t)(s->light_count + 1));
+  plan->tile = st->resolution;
   lm_light_data *ld = lm_alloc(sizeof *ld * (size_t)(s->light_count + 1));
   lm_scene_light_data(s, ld, s->light_count);
-  int count = 0;
+  int count = 0, *size = lm_alloc(sizeof *size * (size_t)(6 * s->light_count + 1));
   for (int i = 0; i < s->light_count; i++) {
     const lm_light *l = &s->lights[i];
+    plan->levels[i] = 0;
     if (!l->casts_shadows) continue;
-    if (l->type == LM_LIGHT_POINT) {
+    int views = st->cascades + (st->rsm > 0);
+    if (l->type != LM_LIGHT_DIRECTIONAL) {
       vec3 pos = {ld[i].position[0], ld[i].position[1], ld[i].position[2]};
+      float range = light_range(s, l, pos);
+      plan->levels[i] = coverage_level(plan, cam, pos, range, l->type == LM_LIGHT_POINT);
       /* An RSM needs every face: a sender off screen lights what is seen. */
-      plan->lights[i].cube[0] = st->rsm > 0 ? 63 : cube_faces_seen(plan, s, cam, pos, light_range(s, l, pos));
+      if (l->type == LM_LIGHT_POINT) plan->lights[i].cube[0] = st->rsm > 0 ? 63 : cube_faces_seen(plan, s, cam, pos, range);
+      views = l->type == LM_LIGHT_SPOT ? 1 : __builtin_popcount((unsigned)plan->lights[i].cube[0]);
     }
-    count += l->type == LM_LIGHT_DIRECTIONAL ? st->cascades + (st->rsm > 0)
-             : l->type == LM_LIGHT_SPOT      ? 1
-                                             : __builtin_popcount((unsigned)plan->lights[i].cube[0]);
+    for (int k = 0; k < views; k++) size[count++] = tile_size(plan->tile, plan->levels[i]);
   }
   free(ld);
-  plan->tile = st->resolution;
-  plan->columns = count ? (int)ceil(sqrt((double)count)) : 0;
-  plan->rows = count ? (count + plan->columns - 1) / plan->columns : 0;
+  int *cell = lm_alloc(sizeof *cell * (size_t)(3 * count + 1));
+  int cells = pack_tiles(plan->tile, size, count, cell, cell + count, cell + 2 * count);
+  free(cell);
+  free(size);
+  plan->columns = cells ? (int)ceil(sqrt((double)cells)) : 0;
+  plan->rows = cells ? (cells + plan->columns - 1) / plan->columns : 0;
   int max = 16384;
-  while (count && (plan->tile * plan->columns > max || plan->tile * plan->rows > max)) plan->tile /= 2;
+  while (cells && plan->tile > 1 && (plan->tile * plan->columns > max || plan->tile * plan->rows > max)) plan->tile /= 2;
   plan->atlas_width = plan->tile * plan->columns;
   plan->atlas_height = plan->tile * plan->rows;
   plan_views(plan, s, cam);
@@ -493,6 +574,7 @@ void lm_shadow_plan_fit(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_
 }
 
 void lm_shadow_plan_free(lm_shadow_plan *plan) {
+  free(plan->levels);
   free(plan->views);
   free(plan->view_data);
   free(plan->lights);

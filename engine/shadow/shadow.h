@@ -38,6 +38,8 @@ typedef struct lm_shadow_settings {
   float penumbra;  /* PCSS: the widest penumbra radius and blocker search, texels */
   bool cache;      /* a tile whose view and casters are those of the last frame's tile in its
                     * place keeps that tile's texels (engine/render: copied, not drawn) */
+  bool coverage;   /* spot and point tiles as fine as the screen needs (lm_shadow_plan.levels);
+                    * false: every tile at resolution */
   float rsm;       /* > 0: a frame reads reflective shadow maps (seed 004's senders); each
                     * directional light gets one more tile, over the sphere around all
                     * that is seen with its radius times rsm (senders off screen), 0..64 */
@@ -63,7 +65,12 @@ typedef struct lm_shadow_view_data {
 
 typedef struct lm_shadow_plan {
   lm_shadow_settings settings;
+  /* The atlas is a grid of columns x rows cells of tile texels a side (the
+   * resolution, halved while the atlas would pass the GL limit). A cascade
+   * or RSM tile fills a cell; a spot or point light's tiles are the cell
+   * halved levels[light] times, packed into quadrants of shared cells. */
   int tile, columns, rows, atlas_width, atlas_height;
+  int *levels;         /* per scene light */
   lm_pass_view *views; /* for the scene pass, one per tile */
   lm_shadow_view_data *view_data;
   int view_count;
