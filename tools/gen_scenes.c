@@ -991,6 +991,65 @@ static void ref_blocks(const char *dir) {
   finish(&d, dir, "blocks");
 }
 
+/* A street at night: 16 lamps with a range (KHR_lights_punctual's), each
+ * casting shadows, along 80 m between blocks of houses, under a dim moon.
+ * Lamps far down the street cover few pixels: their shadow tiles are small
+ * (engine/shadow's screen coverage), and light culling lists each lamp only
+ * where its range reaches. */
+static void night(const char *dir) {
+  doc d = {0};
+  int asphalt = add_material(&d, "asphalt", 0.12f, 0.12f, 0.13f, 0, 0.9f, -1);
+  int paving = add_material(&d, "paving", 0.45f, 0.43f, 0.4f, 0, 0.85f, -1);
+  int plaster = add_material(&d, "plaster", 0.7f, 0.62f, 0.5f, 0, 0.9f, -1);
+  int iron = add_material(&d, "iron", 0.2f, 0.2f, 0.22f, 0, 0.6f, -1);
+  int paints[3] = {add_material(&d, "paint_blue", 0.1f, 0.2f, 0.55f, 0, 0.4f, -1),
+                   add_material(&d, "paint_red", 0.6f, 0.08f, 0.06f, 0, 0.4f, -1),
+                   add_material(&d, "paint_white", 0.8f, 0.8f, 0.78f, 0, 0.4f, -1)};
+  int glass = add_material(&d, "glass", 0.15f, 0.2f, 0.25f, 0, 0.1f, -1);
+  int tyre = add_material(&d, "tyre", 0.05f, 0.05f, 0.05f, 0, 0.9f, -1);
+  float L = 80; /* the street runs from z = 0 to -L */
+  mesh m = {0};
+  quad(&m, (float[]){-4, 0, 0}, (float[]){8, 0, 0}, (float[]){0, 0, -L}, 4, 40);
+  mesh_node(&d, "road", -1, add_mesh1(&d, "road", &m, asphalt), 0, 0, 0, 0, 1);
+  box(&m, -5.5f, 0.075f, -L / 2, 1.5f, 0.075f, L / 2);
+  box(&m, 5.5f, 0.075f, -L / 2, 1.5f, 0.075f, L / 2);
+  mesh_node(&d, "sidewalks", -1, add_mesh1(&d, "sidewalks", &m, paving), 0, 0, 0, 0, 1);
+  for (int i = 0; i < 10; i++) /* houses of 6 to 14 m, 8 m wide, both sides */
+    for (int side = 0; side < 2; side++) {
+      float h = 6 + (float)((i * 7 + side * 3) % 5) * 2, x = side ? 11 : -11;
+      box(&m, x, h / 2, -4 - 8 * (float)i, 4, h / 2, 3.9f);
+    }
+  mesh_node(&d, "houses", -1, add_mesh1(&d, "houses", &m, plaster), 0, 0, 0, 0, 1);
+  mesh parts[1] = {{0}};
+  cylinder(&parts[0], 0.08f, 5, 8, 'y');
+  for (int v = 0; v < parts[0].nv; v++) parts[0].v[v * 8 + 1] += 2.5f;
+  box(&parts[0], 0.35f, 5.0f, 0, 0.45f, 0.06f, 0.12f);
+  int post = add_mesh(&d, "lamp_post", parts, &iron, 1);
+  mesh_free(&parts[0]);
+  for (int i = 0; i < 8; i++)
+    for (int side = 0; side < 2; side++) {
+      char nm[32];
+      float x = side ? 5.2f : -5.2f, z = -5 - 10 * (float)i - (side ? 5 : 0);
+      snprintf(nm, sizeof nm, "post%d%c", i, side ? 'r' : 'l');
+      mesh_node(&d, nm, -1, post, x, 0.15f, z, side ? 180 : 0, 1);
+      snprintf(nm, sizeof nm, "lamp%d%c", i, side ? 'r' : 'l');
+      light(&d, nm, "point", side ? x - 0.5f : x + 0.5f, 4.85f, z, NULL, 1, 0.8f, 0.55f, 40000, 14);
+    }
+  int cars[3];
+  for (int k = 0; k < 3; k++) cars[k] = car_mesh(&d, paints[k], glass, tyre);
+  for (int i = 0; i < 7; i++) { /* parked along both kerbs */
+    char nm[32];
+    snprintf(nm, sizeof nm, "car%d", i);
+    mesh_node(&d, nm, -1, cars[i % 3], i % 2 ? 3.1f : -3.1f, 0, -9 - 10 * (float)i, i % 2 ? 90 : -90, 1);
+  }
+  light(&d, "moon", "directional", 0, 30, 0, (float[]){0.3f, -0.8f, 0.5f}, 0.6f, 0.7f, 1, 40, 0);
+  view(&d, "street", 0.5f, 1.7f, 2, -0.5f, 1.6f, -40, 60, 150);
+  view(&d, "kerb", 4.2f, 1.6f, -22, -1.5f, 1.0f, -34, 60, 150);
+  view(&d, "above", -2, 22, -20, 0.5f, 0, -42, 55, 150);
+  view(&d, "far", 0, 1.7f, -78, 0, 2.5f, -20, 50, 150);
+  finish(&d, dir, "night");
+}
+
 int main(int argc, char **argv) {
   if (argc != 2) {
     fprintf(stderr, "usage: gen_scenes OUTDIR\n");
@@ -1010,5 +1069,6 @@ int main(int argc, char **argv) {
   ref_room(ref);
   ref_street(ref);
   ref_blocks(ref);
+  night(argv[1]); /* last: it draws no random number, but stays after those that do */
   return 0;
 }

@@ -9,14 +9,15 @@
 #   FRAMES     timed frames (default 5)    TECHS (default below; "tech:opt=v,opt=v" sets options)
 #   WARMUP     untimed frames first (default 1; with temporal reuse, more than rsm.temporal.frames
 #              times the converged frame)
+#   SCENES     the scenes, space-separated (default the reference set's and the Cornell box)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 LIMN=${BUILD_DIR:-build}/limn
 [ -x "$LIMN" ] || { echo "gi_time: no $LIMN (build first: tools/dev.sh build)" >&2; exit 2; }
 SIZE=${SIZE:-256x192} FRAMES=${FRAMES:-5} WARMUP=${WARMUP:-1}
 read -r -a techs <<< "${TECHS:-dl+esm rsm+esm vpl+esm isr+rsm+esm isr+esm lpv+esm isr+lpv+esm}"
-scenes=(data/scenes/reference/room.glb data/scenes/reference/street.glb data/scenes/reference/blocks.glb
-        data/scenes/cornell.glb)
+read -r -a scenes <<< "${SCENES:-data/scenes/reference/room.glb data/scenes/reference/street.glb \
+data/scenes/reference/blocks.glb data/scenes/cornell.glb}"
 declare -A sum
 for scene in "${scenes[@]}"; do
   for spec in "${techs[@]}"; do
