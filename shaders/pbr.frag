@@ -10,6 +10,7 @@
 
 in vec3 world_normal;
 in vec3 world_pos;
+in vec4 world_tangent; // the mesh's (glTF TANGENT); w: handedness, 0 when it has none
 in float view_depth;
 in vec2 tex_uv;
 
@@ -48,16 +49,23 @@ layout(location = 4) out vec4 out_emi;
 vec2 uv_of(mat3 xform) { return (xform * vec3(tex_uv, 1.0)).xy; }
 
 #ifdef NORMAL_TEXTURE
-// Tangent frame from screen derivatives (no tangents in the mesh): T along
-// +u, B = N x T as glTF's bitangent; a degenerate frame keeps n.
+// The tangent frame: the mesh's tangents where it has them (glTF: B = N x T
+// times the handedness w), else one from screen derivatives with T along +u
+// and B = N x T. A degenerate frame keeps n.
 vec3 perturb(vec3 n, vec3 tn) {
-  vec3 dp1 = dFdx(world_pos), dp2 = dFdy(world_pos);
-  vec2 duv1 = dFdx(tex_uv), duv2 = dFdy(tex_uv);
-  vec3 t = dp1 * duv2.y - dp2 * duv1.y;
-  float det = duv1.x * duv2.y - duv2.x * duv1.y;
-  t = safe_normalize((det < 0.0 ? -t : t) - n * dot(n, t), vec3(0.0));
+  vec3 t = world_tangent.xyz;
+  float w = world_tangent.w < 0.0 ? -1.0 : 1.0;
+  if (abs(world_tangent.w) < 0.5) {
+    vec3 dp1 = dFdx(world_pos), dp2 = dFdy(world_pos);
+    vec2 duv1 = dFdx(tex_uv), duv2 = dFdy(tex_uv);
+    float det = duv1.x * duv2.y - duv2.x * duv1.y;
+    t = dp1 * duv2.y - dp2 * duv1.y;
+    t = det < 0.0 ? -t : t;
+    w = 1.0;
+  }
+  t = safe_normalize(t - n * dot(n, t), vec3(0.0));
   if (dot(t, t) < 0.5) return n;
-  vec3 b = cross(n, t);
+  vec3 b = cross(n, t) * w;
   return safe_normalize(mat3(t, b, n) * tn, n);
 }
 #endif

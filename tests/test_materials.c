@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
+#include <cglm/cglm.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +15,7 @@
 #include <unistd.h>
 
 #include "gl_test.h"
+#include "image/image.h"
 #include "scene/gltf.h"
 
 enum { W = 96, H = 72 };
@@ -566,6 +568,97 @@ static void strips_and_fans_render_as_their_triangle_lists(void **state) {
   lm_scene_destroy(ref_scene);
 }
 
+/* Normal maps take the mesh's tangents (glTF TANGENT, B = N x T times w)
+ * where it has them, else a frame from screen derivatives with T along +u:
+ * a quad facing the camera (u along +x) whose map tilts the normal 37
+ * degrees towards T (or B), lit at 45 degrees from +x (or +y). */
+typedef struct quad_data {
+  float pos[12], nrm[12], uv[8], tan[16];
+  uint16_t idx[6];
+} quad_data;
+
+static const char *normal_map_quad(const char *name, const float *tangents, const char *tangent_type,
+                                   const unsigned char texel[3]) {
+  char dir[1024], png[1100], bin[1100], json[4096];
+  snprintf(dir, sizeof dir, "%s", gl_root());
+  snprintf(png, sizeof png, "%s/%s.png", dir, name);
+  unsigned char image[4 * 4 * 3];
+  for (int i = 0; i < 16; i++) memcpy(image + i * 3, texel, 3);
+  lm_error err;
+  if (!lm_image_write(png, 4, 4, 3, false, image, &err)) fail_msg("%s", err.msg);
+  quad_data data = {{-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1},
+            {0, 1, 1, 1, 1, 0, 0, 0}, {0}, {0, 1, 2, 0, 2, 3}};
+  int ncomp = strcmp(tangent_type, "VEC4") ? 3 : 4;
+  for (int v = 0; v < 4 && tangents; v++) memcpy(data.tan + v * ncomp, tangents, sizeof(float) * (size_t)ncomp);
+  snprintf(bin, sizeof bin, "%s/%s.bin", dir, name);
+  FILE *f = fopen(bin, "wb");
+  assert_non_null(f);
+  assert_int_equal(fwrite(&data, sizeof data, 1, f), 1);
+  fclose(f);
+  size_t at_tan = offsetof(quad_data, tan), at_idx = offsetof(quad_data, idx);
+  snprintf(json, sizeof json,
+           "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0,1]}],"
+           "\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,3]}],"
+           "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.1,\"zfar\":20}}],"
+           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2%s},"
+           "\"indices\":4,\"material\":0}]}],"
+           "\"materials\":[{\"pbrMetallicRoughness\":{\"metallicFactor\":0,\"roughnessFactor\":1},"
+           "\"normalTexture\":{\"index\":0}}],\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"%s.png\"}],"
+           "\"buffers\":[{\"uri\":\"%s.bin\",\"byteLength\":%zu}],"
+           "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":48},"
+           "{\"buffer\":0,\"byteOffset\":96,\"byteLength\":32},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":64},"
+           "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":12}],"
+           "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+           "\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+           "{\"bufferView\":2,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+           "{\"bufferView\":3,\"componentType\":5126,\"count\":4,\"type\":\"%s\"},"
+           "{\"bufferView\":4,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}",
+           tangents ? ",\"TANGENT\":3" : "", name, name, sizeof data, at_tan, at_idx, tangent_type);
+  static char path[1200];
+  write_file(name, json, path, sizeof path);
+  return path;
+}
+
+static float lit_quad(const float *tangents, const unsigned char texel[3], const float light_dir[3]) {
+  lm_error err;
+  lm_scene *s = lm_scene_load_gltf(normal_map_quad("nmap.gltf", tangents, "VEC4", texel), &err);
+  if (!s) fail_msg("%s", err.msg);
+  s->lights[0].power = 0; /* the loader's default light (the file has none) */
+  mat4 m;
+  glm_lookat((vec3){0, 0, 0}, (float *)light_dir, (vec3){0, 1, 0}, m);
+  glm_mat4_inv(m, m); /* the node looks along -Z towards light_dir */
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 1,
+                                    .node = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1)});
+  lm_scene_update(s);
+  const char *sets[] = {"materials=pbr", "ambient=0", NULL};
+  gl_result g = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = sets, .width = 64, .height = 48});
+  if (!g.ok) fail_msg("%s", g.err.msg);
+  float rgb[3];
+  gl_region(&g, 20, 14, 43, 33, rgb);
+  gl_result_free(&g);
+  lm_scene_destroy(s);
+  return gl_luminance(rgb);
+}
+
+static void normal_maps_take_the_mesh_tangents(void **state) {
+  (void)state;
+  const unsigned char towards_t[3] = {204, 128, 230}, towards_b[3] = {128, 204, 230}; /* (0.6, 0, 0.8), (0, 0.6, 0.8) */
+  const float from_x[3] = {-1, 0, -1}, from_y[3] = {0, -1, -1}; /* where the light shines */
+  const float along_x[4] = {1, 0, 0, 1}, along_y[4] = {0, 1, 0, 1}, mirrored[4] = {1, 0, 0, -1};
+  float derived = lit_quad(NULL, towards_t, from_x), given_x = lit_quad(along_x, towards_t, from_x);
+  float given_y = lit_quad(along_y, towards_t, from_x);
+  float b_up = lit_quad(along_x, towards_b, from_y), b_down = lit_quad(mirrored, towards_b, from_y);
+  printf("tilted towards T, light from +x: derived frame %.4f, T = +x %.4f, T = +y %.4f\n", derived, given_x, given_y);
+  printf("tilted towards B, light from +y: w = 1 %.4f, w = -1 %.4f\n", b_up, b_down);
+  /* n.l: 0.99 tilted towards the light, 0.57 across it, 0.14 away from it. */
+  assert_true(fabsf(given_x - derived) < 0.02f * derived);
+  assert_true(given_y < 0.7f * given_x && given_y > 0.45f * given_x);
+  assert_true(b_down < 0.25f * b_up);
+  lm_error err;
+  assert_null(lm_scene_load_gltf(normal_map_quad("nmap3.gltf", along_x, "VEC3", towards_t), &err));
+  if (!strstr(err.msg, "TANGENT")) fail_msg("%s", err.msg);
+}
+
 static int setup(void **state) {
   int rc = gl_test_setup(state);
   lm_log_set_level(LM_LOG_ERROR); /* the bad-texture cases warn by design */
@@ -576,6 +669,7 @@ int main(void) {
   snprintf(pp_lua, sizeof pp_lua, "%s/scripts/pp.lua", LIMN_SOURCE_ROOT);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(textures_show_as_detail),
+      cmocka_unit_test(normal_maps_take_the_mesh_tangents),
       cmocka_unit_test(culling_drops_what_the_camera_cannot_see),
       cmocka_unit_test(scripts_override_materials_by_name),
       cmocka_unit_test(materials_reload_without_a_restart),

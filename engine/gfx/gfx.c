@@ -291,8 +291,8 @@ void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, in
 }
 
 /* ---- meshes ------------------------------------------------------------ */
-void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const uint32_t *indices,
-                    int index_count) {
+void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const float *tangents,
+                    const uint32_t *indices, int index_count) {
   glCreateVertexArrays(1, &m->vao);
   glCreateBuffers(1, &m->vbo);
   glCreateBuffers(1, &m->ibo);
@@ -316,12 +316,21 @@ void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const u
     glVertexArrayAttribBinding(m->vao, (GLuint)a, 1);
   }
   glVertexArrayBindingDivisor(m->vao, 1, 1);
+  if (tangents) { /* binding 2 */
+    glCreateBuffers(1, &m->tbo);
+    glNamedBufferData(m->tbo, (GLsizeiptr)vertex_count * 4 * sizeof(float), tangents, GL_STATIC_DRAW);
+    glVertexArrayVertexBuffer(m->vao, 2, m->tbo, 0, 4 * sizeof(float));
+    glEnableVertexArrayAttrib(m->vao, 10);
+    glVertexArrayAttribFormat(m->vao, 10, 4, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(m->vao, 10, 2);
+  }
   m->index_count = index_count;
 }
 
 void lm_mesh_destroy(lm_mesh *m) {
   if (m->vao) glDeleteVertexArrays(1, &m->vao);
   if (m->vbo) glDeleteBuffers(1, &m->vbo);
+  if (m->tbo) glDeleteBuffers(1, &m->tbo);
   if (m->ibo) glDeleteBuffers(1, &m->ibo);
   *m = (lm_mesh){0};
 }

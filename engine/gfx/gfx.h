@@ -183,10 +183,12 @@ typedef struct lm_light_data {
 void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, int light_count);
 
 /* ---- meshes ------------------------------------------------------------ */
-typedef struct lm_mesh { uint32_t vao, vbo, ibo; int index_count; } lm_mesh;
-/* Interleaved position(3) normal(3) uv(2) floats (attributes 0, 1, 2); 32-bit indices. */
-void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const uint32_t *indices,
-                    int index_count);
+typedef struct lm_mesh { uint32_t vao, vbo, tbo, ibo; int index_count; } lm_mesh;
+/* Interleaved position(3) normal(3) uv(2) floats (attributes 0, 1, 2); 32-bit indices.
+ * tangents (may be NULL): xyz and handedness w a vertex, attribute 10; without,
+ * the attribute reads (0, 0, 0, 1), which shaders take for "none". */
+void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const float *tangents,
+                    const uint32_t *indices, int index_count);
 void lm_mesh_destroy(lm_mesh *m);
 /* One instance of a drawn mesh: attributes 3-6 (mat4 instance_model, the
  * columns) and 7-9 (mat3 instance_normal, the model matrix's inverse

@@ -175,7 +175,7 @@ double view_get(const View &v, size_t i, int c) {
 // Copies attribute `name` of the primitive into slots [at, at + ncomp) of the
 // 8-float vertices; false when absent (*present = false) or bad (error set).
 bool read_attribute(Loader &L, const char *where, const tinygltf::Primitive &p, const char *name,
-                    int ncomp, int at, std::vector<float> &verts, size_t count, bool *present) {
+                    int ncomp, int at, int stride, std::vector<float> &verts, size_t count, bool *present) {
   auto it = p.attributes.find(name);
   *present = it != p.attributes.end();
   if (!*present) return true;
@@ -186,14 +186,14 @@ bool read_attribute(Loader &L, const char *where, const tinygltf::Primitive &p, 
   if (v.count != count)
     return fail(L, "%s: accessor %d has %zu elements, but POSITION has %zu", what, it->second,
                 v.count, count);
-  verts.resize(count * 8);
+  verts.resize(count * (size_t)stride);
   for (size_t i = 0; i < count; i++)
     for (int c = 0; c < ncomp; c++) {
       double x = view_get(v, i, c);
       if (!std::isfinite(x) || std::fabs(x) > LM_GLTF_MAX_COORD)
         return fail(L, "%s: accessor %d: element %zu has a non-finite or huge value (%g)", what,
                     it->second, i, x);
-      verts[i * 8 + at + c] = (float)x;
+      verts[i * (size_t)stride + at + c] = (float)x;
     }
   return true;
 }
@@ -264,6 +264,17 @@ void normalize_normals(std::vector<float> &verts) {
   }
 }
 
+// Tangents as the shaders take them: xyz of unit length (a zero one stays
+// zero: that vertex falls back to a frame from screen derivatives) and the
+// handedness w as +-1.
+void normalize_tangents(std::vector<float> &t) {
+  for (size_t i = 0; i < t.size(); i += 4) {
+    double len = std::sqrt((double)t[i] * t[i] + (double)t[i + 1] * t[i + 1] + (double)t[i + 2] * t[i + 2]);
+    for (int k = 0; k < 3; k++) t[i + k] = len > 0 ? (float)(t[i + k] / len) : 0.0f;
+    t[i + 3] = t[i + 3] < 0 ? -1.0f : 1.0f;
+  }
+}
+
 // A strip's or fan's indices as a triangle list, winding kept (glTF 2.0
 // section 3.7.2.1: strip triangle i is (i, i + 1 + i % 2, i + 2 - i % 2),
 // fan triangle i is (i + 1, i + 2, 0)).
@@ -302,9 +313,12 @@ int load_primitive(Loader &L, int mi, int pi) {
   size_t count = v.count;
   std::vector<float> verts;
   bool present, has_normals;
-  if (!read_attribute(L, where, p, "POSITION", 3, 0, verts, count, &present) ||
-      !read_attribute(L, where, p, "NORMAL", 3, 3, verts, count, &has_normals) ||
-      !read_attribute(L, where, p, "TEXCOORD_0", 2, 6, verts, count, &present))
+  std::vector<float> tangents;
+  bool has_tangents;
+  if (!read_attribute(L, where, p, "POSITION", 3, 0, 8, verts, count, &present) ||
+      !read_attribute(L, where, p, "NORMAL", 3, 3, 8, verts, count, &has_normals) ||
+      !read_attribute(L, where, p, "TEXCOORD_0", 2, 6, 8, verts, count, &present) ||
+      !read_attribute(L, where, p, "TANGENT", 4, 0, 4, tangents, count, &has_tangents))
     return -1;
 
   std::vector<uint32_t> idx;
@@ -332,7 +346,12 @@ int load_primitive(Loader &L, int mi, int pi) {
   else snprintf(base, sizeof base, "%s", mesh.name.c_str());
   if (mesh.primitives.size() == 1) snprintf(name, sizeof name, "%s", base);
   else snprintf(name, sizeof name, "%s.%d", base, pi);
-  return lm_scene_add_mesh(L.s, name, verts.data(), (int)count, idx.data(), (int)idx.size());
+  int m = lm_scene_add_mesh(L.s, name, verts.data(), (int)count, idx.data(), (int)idx.size());
+  if (has_tangents && count > 0) {
+    normalize_tangents(tangents);
+    lm_scene_mesh_set_tangents(L.s, m, tangents.data());
+  }
+  return m;
 }
 
 // ---- materials -------------------------------------------------------------

@@ -18,6 +18,7 @@ void lm_scene_destroy(lm_scene *s) {
   for (int i = 0; i < s->mesh_count; i++) {
     if (s->uploaded) lm_mesh_destroy(&s->meshes[i].gpu);
     free(s->meshes[i].vertices);
+    free(s->meshes[i].tangents);
     free(s->meshes[i].indices);
   }
   for (int i = 0; i < s->texture_count; i++) {
@@ -60,6 +61,13 @@ int lm_scene_add_mesh(lm_scene *s, const char *name, const float *vertices, int 
     glm_vec3_maxv(m->bounds[1], (float *)p, m->bounds[1]);
   }
   return s->mesh_count - 1;
+}
+
+void lm_scene_mesh_set_tangents(lm_scene *s, int mesh, const float *tangents) {
+  lm_scene_mesh *m = &s->meshes[mesh];
+  size_t size = sizeof(float) * 4 * (size_t)m->vertex_count;
+  free(m->tangents);
+  m->tangents = memcpy(lm_alloc(size + 1), tangents, size);
 }
 
 int lm_scene_add_texture(lm_scene *s, const char *name, int width, int height, unsigned char *rgba) {
@@ -226,7 +234,7 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
   }
   for (int i = 0; i < s->mesh_count; i++) {
     lm_scene_mesh *m = &s->meshes[i];
-    lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->indices, m->index_count);
+    lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, m->indices, m->index_count);
   }
   s->uploaded = true;
   return true;

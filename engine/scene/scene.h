@@ -115,6 +115,7 @@ typedef struct lm_camera {
 typedef struct lm_scene_mesh {
   char name[LM_NAME_MAX];
   float *vertices; /* position(3) normal(3) uv(2) */
+  float *tangents; /* xyz, handedness w (glTF TANGENT) a vertex; NULL: none (pbr.frag derives a frame) */
   int vertex_count;
   uint32_t *indices;
   int index_count;
@@ -154,6 +155,8 @@ int lm_scene_add_material(lm_scene *s, const lm_material *m);
 /* Copies the arrays. */
 int lm_scene_add_mesh(lm_scene *s, const char *name, const float *vertices, int vertex_count,
                       const uint32_t *indices, int index_count);
+/* Gives mesh `mesh` tangents (4 floats a vertex, copied), before the upload. */
+void lm_scene_mesh_set_tangents(lm_scene *s, int mesh, const float *tangents);
 int lm_scene_add_node(lm_scene *s, const char *name, int parent, const float local[16], int mesh,
                       int material);
 int lm_scene_add_light(lm_scene *s, const lm_light *l);
