@@ -5,7 +5,8 @@
 #                       default against POV-Ray references (data/jobs/quick.lua, cached)
 #   tools/dev.sh test   install what is missing, build, run the whole test suite
 #   tools/dev.sh build  install what is missing and build
-# BUILD_DIR (default build) and CMAKE_ARGS pass through to CMake, CTEST_ARGS to ctest.
+# BUILD_DIR (default build) and CMAKE_ARGS pass through to CMake, CTEST_ARGS to ctest;
+# CTEST_JOBS is how many tests run at once (default: one a core).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -64,7 +65,7 @@ case "${1:-run}" in
     # Tests in parallel, one a core: each renders on llvmpipe, whose threads
     # mostly wait on a single draw thread, so two at once fill two cores.
     # shellcheck disable=SC2086
-    ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure -j "$(nproc)" ${CTEST_ARGS:-}
+    ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure -j "${CTEST_JOBS:-$(nproc)}" ${CTEST_ARGS:-}
     ;;
   *) echo "usage: tools/dev.sh run|test|build|deps" >&2; exit 2 ;;
 esac
