@@ -62,8 +62,7 @@ case "${1:-run}" in
     ;;
   test)
     deps; build
-    # Tests in parallel, one a core: each renders on llvmpipe, whose threads
-    # mostly wait on a single draw thread, so two at once fill two cores.
+    # Tests in parallel, one a core by default (CTEST_JOBS).
     # shellcheck disable=SC2086
     ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure -j "${CTEST_JOBS:-$(nproc)}" ${CTEST_ARGS:-}
     ;;
