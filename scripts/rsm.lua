@@ -1,9 +1,10 @@
 -- Indirect light from reflective shadow maps (seed 004, lines 858-958), on
 -- POV-Ray's scale (/work/shared/design/gi-scale.md). The shadow pass writes
 -- the maps when this module asks (shadow.render(o, G, reach)); the gather
--- runs at a coarse size over isr.lua's coarse G-buffer (rsm.frag), then the
--- same geometry-aware blur, bilateral upsampling and composite as ISR
--- (isr.blur, isr.composite: L = D + k_a L_a albedo + k k_d albedo E).
+-- runs at a coarse size over isr.lua's coarse view of the G-buffer
+-- (isr.coarse_view: no downsampling pass; rsm.frag), then the same
+-- geometry-aware blur, bilateral upsampling and composite as ISR (isr.blur,
+-- isr.composite: L = D + k_a L_a albedo + k k_d albedo E).
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local options = require "options"
@@ -51,20 +52,24 @@ function rsm.check(o)
   return o
 end
 
--- Records the gather over the coarse G-buffer C (isr.coarse_gbuffer) from
--- the RSM targets R (shadow.render's second result) and the atlas `shadows`.
--- base (optional): a coarse result to add to (the screen-space pass's), in
--- which case senders the camera sees are left to it. Returns the coarse E.
+-- Records the gather over the coarse grid C (isr.coarse_view, or a coarse
+-- copy, isr.coarse_gbuffer, factor f) from the RSM targets R (shadow.render's
+-- second result) and the atlas `shadows`. base (optional): a coarse result
+-- to add to (the screen-space pass's), in which case senders the camera sees
+-- are left to it. Returns the coarse E.
 function rsm.gather(C, f, R, shadows, o, base)
+  local z = C.z and not base -- the first pass over a view writes its depth (isr.coarse_view)
   local inputs, defines = shadow.bind(shadows, gbuffer.inputs(C),
-                                      { VISIBILITY = o.steps > 0, BASE = base ~= nil, EXCLUDE_SEEN = base ~= nil })
+                                      { VISIBILITY = o.steps > 0, BASE = base ~= nil, EXCLUDE_SEEN = base ~= nil,
+                                        STRIDE = C.stride, Z = z })
   inputs.rsm_flux, inputs.rsm_pos, inputs.base = R.flux, R.pos, base
   local params = { samples = o.samples, radius = o.radius, steps = o.steps,
                    rotate = o.temporal.enabled and o.rotate / 360 or 0 }
   if not base then temporal.skip("rsm", inputs, defines, params, o.temporal, 1 / f) end
-  return pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines, params = params,
-               fetches = 4 + o.samples * (2 + o.steps * 2 + (base and 3 or 0)),
-               out = target{ "rsm.e", format = "rgba16f", scale = 1 / f } }
+  local E = target{ "rsm.e", format = "rgba16f", scale = 1 / f }
+  pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines, params = params,
+        fetches = 4 + o.samples * (2 + o.steps * 2 + (base and 3 or 0)), out = { E, z and C.z or nil } }
+  return E
 end
 
 -- Records RSM lighting of G given its direct light `direct` (no ambient
@@ -73,7 +78,9 @@ end
 -- Returns the lit target.
 function rsm.render(G, direct, shadows, R, o, light)
   local f = o.coarse
-  local C = isr.coarse_gbuffer(G, direct, f)
+  -- Temporal reuse compares depths and coverage in a coarse copy (temporal.apply); without it the gather
+  -- reads the G-buffer at each coarse texel's block centre, and no pass averages the blocks first.
+  local C = o.temporal.enabled and isr.coarse_gbuffer(G, direct, f) or isr.coarse_view(G, direct, f)
   local E = temporal.apply("rsm", rsm.gather(C, f, R, shadows, o), C, o.temporal, 1 / f)
   E = isr.blur(E, C, f, o.blur)
   return isr.composite(G, direct, C, E, { ambient = light.ambient, background = light.background, k = o.k }, false,
