@@ -19,6 +19,11 @@
 // the light there, its area) is worked out once in LIGHTS and NEGATIVES, not
 // per pixel: the per-pixel loops read one small texture at one place for
 // all pixels, and compute the geometry alone.
+// The coarse grid is a view of the G-buffer (isr.coarse_view): GATHER and
+// NEGATIVE read it, STRIDE times finer, at each coarse texel's block centre,
+// GATHER writes that depth / far (0 where nothing is drawn) as the grid's
+// depth (`z`), and REFINE compares a pixel with the normals at those block
+// centres and that depth.
 // Indirect lights: the i-th of N lies where the Halton point
 // (Phi_2(i), Phi_3(i)) falls in the light's RSM view (fixed: nothing
 // flickers); the seed's points are directions in a spotlight's cone, which
@@ -33,6 +38,10 @@
 #include "rsm.glsl"
 #include "halton.glsl"
 
+#ifndef STRIDE
+#define STRIDE 1
+#endif
+
 in vec2 uv;
 uniform int indirect_count = 100;              // N indirect lights a light
 uniform int negative = 50;                     // M negative lights
@@ -42,12 +51,12 @@ uniform float focus = 1.0;                     // orthographic tiles: the centra
 layout(location = 0) out vec4 out_pos;         // position, normal (normal_pack; w > 0: none)
 layout(location = 1) out vec4 out_flux;        // radiance times area, area
 #else
-uniform sampler2D clr, nrm, dpt, mat;          // G-buffer (coarse, or full for REFINE)
+uniform sampler2D clr, nrm, dpt, mat;          // G-buffer, STRIDE times finer than the coarse grid
 uniform sampler2D vpl_pos, vpl_flux;           // LIGHTS
 #endif
 #ifdef NEGATIVES
 uniform sampler2D neg, neg_dir;                // GATHER's S_neg, coarse
-uniform sampler2D cdpt;                        // the coarse G-buffer's depth
+uniform sampler2D cdpt;                        // the coarse grid's depth (GATHER's z)
 layout(location = 0) out vec4 out_pos;         // position, the indirect lights' mean direction there
                                                // (normal_pack; w > 0: none)
 layout(location = 1) out vec4 out_neg;         // S_neg, area
@@ -60,7 +69,7 @@ uniform sampler2D positive;                    // GATHER's E+
 #endif
 #ifdef REFINE
 uniform sampler2D coarse;                      // NEGATIVE's E
-uniform sampler2D cdpt, cnrm;                  // the coarse G-buffer's depth and normal
+uniform sampler2D cdpt;                        // the coarse grid's depth (GATHER's z)
 uniform float threshold = 0.1;                 // relative depth and 1 - cos of the normals
 #endif
 
@@ -68,6 +77,7 @@ uniform float threshold = 0.1;                 // relative depth and 1 - cos of 
 layout(location = 0) out vec4 result;
 layout(location = 1) out vec4 out_neg;
 layout(location = 2) out vec4 out_neg_dir;
+layout(location = 3) out float z;
 #elif defined(NEGATIVE) || defined(REFINE)
 out vec4 result;
 #endif
@@ -205,10 +215,15 @@ void main() {
     out_neg = vec4(0.0);
   }
 #else
+#ifdef REFINE
   Surface s = gbuffer_fetch(clr, nrm, dpt, mat, px);
+#else
+  Surface s = gbuffer_fetch(clr, nrm, dpt, mat, block_centre(px, STRIDE, textureSize(dpt, 0)));
+#endif
   vec3 s_neg, neg_d;
 #endif
 #ifdef GATHER
+  z = s.covered ? s.depth01 : 0.0;
   if (!s.covered) {
     result = vec4(0.0, 0.0, 0.0, 1.0);
     out_neg = out_neg_dir = vec4(0.0);
@@ -236,7 +251,7 @@ void main() {
   for (int i = 0; i < 4; i++) {
     ivec2 o = ivec2(i & 1, i >> 1), q = clamp(base + o, ivec2(0), csize - 1);
     float zc = texelFetch(cdpt, q, 0).r;
-    vec3 nc = texelFetch(cnrm, q, 0).xyz;
+    vec3 nc = texelFetch(nrm, block_centre(q, STRIDE, textureSize(nrm, 0)), 0).xyz;
     agree = agree && abs(zc - s.depth01) <= threshold * max(s.depth01, 1e-12) && dot(nc, s.n) >= 1.0 - threshold;
     vec2 w = mix(1.0 - f, f, vec2(o));
     sum += w.x * w.y * texelFetch(coarse, q, 0).rgb;
