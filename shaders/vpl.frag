@@ -14,7 +14,11 @@
 //   NEGATIVE  coarse: E = E+ minus the M negative lights
 //   REFINE    full size: the coarse E where the 2 x 2 coarse texels around a
 //             pixel agree with it in normal and depth (the seed's
-//             discontinuity threshold), else E recomputed at full size
+//             discontinuity threshold), else E recomputed at full size; with
+//             RECOMPUTE_ANY where any of them disagrees (the seed), without
+//             only where all do: elsewhere the bilinear weights of those that
+//             agree, renormalized (llvmpipe runs the recomputation for a
+//             whole block of pixels where one of them needs it)
 // Every pixel meets the same lights, so what each light is (its RSM texel,
 // the light there, its area) is worked out once in LIGHTS and NEGATIVES, not
 // per pixel: the per-pixel loops read one small texture at one place for
@@ -247,16 +251,26 @@ void main() {
   ivec2 base = ivec2(floor(tc));
   vec2 f = tc - floor(tc);
   vec3 sum = vec3(0.0);
-  bool agree = true;
+  float wsum = 0.0;
+  bool all_agree = true;
   for (int i = 0; i < 4; i++) {
     ivec2 o = ivec2(i & 1, i >> 1), q = clamp(base + o, ivec2(0), csize - 1);
     float zc = texelFetch(cdpt, q, 0).r;
     vec3 nc = texelFetch(nrm, block_centre(q, STRIDE, textureSize(nrm, 0)), 0).xyz;
-    agree = agree && abs(zc - s.depth01) <= threshold * max(s.depth01, 1e-12) && dot(nc, s.n) >= 1.0 - threshold;
+    bool agree = abs(zc - s.depth01) <= threshold * max(s.depth01, 1e-12) && dot(nc, s.n) >= 1.0 - threshold;
+    all_agree = all_agree && agree;
     vec2 w = mix(1.0 - f, f, vec2(o));
-    sum += w.x * w.y * texelFetch(coarse, q, 0).rgb;
+    float wq = agree ? w.x * w.y : 0.0;
+    sum += wq * texelFetch(coarse, q, 0).rgb;
+    wsum += wq;
   }
-  vec3 e = agree ? sum : max(indirect(s.p, s.n, s_neg, neg_d) - negative_light(s.p, s.n), vec3(0.0));
+#ifdef RECOMPUTE_ANY
+  bool interpolate = all_agree;
+#else
+  bool interpolate = wsum > 0.0;
+#endif
+  vec3 e = interpolate ? sum / max(wsum, 1e-30)
+                       : max(indirect(s.p, s.n, s_neg, neg_d) - negative_light(s.p, s.n), vec3(0.0));
   result = vec4(finite_or_zero(e), 1.0);
 #endif
 }

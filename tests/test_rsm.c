@@ -231,6 +231,7 @@ static void extremes_stay_finite(void **state) {
   static const char *const vpl_cases[][4] = {
       {"vpl.lights=0", NULL}, {"vpl.lights=4096", "vpl.negative=4096", "vpl.coarse=4", NULL},
       {"vpl.negative=0", "vpl.threshold=0", NULL}, {"vpl.threshold=2", "vpl.focus=0.05", NULL},
+      {"vpl.recompute=any", NULL},
   };
   lm_scene *room = closed_room(LM_LIGHT_POINT);
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
@@ -419,6 +420,7 @@ static void bad_options_name_themselves(void **state) {
       {"isr+rsm+esm", "rsm.steps=33", "rsm.steps"},   {"rsm+esm", "rsm.coarse=5", "rsm.coarse"},
       {"vpl+esm", "vpl.lights=-1", "vpl.lights"},     {"vpl+esm", "vpl.negative=4097", "vpl.negative"},
       {"vpl+esm", "vpl.threshold=3", "vpl.threshold"}, {"vpl+esm", "vpl.focus=0", "vpl.focus"},
+      {"vpl+esm", "vpl.recompute=some", "vpl.recompute"},
       {"rsm+esm", "rsm.temporal.frames=0", "rsm.temporal.frames"},
   };
   gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
