@@ -84,7 +84,7 @@ local rules = {
 }
 
 -- The coarse G-buffer and direct light, each texel its block's average: G
--- itself at factor 1 (rsm.lua and vpl.lua share it).
+-- itself at factor 1 (the seed mode, and rsm.lua with temporal reuse).
 function isr.coarse_gbuffer(G, direct, f)
   if f == 1 then
     local C = gbuffer.inputs(G)
@@ -106,13 +106,15 @@ function isr.coarse_gbuffer(G, direct, f)
 end
 
 -- A coarse grid over G without a pass of its own: the passes over it
--- (isr_march, isr_bounce and lpv_lookup with STRIDE = stride) read G's texel
--- at each coarse texel's block centre (block_centre), where a coarse copy
--- would average the block, and the march steps through G's full depth. The
--- first of them (the march, or the LPV's lookup alone) writes the grid's
--- depth into z (0 where nothing is drawn), which the blur and the composite
--- read. Against the copy (isr.downsample), at 160 x 120 on the room: 0.45 ms
--- a frame less, the march 0.25 ms more (its depth and senders at full size).
+-- (isr_march, isr_bounce, lpv_lookup, rsm and vpl with STRIDE = stride) read
+-- G's texel at each coarse texel's block centre (block_centre), where a
+-- coarse copy would average the block, and the march steps through G's full
+-- depth. The first of them (the march, or the LPV's lookup, RSM's or VPL's
+-- gather alone) writes the grid's depth into z (0 where nothing is drawn),
+-- which the blur and the composite read (VPL: its negative lights and
+-- refinement). Against the copy (isr.downsample), at 160 x 120 on the room:
+-- 0.45 ms a frame less, the march 0.25 ms more (its depth and senders at full
+-- size).
 function isr.coarse_view(G, direct, f)
   return { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat, direct = direct, stride = f,
            z = target{ "isr.z", format = "r32f", scale = 1 / f } }

@@ -109,11 +109,10 @@ function OnRender(tech)
     elseif lighting == "lpv" then
       lit = lpv.render(G, d, R, o_rsm, light)
     elseif lighting == "isr" then
-      -- The combined techniques add the off-screen senders to ISR's coarse result
-      -- (the RSM gather over a coarse copy of G, ISR's grid being a view of G).
+      -- The combined techniques add the off-screen senders to ISR's coarse result, over ISR's grid.
       local extra = R and tech.name:find("lpv+", 1, true) and function(C, E, f)
         return lpv.gather(C, f, lpv.volume(G, R, o_rsm, true), o_rsm, E)
-      end or R and function(_, E, f) return rsm.gather(isr.coarse_gbuffer(G, d, f), f, R, shadows, o_rsm, E) end
+      end or R and function(C, E, f) return rsm.gather(C, f, R, shadows, o_rsm, E) end
       lit = isr.render(G, d, tech.isr, light, extra)
     elseif lighting == "ssdo" then
       lit = ssdo.render(G, d, tech.ssdo, light)

@@ -1,9 +1,10 @@
 -- Indirect light from reflective shadow maps (seed 004, lines 858-958), on
 -- POV-Ray's scale (/work/shared/design/gi-scale.md). The shadow pass writes
 -- the maps when this module asks (shadow.render(o, G, reach)); the gather
--- runs at a coarse size over isr.lua's coarse G-buffer (rsm.frag), then the
--- same geometry-aware blur, bilateral upsampling and composite as ISR
--- (isr.blur, isr.composite: L = D + k_a L_a albedo + k k_d albedo E).
+-- runs at a coarse size over isr.lua's coarse view of the G-buffer
+-- (isr.coarse_view: no downsampling pass; rsm.frag), then the same
+-- geometry-aware blur, bilateral upsampling and composite as ISR (isr.blur,
+-- isr.composite: L = D + k_a L_a albedo + k k_d albedo E).
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local options = require "options"
@@ -14,8 +15,11 @@ local rsm = {}
 
 -- The options a pipeline exposes (pp.lua's Options.rsm), with defaults.
 rsm.defaults = {
-  samples = 64,      -- RSM samples a coarse pixel and light, 1..4096 (the seed: 512 at half size);
-                     -- each pixel of a 4 x 4 tile takes its own block of one pattern (rsm.frag)
+  samples = 24,      -- RSM samples a coarse pixel and light, 1..4096 (the seed: 512 at half size);
+                     -- each pixel of a 4 x 4 tile takes its own block of one pattern (rsm.frag).
+                     -- 24 at coarse 3: the least error of the sweep within 2.5x dl+esm's frame
+                     -- time at 256 x 192 (docs/gi-combined.md: 63.0% of its indirect error
+                     -- removed, where 64 at coarse 2 removed 71.8% at about 4x)
   radius = 1.0,      -- sampling disc radius in tiles of the RSM, (0, 2]
   reach = 3,         -- a directional light's RSM tile covers the sphere around what is seen,
                      -- its radius times reach, 1..64 (senders off screen; no world unit)
@@ -24,10 +28,12 @@ rsm.defaults = {
   rotate = 10,       -- pattern turn a frame in degrees with temporal reuse, 0..180 (the seed: 10;
                      -- its radii shift too); without, the pattern stays (a still camera, a still image)
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
-  coarse = 2,        -- coarse factor a side: 1, 2 or 4 (the seed: half resolution)
+  coarse = 3,        -- coarse factor a side: 1, 2, 3 or 4 (the seed: 2, half resolution); 3 removes
+                     -- as much error as 2 at the same samples (24: 63.0% and 62.6%) on 2.25
+                     -- times fewer pixels
   blur = 4,          -- Gaussian taps each side at coarse size, 0..32
   temporal = {},     -- temporal reuse (scripts/temporal.lua): enabled, frames, epsilon, bias;
-                     -- its history is at coarse 2 (pp.lua's OnCreate)
+                     -- its history is at the default coarse factor (pp.lua's OnCreate)
 }
 for k, v in pairs(temporal.defaults) do rsm.defaults.temporal[k] = v end
 
@@ -38,7 +44,7 @@ local rules = {
   steps = options.whole(0, 32),
   rotate = options.number(0, 180),
   k = options.number(0, 16),
-  coarse = options.one_of(1, 2, 4),
+  coarse = options.one_of(1, 2, 3, 4),
   blur = options.whole(0, 32),
   temporal = function(v) if type(v) ~= "table" then return "a table of temporal reuse options" end end,
 }
@@ -51,20 +57,24 @@ function rsm.check(o)
   return o
 end
 
--- Records the gather over the coarse G-buffer C (isr.coarse_gbuffer) from
--- the RSM targets R (shadow.render's second result) and the atlas `shadows`.
--- base (optional): a coarse result to add to (the screen-space pass's), in
--- which case senders the camera sees are left to it. Returns the coarse E.
+-- Records the gather over the coarse grid C (isr.coarse_view, or a coarse
+-- copy, isr.coarse_gbuffer, factor f) from the RSM targets R (shadow.render's
+-- second result) and the atlas `shadows`. base (optional): a coarse result
+-- to add to (the screen-space pass's), in which case senders the camera sees
+-- are left to it. Returns the coarse E.
 function rsm.gather(C, f, R, shadows, o, base)
+  local z = C.z and not base -- the first pass over a view writes its depth (isr.coarse_view)
   local inputs, defines = shadow.bind(shadows, gbuffer.inputs(C),
-                                      { VISIBILITY = o.steps > 0, BASE = base ~= nil, EXCLUDE_SEEN = base ~= nil })
+                                      { VISIBILITY = o.steps > 0, BASE = base ~= nil, EXCLUDE_SEEN = base ~= nil,
+                                        STRIDE = C.stride, Z = z })
   inputs.rsm_flux, inputs.rsm_pos, inputs.base = R.flux, R.pos, base
   local params = { samples = o.samples, radius = o.radius, steps = o.steps,
                    rotate = o.temporal.enabled and o.rotate / 360 or 0 }
   if not base then temporal.skip("rsm", inputs, defines, params, o.temporal, 1 / f) end
-  return pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines, params = params,
-               fetches = 4 + o.samples * (2 + o.steps * 2 + (base and 3 or 0)),
-               out = target{ "rsm.e", format = "rgba16f", scale = 1 / f } }
+  local E = target{ "rsm.e", format = "rgba16f", scale = 1 / f }
+  pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines, params = params,
+        fetches = 4 + o.samples * (2 + o.steps * 2 + (base and 3 or 0)), out = { E, z and C.z or nil } }
+  return E
 end
 
 -- Records RSM lighting of G given its direct light `direct` (no ambient
@@ -73,7 +83,9 @@ end
 -- Returns the lit target.
 function rsm.render(G, direct, shadows, R, o, light)
   local f = o.coarse
-  local C = isr.coarse_gbuffer(G, direct, f)
+  -- Temporal reuse compares depths and coverage in a coarse copy (temporal.apply); without it the gather
+  -- reads the G-buffer at each coarse texel's block centre, and no pass averages the blocks first.
+  local C = o.temporal.enabled and isr.coarse_gbuffer(G, direct, f) or isr.coarse_view(G, direct, f)
   local E = temporal.apply("rsm", rsm.gather(C, f, R, shadows, o), C, o.temporal, 1 / f)
   E = isr.blur(E, C, f, o.blur)
   return isr.composite(G, direct, C, E, { ambient = light.ambient, background = light.background, k = o.k }, false,

@@ -3,14 +3,18 @@
 -- shadow pass writes (shadow.render(o, G, reach), as rsm.lua). vpl.frag:
 --   1. the indirect lights: N fixed Halton points in each light's RSM, one
 --      texel each (position, normal, radiance times area), worked out once
---   2. gather at a coarse size: each pixel lit by all of them without
+--   2. gather at a coarse size (over isr.coarse_view: the G-buffer at each
+--      coarse texel's block centre, no downsampling pass; the gather writes
+--      the grid's depth): each pixel lit by all of them without
 --      visibility (E+), and the light arriving from behind each pixel's
 --      tangent plane (the seed's S_neg) with its mean direction
 --   3. the M negative lights at Halton pixels of S_neg, one texel each
 --   4. subtract them, at the coarse size
 --   5. at full size, the coarse result where the coarse texels around a
 --      pixel agree with it (the seed's discontinuity threshold), else all
---      lights again for that pixel
+--      lights again for that pixel: where any of them disagrees (recompute
+--      "any", the seed) or only where all do ("all": elsewhere the ones
+--      that agree)
 --   6. ISR's composite (isr.composite: L = D + k_a L_a albedo + k k_d albedo E)
 local gbuffer = require "gbuffer"
 local isr = require "isr"
@@ -24,7 +28,15 @@ vpl.defaults = {
   lights = 100,      -- N indirect lights a light, 0..4096 (the seed: 100 with 50 negative)
   negative = 50,     -- M negative lights, 0..4096 (0: no occlusion)
   threshold = 0.1,   -- discontinuity threshold: relative depth and 1 - cos between normals, 0..2
-  coarse = 2,        -- coarse factor a side: 1, 2 or 4 (the seed: 2)
+  recompute = "all", -- where a full-size pixel gathers every light again: "any" of the 4 coarse texels
+                     -- around it beyond threshold (the seed), or "all" of them, elsewhere the
+                     -- bilinear weights of those within it renormalized: the same error on the
+                     -- reference set (49.1% of dl+esm's indirect error removed, 49.0% with "any")
+                     -- at 2.63x dl+esm's frame time at 256 x 192 against 3.41x (docs/gi-combined.md)
+  coarse = 3,        -- coarse factor a side: 1, 2, 3 or 4 (the seed: 2); the refinement redoes the
+                     -- discontinuities at full size, so the error hardly depends on it (reference
+                     -- set: 49.1%, 49.0%, 49.1% of dl+esm's indirect error removed at 2, 3, 4),
+                     -- and 3 took about three quarters of 2's frame time at 256 x 192
   reach = 3,         -- a directional light's RSM tile, as rsm.reach, 1..64
   focus = 1,         -- the indirect lights of a directional light's tile lie in its central part
                      -- of this side, times reach (1: the sphere around what is seen), 0.05..64
@@ -35,7 +47,8 @@ local rules = {
   lights = options.whole(0, 4096),
   negative = options.whole(0, 4096),
   threshold = options.number(0, 2),
-  coarse = options.one_of(1, 2, 4),
+  recompute = options.one_of("any", "all"),
+  coarse = options.one_of(1, 2, 3, 4),
   reach = options.number(1, 64),
   focus = options.number(0.05, 64),
   k = options.number(0, 16),
@@ -49,7 +62,7 @@ function vpl.check(o) return options.check("vpl", vpl.defaults, o, rules, 3) end
 -- { ambient = {r, g, b}, background = {r, g, b} }. Returns the lit target.
 function vpl.render(G, direct, shadows, R, o, light)
   local f = o.coarse
-  local C = isr.coarse_gbuffer(G, direct, f)
+  local C = isr.coarse_view(G, direct, f)
   local params = { indirect_count = o.lights, negative = o.negative, threshold = o.threshold,
                    focus = math.min(o.focus / o.reach, 1) }
   local coarse = function(name) return target{ name, format = "rgba16f", scale = 1 / f } end
@@ -62,27 +75,30 @@ function vpl.render(G, direct, shadows, R, o, light)
                                       { LIGHTS = true })
   pass{ "vpl.lights", shader = "vpl.frag", inputs = inputs, defines = defines, params = params, fetches = 3,
         out = { L.pos, L.flux } }
-  local function gbuffer_pass(g, define)
-    local t, d = shadow.bind(shadows, gbuffer.inputs(g), { [define] = true })
+  -- Every pass reads the full G-buffer: the coarse ones at each block's centre (STRIDE), the refinement
+  -- its own texel and the coarse texels' normals at their block centres.
+  local function gbuffer_pass(define)
+    local t, d = shadow.bind(shadows, gbuffer.inputs(G), { [define] = true, STRIDE = C.stride })
     t.vpl_pos, t.vpl_flux = L.pos, L.flux
     return t, d
   end
-  local t, d = gbuffer_pass(C, "GATHER")
+  local t, d = gbuffer_pass("GATHER")
   local E, N, D = coarse("vpl.e_plus"), coarse("vpl.neg"), coarse("vpl.neg_dir")
   pass{ "vpl.gather", shader = "vpl.frag", inputs = t, defines = d, params = params,
-        fetches = 4 + o.lights * 2, out = { E, N, D } }
+        fetches = 4 + o.lights * 2, out = { E, N, D, C.z } }
   local M = { pos = list("vpl.neg_pos", o.negative, 1), s = list("vpl.neg_s", o.negative, 1) }
-  inputs, defines = shadow.bind(shadows, { neg = N, neg_dir = D, cdpt = C.dpt }, { NEGATIVES = true })
+  inputs, defines = shadow.bind(shadows, { neg = N, neg_dir = D, cdpt = C.z }, { NEGATIVES = true })
   pass{ "vpl.negatives", shader = "vpl.frag", inputs = inputs, defines = defines, params = params, fetches = 3,
         out = { M.pos, M.s } }
   local function negatives(t) t.neg_pos, t.neg_s = M.pos, M.s end
-  t, d = gbuffer_pass(C, "NEGATIVE")
+  t, d = gbuffer_pass("NEGATIVE")
   t.positive = E
   negatives(t)
   E = pass{ "vpl.negative", shader = "vpl.frag", inputs = t, defines = d, params = params,
             fetches = 5 + o.negative * 2, out = coarse("vpl.e") }
-  t, d = gbuffer_pass(G, "REFINE")
-  t.coarse, t.cdpt, t.cnrm = E, C.dpt, C.nrm
+  t, d = gbuffer_pass("REFINE")
+  d.RECOMPUTE_ANY = o.recompute == "any"
+  t.coarse, t.cdpt = E, C.z
   negatives(t)
   E = pass{ "vpl.refine", shader = "vpl.frag", inputs = t, defines = d, params = params,
             fetches = 4 + 12, -- where coarse texels agree; a discontinuity costs all lights again

@@ -25,9 +25,9 @@ float light_falloff(int mode, float d, float radius) {
   return saturate(1.0 - (d / radius_safe) * (d / radius_safe));
 }
 
-// Light arriving at p from light i: direction to the light in *l, radiance returned.
-vec3 light_incident(int i, vec3 p, out vec3 l) {
-  Light li = lights[i];
+// Light arriving at p from light li: direction to the light in *l, radiance
+// returned. A loop over many points of one light reads li once, outside it.
+vec3 light_arriving(Light li, vec3 p, out vec3 l) {
   int type = int(li.position.w + 0.5);
   if (type == 2) {
     l = safe_normalize(-li.direction.xyz, vec3(0.0, 1.0, 0.0));
@@ -44,6 +44,9 @@ vec3 light_incident(int i, vec3 p, out vec3 l) {
   }
   return li.color.rgb * fall;
 }
+
+// Light arriving at p from light i (light_arriving).
+vec3 light_incident(int i, vec3 p, out vec3 l) { return light_arriving(lights[i], p, l); }
 
 // Light i on a surface at p facing n: false when it arrives from behind or
 // gives nothing there (beyond its range or cone: no shadow lookup); else its

@@ -14,11 +14,20 @@
 //   NEGATIVE  coarse: E = E+ minus the M negative lights
 //   REFINE    full size: the coarse E where the 2 x 2 coarse texels around a
 //             pixel agree with it in normal and depth (the seed's
-//             discontinuity threshold), else E recomputed at full size
+//             discontinuity threshold), else E recomputed at full size; with
+//             RECOMPUTE_ANY where any of them disagrees (the seed), without
+//             only where all do: elsewhere the bilinear weights of those that
+//             agree, renormalized (llvmpipe runs the recomputation for a
+//             whole block of pixels where one of them needs it)
 // Every pixel meets the same lights, so what each light is (its RSM texel,
 // the light there, its area) is worked out once in LIGHTS and NEGATIVES, not
 // per pixel: the per-pixel loops read one small texture at one place for
 // all pixels, and compute the geometry alone.
+// The coarse grid is a view of the G-buffer (isr.coarse_view): GATHER and
+// NEGATIVE read it, STRIDE times finer, at each coarse texel's block centre,
+// GATHER writes that depth / far (0 where nothing is drawn) as the grid's
+// depth (`z`), and REFINE compares a pixel with the normals at those block
+// centres and that depth.
 // Indirect lights: the i-th of N lies where the Halton point
 // (Phi_2(i), Phi_3(i)) falls in the light's RSM view (fixed: nothing
 // flickers); the seed's points are directions in a spotlight's cone, which
@@ -33,6 +42,10 @@
 #include "rsm.glsl"
 #include "halton.glsl"
 
+#ifndef STRIDE
+#define STRIDE 1
+#endif
+
 in vec2 uv;
 uniform int indirect_count = 100;              // N indirect lights a light
 uniform int negative = 50;                     // M negative lights
@@ -42,12 +55,12 @@ uniform float focus = 1.0;                     // orthographic tiles: the centra
 layout(location = 0) out vec4 out_pos;         // position, normal (normal_pack; w > 0: none)
 layout(location = 1) out vec4 out_flux;        // radiance times area, area
 #else
-uniform sampler2D clr, nrm, dpt, mat;          // G-buffer (coarse, or full for REFINE)
+uniform sampler2D clr, nrm, dpt, mat;          // G-buffer, STRIDE times finer than the coarse grid
 uniform sampler2D vpl_pos, vpl_flux;           // LIGHTS
 #endif
 #ifdef NEGATIVES
 uniform sampler2D neg, neg_dir;                // GATHER's S_neg, coarse
-uniform sampler2D cdpt;                        // the coarse G-buffer's depth
+uniform sampler2D cdpt;                        // the coarse grid's depth (GATHER's z)
 layout(location = 0) out vec4 out_pos;         // position, the indirect lights' mean direction there
                                                // (normal_pack; w > 0: none)
 layout(location = 1) out vec4 out_neg;         // S_neg, area
@@ -60,7 +73,7 @@ uniform sampler2D positive;                    // GATHER's E+
 #endif
 #ifdef REFINE
 uniform sampler2D coarse;                      // NEGATIVE's E
-uniform sampler2D cdpt, cnrm;                  // the coarse G-buffer's depth and normal
+uniform sampler2D cdpt;                        // the coarse grid's depth (GATHER's z)
 uniform float threshold = 0.1;                 // relative depth and 1 - cos of the normals
 #endif
 
@@ -68,6 +81,7 @@ uniform float threshold = 0.1;                 // relative depth and 1 - cos of 
 layout(location = 0) out vec4 result;
 layout(location = 1) out vec4 out_neg;
 layout(location = 2) out vec4 out_neg_dir;
+layout(location = 3) out float z;
 #elif defined(NEGATIVE) || defined(REFINE)
 out vec4 result;
 #endif
@@ -205,10 +219,15 @@ void main() {
     out_neg = vec4(0.0);
   }
 #else
+#ifdef REFINE
   Surface s = gbuffer_fetch(clr, nrm, dpt, mat, px);
+#else
+  Surface s = gbuffer_fetch(clr, nrm, dpt, mat, block_centre(px, STRIDE, textureSize(dpt, 0)));
+#endif
   vec3 s_neg, neg_d;
 #endif
 #ifdef GATHER
+  z = s.covered ? s.depth01 : 0.0;
   if (!s.covered) {
     result = vec4(0.0, 0.0, 0.0, 1.0);
     out_neg = out_neg_dir = vec4(0.0);
@@ -232,16 +251,26 @@ void main() {
   ivec2 base = ivec2(floor(tc));
   vec2 f = tc - floor(tc);
   vec3 sum = vec3(0.0);
-  bool agree = true;
+  float wsum = 0.0;
+  bool all_agree = true;
   for (int i = 0; i < 4; i++) {
     ivec2 o = ivec2(i & 1, i >> 1), q = clamp(base + o, ivec2(0), csize - 1);
     float zc = texelFetch(cdpt, q, 0).r;
-    vec3 nc = texelFetch(cnrm, q, 0).xyz;
-    agree = agree && abs(zc - s.depth01) <= threshold * max(s.depth01, 1e-12) && dot(nc, s.n) >= 1.0 - threshold;
+    vec3 nc = texelFetch(nrm, block_centre(q, STRIDE, textureSize(nrm, 0)), 0).xyz;
+    bool agree = abs(zc - s.depth01) <= threshold * max(s.depth01, 1e-12) && dot(nc, s.n) >= 1.0 - threshold;
+    all_agree = all_agree && agree;
     vec2 w = mix(1.0 - f, f, vec2(o));
-    sum += w.x * w.y * texelFetch(coarse, q, 0).rgb;
+    float wq = agree ? w.x * w.y : 0.0;
+    sum += wq * texelFetch(coarse, q, 0).rgb;
+    wsum += wq;
   }
-  vec3 e = agree ? sum : max(indirect(s.p, s.n, s_neg, neg_d) - negative_light(s.p, s.n), vec3(0.0));
+#ifdef RECOMPUTE_ANY
+  bool interpolate = all_agree;
+#else
+  bool interpolate = wsum > 0.0;
+#endif
+  vec3 e = interpolate ? sum / max(wsum, 1e-30)
+                       : max(indirect(s.p, s.n, s_neg, neg_d) - negative_light(s.p, s.n), vec3(0.0));
   result = vec4(finite_or_zero(e), 1.0);
 #endif
 }
