@@ -113,9 +113,10 @@ end
 
 -- Records injection and propagation from the RSM targets R (shadow.render's
 -- second result) and the G-buffer G. exclude_seen: VPLs the camera sees are
--- left out (the combined technique). Returns the volumes: { early = {r, g,
--- b}, late = {r, g, b} (sums of steps 1 .. steps // 2 and the rest, nil when
--- none), grids = their layout, seen = R.seen }.
+-- left out (the combined technique). Returns the volumes: { all = {r, g, b},
+-- late = {r, g, b} (sums of steps 1 .. steps and of steps steps // 2 + 1 ..
+-- steps, the same targets for one step, nil for none), grids = their layout,
+-- seen = R.seen }.
 function lpv.volume(G, R, o, exclude_seen)
   local grids = layout(o, cell_size(o))
   local function volume(name) return target{ name, format = "rgba32f", size = grids.size } end
@@ -147,23 +148,28 @@ function lpv.volume(G, R, o, exclude_seen)
                            out = volume("lpv.geometry") }
   -- The injected light itself (step 0) is in no sum: it sits in its VPL's own cell, which a thin
   -- wall shares with the other side, and would light that side too.
-  local wave, early, late = { inj[1], inj[2], inj[3] }, nil, nil
+  -- The last step (past the first) writes the sum of all steps in place of its wave (ALL).
+  local wave, early, late, all = { inj[1], inj[2], inj[3] }, nil, nil, nil
   local half = o.steps // 2
   for k = 1, o.steps do
     local sum = k <= half and early or k > half and late or nil
+    local last = k == o.steps and early ~= nil
     local out = {}
     for i, ch in ipairs{ "r", "g", "b" } do
-      out[i] = volume("lpv.wave_" .. ch .. k)
+      out[i] = volume((last and "lpv.all_" or "lpv.wave_") .. ch .. k)
       out[i + 3] = volume("lpv.sum_" .. ch .. k)
     end
     local inputs = { wave_r = wave[1], wave_g = wave[2], wave_b = wave[3], geometry = geometry }
     if sum then inputs.sum_r, inputs.sum_g, inputs.sum_b = sum[1], sum[2], sum[3] end
-    pass{ "lpv.propagate" .. k, shader = "lpv_propagate.frag", inputs = inputs, defines = { SUM = sum ~= nil, FIRST = k == 1 },
-          params = grid(o, grids, { occlusion = o.occlusion }), fetches = sum and 22 or 19, out = out }
+    if last then inputs.early_r, inputs.early_g, inputs.early_b = early[1], early[2], early[3] end
+    pass{ "lpv.propagate" .. k, shader = "lpv_propagate.frag", inputs = inputs,
+          defines = { SUM = sum ~= nil, FIRST = k == 1, ALL = last }, params = grid(o, grids, { occlusion = o.occlusion }),
+          fetches = 19 + (sum and 3 or 0) + (last and 3 or 0), out = out }
     wave = { out[1], out[2], out[3] }
     if k <= half then early = { out[4], out[5], out[6] } else late = { out[4], out[5], out[6] } end
+    if last then all = wave end
   end
-  return { early = early, late = late, grids = grids, seen = R.seen }
+  return { all = all or late, late = late, grids = grids, seen = R.seen }
 end
 
 -- Records the lookup over the coarse G-buffer C (isr.coarse_view or
@@ -172,15 +178,17 @@ end
 -- the coarse E.
 function lpv.gather(C, f, V, o, base)
   local inputs = gbuffer.inputs(C)
-  if V.early then inputs.early_r, inputs.early_g, inputs.early_b = V.early[1], V.early[2], V.early[3] end
-  if V.late then inputs.late_r, inputs.late_g, inputs.late_b = V.late[1], V.late[2], V.late[3] end
+  if V.late then
+    inputs.all_r, inputs.all_g, inputs.all_b = V.all[1], V.all[2], V.all[3]
+    inputs.late_r, inputs.late_g, inputs.late_b = V.late[1], V.late[2], V.late[3]
+  end
   inputs.base, inputs.lpv_seen = base, V.seen
   local z = C.z and not base -- the first pass over a view writes its depth (isr.coarse_view)
   local E = target{ "lpv.e", format = "rgba16f", scale = 1 / f }
   pass{ "lpv.lookup", shader = "lpv_lookup.frag", inputs = inputs,
-        defines = { EARLY = V.early ~= nil, LATE = V.late ~= nil, BASE = base ~= nil, STRIDE = C.stride, Z = z },
+        defines = { VOLUMES = V.late ~= nil, BASE = base ~= nil, STRIDE = C.stride, Z = z },
         params = grid(o, V.grids, { lpv_steps = o.steps }),
-        fetches = 4 + o.cascades * 24, out = { E, z and C.z or nil } }
+        fetches = 4 + 6 * (o.cascades + 1), out = { E, z and C.z or nil } }
   return E
 end
 

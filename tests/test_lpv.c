@@ -119,14 +119,16 @@ static void volume_power(gl_result *r, const char *prefix, int step, double out[
  * channel (nothing is made; blocking and the grids' borders take some), and
  * after 12 steps less than after 1. The waves are read as stored, scaled by
  * what each cell may send (lpv_propagate.frag), which lies between a wave's
- * power and the next one's, so the stored sequence falling is the waves'. */
+ * power and the next one's, so the stored sequence falling is the waves'.
+ * Step `steps` of steps + 1: the last step stores the sum of all in place of
+ * its wave. */
 static void energy_does_not_grow_with_propagation_steps(void **state) {
   (void)state;
   lm_scene *s = corner_scene(LM_LIGHT_DIRECTIONAL);
   double last[3] = {0}, first[3] = {0};
   for (int steps = 1; steps <= 12; steps++) {
     char set[32];
-    snprintf(set, sizeof set, "lpv.steps=%d", steps);
+    snprintf(set, sizeof set, "lpv.steps=%d", steps + 1);
     const char *const sets[] = {"ambient=0", set, NULL};
     gl_result r = render_ok(s, "lpv+esm", sets, 48, 36);
     double p[3];
