@@ -21,21 +21,27 @@ local options = require "options"
 local lpv = {}
 
 -- The options a pipeline exposes (pp.lua's Options.lpv), with defaults.
--- No default is a world length: cells follow from the scene's size.
+-- No default is a world length: cells follow from the scene's size. extent,
+-- vpls, surfels and coarse lie on the error/time Pareto front of a sweep
+-- over the reference set (docs/gi-combined.md): an extent of 6 fits every
+-- cascade of the reference scenes to the scene (grids that stay put, in
+-- volumes of 3.6 to 5.8 times fewer texels than at 3), and 24^2 VPLs, 16
+-- surfels a row and the lookup at a quarter a side cost about 2 points of
+-- the indirect error removed against 3, 48, 32 and a half.
 lpv.defaults = {
   cells = 32,        -- cells a side of each cascade, 4..64 (the seed: 32)
   cascades = 3,      -- grids following the camera, each cell twice the last's, 1..4 (the seed: 3)
   steps = 8,         -- propagation steps, 0..256 (light moves up to a cell a step)
-  extent = 3.0,      -- the coarsest cascade's side over the scene's bounding-box diagonal, 1e-3..64
+  extent = 6.0,      -- the coarsest cascade's side over the scene's bounding-box diagonal, 1e-3..64
   cell = 0,          -- cascade 0's cell side in world units, 0..1e30 (0: from extent)
   shift = 1.0,       -- the cascades' centre lies this share of the seen distance ahead of the camera, 0..1
-  vpls = 48,         -- VPLs a side a cascade, 1..1024: vpls^2 over all RSM views (a point light's six faces
+  vpls = 24,         -- VPLs a side a cascade, 1..1024: vpls^2 over all RSM views (a point light's six faces
                      -- share them), the injection's cost
-  surfels = 32,      -- G-buffer surfels a row for the geometry volume, 0..1024 (0: nothing blocks)
+  surfels = 16,      -- G-buffer surfels a row for the geometry volume, 0..1024 (0: nothing blocks)
   occlusion = 1.0,   -- how much the geometry volume blocks, 0..1 (0: light passes through walls)
   reach = 3,         -- a directional light's RSM tile, as rsm.reach, 1..64
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
-  coarse = 2,        -- the lookup's coarse factor a side: 1, 2 or 4
+  coarse = 4,        -- the lookup's coarse factor a side: 1, 2 or 4
   blur = 2,          -- Gaussian taps each side at coarse size, 0..32
 }
 
