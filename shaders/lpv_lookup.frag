@@ -69,10 +69,13 @@ vec3 irradiance(vec4 r, vec4 g, vec4 b, vec3 n) {
 
 vec4 volume(sampler2D v, vec2 uv0, vec2 uv1, float f) { return mix(texture(v, uv0), texture(v, uv1), f); }
 
+// Each cascade's least corner (lpv_origin, the same for every pixel), found once a pixel.
+vec3 origins[4];
+
 // Where p facing n is read in cascade c, in cell centres (1.5 cells in front of it).
 vec3 cell_coords(int c, vec3 p, vec3 n) {
   float h = lpv_cell_size(c);
-  return (p + 1.5 * h * n - lpv_origin(c)) / h - 0.5;
+  return (p + 1.5 * h * n - origins[c]) / h - 0.5;
 }
 
 // How many cells u lies within cascade c's sampled range (negative:
@@ -118,6 +121,7 @@ void main() {
     result = b;
     return;
   }
+  for (int c = 0; c < lpv_cascades; c++) origins[c] = lpv_origin(c);
   int c0 = lpv_cascades;
   float margin = -1.0;
   for (int c = 0; c < lpv_cascades && c0 == lpv_cascades; c++) {
