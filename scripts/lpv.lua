@@ -21,21 +21,27 @@ local options = require "options"
 local lpv = {}
 
 -- The options a pipeline exposes (pp.lua's Options.lpv), with defaults.
--- No default is a world length: cells follow from the scene's size.
+-- No default is a world length: cells follow from the scene's size. extent,
+-- vpls, surfels and coarse lie on the error/time Pareto front of a sweep
+-- over the reference set (docs/gi-combined.md): an extent of 6 fits every
+-- cascade of the reference scenes to the scene (grids that stay put, in
+-- volumes of 3.6 to 5.8 times fewer texels than at 3), and 24^2 VPLs, 16
+-- surfels a row and the lookup at a quarter a side cost about 2 points of
+-- the indirect error removed against 3, 48, 32 and a half.
 lpv.defaults = {
   cells = 32,        -- cells a side of each cascade, 4..64 (the seed: 32)
   cascades = 3,      -- grids following the camera, each cell twice the last's, 1..4 (the seed: 3)
   steps = 8,         -- propagation steps, 0..256 (light moves up to a cell a step)
-  extent = 3.0,      -- the coarsest cascade's side over the scene's bounding-box diagonal, 1e-3..64
+  extent = 6.0,      -- the coarsest cascade's side over the scene's bounding-box diagonal, 1e-3..64
   cell = 0,          -- cascade 0's cell side in world units, 0..1e30 (0: from extent)
   shift = 1.0,       -- the cascades' centre lies this share of the seen distance ahead of the camera, 0..1
-  vpls = 48,         -- VPLs a side a cascade, 1..1024: vpls^2 over all RSM views (a point light's six faces
+  vpls = 24,         -- VPLs a side a cascade, 1..1024: vpls^2 over all RSM views (a point light's six faces
                      -- share them), the injection's cost
-  surfels = 32,      -- G-buffer surfels a row for the geometry volume, 0..1024 (0: nothing blocks)
+  surfels = 16,      -- G-buffer surfels a row for the geometry volume, 0..1024 (0: nothing blocks)
   occlusion = 1.0,   -- how much the geometry volume blocks, 0..1 (0: light passes through walls)
   reach = 3,         -- a directional light's RSM tile, as rsm.reach, 1..64
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
-  coarse = 2,        -- the lookup's coarse factor a side: 1, 2 or 4
+  coarse = 4,        -- the lookup's coarse factor a side: 1, 2 or 4
   blur = 2,          -- Gaussian taps each side at coarse size, 0..32
 }
 
@@ -113,9 +119,10 @@ end
 
 -- Records injection and propagation from the RSM targets R (shadow.render's
 -- second result) and the G-buffer G. exclude_seen: VPLs the camera sees are
--- left out (the combined technique). Returns the volumes: { early = {r, g,
--- b}, late = {r, g, b} (sums of steps 1 .. steps // 2 and the rest, nil when
--- none), grids = their layout, seen = R.seen }.
+-- left out (the combined technique). Returns the volumes: { all = {r, g, b},
+-- late = {r, g, b} (sums of steps 1 .. steps and of steps steps // 2 + 1 ..
+-- steps, the same targets for one step, nil for none), grids = their layout,
+-- seen = R.seen }.
 function lpv.volume(G, R, o, exclude_seen)
   local grids = layout(o, cell_size(o))
   local function volume(name) return target{ name, format = "rgba32f", size = grids.size } end
@@ -147,23 +154,28 @@ function lpv.volume(G, R, o, exclude_seen)
                            out = volume("lpv.geometry") }
   -- The injected light itself (step 0) is in no sum: it sits in its VPL's own cell, which a thin
   -- wall shares with the other side, and would light that side too.
-  local wave, early, late = { inj[1], inj[2], inj[3] }, nil, nil
+  -- The last step (past the first) writes the sum of all steps in place of its wave (ALL).
+  local wave, early, late, all = { inj[1], inj[2], inj[3] }, nil, nil, nil
   local half = o.steps // 2
   for k = 1, o.steps do
     local sum = k <= half and early or k > half and late or nil
+    local last = k == o.steps and early ~= nil
     local out = {}
     for i, ch in ipairs{ "r", "g", "b" } do
-      out[i] = volume("lpv.wave_" .. ch .. k)
+      out[i] = volume((last and "lpv.all_" or "lpv.wave_") .. ch .. k)
       out[i + 3] = volume("lpv.sum_" .. ch .. k)
     end
     local inputs = { wave_r = wave[1], wave_g = wave[2], wave_b = wave[3], geometry = geometry }
     if sum then inputs.sum_r, inputs.sum_g, inputs.sum_b = sum[1], sum[2], sum[3] end
-    pass{ "lpv.propagate" .. k, shader = "lpv_propagate.frag", inputs = inputs, defines = { SUM = sum ~= nil, FIRST = k == 1 },
-          params = grid(o, grids, { occlusion = o.occlusion }), fetches = sum and 22 or 19, out = out }
+    if last then inputs.early_r, inputs.early_g, inputs.early_b = early[1], early[2], early[3] end
+    pass{ "lpv.propagate" .. k, shader = "lpv_propagate.frag", inputs = inputs,
+          defines = { SUM = sum ~= nil, FIRST = k == 1, ALL = last }, params = grid(o, grids, { occlusion = o.occlusion }),
+          fetches = 19 + (sum and 3 or 0) + (last and 3 or 0), out = out }
     wave = { out[1], out[2], out[3] }
     if k <= half then early = { out[4], out[5], out[6] } else late = { out[4], out[5], out[6] } end
+    if last then all = wave end
   end
-  return { early = early, late = late, grids = grids, seen = R.seen }
+  return { all = all or late, late = late, grids = grids, seen = R.seen }
 end
 
 -- Records the lookup over the coarse G-buffer C (isr.coarse_view or
@@ -172,15 +184,17 @@ end
 -- the coarse E.
 function lpv.gather(C, f, V, o, base)
   local inputs = gbuffer.inputs(C)
-  if V.early then inputs.early_r, inputs.early_g, inputs.early_b = V.early[1], V.early[2], V.early[3] end
-  if V.late then inputs.late_r, inputs.late_g, inputs.late_b = V.late[1], V.late[2], V.late[3] end
+  if V.late then
+    inputs.all_r, inputs.all_g, inputs.all_b = V.all[1], V.all[2], V.all[3]
+    inputs.late_r, inputs.late_g, inputs.late_b = V.late[1], V.late[2], V.late[3]
+  end
   inputs.base, inputs.lpv_seen = base, V.seen
   local z = C.z and not base -- the first pass over a view writes its depth (isr.coarse_view)
   local E = target{ "lpv.e", format = "rgba16f", scale = 1 / f }
   pass{ "lpv.lookup", shader = "lpv_lookup.frag", inputs = inputs,
-        defines = { EARLY = V.early ~= nil, LATE = V.late ~= nil, BASE = base ~= nil, STRIDE = C.stride, Z = z },
+        defines = { VOLUMES = V.late ~= nil, BASE = base ~= nil, STRIDE = C.stride, Z = z },
         params = grid(o, V.grids, { lpv_steps = o.steps }),
-        fetches = 4 + o.cascades * 24, out = { E, z and C.z or nil } }
+        fetches = 4 + 6 * (o.cascades + 1), out = { E, z and C.z or nil } }
   return E
 end
 

@@ -23,12 +23,15 @@
 // (`late`: steps floor(S / 2) + 1 .. S) carry light from beyond what cascade
 // c - 1's S steps reach, and each path is counted once:
 //   E = all steps of the finest cascade c0 that holds p + late steps of each coarser one
-// (`early` holds steps 1 .. floor(S / 2); step 0, the injected VPLs in their
-// own cells, is in neither, see lpv.lua). A grid holds only the VPLs inside
-// it: a point less than S cells from c0's border would miss the light from
-// beyond it, so over those S cells the sum blends into the same sum from
-// c0 + 1 (no seam shows either); past the coarsest cascade's border the
-// light fades to nothing.
+// (`all` holds steps 1 .. S; step 0, the injected VPLs in their own cells, is
+// in neither, see lpv.lua). A grid holds only the VPLs inside it: a point
+// less than S cells from c0's border would miss the light from beyond it, so
+// over those S cells the sum blends, by w from 1 inside to 0 at the border,
+// into the same sum from c0 + 1 (no seam shows either); past the coarsest
+// cascade's border the light fades to nothing. The blend shares the
+// cascades past c0 + 1:
+//   E = w all(c0) + (1 - w) all(c0 + 1) + w late(c0 + 1) + late of each cascade past c0 + 1
+// and each cascade's volumes are read once, those with weight 0 not at all.
 // Output: rgb = E / pi, a = 1 (it occludes no ambient term); with BASE, the
 // screen-space pass's coarse result `base` plus it (its a kept).
 // With STRIDE, each texel reads the G-buffer, STRIDE times finer, at its
@@ -43,10 +46,8 @@
 
 in vec2 uv;
 uniform sampler2D clr, nrm, dpt, mat;         // (coarse) G-buffer
-#ifdef EARLY
-uniform sampler2D early_r, early_g, early_b;  // sums of steps 1 .. floor(S / 2)
-#endif
-#ifdef LATE
+#ifdef VOLUMES
+uniform sampler2D all_r, all_g, all_b;        // sums of steps 1 .. S
 uniform sampler2D late_r, late_g, late_b;     // sums of steps floor(S / 2) + 1 .. S
 #endif
 #ifdef BASE
@@ -68,10 +69,13 @@ vec3 irradiance(vec4 r, vec4 g, vec4 b, vec3 n) {
 
 vec4 volume(sampler2D v, vec2 uv0, vec2 uv1, float f) { return mix(texture(v, uv0), texture(v, uv1), f); }
 
+// Each cascade's least corner (lpv_origin, the same for every pixel), found once a pixel.
+vec3 origins[4];
+
 // Where p facing n is read in cascade c, in cell centres (1.5 cells in front of it).
 vec3 cell_coords(int c, vec3 p, vec3 n) {
   float h = lpv_cell_size(c);
-  return (p + 1.5 * h * n - lpv_origin(c)) / h - 0.5;
+  return (p + 1.5 * h * n - origins[c]) / h - 0.5;
 }
 
 // How many cells u lies within cascade c's sampled range (negative:
@@ -85,29 +89,21 @@ float inside(vec3 u, int c) {
   return min(m.x, min(m.y, m.z));
 }
 
-// Cascade c's E / pi at p facing n from its late sum, and its early sum too when asked.
-vec3 cascade(int c, vec3 p, vec3 n, bool early) {
+// Cascade c's E / pi at p facing n: its sum of all steps times a plus its late sum times l.
+vec3 cascade(int c, vec3 p, vec3 n, float a, float l) {
+  vec3 e = vec3(0.0);
+#ifdef VOLUMES
   vec3 last = vec3(lpv_dims(c) - 1);
   vec3 u = clamp(cell_coords(c, p, n), vec3(0.0), last);
   float z0 = floor(u.z), f = u.z - z0, z1 = min(z0 + 1.0, last.z), nx = float(lpv_nx[c]);
   vec2 size = vec2(lpv_size), row = vec2(float(lpv_col[c]) + u.x, u.y);
   vec2 uv0 = (row + vec2(z0 * nx, 0.0) + 0.5) / size, uv1 = (row + vec2(z1 * nx, 0.0) + 0.5) / size;
-  vec3 e = vec3(0.0);
-#ifdef EARLY
-  if (early) e += irradiance(volume(early_r, uv0, uv1, f), volume(early_g, uv0, uv1, f), volume(early_b, uv0, uv1, f), n);
-#endif
-#ifdef LATE
-  e += irradiance(volume(late_r, uv0, uv1, f), volume(late_g, uv0, uv1, f), volume(late_b, uv0, uv1, f), n);
+  if (a > 0.0) e += a * irradiance(volume(all_r, uv0, uv1, f), volume(all_g, uv0, uv1, f), volume(all_b, uv0, uv1, f), n);
+  if (l > 0.0)
+    e += l * irradiance(volume(late_r, uv0, uv1, f), volume(late_g, uv0, uv1, f), volume(late_b, uv0, uv1, f), n);
 #endif
   float h = lpv_cell_size(c);
   return e / max(h * h, 1e-30);
-}
-
-// All steps of cascade c0 and the late ones of every coarser cascade.
-vec3 bands(int c0, vec3 p, vec3 n) {
-  vec3 e = vec3(0.0);
-  for (int c = c0; c < lpv_cascades; c++) e += cascade(c, p, n, c == c0);
-  return e;
 }
 
 void main() {
@@ -125,17 +121,16 @@ void main() {
     result = b;
     return;
   }
+  for (int c = 0; c < lpv_cascades; c++) origins[c] = lpv_origin(c);
   int c0 = lpv_cascades;
   float margin = -1.0;
   for (int c = 0; c < lpv_cascades && c0 == lpv_cascades; c++) {
     margin = inside(cell_coords(c, s.p, s.n), c);
     if (margin >= 0.0) c0 = c;
   }
+  float w = clamp(margin / float(max(lpv_steps, 1)), 0.0, 1.0);
   vec3 e = vec3(0.0);
-  if (c0 < lpv_cascades) {
-    float w = clamp(margin / float(max(lpv_steps, 1)), 0.0, 1.0);
-    e = bands(c0, s.p, s.n);
-    if (w < 1.0) e = mix(bands(c0 + 1, s.p, s.n), e, w);
-  }
+  for (int c = c0; c < lpv_cascades; c++)
+    e += cascade(c, s.p, s.n, c == c0 ? w : c == c0 + 1 ? 1.0 - w : 0.0, c == c0 ? 0.0 : c == c0 + 1 ? w : 1.0);
   result = vec4(b.rgb + finite_or_zero(e), b.a);
 }

@@ -37,7 +37,10 @@
 // Output: the new wave (rgb channels in three targets, scaled by send_scale),
 // and with SUM each channel's running sum over the steps (the lookup's
 // light), the input sum plus the new wave; without SUM the new wave starts a
-// sum.
+// sum. With ALL (the last step, whose wave nobody reads) the first three
+// targets get the sum over all steps instead, the running sum plus the
+// `early` sums of the first half (lpv.lua), so that the lookup reads one sum
+// where it would add two.
 #include "lpv.glsl"
 
 uniform sampler2D wave_r, wave_g, wave_b; // the last step's wave
@@ -45,6 +48,9 @@ uniform sampler2D geometry;               // blocking lobes (lpv_inject.vert)
 uniform float occlusion = 1.0;
 #ifdef SUM
 uniform sampler2D sum_r, sum_g, sum_b;
+#endif
+#ifdef ALL
+uniform sampler2D early_r, early_g, early_b;
 #endif
 
 layout(location = 0) out vec4 out_r;
@@ -82,12 +88,13 @@ vec4 transfer(vec4 sh, int axis, float sign) {
 vec4 r = vec4(0.0), gr = vec4(0.0), b = vec4(0.0);
 
 // Adds what the neighbour on the `sign` side along `axis` sends this cell (at `cell` of cascade
-// c), less what the cell's geometry g blocks.
-void gather(ivec3 cell, int c, vec4 g, int axis, float sign) {
-  ivec3 s = cell;
-  s[axis] -= int(sign);
-  if (s[axis] < 0 || s[axis] >= lpv_dims(c)[axis]) return;
-  ivec2 ts = lpv_texel(s, c);
+// c, texel t; n: the cascade's cells a side), less what the cell's geometry g blocks. The
+// neighbour's texel is t less one column along x, one row along y and a slice's nx columns along z
+// (lpv.glsl's layout), which spares each neighbour lpv_texel's per-cascade uniforms.
+void gather(ivec3 cell, ivec2 t, ivec3 n, vec4 g, int axis, float sign) {
+  int s = cell[axis] - int(sign);
+  if (s < 0 || s >= n[axis]) return;
+  ivec2 ts = t - int(sign) * (axis == 0 ? ivec2(1, 0) : axis == 1 ? ivec2(0, 1) : ivec2(n.x, 0));
   float open = 1.0 - occlusion * clamp(g.x + sign * g[axis + 1], 0.0, 1.0);
   r += open * transfer(texelFetch(wave_r, ts, 0), axis, sign);
   gr += open * transfer(texelFetch(wave_g, ts, 0), axis, sign);
@@ -103,18 +110,16 @@ void main() {
     return;
   }
   vec4 g = texelFetch(geometry, t, 0);
-  gather(cell, c, g, 0, 1.0);
-  gather(cell, c, g, 0, -1.0);
-  gather(cell, c, g, 1, 1.0);
-  gather(cell, c, g, 1, -1.0);
-  gather(cell, c, g, 2, 1.0);
-  gather(cell, c, g, 2, -1.0);
+  ivec3 n = lpv_dims(c);
+  gather(cell, t, n, g, 0, 1.0);
+  gather(cell, t, n, g, 0, -1.0);
+  gather(cell, t, n, g, 1, 1.0);
+  gather(cell, t, n, g, 1, -1.0);
+  gather(cell, t, n, g, 2, 1.0);
+  gather(cell, t, n, g, 2, -1.0);
   r = lpv_finite(r);
   gr = lpv_finite(gr);
   b = lpv_finite(b);
-  out_r = r * send_scale(r);
-  out_g = gr * send_scale(gr);
-  out_b = b * send_scale(b);
 #ifdef SUM
   out_sum_r = lpv_finite(r + texelFetch(sum_r, t, 0));
   out_sum_g = lpv_finite(gr + texelFetch(sum_g, t, 0));
@@ -123,5 +128,14 @@ void main() {
   out_sum_r = r;
   out_sum_g = gr;
   out_sum_b = b;
+#endif
+#ifdef ALL
+  out_r = lpv_finite(out_sum_r + texelFetch(early_r, t, 0));
+  out_g = lpv_finite(out_sum_g + texelFetch(early_g, t, 0));
+  out_b = lpv_finite(out_sum_b + texelFetch(early_b, t, 0));
+#else
+  out_r = r * send_scale(r);
+  out_g = gr * send_scale(gr);
+  out_b = b * send_scale(b);
 #endif
 }
