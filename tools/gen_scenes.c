@@ -633,6 +633,19 @@ static int car_mesh(doc *d, int paint, int glass, int tyre) {
   return id;
 }
 
+/* The cars' materials (the garage's and the night street's): three paints, glass, tyres. */
+typedef struct car_paints { int paint[3], glass, tyre; } car_paints;
+
+static car_paints car_materials(doc *d) {
+  car_paints p; /* one statement each: the materials' order is the file's */
+  p.paint[0] = add_material(d, "paint_blue", 0.1f, 0.2f, 0.7f, 0.3f, 0.35f, -1);
+  p.paint[1] = add_material(d, "paint_white", 0.85f, 0.85f, 0.85f, 0.3f, 0.35f, -1);
+  p.paint[2] = add_material(d, "paint_red", 0.7f, 0.08f, 0.06f, 0.3f, 0.35f, -1);
+  p.glass = add_material(d, "glass", 0.15f, 0.2f, 0.25f, 0, 0.1f, -1);
+  p.tyre = add_material(d, "tyre", 0.05f, 0.05f, 0.05f, 0, 0.9f, -1);
+  return p;
+}
+
 static void primitives(const char *dir) {
   doc d = {0};
   unsigned char *tex = checker(64, 8, WHITE8, GREY8);
@@ -754,11 +767,7 @@ static void garage(const char *dir) {
   int brick = add_material(&d, "brick", 1, 1, 1, 0, 0.9f, brick_tex);
   int pillar = add_material(&d, "pillar", 0.7f, 0.7f, 0.65f, 0, 0.8f, -1);
   int stripe = add_material(&d, "stripe", 0.9f, 0.8f, 0.1f, 0, 0.7f, -1);
-  int paints[3] = {add_material(&d, "paint_blue", 0.1f, 0.2f, 0.7f, 0.3f, 0.35f, -1),
-                   add_material(&d, "paint_white", 0.85f, 0.85f, 0.85f, 0.3f, 0.35f, -1),
-                   add_material(&d, "paint_red", 0.7f, 0.08f, 0.06f, 0.3f, 0.35f, -1)};
-  int glass = add_material(&d, "glass", 0.15f, 0.2f, 0.25f, 0, 0.1f, -1);
-  int tyre = add_material(&d, "tyre", 0.05f, 0.05f, 0.05f, 0, 0.9f, -1);
+  car_paints paints = car_materials(&d);
   float W = 4, L = 20, H = 3; /* corridor x in [-W, W], z in [-L, 0] */
   mesh m = {0};
   quad(&m, (float[]){-W, 0, 0}, (float[]){2 * W, 0, 0}, (float[]){0, 0, -L}, 1, 1);
@@ -773,7 +782,7 @@ static void garage(const char *dir) {
   box(&m, 0, H / 2, 0, 0.2f, H / 2, 0.2f);
   int col = add_mesh1(&d, "pillar", &m, pillar);
   int cars[3];
-  for (int k = 0; k < 3; k++) cars[k] = car_mesh(&d, paints[k], glass, tyre);
+  for (int k = 0; k < 3; k++) cars[k] = car_mesh(&d, paints.paint[k], paints.glass, paints.tyre);
   for (int i = 0; i < 5; i++) {
     char nm[32];
     float z = -2 - 4 * (float)i;
@@ -1002,11 +1011,7 @@ static void night(const char *dir) {
   int paving = add_material(&d, "paving", 0.45f, 0.43f, 0.4f, 0, 0.85f, -1);
   int plaster = add_material(&d, "plaster", 0.7f, 0.62f, 0.5f, 0, 0.9f, -1);
   int iron = add_material(&d, "iron", 0.2f, 0.2f, 0.22f, 0, 0.6f, -1);
-  int paints[3] = {add_material(&d, "paint_blue", 0.1f, 0.2f, 0.55f, 0, 0.4f, -1),
-                   add_material(&d, "paint_red", 0.6f, 0.08f, 0.06f, 0, 0.4f, -1),
-                   add_material(&d, "paint_white", 0.8f, 0.8f, 0.78f, 0, 0.4f, -1)};
-  int glass = add_material(&d, "glass", 0.15f, 0.2f, 0.25f, 0, 0.1f, -1);
-  int tyre = add_material(&d, "tyre", 0.05f, 0.05f, 0.05f, 0, 0.9f, -1);
+  car_paints paints = car_materials(&d);
   float L = 80; /* the street runs from z = 0 to -L */
   mesh m = {0};
   quad(&m, (float[]){-4, 0, 0}, (float[]){8, 0, 0}, (float[]){0, 0, -L}, 4, 40);
@@ -1036,7 +1041,7 @@ static void night(const char *dir) {
       light(&d, nm, "point", side ? x - 0.5f : x + 0.5f, 4.85f, z, NULL, 1, 0.8f, 0.55f, 40000, 14);
     }
   int cars[3];
-  for (int k = 0; k < 3; k++) cars[k] = car_mesh(&d, paints[k], glass, tyre);
+  for (int k = 0; k < 3; k++) cars[k] = car_mesh(&d, paints.paint[k], paints.glass, paints.tyre);
   for (int i = 0; i < 7; i++) { /* parked along both kerbs */
     char nm[32];
     snprintf(nm, sizeof nm, "car%d", i);
