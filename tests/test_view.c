@@ -107,11 +107,21 @@ static int wait_exit(pid_t pid, int timeout_ms) {
   return -1;
 }
 
-/* After each case: a viewer still running (its case failed) is stopped. */
+/* The source tree's shaders and scripts, fresh under root (edits undone). */
+static int copy_sources(void) {
+  char cmd[1024];
+  snprintf(cmd, sizeof cmd, "rm -rf %s/shaders %s/scripts && cp -r %s/shaders %s/scripts %s/", root, root,
+           LIMN_SOURCE_ROOT, LIMN_SOURCE_ROOT, root);
+  return system(cmd) == 0 ? 0 : -1;
+}
+
+/* After each case: a viewer still running (its case failed) is stopped, and
+ * the sources it edited are restored, so that one failure does not fail the
+ * cases after it. */
 static int stop_leftover(void **state) {
   (void)state;
   if (running > 0) wait_exit(running, 0);
-  return 0;
+  return copy_sources();
 }
 
 static bool alive(pid_t pid) {
@@ -182,10 +192,7 @@ static void assert_walls(const lm_image *img) {
 static int setup(void **state) {
   (void)state;
   snprintf(root, sizeof root, "/tmp/limn-view-XXXXXX");
-  if (!mkdtemp(root)) return -1;
-  char cmd[1024];
-  snprintf(cmd, sizeof cmd, "cp -r %s/shaders %s/scripts %s/", LIMN_SOURCE_ROOT, LIMN_SOURCE_ROOT, root);
-  if (system(cmd) != 0) return -1;
+  if (!mkdtemp(root) || copy_sources() != 0) return -1;
   setenv("LIMN_ROOT", root, 1);
   if (!getenv("DISPLAY")) {
     fprintf(stderr, "test_view: no DISPLAY; run it through xvfb-run (ctest does)\n");
