@@ -19,10 +19,9 @@
 enum { W = 96, H = 72 };
 
 static int find_node(const lm_scene *s, const char *name) {
-  for (int i = 0; i < s->node_count; i++)
-    if (!strcmp(s->nodes[i].name, name)) return i;
-  fail_msg("no node '%s'", name);
-  return -1;
+  int i = lm_scene_find_node(s, name);
+  if (i < 0) fail_msg("no node '%s'", name);
+  return i;
 }
 
 /* What each pixel's centre sees in the mirror, by the CPU tracer alone: the

@@ -195,9 +195,7 @@ static void rsm_tiles_are_kept_and_give_the_drawn_image(void **state) {
            kept.in_place, memcmp(c.rgb, u.rgb, bytes) ? "not" : "exactly");
     assert_true(views == 4 && kept.kept == views && kept.in_place == views && kept.drawn == 0);
     assert_memory_equal(c.rgb, u.rgb, bytes);
-    int canopy = -1;
-    for (int i = 0; i < s->node_count; i++)
-      if (!strcmp(s->nodes[i].name, "canopy")) canopy = i;
+    int canopy = lm_scene_find_node(s, "canopy");
     assert_true(canopy >= 0);
     mat4 w;
     memcpy(w, s->nodes[canopy].world, sizeof w);

@@ -713,9 +713,7 @@ static void unchanged_tiles_are_kept_and_changed_ones_drawn(void **state) {
   assert_true(views > 0 && kept.kept == views && kept.in_place == views && kept.drawn == 0 && drawn.kept == 0 &&
               drawn.drawn > 0);
   assert_true(share_different(&c, &u) == 0.0f);
-  int box = -1;
-  for (int i = 0; i < s->node_count; i++)
-    if (!strcmp(s->nodes[i].name, "tall_box")) box = i;
+  int box = lm_scene_find_node(s, "tall_box");
   assert_true(box >= 0);
   mat4 w;
   memcpy(w, s->nodes[box].world, sizeof w);

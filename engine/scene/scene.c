@@ -83,6 +83,12 @@ int lm_scene_find_material(const lm_scene *s, const char *name) {
   return -1;
 }
 
+int lm_scene_find_node(const lm_scene *s, const char *name) {
+  for (int i = 0; i < s->node_count; i++)
+    if (!strcmp(s->nodes[i].name, name)) return i;
+  return -1;
+}
+
 int lm_scene_add_node(lm_scene *s, const char *name, int parent, const float local[16], int mesh,
                       int material) {
   lm_node *n = LM_PUSH(s->nodes, s->node_count, s->node_cap);

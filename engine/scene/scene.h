@@ -166,6 +166,8 @@ int lm_scene_add_texture(lm_scene *s, const char *name, int width, int height, u
 bool lm_scene_reflective(const lm_scene *s);
 /* Index of the material called `name`, or -1. */
 int lm_scene_find_material(const lm_scene *s, const char *name);
+/* Index of the first node called `name`, or -1. */
+int lm_scene_find_node(const lm_scene *s, const char *name);
 int lm_scene_add_camera(lm_scene *s, const lm_camera *c);
 /* Puts a new node (index 0) above every root: all node indices, and the
  * lights' and cameras' nodes, move up by one. A scaled root is the same scene
