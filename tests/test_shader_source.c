@@ -36,6 +36,7 @@ static int setup(void **state) {
   write_file("lib/b.glsl", "float b;\n#include \"../a.glsl\"\n"); /* a cycle: included once */
   write_file("missing.frag", "float x;\n\n#include \"nope.glsl\"\n");
   write_file("malformed.frag", "#include nope.glsl\n");
+  write_file("skipped.frag", "#ifdef NOPE\n#include \"a.glsl\"\n#endif\nfloat after;\n");
   return 0;
 }
 
@@ -87,6 +88,20 @@ static void includes_expand_once_with_line_directives(void **state) {
   lm_shader_source_free(&src);
 }
 
+/* An #include in a group the preprocessor skips still adds its lines, and
+ * the #line after it is skipped with them: the line after the group's end
+ * sets the line again, so what follows maps to its own line. */
+static void includes_in_skipped_groups_keep_lines(void **state) {
+  (void)state;
+  char path[512];
+  snprintf(path, sizeof path, "%s/skipped.frag", dir);
+  lm_shader_source src;
+  lm_error err;
+  assert_true(lm_shader_source_load(&src, path, dir, NULL, &err));
+  assert_non_null(strstr(src.text.data, "#endif\n#line 4 0\nfloat after;"));
+  lm_shader_source_free(&src);
+}
+
 static void missing_includes_name_file_and_line(void **state) {
   (void)state;
   char path[512];
@@ -126,6 +141,7 @@ static void compiler_logs_map_to_files(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(includes_expand_once_with_line_directives),
+      cmocka_unit_test(includes_in_skipped_groups_keep_lines),
       cmocka_unit_test(missing_includes_name_file_and_line),
       cmocka_unit_test(compiler_logs_map_to_files),
   };

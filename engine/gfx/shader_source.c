@@ -74,6 +74,18 @@ static bool is_version_line(const char *line, int len) {
   return len - i >= 8 && !strncmp(line + i, "#version", 8);
 }
 
+/* Does the line end or switch a conditional group (#else, #elif, #endif)?
+ * An #include inside a group that is skipped still adds its lines, and the
+ * #line after it is skipped too: the line after the group sets it again. */
+static bool is_group_switch(const char *line, int len) {
+  int i = 0;
+  while (i < len && (line[i] == ' ' || line[i] == '\t')) i++;
+  if (i == len || line[i] != '#') return false;
+  for (i++; i < len && (line[i] == ' ' || line[i] == '\t'); i++) {}
+  return (len - i >= 4 && (!strncmp(line + i, "else", 4) || !strncmp(line + i, "elif", 4))) ||
+         (len - i >= 5 && !strncmp(line + i, "endif", 5));
+}
+
 static bool expand(lm_shader_source *src, const char *given, const char *include_dir, int depth,
                    lm_error *err) {
   char path[PATH_MAX]; /* canonical, so "lib/../a.glsl" and "a.glsl" are one file */
@@ -124,6 +136,7 @@ static bool expand(lm_shader_source *src, const char *given, const char *include
     } else {
       lm_buf_append(&src->text, p, len);
       lm_buf_append(&src->text, "\n", 1);
+      if (is_group_switch(p, len)) lm_buf_printf(&src->text, "#line %d %d\n", line_no + 1, id);
     }
     p += len + (nl ? 1 : 0);
   }
