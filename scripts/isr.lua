@@ -220,29 +220,39 @@ end
 
 -- A separable Gaussian blur of the coarse result E over the coarse
 -- G-buffer C (a copy, or a view with its depth z) that skips background and
--- does not cross depth edges.
-function isr.blur(E, C, f, radius)
+-- does not cross depth edges. age (optional): temporal reuse's history (a:
+-- the frames a pixel holds, temporal.apply), whose pixels of n frames take
+-- radius / sqrt(n): frames times taps stay about the same, and a converged
+-- still image is left as it is.
+function isr.blur(E, C, f, radius, age)
   if radius == 0 then return E end
   local mask = not C.z and C.mat or nil -- a view's depth is its mask too
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
     E = pass{ "isr.blur_" .. axis[1], shader = "blur.frag",
-              inputs = { src = E, mask = mask, depth = C.z or C.dpt },
-              params = { axis = axis[2], radius = radius }, defines = { MASK = mask ~= nil, DEPTH = true },
+              inputs = { src = E, mask = mask, depth = C.z or C.dpt, age = age },
+              params = { axis = axis[2], radius = radius },
+              defines = { MASK = mask ~= nil, DEPTH = true, AGE = age ~= nil },
               out = coarse_target("isr.blur_" .. axis[1], f) }
   end
   return E
+end
+
+-- Adds to a composite pass's inputs and defines the coarse result E over
+-- the coarse grid C (a copy, or a view with its depth z) that coarse.glsl
+-- upsamples.
+function isr.bind_coarse(inputs, defines, C, E)
+  inputs.coarse, inputs.coarse_dpt, inputs.coarse_mat = E, C.z or C.dpt, not C.z and C.mat or nil
+  defines.Z_MASK = C.z ~= nil
 end
 
 -- Bilateral upsampling of the coarse E (rgb E, a A) and the composite with
 -- the direct light (isr_light.frag), to the target "lit"; skylight (from
 -- sky.light, may be nil) joins the ambient term.
 function isr.composite(G, direct, C, E, params, seed, skylight)
-  local defines = { SEED = seed, Z_MASK = C.z ~= nil }
+  local inputs, defines = { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat, direct = direct }, { SEED = seed }
+  isr.bind_coarse(inputs, defines, C, E)
   sky.bind(skylight, params, defines)
-  return pass{ "isr.light", shader = "isr_light.frag",
-               inputs = { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat, direct = direct,
-                          isr = E, coarse_dpt = C.z or C.dpt, coarse_mat = not C.z and C.mat or nil },
-               defines = defines, params = params,
+  return pass{ "isr.light", shader = "isr_light.frag", inputs = inputs, defines = defines, params = params,
                out = target{ "lit", format = "rgba16f" } }
 end
 

@@ -57,12 +57,18 @@ for name, d in pairs(post.defaults()) do Options[name] = d end
 local function grey(x) return { x, x, x } end
 
 -- The frame's direct light, computed once: the dl techniques' result (with
--- the ambient term) or, for the GI techniques, the lights alone (ambient 0:
--- the GI composite adds the ambient term, occluded, and the indirect light),
--- which also serves as the GI senders' radiance.
-local function direct(G, tech, shadows, ambient, name, skylight)
+-- the ambient term); with `indirect` (rsm, vpl, lpv: { C, E, k }) also the
+-- indirect light, upsampled (direct.frag's INDIRECT); or, for the
+-- screen-space GI techniques, the lights alone (ambient 0: their composite
+-- adds the ambient term, occluded, and the indirect light), which also
+-- serves as their senders' radiance.
+local function direct(G, tech, shadows, ambient, name, skylight, indirect)
   local inputs, defines = shadow.bind(shadows, gbuffer.inputs(G), gbuffer.defines(G, {}))
   local params = sky.bind(skylight, { ambient = grey(ambient), background = grey(tech.background) }, defines)
+  if indirect then
+    isr.bind_coarse(inputs, defines, indirect.C, indirect.E)
+    defines.INDIRECT, params.k = true, indirect.k
+  end
   return pass{ "direct", shader = "direct.frag", inputs = inputs, defines = defines,
                fetches = not shadows and 4 or nil, -- the G-buffer; shadow lookups vary with the lights
                params = params,
@@ -99,16 +105,15 @@ function OnRender(tech)
   local skylight = sky.light(tech.sky) -- nil when off: then nothing of it is recorded
   if lighting == "dl" or (lighting == "rsm" or lighting == "vpl" or lighting == "lpv") and not R then -- no caster: no RSM
     lit = direct(G, tech, shadows, tech.ambient, "lit", skylight)
+  elseif lighting == "rsm" or lighting == "vpl" or lighting == "lpv" then
+    -- Off-screen indirect light needs no direct light of this frame: the direct pass adds it.
+    local indirect = lighting == "rsm" and rsm.indirect(G, shadows, R, o_rsm)
+                     or lighting == "vpl" and vpl.indirect(G, shadows, R, o_rsm) or lpv.indirect(G, R, o_rsm)
+    lit = direct(G, tech, shadows, tech.ambient, "lit", skylight, indirect)
   else
     local d = direct(G, tech, shadows, 0, "direct")
     local light = { ambient = grey(tech.ambient), background = grey(tech.background), sky = skylight }
-    if lighting == "rsm" then
-      lit = rsm.render(G, d, shadows, R, o_rsm, light)
-    elseif lighting == "vpl" then
-      lit = vpl.render(G, d, shadows, R, o_rsm, light)
-    elseif lighting == "lpv" then
-      lit = lpv.render(G, d, R, o_rsm, light)
-    elseif lighting == "isr" then
+    if lighting == "isr" then
       -- The combined techniques add the off-screen senders to ISR's coarse result, over ISR's grid.
       local extra = R and tech.name:find("lpv+", 1, true) and function(C, E, f)
         return lpv.gather(C, f, lpv.volume(G, R, o_rsm, true), o_rsm, E)

@@ -3,8 +3,8 @@
 -- the maps when this module asks (shadow.render(o, G, reach)); the gather
 -- runs at a coarse size over isr.lua's coarse view of the G-buffer
 -- (isr.coarse_view: no downsampling pass; rsm.frag), then the same
--- geometry-aware blur, bilateral upsampling and composite as ISR (isr.blur,
--- isr.composite: L = D + k_a L_a albedo + k k_d albedo E).
+-- geometry-aware blur as ISR (isr.blur); the direct pass upsamples and adds
+-- it (direct.frag's INDIRECT: L = D + k_a L_a albedo + k k_d albedo E).
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local options = require "options"
@@ -31,7 +31,8 @@ rsm.defaults = {
   coarse = 3,        -- coarse factor a side: 1, 2, 3 or 4 (the seed: 2, half resolution); 3 removes
                      -- as much error as 2 at the same samples (24: 63.0% and 62.6%) on 2.25
                      -- times fewer pixels
-  blur = 4,          -- Gaussian taps each side at coarse size, 0..32
+  blur = 4,          -- Gaussian taps each side at coarse size, 0..32; with temporal reuse, a pixel
+                     -- whose history holds n frames takes blur / sqrt(n) (isr.blur's age)
   temporal = {},     -- temporal reuse (scripts/temporal.lua): enabled, frames, epsilon, bias;
                      -- its history is at the default coarse factor (pp.lua's OnCreate)
 }
@@ -77,19 +78,16 @@ function rsm.gather(C, f, R, shadows, o, base)
   return E
 end
 
--- Records RSM lighting of G given its direct light `direct` (no ambient
--- term), the shadow atlas and RSM targets (shadow.render(..., o.reach)), with
--- checked options o and light = { ambient = {r, g, b}, background = {r, g, b}, sky }.
--- Returns the lit target.
-function rsm.render(G, direct, shadows, R, o, light)
+-- Records the RSM's indirect light over G from the shadow atlas and RSM
+-- targets (shadow.render(..., o.reach)), with checked options o: the gather
+-- over a coarse view of G (no pass averages its blocks first), temporal
+-- reuse and the blur. Returns what the direct pass adds (pp.lua's direct:
+-- INDIRECT in direct.frag): { C = the coarse grid, E = the coarse result, k }.
+function rsm.indirect(G, shadows, R, o)
   local f = o.coarse
-  -- Temporal reuse compares depths and coverage in a coarse copy (temporal.apply); without it the gather
-  -- reads the G-buffer at each coarse texel's block centre, and no pass averages the blocks first.
-  local C = o.temporal.enabled and isr.coarse_gbuffer(G, direct, f) or isr.coarse_view(G, direct, f)
-  local E = temporal.apply("rsm", rsm.gather(C, f, R, shadows, o), C, o.temporal, 1 / f)
-  E = isr.blur(E, C, f, o.blur)
-  return isr.composite(G, direct, C, E, { ambient = light.ambient, background = light.background, k = o.k }, false,
-                       light.sky)
+  local C = isr.coarse_view(G, nil, f)
+  local E, age = temporal.apply("rsm", rsm.gather(C, f, R, shadows, o), C, o.temporal, 1 / f)
+  return { C = C, E = isr.blur(E, C, f, o.blur, age), k = o.k }
 end
 
 return rsm

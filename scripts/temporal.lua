@@ -62,7 +62,8 @@ end
 -- Adds to a GI pass's inputs, defines and params what it needs to skip the
 -- pixels whose accumulation has converged (TEMPORAL_SKIP, temporal.glsl):
 -- the history temporal.apply will read this frame. Nothing when off. The
--- pass also needs the coarse G-buffer's dpt as `dpt`.
+-- pass tests each pixel at its coarse depth (temporal.glsl), as the
+-- accumulation will.
 function temporal.skip(user, inputs, defines, params, o, scale)
   if not o.enabled then return end
   local previous = history_of(user, scale).targets[histories[user].turn + 1]
@@ -72,8 +73,10 @@ function temporal.skip(user, inputs, defines, params, o, scale)
 end
 
 -- The accumulated result of `src`, a coarse result at the scale the history
--- was declared with (C: the coarse G-buffer with dpt and mat), or src
--- itself when off.
+-- was declared with (C: the coarse grid, a copy of the G-buffer with dpt
+-- and mat or a view with its depth z, isr.coarse_view), or src itself when
+-- off; and the new history (rgb the value, a the frames it holds), nil when
+-- off.
 function temporal.apply(user, src, C, o, scale)
   if not o.enabled then return src end
   local h = history_of(user, scale)
@@ -81,11 +84,12 @@ function temporal.apply(user, src, C, o, scale)
   h.turn = 1 - h.turn
   local out = target{ "temporal." .. user, format = "rgba16f", scale = scale }
   pass{ "temporal." .. user, shader = "temporal.frag",
-        inputs = { src = src, history = previous.value, history_depth = previous.depth, dpt = C.dpt, mat = C.mat },
-        params = { epsilon = o.epsilon, bias = o.bias, frames = o.frames, confidence = o.confidence,
+        inputs = { src = src, history = previous.value, history_depth = previous.depth, dpt = C.z or C.dpt,
+                   mat = not C.z and C.mat or nil },
+        defines = { Z_MASK = C.z ~= nil }, params = { epsilon = o.epsilon, bias = o.bias, frames = o.frames, confidence = o.confidence,
                    refresh = o.refresh },
         fetches = 6, out = { out, next.value, next.depth } }
-  return out
+  return out, next.value
 end
 
 return temporal

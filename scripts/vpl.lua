@@ -15,7 +15,8 @@
 --      lights again for that pixel: where any of them disagrees (recompute
 --      "any", the seed) or only where all do ("all": elsewhere the ones
 --      that agree)
---   6. ISR's composite (isr.composite: L = D + k_a L_a albedo + k k_d albedo E)
+--   6. the direct pass adds it (direct.frag's INDIRECT: L = D + k_a L_a albedo
+--      + k k_d albedo E)
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local options = require "options"
@@ -57,12 +58,13 @@ local rules = {
 -- Checked options (errors point at the caller's caller).
 function vpl.check(o) return options.check("vpl", vpl.defaults, o, rules, 3) end
 
--- Records VPL lighting of G given its direct light `direct` (no ambient
--- term), the shadow atlas and RSM targets R, checked options o and light =
--- { ambient = {r, g, b}, background = {r, g, b} }. Returns the lit target.
-function vpl.render(G, direct, shadows, R, o, light)
+-- Records the VPLs' indirect light over G from the shadow atlas and RSM
+-- targets R, with checked options o. Returns what the direct pass adds
+-- (pp.lua's direct: INDIRECT in direct.frag): { C = the grid, here G's own,
+-- E = the full-size result, k }.
+function vpl.indirect(G, shadows, R, o)
   local f = o.coarse
-  local C = isr.coarse_view(G, direct, f)
+  local C = isr.coarse_view(G, nil, f)
   local params = { indirect_count = o.lights, negative = o.negative, threshold = o.threshold,
                    focus = math.min(o.focus / o.reach, 1) }
   local coarse = function(name) return target{ name, format = "rgba16f", scale = 1 / f } end
@@ -103,9 +105,7 @@ function vpl.render(G, direct, shadows, R, o, light)
   E = pass{ "vpl.refine", shader = "vpl.frag", inputs = t, defines = d, params = params,
             fetches = 4 + 12, -- where coarse texels agree; a discontinuity costs all lights again
             out = target{ "vpl.full", format = "rgba16f" } }
-  return isr.composite(G, direct, { dpt = G.dpt, mat = G.mat }, E,
-                       { ambient = light.ambient, background = light.background, k = o.k }, false,
-                       light.sky)
+  return { C = { dpt = G.dpt, mat = G.mat }, E = E, k = o.k }
 end
 
 return vpl

@@ -6,7 +6,10 @@
 // halos the seed names as a weakness, lines 2592-2688). The plane's slope
 // is the smaller one-sided difference, which does not straddle an edge, so
 // a floor seen at a grazing angle still blurs along its length. With DEPTH
-// and no MASK, a depth of 0 (nothing drawn) is the mask.
+// and no MASK, a depth of 0 (nothing drawn) is the mask. With AGE (temporal
+// reuse's history, a: the frames a pixel holds), a pixel of n frames takes
+// radius / sqrt(n) taps each side: n frames of samples need about 1/n the
+// taps for the same noise, and a converged pixel is copied.
 #include "common.glsl"
 
 in vec2 uv;
@@ -20,6 +23,9 @@ const float DEPTH_TOLERANCE = 0.05; // relative depth difference of weight 1/e
 #endif
 uniform ivec2 axis = ivec2(1, 0); // (1, 0) horizontal, (0, 1) vertical
 uniform int radius = 4;           // taps each side; sigma = radius / 2
+#ifdef AGE
+uniform sampler2D age;
+#endif
 
 out vec4 dst;
 
@@ -41,6 +47,15 @@ float weight_at(ivec2 q, float z, float expected) {
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy), last = textureSize(src, 0) - 1;
   vec4 centre = texelFetch(src, p, 0);
+#ifdef AGE
+  int taps = int(float(radius) * sqrt(inversesqrt(max(texelFetch(age, p, 0).a, 1.0))));
+#else
+  int taps = radius;
+#endif
+  if (taps < 1) {
+    dst = centre;
+    return;
+  }
   float z = 0.0, slope = 0.0;
 #ifdef DEPTH
   z = texelFetch(depth, p, 0).r;
@@ -49,13 +64,13 @@ void main() {
   slope = abs(ahead) < abs(behind) ? ahead : behind;
 #endif
   float wsum = weight_at(p, z, z); // the centre's tap, fetched once
-  if (wsum == 0.0 || radius < 1) {
+  if (wsum == 0.0) {
     dst = centre;
     return;
   }
-  float sigma = 0.5 * float(radius), inv2s2 = 0.5 / (sigma * sigma);
+  float sigma = 0.5 * float(taps), inv2s2 = 0.5 / (sigma * sigma);
   vec4 sum = wsum * centre;
-  for (int i = -radius; i <= radius; i++) {
+  for (int i = -taps; i <= taps; i++) {
     if (i == 0) continue;
     ivec2 q = clamp(p + axis * i, ivec2(0), last);
     float w = exp(-float(i * i) * inv2s2) * weight_at(q, z, z + float(i) * slope);

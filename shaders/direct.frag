@@ -1,5 +1,14 @@
 // Deferred direct light over the G-buffer: position rebuilt from linear depth.
+// INDIRECT: indirect light that needs no direct light of this frame (RSM,
+// VPL, LPV) is added here, a coarse result upsampled (coarse.glsl), rather
+// than in a composite pass of its own: L = D + k_a L_a albedo + k k_d albedo E
+// (the physical composite of isr_light.frag, with A = 1: these occlude no
+// ambient term).
 #include "gbuffer.glsl"
+#ifdef INDIRECT
+#include "coarse.glsl"
+uniform float k = 1.0;
+#endif
 
 in vec2 uv;
 uniform sampler2D clr, nrm, dpt, mat;
@@ -10,5 +19,13 @@ out vec4 lit;
 
 void main() {
   Surface s = gbuffer_read(clr, nrm, dpt, mat, uv);
-  lit = vec4(s.covered ? direct_light(s, ambient) : background + sky_seen(uv), 1.0);
+  if (!s.covered) {
+    lit = vec4(background + sky_seen(uv), 1.0);
+    return;
+  }
+  vec3 l = direct_light(s, ambient);
+#ifdef INDIRECT
+  l += max(k, 0.0) * s.k.y * s.albedo * coarse_upsample(uv, s.depth01).rgb;
+#endif
+  lit = vec4(l, 1.0);
 }

@@ -15,7 +15,10 @@
 
 in vec2 uv;
 uniform sampler2D src;      // this frame's coarse result (rgb, a kept); where converged, not computed
-uniform sampler2D dpt, mat; // this frame's coarse depth and coverage
+uniform sampler2D dpt;      // this frame's coarse depth
+#ifndef Z_MASK
+uniform sampler2D mat;      // its coverage (a); with Z_MASK, the depth's: 0 where nothing was drawn
+#endif
 uniform float bias = 0.1, confidence = 0.25;
 
 layout(location = 0) out vec4 result;
@@ -26,7 +29,11 @@ void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   vec4 cur = texelFetch(src, px, 0);
   float d = texelFetch(dpt, px, 0).r;
+#ifdef Z_MASK
+  if (d <= 0.0) {
+#else
   if (texelFetch(mat, px, 0).a < 0.5) {
+#endif
     result = cur;
     next = vec4(cur.rgb, 0.0);
     next_depth = 0.0;

@@ -197,7 +197,8 @@ static void cascades_do_not_shimmer_under_sub_cell_motion(void **state) {
   const lm_light_type types[] = {LM_LIGHT_SPOT, LM_LIGHT_DIRECTIONAL};
   for (int k = 0; k < 8; k++) {
     bool surfels = k & 1, follow = k & 4;
-    const char *const sets[] = {"ambient=0", "lpv.coarse=2", follow ? "lpv.extent=1" : "lpv.extent=3",
+    /* 8 steps: lpv.sum_r8 below is the last step's sum */
+    const char *const sets[] = {"ambient=0", "lpv.coarse=2", "lpv.steps=8", follow ? "lpv.extent=1" : "lpv.extent=3",
                                 surfels ? NULL : "lpv.surfels=0", NULL};
     lm_scene *s = corner_scene(types[k / 2 % 2]);
     gl_result r = render_ok(s, "lpv+esm", sets, W, H);
