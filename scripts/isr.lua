@@ -109,15 +109,15 @@ end
 -- (isr_march, isr_bounce, lpv_lookup, rsm and vpl with STRIDE = stride) read
 -- G's texel at each coarse texel's block centre (block_centre), where a
 -- coarse copy would average the block, and the march steps through G's full
--- depth. The first of them (the march, or the LPV's lookup, RSM's or VPL's
--- gather alone) writes the grid's depth into z (0 where nothing is drawn),
--- which the blur and the composite read (VPL: its negative lights and
--- refinement). Against the copy (isr.downsample), at 160 x 120 on the room:
--- 0.45 ms a frame less, the march 0.25 ms more (its depth and senders at full
--- size).
-function isr.coarse_view(G, direct, f)
-  return { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat, direct = direct, stride = f,
-           z = target{ "isr.z", format = "r32f", scale = 1 / f } }
+-- depth. The first of them (the march, the LPV's lookup, RSM's or VPL's
+-- gather) writes the grid's depth into z (0 where nothing is drawn), the
+-- target "<user>.z", which the blur and the composite read (VPL: its
+-- negative lights and refinement). Against the copy (isr.downsample), at
+-- 160 x 120 on the room: 0.45 ms a frame less, the march 0.25 ms more (its
+-- depth and senders at full size).
+function isr.coarse_view(G, direct, f, user)
+  return { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat, direct = direct, stride = f, user = user,
+           z = target{ user .. ".z", format = "r32f", scale = 1 / f } }
 end
 
 -- The coarse factor: o.coarse, or for 0 the auto factor at this output size.
@@ -160,17 +160,16 @@ local function march_params(o)
 end
 
 -- Records ISR lighting of G given its direct light `direct` (lights only, no
--- ambient term: a target from direct.frag with ambient 0), with options o
+-- ambient term: a target from direct.frag with ambient 0; the combined
+-- techniques' also holds the off-screen senders' light), with options o
 -- (see isr.defaults) and light = { ambient = {r, g, b}, background = {r, g, b} }.
--- extra (optional), a function (C, E, f) -> E', adds to the transport's coarse
--- result before the blur (the combined technique's off-screen light).
 -- Returns the lit target.
-function isr.render(G, direct, o, light, extra)
+function isr.render(G, direct, o, light)
   o = options.check("isr", isr.defaults, o, rules, 2)
   local seed = options.check("isr.seed", isr.defaults.seed, o.seed, seed_rules, 2) -- checked in either mode
   if o.mode ~= "seed" then seed = nil end
   local f = factor(o)
-  local C = seed and isr.coarse_gbuffer(G, direct, f) or isr.coarse_view(G, direct, f)
+  local C = seed and isr.coarse_gbuffer(G, direct, f) or isr.coarse_view(G, direct, f, "isr")
   local E, E1, H
   local hits = seed and 0 or hit_targets(o)
   for b = 1, seed and seed.bounces or o.bounces do
@@ -207,7 +206,6 @@ function isr.render(G, direct, o, light, extra)
             defines = { BOUNCE = b > 1, Z = b == 1, HITS = H and hits or nil, STRIDE = C.stride }, out = out }
     end
   end
-  if extra then E = extra(C, E, f) end
   E = isr.blur(E, C, f, o.blur)
   local params = { ambient = light.ambient, background = light.background, view = views[o.view] }
   if seed then
@@ -219,8 +217,8 @@ function isr.render(G, direct, o, light, extra)
 end
 
 -- A separable Gaussian blur of the coarse result E over the coarse
--- G-buffer C (a copy, or a view with its depth z) that skips background and
--- does not cross depth edges. age (optional): temporal reuse's history (a:
+-- G-buffer C (a copy, or a view with its depth z: passes "<user>.blur_x"
+-- and _y) that skips background and does not cross depth edges. age (optional): temporal reuse's history (a:
 -- the frames a pixel holds, temporal.apply), whose pixels of n frames take
 -- radius / sqrt(n): frames times taps stay about the same, and a converged
 -- still image is left as it is.
@@ -228,11 +226,12 @@ function isr.blur(E, C, f, radius, age)
   if radius == 0 then return E end
   local mask = not C.z and C.mat or nil -- a view's depth is its mask too
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
-    E = pass{ "isr.blur_" .. axis[1], shader = "blur.frag",
+    local name = (C.user or "isr") .. ".blur_" .. axis[1]
+    E = pass{ name, shader = "blur.frag",
               inputs = { src = E, mask = mask, depth = C.z or C.dpt, age = age },
               params = { axis = axis[2], radius = radius },
               defines = { MASK = mask ~= nil, DEPTH = true, AGE = age ~= nil },
-              out = coarse_target("isr.blur_" .. axis[1], f) }
+              out = coarse_target(name, f) }
   end
   return E
 end

@@ -181,33 +181,31 @@ function lpv.volume(G, R, o, exclude_seen)
   return { all = all or late, late = late, grids = grids, seen = R.seen }
 end
 
--- Records the lookup over the coarse G-buffer C (isr.coarse_view or
--- isr.coarse_gbuffer, factor f) in the volumes V (lpv.volume). base
--- (optional): a coarse result to add to (the screen-space pass's). Returns
--- the coarse E.
-function lpv.gather(C, f, V, o, base)
+-- Records the lookup over the coarse view C (isr.coarse_view, factor f),
+-- whose depth it writes, in the volumes V (lpv.volume). Returns the coarse E.
+function lpv.gather(C, f, V, o)
   local inputs = gbuffer.inputs(C)
   if V.late then
     inputs.all_r, inputs.all_g, inputs.all_b = V.all[1], V.all[2], V.all[3]
     inputs.late_r, inputs.late_g, inputs.late_b = V.late[1], V.late[2], V.late[3]
   end
-  inputs.base, inputs.lpv_seen = base, V.seen
-  local z = C.z and not base -- the first pass over a view writes its depth (isr.coarse_view)
+  inputs.lpv_seen = V.seen
   local E = target{ "lpv.e", format = "rgba16f", scale = 1 / f }
   pass{ "lpv.lookup", shader = "lpv_lookup.frag", inputs = inputs,
-        defines = { VOLUMES = V.late ~= nil, BASE = base ~= nil, STRIDE = C.stride, Z = z },
+        defines = { VOLUMES = V.late ~= nil, STRIDE = C.stride, Z = true },
         params = grid(o, V.grids, { lpv_steps = o.steps }),
-        fetches = 4 + 6 * (o.cascades + 1), out = { E, z and C.z or nil } }
+        fetches = 4 + 6 * (o.cascades + 1), out = { E, C.z } }
   return E
 end
 
 -- Records the LPV's indirect light over G from the RSM targets R, with
--- checked options o. Returns what the direct pass adds (pp.lua's direct:
--- INDIRECT in direct.frag): { C = the coarse grid, E = the coarse result, k }.
-function lpv.indirect(G, R, o)
+-- checked options o; exclude_seen as lpv.volume. Returns what the direct
+-- pass adds (pp.lua's direct: INDIRECT in direct.frag): { C = the coarse
+-- grid, E = the coarse result, k }.
+function lpv.indirect(G, R, o, exclude_seen)
   local f = o.coarse
-  local C = isr.coarse_view(G, nil, f)
-  return { C = C, E = isr.blur(lpv.gather(C, f, lpv.volume(G, R, o), o), C, f, o.blur), k = o.k }
+  local C = isr.coarse_view(G, nil, f, "lpv")
+  return { C = C, E = isr.blur(lpv.gather(C, f, lpv.volume(G, R, o, exclude_seen), o), C, f, o.blur), k = o.k }
 end
 
 return lpv

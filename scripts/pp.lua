@@ -111,14 +111,14 @@ function OnRender(tech)
                      or lighting == "vpl" and vpl.indirect(G, shadows, R, o_rsm) or lpv.indirect(G, R, o_rsm)
     lit = direct(G, tech, shadows, tech.ambient, "lit", skylight, indirect)
   else
-    local d = direct(G, tech, shadows, 0, "direct")
+    -- The combined techniques (isr+rsm+esm, isr+lpv+esm): the light of the senders the camera does not
+    -- see joins the direct light, where ISR's senders send it on too; ISR adds those it sees.
+    local offscreen = lighting == "isr" and R and (tech.name:find("lpv+", 1, true) and lpv.indirect(G, R, o_rsm, true)
+                                                   or rsm.indirect(G, shadows, R, o_rsm, true))
+    local d = direct(G, tech, shadows, 0, "direct", nil, offscreen or nil)
     local light = { ambient = grey(tech.ambient), background = grey(tech.background), sky = skylight }
     if lighting == "isr" then
-      -- The combined techniques add the off-screen senders to ISR's coarse result, over ISR's grid.
-      local extra = R and tech.name:find("lpv+", 1, true) and function(C, E, f)
-        return lpv.gather(C, f, lpv.volume(G, R, o_rsm, true), o_rsm, E)
-      end or R and function(C, E, f) return rsm.gather(C, f, R, shadows, o_rsm, E) end
-      lit = isr.render(G, d, tech.isr, light, extra)
+      lit = isr.render(G, d, tech.isr, light)
     elseif lighting == "ssdo" then
       lit = ssdo.render(G, d, tech.ssdo, light)
     else

@@ -58,35 +58,34 @@ function rsm.check(o)
   return o
 end
 
--- Records the gather over the coarse grid C (isr.coarse_view, or a coarse
--- copy, isr.coarse_gbuffer, factor f) from the RSM targets R (shadow.render's
--- second result) and the atlas `shadows`. base (optional): a coarse result
--- to add to (the screen-space pass's), in which case senders the camera sees
--- are left to it. Returns the coarse E.
-function rsm.gather(C, f, R, shadows, o, base)
-  local z = C.z and not base -- the first pass over a view writes its depth (isr.coarse_view)
+-- Records the gather over the coarse view C (isr.coarse_view, factor f),
+-- whose depth it writes, from the RSM targets R (shadow.render's second
+-- result) and the atlas `shadows`. exclude_seen: senders the camera sees are
+-- left to the combined technique's screen-space pass. Returns the coarse E.
+function rsm.gather(C, f, R, shadows, o, exclude_seen)
   local inputs, defines = shadow.bind(shadows, gbuffer.inputs(C),
-                                      { VISIBILITY = o.steps > 0, BASE = base ~= nil, EXCLUDE_SEEN = base ~= nil,
-                                        STRIDE = C.stride, Z = z })
-  inputs.rsm_flux, inputs.rsm_pos, inputs.base = R.flux, R.pos, base
+                                      { VISIBILITY = o.steps > 0, EXCLUDE_SEEN = exclude_seen,
+                                        STRIDE = C.stride, Z = true })
+  inputs.rsm_flux, inputs.rsm_pos = R.flux, R.pos
   local params = { samples = o.samples, radius = o.radius, steps = o.steps,
                    rotate = o.temporal.enabled and o.rotate / 360 or 0 }
-  if not base then temporal.skip("rsm", inputs, defines, params, o.temporal, 1 / f) end
+  temporal.skip("rsm", inputs, defines, params, o.temporal, 1 / f)
   local E = target{ "rsm.e", format = "rgba16f", scale = 1 / f }
   pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines, params = params,
-        fetches = 4 + o.samples * (2 + o.steps * 2 + (base and 3 or 0)), out = { E, z and C.z or nil } }
+        fetches = 4 + o.samples * (2 + o.steps * 2 + (exclude_seen and 3 or 0)), out = { E, C.z } }
   return E
 end
 
 -- Records the RSM's indirect light over G from the shadow atlas and RSM
 -- targets (shadow.render(..., o.reach)), with checked options o: the gather
 -- over a coarse view of G (no pass averages its blocks first), temporal
--- reuse and the blur. Returns what the direct pass adds (pp.lua's direct:
--- INDIRECT in direct.frag): { C = the coarse grid, E = the coarse result, k }.
-function rsm.indirect(G, shadows, R, o)
+-- reuse and the blur; exclude_seen as rsm.gather. Returns what the direct
+-- pass adds (pp.lua's direct: INDIRECT in direct.frag): { C = the coarse
+-- grid, E = the coarse result, k }.
+function rsm.indirect(G, shadows, R, o, exclude_seen)
   local f = o.coarse
-  local C = isr.coarse_view(G, nil, f)
-  local E, age = temporal.apply("rsm", rsm.gather(C, f, R, shadows, o), C, o.temporal, 1 / f)
+  local C = isr.coarse_view(G, nil, f, "rsm")
+  local E, age = temporal.apply("rsm", rsm.gather(C, f, R, shadows, o, exclude_seen), C, o.temporal, 1 / f)
   return { C = C, E = isr.blur(E, C, f, o.blur, age), k = o.k }
 end
 

@@ -64,7 +64,7 @@ function vpl.check(o) return options.check("vpl", vpl.defaults, o, rules, 3) end
 -- E = the full-size result, k }.
 function vpl.indirect(G, shadows, R, o)
   local f = o.coarse
-  local C = isr.coarse_view(G, nil, f)
+  local C = isr.coarse_view(G, nil, f, "vpl")
   local params = { indirect_count = o.lights, negative = o.negative, threshold = o.threshold,
                    focus = math.min(o.focus / o.reach, 1) }
   local coarse = function(name) return target{ name, format = "rgba16f", scale = 1 / f } end

@@ -32,8 +32,7 @@
 // cascades past c0 + 1:
 //   E = w all(c0) + (1 - w) all(c0 + 1) + w late(c0 + 1) + late of each cascade past c0 + 1
 // and each cascade's volumes are read once, those with weight 0 not at all.
-// Output: rgb = E / pi, a = 1 (it occludes no ambient term); with BASE, the
-// screen-space pass's coarse result `base` plus it (its a kept).
+// Output: rgb = E / pi, a = 1 (it occludes no ambient term).
 // With STRIDE, each texel reads the G-buffer, STRIDE times finer, at its
 // block's centre (isr.coarse_view); with Z it also writes that depth / far,
 // 0 where nothing is drawn, into z (the view's depth).
@@ -49,9 +48,6 @@ uniform sampler2D clr, nrm, dpt, mat;         // (coarse) G-buffer
 #ifdef VOLUMES
 uniform sampler2D all_r, all_g, all_b;        // sums of steps 1 .. S
 uniform sampler2D late_r, late_g, late_b;     // sums of steps floor(S / 2) + 1 .. S
-#endif
-#ifdef BASE
-uniform sampler2D base;
 #endif
 uniform int lpv_steps = 8;
 
@@ -108,17 +104,12 @@ vec3 cascade(int c, vec3 p, vec3 n, float a, float l) {
 
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
-#ifdef BASE
-  vec4 b = texelFetch(base, px, 0);
-#else
-  vec4 b = vec4(0.0, 0.0, 0.0, 1.0);
-#endif
   Surface s = gbuffer_fetch(clr, nrm, dpt, mat, block_centre(px, STRIDE, textureSize(dpt, 0)));
 #ifdef Z
   z = s.covered ? s.depth01 : 0.0;
 #endif
   if (!s.covered) {
-    result = b;
+    result = vec4(0.0, 0.0, 0.0, 1.0);
     return;
   }
   for (int c = 0; c < lpv_cascades; c++) origins[c] = lpv_origin(c);
@@ -132,5 +123,5 @@ void main() {
   vec3 e = vec3(0.0);
   for (int c = c0; c < lpv_cascades; c++)
     e += cascade(c, s.p, s.n, c == c0 ? w : c == c0 + 1 ? 1.0 - w : 0.0, c == c0 ? 0.0 : c == c0 + 1 ? w : 1.0);
-  result = vec4(b.rgb + finite_or_zero(e), b.a);
+  result = vec4(finite_or_zero(e), 1.0);
 }

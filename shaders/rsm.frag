@@ -29,11 +29,10 @@
 // VISIBILITY: the seed's screen-space test (lines 930-958): `steps` points
 // on p -> q; one behind the depth buffer rejects q.
 // EXCLUDE_SEEN: a sender the camera sees (on screen, depth within 2% of the
-// buffer's) is left to the screen-space pass the combined technique adds.
+// buffer's) is left to the screen-space pass of the combined technique.
 // TEMPORAL_SKIP: a pixel whose temporal accumulation has converged
 // (temporal.glsl) takes no samples; the accumulation keeps its history.
-// Output: rgb = E, a = 1 (RSM light occludes no ambient term); with BASE,
-// the coarse result `base` of the screen-space pass plus E (its a kept).
+// Output: rgb = E, a = 1 (RSM light occludes no ambient term).
 // With STRIDE, each texel reads the G-buffer, STRIDE times finer, at its
 // block's centre (isr.coarse_view); with Z it also writes that depth / far,
 // 0 where nothing is drawn, into z (the view's depth).
@@ -54,9 +53,6 @@ uniform int samples = 64;
 uniform float radius = 1.0;
 uniform float rotate = 0.0; // turn of the pattern a frame, in turns (seed 004: 10 degrees)
 uniform int steps = 0;
-#ifdef BASE
-uniform sampler2D base;
-#endif
 
 layout(location = 0) out vec4 result;
 #ifdef Z
@@ -83,23 +79,19 @@ bool blocked(vec3 p, vec3 q) {
 
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
-#ifdef BASE
-  vec4 b = texelFetch(base, px, 0);
-#else
-  vec4 b = vec4(0.0, 0.0, 0.0, 1.0);
-#endif
+  const vec4 none = vec4(0.0, 0.0, 0.0, 1.0);
   Surface s = gbuffer_fetch(clr, nrm, dpt, mat, block_centre(px, STRIDE, textureSize(dpt, 0)));
 #ifdef Z
   z = s.covered ? s.depth01 : 0.0;
 #endif
   if (!s.covered) {
-    result = b;
+    result = none;
     return;
   }
 #ifdef TEMPORAL_SKIP
   vec4 h;
   if (temporal_converged(uv, s.depth01, px, h)) { // the accumulation keeps its history
-    result = b;
+    result = none;
     return;
   }
 #endif
@@ -158,5 +150,5 @@ void main() {
       }
     }
   }
-  result = vec4(b.rgb + finite_or_zero(e / PI), b.a);
+  result = vec4(finite_or_zero(e / PI), 1.0);
 }
