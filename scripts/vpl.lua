@@ -105,7 +105,7 @@ function vpl.indirect(G, shadows, R, o)
   E = pass{ "vpl.refine", shader = "vpl.frag", inputs = t, defines = d, params = params,
             fetches = 4 + 12, -- where coarse texels agree; a discontinuity costs all lights again
             out = target{ "vpl.full", format = "rgba16f" } }
-  return { C = { dpt = G.dpt, mat = G.mat }, E = E, k = o.k }
+  return { C = { full = true }, E = E, k = o.k }
 end
 
 return vpl

@@ -5,10 +5,15 @@
 // result `coarse` (rgb E, a A) and its depth `coarse_dpt`; the coverage is
 // coarse_mat's (a coarse copy of the G-buffer) or with Z_MASK the depth's,
 // 0 where nothing was drawn (a coarse view's depth, isr.coarse_view).
+// FULL: the result is at full size already (VPL's refinement): one fetch.
 #ifndef LIMN_COARSE_GLSL
 #define LIMN_COARSE_GLSL
 
-uniform sampler2D coarse, coarse_dpt;
+uniform sampler2D coarse;
+#ifdef FULL
+vec4 coarse_upsample(vec2 uv, float z) { return texelFetch(coarse, ivec2(gl_FragCoord.xy), 0); }
+#else
+uniform sampler2D coarse_dpt;
 #ifndef Z_MASK
 uniform sampler2D coarse_mat;
 #endif
@@ -51,4 +56,5 @@ vec4 coarse_upsample(vec2 uv, float z) {
   }
   return wsum > 1e-6 ? sum / wsum : nearest;
 }
+#endif
 #endif
