@@ -237,15 +237,10 @@ function isr.blur(E, C, f, radius, age)
 end
 
 -- Adds to a composite pass's inputs and defines the coarse result E over
--- the coarse grid C (a copy, or a view with its depth z; C.full: E is at
--- full size) that coarse.glsl upsamples.
+-- the coarse grid C (a copy, or a view with its depth z) that coarse.glsl
+-- upsamples.
 function isr.bind_coarse(inputs, defines, C, E)
-  inputs.coarse = E
-  if C.full then
-    defines.FULL = true
-    return
-  end
-  inputs.coarse_dpt, inputs.coarse_mat = C.z or C.dpt, not C.z and C.mat or nil
+  inputs.coarse, inputs.coarse_dpt, inputs.coarse_mat = E, C.z or C.dpt, not C.z and C.mat or nil
   defines.Z_MASK = C.z ~= nil
 end
 

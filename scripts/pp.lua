@@ -57,7 +57,7 @@ for name, d in pairs(post.defaults()) do Options[name] = d end
 local function grey(x) return { x, x, x } end
 
 -- The frame's direct light, computed once: the dl techniques' result (with
--- the ambient term); with `indirect` (rsm, vpl, lpv: { C, E, k }) also the
+-- the ambient term); with `indirect` (rsm, lpv: { C, E, k }) also the
 -- indirect light, upsampled (direct.frag's INDIRECT); or, for the
 -- screen-space GI techniques, the lights alone (ambient 0: their composite
 -- adds the ambient term, occluded, and the indirect light), which also
@@ -105,10 +105,12 @@ function OnRender(tech)
   local skylight = sky.light(tech.sky) -- nil when off: then nothing of it is recorded
   if lighting == "dl" or (lighting == "rsm" or lighting == "vpl" or lighting == "lpv") and not R then -- no caster: no RSM
     lit = direct(G, tech, shadows, tech.ambient, "lit", skylight)
-  elseif lighting == "rsm" or lighting == "vpl" or lighting == "lpv" then
+  elseif lighting == "vpl" then -- its full-size refinement lights the pixel too
+    lit = vpl.render(G, shadows, R, o_rsm, { ambient = grey(tech.ambient), background = grey(tech.background),
+                                             sky = skylight })
+  elseif lighting == "rsm" or lighting == "lpv" then
     -- Off-screen indirect light needs no direct light of this frame: the direct pass adds it.
-    local indirect = lighting == "rsm" and rsm.indirect(G, shadows, R, o_rsm)
-                     or lighting == "vpl" and vpl.indirect(G, shadows, R, o_rsm) or lpv.indirect(G, R, o_rsm)
+    local indirect = lighting == "rsm" and rsm.indirect(G, shadows, R, o_rsm) or lpv.indirect(G, R, o_rsm)
     lit = direct(G, tech, shadows, tech.ambient, "lit", skylight, indirect)
   else
     -- The combined techniques (isr+rsm+esm, isr+lpv+esm): the light of the senders the camera does not

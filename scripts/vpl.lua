@@ -15,12 +15,13 @@
 --      lights again for that pixel: where any of them disagrees (recompute
 --      "any", the seed) or only where all do ("all": elsewhere the ones
 --      that agree)
---   6. the direct pass adds it (direct.frag's INDIRECT: L = D + k_a L_a albedo
---      + k k_d albedo E)
+--      and that pass lights the pixel too: L = D + k_a L_a albedo + k k_d albedo E
+--      (direct.frag's, with INDIRECT)
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local options = require "options"
 local shadow = require "shadow"
+local sky = require "sky"
 
 local vpl = {}
 
@@ -58,11 +59,11 @@ local rules = {
 -- Checked options (errors point at the caller's caller).
 function vpl.check(o) return options.check("vpl", vpl.defaults, o, rules, 3) end
 
--- Records the VPLs' indirect light over G from the shadow atlas and RSM
--- targets R, with checked options o. Returns what the direct pass adds
--- (pp.lua's direct: INDIRECT in direct.frag): { C = the grid, here G's own,
--- E = the full-size result, k }.
-function vpl.indirect(G, shadows, R, o)
+-- Records VPL lighting of G from the shadow atlas and RSM targets R, with
+-- checked options o and light = { ambient = {r, g, b}, background = {r, g,
+-- b}, sky }: the refinement is the frame's direct pass too. Returns the lit
+-- target.
+function vpl.render(G, shadows, R, o, light)
   local f = o.coarse
   local C = isr.coarse_view(G, nil, f, "vpl")
   local params = { indirect_count = o.lights, negative = o.negative, threshold = o.threshold,
@@ -102,10 +103,12 @@ function vpl.indirect(G, shadows, R, o)
   d.RECOMPUTE_ANY = o.recompute == "any"
   t.coarse, t.cdpt = E, C.z
   negatives(t)
-  E = pass{ "vpl.refine", shader = "vpl.frag", inputs = t, defines = d, params = params,
-            fetches = 4 + 12, -- where coarse texels agree; a discontinuity costs all lights again
-            out = target{ "vpl.full", format = "rgba16f" } }
-  return { C = { full = true }, E = E, k = o.k }
+  local lit = { ambient = light.ambient, background = light.background, k = o.k }
+  for key, v in pairs(params) do lit[key] = v end
+  return pass{ "vpl.refine", shader = "vpl.frag", inputs = t, defines = gbuffer.defines(G, d),
+               params = sky.bind(light.sky, lit, d),
+               fetches = 4 + 12, -- where coarse texels agree; a discontinuity costs all lights again
+               out = target{ "lit", format = "rgba16f" } }
 end
 
 return vpl

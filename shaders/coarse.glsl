@@ -1,19 +1,14 @@
 // A coarse GI result brought to full size (seed 000, eq 27-28): depth-aware
 // bilateral upsampling over the 2 x 2 coarse texels around a pixel, shared
 // by the composites (isr_light.frag, and direct.frag with INDIRECT, which
-// adds RSM, VPL or LPV light in the direct pass itself). Inputs: the coarse
+// adds RSM or LPV light in the direct pass itself). Inputs: the coarse
 // result `coarse` (rgb E, a A) and its depth `coarse_dpt`; the coverage is
 // coarse_mat's (a coarse copy of the G-buffer) or with Z_MASK the depth's,
 // 0 where nothing was drawn (a coarse view's depth, isr.coarse_view).
-// FULL: the result is at full size already (VPL's refinement): one fetch.
 #ifndef LIMN_COARSE_GLSL
 #define LIMN_COARSE_GLSL
 
-uniform sampler2D coarse;
-#ifdef FULL
-vec4 coarse_upsample(vec2 uv, float z) { return texelFetch(coarse, ivec2(gl_FragCoord.xy), 0); }
-#else
-uniform sampler2D coarse_dpt;
+uniform sampler2D coarse, coarse_dpt;
 #ifndef Z_MASK
 uniform sampler2D coarse_mat;
 #endif
@@ -56,5 +51,4 @@ vec4 coarse_upsample(vec2 uv, float z) {
   }
   return wsum > 1e-6 ? sum / wsum : nearest;
 }
-#endif
 #endif

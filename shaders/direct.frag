@@ -1,9 +1,9 @@
 // Deferred direct light over the G-buffer: position rebuilt from linear depth.
 // INDIRECT: indirect light that needs no direct light of this frame (RSM,
-// VPL, LPV) is added here, a coarse result upsampled (coarse.glsl), rather
-// than in a composite pass of its own: L = D + k_a L_a albedo + k k_d albedo E
-// (the physical composite of isr_light.frag, with A = 1: these occlude no
-// ambient term).
+// LPV; vpl.frag's refinement does the same for VPLs) is added here, a
+// coarse result upsampled (coarse.glsl), rather than in a composite pass of
+// its own: L = D + k_a L_a albedo + k k_d albedo E (the physical composite
+// of isr_light.frag, with A = 1: these occlude no ambient term).
 #include "gbuffer.glsl"
 #ifdef INDIRECT
 #include "coarse.glsl"

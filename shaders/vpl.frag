@@ -12,13 +12,16 @@
 //             pixels: position and the direction they block (normal_pack;
 //             w > 0: none), S_neg and the area
 //   NEGATIVE  coarse: E = E+ minus the M negative lights
-//   REFINE    full size: the coarse E where the 2 x 2 coarse texels around a
-//             pixel agree with it in normal and depth (the seed's
-//             discontinuity threshold), else E recomputed at full size; with
-//             RECOMPUTE_ANY where any of them disagrees (the seed), without
-//             only where all do: elsewhere the bilinear weights of those that
-//             agree, renormalized (llvmpipe runs the recomputation for a
-//             whole block of pixels where one of them needs it)
+//   REFINE    full size, the frame's direct pass too: the coarse E where the
+//             2 x 2 coarse texels around a pixel agree with it in normal and
+//             depth (the seed's discontinuity threshold), else E recomputed
+//             at full size; with RECOMPUTE_ANY where any of them disagrees
+//             (the seed), without only where all do: elsewhere the bilinear
+//             weights of those that agree, renormalized (llvmpipe runs the
+//             recomputation for a whole block of pixels where one of them
+//             needs it); then the pixel's direct light and ambient term
+//             (direct.frag) plus k k_d albedo E: one full-size pass, not a
+//             refinement and a direct pass that reads it
 // Every pixel meets the same lights, so what each light is (its RSM texel,
 // the light there, its area) is worked out once in LIGHTS and NEGATIVES, not
 // per pixel: the per-pixel loops read one small texture at one place for
@@ -38,7 +41,7 @@
 //   E(p) += (1/pi) Phi max(0, n_p.t) max(0, n_q.-t) / max(|q - p|^2, A)
 // (seed 002's gather, t = (q - p)/|q - p|), A the area the light stands
 // for: its own size caps 1/d^2. Output of GATHER: E+ (rgb), S_neg (rgb) and
-// its mean direction (xyz); NEGATIVE and REFINE: rgb = E, a = 1.
+// its mean direction (xyz); NEGATIVE: rgb = E, a = 1; REFINE: the lit pixel.
 #include "rsm.glsl"
 #include "halton.glsl"
 
@@ -75,6 +78,9 @@ uniform sampler2D positive;                    // GATHER's E+
 uniform sampler2D coarse;                      // NEGATIVE's E
 uniform sampler2D cdpt;                        // the coarse grid's depth (GATHER's z)
 uniform float threshold = 0.1;                 // relative depth and 1 - cos of the normals
+uniform vec3 ambient = vec3(0.0);
+uniform vec3 background = vec3(0.0);
+uniform float k = 1.0;                         // indirect light factor
 #endif
 
 #ifdef GATHER
@@ -243,7 +249,7 @@ void main() {
   result = vec4(finite_or_zero(e), 1.0);
 #elif defined(REFINE)
   if (!s.covered) {
-    result = vec4(0.0, 0.0, 0.0, 1.0);
+    result = vec4(background + sky_seen(uv), 1.0);
     return;
   }
   ivec2 csize = textureSize(coarse, 0);
@@ -271,6 +277,6 @@ void main() {
 #endif
   vec3 e = interpolate ? sum / max(wsum, 1e-30)
                        : max(indirect(s.p, s.n, s_neg, neg_d) - negative_light(s.p, s.n), vec3(0.0));
-  result = vec4(finite_or_zero(e), 1.0);
+  result = vec4(direct_light(s, ambient) + max(k, 0.0) * s.k.y * s.albedo * finite_or_zero(e), 1.0);
 #endif
 }

@@ -190,7 +190,7 @@ static double aligned_difference(const float *a, const float *b, int w, int h, i
  * where it was (no grid moved, and the VPLs sit on the same world points);
  * with them, within 2%; the image's indirect light on the white wall within
  * 2% (its pixels see the wall shifted), with the lookup at half size a side
- * (at the default quarter, this image's 24 x 18 coarse pixels see the wall
+ * (at a quarter, this image's 24 x 18 coarse pixels see the wall
  * shift by 2.0% under the sun with the grids kept; the volumes as here). */
 static void cascades_do_not_shimmer_under_sub_cell_motion(void **state) {
   (void)state;
@@ -304,7 +304,7 @@ static void extremes_stay_finite(void **state) {
       {"lpv.cell=1e-30", NULL},
       {"lpv.cell=1e30", NULL},
       {"lpv.occlusion=0", "lpv.shift=0", NULL},
-      {"lpv.coarse=4", "lpv.blur=32", "lpv.k=16", NULL},
+      {"lpv.coarse=8", "lpv.blur=32", "lpv.k=16", NULL},
       {"lpv.coarse=1", "lpv.blur=0", "lpv.reach=64", NULL},
   };
   lm_scene *s = corner_scene(LM_LIGHT_DIRECTIONAL);
