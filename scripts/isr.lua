@@ -218,10 +218,10 @@ end
 
 -- A separable Gaussian blur of the coarse result E over the coarse
 -- G-buffer C (a copy, or a view with its depth z: passes "<user>.blur_x"
--- and _y) that skips background and does not cross depth edges. age (optional): temporal reuse's history (a:
--- the frames a pixel holds, temporal.apply), whose pixels of n frames take
--- radius / sqrt(n): frames times taps stay about the same, and a converged
--- still image is left as it is.
+-- and _y) that skips background and does not cross depth edges. age
+-- (optional): temporal reuse's history (a: the frames a pixel holds,
+-- temporal.bind), whose pixels of n frames take radius / n^(1/4) taps
+-- (blur.frag): a new pixel is blurred in full, a converged one barely.
 function isr.blur(E, C, f, radius, age)
   if radius == 0 then return E end
   local mask = not C.z and C.mat or nil -- a view's depth is its mask too

@@ -32,7 +32,7 @@ rsm.defaults = {
                      -- as much error as 2 at the same samples (24: 63.0% and 62.6%) on 2.25
                      -- times fewer pixels
   blur = 4,          -- Gaussian taps each side at coarse size, 0..32; with temporal reuse, a pixel
-                     -- whose history holds n frames takes blur / sqrt(n) (isr.blur's age)
+                     -- whose history holds n frames takes blur / n^(1/4) (isr.blur's age)
   temporal = {},     -- temporal reuse (scripts/temporal.lua): enabled, frames, epsilon, bias;
                      -- its history is at the default coarse factor (pp.lua's OnCreate)
 }
@@ -61,7 +61,8 @@ end
 -- Records the gather over the coarse view C (isr.coarse_view, factor f),
 -- whose depth it writes, from the RSM targets R (shadow.render's second
 -- result) and the atlas `shadows`. exclude_seen: senders the camera sees are
--- left to the combined technique's screen-space pass. Returns the coarse E.
+-- left to the combined technique's screen-space pass. Returns the coarse E
+-- and, with temporal reuse, the history it wrote (temporal.bind).
 function rsm.gather(C, f, R, shadows, o, exclude_seen)
   local inputs, defines = shadow.bind(shadows, gbuffer.inputs(C),
                                       { VISIBILITY = o.steps > 0, EXCLUDE_SEEN = exclude_seen,
@@ -69,11 +70,12 @@ function rsm.gather(C, f, R, shadows, o, exclude_seen)
   inputs.rsm_flux, inputs.rsm_pos = R.flux, R.pos
   local params = { samples = o.samples, radius = o.radius, steps = o.steps,
                    rotate = o.temporal.enabled and o.rotate / 360 or 0 }
-  temporal.skip("rsm", inputs, defines, params, o.temporal, 1 / f)
+  local history = temporal.bind("rsm", inputs, defines, params, o.temporal, 1 / f)
   local E = target{ "rsm.e", format = "rgba16f", scale = 1 / f }
   pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines, params = params,
-        fetches = 4 + o.samples * (2 + o.steps * 2 + (exclude_seen and 3 or 0)), out = { E, C.z } }
-  return E
+        fetches = 4 + o.samples * (2 + o.steps * 2 + (exclude_seen and 3 or 0)),
+        out = { E, C.z, history and history.value, history and history.depth } }
+  return E, history
 end
 
 -- Records the RSM's indirect light over G from the shadow atlas and RSM
@@ -85,8 +87,8 @@ end
 function rsm.indirect(G, shadows, R, o, exclude_seen)
   local f = o.coarse
   local C = isr.coarse_view(G, nil, f, "rsm")
-  local E, age = temporal.apply("rsm", rsm.gather(C, f, R, shadows, o, exclude_seen), C, o.temporal, 1 / f)
-  return { C = C, E = isr.blur(E, C, f, o.blur, age), k = o.k }
+  local E, history = rsm.gather(C, f, R, shadows, o, exclude_seen)
+  return { C = C, E = isr.blur(E, C, f, o.blur, history and history.value), k = o.k }
 end
 
 return rsm

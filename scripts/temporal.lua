@@ -1,14 +1,15 @@
 -- Temporal reuse for any coarse GI result (seed 004, chapter 3.3;
--- shaders/temporal.frag): reverse reprojection through the previous frame's
+-- shaders/temporal.glsl): reverse reprojection through the previous frame's
 -- matrices, the disocclusion test, accumulation restarted by the seed's
--- confidence. The
--- history is two persistent targets a user (say "rsm") declares from
--- OnCreate at its coarse scale, taking turns (a pass cannot read and write
--- one target); the viewer's reload keeps them by name, format and size.
--- The GI pass turns its sampling pattern each frame (rsm.rotate) so the
--- accumulation averages different samples, and skips the pixels that have
--- converged (temporal.skip): on a still camera it then costs the
--- reprojection and the refreshed tiles.
+-- confidence, all inside the GI pass (rsm.frag's TEMPORAL): the pass that
+-- computes a pixel's value also blends it with its history and writes the
+-- next, and skips the pixels that have converged, so a still camera's frame
+-- costs the reprojection and the refreshed tiles. The history is two
+-- persistent targets a user (say "rsm") declares from OnCreate at its
+-- coarse scale, taking turns (a pass cannot read and write one target);
+-- the viewer's reload keeps them by name, format and size. The GI pass
+-- turns its sampling pattern each frame (rsm.rotate) so the accumulation
+-- averages different samples.
 local options = require "options"
 
 local temporal = {}
@@ -59,37 +60,22 @@ local function history_of(user, scale)
   return h
 end
 
--- Adds to a GI pass's inputs, defines and params what it needs to skip the
--- pixels whose accumulation has converged (TEMPORAL_SKIP, temporal.glsl):
--- the history temporal.apply will read this frame. Nothing when off. The
--- pass tests each pixel at its coarse depth (temporal.glsl), as the
--- accumulation will.
-function temporal.skip(user, inputs, defines, params, o, scale)
-  if not o.enabled then return end
-  local previous = history_of(user, scale).targets[histories[user].turn + 1]
-  inputs.history, inputs.history_depth = previous.value, previous.depth
-  defines.TEMPORAL_SKIP = true
-  params.frames, params.epsilon, params.refresh = o.frames, o.epsilon, o.refresh
-end
-
--- The accumulated result of `src`, a coarse result at the scale the history
--- was declared with (C: the coarse grid, a copy of the G-buffer with dpt
--- and mat or a view with its depth z, isr.coarse_view), or src itself when
--- off; and the new history (rgb the value, a the frames it holds), nil when
--- off.
-function temporal.apply(user, src, C, o, scale)
-  if not o.enabled then return src end
+-- Adds to a GI pass's inputs, defines and params the history of `user`
+-- at `scale` (TEMPORAL, temporal.glsl: the pass accumulates, and skips the
+-- pixels that have converged), and returns the targets the pass writes this
+-- frame's history to, its outputs after its result and depth: { value,
+-- depth }; value (a: the frames each pixel holds) is what isr.blur's age
+-- reads. Nothing when off.
+function temporal.bind(user, inputs, defines, params, o, scale)
+  if not o.enabled then return nil end
   local h = history_of(user, scale)
   local previous, next = h.targets[h.turn + 1], h.targets[2 - h.turn]
   h.turn = 1 - h.turn
-  local out = target{ "temporal." .. user, format = "rgba16f", scale = scale }
-  pass{ "temporal." .. user, shader = "temporal.frag",
-        inputs = { src = src, history = previous.value, history_depth = previous.depth, dpt = C.z or C.dpt,
-                   mat = not C.z and C.mat or nil },
-        defines = { Z_MASK = C.z ~= nil }, params = { epsilon = o.epsilon, bias = o.bias, frames = o.frames, confidence = o.confidence,
-                   refresh = o.refresh },
-        fetches = 6, out = { out, next.value, next.depth } }
-  return out, next.value
+  inputs.history, inputs.history_depth = previous.value, previous.depth
+  defines.TEMPORAL = true
+  params.frames, params.epsilon, params.refresh = o.frames, o.epsilon, o.refresh
+  params.bias, params.confidence = o.bias, o.confidence
+  return next
 end
 
 return temporal

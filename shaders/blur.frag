@@ -8,8 +8,10 @@
 // a floor seen at a grazing angle still blurs along its length. With DEPTH
 // and no MASK, a depth of 0 (nothing drawn) is the mask. With AGE (temporal
 // reuse's history, a: the frames a pixel holds), a pixel of n frames takes
-// radius / sqrt(n) taps each side: n frames of samples need about 1/n the
-// taps for the same noise, and a converged pixel is copied.
+// radius / n^(1/4) taps each side: a new or disoccluded pixel is blurred in
+// full, a converged one (36 frames) with 1 tap at radius 4. (radius /
+// sqrt(n), the same noise for n frames of samples, left converged pixels
+// unblurred: more error against the references, docs/gi-combined.md.)
 #include "common.glsl"
 
 in vec2 uv;

@@ -30,15 +30,16 @@
 // on p -> q; one behind the depth buffer rejects q.
 // EXCLUDE_SEEN: a sender the camera sees (on screen, depth within 2% of the
 // buffer's) is left to the screen-space pass of the combined technique.
-// TEMPORAL_SKIP: a pixel whose temporal accumulation has converged
-// (temporal.glsl) takes no samples; the accumulation keeps its history.
+// TEMPORAL: temporal reuse (temporal.glsl): the result is the accumulation,
+// and the history for the next frame goes to `next` and `next_depth`; a
+// pixel whose accumulation has converged takes no samples and keeps it.
 // Output: rgb = E, a = 1 (RSM light occludes no ambient term).
 // With STRIDE, each texel reads the G-buffer, STRIDE times finer, at its
 // block's centre (isr.coarse_view); with Z it also writes that depth / far,
 // 0 where nothing is drawn, into z (the view's depth).
 #include "rsm.glsl"
 #include "halton.glsl"
-#ifdef TEMPORAL_SKIP
+#ifdef TEMPORAL
 #include "temporal.glsl"
 #endif
 
@@ -57,6 +58,10 @@ uniform int steps = 0;
 layout(location = 0) out vec4 result;
 #ifdef Z
 layout(location = 1) out float z;
+#endif
+#ifdef TEMPORAL
+layout(location = 2) out vec4 next;     // the history's value (rgb, a frames seen)
+layout(location = 3) out float next_depth; // and view depth, 0 none
 #endif
 
 const int INTERLEAVE = 4;                          // tile side of the interleaved pattern
@@ -84,14 +89,20 @@ void main() {
 #ifdef Z
   z = s.covered ? s.depth01 : 0.0;
 #endif
+#ifdef TEMPORAL
+  next = vec4(0.0);
+  next_depth = s.covered ? dpt_view_depth(s.depth01) : 0.0;
+#endif
   if (!s.covered) {
     result = none;
     return;
   }
-#ifdef TEMPORAL_SKIP
+#ifdef TEMPORAL
   vec4 h;
-  if (temporal_converged(uv, s.depth01, px, h)) { // the accumulation keeps its history
-    result = none;
+  bool found = temporal_history(uv, s.depth01, h);
+  if (found && temporal_converged(h, px)) { // kept as it is
+    next = vec4(h.rgb, max(frames, 1.0));
+    result = vec4(h.rgb, 1.0);
     return;
   }
 #endif
@@ -150,5 +161,10 @@ void main() {
       }
     }
   }
-  result = vec4(finite_or_zero(e / PI), 1.0);
+  vec3 v = finite_or_zero(e / PI);
+#ifdef TEMPORAL
+  next = temporal_accumulate(v, found, h);
+  v = next.rgb;
+#endif
+  result = vec4(v, 1.0);
 }

@@ -1,16 +1,26 @@
-// Temporal reuse's reprojection (seed 004, chapter 3.3), shared by the
-// accumulation (temporal.frag) and the GI passes that skip their work where
-// it has converged (TEMPORAL_SKIP in rsm.frag): both must take the same
-// history texel and make the same decision. The history is last frame's
-// accumulation: value (rgb V, a frames seen) and depth (r: view depth, 0
-// none), at the coarse size of the pass.
+// Temporal reuse of a coarse GI result (seed 004, chapter 3.3; lines
+// 560-610), inside the GI pass that computes it (TEMPORAL in rsm.frag;
+// scripts/temporal.lua binds the history): reverse reprojection of each
+// pixel's world position through the previous frame's view-projection, a
+// disocclusion test, and accumulation: the running mean of the frames a
+// pixel has seen, up to `frames`, after which it stops (the seed's "stop
+// when converged"): a converged pixel keeps its history, and the pass takes
+// no samples for it except in the frames that refresh its tile. The seed's
+// confidence
+//   conf = 1 - saturate(|V_{t-1} - V_t|) / (1 + bias)
+// over values normalized as HDR (v / (1 + v), the seed's "normalize HDR
+// values before the confidence") restarts a pixel whose confidence falls
+// below `confidence` (its light changed), on the frames it has fresh samples.
+// The history is last frame's accumulation: value (rgb V, a frames seen)
+// and depth (r: view depth, 0 none), at the coarse size of the pass; the
+// pass writes this frame's into two more outputs.
 #ifndef LIMN_TEMPORAL_GLSL
 #define LIMN_TEMPORAL_GLSL
 #include "common.glsl"
 #include "halton.glsl"
 
 uniform sampler2D history, history_depth;
-uniform float epsilon = 0.02, frames = 36.0;
+uniform float epsilon = 0.02, frames = 36.0, bias = 0.1, confidence = 0.25;
 uniform int refresh = 32;
 
 // The history of the pixel at uv whose coarse depth is d (dpt): the
@@ -44,10 +54,25 @@ bool temporal_refresh(ivec2 px) {
   return (turn + int(frame.time.y)) % refresh == 0;
 }
 
-// Has the pixel's accumulation converged, so that this frame's samples
+// Has the pixel whose history is h converged, so that this frame's samples
 // would not change it? Its history holds `frames` frames and it is not
 // being refreshed. The accumulation then keeps the history as it is.
-bool temporal_converged(vec2 uv, float d, ivec2 px, out vec4 h) {
-  return temporal_history(uv, d, h) && h.a >= max(frames, 1.0) && !temporal_refresh(px);
+bool temporal_converged(vec4 h, ivec2 px) { return h.a >= max(frames, 1.0) && !temporal_refresh(px); }
+
+// The history to store for a pixel that took fresh samples `cur`: the
+// running mean with its history h (found: temporal_history) while the
+// confidence holds, else cur alone (rgb V, a frames seen).
+vec4 temporal_accumulate(vec3 cur, bool found, vec4 h) {
+  float most = max(frames, 1.0);
+  if (found) {
+    vec3 a = h.rgb / (1.0 + h.rgb), b = cur / (1.0 + cur), diff = abs(a - b);
+    float conf = 1.0 - saturate(max(diff.r, max(diff.g, diff.b))) / (1.0 + bias);
+    if (conf >= confidence) {
+      float seen = min(h.a, most);
+      float w = seen >= frames ? 1.0 : seen / (seen + 1.0);
+      return vec4(finite_or_zero(mix(cur, h.rgb, w)), min(seen + 1.0, most));
+    }
+  }
+  return vec4(finite_or_zero(cur), 1.0);
 }
 #endif
