@@ -84,7 +84,7 @@ local rules = {
 }
 
 -- The coarse G-buffer and direct light, each texel its block's average: G
--- itself at factor 1 (the seed mode, and rsm.lua with temporal reuse).
+-- itself at factor 1 (the seed mode's).
 function isr.coarse_gbuffer(G, direct, f)
   if f == 1 then
     local C = gbuffer.inputs(G)

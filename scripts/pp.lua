@@ -117,7 +117,7 @@ function OnRender(tech)
     -- see joins the direct light, where ISR's senders send it on too; ISR adds those it sees.
     local offscreen = lighting == "isr" and R and (tech.name:find("lpv+", 1, true) and lpv.indirect(G, R, o_rsm, true)
                                                    or rsm.indirect(G, shadows, R, o_rsm, true))
-    local d = direct(G, tech, shadows, 0, "direct", nil, offscreen or nil)
+    local d = direct(G, tech, shadows, 0, "direct", nil, offscreen)
     local light = { ambient = grey(tech.ambient), background = grey(tech.background), sky = skylight }
     if lighting == "isr" then
       lit = isr.render(G, d, tech.isr, light)

@@ -25,7 +25,7 @@ void main() {
   }
   vec3 l = direct_light(s, ambient);
 #ifdef INDIRECT
-  l += max(k, 0.0) * s.k.y * s.albedo * coarse_upsample(uv, s.depth01).rgb;
+  l += gi_reflected(s, k, coarse_upsample(uv, s.depth01).rgb);
 #endif
   lit = vec4(l, 1.0);
 }

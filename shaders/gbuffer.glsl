@@ -75,4 +75,9 @@ vec3 direct_light(Surface s, vec3 ambient) {
   Reflector m = Reflector(s.pbr, diffuse, s.k, s.shininess, s.f0, s.roughness);
   return s.k.x * a * diffuse + reflected_light(m, s.n, v, s.p);
 }
+
+// Indirect irradiance E / pi (the GI passes' E, gi-scale.md) reflected by a
+// covered surface, times the indirect light factor k: k k_d albedo E, the
+// term every physical GI composite adds.
+vec3 gi_reflected(Surface s, float k, vec3 e) { return max(k, 0.0) * s.k.y * s.albedo * e; }
 #endif

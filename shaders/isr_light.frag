@@ -39,7 +39,7 @@ void main() {
   vec3 indirect = s.rho * e.rgb;
   vec3 l = (d + sky) * saturate(e.a + 1.0 - k_ssao) + k_isr * indirect;
 #else
-  vec3 indirect = max(k, 0.0) * s.k.y * s.albedo * e.rgb;
+  vec3 indirect = gi_reflected(s, k, e.rgb);
   vec3 l = d + sky * saturate(e.a) + indirect;
 #endif
   if (view == 1) l = indirect;

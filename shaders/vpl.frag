@@ -277,6 +277,6 @@ void main() {
 #endif
   vec3 e = interpolate ? sum / max(wsum, 1e-30)
                        : max(indirect(s.p, s.n, s_neg, neg_d) - negative_light(s.p, s.n), vec3(0.0));
-  result = vec4(direct_light(s, ambient) + max(k, 0.0) * s.k.y * s.albedo * finite_or_zero(e), 1.0);
+  result = vec4(direct_light(s, ambient) + gi_reflected(s, k, finite_or_zero(e)), 1.0);
 #endif
 }
