@@ -221,7 +221,7 @@ end
 -- and _y) that skips background and does not cross depth edges. age
 -- (optional): temporal reuse's history (a: the frames a pixel holds,
 -- temporal.bind), whose pixels of n frames take radius / n^(1/4) taps
--- (blur.frag): a new pixel is blurred in full, a converged one barely.
+-- (blur.frag): a new pixel is blurred in full, a converged one a little.
 function isr.blur(E, C, f, radius, age)
   if radius == 0 then return E end
   local mask = not C.z and C.mat or nil -- a view's depth is its mask too

@@ -350,12 +350,14 @@ static void converged_pixels_take_no_samples_until_their_tile_refreshes(void **s
 /* A camera move with temporal reuse: after 20 still frames the camera
  * slides sideways by a tenth of the room; the first frame after the move
  * differs from 21 still frames with reuse at the new place (the same
- * blur: the blur shrinks with a pixel's frames, isr.blur) by less than 1%
- * of the image's mean, edges (ceiling and walls, the lit patch) included,
- * where a ghost trail would show the old ones: reprojection keeps what is
- * still seen, the disocclusion test drops what was not. 64 samples a frame,
- * not the default 24: the pixels the move uncovers hold one frame's samples,
- * and at 24 their noise alone comes to about 1% (a ghost is what is tested). */
+ * blur: the blur shrinks with a pixel's frames, isr.blur) by less than 0.7%
+ * of the image's mean (0.50% measured; 0.87% at rsm.temporal.epsilon = 1,
+ * which keeps the ghost), edges (ceiling and walls, the lit patch)
+ * included, where a ghost trail would show the old ones: reprojection keeps
+ * what is still seen, the disocclusion test drops what was not. 64 samples
+ * a frame, not the default 24: the pixels the move uncovers hold one frame's
+ * samples, and at 24 their noise alone comes to about 1% (a ghost is what
+ * is tested). */
 static void a_camera_move_leaves_no_ghost_edge(void **state) {
   (void)state;
   static const char *const on[] = {"ambient=0", "rsm.samples=64", "rsm.temporal.enabled=true", NULL};
@@ -386,7 +388,7 @@ static void a_camera_move_leaves_no_ghost_edge(void **state) {
   double mean = (all[0] + all[1] + all[2]) / 3.0;
   print_message("after the move: mean difference to 21 still frames %.2e of a mean %.3f\n", diff, mean);
   assert_true(gl_all_finite(&r));
-  assert_true(diff < 0.01 * mean);
+  assert_true(diff < 0.007 * mean);
   gl_result_free(&r);
   gl_result_free(&still);
   lm_scene_destroy(s);
