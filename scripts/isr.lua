@@ -20,12 +20,16 @@
 --      indirect light added to the senders' radiance (physical: the first
 --      march records each ray's sender and the later bounces sum over those,
 --      isr_bounce.frag, rather than march the same rays again)
+--      With isr.temporal.enabled (physical), temporal reuse (temporal.lua):
+--      each frame marches the next rays of the sequence, the last step
+--      accumulates, and a pixel whose history has converged is not marched
 --   3. a separable Gaussian blur of the coarse result that skips background
 --      and does not cross depth edges (blur.frag)
 --   4. bilateral upsampling and the composite (isr_light.frag)
 local gbuffer = require "gbuffer"
 local options = require "options"
 local sky = require "sky"
+local temporal = require "temporal"
 
 local isr = {}
 
@@ -48,6 +52,8 @@ isr.defaults = {
                      -- a 4 x 4 tile's interleaved rays averaged over a wider area raise Pearson
                      -- in every view of the reference set (4: 14 of 15)
   view = "lit",      -- "lit"; "indirect" (the indirect light) or "ao" (accessibility) to inspect
+  temporal = {},     -- temporal reuse (scripts/temporal.lua), physical mode: enabled, frames, epsilon,
+                     -- bias, confidence, refresh; with it a converged pixel's blur shrinks as rsm's
   seed = {           -- mode "seed": the dissertation's parameters
     samples = 48,      -- N samples a pixel, 1..256 (the seed timed 48; 80 after its fig 5.7)
     radius = 0.5,      -- sampling disc radius in world units, > 0
@@ -57,6 +63,8 @@ isr.defaults = {
     bounces = 1,       -- transport steps, 1..4 (1: the seed)
   },
 }
+
+for k, v in pairs(temporal.defaults) do isr.defaults.temporal[k] = v end
 
 local views = { lit = 0, indirect = 1, ao = 2 }
 
@@ -81,6 +89,7 @@ local rules = {
   blur = options.whole(0, 32),
   view = options.one_of("lit", "indirect", "ao"),
   seed = function(v) if type(v) ~= "table" then return "a table of the seed mode's options" end end,
+  temporal = function(v) if type(v) ~= "table" then return "a table of temporal reuse options" end end,
 }
 
 -- The coarse G-buffer and direct light, each texel its block's average: G
@@ -167,12 +176,29 @@ end
 function isr.render(G, direct, o, light)
   o = options.check("isr", isr.defaults, o, rules, 2)
   local seed = options.check("isr.seed", isr.defaults.seed, o.seed, seed_rules, 2) -- checked in either mode
+  o.temporal = temporal.check("isr.temporal", o.temporal)
   if o.mode ~= "seed" then seed = nil end
+  if seed and o.temporal.enabled then error("isr.temporal is for isr.mode \"physical\"", 2) end
   local f = factor(o)
   local C = seed and isr.coarse_gbuffer(G, direct, f) or isr.coarse_view(G, direct, f, "isr")
   local E, E1, H
   local hits = seed and 0 or hit_targets(o)
-  for b = 1, seed and seed.bounces or o.bounces do
+  -- Temporal reuse: every step reads the history (all skip the same converged pixels), the last
+  -- accumulates and writes the next one after its other outputs (NEXT).
+  local T, history = { inputs = {}, defines = {}, params = {} }, nil
+  if not seed then history = temporal.bind("isr", T.inputs, T.defines, T.params, o.temporal, f) end
+  local function with_history(inputs, defines, params, out, last)
+    if not history then return end
+    for k, v in pairs(T.inputs) do inputs[k] = v end
+    for k, v in pairs(T.defines) do defines[k] = v end
+    for k, v in pairs(T.params) do params[k] = v end
+    if last then
+      defines.TEMPORAL_NEXT, defines.NEXT = true, #out
+      out[#out + 1], out[#out + 2] = history.value, history.state
+    end
+  end
+  local steps = seed and seed.bounces or o.bounces
+  for b = 1, steps do
     local inputs = gbuffer.inputs(C)
     inputs.previous = E
     local name = b == 1 and "isr.transport" or "isr.transport" .. b
@@ -182,11 +208,14 @@ function isr.render(G, direct, o, light)
                 fetches = 4 + seed.samples * (E and 6 or 5), -- at most: G-buffer and sender (and bounce) a sample
                 defines = { BOUNCE = E ~= nil }, out = coarse_target("isr.e" .. b, f) }
     elseif H then
-      local from = { clr = C.clr, mat = C.mat, first = E1, previous = E }
+      local from = { clr = C.clr, mat = C.mat, first = E1, previous = E, z = history and C.z or nil }
       for k = 1, hits do from["hits" .. (k - 1)] = H[k] end
-      E = pass{ name, shader = "isr_bounce.frag", inputs = from, params = { samples = o.samples },
-                fetches = 2 + hits + 3 * o.samples, -- first, the hits, and three fetches a sending ray
-                defines = { HITS = hits, STRIDE = C.stride }, out = coarse_target("isr.e" .. b, f) }
+      local defines, params = { HITS = hits, STRIDE = C.stride }, { samples = o.samples }
+      E = coarse_target("isr.e" .. b, f)
+      local out = { E }
+      with_history(from, defines, params, out, b == steps)
+      pass{ name, shader = "isr_bounce.frag", inputs = from, params = params, defines = defines, out = out,
+            fetches = 2 + hits + 3 * o.samples } -- first, the hits, and three fetches a sending ray
     else
       inputs.sender = C.direct
       -- The later bounces add to the first E (isr_bounce.frag), or march from it: 32-bit floats in
@@ -201,12 +230,13 @@ function isr.render(G, direct, o, light)
           out[k + 2] = H[k]
         end
       end
-      pass{ name, shader = "isr_march.frag", inputs = inputs, params = march_params(o),
-            fetches = 4 + o.samples * (o.steps + (b > 1 and 6 or 5)), -- the march, and the hit's G-buffer and light
-            defines = { BOUNCE = b > 1, Z = b == 1, HITS = H and hits or nil, STRIDE = C.stride }, out = out }
+      local defines, params = { BOUNCE = b > 1, Z = b == 1, HITS = H and hits or nil, STRIDE = C.stride }, march_params(o)
+      with_history(inputs, defines, params, out, b == steps)
+      pass{ name, shader = "isr_march.frag", inputs = inputs, params = params, defines = defines, out = out,
+            fetches = 4 + o.samples * (o.steps + (b > 1 and 6 or 5)) } -- the march, and the hit's G-buffer and light
     end
   end
-  E = isr.blur(E, C, f, o.blur)
+  E = isr.blur(E, C, f, o.blur, history and history.state)
   local params = { ambient = light.ambient, background = light.background, view = views[o.view] }
   if seed then
     params.k_isr, params.k_ssao = seed.k_isr, seed.k_ssao
@@ -219,7 +249,7 @@ end
 -- A separable Gaussian blur of the coarse result E over the coarse
 -- G-buffer C (a copy, or a view with its depth z: passes "<user>.blur_x"
 -- and _y) that skips background and does not cross depth edges. age
--- (optional): temporal reuse's history (a: the frames a pixel holds,
+-- (optional): temporal reuse's history state (g: the frames a pixel holds,
 -- temporal.bind), whose pixels of n frames take radius / n^(1/4) taps
 -- (blur.frag): a new pixel is blurred in full, a converged one a little.
 function isr.blur(E, C, f, radius, age)

@@ -79,7 +79,8 @@ local rules = { ambient = options.number(0, 1e6), background = options.number(0,
 
 function OnCreate()
   post.create()
-  temporal.create("rsm", 1 / rsm.defaults.coarse) -- rsm.temporal's history
+  temporal.create("rsm", rsm.defaults.coarse) -- rsm.temporal's history
+  temporal.create("isr", { 1, 2, 3, 4 })       -- isr.temporal's, at each coarse factor (one is made)
 end
 
 function OnRender(tech)

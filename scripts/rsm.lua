@@ -70,11 +70,11 @@ function rsm.gather(C, f, R, shadows, o, exclude_seen)
   inputs.rsm_flux, inputs.rsm_pos = R.flux, R.pos
   local params = { samples = o.samples, radius = o.radius, steps = o.steps,
                    rotate = o.temporal.enabled and o.rotate / 360 or 0 }
-  local history = temporal.bind("rsm", inputs, defines, params, o.temporal, 1 / f)
+  local history = temporal.bind("rsm", inputs, defines, params, o.temporal, f)
   local E = target{ "rsm.e", format = "rgba16f", scale = 1 / f }
   pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines, params = params,
         fetches = 4 + o.samples * (2 + o.steps * 2 + (exclude_seen and 3 or 0)),
-        out = { E, C.z, history and history.value, history and history.depth } }
+        out = { E, C.z, history and history.value, history and history.state } }
   return E, history
 end
 
@@ -88,7 +88,7 @@ function rsm.indirect(G, shadows, R, o, exclude_seen)
   local f = o.coarse
   local C = isr.coarse_view(G, nil, f, "rsm")
   local E, history = rsm.gather(C, f, R, shadows, o, exclude_seen)
-  return { C = C, E = isr.blur(E, C, f, o.blur, history and history.value), k = o.k }
+  return { C = C, E = isr.blur(E, C, f, o.blur, history and history.state), k = o.k }
 end
 
 return rsm

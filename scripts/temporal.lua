@@ -1,15 +1,17 @@
 -- Temporal reuse for any coarse GI result (seed 004, chapter 3.3;
 -- shaders/temporal.glsl): reverse reprojection through the previous frame's
 -- matrices, the disocclusion test, accumulation restarted by the seed's
--- confidence, all inside the GI pass (rsm.frag's TEMPORAL): the pass that
--- computes a pixel's value also blends it with its history and writes the
--- next, and skips the pixels that have converged, so a still camera's frame
--- costs the reprojection and the refreshed tiles. The history is two
--- persistent targets a user (say "rsm") declares from OnCreate at its
--- coarse scale, taking turns (a pass cannot read and write one target);
--- the viewer's reload keeps them by name, format and size. The GI pass
--- turns its sampling pattern each frame (rsm.rotate) so the accumulation
--- averages different samples.
+-- confidence, all inside the GI pass (rsm.frag's and isr_march.frag's
+-- TEMPORAL): the pass that computes a pixel's value also blends it with its
+-- history and writes the next, and skips the pixels that have converged, so
+-- a still camera's frame costs the reprojection and the refreshed tiles. The
+-- history is two pairs of persistent targets a user (say "rsm") declares
+-- from OnCreate at its coarse scales, taking turns (a pass cannot read and
+-- write one target): the value (rgba, all four channels accumulated) and the
+-- state (r: view depth, 0 none; g: the frames it holds); the viewer's reload
+-- keeps them by name, format and size. The GI pass turns its sampling
+-- pattern each frame (rsm.rotate, ISR's next rays of its sequence) so the
+-- accumulation averages different samples.
 local options = require "options"
 
 local temporal = {}
@@ -36,42 +38,56 @@ local rules = {
   refresh = options.whole(0, 1024),
 }
 
-local histories = {} -- user -> { targets = {a, b}, turn = 0, scale = s }
+local histories = {} -- user -> coarse factor -> { targets = {a, b}, turn = 0 }
 
--- Declares the history of `user` at `scale` of the output; from OnCreate.
-function temporal.create(user, scale)
-  local function history(i)
-    return { value = target{ "temporal." .. user .. i, format = "rgba32f", scale = scale },
-             depth = target{ "temporal." .. user .. "_depth" .. i, format = "r32f", scale = scale } }
+-- Declares the history of `user` at 1 / f of the output for each coarse
+-- factor f of `factors` (a number or a list); from OnCreate. Only the
+-- factor a frame uses is made: a persistent target no pass reads or writes
+-- has no texture.
+function temporal.create(user, factors)
+  if type(factors) == "number" then factors = { factors } end
+  histories[user] = {}
+  for _, f in ipairs(factors) do
+    local function history(i)
+      local name = string.format("temporal.%s%d.", user, f)
+      return { value = target{ name .. "value" .. i, format = "rgba32f", scale = 1 / f },
+               state = target{ name .. "state" .. i, format = "rg32f", scale = 1 / f } }
+    end
+    histories[user][f] = { turn = 0, targets = { history(0), history(1) } }
   end
-  histories[user] = { scale = scale, turn = 0, targets = { history(0), history(1) } }
 end
 
 -- Checked options under `name` (errors point at the caller's caller).
 function temporal.check(name, o) return options.check(name, temporal.defaults, o, rules, 3) end
 
--- The history of `user` at `scale`, checked (errors point at the caller's caller).
-local function history_of(user, scale)
-  local h = histories[user]
-  if not h then error("temporal: call temporal.create(\"" .. user .. "\", scale) from OnCreate", 3) end
-  if h.scale ~= scale then
-    error(string.format("temporal: the history of %s is at scale %g, the result at %g", user, h.scale, scale), 3)
+-- The history of `user` at coarse factor f, checked (errors point at the caller's caller).
+local function history_of(user, f)
+  local all = histories[user]
+  if not all then error("temporal: call temporal.create(\"" .. user .. "\", factors) from OnCreate", 3) end
+  local h = all[f]
+  if not h then
+    local have = {}
+    for k in pairs(all) do have[#have + 1] = k end
+    table.sort(have)
+    error(string.format("temporal: %s has a history at coarse %s, not at coarse %d", user,
+                        table.concat(have, ", "), f), 3)
   end
   return h
 end
 
 -- Adds to a GI pass's inputs, defines and params the history of `user`
--- at `scale` (TEMPORAL, temporal.glsl: the pass accumulates, and skips the
--- pixels that have converged), and returns the targets the pass writes this
--- frame's history to, its outputs after its result and depth: { value,
--- depth }; value (a: the frames each pixel holds) is what isr.blur's age
--- reads. Nothing when off.
-function temporal.bind(user, inputs, defines, params, o, scale)
+-- at coarse factor f (TEMPORAL, temporal.glsl: the pass accumulates, and
+-- skips the pixels that have converged), and returns the targets this
+-- frame's history goes to: { value, state }; state (g: the frames each
+-- pixel holds) is what isr.blur's age reads. Nothing when off. A result
+-- made in several passes gives each of them these inputs (so all agree on
+-- which pixels have converged) and writes the next history from its last.
+function temporal.bind(user, inputs, defines, params, o, f)
   if not o.enabled then return nil end
-  local h = history_of(user, scale)
+  local h = history_of(user, f)
   local previous, next = h.targets[h.turn + 1], h.targets[2 - h.turn]
   h.turn = 1 - h.turn
-  inputs.history, inputs.history_depth = previous.value, previous.depth
+  inputs.history, inputs.history_state = previous.value, previous.state
   defines.TEMPORAL = true
   params.frames, params.epsilon, params.refresh = o.frames, o.epsilon, o.refresh
   params.bias, params.confidence = o.bias, o.confidence

@@ -7,7 +7,7 @@
 // is the smaller one-sided difference, which does not straddle an edge, so
 // a floor seen at a grazing angle still blurs along its length. With DEPTH
 // and no MASK, a depth of 0 (nothing drawn) is the mask. With AGE (temporal
-// reuse's history, a: the frames a pixel holds), a pixel of n frames takes
+// reuse's history state, g: the frames a pixel holds), a pixel of n frames takes
 // radius / n^(1/4) taps each side, rounded: a new or disoccluded pixel is
 // blurred in full, a converged one (36 frames) with 2 taps at radius 4,
 // which still smooths the 4 x 4 pattern's grain (1 tap left it visible on
@@ -52,7 +52,7 @@ void main() {
   ivec2 p = ivec2(gl_FragCoord.xy), last = textureSize(src, 0) - 1;
   vec4 centre = texelFetch(src, p, 0);
 #ifdef AGE
-  int taps = int(round(float(radius) * sqrt(inversesqrt(max(texelFetch(age, p, 0).a, 1.0)))));
+  int taps = int(round(float(radius) * sqrt(inversesqrt(max(texelFetch(age, p, 0).g, 1.0)))));
 #else
   int taps = radius;
 #endif

@@ -103,6 +103,10 @@ vec3 finite_or_zero(vec3 c) {
   bvec3 bad = bvec3(isnan(c.x) || isinf(c.x), isnan(c.y) || isinf(c.y), isnan(c.z) || isinf(c.z));
   return max(mix(c, vec3(0.0), bad), vec3(0.0));
 }
+vec4 finite_or_zero(vec4 c) {
+  bool bad = isnan(c.w) || isinf(c.w);
+  return vec4(finite_or_zero(c.xyz), bad ? 0.0 : max(c.w, 0.0));
+}
 
 // glTF alphaMode MASK (a material variant's ALPHA_MASK, lm_scene_draw): a
 // fragment whose alpha, material_alpha.x times the base colour texel's, is

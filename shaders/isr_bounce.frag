@@ -9,7 +9,13 @@
 // floats so that the sum is the march's), previous the last step's E (at the
 // coarse texel over q, the G-buffer being STRIDE times finer); A, the share
 // of open rays, is first's.
+// TEMPORAL, TEMPORAL_NEXT: as isr_march.frag (temporal reuse; z, the grid's
+// depth the march wrote, places each pixel for the reprojection).
 #include "gbuffer.glsl"
+#ifdef TEMPORAL
+#include "temporal.glsl"
+uniform sampler2D z; // the grid's depth / far, 0 where nothing is drawn
+#endif
 
 #ifndef STRIDE
 #define STRIDE 1
@@ -37,7 +43,11 @@ uniform sampler2D hits5;
 #endif
 uniform int samples = 4;
 
-out vec4 isr;
+layout(location = 0) out vec4 isr;
+#ifdef TEMPORAL_NEXT
+layout(location = NEXT) out vec4 next;
+layout(location = NEXT + 1) out vec2 next_state; // view depth (0 none), frames seen
+#endif
 
 // What a ray whose recorded hit is `hit` sends of the last step's light (nothing for 0).
 vec3 sent(float hit, int width) {
@@ -52,6 +62,24 @@ vec3 sent4(vec4 h, int width) { return sent(h.x, width) + sent(h.y, width) + sen
 
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
+#ifdef TEMPORAL
+  float d = texelFetch(z, px, 0).r;
+  vec4 h = vec4(0.0);
+  float held = 0.0;
+  bool found = d > 0.0 && temporal_history(uv, d, h, held);
+#ifdef TEMPORAL_NEXT
+  next = vec4(0.0);
+  next_state = vec2(dpt_view_depth(d), 0.0);
+#endif
+  if (found && temporal_converged(held, px)) { // kept as it is
+    isr = h;
+#ifdef TEMPORAL_NEXT
+    next = h;
+    next_state.y = max(frames, 1.0);
+#endif
+    return;
+  }
+#endif
   int width = textureSize(clr, 0).x, n = clamp(samples, 1, 4 * HITS);
   vec3 gathered = sent4(texelFetch(hits0, px, 0), width);
 #if HITS > 1
@@ -71,4 +99,10 @@ void main() {
 #endif
   vec4 e = texelFetch(first, px, 0);
   isr = vec4(e.rgb + gathered / float(n), e.a);
+#ifdef TEMPORAL_NEXT
+  if (d > 0.0) {
+    next = temporal_accumulate(isr, found, h, held, next_state.y);
+    isr = next;
+  }
+#endif
 }

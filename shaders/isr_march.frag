@@ -53,8 +53,19 @@
 // texels; isr.lua keeps within), or 0 when the ray sends nothing;
 // isr_bounce.frag takes the later bounces from them instead of marching the
 // same rays again.
+// TEMPORAL (isr.temporal, temporal.glsl): each frame the rays are the next
+// 16 n points of the sequence, and a pixel whose history has converged is
+// not marched: its E is that history (every bounce's sum), which a later
+// bounce then reads as the sender's light of this step (a bounce more than
+// the march's own: it matters only where a pixel starts again beside
+// converged ones). With TEMPORAL_NEXT (the last step) the result is the
+// accumulation, and the history for the next frame goes to outputs NEXT
+// (value) and NEXT + 1 (state).
 #include "gbuffer.glsl"
 #include "halton.glsl"
+#ifdef TEMPORAL
+#include "temporal.glsl"
+#endif
 
 #ifndef STRIDE
 #define STRIDE 1
@@ -74,6 +85,10 @@ uniform vec3 scene_lo = vec3(-1e30), scene_hi = vec3(1e30); // the scene's box, 
 layout(location = 0) out vec4 isr;
 #ifdef Z
 layout(location = 1) out float z;
+#endif
+#ifdef TEMPORAL_NEXT
+layout(location = NEXT) out vec4 next;
+layout(location = NEXT + 1) out vec2 next_state; // view depth (0 none), frames seen
 #endif
 #ifdef HITS
 layout(location = 2) out vec4 hits0;
@@ -171,16 +186,36 @@ void main() {
   hits5 = vec4(0.0);
 #endif
 #endif
+#ifdef TEMPORAL_NEXT
+  next = vec4(0.0);
+  next_state = vec2(s.covered ? dpt_view_depth(s.depth01) : 0.0, 0.0);
+#endif
   if (!s.covered) {
     isr = vec4(0.0, 0.0, 0.0, 1.0);
     return;
   }
+#ifdef TEMPORAL
+  vec4 h;
+  float held;
+  bool found = temporal_history(uv, s.depth01, h, held);
+  if (found && temporal_converged(held, px)) { // kept as it is
+    isr = h;
+#ifdef TEMPORAL_NEXT
+    next = h;
+    next_state.y = max(frames, 1.0);
+#endif
+    return;
+  }
+#endif
   int n = clamp(samples, 1, 256), m = clamp(steps, 1, 64);
   float far = frame.clip.y, thick = max(thickness, 0.0);
   // World size of one coarse texel at p: 2 z tan(fov / 2) / height.
   float foot = max(2.0 * s.depth01 * far * frame.clip.w * float(STRIDE) / float(size.y), 1e-12 * far); // never 0
   mat3 basis = tangent_frame(s.n);
   int first = interleave_index(px, 4) * n;
+#ifdef TEMPORAL
+  first += int(uint(frame.time.y) & 65535u) * 16 * n; // this frame's points (below 2^28: no overflow)
+#endif
   vec4 a = frame.view_proj * vec4(s.p, 1.0);
   vec3 gathered = vec3(0.0);
   float open = 0.0;
@@ -247,4 +282,8 @@ void main() {
     if (!seen) open += 1.0;
   }
   isr = vec4(gathered / float(n), open / float(n));
+#ifdef TEMPORAL_NEXT
+  next = temporal_accumulate(isr, found, h, held, next_state.y);
+  isr = next;
+#endif
 }

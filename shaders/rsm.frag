@@ -31,7 +31,7 @@
 // EXCLUDE_SEEN: a sender the camera sees (on screen, depth within 2% of the
 // buffer's) is left to the screen-space pass of the combined technique.
 // TEMPORAL: temporal reuse (temporal.glsl): the result is the accumulation,
-// and the history for the next frame goes to `next` and `next_depth`; a
+// and the history for the next frame goes to `next` and `next_state`; a
 // pixel whose accumulation has converged takes no samples and keeps it.
 // Output: rgb = E, a = 1 (RSM light occludes no ambient term).
 // With STRIDE, each texel reads the G-buffer, STRIDE times finer, at its
@@ -60,8 +60,8 @@ layout(location = 0) out vec4 result;
 layout(location = 1) out float z;
 #endif
 #ifdef TEMPORAL
-layout(location = 2) out vec4 next;     // the history's value (rgb, a frames seen)
-layout(location = 3) out float next_depth; // and view depth, 0 none
+layout(location = 2) out vec4 next;       // the history's value
+layout(location = 3) out vec2 next_state; // and state: view depth (0 none), frames seen
 #endif
 
 const int INTERLEAVE = 4;                          // tile side of the interleaved pattern
@@ -91,7 +91,7 @@ void main() {
 #endif
 #ifdef TEMPORAL
   next = vec4(0.0);
-  next_depth = s.covered ? dpt_view_depth(s.depth01) : 0.0;
+  next_state = vec2(s.covered ? dpt_view_depth(s.depth01) : 0.0, 0.0);
 #endif
   if (!s.covered) {
     result = none;
@@ -99,10 +99,12 @@ void main() {
   }
 #ifdef TEMPORAL
   vec4 h;
-  bool found = temporal_history(uv, s.depth01, h);
-  if (found && temporal_converged(h, px)) { // kept as it is
-    next = vec4(h.rgb, max(frames, 1.0));
-    result = vec4(h.rgb, 1.0);
+  float held;
+  bool found = temporal_history(uv, s.depth01, h, held);
+  if (found && temporal_converged(held, px)) { // kept as it is
+    next = vec4(h.rgb, 1.0);
+    next_state.y = max(frames, 1.0);
+    result = next;
     return;
   }
 #endif
@@ -163,7 +165,7 @@ void main() {
   }
   vec3 v = finite_or_zero(e / PI);
 #ifdef TEMPORAL
-  next = temporal_accumulate(v, found, h);
+  next = temporal_accumulate(vec4(v, 1.0), found, h, held, next_state.y);
   v = next.rgb;
 #endif
   result = vec4(v, 1.0);

@@ -1,6 +1,6 @@
 // Temporal reuse of a coarse GI result (seed 004, chapter 3.3; lines
 // 560-610), inside the GI pass that computes it (TEMPORAL in rsm.frag;
-// scripts/temporal.lua binds the history): reverse reprojection of each
+// and isr_march.frag; scripts/temporal.lua binds the history): reverse reprojection of each
 // pixel's world position through the previous frame's view-projection, a
 // disocclusion test, and accumulation: the running mean of the frames a
 // pixel has seen, up to `frames`, after which it stops (the seed's "stop
@@ -11,15 +11,16 @@
 // over values normalized as HDR (v / (1 + v), the seed's "normalize HDR
 // values before the confidence") restarts a pixel whose confidence falls
 // below `confidence` (its light changed), on the frames it has fresh samples.
-// The history is last frame's accumulation: value (rgb V, a frames seen)
-// and depth (r: view depth, 0 none), at the coarse size of the pass; the
-// pass writes this frame's into two more outputs.
+// The history is last frame's accumulation: value (rgba, every channel
+// accumulated; the confidence reads rgb) and state (r: view depth, 0 none;
+// g: frames seen), at the coarse size of the pass; the pass writes this
+// frame's into two more outputs.
 #ifndef LIMN_TEMPORAL_GLSL
 #define LIMN_TEMPORAL_GLSL
 #include "common.glsl"
 #include "halton.glsl"
 
-uniform sampler2D history, history_depth;
+uniform sampler2D history, history_state;
 uniform float epsilon = 0.02, frames = 36.0, bias = 0.1, confidence = 0.25;
 uniform int refresh = 32;
 
@@ -27,17 +28,20 @@ uniform int refresh = 32;
 // pixel's world position through the previous frame's view-projection; kept
 // where the previous frame stored a depth that matches the reprojected
 // clip w (the view depth there) within `epsilon` of it (relative: any
-// unit), else dropped (off the last frame, disoccluded). False: none.
-bool temporal_history(vec2 uv, float d, out vec4 h) {
+// unit), else dropped (off the last frame, disoccluded). False: none; else
+// h its value and n the frames it holds.
+bool temporal_history(vec2 uv, float d, out vec4 h, out float n) {
   h = vec4(0.0);
+  n = 0.0;
   vec4 c = frame.prev_view_proj * vec4(position_from_depth(uv, d), 1.0);
   if (c.w <= 1e-12) return false;
   vec2 q = c.xy / c.w * 0.5 + 0.5;
   if (any(lessThan(q, vec2(0.0))) || any(greaterThan(q, vec2(1.0)))) return false;
   ivec2 size = textureSize(history, 0), t = clamp(ivec2(q * vec2(size)), ivec2(0), size - 1);
   h = texelFetch(history, t, 0);
-  float hd = texelFetch(history_depth, t, 0).r;
-  return hd > 0.0 && abs(hd - c.w) <= epsilon * hd && h.a >= 1.0;
+  vec2 state = texelFetch(history_state, t, 0).rg;
+  n = state.g;
+  return state.r > 0.0 && abs(state.r - c.w) <= epsilon * state.r && n >= 1.0;
 }
 
 // Does pixel px take fresh samples this frame although it has converged?
@@ -54,25 +58,27 @@ bool temporal_refresh(ivec2 px) {
   return (turn + int(frame.time.y)) % refresh == 0;
 }
 
-// Has the pixel whose history is h converged, so that this frame's samples
-// would not change it? Its history holds `frames` frames and it is not
+// Has the pixel whose history holds n frames converged, so that this
+// frame's samples would not change it? It holds `frames` frames and is not
 // being refreshed. The accumulation then keeps the history as it is.
-bool temporal_converged(vec4 h, ivec2 px) { return h.a >= max(frames, 1.0) && !temporal_refresh(px); }
+bool temporal_converged(float n, ivec2 px) { return n >= max(frames, 1.0) && !temporal_refresh(px); }
 
-// The history to store for a pixel that took fresh samples `cur`: the
-// running mean with its history h (found: temporal_history) while the
-// confidence holds, else cur alone (rgb V, a frames seen).
-vec4 temporal_accumulate(vec3 cur, bool found, vec4 h) {
+// The value to store for a pixel that took fresh samples `cur`: the running
+// mean with its history h of n frames (found: temporal_history) while the
+// confidence holds, else cur alone; `seen` the frames it then holds.
+vec4 temporal_accumulate(vec4 cur, bool found, vec4 h, float n, out float seen) {
   float most = max(frames, 1.0);
   if (found) {
-    vec3 a = h.rgb / (1.0 + h.rgb), b = cur / (1.0 + cur), diff = abs(a - b);
+    vec3 a = h.rgb / (1.0 + h.rgb), b = cur.rgb / (1.0 + cur.rgb), diff = abs(a - b);
     float conf = 1.0 - saturate(max(diff.r, max(diff.g, diff.b))) / (1.0 + bias);
     if (conf >= confidence) {
-      float seen = min(h.a, most);
-      float w = seen >= frames ? 1.0 : seen / (seen + 1.0);
-      return vec4(finite_or_zero(mix(cur, h.rgb, w)), min(seen + 1.0, most));
+      float held = min(n, most);
+      float w = held >= frames ? 1.0 : held / (held + 1.0);
+      seen = min(held + 1.0, most);
+      return finite_or_zero(mix(cur, h, w));
     }
   }
-  return vec4(finite_or_zero(cur), 1.0);
+  seen = 1.0;
+  return finite_or_zero(cur);
 }
 #endif
