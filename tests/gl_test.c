@@ -124,6 +124,28 @@ bool gl_render_again(gl_result *r) {
   return r->ok;
 }
 
+double gl_mean_abs_diff(const float *a, const float *b, int n) {
+  double sum = 0;
+  for (int i = 0; i < n; i++) sum += fabs(a[i] - b[i]);
+  return n > 0 ? sum / n : 0;
+}
+
+bool gl_render_until(gl_result *r, int last, int first_frames, double *early, double *late) {
+  int n = r->width * r->height * 3;
+  float *before = malloc(sizeof(float) * (size_t)n);
+  *early = *late = 0;
+  bool ok = r->ok;
+  for (int f = first_frames + 1; f <= last && ok; f++) {
+    memcpy(before, r->rgb, sizeof(float) * (size_t)n);
+    ok = gl_render_again(r);
+    if (!ok) break;
+    *late = gl_mean_abs_diff(before, r->rgb, n);
+    if (f == first_frames + 1) *early = *late;
+  }
+  free(before);
+  return ok;
+}
+
 void gl_result_free(gl_result *r) {
   lm_renderer_destroy(r->renderer);
   lm_pipeline_destroy(r->pipeline);

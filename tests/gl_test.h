@@ -50,6 +50,13 @@ gl_result gl_render_ok(const gl_run *run);
 bool gl_set(gl_result *r, const char *assignment);
 /* Renders one more frame with the same pipeline (after moving a camera, say). */
 bool gl_render_again(gl_result *r);
+/* Renders r's frames again up to its frame `last` (frame count, from its
+ * first render's frames + 1): *early is the mean absolute change of its
+ * linear RGB over the first of them, *late over the last (a still camera's
+ * convergence). False when a frame fails. */
+bool gl_render_until(gl_result *r, int last, int first_frames, double *early, double *late);
+/* Mean |a[i] - b[i]| over n values. */
+double gl_mean_abs_diff(const float *a, const float *b, int n);
 void gl_result_free(gl_result *r);
 /* The passes of the last frame that ran, space separated, into out. */
 void gl_pass_names(const gl_result *r, char *out, size_t cap);

@@ -276,12 +276,6 @@ static void later_bounces_from_the_recorded_senders_are_the_marched_ones(void **
   gl_result_free(&r);
 }
 
-static double mean_abs_diff(const float *a, const float *b, int n) {
-  double sum = 0;
-  for (int i = 0; i < n; i++) sum += fabs(a[i] - b[i]);
-  return sum / n;
-}
-
 /* Temporal reuse (isr.temporal) on a still camera over the Cornell box's
  * indirect light: the change from one frame to the next falls from frame 3
  * to frame 40 by more than 5x and ends below 1e-3 of the image's mean, and
@@ -295,19 +289,11 @@ static void still_frames_with_temporal_reuse_converge(void **state) {
   static const char *const off[] = {"isr.view=indirect", NULL};
   static const char *const ref[] = {"isr.view=indirect", "isr.samples=64", NULL};
   int n = W * H * 3;
-  float *last = malloc(sizeof(float) * (size_t)n);
   gl_result r = gl_render(&(gl_run){.tech = "isr", .sets = on, .width = W, .height = H, .frames = 2});
-  assert_true(r.ok);
-  memcpy(last, r.rgb, sizeof(float) * (size_t)n);
-  assert_true(gl_render_again(&r));
-  double early = mean_abs_diff(last, r.rgb, n), late = 0;
-  for (int f = 3; f < 40; f++) {
-    memcpy(last, r.rgb, sizeof(float) * (size_t)n);
-    assert_true(gl_render_again(&r));
-    late = mean_abs_diff(last, r.rgb, n);
-  }
+  double early, late;
+  assert_true(gl_render_until(&r, 40, 2, &early, &late));
   gl_result one = render_ok("isr", off), best = render_ok("isr", ref);
-  double e_acc = mean_abs_diff(r.rgb, best.rgb, n), e_one = mean_abs_diff(one.rgb, best.rgb, n);
+  double e_acc = gl_mean_abs_diff(r.rgb, best.rgb, n), e_one = gl_mean_abs_diff(one.rgb, best.rgb, n);
   float all[3];
   gl_region(&r, 0, 0, W - 1, H - 1, all);
   double mean = (all[0] + all[1] + all[2]) / 3.0;
@@ -316,7 +302,6 @@ static void still_frames_with_temporal_reuse_converge(void **state) {
   assert_true(gl_all_finite(&r));
   assert_true(mean > 0.01 && late < 1e-3 * mean && late * 5 < early);
   assert_true(e_acc < e_one);
-  free(last);
   gl_result_free(&r);
   gl_result_free(&one);
   gl_result_free(&best);

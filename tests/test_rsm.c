@@ -262,12 +262,6 @@ static void extremes_stay_finite(void **state) {
 }
 
 
-static double mean_abs_diff(const float *a, const float *b, int n) {
-  double sum = 0;
-  for (int i = 0; i < n; i++) sum += fabs(a[i] - b[i]);
-  return sum / n;
-}
-
 /* A still camera with temporal reuse (16 samples a frame, the pattern
  * turning 10 degrees a frame): the change from one frame to the next falls
  * from frame 2 to frame 40 by more than 5x and ends below 1e-3 of the
@@ -280,19 +274,11 @@ static void still_frames_with_temporal_reuse_converge(void **state) {
   static const char *const ref[] = {"ambient=0", "rsm.samples=1024", NULL};
   lm_scene *s = closed_room(LM_LIGHT_POINT);
   int n = W * H * 3;
-  float *last = malloc(sizeof(float) * (size_t)n);
   gl_result r = gl_render(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = on, .width = W, .height = H, .frames = 2});
-  assert_true(r.ok);
-  memcpy(last, r.rgb, sizeof(float) * (size_t)n);
-  assert_true(gl_render_again(&r));
-  double early = mean_abs_diff(last, r.rgb, n), late = 0;
-  for (int f = 3; f < 40; f++) {
-    memcpy(last, r.rgb, sizeof(float) * (size_t)n);
-    assert_true(gl_render_again(&r));
-    late = mean_abs_diff(last, r.rgb, n);
-  }
+  double early, late;
+  assert_true(gl_render_until(&r, 40, 2, &early, &late));
   gl_result one = render_ok(s, "rsm+esm", off), best = render_ok(s, "rsm+esm", ref);
-  double e_acc = mean_abs_diff(r.rgb, best.rgb, n), e_one = mean_abs_diff(one.rgb, best.rgb, n);
+  double e_acc = gl_mean_abs_diff(r.rgb, best.rgb, n), e_one = gl_mean_abs_diff(one.rgb, best.rgb, n);
   float all[3];
   gl_region(&r, 0, 0, W - 1, H - 1, all);
   double mean = (all[0] + all[1] + all[2]) / 3.0;
@@ -301,7 +287,6 @@ static void still_frames_with_temporal_reuse_converge(void **state) {
   assert_true(gl_all_finite(&r));
   assert_true(late < 1e-3 * mean && late * 5 < early);
   assert_true(e_acc < e_one);
-  free(last);
   gl_result_free(&r);
   gl_result_free(&one);
   gl_result_free(&best);
@@ -382,7 +367,7 @@ static void a_camera_move_leaves_no_ghost_edge(void **state) {
   assert_true(gl_render_again(&r));
   gl_result still = gl_render(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = on, .width = W, .height = H, .frames = 21});
   assert_true(still.ok);
-  double diff = mean_abs_diff(r.rgb, still.rgb, W * H * 3);
+  double diff = gl_mean_abs_diff(r.rgb, still.rgb, W * H * 3);
   float all[3];
   gl_region(&still, 0, 0, W - 1, H - 1, all);
   double mean = (all[0] + all[1] + all[2]) / 3.0;
