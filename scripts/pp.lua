@@ -81,6 +81,7 @@ function OnCreate()
   post.create()
   temporal.create("rsm", rsm.defaults.coarse) -- rsm.temporal's history
   temporal.create("isr", { 1, 2, 3, 4 })       -- isr.temporal's, at each coarse factor (one is made)
+  temporal.create("ssdo", { 1, 2, 4 })         -- ssdo.temporal's, at each resolution
 end
 
 function OnRender(tech)

@@ -19,10 +19,15 @@
 -- Sampling: halton.glsl (bases 5, 2, 3, a per-pixel rotation). With
 -- `adaptive`, a 1/16-size edge map (ssdo_edges.frag) picks 10, 20 or 30
 -- samples a pixel and `samples` is not used.
+-- Temporal reuse (ssdo.temporal, physical only; scripts/temporal.lua): the
+-- pass turns its pattern each frame and accumulates (A, bounce), skipping
+-- the pixels that have converged; the blur takes fewer taps where a pixel's
+-- history holds more frames (filters.blur's age).
 local gbuffer = require "gbuffer"
 local filters = require "filters"
 local options = require "options"
 local sky = require "sky"
+local temporal = require "temporal"
 
 local ssdo = {}
 
@@ -35,9 +40,12 @@ ssdo.defaults = {
   bounce = 1.0,        -- bounce strength, 0..100 (0: none; physical: 1 is physical; merged, two_step:
                        -- A_s in units of pi r_max^2 / K)
   lobe = 4,            -- light lobe exponent n of L_in (ssdo.frag), 1..64
-  resolution = 1,      -- computed at 1/resolution a side: 1, 2 or 4 (merged only)
+  resolution = 1,      -- computed at 1/resolution a side: 1, 2 or 4 (physical and merged)
   interleave = 4,      -- per-pixel rotation tile side: 1 (none), 2 or 4
+  temporal = {},       -- temporal reuse (scripts/temporal.lua), physical variant: enabled, frames,
+                       -- epsilon, bias, confidence, refresh; its history is at 1/resolution
 }
+for k, v in pairs(temporal.defaults) do ssdo.defaults.temporal[k] = v end
 
 local rules = {
   variant = options.one_of("physical", "merged", "two_step"),
@@ -54,6 +62,7 @@ local rules = {
     end,
   },
   interleave = options.one_of(1, 2, 4),
+  temporal = function(v) if type(v) ~= "table" then return "a table of temporal reuse options" end end,
 }
 filters.expose(ssdo.defaults, rules)
 
@@ -62,7 +71,9 @@ filters.expose(ssdo.defaults, rules)
 -- Returns the result, a full-size rgba16f target "ssdo.lit".
 function ssdo.render(G, lit, o, light)
   o = options.check("ssdo", ssdo.defaults, o, rules, 2)
+  o.temporal = temporal.check("ssdo.temporal", o.temporal)
   local f, merged, physical = o.resolution, o.variant == "merged", o.variant == "physical"
+  if o.temporal.enabled and not physical then error('ssdo.temporal is for ssdo.variant "physical"', 2) end
   local edges
   if o.adaptive then
     edges = pass{ "ssdo.edges", shader = "ssdo_edges.frag", inputs = { nrm = G.nrm, dpt = G.dpt, mat = G.mat },
@@ -75,12 +86,14 @@ function ssdo.render(G, lit, o, light)
     t.sender, t.edges = sender, edges
     return t
   end
-  local a, b
+  local a, b, history
   if merged or physical then
     a = target{ "ssdo.m", format = "rgba16f", scale = 1 / f }
     b = target{ "ssdo.bounce", format = "rgba16f", scale = 1 / f }
-    pass{ physical and "ssdo.physical" or "ssdo.merged", shader = "ssdo.frag", inputs = inputs(lit), params = params,
-          defines = { MERGED = merged, PHYSICAL = physical, ADAPTIVE = o.adaptive }, out = { a, b } }
+    local t, defines = inputs(lit), { MERGED = merged, PHYSICAL = physical, ADAPTIVE = o.adaptive }
+    history = temporal.bind("ssdo", t, defines, params, o.temporal, f)
+    pass{ physical and "ssdo.physical" or "ssdo.merged", shader = "ssdo.frag", inputs = t, params = params,
+          defines = defines, out = { a, b, history and history.value, history and history.state } }
   else
     local defines = { DIRECT = true, ADAPTIVE = o.adaptive }
     local direct_params = sky.bind(light.sky, { ambient = light.ambient }, defines)
@@ -91,7 +104,7 @@ function ssdo.render(G, lit, o, light)
               defines = { BOUNCE = true, ADAPTIVE = o.adaptive },
               out = target{ "ssdo.indirect", format = "rgba16f" } }
   end
-  a, b = filters.smooth({ a, b }, G, o, "ssdo", "rgba16f", f)
+  a, b = filters.smooth({ a, b }, G, o, "ssdo", "rgba16f", f, history and history.state)
   local inputs_, params_, defines = { lit = lit, clr = G.clr, mat = G.mat, a = a, b = b }, { ambient = light.ambient },
     { PHYSICAL = physical, MERGED = merged, TWO_STEP = o.variant == "two_step" }
   sky.bind(light.sky, params_, defines, inputs_, G)

@@ -4,7 +4,9 @@
 // range weight of filters.glsl. Background texels pass through unchanged.
 // With PAIR a second image (src2) is blurred with the same weights (SSDO's
 // modulation factor and bounce, blurred together as the seed suggests).
-// The pass may run at 1/factor of the G-buffer's size.
+// The pass may run at 1/factor of the G-buffer's size. With AGE (temporal
+// reuse's history state at this size), a pixel of n frames takes
+// aged_radius(radius, n) taps each side (common.glsl; blur.frag's AGE).
 #include "filters.glsl"
 
 uniform sampler2D src;
@@ -18,6 +20,9 @@ uniform float sigma_space = 3.0;   // texels
 uniform float sigma_depth = 0.02;  // off-plane distance, fraction of the depth
 uniform float sigma_normal = 0.2;  // 1 - cos of the angle between normals
 uniform int factor = 1;
+#ifdef AGE
+uniform sampler2D age;
+#endif
 
 layout(location = 0) out vec4 dst;
 #ifdef PAIR
@@ -31,7 +36,11 @@ void main() {
   vec4 sum2 = texelFetch(src2, p, 0);
 #endif
   Geometry c = geometry_at(nrm, dpt, mat, p, factor);
+#ifdef AGE
+  int r = clamp(aged_radius(radius, texelFetch(age, p, 0).g), 0, 32);
+#else
   int r = clamp(radius, 0, 32);
+#endif
   if (c.covered && r > 0) {
     float inv2s2 = 0.5 / max(sigma_space * sigma_space, 1e-6), wsum = 1.0; // the centre weighs 1
     for (int i = -r; i <= r; i++) {

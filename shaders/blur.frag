@@ -52,7 +52,7 @@ void main() {
   ivec2 p = ivec2(gl_FragCoord.xy), last = textureSize(src, 0) - 1;
   vec4 centre = texelFetch(src, p, 0);
 #ifdef AGE
-  int taps = int(round(float(radius) * sqrt(inversesqrt(max(texelFetch(age, p, 0).g, 1.0)))));
+  int taps = aged_radius(radius, texelFetch(age, p, 0).g);
 #else
   int taps = radius;
 #endif

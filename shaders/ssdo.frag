@@ -51,8 +51,15 @@
 // 1/d^2 becomes 1/(d^2 + r_max^2 / 2): at bounce = 1 a sender's solid
 // angle then never exceeds 2 pi / K, its share of the hemisphere, however
 // close it lies.
+// TEMPORAL (PHYSICAL only; temporal.glsl, scripts/temporal.lua): each frame
+// turns the pixel's samples by another point of the R3 sequence, out0 and
+// out1 are the accumulation of (bounce, A), whose history goes to `next`
+// and `next_state`; a converged pixel takes no samples and keeps it.
 #include "gbuffer.glsl"
 #include "halton.glsl"
+#ifdef TEMPORAL
+#include "temporal.glsl"
+#endif
 
 in vec2 uv;
 uniform sampler2D clr, nrm, dpt, mat; // full-size G-buffer
@@ -77,6 +84,10 @@ layout(location = 0) out vec4 out0;
 #if defined(MERGED) || defined(PHYSICAL)
 layout(location = 1) out vec4 out1;
 #endif
+#ifdef TEMPORAL
+layout(location = 2) out vec4 next;       // the history's value: (bounce, A)
+layout(location = 3) out vec2 next_state; // and state: view depth (0 none), frames seen
+#endif
 
 // The shadow manager's factor for light i at p goes here (1: unshadowed).
 float light_visibility(int i, vec3 p) { return 1.0; }
@@ -98,6 +109,20 @@ void main() {
   int f = max(factor, 1);
   ivec2 g = clamp(px * f + f / 2, ivec2(0), gsize - 1);
   Surface s = gbuffer_fetch(clr, nrm, dpt, mat, g);
+#ifdef TEMPORAL
+  next = vec4(0.0);
+  next_state = vec2(s.covered ? dpt_view_depth(s.depth01) : 0.0, 0.0);
+  vec4 h;
+  float held;
+  bool found = s.covered && temporal_history((vec2(g) + 0.5) / vec2(gsize), s.depth01, h, held);
+  if (found && temporal_converged(held, px)) { // kept as it is
+    next = h;
+    next_state.y = max(frames, 1.0);
+    out0 = vec4(h.a);
+    out1 = vec4(h.rgb, 0.0);
+    return;
+  }
+#endif
   if (!s.covered) { // background: nothing to darken or light
 #if defined(MERGED) || defined(PHYSICAL)
     out0 = vec4(1.0);
@@ -118,6 +143,9 @@ void main() {
   float far = frame.clip.y;
   mat3 frame_n = tangent_frame(s.n);
   vec3 offset = halton_offset(px, clamp(interleave, 1, 4));
+#ifdef TEMPORAL
+  offset = r3_sample(int(frame.time.y), offset); // this frame's turn of the pattern
+#endif
   vec3 visible = vec3(0.0), total = vec3(0.0), gathered = vec3(0.0);
   float open = 0.0;
   for (int i = 0; i < k; i++) {
@@ -189,9 +217,12 @@ void main() {
   m = saturate(m);
 #endif
 #ifdef PHYSICAL
-  float access = open / float(k);
-  out0 = vec4(access);
-  out1 = vec4(max(bounce, 0.0) * rho * gathered / float(k), 0.0);
+  vec4 v = vec4(max(bounce, 0.0) * rho * gathered / float(k), open / float(k));
+  #ifdef TEMPORAL
+  v = next = temporal_accumulate(v, found, h, held, next_state.y);
+  #endif
+  out0 = vec4(v.a);
+  out1 = vec4(v.rgb, 0.0);
 #elif defined(MERGED)
   out0 = vec4(m, access);
   out1 = vec4(rho / PI * gathered, 0.0);
