@@ -10,7 +10,8 @@
 // coarse texel over q, the G-buffer being STRIDE times finer); A, the share
 // of open rays, is first's.
 // TEMPORAL, TEMPORAL_NEXT: as isr_march.frag (temporal reuse; z, the grid's
-// depth the march wrote, places each pixel for the reprojection).
+// depth the march wrote, places each pixel for the reprojection); a pixel
+// the march found converged (hits0 -1) keeps the march's E, its history.
 #include "gbuffer.glsl"
 #ifdef TEMPORAL
 #include "temporal.glsl"
@@ -62,26 +63,27 @@ vec3 sent4(vec4 h, int width) { return sent(h.x, width) + sent(h.y, width) + sen
 
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
+  vec4 hit0 = texelFetch(hits0, px, 0);
 #ifdef TEMPORAL
   float d = texelFetch(z, px, 0).r;
-  vec4 h = vec4(0.0);
-  float held = 0.0;
-  bool found = d > 0.0 && temporal_history(uv, d, h, held);
 #ifdef TEMPORAL_NEXT
   next = vec4(0.0);
   next_state = vec2(dpt_view_depth(d), 0.0);
 #endif
-  if (found && temporal_converged(held, px)) { // kept as it is
-    isr = h;
+  if (hit0.x < 0.0) { // the march found it converged and wrote its history as E: kept as it is
+    isr = texelFetch(first, px, 0);
 #ifdef TEMPORAL_NEXT
-    next = h;
+    next = isr;
     next_state.y = max(frames, 1.0);
 #endif
     return;
   }
+  vec4 h = vec4(0.0);
+  float held = 0.0;
+  bool found = d > 0.0 && temporal_history(uv, d, h, held);
 #endif
   int width = textureSize(clr, 0).x, n = clamp(samples, 1, 4 * HITS);
-  vec3 gathered = sent4(texelFetch(hits0, px, 0), width);
+  vec3 gathered = sent4(hit0, width);
 #if HITS > 1
   gathered += sent4(texelFetch(hits1, px, 0), width);
 #endif

@@ -60,7 +60,8 @@
 // the march's own: it matters only where a pixel starts again beside
 // converged ones). With TEMPORAL_NEXT (the last step) the result is the
 // accumulation, and the history for the next frame goes to outputs NEXT
-// (value) and NEXT + 1 (state).
+// (value) and NEXT + 1 (state); with HITS a converged pixel's hits0 is -1,
+// which tells the recorded-senders bounce (isr_bounce.frag) to keep it.
 #include "gbuffer.glsl"
 #include "halton.glsl"
 #ifdef TEMPORAL
@@ -203,6 +204,9 @@ void main() {
 #ifdef TEMPORAL_NEXT
     next = h;
     next_state.y = max(frames, 1.0);
+#endif
+#ifdef HITS
+    hits0 = vec4(-1.0); // converged: isr_bounce.frag keeps `isr` without reprojecting again
 #endif
     return;
   }
