@@ -3,9 +3,14 @@
 # measured in one run: each technique renders every scene of the reference
 # set (data/jobs/reference.lua's scenes, camera 0) at SIZE, FRAMES timed
 # frames after WARMUP untimed ones (capture's median "total"), interleaved
-# scene by scene so that load on the machine falls on all alike. A
-# benchmark, not a test: it prints figures and exits 0 when the run completes.
+# scene by scene so that load on the machine falls on all alike; ROUNDS
+# times over, and a technique's figure is the median of its rounds' means
+# over the scenes (one process's frames on this 2-core machine run 10-30%
+# slower or faster than the next one's, alike for every technique: one round
+# moved dl+esm's mean from 4.5 to 6.7 ms). A benchmark, not a test: it
+# prints figures and exits 0 when the run completes.
 #   BUILD_DIR  the build (default build)   SIZE  (default 256x192)
+#   ROUNDS     rounds over scenes and techniques (default 3)
 #   FRAMES     timed frames (default 5)    TECHS (default below; "tech:opt=v,opt=v" sets options)
 #   WARMUP     untimed frames first (default 1; with temporal reuse, more than rsm.temporal.frames
 #              times the converged frame)
@@ -14,11 +19,13 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 LIMN=${BUILD_DIR:-build}/limn
 [ -x "$LIMN" ] || { echo "gi_time: no $LIMN (build first: tools/dev.sh build)" >&2; exit 2; }
-SIZE=${SIZE:-256x192} FRAMES=${FRAMES:-5} WARMUP=${WARMUP:-1}
+SIZE=${SIZE:-256x192} FRAMES=${FRAMES:-5} WARMUP=${WARMUP:-1} ROUNDS=${ROUNDS:-3}
 read -r -a techs <<< "${TECHS:-dl+esm rsm+esm vpl+esm isr+rsm+esm isr+esm lpv+esm isr+lpv+esm}"
 read -r -a scenes <<< "${SCENES:-data/scenes/reference/room.glb data/scenes/reference/street.glb \
 data/scenes/reference/blocks.glb data/scenes/cornell.glb}"
-declare -A sum
+declare -A rounds # spec -> its rounds' means over the scenes, space-separated
+for ((round = 0; round < ROUNDS; round++)); do
+declare -A sum=()
 for scene in "${scenes[@]}"; do
   for spec in "${techs[@]}"; do
     args=(--tech "${spec%%:*}")
@@ -31,11 +38,17 @@ for scene in "${scenes[@]}"; do
     sum[$spec]=$(awk -v a="${sum[$spec]:-0}" -v b="$ms" 'BEGIN { print a + b }')
   done
 done
-rm -f /tmp/gi_time_$$.png
-base=${techs[0]}
-echo "frame time: median of $FRAMES frames after $WARMUP untimed; clock: capture's (glFinish + CLOCK_MONOTONIC on llvmpipe)"
-printf "%-40s %10s %8s\n" "technique ($SIZE, ${#scenes[@]} scenes)" "ms/frame" "time x"
 for spec in "${techs[@]}"; do
-  awk -v n="${#scenes[@]}" -v s="${sum[$spec]}" -v b="${sum[$base]}" -v t="$spec" \
-    'BEGIN { printf "%-40s %10.1f %8.2f\n", t, s / n, s / b }'
+  rounds[$spec]+="$(awk -v s="${sum[$spec]}" -v n="${#scenes[@]}" 'BEGIN { print s / n }') "
+done
+done
+rm -f /tmp/gi_time_$$.png
+median() { tr ' ' '\n' | sed '/^$/d' | sort -g | awk '{ v[NR] = $1 } END { print NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
+base=$(median <<< "${rounds[${techs[0]}]}")
+echo "frame time: median of $FRAMES frames after $WARMUP untimed, median of $ROUNDS rounds;" \
+     "clock: capture's (glFinish + CLOCK_MONOTONIC on llvmpipe)"
+printf "%-40s %10s %8s  %s\n" "technique ($SIZE, ${#scenes[@]} scenes)" "ms/frame" "time x" "rounds (ms)"
+for spec in "${techs[@]}"; do
+  awk -v m="$(median <<< "${rounds[$spec]}")" -v b="$base" -v t="$spec" -v r="${rounds[$spec]}" \
+    'BEGIN { printf "%-40s %10.1f %8.2f  %s\n", t, m, m / b, r }'
 done
