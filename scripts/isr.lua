@@ -169,9 +169,12 @@ local function march_params(o)
 end
 
 -- Records ISR lighting of G given its direct light `direct` (lights only, no
--- ambient term: a target from direct.frag with ambient 0; the combined
--- techniques' also holds the off-screen senders' light), with options o
--- (see isr.defaults) and light = { ambient = {r, g, b}, background = {r, g, b} }.
+-- ambient term: a target from direct.frag with ambient 0; isr+lpv+esm's
+-- also holds the off-screen senders' light), with options o (see
+-- isr.defaults) and light = { ambient = {r, g, b}, background = {r, g, b},
+-- rsm = }. light.rsm (isr+rsm+esm): function(inputs, defines, params, f,
+-- temporal) that binds the RSM's gather into the first march (rsm.bind)
+-- and returns its fetches; its light joins E (isr_march.frag's RSM_GATHER).
 -- Returns the lit target.
 function isr.render(G, direct, o, light)
   o = options.check("isr", isr.defaults, o, rules, 2)
@@ -179,9 +182,10 @@ function isr.render(G, direct, o, light)
   o.temporal = temporal.check("isr.temporal", o.temporal)
   if o.mode ~= "seed" then seed = nil end
   if seed and o.temporal.enabled then error("isr.temporal is for isr.mode \"physical\"", 2) end
+  if seed and light.rsm then error("isr+rsm+esm needs isr.mode \"physical\" (its march gathers the RSM)", 2) end
   local f = factor(o)
   local C = seed and isr.coarse_gbuffer(G, direct, f) or isr.coarse_view(G, direct, f, "isr")
-  local E, E1, H
+  local E, E1, H, first
   local hits = seed and 0 or hit_targets(o)
   -- Temporal reuse: every step reads the history (all skip the same converged pixels), the last
   -- accumulates and writes the next one after its other outputs (NEXT).
@@ -231,9 +235,16 @@ function isr.render(G, direct, o, light)
         end
       end
       local defines, params = { BOUNCE = b > 1, Z = b == 1, HITS = H and hits or nil, STRIDE = C.stride }, march_params(o)
+      local fetches = 4 + o.samples * (o.steps + (b > 1 and 6 or 5)) -- the march, and the hit's G-buffer and light
+      if light.rsm and b == 1 then
+        fetches = fetches + light.rsm(inputs, defines, params, f, o.temporal.enabled)
+        first = E
+      elseif light.rsm then -- its senders send only the last step's light; E adds the first step's at p
+        inputs.first_step, inputs.sender, defines.FIRST = first, nil, true
+      end
       with_history(inputs, defines, params, out, b == steps)
       pass{ name, shader = "isr_march.frag", inputs = inputs, params = params, defines = defines, out = out,
-            fetches = 4 + o.samples * (o.steps + (b > 1 and 6 or 5)) } -- the march, and the hit's G-buffer and light
+            fetches = fetches }
     end
   end
   E = isr.blur(E, C, f, o.blur, history and history.state)

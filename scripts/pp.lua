@@ -89,6 +89,9 @@ function OnRender(tech)
     local want = rules[k](tech[k])
     if want then error(string.format("%s must be %s (got %s)", k, want, tostring(tech[k])), 2) end
   end
+  -- What the GI histories depend on (temporal.lua): a change starts them again.
+  temporal.begin{ tech.name, tech.ambient, tech.background, tech.materials, tech.isr, tech.rsm, tech.vpl,
+                  tech.lpv, tech.shadow, tech.sky, tech.ssdo }
   local lighting = tech.name:match("^[^+]*")
   if tech.name:find("+esm", 1, true) and lighting == "ssdo" and tech.ssdo.variant == "two_step" then
     error('ssdo+esm cannot take ssdo.variant = "two_step" (it relights without shadows)')
@@ -115,12 +118,23 @@ function OnRender(tech)
     local indirect = lighting == "rsm" and rsm.indirect(G, shadows, R, o_rsm) or lpv.indirect(G, R, o_rsm)
     lit = direct(G, tech, shadows, tech.ambient, "lit", skylight, indirect)
   else
-    -- The combined techniques (isr+rsm+esm, isr+lpv+esm): the light of the senders the camera does not
-    -- see joins the direct light, where ISR's senders send it on too; ISR adds those it sees.
-    local offscreen = lighting == "isr" and R and (tech.name:find("lpv+", 1, true) and lpv.indirect(G, R, o_rsm, true)
-                                                   or rsm.indirect(G, shadows, R, o_rsm, true))
-    local d = direct(G, tech, shadows, 0, "direct", nil, offscreen)
+    -- The combined techniques count each sender once (docs/gi-combined.md): isr+lpv+esm adds the
+    -- light of the senders the camera does not see to the direct light, where ISR's senders send it on;
+    -- isr+rsm+esm gathers it in ISR's first march, whose next step sends it on. ISR adds those it sees.
     local light = { ambient = grey(tech.ambient), background = grey(tech.background), sky = skylight }
+    local offscreen
+    if lighting == "isr" and R and tech.name:find("lpv+", 1, true) then
+      offscreen = lpv.indirect(G, R, o_rsm, true)
+    elseif lighting == "isr" and R then
+      if o_rsm.temporal.enabled then
+        error("isr+rsm+esm takes temporal reuse from isr.temporal (one pass gathers both); rsm.temporal is rsm+esm's")
+      end
+      light.rsm = function(inputs, defines, params, f, temporal_on)
+        params.rsm_k = o_rsm.k
+        return rsm.bind(inputs, defines, params, R, shadows, o_rsm, f, temporal_on, true)
+      end
+    end
+    local d = direct(G, tech, shadows, 0, "direct", nil, offscreen)
     if lighting == "isr" then
       lit = isr.render(G, d, tech.isr, light)
     elseif lighting == "ssdo" then

@@ -5,6 +5,9 @@
 -- (isr.coarse_view: no downsampling pass; rsm.frag), then the same
 -- geometry-aware blur as ISR (isr.blur); the direct pass upsamples and adds
 -- it (direct.frag's INDIRECT: L = D + k_a L_a albedo + k k_d albedo E).
+-- The combined technique (isr+rsm+esm) runs the same gather inside ISR's
+-- first march instead (rsm.bind; docs/gi-combined.md): on ISR's grid, with
+-- ISR's blur and temporal reuse, so `coarse` and `blur` only set its density.
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local options = require "options"
@@ -58,36 +61,47 @@ function rsm.check(o)
   return o
 end
 
+-- Binds the RSM's gather (rsm.glsl's rsm_gather, RSM_GATHER) to a pass
+-- over a grid of coarse factor f: the RSM targets R and the atlas
+-- `shadows` into inputs and defines, the checked options o into params.
+-- A pixel takes o.samples at o.coarse, and on another grid as many as keep
+-- the samples per unit of screen area (at least one). temporal: the pass
+-- accumulates, so the pattern turns each frame (o.rotate). exclude_seen:
+-- senders the camera sees are left to the combined technique's march.
+-- Returns the fetches a coarse pixel (the pass's cost estimate).
+function rsm.bind(inputs, defines, params, R, shadows, o, f, temporal_on, exclude_seen)
+  local samples = math.max(1, math.floor(o.samples * (f / o.coarse) ^ 2 + 0.5))
+  shadow.bind(shadows, inputs, defines)
+  inputs.rsm_flux, inputs.rsm_pos = R.flux, R.pos
+  defines.RSM_GATHER, defines.VISIBILITY, defines.EXCLUDE_SEEN = true, o.steps > 0, exclude_seen
+  params.rsm_samples, params.rsm_radius, params.rsm_steps = samples, o.radius, o.steps
+  params.rsm_rotate = temporal_on and o.rotate / 360 or 0
+  return samples * (2 + o.steps * 2 + (exclude_seen and 1 or 0))
+end
+
 -- Records the gather over the coarse view C (isr.coarse_view, factor f),
 -- whose depth it writes, from the RSM targets R (shadow.render's second
--- result) and the atlas `shadows`. exclude_seen: senders the camera sees are
--- left to the combined technique's screen-space pass. Returns the coarse E
--- and, with temporal reuse, the history it wrote (temporal.bind).
-function rsm.gather(C, f, R, shadows, o, exclude_seen)
-  local inputs, defines = shadow.bind(shadows, gbuffer.inputs(C),
-                                      { VISIBILITY = o.steps > 0, EXCLUDE_SEEN = exclude_seen,
-                                        STRIDE = C.stride, Z = true })
-  inputs.rsm_flux, inputs.rsm_pos = R.flux, R.pos
-  local params = { samples = o.samples, radius = o.radius, steps = o.steps,
-                   rotate = o.temporal.enabled and o.rotate / 360 or 0 }
+-- result) and the atlas `shadows`. Returns the coarse E and, with temporal
+-- reuse, the history it wrote (temporal.bind).
+function rsm.gather(C, f, R, shadows, o)
+  local inputs, defines, params = gbuffer.inputs(C), { STRIDE = C.stride, Z = true }, {}
+  local fetches = rsm.bind(inputs, defines, params, R, shadows, o, f, o.temporal.enabled)
   local history = temporal.bind("rsm", inputs, defines, params, o.temporal, f)
   local E = target{ "rsm.e", format = "rgba16f", scale = 1 / f }
   pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines, params = params,
-        fetches = 4 + o.samples * (2 + o.steps * 2 + (exclude_seen and 3 or 0)),
-        out = { E, C.z, history and history.value, history and history.state } }
+        fetches = 4 + fetches, out = { E, C.z, history and history.value, history and history.state } }
   return E, history
 end
 
 -- Records the RSM's indirect light over G from the shadow atlas and RSM
 -- targets (shadow.render(..., o.reach)), with checked options o: the gather
 -- over a coarse view of G (no pass averages its blocks first), temporal
--- reuse and the blur; exclude_seen as rsm.gather. Returns what the direct
--- pass adds (pp.lua's direct: INDIRECT in direct.frag): { C = the coarse
--- grid, E = the coarse result, k }.
-function rsm.indirect(G, shadows, R, o, exclude_seen)
+-- reuse and the blur. Returns what the direct pass adds (pp.lua's direct:
+-- INDIRECT in direct.frag): { C = the coarse grid, E = the coarse result, k }.
+function rsm.indirect(G, shadows, R, o)
   local f = o.coarse
   local C = isr.coarse_view(G, nil, f, "rsm")
-  local E, history = rsm.gather(C, f, R, shadows, o, exclude_seen)
+  local E, history = rsm.gather(C, f, R, shadows, o)
   return { C = C, E = isr.blur(E, C, f, o.blur, history and history.state), k = o.k }
 end
 

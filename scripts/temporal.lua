@@ -39,6 +39,33 @@ local rules = {
 }
 
 local histories = {} -- user -> coarse factor -> { targets = {a, b}, turn = 0 }
+local settings, restart = nil, false -- the last frame's key (temporal.begin), and whether it changed
+
+-- A value as text, tables with their keys sorted, so that equal settings
+-- give equal keys.
+local function key_of(v)
+  if type(v) ~= "table" then return tostring(v) end
+  local keys, parts = {}, {}
+  for k in pairs(v) do keys[#keys + 1] = k end
+  table.sort(keys, function(a, b) return tostring(a) < tostring(b) end)
+  for _, k in ipairs(keys) do parts[#parts + 1] = tostring(k) .. "=" .. key_of(v[k]) end
+  return "{" .. table.concat(parts, ",") .. "}"
+end
+
+-- Starts a frame, from OnRender before any temporal.bind: `settings_now`
+-- is what the GI results depend on besides the scene and the camera (the
+-- technique's name and the options of its passes; any value, tables
+-- compared by content). When it differs from the last frame's, every
+-- history starts again this frame: a history is the same computation's
+-- result, and the confidence test would keep one made under other
+-- settings wherever the two differ by less than its threshold (a report's
+-- next setting, the viewer's next technique). A pipeline's first frame
+-- keeps them: the viewer's reload keeps the histories on purpose.
+function temporal.begin(settings_now)
+  local key = key_of(settings_now)
+  restart = settings ~= nil and key ~= settings
+  settings = key
+end
 
 -- Declares the history of `user` at 1 / f of the output for each coarse
 -- factor f of `factors` (a number or a list); from OnCreate. Only the
@@ -90,7 +117,7 @@ function temporal.bind(user, inputs, defines, params, o, f)
   inputs.history, inputs.history_state = previous.value, previous.state
   defines.TEMPORAL = true
   params.frames, params.epsilon, params.refresh = o.frames, o.epsilon, o.refresh
-  params.bias, params.confidence = o.bias, o.confidence
+  params.bias, params.confidence, params.restart = o.bias, o.confidence, restart and 1 or 0
   return next
 end
 

@@ -62,10 +62,22 @@
 // accumulation, and the history for the next frame goes to outputs NEXT
 // (value) and NEXT + 1 (state); with HITS a converged pixel's hits0 is -1,
 // which tells the recorded-senders bounce (isr_bounce.frag) to keep it.
+// RSM_GATHER (the combined technique, isr+rsm+esm; docs/gi-combined.md):
+// the first march adds the RSM's light of the senders the camera does not
+// see (rsm.glsl's rsm_gather, EXCLUDE_SEEN, times rsm_k) to E, so one pass,
+// one blur and one composite carry both, and the next step sends it on
+// from the senders it lights. FIRST (the later marches then): a ray's
+// sender sends only k_d albedo times the last step's E, and E adds the
+// first step's E at p, which holds the rays' direct light (the same rays
+// meet the same senders) and the RSM's light at p, as isr_bounce.frag sums.
 #include "gbuffer.glsl"
 #include "halton.glsl"
 #ifdef TEMPORAL
 #include "temporal.glsl"
+#endif
+#ifdef RSM_GATHER
+#include "rsm.glsl"
+uniform float rsm_k = 1.0; // the RSM light's factor (rsm.k)
 #endif
 
 #ifndef STRIDE
@@ -77,6 +89,9 @@ uniform sampler2D clr, nrm, dpt, mat; // the G-buffer, STRIDE times finer than t
 uniform sampler2D sender;             // direct light, the G-buffer's size
 #ifdef BOUNCE
 uniform sampler2D previous;           // the last step's E, the output's size
+#endif
+#ifdef FIRST
+uniform sampler2D first_step;         // the first step's E, the output's size
 #endif
 uniform int samples = 4;
 uniform int steps = 10;
@@ -268,7 +283,11 @@ void main() {
         seen = true;
         float cos_x = dot(x.n, -safe_normalize(to_x, w));
         if (cos_x > 0.0) {
+#ifdef FIRST
+          vec3 radiance = vec3(0.0); // the direct light is in `first`
+#else
           vec3 radiance = texelFetch(sender, q, 0).rgb;
+#endif
 #ifdef BOUNCE
           radiance += x.k.y * x.albedo * texelFetch(previous, min(q / STRIDE, textureSize(previous, 0) - 1), 0).rgb;
 #endif
@@ -286,6 +305,12 @@ void main() {
     if (!seen) open += 1.0;
   }
   isr = vec4(gathered / float(n), open / float(n));
+#ifdef RSM_GATHER
+  isr.rgb += max(rsm_k, 0.0) * rsm_gather(s, px, dpt, mat);
+#endif
+#ifdef FIRST
+  isr.rgb += texelFetch(first_step, px, 0).rgb;
+#endif
 #ifdef TEMPORAL_NEXT
   next = temporal_accumulate(isr, found, h, held, next_state.y);
   isr = next;

@@ -5,6 +5,7 @@
 #ifndef LIMN_RSM_GLSL
 #define LIMN_RSM_GLSL
 #include "gbuffer.glsl"
+#include "halton.glsl" // RSM_GATHER's pattern (an include inside an #ifdef would count as made)
 
 // The area of the texel at tile coordinates t (0..1) of view sv (a tile of
 // `tile` texels a side) whose sender lies at q, as the light sees it:
@@ -30,8 +31,118 @@ bool rsm_seen(sampler2D dpt, vec3 q) {
   if (c.w <= 1e-12) return false;
   vec2 s = c.xy / c.w * 0.5 + 0.5;
   if (any(lessThan(s, vec2(0.0))) || any(greaterThan(s, vec2(1.0)))) return false;
-  float z = -(frame.view * vec4(q, 1.0)).z * frame.clip.z, zb = texture(dpt, s).r;
+  float z = c.w * frame.clip.z, zb = texture(dpt, s).r; // a perspective's clip w is the view depth
   return abs(z - zb) <= 0.02 * max(zb, 1e-12);
 }
+
+#ifdef RSM_GATHER
+// The gather of E(p) (rsm.frag's formula) in the passes that compute it:
+// rsm.frag and, in the combined technique, ISR's first march
+// (isr_march.frag), bound by rsm.bind (scripts/rsm.lua).
+// Sampling: the seed's pattern around p's projection into each RSM view,
+// offsets xi_1 R at angle 2 pi xi_2 (R = `radius` tiles), denser near the
+// centre where senders are nearest; its density per texel falls as
+// 1 / (2 pi R^2 xi_1), so each sample weighs 2 pi R^2 xi_1 T^2 / N texels
+// (T the tile's side): the seed's "samples weighed by their squared
+// distance" (line 917) made exact for this pattern. Samples outside the tile
+// or on an empty texel add nothing; so R is at most the distance to the
+// tile's farthest corner, where the disc covers the whole tile already.
+// Interleaved sampling: the pattern is one sequence, xi_1 = Phi_2(k) (van der
+// Corput) and xi_2 = k phi (golden ratio, mod 1), of which pixel j of a 4 x 4
+// tile (Bayer order, halton.glsl) takes the block k = j n .. j n + n - 1: each
+// pixel's n samples are stratified in xi_1 and spread in angle, and the 16
+// blocks together are the sequence's first 16 n points, which the
+// geometry-aware blur averages. Each sample still weighs its own density, so
+// one pixel alone is exact too, only noisier. The angle steps by a fixed
+// rotation (no sin or cos a sample); the pattern turns per frame by `rotate`.
+// 1/d^2 is capped at the texel's own area, so a sender next to p stays finite.
+// VISIBILITY: the seed's screen-space test (lines 930-958): `steps` points
+// on p -> q; one behind the depth buffer rejects q.
+// EXCLUDE_SEEN: a sender the camera sees (rsm_seen) is left to the
+// screen-space march of the combined technique.
+uniform sampler2D rsm_flux, rsm_pos; // shadow.lua's RSM targets (atlas-sized; the normal in rsm_pos.w)
+uniform int rsm_samples = 24;        // a coarse pixel and light
+uniform float rsm_radius = 1.0;      // the disc's radius, in tiles
+uniform float rsm_rotate = 0.0;      // turn of the pattern a frame, in turns (seed 004: 10 degrees)
+uniform int rsm_steps = 0;           // VISIBILITY's march
+
+const int INTERLEAVE = 4;                          // tile side of the interleaved pattern
+const float GOLDEN = 0.61803398874989;             // the angle's step, in turns
+const vec2 TURN = vec2(-0.73736887807832, -0.67549029426152); // cos, sin of 2 pi GOLDEN
+const float PLASTIC = 0.75487766624669;            // 1 / the plastic number
+
+bool rsm_blocked(vec3 p, vec3 q, sampler2D dpt, sampler2D mat) {
+  for (int j = 1; j <= rsm_steps; j++) {
+    vec3 x = mix(p, q, float(j) / float(rsm_steps + 1));
+    vec4 c = frame.view_proj * vec4(x, 1.0);
+    if (c.w <= 1e-12) continue;
+    vec2 s = c.xy / c.w * 0.5 + 0.5;
+    if (any(lessThan(s, vec2(0.0))) || any(greaterThan(s, vec2(1.0)))) continue;
+    float z = c.w * frame.clip.z, zb = texture(dpt, s).r; // a perspective's clip w is the view depth
+    if (texture(mat, s).a >= 0.5 && z > zb * 1.02) return true;
+  }
+  return false;
+}
+
+// E(p) at the surface s of coarse pixel px; dpt and mat: the full G-buffer's,
+// for EXCLUDE_SEEN and VISIBILITY.
+vec3 rsm_gather(Surface s, ivec2 px, sampler2D dpt, sampler2D mat) {
+  int j = interleave_index(px, INTERLEAVE);
+  float turn = fract(frame.time.y * rsm_rotate);
+  // With temporal reuse the radii move too (by the plastic number's step, unrelated to the angle's), so
+  // that the frames a pixel accumulates cover other distances, not only other angles.
+  float shift = rsm_rotate > 0.0 ? fract(frame.time.y * PLASTIC) : 0.0;
+  vec2 atlas = vec2(textureSize(rsm_pos, 0));
+  vec3 e = vec3(0.0);
+  for (int i = 0; i < frame.counts.x; i++) {
+    ShadowLight sl = shadow_lights[i];
+    Light li = lights[i]; // read once, not in the sample loop (rsm.gather about 8% faster on llvmpipe)
+    int first = sl.cube.y, count = sl.cube.z;
+    int n = count > 0 ? max(rsm_samples / count, 1) : 0;
+    // The block's first angle: j n phi turns (j integer: fract(j fract(n phi)) = fract(j n phi),
+    // without the rounding of the large product).
+    float a0 = 2.0 * PI * fract(float(j) * fract(float(n) * GOLDEN) + turn);
+    uint k0 = uint(j * n);
+    float centred = 0.5 / float(max(n * INTERLEAVE * INTERLEAVE, 1)) + shift; // half the union's radial stratum
+    for (int v = first; v < first + count; v++) {
+      ShadowView sv = shadow_views[v];
+      vec4 c = sv.view_proj * vec4(s.p, 1.0);
+      vec2 centre = c.w > 1e-12 ? c.xy / c.w * 0.5 + 0.5 : vec2(0.5);
+      centre = clamp(centre, vec2(0.0), vec2(1.0)); // behind a cube face: its nearest edge
+      float tile = sv.rect.z * atlas.x;
+      // The disc reaches no farther than the tile's farthest corner: beyond it every sample would fall
+      // outside and add nothing, so the pattern keeps its samples where texels are.
+      float reach = min(rsm_radius, length(max(centre, 1.0 - centre)));
+      float texels = 2.0 * PI * reach * reach * tile * tile / float(max(n, 1));
+      vec2 dir = vec2(cos(a0), sin(a0));
+      for (int k = 0; k < n; k++, dir = vec2(dir.x * TURN.x - dir.y * TURN.y, dir.x * TURN.y + dir.y * TURN.x)) {
+        float xi = fract(radical_inverse(k0 + uint(k), 2u) + centred);
+        vec2 t = centre + xi * reach * dir;
+        if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
+        ivec2 a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
+        vec4 qn = texelFetch(rsm_pos, a, 0); // position, normal (normal_pack)
+        if (qn.w > 0.0) continue; // empty
+        vec3 q = qn.xyz, nq = normal_unpack(qn.w);
+        float area = rsm_texel_area(sv, t, q, tile);
+        vec3 d = q - s.p;
+        float d2 = dot(d, d);
+        vec3 towards = d * inversesqrt(max(d2, 1e-30));
+        float g = max(dot(s.n, towards), 0.0) * max(dot(nq, -towards), 0.0) / max(d2, area);
+        if (g <= 0.0) continue; // before the flux and the light: coplanar and facing-away senders are common
+#ifdef EXCLUDE_SEEN
+        if (rsm_seen(dpt, q)) continue;
+#endif
+#ifdef VISIBILITY
+        if (rsm_blocked(s.p, q, dpt, mat)) continue;
+#endif
+        vec3 l;
+        vec3 radiance = light_arriving(li, q, l);
+        e += texelFetch(rsm_flux, a, 0).rgb * radiance * area * g * texels * xi;
+      }
+    }
+  }
+  return finite_or_zero(e / PI);
+}
+#endif
 
 #endif

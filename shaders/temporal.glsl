@@ -23,6 +23,7 @@
 uniform sampler2D history, history_state;
 uniform float epsilon = 0.02, frames = 36.0, bias = 0.1, confidence = 0.25;
 uniform int refresh = 32;
+uniform int restart = 0; // 1: the settings changed (temporal.begin), no history is kept
 
 // The history of the pixel at uv whose coarse depth is d (dpt): the
 // pixel's world position through the previous frame's view-projection; kept
@@ -33,6 +34,7 @@ uniform int refresh = 32;
 bool temporal_history(vec2 uv, float d, out vec4 h, out float n) {
   h = vec4(0.0);
   n = 0.0;
+  if (restart != 0) return false;
   vec4 c = frame.prev_view_proj * vec4(position_from_depth(uv, d), 1.0);
   if (c.w <= 1e-12) return false;
   vec2 q = c.xy / c.w * 0.5 + 0.5;

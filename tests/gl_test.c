@@ -130,20 +130,39 @@ double gl_mean_abs_diff(const float *a, const float *b, int n) {
   return n > 0 ? sum / n : 0;
 }
 
-bool gl_render_until(gl_result *r, int last, int first_frames, double *early, double *late) {
-  int n = r->width * r->height * 3;
+gl_convergence gl_temporal_convergence(gl_run run, const char *const *on, const char *const *off,
+                                       const char *const *ref, int last, const char *label) {
+  gl_convergence c = {0};
+  run.sets = on;
+  run.frames = 2;
+  gl_result r = gl_render(&run);
+  if (!r.ok) fail_msg("%s: %s", label, r.err.msg);
+  int n = r.width * r.height * 3;
   float *before = malloc(sizeof(float) * (size_t)n);
-  *early = *late = 0;
-  bool ok = r->ok;
-  for (int f = first_frames + 1; f <= last && ok; f++) {
-    memcpy(before, r->rgb, sizeof(float) * (size_t)n);
-    ok = gl_render_again(r);
-    if (!ok) break;
-    *late = gl_mean_abs_diff(before, r->rgb, n);
-    if (f == first_frames + 1) *early = *late;
+  for (int f = 3; f <= last; f++) {
+    memcpy(before, r.rgb, sizeof(float) * (size_t)n);
+    if (!gl_render_again(&r)) fail_msg("%s, frame %d: %s", label, f, r.err.msg);
+    c.late = gl_mean_abs_diff(before, r.rgb, n);
+    if (f == 3) c.early = c.late;
   }
   free(before);
-  return ok;
+  if (!gl_all_finite(&r)) fail_msg("%s: a value is not finite or is negative", label);
+  run.frames = 1;
+  run.sets = off;
+  gl_result one = gl_render_ok(&run);
+  run.sets = ref;
+  gl_result best = gl_render_ok(&run);
+  c.e_acc = gl_mean_abs_diff(r.rgb, best.rgb, n);
+  c.e_one = gl_mean_abs_diff(one.rgb, best.rgb, n);
+  float all[3];
+  gl_region(&r, 0, 0, r.width - 1, r.height - 1, all);
+  c.mean = (all[0] + all[1] + all[2]) / 3.0;
+  print_message("%s: change %.2e (frame 3) -> %.2e (frame %d) of a mean %.3f; error to the reference %.2e "
+                "(one frame without reuse: %.2e)\n", label, c.early, c.late, last, c.mean, c.e_acc, c.e_one);
+  gl_result_free(&r);
+  gl_result_free(&one);
+  gl_result_free(&best);
+  return c;
 }
 
 void gl_result_free(gl_result *r) {

@@ -50,11 +50,19 @@ gl_result gl_render_ok(const gl_run *run);
 bool gl_set(gl_result *r, const char *assignment);
 /* Renders one more frame with the same pipeline (after moving a camera, say). */
 bool gl_render_again(gl_result *r);
-/* Renders r's frames again up to its frame `last` (frame count, from its
- * first render's frames + 1): *early is the mean absolute change of its
- * linear RGB over the first of them, *late over the last (a still camera's
- * convergence). False when a frame fails. */
-bool gl_render_until(gl_result *r, int last, int first_frames, double *early, double *late);
+/* Temporal reuse on a still camera: `run` (its scene, technique, size;
+ * sets and frames are replaced) with the options `on` for frames 1..last,
+ * then one frame with `off` (no reuse) and one with `ref` (many samples).
+ * early and late: the mean absolute change of the linear RGB from frame 2
+ * to 3 and from last - 1 to last; mean: the last frame's; e_acc and e_one:
+ * the mean absolute error against ref's frame of the last frame and of
+ * off's. Printed after `label`; fails the test when a frame fails or a
+ * value of the accumulation is NaN, Inf or negative. */
+typedef struct gl_convergence {
+  double early, late, mean, e_acc, e_one;
+} gl_convergence;
+gl_convergence gl_temporal_convergence(gl_run run, const char *const *on, const char *const *off,
+                                       const char *const *ref, int last, const char *label);
 /* Mean |a[i] - b[i]| over n values. */
 double gl_mean_abs_diff(const float *a, const float *b, int n);
 void gl_result_free(gl_result *r);

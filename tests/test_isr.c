@@ -288,23 +288,10 @@ static void still_frames_with_temporal_reuse_converge(void **state) {
   static const char *const on[] = {"isr.view=indirect", "isr.temporal.enabled=true", NULL};
   static const char *const off[] = {"isr.view=indirect", NULL};
   static const char *const ref[] = {"isr.view=indirect", "isr.samples=64", NULL};
-  int n = W * H * 3;
-  gl_result r = gl_render(&(gl_run){.tech = "isr", .sets = on, .width = W, .height = H, .frames = 2});
-  double early, late;
-  assert_true(gl_render_until(&r, 40, 2, &early, &late));
-  gl_result one = render_ok("isr", off), best = render_ok("isr", ref);
-  double e_acc = gl_mean_abs_diff(r.rgb, best.rgb, n), e_one = gl_mean_abs_diff(one.rgb, best.rgb, n);
-  float all[3];
-  gl_region(&r, 0, 0, W - 1, H - 1, all);
-  double mean = (all[0] + all[1] + all[2]) / 3.0;
-  print_message("isr temporal: change %.2e (frame 3) -> %.2e (frame 40) of a mean %.3f; error to 64 rays %.2e "
-                "(one frame of 4: %.2e)\n", early, late, mean, e_acc, e_one);
-  assert_true(gl_all_finite(&r));
-  assert_true(mean > 0.01 && late < 1e-3 * mean && late * 5 < early);
-  assert_true(e_acc < e_one);
-  gl_result_free(&r);
-  gl_result_free(&one);
-  gl_result_free(&best);
+  gl_convergence c = gl_temporal_convergence((gl_run){.tech = "isr", .width = W, .height = H}, on, off, ref, 40,
+                                             "isr temporal (reference: 64 rays)");
+  assert_true(c.mean > 0.01 && c.late < 1e-3 * c.mean && c.late * 5 < c.early);
+  assert_true(c.e_acc < c.e_one);
 
   static const char *const ways[][2] = {{"isr.bounces=1", NULL}, {"isr.reuse=false", NULL}, {"isr.bounces=3", NULL}};
   for (size_t i = 0; i < sizeof ways / sizeof *ways; i++) {

@@ -441,23 +441,10 @@ static void still_frames_with_temporal_reuse_converge(void **state) {
   (void)state;
   static const char *const on[] = {"ssdo.temporal.enabled=true", NULL};
   static const char *const many[] = {"ssdo.samples=300", NULL};
-  int n = W * H * 3;
-  gl_result r = gl_render(&(gl_run){.tech = "ssdo", .sets = on, .width = W, .height = H, .frames = 2});
-  double early, late;
-  assert_true(gl_render_until(&r, 40, 2, &early, &late));
-  gl_result one = render_ok("ssdo", NULL), best = render_ok("ssdo", many);
-  double e_acc = gl_mean_abs_diff(r.rgb, best.rgb, n), e_one = gl_mean_abs_diff(one.rgb, best.rgb, n);
-  float all[3];
-  gl_region(&r, 0, 0, W - 1, H - 1, all);
-  double mean = (all[0] + all[1] + all[2]) / 3.0;
-  print_message("ssdo temporal: change %.2e (frame 3) -> %.2e (frame 40) of a mean %.3f; error to 300 samples "
-                "%.2e (one frame of 20: %.2e)\n", early, late, mean, e_acc, e_one);
-  assert_true(gl_all_finite(&r));
-  assert_true(mean > 0.01 && late < 1e-3 * mean && late * 5 < early);
-  assert_true(e_acc < e_one);
-  gl_result_free(&r);
-  gl_result_free(&one);
-  gl_result_free(&best);
+  gl_convergence c = gl_temporal_convergence((gl_run){.tech = "ssdo", .width = W, .height = H}, on, NULL, many, 40,
+                                             "ssdo temporal (reference: 300 samples)");
+  assert_true(c.mean > 0.01 && c.late < 1e-3 * c.mean && c.late * 5 < c.early);
+  assert_true(c.e_acc < c.e_one);
 
   static const char *const half[] = {"ssdo.temporal.enabled=true", "ssdo.resolution=2", NULL};
   gl_result h = gl_render(&(gl_run){.tech = "ssdo", .sets = half, .width = W, .height = H, .frames = 3});
