@@ -348,47 +348,63 @@ static void converged_pixels_take_no_samples_until_their_tile_refreshes(void **s
 /* A camera move with temporal reuse: after 20 still frames the camera
  * slides sideways by a tenth of the room; the first frame after the move
  * differs from 21 still frames with reuse at the new place (the same
- * blur: the blur shrinks with a pixel's frames, isr.blur) by less than 0.7%
- * of the image's mean (0.50% measured; 0.87% at rsm.temporal.epsilon = 1,
- * which keeps the ghost), edges (ceiling and walls, the lit patch)
+ * blur: the blur shrinks with a pixel's frames, isr.blur) by less than a
+ * bound of the image's mean, edges (ceiling and walls, the lit patch)
  * included, where a ghost trail would show the old ones: reprojection keeps
- * what is still seen, the disocclusion test drops what was not. 64 samples
- * a frame, not the default 24: the pixels the move uncovers hold one frame's
- * samples, and at 24 their noise alone comes to about 1% (a ghost is what
- * is tested). */
+ * what is still seen, the disocclusion test drops what was not. Measured
+ * (bound): rsm+esm 0.50% (0.7%; 0.87% at rsm.temporal.epsilon = 1, which
+ * keeps the ghost), isr+rsm+esm with isr.temporal 0.35% (0.6%), isr+esm
+ * 1.20% (1.5%): ISR's light at a point depends on what the screen shows,
+ * and a reprojected pixel holds the old view's estimate, which the new
+ * frames replace only as they accumulate (1.20% at 16 and at 64 rays: not
+ * noise; 1.24% with the ghost kept). More samples a frame than the defaults: the pixels the
+ * move uncovers hold one frame's samples, and at the defaults their noise
+ * alone comes to about 1% (a ghost is what is tested). */
 static void a_camera_move_leaves_no_ghost_edge(void **state) {
   (void)state;
-  static const char *const on[] = {"ambient=0", "rsm.samples=64", "rsm.temporal.enabled=true", NULL};
+  static const struct {
+    const char *tech, *sets[5];
+    double bound;
+  } cases[] = {
+      {"rsm+esm", {"ambient=0", "rsm.samples=64", "rsm.temporal.enabled=true", NULL}, 0.007},
+      {"isr+rsm+esm", {"ambient=0", "rsm.samples=64", "isr.samples=16", "isr.temporal.enabled=true", NULL}, 0.006},
+      {"isr+esm", {"ambient=0", "isr.samples=16", "isr.temporal.enabled=true", NULL}, 0.015},
+  };
   lm_scene *s = closed_room(LM_LIGHT_POINT);
   /* A panel halfway to the far wall: the move uncovers the wall behind it, where a ghost would keep
    * the panel's light (the disocclusion test drops it: at rsm.temporal.epsilon = 1 it would not). */
   static const float panel[4][3] = {{-0.3f, -1, -0.5f}, {0.3f, -1, -0.5f}, {0.3f, 0.2f, -0.5f}, {-0.3f, 0.2f, -0.5f}};
   gl_quad(s, "panel", gl_material(s, "white", 0.9f, 0.9f, 0.9f), panel, (float[3]){0, 0, 1});
-  /* Look along the room at the far wall, ceiling in the upper half. */
   int cam = s->cameras[0].node;
-  mat4 m;
-  glm_translate_make(m, (vec3){0, -0.5f, 0.9f});
-  glm_rotate(m, glm_rad(20.0f), (vec3){1, 0, 0});
-  memcpy(s->nodes[cam].local, m, sizeof m);
-  lm_scene_update(s);
-  gl_result r = gl_render(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = on, .width = W, .height = H, .frames = 20});
-  assert_true(r.ok);
-  glm_translate_make(m, (vec3){0.2f, -0.5f, 0.9f});
-  glm_rotate(m, glm_rad(20.0f), (vec3){1, 0, 0});
-  memcpy(s->nodes[cam].local, m, sizeof m);
-  lm_scene_update(s);
-  assert_true(gl_render_again(&r));
-  gl_result still = gl_render(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = on, .width = W, .height = H, .frames = 21});
-  assert_true(still.ok);
-  double diff = gl_mean_abs_diff(r.rgb, still.rgb, W * H * 3);
-  float all[3];
-  gl_region(&still, 0, 0, W - 1, H - 1, all);
-  double mean = (all[0] + all[1] + all[2]) / 3.0;
-  print_message("after the move: mean difference to 21 still frames %.2e of a mean %.3f\n", diff, mean);
-  assert_true(gl_all_finite(&r));
-  assert_true(diff < 0.007 * mean);
-  gl_result_free(&r);
-  gl_result_free(&still);
+  for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+    /* Look along the room at the far wall, ceiling in the upper half. */
+    mat4 m;
+    glm_translate_make(m, (vec3){0, -0.5f, 0.9f});
+    glm_rotate(m, glm_rad(20.0f), (vec3){1, 0, 0});
+    memcpy(s->nodes[cam].local, m, sizeof m);
+    lm_scene_update(s);
+    gl_result r = gl_render(&(gl_run){.scene = s, .tech = cases[c].tech, .sets = cases[c].sets, .width = W,
+                                      .height = H, .frames = 20});
+    assert_true(r.ok);
+    glm_translate_make(m, (vec3){0.2f, -0.5f, 0.9f});
+    glm_rotate(m, glm_rad(20.0f), (vec3){1, 0, 0});
+    memcpy(s->nodes[cam].local, m, sizeof m);
+    lm_scene_update(s);
+    assert_true(gl_render_again(&r));
+    gl_result still = gl_render(&(gl_run){.scene = s, .tech = cases[c].tech, .sets = cases[c].sets, .width = W,
+                                          .height = H, .frames = 21});
+    assert_true(still.ok);
+    double diff = gl_mean_abs_diff(r.rgb, still.rgb, W * H * 3);
+    float all[3];
+    gl_region(&still, 0, 0, W - 1, H - 1, all);
+    double mean = (all[0] + all[1] + all[2]) / 3.0;
+    print_message("%s after the move: mean difference to 21 still frames %.2e of a mean %.3f (%.2f%%)\n",
+                  cases[c].tech, diff, mean, 100 * diff / mean);
+    assert_true(gl_all_finite(&r));
+    assert_true(diff < cases[c].bound * mean);
+    gl_result_free(&r);
+    gl_result_free(&still);
+  }
   lm_scene_destroy(s);
 }
 
