@@ -447,9 +447,7 @@ static void still_frames_with_temporal_reuse_converge(void **state) {
   assert_true(c.e_acc < c.e_one);
 
   static const char *const half[] = {"ssdo.temporal.enabled=true", "ssdo.resolution=2", NULL};
-  gl_result h = gl_render(&(gl_run){.tech = "ssdo", .sets = half, .width = W, .height = H, .frames = 3});
-  if (!h.ok) fail_msg("%s", h.err.msg);
-  assert_true(gl_all_finite(&h));
+  gl_result h = gl_render_ok(&(gl_run){.tech = "ssdo", .sets = half, .width = W, .height = H, .frames = 3});
   assert_true(lm_graph_find_target(lm_renderer_graph(h.renderer), "temporal.ssdo2.value0") >= 0);
   gl_result_free(&h);
   static const char *const merged[] = {"ssdo.variant=merged", "ssdo.temporal.enabled=true", NULL};
