@@ -129,10 +129,10 @@ function OnRender(tech)
       if o_rsm.temporal.enabled then
         error("isr+rsm+esm takes temporal reuse from isr.temporal (one pass gathers both); rsm.temporal is rsm+esm's")
       end
-      light.rsm = function(inputs, defines, params, f, temporal_on)
+      light.rsm = { coarse = o_rsm.coarse, bind = function(inputs, defines, params, f, temporal_on)
         params.rsm_k = o_rsm.k
         return rsm.bind(inputs, defines, params, R, shadows, o_rsm, f, temporal_on, true)
-      end
+      end }
     end
     local d = direct(G, tech, shadows, 0, "direct", nil, offscreen)
     if lighting == "isr" then

@@ -6,8 +6,9 @@
 -- geometry-aware blur as ISR (isr.blur); the direct pass upsamples and adds
 -- it (direct.frag's INDIRECT: L = D + k_a L_a albedo + k k_d albedo E).
 -- The combined technique (isr+rsm+esm) runs the same gather inside ISR's
--- first march instead (rsm.bind; docs/gi-combined.md): on ISR's grid, with
--- ISR's blur and temporal reuse, so `coarse` and `blur` only set its density.
+-- first march instead (rsm.bind; docs/gi-combined.md): on ISR's grid (no
+-- finer than `coarse` when isr.coarse is auto), with ISR's blur and temporal
+-- reuse, so there `coarse` sets the grid's bound and the samples' density.
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local options = require "options"
