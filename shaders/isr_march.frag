@@ -284,7 +284,7 @@ void main() {
         float cos_x = dot(x.n, -safe_normalize(to_x, w));
         if (cos_x > 0.0) {
 #ifdef FIRST
-          vec3 radiance = vec3(0.0); // the direct light is in `first`
+          vec3 radiance = vec3(0.0); // the direct light is in `first_step`
 #else
           vec3 radiance = texelFetch(sender, q, 0).rgb;
 #endif

@@ -1,8 +1,9 @@
 // Temporal reuse of a coarse GI result (seed 004, chapter 3.3; lines
-// 560-610), inside the GI pass that computes it (TEMPORAL in rsm.frag;
-// and isr_march.frag; scripts/temporal.lua binds the history): reverse reprojection of each
-// pixel's world position through the previous frame's view-projection, a
-// disocclusion test, and accumulation: the running mean of the frames a
+// 560-610), inside the GI pass that computes it (TEMPORAL in rsm.frag,
+// isr_march.frag, isr_bounce.frag and ssdo.frag; scripts/temporal.lua binds
+// the history): reverse reprojection of each pixel's world position
+// through the previous frame's view-projection, a disocclusion test, and
+// accumulation: the running mean of the frames a
 // pixel has seen, up to `frames`, after which it stops (the seed's "stop
 // when converged"): a converged pixel keeps its history, and the pass takes
 // no samples for it except in the frames that refresh its tile. The seed's
