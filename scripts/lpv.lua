@@ -1,6 +1,6 @@
 -- Light propagation volumes (seed 003, section 5.2), on POV-Ray's scale
 -- (/work/shared/design/gi-scale.md), over the reflective shadow maps the
--- shadow pass writes (shadow.render(o, G, reach), as rsm.lua). Each frame:
+-- shadow pass writes (shadow.render(o, G, rsm), as rsm.lua). Each frame:
 --   1. injection (points passes, lpv_inject.vert): VPLs from every light's
 --      RSM views, each a Lambertian lobe in 2-band spherical harmonics per
 --      colour channel, and surfels of the G-buffer as the geometry volume's
@@ -42,6 +42,7 @@ lpv.defaults = {
   surfels = 16,      -- G-buffer surfels a row for the geometry volume, 0..1024 (0: nothing blocks)
   occlusion = 1.0,   -- how much the geometry volume blocks, 0..1 (0: light passes through walls)
   reach = 3,         -- a directional light's RSM tile, as rsm.reach, 1..64
+  resolution = 128,  -- its texels a side, as rsm.resolution, 16..8192
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
   coarse = 8,        -- the lookup's coarse factor a side: 1, 2, 4 or 8; the volume's light varies
                      -- slowly, and the direct pass's upsampling keeps depth edges: 8 removed 51.0% of
@@ -63,13 +64,14 @@ local rules = {
   surfels = options.whole(0, 1024),
   occlusion = options.number(0, 1),
   reach = options.number(1, 64),
+  resolution = options.whole(16, 8192),
   k = options.number(0, 16),
   coarse = options.one_of(1, 2, 4, 8),
   blur = options.whole(0, 32),
 }
 
 -- Checked options (errors name the option, pointing at the caller's caller);
--- shadow.render(..., o.reach) then writes the maps.
+-- shadow.render(..., o) then writes the maps.
 function lpv.check(o) return options.check("lpv", lpv.defaults, o, rules, 3) end
 
 -- Cascade 0's cell side: o.cell, or the coarsest cascade spanning extent

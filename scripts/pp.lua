@@ -104,7 +104,7 @@ function OnRender(tech)
   local o_rsm = lighting == "vpl" and vpl.check(tech.vpl) or tech.name:find("rsm+", 1, true) and rsm.check(tech.rsm)
                 or tech.name:find("lpv+", 1, true) and lpv.check(tech.lpv)
   local shadows, R
-  if tech.name:find("+esm", 1, true) then shadows, R = shadow.render(tech.shadow, G, o_rsm and o_rsm.reach) end
+  if tech.name:find("+esm", 1, true) then shadows, R = shadow.render(tech.shadow, G, o_rsm) end
   if shadows and tech.shadow.debug then return present(shadow.debug(shadows)) end
   local lit
   local skylight = sky.light(tech.sky) -- nil when off: then nothing of it is recorded

@@ -1,6 +1,6 @@
 -- Indirect light from reflective shadow maps (seed 004, lines 858-958), on
 -- POV-Ray's scale (/work/shared/design/gi-scale.md). The shadow pass writes
--- the maps when this module asks (shadow.render(o, G, reach)); the gather
+-- the maps when this module asks (shadow.render(o, G, rsm)); the gather
 -- runs at a coarse size over isr.lua's coarse view of the G-buffer
 -- (isr.coarse_view: no downsampling pass; rsm.frag), then the same
 -- geometry-aware blur as ISR (isr.blur); the direct pass upsamples and adds
@@ -27,6 +27,10 @@ rsm.defaults = {
   radius = 1.0,      -- sampling disc radius in tiles of the RSM, (0, 2]
   reach = 3,         -- a directional light's RSM tile covers the sphere around what is seen,
                      -- its radius times reach, 1..64 (senders off screen; no world unit)
+  resolution = 128,  -- that tile's texels a side, 16..8192 (shadow.resolution halved whole times, the
+                     -- least at or above; spot and point lights' RSMs are their shadow tiles): the
+                     -- gather's cost grows with the texels its samples scatter over, and 128 removed
+                     -- as much of dl+esm's indirect error as 512 (docs/gi-combined.md)
   steps = 0,         -- screen-space visibility march a sample, 0..32 (0: none; the seed's
                      -- test, which about halves its frame rate)
   rotate = 10,       -- pattern turn a frame in degrees with temporal reuse, 0..180 (the seed: 10;
@@ -46,6 +50,7 @@ local rules = {
   samples = options.whole(1, 4096),
   radius = options.positive(2),
   reach = options.number(1, 64),
+  resolution = options.whole(16, 8192),
   steps = options.whole(0, 32),
   rotate = options.number(0, 180),
   k = options.number(0, 16),
@@ -55,7 +60,7 @@ local rules = {
 }
 
 -- Checked options (errors name the option, pointing at the caller's caller);
--- shadow.render(..., o.reach) then writes the maps.
+-- shadow.render(..., o) then writes the maps.
 function rsm.check(o)
   o = options.check("rsm", rsm.defaults, o, rules, 3)
   o.temporal = temporal.check("rsm.temporal", o.temporal)
@@ -95,7 +100,7 @@ function rsm.gather(C, f, R, shadows, o)
 end
 
 -- Records the RSM's indirect light over G from the shadow atlas and RSM
--- targets (shadow.render(..., o.reach)), with checked options o: the gather
+-- targets (shadow.render(..., o)), with checked options o: the gather
 -- over a coarse view of G (no pass averages its blocks first), temporal
 -- reuse and the blur. Returns what the direct pass adds (pp.lua's direct:
 -- INDIRECT in direct.frag): { C = the coarse grid, E = the coarse result, k }.

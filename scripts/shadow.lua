@@ -67,11 +67,12 @@ end
 -- `shadow_atlas`, or nil when no light casts shadows (nothing is recorded).
 -- With the G-buffer G (recorded before), cascades fit the depths it sees
 -- (shadow.depth_range); without, the depths of the meshes in view.
--- With rsm (a number >= 1), the same pass also writes reflective shadow maps
--- (seed 004; shadow.frag), returned second as { flux =, nrm =, pos =, views =, seen = }
--- (atlas-sized, rsm.frag reads them; views: how many tiles are the lights' RSM views; seen: the
--- depth range G sees, shadow.depth_range, nil without G); a directional light gets one more tile
--- for them, over the sphere around all that is seen, its radius times rsm.
+-- With rsm ({ reach =, resolution = }: the checked options of rsm, vpl or lpv), the same pass
+-- also writes reflective shadow maps (seed 004; shadow.frag), returned second as
+-- { flux =, nrm =, pos =, views =, seen = } (atlas-sized, rsm.frag reads them; views: how many
+-- tiles are the lights' RSM views; seen: the depth range G sees, shadow.depth_range, nil
+-- without G); a directional light gets one more tile for them, over the sphere around all that
+-- is seen, its radius times reach, of `resolution` texels a side (shadow_plan's rsm_resolution).
 -- Without, no RSM target or tile exists.
 function shadow.render(o, G, rsm)
   o = options.check("shadow", shadow.defaults, o, rules, 2)
@@ -79,7 +80,7 @@ function shadow.render(o, G, rsm)
   for k, v in pairs(o) do
     if k ~= "debug" then settings[k] = v end
   end
-  settings.rsm = rsm
+  if rsm then settings.rsm, settings.rsm_resolution = rsm.reach, rsm.resolution end
   local plan = shadow_plan(settings)
   if not plan then return nil end
   local size = { plan.width, plan.height }

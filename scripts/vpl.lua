@@ -1,6 +1,6 @@
 -- Indirect point lights with negative lights (seed 002), on POV-Ray's scale
 -- (/work/shared/design/gi-scale.md), over the reflective shadow maps the
--- shadow pass writes (shadow.render(o, G, reach), as rsm.lua). vpl.frag:
+-- shadow pass writes (shadow.render(o, G, rsm), as rsm.lua). vpl.frag:
 --   1. the indirect lights: N fixed Halton points in each light's RSM, one
 --      texel each (position, normal, radiance times area), worked out once
 --   2. gather at a coarse size (over isr.coarse_view: the G-buffer at each
@@ -40,6 +40,7 @@ vpl.defaults = {
                      -- set: 49.1%, 49.0%, 49.1% of dl+esm's indirect error removed at 2, 3, 4),
                      -- and 3 took about three quarters of 2's frame time at 256 x 192
   reach = 3,         -- a directional light's RSM tile, as rsm.reach, 1..64
+  resolution = 128,  -- its texels a side, as rsm.resolution, 16..8192
   focus = 1,         -- the indirect lights of a directional light's tile lie in its central part
                      -- of this side, times reach (1: the sphere around what is seen), 0.05..64
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
@@ -52,6 +53,7 @@ local rules = {
   recompute = options.one_of("any", "all"),
   coarse = options.one_of(1, 2, 3, 4),
   reach = options.number(1, 64),
+  resolution = options.whole(16, 8192),
   focus = options.number(0.05, 64),
   k = options.number(0, 16),
 }

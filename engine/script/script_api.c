@@ -169,7 +169,7 @@ static float opt_number(lua_State *L, int idx, const char *field, float def, flo
 }
 
 /* shadow_plan{ technique, resolution, c, blur, cascades, lambda, bias, distance,
- * blend, radius, stabilize, size, penumbra, rsm, cache, coverage }: tiles for every light that casts shadows, or nil
+ * blend, radius, stabilize, size, penumbra, rsm, rsm_resolution, cache, coverage }: tiles for every light that casts shadows, or nil
  * when none does. scene{ views = plan } draws them; scene{ views = plan, fit =
  * T } first fits them to the camera depths T's first texel holds (min in r,
  * max in g, as depth / far). */
@@ -181,7 +181,7 @@ static int l_shadow_plan(lua_State *L) {
   luaL_checktype(L, 1, LUA_TTABLE);
   static const char *const fields[] = {"technique", "resolution", "c", "blur", "cascades", "lambda",
                                        "bias", "distance", "blend", "radius", "stabilize", "size",
-                                       "penumbra", "rsm", "cache", "coverage", NULL};
+                                       "penumbra", "rsm", "rsm_resolution", "cache", "coverage", NULL};
   check_fields(L, 1, "shadow_plan", fields);
   lm_shadow_settings st;
   lm_shadow_settings_default(&st);
@@ -213,6 +213,7 @@ static int l_shadow_plan(lua_State *L) {
   if (!lua_isnil(L, -1)) st.coverage = lua_toboolean(L, -1);
   lua_pop(L, 1);
   st.rsm = opt_number(L, 1, "rsm", 0, 0, 64, what);
+  st.rsm_resolution = (int)opt_number(L, 1, "rsm_resolution", (float)st.rsm_resolution, 16, 8192, what);
   lm_shadow_plan_free(p->shadows);
   lm_error err;
   if (!lm_shadow_plan_make(p->shadows, p->scene, p->camera, &st, &err)) return luaL_error(L, "shadow_plan: %s", err.msg);

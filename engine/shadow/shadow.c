@@ -19,7 +19,7 @@ void lm_shadow_settings_default(lm_shadow_settings *s) {
   *s = (lm_shadow_settings){.technique = LM_SHADOW_ESM, .resolution = 512, .c = 16.0f, .blur = 0,
                             .cascades = 3, .lambda = 0.75f, .distance = 0.0f,
                             .blend = 0.1f, .radius = 2.5f, .stabilize = true, .cache = true, .coverage = true,
-                            .size = -1.0f, .penumbra = 16.0f};
+                            .size = -1.0f, .penumbra = 16.0f, .rsm_resolution = 8192};
   s->bias = 1.0f; /* texels; the seed has 0: lit slanted surfaces then lose 1-2% to ESM */
 }
 
@@ -192,6 +192,9 @@ static void cascade_cull(const lm_frame_data *cam, mat4 view, float zr, float z1
   glm_mat4_mul(proj, view, cull);
 }
 
+/* A tile of the cell's `tile` texels halved `level` times (never empty). */
+static int tile_size(int tile, int level) { return tile >> level > 0 ? tile >> level : 1; }
+
 /* One orthographic tile along dir over the camera's slice z0 .. z1: a
  * cascade (grow 0; its receivers from camera depth zr), or the RSM's wide
  * tile over the slice's bounding sphere with its radius times grow. */
@@ -246,21 +249,22 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
   if (!(zf > zn) || !isfinite(zf)) zn = 0, zf = 2.0f * extent + step;
   glm_ortho(l, r, b, t, zn, zf, proj);
   glm_mat4_mul(proj, view, vp);
+  int size = grow > 0 ? tile_size(plan->tile, plan->rsm_level) : plan->tile;
   if (st->stabilize) {
     /* Texel snapping: move the projection so the world origin falls on a
      * texel corner; a camera moving by less than a texel moves no edge. */
     vec4 origin = {0, 0, 0, 1}, o;
     glm_mat4_mulv(vp, origin, o);
-    float half = (float)plan->tile * 0.5f;
+    float half = (float)size * 0.5f;
     float dx = (roundf(o[0] * half) - o[0] * half) / half, dy = (roundf(o[1] * half) - o[1] * half) / half;
     proj[3][0] += dx, proj[3][1] += dy;
     glm_mat4_mul(proj, view, vp);
   }
-  float texel = (r - l) / (float)plan->tile;
+  float texel = (r - l) / (float)size;
   mat4 cull;
   if (grow <= 0) cascade_cull(cam, view, zr, z1, bounds, texel, filter_reach(st), (float[6]){l, r, b, t, zn, zf}, cull);
   /* A texel's world size and the world depth the tile's 0..1 spans. */
-  add_view(plan, plan->tile, vp, (float[4]){0, 0, 0, 0}, (float[4]){texel, zf - zn, 0, 0}, grow <= 0 ? cull : NULL);
+  add_view(plan, size, vp, (float[4]){0, 0, 0, 0}, (float[4]){texel, zf - zn, 0, 0}, grow <= 0 ? cull : NULL);
 }
 
 /* Cascades cover the depths where receivers are seen (plan->seen), snapped
@@ -375,9 +379,6 @@ static int cube_faces_seen(const lm_shadow_plan *plan, const lm_scene *s, const 
   }
   return mask;
 }
-
-/* A tile of the cell's `tile` texels halved `level` times (never empty). */
-static int tile_size(int tile, int level) { return tile >> level > 0 ? tile >> level : 1; }
 
 enum { MIN_TILE = 32 };
 
@@ -518,6 +519,7 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
       !(st->c > 0 && st->c <= 10000) || st->blur < 0 || st->blur > 32 || !(st->lambda >= 0 && st->lambda <= 1) ||
       !(st->bias >= 0 && st->bias <= 64) || !(st->distance >= 0) || !(st->blend >= 0 && st->blend <= 1) ||
       !(st->radius >= 0 && st->radius <= 32) || !(st->rsm >= 0 && st->rsm <= 64) ||
+      st->rsm_resolution < 16 || st->rsm_resolution > 8192 ||
       (unsigned)st->technique > LM_SHADOW_PCSS ||
       !(st->size < 0 || st->size <= 1e30f) || !(st->penumbra >= 1 && st->penumbra <= 64)) {
     lm_error_set(err, "shadow settings out of range");
@@ -532,6 +534,8 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
    * (texel snapping). */
   plan->levels = lm_alloc(sizeof *plan->levels * (size_t)(s->light_count + 1));
   plan->tile = st->resolution;
+  /* Relative to the cell, so that a tile halved to fit the GL limit below halves it too. */
+  while (tile_size(plan->tile, plan->rsm_level + 1) >= st->rsm_resolution) plan->rsm_level++;
   lm_light_data *ld = lm_alloc(sizeof *ld * (size_t)(s->light_count + 1));
   lm_scene_light_data(s, ld, s->light_count);
   int count = 0, *size = lm_alloc(sizeof *size * (size_t)(6 * s->light_count + 1));
@@ -539,7 +543,7 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
     const lm_light *l = &s->lights[i];
     plan->levels[i] = 0;
     if (!l->casts_shadows) continue;
-    int views = st->cascades + (st->rsm > 0);
+    int views = st->cascades;
     if (l->type != LM_LIGHT_DIRECTIONAL) {
       vec3 pos = {ld[i].position[0], ld[i].position[1], ld[i].position[2]};
       float range = light_range(s, l, pos);
@@ -549,6 +553,7 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
       views = l->type == LM_LIGHT_SPOT ? 1 : __builtin_popcount((unsigned)plan->lights[i].cube[0]);
     }
     for (int k = 0; k < views; k++) size[count++] = tile_size(plan->tile, plan->levels[i]);
+    if (st->rsm > 0 && l->type == LM_LIGHT_DIRECTIONAL) size[count++] = tile_size(plan->tile, plan->rsm_level);
   }
   free(ld);
   int *cell = lm_alloc(sizeof *cell * (size_t)(3 * count + 1));

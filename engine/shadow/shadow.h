@@ -43,6 +43,9 @@ typedef struct lm_shadow_settings {
   float rsm;       /* > 0: a frame reads reflective shadow maps (seed 004's senders); each
                     * directional light gets one more tile, over the sphere around all
                     * that is seen with its radius times rsm (senders off screen), 0..64 */
+  int rsm_resolution; /* texels a side of that tile (16 .. 8192): the cell's tile halved whole times,
+                       * the least at or above this (the gathers' cost grows with the texels they
+                       * scatter over, not their count) */
 } lm_shadow_settings;
 void lm_shadow_settings_default(lm_shadow_settings *s);
 
@@ -71,6 +74,7 @@ typedef struct lm_shadow_plan {
    * halved levels[light] times, packed into quadrants of shared cells. */
   int tile, columns, rows, atlas_width, atlas_height;
   int *levels;         /* per scene light */
+  int rsm_level;       /* the halvings of a directional light's RSM tile (settings.rsm_resolution) */
   lm_pass_view *views; /* for the scene pass, one per tile */
   lm_shadow_view_data *view_data;
   int view_count;
