@@ -204,6 +204,19 @@ static struct cached_tile *tile_at(tile_cache *c, const lm_pass_view *v) {
   return t;
 }
 
+/* Tile t was drawn again: a cached tile of another size that overlaps it
+ * (tiles resize with a light's coverage or the RSM's resolution) lost texels,
+ * so it is drawn again when its view comes back, even with the same key. */
+static void tile_cache_drawn(tile_cache *c, struct cached_tile *t, uint64_t key) {
+  for (int i = 0; i < c->tile_count; i++) {
+    struct cached_tile *o = &c->tiles[i];
+    if (o != t && o->x < t->x + t->width && t->x < o->x + o->width && o->y < t->y + t->height &&
+        t->y < o->y + o->height)
+      o->drawn = false;
+  }
+  t->drawn = true, t->key = key;
+}
+
 /* Where a pass's views lie in its outputs, and the outputs' size. */
 static uint64_t view_layout(const lm_scene_pass *sp, const lm_graph_target_info *t) {
   uint64_t h = lm_hash(&t[0].width, sizeof t[0].width, lm_hash(&t[0].height, sizeof t[0].height, 0));
@@ -261,7 +274,7 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   if (cached) {
     for (int i = 0; i < nt; i++)
       lm_texture_copy_rect(c->tex[i], t[i].texture, cached->x, cached->y, cached->width, cached->height);
-    cached->drawn = true, cached->key = key;
+    tile_cache_drawn(c, cached, key);
   }
   return true;
 }
