@@ -27,6 +27,13 @@ temporal.defaults = {
   refresh = 32,     -- a converged pixel's 4 x 4 tile takes fresh samples one frame in this many,
                     -- so that a change of its light shows within as many frames, 0..1024 (0: never;
                     -- the seed: one 16 x 16 tile a frame, 1 in 256 at its half of 512 x 512)
+  moving = 4,       -- while the camera moves, a view-dependent result's history (ISR's, SSDO's: their
+                    -- light at a point depends on what the screen shows) holds at most this many
+                    -- frames, and no pixel counts as converged, 0..1024 (0: as a still camera, the
+                    -- old view's light kept until a refresh; RSM's light does not depend on the view).
+                    -- After a 12-frame slide (test_rsm) ISR's frame lay 0.82%, 1.18%, 1.61% and 1.91%
+                    -- of the image's mean from a still camera's at 2, 4, 8 and 16, 2.44% at 0; 4
+                    -- keeps the moving image's noise near a 4-frame average
 }
 
 local rules = {
@@ -36,9 +43,10 @@ local rules = {
   bias = options.number(0, 16),
   confidence = options.number(0, 1),
   refresh = options.whole(0, 1024),
+  moving = options.number(0, 1024),
 }
 
-local histories = {} -- user -> coarse factor -> { targets = {a, b}, turn = 0 }
+local histories = {} -- user -> { view = bool, at = { [coarse factor] = { targets = {a, b}, turn = 0 } } }
 local settings, restart = nil, false -- a copy of the last frame's settings (temporal.begin), and whether they changed
 
 -- Do two values hold the same content (tables compared key by key)?
@@ -79,17 +87,18 @@ end
 -- Declares the history of `user` at 1 / f of the output for each coarse
 -- factor f of `factors` (a number or a list); from OnCreate. Only the
 -- factor a frame uses is made: a persistent target no pass reads or writes
--- has no texture.
-function temporal.create(user, factors)
+-- has no texture. view: the result depends on the view (a screen-space
+-- gather), so a moving camera caps its history (the `moving` option).
+function temporal.create(user, factors, view)
   if type(factors) == "number" then factors = { factors } end
-  histories[user] = {}
+  histories[user] = { view = view == true, at = {} }
   for _, f in ipairs(factors) do
     local function history(i)
       local name = string.format("temporal.%s%d.", user, f)
       return { value = target{ name .. "value" .. i, format = "rgba32f", scale = 1 / f },
                state = target{ name .. "state" .. i, format = "rg32f", scale = 1 / f } }
     end
-    histories[user][f] = { turn = 0, targets = { history(0), history(1) } }
+    histories[user].at[f] = { turn = 0, targets = { history(0), history(1) } }
   end
 end
 
@@ -100,10 +109,10 @@ function temporal.check(name, o) return options.check(name, temporal.defaults, o
 local function history_of(user, f)
   local all = histories[user]
   if not all then error("temporal: call temporal.create(\"" .. user .. "\", factors) from OnCreate", 3) end
-  local h = all[f]
+  local h = all.at[f]
   if not h then
     local have = {}
-    for k in pairs(all) do have[#have + 1] = k end
+    for k in pairs(all.at) do have[#have + 1] = k end
     table.sort(have)
     error(string.format("temporal: %s has a history at coarse %s, not at coarse %d", user,
                         table.concat(have, ", "), f), 3)
@@ -127,6 +136,7 @@ function temporal.bind(user, inputs, defines, params, o, f)
   defines.TEMPORAL = true
   params.frames, params.epsilon, params.refresh = o.frames, o.epsilon, o.refresh
   params.bias, params.confidence, params.restart = o.bias, o.confidence, restart and 1 or 0
+  params.moving = histories[user].view and o.moving or 0
   return next
 end
 

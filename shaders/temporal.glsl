@@ -25,6 +25,15 @@ uniform sampler2D history, history_state;
 uniform float epsilon = 0.02, frames = 36.0, bias = 0.1, confidence = 0.25;
 uniform int refresh = 32;
 uniform int restart = 0; // 1: the settings changed (temporal.begin), no history is kept
+uniform float moving = 0.0; // > 0: a view-dependent result's most frames while the view changes
+
+// Does the view change this frame, for a result that depends on it
+// (`moving` > 0: ISR's and SSDO's light at a point depends on what the
+// screen shows, where RSM's does not)? Its history then counts at most
+// `moving` frames, so that it follows the view with about that lag, and no
+// pixel counts as converged (a converged one would keep the old view's
+// light until its tile's refresh).
+bool temporal_moving() { return moving > 0.0 && frame.view_proj != frame.prev_view_proj; }
 
 // The history of the pixel at uv whose coarse depth is d (dpt): the
 // pixel's world position through the previous frame's view-projection; kept
@@ -64,19 +73,22 @@ bool temporal_refresh(ivec2 px) {
 // Has the pixel whose history holds n frames converged, so that this
 // frame's samples would not change it? It holds `frames` frames and is not
 // being refreshed. The accumulation then keeps the history as it is.
-bool temporal_converged(float n, ivec2 px) { return n >= max(frames, 1.0) && !temporal_refresh(px); }
+bool temporal_converged(float n, ivec2 px) {
+  return n >= max(frames, 1.0) && !temporal_refresh(px) && !temporal_moving();
+}
 
 // The value to store for a pixel that took fresh samples `cur`: the running
 // mean with its history h of n frames (found: temporal_history) while the
 // confidence holds, else cur alone; `seen` the frames it then holds.
 vec4 temporal_accumulate(vec4 cur, bool found, vec4 h, float n, out float seen) {
-  float most = max(frames, 1.0);
+  bool moved = temporal_moving();
+  float most = moved ? clamp(moving, 1.0, max(frames, 1.0)) : max(frames, 1.0);
   if (found) {
     vec3 a = h.rgb / (1.0 + h.rgb), b = cur.rgb / (1.0 + cur.rgb), diff = abs(a - b);
     float conf = 1.0 - saturate(max(diff.r, max(diff.g, diff.b))) / (1.0 + bias);
     if (conf >= confidence) {
       float held = min(n, most);
-      float w = held >= frames ? 1.0 : held / (held + 1.0);
+      float w = held >= frames && !moved ? 1.0 : held / (held + 1.0);
       seen = min(held + 1.0, most);
       return finite_or_zero(mix(cur, h, w));
     }
