@@ -285,6 +285,14 @@ static void extremes_stay_finite(void **state) {
   r = render_ok(outside, "vpl+esm", NULL);
   gl_result_free(&r);
   lm_scene_destroy(outside);
+  /* A sun's RSM tile at its least and greatest resolution (16 texels; the shadow tile). */
+  lm_scene *canopy = canopy_scene();
+  static const char *const tiles[][2] = {{"rsm.resolution=16", NULL}, {"rsm.resolution=8192", NULL}};
+  for (int i = 0; i < 2; i++) {
+    r = render_ok(canopy, "isr+rsm+esm", tiles[i]);
+    gl_result_free(&r);
+  }
+  lm_scene_destroy(canopy);
 }
 
 
@@ -475,6 +483,9 @@ static void bad_options_name_themselves(void **state) {
       {"vpl+esm", "vpl.threshold=3", "vpl.threshold"}, {"vpl+esm", "vpl.focus=0", "vpl.focus"},
       {"vpl+esm", "vpl.recompute=some", "vpl.recompute"},
       {"rsm+esm", "rsm.temporal.frames=0", "rsm.temporal.frames"},
+      {"rsm+esm", "rsm.resolution=8", "rsm.resolution"}, {"vpl+esm", "vpl.resolution=16.5", "vpl.resolution"},
+      {"lpv+esm", "lpv.resolution=9000", "lpv.resolution"},
+      {"isr+esm", "isr.temporal.moving=-1", "isr.temporal.moving"},
       {"isr+rsm+esm", "rsm.temporal.enabled=true", "isr+rsm+esm takes temporal reuse from isr.temporal"},
       {"isr+rsm+esm", "isr.mode=seed", "isr+rsm+esm needs isr.mode \"physical\""},
   };
