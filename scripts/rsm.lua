@@ -36,13 +36,17 @@ rsm.defaults = {
   rotate = 10,       -- pattern turn a frame in degrees with temporal reuse, 0..180 (the seed: 10;
                      -- its radii shift too); without, the pattern stays (a still camera, a still image)
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
-  coarse = 3,        -- coarse factor a side: 1, 2, 3 or 4 (the seed: 2, half resolution); 3 removes
-                     -- as much error as 2 at the same samples (24: 63.0% and 62.6%) on 2.25
-                     -- times fewer pixels
+  coarse = 0,        -- coarse factor a side: 1, 2, 3 or 4 (the seed: 2, half resolution); 0 (auto): 4
+                     -- from 256 pixels wide, else 3. At the same samples a pixel 3 removed as much
+                     -- error as 2 (24: 63.0% and 62.6%) on 2.25 times fewer pixels, and 4 as much as
+                     -- 3 at 256 x 192 (the reference set: 62.2% and 61.8%) on 1.78 times fewer, but
+                     -- less below (160 x 120: 61.3% and 61.8%; isr+rsm+esm, whose grid it bounds,
+                     -- 72.5% and 73.4%, at 256 x 192 74.5% and 75.7% in 2.34x dl+esm's frame time
+                     -- against 2.80x; docs/gi-combined.md)
   blur = 4,          -- Gaussian taps each side at coarse size, 0..32; with temporal reuse, a pixel
                      -- whose history holds n frames takes blur / n^(1/4) (isr.blur's age)
   temporal = {},     -- temporal reuse (scripts/temporal.lua): enabled, frames, epsilon, bias;
-                     -- its history is at the default coarse factor (pp.lua's OnCreate)
+                     -- its history is declared at each coarse factor (pp.lua's OnCreate)
 }
 for k, v in pairs(temporal.defaults) do rsm.defaults.temporal[k] = v end
 
@@ -54,16 +58,18 @@ local rules = {
   steps = options.whole(0, 32),
   rotate = options.number(0, 180),
   k = options.number(0, 16),
-  coarse = options.one_of(1, 2, 3, 4),
+  coarse = options.one_of(0, 1, 2, 3, 4),
   blur = options.whole(0, 32),
   temporal = function(v) if type(v) ~= "table" then return "a table of temporal reuse options" end end,
 }
 
--- Checked options (errors name the option, pointing at the caller's caller);
+-- Checked options (errors name the option, pointing at the caller's caller),
+-- with the auto coarse factor resolved for this output size;
 -- shadow.render(..., o) then writes the maps.
 function rsm.check(o)
   o = options.check("rsm", rsm.defaults, o, rules, 3)
   o.temporal = temporal.check("rsm.temporal", o.temporal)
+  if o.coarse == 0 then o.coarse = output_size() >= 256 and 4 or 3 end
   return o
 end
 
