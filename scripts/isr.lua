@@ -191,6 +191,19 @@ function isr.render(G, direct, o, light)
   local f = factor(o)
   if light.rsm and o.coarse == 0 then f = math.max(f, light.rsm.coarse) end
   local C = seed and isr.coarse_gbuffer(G, direct, f) or isr.coarse_view(G, direct, f, "isr")
+  local params = { ambient = light.ambient, background = light.background, view = views[o.view] }
+  if seed then
+    params.k_isr, params.k_ssao = seed.k_isr, seed.k_ssao
+  else
+    params.k = o.k
+  end
+  -- With temporal reuse the final E and the grid's depth are kept (temporal.kept); once settled (a still
+  -- world, every pixel converged: temporal.settled) the frame composites them without the passes.
+  local kept = not seed and o.temporal.enabled and temporal.kept("isr", f) or nil
+  if kept then
+    C.z = kept.z
+    if temporal.settled(o.temporal) then return isr.composite(G, direct, C, kept.value, params, false, light.sky) end
+  end
   local E, E1, H, first
   local hits = seed and 0 or hit_targets(o)
   -- Temporal reuse: every step reads the history (all skip the same converged pixels), the last
@@ -221,7 +234,7 @@ function isr.render(G, direct, o, light)
       local from = { clr = C.clr, mat = C.mat, first = E1, previous = E, z = history and C.z or nil }
       for k = 1, hits do from["hits" .. (k - 1)] = H[k] end
       local defines, params = { HITS = hits, STRIDE = C.stride }, { samples = o.samples }
-      E = coarse_target("isr.e" .. b, f)
+      E = kept and b == steps and o.blur == 0 and kept.value or coarse_target("isr.e" .. b, f)
       local out = { E }
       with_history(from, defines, params, out, b == steps)
       pass{ name, shader = "isr_bounce.frag", inputs = from, params = params, defines = defines, out = out,
@@ -231,7 +244,7 @@ function isr.render(G, direct, o, light)
       -- The later bounces add to the first E (isr_bounce.frag), or march from it: 32-bit floats in
       -- either case, so that both give the same sum.
       E = b == 1 and o.bounces > 1 and target{ "isr.e1", format = "rgba32f", scale = 1 / f }
-          or coarse_target("isr.e" .. b, f)
+          or kept and b == steps and o.blur == 0 and kept.value or coarse_target("isr.e" .. b, f)
       local out = { E, b == 1 and C.z or nil }
       if b == 1 and hits > 0 then
         E1, H = E, {}
@@ -253,13 +266,7 @@ function isr.render(G, direct, o, light)
             fetches = fetches }
     end
   end
-  E = isr.blur(E, C, f, o.blur, history and history.state)
-  local params = { ambient = light.ambient, background = light.background, view = views[o.view] }
-  if seed then
-    params.k_isr, params.k_ssao = seed.k_isr, seed.k_ssao
-  else
-    params.k = o.k
-  end
+  E = isr.blur(E, C, f, o.blur, history and history.state, kept and kept.value)
   return isr.composite(G, direct, C, E, params, seed ~= nil, light.sky)
 end
 
@@ -269,7 +276,8 @@ end
 -- (optional): temporal reuse's history state (g: the frames a pixel holds,
 -- temporal.bind), whose pixels of n frames take radius / n^(1/4) taps
 -- (blur.frag): a new pixel is blurred in full, a converged one a little.
-function isr.blur(E, C, f, radius, age)
+-- out (optional): the target the last pass writes.
+function isr.blur(E, C, f, radius, age, out)
   if radius == 0 then return E end
   local mask = not C.z and C.mat or nil -- a view's depth is its mask too
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
@@ -278,7 +286,7 @@ function isr.blur(E, C, f, radius, age)
               inputs = { src = E, mask = mask, depth = C.z or C.dpt, age = age },
               params = { axis = axis[2], radius = radius },
               defines = { MASK = mask ~= nil, DEPTH = true, AGE = age ~= nil },
-              out = coarse_target(name, f) }
+              out = axis[1] == "y" and out or coarse_target(name, f) }
   end
   return E
 end

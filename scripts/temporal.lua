@@ -34,6 +34,9 @@ temporal.defaults = {
                     -- After a 12-frame slide (test_rsm) ISR's frame lay 0.82%, 1.18%, 1.61% and 1.91%
                     -- of the image's mean from a still camera's at 2, 4, 8 and 16, 2.44% at 0; 4
                     -- keeps the moving image's noise near a 4-frame average
+  skip = true,      -- a settled frame (the world and settings unchanged for `frames` frames: every
+                    -- pixel converged) keeps the last result and runs none of the GI passes (ISR's;
+                    -- false: they run, each pixel keeping its history)
 }
 
 local rules = {
@@ -44,10 +47,12 @@ local rules = {
   confidence = options.number(0, 1),
   refresh = options.whole(0, 1024),
   moving = options.number(0, 1024),
+  skip = options.boolean,
 }
 
-local histories = {} -- user -> { view = bool, at = { [coarse factor] = { targets = {a, b}, turn = 0 } } }
+local histories = {} -- user -> { view = bool, at = { [coarse factor] = { targets = {a, b}, turn = 0, kept = } } }
 local settings, restart = nil, false -- a copy of the last frame's settings (temporal.begin), and whether they changed
+local quiet = 0 -- frames in a row before this one with the same world and settings
 
 -- Do two values hold the same content (tables compared key by key)?
 -- Walked each frame instead of a text key: building and sorting one took
@@ -82,23 +87,40 @@ end
 function temporal.begin(settings_now)
   restart = settings ~= nil and not same(settings_now, settings)
   if restart or not settings then settings = copy(settings_now) end
+  quiet = (restart or still_frames() == 0) and 0 or quiet + 1
 end
+
+-- May a user keep last frame's result instead of running its passes? When
+-- the world and the settings have stayed the same for `frames` frames in a
+-- row (still_frames, temporal.begin), every pixel that kept its history
+-- holds `frames` frames: converged, it takes no samples and its value
+-- stays as it is, and a refreshed tile finds no change to see (nothing
+-- changed), so the passes would give the same result again (a pixel whose
+-- noise restarted it since keeps the value it has). o: the user's checked
+-- options.
+function temporal.settled(o) return o.enabled and o.skip and quiet >= o.frames end
 
 -- Declares the history of `user` at 1 / f of the output for each coarse
 -- factor f of `factors` (a number or a list); from OnCreate. Only the
 -- factor a frame uses is made: a persistent target no pass reads or writes
--- has no texture. view: the result depends on the view (a screen-space
--- gather), so a moving camera caps its history (the `moving` option).
-function temporal.create(user, factors, view)
+-- has no texture. how (optional): { view = the result depends on the view
+-- (a screen-space gather), so a moving camera caps its history (the
+-- `moving` option); keep = the user's final result and its grid's depth are
+-- kept too (temporal.kept), so that a settled frame can skip its passes }.
+function temporal.create(user, factors, how)
   if type(factors) == "number" then factors = { factors } end
-  histories[user] = { view = view == true, at = {} }
+  how = how or {}
+  histories[user] = { view = how.view == true, at = {} }
   for _, f in ipairs(factors) do
     local function history(i)
       local name = string.format("temporal.%s%d.", user, f)
       return { value = target{ name .. "value" .. i, format = "rgba32f", scale = 1 / f },
                state = target{ name .. "state" .. i, format = "rg32f", scale = 1 / f } }
     end
-    histories[user].at[f] = { turn = 0, targets = { history(0), history(1) } }
+    local name = string.format("temporal.%s%d.", user, f)
+    histories[user].at[f] = { turn = 0, targets = { history(0), history(1) },
+                              kept = how.keep and { value = target{ name .. "kept", format = "rgba16f", scale = 1 / f },
+                                                    z = target{ name .. "z", format = "r32f", scale = 1 / f } } }
   end
 end
 
@@ -119,6 +141,11 @@ local function history_of(user, f)
   end
   return h
 end
+
+-- The targets `user` (created with keep) writes its final result and its
+-- grid's depth to at coarse factor f, where a settled frame reads them:
+-- { value = rgba16f, z = r32f }, persistent.
+function temporal.kept(user, f) return history_of(user, f).kept end
 
 -- Adds to a GI pass's inputs, defines and params the history of `user`
 -- at coarse factor f (TEMPORAL, temporal.glsl: the pass accumulates, and

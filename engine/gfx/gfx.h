@@ -157,6 +157,8 @@ void lm_programs_clear(void);
  * its next use; when that fails the old program stays in use and
  * lm_programs_error says why (file:line) until a later rebuild succeeds. */
 void lm_programs_invalidate(void);
+/* How many times lm_programs_invalidate ran: a change means the shaders may draw otherwise. */
+unsigned lm_programs_generation(void);
 /* The first failed rebuild's message since the last invalidation, or NULL. */
 const char *lm_programs_error(void);
 int lm_program_count(void);

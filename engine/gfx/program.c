@@ -242,7 +242,12 @@ lm_program *lm_program_get(const char *vert, const char *frag, const char *defin
   return p;
 }
 
+static unsigned generation;
+
+unsigned lm_programs_generation(void) { return generation; }
+
 void lm_programs_invalidate(void) {
+  generation++;
   for (int i = 0; i < cache_count; i++) {
     cache[i].stale = true;
     free(cache[i].error);

@@ -46,6 +46,8 @@ struct lm_renderer {
   uint64_t trace_hash; /* geometry_hash when it was built or refitted */
   tile_cache tiles;
   uint64_t casters_hash; /* this frame's caster_hash */
+  uint64_t world;  /* the last frame's world_hash */
+  int still;       /* frames in a row before this one whose world_hash was this one's */
   long executions; /* frames executed, never reset (tile_cache.execution) */
 };
 
@@ -435,6 +437,23 @@ static bool add_output_stage(lm_renderer *r, lm_graph *g, lm_pipeline *p, int pr
   return true;
 }
 
+/* A hash of what a frame draws besides its script's settings: the pipeline,
+ * the scene's casters and materials (caster_hash), its lights, the camera,
+ * the output size and the shaders' generation (not the time: a GI pass's
+ * pattern turns each frame, but a still world's converged result stays). */
+static uint64_t world_hash(const lm_renderer *r, const lm_pipeline *p, const lm_frame_data *frame) {
+  lm_light_data lights[MAX_LIGHTS];
+  int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
+  unsigned shaders = lm_programs_generation();
+  uint64_t h = lm_hash(&p, sizeof p, caster_hash(r->desc.scene));
+  h = lm_hash(lights, sizeof *lights * (size_t)n, lm_hash(&n, sizeof n, h));
+  h = lm_hash(frame->view_proj, sizeof frame->view_proj, h);
+  h = lm_hash(frame->camera_pos, sizeof frame->camera_pos, h);
+  h = lm_hash(frame->clip, sizeof frame->clip, h);
+  h = lm_hash(frame->output_size, sizeof frame->output_size, h);
+  return lm_hash(&shaders, sizeof shaders, h);
+}
+
 /* Records (OnRender) and compiles one frame of pipeline p into g. */
 static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_error *err) {
   if (!lm_scene_camera_check(r->desc.scene, r->desc.camera, err)) return false;
@@ -442,7 +461,10 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
   lm_frame_data *frame = &r->camera;
   lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, frame);
   lm_shadow_plan_free(&r->shadows);
-  lm_pipeline_set_scene(p, r->desc.scene, frame, &r->shadows);
+  uint64_t world = world_hash(r, p, frame);
+  r->still = r->frame > 0 && world == r->world ? r->still + 1 : 0;
+  r->world = world;
+  lm_pipeline_set_scene(p, r->desc.scene, frame, &r->shadows, r->still);
   double t0 = lm_cpu_ms();
   int presented = -1;
   if (!lm_pipeline_record(p, g, &presented, err)) return false;

@@ -701,6 +701,15 @@ static int l_output_size(lua_State *L) {
   return 2;
 }
 
+/* still_frames(): how many frames in a row before this one drew the same
+ * world (pipeline, scene content, lights, camera, output size, shaders);
+ * 0 when anything changed since the last frame. */
+static int l_still_frames(lua_State *L) {
+  lm_pipeline *p = recording(L, "still_frames");
+  lua_pushinteger(L, p->in_create ? 0 : p->still);
+  return 1;
+}
+
 void lm_script_open_api(lua_State *L) {
   luaL_newmetatable(L, PLAN_META);
   lua_pushcfunction(L, l_plan_index);
@@ -713,7 +722,7 @@ void lm_script_open_api(lua_State *L) {
   lua_setfield(L, -2, "__index");
   lua_pop(L, 1);
   static const luaL_Reg api[] = {{"target", l_target}, {"scene", l_scene}, {"pass", l_pass},
-                                 {"present", l_present}, {"output_size", l_output_size},
+                                 {"present", l_present}, {"output_size", l_output_size}, {"still_frames", l_still_frames},
                                  {"shadow_plan", l_shadow_plan}, {"sky_sh", l_sky_sh}, {"cpu", l_cpu},
                                  {"scene_reflective", l_scene_reflective}, {"points", l_points},
                                  {"scene_bounds", l_scene_bounds}, {NULL, NULL}};
