@@ -23,13 +23,6 @@ float rsm_texel_area(ShadowView sv, vec2 t, vec3 q, float tile) {
   return area;
 }
 
-// The depth buffer's texel under screen position s (0..1): its texel, not
-// a filtered blend, which across an edge would be a depth of neither side.
-float rsm_depth_at(sampler2D dpt, vec2 s) {
-  ivec2 size = textureSize(dpt, 0);
-  return texelFetch(dpt, min(ivec2(s * vec2(size)), size - 1), 0).r;
-}
-
 // Does the camera see q: on screen and within 2% of the depth buffer's
 // depth (`dpt`, the G-buffer's) there? The combined techniques leave such
 // senders to the screen-space pass (docs/gi-combined.md).
@@ -38,7 +31,7 @@ bool rsm_seen(sampler2D dpt, vec3 q) {
   if (c.w <= 1e-12) return false;
   vec2 s = c.xy / c.w * 0.5 + 0.5;
   if (any(lessThan(s, vec2(0.0))) || any(greaterThan(s, vec2(1.0)))) return false;
-  float z = c.w * frame.clip.z, zb = rsm_depth_at(dpt, s); // a perspective's clip w is the view depth
+  float z = c.w * frame.clip.z, zb = texture(dpt, s).r; // a perspective's clip w is the view depth
   return abs(z - zb) <= 0.02 * max(zb, 1e-12);
 }
 
@@ -85,9 +78,8 @@ bool rsm_blocked(vec3 p, vec3 q, sampler2D dpt, sampler2D mat) {
     if (c.w <= 1e-12) continue;
     vec2 s = c.xy / c.w * 0.5 + 0.5;
     if (any(lessThan(s, vec2(0.0))) || any(greaterThan(s, vec2(1.0)))) continue;
-    ivec2 size = textureSize(dpt, 0), t = min(ivec2(s * vec2(size)), size - 1);
-    float z = c.w * frame.clip.z, zb = texelFetch(dpt, t, 0).r; // a perspective's clip w is the view depth
-    if (texelFetch(mat, t, 0).a >= 0.5 && z > zb * 1.02) return true;
+    float z = c.w * frame.clip.z, zb = texture(dpt, s).r; // a perspective's clip w is the view depth
+    if (texture(mat, s).a >= 0.5 && z > zb * 1.02) return true;
   }
   return false;
 }
