@@ -112,12 +112,11 @@ function temporal.create(user, factors, how)
   how = how or {}
   histories[user] = { view = how.view == true, at = {} }
   for _, f in ipairs(factors) do
+    local name = string.format("temporal.%s%d.", user, f)
     local function history(i)
-      local name = string.format("temporal.%s%d.", user, f)
       return { value = target{ name .. "value" .. i, format = "rgba32f", scale = 1 / f },
                state = target{ name .. "state" .. i, format = "rg32f", scale = 1 / f } }
     end
-    local name = string.format("temporal.%s%d.", user, f)
     histories[user].at[f] = { turn = 0, targets = { history(0), history(1) },
                               kept = how.keep and { value = target{ name .. "kept", format = "rgba16f", scale = 1 / f },
                                                     z = target{ name .. "z", format = "r32f", scale = 1 / f } } }
