@@ -129,6 +129,16 @@ function isr.coarse_view(G, direct, f, user)
            z = target{ user .. ".z", format = "r32f", scale = 1 / f } }
 end
 
+-- The coarse factor of an off-screen gather (rsm.coarse, vpl.coarse): c, or for
+-- 0 (auto) 4 from 256 pixels wide, else 3. Its light is smooth, so at 256 x 192
+-- 4 removes as much of dl+esm's indirect error on the reference set as 3 (rsm+esm
+-- 62.2% and 61.8%, vpl+esm 49.9% and 49.8%) on 1.78 times fewer pixels; below,
+-- 4 loses (160 x 120: rsm+esm 61.3% and 61.8%; at 64 x 48 test_gi_isr_rsm fails).
+function isr.gather_factor(c)
+  if c > 0 then return c end
+  return output_size() >= 256 and 4 or 3
+end
+
 -- The coarse factor: o.coarse, or for 0 the auto factor at this output size.
 -- Below 256 pixels wide, 3: on the reference set at 160 x 120 (tools/fidelity.sh)
 -- it removes 42.1% of dl+esm's indirect error against 42.9% at 2, in 80% of the

@@ -37,12 +37,12 @@ rsm.defaults = {
                      -- its radii shift too); without, the pattern stays (a still camera, a still image)
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
   coarse = 0,        -- coarse factor a side: 1, 2, 3 or 4 (the seed: 2, half resolution); 0 (auto): 4
-                     -- from 256 pixels wide, else 3. At the same samples a pixel 3 removed as much
-                     -- error as 2 (24: 63.0% and 62.6%) on 2.25 times fewer pixels, and 4 as much as
-                     -- 3 at 256 x 192 (the reference set: 62.2% and 61.8%) on 1.78 times fewer, but
-                     -- less below (160 x 120: 61.3% and 61.8%; isr+rsm+esm, whose grid it bounds,
-                     -- 72.5% and 73.4%, at 256 x 192 74.5% and 75.7% in 2.34x dl+esm's frame time
-                     -- against 2.80x; docs/gi-combined.md)
+                     -- from 256 pixels wide, else 3 (isr.gather_factor). At the same samples a pixel
+                     -- 3 removed as much error as 2 (24: 63.0% and 62.6%) on 2.25 times fewer pixels,
+                     -- and 4 as much as 3 at 256 x 192 (the reference set: 62.2% and 61.8%) on 1.78
+                     -- times fewer, but less below (160 x 120: 61.3% and 61.8%; isr+rsm+esm, whose
+                     -- grid it bounds, 72.5% and 73.4%, at 256 x 192 74.5% and 75.7% in 2.34x dl+esm's
+                     -- frame time against 2.80x; docs/gi-combined.md)
   blur = 4,          -- Gaussian taps each side at coarse size, 0..32; with temporal reuse, a pixel
                      -- whose history holds n frames takes blur / n^(1/4) (isr.blur's age)
   temporal = {},     -- temporal reuse (scripts/temporal.lua): enabled, frames, epsilon, bias;
@@ -69,7 +69,7 @@ local rules = {
 function rsm.check(o)
   o = options.check("rsm", rsm.defaults, o, rules, 3)
   o.temporal = temporal.check("rsm.temporal", o.temporal)
-  if o.coarse == 0 then o.coarse = output_size() >= 256 and 4 or 3 end
+  o.coarse = isr.gather_factor(o.coarse)
   return o
 end
 

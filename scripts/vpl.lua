@@ -35,10 +35,12 @@ vpl.defaults = {
                      -- bilinear weights of those within it renormalized: the same error on the
                      -- reference set (49.1% of dl+esm's indirect error removed, 49.0% with "any")
                      -- at 2.63x dl+esm's frame time at 256 x 192 against 3.41x (docs/gi-combined.md)
-  coarse = 3,        -- coarse factor a side: 1, 2, 3 or 4 (the seed: 2); the refinement redoes the
-                     -- discontinuities at full size, so the error hardly depends on it (reference
-                     -- set: 49.1%, 49.0%, 49.1% of dl+esm's indirect error removed at 2, 3, 4),
-                     -- and 3 took about three quarters of 2's frame time at 256 x 192
+  coarse = 0,        -- coarse factor a side: 1, 2, 3 or 4 (the seed: 2); 0 (auto): 4 from 256 pixels
+                     -- wide, else 3 (isr.gather_factor). The refinement redoes the discontinuities at
+                     -- full size, so the error hardly depends on it (reference set at 160 x 120:
+                     -- 49.1%, 49.0%, 49.1% of dl+esm's indirect error removed at 2, 3, 4; at 256 x 192
+                     -- 49.8% at 3, 49.9% at 4), and 4 took 2.20-2.22x dl+esm's frame time at 256 x 192
+                     -- where 3 took 2.26-2.50x in the same runs (3 about three quarters of 2's)
   reach = 3,         -- a directional light's RSM tile, as rsm.reach, 1..64
   resolution = 128,  -- its texels a side, as rsm.resolution, 16..8192
   focus = 1,         -- the indirect lights of a directional light's tile lie in its central part
@@ -51,15 +53,20 @@ local rules = {
   negative = options.whole(0, 4096),
   threshold = options.number(0, 2),
   recompute = options.one_of("any", "all"),
-  coarse = options.one_of(1, 2, 3, 4),
+  coarse = options.one_of(0, 1, 2, 3, 4),
   reach = options.number(1, 64),
   resolution = options.whole(16, 8192),
   focus = options.number(0.05, 64),
   k = options.number(0, 16),
 }
 
--- Checked options (errors point at the caller's caller).
-function vpl.check(o) return options.check("vpl", vpl.defaults, o, rules, 3) end
+-- Checked options (errors point at the caller's caller), with the auto
+-- coarse factor resolved for this output size.
+function vpl.check(o)
+  o = options.check("vpl", vpl.defaults, o, rules, 3)
+  o.coarse = isr.gather_factor(o.coarse)
+  return o
+end
 
 -- Records VPL lighting of G from the shadow atlas and RSM targets R, with
 -- checked options o and light = { ambient = {r, g, b}, background = {r, g,
