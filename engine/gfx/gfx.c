@@ -327,6 +327,10 @@ void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const f
   m->index_count = index_count;
 }
 
+void lm_mesh_update_vertices(lm_mesh *m, const float *vertices, int vertex_count) {
+  glNamedBufferSubData(m->vbo, 0, (GLsizeiptr)vertex_count * 8 * sizeof(float), vertices);
+}
+
 void lm_mesh_destroy(lm_mesh *m) {
   if (m->vao) glDeleteVertexArrays(1, &m->vao);
   if (m->vbo) glDeleteBuffers(1, &m->vbo);

@@ -192,6 +192,8 @@ typedef struct lm_mesh { uint32_t vao, vbo, tbo, ibo; int index_count; } lm_mesh
 void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const float *tangents,
                     const uint32_t *indices, int index_count);
 void lm_mesh_destroy(lm_mesh *m);
+/* Replaces the interleaved vertices (the same count as created): a deformed mesh's new pose. */
+void lm_mesh_update_vertices(lm_mesh *m, const float *vertices, int vertex_count);
 /* One instance of a drawn mesh: attributes 3-6 (mat4 instance_model, the
  * columns) and 7-9 (mat3 instance_normal, the model matrix's inverse
  * transpose), stepping once an instance. */

@@ -1,4 +1,4 @@
-#include "scene/scene.h"
+#include "scene/scene_internal.h"
 
 #include <cglm/cglm.h>
 #include <float.h>
@@ -10,6 +10,7 @@
 lm_scene *lm_scene_create(const char *name) {
   lm_scene *s = lm_alloc(sizeof *s);
   snprintf(s->name, sizeof s->name, "%s", name);
+  s->animation = LM_ANIM_NONE;
   return s;
 }
 
@@ -20,7 +21,10 @@ void lm_scene_destroy(lm_scene *s) {
     free(s->meshes[i].vertices);
     free(s->meshes[i].tangents);
     free(s->meshes[i].indices);
+    lm_scene_mesh_free_deform(&s->meshes[i]);
   }
+  for (int i = 0; i < s->node_count; i++) free(s->nodes[i].weights);
+  lm_scene_free_animations(s);
   for (int i = 0; i < s->texture_count; i++) {
     if (s->uploaded) lm_texture_destroy(&s->textures[i].gpu);
     free(s->textures[i].rgba);
@@ -97,6 +101,7 @@ int lm_scene_add_node(lm_scene *s, const char *name, int parent, const float loc
   memcpy(n->local, local, sizeof n->local);
   n->mesh = mesh;
   n->material = material;
+  n->skin = -1;
   return s->node_count - 1;
 }
 
@@ -116,12 +121,13 @@ int lm_scene_add_root(lm_scene *s, const char *name, const float local[16]) {
   for (int i = 1; i < s->node_count; i++) s->nodes[i].parent = s->nodes[i].parent >= 0 ? s->nodes[i].parent + 1 : 0;
   for (int i = 0; i < s->light_count; i++) s->lights[i].node += s->lights[i].node >= 0;
   for (int i = 0; i < s->camera_count; i++) s->cameras[i].node += s->cameras[i].node >= 0;
+  lm_scene_shift_animation_nodes(s, 0, 1);
   lm_node *n = &s->nodes[0];
   memset(n, 0, sizeof *n);
   snprintf(n->name, sizeof n->name, "%s", name);
   n->parent = -1;
   memcpy(n->local, local, sizeof n->local);
-  n->mesh = n->material = -1;
+  n->mesh = n->material = n->skin = -1;
   lm_scene_update(s);
   return 0;
 }
@@ -244,6 +250,16 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
   }
   s->uploaded = true;
   return true;
+}
+
+void lm_scene_upload_deformed(lm_scene *s) {
+  if (!s->uploaded) return;
+  for (int i = 0; i < s->mesh_count; i++) {
+    lm_scene_mesh *m = &s->meshes[i];
+    if (!m->dirty) continue;
+    lm_mesh_update_vertices(&m->gpu, m->vertices, m->vertex_count);
+    m->dirty = false;
+  }
 }
 
 bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err) {

@@ -114,13 +114,27 @@ typedef struct lm_camera {
 
 typedef struct lm_scene_mesh {
   char name[LM_NAME_MAX];
-  float *vertices; /* position(3) normal(3) uv(2) */
+  float *vertices; /* position(3) normal(3) uv(2); a deformed mesh's: its pose at the scene's time */
   float *tangents; /* xyz, handedness w (glTF TANGENT) a vertex; NULL: none (pbr.frag derives a frame) */
   int vertex_count;
   uint32_t *indices;
   int index_count;
   float bounds[2][3]; /* min, max of the finite positions, local space */
   lm_mesh gpu;
+  /* Deformation (glTF morph targets and skins), evaluated on the CPU by
+   * lm_scene_set_time into `vertices` from `rest`; NULL / 0 when none. A
+   * deformed mesh belongs to one node (the loader gives each skinned or
+   * morphed node its own copy), so its vertices are that node's pose. */
+  float *rest;             /* the undeformed vertices, 8 floats each as `vertices` */
+  float *prev_positions;   /* xyz a vertex at the previous time lm_scene_set_time posed (velocities) */
+  int target_count;        /* morph targets */
+  float *target_positions; /* target_count * vertex_count * 3 deltas */
+  float *target_normals;   /* the same, or NULL */
+  float *default_weights;  /* target_count: the mesh's `weights` (0 when absent) */
+  int influence_sets;      /* JOINTS_n / WEIGHTS_n pairs: 4 influences each */
+  uint16_t *joints;        /* vertex_count * 4 * influence_sets, indices into the skin's joints */
+  float *joint_weights;    /* the same layout, normalized to sum 1 a vertex */
+  bool dirty;              /* vertices changed since the last upload (lm_scene_upload_deformed) */
 } lm_scene_mesh;
 
 typedef struct lm_node {
@@ -129,7 +143,43 @@ typedef struct lm_node {
   float local[16];       /* column-major */
   float world[16];       /* by lm_scene_update */
   int mesh, material;    /* -1: none */
+  /* The rest pose as glTF's T * R * S (what an animation channel replaces);
+   * trs false: `local` is a matrix and no channel may target the node. */
+  bool trs;
+  float translation[3], rotation[4], scale[3]; /* rotation: x y z w, unit */
+  int skin;              /* index into the scene's skins; -1: none */
+  float *weights;        /* morph weights, its mesh's target_count; NULL: none */
 } lm_node;
+
+/* ---- time: glTF animation (engine/scene/anim.c) ------------------------ */
+typedef enum lm_anim_path { LM_ANIM_TRANSLATION, LM_ANIM_ROTATION, LM_ANIM_SCALE, LM_ANIM_WEIGHTS } lm_anim_path;
+typedef enum lm_anim_interp { LM_ANIM_STEP, LM_ANIM_LINEAR, LM_ANIM_CUBICSPLINE } lm_anim_interp;
+typedef struct lm_anim_channel {
+  int node;              /* the lm node it moves (for weights: the node whose mesh morphs) */
+  lm_anim_path path;
+  lm_anim_interp interp;
+  int count;             /* keys */
+  int width;             /* floats a value: 3 (translation, scale), 4 (rotation), target count (weights) */
+  float *times;          /* count, finite, strictly increasing */
+  float *values;         /* count * width; CUBICSPLINE: count * 3 * width (in-tangent, value, out-tangent) */
+} lm_anim_channel;
+typedef struct lm_animation {
+  char name[LM_NAME_MAX];
+  lm_anim_channel *channels;
+  int channel_count;
+  float start, end;      /* first and last key time over its channels */
+} lm_animation;
+/* glTF skin: joint j's matrix is inverse(world of the skinned node) x world
+ * of joints[j] x inverse_bind[j]. */
+#define LM_SKIN_MAX_JOINTS 256
+typedef struct lm_skin {
+  char name[LM_NAME_MAX];
+  int *joints;           /* lm nodes */
+  float *inverse_bind;   /* joint_count * 16, column-major (identity when the file has none) */
+  int joint_count;
+} lm_skin;
+#define LM_ANIM_ALL (-1)  /* every animation of the scene at once */
+#define LM_ANIM_NONE (-2) /* the rest pose */
 
 typedef struct lm_scene {
   char name[LM_NAME_MAX];
@@ -146,8 +196,30 @@ typedef struct lm_scene {
   int camera_count, camera_cap;
   lm_scene_texture *textures;
   int texture_count, texture_cap;
+  lm_animation *animations;
+  int animation_count, animation_cap;
+  lm_skin *skins;
+  int skin_count, skin_cap;
+  double time;           /* the seconds lm_scene_set_time last posed */
+  int animation;         /* and its animation (LM_ANIM_NONE before any) */
   bool uploaded;
 } lm_scene;
+
+/* The animation `spec` names: its name, its index ("0"), or "all"
+ * (LM_ANIM_ALL). -3 with a message listing the scene's animations. */
+int lm_scene_find_animation(const lm_scene *s, const char *spec, lm_error *err);
+/* First and last key time of animation `anim` (LM_ANIM_ALL: over all); 0, 0 when none. */
+void lm_scene_animation_range(const lm_scene *s, int anim, float *start, float *end);
+/* Poses the scene at `seconds` of animation `anim` (LM_ANIM_ALL, or
+ * LM_ANIM_NONE for the rest pose): node transforms and morph weights from
+ * the channels (times before the first key hold the first value, after the
+ * last the last), world transforms, then skinned and morphed vertices and
+ * their bounds on the CPU (meshes marked dirty). The pose it replaces becomes
+ * the previous one (mesh prev_positions), for velocities. Never produces a
+ * non-finite value from finite keys. */
+void lm_scene_set_time(lm_scene *s, int anim, double seconds);
+/* True when the scene has any animation (and so any node that can move). */
+bool lm_scene_animated(const lm_scene *s);
 
 lm_scene *lm_scene_create(const char *name);
 void lm_scene_destroy(lm_scene *s);
@@ -223,6 +295,8 @@ bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err)
 
 /* ---- rendering (needs a GL context) ------------------------------------ */
 bool lm_scene_upload(lm_scene *s, lm_error *err);
+/* Uploads the vertices of the deformed meshes that lm_scene_set_time changed. */
+void lm_scene_upload_deformed(lm_scene *s);
 /* Frame block for camera `cam` at an output of width x height. */
 void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_frame_data *out);
 /* Fills up to `max` lights; returns how many. */
