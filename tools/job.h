@@ -31,6 +31,12 @@ typedef struct job {
 
 typedef struct job_view {
   int scene, camera, size, technique;
+  /* A sequence's frame (a job's `time = { start, stop, fps }`): frame 0 ..
+   * frames - 1 at `time` seconds; a still job's views are frame 0 at its
+   * one time. Views of one place (scene, size, technique, camera) differing
+   * only in frame are one sequence, listed in frame order. */
+  int frame;
+  double time;
   char output[1024];
 } job_view;
 
