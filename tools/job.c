@@ -524,7 +524,7 @@ bool job_views(job *j, bool all_techniques, job_view **out, int *count, lm_error
       for (int t = 0; t < techniques; t++)
         for (int c = 0; c < j->scenes[si].camera_count; c++) {
           job_view *v = &views[n];
-          *v = (job_view){si, j->scenes[si].first_camera + c, z, t, ""};
+          *v = (job_view){.scene = si, .camera = j->scenes[si].first_camera + c, .size = z, .technique = t};
           if (!all_techniques) { /* places only: no output pattern */
             n++;
             continue;
