@@ -100,8 +100,11 @@ bool lm_context_create_headless(const lm_context_desc *desc, lm_error *err) {
     return false;
   }
   lm_error tried = {{0}};
-  if (strcmp(want, "surfaceless") && has_ext(client, "EGL_EXT_platform_device") &&
-      has_ext(client, "EGL_EXT_device_enumeration")) {
+  /* NVIDIA's libEGL lists EGL_EXT_device_base, which holds enumeration and
+   * query, instead of EGL_EXT_device_enumeration (seen with driver 580). */
+  bool enumerate = has_ext(client, "EGL_EXT_device_enumeration") || has_ext(client, "EGL_EXT_device_base");
+  bool device_platform = has_ext(client, "EGL_EXT_platform_device") && enumerate;
+  if (strcmp(want, "surfaceless") && device_platform) {
     EGLDisplay d = device_display();
     if (d != EGL_NO_DISPLAY && make_context(d, &tried)) {
       ctx.platform = "egl-device";
@@ -109,7 +112,8 @@ bool lm_context_create_headless(const lm_context_desc *desc, lm_error *err) {
     }
     if (d == EGL_NO_DISPLAY) lm_error_set(&tried, "EGL device platform: no hardware device");
   } else if (!strcmp(want, "device")) {
-    lm_error_set(&tried, "EGL: EGL_EXT_platform_device is missing");
+    lm_error_set(&tried, "EGL: %s is missing", enumerate ? "EGL_EXT_platform_device"
+                                                          : "EGL_EXT_device_enumeration (or EGL_EXT_device_base)");
   }
   if (!strcmp(want, "device")) {
     lm_error_set(err, "%s", tried.msg);
