@@ -155,6 +155,143 @@ static void heatmap_ramp(void **state) {
   assert_float_equal(lm_metrics_max_pixel_error(&a, &b), 2.0, 1e-12);
 }
 
+/* A still sequence, Limn's frames identical and the reference's too (but
+ * not Limn's): no pair changes, so flicker is exactly 0 however far apart
+ * Limn and the reference are. */
+static void flicker_of_a_still_sequence_is_zero(void **state) {
+  (void)state;
+  float pl[] = {0.1f, 0.2f, 0.3f, 0.9f, 0.8f, 0.7f}, pr[] = {0.5f, 0.5f, 0.5f, 0.0f, 1.0f, 0.25f};
+  float frames[4][2][6]; /* four frames, each its own copy of Limn's and the reference's */
+  lm_image l[4], r[4];
+  for (int t = 0; t < 4; t++) {
+    memcpy(frames[t][0], pl, sizeof pl);
+    memcpy(frames[t][1], pr, sizeof pr);
+    l[t] = img(2, 1, 3, frames[t][0]), r[t] = img(2, 1, 3, frames[t][1]);
+  }
+  lm_metrics m;
+  lm_metrics_compute(&l[3], &r[3], &m);
+  assert_true(m.mean_error > 0.2);
+  for (int t = 1; t < 4; t++) assert_float_equal(lm_metrics_flicker(&l[t - 1], &l[t], &r[t - 1], &r[t]), 0.0, 0);
+}
+
+/* Limn's red alternates between 0.25 and 0.75 every frame, green and blue
+ * hold: each pair changes one of 3 values by 0.5, so against a still
+ * reference the flicker is 0.5 / 3; against a reference alternating the
+ * other way (change -0.5 where Limn's is +0.5) it is 1 / 3. */
+static void flicker_of_an_alternating_pattern_by_hand(void **state) {
+  (void)state;
+  float lo[] = {0.25f, 0.5f, 0.5f, 0.25f, 0.5f, 0.5f}, hi[] = {0.75f, 0.5f, 0.5f, 0.75f, 0.5f, 0.5f};
+  float still[] = {0.3f, 0.3f, 0.3f, 0.6f, 0.6f, 0.6f};
+  lm_image l[2] = {img(2, 1, 3, lo), img(2, 1, 3, hi)}, r = img(2, 1, 3, still);
+  double still_ref = 0, opposite_ref = 0;
+  for (int t = 1; t < 5; t++) {
+    still_ref += lm_metrics_flicker(&l[(t - 1) % 2], &l[t % 2], &r, &r);
+    opposite_ref += lm_metrics_flicker(&l[(t - 1) % 2], &l[t % 2], &l[t % 2], &l[(t - 1) % 2]);
+  }
+  assert_float_equal(still_ref / 4, 0.5 / 3, 1e-12);
+  assert_float_equal(opposite_ref / 4, 1.0 / 3, 1e-12);
+  /* In phase with the reference it is 0 again. */
+  assert_float_equal(lm_metrics_flicker(&l[0], &l[1], &l[0], &l[1]), 0.0, 0);
+}
+
+/* Limn's frames are the reference's plus a constant 0.25 (values exact in
+ * float): its change equals the reference's, so flicker is 0 while the
+ * mean error is the bias. */
+static void flicker_ignores_a_constant_bias(void **state) {
+  (void)state;
+  float r0[] = {0.125f, 0.5f, 0.0f}, r1[] = {0.625f, 0.25f, 0.375f}, l0[3], l1[3];
+  for (int i = 0; i < 3; i++) l0[i] = r0[i] + 0.25f, l1[i] = r1[i] + 0.25f;
+  lm_image a0 = img(1, 1, 3, l0), a1 = img(1, 1, 3, l1), b0 = img(1, 1, 3, r0), b1 = img(1, 1, 3, r1);
+  assert_float_equal(lm_metrics_flicker(&a0, &a1, &b0, &b1), 0.0, 0);
+  lm_metrics m;
+  lm_metrics_compute(&a1, &b1, &m);
+  assert_float_equal(m.mean_error, 0.25, 0);
+  /* Without the bias in the second frame the change differs by 0.25 in each channel. */
+  assert_float_equal(lm_metrics_flicker(&a0, &b1, &b0, &b1), 0.25, 1e-12);
+}
+
+/* A step at the event (frame 5) from 0.1 to 0.5, then back halving the
+ * excess each frame: error(5 + d) = 0.1 + 0.4 / 2^d. Settled is the median
+ * of frames 15 .. 19, 0.1 + 0.4 / 2^12; 10% of it is 0.0100098, so d = 5
+ * (excess 0.0125 - 0.0001) is still off and d = 6 (0.00625 - 0.0001) is
+ * back: the lag is 6 frames. */
+static void lag_of_an_exponential_return_by_hand(void **state) {
+  (void)state;
+  double e[20];
+  for (int t = 0; t < 20; t++) e[t] = t < 5 ? 0.1 : 0.1 + 0.4 / pow(2, t - 5);
+  lm_lag lag;
+  lm_error err;
+  assert_true(lm_metrics_lag(e, 5, 20, &lag, &err));
+  assert_int_equal(lag.frames, 6);
+  assert_true(lag.returned);
+  assert_float_equal(lag.settled, 0.1 + 0.4 / 4096, 1e-15);
+  /* A window cut at the next event (frame 12) while the error still falls:
+   * settled is the median of frames 7 .. 11, 0.1 + 0.4 / 2^4 = 0.125, and
+   * the last frame, 0.10625, is 0.01875 below it, past the tolerance
+   * 0.0125: never settled, the lag is the window's 7 frames. */
+  assert_true(lm_metrics_lag(e, 5, 12, &lag, &err));
+  assert_false(lag.returned);
+  assert_int_equal(lag.frames, 7);
+  assert_float_equal(lag.settled, 0.125, 1e-15);
+  /* No change at all: lag 0. */
+  assert_true(lm_metrics_lag(e, 0, 5, &lag, &err));
+  assert_int_equal(lag.frames, 0);
+  assert_true(lag.returned);
+}
+
+/* An error swinging through its settled value counts from where it stays;
+ * one whose last frame is off never returned, and the lag is the window. */
+static void lag_that_swings_or_never_settles(void **state) {
+  (void)state;
+  /* last 5: 0.2 0.2 0.3 0.2 0.2, median 0.2; frame 1 passes 0.2 on the way */
+  double swing[] = {0.5, 0.2, 0.05, 0.2, 0.2, 0.3, 0.2, 0.2};
+  lm_lag lag;
+  lm_error err;
+  assert_true(lm_metrics_lag(swing, 0, 8, &lag, &err));
+  assert_int_equal(lag.frames, 6); /* frame 5 (0.3) is off */
+  assert_true(lag.returned);
+  /* last 5: 0.2 0.1 0.2 0.2 0.1, median 0.2, the last frame 0.1 is off */
+  double noisy[] = {0.9, 0.5, 0.2, 0.1, 0.2, 0.2, 0.1};
+  assert_true(lm_metrics_lag(noisy, 1, 7, &lag, &err));
+  assert_false(lag.returned);
+  assert_int_equal(lag.frames, 6);
+  assert_float_equal(lag.settled, 0.2, 0);
+  /* a settled error of 0 tolerates nothing, and never divides */
+  double zero[] = {0.3, 0, 0, 0, 0, 0};
+  assert_true(lm_metrics_lag(zero, 0, 6, &lag, &err));
+  assert_int_equal(lag.frames, 1);
+  assert_float_equal(lag.settled, 0, 0);
+  /* Bad input is refused by name. */
+  assert_false(lm_metrics_lag(zero, 6, 6, &lag, &err));
+  assert_string_equal(err.msg, "event at frame 6: not among the sequence's frames 0 .. 5");
+  assert_false(lm_metrics_lag(zero, -1, 6, &lag, &err));
+  zero[3] = NAN;
+  assert_false(lm_metrics_lag(zero, 0, 6, &lag, &err));
+  assert_string_equal(err.msg, "frame 3: error nan is not a finite value >= 0");
+  zero[3] = -0.5;
+  assert_false(lm_metrics_lag(zero, 2, 6, &lag, &err));
+  assert_string_equal(err.msg, "frame 3: error -0.5 is not a finite value >= 0");
+  assert_true(lm_metrics_lag(zero, 4, 6, &lag, &err)); /* frame 3 is outside that window */
+}
+
+/* Band error: pixels 0 and 2 of 4 are in the band, off by 0.3 in every
+ * channel and by 0.6 in one of three; pixels outside (off by 1) do not count. */
+static void band_error_by_hand(void **state) {
+  (void)state;
+  float pa[12] = {0}, pb[12] = {0.3f, 0.3f, 0.3f, 1, 1, 1, 0.6f, 0, 0, 1, 1, 1};
+  lm_image a = img(4, 1, 3, pa), b = img(4, 1, 3, pb);
+  unsigned char band[] = {1, 0, 255, 0}, none[4] = {0};
+  double e = -1;
+  size_t px = 0;
+  assert_true(lm_metrics_band_error(&a, &b, band, &e, &px));
+  assert_int_equal(px, 2);
+  assert_float_equal(e, (0.9 + 0.6) / 6, 1e-7);
+  e = -1;
+  assert_false(lm_metrics_band_error(&a, &b, none, &e, &px)); /* empty: no mean, no 0/0 */
+  assert_int_equal(px, 0);
+  assert_float_equal(e, -1, 0);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(two_pixels_by_hand),
@@ -165,6 +302,12 @@ int main(void) {
       cmocka_unit_test(closer_share_by_hand),
       cmocka_unit_test(mismatched_images_are_refused_by_name),
       cmocka_unit_test(heatmap_ramp),
+      cmocka_unit_test(flicker_of_a_still_sequence_is_zero),
+      cmocka_unit_test(flicker_of_an_alternating_pattern_by_hand),
+      cmocka_unit_test(flicker_ignores_a_constant_bias),
+      cmocka_unit_test(lag_of_an_exponential_return_by_hand),
+      cmocka_unit_test(lag_that_swings_or_never_settles),
+      cmocka_unit_test(band_error_by_hand),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

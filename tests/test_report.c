@@ -1,11 +1,13 @@
 /* The report's arithmetic (tools/report_math.h): the Pareto front of a
- * crafted set of points, the gains and summary against hand values, and the
- * sweep syntax with its errors. */
+ * crafted set of points, the gains and summary against hand values, the
+ * sweep syntax with its errors, and sequences (views grouped into runs, a
+ * setting's mean error, flicker and lag over one) on synthetic data. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
+#include <math.h>
 #include <string.h>
 
 #include "report_math.h"
@@ -128,12 +130,101 @@ static void sweep_syntax(void **state) {
   assert_int_equal(n, 9);
 }
 
+/* Views as a job lists them: camera 0 in frames 0 1 2, camera 1 in frames
+ * 0 1 2, then a still view of scene 1, then the same place again at frame 0
+ * (not after the last: a new run), then another technique's frame 1. */
+static void views_group_into_sequences(void **state) {
+  (void)state;
+  job_view v[9] = {
+      {.camera = 0, .frame = 0}, {.camera = 0, .frame = 1}, {.camera = 0, .frame = 2},
+      {.camera = 1, .frame = 0}, {.camera = 1, .frame = 1}, {.camera = 1, .frame = 2},
+      {.scene = 1, .frame = 0},  {.scene = 1, .frame = 0},  {.scene = 1, .technique = 1, .frame = 1},
+  };
+  int first[10];
+  assert_int_equal(report_sequences(v, 9, first), 5);
+  int want[] = {0, 3, 6, 7, 8, 9};
+  for (int i = 0; i < 6; i++) assert_int_equal(first[i], want[i]);
+  /* A still job: every view its own run. */
+  job_view still[3] = {{.camera = 0}, {.camera = 1}, {.size = 1}};
+  assert_int_equal(report_sequences(still, 3, first), 3);
+  assert_int_equal(first[3], 3);
+  assert_int_equal(report_sequences(still, 0, first), 0);
+  assert_int_equal(first[0], 0);
+}
+
+/* Ten frames, events at frames 1 and 3. Errors 0.1 0.1 0.1 then the step
+ * 0.6 0.4 0.21 0.2 0.2 0.2 0.2: mean 2.31 / 10. Event 1's window is frames
+ * 1 .. 2, flat: lag 0. Event 3's is frames 3 .. 9, settled the median of
+ * 0.21 0.2 0.2 0.2 0.2 = 0.2, tolerance 0.02: 0.21 is back, 0.4 is not, so
+ * the lag is 2. Flicker is the mean over the nine pairs: 0.1 / 9. */
+static void sequence_summary_by_hand(void **state) {
+  (void)state;
+  double error[] = {0.1, 0.1, 0.1, 0.6, 0.4, 0.21, 0.2, 0.2, 0.2, 0.2};
+  double flicker[] = {NAN /* not read */, 0.01, 0.02, 0.03, 0, 0, 0, 0, 0, 0.04};
+  int events[] = {1, 3};
+  report_sequence s;
+  lm_error err;
+  assert_true(report_sequence_summarize(10, error, flicker, events, 2, &s, &err));
+  assert_int_equal(s.frames, 10);
+  assert_float_equal(s.mean_error, 0.231, 1e-12);
+  assert_float_equal(s.flicker, 0.1 / 9, 1e-12);
+  assert_int_equal(s.event_count, 2);
+  assert_int_equal(s.lags[0].frames, 0);
+  assert_true(s.lags[0].returned);
+  assert_float_equal(s.lags[0].settled, 0.1, 1e-12);
+  assert_int_equal(s.lags[1].frames, 2);
+  assert_true(s.lags[1].returned);
+  assert_float_equal(s.lags[1].settled, 0.2, 1e-12);
+  /* No events: no lags; one frame: flicker 0, not 0/0. */
+  assert_true(report_sequence_summarize(1, error, flicker, NULL, 0, &s, &err));
+  assert_int_equal(s.event_count, 0);
+  assert_float_equal(s.flicker, 0, 0);
+  assert_float_equal(s.mean_error, 0.1, 1e-12);
+  /* A non-finite value is refused naming its frame. */
+  error[4] = INFINITY;
+  assert_false(report_sequence_summarize(10, error, flicker, events, 2, &s, &err));
+  assert_non_null(strstr(err.msg, "frame 4:"));
+  error[4] = 0.4;
+  flicker[7] = NAN;
+  assert_false(report_sequence_summarize(10, error, flicker, NULL, 0, &s, &err));
+  assert_non_null(strstr(err.msg, "frame 7:"));
+}
+
+static void events_are_checked(void **state) {
+  (void)state;
+  lm_error err;
+  int ok[] = {0, 12, 30}, late[] = {12, 48}, back[] = {30, 12}, same[] = {5, 5};
+  assert_true(report_events_check("job.lua", ok, 3, 48, &err));
+  assert_true(report_events_check("job.lua", ok, 0, 48, &err));
+  assert_false(report_events_check("job.lua", late, 2, 48, &err));
+  assert_string_equal(err.msg, "job.lua: events[2]: frame 48 is not among the sequence's frames 0 .. 47");
+  assert_false(report_events_check("job.lua", back, 2, 48, &err));
+  assert_string_equal(err.msg, "job.lua: events[2]: frame 12 does not come after frame 30 (events go in order)");
+  assert_false(report_events_check("job.lua", same, 2, 48, &err));
+}
+
+/* Two runs of 3 and 2 frames: frame 2 has one run, so its mean is its value. */
+static void frame_curve_by_hand(void **state) {
+  (void)state;
+  double a[] = {1, 2, 3}, b[] = {3, 4}, curve[3];
+  const double *errors[] = {a, b};
+  int frames[] = {3, 2};
+  assert_int_equal(report_frame_curve(errors, frames, 2, curve), 3);
+  assert_float_equal(curve[0], 2, 0);
+  assert_float_equal(curve[1], 3, 0);
+  assert_float_equal(curve[2], 3, 0);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(pareto_crafted),
       cmocka_unit_test(gains_by_hand),
       cmocka_unit_test(indirect_share_by_hand),
       cmocka_unit_test(sweep_syntax),
+      cmocka_unit_test(views_group_into_sequences),
+      cmocka_unit_test(sequence_summary_by_hand),
+      cmocka_unit_test(events_are_checked),
+      cmocka_unit_test(frame_curve_by_hand),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -2,9 +2,14 @@
  * run time for every technique and setting of a sweep, on every view of a
  * capture job. Writes report.csv, report.json, report.svg and report.md
  * (seed 000 chapter 5.3: mean error eq 19, Pearson eq 20, gain over direct
- * light, share of pixels closer to the reference). */
+ * light, share of pixels closer to the reference). Over a job's sequences
+ * also the error over time of shared/design/motion.md: mean error over
+ * frames, flicker and lag after the job's events, and error against frame. */
 #define _GNU_SOURCE
 #include <getopt.h>
+#include <lauxlib.h>
+#include <limits.h>
+#include <lua.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -33,6 +38,13 @@ static const char report_usage[] =
     "radiosity, cached too) gives its floor, the baseline's error against it,\n"
     "and each setting's share of the baseline's indirect error removed:\n"
     "100 (e_base - e) / (e_base - floor), n/a where the floor is not below.\n"
+    "A job with sequences (time = { start, stop, fps }) renders each setting\n"
+    "through each sequence's frames in order, one frame each after the first's\n"
+    "warm-up, and adds per setting and sequence: the mean error over frames,\n"
+    "flicker (mean |(L_t - L_t-1) - (R_t - R_t-1)|, the change the reference\n"
+    "does not have) and the lag after each of the job's events = { frame, ... }\n"
+    "(frames until the error stays within 10% of its settled value), with\n"
+    "error against frame plotted under report.svg's scatter.\n"
     "\n"
     "SPEC: TECH, or TECH:OPTION=V1,V2,...;OPTION=V1,... for every combination,\n"
     "  e.g. --sweep \"isr:isr.samples=8,16,32;isr.coarse=1,2\" --sweep ssao\n"
@@ -60,6 +72,7 @@ typedef struct report_row {
   lm_metrics m;      /* against the reference */
   double floor;      /* the view's direct-only floor: the baseline against POV-Ray without radiosity */
   double closer;     /* share of pixels closer to the reference than the baseline's */
+  double flicker;    /* of this frame and the one before in its sequence (lm_metrics_flicker); 0 for a first */
   double total_ms;
   capture_result res;
 } report_row;
@@ -70,7 +83,17 @@ typedef struct report_args {
   int setting_count, frames, warmup;
   bool require_refs;
   reference_args ref;
+  bool sequences; /* the job has a run of two frames or more: views are named with their frame */
+  int events[REPORT_MAX_EVENTS], event_count; /* the job's events (read_events) */
 } report_args;
+
+/* The places in runs (report_sequences) and, with sequences, each setting's
+ * error over each run: summary[run * settings + setting] (frames 0 for a
+ * run of one view). */
+typedef struct report_runs {
+  int *first, count;
+  report_sequence *summary;
+} report_runs;
 
 static int usage_error(const char *fmt, const char *arg) {
   fprintf(stderr, "limn report: ");
@@ -106,6 +129,13 @@ static void place_name(const job *j, const job_view *v, char *out, size_t cap) {
            j->sizes[v->size][1]);
 }
 
+/* A row's view: its place, and "#frame" after it in a job with sequences. */
+static void view_name(const report_args *a, const job *j, const job_view *v, char *out, size_t cap) {
+  place_name(j, v, out, cap);
+  size_t len = strlen(out);
+  if (a->sequences) snprintf(out + len, cap - len, "#%d", v->frame);
+}
+
 /* PSNR is infinite for identical images: JSON null, CSV "inf". */
 static void write_csv(lm_buf *b, const report_args *a, const job *j, const job_view *places,
                       const report_row *rows, int n) {
@@ -117,7 +147,7 @@ static void write_csv(lm_buf *b, const report_args *a, const job *j, const job_v
     const job_view *v = &places[r->place];
     const job_scene *sc = &j->scenes[v->scene];
     char view[512];
-    place_name(j, v, view, sizeof view);
+    view_name(a, j, v, view, sizeof view);
     csv_str(b, s->technique);
     lm_buf_append(b, ",", 1);
     csv_str(b, s->label);
@@ -142,8 +172,31 @@ static void write_csv(lm_buf *b, const report_args *a, const job *j, const job_v
   }
 }
 
+/* One setting's error over one sequence, a JSON object (write_json). */
+static void json_sequence(lm_buf *b, const report_args *a, const job *j, const job_view *places,
+                          const report_row *rows, int first, int setting, const report_sequence *q) {
+  char place[512];
+  place_name(j, &places[first], place, sizeof place);
+  lm_buf_append(b, "    {\"setting\": ", -1);
+  limn_json_append(b, a->settings[setting].label);
+  lm_buf_append(b, ", \"sequence\": ", -1);
+  limn_json_append(b, place);
+  lm_buf_printf(b, ", \"frames\": %d, \"mean_error\": %.9g, \"flicker\": %.9g, \"lags\": [", q->frames,
+                q->mean_error, q->flicker);
+  for (int e = 0; e < q->event_count; e++)
+    lm_buf_printf(b, "%s{\"event\": %d, \"frames\": %d, \"returned\": %s, \"settled_error\": %.9g}", e ? ", " : "",
+                  a->events[e], q->lags[e].frames, q->lags[e].returned ? "true" : "false", q->lags[e].settled);
+  lm_buf_append(b, "], \"errors\": [", -1);
+  for (int t = 0; t < q->frames; t++) {
+    const report_row *r = &rows[(size_t)(first + t) * (size_t)a->setting_count + (size_t)setting];
+    lm_buf_printf(b, "%s%.9g", t ? ", " : "", r->m.mean_error);
+  }
+  lm_buf_append(b, "]}", -1);
+}
+
 static void write_json(lm_buf *b, const report_args *a, const job *j, const job_view *places,
-                       const report_row *rows, int n, const char *clock, int frames, int warmup) {
+                       const report_row *rows, int n, const report_runs *runs, const char *clock, int frames,
+                       int warmup) {
   lm_buf_append(b, "{\n  \"job\": ", -1);
   limn_json_append(b, j->path);
   lm_buf_printf(b, ",\n  \"clock\": \"%s\",\n  \"renderer\": ", clock);
@@ -157,7 +210,7 @@ static void write_json(lm_buf *b, const report_args *a, const job *j, const job_
     const job_view *v = &places[r->place];
     const job_scene *sc = &j->scenes[v->scene];
     char view[512];
-    place_name(j, v, view, sizeof view);
+    view_name(a, j, v, view, sizeof view);
     lm_buf_append(b, "    {\"technique\": ", -1);
     limn_json_append(b, s->technique);
     lm_buf_append(b, ", \"setting\": ", -1);
@@ -175,6 +228,8 @@ static void write_json(lm_buf *b, const report_args *a, const job *j, const job_
     limn_json_append(b, sc->path);
     lm_buf_append(b, ", \"camera\": ", -1);
     limn_json_append(b, sc->scene->cameras[v->camera].name);
+    if (a->sequences)
+      lm_buf_printf(b, ", \"frame\": %d, \"time\": %.9g, \"flicker\": %.9g", v->frame, v->time, r->flicker);
     lm_buf_printf(b, ", \"width\": %d, \"height\": %d, \"mean_error\": %.9g, \"rmse\": %.9g, \"psnr\": ",
                   j->sizes[v->size][0], j->sizes[v->size][1], r->m.mean_error, r->m.rmse);
     if (r->m.identical) lm_buf_append(b, "null", -1);
@@ -193,7 +248,23 @@ static void write_json(lm_buf *b, const report_args *a, const job *j, const job_
     }
     lm_buf_printf(b, "]}%s\n", i + 1 < n ? "," : "");
   }
-  lm_buf_append(b, "  ]\n}\n", -1);
+  lm_buf_append(b, "  ]", -1);
+  if (runs->summary) {
+    lm_buf_append(b, ",\n  \"events\": [", -1);
+    for (int e = 0; e < a->event_count; e++) lm_buf_printf(b, "%s%d", e ? ", " : "", a->events[e]);
+    lm_buf_append(b, "],\n  \"sequences\": [", -1);
+    bool any = false;
+    for (int k = 0; k < runs->count; k++)
+      for (int s = 0; s < a->setting_count; s++) {
+        const report_sequence *q = &runs->summary[k * a->setting_count + s];
+        if (q->frames < 2) continue;
+        lm_buf_append(b, any ? ",\n" : "\n", -1);
+        json_sequence(b, a, j, places, rows, runs->first[k], s, q);
+        any = true;
+      }
+    lm_buf_append(b, "\n  ]", -1);
+  }
+  lm_buf_append(b, "\n}\n", -1);
 }
 
 /* Per setting, over the views: mean error and mean total milliseconds. */
@@ -213,15 +284,64 @@ static void setting_means(const report_row *rows, int n, int settings, double *e
 static const char *const palette[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
                                       "#e377c2", "#17becf"};
 
+/* Under the scatter, in a job with sequences, from `top` down: each
+ * setting's error against frame (curve[setting * frames + t], the mean over
+ * its sequences: report_frame_curve), one line a setting, the job's events
+ * as dashed verticals. The axis starts at 0: a lag is a rise and fall. */
+static void write_svg_frames(lm_buf *b, const report_args *a, const double *curve, int frames, double top) {
+  int n = a->setting_count;
+  const double W = 720, H = 360, L = 80, R = 200, T = 40, B = 50;
+  double hi = 0, x1 = frames > 1 ? frames - 1 : 1;
+  for (int i = 0; i < n * frames; i++) hi = fmax(hi, curve[i]);
+  double y1 = hi > 0 ? 1.1 * hi : 1e-3;
+#define PX(v) (L + (v) / x1 * (W - L - R))
+#define PY(v) (top + H - B - (v) / y1 * (H - T - B))
+  lm_buf_printf(b, "<text x=\"%.0f\" y=\"%.1f\" font-size=\"15\">Mean error (seed eq 19) against frame</text>\n", L,
+                top + 24);
+  lm_buf_printf(b, "<g stroke=\"black\"><line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>"
+                "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/></g>\n",
+                L, PY(0), W - R, PY(0), L, PY(0), L, top + T);
+  for (int k = 0; k <= 4; k++) {
+    double xv = round(x1 * k / 4), yv = y1 * k / 4; /* whole frames */
+    lm_buf_printf(b, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%.0f</text>\n", PX(xv), PY(0) + 18, xv);
+    lm_buf_printf(b, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%.4g</text>\n", L - 6, PY(yv) + 4, yv);
+  }
+  lm_buf_printf(b, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">frame</text>\n", (L + W - R) / 2, top + H - 14);
+  lm_buf_printf(b, "<text x=\"16\" y=\"%.1f\" transform=\"rotate(-90 16 %.1f)\" text-anchor=\"middle\">"
+                "mean error against POV-Ray</text>\n", top + (T + H - B) / 2, top + (T + H - B) / 2);
+  for (int e = 0; e < a->event_count; e++)
+    lm_buf_printf(b, "<line class=\"event\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#888\" "
+                  "stroke-dasharray=\"4 3\"><title>event at frame %d</title></line>\n", PX(a->events[e]), PY(0),
+                  PX(a->events[e]), PY(y1), a->events[e]);
+  /* one colour a setting, dashed past the palette's eight */
+  for (int s = 0; s < n; s++) {
+    const char *dash = s >= 8 ? " stroke-dasharray=\"6 3\"" : "";
+    lm_buf_printf(b, "<polyline class=\"frames\" fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s points=\"",
+                  palette[s % 8], dash);
+    for (int t = 0; t < frames; t++) lm_buf_printf(b, "%s%.1f,%.1f", t ? " " : "", PX(t), PY(curve[s * frames + t]));
+    lm_buf_append(b, "\"><title>", -1);
+    xml_str(b, a->settings[s].label);
+    lm_buf_append(b, "</title></polyline>\n", -1);
+    lm_buf_printf(b, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\" stroke-width=\"2\"%s/>"
+                  "<text x=\"%.1f\" y=\"%.1f\">", W - R + 12, top + T + 10 + 18.0 * s, W - R + 26,
+                  top + T + 10 + 18.0 * s, palette[s % 8], dash, W - R + 30, top + T + 14 + 18.0 * s);
+    xml_str(b, a->settings[s].label);
+    lm_buf_append(b, "</text>\n", -1);
+  }
+#undef PX
+#undef PY
+}
+
 /* Hand-written SVG: a scatter plot needs a few dozen elements, and no
  * Debian C library writes plots without pulling in a toolkit (plplot,
  * cairo), so text is simpler and keeps the output byte-stable. The error
  * axis spans the data and the direct-only floor (floor < 0: none), not 0:
- * settings differ by a few percent of an error that is mostly there. */
+ * settings differ by a few percent of an error that is mostly there. With
+ * a curve (NULL in a still job), error against frame goes under the scatter. */
 static void write_svg(lm_buf *b, const report_args *a, const double *err, const double *ms, const bool *front,
-                      double floor, const char *clock) {
+                      double floor, const char *clock, const double *curve, int curve_frames) {
   int n = a->setting_count;
-  const double W = 720, H = 480, L = 80, R = 200, T = 40, B = 60;
+  const double W = 720, H = 480, L = 80, R = 200, T = 40, B = 60, FRAMES_H = 360;
   double x0 = 0, x1 = 0, lo = floor >= 0 ? floor : err[0], hi = lo;
   for (int i = 0; i < n; i++) {
     if (ms[i] > x1) x1 = ms[i];
@@ -238,7 +358,7 @@ static void write_svg(lm_buf *b, const report_args *a, const double *err, const 
                 "viewBox=\"0 0 %.0f %.0f\" font-family=\"sans-serif\" font-size=\"12\">\n"
                 "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n"
                 "<text x=\"%.0f\" y=\"24\" font-size=\"15\">Mean error (seed eq 19) against time per frame</text>\n",
-                W, H, W, H, L);
+                W, H + (curve ? FRAMES_H : 0), W, H + (curve ? FRAMES_H : 0), L);
   /* axes with five ticks each */
   lm_buf_printf(b, "<g stroke=\"black\"><line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>"
                 "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/></g>\n",
@@ -300,14 +420,52 @@ static void write_svg(lm_buf *b, const report_args *a, const double *err, const 
     lm_buf_printf(b, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#888\" stroke-width=\"2\"/>"
                   "<text x=\"%.1f\" y=\"%.1f\">direct-only floor</text>\n", W - R + 12, T + 28 + 18.0 * tech_count,
                   W - R + 26, T + 28 + 18.0 * tech_count, W - R + 30, T + 32 + 18.0 * tech_count);
-  lm_buf_append(b, "</svg>\n", -1);
 #undef PX
 #undef PY
+  if (curve) write_svg_frames(b, a, curve, curve_frames, H);
+  lm_buf_append(b, "</svg>\n", -1);
+}
+
+/* "12: 3, 30: 7+ (not settled)", or "-" without events. */
+static void append_lags(lm_buf *b, const report_args *a, const report_sequence *q) {
+  if (!q->event_count) lm_buf_append(b, "-", 1);
+  for (int e = 0; e < q->event_count; e++)
+    lm_buf_printf(b, "%s%d: %d%s", e ? ", " : "", a->events[e], q->lags[e].frames,
+                  q->lags[e].returned ? "" : "+ (not settled)");
+}
+
+/* Per setting and sequence: mean error over frames, flicker, lags. */
+static void md_sequences(lm_buf *b, const report_args *a, const job *j, const job_view *places,
+                         const report_runs *runs) {
+  lm_buf_printf(b, "\n## Sequences\n\nError over time against the reference frames. Mean error: eq 19's mean over a "
+                "sequence's frames. Flicker: the mean over frames t >= 1 and values of |(L_t - L_t-1) - "
+                "(R_t - R_t-1)|, the frame-to-frame change the reference does not have (0 for a still scene). "
+                "Lag after each of the job's events (frame: frames): the frames from the event until the error "
+                "stays within %g%% of its settled value, the median of the last %d frames before the next event "
+                "or the end; N+ where even the last is off; - without events. A sequence's frames render once each, "
+                "in order (the first after the warm-up), so that temporal reuse sees them as a viewer would: "
+                "their times are single frames'.\n\n"
+                "| setting | sequence | frames | mean error | flicker | lag |\n|---|---|---|---|---|---|\n",
+                100 * LM_LAG_TOLERANCE, LM_LAG_SETTLED_FRAMES);
+  for (int k = 0; k < runs->count; k++)
+    for (int s = 0; s < a->setting_count; s++) {
+      const report_sequence *q = &runs->summary[k * a->setting_count + s];
+      if (q->frames < 2) continue;
+      char place[512];
+      place_name(j, &places[runs->first[k]], place, sizeof place);
+      lm_buf_append(b, "| ", -1);
+      xml_str(b, a->settings[s].label);
+      lm_buf_append(b, " | ", -1);
+      xml_str(b, place);
+      lm_buf_printf(b, " | %d | %.5f | %.6f | ", q->frames, q->mean_error, q->flicker);
+      append_lags(b, a, q);
+      lm_buf_append(b, " |\n", -1);
+    }
 }
 
 static void write_md(lm_buf *b, const report_args *a, const job *j, const job_view *places, int place_count,
-                     const report_row *rows, int n, const double *err, const double *ms, const bool *front,
-                     double floor, const char *clock, int frames, int warmup) {
+                     const report_row *rows, int n, const report_runs *runs, const double *err, const double *ms,
+                     const bool *front, double floor, const char *clock, int frames, int warmup) {
   lm_buf_append(b, "# Error against POV-Ray and run time\n\nJob `", -1);
   xml_str(b, j->path);
   lm_buf_printf(b, "`, %d view%s; renderer ", place_count, place_count == 1 ? "" : "s");
@@ -356,6 +514,7 @@ static void write_md(lm_buf *b, const report_args *a, const job *j, const job_vi
                   100 * sum.views_pearson_rose, 100 * sum.pixels_closer, sum.pearson_before, sum.pearson_after,
                   front[s] ? "yes" : "");
   }
+  if (runs->summary) md_sequences(b, a, j, places, runs);
   lm_buf_append(b, "\n## Per view\n\n| setting | view | error baseline | error | gain % | direct-only floor | "
                    "indirect error removed % | pixels closer | Pearson baseline | Pearson |\n"
                    "|---|---|---|---|---|---|---|---|---|---|\n", -1);
@@ -363,7 +522,7 @@ static void write_md(lm_buf *b, const report_args *a, const job *j, const job_vi
     if (rows[i].setting == 0) continue;
     const report_row *base = &rows[i - rows[i].setting];
     char view[512];
-    place_name(j, &places[rows[i].place], view, sizeof view);
+    view_name(a, j, &places[rows[i].place], view, sizeof view);
     lm_buf_append(b, "| ", -1);
     xml_str(b, a->settings[rows[i].setting].label);
     lm_buf_append(b, " | ", -1);
@@ -465,12 +624,160 @@ static int get_refs(const report_args *a, const reference_args *ref, const job *
   return rc;
 }
 
-static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
+/* The job's `events = { 12, 30 }`: frames of its sequences where a light,
+ * a door or an object changes, the starts of the lags. Read here on its
+ * own, the job file run again as job_read runs it (data in an empty
+ * environment; job_read's budget has already let it finish once). */
+static bool read_events(const char *path, int *events, int *count, lm_error *err) {
+  *count = 0;
+  lua_State *L = luaL_newstate();
+  bool ok = luaL_loadfilex(L, path, "t") == LUA_OK;
+  if (ok) {
+    lua_newtable(L);
+    lua_setupvalue(L, -2, 1);
+    ok = lua_pcall(L, 0, 1, 0) == LUA_OK;
+  }
+  if (!ok) {
+    lm_error_set(err, "%s", lua_tostring(L, -1));
+    lua_close(L);
+    return false;
+  }
+  if (lua_istable(L, -1)) lua_getfield(L, -1, "events");
+  else lua_pushnil(L);
+  if (lua_istable(L, -1)) {
+    int n = (int)lua_rawlen(L, -1);
+    if (n > REPORT_MAX_EVENTS) {
+      lm_error_set(err, "%s: events: %d of them, at most %d", path, n, REPORT_MAX_EVENTS);
+      ok = false;
+    }
+    for (int i = 1; i <= n && ok; i++) {
+      lua_rawgeti(L, -1, i);
+      lua_Integer f = lua_isinteger(L, -1) ? lua_tointeger(L, -1) : -1;
+      if (f >= 0 && f <= INT_MAX) events[(*count)++] = (int)f;
+      else if (lua_type(L, -1) == LUA_TNUMBER)
+        lm_error_set(err, "%s: events[%d]: %g is not a frame number (0, 1, ...)", path, i, lua_tonumber(L, -1));
+      else lm_error_set(err, "%s: events[%d]: a frame number (0, 1, ...), not a %s", path, i, luaL_typename(L, -1));
+      ok = f >= 0 && f <= INT_MAX;
+      lua_pop(L, 1);
+    }
+  } else if (!lua_isnil(L, -1)) {
+    lm_error_set(err, "%s: events: a list of frame numbers, not a %s", path, luaL_typename(L, -1));
+    ok = false;
+  }
+  lua_close(L);
+  return ok;
+}
+
+/* Poses a sequence's scene at its frame's time. Every animation plays: a
+ * job's choice of one belongs to the sequence jobs (tools/job.c). */
+static void pose(lm_scene *scene, double seconds) {
+  lm_scene_set_time(scene, LM_ANIM_ALL, seconds);
+  lm_scene_upload_deformed(scene);
+}
+
+/* A sequence's next frame on the view its first frame set, written to
+ * `out` (EXR): lm_renderer_frame alone, since capture_render_write's
+ * lm_renderer_set_view would drop the history that temporal reuse
+ * reprojects. One frame, so res holds that frame's pass times. */
+static bool render_next_frame(lm_renderer *r, int w, int h, const char *out, capture_result *res, lm_error *err) {
+  *res = (capture_result){0};
+  if (!lm_renderer_frame(r, err)) return false;
+  lm_graph *g = lm_renderer_graph(r);
+  res->passes = lm_alloc(sizeof *res->passes * (size_t)(lm_graph_pass_count(g) + 1));
+  for (int i = 0; i < lm_graph_pass_count(g); i++) {
+    lm_graph_pass_info p = lm_graph_pass(g, i);
+    if (p.culled || p.ms < 0) continue;
+    res->passes[res->pass_count++] = (capture_pass_time){lm_strdup(p.name), lm_pass_kind_name(p.kind), p.ms};
+    res->total_ms += p.ms;
+  }
+  res->stats = lm_renderer_draw_stats(r);
+  float *linear = lm_alloc(sizeof *linear * (size_t)w * (size_t)h * 3);
+  bool ok = lm_renderer_read(r, true, linear, err) && lm_image_write(out, w, h, 3, true, linear, err);
+  free(linear);
+  return ok;
+}
+
+/* Where setting s's image of view v goes: one a place, and in a sequence
+ * one a frame. */
+static void image_path(const report_args *a, const job *j, const job_view *v, int s, bool sequence, char *out,
+                       size_t cap) {
+  const job_scene *sc = &j->scenes[v->scene];
+  char cam[LM_NAME_MAX];
+  snprintf(cam, sizeof cam, "%s", sc->scene->cameras[v->camera].name);
+  for (char *c = cam; *c; c++)
+    if (*c == '/' || *c == ' ') *c = '_';
+  int len = snprintf(out, cap, "%s/images/%s_%s_%dx%d_%d", a->out, sc->name, cam, j->sizes[v->size][0],
+                     j->sizes[v->size][1], s);
+  if (len >= 0 && (size_t)len < cap)
+    snprintf(out + len, cap - (size_t)len, sequence ? "_%04d.exr" : ".exr", v->frame);
+}
+
+/* Each setting's error over each sequence (runs of two frames or more) and
+ * its error-against-frame curve (curve[setting * curve_frames + t], the
+ * longest run's frames); false after logging a frame whose error is not
+ * finite. */
+static bool summarize_runs(const report_args *a, const report_row *rows, int place_count, report_runs *runs,
+                           double **curve, int *curve_frames) {
+  int sn = a->setting_count;
+  runs->summary = lm_alloc(sizeof *runs->summary * (size_t)(runs->count * sn + 1));
+  double *error = lm_alloc(sizeof *error * (size_t)(place_count + 1) * 2), *flicker = error + place_count + 1;
+  const double **errors = lm_alloc(sizeof *errors * (size_t)(runs->count + 1));
+  int *lengths = lm_alloc(sizeof *lengths * (size_t)(runs->count + 1)), seqs = 0;
+  *curve_frames = 0;
+  for (int k = 0; k < runs->count; k++)
+    if (runs->first[k + 1] - runs->first[k] > *curve_frames) *curve_frames = runs->first[k + 1] - runs->first[k];
+  *curve = lm_alloc(sizeof **curve * (size_t)(*curve_frames * sn + 1));
+  bool ok = true;
+  for (int s = 0; s < sn && ok; s++) {
+    seqs = 0;
+    for (int p = 0; p < place_count; p++) {
+      error[p] = rows[(size_t)p * (size_t)sn + (size_t)s].m.mean_error;
+      flicker[p] = rows[(size_t)p * (size_t)sn + (size_t)s].flicker;
+    }
+    for (int k = 0; k < runs->count && ok; k++) {
+      int first = runs->first[k], len = runs->first[k + 1] - first;
+      report_sequence *q = &runs->summary[k * sn + s];
+      *q = (report_sequence){0};
+      if (len < 2) continue;
+      lm_error err;
+      ok = report_sequence_summarize(len, error + first, flicker + first, a->events, a->event_count, q, &err);
+      if (!ok) lm_log(LM_LOG_ERROR, "%s, sequence from view %d: %s", a->settings[s].label, first, err.msg);
+      errors[seqs] = error + first; /* report_frame_curve reads them before the next setting */
+      lengths[seqs++] = len;
+    }
+    if (ok) report_frame_curve(errors, lengths, seqs, *curve + (size_t)s * (size_t)*curve_frames);
+  }
+  free(error);
+  free(errors);
+  free(lengths);
+  return ok;
+}
+
+static int run(report_args *a, job *j, lm_pipeline *pipeline) {
   lm_error err;
   job_view *places = NULL;
   int place_count = 0;
   if (!job_views(j, false, &places, &place_count, &err)) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
+    return 2;
+  }
+  /* Runs of frames (a still job's places are runs of one) and the job's events in each. */
+  report_runs runs = {.first = lm_alloc(sizeof(int) * (size_t)(place_count + 1))};
+  runs.count = report_sequences(places, place_count, runs.first);
+  a->sequences = runs.count < place_count;
+  bool events_ok = read_events(j->path, a->events, &a->event_count, &err);
+  if (events_ok && a->event_count && !a->sequences) {
+    lm_error_set(&err, "%s: events: the job has no sequence (time = { start, stop, fps })",
+                 j->path);
+    events_ok = false;
+  }
+  for (int k = 0; k < runs.count && events_ok; k++)
+    if (runs.first[k + 1] - runs.first[k] > 1)
+      events_ok = report_events_check(j->path, a->events, a->event_count, runs.first[k + 1] - runs.first[k], &err);
+  if (!events_ok) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    free(runs.first);
+    free(places);
     return 2;
   }
   /* Every setting is checked before anything renders. */
@@ -480,6 +787,7 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
     if (!set_setting(pipeline, &base_options, &a->settings[s], &err)) {
       lm_log(LM_LOG_ERROR, "--sweep %s: %s", a->settings[s].label, err.msg);
       base_free(&base_options);
+      free(runs.first);
       free(places);
       return 2;
     }
@@ -492,6 +800,7 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
   if (!rc && a->ref.pov.radiosity) rc = get_refs(a, &direct_args, j, places, place_count, direct, " --radiosity off");
   if (rc) {
     free(refs);
+    free(runs.first);
     free(places);
     base_free(&base_options);
     return rc;
@@ -500,6 +809,7 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
   if (!lm_context_create_headless(&(lm_context_desc){0}, &err)) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     free(refs);
+    free(runs.first);
     free(places);
     base_free(&base_options);
     return 1;
@@ -510,87 +820,125 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     rc = 1;
   }
-  int total = place_count * a->setting_count, n = 0;
+  int sn = a->setting_count, total = place_count * sn, n = 0;
+  /* rows[place * settings + setting]: place by place, the baseline first */
   report_row *rows = lm_alloc(sizeof *rows * (size_t)(total + 1));
   memset(rows, 0, sizeof *rows * (size_t)(total + 1));
+  double *floors = lm_alloc(sizeof *floors * (size_t)(place_count + 1));
   bool tty = isatty(STDOUT_FILENO);
   const lm_scene *current = j->scenes[0].scene;
-  if (r && !a->ref.quiet) printf("report of %s: %d setting%s x %d view%s on %s\n", j->path, a->setting_count,
-                                 a->setting_count == 1 ? "" : "s", place_count, place_count == 1 ? "" : "s",
+  if (r && !a->ref.quiet) printf("report of %s: %d setting%s x %d view%s on %s\n", j->path, sn,
+                                 sn == 1 ? "" : "s", place_count, place_count == 1 ? "" : "s",
                                  lm_gl_renderer());
-  for (int p = 0; p < place_count && !rc; p++) {
-    const job_view *v = &places[p];
-    job_scene *sc = &j->scenes[v->scene];
-    int w = j->sizes[v->size][0], h = j->sizes[v->size][1];
-    lm_image ref = {0}, base = {0}, floor_ref = {0};
-    bool ok = lm_image_read(refs[p], &ref, &err);
-    if (ok && a->ref.pov.radiosity)
-      ok = lm_image_read(direct[p], &floor_ref, &err) && lm_metrics_check(&floor_ref, direct[p], &ref, refs[p], &err);
-    double floor = 0;
-    if (ok && sc->scene != current) ok = lm_renderer_set_scene(r, sc->scene, &err), current = sc->scene;
-    for (int s = 0; s < a->setting_count && ok; s++) {
-      report_row *row = &rows[n];
-      row->setting = s;
-      row->place = p;
-      char out[1400], view[512], cam[LM_NAME_MAX];
-      snprintf(cam, sizeof cam, "%s", sc->scene->cameras[v->camera].name);
-      for (char *c = cam; *c; c++)
-        if (*c == '/' || *c == ' ') *c = '_';
-      snprintf(out, sizeof out, "%s/images/%s_%s_%dx%d_%d.exr", a->out, sc->name, cam, w, h, s);
-      const char *outs[1] = {out};
-      capture_view warm = {.camera = v->camera, .width = w, .height = h, .frames = a->warmup, .quiet = true};
-      capture_view cv = {.camera = v->camera, .width = w, .height = h, .frames = a->frames, .outputs = outs,
-                         .output_count = 1, .quiet = true};
-      capture_result scratch = {0};
-      ok = set_setting(pipeline, &base_options, &a->settings[s], &err) && job_make_parent(out, &err) &&
-           (a->warmup == 0 || capture_render_write(r, &warm, &scratch, &err)) &&
-           capture_render_write(r, &cv, &row->res, &err);
-      capture_result_free(&scratch);
-      lm_image img = {0};
-      if (ok) ok = lm_image_read(out, &img, &err);
-      if (ok) ok = lm_metrics_check(&img, out, &ref, refs[p], &err);
-      if (ok) {
-        lm_metrics_compute(&img, &ref, &row->m);
-        if (s == 0) {
-          lm_metrics fm = row->m;
-          if (a->ref.pov.radiosity) lm_metrics_compute(&img, &floor_ref, &fm);
-          floor = fm.mean_error; /* without radiosity the reference is direct-only: no indirect error */
-          row->closer = 0;
-          base = img;
-          img = (lm_image){0};
-        } else {
+  /* Run by run, setting by setting, frame by frame: a sequence's frames in
+   * order, each rendered once after the first's warm-up and with no reset
+   * between them, so that temporal reuse sees them as a viewer would; a
+   * still place (a run of one) renders its warm-up and timed frames as it
+   * always has. The baseline's image of a frame is read back for the share
+   * of pixels closer. */
+  for (int k = 0; k < runs.count && !rc; k++) {
+    bool sequence = runs.first[k + 1] - runs.first[k] > 1;
+    for (int s = 0; s < sn && !rc; s++) {
+      lm_image prev = {0}, prev_ref = {0}; /* the frame before, Limn's and the reference's */
+      char prev_out[1400] = "";
+      for (int p = runs.first[k]; p < runs.first[k + 1] && !rc; p++) {
+        const job_view *v = &places[p];
+        job_scene *sc = &j->scenes[v->scene];
+        int w = j->sizes[v->size][0], h = j->sizes[v->size][1];
+        bool first_frame = p == runs.first[k];
+        report_row *row = &rows[(size_t)p * (size_t)sn + (size_t)s];
+        row->setting = s;
+        row->place = p;
+        char out[1400], base_out[1400], view[512];
+        image_path(a, j, v, s, sequence, out, sizeof out);
+        image_path(a, j, v, 0, sequence, base_out, sizeof base_out);
+        /* A still place: the warm-up, then the timed frames, as always. A
+         * sequence: its first frame after the warm-up in one call (no reset
+         * between them), then each next frame on from it. */
+        const char *outs[1] = {out};
+        capture_view warm = {.camera = v->camera, .width = w, .height = h, .frames = sequence ? 0 : a->warmup,
+                             .quiet = true};
+        capture_view cv = {.camera = v->camera, .width = w, .height = h, .frames = sequence ? 1 : a->frames,
+                           .warmup = sequence ? a->warmup : 0, .outputs = outs, .output_count = 1, .quiet = true};
+        capture_result scratch = {0};
+        lm_image ref = {0}, img = {0}, base = {0}, floor_ref = {0};
+        bool ok = lm_image_read(refs[p], &ref, &err);
+        if (ok && sc->scene != current) ok = lm_renderer_set_scene(r, sc->scene, &err), current = sc->scene;
+        if (ok && sequence) pose(sc->scene, v->time);
+        if (first_frame)
+          ok = ok && set_setting(pipeline, &base_options, &a->settings[s], &err) && job_make_parent(out, &err) &&
+               (warm.frames == 0 || capture_render_write(r, &warm, &scratch, &err)) &&
+               capture_render_write(r, &cv, &row->res, &err);
+        else ok = ok && render_next_frame(r, w, h, out, &row->res, &err);
+        capture_result_free(&scratch);
+        if (ok) ok = lm_image_read(out, &img, &err) && lm_metrics_check(&img, out, &ref, refs[p], &err);
+        if (ok) lm_metrics_compute(&img, &ref, &row->m);
+        if (ok && s == 0) {
+          floors[p] = row->m.mean_error; /* without radiosity the reference is direct-only: no indirect error */
+          if (a->ref.pov.radiosity) {
+            ok = lm_image_read(direct[p], &floor_ref, &err) &&
+                 lm_metrics_check(&floor_ref, direct[p], &ref, refs[p], &err);
+            lm_metrics fm;
+            if (ok) lm_metrics_compute(&img, &floor_ref, &fm), floors[p] = fm.mean_error;
+          }
+        } else if (ok) {
+          ok = lm_image_read(base_out, &base, &err) && lm_metrics_check(&base, base_out, &ref, refs[p], &err);
           lm_metrics closer = row->m;
-          lm_metrics_closer(&img, &base, &ref, &closer);
-          row->closer = closer.closer;
+          if (ok) lm_metrics_closer(&img, &base, &ref, &closer), row->closer = closer.closer;
         }
-        row->floor = floor;
-        row->total_ms = row->res.total_ms;
-        n++;
-        place_name(j, v, view, sizeof view);
-        char what[1200];
-        snprintf(what, sizeof what, "%s %s: error %.5f, %.2f ms", a->settings[s].label, view, row->m.mean_error,
-                 row->total_ms);
-        job_progress(a->ref.quiet, tty, n, total, what);
-      } else {
-        capture_result_free(&row->res);
-        if (tty && !a->ref.quiet) printf("\n");
-        lm_log(LM_LOG_ERROR, "%s: view %d (%s, camera '%s', %dx%d), %s: %s", j->path, p, sc->name,
-               sc->scene->cameras[v->camera].name, w, h, a->settings[s].label, err.msg);
-        rc = 1;
+        if (ok && !first_frame) {
+          ok = lm_metrics_check(&prev, prev_out, &img, out, &err) &&
+               lm_metrics_check(&prev_ref, refs[p - 1], &ref, refs[p], &err);
+          if (ok) row->flicker = lm_metrics_flicker(&prev, &img, &prev_ref, &ref);
+        }
+        if (ok) {
+          row->floor = floors[p];
+          row->total_ms = row->res.total_ms;
+          n++;
+          view_name(a, j, v, view, sizeof view);
+          char what[1200];
+          snprintf(what, sizeof what, "%s %s: error %.5f, %.2f ms", a->settings[s].label, view, row->m.mean_error,
+                   row->total_ms);
+          job_progress(a->ref.quiet, tty, n, total, what);
+          lm_image_free(&prev);
+          lm_image_free(&prev_ref);
+          prev = img, prev_ref = ref;
+          img = ref = (lm_image){0};
+          snprintf(prev_out, sizeof prev_out, "%s", out);
+        } else {
+          capture_result_free(&row->res);
+          if (tty && !a->ref.quiet) printf("\n");
+          lm_log(LM_LOG_ERROR, "%s: view %d (%s, camera '%s', %dx%d), %s: %s", j->path, p, sc->name,
+                 sc->scene->cameras[v->camera].name, w, h, a->settings[s].label, err.msg);
+          rc = 1;
+        }
+        lm_image_free(&img);
+        lm_image_free(&ref);
+        lm_image_free(&base);
+        lm_image_free(&floor_ref);
       }
-      lm_image_free(&img);
+      lm_image_free(&prev);
+      lm_image_free(&prev_ref);
     }
-    if (!ok && !rc) {
-      lm_log(LM_LOG_ERROR, "%s: view %d (%s): %s", j->path, p, sc->name, err.msg);
-      rc = 1;
-    }
-    lm_image_free(&ref);
-    lm_image_free(&floor_ref);
-    lm_image_free(&base);
   }
+  double *curve = NULL;
+  int curve_frames = 0;
+  if (!rc && a->sequences && !summarize_runs(a, rows, place_count, &runs, &curve, &curve_frames)) rc = 1;
+  if (!rc && a->sequences && !a->ref.quiet)
+    for (int k = 0; k < runs.count; k++)
+      for (int s = 0; s < sn; s++) {
+        const report_sequence *q = &runs.summary[k * sn + s];
+        if (q->frames < 2) continue;
+        char place[512];
+        place_name(j, &places[runs.first[k]], place, sizeof place);
+        lm_buf lags = {0};
+        append_lags(&lags, a, q);
+        printf("%s over %s (%d frames): mean error %.5f, flicker %.6f, lag %s\n", a->settings[s].label, place,
+               q->frames, q->mean_error, q->flicker, lags.data);
+        lm_buf_free(&lags);
+      }
   const char *clock = r ? lm_clock_name(lm_renderer_clock(r)) : "";
   if (!rc) {
-    int sn = a->setting_count;
     double *err_mean = lm_alloc(sizeof(double) * (size_t)sn * 2), *ms_mean = err_mean + sn;
     bool *front = lm_alloc(sizeof(bool) * (size_t)sn);
     setting_means(rows, n, sn, err_mean, ms_mean);
@@ -602,9 +950,10 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
     report_pareto(ms_mean, err_mean, sn, front);
     lm_buf csv = {0}, json = {0}, svg = {0}, md = {0};
     write_csv(&csv, a, j, places, rows, n);
-    write_json(&json, a, j, places, rows, n, clock, a->frames, a->warmup);
-    write_svg(&svg, a, err_mean, ms_mean, front, floor, clock);
-    write_md(&md, a, j, places, place_count, rows, n, err_mean, ms_mean, front, floor, clock, a->frames, a->warmup);
+    write_json(&json, a, j, places, rows, n, &runs, clock, a->frames, a->warmup);
+    write_svg(&svg, a, err_mean, ms_mean, front, floor, clock, curve, curve_frames);
+    write_md(&md, a, j, places, place_count, rows, n, &runs, err_mean, ms_mean, front, floor, clock, a->frames,
+             a->warmup);
     bool ok = write_file(a, "report.csv", &csv, &err) && write_file(a, "report.json", &json, &err) &&
               write_file(a, "report.svg", &svg, &err) && write_file(a, "report.md", &md, &err);
     lm_buf_free(&csv);
@@ -615,8 +964,12 @@ static int run(const report_args *a, job *j, lm_pipeline *pipeline) {
     free(err_mean);
     free(front);
   }
-  for (int i = 0; i < n; i++) capture_result_free(&rows[i].res);
+  for (int i = 0; i < total; i++) capture_result_free(&rows[i].res);
   free(rows);
+  free(floors);
+  free(curve);
+  free(runs.summary);
+  free(runs.first);
   lm_renderer_destroy(r);
   lm_programs_clear();
   job_free_scenes(j); /* GL objects go before the context */

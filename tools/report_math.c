@@ -1,4 +1,5 @@
 /* The report's arithmetic (tools/report_math.h). */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -156,4 +157,63 @@ void report_summarize(int n, const double *base_error, const double *floor, cons
   out->views_improved = improved / n;
   out->pixels_closer = all_px > 0 ? closer_px / all_px : 0;
   free(gains);
+}
+
+int report_sequences(const job_view *views, int n, int *first) {
+  int runs = 0;
+  for (int i = 0; i < n; i++) {
+    const job_view *v = &views[i], *u = &views[i > 0 ? i - 1 : 0];
+    bool continues = i > 0 && v->scene == u->scene && v->camera == u->camera && v->size == u->size &&
+                     v->technique == u->technique && v->frame > u->frame;
+    if (!continues) first[runs++] = i;
+  }
+  first[runs] = n;
+  return runs;
+}
+
+bool report_events_check(const char *path, const int *events, int count, int frames, lm_error *err) {
+  for (int i = 0; i < count; i++) {
+    if (events[i] < 0 || events[i] >= frames) {
+      lm_error_set(err, "%s: events[%d]: frame %d is not among the sequence's frames 0 .. %d", path, i + 1,
+                   events[i], frames - 1);
+      return false;
+    }
+    if (i > 0 && events[i] <= events[i - 1]) {
+      lm_error_set(err, "%s: events[%d]: frame %d does not come after frame %d (events go in order)", path, i + 1,
+                   events[i], events[i - 1]);
+      return false;
+    }
+  }
+  return true;
+}
+
+bool report_sequence_summarize(int frames, const double *error, const double *flicker, const int *events,
+                               int event_count, report_sequence *out, lm_error *err) {
+  *out = (report_sequence){.frames = frames, .event_count = event_count};
+  for (int t = 0; t < frames; t++)
+    if (!(isfinite(error[t]) && error[t] >= 0) || (t > 0 && !(isfinite(flicker[t]) && flicker[t] >= 0))) {
+      lm_error_set(err, "frame %d: error %g, flicker %g: not finite values >= 0", t, error[t],
+                   t > 0 ? flicker[t] : 0.0);
+      return false;
+    }
+  for (int t = 0; t < frames; t++) out->mean_error += error[t] / frames;
+  for (int t = 1; t < frames; t++) out->flicker += flicker[t] / (frames - 1);
+  for (int e = 0; e < event_count; e++) {
+    int end = e + 1 < event_count ? events[e + 1] : frames;
+    if (!lm_metrics_lag(error, events[e], end, &out->lags[e], err)) return false;
+  }
+  return true;
+}
+
+int report_frame_curve(const double *const *errors, const int *frames, int runs, double *curve) {
+  int longest = 0;
+  for (int r = 0; r < runs; r++) longest = frames[r] > longest ? frames[r] : longest;
+  for (int t = 0; t < longest; t++) {
+    int count = 0;
+    curve[t] = 0;
+    for (int r = 0; r < runs; r++)
+      if (t < frames[r]) curve[t] += errors[r][t], count++;
+    curve[t] /= count; /* t < longest: some run has frame t */
+  }
+  return longest;
 }

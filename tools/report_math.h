@@ -1,11 +1,13 @@
 /* What `limn report` computes that needs no GL or files, kept apart so that
  * unit tests check it against hand values: the sweep syntax, the Pareto
- * front, the gains over the baseline (seed 000 chapter 5.3.2) and the share
- * of its indirect error removed. */
+ * front, the gains over the baseline (seed 000 chapter 5.3.2), the share
+ * of its indirect error removed, and a sequence's error over time
+ * (shared/design/motion.md). */
 #ifndef LIMN_REPORT_MATH_H
 #define LIMN_REPORT_MATH_H
 
-#include "core/core.h"
+#include "image/metrics.h"
+#include "job.h"
 
 #define REPORT_MAX_OPTIONS 8
 #define REPORT_MAX_SETTINGS 256
@@ -60,5 +62,42 @@ typedef struct report_summary {
 void report_summarize(int n, const double *base_error, const double *floor, const double *error,
                       const double *closer, const double *pixels, const double *pearson_base,
                       const double *pearson, report_summary *out);
+
+/* ---- sequences ----------------------------------------------------------- */
+
+#define REPORT_MAX_EVENTS 64
+
+/* Splits n views, in the job's order, into runs: view i continues view
+ * i - 1's run when both show the same scene, camera, size and technique and
+ * its frame is greater; any other view starts a run. first[k] is run k's
+ * first view and first[runs] = n (first holds n + 1). Returns the run
+ * count: n for a still job (every run one view), fewer when it has sequences. */
+int report_sequences(const job_view *views, int n, int *first);
+
+/* A job's `events`: frame indices, strictly increasing, each in
+ * 0 .. frames - 1 (frames: its sequences' length). False with a message
+ * naming the job file (path) and the event otherwise. */
+bool report_events_check(const char *path, const int *events, int count, int frames, lm_error *err);
+
+/* One setting's error over one sequence. */
+typedef struct report_sequence {
+  int frames;
+  double mean_error; /* eq 19, the mean over frames */
+  double flicker;    /* lm_metrics_flicker's mean over the pairs t >= 1; 0 with one frame */
+  lm_lag lags[REPORT_MAX_EVENTS]; /* after each event, the window ending at the next */
+  int event_count;
+} report_sequence;
+
+/* From per-frame errors error[t] and flickers flicker[t] (of frames t - 1
+ * and t; flicker[0] is not read) over `frames` frames, and the job's events
+ * (checked by report_events_check). False with a message naming the frame
+ * whose error or flicker is not a finite value >= 0. */
+bool report_sequence_summarize(int frames, const double *error, const double *flicker, const int *events,
+                               int event_count, report_sequence *out, lm_error *err);
+
+/* The error-against-frame curve of one setting over several sequences:
+ * curve[t] is the mean of frame t's error over the runs that have a frame t
+ * (errors[r][t] for t < frames[r]); returns the longest run's length. */
+int report_frame_curve(const double *const *errors, const int *frames, int runs, double *curve);
 
 #endif

@@ -216,3 +216,57 @@ void lm_metrics_heatmap(const lm_image *a, const lm_image *b, double scale, unsi
     }
   }
 }
+
+double lm_metrics_flicker(const lm_image *a_prev, const lm_image *a, const lm_image *r_prev, const lm_image *r) {
+  int nc = compared_channels(a);
+  size_t px = (size_t)a->width * a->height;
+  double sum = 0;
+  for (size_t i = 0; i < px; i++)
+    for (int k = 0; k < nc; k++)
+      sum += fabs((at(a, i, k) - at(a_prev, i, k)) - (at(r, i, k) - at(r_prev, i, k)));
+  return sum / ((double)px * nc); /* checked images: px, nc > 0 */
+}
+
+bool lm_metrics_lag(const double *error, int event, int end, lm_lag *out, lm_error *err) {
+  if (event < 0 || event >= end) {
+    lm_error_set(err, "event at frame %d: not among the sequence's frames 0 .. %d", event, end - 1);
+    return false;
+  }
+  for (int t = event; t < end; t++)
+    if (!isfinite(error[t]) || error[t] < 0) {
+      lm_error_set(err, "frame %d: error %g is not a finite value >= 0", t, error[t]);
+      return false;
+    }
+  /* The median of the last k frames: a sorted copy, k is small. */
+  int k = end - event < LM_LAG_SETTLED_FRAMES ? end - event : LM_LAG_SETTLED_FRAMES;
+  double last[LM_LAG_SETTLED_FRAMES];
+  for (int i = 0; i < k; i++) {
+    double v = error[end - k + i];
+    int j = i;
+    for (; j > 0 && last[j - 1] > v; j--) last[j] = last[j - 1];
+    last[j] = v;
+  }
+  double settled = k % 2 ? last[k / 2] : 0.5 * (last[k / 2 - 1] + last[k / 2]);
+  /* Walk back from the end while the error stays within the tolerance. */
+  int first = end;
+  while (first > event && fabs(error[first - 1] - settled) <= LM_LAG_TOLERANCE * settled) first--;
+  /* first == end: even the last frame is off, and frames is the window's count. */
+  *out = (lm_lag){.frames = first - event, .returned = first < end, .settled = settled};
+  return true;
+}
+
+bool lm_metrics_band_error(const lm_image *a, const lm_image *b, const unsigned char *mask, double *out,
+                           size_t *pixels) {
+  int nc = compared_channels(a);
+  size_t px = (size_t)a->width * a->height, band = 0;
+  double sum = 0;
+  for (size_t i = 0; i < px; i++)
+    if (mask[i]) {
+      for (int k = 0; k < nc; k++) sum += fabs(at(a, i, k) - at(b, i, k));
+      band++;
+    }
+  if (pixels) *pixels = band;
+  if (!band) return false;
+  *out = sum / ((double)band * nc);
+  return true;
+}

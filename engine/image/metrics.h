@@ -65,6 +65,56 @@ void lm_metrics_heatmap(const lm_image *a, const lm_image *b, double scale, unsi
 /* The largest per-pixel mean |a - b| (the heat map's natural scale). */
 double lm_metrics_max_pixel_error(const lm_image *a, const lm_image *b);
 
+/* ---- error over time (shared/design/motion.md) --------------------------
+ * Limn's own measures of a sequence against a reference sequence, both
+ * linear, frame t of one at the same view and time as frame t of the other. */
+
+/* Flicker of one pair of consecutive frames: the mean over pixels and
+ * compared channels of |(a - a_prev) - (r - r_prev)|, the frame-to-frame
+ * change of Limn's frames (a_prev, a) that the reference's (r_prev, r) does
+ * not have. Per RGB channel and divided by 3wh like eq 19, not on
+ * luminance: a change of hue at one luminance flickers too. A constant bias
+ * (a = r + c in both frames) cancels, and a still sequence (a_prev = a,
+ * r_prev = r) gives exactly 0. A sequence's flicker is the mean of this over
+ * its pairs t >= 1 (none for one frame). All four images must pass
+ * lm_metrics_check against a (same size, finite). */
+double lm_metrics_flicker(const lm_image *a_prev, const lm_image *a, const lm_image *r_prev, const lm_image *r);
+
+/* Lag after an event (a light switched, a door opened, an object stopped)
+ * at frame `event`, from per-frame errors (eq 19) error[event .. end - 1],
+ * end being the next event or the sequence's end.
+ * - settled: the error the technique settles to after the event, the median
+ *   of the window's last LM_LAG_SETTLED_FRAMES frames (all of them in a
+ *   shorter window). After the event, not before: the change alters the
+ *   image, so the error before it is no target.
+ * - frames: the smallest d >= 0 such that every frame from event + d to
+ *   end - 1 is within LM_LAG_TOLERANCE of settled (|e - settled| <=
+ *   0.1 settled): frames event .. event + d - 1 were off. Every frame to the
+ *   end, not the first one back, so that an error swinging through the
+ *   settled value on its way does not count as settled.
+ * - returned: false when even the window's last frame is off (noise wider
+ *   than 10%); frames is then the window's frame count, end - event.
+ * A settled error of 0 allows no deviation at all. */
+#define LM_LAG_SETTLED_FRAMES 5
+#define LM_LAG_TOLERANCE 0.1
+typedef struct lm_lag {
+  int frames;
+  bool returned;
+  double settled;
+} lm_lag;
+/* False with a message when event is not in 0 .. end - 1 or an error of the
+ * window is negative, NaN or Inf (naming its frame). */
+bool lm_metrics_lag(const double *error, int event, int end, lm_lag *out, lm_error *err);
+
+/* Eq 19's mean error over a band of pixels only: mask[i] != 0 marks pixel i
+ * (w * h bytes, top row first). Ghosting is this error in the band a moving
+ * object disoccluded, set against the same band's in a frame where nothing
+ * moved (motion.md): a trail the history left there raises the first only.
+ * a and b must pass lm_metrics_check. False when the band is empty (no mean);
+ * *pixels (may be NULL) gets the band's pixel count. */
+bool lm_metrics_band_error(const lm_image *a, const lm_image *b, const unsigned char *mask, double *out,
+                           size_t *pixels);
+
 #ifdef __cplusplus
 }
 #endif
