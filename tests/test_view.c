@@ -684,9 +684,9 @@ static void assert_time(const time_line *t, const char *why, double time, long f
              paused ? " paused" : "", why, t->time, t->frame, t->paused ? " paused" : "", t->why);
 }
 
-static void run_view_ok(const char *log, const char *scene, const char *time, const char *keys, const char *frames,
-                        const char *shot) {
-  pid_t pid = spawn_view(log, "--scene", scene, "--tech", "dl", "--size", "96x72", "--overlay", "off", "--time", time,
+static void run_view_ok(const char *log, const char *scene, const char *size, const char *time, const char *keys,
+                        const char *frames, const char *shot) {
+  pid_t pid = spawn_view(log, "--scene", scene, "--tech", "dl", "--size", size, "--overlay", "off", "--time", time,
                          "--exit-after", frames, "--script-keys", keys, "--screenshot", shot, NULL);
   int rc = wait_exit(pid, 30000);
   if (rc) print_log(log);
@@ -711,7 +711,7 @@ static void time_pauses_steps_and_scrubs(void **state) {
   shot_path(a, "time_a.png");
   shot_path(b, "time_b.png");
   const char *keys = "3:Space,5:Right,6:Right,7:Left,8:Right,9:time=1.25,10:Right";
-  run_view_ok(log, SCENE("moving_light"), "0", keys, "12", a);
+  run_view_ok(log, SCENE("moving_light"), "96x72", "0", keys, "12", a);
   time_line t[16];
   int n = time_lines(log, t, 16);
   if (n != 8) print_log(log);
@@ -726,7 +726,7 @@ static void time_pauses_steps_and_scrubs(void **state) {
   assert_time(&t[6], "Right", 1.25 + frame, 31, true);
   assert_time(&t[7], "at exit", 1.25 + frame, 31, true);
   /* Twice the frames, paused all the same: the same time and the same pixels. */
-  run_view_ok(log, SCENE("moving_light"), "0", keys, "24", b);
+  run_view_ok(log, SCENE("moving_light"), "96x72", "0", keys, "24", b);
   n = time_lines(log, t, 16);
   assert_int_equal(n, 8);
   assert_time(&t[7], "at exit", 1.25 + frame, 31, true);
@@ -738,7 +738,7 @@ static void time_pauses_steps_and_scrubs(void **state) {
   lm_image_free(&ib);
   /* Playing from 0.9 s: 1/60 s at frames 1 to 11, Right pauses a frame
    * later (1.125 s, frame 27), Space plays on at frames 13 to 15. */
-  run_view_ok(log, SCENE("moving_light"), "0.9", "1:F5,12:Right,13:Space", "16", b);
+  run_view_ok(log, SCENE("moving_light"), "96x72", "0.9", "1:F5,12:Right,13:Space", "16", b);
   n = time_lines(log, t, 16);
   assert_int_equal(n, 3);
   assert_time(&t[0], "Right", 0.9 + 11.0 / 60 + frame, 27, true);
@@ -833,7 +833,7 @@ static void animation_moves_light_and_camera(void **state) {
     char name[32];
     snprintf(name, sizeof name, "light%d.png", i);
     shot_path(path, name);
-    run_view_ok(log, SCENE("moving_light"), times[i], "1:Space", "3", path);
+    run_view_ok(log, SCENE("moving_light"), "96x72", times[i], "1:Space", "3", path);
     lm_image img;
     load(name, &img);
     box_mean(&img, 0, 0.5, 0.33, 1, left[i]);
@@ -844,6 +844,8 @@ static void animation_moves_light_and_camera(void **state) {
   assert_true(left[0][0] > 1.3 * right[0][0]);
   assert_true(right[1][0] > 1.3 * left[1][0]);
 
+  /* 128x96: the lower half that image_diff compares stays clear of the
+   * message a drag shows (three lines at the top). */
   static const struct { const char *time, *keys, *name; } runs[] = {
       {"0", "1:Space", "turn0.png"},       {"1", "1:Space", "turn1.png"},
       {"4", "1:Space", "turn4.png"},       {"1", "1:Space,2:drag=1;0,3:time=0", "dragged.png"},
@@ -851,7 +853,7 @@ static void animation_moves_light_and_camera(void **state) {
   lm_image img[5];
   for (int i = 0; i < 5; i++) {
     shot_path(path, runs[i].name);
-    run_view_ok(log, SCENE("turntable"), runs[i].time, runs[i].keys, "7", path);
+    run_view_ok(log, SCENE("turntable"), "128x96", runs[i].time, runs[i].keys, "7", path);
     load(runs[i].name, &img[i]);
   }
   assert_true(file_has(log, "camera 1 follows the animation"));

@@ -263,6 +263,8 @@ static void move_camera(viewer *v, double dt_ms) {
   float ahead = (key_down(v, "W") ? 1.0f : 0.0f) - (key_down(v, "S") ? 1.0f : 0.0f);
   float side = (key_down(v, "D") ? 1.0f : 0.0f) - (key_down(v, "A") ? 1.0f : 0.0f);
   if (!ahead && !side && !dx && !dy) return; /* the scene's own transform stays exact */
+  if (!v->camera_user && camera_node(v) >= 0)
+    memcpy(v->camera_local, v->scene->nodes[camera_node(v)].local, sizeof v->camera_local);
   if (v->camera_animated && !v->camera_user)
     say(v, "camera %d is yours now (0 gives it back to the animation)", v->camera + 1);
   v->camera_user = true;
@@ -310,15 +312,33 @@ static bool find_animation(viewer *v, lm_error *err) {
 }
 
 /* Poses the scene at the viewer's time; an animated camera the user has
- * not taken over follows it, one the user has keeps the user's view. */
+ * not taken over follows it, one the user has keeps the user's view (the
+ * node's local transform goes back to the animation's for the pose, so that
+ * giving the camera back finds the animation's view at once). */
 static void pose(viewer *v) {
   if (!lm_scene_animated(v->scene)) return; /* a still scene: nothing moves */
+  int node = camera_node(v);
+  float *local = node >= 0 ? v->scene->nodes[node].local : NULL;
+  if (v->camera_user && local) memcpy(local, v->camera_local, sizeof v->camera_local);
   lm_scene_set_time(v->scene, v->anim, v->time);
   lm_scene_upload_deformed(v->scene);
-  if (v->camera_user)
+  if (v->camera_user && local) {
+    memcpy(v->camera_local, local, sizeof v->camera_local);
     fly_to_camera(v);
-  else if (v->camera_animated)
+  } else if (v->camera_animated) {
     fly_from_camera(v);
+  }
+}
+
+/* The animation drives the camera the user moved again. */
+static void give_camera_back(viewer *v) {
+  int node = camera_node(v);
+  if (v->camera_user && node >= 0) {
+    memcpy(v->scene->nodes[node].local, v->camera_local, sizeof v->camera_local);
+    lm_scene_update(v->scene);
+    fly_from_camera(v);
+  }
+  v->camera_user = false;
 }
 
 /* Moves the time by dt seconds, looping over the animation's range (a time
@@ -512,7 +532,7 @@ static void handle_key(viewer *v, const char *key) {
       say(v, "camera %d is not animated", v->camera + 1);
       return;
     }
-    v->camera_user = false;
+    give_camera_back(v);
     say(v, "camera %d follows the animation", v->camera + 1);
   } else if (key[0] >= '1' && key[0] <= '9' && !key[1]) {
     int c = key[0] - '1';
@@ -520,6 +540,7 @@ static void handle_key(viewer *v, const char *key) {
       say(v, "scene %s has %d camera(s)", v->scene->name, v->scene->camera_count);
       return;
     }
+    if (v->camera_animated) give_camera_back(v);
     v->camera = c;
     lm_renderer_set_camera(v->renderer, c);
     v->camera_user = false;

@@ -59,6 +59,7 @@ typedef struct viewer {
   bool paused;
   bool camera_animated;     /* the camera's node or an ancestor is a channel's target */
   bool camera_user;         /* the user moved it: the animation no longer drives it */
+  float camera_local[16];   /* meanwhile, the camera node's local transform as the animation poses it */
   bool held[4];             /* W A S D held by --script-keys */
   double drag[2];           /* a scripted drag not yet applied */
   bool overlay_on;
