@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "image/image.h"
+#include "scene/gltf.h"
 
 static char root[256];
 static pid_t running; /* the viewer a failed case left behind */
@@ -532,6 +533,10 @@ static void command_line_errors(void **state) {
       {{"--tech", "nope"}, "unknown technique 'nope'", 2},
       {{"--script", "nope.lua"}, "nope.lua: cannot open", 1},
       {{"--scene", "nope"}, "nope", 2},
+      {{"--animation", "nope"}, "has no animation 'nope'", 2},
+      {{"--time", "soon"}, "--time wants seconds", 2},
+      {{"--fps", "0"}, "--fps wants 1..1000", 2},
+      {{"--script-keys", "4:time=later"}, "--script-keys wants FRAME:KEY", 2},
       {{"--help"}, "F2 isr+esm", 0},
   };
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
@@ -646,6 +651,221 @@ static void cameras_and_scene_reload(void **state) {
   lm_image_free(&a);
 }
 
+/* ---- time: the animated test scenes of data/scenes ---------------------- */
+#define SCENE(name) LIMN_SOURCE_ROOT "/data/scenes/" name ".glb"
+
+typedef struct time_line {
+  double time;
+  long frame;
+  bool paused;
+  char why[32];
+} time_line;
+
+/* The viewer's "time T s, frame F, animation 'A'[, paused] (why)" lines, in order. */
+static int time_lines(const char *log, time_line *out, int max) {
+  char *s = read_text(log);
+  int n = 0;
+  for (char *p = s; (p = strstr(p, "limn: time ")) && n < max; p++) {
+    time_line *t = &out[n];
+    char *why = strchr(p, '(');
+    if (sscanf(p, "limn: time %lf s, frame %ld", &t->time, &t->frame) != 2 || !why) continue;
+    char *eol = strchr(p, '\n');
+    t->paused = strstr(p, ", paused (") && strstr(p, ", paused (") < (eol ? eol : p + strlen(p));
+    sscanf(why, "(%31[^)])", t->why);
+    n++;
+  }
+  free(s);
+  return n;
+}
+
+static void assert_time(const time_line *t, const char *why, double time, long frame, bool paused) {
+  if (strcmp(t->why, why) || fabs(t->time - time) > 2e-6 || t->frame != frame || t->paused != paused)
+    fail_msg("wanted time %.6f frame %ld%s (%s), the viewer said %.6f frame %ld%s (%s)", time, frame,
+             paused ? " paused" : "", why, t->time, t->frame, t->paused ? " paused" : "", t->why);
+}
+
+static void run_view_ok(const char *log, const char *scene, const char *size, const char *time, const char *keys,
+                        const char *frames, const char *shot) {
+  pid_t pid = spawn_view(log, "--scene", scene, "--tech", "dl", "--size", size, "--overlay", "off", "--time", time,
+                         "--exit-after", frames, "--script-keys", keys, "--screenshot", shot, NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+}
+
+/* The largest difference of one value between two images. */
+static double image_max_diff(const lm_image *a, const lm_image *b) {
+  assert_int_equal(a->width, b->width);
+  assert_int_equal(a->height, b->height);
+  double m = 0;
+  for (size_t i = 0; i < (size_t)a->width * a->height * a->channels; i++) m = fmax(m, fabs(a->pixels[i] - b->pixels[i]));
+  return m;
+}
+
+/* Space pauses, Left/Right step 1/24 s, time= scrubs; scripted runs play
+ * 1/60 s a frame from the first. Paused, later frames are the same image. */
+static void time_pauses_steps_and_scrubs(void **state) {
+  (void)state;
+  char log[512], a[512], b[512];
+  log_path(log, "time");
+  shot_path(a, "time_a.png");
+  shot_path(b, "time_b.png");
+  const char *keys = "3:Space,5:Right,6:Right,7:Left,8:Right,9:time=1.25,10:Right";
+  run_view_ok(log, SCENE("moving_light"), "96x72", "0", keys, "12", a);
+  time_line t[16];
+  int n = time_lines(log, t, 16);
+  if (n != 8) print_log(log);
+  assert_int_equal(n, 8);
+  double paused = 2.0 / 60, frame = 1.0 / 24; /* frames 1 and 2 played; Space came before frame 3's step */
+  assert_time(&t[0], "Space", paused, 0, true);
+  assert_time(&t[1], "Right", paused + frame, 1, true);
+  assert_time(&t[2], "Right", paused + 2 * frame, 2, true);
+  assert_time(&t[3], "Left", paused + frame, 1, true);
+  assert_time(&t[4], "Right", paused + 2 * frame, 2, true);
+  assert_time(&t[5], "scrubbed", 1.25, 30, true);
+  assert_time(&t[6], "Right", 1.25 + frame, 31, true);
+  assert_time(&t[7], "at exit", 1.25 + frame, 31, true);
+  /* Twice the frames, paused all the same: the same time and the same pixels. */
+  run_view_ok(log, SCENE("moving_light"), "96x72", "0", keys, "24", b);
+  n = time_lines(log, t, 16);
+  assert_int_equal(n, 8);
+  assert_time(&t[7], "at exit", 1.25 + frame, 31, true);
+  lm_image ia, ib;
+  load("time_a.png", &ia);
+  load("time_b.png", &ib);
+  assert_true(image_max_diff(&ia, &ib) == 0);
+  lm_image_free(&ia);
+  lm_image_free(&ib);
+  /* Playing from 0.9 s: 1/60 s at frames 1 to 11, Right pauses a frame
+   * later (1.125 s, frame 27), Space plays on at frames 13 to 15. */
+  run_view_ok(log, SCENE("moving_light"), "96x72", "0.9", "1:F5,12:Right,13:Space", "16", b);
+  n = time_lines(log, t, 16);
+  assert_int_equal(n, 3);
+  assert_time(&t[0], "Right", 0.9 + 11.0 / 60 + frame, 27, true);
+  assert_time(&t[1], "Space", 0.9 + 11.0 / 60 + frame, 27, false);
+  assert_time(&t[2], "at exit", 0.9 + 14.0 / 60 + frame, 28, false);
+}
+
+/* A script and a scene file saved while paused at 1.25 s: the time and the
+ * pause stay. */
+static void time_survives_reload(void **state) {
+  (void)state;
+  char log[512], scene[512], cmd[1200];
+  log_path(log, "time_reload");
+  path_in_root(scene, sizeof scene, "motion.glb");
+  snprintf(cmd, sizeof cmd, "cp %s %s", SCENE("moving_light"), scene);
+  assert_int_equal(system(cmd), 0);
+  pid_t pid = spawn_view(log, "--scene", scene, "--tech", "dl", "--size", "64x48", "--overlay", "off", "--time",
+                         "1.25", "--script-keys", "1:Space", "--exit-after", "1000000", NULL);
+  bool paused = wait_for(log, "(Space)", 20000);
+  if (!paused) print_log(log);
+  assert_true(paused);
+  char *pp = read_text(LIMN_SOURCE_ROOT "/scripts/pp.lua");
+  lm_buf b = {0};
+  lm_buf_printf(&b, "%s\n-- edited\n", pp);
+  write_file("scripts/pp.lua", b.data);
+  bool reloaded = wait_for(log, "(script reloaded)", 10000);
+  if (!reloaded) print_log(log);
+  assert_true(reloaded);
+  snprintf(cmd, sizeof cmd, "cp %s %s.tmp~ && mv %s.tmp~ %s", SCENE("moving_light"), scene, scene, scene);
+  assert_int_equal(system(cmd), 0);
+  reloaded = wait_for(log, "(scene reloaded)", 10000);
+  if (!reloaded) print_log(log);
+  assert_true(reloaded);
+  sleep_ms(200);
+  kill(pid, SIGTERM);
+  assert_int_equal(wait_exit(pid, 10000), 0);
+  time_line t[8];
+  int n = time_lines(log, t, 8);
+  assert_int_equal(n, 4);
+  assert_time(&t[0], "Space", 1.25, 30, true);
+  assert_time(&t[1], "script reloaded", 1.25, 30, true);
+  assert_time(&t[2], "scene reloaded", 1.25, 30, true);
+  assert_time(&t[3], "at exit", 1.25, 30, true);
+  write_file("scripts/pp.lua", pp);
+  lm_buf_free(&b);
+  free(pp);
+}
+
+/* World position of node `name` of `path` at `seconds` (all animations). */
+static void node_at(lm_scene *s, const char *name, double seconds, float pos[3]) {
+  int node = lm_scene_find_node(s, name);
+  assert_true(node >= 0);
+  lm_scene_set_time(s, LM_ANIM_ALL, seconds);
+  memcpy(pos, s->nodes[node].world + 12, 3 * sizeof *pos);
+}
+
+/* Are the scene's animations read and evaluated? The lamp of moving_light
+ * crosses the room (x from -1.5 to 1.5 in 3 s) once they are. */
+static const char *animation_missing(void) {
+  lm_error err;
+  lm_scene *s = lm_scene_load(SCENE("moving_light"), &err);
+  if (!s) fail_msg("%s", err.msg);
+  bool animated = lm_scene_animated(s);
+  float a[3] = {0}, b[3] = {0};
+  if (animated) {
+    node_at(s, "lamp", 0, a);
+    node_at(s, "lamp", 3, b);
+  }
+  lm_scene_destroy(s);
+  if (!animated) return "the glTF loader reads no animations yet";
+  if (fabsf(b[0] - a[0]) < 1e-3f) return "lm_scene_set_time is still a stub";
+  if (fabsf(a[0] + 1.5f) > 1e-4f || fabsf(b[0] - 1.5f) > 1e-4f)
+    fail_msg("the lamp goes from x %g to %g, not -1.5 to 1.5", a[0], b[0]);
+  return NULL;
+}
+
+/* The moving light lights the left of the room at 0.25 s and its right at
+ * 2.75 s; the turntable's camera, a quarter turn round at 1 s and whole
+ * again at 4 s, is the user's once dragged (a scrub leaves it) until 0. */
+static void animation_moves_light_and_camera(void **state) {
+  (void)state;
+  const char *missing = animation_missing();
+  if (missing) {
+    print_message("skipped: %s (the viewer's time is tested above)\n", missing);
+    skip();
+  }
+  char log[512], path[512];
+  log_path(log, "animated");
+  const char *times[2] = {"0.25", "2.75"};
+  double left[2][3], right[2][3];
+  for (int i = 0; i < 2; i++) {
+    char name[32];
+    snprintf(name, sizeof name, "light%d.png", i);
+    shot_path(path, name);
+    run_view_ok(log, SCENE("moving_light"), "96x72", times[i], "1:Space", "3", path);
+    lm_image img;
+    load(name, &img);
+    box_mean(&img, 0, 0.5, 0.33, 1, left[i]);
+    box_mean(&img, 0.67, 0.5, 1, 1, right[i]);
+    lm_image_free(&img);
+    print_message("light at %s s: left %.3f, right %.3f (red)\n", times[i], left[i][0], right[i][0]);
+  }
+  assert_true(left[0][0] > 1.3 * right[0][0]);
+  assert_true(right[1][0] > 1.3 * left[1][0]);
+
+  /* 128x96: the lower half that image_diff compares stays clear of the
+   * message a drag shows (three lines at the top). */
+  static const struct { const char *time, *keys, *name; } runs[] = {
+      {"0", "1:Space", "turn0.png"},       {"1", "1:Space", "turn1.png"},
+      {"4", "1:Space", "turn4.png"},       {"1", "1:Space,2:drag=1;0,3:time=0", "dragged.png"},
+      {"1", "1:Space,2:drag=1;0,3:time=0,4:0", "given_back.png"}};
+  lm_image img[5];
+  for (int i = 0; i < 5; i++) {
+    shot_path(path, runs[i].name);
+    run_view_ok(log, SCENE("turntable"), "128x96", runs[i].time, runs[i].keys, "7", path);
+    load(runs[i].name, &img[i]);
+  }
+  assert_true(file_has(log, "camera 1 follows the animation"));
+  assert_walls(&img[0]);
+  assert_true(image_diff(&img[0], &img[1]) > 0.05);  /* a quarter turn round */
+  assert_true(image_diff(&img[0], &img[2]) < 0.01);  /* whole round */
+  assert_true(image_diff(&img[3], &img[1]) < 0.02);  /* the user's view stays at 1 s's */
+  assert_true(image_diff(&img[3], &img[0]) > 0.05);
+  assert_true(image_diff(&img[4], &img[0]) < 0.01);  /* 0 gives the camera back: 0 s's view */
+  for (int i = 0; i < 5; i++) lm_image_free(&img[i]);
+}
+
 /* 1000 script edits through the real file watch (every tenth broken, every
  * hundredth rebuilding all shaders) leave the GL object and heap counts where
  * they were after the warm-up. */
@@ -686,6 +906,9 @@ int main(void) {
       cmocka_unit_test_teardown(inspector_writes_target_and_frame, stop_leftover),
       cmocka_unit_test_teardown(cameras_and_scene_reload, stop_leftover),
       cmocka_unit_test_teardown(camera_moves_and_turns, stop_leftover),
+      cmocka_unit_test_teardown(time_pauses_steps_and_scrubs, stop_leftover),
+      cmocka_unit_test_teardown(time_survives_reload, stop_leftover),
+      cmocka_unit_test_teardown(animation_moves_light_and_camera, stop_leftover),
       cmocka_unit_test_teardown(reload_loop_leaks_nothing, stop_leftover),
   };
   return cmocka_run_group_tests(tests, setup, teardown);

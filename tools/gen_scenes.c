@@ -255,13 +255,14 @@ typedef struct node {
   char name[64];
   int parent;
   float t[3], r[4], s[3];
-  int mesh, camera, light;
+  int mesh, camera, light, skin;
 } node;
 
 typedef struct doc {
   buf bin;
-  buf views, accessors, meshes, materials, images, textures, cameras, lights;
+  buf views, accessors, meshes, materials, images, textures, cameras, lights, animations, skins;
   int view_count, accessor_count, mesh_count, material_count, image_count, camera_count, light_count;
+  int animation_count, skin_count;
   node *nodes;
   int node_count, node_cap;
   buf cams; /* the camera list text */
@@ -299,8 +300,10 @@ static int add_accessor(doc *d, int view, int ctype, int count, const char *type
   return d->accessor_count++;
 }
 
-/* The primitive's JSON for one mesh part: attributes, indices, material. */
-static void add_primitive(doc *d, buf *out, const mesh *m, int material) {
+/* The primitive's JSON for one mesh part: attributes, indices, material;
+ * joints and weights (4 a vertex) when skinned, else NULL. */
+static void add_primitive(doc *d, buf *out, const mesh *m, int material, const uint8_t *joints,
+                          const float *weights) {
   size_t nv = (size_t)m->nv;
   float *pos = malloc(nv * 12), *nrm = malloc(nv * 12), *uv = malloc(nv * 8);
   float mn[3] = {1e30f, 1e30f, 1e30f}, mx[3] = {-1e30f, -1e30f, -1e30f};
@@ -322,21 +325,33 @@ static void add_primitive(doc *d, buf *out, const mesh *m, int material) {
   } else {
     ai = add_accessor(d, add_view(d, m->ix, (size_t)m->ni * 4, 34963), 5125, m->ni, "SCALAR", NULL, NULL);
   }
-  putf(out, "{\"attributes\":{\"POSITION\":%d,\"NORMAL\":%d,\"TEXCOORD_0\":%d},\"indices\":%d,\"material\":%d}",
-       ap, an, at, ai, material);
+  putf(out, "{\"attributes\":{\"POSITION\":%d,\"NORMAL\":%d,\"TEXCOORD_0\":%d", ap, an, at);
+  if (joints) {
+    int aj = add_accessor(d, add_view(d, joints, nv * 4, 34962), 5121, m->nv, "VEC4", NULL, NULL);
+    int aw = add_accessor(d, add_view(d, weights, nv * 16, 34962), 5126, m->nv, "VEC4", NULL, NULL);
+    putf(out, ",\"JOINTS_0\":%d,\"WEIGHTS_0\":%d", aj, aw);
+  }
+  putf(out, "},\"indices\":%d,\"material\":%d}", ai, material);
   free(pos), free(nrm), free(uv);
 }
 
-/* A mesh of `n` parts, part i with materials[i]. */
-static int add_mesh(doc *d, const char *name, mesh *parts, const int *materials, int n) {
+/* A mesh of `n` parts, part i with materials[i]; skinned (joints and
+ * weights of every part's vertices, parts in order) or not (NULL). */
+static int add_skinned_mesh(doc *d, const char *name, mesh *parts, const int *materials, int n,
+                            const uint8_t *joints, const float *weights) {
   sep(&d->meshes, d->mesh_count);
   putf(&d->meshes, "{\"name\":\"%s\",\"primitives\":[", name);
   for (int i = 0; i < n; i++) {
     if (i) put(&d->meshes, ",", 1);
-    add_primitive(d, &d->meshes, &parts[i], materials[i]);
+    add_primitive(d, &d->meshes, &parts[i], materials[i], joints, weights);
+    if (joints) joints += parts[i].nv * 4, weights += parts[i].nv * 4;
   }
   put(&d->meshes, "]}", 2);
   return d->mesh_count++;
+}
+
+static int add_mesh(doc *d, const char *name, mesh *parts, const int *materials, int n) {
+  return add_skinned_mesh(d, name, parts, materials, n, NULL, NULL);
 }
 
 static int add_mesh1(doc *d, const char *name, mesh *m, int material) {
@@ -380,7 +395,7 @@ static int add_node(doc *d, const char *name, int parent, float x, float y, floa
   n->t[0] = x, n->t[1] = y, n->t[2] = z;
   n->r[3] = 1;
   n->s[0] = n->s[1] = n->s[2] = 1;
-  n->mesh = n->camera = n->light = -1;
+  n->mesh = n->camera = n->light = n->skin = -1;
   return d->node_count++;
 }
 
@@ -419,15 +434,20 @@ static void look_quat(const float dir_in[3], float q[4]) {
   }
 }
 
+/* Makes node n a glTF camera called `name`. */
+static void camera(doc *d, int n, const char *name, float fov_deg, float zfar) {
+  sep(&d->cameras, d->camera_count);
+  putf(&d->cameras, "{\"name\":\"%s\",\"type\":\"perspective\",\"perspective\":{\"yfov\":%.6g,\"znear\":0.05,"
+       "\"zfar\":%.6g}}", name, fov_deg * PI / 180.0f, zfar);
+  d->nodes[n].camera = d->camera_count++;
+}
+
 /* A view: a glTF camera node (the first one is what `--scene FILE` shows) and a camera list line. */
 static void view(doc *d, const char *name, float ex, float ey, float ez, float tx, float ty, float tz,
                  float fov_deg, float zfar) {
   int n = add_node(d, name, -1, ex, ey, ez);
   look_quat((float[]){tx - ex, ty - ey, tz - ez}, d->nodes[n].r);
-  sep(&d->cameras, d->camera_count);
-  putf(&d->cameras, "{\"name\":\"%s\",\"type\":\"perspective\",\"perspective\":{\"yfov\":%.6g,\"znear\":0.05,"
-       "\"zfar\":%.6g}}", name, fov_deg * PI / 180.0f, zfar);
-  d->nodes[n].camera = d->camera_count++;
+  camera(d, n, name, fov_deg, zfar);
   putf(&d->cams, "%-10s %8.3f %8.3f %8.3f   %8.3f %8.3f %8.3f   %5.1f\n", name, ex, ey, ez, tx, ty, tz, fov_deg);
 }
 
@@ -449,6 +469,69 @@ static void light(doc *d, const char *name, const char *type, float x, float y, 
   if (!strcmp(type, "spot")) putf(&d->lights, ",\"spot\":{\"innerConeAngle\":0.5,\"outerConeAngle\":0.8}");
   put(&d->lights, "}", 1);
   d->nodes[n].light = d->light_count++;
+}
+
+/* ---- animation and skins ---------------------------------------------------- */
+/* An animation being written: its channels' and samplers' JSON. */
+typedef struct anim {
+  buf channels, samplers;
+  int count;
+} anim;
+
+/* A channel moving node's `path` (translation, rotation, scale) by `count`
+ * keys at `times` (increasing; the input accessor's min and max are the
+ * first and last) of `width` floats each, CUBICSPLINE's three a key
+ * (in-tangent, value, out-tangent). */
+static void channel(doc *d, anim *a, int node, const char *path, const char *interp, const float *times,
+                    int count, const float *values, int width) {
+  int view = add_view(d, times, (size_t)count * 4, 0);
+  sep(&d->accessors, d->accessor_count);
+  putf(&d->accessors, "{\"bufferView\":%d,\"componentType\":5126,\"count\":%d,\"type\":\"SCALAR\","
+       "\"min\":[%.9g],\"max\":[%.9g]}", view, count, times[0], times[count - 1]);
+  int input = d->accessor_count++;
+  int per_key = !strcmp(interp, "CUBICSPLINE") ? 3 : 1;
+  view = add_view(d, values, (size_t)count * per_key * width * 4, 0);
+  int output = add_accessor(d, view, 5126, count * per_key, width == 4 ? "VEC4" : "VEC3", NULL, NULL);
+  sep(&a->samplers, a->count);
+  putf(&a->samplers, "{\"input\":%d,\"output\":%d,\"interpolation\":\"%s\"}", input, output, interp);
+  sep(&a->channels, a->count);
+  putf(&a->channels, "{\"sampler\":%d,\"target\":{\"node\":%d,\"path\":\"%s\"}}", a->count, node, path);
+  a->count++;
+}
+
+static void add_animation(doc *d, const char *name, anim *a) {
+  sep(&d->animations, d->animation_count++);
+  putf(&d->animations, "{\"name\":\"%s\",\"channels\":[", name);
+  put(&d->animations, a->channels.data, a->channels.len);
+  putf(&d->animations, "],\"samplers\":[");
+  put(&d->animations, a->samplers.data, a->samplers.len);
+  put(&d->animations, "]}", 2);
+  free(a->channels.data), free(a->samplers.data);
+  memset(a, 0, sizeof *a);
+}
+
+/* The rotation by `deg` degrees about axis (x, y, z) (unit), x y z w. */
+static void axis_quat(float x, float y, float z, float deg, float q[4]) {
+  float h = deg * PI / 360.0f;
+  q[0] = x * sinf(h), q[1] = y * sinf(h), q[2] = z * sinf(h), q[3] = cosf(h);
+}
+
+/* A skin of `n` joints (nodes) whose bind pose is a translation each
+ * (their world positions `at`, 3 floats a joint). */
+static int add_skin(doc *d, const int *joints, int n, const float *at) {
+  float *ibm = calloc((size_t)n * 16, sizeof *ibm);
+  for (int j = 0; j < n; j++) {
+    float *m = ibm + j * 16;
+    m[0] = m[5] = m[10] = m[15] = 1;
+    m[12] = -at[j * 3], m[13] = -at[j * 3 + 1], m[14] = -at[j * 3 + 2];
+  }
+  int acc = add_accessor(d, add_view(d, ibm, (size_t)n * 64, 0), 5126, n, "MAT4", NULL, NULL);
+  free(ibm);
+  sep(&d->skins, d->skin_count);
+  putf(&d->skins, "{\"inverseBindMatrices\":%d,\"skeleton\":%d,\"joints\":[", acc, joints[0]);
+  for (int j = 0; j < n; j++) putf(&d->skins, j ? ",%d" : "%d", joints[j]);
+  put(&d->skins, "]}", 2);
+  return d->skin_count++;
 }
 
 static void write_file(const char *path, const void *data, size_t len) {
@@ -475,6 +558,7 @@ static void finish(doc *d, const char *dir, const char *name) {
     if (n->r[3] != 1) putf(&j, ",\"rotation\":[%.6g,%.6g,%.6g,%.6g]", n->r[0], n->r[1], n->r[2], n->r[3]);
     if (n->s[0] != 1 || n->s[1] != 1 || n->s[2] != 1) putf(&j, ",\"scale\":[%.6g,%.6g,%.6g]", n->s[0], n->s[1], n->s[2]);
     if (n->mesh >= 0) putf(&j, ",\"mesh\":%d", n->mesh);
+    if (n->skin >= 0) putf(&j, ",\"skin\":%d", n->skin);
     if (n->camera >= 0) putf(&j, ",\"camera\":%d", n->camera);
     if (n->light >= 0) putf(&j, ",\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}", n->light);
     int kids = 0;
@@ -493,6 +577,8 @@ static void finish(doc *d, const char *dir, const char *name) {
   SECTION("cameras", d->cameras, d->camera_count);
   SECTION("accessors", d->accessors, d->accessor_count);
   SECTION("bufferViews", d->views, d->view_count);
+  SECTION("animations", d->animations, d->animation_count);
+  SECTION("skins", d->skins, d->skin_count);
 #undef SECTION
   if (d->light_count) {
     putf(&j, ",\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[");
@@ -528,6 +614,7 @@ static void finish(doc *d, const char *dir, const char *name) {
   free(j.data), free(glb.data), free(cams.data), free(d->bin.data), free(d->views.data);
   free(d->accessors.data), free(d->meshes.data), free(d->materials.data), free(d->images.data);
   free(d->textures.data), free(d->cameras.data), free(d->lights.data), free(d->nodes), free(d->cams.data);
+  free(d->animations.data), free(d->skins.data);
   memset(d, 0, sizeof *d);
 }
 
@@ -579,28 +666,33 @@ static unsigned char *bricks(int size) {
 /* ---- the scenes ------------------------------------------------------------- */
 static const unsigned char WHITE8[3] = {230, 230, 230}, GREY8[3] = {60, 60, 70};
 
-static void cornell(const char *dir) {
-  doc d = {0};
-  int white = add_material(&d, "white", 0.73f, 0.73f, 0.73f, 0, 1, -1);
-  int red = add_material(&d, "red", 0.63f, 0.065f, 0.05f, 0, 1, -1);
-  int green = add_material(&d, "green", 0.14f, 0.45f, 0.091f, 0, 1, -1);
-  int boxm = add_material(&d, "box", 0.73f, 0.73f, 0.73f, 0, 0.45f, -1);
+/* The Cornell box, its light and no views (cornell and turntable). */
+static void cornell_box(doc *d) {
+  int white = add_material(d, "white", 0.73f, 0.73f, 0.73f, 0, 1, -1);
+  int red = add_material(d, "red", 0.63f, 0.065f, 0.05f, 0, 1, -1);
+  int green = add_material(d, "green", 0.14f, 0.45f, 0.091f, 0, 1, -1);
+  int boxm = add_material(d, "box", 0.73f, 0.73f, 0.73f, 0, 0.45f, -1);
   mesh m = {0};
   quad(&m, (float[]){-1, 0, 1}, (float[]){2, 0, 0}, (float[]){0, 0, -2}, 1, 1);   /* floor */
   quad(&m, (float[]){-1, 2, -1}, (float[]){2, 0, 0}, (float[]){0, 0, 2}, 1, 1);   /* ceiling */
   quad(&m, (float[]){-1, 0, -1}, (float[]){2, 0, 0}, (float[]){0, 2, 0}, 1, 1);   /* back */
-  mesh_node(&d, "walls", -1, add_mesh1(&d, "walls", &m, white), 0, 0, 0, 0, 1);
+  mesh_node(d, "walls", -1, add_mesh1(d, "walls", &m, white), 0, 0, 0, 0, 1);
   quad(&m, (float[]){-1, 0, 1}, (float[]){0, 0, -2}, (float[]){0, 2, 0}, 1, 1);
-  mesh_node(&d, "left", -1, add_mesh1(&d, "left", &m, red), 0, 0, 0, 0, 1);
+  mesh_node(d, "left", -1, add_mesh1(d, "left", &m, red), 0, 0, 0, 0, 1);
   quad(&m, (float[]){1, 0, -1}, (float[]){0, 0, 2}, (float[]){0, 2, 0}, 1, 1);
-  mesh_node(&d, "right", -1, add_mesh1(&d, "right", &m, green), 0, 0, 0, 0, 1);
+  mesh_node(d, "right", -1, add_mesh1(d, "right", &m, green), 0, 0, 0, 0, 1);
   box(&m, 0, 0.5f, 0, 0.5f, 0.5f, 0.5f);
-  int cube = add_mesh1(&d, "cube", &m, boxm);
-  int s = mesh_node(&d, "short_box", -1, cube, 0.35f, 0, 0.3f, -17, 1);
-  d.nodes[s].s[0] = d.nodes[s].s[1] = d.nodes[s].s[2] = 0.6f;
-  int t = mesh_node(&d, "tall_box", -1, cube, -0.35f, 0, -0.35f, 17, 1);
-  d.nodes[t].s[0] = 0.6f, d.nodes[t].s[1] = 1.2f, d.nodes[t].s[2] = 0.6f;
-  light(&d, "ceiling_light", "point", 0, 1.7f, 0, NULL, 1, 0.95f, 0.85f, 6000, 0);
+  int cube = add_mesh1(d, "cube", &m, boxm);
+  int s = mesh_node(d, "short_box", -1, cube, 0.35f, 0, 0.3f, -17, 1);
+  d->nodes[s].s[0] = d->nodes[s].s[1] = d->nodes[s].s[2] = 0.6f;
+  int t = mesh_node(d, "tall_box", -1, cube, -0.35f, 0, -0.35f, 17, 1);
+  d->nodes[t].s[0] = 0.6f, d->nodes[t].s[1] = 1.2f, d->nodes[t].s[2] = 0.6f;
+  light(d, "ceiling_light", "point", 0, 1.7f, 0, NULL, 1, 0.95f, 0.85f, 6000, 0);
+}
+
+static void cornell(const char *dir) {
+  doc d = {0};
+  cornell_box(&d);
   view(&d, "front", 0, 1, 3.4f, 0, 1, 0, 45, 20);
   view(&d, "left", -0.6f, 1.2f, 2.6f, 0.1f, 0.8f, 0, 50, 20);
   view(&d, "high", 0.3f, 1.8f, 2.2f, 0, 0.4f, 0, 55, 20);
@@ -1055,6 +1147,146 @@ static void night(const char *dir) {
   finish(&d, dir, "night");
 }
 
+/* ---- scenes that move (data/jobs/motion.lua) ---------------------------------
+ * glTF animations: LINEAR and CUBICSPLINE channels, a skin; each a few
+ * hundred triangles. Loaded by tests/test_scenes_gen.sh's checks. */
+
+/* The Cornell box seen from a camera that orbits it once in 4 s: a rotation
+ * channel (LINEAR, a key every quarter turn) on a pivot at the box's centre,
+ * the camera its child 3.4 in front. The camera list holds the still front
+ * view. */
+static void turntable(const char *dir) {
+  doc d = {0};
+  cornell_box(&d);
+  int pivot = add_node(&d, "pivot", -1, 0, 1, 0);
+  camera(&d, add_node(&d, "orbit", pivot, 0, 0, 3.4f), "orbit", 45, 20);
+  view(&d, "front", 0, 1, 3.4f, 0, 1, 0, 45, 20);
+  float times[5], q[5][4];
+  for (int k = 0; k < 5; k++) times[k] = (float)k, axis_quat(0, 1, 0, 90.0f * (float)k, q[k]);
+  anim a = {0};
+  channel(&d, &a, pivot, "rotation", "LINEAR", times, 5, q[0], 4);
+  add_animation(&d, "orbit", &a);
+  finish(&d, dir, "turntable");
+}
+
+/* A room, 4 x 2.5 x 4, with a doorway in its left wall (x = -2) and a door
+ * that swings open 90 degrees into the room about its hinge from 0.5 s to
+ * 1.5 s (CUBICSPLINE with zero tangents: it eases in and out), letting in a
+ * sun it shut out; a dim lamp lights the room before. */
+static void door(const char *dir) {
+  doc d = {0};
+  int wall = diffuse(&d, "plaster", 0.8f, 0.78f, 0.74f), floor = diffuse(&d, "floor", 0.6f, 0.42f, 0.28f);
+  int ceiling = diffuse(&d, "ceiling", 0.85f, 0.85f, 0.85f), wood = diffuse(&d, "door", 0.45f, 0.25f, 0.12f);
+  float W = 2, H = 2.5f, D = 2, z0 = -0.5f, z1 = 0.5f, top = 2; /* the doorway: z in [z0, z1], y below top */
+  mesh m = {0};
+  slab(&m, 0, true, -W, W, -D, D);
+  mesh_node(&d, "floor", -1, add_mesh1(&d, "floor", &m, floor), 0, 0, 0, 0, 1);
+  slab(&m, H, false, -W, W, -D, D);
+  mesh_node(&d, "ceiling", -1, add_mesh1(&d, "ceiling", &m, ceiling), 0, 0, 0, 0, 1);
+  wall_x(&m, -W, 1, -D, z0, 0, H); /* beside the doorway */
+  wall_x(&m, -W, 1, z1, D, 0, H);
+  wall_x(&m, -W, 1, z0, z1, top, H); /* over it */
+  wall_x(&m, W, -1, -D, D, 0, H);
+  wall_z(&m, -D, 1, -W, W, 0, H);
+  wall_z(&m, D, -1, -W, W, 0, H);
+  mesh_node(&d, "walls", -1, add_mesh1(&d, "walls", &m, wall), 0, 0, 0, 0, 1);
+  /* 1 wide, 2 high, 6 cm thick, its hinge edge on the hinge node's y axis. */
+  box(&m, 0.03f, top / 2, (z1 - z0) / 2, 0.03f, top / 2, (z1 - z0) / 2);
+  int hinge = add_node(&d, "hinge", -1, -W, 0, z0);
+  mesh_node(&d, "door", hinge, add_mesh1(&d, "door", &m, wood), 0, 0, 0, 0, 1);
+  light(&d, "sun", "directional", -6, 4, 0, (float[]){1, -0.45f, 0.15f}, 1, 0.96f, 0.9f, 3 * LUX, 0);
+  light(&d, "lamp", "point", 0.5f, 2.3f, 0.5f, NULL, 1, 0.9f, 0.8f, 800, 0);
+  view(&d, "inside", 1.6f, 1.5f, 1.6f, -1.5f, 0.7f, -0.3f, 60, 20);
+  float times[2] = {0.5f, 1.5f}, keys[2][3][4] = {{{0}}};
+  axis_quat(0, 1, 0, 0, keys[0][1]);
+  axis_quat(0, 1, 0, 90, keys[1][1]);
+  anim a = {0};
+  channel(&d, &a, hinge, "rotation", "CUBICSPLINE", times, 2, keys[0][0], 4);
+  add_animation(&d, "open", &a);
+  finish(&d, dir, "door");
+}
+
+/* A skinned tube on a floor under a lamp: radius 0.2, 2 high, 13 rings of 16
+ * sides (a cap on top) about two joints, `base` on the floor and `bend` 1 up;
+ * vertices from 0.75 to 1.25 high blend the two so that the bend stays round.
+ * `bend` turns 90 degrees about z over 2 s (LINEAR, keys at 0, 1, 2 s). */
+static void bending_tube(const char *dir) {
+  enum { RINGS = 12, SIDES = 16 };
+  doc d = {0};
+  int floor = diffuse(&d, "floor", 0.7f, 0.7f, 0.68f), paint = diffuse(&d, "tube", 0.2f, 0.45f, 0.8f);
+  mesh m = {0};
+  slab(&m, 0, true, -4, 4, -4, 4);
+  mesh_node(&d, "floor", -1, add_mesh1(&d, "floor", &m, floor), 0, 0, 0, 0, 1);
+  float R = 0.2f, L = 2;
+  for (int j = 0; j <= RINGS; j++)
+    for (int i = 0; i <= SIDES; i++) {
+      float a = 2 * PI * (float)i / SIDES, c = cosf(a), s = sinf(a);
+      vert(&m, R * c, L * (float)j / RINGS, R * s, c, 0, s, (float)i / SIDES, (float)j / RINGS);
+    }
+  for (int j = 0; j < RINGS; j++)
+    for (int i = 0; i < SIDES; i++) {
+      int a = j * (SIDES + 1) + i, b = a + SIDES + 1;
+      tri(&m, a, b, a + 1), tri(&m, a + 1, b, b + 1);
+    }
+  int centre = vert(&m, 0, L, 0, 0, 1, 0, 0.5f, 0.5f), rim = m.nv;
+  for (int i = 0; i <= SIDES; i++) {
+    float a = 2 * PI * (float)i / SIDES;
+    vert(&m, R * cosf(a), L, R * sinf(a), 0, 1, 0, 0.5f + 0.5f * cosf(a), 0.5f + 0.5f * sinf(a));
+  }
+  for (int i = 0; i < SIDES; i++) tri(&m, centre, rim + i + 1, rim + i);
+  uint8_t *joints = calloc((size_t)m.nv * 4, 1);
+  float *weights = calloc((size_t)m.nv * 4, sizeof *weights);
+  for (int v = 0; v < m.nv; v++) {
+    float w = fminf(1, fmaxf(0, (m.v[v * 8 + 1] - 0.75f) / 0.5f)); /* bend's share */
+    joints[v * 4 + 1] = w > 0; /* an unused influence names joint 0 */
+    weights[v * 4] = 1 - w, weights[v * 4 + 1] = w;
+  }
+  int base = add_node(&d, "base", -1, 0, 0, 0), bend = add_node(&d, "bend", base, 0, 1, 0);
+  int skin = add_skin(&d, (int[]){base, bend}, 2, (float[]){0, 0, 0, 0, 1, 0});
+  int tube = mesh_node(&d, "tube", -1, add_skinned_mesh(&d, "tube", &m, &paint, 1, joints, weights), 0, 0, 0, 0, 1);
+  d.nodes[tube].skin = skin;
+  mesh_free(&m), free(joints), free(weights);
+  light(&d, "lamp", "point", 1.5f, 3.5f, 1.5f, NULL, 1, 0.95f, 0.85f, 20000, 0);
+  view(&d, "side", 0.5f, 1.4f, 4.2f, -0.3f, 0.9f, 0, 50, 30);
+  float times[3] = {0, 1, 2}, q[3][4];
+  for (int k = 0; k < 3; k++) axis_quat(0, 0, 1, 45.0f * (float)k, q[k]);
+  anim a = {0};
+  channel(&d, &a, bend, "rotation", "LINEAR", times, 3, q[0], 4);
+  add_animation(&d, "bend", &a);
+  finish(&d, dir, "bending_tube");
+}
+
+/* A closed room with three boxes and a point light that crosses it from
+ * left to right, 2 m high, in 3 s (LINEAR translation keys at 0 and 3 s):
+ * the boxes' shadows sweep over the floor. */
+static void moving_light(const char *dir) {
+  doc d = {0};
+  int wall = diffuse(&d, "plaster", 0.8f, 0.78f, 0.74f), floor = diffuse(&d, "floor", 0.6f, 0.42f, 0.28f);
+  int boxes = diffuse(&d, "boxes", 0.25f, 0.55f, 0.3f);
+  float W = 2, H = 2.5f, D = 2;
+  mesh m = {0};
+  slab(&m, 0, true, -W, W, -D, D);
+  mesh_node(&d, "floor", -1, add_mesh1(&d, "floor", &m, floor), 0, 0, 0, 0, 1);
+  slab(&m, H, false, -W, W, -D, D);
+  wall_x(&m, -W, 1, -D, D, 0, H);
+  wall_x(&m, W, -1, -D, D, 0, H);
+  wall_z(&m, -D, 1, -W, W, 0, H);
+  wall_z(&m, D, -1, -W, W, 0, H);
+  mesh_node(&d, "walls", -1, add_mesh1(&d, "walls", &m, wall), 0, 0, 0, 0, 1);
+  box(&m, -0.8f, 0.4f, -0.6f, 0.3f, 0.4f, 0.3f);
+  box(&m, 0.7f, 0.6f, -0.9f, 0.25f, 0.6f, 0.25f);
+  box(&m, 0.125f, 0.25f, 0.5f, 0.375f, 0.25f, 0.25f); /* binary fractions: exact bounds */
+  mesh_node(&d, "boxes", -1, add_mesh1(&d, "boxes", &m, boxes), 0, 0, 0, 0, 1);
+  int lamp = d.node_count;
+  light(&d, "lamp", "point", -1.5f, 2, 0, NULL, 1, 0.95f, 0.85f, 6000, 0);
+  view(&d, "front", 0, 1.4f, 1.9f, 0, 0.9f, -1, 65, 20);
+  float times[2] = {0, 3}, path[2][3] = {{-1.5f, 2, 0}, {1.5f, 2, 0}};
+  anim a = {0};
+  channel(&d, &a, lamp, "translation", "LINEAR", times, 2, path[0], 3);
+  add_animation(&d, "cross", &a);
+  finish(&d, dir, "moving_light");
+}
+
 int main(int argc, char **argv) {
   if (argc != 2) {
     fprintf(stderr, "usage: gen_scenes OUTDIR\n");
@@ -1074,6 +1306,10 @@ int main(int argc, char **argv) {
   ref_room(ref);
   ref_street(ref);
   ref_blocks(ref);
-  night(argv[1]); /* last: it draws no random number, but stays after those that do */
+  night(argv[1]); /* it draws no random number, but stays after those that do */
+  turntable(argv[1]);
+  door(argv[1]);
+  bending_tube(argv[1]);
+  moving_light(argv[1]);
   return 0;
 }

@@ -40,14 +40,18 @@ static const char view_usage[] =
     "  --set NAME=VALUE     set an option the script declares (repeatable)\n"
     "  --size WxH           window size (default 512x384)\n"
     "  --camera N           scene camera to start from (default 0)\n"
+    "  --animation NAME|INDEX|all  the glTF animation to play (default all)\n"
+    "  --time SECONDS       time to start at (default: the animation's first key)\n"
+    "  --fps N              frames a second of Left/Right steps and of the frame\n"
+    "                       number on the overlay (default 24)\n"
     "  --overlay on|off     show the overlay at start (default on; F1/Tab toggles)\n"
     "  --capture-dir DIR    where P writes images (default .)\n"
     "  --exit-after N       close after N frames\n"
     "  --screenshot FILE    write the window's content at exit (PNG)\n"
     "  --script-keys LIST   press keys at frames, e.g. \"5:F5,10:F3\" (for tests);\n"
     "                       also resize=WxH, hold=W|A|S|D, release=W|A|S|D and\n"
-    "                       drag=DX;DY (a left-button drag, pixels); camera steps\n"
-    "                       are then 1/60 s a frame\n"
+    "                       drag=DX;DY (a left-button drag, pixels) and time=SECONDS;\n"
+    "                       camera and animation steps are then 1/60 s a frame\n"
     "  --reload-test N      test hook: N edits of a copy of the script, each one\n"
     "                       reloaded through the file watch; prints GL object and\n"
     "                       heap counts and fails when any grew\n"
@@ -56,6 +60,8 @@ static const char view_usage[] =
     "\n"
     "keys:\n"
     "  W/S/A/D move, left mouse drag looks around, 1-9 the scene's cameras\n"
+    "  Space pauses and plays, Left/Right step a frame (and pause); an animated\n"
+    "  camera follows its animation until moved, 0 gives it back\n"
     "  F2 isr+esm  F3 isr  F4 dl+esm  F5 dl (techniques the script lists)\n"
     "  F6 bloom  F7 dof  F8 glass  F9 radial_blur  F11 sepia  F12 tiles (options\n"
     "  the script declares, a boolean or a table with `enabled`)\n"
@@ -85,7 +91,9 @@ static bool parse_script_keys(const char *list, view_args *a) {
     k->frame = frame;
     snprintf(k->key, sizeof k->key, "%s", colon + 1);
     int w, h;
+    double t;
     if (!strncmp(k->key, "resize=", 7) && !limn_parse_size(k->key + 7, &w, &h)) return false;
+    if (!strncmp(k->key, "time=", 5) && !limn_parse_double(k->key + 5, &t)) return false;
   }
   return true;
 }
@@ -97,7 +105,8 @@ static void free_args(view_args *a) {
 
 /* Returns 0 to go on, -1 when done (help), else the exit code. */
 static int parse_args(int argc, char **argv, view_args *a) {
-  *a = (view_args){.scene = "cornell", .capture_dir = ".", .width = 512, .height = 384, .overlay = true};
+  *a = (view_args){.scene = "cornell", .capture_dir = ".", .width = 512, .height = 384, .overlay = true,
+                   .animation = "all", .fps = 24};
   static const struct option opts[] = {
       {"scene", required_argument, 0, 's'},      {"script", required_argument, 0, 'p'},
       {"tech", required_argument, 0, 't'},       {"set", required_argument, 0, 'D'},
@@ -105,6 +114,8 @@ static int parse_args(int argc, char **argv, view_args *a) {
       {"overlay", required_argument, 0, 'o'},    {"capture-dir", required_argument, 0, 'C'},
       {"exit-after", required_argument, 0, 'n'}, {"screenshot", required_argument, 0, 'S'},
       {"script-keys", required_argument, 0, 'k'}, {"reload-test", required_argument, 0, 'R'},
+      {"animation", required_argument, 0, 'A'},  {"time", required_argument, 0, 'T'},
+      {"fps", required_argument, 0, 'F'},
       {"quiet", no_argument, 0, 'q'},            {"verbose", no_argument, 0, 'v'},
       {"help", no_argument, 0, 'h'},             {0, 0, 0, 0}};
   opterr = 0;
@@ -131,6 +142,14 @@ static int parse_args(int argc, char **argv, view_args *a) {
       if (!limn_parse_on_off(optarg, &a->overlay)) return usage_error("--overlay wants on or off, not '%s'", optarg);
       break;
     case 'C': a->capture_dir = optarg; break;
+    case 'A': a->animation = optarg; break;
+    case 'T':
+      if (!limn_parse_double(optarg, &a->time)) return usage_error("--time wants seconds, not '%s'", optarg);
+      a->time_given = true;
+      break;
+    case 'F':
+      if (!limn_parse_int(optarg, 1, 1000, &a->fps)) return usage_error("--fps wants 1..1000, not '%s'", optarg);
+      break;
     case 'n':
       if (!limn_parse_int(optarg, 1, 1 << 30, &n)) return usage_error("--exit-after wants a frame count, not '%s'", optarg);
       a->exit_after = n;
@@ -244,12 +263,93 @@ static void move_camera(viewer *v, double dt_ms) {
   float ahead = (key_down(v, "W") ? 1.0f : 0.0f) - (key_down(v, "S") ? 1.0f : 0.0f);
   float side = (key_down(v, "D") ? 1.0f : 0.0f) - (key_down(v, "A") ? 1.0f : 0.0f);
   if (!ahead && !side && !dx && !dy) return; /* the scene's own transform stays exact */
+  if (!v->camera_user && camera_node(v) >= 0)
+    memcpy(v->camera_local, v->scene->nodes[camera_node(v)].local, sizeof v->camera_local);
+  if (v->camera_animated && !v->camera_user)
+    say(v, "camera %d is yours now (0 gives it back to the animation)", v->camera + 1);
+  v->camera_user = true;
   v->cam.yaw -= (float)dx * 0.005f;
   v->cam.pitch = fmaxf(-1.5f, fminf(1.5f, v->cam.pitch - (float)dy * 0.005f));
   float cy = cosf(v->cam.yaw), sy = sinf(v->cam.yaw), cp = cosf(v->cam.pitch), sp = sinf(v->cam.pitch);
   float f[3] = {-sy * cp, sp, -cy * cp}, r[3] = {cy, 0, -sy};
   for (int i = 0; i < 3; i++) v->cam.pos[i] += step * (ahead * f[i] + side * r[i]);
   fly_to_camera(v);
+}
+
+/* ---- time ------------------------------------------------------------- */
+long view_frame(const viewer *v) { return (long)floor(v->time * v->args->fps + 1e-6); }
+
+const char *view_animation_name(const viewer *v) {
+  return v->anim >= 0 && v->anim < v->scene->animation_count ? v->scene->animations[v->anim].name : "all";
+}
+
+/* One line a test can parse: "time 1.250000 s, frame 30, animation 'all', paused (why)". */
+static void report_time(const viewer *v, const char *why) {
+  lm_info("time %.6f s, frame %ld, animation '%s'%s (%s)", v->time, view_frame(v), view_animation_name(v),
+          v->paused ? ", paused" : "", why);
+}
+
+/* Is the node, or one of its ancestors, moved by a channel of the viewer's animation? */
+static bool node_animated(const viewer *v, int node) {
+  const lm_scene *s = v->scene;
+  for (int n = node; n >= 0 && n < s->node_count; n = s->nodes[n].parent)
+    for (int a = 0; a < s->animation_count; a++)
+      for (int c = 0; (v->anim == LM_ANIM_ALL || v->anim == a) && c < s->animations[a].channel_count; c++)
+        if (s->animations[a].channels[c].node == n && s->animations[a].channels[c].path != LM_ANIM_WEIGHTS)
+          return true;
+  return false;
+}
+
+/* The animation --animation names, in the scene as it is now (at start and
+ * after the scene file reloads); false with err when the scene lacks it. */
+static bool find_animation(viewer *v, lm_error *err) {
+  int anim = lm_scene_find_animation(v->scene, v->args->animation, err);
+  if (anim < LM_ANIM_ALL) return false;
+  v->anim = anim;
+  lm_scene_animation_range(v->scene, anim, &v->anim_range[0], &v->anim_range[1]);
+  v->camera_animated = node_animated(v, camera_node(v));
+  return true;
+}
+
+/* Poses the scene at the viewer's time; an animated camera the user has
+ * not taken over follows it, one the user has keeps the user's view (the
+ * node's local transform goes back to the animation's for the pose, so that
+ * giving the camera back finds the animation's view at once). */
+static void pose(viewer *v) {
+  if (!lm_scene_animated(v->scene)) return; /* a still scene: nothing moves */
+  int node = camera_node(v);
+  float *local = node >= 0 ? v->scene->nodes[node].local : NULL;
+  if (v->camera_user && local) memcpy(local, v->camera_local, sizeof v->camera_local);
+  lm_scene_set_time(v->scene, v->anim, v->time);
+  lm_scene_upload_deformed(v->scene);
+  if (v->camera_user && local) {
+    memcpy(v->camera_local, local, sizeof v->camera_local);
+    fly_to_camera(v);
+  } else if (v->camera_animated) {
+    fly_from_camera(v);
+  }
+}
+
+/* The animation drives the camera the user moved again. */
+static void give_camera_back(viewer *v) {
+  int node = camera_node(v);
+  if (v->camera_user && node >= 0) {
+    memcpy(v->scene->nodes[node].local, v->camera_local, sizeof v->camera_local);
+    lm_scene_update(v->scene);
+    fly_from_camera(v);
+  }
+  v->camera_user = false;
+}
+
+/* Moves the time by dt seconds, looping over the animation's range (a time
+ * before its start, as --time may give, plays on into it). */
+static void advance(viewer *v, double dt) {
+  double lo = v->anim_range[0], hi = v->anim_range[1], t = v->time + dt;
+  if (hi > lo) {
+    if (dt > 0 && t >= hi) t = lo + fmod(t - lo, hi - lo);
+    else if (dt < 0 && t < lo && v->time >= lo) t += hi - lo;
+  }
+  v->time = t;
 }
 
 /* ---- options and techniques -------------------------------------------- */
@@ -335,6 +435,7 @@ static bool reload_script(viewer *v) {
   v->frame_error[0] = '\0';
   set_error(v->script_error, sizeof v->script_error, "", "script reloaded: error cleared");
   lm_info("reloaded %s", v->script);
+  report_time(v, "script reloaded");
   return true;
 }
 
@@ -358,8 +459,16 @@ static void reload_scene(viewer *v) {
   lm_scene_destroy(s);
   if (v->camera >= v->scene->camera_count) v->camera = 0;
   lm_renderer_set_camera(v->renderer, v->camera);
+  if (!find_animation(v, &err)) { /* the file lost it: play them all */
+    say(v, "%s: playing all", err.msg);
+    v->args->animation = "all";
+    find_animation(v, &err);
+  }
+  v->camera_user = false; /* the file's camera again, as for a still scene; its animation drives it */
   fly_from_camera(v);
+  pose(v);
   lm_info("reloaded scene %s", v->args->scene);
+  report_time(v, "scene reloaded");
 }
 
 static bool has_suffix(const char *s, const char *suffix) {
@@ -409,14 +518,33 @@ static void handle_key(viewer *v, const char *key) {
   } else if (!strncmp(key, "drag=", 5)) {
     double dx, dy;
     if (sscanf(key + 5, "%lf;%lf", &dx, &dy) == 2) v->drag[0] += dx, v->drag[1] += dy;
+  } else if (!strcmp(key, "Space")) {
+    v->paused = !v->paused;
+    report_time(v, "Space");
+  } else if (!strcmp(key, "Left") || !strcmp(key, "Right")) {
+    v->paused = true;
+    advance(v, (key[0] == 'L' ? -1.0 : 1.0) / v->args->fps);
+    report_time(v, key);
+  } else if (!strncmp(key, "time=", 5)) {
+    if (limn_parse_double(key + 5, &v->time)) report_time(v, "scrubbed");
+  } else if (!strcmp(key, "0")) {
+    if (!v->camera_animated) {
+      say(v, "camera %d is not animated", v->camera + 1);
+      return;
+    }
+    give_camera_back(v);
+    say(v, "camera %d follows the animation", v->camera + 1);
   } else if (key[0] >= '1' && key[0] <= '9' && !key[1]) {
     int c = key[0] - '1';
     if (c >= v->scene->camera_count) {
       say(v, "scene %s has %d camera(s)", v->scene->name, v->scene->camera_count);
       return;
     }
+    if (v->camera_animated) give_camera_back(v);
     v->camera = c;
     lm_renderer_set_camera(v->renderer, c);
+    v->camera_user = false;
+    v->camera_animated = node_animated(v, camera_node(v));
     fly_from_camera(v);
     say(v, "camera %d (%s)", c + 1, v->scene->cameras[c].name);
   } else if (!strcmp(key, "F1") || !strcmp(key, "Tab")) {
@@ -583,13 +711,18 @@ static int run(viewer *v) {
     lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a->camera, a->scene, v->scene->camera_count);
     return 2;
   }
+  v->camera = a->camera;
+  if (!find_animation(v, &err)) {
+    lm_log(LM_LOG_ERROR, "--animation: %s", err.msg);
+    return 2;
+  }
+  v->time = a->time_given ? a->time : v->anim_range[0];
   v->font = lm_font_open(11, &err);
   if (!v->font || !watch_dirs(v, &err) ||
       !(v->window = lm_window_create("limn view", a->width, a->height, &err))) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 1;
   }
-  v->camera = a->camera;
   lm_window_size(v->window, &v->width, &v->height);
   if (v->width < 1 || v->height < 1) v->width = a->width, v->height = a->height;
   v->renderer = lm_renderer_create(&(lm_renderer_desc){.scene = v->scene, .pipeline = v->pipeline,
@@ -602,6 +735,9 @@ static int run(viewer *v) {
   fly_from_camera(v);
   lm_info("renderer: %s (%s); scene %s; script %s; technique %s; %dx%d", lm_gl_renderer(), lm_gl_version(),
           a->scene, v->script, lm_pipeline_technique(v->pipeline), v->width, v->height);
+  if (lm_scene_animated(v->scene))
+    lm_info("animation '%s': keys %.6g..%.6g s%s", view_animation_name(v), v->anim_range[0], v->anim_range[1],
+            v->camera_animated ? "; it moves the camera" : "");
   if (a->reload_test) return reload_test(v, a->reload_test);
 
   double last = lm_now_ms();
@@ -613,6 +749,10 @@ static int run(viewer *v) {
       if (a->keys[i].frame == v->frame) handle_key(v, a->keys[i].key);
     double now = lm_now_ms();
     v->frame_ms = now - last;
+    /* Real time, a frame's stall (a shader rebuild) counted at most 0.25 s;
+     * scripted runs (tests) 1/60 s a frame. The first frame shows --time. */
+    if (!v->paused && v->frame > 0) advance(v, a->key_count ? 1.0 / 60.0 : fmin(now - last, 250.0) * 1e-3);
+    pose(v);
     move_camera(v, now - last);
     last = now;
     if (!follow_size(v)) {
@@ -627,6 +767,7 @@ static int run(viewer *v) {
   }
   if (stop_requested || lm_window_should_close(v->window)) display(v); /* the back buffer after a swap is undefined */
   lm_info("%ld frames", v->frame + 1);
+  report_time(v, "at exit");
   if (a->screenshot && !screenshot(v, a->screenshot)) return 1;
   return 0;
 }

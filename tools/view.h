@@ -20,6 +20,10 @@ typedef struct view_args {
   char *sets[MAX_SETS]; /* owned: toggles add and replace entries */
   int set_count;
   int width, height, camera;
+  const char *animation; /* NAME, INDEX or "all" */
+  double time;           /* --time; with time_given */
+  bool time_given;
+  int fps;               /* frames a second: what Left/Right step and the overlay counts */
   long exit_after, reload_test;
   bool overlay, quiet, verbose;
   script_key keys[MAX_SCRIPT_KEYS];
@@ -47,6 +51,15 @@ typedef struct viewer {
   int probe_w, probe_h;
   int camera;
   fly cam;
+  /* Time: the scene shows animation `anim` (LM_ANIM_ALL: all) at `time`
+   * seconds, looping over its keys' range while it plays. */
+  int anim;
+  double time;
+  float anim_range[2];      /* equal: nothing to loop (time runs on) */
+  bool paused;
+  bool camera_animated;     /* the camera's node or an ancestor is a channel's target */
+  bool camera_user;         /* the user moved it: the animation no longer drives it */
+  float camera_local[16];   /* meanwhile, the camera node's local transform as the animation poses it */
   bool held[4];             /* W A S D held by --script-keys */
   double drag[2];           /* a scripted drag not yet applied */
   bool overlay_on;
@@ -71,6 +84,10 @@ typedef struct viewer {
 void say(viewer *v, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* An error shows once on stderr when it appears and once (as `cleared`) when it goes. */
 void set_error(char *slot, size_t cap, const char *msg, const char *cleared);
+
+/* The frame number at the viewer's time (--fps frames a second) and its animation's name. */
+long view_frame(const viewer *v);
+const char *view_animation_name(const viewer *v);
 
 /* view_display.c */
 bool make_window_textures(viewer *v, lm_error *err);

@@ -127,6 +127,9 @@ static void draw_overlay(viewer *v) {
   if (v->overlay_on)
     draw_line(v, &y, white, "%s | %s | %s | %dx%d", lm_pipeline_technique(v->pipeline), v->scene->name,
               strrchr(v->script, '/') ? strrchr(v->script, '/') + 1 : v->script, v->width, v->height);
+  if (v->overlay_on && lm_scene_animated(v->scene))
+    draw_line(v, &y, white, "time %.3f s | frame %ld | animation %s (%.3g..%.3g s)%s", v->time, view_frame(v),
+              view_animation_name(v), v->anim_range[0], v->anim_range[1], v->paused ? " | paused" : "");
   if (v->overlay_on && v->inspect >= 0 && v->inspect < lm_graph_target_count(g)) {
     lm_graph_target_info t = lm_graph_target(g, v->inspect);
     draw_line(v, &y, yellow, "target %d/%d '%s' %s %dx%d%s | %s | exposure %+.1f%s", v->inspect + 1,
