@@ -102,6 +102,7 @@ int lm_scene_add_node(lm_scene *s, const char *name, int parent, const float loc
   n->mesh = mesh;
   n->material = material;
   n->skin = -1;
+  n->rotation[3] = n->scale[0] = n->scale[1] = n->scale[2] = 1; /* an identity T * R * S (trs stays false) */
   return s->node_count - 1;
 }
 
@@ -128,6 +129,7 @@ int lm_scene_add_root(lm_scene *s, const char *name, const float local[16]) {
   n->parent = -1;
   memcpy(n->local, local, sizeof n->local);
   n->mesh = n->material = n->skin = -1;
+  n->rotation[3] = n->scale[0] = n->scale[1] = n->scale[2] = 1;
   lm_scene_update(s);
   return 0;
 }
