@@ -3,6 +3,7 @@
  * shader so that every pass that draws geometry, the tracer's refit and the
  * bounds that cull and frame read one posed mesh (lm_scene_mesh.vertices),
  * with the previous pose beside it for velocities. */
+#include "scene/gltf.h"
 #include "scene/scene_internal.h"
 
 #include <cglm/cglm.h>
@@ -180,16 +181,17 @@ typedef struct node_pose {
   bool moved;     /* a channel of some animation moves it: local from t, r, s */
 } node_pose;
 
-/* World transforms, each finite: a node whose animated transform overflows
- * (vast keys down a deep hierarchy) loses its local transform and keeps its
- * parent's frame, which is finite since parents come first. */
+/* World transforms within LM_GLTF_MAX_COORD, the loader's bound for rest
+ * poses: a node whose animated transform reaches past it (vast keys down a
+ * deep hierarchy, up to overflow) loses its local transform and keeps its
+ * parent's frame, which is within since parents come first. */
 static void update_finite(lm_scene *s) {
   for (;;) {
     lm_scene_update(s);
     int bad = -1;
     for (int i = 0; i < s->node_count && bad < 0; i++)
       for (int k = 0; k < 16; k++)
-        if (!isfinite(s->nodes[i].world[k])) {
+        if (!(fabsf(s->nodes[i].world[k]) <= LM_GLTF_MAX_COORD)) {
           bad = i;
           break;
         }
@@ -219,11 +221,15 @@ static void joint_matrices(const lm_scene *s, const lm_skin *skin, const lm_node
   }
 }
 
-static bool finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+/* Finite and within the loader's bound for coordinates. */
+static bool bounded3(const float *v) {
+  return fabsf(v[0]) <= LM_GLTF_MAX_COORD && fabsf(v[1]) <= LM_GLTF_MAX_COORD && fabsf(v[2]) <= LM_GLTF_MAX_COORD;
+}
 
 /* Node n's deformed mesh posed from its rest vertices: morph targets with
  * weights w (NULL: the mesh's defaults), then the node's skin. Positions
- * and normals that come out non-finite keep their rest values. */
+ * that come out non-finite or past LM_GLTF_MAX_COORD, and normals that come
+ * out non-finite or zero, keep their rest values. */
 static void deform(lm_scene *s, const lm_node *n, const float *w) {
   lm_scene_mesh *m = &s->meshes[n->mesh];
   const lm_skin *skin = n->skin >= 0 && n->skin < s->skin_count && m->influence_sets > 0 && m->joints &&
@@ -282,8 +288,7 @@ static void deform(lm_scene *s, const lm_node *n, const float *w) {
       for (int k = 0; k < 3; k++) out[3 + k] = nr[k] / len;
     else
       memcpy(out + 3, rest + 3, 3 * sizeof(float));
-    if (!finite3(out + 3)) memcpy(out + 3, rest + 3, 3 * sizeof(float));
-    memcpy(out, finite3(p) ? p : rest, 3 * sizeof(float));
+    memcpy(out, bounded3(p) ? p : rest, 3 * sizeof(float));
     glm_vec3_minv(lo, out, lo);
     glm_vec3_maxv(hi, out, hi);
   }

@@ -1362,8 +1362,8 @@ bool convert(const char *path, const tinygltf::Model &model, lm_scene *s, lm_err
     lm_warn("%s: %d morph target attribute%s ignored (the first: %s): only POSITION and NORMAL morph", path,
             L.ignored_targets, L.ignored_targets > 1 ? "s" : "", L.first_target.c_str());
   if (L.mended_weights)
-    lm_warn("%s: %d vertices' skin weights did not sum to 1 and were normalized (the first: %s)", path,
-            L.mended_weights, L.first_weights.c_str());
+    lm_warn("%s: the skin weights of %d vert%s did not sum to 1 and were normalized (the first: %s)", path,
+            L.mended_weights, L.mended_weights > 1 ? "ices" : "ex", L.first_weights.c_str());
   lm_scene_update(s);
   if (!check_world(L)) return false;
   lm_scene_pose(s, LM_ANIM_NONE, 0); // morph weights and skins at rest

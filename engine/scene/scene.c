@@ -249,6 +249,7 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
   for (int i = 0; i < s->mesh_count; i++) {
     lm_scene_mesh *m = &s->meshes[i];
     lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, m->indices, m->index_count);
+    m->dirty = false;
   }
   s->uploaded = true;
   return true;
