@@ -94,3 +94,31 @@ size_t make_glb(const char *json, const blob *b, unsigned char *out, size_t cap)
   memcpy(out + 28 + jlen, b->data, b->len);
   return total;
 }
+
+static uint32_t rng_state = 12345;
+static uint32_t rng(void) {
+  rng_state = rng_state * 1664525u + 1013904223u;
+  return rng_state >> 8;
+}
+
+size_t mutate_glb(unsigned char *glb, size_t len, size_t json_end) {
+  int edits = 1 + (int)(rng() % 3);
+  for (int e = 0; e < edits; e++) {
+    uint32_t r = rng();
+    size_t at = rng() % len;
+    switch (r % 5) {
+    case 0: glb[at] ^= (unsigned char)(1u << (rng() % 8)); break; /* flip a bit */
+    case 1: glb[at] = (unsigned char)rng(); break;                 /* any byte */
+    case 2: len = at + 1; break;                                   /* truncate */
+    default: {
+      size_t j = 20 + rng() % (json_end - 20);
+      for (size_t k = 0; k < 64 && j + k < json_end; k++)
+        if (glb[j + k] >= '0' && glb[j + k] <= '9') {
+          glb[j + k] = (unsigned char)('0' + rng() % 10);
+          break;
+        }
+    }
+    }
+  }
+  return len;
+}

@@ -28,5 +28,10 @@ const char *write_bytes(const char *name, const void *data, size_t len);
 const char *write_gltf(const char *name, const char *json, const blob *b);
 /* GLB bytes of `json` (its buffer 0 without a uri) and `b` as the BIN chunk. */
 size_t make_glb(const char *json, const blob *b, unsigned char *out, size_t cap);
+/* One to three random edits of the GLB's len bytes, whose JSON ends at
+ * json_end: a bit flipped, a byte replaced, the end cut off, or a digit of
+ * the JSON changed (still JSON, other indices and sizes). Returns the new
+ * length. Deterministic: failures reproduce. */
+size_t mutate_glb(unsigned char *glb, size_t len, size_t json_end);
 
 #endif

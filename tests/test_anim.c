@@ -46,15 +46,25 @@ static int floats(doc *d, const float *p, int count, const char *type) {
 }
 
 /* The file: `body` is the JSON members beside asset, buffers, bufferViews
- * and accessors ("\"scene\":0,\"scenes\":...,\"nodes\":..."). */
+ * and accessors ("\"scene\":0,\"scenes\":...,\"nodes\":..."). A name
+ * ending in .glb writes a GLB, else JSON with a data URI. */
 static const char *write_doc(const char *name, const doc *d, const char *body) {
   size_t cap = strlen(body) + strlen(d->views) + strlen(d->accessors) + 256;
-  char *json = malloc(cap);
-  snprintf(json, cap,
-           "{\"asset\":{\"version\":\"2.0\"},%s,\"buffers\":[{\"uri\":\"%%s\",\"byteLength\":%%zu}],"
-           "\"bufferViews\":[%s],\"accessors\":[%s]}",
-           body, d->views, d->accessors);
-  const char *path = write_gltf(name, json, &d->b);
+  char *json = malloc(cap), buffer[64];
+  bool glb = strstr(name, ".glb") != NULL;
+  if (glb) snprintf(buffer, sizeof buffer, "{\"byteLength\":%zu}", d->b.len);
+  else snprintf(buffer, sizeof buffer, "{\"uri\":\"%%s\",\"byteLength\":%%zu}");
+  snprintf(json, cap, "{\"asset\":{\"version\":\"2.0\"},%s,\"buffers\":[%s],\"bufferViews\":[%s],\"accessors\":[%s]}", body,
+           buffer, d->views, d->accessors);
+  const char *path;
+  if (glb) {
+    size_t size = strlen(json) + d->b.len + 64;
+    unsigned char *bytes = malloc(size);
+    path = write_bytes(name, bytes, make_glb(json, &d->b, bytes, size));
+    free(bytes);
+  } else {
+    path = write_gltf(name, json, &d->b);
+  }
   free(json);
   return path;
 }
@@ -89,7 +99,7 @@ static const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
 
 /* Nodes a, b, c slid along x by STEP, LINEAR and CUBICSPLINE keys at times
  * 1 and 3 (animation "interp"); node d by the unnamed animation 1. */
-static const char *write_interp(void) {
+static const char *write_interp(const char *name) {
   doc d = {0};
   static const float times[2] = {1, 3}, slide[6] = {0, 0, 0, 4, 0, 0}, d_keys[6] = {0, 0, 0, 0, 8, 0};
   /* in-tangent, value, out-tangent a key: out-tangent 1 at key 0, in-tangent 3 at key 1 */
@@ -112,14 +122,14 @@ static const char *write_interp(void) {
            "{\"channels\":[{\"sampler\":0,\"target\":{\"node\":3,\"path\":\"translation\"}}],"
            "\"samplers\":[{\"input\":%d,\"output\":%d}]}]",
            t, v, t, v, t, c, t, dv);
-  return write_doc("interp.gltf", &d, body);
+  return write_doc(name, &d, body);
 }
 
 static float x_of(const lm_scene *s, const char *name) { return node(s, name)->world[12]; }
 
 static void interpolations_match_hand_values(void **state) {
   (void)state;
-  lm_scene *s = load(write_interp());
+  lm_scene *s = load(write_interp("interp.gltf"));
   assert_int_equal(s->animation_count, 2);
   assert_string_equal(s->animations[0].name, "interp");
   assert_string_equal(s->animations[1].name, "animation 1");
@@ -162,7 +172,7 @@ static void interpolations_match_hand_values(void **state) {
 
 static void animations_are_found_by_name_index_or_all(void **state) {
   (void)state;
-  lm_scene *s = load(write_interp());
+  lm_scene *s = load(write_interp("interp.gltf"));
   lm_error err = {0};
   assert_int_equal(lm_scene_find_animation(s, "interp", &err), 0);
   assert_int_equal(lm_scene_find_animation(s, "animation 1", &err), 1);
@@ -228,7 +238,7 @@ static void rotation_takes_the_short_arc(void **state) {
  * one target each: positions + (0, 0, 2) and normals + (1, 0, -1), and
  * + (0, 0, 4); mesh weights [0.25]. Node "morph" plays animation "grow"
  * (weights 0 to 1 over times 0, 1); node "held" (at x = 10) has weights [1]. */
-static const char *write_morph(void) {
+static const char *write_morph(const char *name) {
   doc d = {0};
   const float tri2[9] = {2, 0, 0, 3, 0, 0, 2, 1, 0}, normals[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
   const float up2[9] = {0, 0, 2, 0, 0, 2, 0, 0, 2}, up4[9] = {0, 0, 4, 0, 0, 4, 0, 0, 4};
@@ -247,14 +257,14 @@ static const char *write_morph(void) {
            "\"animations\":[{\"name\":\"grow\",\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"weights\"}}],"
            "\"samplers\":[{\"input\":%d,\"output\":%d}]}]",
            p0, n, d0, dn, p1, n, d1, t, v);
-  return write_doc("morph.gltf", &d, body);
+  return write_doc(name, &d, body);
 }
 
 static float z_of(const lm_scene *s, const char *name, int v) { return s->meshes[node(s, name)->mesh].vertices[v * 8 + 2]; }
 
 static void morph_targets_blend_by_weight(void **state) {
   (void)state;
-  lm_scene *s = load(write_morph());
+  lm_scene *s = load(write_morph("morph.gltf"));
   /* each node its own meshes; the weights channel drives both primitives */
   assert_int_not_equal(node(s, "morph.0")->mesh, node(s, "held.0")->mesh);
   assert_int_equal(s->animations[0].channel_count, 2);
@@ -279,7 +289,7 @@ static void morph_targets_blend_by_weight(void **state) {
 
 static void prev_positions_hold_the_previous_pose(void **state) {
   (void)state;
-  lm_scene *s = load(write_morph());
+  lm_scene *s = load(write_morph("morph.gltf"));
   const lm_scene_mesh *m = &s->meshes[node(s, "morph.0")->mesh];
   assert_null(m->prev_positions); /* never posed by lm_scene_set_time yet */
   lm_scene_set_time(s, 0, 0.4);
@@ -301,7 +311,7 @@ static void prev_positions_hold_the_previous_pose(void **state) {
 /* The tracer's refit reads the posed vertices, not only node transforms. */
 static void trace_refit_follows_morphed_vertices(void **state) {
   (void)state;
-  lm_scene *s = load(write_morph());
+  lm_scene *s = load(write_morph("morph.gltf"));
   lm_trace *t = lm_trace_create(s, NULL);
   lm_trace_ray r = {.origin = {0.25f, 0.25f, 10}, .dir = {0, 0, -1}, .tmax = INFINITY};
   lm_trace_hit hit;
@@ -639,6 +649,75 @@ static void vast_keys_never_pose_non_finite_values(void **state) {
   lm_scene_destroy(s);
 }
 
+/* Whatever loads poses sane: channels and joints on real nodes, and every
+ * pose finite. */
+static void assert_posable(lm_scene *s) {
+  for (int a = 0; a < s->animation_count; a++)
+    for (int c = 0; c < s->animations[a].channel_count; c++) {
+      const lm_anim_channel *ch = &s->animations[a].channels[c];
+      assert_true(ch->node >= 0 && ch->node < s->node_count);
+      for (int k = 1; k < ch->count; k++) assert_true(ch->times[k] > ch->times[k - 1]);
+    }
+  for (int k = 0; k < s->skin_count; k++)
+    for (int j = 0; j < s->skins[k].joint_count; j++)
+      assert_true(s->skins[k].joints[j] >= 0 && s->skins[k].joints[j] < s->node_count);
+  const double times[] = {-1, 0, 0.3, 1, 2.5, 1e9};
+  for (size_t i = 0; i < sizeof times / sizeof *times; i++) {
+    lm_scene_set_time(s, 0, times[i]);
+    assert_true(all_finite(s));
+    lm_scene_set_time(s, LM_ANIM_ALL, times[i]);
+    assert_true(all_finite(s));
+  }
+}
+
+/* The animated files as GLB, mutated (tests/gltf_test.c): refused with the
+ * file named, or loaded and posable; never a crash. */
+static void mutated_animations_never_crash(void **state) {
+  (void)state;
+  lm_log_level level = lm_log_get_level();
+  lm_log_set_level(LM_LOG_ERROR); /* mended weights and skipped channels warn */
+  const char *seeds[3] = {write_interp("interp.glb"), write_morph("morph.glb"),
+                          write_skin("skin.glb", skin_joints, "[1,2]", 2)};
+  unsigned char *glb[3];
+  size_t lens[3], ends[3];
+  for (int i = 0; i < 3; i++) {
+    lm_error err;
+    glb[i] = (unsigned char *)lm_read_file(seeds[i], &lens[i], &err);
+    assert_non_null(glb[i]);
+    uint32_t json_len;
+    memcpy(&json_len, glb[i] + 12, 4);
+    ends[i] = 20 + json_len;
+    lm_scene *s = load(seeds[i]); /* the seeds themselves load */
+    assert_posable(s);
+    lm_scene_destroy(s);
+  }
+  /* LIMN_GLTF_MUTATIONS=N runs a longer soak (as under ASan). */
+  const char *env = getenv("LIMN_GLTF_MUTATIONS");
+  int loaded = 0, iters = env && atoi(env) > 0 ? atoi(env) : 600;
+  unsigned char *mutant = malloc(8192 * 2);
+  for (int iter = 0; iter < iters; iter++) {
+    int seed = iter % 3;
+    assert_true(lens[seed] <= 8192 * 2);
+    memcpy(mutant, glb[seed], lens[seed]);
+    size_t len = mutate_glb(mutant, lens[seed], ends[seed]);
+    lm_error err = {""};
+    const char *path = write_bytes("mutant.glb", mutant, len);
+    lm_scene *s = lm_scene_load_gltf(path, &err);
+    if (s) {
+      assert_posable(s);
+      lm_scene_destroy(s);
+      loaded++;
+    } else if (!strstr(err.msg, path)) {
+      fail_msg("iteration %d: message without the path: %s", iter, err.msg);
+    }
+  }
+  print_message("mutations: %d of %d still loaded\n", loaded, iters);
+  assert_true(loaded > 0 && loaded < iters);
+  for (int i = 0; i < 3; i++) free(glb[i]);
+  free(mutant);
+  lm_log_set_level(level);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(interpolations_match_hand_values),
@@ -653,6 +732,7 @@ int main(void) {
       cmocka_unit_test(bad_animation_data_is_refused_by_name),
       cmocka_unit_test(bad_skins_are_refused_by_name),
       cmocka_unit_test(vast_keys_never_pose_non_finite_values),
+      cmocka_unit_test(mutated_animations_never_crash),
   };
   return cmocka_run_group_tests(tests, gltf_test_setup, gltf_test_teardown);
 }

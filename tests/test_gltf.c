@@ -806,12 +806,6 @@ static void truncated_and_missing_files_are_refused(void **state) {
 
 /* ---- mutations ---------------------------------------------------------- */
 
-static uint32_t rng_state = 12345;
-static uint32_t rng(void) {
-  rng_state = rng_state * 1664525u + 1013904223u;
-  return rng_state >> 8;
-}
-
 /* Whatever loads must be usable: finite vertices, indices in range, world
  * transforms for every node, lights and cameras on real nodes. */
 static void assert_sane(const lm_scene *s) {
@@ -866,26 +860,7 @@ static void mutated_glb_never_crashes(void **state) {
   for (int iter = 0; iter < iters; iter++) {
     size_t n = lens[iter % 2], json_end = ends[iter % 2];
     memcpy(mutant, glb[iter % 2], n);
-    size_t len = n;
-    int edits = 1 + (int)(rng() % 3);
-    for (int e = 0; e < edits; e++) {
-      uint32_t r = rng();
-      size_t at = rng() % len;
-      switch (r % 5) {
-      case 0: mutant[at] ^= (unsigned char)(1u << (rng() % 8)); break; /* flip a bit */
-      case 1: mutant[at] = (unsigned char)rng(); break;                 /* any byte */
-      case 2: len = at + 1; break;                                      /* truncate */
-      default: {
-        /* A digit of the JSON for another: still JSON, other indices and sizes. */
-        size_t j = 20 + rng() % (json_end - 20);
-        for (size_t k = 0; k < 64 && j + k < json_end; k++)
-          if (mutant[j + k] >= '0' && mutant[j + k] <= '9') {
-            mutant[j + k] = (unsigned char)('0' + rng() % 10);
-            break;
-          }
-      }
-      }
-    }
+    size_t len = mutate_glb(mutant, n, json_end);
     lm_error err = {""};
     const char *path = write_bytes("mutant.glb", mutant, len);
     lm_scene *s = lm_scene_load_gltf(path, &err);
