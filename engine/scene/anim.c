@@ -76,6 +76,7 @@ void lm_scene_animation_range(const lm_scene *s, int anim, float *start, float *
   }
 }
 
+/* In double, and into any float[16] (cglm's SIMD paths want aligned matrices). */
 void lm_scene_trs_matrix(const float t[3], const float q[4], const float s[3], float out[16]) {
   double x = q[0], y = q[1], z = q[2], w = q[3];
   double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),
@@ -118,7 +119,9 @@ static bool normalize4(const double q[4], float out[4]) {
 }
 
 /* Spherical linear interpolation of unit quaternions the shorter way: b is
- * flipped when a . b < 0 (q and -q are the same rotation). */
+ * flipped when a . b < 0 (q and -q are the same rotation). Not cglm's
+ * glm_quat_slerp: for nearly opposite keys (q and about -q, the same
+ * rotation) it falls back to lerping the unflipped pair, through zero. */
 static void slerp(const float a[4], const float b[4], double u, float out[4]) {
   double d = (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2] + (double)a[3] * b[3];
   double sign = d < 0 ? -1 : 1, wa = 1 - u, wb = u;
