@@ -467,6 +467,26 @@ static void skinned_grid_poses_where_its_joints_say(void **state) {
   lm_scene_destroy(s);
 }
 
+/* lm_scene_add_root moves every node index up: channels and skin joints
+ * follow, and the poses scale with the new root. */
+static void a_root_added_above_keeps_channels_and_joints(void **state) {
+  (void)state;
+  const float twice[16] = {2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 1};
+  lm_scene *s = load(write_interp("interp.gltf"));
+  lm_scene_add_root(s, "unit", twice);
+  lm_scene_set_time(s, 0, 2);
+  assert_float_equal(x_of(s, "b"), 4, 1e-5);
+  assert_float_equal(x_of(s, "c"), 3, 1e-5);
+  lm_scene_destroy(s);
+  s = load(write_skin("skin.gltf", skin_joints, "[1,2]", 2));
+  lm_scene_add_root(s, "unit", twice);
+  lm_scene_set_time(s, 0, 1);
+  float p[3];
+  world_vertex(s, node(s, "skinned"), 4, p);
+  assert_vec3(p, -2, 4, 0, 1e-5f);
+  lm_scene_destroy(s);
+}
+
 /* ---- cameras ------------------------------------------------------------ */
 
 static void animated_camera_moves_the_view(void **state) {
@@ -728,6 +748,7 @@ int main(void) {
       cmocka_unit_test(trace_refit_follows_morphed_vertices),
       cmocka_unit_test(skinned_joint_bends),
       cmocka_unit_test(skinned_grid_poses_where_its_joints_say),
+      cmocka_unit_test(a_root_added_above_keeps_channels_and_joints),
       cmocka_unit_test(animated_camera_moves_the_view),
       cmocka_unit_test(bad_animation_data_is_refused_by_name),
       cmocka_unit_test(bad_skins_are_refused_by_name),
