@@ -184,24 +184,32 @@ typedef struct node_pose {
   bool moved;     /* a channel of some animation moves it: local from t, r, s */
 } node_pose;
 
-/* World transforms within LM_GLTF_MAX_COORD, the loader's bound for rest
- * poses: a node whose animated transform reaches past it (vast keys down a
- * deep hierarchy, up to overflow) loses its local transform and keeps its
- * parent's frame, which is within since parents come first. */
-static void update_finite(lm_scene *s) {
-  for (;;) {
+/* World transforms, finite: a node that moves (or whose parent moves) and
+ * whose world transform then reaches past LM_GLTF_MAX_COORD, the loader's
+ * bound for rest poses (vast keys down a deep hierarchy, up to overflow),
+ * loses its local transform and keeps its parent's frame, which is within
+ * since parents come first. Nodes at rest are left as they are. */
+static void update_bounded(lm_scene *s, const node_pose *pose) {
+  bool *moving = lm_alloc(sizeof *moving * (size_t)s->node_count);
+  for (int i = 0; i < s->node_count; i++) {
+    int parent = s->nodes[i].parent;
+    moving[i] = pose[i].moved || (parent >= 0 && parent < i && moving[parent]);
+  }
+  for (int from = 0;;) {
     lm_scene_update(s);
     int bad = -1;
-    for (int i = 0; i < s->node_count && bad < 0; i++)
-      for (int k = 0; k < 16; k++)
+    for (int i = from; i < s->node_count && bad < 0; i++)
+      for (int k = 0; k < 16 && moving[i]; k++)
         if (!(fabsf(s->nodes[i].world[k]) <= LM_GLTF_MAX_COORD)) {
           bad = i;
           break;
         }
-    if (bad < 0) return;
+    if (bad < 0) break;
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     memcpy(s->nodes[bad].local, identity, sizeof identity);
+    from = bad + 1;
   }
+  free(moving);
 }
 
 /* Skin `skin`'s joint matrices for node `node` (glTF: inverse(node world) x
@@ -353,7 +361,7 @@ void lm_scene_pose(lm_scene *s, int anim, double seconds) {
     }
   for (int i = 0; i < s->node_count; i++)
     if (pose[i].moved && s->nodes[i].trs) lm_scene_trs_matrix(pose[i].t, pose[i].r, pose[i].s, s->nodes[i].local);
-  update_finite(s);
+  update_bounded(s, pose);
   for (int i = 0; i < s->node_count; i++) {
     const lm_node *n = &s->nodes[i];
     if (n->mesh >= 0 && n->mesh < s->mesh_count && s->meshes[n->mesh].rest) deform(s, n, pose[i].weights);
