@@ -13,90 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gltf_test.h"
 #include "scene/gltf.h"
-
-static char tmp_dir[64];
-
-/* ---- writing files ------------------------------------------------------ */
-
-/* Binary data of a file under construction; each piece 4-byte aligned. */
-typedef struct blob {
-  unsigned char data[4096];
-  size_t len;
-} blob;
-
-static size_t blob_add(blob *b, const void *p, size_t n) {
-  b->len = (b->len + 3) & ~(size_t)3;
-  size_t at = b->len;
-  assert_true(at + n <= sizeof b->data);
-  memcpy(b->data + at, p, n);
-  b->len += n;
-  return at;
-}
-
-static char *base64(const unsigned char *p, size_t n) {
-  static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  char *out = malloc(4 * ((n + 2) / 3) + 1), *o = out;
-  for (size_t i = 0; i < n; i += 3) {
-    uint32_t v = (uint32_t)p[i] << 16 | (i + 1 < n ? (uint32_t)p[i + 1] << 8 : 0) |
-                 (i + 2 < n ? p[i + 2] : 0);
-    *o++ = tab[v >> 18 & 63];
-    *o++ = tab[v >> 12 & 63];
-    *o++ = i + 1 < n ? tab[v >> 6 & 63] : '=';
-    *o++ = i + 2 < n ? tab[v & 63] : '=';
-  }
-  *o = '\0';
-  return out;
-}
-
-static const char *path_of(const char *name) {
-  static char path[8][256];
-  static int next;
-  char *p = path[next++ % 8];
-  snprintf(p, 256, "%s/%s", tmp_dir, name);
-  return p;
-}
-
-static const char *write_bytes(const char *name, const void *data, size_t len) {
-  const char *path = path_of(name);
-  FILE *f = fopen(path, "wb");
-  assert_non_null(f);
-  assert_int_equal(fwrite(data, 1, len, f), len);
-  fclose(f);
-  return path;
-}
-
-/* Writes `json` with its one "%s" replaced by `b` as a data URI, and
- * "%zu" (if any, after it) by the blob's length. */
-static const char *write_gltf(const char *name, const char *json, const blob *b) {
-  char *b64 = base64(b->data, b->len);
-  size_t cap = strlen(json) + strlen(b64) + 128;
-  char *text = malloc(cap), uri[64];
-  snprintf(uri, sizeof uri, "data:application/octet-stream;base64,");
-  char *full = malloc(strlen(uri) + strlen(b64) + 1);
-  strcpy(full, uri), strcat(full, b64);
-  snprintf(text, cap, json, full, b->len);
-  const char *path = write_bytes(name, text, strlen(text));
-  free(b64), free(full), free(text);
-  return path;
-}
-
-/* GLB bytes of `json` (its buffer 0 without a uri) and `b` as the BIN chunk. */
-static size_t make_glb(const char *json, const blob *b, unsigned char *out, size_t cap) {
-  size_t jlen = (strlen(json) + 3) & ~(size_t)3, blen = (b->len + 3) & ~(size_t)3;
-  size_t total = 12 + 8 + jlen + 8 + blen;
-  assert_true(total <= cap);
-  memset(out, 0, total);
-  uint32_t head[3] = {0x46546C67, 2, (uint32_t)total}, jhead[2] = {(uint32_t)jlen, 0x4E4F534A},
-           bhead[2] = {(uint32_t)blen, 0x004E4942};
-  memcpy(out, head, 12);
-  memcpy(out + 12, jhead, 8);
-  memset(out + 20, ' ', jlen);
-  memcpy(out + 20, json, strlen(json));
-  memcpy(out + 20 + jlen, bhead, 8);
-  memcpy(out + 28 + jlen, b->data, b->len);
-  return total;
-}
 
 /* ---- the files ---------------------------------------------------------- */
 
@@ -882,17 +800,11 @@ static void truncated_and_missing_files_are_refused(void **state) {
   const char *missing = path_of("nothing_here.gltf");
   assert_null(lm_scene_load_gltf(missing, &err));
   assert_non_null(strstr(err.msg, missing));
-  assert_null(lm_scene_load_gltf(tmp_dir, &err)); /* a directory */
-  assert_non_null(strstr(err.msg, tmp_dir));
+  assert_null(lm_scene_load_gltf(gltf_test_dir, &err)); /* a directory */
+  assert_non_null(strstr(err.msg, gltf_test_dir));
 }
 
 /* ---- mutations ---------------------------------------------------------- */
-
-static uint32_t rng_state = 12345;
-static uint32_t rng(void) {
-  rng_state = rng_state * 1664525u + 1013904223u;
-  return rng_state >> 8;
-}
 
 /* Whatever loads must be usable: finite vertices, indices in range, world
  * transforms for every node, lights and cameras on real nodes. */
@@ -948,26 +860,7 @@ static void mutated_glb_never_crashes(void **state) {
   for (int iter = 0; iter < iters; iter++) {
     size_t n = lens[iter % 2], json_end = ends[iter % 2];
     memcpy(mutant, glb[iter % 2], n);
-    size_t len = n;
-    int edits = 1 + (int)(rng() % 3);
-    for (int e = 0; e < edits; e++) {
-      uint32_t r = rng();
-      size_t at = rng() % len;
-      switch (r % 5) {
-      case 0: mutant[at] ^= (unsigned char)(1u << (rng() % 8)); break; /* flip a bit */
-      case 1: mutant[at] = (unsigned char)rng(); break;                 /* any byte */
-      case 2: len = at + 1; break;                                      /* truncate */
-      default: {
-        /* A digit of the JSON for another: still JSON, other indices and sizes. */
-        size_t j = 20 + rng() % (json_end - 20);
-        for (size_t k = 0; k < 64 && j + k < json_end; k++)
-          if (mutant[j + k] >= '0' && mutant[j + k] <= '9') {
-            mutant[j + k] = (unsigned char)('0' + rng() % 10);
-            break;
-          }
-      }
-      }
-    }
+    size_t len = mutate_glb(mutant, n, json_end);
     lm_error err = {""};
     const char *path = write_bytes("mutant.glb", mutant, len);
     lm_scene *s = lm_scene_load_gltf(path, &err);
@@ -1003,19 +896,6 @@ static void names_pick_files_or_builtins(void **state) {
   lm_scene_destroy(s);
 }
 
-static int setup(void **state) {
-  (void)state;
-  snprintf(tmp_dir, sizeof tmp_dir, "/tmp/limn_gltf_XXXXXX");
-  return mkdtemp(tmp_dir) ? 0 : -1;
-}
-
-static int teardown(void **state) {
-  (void)state;
-  char cmd[128];
-  snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmp_dir);
-  return system(cmd) == 0 ? 0 : -1;
-}
-
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(triangle_loads_with_every_index_type),
@@ -1036,5 +916,5 @@ int main(void) {
       cmocka_unit_test(mutated_glb_never_crashes),
       cmocka_unit_test(names_pick_files_or_builtins),
   };
-  return cmocka_run_group_tests(tests, setup, teardown);
+  return cmocka_run_group_tests(tests, gltf_test_setup, gltf_test_teardown);
 }

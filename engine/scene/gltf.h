@@ -23,7 +23,36 @@
  *   the file are computed, area-weighted; a vertex that only touches
  *   zero-area triangles gets +Z. UVs (TEXCOORD_0) are optional (0 when
  *   absent). Coordinates must be finite and within LM_GLTF_MAX_COORD.
- *   Sparse accessors, skins and morph targets are not supported.
+ *   Sparse accessors are not supported.
+ * - Morph targets: POSITION and NORMAL deltas (TANGENT and other attributes
+ *   are ignored with one warning a file; tangents are not deformed). Every
+ *   primitive of a mesh must have as many targets; the mesh's `weights` are
+ *   the defaults, a node's `weights` override them (each of the target
+ *   count). Skins: JOINTS_n / WEIGHTS_n sets (joints unsigned byte or short;
+ *   weights float or normalized unsigned byte or short), all of them, 4
+ *   influences a set; weights that do not sum to 1 (or are negative) are
+ *   normalized with one warning a file, and a vertex whose weights are all
+ *   0 is not skinned. A skin's joints must be nodes of the scene, at most
+ *   LM_SKIN_MAX_JOINTS; inverseBindMatrices are float MAT4s (identity when
+ *   absent); an influence with a weight must name one of its joints. A node
+ *   with a skin, or whose mesh has morph targets, gets its own copies of the
+ *   mesh's lm meshes: their vertices are that node's pose, posed on the CPU
+ *   (engine/scene/anim.c), at rest when loaded; `rest` keeps the undeformed
+ *   vertices. Node `translation`, `rotation`, `scale` are kept (lm_node.trs)
+ *   for the channels that replace them.
+ * - Animations, all of them in the file's order (unnamed: "animation N"),
+ *   every channel on translation, rotation, scale and weights with its
+ *   sampler's STEP, LINEAR or CUBICSPLINE keys: times are floats, finite and
+ *   strictly increasing; values are floats (rotation and weights also
+ *   normalized integers), finite and within LM_GLTF_MAX_COORD, rotations
+ *   normalized; the output holds a value a key (CUBICSPLINE: in-tangent,
+ *   value, out-tangent; weights: the target count each). A weights channel
+ *   drives every primitive of its node's mesh. Bad data fails the file
+ *   naming the animation, channel and field ("animation 0 ('walk') channel
+ *   2: sampler 1: input: accessor 4: time 3 (0.5) is not after time 2
+ *   (0.5)"), as do a channel on a node the file lacks or one with a matrix,
+ *   and a weights channel of the wrong width; channels on other paths or on
+ *   nodes outside the scene are skipped with one warning a file.
  * - Materials, metallic-roughness to Phong (emissive ignored):
  *     color     = baseColorFactor.rgb, clamped to [0, 1]
  *     kd        = 1 - metallic               (metals have no diffuse part)

@@ -9,6 +9,7 @@
 
 #include "image/image.h"
 #include "scene/gltf.h"
+#include "scene/scene_internal.h"
 
 #include <strings.h>
 
@@ -33,6 +34,10 @@ struct Loader {
   std::vector<int> nodes;               // [node] -> lm node; -1 not in the scene
   int skipped = 0;                      // point and line primitives, warned about once
   std::string first_skipped;            // "mesh M primitive P (mode K)"
+  std::vector<std::vector<int>> holders; // [node] -> the lm nodes holding its mesh's primitives
+  // What is skipped or mended with one warning a file: the count and the first case.
+  int skipped_channels = 0, ignored_targets = 0, mended_weights = 0;
+  std::string first_channel, first_target, first_weights;
 };
 
 // Every failure goes through here: "path: what".
@@ -54,6 +59,12 @@ bool finite_all(const std::vector<double> &v) {
 
 float clamp01(double x) { return (float)(x < 0 ? 0 : x > 1 ? 1 : x); }
 
+// LM_PUSH for C++, which wants lm_grow's void * cast: a new zeroed slot.
+template <typename T> T *push(T *&items, int &count, int &cap) {
+  items = (T *)lm_grow(items, &cap, count + 1, sizeof(T));
+  return &items[count++];
+}
+
 // ---- accessors -------------------------------------------------------------
 
 int component_size(int type) {
@@ -74,7 +85,8 @@ int component_count(int type) {
   case TINYGLTF_TYPE_VEC2: return 2;
   case TINYGLTF_TYPE_VEC3: return 3;
   case TINYGLTF_TYPE_VEC4: return 4;
-  default: return 0; // matrices: never a vertex attribute we read
+  case TINYGLTF_TYPE_MAT4: return 16; // a skin's inverse bind matrices
+  default: return 0; // other matrices: nothing we read
   }
 }
 
@@ -290,6 +302,148 @@ std::vector<uint32_t> triangle_list(int mode, const std::vector<uint32_t> &in) {
   return out;
 }
 
+// ---- deformation: morph targets and skin influences ------------------------
+
+// A component type view_get reads as [0, 1] or [-1, 1]: glTF's normalized integers.
+bool normalized_int(const View &v) { return v.normalized && v.type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT; }
+
+// Morph target t's `name` deltas (POSITION or NORMAL) into out[count * 3].
+bool read_target(Loader &L, const char *where, size_t t, const std::string &name, int index, size_t count,
+                 float *out) {
+  char what[192];
+  snprintf(what, sizeof what, "%s: target %zu: %s", where, t, name.c_str());
+  View v;
+  if (!accessor_view(L, what, index, 3, &v)) return false;
+  if (v.count != count)
+    return fail(L, "%s: accessor %d has %zu elements, but POSITION has %zu", what, index, v.count, count);
+  for (size_t i = 0; i < count; i++)
+    for (int c = 0; c < 3; c++) {
+      double x = view_get(v, i, c);
+      if (!std::isfinite(x) || std::fabs(x) > LM_GLTF_MAX_COORD)
+        return fail(L, "%s: accessor %d: element %zu has a non-finite or huge value (%g)", what, index, i, x);
+      out[i * 3 + c] = (float)x;
+    }
+  return true;
+}
+
+// JOINTS_k and WEIGHTS_k of a primitive into influences [k * 4, k * 4 + 4) of
+// each vertex's 4 * sets (the weights not yet normalized).
+bool read_influences(Loader &L, const char *where, const tinygltf::Primitive &p, int k, int sets, size_t count,
+                     uint16_t *joints, float *weights) {
+  std::string jname = "JOINTS_" + std::to_string(k), wname = "WEIGHTS_" + std::to_string(k);
+  char what[192];
+  snprintf(what, sizeof what, "%s: %s", where, jname.c_str());
+  View jv, wv;
+  int ji = p.attributes.at(jname), wi = p.attributes.at(wname);
+  if (!accessor_view(L, what, ji, 4, &jv)) return false;
+  if ((jv.type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && jv.type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) ||
+      jv.normalized)
+    return fail(L, "%s: accessor %d has component type %d%s; joints are unsigned bytes or shorts (5121, 5123)", what,
+                ji, jv.type, jv.normalized ? ", normalized" : "");
+  if (jv.count != count)
+    return fail(L, "%s: accessor %d has %zu elements, but POSITION has %zu", what, ji, jv.count, count);
+  snprintf(what, sizeof what, "%s: %s", where, wname.c_str());
+  if (!accessor_view(L, what, wi, 4, &wv)) return false;
+  if (wv.type != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+      !(normalized_int(wv) && (wv.type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                wv.type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT)))
+    return fail(L, "%s: accessor %d has component type %d; weights are floats or normalized unsigned bytes or "
+                "shorts", what, wi, wv.type);
+  if (wv.count != count)
+    return fail(L, "%s: accessor %d has %zu elements, but POSITION has %zu", what, wi, wv.count, count);
+  for (size_t v = 0; v < count; v++)
+    for (int c = 0; c < 4; c++) {
+      size_t at = (v * (size_t)sets + (size_t)k) * 4 + (size_t)c;
+      double w = view_get(wv, v, c);
+      if (!std::isfinite(w) || std::fabs(w) > 1e6)
+        return fail(L, "%s: accessor %d: element %zu has a non-finite or huge weight (%g)", what, wi, v, w);
+      joints[at] = (uint16_t)view_get(jv, v, c);
+      weights[at] = (float)w;
+    }
+  return true;
+}
+
+// Each vertex's weights scaled to sum 1; negative ones count as 0. A vertex
+// whose weights did not sum to 1 is mended with one warning a file; one
+// whose weights are all 0 stays unskinned (anim.c keeps it in place).
+void normalize_weights(Loader &L, const char *where, float *weights, size_t count, int sets) {
+  size_t n = 4 * (size_t)sets;
+  for (size_t v = 0; v < count; v++) {
+    float *w = weights + v * n;
+    double sum = 0;
+    bool negative = false;
+    for (size_t i = 0; i < n; i++) {
+      negative |= w[i] < 0;
+      w[i] = std::fmax(w[i], 0.0f);
+      sum += w[i];
+    }
+    if ((negative || std::fabs(sum - 1) > 0.01) && !L.mended_weights++)
+      L.first_weights = std::string(where) + " vertex " + std::to_string(v) + " (sum " + std::to_string(sum) + ")";
+    for (size_t i = 0; i < n && sum > 0; i++) w[i] = (float)(w[i] / sum);
+  }
+}
+
+// A primitive's morph targets (POSITION and NORMAL deltas; TANGENT and
+// others are ignored, with one warning a file) and its JOINTS_n / WEIGHTS_n
+// sets into lm mesh `id`, which keeps its undeformed vertices as `rest`.
+bool read_deform(Loader &L, const char *where, const tinygltf::Mesh &mesh, const tinygltf::Primitive &p, size_t count,
+                 int id) {
+  int sets = 0;
+  for (;; sets++) {
+    bool j = p.attributes.count("JOINTS_" + std::to_string(sets)) > 0;
+    bool w = p.attributes.count("WEIGHTS_" + std::to_string(sets)) > 0;
+    if (j != w)
+      return fail(L, "%s: %s_%d comes without %s_%d", where, j ? "JOINTS" : "WEIGHTS", sets, j ? "WEIGHTS" : "JOINTS",
+                  sets);
+    if (!j) break;
+  }
+  size_t nt = p.targets.size();
+  if (!nt && !sets) return true;
+  if (nt > (size_t)LM_GLTF_MAX_ELEMENTS / count || (size_t)sets * 4 > (size_t)LM_GLTF_MAX_ELEMENTS / count)
+    return fail(L, "%s: %zu morph targets and %d joint sets of %zu vertices: more than %d values", where, nt, sets,
+                count, LM_GLTF_MAX_ELEMENTS);
+  lm_scene_mesh *m = &L.s->meshes[id];
+  size_t floats = count * 8;
+  m->rest = (float *)memcpy(lm_alloc(sizeof(float) * floats), m->vertices, sizeof(float) * floats);
+  if (nt) {
+    m->target_count = (int)nt;
+    m->target_positions = (float *)lm_alloc(sizeof(float) * nt * count * 3);
+    m->default_weights = (float *)lm_alloc(sizeof(float) * nt);
+    for (size_t t = 0; t < mesh.weights.size() && t < nt; t++) m->default_weights[t] = (float)mesh.weights[t];
+    for (size_t t = 0; t < nt; t++)
+      for (const auto &[name, index] : p.targets[t]) {
+        float *out = nullptr;
+        if (name == "POSITION") {
+          out = m->target_positions;
+        } else if (name == "NORMAL") {
+          if (!m->target_normals) m->target_normals = (float *)lm_alloc(sizeof(float) * nt * count * 3);
+          out = m->target_normals;
+        } else {
+          if (!L.ignored_targets++) L.first_target = std::string(where) + " target " + std::to_string(t) + " " + name;
+          continue;
+        }
+        if (!read_target(L, where, t, name, index, count, out + t * count * 3)) return false;
+      }
+  }
+  if (sets) {
+    m->influence_sets = sets;
+    m->joints = (uint16_t *)lm_alloc(sizeof(uint16_t) * count * 4 * (size_t)sets);
+    m->joint_weights = (float *)lm_alloc(sizeof(float) * count * 4 * (size_t)sets);
+    for (int k = 0; k < sets; k++)
+      if (!read_influences(L, where, p, k, sets, count, m->joints, m->joint_weights)) return false;
+    normalize_weights(L, where, m->joint_weights, count, sets);
+  }
+  return true;
+}
+
+// True when a primitive of the mesh morphs or is skinned: its lm meshes are
+// then one node's pose, and each node that uses it gets its own copies.
+bool deformable(const tinygltf::Mesh &mesh) {
+  for (const tinygltf::Primitive &p : mesh.primitives)
+    if (!p.targets.empty() || p.attributes.count("JOINTS_0")) return true;
+  return false;
+}
+
 // lm mesh of primitive pi of mesh mi; -2 when skipped, -1 on error.
 int load_primitive(Loader &L, int mi, int pi) {
   const tinygltf::Mesh &mesh = L.m.meshes[mi];
@@ -351,6 +505,7 @@ int load_primitive(Loader &L, int mi, int pi) {
     normalize_tangents(tangents);
     lm_scene_mesh_set_tangents(L.s, m, tangents.data());
   }
+  if (!read_deform(L, where, mesh, p, count, m)) return -1;
   return m;
 }
 
@@ -514,12 +669,12 @@ int material_for(Loader &L, const char *where, int index) {
 
 // ---- nodes -----------------------------------------------------------------
 
-// Column-major T * R * S, or the node's matrix.
-bool local_transform(Loader &L, int ni, const tinygltf::Node &n, float out[16]) {
+// The node's matrix, or T * R * S kept beside its matrix (what channels replace).
+bool local_transform(Loader &L, int ni, const tinygltf::Node &n, lm_node *out) {
   if (!n.matrix.empty()) {
     if (n.matrix.size() != 16 || !finite_all(n.matrix))
       return fail(L, "node %d: matrix needs 16 finite numbers", ni);
-    for (int i = 0; i < 16; i++) out[i] = (float)n.matrix[i];
+    for (int i = 0; i < 16; i++) out->local[i] = (float)n.matrix[i];
     return true;
   }
   double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
@@ -536,16 +691,10 @@ bool local_transform(Loader &L, int ni, const tinygltf::Node &n, float out[16]) 
       return fail(L, "node %d: rotation is not a usable quaternion", ni);
     for (int i = 0; i < 4; i++) q[i] = n.rotation[i] / len;
   }
-  double x = q[0], y = q[1], z = q[2], w = q[3];
-  double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),
-                 2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
-                 2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y)};
-  for (int c = 0; c < 3; c++) {
-    for (int k = 0; k < 3; k++) out[c * 4 + k] = (float)(r[c * 3 + k] * s[c]);
-    out[c * 4 + 3] = 0;
-  }
-  for (int k = 0; k < 3; k++) out[12 + k] = (float)t[k];
-  out[15] = 1;
+  out->trs = true;
+  for (int k = 0; k < 3; k++) out->translation[k] = (float)t[k], out->scale[k] = (float)s[k];
+  for (int k = 0; k < 4; k++) out->rotation[k] = (float)q[k];
+  lm_scene_trs_matrix(out->translation, out->rotation, out->scale, out->local);
   return true;
 }
 
@@ -636,33 +785,57 @@ bool add_light(Loader &L, int ni, int li, int node) {
 }
 
 // The node's mesh: on the node itself when it has one primitive, else one
-// child per primitive.
+// child per primitive. Nodes share a mesh's lm meshes unless it deforms. A
+// morphing mesh's nodes get their weights: the node's, else the mesh's.
 bool add_mesh(Loader &L, int ni, int mi, int lm_node) {
   if (mi < 0 || (size_t)mi >= L.m.meshes.size())
     return fail(L, "node %d: mesh %d does not exist (the file has %zu)", ni, mi, L.m.meshes.size());
   const tinygltf::Mesh &mesh = L.m.meshes[mi];
+  const tinygltf::Node &node = L.m.nodes[ni];
+  size_t targets = mesh.primitives.empty() ? 0 : mesh.primitives[0].targets.size();
+  for (size_t pi = 1; pi < mesh.primitives.size(); pi++)
+    if (mesh.primitives[pi].targets.size() != targets)
+      return fail(L, "mesh %d: primitive %zu has %zu morph targets, primitive 0 has %zu (glTF wants the same)", mi,
+                  pi, mesh.primitives[pi].targets.size(), targets);
+  if ((!mesh.weights.empty() && mesh.weights.size() != targets) || !finite_all(mesh.weights))
+    return fail(L, "mesh %d: weights has %zu numbers for %zu morph targets (or one is not finite)", mi,
+                mesh.weights.size(), targets);
+  if ((!node.weights.empty() && node.weights.size() != targets) || !finite_all(node.weights))
+    return fail(L, "node %d: weights has %zu numbers for the %zu morph targets of mesh %d (or one is not finite)", ni,
+                node.weights.size(), targets, mi);
   std::vector<int> &cache = L.meshes[mi];
-  if (cache.empty()) {
+  std::vector<int> ids = cache;
+  if (cache.empty() || deformable(mesh)) {
+    ids.clear();
     for (size_t pi = 0; pi < mesh.primitives.size(); pi++) {
       int id = load_primitive(L, mi, (int)pi);
       if (id == -1) return false;
-      cache.push_back(id);
+      ids.push_back(id);
     }
+    if (cache.empty()) cache = ids;
   }
   static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   for (size_t pi = 0; pi < mesh.primitives.size(); pi++) {
-    if (cache[pi] < 0) continue;
+    if (ids[pi] < 0) continue;
     char where[64];
     snprintf(where, sizeof where, "mesh %d primitive %zu", mi, pi);
     int mat = material_for(L, where, mesh.primitives[pi].material);
     if (mat == -1 && mesh.primitives[pi].material >= 0) return false;
+    int holder = lm_node;
     if (mesh.primitives.size() == 1) {
-      L.s->nodes[lm_node].mesh = cache[pi];
+      L.s->nodes[lm_node].mesh = ids[pi];
       L.s->nodes[lm_node].material = mat;
     } else {
       char name[LM_NAME_MAX];
       snprintf(name, sizeof name, "%s.%zu", L.s->nodes[lm_node].name, pi);
-      lm_scene_add_node(L.s, name, lm_node, identity, cache[pi], mat);
+      holder = lm_scene_add_node(L.s, name, lm_node, identity, ids[pi], mat);
+    }
+    L.holders[ni].push_back(holder);
+    if (targets) {
+      const std::vector<double> &w = node.weights.empty() ? mesh.weights : node.weights;
+      float *weights = (float *)lm_alloc(sizeof(float) * targets);
+      for (size_t t = 0; t < w.size(); t++) weights[t] = (float)w[t];
+      L.s->nodes[holder].weights = weights;
     }
   }
   return true;
@@ -670,12 +843,18 @@ bool add_mesh(Loader &L, int ni, int mi, int lm_node) {
 
 bool add_node(Loader &L, int ni, int parent, int *out) {
   const tinygltf::Node &n = L.m.nodes[ni];
-  float local[16];
-  if (!local_transform(L, ni, n, local)) return false;
+  lm_node pose = {};
+  pose.rotation[3] = pose.scale[0] = pose.scale[1] = pose.scale[2] = 1;
+  if (!local_transform(L, ni, n, &pose)) return false;
   char name[LM_NAME_MAX];
   if (n.name.empty()) snprintf(name, sizeof name, "node%d", ni);
   else snprintf(name, sizeof name, "%s", n.name.c_str());
-  int id = *out = lm_scene_add_node(L.s, name, parent, local, -1, -1);
+  int id = *out = lm_scene_add_node(L.s, name, parent, pose.local, -1, -1);
+  lm_node *node = &L.s->nodes[id];
+  node->trs = pose.trs;
+  memcpy(node->translation, pose.translation, sizeof pose.translation);
+  memcpy(node->rotation, pose.rotation, sizeof pose.rotation);
+  memcpy(node->scale, pose.scale, sizeof pose.scale);
   L.nodes[ni] = id;
   if (n.mesh >= 0 && !add_mesh(L, ni, n.mesh, id)) return false;
   if (n.camera >= 0 && !add_camera(L, ni, n.camera, id)) return false;
@@ -756,6 +935,218 @@ bool check_world(Loader &L) {
       return fail(L, "camera '%s' on node '%s': its world transform has (near) zero scale and "
                   "cannot be inverted into a view", L.s->cameras[ci].name,
                   L.s->nodes[L.s->cameras[ci].node].name);
+  }
+  return true;
+}
+
+// ---- skins -----------------------------------------------------------------
+
+// lm skin of glTF skin si: joints as lm nodes, inverse bind matrices
+// (identity when the file has none). Its index in *out; false on bad data.
+bool add_skin(Loader &L, int si, int *out) {
+  const tinygltf::Skin &sk = L.m.skins[si];
+  char where[LM_NAME_MAX + 32];
+  if (sk.name.empty()) snprintf(where, sizeof where, "skin %d", si);
+  else snprintf(where, sizeof where, "skin %d ('%.*s')", si, LM_NAME_MAX - 1, sk.name.c_str());
+  size_t n = sk.joints.size();
+  if (n == 0) return fail(L, "%s: joints is empty", where);
+  if (n > LM_SKIN_MAX_JOINTS)
+    return fail(L, "%s: joints: %zu joints, more than the %d the engine takes", where, n, LM_SKIN_MAX_JOINTS);
+  std::vector<int> joints(n);
+  for (size_t j = 0; j < n; j++) {
+    int jn = sk.joints[j];
+    if (jn < 0 || (size_t)jn >= L.m.nodes.size())
+      return fail(L, "%s: joints[%zu]: node %d does not exist (the file has %zu)", where, j, jn, L.m.nodes.size());
+    if (L.nodes[jn] < 0) return fail(L, "%s: joints[%zu]: node %d is not in the scene", where, j, jn);
+    joints[j] = L.nodes[jn];
+  }
+  std::vector<float> bind(n * 16, 0.0f);
+  for (size_t j = 0; j < n; j++)
+    for (int k = 0; k < 4; k++) bind[j * 16 + k * 5] = 1;
+  if (sk.inverseBindMatrices >= 0) {
+    char what[LM_NAME_MAX + 64];
+    snprintf(what, sizeof what, "%s: inverseBindMatrices", where);
+    View v;
+    int ai = sk.inverseBindMatrices;
+    if (!accessor_view(L, what, ai, 16, &v)) return false;
+    if (v.type != TINYGLTF_COMPONENT_TYPE_FLOAT)
+      return fail(L, "%s: accessor %d has component type %d, not floats (5126)", what, ai, v.type);
+    if (v.count < n) return fail(L, "%s: accessor %d has %zu matrices for %zu joints", what, ai, v.count, n);
+    for (size_t j = 0; j < n; j++)
+      for (int k = 0; k < 16; k++) {
+        double x = view_get(v, j, k);
+        if (!std::isfinite(x) || std::fabs(x) > LM_GLTF_MAX_COORD)
+          return fail(L, "%s: accessor %d: matrix %zu has a non-finite or huge value (%g)", what, ai, j, x);
+        bind[j * 16 + k] = (float)x;
+      }
+  }
+  lm_skin *k = push(L.s->skins, L.s->skin_count, L.s->skin_cap);
+  snprintf(k->name, sizeof k->name, "%s", sk.name.empty() ? where : sk.name.c_str());
+  k->joints = (int *)memcpy(lm_alloc(sizeof(int) * n), joints.data(), sizeof(int) * n);
+  k->inverse_bind = (float *)memcpy(lm_alloc(sizeof(float) * 16 * n), bind.data(), sizeof(float) * 16 * n);
+  k->joint_count = (int)n;
+  *out = L.s->skin_count - 1;
+  return true;
+}
+
+// The skins of the scene's nodes, given to the lm nodes that hold their
+// meshes; every influence with a weight must name one of the skin's joints.
+bool load_skins(Loader &L) {
+  std::vector<int> skins(L.m.skins.size(), -1); // [glTF skin] -> lm skin
+  for (size_t ni = 0; ni < L.m.nodes.size(); ni++) {
+    int si = L.m.nodes[ni].skin;
+    if (si < 0 || L.nodes[ni] < 0) continue;
+    if ((size_t)si >= L.m.skins.size())
+      return fail(L, "node %zu: skin %d does not exist (the file has %zu)", ni, si, L.m.skins.size());
+    if (skins[si] < 0 && !add_skin(L, si, &skins[si])) return false;
+    for (int h : L.holders[ni]) {
+      L.s->nodes[h].skin = skins[si];
+      lm_scene_mesh *m = &L.s->meshes[L.s->nodes[h].mesh];
+      int joints = L.s->skins[skins[si]].joint_count, per_vertex = 4 * m->influence_sets;
+      for (size_t i = 0; i < (size_t)m->vertex_count * per_vertex; i++) {
+        if (m->joints[i] < joints) continue;
+        if (m->joint_weights[i] > 0)
+          return fail(L, "node %zu: mesh '%s': JOINTS_%zu of vertex %zu names joint %d, past the %d joints of skin %d",
+                      ni, m->name, i % per_vertex / 4, i / per_vertex, m->joints[i], joints, si);
+        m->joints[i] = 0; // no weight: no matter which
+      }
+    }
+  }
+  return true;
+}
+
+// ---- animations ------------------------------------------------------------
+
+// Channel ci of animation ai into lm channels (a weights channel: one for
+// each lm node that holds a primitive of the target's mesh). Bad data fails
+// the file naming the animation, the channel and the field; a channel the
+// engine cannot use (another path, a node outside the scene) is skipped.
+bool add_channel(Loader &L, int ai, int ci) {
+  const tinygltf::Animation &ga = L.m.animations[ai];
+  const tinygltf::AnimationChannel &gc = ga.channels[ci];
+  char where[LM_NAME_MAX + 96], what[LM_NAME_MAX + 160];
+  snprintf(where, sizeof where, "animation %d ('%s') channel %d", ai, L.s->animations[ai].name, ci);
+  auto skip = [&](const std::string &why) {
+    if (!L.skipped_channels++) L.first_channel = std::string(where) + ": " + why;
+    return true;
+  };
+  static const char *const kPaths[] = {"translation", "rotation", "scale", "weights"};
+  int path = -1;
+  for (int k = 0; k < 4; k++)
+    if (gc.target_path == kPaths[k]) path = k;
+  if (path < 0) return skip("target.path '" + gc.target_path + "'");
+  if (gc.target_node < 0) return skip("no target.node");
+  if ((size_t)gc.target_node >= L.m.nodes.size())
+    return fail(L, "%s: target.node %d does not exist (the file has %zu)", where, gc.target_node, L.m.nodes.size());
+  int node = L.nodes[gc.target_node];
+  if (node < 0) return skip("target.node " + std::to_string(gc.target_node) + " is not in the scene");
+  const char *node_name = L.s->nodes[node].name;
+  if (path != LM_ANIM_WEIGHTS && !L.s->nodes[node].trs)
+    return fail(L, "%s: target.node %d ('%s') has a matrix, and glTF lets no animation move such a node", where,
+                gc.target_node, node_name);
+  if (gc.sampler < 0 || (size_t)gc.sampler >= ga.samplers.size())
+    return fail(L, "%s: sampler %d does not exist (the animation has %zu)", where, gc.sampler, ga.samplers.size());
+  const tinygltf::AnimationSampler &gs = ga.samplers[gc.sampler];
+  lm_anim_interp interp = gs.interpolation == "STEP" ? LM_ANIM_STEP
+                          : gs.interpolation == "CUBICSPLINE" ? LM_ANIM_CUBICSPLINE : LM_ANIM_LINEAR;
+  if (gs.interpolation != "STEP" && gs.interpolation != "CUBICSPLINE" && gs.interpolation != "LINEAR")
+    return fail(L, "%s: sampler %d: interpolation '%s' is none of LINEAR, STEP, CUBICSPLINE", where, gc.sampler,
+                gs.interpolation.c_str());
+  bool cubic = interp == LM_ANIM_CUBICSPLINE;
+
+  std::vector<int> holders; // a weights channel's lm nodes, and their target count
+  int targets = 0;
+  if (path == LM_ANIM_WEIGHTS) {
+    for (int h : L.holders[gc.target_node])
+      if (L.s->meshes[L.s->nodes[h].mesh].target_count > 0) {
+        holders.push_back(h);
+        targets = L.s->meshes[L.s->nodes[h].mesh].target_count;
+      }
+    if (!targets)
+      return fail(L, "%s: target.node %d ('%s') has no mesh with morph targets for its weights", where,
+                  gc.target_node, node_name);
+  }
+  int width = path == LM_ANIM_ROTATION ? 4 : path == LM_ANIM_WEIGHTS ? targets : 3;
+
+  snprintf(what, sizeof what, "%s: sampler %d: input", where, gc.sampler);
+  View in;
+  if (!accessor_view(L, what, gs.input, 1, &in)) return false;
+  if (in.type != TINYGLTF_COMPONENT_TYPE_FLOAT)
+    return fail(L, "%s: accessor %d has component type %d; times are floats (5126)", what, gs.input, in.type);
+  size_t n = in.count;
+  std::vector<float> times(n);
+  for (size_t i = 0; i < n; i++) {
+    double t = view_get(in, i, 0);
+    if (!std::isfinite(t)) return fail(L, "%s: accessor %d: time %zu is not finite", what, gs.input, i);
+    times[i] = (float)t;
+    if (i > 0 && !(times[i] > times[i - 1]))
+      return fail(L, "%s: accessor %d: time %zu (%g) is not after time %zu (%g): times must increase", what,
+                  gs.input, i, t, i - 1, (double)times[i - 1]);
+  }
+  if (cubic && n < 2)
+    return fail(L, "%s: a CUBICSPLINE sampler needs 2 keys or more; it has %zu", what, n);
+
+  snprintf(what, sizeof what, "%s: sampler %d: output", where, gc.sampler);
+  View out;
+  int ncomp = path == LM_ANIM_WEIGHTS ? 1 : width;
+  if (!accessor_view(L, what, gs.output, ncomp, &out)) return false;
+  bool may_normalize = path == LM_ANIM_ROTATION || path == LM_ANIM_WEIGHTS;
+  if (out.type != TINYGLTF_COMPONENT_TYPE_FLOAT && !(may_normalize && normalized_int(out)))
+    return fail(L, "%s: accessor %d has component type %d%s; %s wants floats%s", what, gs.output, out.type,
+                out.normalized ? ", normalized" : "", kPaths[path], may_normalize ? " or normalized integers" : "");
+  size_t per_key = (cubic ? 3 : 1) * (path == LM_ANIM_WEIGHTS ? (size_t)targets : 1);
+  if (out.count != n * per_key) {
+    if (path == LM_ANIM_WEIGHTS && out.count % (n * (cubic ? 3 : 1)) == 0)
+      return fail(L, "%s: accessor %d holds %zu weights a key, but the mesh of target.node %d ('%s') has %d morph "
+                  "targets", what, gs.output, out.count / (n * (cubic ? 3 : 1)), gc.target_node, node_name, targets);
+    return fail(L, "%s: accessor %d has %zu elements for the input's %zu keys (want %zu%s)", what, gs.output,
+                out.count, n, n * per_key, cubic ? ": CUBICSPLINE keys are in-tangent, value, out-tangent" : "");
+  }
+  std::vector<float> values(out.count * (size_t)ncomp);
+  for (size_t e = 0; e < out.count; e++)
+    for (int c = 0; c < ncomp; c++) {
+      double x = view_get(out, e, c);
+      if (!std::isfinite(x) || std::fabs(x) > LM_GLTF_MAX_COORD)
+        return fail(L, "%s: accessor %d: element %zu has a non-finite or huge value (%g)", what, gs.output, e, x);
+      values[e * (size_t)ncomp + (size_t)c] = (float)x;
+    }
+  if (path == LM_ANIM_ROTATION) // unit quaternions, so that slerp stays on the sphere (tangents as they are)
+    for (size_t k = 0; k < n; k++) {
+      float *q = &values[(cubic ? 3 * k + 1 : k) * 4];
+      double len = std::sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2] + (double)q[3] * q[3]);
+      if (!(len > 1e-12))
+        return fail(L, "%s: accessor %d: key %zu is no rotation (a zero quaternion)", what, gs.output, k);
+      for (int c = 0; c < 4; c++) q[c] = (float)(q[c] / len);
+    }
+
+  if (path != LM_ANIM_WEIGHTS) holders.assign(1, node);
+  lm_animation *a = &L.s->animations[ai];
+  for (int h : holders) {
+    a->channels = (lm_anim_channel *)lm_realloc(a->channels, sizeof *a->channels * (size_t)(a->channel_count + 1));
+    lm_anim_channel *c = &a->channels[a->channel_count++];
+    c->node = h;
+    c->path = (lm_anim_path)path;
+    c->interp = interp;
+    c->count = (int)n;
+    c->width = width;
+    c->times = (float *)memcpy(lm_alloc(sizeof(float) * n), times.data(), sizeof(float) * n);
+    c->values = (float *)memcpy(lm_alloc(sizeof(float) * values.size()), values.data(), sizeof(float) * values.size());
+    if (a->channel_count == 1 || times[0] < a->start) a->start = times[0];
+    if (a->channel_count == 1 || times[n - 1] > a->end) a->end = times[n - 1];
+  }
+  return true;
+}
+
+// Every animation of the file, in its order (an unnamed one: "animation N"),
+// even one left without channels, so that indices stay the file's.
+bool load_animations(Loader &L) {
+  for (size_t ai = 0; ai < L.m.animations.size(); ai++) {
+    const tinygltf::Animation &ga = L.m.animations[ai];
+    lm_animation *a = push(L.s->animations, L.s->animation_count, L.s->animation_cap);
+    if (ga.name.empty()) snprintf(a->name, sizeof a->name, "animation %zu", ai);
+    else snprintf(a->name, sizeof a->name, "%s", ga.name.c_str());
+    for (size_t ci = 0; ci < ga.channels.size(); ci++)
+      if (!add_channel(L, (int)ai, (int)ci)) return false;
   }
   return true;
 }
@@ -953,17 +1344,29 @@ bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
 
 // Fills `s` from the parsed model; false (message in L.err) on bad input.
 bool convert(const char *path, const tinygltf::Model &model, lm_scene *s, lm_error *err) {
-  Loader L{path, model, s, err, {}, {}, {}, {}, 0, {}};
+  Loader L{path, model, s, err, {}, {}, {}, {}, 0, {}, {}, 0, 0, 0, {}, {}, {}};
   L.meshes.resize(model.meshes.size());
   L.materials.assign(model.materials.size(), -1);
   L.textures.assign(model.images.size() * 2, -1);
   L.nodes.assign(model.nodes.size(), -1);
-  if (!load_nodes(L)) return false;
+  L.holders.resize(model.nodes.size());
+  if (!load_nodes(L) || !load_skins(L) || !load_animations(L)) return false;
   if (L.skipped)
     lm_warn("%s: %d point or line primitive%s skipped (the first: %s): only triangles are drawn", path,
             L.skipped, L.skipped > 1 ? "s" : "", L.first_skipped.c_str());
+  if (L.skipped_channels)
+    lm_warn("%s: %d animation channel%s skipped (the first: %s): only translation, rotation, scale and weights of "
+            "the scene's nodes move", path, L.skipped_channels, L.skipped_channels > 1 ? "s" : "",
+            L.first_channel.c_str());
+  if (L.ignored_targets)
+    lm_warn("%s: %d morph target attribute%s ignored (the first: %s): only POSITION and NORMAL morph", path,
+            L.ignored_targets, L.ignored_targets > 1 ? "s" : "", L.first_target.c_str());
+  if (L.mended_weights)
+    lm_warn("%s: the skin weights of %d vert%s did not sum to 1 and were normalized (the first: %s)", path,
+            L.mended_weights, L.mended_weights > 1 ? "ices" : "ex", L.first_weights.c_str());
   lm_scene_update(s);
   if (!check_world(L)) return false;
+  lm_scene_pose(s, LM_ANIM_NONE, 0); // morph weights and skins at rest
   add_defaults(s);
   return true;
 }

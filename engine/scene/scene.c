@@ -102,6 +102,7 @@ int lm_scene_add_node(lm_scene *s, const char *name, int parent, const float loc
   n->mesh = mesh;
   n->material = material;
   n->skin = -1;
+  n->rotation[3] = n->scale[0] = n->scale[1] = n->scale[2] = 1; /* an identity T * R * S (trs stays false) */
   return s->node_count - 1;
 }
 
@@ -128,6 +129,7 @@ int lm_scene_add_root(lm_scene *s, const char *name, const float local[16]) {
   n->parent = -1;
   memcpy(n->local, local, sizeof n->local);
   n->mesh = n->material = n->skin = -1;
+  n->rotation[3] = n->scale[0] = n->scale[1] = n->scale[2] = 1;
   lm_scene_update(s);
   return 0;
 }
@@ -247,6 +249,7 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
   for (int i = 0; i < s->mesh_count; i++) {
     lm_scene_mesh *m = &s->meshes[i];
     lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, m->indices, m->index_count);
+    m->dirty = false;
   }
   s->uploaded = true;
   return true;

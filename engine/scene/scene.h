@@ -126,15 +126,17 @@ typedef struct lm_scene_mesh {
    * deformed mesh belongs to one node (the loader gives each skinned or
    * morphed node its own copy), so its vertices are that node's pose. */
   float *rest;             /* the undeformed vertices, 8 floats each as `vertices` */
-  float *prev_positions;   /* xyz a vertex at the previous time lm_scene_set_time posed (velocities) */
+  float *prev_positions;   /* xyz a vertex at the previous time lm_scene_set_time posed (velocities);
+                              NULL until its first call, which makes it the pose itself */
   int target_count;        /* morph targets */
   float *target_positions; /* target_count * vertex_count * 3 deltas */
   float *target_normals;   /* the same, or NULL */
   float *default_weights;  /* target_count: the mesh's `weights` (0 when absent) */
   int influence_sets;      /* JOINTS_n / WEIGHTS_n pairs: 4 influences each */
-  uint16_t *joints;        /* vertex_count * 4 * influence_sets, indices into the skin's joints */
+  uint16_t *joints;        /* vertex_count * 4 * influence_sets (a vertex's sets together), indices into
+                              the skin's joints */
   float *joint_weights;    /* the same layout, normalized to sum 1 a vertex */
-  bool dirty;              /* vertices changed since the last upload (lm_scene_upload_deformed) */
+  bool dirty;              /* vertices (or prev_positions) changed since the last upload (lm_scene_upload_deformed) */
 } lm_scene_mesh;
 
 typedef struct lm_node {

@@ -2,6 +2,11 @@
 #ifndef LIMN_SCENE_INTERNAL_H
 #define LIMN_SCENE_INTERNAL_H
 
+/* The glTF bridge is C++ and uses these too. */
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #include "scene/scene.h"
 
 /* Frees a mesh's deformation data (rest pose, morph targets, skin weights). */
@@ -11,5 +16,13 @@ void lm_scene_free_animations(lm_scene *s);
 /* Node indices at or above `from` moved up by `by` (lm_scene_add_root): the
  * animations' and skins' node references follow. */
 void lm_scene_shift_animation_nodes(lm_scene *s, int from, int by);
+/* Column-major T * R * S (q: x y z w, unit) as glTF composes a node. */
+void lm_scene_trs_matrix(const float t[3], const float q[4], const float s[3], float out[16]);
+/* Poses the scene as lm_scene_set_time does, leaving prev_positions, the
+ * scene's time and its animation alone: the loader's rest pose. */
+void lm_scene_pose(lm_scene *s, int anim, double seconds);
 
+#ifdef __cplusplus
+}
+#endif
 #endif
