@@ -139,6 +139,8 @@ if len(eyes) != m["frames"] or len(set(eyes)) != len(eyes) or m["moved"] != m["f
 tiles = {k: m[k]["shadow_tiles_drawn"] for k in ("still", "moving", "alone")}
 if tiles["still"] != 0 or tiles["alone"] <= 0 or (tiles["moving"] == 0) != (want == "0"):
     bad.append(f"shadow tiles drawn {tiles}")
+if "shadow.cache=false" not in m["alone_options"].split() or "isr.temporal.enabled=false" not in m["alone_options"].split():
+    bad.append(f"alone options {m['alone_options']}")
 r = m["target"]["moving_over_alone"]
 if not (math.isfinite(r) and r > 0) or m["target"]["pass"] != (r <= m["target"]["limit"]):
     bad.append(f"target {m['target']}")

@@ -38,9 +38,11 @@ static const char bench_usage[] =
     "renderers, each with its own scene and pipeline, take turns frame by frame\n"
     "(so that the machine's load falls on all three): `still` holds the path's\n"
     "first view, `moving` follows the path with every cache on and histories\n"
-    "carried, `alone` renders each moving frame again as a new renderer's first\n"
-    "frame with shadow.cache=false (every cache off: no shadow tile kept, no\n"
-    "temporal history, no previous frame, no settled skip). Prints per pass the\n"
+    "carried, `alone` renders each moving frame again with every cache off: its\n"
+    "pipeline with shadow.cache=false and every NAME.temporal.enabled=false (no\n"
+    "shadow tile kept, no temporal history, no settled skip), its renderer's view\n"
+    "set again before each frame (no previous frame; textures stay allocated, as\n"
+    "in the sequence: lm_renderer_set_view). Prints per pass the\n"
     "three medians, moving / still and moving / alone, the shadow tiles drawn a\n"
     "frame, and the target: each frame of a sequence within 1.2x of the same\n"
     "frame alone (PASS or FAIL on the whole frame's ratio of medians).\n"
@@ -112,9 +114,11 @@ typedef struct motion {
   /* what the run used and measured */
   bool orbit;            /* the path is the orbit, else the scene's camera moved by the animation */
   char camera[LM_NAME_MAX];
+  char caches_off[512];  /* the alone pipeline's options turned off */
   int anim;              /* lm_scene_find_animation's index */
   float centre[3];
   double frame_ms[STREAMS], animate_ms[STREAMS], tiles[STREAMS]; /* medians; tiles: shadow tiles drawn */
+  double outside_ms[STREAMS]; /* median of the frame's wall time less its passes' (record, compile, uploads) */
   double ratio_worst;    /* the largest moving / alone of one frame */
   float (*eye)[3];       /* the moving camera's position each timed frame */
   int moved;             /* timed frames whose camera is not the previous one's */
@@ -359,8 +363,9 @@ static double lights_per_pixel(lm_renderer *r, int light_count) {
 
 /* Appends the last frame's time of each pass that ran to that pass's row of
  * pass_ms (`cap` a row, counts in pass_n); `largest` also keeps its declared
- * fetches and output size. */
-static void collect_passes(bench *b, lm_renderer *r, bool largest, double *pass_ms, int *pass_n, int cap) {
+ * fetches and output size. Returns the sum of those times. */
+static double collect_passes(bench *b, lm_renderer *r, bool largest, double *pass_ms, int *pass_n, int cap) {
+  double sum = 0;
   lm_graph *g = lm_renderer_graph(r);
   for (int i = 0; i < lm_graph_pass_count(g); i++) {
     lm_graph_pass_info p = lm_graph_pass(g, i);
@@ -371,7 +376,9 @@ static void collect_passes(bench *b, lm_renderer *r, bool largest, double *pass_
     bp->cpu = p.kind == LM_PASS_CPU;
     int slot = (int)(bp - b->passes);
     if (pass_n[slot] < cap) pass_ms[slot * cap + pass_n[slot]++] = p.ms;
+    sum += p.ms;
   }
+  return sum;
 }
 
 /* One configuration (size si, or column si of another series): warm-up,
@@ -633,11 +640,10 @@ static void print_tables(const bench *b, lm_clock clock) {
   }
 }
 
-/* The script with the --set options, `extra` (NAME=VALUE, or NULL; left out
- * when the script has no such option) and
- * --tech. NULL with err set and *rc the exit status: 1 when the script does
- * not load, 2 for a bad option or technique (the user's flags). */
-static lm_pipeline *load_pipeline(const bench *b, const char *extra, int *rc, lm_error *err) {
+/* The script with the --set options and --tech. NULL with err set and *rc
+ * the exit status: 1 when the script does not load, 2 for a bad option or
+ * technique (the user's flags). */
+static lm_pipeline *load_pipeline(const bench *b, int *rc, lm_error *err) {
   char script[2048];
   if (b->script) snprintf(script, sizeof script, "%s", b->script);
   else snprintf(script, sizeof script, "%s/scripts/pp.lua", lm_root_dir());
@@ -645,14 +651,10 @@ static lm_pipeline *load_pipeline(const bench *b, const char *extra, int *rc, lm
   lm_pipeline *pipe = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, err);
   if (!pipe) return NULL;
   bool ok = true;
-  for (int i = 0; i <= b->set_count && ok; i++) {
-    const char *set = i < b->set_count ? b->sets[i] : extra;
-    if (!set) continue;
+  for (int i = 0; i < b->set_count && ok; i++) {
     char name[256];
-    const char *eq = strchr(set, '=');
-    snprintf(name, sizeof name, "%.*s", (int)(eq - set), set);
-    char now[256];
-    if (set == extra && !lm_pipeline_get_option(pipe, name, now, sizeof now)) continue; /* a script without it */
+    const char *eq = strchr(b->sets[i], '=');
+    snprintf(name, sizeof name, "%.*s", (int)(eq - b->sets[i]), b->sets[i]);
     ok = lm_pipeline_set_option(pipe, name, eq + 1, err);
   }
   if (!ok || (b->tech && !lm_pipeline_set_technique(pipe, b->tech, err))) {
@@ -720,14 +722,37 @@ static double pose(const motion *m, stream *s, int f) {
   return ms;
 }
 
+/* Turns off what p keeps from frame to frame: shadow.cache and every
+ * temporal reuse (options NAME.temporal.enabled), naming them in `off`. */
+static bool caches_off(lm_pipeline *p, char *off, size_t cap, lm_error *err) {
+  lm_buf list = {0};
+  lm_pipeline_list_options(p, &list);
+  bool ok = true;
+  off[0] = 0;
+  /* "name=value" items, ", " between them (a value's own commas give items without '=') */
+  for (char *save = NULL, *line = list.data ? strtok_r(list.data, ", ", &save) : NULL; line && ok;
+       line = strtok_r(NULL, ", ", &save)) {
+    char *eq = strchr(line, '=');
+    if (!eq) continue;
+    *eq = 0;
+    size_t n = strlen(line), t = strlen(".temporal.enabled");
+    if (strcmp(line, "shadow.cache") && !(n > t && !strcmp(line + n - t, ".temporal.enabled"))) continue;
+    ok = lm_pipeline_set_option(p, line, "false", err);
+    snprintf(off + strlen(off), cap - strlen(off), "%s%s=false", off[0] ? " " : "", line);
+  }
+  lm_buf_free(&list);
+  return ok;
+}
+
 /* Loads stream k's scene and pipeline and picks its camera (the orbit's is
  * added; its radius, when not given, is the framing camera's distance). */
 static bool stream_open(bench *b, int k, stream *s, lm_error *err) {
   motion *m = &b->motion;
   int rc;
   s->scene = lm_scene_load(b->scene, err);
-  s->pipe = s->scene ? load_pipeline(b, k == STREAM_ALONE ? "shadow.cache=false" : NULL, &rc, err) : NULL;
+  s->pipe = s->scene ? load_pipeline(b, &rc, err) : NULL;
   if (!s->pipe || !lm_scene_upload(s->scene, err)) return false;
+  if (k == STREAM_ALONE && !caches_off(s->pipe, m->caches_off, sizeof m->caches_off, err)) return false;
   if (m->orbit) {
     const int *size = b->sizes[b->largest];
     s->camera = lm_scene_add_framing_camera(s->scene, "bench.orbit", (float)size[0] / (float)size[1]);
@@ -743,12 +768,10 @@ static bool stream_open(bench *b, int k, stream *s, lm_error *err) {
     s->node = s->scene->cameras[0].node;
   }
   snprintf(m->camera, sizeof m->camera, "%s", s->scene->cameras[s->camera].name);
-  if (k != STREAM_ALONE) {
-    s->r = lm_renderer_create(&(lm_renderer_desc){.scene = s->scene, .pipeline = s->pipe, .camera = s->camera,
-                                                  .width = b->sizes[b->largest][0],
-                                                  .height = b->sizes[b->largest][1], .clock = b->clock}, err);
-    if (!s->r) return false;
-  }
+  s->r = lm_renderer_create(&(lm_renderer_desc){.scene = s->scene, .pipeline = s->pipe, .camera = s->camera,
+                                                .width = b->sizes[b->largest][0],
+                                                .height = b->sizes[b->largest][1], .clock = b->clock}, err);
+  if (!s->r) return false;
   if (k == STREAM_STILL) pose(m, s, 0);
   return true;
 }
@@ -760,8 +783,8 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
   m->orbit = !m->timed || m->orbit_given || first->camera_count == 0 || !node_animated(first, m->anim, cams[0].node);
   int n = m->frames;
   stream st[STREAMS] = {{0}};
-  double *wall = lm_alloc(sizeof(double) * STREAMS * 3 * (size_t)n), *anim = wall + STREAMS * n,
-         *tiles = anim + STREAMS * n, *ratio = lm_alloc(sizeof(double) * (size_t)n);
+  double *wall = lm_alloc(sizeof(double) * STREAMS * 4 * (size_t)n), *anim = wall + STREAMS * n,
+         *tiles = anim + STREAMS * n, *outside = tiles + STREAMS * n, *ratio = lm_alloc(sizeof(double) * (size_t)n);
   double *pass_ms = lm_alloc(sizeof(double) * STREAMS * MAX_PASSES * (size_t)n);
   int pass_n[STREAMS][MAX_PASSES] = {{0}};
   m->eye = lm_alloc(sizeof *m->eye * (size_t)n);
@@ -773,14 +796,8 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
     for (int j = 0; j < STREAMS && ok; j++) {
       int k = (f + b->warmup + j) % STREAMS; /* who goes first turns each frame */
       stream *s = &st[k];
-      if (k == STREAM_ALONE)
-        s->r = lm_renderer_create(&(lm_renderer_desc){.scene = s->scene, .pipeline = s->pipe, .camera = s->camera,
-                                                      .width = b->sizes[b->largest][0],
-                                                      .height = b->sizes[b->largest][1], .clock = b->clock}, err);
-      if (!s->r) {
-        ok = false;
-        break;
-      }
+      /* alone: a frame with no previous one (nothing to reproject, no still frames counted) */
+      if (k == STREAM_ALONE) lm_renderer_set_view(s->r, s->camera, b->sizes[b->largest][0], b->sizes[b->largest][1]);
       lm_finish(); /* nothing of the last frame left in flight */
       double t0 = lm_now_ms();
       double a = k == STREAM_STILL ? 0 : pose(m, s, f);
@@ -791,7 +808,7 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
         wall[k * n + f] = t1 - t0;
         anim[k * n + f] = a;
         tiles[k * n + f] = lm_renderer_shadows(s->r)->view_count - lm_renderer_shadow_draw_stats(s->r).kept;
-        collect_passes(b, s->r, false, pass_ms + (size_t)k * MAX_PASSES * n, pass_n[k], n);
+        outside[k * n + f] = t1 - t0 - collect_passes(b, s->r, false, pass_ms + (size_t)k * MAX_PASSES * n, pass_n[k], n);
       }
       if (ok && k == STREAM_MOVING) {
         const float *eye = s->scene->nodes[s->node].world + 12;
@@ -801,7 +818,6 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
         }
         memcpy(last, eye, sizeof last);
       }
-      if (k == STREAM_ALONE) lm_renderer_destroy(s->r), s->r = NULL;
     }
   }
   if (ok) {
@@ -814,6 +830,7 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
       m->frame_ms[k] = median(wall + k * n, n);
       m->animate_ms[k] = median(anim + k * n, n);
       m->tiles[k] = median(tiles + k * n, n);
+      m->outside_ms[k] = median(outside + k * n, n);
       for (int i = 0; i < b->pass_count; i++)
         if (pass_n[k][i]) b->passes[i].motion_ms[k] = median(pass_ms + ((size_t)k * MAX_PASSES + i) * n, pass_n[k][i]);
     }
@@ -843,13 +860,16 @@ static void print_motion(const bench *b) {
   if (m->timed)
     printf("  animation '%s' from %.4g to %.4g s at %.4g fps: lm_scene_set_time and the deformed vertices' upload "
            "before each frame, in its time\n", b->motion.animation, m->start, m->stop, m->fps);
-  printf("  still: the path's first view held; moving: the path, every cache on, histories carried; alone: each\n"
-         "  moving frame as a new renderer's first (shadow.cache=false: every shadow tile drawn; no temporal\n"
-         "  history, no previous frame, no settled skip; its textures allocated in the frame)\n");
+  printf("  still: the path's first view held; moving: the path, every cache on, histories carried;\n"
+         "  alone: each moving frame again with every cache off (every shadow tile drawn, no temporal history\n"
+         "  or settled skip) and no previous frame (lm_renderer_set_view), options: %s\n",
+         m->caches_off[0] ? m->caches_off : "none to turn off");
   printf("  %-24s %10s %10s %10s %13s %13s\n", "pass (ms)", "still", "moving", "alone", "moving/still", "moving/alone");
   const char *row = "  %-24s %10.3f %10.3f %10.3f %13.3f %13.3f\n";
   printf(row, "frame (wall)", m->frame_ms[0], m->frame_ms[1], m->frame_ms[2], ratio_of(m->frame_ms[1], m->frame_ms[0]),
          ratio_of(m->frame_ms[1], m->frame_ms[2]));
+  printf(row, "outside the passes", m->outside_ms[0], m->outside_ms[1], m->outside_ms[2],
+         ratio_of(m->outside_ms[1], m->outside_ms[0]), ratio_of(m->outside_ms[1], m->outside_ms[2]));
   if (m->timed)
     printf(row, "animate (cpu)", m->animate_ms[0], m->animate_ms[1], m->animate_ms[2], -1.0,
            ratio_of(m->animate_ms[1], m->animate_ms[2]));
@@ -859,7 +879,9 @@ static void print_motion(const bench *b) {
     printf(row, b->passes[i].name, t[0], t[1], t[2], ratio_of(t[1], t[0]), ratio_of(t[1], t[2]));
   }
   printf("  %-24s %10.0f %10.0f %10.0f\n", "shadow tiles drawn", m->tiles[0], m->tiles[1], m->tiles[2]);
-  printf("  (-1: not run, or no ratio; a pass missing from one column did not run there)\n");
+  printf("  (-1: not run, or no ratio; a pass missing from one column did not run there; outside the passes:\n"
+         "  the frame's wall time less its passes' times, with the pass clock cpu: Lua, graph compilation,\n"
+         "  uploads)\n");
   printf("  the moving camera moved in %d of %d frames\n", m->moved, m->frames);
   double r = ratio_of(m->frame_ms[1], m->frame_ms[2]);
   printf("target: a frame of a sequence within %.1fx of the same frame alone with every cache off: moving / alone "
@@ -887,7 +909,8 @@ static void print_motion_json(const bench *b) {
     printf(", \"time\": null");
   }
   for (int k = 0; k < STREAMS; k++) {
-    printf(", \"%s\": {\"frame_ms\": %.6g, \"shadow_tiles_drawn\": %.6g", stream_names[k], m->frame_ms[k], m->tiles[k]);
+    printf(", \"%s\": {\"frame_ms\": %.6g, \"outside_passes_ms\": %.6g, \"shadow_tiles_drawn\": %.6g", stream_names[k],
+           m->frame_ms[k], m->outside_ms[k], m->tiles[k]);
     if (m->timed) printf(", \"animate_ms\": %.6g", m->animate_ms[k]);
     printf("}");
   }
@@ -906,7 +929,9 @@ static void print_motion_json(const bench *b) {
   for (int f = 0; f < m->frames; f++)
     printf("%s[%.6g, %.6g, %.6g]", f ? ", " : "", m->eye[f][0], m->eye[f][1], m->eye[f][2]);
   double r = ratio_of(m->frame_ms[1], m->frame_ms[2]);
-  printf("], \"moved\": %d, \"target\": {\"limit\": %.6g, \"moving_over_alone\": %.6g, \"worst_frame\": %.6g, "
+  printf("], \"alone_options\": ");
+  limn_json_string(m->caches_off);
+  printf(", \"moved\": %d, \"target\": {\"limit\": %.6g, \"moving_over_alone\": %.6g, \"worst_frame\": %.6g, "
          "\"pass\": %s}}", m->moved, MOTION_TARGET, r, m->ratio_worst, r >= 0 && r <= MOTION_TARGET ? "true" : "false");
 }
 
@@ -1069,7 +1094,7 @@ int limn_bench(int argc, char **argv) {
   if (rc) return rc < 0 ? 0 : rc;
   lm_error err;
   int prc;
-  lm_pipeline *pipe = load_pipeline(&b, NULL, &prc, &err);
+  lm_pipeline *pipe = load_pipeline(&b, &prc, &err);
   if (!pipe) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return prc;
