@@ -848,6 +848,17 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
 
 static double ratio_of(double a, double c) { return a >= 0 && c > 0 ? a / c : -1; }
 
+/* A row of the motion table: the three medians and the two ratios, "-" where one did not run. */
+static void motion_row(const char *name, const double t[STREAMS]) {
+  double cells[5] = {t[0], t[1], t[2], ratio_of(t[1], t[0]), ratio_of(t[1], t[2])};
+  printf("  %-24s", name);
+  for (int i = 0; i < 5; i++) {
+    if (cells[i] < 0) printf(" %*s", i < 3 ? 10 : 13, "-");
+    else printf(" %*.3f", i < 3 ? 10 : 13, cells[i]);
+  }
+  printf("\n");
+}
+
 static void print_motion(const bench *b) {
   const motion *m = &b->motion;
   printf("motion at %dx%d: medians of %d frames after %d warm-up, the three renderers taking turns frame by frame\n",
@@ -862,26 +873,20 @@ static void print_motion(const bench *b) {
            "before each frame, in its time\n", b->motion.animation, m->start, m->stop, m->fps);
   printf("  still: the path's first view held; moving: the path, every cache on, histories carried;\n"
          "  alone: each moving frame again with every cache off (every shadow tile drawn, no temporal history\n"
-         "  or settled skip) and no previous frame (lm_renderer_set_view), options: %s\n",
+         "  or settled skip) and no previous frame (lm_renderer_set_view); its options:\n    %s\n",
          m->caches_off[0] ? m->caches_off : "none to turn off");
   printf("  %-24s %10s %10s %10s %13s %13s\n", "pass (ms)", "still", "moving", "alone", "moving/still", "moving/alone");
-  const char *row = "  %-24s %10.3f %10.3f %10.3f %13.3f %13.3f\n";
-  printf(row, "frame (wall)", m->frame_ms[0], m->frame_ms[1], m->frame_ms[2], ratio_of(m->frame_ms[1], m->frame_ms[0]),
-         ratio_of(m->frame_ms[1], m->frame_ms[2]));
-  printf(row, "outside the passes", m->outside_ms[0], m->outside_ms[1], m->outside_ms[2],
-         ratio_of(m->outside_ms[1], m->outside_ms[0]), ratio_of(m->outside_ms[1], m->outside_ms[2]));
-  if (m->timed)
-    printf(row, "animate (cpu)", m->animate_ms[0], m->animate_ms[1], m->animate_ms[2], -1.0,
-           ratio_of(m->animate_ms[1], m->animate_ms[2]));
+  double still_none[STREAMS] = {-1, m->animate_ms[STREAM_MOVING], m->animate_ms[STREAM_ALONE]};
+  motion_row("frame (wall)", m->frame_ms);
+  motion_row("outside the passes", m->outside_ms);
+  if (m->timed) motion_row("animate (cpu)", still_none);
   for (int i = 0; i < b->pass_count; i++) {
     const double *t = b->passes[i].motion_ms;
-    if (t[0] < 0 && t[1] < 0 && t[2] < 0) continue;
-    printf(row, b->passes[i].name, t[0], t[1], t[2], ratio_of(t[1], t[0]), ratio_of(t[1], t[2]));
+    if (t[0] >= 0 || t[1] >= 0 || t[2] >= 0) motion_row(b->passes[i].name, t);
   }
   printf("  %-24s %10.0f %10.0f %10.0f\n", "shadow tiles drawn", m->tiles[0], m->tiles[1], m->tiles[2]);
-  printf("  (-1: not run, or no ratio; a pass missing from one column did not run there; outside the passes:\n"
-         "  the frame's wall time less its passes' times, with the pass clock cpu: Lua, graph compilation,\n"
-         "  uploads)\n");
+  printf("  (-: the pass did not run there; outside the passes: the frame's wall time less its passes'\n"
+         "  times, with the pass clock cpu: Lua, graph compilation, uploads)\n");
   printf("  the moving camera moved in %d of %d frames\n", m->moved, m->frames);
   double r = ratio_of(m->frame_ms[1], m->frame_ms[2]);
   printf("target: a frame of a sequence within %.1fx of the same frame alone with every cache off: moving / alone "
@@ -911,7 +916,7 @@ static void print_motion_json(const bench *b) {
   for (int k = 0; k < STREAMS; k++) {
     printf(", \"%s\": {\"frame_ms\": %.6g, \"outside_passes_ms\": %.6g, \"shadow_tiles_drawn\": %.6g", stream_names[k],
            m->frame_ms[k], m->outside_ms[k], m->tiles[k]);
-    if (m->timed) printf(", \"animate_ms\": %.6g", m->animate_ms[k]);
+    if (m->timed && k != STREAM_STILL) printf(", \"animate_ms\": %.6g", m->animate_ms[k]);
     printf("}");
   }
   printf(", \"passes\": [");
