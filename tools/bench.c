@@ -76,7 +76,8 @@ static const char bench_usage[] =
     "                      whose camera the animation moves, that camera\n"
     "  --orbit STEP[,RADIUS[,ELEVATION]]  that orbit (implies --motion): degrees a\n"
     "                      frame (0..360), radius in scene units (0: the framing\n"
-    "                      camera's), elevation in degrees (-89..89)\n"
+    "                      camera's), elevation in degrees (-89..89); with --time,\n"
+    "                      --orbit 0 holds the camera while the animation plays\n"
     "  --time START:STOP   play the scene's animation over the moving frames at\n"
     "                      --fps (implies --motion; sets the timed frames'\n"
     "                      count; warm-up frames come before START): its pose\n"
@@ -672,7 +673,7 @@ static lm_pipeline *load_pipeline(const bench *b, int *rc, lm_error *err) {
 typedef struct stream {
   lm_scene *scene;
   lm_pipeline *pipe;
-  lm_renderer *r; /* still and moving: one for the run; alone: one a frame */
+  lm_renderer *r;    /* one for the run (alone's view is set again before each frame) */
   int camera, node; /* the camera rendered through and its node */
 } stream;
 
@@ -776,6 +777,9 @@ static bool stream_open(bench *b, int k, stream *s, lm_error *err) {
   return true;
 }
 
+/* a / c, -1 when either is missing (< 0) or c is 0 */
+static double ratio_of(double a, double c) { return a >= 0 && c > 0 ? a / c : -1; }
+
 /* The --motion run (see the usage text) at the largest size. */
 static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
   motion *m = &b->motion;
@@ -784,7 +788,7 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
   int n = m->frames;
   stream st[STREAMS] = {{0}};
   double *wall = lm_alloc(sizeof(double) * STREAMS * 4 * (size_t)n), *anim = wall + STREAMS * n,
-         *tiles = anim + STREAMS * n, *outside = tiles + STREAMS * n, *ratio = lm_alloc(sizeof(double) * (size_t)n);
+         *tiles = anim + STREAMS * n, *outside = tiles + STREAMS * n;
   double *pass_ms = lm_alloc(sizeof(double) * STREAMS * MAX_PASSES * (size_t)n);
   int pass_n[STREAMS][MAX_PASSES] = {{0}};
   m->eye = lm_alloc(sizeof *m->eye * (size_t)n);
@@ -822,9 +826,9 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
   }
   if (ok) {
     m->ratio_worst = 0;
-    for (int f = 0; f < n; f++) {
-      ratio[f] = wall[STREAM_ALONE * n + f] > 0 ? wall[STREAM_MOVING * n + f] / wall[STREAM_ALONE * n + f] : 0;
-      if (ratio[f] > m->ratio_worst) m->ratio_worst = ratio[f];
+    for (int f = 0; f < n; f++) { /* before the medians sort the rows */
+      double r = ratio_of(wall[STREAM_MOVING * n + f], wall[STREAM_ALONE * n + f]);
+      if (r > m->ratio_worst) m->ratio_worst = r;
     }
     for (int k = 0; k < STREAMS; k++) {
       m->frame_ms[k] = median(wall + k * n, n);
@@ -841,12 +845,9 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
     lm_scene_destroy(st[k].scene);
   }
   free(wall);
-  free(ratio);
   free(pass_ms);
   return ok;
 }
-
-static double ratio_of(double a, double c) { return a >= 0 && c > 0 ? a / c : -1; }
 
 /* A row of the motion table: the three medians and the two ratios, "-" where one did not run. */
 static void motion_row(const char *name, const double t[STREAMS]) {
