@@ -116,5 +116,61 @@ check "bench lights" run 0 bench --tech dl --sizes 64x48 --frames 1 --warmup 0 -
 check "bench lights unculled: every light" awk '/lights\/pixel all/ { ok = $3 == 1 && $4 == 65 } END { exit !ok }' "$tmp/out"
 check "bench lights culled: a few" awk '/lights\/pixel culled/ { ok = $3 == 1 && $4 < 16 } END { exit !ok }' "$tmp/out"
 
+# bench --motion: the still, moving and alone columns, every figure finite and > 0, the camera moving.
+# Timings are not asserted (a shared machine); what the caches keep is: cornell's point light keeps
+# its tiles under a moving camera (they do not depend on the view), the field's sun cascades follow
+# the camera (drawn each moving frame), and the still view draws none after the first frame.
+motion_json() {  # $1: moving tiles wanted, "0" or "some"
+  python3 - "$1" "$tmp/out" <<'PY'
+import json, math, sys
+want, path = sys.argv[1], sys.argv[2]
+m = json.load(open(path))["motion"]
+bad = []
+for k in ("still", "moving", "alone"):
+    v = m[k]["frame_ms"]
+    if not (math.isfinite(v) and v > 0): bad.append(f"{k} frame_ms {v}")
+for p in m["passes"]:
+    for k in ("still", "moving", "alone"):
+        v = p[k]
+        if v is None or not (math.isfinite(v) and v > 0): bad.append(f"{p['name']} {k} {v}")
+eyes = [tuple(e) for e in m["camera_positions"]]
+if len(eyes) != m["frames"] or len(set(eyes)) != len(eyes) or m["moved"] != m["frames"]:
+    bad.append(f"camera positions {eyes}, moved {m['moved']}")
+tiles = {k: m[k]["shadow_tiles_drawn"] for k in ("still", "moving", "alone")}
+if tiles["still"] != 0 or tiles["alone"] <= 0 or (tiles["moving"] == 0) != (want == "0"):
+    bad.append(f"shadow tiles drawn {tiles}")
+if "shadow.cache=false" not in m["alone_options"].split() or "isr.temporal.enabled=false" not in m["alone_options"].split():
+    bad.append(f"alone options {m['alone_options']}")
+r = m["target"]["moving_over_alone"]
+if not (math.isfinite(r) and r > 0) or m["target"]["pass"] != (r <= m["target"]["limit"]):
+    bad.append(f"target {m['target']}")
+for b in bad: print("  " + b)
+sys.exit(1 if bad else 0)
+PY
+}
+check "bench motion" run 0 bench --tech isr+esm --sizes 32x24 --frames 3 --warmup 1 --motion --json
+check "bench motion figures, tiles kept" motion_json 0
+check "bench motion field" run 0 bench --scene field --tech dl+esm --sizes 48x32 --frames 3 --warmup 1 --orbit 5,0,30 --json
+check "bench motion field figures, cascades drawn" motion_json some
+check "bench motion orbit stated" out_has '"orbit": {"centre": [0, 1, 0], "radius": '
+check "bench motion table" run 0 bench --tech dl+esm --sizes 32x24 --frames 2 --warmup 1 --motion
+check "bench motion table columns" out_has "still     moving      alone  moving/still  moving/alone"
+check "bench motion table moved" out_has "the moving camera moved in 2 of 2 frames"
+check "bench motion table target" grep -qE "^target: a frame of a sequence within 1.2x .*: (PASS|FAIL)$" "$tmp/out"
+check "bench bad orbit" run 2 bench --orbit 400
+check "bench bad orbit message" err_has "--orbit wants STEP[,RADIUS[,ELEVATION]]"
+check "bench still orbit" run 2 bench --orbit 0
+check "bench still orbit message" err_has "--orbit with a step of 0 and no --time: nothing moves"
+check "bench bad time" run 2 bench --time 2:1
+check "bench bad time message" err_has "--time wants START:STOP"
+check "bench fps without time" run 2 bench --fps 30
+check "bench fps without time message" err_has "--fps plays an animation: it needs --time"
+check "bench animation without time" run 2 bench --animation 0
+check "bench animation without time message" err_has "--animation plays an animation: it needs --time"
+check "bench bad fps" run 2 bench --time 0:1 --fps 0
+check "bench bad fps message" err_has "--fps wants frames a second"
+check "bench time without animation" run 2 bench --time 0:1 --sizes 32x24
+check "bench time without animation message" err_has "--time: scene 'cornell' has no animation"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -34,6 +34,18 @@ static const char bench_usage[] =
     "rate on the reflection rays of a view where every surface is a mirror at\n"
     "800x450 (the seed's quarter of 1600x900), and the same at a quarter of the\n"
     "largest size against that size's frame time, as a ratio.\n"
+    "With --motion, at the largest size, the frame while things move: three\n"
+    "renderers, each with its own scene and pipeline, take turns frame by frame\n"
+    "(so that the machine's load falls on all three): `still` holds the path's\n"
+    "first view, `moving` follows the path with every cache on and histories\n"
+    "carried, `alone` renders each moving frame again with every cache off: its\n"
+    "pipeline with shadow.cache=false and every NAME.temporal.enabled=false (no\n"
+    "shadow tile kept, no temporal history, no settled skip), its renderer's view\n"
+    "set again before each frame (no previous frame; textures stay allocated, as\n"
+    "in the sequence: lm_renderer_set_view). Prints per pass the\n"
+    "three medians, moving / still and moving / alone, the shadow tiles drawn a\n"
+    "frame, and the target: each frame of a sequence within 1.2x of the same\n"
+    "frame alone (PASS or FAIL on the whole frame's ratio of medians).\n"
     "\n"
     "options:\n"
     "  --scene NAME|FILE   (default cornell)\n"
@@ -57,10 +69,31 @@ static const char bench_usage[] =
     "  --clock auto|gpu|cpu\n"
     "  --trace             also measure the ray tracer (see above)\n"
     "  --trace-threads N   its threads (default 2)\n"
+    "  --motion            the moving frame (see above); the path is an orbit\n"
+    "                      around the centre of the scene's bounds (default 2\n"
+    "                      degrees a frame, at the distance and 20 degrees above\n"
+    "                      as the framing camera), or with --time and a scene\n"
+    "                      whose camera the animation moves, that camera\n"
+    "  --orbit STEP[,RADIUS[,ELEVATION]]  that orbit (implies --motion): degrees a\n"
+    "                      frame (0..360), radius in scene units (0: the framing\n"
+    "                      camera's), elevation in degrees (-89..89); with --time,\n"
+    "                      --orbit 0 holds the camera while the animation plays\n"
+    "  --time START:STOP   play the scene's animation over the moving frames at\n"
+    "                      --fps (implies --motion; sets the timed frames'\n"
+    "                      count; warm-up frames come before START): its pose\n"
+    "                      (lm_scene_set_time, timed as \"animate (cpu)\") and the\n"
+    "                      deformed vertices' upload before each frame\n"
+    "  --fps N             frames a second of --time (default 24)\n"
+    "  --animation NAME|INDEX|all  which animation --time plays (default all)\n"
     "  --json              one JSON object on stdout instead of the tables\n"
     "  --help              this text\n";
 
 enum { MAX_SIZES = 16, MAX_PASSES = 64 };
+
+/* The --motion run's renderers (see the usage text). */
+enum { STREAM_STILL, STREAM_MOVING, STREAM_ALONE, STREAMS };
+static const char *const stream_names[STREAMS] = {"still", "moving", "alone"};
+#define MOTION_TARGET 1.2 /* issue 29: a sequence's frame within 1.2x of the same frame alone */
 
 typedef struct bench_pass {
   char name[64];
@@ -68,9 +101,29 @@ typedef struct bench_pass {
   double vary_ms[MAX_SIZES]; /* median per --vary value at the largest size */
   double lights_ms[2][MAX_SIZES]; /* median per --lights count: culled, every light everywhere */
   double fetches;           /* declared fetches a pixel (0: not said) */
+  double motion_ms[STREAMS]; /* --motion: median per renderer; -1 when it did not run */
   bool cpu;                 /* a CPU pass (cpu{}: the ray tracer's step) */
   int width, height;        /* its output at the largest size */
 } bench_pass;
+
+typedef struct motion {
+  bool on, orbit_given, timed;
+  double step, radius, elevation; /* the orbit: degrees a frame, scene units (0: the framing camera's), degrees */
+  double start, stop, fps;        /* --time and --fps */
+  const char *animation;          /* --animation */
+  int frames;                     /* timed frames: --frames, or those of --time */
+  /* what the run used and measured */
+  bool orbit;            /* the path is the orbit, else the scene's camera moved by the animation */
+  char camera[LM_NAME_MAX];
+  char caches_off[512];  /* the alone pipeline's options turned off */
+  int anim;              /* lm_scene_find_animation's index */
+  float centre[3];
+  double frame_ms[STREAMS], animate_ms[STREAMS], tiles[STREAMS]; /* medians; tiles: shadow tiles drawn */
+  double outside_ms[STREAMS]; /* median of the frame's wall time less its passes' (record, compile, uploads) */
+  double ratio_worst;    /* the largest moving / alone of one frame */
+  float (*eye)[3];       /* the moving camera's position each timed frame */
+  int moved;             /* timed frames whose camera is not the previous one's */
+} motion;
 
 typedef struct bench {
   int sizes[MAX_SIZES][2], size_count, frames, warmup;
@@ -98,6 +151,7 @@ typedef struct bench {
   int trace_rays, frame_rays;  /* reflection rays at 800x450, and at a quarter of the largest size */
   double trace_ms, frame_trace_ms; /* medians of tracing them (wall clock) */
   double trace_cpu_ms;         /* median CPU time (all threads) of the 800x450 rays */
+  motion motion;
 } bench;
 
 static int usage_error(const char *fmt, const char *arg) {
@@ -118,7 +172,13 @@ static int parse_args(int argc, char **argv, bench *b) {
       {"vary", required_argument, 0, 'V'},  {"help", no_argument, 0, 'h'},
       {"set", required_argument, 0, 'S'},   {"lights", required_argument, 0, 'L'}, {"light-reach", required_argument, 0, 'R'},
       {"trace", no_argument, 0, 'r'},       {"trace-threads", required_argument, 0, 'T'},
+      {"motion", no_argument, 0, 'M'},      {"orbit", required_argument, 0, 'O'},
+      {"time", required_argument, 0, 'I'},  {"fps", required_argument, 0, 'F'},
+      {"animation", required_argument, 0, 'A'},
       {0, 0, 0, 0}};
+  motion *m = &b->motion;
+  *m = (motion){.step = 2, .elevation = 20, .fps = 24, .animation = "all"};
+  bool fps_given = false, animation_given = false;
   opterr = 0;
   optind = 1;
   int c;
@@ -183,12 +243,55 @@ static int parse_args(int argc, char **argv, bench *b) {
       if (!limn_parse_double(optarg, &b->light_reach) || !(b->light_reach > 0 && b->light_reach <= 10))
         return usage_error("--light-reach wants a fraction in (0, 10], not '%s'", optarg);
       break;
+    case 'M': m->on = true; break;
+    case 'O': {
+      char text[256], *parts[4] = {0};
+      int n = 0;
+      snprintf(text, sizeof text, "%s", optarg);
+      for (char *save = NULL, *tok = strtok_r(text, ",", &save); tok && n < 4; tok = strtok_r(NULL, ",", &save))
+        parts[n++] = tok;
+      double v[3] = {m->step, 0, m->elevation};
+      bool ok = n >= 1 && n <= 3;
+      for (int i = 0; i < n && ok; i++) ok = limn_parse_double(parts[i], &v[i]);
+      if (!ok || v[0] < 0 || v[0] > 360 || v[1] < 0 || v[2] < -89 || v[2] > 89)
+        return usage_error("--orbit wants STEP[,RADIUS[,ELEVATION]]: degrees a frame 0..360, a radius >= 0, "
+                           "an elevation -89..89, not '%s'", optarg);
+      m->step = v[0], m->radius = v[1], m->elevation = v[2];
+      m->on = m->orbit_given = true;
+      break;
+    }
+    case 'I': {
+      const char *colon = strchr(optarg, ':');
+      char start[64];
+      snprintf(start, sizeof start, "%.*s", colon ? (int)(colon - optarg) : 0, optarg);
+      if (!colon || !limn_parse_double(start, &m->start) || !limn_parse_double(colon + 1, &m->stop) ||
+          m->stop < m->start)
+        return usage_error("--time wants START:STOP in seconds, STOP >= START, not '%s'", optarg);
+      m->on = m->timed = true;
+      break;
+    }
+    case 'F':
+      if (!limn_parse_double(optarg, &m->fps) || !(m->fps > 0 && m->fps <= 1000))
+        return usage_error("--fps wants frames a second in (0, 1000], not '%s'", optarg);
+      fps_given = true;
+      break;
+    case 'A': m->animation = optarg, animation_given = true; break;
     case 'h': fputs(bench_usage, stdout); return -1;
     case ':': return usage_error("%s needs a value", argv[optind - 1]);
     default: return usage_error("unknown flag '%s'", argv[optind - 1]);
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
+  if ((fps_given || animation_given) && !m->timed)
+    return usage_error("%s plays an animation: it needs --time START:STOP", fps_given ? "--fps" : "--animation");
+  if (m->timed) {
+    double frames = floor((m->stop - m->start) * m->fps + 1e-9) + 1;
+    if (frames > 10000) return usage_error("%s: more than 10000 frames", "--time at --fps");
+    m->frames = (int)frames;
+  } else if (m->on && !(m->step > 0)) {
+    return usage_error("%s", "--orbit with a step of 0 and no --time: nothing moves");
+  }
+  if (!m->timed) m->frames = b->frames;
   char list[1024];
   snprintf(list, sizeof list, "%s", sizes);
   for (char *save = NULL, *tok = strtok_r(list, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
@@ -220,6 +323,7 @@ static bench_pass *find_pass(bench *b, const char *name) {
   bench_pass *p = &b->passes[b->pass_count++];
   snprintf(p->name, sizeof p->name, "%s", name);
   for (int s = 0; s < MAX_SIZES; s++) p->ms[s] = p->vary_ms[s] = p->lights_ms[0][s] = p->lights_ms[1][s] = -1;
+  for (int k = 0; k < STREAMS; k++) p->motion_ms[k] = -1;
   return p;
 }
 
@@ -258,6 +362,26 @@ static double lights_per_pixel(lm_renderer *r, int light_count) {
   return covered > 0 ? sum / covered : 0;
 }
 
+/* Appends the last frame's time of each pass that ran to that pass's row of
+ * pass_ms (`cap` a row, counts in pass_n); `largest` also keeps its declared
+ * fetches and output size. Returns the sum of those times. */
+static double collect_passes(bench *b, lm_renderer *r, bool largest, double *pass_ms, int *pass_n, int cap) {
+  double sum = 0;
+  lm_graph *g = lm_renderer_graph(r);
+  for (int i = 0; i < lm_graph_pass_count(g); i++) {
+    lm_graph_pass_info p = lm_graph_pass(g, i);
+    if (p.culled || p.ms < 0) continue;
+    bench_pass *bp = find_pass(b, p.name);
+    if (!bp) continue;
+    if (largest) bp->fetches = p.fetches, bp->width = p.width, bp->height = p.height;
+    bp->cpu = p.kind == LM_PASS_CPU;
+    int slot = (int)(bp - b->passes);
+    if (pass_n[slot] < cap) pass_ms[slot * cap + pass_n[slot]++] = p.ms;
+    sum += p.ms;
+  }
+  return sum;
+}
+
 /* One configuration (size si, or column si of another series): warm-up,
  * then medians of frame wall time, overhead and passes. */
 static bool run_size(bench *b, int si, int series, lm_scene *scene, lm_pipeline *pipe, lm_clock *used,
@@ -289,17 +413,7 @@ static bool run_size(bench *b, int si, int series, lm_scene *scene, lm_pipeline 
     wall[k] = t1 - t0;
     over[k] = rec + comp;
     readback[k] = lm_renderer_fit_ms(r);
-    lm_graph *g = lm_renderer_graph(r);
-    for (int i = 0; i < lm_graph_pass_count(g); i++) {
-      lm_graph_pass_info p = lm_graph_pass(g, i);
-      if (p.culled || p.ms < 0) continue;
-      bench_pass *bp = find_pass(b, p.name);
-      if (!bp) continue;
-      if (!vary && size == b->largest) bp->fetches = p.fetches, bp->width = p.width, bp->height = p.height;
-      bp->cpu = p.kind == LM_PASS_CPU;
-      int slot = (int)(bp - b->passes);
-      if (pass_n[slot] < b->frames) pass_ms[slot * b->frames + pass_n[slot]++] = p.ms;
-    }
+    collect_passes(b, r, !vary && size == b->largest, pass_ms, pass_n, b->frames);
   }
   if (ok && !vary) {
     b->frame_ms[si] = median(wall, b->frames);
@@ -527,6 +641,306 @@ static void print_tables(const bench *b, lm_clock clock) {
   }
 }
 
+/* The script with the --set options and --tech. NULL with err set and *rc
+ * the exit status: 1 when the script does not load, 2 for a bad option or
+ * technique (the user's flags). */
+static lm_pipeline *load_pipeline(const bench *b, int *rc, lm_error *err) {
+  char script[2048];
+  if (b->script) snprintf(script, sizeof script, "%s", b->script);
+  else snprintf(script, sizeof script, "%s/scripts/pp.lua", lm_root_dir());
+  *rc = 1;
+  lm_pipeline *pipe = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, err);
+  if (!pipe) return NULL;
+  bool ok = true;
+  for (int i = 0; i < b->set_count && ok; i++) {
+    char name[256];
+    const char *eq = strchr(b->sets[i], '=');
+    snprintf(name, sizeof name, "%.*s", (int)(eq - b->sets[i]), b->sets[i]);
+    ok = lm_pipeline_set_option(pipe, name, eq + 1, err);
+  }
+  if (!ok || (b->tech && !lm_pipeline_set_technique(pipe, b->tech, err))) {
+    lm_pipeline_destroy(pipe);
+    *rc = 2;
+    return NULL;
+  }
+  return pipe;
+}
+
+/* ---- --motion -------------------------------------------------------- */
+
+/* One of the --motion run's renderers with its own scene and pipeline (a
+ * pipeline's Lua state counts the still frames its temporal reuse sees). */
+typedef struct stream {
+  lm_scene *scene;
+  lm_pipeline *pipe;
+  lm_renderer *r;    /* one for the run (alone's view is set again before each frame) */
+  int camera, node; /* the camera rendered through and its node */
+} stream;
+
+/* Does animation `anim` move node `node` or a node above it? */
+static bool node_animated(const lm_scene *s, int anim, int node) {
+  for (int n = node; n >= 0; n = s->nodes[n].parent)
+    for (int a = 0; a < s->animation_count; a++)
+      for (int c = 0; c < s->animations[a].channel_count && (anim == LM_ANIM_ALL || anim == a); c++)
+        if (s->animations[a].channels[c].node == n) return true;
+  return false;
+}
+
+/* The world transform of a camera at `eye` looking at `at`, +Y up (a camera
+ * looks along its -Z). The orbit's elevation stays within 89 degrees, so the
+ * view is never along Y. */
+static void look_at(const float eye[3], const float at[3], float m[16]) {
+  float f[3] = {at[0] - eye[0], at[1] - eye[1], at[2] - eye[2]};
+  float fl = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+  if (!(fl > 0)) f[0] = 0, f[1] = 0, f[2] = -1, fl = 1;
+  for (int i = 0; i < 3; i++) f[i] /= fl;
+  float x[3] = {-f[2], 0, f[0]}; /* f x (0, 1, 0) */
+  float xl = sqrtf(x[0] * x[0] + x[2] * x[2]);
+  if (!(xl > 0)) x[0] = 1, x[2] = 0, xl = 1;
+  x[0] /= xl, x[2] /= xl;
+  float y[3] = {x[1] * f[2] - x[2] * f[1], x[2] * f[0] - x[0] * f[2], x[0] * f[1] - x[1] * f[0]};
+  float w[16] = {x[0], x[1], x[2], 0, y[0], y[1], y[2], 0, -f[0], -f[1], -f[2], 0, eye[0], eye[1], eye[2], 1};
+  memcpy(m, w, sizeof w);
+}
+
+/* Poses s's scene for frame f of the path (f < 0: the warm-up before its
+ * start): the orbit camera at f steps, and the animation at START + f / fps
+ * with the deformed vertices uploaded. Returns the milliseconds that
+ * lm_scene_set_time took (0 without --time). */
+static double pose(const motion *m, stream *s, int f) {
+  if (m->orbit) {
+    double az = m->step * f * M_PI / 180, el = m->elevation * M_PI / 180;
+    float eye[3] = {m->centre[0] + (float)(m->radius * cos(el) * sin(az)), m->centre[1] + (float)(m->radius * sin(el)),
+                    m->centre[2] + (float)(m->radius * cos(el) * cos(az))}, w[16];
+    look_at(eye, m->centre, w);
+    lm_scene_node_set_world(s->scene, s->node, w);
+  }
+  if (!m->timed) return 0;
+  double t0 = lm_now_ms();
+  lm_scene_set_time(s->scene, m->anim, m->start + f / m->fps);
+  double ms = lm_now_ms() - t0;
+  lm_scene_upload_deformed(s->scene);
+  return ms;
+}
+
+/* Turns off what p keeps from frame to frame: shadow.cache and every
+ * temporal reuse (options NAME.temporal.enabled), naming them in `off`. */
+static bool caches_off(lm_pipeline *p, char *off, size_t cap, lm_error *err) {
+  lm_buf list = {0};
+  lm_pipeline_list_options(p, &list);
+  bool ok = true;
+  off[0] = 0;
+  /* "name=value" items, ", " between them (a value's own commas give items without '=') */
+  for (char *save = NULL, *line = list.data ? strtok_r(list.data, ", ", &save) : NULL; line && ok;
+       line = strtok_r(NULL, ", ", &save)) {
+    char *eq = strchr(line, '=');
+    if (!eq) continue;
+    *eq = 0;
+    size_t n = strlen(line), t = strlen(".temporal.enabled");
+    if (strcmp(line, "shadow.cache") && !(n > t && !strcmp(line + n - t, ".temporal.enabled"))) continue;
+    ok = lm_pipeline_set_option(p, line, "false", err);
+    snprintf(off + strlen(off), cap - strlen(off), "%s%s=false", off[0] ? " " : "", line);
+  }
+  lm_buf_free(&list);
+  return ok;
+}
+
+/* Loads stream k's scene and pipeline and picks its camera (the orbit's is
+ * added; its radius, when not given, is the framing camera's distance). */
+static bool stream_open(bench *b, int k, stream *s, lm_error *err) {
+  motion *m = &b->motion;
+  int rc;
+  s->scene = lm_scene_load(b->scene, err);
+  s->pipe = s->scene ? load_pipeline(b, &rc, err) : NULL;
+  if (!s->pipe || !lm_scene_upload(s->scene, err)) return false;
+  if (k == STREAM_ALONE && !caches_off(s->pipe, m->caches_off, sizeof m->caches_off, err)) return false;
+  if (m->orbit) {
+    const int *size = b->sizes[b->largest];
+    s->camera = lm_scene_add_framing_camera(s->scene, "bench.orbit", (float)size[0] / (float)size[1]);
+    s->node = s->scene->cameras[s->camera].node;
+    float lo[3], hi[3];
+    lm_scene_bounds(s->scene, lo, hi);
+    const float *eye = s->scene->nodes[s->node].world + 12;
+    double d = 0;
+    for (int i = 0; i < 3; i++) m->centre[i] = 0.5f * (lo[i] + hi[i]), d += (eye[i] - m->centre[i]) * (eye[i] - m->centre[i]);
+    if (!(m->radius > 0)) m->radius = sqrt(d);
+  } else {
+    s->camera = 0;
+    s->node = s->scene->cameras[0].node;
+  }
+  snprintf(m->camera, sizeof m->camera, "%s", s->scene->cameras[s->camera].name);
+  s->r = lm_renderer_create(&(lm_renderer_desc){.scene = s->scene, .pipeline = s->pipe, .camera = s->camera,
+                                                .width = b->sizes[b->largest][0],
+                                                .height = b->sizes[b->largest][1], .clock = b->clock}, err);
+  if (!s->r) return false;
+  if (k == STREAM_STILL) pose(m, s, 0);
+  return true;
+}
+
+/* a / c, -1 when either is missing (< 0) or c is 0 */
+static double ratio_of(double a, double c) { return a >= 0 && c > 0 ? a / c : -1; }
+
+/* The --motion run (see the usage text) at the largest size. */
+static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
+  motion *m = &b->motion;
+  const lm_camera *cams = first->cameras;
+  m->orbit = !m->timed || m->orbit_given || first->camera_count == 0 || !node_animated(first, m->anim, cams[0].node);
+  int n = m->frames;
+  stream st[STREAMS] = {{0}};
+  double *wall = lm_alloc(sizeof(double) * STREAMS * 4 * (size_t)n), *anim = wall + STREAMS * n,
+         *tiles = anim + STREAMS * n, *outside = tiles + STREAMS * n;
+  double *pass_ms = lm_alloc(sizeof(double) * STREAMS * MAX_PASSES * (size_t)n);
+  int pass_n[STREAMS][MAX_PASSES] = {{0}};
+  m->eye = lm_alloc(sizeof *m->eye * (size_t)n);
+  m->moved = 0;
+  bool ok = true;
+  for (int k = 0; k < STREAMS && ok; k++) ok = stream_open(b, k, &st[k], err);
+  float last[3] = {0};
+  for (int f = -b->warmup; f < n && ok; f++) {
+    for (int j = 0; j < STREAMS && ok; j++) {
+      int k = (f + b->warmup + j) % STREAMS; /* who goes first turns each frame */
+      stream *s = &st[k];
+      /* alone: a frame with no previous one (nothing to reproject, no still frames counted) */
+      if (k == STREAM_ALONE) lm_renderer_set_view(s->r, s->camera, b->sizes[b->largest][0], b->sizes[b->largest][1]);
+      lm_finish(); /* nothing of the last frame left in flight */
+      double t0 = lm_now_ms();
+      double a = k == STREAM_STILL ? 0 : pose(m, s, f);
+      ok = lm_renderer_frame(s->r, err);
+      lm_finish();
+      double t1 = lm_now_ms();
+      if (ok && f >= 0) {
+        wall[k * n + f] = t1 - t0;
+        anim[k * n + f] = a;
+        tiles[k * n + f] = lm_renderer_shadows(s->r)->view_count - lm_renderer_shadow_draw_stats(s->r).kept;
+        outside[k * n + f] = t1 - t0 - collect_passes(b, s->r, false, pass_ms + (size_t)k * MAX_PASSES * n, pass_n[k], n);
+      }
+      if (ok && k == STREAM_MOVING) {
+        const float *eye = s->scene->nodes[s->node].world + 12;
+        if (f >= 0) {
+          memcpy(m->eye[f], eye, sizeof m->eye[f]);
+          m->moved += memcmp(eye, last, sizeof last) != 0;
+        }
+        memcpy(last, eye, sizeof last);
+      }
+    }
+  }
+  if (ok) {
+    m->ratio_worst = 0;
+    for (int f = 0; f < n; f++) { /* before the medians sort the rows */
+      double r = ratio_of(wall[STREAM_MOVING * n + f], wall[STREAM_ALONE * n + f]);
+      if (r > m->ratio_worst) m->ratio_worst = r;
+    }
+    for (int k = 0; k < STREAMS; k++) {
+      m->frame_ms[k] = median(wall + k * n, n);
+      m->animate_ms[k] = median(anim + k * n, n);
+      m->tiles[k] = median(tiles + k * n, n);
+      m->outside_ms[k] = median(outside + k * n, n);
+      for (int i = 0; i < b->pass_count; i++)
+        if (pass_n[k][i]) b->passes[i].motion_ms[k] = median(pass_ms + ((size_t)k * MAX_PASSES + i) * n, pass_n[k][i]);
+    }
+  }
+  for (int k = 0; k < STREAMS; k++) {
+    lm_renderer_destroy(st[k].r);
+    lm_pipeline_destroy(st[k].pipe);
+    lm_scene_destroy(st[k].scene);
+  }
+  free(wall);
+  free(pass_ms);
+  return ok;
+}
+
+/* A row of the motion table: the three medians and the two ratios, "-" where one did not run. */
+static void motion_row(const char *name, const double t[STREAMS]) {
+  double cells[5] = {t[0], t[1], t[2], ratio_of(t[1], t[0]), ratio_of(t[1], t[2])};
+  printf("  %-24s", name);
+  for (int i = 0; i < 5; i++) {
+    if (cells[i] < 0) printf(" %*s", i < 3 ? 10 : 13, "-");
+    else printf(" %*.3f", i < 3 ? 10 : 13, cells[i]);
+  }
+  printf("\n");
+}
+
+static void print_motion(const bench *b) {
+  const motion *m = &b->motion;
+  printf("motion at %dx%d: medians of %d frames after %d warm-up, the three renderers taking turns frame by frame\n",
+         b->sizes[b->largest][0], b->sizes[b->largest][1], m->frames, b->warmup);
+  if (m->orbit)
+    printf("  camera: an orbit around (%.4g, %.4g, %.4g), radius %.4g, elevation %.4g degrees, %.4g degrees a frame\n",
+           m->centre[0], m->centre[1], m->centre[2], m->radius, m->elevation, m->step);
+  else
+    printf("  camera: the scene's camera '%s', moved by the animation\n", m->camera);
+  if (m->timed)
+    printf("  animation '%s' from %.4g to %.4g s at %.4g fps: lm_scene_set_time and the deformed vertices' upload "
+           "before each frame, in its time\n", b->motion.animation, m->start, m->stop, m->fps);
+  printf("  still: the path's first view held; moving: the path, every cache on, histories carried;\n"
+         "  alone: each moving frame again with every cache off (every shadow tile drawn, no temporal history\n"
+         "  or settled skip) and no previous frame (lm_renderer_set_view); its options:\n    %s\n",
+         m->caches_off[0] ? m->caches_off : "none to turn off");
+  printf("  %-24s %10s %10s %10s %13s %13s\n", "pass (ms)", "still", "moving", "alone", "moving/still", "moving/alone");
+  double still_none[STREAMS] = {-1, m->animate_ms[STREAM_MOVING], m->animate_ms[STREAM_ALONE]};
+  motion_row("frame (wall)", m->frame_ms);
+  motion_row("outside the passes", m->outside_ms);
+  if (m->timed) motion_row("animate (cpu)", still_none);
+  for (int i = 0; i < b->pass_count; i++) {
+    const double *t = b->passes[i].motion_ms;
+    if (t[0] >= 0 || t[1] >= 0 || t[2] >= 0) motion_row(b->passes[i].name, t);
+  }
+  printf("  %-24s %10.0f %10.0f %10.0f\n", "shadow tiles drawn", m->tiles[0], m->tiles[1], m->tiles[2]);
+  printf("  (-: the pass did not run there; outside the passes: the frame's wall time less its passes'\n"
+         "  times, with the pass clock cpu: Lua, graph compilation, uploads)\n");
+  printf("  the moving camera moved in %d of %d frames\n", m->moved, m->frames);
+  double r = ratio_of(m->frame_ms[1], m->frame_ms[2]);
+  printf("target: a frame of a sequence within %.1fx of the same frame alone with every cache off: moving / alone "
+         "%.3f (frame medians), worst frame %.3f: %s\n", MOTION_TARGET, r, m->ratio_worst,
+         r >= 0 && r <= MOTION_TARGET ? "PASS" : "FAIL");
+}
+
+static void print_motion_json(const bench *b) {
+  const motion *m = &b->motion;
+  printf(", \"motion\": {\"width\": %d, \"height\": %d, \"frames\": %d, \"warmup\": %d, \"camera\": ",
+         b->sizes[b->largest][0], b->sizes[b->largest][1], m->frames, b->warmup);
+  if (m->orbit)
+    printf("{\"orbit\": {\"centre\": [%.6g, %.6g, %.6g], \"radius\": %.6g, \"elevation\": %.6g, \"step\": %.6g}}",
+           m->centre[0], m->centre[1], m->centre[2], m->radius, m->elevation, m->step);
+  else {
+    printf("{\"scene\": ");
+    limn_json_string(m->camera);
+    printf("}");
+  }
+  if (m->timed) {
+    printf(", \"time\": {\"animation\": ");
+    limn_json_string(m->animation);
+    printf(", \"start\": %.6g, \"stop\": %.6g, \"fps\": %.6g}", m->start, m->stop, m->fps);
+  } else {
+    printf(", \"time\": null");
+  }
+  for (int k = 0; k < STREAMS; k++) {
+    printf(", \"%s\": {\"frame_ms\": %.6g, \"outside_passes_ms\": %.6g, \"shadow_tiles_drawn\": %.6g", stream_names[k],
+           m->frame_ms[k], m->outside_ms[k], m->tiles[k]);
+    if (m->timed && k != STREAM_STILL) printf(", \"animate_ms\": %.6g", m->animate_ms[k]);
+    printf("}");
+  }
+  printf(", \"passes\": [");
+  bool first = true;
+  for (int i = 0; i < b->pass_count; i++) {
+    const double *t = b->passes[i].motion_ms;
+    if (t[0] < 0 && t[1] < 0 && t[2] < 0) continue;
+    printf("%s{\"name\": ", first ? "" : ", ");
+    limn_json_string(b->passes[i].name);
+    for (int k = 0; k < STREAMS; k++) printf(t[k] < 0 ? ", \"%s\": null" : ", \"%s\": %.6g", stream_names[k], t[k]);
+    printf("}");
+    first = false;
+  }
+  printf("], \"camera_positions\": [");
+  for (int f = 0; f < m->frames; f++)
+    printf("%s[%.6g, %.6g, %.6g]", f ? ", " : "", m->eye[f][0], m->eye[f][1], m->eye[f][2]);
+  double r = ratio_of(m->frame_ms[1], m->frame_ms[2]);
+  printf("], \"alone_options\": ");
+  limn_json_string(m->caches_off);
+  printf(", \"moved\": %d, \"target\": {\"limit\": %.6g, \"moving_over_alone\": %.6g, \"worst_frame\": %.6g, "
+         "\"pass\": %s}}", m->moved, MOTION_TARGET, r, m->ratio_worst, r >= 0 && r <= MOTION_TARGET ? "true" : "false");
+}
+
 static void print_json(const bench *b, lm_clock clock) {
   printf("{\"clock\": ");
   limn_json_string(lm_clock_name(clock));
@@ -588,6 +1002,7 @@ static void print_json(const bench *b, lm_clock clock) {
   }
   if (b->ns_per_fetch > 0) printf(", \"calibration\": {\"ns_per_fetch\": %.6g}", b->ns_per_fetch);
   else printf(", \"calibration\": null");
+  if (b->motion.on) print_motion_json(b);
   printf("}\n");
 }
 
@@ -683,32 +1098,30 @@ int limn_bench(int argc, char **argv) {
   static bench b; /* large: keep it off the stack */
   int rc = parse_args(argc, argv, &b);
   if (rc) return rc < 0 ? 0 : rc;
-  char script[2048];
-  if (b.script) snprintf(script, sizeof script, "%s", b.script);
-  else snprintf(script, sizeof script, "%s/scripts/pp.lua", lm_root_dir());
   lm_error err;
-  lm_pipeline *pipe = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, &err);
+  int prc;
+  lm_pipeline *pipe = load_pipeline(&b, &prc, &err);
   if (!pipe) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
-    return 1;
-  }
-  bool set_ok = true;
-  for (int i = 0; i < b.set_count && set_ok; i++) {
-    char name[256];
-    const char *eq = strchr(b.sets[i], '=');
-    snprintf(name, sizeof name, "%.*s", (int)(eq - b.sets[i]), b.sets[i]);
-    set_ok = lm_pipeline_set_option(pipe, name, eq + 1, &err);
-  }
-  if (!set_ok || (b.tech && !lm_pipeline_set_technique(pipe, b.tech, &err))) {
-    lm_log(LM_LOG_ERROR, "%s", err.msg);
-    lm_pipeline_destroy(pipe);
-    return 2;
+    return prc;
   }
   lm_scene *scene = lm_scene_load(b.scene, &err);
   if (!scene) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     lm_pipeline_destroy(pipe);
     return 2;
+  }
+  motion *m = &b.motion;
+  if (m->timed) {
+    m->anim = lm_scene_find_animation(scene, m->animation, &err);
+    if (m->anim >= LM_ANIM_ALL && !lm_scene_animated(scene))
+      lm_error_set(&err, "--time: scene '%s' has no animation", scene->name), m->anim = -3;
+    if (m->anim < LM_ANIM_ALL) {
+      lm_log(LM_LOG_ERROR, "%s", err.msg);
+      lm_scene_destroy(scene);
+      lm_pipeline_destroy(pipe);
+      return 2;
+    }
   }
   bool ok = lm_context_create_headless(&(lm_context_desc){.platform = "auto"}, &err);
   lm_clock used = LM_CLOCK_AUTO;
@@ -723,6 +1136,7 @@ int limn_bench(int argc, char **argv) {
     ok = run_size(&b, v, SERIES_LIGHTS, scene, pipe, &used, &err) &&
          run_size(&b, v, SERIES_LIGHTS_ALL, scene, pipe, &used, &err);
   }
+  if (ok && m->on) ok = run_motion(&b, scene, &err);
   if (ok) ok = calibrate(&b, scene, &err);
   if (ok && b.trace) trace_figures(&b, scene);
   if (ok) {
@@ -730,9 +1144,11 @@ int limn_bench(int argc, char **argv) {
     else print_tables(&b, used);
     if (b.lights_count && !b.json) print_lights(&b); /* tables only */
     if (b.trace && !b.json) print_trace(&b);
+    if (m->on && !b.json) print_motion(&b);
   } else {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
   }
+  free(m->eye);
   lm_programs_clear();
   lm_scene_destroy(scene);
   lm_context_destroy();

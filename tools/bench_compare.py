@@ -3,6 +3,7 @@
 
     tools/bench_compare.py REV [--case SCENE[:TECH[:NAME=VALUE,...]]] ... [options]
     (--set-this NAME=VALUE: an option for this checkout alone, one REV lacks)
+    tools/bench_compare.py REV --motion [--orbit ...] [--time START:STOP --fps N --animation A] ...
 
 Builds REV's `limn` in a scratch git worktree (under /tmp, removed at the end
 unless --keep), then renders every case with both builds in turn, round after
@@ -11,7 +12,12 @@ Each run is `limn capture --frames F`; a pass's time is its median over the
 rounds of the per-run medians, the frame time the median of the runs' sums.
 Prints per case and pass both times and the ratio REV / this (above 1: this
 checkout is faster), and the mean error between the two images (limn compare),
-so that a speed-up that changes the picture shows. Standard library only.
+so that a speed-up that changes the picture shows. With --motion (or --orbit,
+--time: passed to `limn bench`, which both revisions must have), each run is
+`limn bench --motion --json` at the size instead, and the times compared are
+its moving column (the camera on its path, the animation playing), with the
+still frame's as one more row; no images, so no mean error. Standard library
+only.
 """
 import argparse
 import json
@@ -84,6 +90,38 @@ def capture(limn, case, args, image, sets):
     return passes
 
 
+def motion_flags(args):
+    """The flags of `limn bench` for the moving frame, [] without --motion."""
+    flags = []
+    for name in ("orbit", "time", "fps", "animation"):
+        value = getattr(args, name)
+        if value is not None:
+            flags += ["--" + name, value]
+    return ["--motion"] + flags if flags or args.motion else []
+
+
+def bench_motion(limn, case, args, sets, who):
+    """One `limn bench --motion` run: its moving column's pass medians, its
+    moving frame as "total" and its still frame as "frame (still)"."""
+    cmd = [limn, "bench", "--scene", case["scene"], "--sizes", args.size, "--frames", str(args.frames),
+           "--json"] + motion_flags(args)
+    if case["tech"]:
+        cmd += ["--tech", case["tech"]]
+    for s in case["sets"] + sets:
+        cmd += ["--set", s]
+    p = subprocess.run(cmd, text=True, capture_output=True)
+    if p.returncode != 0:
+        if "unknown flag '--" in p.stderr:
+            fail(f"the {who} revision's limn bench lacks a motion flag ({p.stderr.strip().splitlines()[0]}); "
+                 "a revision before `limn bench --motion` compares still frames only (leave the motion flags out)")
+        fail(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stderr.strip()}")
+    motion = json.loads(p.stdout)["motion"]
+    passes = {q["name"]: q["moving"] for q in motion["passes"] if q["moving"] is not None}
+    passes["frame (still)"] = motion["still"]["frame_ms"]
+    passes["total"] = motion["moving"]["frame_ms"]
+    return passes
+
+
 def mean_error(limn, a, b):
     p = subprocess.run([limn, "compare", a, b, "--json"], text=True, capture_output=True)
     try:
@@ -107,10 +145,19 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"), help="this checkout's build folder")
     ap.add_argument("--keep", metavar="DIR", help="keep REV's worktree and build in DIR (reused when it exists)")
     ap.add_argument("--json", action="store_true", help="print one JSON object instead of the tables")
+    ap.add_argument("--motion", action="store_true",
+                    help="time the moving frame (limn bench --motion: the moving column) instead of a still capture")
+    ap.add_argument("--orbit", metavar="STEP[,RADIUS[,ELEVATION]]", help="limn bench --orbit (implies --motion)")
+    ap.add_argument("--time", metavar="START:STOP", help="limn bench --time: the animation played (implies --motion)")
+    ap.add_argument("--fps", help="limn bench --fps (with --time)")
+    ap.add_argument("--animation", metavar="NAME|INDEX|all", help="limn bench --animation (with --time)")
     args = ap.parse_args()
     if args.frames < 1 or args.rounds < 1:
         fail("--frames and --rounds want at least 1")
     cases = [parse_case(c) for c in (args.case or DEFAULT_CASES)]
+    if (args.fps or args.animation) and not args.time:
+        fail("--fps and --animation play an animation: they need --time START:STOP")
+    moving = motion_flags(args) != []
     try:
         sha = run(["git", "-C", ROOT, "rev-parse", "--verify", args.rev + "^{commit}"],
                   capture_output=True).stdout.strip()
@@ -139,10 +186,11 @@ def main():
                 for who in order:
                     print(f"  {case['label']}: round {r + 1}/{args.rounds}, {who}", file=log)
                     img = os.path.join(images, f"{len(results)}-{who}.exr")
-                    times[who].append(capture(limn[who], case, args, img,
-                                              args.set + (args.set_this if who == "this" else [])))
-            err = mean_error(limn["this"], os.path.join(images, f"{len(results)}-base.exr"),
-                             os.path.join(images, f"{len(results)}-this.exr"))
+                    sets = args.set + (args.set_this if who == "this" else [])
+                    times[who].append(bench_motion(limn[who], case, args, sets, who) if moving
+                                      else capture(limn[who], case, args, img, sets))
+            err = None if moving else mean_error(limn["this"], os.path.join(images, f"{len(results)}-base.exr"),
+                                                 os.path.join(images, f"{len(results)}-this.exr"))
             names = [n for n in times["base"][0] if n != "total"]
             names += [n for n in times["this"][0] if n != "total" and n not in names]
             rows = []
@@ -163,11 +211,15 @@ def main():
     label = here + (" (uncommitted changes)" if dirty else "")
     if args.json:
         print(json.dumps({"base": sha, "this": label, "size": args.size, "frames": args.frames,
+                          "motion": motion_flags(args),
                           "rounds": args.rounds, "sets": args.set, "sets_this": args.set_this, "cases": results},
                          indent=1))
         return
     print(f"base {args.rev} ({sha[:10]}) against this checkout {label}; {args.size}, medians of "
           f"{args.rounds} alternated runs of {args.frames} frames; ratio = base / this (> 1: faster now)")
+    if moving:
+        print(f"moving frames: limn bench {' '.join(motion_flags(args))} (its moving column; 'frame' is the moving "
+              "frame, 'frame (still)' the still one)")
     if args.set_this:
         print(f"this checkout only: {', '.join(args.set_this)}")
     fmt = "  {:<26} {:>10} {:>10} {:>8}"
