@@ -1,6 +1,7 @@
 /* limn capture: render headless and write images, printing per-pass times. */
 #define _GNU_SOURCE
 #include <getopt.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -32,7 +33,12 @@ static const char capture_usage[] =
     "                       say a temporal accumulation's convergence)\n"
     "  --camera N           camera index of the scene (default 0), or auto:\n"
     "                       one framing the scene's bounds\n"
-    "  --output FILE        image to write, .png or .exr (repeatable)\n"
+    "  --output FILE        image to write, .png or .exr (repeatable); {frame} (0000,\n"
+    "                       0001, ...) and {time} (seconds) name a sequence's frames\n"
+    "  --time SECONDS       pose the scene's animation at that time\n"
+    "  --time START:STOP    a sequence: frames at START + k / fps up to STOP\n"
+    "  --fps N              frames a second of a sequence\n"
+    "  --animation NAME|INDEX|all   the animation posed (default all)\n"
     "  --clock auto|gpu|cpu how passes are timed (default auto: GL timer queries,\n"
     "                       or glFinish + a CPU clock on software renderers)\n"
     "  --egl auto|device|surfaceless   EGL platform (default auto)\n"
@@ -43,7 +49,8 @@ static const char capture_usage[] =
     "                       techniques, sizes, options and an output pattern; see\n"
     "                       README.md); --set adds to the job's options\n"
     "  --force              with --job: render images that exist already\n"
-    "  --shard I/N          with --job: render views I, I+N, I+2N ... only\n"
+    "  --shard I/N          with --job: render views I, I+N, I+2N ... only; of a\n"
+    "                       sequence, the I-th of N contiguous runs of frames\n"
     "  --shard auto[/N]     the shard from a job array: Slurm's SLURM_ARRAY_TASK_ID\n"
     "                       (less _MIN, of _COUNT shards; with /N as it is, of N),\n"
     "                       or Kubernetes' JOB_COMPLETION_INDEX (auto/N)\n"
@@ -62,6 +69,9 @@ typedef struct capture_args {
   const char *sets[64];
   int set_count;
   int width, height, frames, warmup, camera;
+  const char *animation, *time_flag;
+  double time_start, time_stop, fps; /* fps 0: one frame at time_start */
+  int frame_count;
   lm_clock clock;
   bool list_options, quiet, verbose, check_nan;
 } capture_args;
@@ -97,12 +107,14 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       {"check-nan", no_argument, 0, 'N'},
       {"job", required_argument, 0, 'j'},    {"force", no_argument, 0, 'f'},
       {"shard", required_argument, 0, 'S'},
+      {"time", required_argument, 0, 'T'},   {"fps", required_argument, 0, 'F'},
+      {"animation", required_argument, 0, 'A'},
       {0, 0, 0, 0}};
   opterr = 0;
   optind = 1;
   int c;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
-    for (const struct option *o = opts; o->name && c && strchr("sptznwc", c); o++)
+    for (const struct option *o = opts; o->name && c && strchr("sptznwcTFA", c); o++)
       if (o->val == c) a->single_flag = o->name;
     switch (c) {
     case 's': a->scene = optarg; break;
@@ -145,6 +157,21 @@ static int parse_args(int argc, char **argv, capture_args *a) {
         return usage_error("--egl wants auto, device or surfaceless, not '%s'", optarg);
       a->egl = optarg;
       break;
+    case 'T': {
+      char start[64];
+      const char *colon = strchr(optarg, ':');
+      snprintf(start, sizeof start, "%.*s", colon ? (int)(colon - optarg) : 63, optarg);
+      if (!limn_parse_double(start, &a->time_start) || !limn_parse_double(colon ? colon + 1 : start, &a->time_stop))
+        return usage_error("--time wants SECONDS or START:STOP (finite numbers), not '%s'", optarg);
+      if (a->time_stop < a->time_start) return usage_error("--time START:STOP wants STOP >= START, not '%s'", optarg);
+      a->time_flag = optarg;
+      break;
+    }
+    case 'F':
+      if (!limn_parse_double(optarg, &a->fps) || !(a->fps > 0) || a->fps > 1e6)
+        return usage_error("--fps wants frames a second above 0, not '%s'", optarg);
+      break;
+    case 'A': a->animation = optarg; break;
     case 'j': a->job = optarg; break;
     case 'f': a->force = true; break;
     case 'S':
@@ -168,6 +195,21 @@ static int parse_args(int argc, char **argv, capture_args *a) {
                        a->single_flag);
   if (!a->job && (a->force || a->shards))
     return usage_error("%s", "--force and --shard go with --job");
+  bool range = a->time_flag && strchr(a->time_flag, ':');
+  if (range && !a->fps) return usage_error("--time %s: a sequence needs --fps N", a->time_flag);
+  if (a->fps && !range) return usage_error("%s", "--fps goes with --time START:STOP");
+  a->frame_count = 1;
+  if (range) {
+    double n = floor((a->time_stop - a->time_start) * a->fps + 1e-9) + 1;
+    if (n > 100000) return usage_error("--time %s: more than 100000 frames at that --fps", a->time_flag);
+    a->frame_count = (int)n;
+  }
+  for (int i = 0; i < a->output_count && a->frame_count > 1; i++)
+    if (!strstr(a->outputs[i], "{frame}")) {
+      fprintf(stderr, "limn capture: --output '%s': a sequence of %d frames (--time %s --fps %g) needs {frame} in "
+              "the name\n(see limn capture --help)\n", a->outputs[i], a->frame_count, a->time_flag, a->fps);
+      return 2;
+    }
   return 0;
 }
 
@@ -247,7 +289,7 @@ bool capture_render_write(lm_renderer *r, const capture_view *v, capture_result 
   *res = (capture_result){0};
   pass_samples *samples = NULL;
   int n = 0;
-  lm_renderer_set_view(r, v->camera, v->width, v->height);
+  if (!v->continues) lm_renderer_set_view(r, v->camera, v->width, v->height);
   bool ok = true;
   for (int f = 0; f < v->warmup + v->frames && ok; f++) {
     ok = lm_renderer_frame(r, err);
@@ -270,6 +312,18 @@ void capture_result_free(capture_result *res) {
   for (int i = 0; i < res->pass_count; i++) free((char *)res->passes[i].name);
   free(res->passes);
   *res = (capture_result){0};
+}
+
+/* The output name of a sequence's frame: {frame} and {time} filled. */
+static void frame_name(const char *pattern, int frame, double time, char *out, size_t cap) {
+  lm_buf b = {0};
+  for (const char *p = pattern; *p; p++) {
+    if (!strncmp(p, "{frame}", 7)) lm_buf_printf(&b, CAPTURE_FRAME_FORMAT, frame), p += 6;
+    else if (!strncmp(p, "{time}", 6)) lm_buf_printf(&b, CAPTURE_TIME_FORMAT, time), p += 5;
+    else lm_buf_append(&b, p, 1);
+  }
+  snprintf(out, cap, "%s", b.data ? b.data : "");
+  lm_buf_free(&b);
 }
 
 static void print_times(const capture_result *res, int frames, int warmup, lm_clock clock) {
@@ -333,6 +387,13 @@ int limn_capture(int argc, char **argv) {
     lm_pipeline_destroy(pipeline);
     return 2;
   }
+  int animation = LM_ANIM_ALL;
+  if (a.animation && (animation = lm_scene_find_animation(scene, a.animation, &err)) < LM_ANIM_NONE) {
+    lm_log(LM_LOG_ERROR, "--animation %s: %s", a.animation, err.msg);
+    lm_scene_destroy(scene);
+    lm_pipeline_destroy(pipeline);
+    return 2;
+  }
   a.camera = limn_camera_resolve(scene, a.camera, a.width, a.height);
   if (a.camera > 0 && a.camera >= scene->camera_count) {
     lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a.camera, a.scene, scene->camera_count);
@@ -363,11 +424,29 @@ int limn_capture(int argc, char **argv) {
             lm_gl_version(), lm_context_platform(), a.scene, script, lm_pipeline_technique(pipeline),
             a.width, a.height);
   capture_result res = {0};
-  if (ok) {
-    capture_view v = {.camera = a.camera, .width = a.width, .height = a.height, .frames = a.frames, .warmup = a.warmup,
-                      .outputs = a.outputs, .output_count = a.output_count, .quiet = a.quiet};
+  /* A sequence renders its frames through one renderer, so that temporal
+   * histories carry from frame to frame as they would live. */
+  char names[16][2048];
+  const char *outputs[16];
+  for (int k = 0; k < a.frame_count && ok; k++) {
+    double t = a.frame_count > 1 ? a.time_start + k / a.fps : a.time_start;
+    if (a.time_flag || a.animation) {
+      lm_scene_set_time(scene, animation, t);
+      lm_scene_upload_deformed(scene);
+    }
+    for (int i = 0; i < a.output_count; i++) {
+      frame_name(a.outputs[i], k, t, names[i], sizeof names[i]);
+      outputs[i] = names[i];
+    }
+    capture_view v = {.camera = a.camera, .width = a.width, .height = a.height, .frames = a.frames,
+                      .warmup = k ? 0 : a.warmup, .outputs = outputs, .output_count = a.output_count,
+                      .quiet = a.quiet, .continues = k > 0};
+    capture_result_free(&res);
     ok = capture_render_write(r, &v, &res, &err);
+    if (!ok && a.frame_count > 1) lm_error_prefix(&err, "frame %d at %.3f s", k, t);
   }
+  if (ok && !a.quiet && a.frame_count > 1) printf("%d frames, %.3f s to %.3f s at %g fps (times: the last frame's)\n",
+                                                  a.frame_count, a.time_start, a.time_stop, a.fps);
   if (ok && !a.quiet) print_times(&res, a.frames, a.warmup, lm_renderer_clock(r));
   if (!ok) lm_log(LM_LOG_ERROR, "%s", err.msg);
   capture_result_free(&res);

@@ -4,15 +4,22 @@
 #ifndef LIMN_JOB_H
 #define LIMN_JOB_H
 
+#include "camera_path.h"
 #include "capture.h"
 
 #define MAX_LIST 64
+#define MAX_PATH_KEYS 256
+#define MAX_FRAMES 100000
 
 typedef struct job_scene {
   char path[1024], cameras[1024], name[LM_NAME_MAX];
   lm_scene *scene;
   int first_camera, camera_count;
   uint64_t hash;
+  int animation;      /* the job's `animation` in this scene (LM_ANIM_ALL by default) */
+  int path_camera;    /* the camera a `path` or `turntable` moves (-1: none) */
+  float centre[3], radius; /* of the scene's bounds as loaded: the orbit, near and far */
+  float orbit;        /* a turntable's distance from the centre */
 } job_scene;
 
 typedef struct job {
@@ -27,6 +34,17 @@ typedef struct job {
   int set_count;
   int frames;
   uint64_t hash;
+  /* `time`: timed false leaves the scenes as loaded. A sequence has
+   * frame_count frames at time_start + k / fps; a still (fps 0) one. */
+  bool timed;
+  double time_start, time_stop, fps;
+  int frame_count;
+  char animation[LM_NAME_MAX];
+  /* `path` (keys) or `turntable`: each scene's one view is a camera they move. */
+  camera_key keys[MAX_PATH_KEYS];
+  int key_count;
+  bool turntable;
+  double turns, elevation, distance; /* degrees; distance 0: auto (the scene framed) */
 } job;
 
 typedef struct job_view {
@@ -53,6 +71,14 @@ void job_free_scenes(job *j);
  * with check_techniques its techniques must exist (an empty list becomes
  * the script's first). NULL after logging what is wrong. */
 lm_pipeline *job_pipeline(job *j, const char *const *sets, int set_count, bool check_techniques);
+/* Poses view v's scene at the view's time (lm_scene_set_time, when the job
+ * is timed) and moves the path's or turntable's camera there. The caller
+ * uploads deformed meshes where there is a GL context. */
+void job_pose(const job *j, const job_view *v);
+/* The shard (of `shards`) that renders view i of `count`: i % shards for
+ * stills; for sequences contiguous runs of views, so that a shard renders
+ * consecutive frames and temporal histories carry from frame to frame. */
+int job_shard_of(const job *j, int i, int count, int shards);
 /* Creates the folders above `file`. */
 bool job_make_parent(const char *file, lm_error *err);
 /* A progress bar on a terminal (tty), else one line per item. */
