@@ -107,6 +107,33 @@ check "fps without a range message" err_has "--fps goes with --time START:STOP"
 check "unknown animation" run 2 capture --size 16x12 --animation walk --output "$tmp/img/s.png"
 check "unknown animation message" first_error_has "--animation walk: scene 'cornell' has no animation 'walk'"
 check "bad time values leave no file" no_files
+# video: raw RGB frames piped to the ffmpeg program (a stand-in here that keeps its arguments and
+# input; the real program is not needed to check what limn hands it)
+mkdir -p "$tmp/bin"
+cat > "$tmp/bin/ffmpeg" <<'SH'
+#!/bin/sh
+for a; do out=$a; done
+echo "$@" > "$(dirname "$out")/../ffmpeg-args"
+cat > "$out"
+[ -z "${FAKE_FFMPEG_FAIL:-}" ] || { echo "ffmpeg: no encoder" >&2; exit 1; }
+SH
+chmod +x "$tmp/bin/ffmpeg"
+check "video of a sequence" env PATH="$tmp/bin:$PATH" "$limn" capture --size 32x24 --tech dl --time 0:1 --fps 4 --quiet \
+  --output "$tmp/img/v.mp4"
+check "video: 5 frames of 32x24 RGB handed over" test "$(stat -c %s "$tmp/img/v.mp4")" = $((5 * 32 * 24 * 3))
+check "video: raw RGB at the sequence's size and rate" grep -qF -- "-f rawvideo -pix_fmt rgb24 -s 32x24 -r 4 -i -" "$tmp/ffmpeg-args"
+check "video: ffmpeg writes a temporary name" grep -q "/v.tmp-[0-9]*.mp4\$" "$tmp/ffmpeg-args"
+rm -f "$tmp/img/"*
+check "video: ffmpeg fails" bash -c "FAKE_FFMPEG_FAIL=1 PATH='$tmp/bin:$PATH' '$limn' capture --size 32x24 --tech dl \
+  --time 0:1 --fps 4 --output '$tmp/img/v.webm' 2>'$tmp/err'; [ \$? = 1 ]"
+check "video: ffmpeg's failure named" err_has "--output $tmp/img/v.webm: ffmpeg failed (exit status 1"
+check "video: no file from a failed ffmpeg" no_files
+check "video without ffmpeg" bash -c "PATH=/nonexistent '$limn' capture --size 32x24 --tech dl --time 0:1 --fps 4 \
+  --output '$tmp/img/v.mp4' 2>'$tmp/err'; [ \$? = 1 ]"
+check "video without ffmpeg: a clear error" err_has "--output $tmp/img/v.mp4: video needs the ffmpeg program (Debian package ffmpeg): not found on the PATH"
+check "video without ffmpeg: no file" no_files
+check "video of a still" run 2 capture --time 1 --output "$tmp/img/v.mp4"
+check "video of a still message" err_has "a video is of a sequence"
 
 # effects: `--set bloom=true` turns on bloom.enabled; dotted names set parameters
 check "effects capture" run 0 capture --scene cornell --script scripts/pp.lua --tech dl --size 64x48 \

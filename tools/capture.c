@@ -1,11 +1,17 @@
 /* limn capture: render headless and write images, printing per-pass times. */
 #define _GNU_SOURCE
+#include <errno.h>
+#include <fcntl.h>
 #include <getopt.h>
 #include <math.h>
+#include <signal.h>
+#include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "image/image.h"
 #include "render/render.h"
@@ -34,7 +40,9 @@ static const char capture_usage[] =
     "  --camera N           camera index of the scene (default 0), or auto:\n"
     "                       one framing the scene's bounds\n"
     "  --output FILE        image to write, .png or .exr (repeatable); {frame} (0000,\n"
-    "                       0001, ...) and {time} (seconds) name a sequence's frames\n"
+    "                       0001, ...) and {time} (seconds) name a sequence's frames;\n"
+    "                       a sequence also goes to .mp4 or .webm video (the ffmpeg\n"
+    "                       program encodes it)\n"
     "  --time SECONDS       pose the scene's animation at that time\n"
     "  --time START:STOP    a sequence: frames at START + k / fps up to STOP\n"
     "  --fps N              frames a second of a sequence\n"
@@ -66,6 +74,8 @@ typedef struct capture_args {
   const char *single_flag; /* a flag of single captures (the job names these itself) */
   const char *outputs[16];
   int output_count;
+  const char *videos[16]; /* .mp4, .webm */
+  int video_count;
   const char *sets[64];
   int set_count;
   int width, height, frames, warmup, camera;
@@ -89,6 +99,93 @@ bool capture_known_extension(const char *path, bool *linear) {
   if (!dot || strchr(dot, '/')) return false;
   *linear = !strcasecmp(dot, ".exr") || !strcasecmp(dot, ".hdr");
   return *linear || !strcasecmp(dot, ".png") || !strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".tif");
+}
+
+static bool is_video(const char *path) {
+  const char *dot = strrchr(path, '.');
+  return dot && !strchr(dot, '/') && (!strcasecmp(dot, ".mp4") || !strcasecmp(dot, ".webm"));
+}
+
+/* A sequence as video through Debian's ffmpeg program, raw RGB frames on its
+ * standard input. The program, not libavcodec: one pipe instead of a codec,
+ * muxer and pixel-format conversion set up by hand, and the codec choices
+ * for each container stay ffmpeg's own defaults. Written to a temporary name
+ * (the extension kept last: ffmpeg picks the container by it) and renamed
+ * when ffmpeg succeeds. */
+typedef struct video {
+  const char *path;
+  char tmp[2100];
+  pid_t pid;
+  int fd; /* the pipe's writing end; -1 when closed */
+} video;
+
+static bool video_open(video *v, const char *path, int width, int height, double fps, lm_error *err) {
+  *v = (video){.path = path, .pid = -1, .fd = -1};
+  const char *dot = strrchr(path, '.');
+  snprintf(v->tmp, sizeof v->tmp, "%.*s.tmp-%ld%s", (int)(dot - path), path, (long)getpid(), dot);
+  char size[64], rate[64];
+  snprintf(size, sizeof size, "%dx%d", width, height);
+  snprintf(rate, sizeof rate, "%.9g", fps);
+  char *argv[] = {"ffmpeg", "-hide_banner", "-loglevel", "error", "-nostats", "-y", "-f", "rawvideo",
+                  "-pix_fmt", "rgb24", "-s", size, "-r", rate, "-i", "-", "-pix_fmt", "yuv420p", v->tmp, NULL};
+  int fds[2];
+  if (pipe2(fds, O_CLOEXEC) != 0) {
+    lm_error_set(err, "%s: cannot make a pipe: %s", path, strerror(errno));
+    return false;
+  }
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_adddup2(&fa, fds[0], STDIN_FILENO);
+  fflush(stdout);
+  fflush(stderr);
+  extern char **environ;
+  int rc = posix_spawnp(&v->pid, "ffmpeg", &fa, NULL, argv, environ);
+  posix_spawn_file_actions_destroy(&fa);
+  close(fds[0]);
+  if (rc != 0) {
+    close(fds[1]);
+    v->pid = -1;
+    lm_error_set(err, "--output %s: video needs the ffmpeg program (Debian package ffmpeg): %s", path,
+                 rc == ENOENT ? "not found on the PATH" : strerror(rc));
+    return false;
+  }
+  v->fd = fds[1];
+  return true;
+}
+
+static bool video_write(video *v, const unsigned char *rgb, size_t bytes, lm_error *err) {
+  while (bytes > 0) {
+    ssize_t n = write(v->fd, rgb, bytes);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      lm_error_set(err, "--output %s: ffmpeg stopped taking frames (%s)", v->path, strerror(errno));
+      return false;
+    }
+    rgb += n, bytes -= (size_t)n;
+  }
+  return true;
+}
+
+/* Ends the stream; renames the file when ffmpeg and `ok` both succeeded, else removes it. */
+static bool video_close(video *v, bool ok, lm_error *err) {
+  if (v->fd >= 0) close(v->fd);
+  v->fd = -1;
+  int status = 0;
+  if (v->pid > 0) {
+    while (waitpid(v->pid, &status, 0) < 0 && errno == EINTR) {}
+    if (ok && !(WIFEXITED(status) && WEXITSTATUS(status) == 0)) {
+      lm_error_set(err, "--output %s: ffmpeg failed (%s %d; its messages above)", v->path,
+                   WIFEXITED(status) ? "exit status" : "signal", WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
+      ok = false;
+    }
+  }
+  if (ok && rename(v->tmp, v->path) != 0) {
+    lm_error_set(err, "--output %s: cannot rename %s: %s", v->path, v->tmp, strerror(errno));
+    ok = false;
+  }
+  if (!ok) remove(v->tmp);
+  v->pid = -1;
+  return ok;
 }
 
 /* Returns 0 to go on, else the exit code. */
@@ -140,10 +237,12 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       break;
     case 'o': {
       bool linear;
-      if (!capture_known_extension(optarg, &linear))
-        return usage_error("--output '%s': use a .png, .exr, .jpg, .tif or .hdr file", optarg);
-      if (a->output_count == 16) return usage_error("%s", "at most 16 --output flags");
-      a->outputs[a->output_count++] = optarg;
+      if (a->output_count + a->video_count == 16) return usage_error("%s", "at most 16 --output flags");
+      if (is_video(optarg)) a->videos[a->video_count++] = optarg;
+      else if (!capture_known_extension(optarg, &linear))
+        return usage_error("--output '%s': use a .png, .exr, .jpg, .tif or .hdr file (or .mp4, .webm for a "
+                           "sequence)", optarg);
+      else a->outputs[a->output_count++] = optarg;
       break;
     }
     case 'k':
@@ -188,7 +287,7 @@ static int parse_args(int argc, char **argv, capture_args *a) {
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
-  if (a->job && (a->output_count || a->list_options))
+  if (a->job && (a->output_count || a->video_count || a->list_options))
     return usage_error("%s", "--job names its own outputs: no --output or --list-options with it");
   if (a->job && a->single_flag)
     return usage_error("--job names its scenes, script, techniques, sizes and frames: '--%s' does not go with it",
@@ -204,6 +303,9 @@ static int parse_args(int argc, char **argv, capture_args *a) {
     if (n > 100000) return usage_error("--time %s: more than 100000 frames at that --fps", a->time_flag);
     a->frame_count = (int)n;
   }
+  if (a->video_count && a->frame_count < 2)
+    return usage_error("--output '%s': a video is of a sequence (--time START:STOP --fps N, two frames or more)",
+                       a->videos[0]);
   for (int i = 0; i < a->output_count && a->frame_count > 1; i++)
     if (!strstr(a->outputs[i], "{frame}")) {
       fprintf(stderr, "limn capture: --output '%s': a sequence of %d frames (--time %s --fps %g) needs {frame} in "
@@ -428,6 +530,13 @@ int limn_capture(int argc, char **argv) {
    * histories carry from frame to frame as they would live. */
   char names[16][2048];
   const char *outputs[16];
+  video videos[16];
+  unsigned char *rgb = a.video_count ? lm_alloc((size_t)a.width * a.height * 3) : NULL;
+  int opened = 0;
+  if (a.video_count) signal(SIGPIPE, SIG_IGN); /* a failed ffmpeg is an error from write, not a kill */
+  for (; opened < a.video_count && ok; opened++)
+    ok = video_open(&videos[opened], a.videos[opened], a.width, a.height, a.fps, &err);
+  if (!ok) opened--;
   for (int k = 0; k < a.frame_count && ok; k++) {
     double t = a.frame_count > 1 ? a.time_start + k / a.fps : a.time_start;
     if (a.time_flag || a.animation) {
@@ -443,8 +552,16 @@ int limn_capture(int argc, char **argv) {
                       .quiet = a.quiet, .continues = k > 0};
     capture_result_free(&res);
     ok = capture_render_write(r, &v, &res, &err);
+    if (ok && a.video_count) ok = lm_renderer_read(r, false, rgb, &err);
+    for (int i = 0; i < a.video_count && ok; i++) ok = video_write(&videos[i], rgb, (size_t)a.width * a.height * 3, &err);
     if (!ok && a.frame_count > 1) lm_error_prefix(&err, "frame %d at %.3f s", k, t);
   }
+  for (int i = 0; i < opened; i++) {
+    lm_error e;
+    if (!video_close(&videos[i], ok, &e) && ok) err = e, ok = false;
+    else if (ok && !a.quiet) lm_info("wrote %s", videos[i].path);
+  }
+  free(rgb);
   if (ok && !a.quiet && a.frame_count > 1) printf("%d frames, %.3f s to %.3f s at %g fps (times: the last frame's)\n",
                                                   a.frame_count, a.time_start, a.time_stop, a.fps);
   if (ok && !a.quiet) print_times(&res, a.frames, a.warmup, lm_renderer_clock(r));
