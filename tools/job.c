@@ -229,9 +229,7 @@ static bool read_time(lua_State *L, job *j, lm_error *err) {
   if (type == LUA_TNUMBER) {
     snprintf(what, sizeof what, "%s: time", j->path);
     lua_pop(L, 1);
-    lua_pushvalue(L, -1); /* field_number reads job.time again */
     ok = field_number(L, -1, "time", 0, &j->time_start, what, err);
-    lua_pop(L, 1);
     j->time_stop = j->time_start;
     return ok;
   }
@@ -995,7 +993,7 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
       job_pose(j, v);
       lm_scene_upload_deformed(s->scene);
       /* The next frame of the view rendered last: its temporal histories carry on. */
-      const job_view *p = last == i - 1 ? &views[last] : NULL;
+      const job_view *p = last >= 0 && last == i - 1 ? &views[last] : NULL;
       bool continues = p && p->scene == v->scene && p->size == v->size && p->technique == v->technique &&
                        p->camera == v->camera && p->frame + 1 == v->frame;
       const char *outs[1] = {v->output};

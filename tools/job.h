@@ -61,8 +61,9 @@ typedef struct job_view {
 
 /* Reads and checks the job file (Lua data); false with a message naming it. */
 bool job_read(job *j, const char *path, lm_error *err);
-/* Loads every scene and camera list (once) and lists the views in the job's
- * order: scene, size, technique, camera, with their outputs. Without
+/* Loads every scene and camera list (once; a path or turntable adds its
+ * camera instead) and lists the views in the job's order: scene, size,
+ * technique, camera, frame, with their outputs. Without
  * all_techniques, the places only (technique 0, no output): what does not
  * depend on the technique, as a reference render. *out is malloc'd. */
 bool job_views(job *j, bool all_techniques, job_view **out, int *count, lm_error *err);
