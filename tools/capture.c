@@ -534,9 +534,8 @@ int limn_capture(int argc, char **argv) {
   unsigned char *rgb = a.video_count ? lm_alloc((size_t)a.width * a.height * 3) : NULL;
   int opened = 0;
   if (a.video_count) signal(SIGPIPE, SIG_IGN); /* a failed ffmpeg is an error from write, not a kill */
-  for (; opened < a.video_count && ok; opened++)
-    ok = video_open(&videos[opened], a.videos[opened], a.width, a.height, a.fps, &err);
-  if (!ok) opened--;
+  for (int i = 0; i < a.video_count && ok; i++)
+    if ((ok = video_open(&videos[i], a.videos[i], a.width, a.height, a.fps, &err))) opened++;
   for (int k = 0; k < a.frame_count && ok; k++) {
     double t = a.frame_count > 1 ? a.time_start + k / a.fps : a.time_start;
     if (a.time_flag || a.animation) {

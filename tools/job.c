@@ -405,11 +405,11 @@ static bool read_turntable(lua_State *L, job *j, lm_error *err) {
       ok = false;
     }
     lua_getfield(L, -1, "distance");
-    bool is_auto = lua_type(L, -1) == LUA_TSTRING && !strcmp(lua_tostring(L, -1), "auto");
+    bool is_auto = lua_isnil(L, -1) || (lua_type(L, -1) == LUA_TSTRING && !strcmp(lua_tostring(L, -1), "auto"));
     lua_pop(L, 1);
     snprintf(what, sizeof what, "%s: turntable.distance", j->path);
     if (ok && !is_auto) ok = field_number(L, -1, "distance", 0, &j->distance, what, err);
-    if (ok && !is_auto && !(j->distance >= 0)) {
+    if (ok && !is_auto && !(j->distance > 0)) {
       lm_error_set(err, "%s: %g; want \"auto\" or a distance above 0", what, j->distance);
       ok = false;
     }
@@ -677,13 +677,20 @@ bool job_manifest_load(const char *path, const job_view *views, int view_count, 
     if (!f) continue;
     size_t n = strlen(line);
     while (n && (line[n - 1] == ',' || line[n - 1] == ' ')) line[--n] = '\0';
-    for (int i = 0; i < view_count; i++) {
+    /* The view the entry names first (a sequence has many), then any whose output it is. */
+    const char *number = strstr(f, "\"view\": ");
+    int named = number ? atoi(number + 8) : -1;
+    for (int k = -1; k < view_count; k++) {
+      int i = k < 0 ? named : k;
+      if (i < 0 || i >= view_count || (k >= 0 && i == named)) continue;
       lm_buf key = {0};
       lm_buf_append(&key, "{\"file\": ", -1);
       limn_json_append(&key, views[i].output);
       lm_buf_append(&key, ",", 1);
-      if (!strncmp(f, key.data, (size_t)key.len) && !m->entries[i]) m->entries[i] = lm_strdup(f);
+      bool match = !strncmp(f, key.data, (size_t)key.len);
+      if (match && !m->entries[i]) m->entries[i] = lm_strdup(f);
       lm_buf_free(&key);
+      if (match) break; /* outputs are unique */
     }
   }
   free(text);
@@ -862,8 +869,8 @@ bool job_views(job *j, bool all_techniques, job_view **out, int *count, lm_error
               free(views);
               return false;
             }
-            for (int k = 0; k < n; k++)
-              if (!strcmp(views[k].output, v->output)) {
+            for (int k = 0; k < n; k++) /* {frame} tells frames apart: only views of one frame can collide */
+              if (views[k].frame == v->frame && !strcmp(views[k].output, v->output)) {
                 lm_error_set(err, "%s: output: views %d and %d both write %s (add {camera}, {technique} or "
                              "{size} to the pattern)", j->path, k, n, v->output);
                 free(views);
