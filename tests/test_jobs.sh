@@ -381,6 +381,8 @@ badseq "turntable elevation" 2 "bad.lua: turntable.elevation: 95 degrees; want o
   "time = { 0, 1, 4 }, turntable = { elevation = 95 }"
 badseq "turntable distance" 2 "bad.lua: turntable.distance: -1; want \"auto\" or a distance above 0" \
   "time = { 0, 1, 4 }, turntable = { distance = -1 }"
+badseq "too many views" 1 "bad.lua: 360004 views (scenes' cameras x sizes x techniques x frames); at most 200000" \
+  "time = { 0, 3000, 30 }"
 badseq "unknown animation" 1 "bad.lua: scenes[1]: animation: scene " "time = 0, animation = 'walk'"
 check "no image from a bad sequence" test ! -e o
 

@@ -766,6 +766,29 @@ static char *manifest_entry(const job *j, const job_view *v, int index, const ca
   return b.data;
 }
 
+static int compare_outputs(const void *a, const void *b) {
+  const job_view *x = *(const job_view *const *)a, *y = *(const job_view *const *)b;
+  int c = strcmp(x->output, y->output);
+  return c ? c : (x > y) - (x < y); /* ties in view order */
+}
+
+/* False, naming two views, when two views write one file (sorted: a long
+ * sequence's views are many). */
+static bool unique_outputs(const job *j, const job_view *views, int n, lm_error *err) {
+  const job_view **sorted = lm_alloc(sizeof *sorted * (size_t)(n + 1));
+  for (int i = 0; i < n; i++) sorted[i] = &views[i];
+  qsort(sorted, (size_t)n, sizeof *sorted, compare_outputs);
+  bool ok = true;
+  for (int i = 1; i < n && ok; i++)
+    if (!strcmp(sorted[i - 1]->output, sorted[i]->output)) {
+      lm_error_set(err, "%s: output: views %d and %d both write %s (add {camera}, {technique} or {size} to the "
+                   "pattern)", j->path, (int)(sorted[i - 1] - views), (int)(sorted[i] - views), sorted[i]->output);
+      ok = false;
+    }
+  free(sorted);
+  return ok;
+}
+
 /* Scene s's views: its camera list's, or the one camera a path or turntable
  * moves (job_pose); and the job's animation in it. */
 static bool add_cameras(const job *j, job_scene *s, lm_error *err) {
@@ -837,7 +860,8 @@ bool job_views(job *j, bool all_techniques, job_view **out, int *count, lm_error
   *count = 0;
   /* Every scene and camera list is read before anything renders: a bad
    * entry stops the job at once, naming it. */
-  int techniques = all_techniques ? j->technique_count : 1, view_count = 0;
+  int techniques = all_techniques ? j->technique_count : 1;
+  long long view_count = 0;
   for (int i = 0; i < j->scene_count; i++) {
     job_scene *s = &j->scenes[i];
     if (!s->scene) {
@@ -849,7 +873,12 @@ bool job_views(job *j, bool all_techniques, job_view **out, int *count, lm_error
       }
       s->hash = hash_file(s->cameras, hash_file(s->path, LM_HASH_SEED));
     }
-    view_count += s->camera_count * j->size_count * techniques * j->frame_count;
+    view_count += (long long)s->camera_count * j->size_count * techniques * j->frame_count;
+  }
+  if (view_count > MAX_VIEWS) {
+    lm_error_set(err, "%s: %lld views (scenes' cameras x sizes x techniques x frames); at most %d: split the job",
+                 j->path, view_count, MAX_VIEWS);
+    return false;
   }
   job_view *views = lm_alloc(sizeof *views * (size_t)(view_count + 1));
   int n = 0;
@@ -861,23 +890,16 @@ bool job_views(job *j, bool all_techniques, job_view **out, int *count, lm_error
             job_view *v = &views[n];
             *v = (job_view){.scene = si, .camera = j->scenes[si].first_camera + c, .size = z, .technique = t,
                             .frame = f, .time = j->fps > 0 ? j->time_start + f / j->fps : j->time_start};
-            if (!all_techniques) { /* places only: no output pattern */
-              n++;
-              continue;
-            }
-            if (!expand(j, v, n, v->output, sizeof v->output, err)) {
+            if (all_techniques && !expand(j, v, n, v->output, sizeof v->output, err)) { /* places: no output */
               free(views);
               return false;
             }
-            for (int k = 0; k < n; k++) /* {frame} tells frames apart: only views of one frame can collide */
-              if (views[k].frame == v->frame && !strcmp(views[k].output, v->output)) {
-                lm_error_set(err, "%s: output: views %d and %d both write %s (add {camera}, {technique} or "
-                             "{size} to the pattern)", j->path, k, n, v->output);
-                free(views);
-                return false;
-              }
             n++;
           }
+  if (all_techniques && !unique_outputs(j, views, n, err)) {
+    free(views);
+    return false;
+  }
   *out = views;
   *count = n;
   return true;

@@ -10,6 +10,7 @@
 #define MAX_LIST 64
 #define MAX_PATH_KEYS 256
 #define MAX_FRAMES 100000
+#define MAX_VIEWS 200000 /* a job's views, frames counted (about 1 KB each) */
 
 typedef struct job_scene {
   char path[1024], cameras[1024], name[LM_NAME_MAX];
