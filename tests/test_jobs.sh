@@ -379,7 +379,7 @@ badseq "path and turntable" 2 "bad.lua: path and turntable: one camera motion at
   "time = { 0, 1, 4 }, path = { $k0 }, turntable = {}"
 badseq "turntable elevation" 2 "bad.lua: turntable.elevation: 95 degrees; want one within (-89, 89)" \
   "time = { 0, 1, 4 }, turntable = { elevation = 95 }"
-badseq "turntable distance" 2 "bad.lua: turntable.distance: -1; want \"auto\" or a distance above 0" \
+badseq "turntable distance" 2 "bad.lua: turntable.distance: -1; want \"auto\" or a distance in (0, 1e9)" \
   "time = { 0, 1, 4 }, turntable = { distance = -1 }"
 badseq "too many views" 1 "bad.lua: 360004 views (scenes' cameras x sizes x techniques x frames); at most 200000" \
   "time = { 0, 3000, 30 }"

@@ -409,8 +409,8 @@ static bool read_turntable(lua_State *L, job *j, lm_error *err) {
     lua_pop(L, 1);
     snprintf(what, sizeof what, "%s: turntable.distance", j->path);
     if (ok && !is_auto) ok = field_number(L, -1, "distance", 0, &j->distance, what, err);
-    if (ok && !is_auto && !(j->distance > 0)) {
-      lm_error_set(err, "%s: %g; want \"auto\" or a distance above 0", what, j->distance);
+    if (ok && !is_auto && !(j->distance > 0 && j->distance < 1e9)) {
+      lm_error_set(err, "%s: %g; want \"auto\" or a distance in (0, 1e9)", what, j->distance);
       ok = false;
     }
   } else if (!lua_isnil(L, -1)) {
