@@ -25,7 +25,8 @@
  * I+N, ... of a still job and the I-th of N contiguous runs of a sequence's
  * views (job_shard_of). A shard starts its run cold: it does not render the
  * frames before it to warm temporal histories up, so that shards cost the
- * same and never render a frame twice. An image that exists is skipped unless
+ * same and never render a frame twice (it poses the scene at the frame
+ * before, for velocities). An image that exists is skipped unless
  * --force. The manifest is rewritten (whole, renamed into place) after each
  * image, so a killed job leaves it consistent with the files on disk. */
 #define _GNU_SOURCE
@@ -1019,12 +1020,18 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     bool ok = job_make_parent(v->output, &err) && lm_pipeline_set_technique(pipeline, j->techniques[v->technique], &err);
     if (ok && s->scene != current) ok = lm_renderer_set_scene(r, s->scene, &err), current = s->scene;
     if (ok) {
-      job_pose(j, v);
-      lm_scene_upload_deformed(s->scene);
       /* The next frame of the view rendered last: its temporal histories carry on. */
       const job_view *p = last >= 0 && last == i - 1 ? &views[last] : NULL;
       bool continues = p && p->scene == v->scene && p->size == v->size && p->technique == v->technique &&
                        p->camera == v->camera && p->frame + 1 == v->frame;
+      if (!continues && v->frame > 0) { /* a shard's or a rerun's first frame: the pose before it, */
+        job_view before = *v;           /* for velocities, though that frame is not rendered here */
+        before.frame--;
+        before.time = j->time_start + before.frame / j->fps;
+        job_pose(j, &before);
+      }
+      job_pose(j, v);
+      lm_scene_upload_deformed(s->scene);
       const char *outs[1] = {v->output};
       capture_view cv = {.camera = v->camera, .width = j->sizes[v->size][0], .height = j->sizes[v->size][1],
                          .frames = j->frames, .outputs = outs, .output_count = 1, .quiet = true,
