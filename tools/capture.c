@@ -539,6 +539,8 @@ int limn_capture(int argc, char **argv) {
   for (int k = 0; k < a.frame_count && ok; k++) {
     double t = a.frame_count > 1 ? a.time_start + k / a.fps : a.time_start;
     if (a.time_flag || a.animation) {
+      if (k == 0) /* the previous pose (velocities): the frame before's, a still's own */
+        lm_scene_set_time(scene, animation, a.frame_count > 1 ? t - 1 / a.fps : t);
       lm_scene_set_time(scene, animation, t);
       lm_scene_upload_deformed(scene);
     }

@@ -26,7 +26,7 @@
  * views (job_shard_of). A shard starts its run cold: it does not render the
  * frames before it to warm temporal histories up, so that shards cost the
  * same and never render a frame twice (it poses the scene at the frame
- * before, for velocities). An image that exists is skipped unless
+ * before first, for velocities). An image that exists is skipped unless
  * --force. The manifest is rewritten (whole, renamed into place) after each
  * image, so a killed job leaves it consistent with the files on disk. */
 #define _GNU_SOURCE
@@ -1024,10 +1024,9 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
       const job_view *p = last >= 0 && last == i - 1 ? &views[last] : NULL;
       bool continues = p && p->scene == v->scene && p->size == v->size && p->technique == v->technique &&
                        p->camera == v->camera && p->frame + 1 == v->frame;
-      if (!continues && v->frame > 0) { /* a shard's or a rerun's first frame: the pose before it, */
-        job_view before = *v;           /* for velocities, though that frame is not rendered here */
-        before.frame--;
-        before.time = j->time_start + before.frame / j->fps;
+      if (!continues && j->timed) { /* posed after the frame before (a still after itself): the */
+        job_view before = *v;         /* previous pose, for velocities, though that is not rendered */
+        before.time -= j->fps > 0 ? 1 / j->fps : 0;
         job_pose(j, &before);
       }
       job_pose(j, v);
