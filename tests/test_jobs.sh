@@ -272,6 +272,10 @@ check "sequence job" run 0 capture --job seq.lua
 check "a 5-frame sequence writes 5 numbered files" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png 0002.png 0003.png 0004.png "
 check "sequence manifest: frame and time" grep -qF '"file": "seq/front-0003.png", "view": 3, "run": 1, "scene": "'"$scenes"'/cornell.glb", "scene_hash": ' seq/manifest.json
 check "sequence manifest: frame 3 at 0.75 s" grep -qF '"frame": 3, "time": 0.750000' seq/manifest.json
+sed -e 's|time = .*|time = 1.5,|' -e 's|seq/{camera}-{frame}|still/{camera}-{time}|' seq.lua > still.lua
+check "a still at a time" run 0 capture --job still.lua
+check "one image, named by its time" test "$(ls still | grep png)" = "front-1.500.png"
+check "its manifest entry: frame 0 at 1.5 s" grep -qF '"frame": 0, "time": 1.500000' still/manifest.json
 rm -rf seq
 (LIMN_JOB_KILL_AFTER=2 "$limn" capture --job seq.lua >/dev/null 2>&1) 2>/dev/null
 check "sequence killed by SIGKILL" test $? -eq 137
