@@ -28,7 +28,8 @@ check "no command" run 2
 check "help" run 0 --help
 check "help lists capture" out_has "capture"
 check "capture help" run 0 capture --help
-for flag in --scene --script --tech --set --size --frames --warmup --camera --output --clock --egl --list-options; do
+for flag in --scene --script --tech --set --size --frames --warmup --camera --output --clock --egl --list-options \
+            --time --fps --animation; do
   check "capture help names $flag" out_has "$flag"
 done
 check "unknown command" run 2 frobnicate
@@ -77,6 +78,62 @@ check "times list the gbuffer pass" out_has "gbuffer"
 check "times list the direct pass" out_has "direct"
 check "times are medians of 2" out_has "median of 2 frames"
 rm -f "$tmp/img/"*
+
+# time: a still at --time SECONDS, a sequence at --time START:STOP --fps N, one file a frame
+check "sequence capture" run 0 capture --size 32x24 --tech dl --time 0:1 --fps 4 --output "$tmp/img/s{frame}_{time}.png"
+check "a 5-frame sequence writes 5 numbered files" \
+  test "$(ls "$tmp/img" | tr '\n' ' ')" = "s0000_0.000.png s0001_0.250.png s0002_0.500.png s0003_0.750.png s0004_1.000.png "
+check "the sequence is said" out_has "5 frames, 0.000 s to 1.000 s at 4 fps"
+check "frames of a still scene are equal" cmp "$tmp/img/s0000_0.000.png" "$tmp/img/s0004_1.000.png"
+rm -f "$tmp/img/"*
+check "a stop on no frame" run 0 capture --size 16x12 --tech dl --time 0.5:0.9 --fps 4 --output "$tmp/img/s{frame}.png"
+check "frames up to the stop only" test "$(ls "$tmp/img" | tr '\n' ' ')" = "s0000.png s0001.png "
+rm -f "$tmp/img/"*
+check "still at a time" run 0 capture --size 16x12 --tech dl --time 1.5 --animation all --output "$tmp/img/t{time}.png"
+check "still at a time named" test -s "$tmp/img/t1.500.png"
+rm -f "$tmp/img/"*
+check "sequence without {frame}" run 2 capture --time 0:1 --fps 4 --output "$tmp/img/s.png"
+check "sequence without {frame} names the flag" err_has "--output '$tmp/img/s.png': a sequence of 5 frames (--time 0:1 --fps 4) needs {frame} in the name"
+check "sequence without --fps" run 2 capture --time 0:1 --output "$tmp/img/s{frame}.png"
+check "sequence without --fps message" err_has "--time 0:1: a sequence needs --fps N"
+check "negative fps" run 2 capture --time 0:1 --fps -4 --output "$tmp/img/s{frame}.png"
+check "negative fps message" err_has "--fps wants frames a second above 0, not '-4'"
+check "stop before start" run 2 capture --time 2:1 --fps 4 --output "$tmp/img/s{frame}.png"
+check "stop before start message" err_has "--time START:STOP wants STOP >= START, not '2:1'"
+check "NaN time" run 2 capture --time nan --output "$tmp/img/s.png"
+check "NaN time message" err_has "--time wants SECONDS or START:STOP (finite numbers), not 'nan'"
+check "fps without a range" run 2 capture --time 1 --fps 4 --output "$tmp/img/s.png"
+check "fps without a range message" err_has "--fps goes with --time START:STOP"
+check "unknown animation" run 2 capture --size 16x12 --animation walk --output "$tmp/img/s.png"
+check "unknown animation message" first_error_has "--animation walk: scene 'cornell' has no animation 'walk'"
+check "bad time values leave no file" no_files
+# video: raw RGB frames piped to the ffmpeg program (a stand-in here that keeps its arguments and
+# input; the real program is not needed to check what limn hands it)
+mkdir -p "$tmp/bin"
+cat > "$tmp/bin/ffmpeg" <<'SH'
+#!/bin/sh
+for a; do out=$a; done
+echo "$@" > "$(dirname "$out")/../ffmpeg-args"
+cat > "$out"
+[ -z "${FAKE_FFMPEG_FAIL:-}" ] || { echo "ffmpeg: no encoder" >&2; exit 1; }
+SH
+chmod +x "$tmp/bin/ffmpeg"
+check "video of a sequence" env PATH="$tmp/bin:$PATH" "$limn" capture --size 32x24 --tech dl --time 0:1 --fps 4 --quiet \
+  --output "$tmp/img/v.mp4"
+check "video: 5 frames of 32x24 RGB handed over" test "$(stat -c %s "$tmp/img/v.mp4")" = $((5 * 32 * 24 * 3))
+check "video: raw RGB at the sequence's size and rate" grep -qF -- "-f rawvideo -pix_fmt rgb24 -s 32x24 -r 4 -i -" "$tmp/ffmpeg-args"
+check "video: ffmpeg writes a temporary name" grep -q "/v.tmp-[0-9]*.mp4\$" "$tmp/ffmpeg-args"
+rm -f "$tmp/img/"*
+check "video: ffmpeg fails" bash -c "FAKE_FFMPEG_FAIL=1 PATH='$tmp/bin:$PATH' '$limn' capture --size 32x24 --tech dl \
+  --time 0:1 --fps 4 --output '$tmp/img/v.webm' 2>'$tmp/err'; [ \$? = 1 ]"
+check "video: ffmpeg's failure named" err_has "--output $tmp/img/v.webm: ffmpeg failed (exit status 1"
+check "video: no file from a failed ffmpeg" no_files
+check "video without ffmpeg" bash -c "PATH=/nonexistent '$limn' capture --size 32x24 --tech dl --time 0:1 --fps 4 \
+  --output '$tmp/img/v.mp4' 2>'$tmp/err'; [ \$? = 1 ]"
+check "video without ffmpeg: a clear error" err_has "--output $tmp/img/v.mp4: video needs the ffmpeg program (Debian package ffmpeg): not found on the PATH"
+check "video without ffmpeg: no file" no_files
+check "video of a still" run 2 capture --time 1 --output "$tmp/img/v.mp4"
+check "video of a still message" err_has "a video is of a sequence"
 
 # effects: `--set bloom=true` turns on bloom.enabled; dotted names set parameters
 check "effects capture" run 0 capture --scene cornell --script scripts/pp.lua --tech dl --size 64x48 \

@@ -246,5 +246,149 @@ check "camera list: empty" run 1 capture --job bad.lua
 check "empty message" err_has "bad.cams: no views"
 check "no image from a failed job" test ! -e o
 
+# Sequences: time = { start, stop, fps } renders frames 0 .. floor((stop - start) fps) as
+# consecutive views, {frame} in their names; resumable, sharded in contiguous runs.
+mean_error() { "$limn" compare "$1" "$2" --json | grep -o '"mean_error": [-0-9.e+]*' | awk '{ print $2 }'; }
+error_above() { # error_above A B X: mean error of A against B above X
+  local m; m=$(mean_error "$1" "$2")
+  awk -v m="$m" -v x="$3" 'BEGIN { exit !(m > x) }' || { echo "  $1 vs $2: mean error $m, not above $3"; return 1; }
+}
+error_below() {
+  local m; m=$(mean_error "$1" "$2")
+  awk -v m="$m" -v x="$3" 'BEGIN { exit !(m < x) }' || { echo "  $1 vs $2: mean error $m, not below $3"; return 1; }
+}
+frames_of() { ls "$@" 2>/dev/null | grep -o '[0-9]\{4\}\.png' | tr '\n' ' '; }
+printf 'front 0 1 3.4  0 1 0  45\n' > one.cams
+cat > seq.lua <<LUA
+return {
+  scenes = { { scene = "$scenes/cornell.glb", cameras = "$tmp/one.cams" } },
+  sizes = { "48x36" }, techniques = { "dl" },
+  time = { 0, 1, 4 },
+  output = "seq/{camera}-{frame}.png",
+}
+LUA
+rm -rf seq
+check "sequence job" run 0 capture --job seq.lua
+check "a 5-frame sequence writes 5 numbered files" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png 0002.png 0003.png 0004.png "
+check "sequence manifest: frame and time" grep -qF '"file": "seq/front-0003.png", "view": 3, "run": 1, "scene": "'"$scenes"'/cornell.glb", "scene_hash": ' seq/manifest.json
+check "sequence manifest: frame 3 at 0.75 s" grep -qF '"frame": 3, "time": 0.750000' seq/manifest.json
+sed -e 's|time = .*|time = 1.5,|' -e 's|seq/{camera}-{frame}|still/{camera}-{time}|' seq.lua > still.lua
+check "a still at a time" run 0 capture --job still.lua
+check "one image, named by its time" test "$(ls still | grep png)" = "front-1.500.png"
+check "its manifest entry: frame 0 at 1.5 s" grep -qF '"frame": 0, "time": 1.500000' still/manifest.json
+rm -rf seq
+(LIMN_JOB_KILL_AFTER=2 "$limn" capture --job seq.lua >/dev/null 2>&1) 2>/dev/null
+check "sequence killed by SIGKILL" test $? -eq 137
+check "2 frames before the kill" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png "
+check "rerun the killed sequence" run 0 capture --job seq.lua
+check "the rerun renders only the 3 missing frames" out_has "3 rendered, 2 skipped"
+check "all 5 frames after the rerun" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png 0002.png 0003.png 0004.png "
+rm -rf seq
+check "sequence shard 0/2" run 0 capture --job seq.lua --shard 0/2
+check "shard 0/2 renders frames 0-2 (a contiguous run)" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png 0002.png "
+check "sequence shard 1/2" run 0 capture --job seq.lua --shard 1/2
+check "shard 1/2 renders the 2 others" out_has "2 rendered, 0 skipped"
+check "shards 0/2 and 1/2 cover every frame once" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png 0002.png 0003.png 0004.png "
+check "sequence shards merge" run 0 manifest merge --job seq.lua --shards 2
+check "sequence merge: each frame once" out_has "seq.lua: 5 views from 2 shards, each rendered once"
+rm -rf seq
+check "farm a sequence" run 0 farm slurm --job seq.lua --shards 2 --dir seqfarm
+: > seqtasks.txt
+for i in 0 1; do SLURM_ARRAY_TASK_ID=$i bash seqfarm/limn-seq.sbatch >>seqtasks.txt 2>&1; done
+check "farm tasks render every frame" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png 0002.png 0003.png 0004.png "
+check "farm tasks render each frame once (3 + 2)" test "$(grep -o '[0-9]* rendered' seqtasks.txt | tr '\n' ' ')" = "3 rendered 2 rendered "
+# References of a sequence: one per frame (named and hashed with it), cached, sharded
+# (a stand-in POV-Ray writes its output file; test_reference.sh runs the real one).
+printf '#!/bin/sh\nfor a; do case "$a" in +O*) printf x > "${a#+O}";; esac; done\n' > fakepov
+chmod +x fakepov
+check "references of a sequence, shard 1/2" run 0 reference --job seq.lua --povray "$tmp/fakepov" --refs seqrefs --shard 1/2
+check "shard 1/2 exports frames 3 and 4" test "$(ls seqrefs/cornell | grep -c '\.exr$')" = 2
+check "their names carry frame and time" test -n "$(ls seqrefs/cornell/front_48x36-0003-0.750-*.exr)"
+check "references of a sequence" run 0 reference --job seq.lua --povray "$tmp/fakepov" --refs seqrefs
+check "one reference a frame, the shard's cached" out_has "3 rendered, 2 cached"
+
+# A camera path: frames differ, the first is the still view at the first key.
+cat > path.lua <<LUA
+return {
+  scenes = { "$scenes/cornell.glb" },
+  sizes = { "48x36" }, techniques = { "dl" },
+  time = { 0, 1, 3 },
+  path = { { t = 0, eye = { 0, 1, 3.4 }, target = { 0, 1, 0 }, fov = 45 },
+           { t = 0.4, eye = { 0.6, 1.3, 2.8 }, target = { 0, 0.9, 0 } },
+           { t = 1, eye = { -0.6, 1.2, 2.6 }, target = { 0.1, 0.8, 0 }, fov = 50 } },
+  output = "path/{camera}-{frame}.png",
+}
+LUA
+check "camera path job" run 0 capture --job path.lua
+check "a path writes its 4 frames" test "$(frames_of path/path-*.png)" = "0000.png 0001.png 0002.png 0003.png "
+check "still of the first key" run 0 capture --job seq.lua --force
+check "path frame 0 is the first key's view" error_below path/path-0000.png seq/front-0000.png 0.000001
+check "path frames 0 and 1 differ" error_above path/path-0000.png path/path-0001.png 0.01
+check "path frames 2 and 3 differ" error_above path/path-0002.png path/path-0003.png 0.01
+# The keys of a camera list, evenly over the time: the last frame is the list's last view.
+printf 'a 0 1 3.4  0 1 0  45\nb -0.6 1.2 2.6  0.1 0.8 0  50\n' > keys.cams
+printf 'b -0.6 1.2 2.6  0.1 0.8 0  50\n' > last.cams
+sed -e 's|path = {.*|path = "keys.cams",|' -e '/^           { t = /d' -e 's|path/{camera}|listpath/{camera}|' path.lua > listpath.lua
+sed -e "s|$tmp/one.cams|$tmp/last.cams|" -e 's|time = .*||' -e 's|seq/{camera}-{frame}|last/{camera}|' seq.lua > last.lua
+check "path from a camera list" run 0 capture --job listpath.lua
+check "still of the list's last view" run 0 capture --job last.lua
+check "its last frame is the list's last view" error_below listpath/path-0003.png last/b.png 0.002
+check "its first frame is the list's first" error_below listpath/path-0000.png path/path-0000.png 0.002
+# A turntable: one turn over the time, so frame 0 and the last (a full turn) agree.
+cat > turn.lua <<LUA
+return {
+  scenes = { "$scenes/cornell.glb" },
+  sizes = { "48x36" }, techniques = { "dl" },
+  time = { 0, 1, 4 },
+  turntable = { turns = 1, elevation = 20 },
+  output = "turn/{scene}-{frame}.png",
+}
+LUA
+check "turntable job" run 0 capture --job turn.lua
+check "turntable frames 0 and 1 differ" error_above turn/cornell-0000.png turn/cornell-0001.png 0.01
+check "turntable frames 1 and 2 differ" error_above turn/cornell-0001.png turn/cornell-0002.png 0.01
+check "a full turn comes back to frame 0" error_below turn/cornell-0000.png turn/cornell-0004.png 0.002
+
+# Bad sequences and paths: named by field (and key), exit 2, nothing written.
+job_with() { # job_with FIELDS: a cornell job with those fields
+  printf 'return { scenes = { "%s" }, sizes = { "8x8" }, output = "o/{camera}-{frame}.png", %s }\n' "$scenes/cornell.glb" "$1" > bad.lua
+}
+badseq() { # badseq NAME RC MESSAGE FIELDS
+  job_with "$4"
+  check "$1" run "$2" capture --job bad.lua
+  check "$1: message" err_has "$3"
+}
+k0='{ t = 0, eye = { 0, 1, 3 }, target = { 0, 1, 0 } }'
+bad "sequence without {frame}" 2 "bad.lua: output: a sequence of 5 frames needs {frame} in the pattern" \
+  "return { scenes = { '$scenes/cornell.glb' }, time = { 0, 1, 4 }, output = 'o/{camera}.png' }"
+badseq "negative fps" 2 "bad.lua: time.fps: -4 frames a second; want a number above 0" 'time = { 0, 1, -4 }'
+badseq "stop before start" 2 "bad.lua: time.stop: 0 is before time.start 1" 'time = { start = 1, stop = 0, fps = 4 }'
+badseq "time of no number" 2 "bad.lua: time.start: a number, not a string" 'time = { "0", 1, 4 }'
+badseq "NaN time" 2 "nan is not a finite number" 'time = 0/0'
+badseq "path without time" 2 "bad.lua: path: needs time = { start, stop, fps }" "path = { $k0 }"
+badseq "path eye of 2 numbers" 2 "bad.lua: path[2].eye: needs 3 numbers" \
+  "time = { 0, 1, 4 }, path = { $k0, { t = 1, eye = { 1, 2 }, target = { 0, 1, 0 } } }"
+badseq "path times not increasing" 2 "bad.lua: path[2].t: 0 is not after path[1].t (0)" \
+  "time = { 0, 1, 4 }, path = { $k0, $k0 }"
+badseq "path key without t" 2 "bad.lua: path[1].t: missing" \
+  "time = { 0, 1, 4 }, path = { { eye = { 0, 1, 3 }, target = { 0, 1, 0 } } }"
+badseq "path fov" 2 "bad.lua: path[1].fov: 200 degrees is outside (0.1, 179)" \
+  "time = { 0, 1, 4 }, path = { { t = 0, eye = { 0, 1, 3 }, target = { 0, 1, 0 }, fov = 200 } }"
+badseq "path eye at target" 2 "bad.lua: path[1]: the eye is at the target" \
+  "time = { 0, 1, 4 }, path = { { t = 0, eye = { 0, 1, 0 }, target = { 0, 1, 0 } } }"
+badseq "path list times" 2 "bad.lua: path.times: a list of 2 times (one for each view of $tmp/keys.cams)" \
+  "time = { 0, 1, 4 }, path = { cameras = '$tmp/keys.cams', times = { 0 } }"
+badseq "path list missing" 2 "bad.lua: path: " "time = { 0, 1, 4 }, path = '$tmp/nosuch.cams'"
+badseq "path and turntable" 2 "bad.lua: path and turntable: one camera motion at a time" \
+  "time = { 0, 1, 4 }, path = { $k0 }, turntable = {}"
+badseq "turntable elevation" 2 "bad.lua: turntable.elevation: 95 degrees; want one within (-89, 89)" \
+  "time = { 0, 1, 4 }, turntable = { elevation = 95 }"
+badseq "turntable distance" 2 "bad.lua: turntable.distance: -1; want \"auto\" or a distance in (0, 1e9)" \
+  "time = { 0, 1, 4 }, turntable = { distance = -1 }"
+badseq "too many views" 1 "bad.lua: 360004 views (scenes' cameras x sizes x techniques x frames); at most 200000" \
+  "time = { 0, 3000, 30 }"
+badseq "unknown animation" 1 "bad.lua: scenes[1]: animation: scene " "time = 0, animation = 'walk'"
+check "no image from a bad sequence" test ! -e o
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -54,6 +54,24 @@ second=$(ls refs/ball/front_48x36-*.exr | grep -v "$first")
 mean=$(grep -o '"mean_error": [-0-9.e+]*' m.json | awk '{print $2}')
 awk -v m="$mean" 'BEGIN { exit !(m > 0.005) }' || { cat m.json; fail "references equal (mean error $mean)"; }
 
+# A sequence along a camera path: one reference a frame, each posed at its time (the two differ), cached.
+cat > path.lua <<'JOB'
+return {
+  scenes = { "ball.gltf" }, sizes = { "48x36" }, time = { 0, 1, 1 },
+  path = { { t = 0, eye = { 0, 1.5, 3 }, target = { 0, 0.3, 0 } }, { t = 1, eye = { 2, 1.2, 2 }, target = { 0, 0.3, 0 } } },
+  output = "out/{camera}_{frame}.png",
+}
+JOB
+"$limn" reference --job path.lua "${fast[@]}" --refs refs-seq >log6 2>&1 || { cat log6; fail "references of a sequence"; }
+grep -q "2 rendered, 0 cached" log6 || { cat log6; fail "a 2-frame sequence did not render 2 references"; }
+f0=$(ls refs-seq/ball/path_48x36-0000-0.000-*.exr) && f1=$(ls refs-seq/ball/path_48x36-0001-1.000-*.exr) \
+  || fail "no reference named by frame: $(ls refs-seq/ball)"
+"$limn" compare "$f0" "$f1" --json >m.json || fail "compare frame references"
+mean=$(grep -o '"mean_error": [-0-9.e+]*' m.json | awk '{print $2}')
+awk -v m="$mean" 'BEGIN { exit !(m > 0.005) }' || { cat m.json; fail "the frames' references are equal (mean error $mean)"; }
+"$limn" reference --job path.lua "${fast[@]}" --refs refs-seq >log7 2>&1 || { cat log7; fail "references of a sequence again"; }
+grep -q "0 rendered, 2 cached" log7 || { cat log7; fail "a sequence's references were not cached per frame"; }
+
 # 2. a failing POV-Ray run: named by view, its error lines shown, exit 1
 cat > fakepov <<'FAKE'
 #!/bin/sh

@@ -7,6 +7,8 @@
 # 2. Afresh, one task cancelled (scancel) while it renders its references:
 #    the merge fails naming what is missing; the array run again renders only
 #    that (each image still from its first run).
+# 3. A 6-frame turntable sequence with its references: each task renders two
+#    consecutive frames and their references; the merge finds each once.
 # Every daemon started here is stopped by its process id, also on failure.
 # Skipped (77) without Slurm, munge or POV-Ray (tools/dev.sh installs them),
 # or when not root (slurmd runs the tasks as their user).
@@ -215,4 +217,30 @@ grep -q "3 rendered, 0 skipped" farm/logs/limn-job-"$array3"_1.log || fail "task
 [ "$(grep -c '"run": 1,' out/manifest.json)" = 10 ] || fail "an image was rendered in another run than the first"
 grep -q '"run": 2,' out/manifest.shard-0-of-3.json || fail "shard 0's manifest does not count its second run"
 echo "step 2: the rerun rendered only the 3 images and 1 reference that were missing; merged"
+
+# ---- 3. a sequence: its frames split into contiguous runs, references per frame ----
+cat > turn.lua <<'JOB'
+return {
+  scenes = { "ball.gltf" }, techniques = { "dl" }, sizes = { "32x24" }, set = { ambient = 0 },
+  time = { 0, 1, 5 }, turntable = { turns = 1 },
+  output = "seq/{camera}_{frame}.png",
+}
+JOB
+"$limn" farm slurm --job turn.lua --shards 3 --references --refs seqrefs --count 10 --pretrace-start 0.2 \
+  --pretrace-end 0.1 --time 5 --submit > submit4.txt 2>&1 || { cat submit4.txt; fail "limn farm slurm of a sequence"; }
+read -r array4 merge4 < <(sed -n 's/.*as job \([0-9]*\), the merge as job \([0-9]*\).*/\1 \2/p' submit4.txt)
+wait_jobs
+[ "$(job_state "$merge4")" = JobState=COMPLETED ] || { cat farm/logs/limn-turn-merge-"$merge4".log; fail "the sequence's merge: $(job_state "$merge4")"; }
+for i in 0 1 2; do # task i renders frames 2i and 2i + 1, and their references
+  log=farm/logs/limn-turn-"$array4"_$i.log
+  grep -q "turn.lua: 6 views (2 in shard $i/3)" "$log" || fail "task $i's share of the frames: $(cat "$log")"
+  grep -q "seq/turntable_000$((2 * i)).png" "$log" && grep -q "seq/turntable_000$((2 * i + 1)).png" "$log" \
+    || fail "task $i did not render frames $((2 * i)) and $((2 * i + 1)): $(cat "$log")"
+  grep -q "2 rendered, 0 cached" "$log" || fail "task $i did not render its 2 frames' references"
+done
+[ "$(ls seq/*.png | wc -l)" = 6 ] && [ "$(ls seqrefs/ball/turntable_32x24-000[0-5]-*.exr | wc -l)" = 6 ] \
+  || fail "not 6 frames and 6 references: $(ls seq seqrefs/ball)"
+grep -q "turn.lua: 6 views from 3 shards, each rendered once; 6 references there; seq/manifest.json" \
+  farm/logs/limn-turn-merge-"$merge4".log || fail "the sequence's merge log"
+echo "step 3: a 6-frame sequence in 3 tasks of 2 consecutive frames each, with a reference a frame; merged"
 echo "passed"

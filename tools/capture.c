@@ -1,10 +1,17 @@
 /* limn capture: render headless and write images, printing per-pass times. */
 #define _GNU_SOURCE
+#include <errno.h>
+#include <fcntl.h>
 #include <getopt.h>
+#include <math.h>
+#include <signal.h>
+#include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "image/image.h"
 #include "render/render.h"
@@ -32,7 +39,14 @@ static const char capture_usage[] =
     "                       say a temporal accumulation's convergence)\n"
     "  --camera N           camera index of the scene (default 0), or auto:\n"
     "                       one framing the scene's bounds\n"
-    "  --output FILE        image to write, .png or .exr (repeatable)\n"
+    "  --output FILE        image to write, .png or .exr (repeatable); {frame} (0000,\n"
+    "                       0001, ...) and {time} (seconds) name a sequence's frames;\n"
+    "                       a sequence also goes to .mp4 or .webm video (the ffmpeg\n"
+    "                       program encodes it)\n"
+    "  --time SECONDS       pose the scene's animation at that time\n"
+    "  --time START:STOP    a sequence: frames at START + k / fps up to STOP\n"
+    "  --fps N              frames a second of a sequence\n"
+    "  --animation NAME|INDEX|all   the animation posed (default all)\n"
     "  --clock auto|gpu|cpu how passes are timed (default auto: GL timer queries,\n"
     "                       or glFinish + a CPU clock on software renderers)\n"
     "  --egl auto|device|surfaceless   EGL platform (default auto)\n"
@@ -43,7 +57,8 @@ static const char capture_usage[] =
     "                       techniques, sizes, options and an output pattern; see\n"
     "                       README.md); --set adds to the job's options\n"
     "  --force              with --job: render images that exist already\n"
-    "  --shard I/N          with --job: render views I, I+N, I+2N ... only\n"
+    "  --shard I/N          with --job: render views I, I+N, I+2N ... only; of a\n"
+    "                       sequence, the I-th of N contiguous runs of frames\n"
     "  --shard auto[/N]     the shard from a job array: Slurm's SLURM_ARRAY_TASK_ID\n"
     "                       (less _MIN, of _COUNT shards; with /N as it is, of N),\n"
     "                       or Kubernetes' JOB_COMPLETION_INDEX (auto/N)\n"
@@ -59,9 +74,14 @@ typedef struct capture_args {
   const char *single_flag; /* a flag of single captures (the job names these itself) */
   const char *outputs[16];
   int output_count;
+  const char *videos[16]; /* .mp4, .webm */
+  int video_count;
   const char *sets[64];
   int set_count;
   int width, height, frames, warmup, camera;
+  const char *animation, *time_flag;
+  double time_start, time_stop, fps; /* fps 0: one frame at time_start */
+  int frame_count;
   lm_clock clock;
   bool list_options, quiet, verbose, check_nan;
 } capture_args;
@@ -81,6 +101,93 @@ bool capture_known_extension(const char *path, bool *linear) {
   return *linear || !strcasecmp(dot, ".png") || !strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".tif");
 }
 
+static bool is_video(const char *path) {
+  const char *dot = strrchr(path, '.');
+  return dot && !strchr(dot, '/') && (!strcasecmp(dot, ".mp4") || !strcasecmp(dot, ".webm"));
+}
+
+/* A sequence as video through Debian's ffmpeg program, raw RGB frames on its
+ * standard input. The program, not libavcodec: one pipe instead of a codec,
+ * muxer and pixel-format conversion set up by hand, and the codec choices
+ * for each container stay ffmpeg's own defaults. Written to a temporary name
+ * (the extension kept last: ffmpeg picks the container by it) and renamed
+ * when ffmpeg succeeds. */
+typedef struct video {
+  const char *path;
+  char tmp[2100];
+  pid_t pid;
+  int fd; /* the pipe's writing end; -1 when closed */
+} video;
+
+static bool video_open(video *v, const char *path, int width, int height, double fps, lm_error *err) {
+  *v = (video){.path = path, .pid = -1, .fd = -1};
+  const char *dot = strrchr(path, '.');
+  snprintf(v->tmp, sizeof v->tmp, "%.*s.tmp-%ld%s", (int)(dot - path), path, (long)getpid(), dot);
+  char size[64], rate[64];
+  snprintf(size, sizeof size, "%dx%d", width, height);
+  snprintf(rate, sizeof rate, "%.9g", fps);
+  char *argv[] = {"ffmpeg", "-hide_banner", "-loglevel", "error", "-nostats", "-y", "-f", "rawvideo",
+                  "-pix_fmt", "rgb24", "-s", size, "-r", rate, "-i", "-", "-pix_fmt", "yuv420p", v->tmp, NULL};
+  int fds[2];
+  if (pipe2(fds, O_CLOEXEC) != 0) {
+    lm_error_set(err, "%s: cannot make a pipe: %s", path, strerror(errno));
+    return false;
+  }
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_adddup2(&fa, fds[0], STDIN_FILENO);
+  fflush(stdout);
+  fflush(stderr);
+  extern char **environ;
+  int rc = posix_spawnp(&v->pid, "ffmpeg", &fa, NULL, argv, environ);
+  posix_spawn_file_actions_destroy(&fa);
+  close(fds[0]);
+  if (rc != 0) {
+    close(fds[1]);
+    v->pid = -1;
+    lm_error_set(err, "--output %s: video needs the ffmpeg program (Debian package ffmpeg): %s", path,
+                 rc == ENOENT ? "not found on the PATH" : strerror(rc));
+    return false;
+  }
+  v->fd = fds[1];
+  return true;
+}
+
+static bool video_write(video *v, const unsigned char *rgb, size_t bytes, lm_error *err) {
+  while (bytes > 0) {
+    ssize_t n = write(v->fd, rgb, bytes);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      lm_error_set(err, "--output %s: ffmpeg stopped taking frames (%s)", v->path, strerror(errno));
+      return false;
+    }
+    rgb += n, bytes -= (size_t)n;
+  }
+  return true;
+}
+
+/* Ends the stream; renames the file when ffmpeg and `ok` both succeeded, else removes it. */
+static bool video_close(video *v, bool ok, lm_error *err) {
+  if (v->fd >= 0) close(v->fd);
+  v->fd = -1;
+  int status = 0;
+  if (v->pid > 0) {
+    while (waitpid(v->pid, &status, 0) < 0 && errno == EINTR) {}
+    if (ok && !(WIFEXITED(status) && WEXITSTATUS(status) == 0)) {
+      lm_error_set(err, "--output %s: ffmpeg failed (%s %d; its messages above)", v->path,
+                   WIFEXITED(status) ? "exit status" : "signal", WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
+      ok = false;
+    }
+  }
+  if (ok && rename(v->tmp, v->path) != 0) {
+    lm_error_set(err, "--output %s: cannot rename %s: %s", v->path, v->tmp, strerror(errno));
+    ok = false;
+  }
+  if (!ok) remove(v->tmp);
+  v->pid = -1;
+  return ok;
+}
+
 /* Returns 0 to go on, else the exit code. */
 static int parse_args(int argc, char **argv, capture_args *a) {
   *a = (capture_args){.scene = "cornell", .script = NULL, .egl = "auto", .width = 256,
@@ -97,12 +204,14 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       {"check-nan", no_argument, 0, 'N'},
       {"job", required_argument, 0, 'j'},    {"force", no_argument, 0, 'f'},
       {"shard", required_argument, 0, 'S'},
+      {"time", required_argument, 0, 'T'},   {"fps", required_argument, 0, 'F'},
+      {"animation", required_argument, 0, 'A'},
       {0, 0, 0, 0}};
   opterr = 0;
   optind = 1;
   int c;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
-    for (const struct option *o = opts; o->name && c && strchr("sptznwc", c); o++)
+    for (const struct option *o = opts; o->name && c && strchr("sptznwcTFA", c); o++)
       if (o->val == c) a->single_flag = o->name;
     switch (c) {
     case 's': a->scene = optarg; break;
@@ -128,10 +237,12 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       break;
     case 'o': {
       bool linear;
-      if (!capture_known_extension(optarg, &linear))
-        return usage_error("--output '%s': use a .png, .exr, .jpg, .tif or .hdr file", optarg);
-      if (a->output_count == 16) return usage_error("%s", "at most 16 --output flags");
-      a->outputs[a->output_count++] = optarg;
+      if (a->output_count + a->video_count == 16) return usage_error("%s", "at most 16 --output flags");
+      if (is_video(optarg)) a->videos[a->video_count++] = optarg;
+      else if (!capture_known_extension(optarg, &linear))
+        return usage_error("--output '%s': use a .png, .exr, .jpg, .tif or .hdr file (or .mp4, .webm for a "
+                           "sequence)", optarg);
+      else a->outputs[a->output_count++] = optarg;
       break;
     }
     case 'k':
@@ -145,6 +256,21 @@ static int parse_args(int argc, char **argv, capture_args *a) {
         return usage_error("--egl wants auto, device or surfaceless, not '%s'", optarg);
       a->egl = optarg;
       break;
+    case 'T': {
+      char start[64];
+      const char *colon = strchr(optarg, ':');
+      snprintf(start, sizeof start, "%.*s", colon ? (int)(colon - optarg) : 63, optarg);
+      if (!limn_parse_double(start, &a->time_start) || !limn_parse_double(colon ? colon + 1 : start, &a->time_stop))
+        return usage_error("--time wants SECONDS or START:STOP (finite numbers), not '%s'", optarg);
+      if (a->time_stop < a->time_start) return usage_error("--time START:STOP wants STOP >= START, not '%s'", optarg);
+      a->time_flag = optarg;
+      break;
+    }
+    case 'F':
+      if (!limn_parse_double(optarg, &a->fps) || !(a->fps > 0) || a->fps > 1e6)
+        return usage_error("--fps wants frames a second above 0, not '%s'", optarg);
+      break;
+    case 'A': a->animation = optarg; break;
     case 'j': a->job = optarg; break;
     case 'f': a->force = true; break;
     case 'S':
@@ -161,13 +287,31 @@ static int parse_args(int argc, char **argv, capture_args *a) {
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
-  if (a->job && (a->output_count || a->list_options))
+  if (a->job && (a->output_count || a->video_count || a->list_options))
     return usage_error("%s", "--job names its own outputs: no --output or --list-options with it");
   if (a->job && a->single_flag)
     return usage_error("--job names its scenes, script, techniques, sizes and frames: '--%s' does not go with it",
                        a->single_flag);
   if (!a->job && (a->force || a->shards))
     return usage_error("%s", "--force and --shard go with --job");
+  bool range = a->time_flag && strchr(a->time_flag, ':');
+  if (range && !a->fps) return usage_error("--time %s: a sequence needs --fps N", a->time_flag);
+  if (a->fps && !range) return usage_error("%s", "--fps goes with --time START:STOP");
+  a->frame_count = 1;
+  if (range) {
+    double n = floor((a->time_stop - a->time_start) * a->fps + 1e-9) + 1;
+    if (n > 100000) return usage_error("--time %s: more than 100000 frames at that --fps", a->time_flag);
+    a->frame_count = (int)n;
+  }
+  if (a->video_count && a->frame_count < 2)
+    return usage_error("--output '%s': a video is of a sequence (--time START:STOP --fps N, two frames or more)",
+                       a->videos[0]);
+  for (int i = 0; i < a->output_count && a->frame_count > 1; i++)
+    if (!strstr(a->outputs[i], "{frame}")) {
+      fprintf(stderr, "limn capture: --output '%s': a sequence of %d frames (--time %s --fps %g) needs {frame} in "
+              "the name\n(see limn capture --help)\n", a->outputs[i], a->frame_count, a->time_flag, a->fps);
+      return 2;
+    }
   return 0;
 }
 
@@ -247,7 +391,7 @@ bool capture_render_write(lm_renderer *r, const capture_view *v, capture_result 
   *res = (capture_result){0};
   pass_samples *samples = NULL;
   int n = 0;
-  lm_renderer_set_view(r, v->camera, v->width, v->height);
+  if (!v->continues) lm_renderer_set_view(r, v->camera, v->width, v->height);
   bool ok = true;
   for (int f = 0; f < v->warmup + v->frames && ok; f++) {
     ok = lm_renderer_frame(r, err);
@@ -270,6 +414,18 @@ void capture_result_free(capture_result *res) {
   for (int i = 0; i < res->pass_count; i++) free((char *)res->passes[i].name);
   free(res->passes);
   *res = (capture_result){0};
+}
+
+/* The output name of a sequence's frame: {frame} and {time} filled. */
+static void frame_name(const char *pattern, int frame, double time, char *out, size_t cap) {
+  lm_buf b = {0};
+  for (const char *p = pattern; *p; p++) {
+    if (!strncmp(p, "{frame}", 7)) lm_buf_printf(&b, CAPTURE_FRAME_FORMAT, frame), p += 6;
+    else if (!strncmp(p, "{time}", 6)) lm_buf_printf(&b, CAPTURE_TIME_FORMAT, time), p += 5;
+    else lm_buf_append(&b, p, 1);
+  }
+  snprintf(out, cap, "%s", b.data ? b.data : "");
+  lm_buf_free(&b);
 }
 
 static void print_times(const capture_result *res, int frames, int warmup, lm_clock clock) {
@@ -333,6 +489,13 @@ int limn_capture(int argc, char **argv) {
     lm_pipeline_destroy(pipeline);
     return 2;
   }
+  int animation = LM_ANIM_ALL;
+  if (a.animation && (animation = lm_scene_find_animation(scene, a.animation, &err)) < LM_ANIM_NONE) {
+    lm_log(LM_LOG_ERROR, "--animation %s: %s", a.animation, err.msg);
+    lm_scene_destroy(scene);
+    lm_pipeline_destroy(pipeline);
+    return 2;
+  }
   a.camera = limn_camera_resolve(scene, a.camera, a.width, a.height);
   if (a.camera > 0 && a.camera >= scene->camera_count) {
     lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a.camera, a.scene, scene->camera_count);
@@ -363,11 +526,45 @@ int limn_capture(int argc, char **argv) {
             lm_gl_version(), lm_context_platform(), a.scene, script, lm_pipeline_technique(pipeline),
             a.width, a.height);
   capture_result res = {0};
-  if (ok) {
-    capture_view v = {.camera = a.camera, .width = a.width, .height = a.height, .frames = a.frames, .warmup = a.warmup,
-                      .outputs = a.outputs, .output_count = a.output_count, .quiet = a.quiet};
+  /* A sequence renders its frames through one renderer, so that temporal
+   * histories carry from frame to frame as they would live. */
+  char names[16][2048];
+  const char *outputs[16];
+  video videos[16];
+  unsigned char *rgb = a.video_count ? lm_alloc((size_t)a.width * a.height * 3) : NULL;
+  int opened = 0;
+  if (a.video_count) signal(SIGPIPE, SIG_IGN); /* a failed ffmpeg is an error from write, not a kill */
+  for (int i = 0; i < a.video_count && ok; i++)
+    if ((ok = video_open(&videos[i], a.videos[i], a.width, a.height, a.fps, &err))) opened++;
+  for (int k = 0; k < a.frame_count && ok; k++) {
+    double t = a.frame_count > 1 ? a.time_start + k / a.fps : a.time_start;
+    if (a.time_flag || a.animation) {
+      if (k == 0) /* the previous pose (velocities): the frame before's, a still's own */
+        lm_scene_set_time(scene, animation, a.frame_count > 1 ? t - 1 / a.fps : t);
+      lm_scene_set_time(scene, animation, t);
+      lm_scene_upload_deformed(scene);
+    }
+    for (int i = 0; i < a.output_count; i++) {
+      frame_name(a.outputs[i], k, t, names[i], sizeof names[i]);
+      outputs[i] = names[i];
+    }
+    capture_view v = {.camera = a.camera, .width = a.width, .height = a.height, .frames = a.frames,
+                      .warmup = k ? 0 : a.warmup, .outputs = outputs, .output_count = a.output_count,
+                      .quiet = a.quiet, .continues = k > 0};
+    capture_result_free(&res);
     ok = capture_render_write(r, &v, &res, &err);
+    if (ok && a.video_count) ok = lm_renderer_read(r, false, rgb, &err);
+    for (int i = 0; i < a.video_count && ok; i++) ok = video_write(&videos[i], rgb, (size_t)a.width * a.height * 3, &err);
+    if (!ok && a.frame_count > 1) lm_error_prefix(&err, "frame %d at %.3f s", k, t);
   }
+  for (int i = 0; i < opened; i++) {
+    lm_error e;
+    if (!video_close(&videos[i], ok, &e) && ok) err = e, ok = false;
+    else if (ok && !a.quiet) lm_info("wrote %s", videos[i].path);
+  }
+  free(rgb);
+  if (ok && !a.quiet && a.frame_count > 1) printf("%d frames, %.3f s to %.3f s at %g fps (times: the last frame's)\n",
+                                                  a.frame_count, a.time_start, a.time_stop, a.fps);
   if (ok && !a.quiet) print_times(&res, a.frames, a.warmup, lm_renderer_clock(r));
   if (!ok) lm_log(LM_LOG_ERROR, "%s", err.msg);
   capture_result_free(&res);

@@ -11,7 +11,14 @@ typedef struct capture_view {
   const char *const *outputs; /* .png (sRGB), .exr (linear), ... */
   int output_count;
   bool quiet;
+  /* The next frame of a sequence through the same camera and size: the
+   * renderer keeps its temporal histories (no lm_renderer_set_view). */
+  bool continues;
 } capture_view;
+
+/* How outputs name a sequence's frame and time ({frame}, {time}). */
+#define CAPTURE_FRAME_FORMAT "%04d"
+#define CAPTURE_TIME_FORMAT "%.3f"
 
 typedef struct capture_pass_time {
   const char *name, *kind;

@@ -11,10 +11,22 @@
  *     frames = 1,
  *     output = "out/{scene}/{camera}_{technique}_{size}.png",
  *     manifest = "out/manifest.json",             -- default: beside the images
+ *     time = { 0, 2, 24 },                        -- a sequence: start, stop (seconds), fps;
+ *                                                 -- or time = 1.5, a still at that time
+ *     animation = "walk",                         -- name or index (default all)
+ *     path = { { t = 0, eye = { 0, 1, 5 }, target = { 0, 1, 0 }, fov = 45 }, ... },
+ *                                                 -- or "file.cams" / { cameras = "file.cams",
+ *                                                 -- times = {...} }; or instead
+ *     turntable = { turns = 1, elevation = 20, distance = "auto" },
  *   }
  *
- * Views are numbered scene by scene, then size, technique and camera; a
- * shard I/N renders views I, I+N, ... An image that exists is skipped unless
+ * Views are numbered scene by scene, then size, technique, camera and frame
+ * (a sequence's frames are consecutive views); a shard I/N renders views I,
+ * I+N, ... of a still job and the I-th of N contiguous runs of a sequence's
+ * views (job_shard_of). A shard starts its run cold: it does not render the
+ * frames before it to warm temporal histories up, so that shards cost the
+ * same and never render a frame twice (it poses the scene at the frame
+ * before first, for velocities). An image that exists is skipped unless
  * --force. The manifest is rewritten (whole, renamed into place) after each
  * image, so a killed job leaves it consistent with the files on disk. */
 #define _GNU_SOURCE
@@ -23,6 +35,7 @@
 #include <signal.h>
 #include <lauxlib.h>
 #include <lua.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -186,6 +199,230 @@ static bool read_sets(lua_State *L, job *j, lm_error *err) {
   return ok;
 }
 
+/* A finite number at t[key] (or t[index] when key is NULL) into *out; nil
+ * leaves *out. */
+static bool field_number(lua_State *L, int t, const char *key, int index, double *out, const char *what,
+                         lm_error *err) {
+  if (key) lua_getfield(L, t, key);
+  else lua_rawgeti(L, t, index);
+  bool ok = true;
+  if (lua_type(L, -1) == LUA_TNUMBER && isfinite(lua_tonumber(L, -1))) {
+    *out = lua_tonumber(L, -1);
+  } else if (lua_type(L, -1) == LUA_TNUMBER) {
+    lm_error_set(err, "%s: %g is not a finite number", what, lua_tonumber(L, -1));
+    ok = false;
+  } else if (!lua_isnil(L, -1)) {
+    lm_error_set(err, "%s: a number, not a %s", what, luaL_typename(L, -1));
+    ok = false;
+  }
+  lua_pop(L, 1);
+  return ok;
+}
+
+/* time = seconds | { start, stop, fps } (or named). */
+static bool read_time(lua_State *L, job *j, lm_error *err) {
+  char what[1100];
+  lua_getfield(L, -1, "time");
+  int type = lua_type(L, -1);
+  bool ok = true;
+  j->timed = type != LUA_TNIL;
+  j->frame_count = 1;
+  if (type == LUA_TNUMBER) {
+    snprintf(what, sizeof what, "%s: time", j->path);
+    lua_pop(L, 1);
+    ok = field_number(L, -1, "time", 0, &j->time_start, what, err);
+    j->time_stop = j->time_start;
+    return ok;
+  }
+  if (type == LUA_TTABLE) {
+    static const char *const names[3] = {"start", "stop", "fps"};
+    double v[3] = {NAN, NAN, NAN};
+    for (int i = 0; i < 3 && ok; i++) {
+      snprintf(what, sizeof what, "%s: time.%s", j->path, names[i]);
+      ok = field_number(L, -1, NULL, i + 1, &v[i], what, err) && field_number(L, -1, names[i], 0, &v[i], what, err);
+      if (ok && isnan(v[i])) {
+        lm_error_set(err, "%s: missing (time = { start, stop, fps }, seconds and frames a second)", what);
+        ok = false;
+      }
+    }
+    if (ok && v[1] < v[0]) {
+      lm_error_set(err, "%s: time.stop: %g is before time.start %g", j->path, v[1], v[0]);
+      ok = false;
+    } else if (ok && !(v[2] > 0)) {
+      lm_error_set(err, "%s: time.fps: %g frames a second; want a number above 0", j->path, v[2]);
+      ok = false;
+    } else if (ok && (v[1] - v[0]) * v[2] >= MAX_FRAMES) {
+      lm_error_set(err, "%s: time: %g s at %g fps is more than %d frames", j->path, v[1] - v[0], v[2], MAX_FRAMES);
+      ok = false;
+    }
+    if (ok) {
+      j->time_start = v[0], j->time_stop = v[1], j->fps = v[2];
+      j->frame_count = (int)floor((v[1] - v[0]) * v[2] + 1e-9) + 1;
+    }
+  } else if (type != LUA_TNIL) {
+    lm_error_set(err, "%s: time: seconds, or { start, stop, fps }, not a %s", j->path, luaL_typename(L, -1));
+    ok = false;
+  }
+  lua_pop(L, 1);
+  return ok;
+}
+
+/* path[i]'s eye or target: three finite numbers. */
+static bool read_point(lua_State *L, const char *key, float out[3], const char *what, lm_error *err) {
+  lua_getfield(L, -1, key);
+  bool ok = lua_istable(L, -1) && lua_rawlen(L, -1) == 3;
+  for (int k = 0; k < 3 && ok; k++) {
+    lua_rawgeti(L, -1, k + 1);
+    ok = lua_type(L, -1) == LUA_TNUMBER && isfinite(lua_tonumber(L, -1)) && fabs(lua_tonumber(L, -1)) < 1e9;
+    out[k] = (float)lua_tonumber(L, -1);
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  if (!ok) lm_error_set(err, "%s.%s: needs 3 numbers", what, key);
+  return ok;
+}
+
+/* The keys of a camera list (engine/scene/camlist.c): each view's eye, a
+ * target one unit along its direction (the list keeps directions, not
+ * distances) and its fov, at `times` or evenly over the job's time. */
+static bool read_path_list(lua_State *L, job *j, const char *given, lm_error *err) {
+  char file[1024];
+  resolve(j, given, file, sizeof file);
+  lm_scene *scratch = lm_scene_create("path");
+  int count = 0, first = lm_scene_add_camera_list(scratch, file, &count, err);
+  bool ok = first >= 0;
+  if (!ok) lm_error_prefix(err, "%s: path", j->path);
+  if (ok && count > MAX_PATH_KEYS) {
+    lm_error_set(err, "%s: path: %s has %d views; at most %d", j->path, file, count, MAX_PATH_KEYS);
+    ok = false;
+  }
+  bool has_times = false;
+  if (ok && lua_istable(L, -1)) {
+    lua_getfield(L, -1, "times");
+    has_times = !lua_isnil(L, -1);
+    if (!has_times) lua_pop(L, 1);
+  }
+  if (has_times && (!lua_istable(L, -1) || (int)lua_rawlen(L, -1) != count)) {
+    lm_error_set(err, "%s: path.times: a list of %d times (one for each view of %s)", j->path, count, file);
+    ok = false;
+  }
+  for (int i = 0; i < count && ok; i++) {
+    camera_key *k = &j->keys[i];
+    const float *w = scratch->nodes[scratch->cameras[first + i].node].world;
+    for (int c = 0; c < 3; c++) k->eye[c] = w[12 + c], k->target[c] = w[12 + c] - w[8 + c];
+    k->fov = scratch->cameras[first + i].fov_y * (float)(180 / M_PI);
+    k->t = count == 1 ? j->time_start : j->time_start + (j->time_stop - j->time_start) * i / (count - 1);
+    if (has_times) {
+      char what[1100];
+      snprintf(what, sizeof what, "%s: path.times[%d]", j->path, i + 1);
+      k->t = NAN;
+      ok = field_number(L, -1, NULL, i + 1, &k->t, what, err);
+      if (ok && !isfinite(k->t)) lm_error_set(err, "%s: a number of seconds", what), ok = false;
+    }
+  }
+  if (has_times) lua_pop(L, 1);
+  j->key_count = ok ? count : 0;
+  lm_scene_destroy(scratch);
+  return ok;
+}
+
+/* One key of a path's list: path[i] = { t = SECONDS, eye = {x,y,z}, target = {x,y,z}, fov = DEGREES }. */
+static bool read_key(lua_State *L, job *j, int i, lm_error *err) {
+  char what[1100], field[1120];
+  snprintf(what, sizeof what, "%s: path[%d]", j->path, i);
+  camera_key *k = &j->keys[i - 1];
+  lua_rawgeti(L, -1, i);
+  bool ok = lua_istable(L, -1);
+  if (!ok)
+    lm_error_set(err, "%s: a key { t = SECONDS, eye = {x,y,z}, target = {x,y,z}, fov = DEGREES }, not a %s", what,
+                 luaL_typename(L, -1));
+  double t = NAN, fov = i > 1 ? j->keys[i - 2].fov : 45; /* fov: the previous key's */
+  snprintf(field, sizeof field, "%s.t", what);
+  ok = ok && field_number(L, -1, "t", 0, &t, field, err);
+  snprintf(field, sizeof field, "%s.fov", what);
+  ok = ok && field_number(L, -1, "fov", 0, &fov, field, err);
+  ok = ok && read_point(L, "eye", k->eye, what, err) && read_point(L, "target", k->target, what, err);
+  lua_pop(L, 1);
+  if (ok && isnan(t)) lm_error_set(err, "%s.t: missing (the key's time in seconds)", what), ok = false;
+  k->t = t, k->fov = (float)fov;
+  return ok;
+}
+
+/* path = { key, ... }, "file.cams" or { cameras = "file.cams", times = {...} }. */
+static bool read_path(lua_State *L, job *j, lm_error *err) {
+  lua_getfield(L, -1, "path");
+  bool ok = true;
+  if (lua_type(L, -1) == LUA_TSTRING) {
+    char given[1024];
+    snprintf(given, sizeof given, "%s", lua_tostring(L, -1));
+    ok = read_path_list(L, j, given, err);
+  } else if (lua_istable(L, -1)) {
+    lua_getfield(L, -1, "cameras");
+    char given[1024] = "";
+    if (lua_type(L, -1) == LUA_TSTRING) snprintf(given, sizeof given, "%s", lua_tostring(L, -1));
+    lua_pop(L, 1);
+    int n = (int)lua_rawlen(L, -1);
+    if (given[0]) {
+      ok = read_path_list(L, j, given, err);
+    } else if (n < 1 || n > MAX_PATH_KEYS) {
+      lm_error_set(err, "%s: path: 1 to %d keys { t = SECONDS, eye = {x,y,z}, target = {x,y,z}, fov = DEGREES }, "
+                   "or { cameras = FILE, times = {...} }", j->path, MAX_PATH_KEYS);
+      ok = false;
+    }
+    for (int i = 1; i <= n && ok && !given[0]; i++) ok = read_key(L, j, i, err);
+    if (ok && !given[0]) j->key_count = n;
+  } else if (!lua_isnil(L, -1)) {
+    lm_error_set(err, "%s: path: a list of keys or a camera list file, not a %s", j->path, luaL_typename(L, -1));
+    ok = false;
+  }
+  lua_pop(L, 1);
+  for (int i = 0; i < j->key_count && ok; i++) {
+    const camera_key *k = &j->keys[i];
+    float d[3] = {k->target[0] - k->eye[0], k->target[1] - k->eye[1], k->target[2] - k->eye[2]};
+    if (i > 0 && !(k->t > k[-1].t))
+      lm_error_set(err, "%s: path[%d].t: %g is not after path[%d].t (%g)", j->path, i + 1, k->t, i, k[-1].t), ok = false;
+    else if (!(k->fov > 0.1f && k->fov < 179))
+      lm_error_set(err, "%s: path[%d].fov: %g degrees is outside (0.1, 179)", j->path, i + 1, k->fov), ok = false;
+    else if (!(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > 0))
+      lm_error_set(err, "%s: path[%d]: the eye is at the target", j->path, i + 1), ok = false;
+  }
+  return ok;
+}
+
+/* turntable = { turns = 1, elevation = 20, distance = "auto" | number }. */
+static bool read_turntable(lua_State *L, job *j, lm_error *err) {
+  lua_getfield(L, -1, "turntable");
+  bool ok = true;
+  j->turns = 1, j->elevation = 20, j->distance = 0;
+  if (lua_istable(L, -1)) {
+    char what[1100];
+    j->turntable = true;
+    snprintf(what, sizeof what, "%s: turntable.turns", j->path);
+    ok = field_number(L, -1, "turns", 0, &j->turns, what, err);
+    snprintf(what, sizeof what, "%s: turntable.elevation", j->path);
+    ok = ok && field_number(L, -1, "elevation", 0, &j->elevation, what, err);
+    if (ok && !(fabs(j->elevation) < 89)) {
+      lm_error_set(err, "%s: %g degrees; want one within (-89, 89)", what, j->elevation);
+      ok = false;
+    }
+    lua_getfield(L, -1, "distance");
+    bool is_auto = lua_isnil(L, -1) || (lua_type(L, -1) == LUA_TSTRING && !strcmp(lua_tostring(L, -1), "auto"));
+    lua_pop(L, 1);
+    snprintf(what, sizeof what, "%s: turntable.distance", j->path);
+    if (ok && !is_auto) ok = field_number(L, -1, "distance", 0, &j->distance, what, err);
+    if (ok && !is_auto && !(j->distance > 0 && j->distance < 1e9)) {
+      lm_error_set(err, "%s: %g; want \"auto\" or a distance in (0, 1e9)", what, j->distance);
+      ok = false;
+    }
+  } else if (!lua_isnil(L, -1)) {
+    lm_error_set(err, "%s: turntable: a table { turns = 1, elevation = 20, distance = \"auto\" }, not a %s",
+                 j->path, luaL_typename(L, -1));
+    ok = false;
+  }
+  lua_pop(L, 1);
+  return ok;
+}
+
 static int compare_sets(const void *a, const void *b) { return strcmp(a, b); }
 
 bool job_read(job *j, const char *path, lm_error *err) {
@@ -218,7 +455,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
     return false;
   }
   static const char *const known[] = {"script", "scenes", "techniques", "sizes", "set", "frames", "output",
-                                      "manifest", NULL};
+                                      "manifest", "time", "animation", "path", "turntable", NULL};
   lua_pushnil(L);
   while (ok && lua_next(L, -2)) {
     lua_pop(L, 1);
@@ -226,7 +463,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
     for (const char *const *k = known; *k && lua_type(L, -1) == LUA_TSTRING; k++) found |= !strcmp(*k, lua_tostring(L, -1));
     if (!found) {
       lm_error_set(err, "%s: unknown field '%s' (known: script, scenes, techniques, sizes, set, frames, output, "
-                   "manifest)", path, lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : luaL_typename(L, -1));
+                   "manifest, time, animation, path, turntable)", path, lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : luaL_typename(L, -1));
       ok = false;
       lua_pop(L, 1);
     }
@@ -237,7 +474,15 @@ bool job_read(job *j, const char *path, lm_error *err) {
        field_string(L, -1, "manifest", manifest, sizeof manifest, path, err) &&
        read_list(L, -1, "scenes", path, &j->scene_count, err, each_scene, j) &&
        read_list(L, -1, "techniques", path, &j->technique_count, err, each_technique, j) &&
-       read_list(L, -1, "sizes", path, &j->size_count, err, each_size, j) && read_sets(L, j, err);
+       read_list(L, -1, "sizes", path, &j->size_count, err, each_size, j) && read_sets(L, j, err) &&
+       read_time(L, j, err) && read_path(L, j, err) && read_turntable(L, j, err);
+  if (ok) { /* a name, or an index as a number */
+    lua_getfield(L, -1, "animation");
+    if (lua_isinteger(L, -1)) lua_pushfstring(L, "%d", (int)lua_tointeger(L, -1)), lua_setfield(L, -3, "animation");
+    lua_pop(L, 1);
+    ok = field_string(L, -1, "animation", j->animation, sizeof j->animation, path, err);
+    j->timed |= j->animation[0] != '\0';
+  }
   if (ok) {
     lua_getfield(L, -1, "frames");
     j->frames = lua_isnil(L, -1) ? 1 : (int)lua_tointeger(L, -1);
@@ -261,6 +506,20 @@ bool job_read(job *j, const char *path, lm_error *err) {
   bool linear;
   if (!capture_known_extension(j->output, &linear)) {
     lm_error_set(err, "%s: output '%s': end it in .png, .exr, .jpg, .tif or .hdr", path, j->output);
+    return false;
+  }
+  if (j->key_count && j->turntable) {
+    lm_error_set(err, "%s: path and turntable: one camera motion at a time", path);
+    return false;
+  }
+  if ((j->key_count || j->turntable) && !j->timed) {
+    lm_error_set(err, "%s: %s: needs time = { start, stop, fps } (or time = SECONDS)", path,
+                 j->turntable ? "turntable" : "path");
+    return false;
+  }
+  if (j->frame_count > 1 && !strstr(j->output, "{frame}")) {
+    lm_error_set(err, "%s: output: a sequence of %d frames needs {frame} in the pattern (\"%s\")", path,
+                 j->frame_count, j->output);
     return false;
   }
   if (!j->size_count) j->sizes[0][0] = 256, j->sizes[0][1] = 192, j->size_count = 1;
@@ -292,7 +551,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
 
 /* ---- output names -------------------------------------------------------- */
 
-/* Fills the pattern's {scene} {camera} {view} {technique} {size} {width} {height}. */
+/* Fills the pattern's {scene} {camera} {view} {technique} {size} {width} {height} {frame} {time}. */
 static bool expand(const job *j, const job_view *v, int index, char *out, size_t cap, lm_error *err) {
   const job_scene *s = &j->scenes[v->scene];
   lm_buf b = {0};
@@ -312,9 +571,11 @@ static bool expand(const job *j, const job_view *v, int index, char *out, size_t
     else if (!strcmp(key, "size")) lm_buf_printf(&b, "%dx%d", j->sizes[v->size][0], j->sizes[v->size][1]);
     else if (!strcmp(key, "width")) lm_buf_printf(&b, "%d", j->sizes[v->size][0]);
     else if (!strcmp(key, "height")) lm_buf_printf(&b, "%d", j->sizes[v->size][1]);
+    else if (!strcmp(key, "frame")) lm_buf_printf(&b, CAPTURE_FRAME_FORMAT, v->frame);
+    else if (!strcmp(key, "time")) lm_buf_printf(&b, CAPTURE_TIME_FORMAT, v->time);
     else {
       lm_error_set(err, "%s: output: unknown placeholder '{%s}' (known: {scene} {camera} {view} {technique} "
-                   "{size} {width} {height})", j->path, key);
+                   "{size} {width} {height} {frame} {time})", j->path, key);
       ok = false;
     }
     if (close) p = close;
@@ -417,13 +678,20 @@ bool job_manifest_load(const char *path, const job_view *views, int view_count, 
     if (!f) continue;
     size_t n = strlen(line);
     while (n && (line[n - 1] == ',' || line[n - 1] == ' ')) line[--n] = '\0';
-    for (int i = 0; i < view_count; i++) {
+    /* The view the entry names first (a sequence has many), then any whose output it is. */
+    const char *number = strstr(f, "\"view\": ");
+    int named = number ? atoi(number + 8) : -1;
+    for (int k = -1; k < view_count; k++) {
+      int i = k < 0 ? named : k;
+      if (i < 0 || i >= view_count || (k >= 0 && i == named)) continue;
       lm_buf key = {0};
       lm_buf_append(&key, "{\"file\": ", -1);
       limn_json_append(&key, views[i].output);
       lm_buf_append(&key, ",", 1);
-      if (!strncmp(f, key.data, (size_t)key.len) && !m->entries[i]) m->entries[i] = lm_strdup(f);
+      bool match = !strncmp(f, key.data, (size_t)key.len);
+      if (match && !m->entries[i]) m->entries[i] = lm_strdup(f);
       lm_buf_free(&key);
+      if (match) break; /* outputs are unique */
     }
   }
   free(text);
@@ -485,6 +753,7 @@ static char *manifest_entry(const job *j, const job_view *v, int index, const ca
   limn_json_append(&b, s->scene->cameras[v->camera].name);
   lm_buf_append(&b, ", \"technique\": ", -1);
   limn_json_append(&b, j->techniques[v->technique]);
+  if (j->timed) lm_buf_printf(&b, ", \"frame\": %d, \"time\": %.6f", v->frame, v->time);
   lm_buf_printf(&b, ", \"width\": %d, \"height\": %d, \"frames\": %d, \"drawn\": %d, \"culled\": %d, "
                 "\"triangles\": %ld, \"total_ms\": %.3f, \"passes\": [",
                 j->sizes[v->size][0], j->sizes[v->size][1], j->frames, res->stats.drawn, res->stats.culled,
@@ -498,50 +767,140 @@ static char *manifest_entry(const job *j, const job_view *v, int index, const ca
   return b.data;
 }
 
+static int compare_outputs(const void *a, const void *b) {
+  const job_view *x = *(const job_view *const *)a, *y = *(const job_view *const *)b;
+  int c = strcmp(x->output, y->output);
+  return c ? c : (x > y) - (x < y); /* ties in view order */
+}
+
+/* False, naming two views, when two views write one file (sorted: a long
+ * sequence's views are many). */
+static bool unique_outputs(const job *j, const job_view *views, int n, lm_error *err) {
+  const job_view **sorted = lm_alloc(sizeof *sorted * (size_t)(n + 1));
+  for (int i = 0; i < n; i++) sorted[i] = &views[i];
+  qsort(sorted, (size_t)n, sizeof *sorted, compare_outputs);
+  bool ok = true;
+  for (int i = 1; i < n && ok; i++)
+    if (!strcmp(sorted[i - 1]->output, sorted[i]->output)) {
+      lm_error_set(err, "%s: output: views %d and %d both write %s (add {camera}, {technique} or {size} to the "
+                   "pattern)", j->path, (int)(sorted[i - 1] - views), (int)(sorted[i] - views), sorted[i]->output);
+      ok = false;
+    }
+  free(sorted);
+  return ok;
+}
+
+/* Scene s's views: its camera list's, or the one camera a path or turntable
+ * moves (job_pose); and the job's animation in it. */
+static bool add_cameras(const job *j, job_scene *s, lm_error *err) {
+  lm_scene *sc = s->scene;
+  s->path_camera = -1;
+  s->animation = LM_ANIM_ALL;
+  if (j->animation[0] && (s->animation = lm_scene_find_animation(sc, j->animation, err)) < LM_ANIM_NONE) {
+    lm_error_prefix(err, "animation");
+    return false;
+  }
+  float lo[3], hi[3], d2 = 0;
+  lm_scene_bounds(sc, lo, hi);
+  for (int k = 0; k < 3; k++) s->centre[k] = 0.5f * (lo[k] + hi[k]), d2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+  s->radius = d2 > 0 ? 0.5f * sqrtf(d2) : 1;
+  if (!j->key_count && !j->turntable) {
+    s->first_camera = lm_scene_add_camera_list(sc, s->cameras, &s->camera_count, err);
+    return s->first_camera >= 0;
+  }
+  int cam;
+  if (j->turntable) { /* its distance, unless given: that of the camera framing the scene */
+    cam = lm_scene_add_framing_camera(sc, "turntable", 0);
+    const float *w = sc->nodes[sc->cameras[cam].node].world;
+    float e[3] = {w[12] - s->centre[0], w[13] - s->centre[1], w[14] - s->centre[2]};
+    s->orbit = j->distance > 0 ? (float)j->distance : sqrtf(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+  } else {
+    lm_camera c = {.name = "path", .fov_y = 0.25f * (float)M_PI};
+    const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    c.node = lm_scene_add_node(sc, c.name, -1, identity, -1, -1);
+    cam = lm_scene_add_camera(sc, &c);
+  }
+  s->path_camera = s->first_camera = cam;
+  s->camera_count = 1;
+  return true;
+}
+
+void job_pose(const job *j, const job_view *v) {
+  const job_scene *s = &j->scenes[v->scene];
+  lm_scene *sc = s->scene;
+  if (j->timed) lm_scene_set_time(sc, s->animation, v->time);
+  if (s->path_camera < 0 || v->camera != s->path_camera) return;
+  float eye[3], target[3], fov = 45, world[16];
+  if (j->turntable) { /* one turn (times turns) over the time range, from the framing camera's side (+Z) */
+    double span = j->time_stop - j->time_start;
+    double a = span > 0 ? 2 * M_PI * j->turns * (v->time - j->time_start) / span : 0;
+    double e = j->elevation * M_PI / 180;
+    float offset[3] = {(float)(sin(a) * cos(e)), (float)sin(e), (float)(cos(a) * cos(e))};
+    for (int k = 0; k < 3; k++) eye[k] = s->centre[k] + s->orbit * offset[k], target[k] = s->centre[k];
+  } else {
+    camera_path_eval(j->keys, j->key_count, v->time, eye, target, &fov);
+  }
+  camera_look_at(eye, target, world);
+  lm_camera *c = &sc->cameras[s->path_camera];
+  lm_scene_node_set_world(sc, c->node, world);
+  c->fov_y = fov * (float)(M_PI / 180);
+  /* Near and far as a camera list's (engine/scene/camlist.c): far past the whole scene. */
+  float d2 = 0;
+  for (int k = 0; k < 3; k++) d2 += (eye[k] - s->centre[k]) * (eye[k] - s->centre[k]);
+  c->zfar = 1.5f * (sqrtf(d2) + s->radius);
+  c->znear = c->zfar * 1e-4f;
+}
+
+int job_shard_of(const job *j, int i, int count, int shards) {
+  if (j->frame_count <= 1) return i % shards;
+  return (int)((long long)i * shards / count);
+}
+
 bool job_views(job *j, bool all_techniques, job_view **out, int *count, lm_error *err) {
   *out = NULL;
   *count = 0;
   /* Every scene and camera list is read before anything renders: a bad
    * entry stops the job at once, naming it. */
-  int techniques = all_techniques ? j->technique_count : 1, view_count = 0;
+  int techniques = all_techniques ? j->technique_count : 1;
+  long long view_count = 0;
   for (int i = 0; i < j->scene_count; i++) {
     job_scene *s = &j->scenes[i];
     if (!s->scene) {
       s->scene = lm_scene_load_gltf(s->path, err);
-      if (s->scene) s->first_camera = lm_scene_add_camera_list(s->scene, s->cameras, &s->camera_count, err);
+      if (s->scene && !add_cameras(j, s, err)) s->first_camera = -1;
       if (!s->scene || s->first_camera < 0) {
         lm_error_prefix(err, "%s: scenes[%d]", j->path, i + 1);
         return false;
       }
       s->hash = hash_file(s->cameras, hash_file(s->path, LM_HASH_SEED));
     }
-    view_count += s->camera_count * j->size_count * techniques;
+    view_count += (long long)s->camera_count * j->size_count * techniques * j->frame_count;
+  }
+  if (view_count > MAX_VIEWS) {
+    lm_error_set(err, "%s: %lld views (scenes' cameras x sizes x techniques x frames); at most %d: split the job",
+                 j->path, view_count, MAX_VIEWS);
+    return false;
   }
   job_view *views = lm_alloc(sizeof *views * (size_t)(view_count + 1));
   int n = 0;
   for (int si = 0; si < j->scene_count; si++)
     for (int z = 0; z < j->size_count; z++)
       for (int t = 0; t < techniques; t++)
-        for (int c = 0; c < j->scenes[si].camera_count; c++) {
-          job_view *v = &views[n];
-          *v = (job_view){.scene = si, .camera = j->scenes[si].first_camera + c, .size = z, .technique = t};
-          if (!all_techniques) { /* places only: no output pattern */
-            n++;
-            continue;
-          }
-          if (!expand(j, v, n, v->output, sizeof v->output, err)) {
-            free(views);
-            return false;
-          }
-          for (int k = 0; k < n; k++)
-            if (!strcmp(views[k].output, v->output)) {
-              lm_error_set(err, "%s: output: views %d and %d both write %s (add {camera}, {technique} or "
-                           "{size} to the pattern)", j->path, k, n, v->output);
+        for (int c = 0; c < j->scenes[si].camera_count; c++)
+          for (int f = 0; f < j->frame_count; f++) {
+            job_view *v = &views[n];
+            *v = (job_view){.scene = si, .camera = j->scenes[si].first_camera + c, .size = z, .technique = t,
+                            .frame = f, .time = j->fps > 0 ? j->time_start + f / j->fps : j->time_start};
+            if (all_techniques && !expand(j, v, n, v->output, sizeof v->output, err)) { /* places: no output */
               free(views);
               return false;
             }
-          n++;
-        }
+            n++;
+          }
+  if (all_techniques && !unique_outputs(j, views, n, err)) {
+    free(views);
+    return false;
+  }
   *out = views;
   *count = n;
   return true;
@@ -639,13 +998,14 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   const char *kill_env = getenv("LIMN_JOB_KILL_AFTER");
   int kill_after = kill_env ? atoi(kill_env) : 0;
   int mine = 0, done = 0, rendered = 0, skipped = 0;
-  for (int i = 0; i < view_count; i++) mine += i % a->shards == a->shard;
+  for (int i = 0; i < view_count; i++) mine += job_shard_of(j, i, view_count, a->shards) == a->shard;
   if (!rc && !a->quiet)
     printf("job %s: %d view%s (%d in shard %d/%d); %s; %s\n", j->path, view_count, view_count == 1 ? "" : "s",
            mine, a->shard, a->shards, lm_gl_renderer(), manifest_path);
   lm_scene *current = j->scenes[0].scene;
+  int last = -1; /* the view rendered last */
   for (int i = 0; i < view_count && !rc; i++) {
-    if (i % a->shards != a->shard) continue;
+    if (job_shard_of(j, i, view_count, a->shards) != a->shard) continue;
     const job_view *v = &views[i];
     const job_scene *s = &j->scenes[v->scene];
     char what[1200];
@@ -660,9 +1020,21 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     bool ok = job_make_parent(v->output, &err) && lm_pipeline_set_technique(pipeline, j->techniques[v->technique], &err);
     if (ok && s->scene != current) ok = lm_renderer_set_scene(r, s->scene, &err), current = s->scene;
     if (ok) {
+      /* The next frame of the view rendered last: its temporal histories carry on. */
+      const job_view *p = last >= 0 && last == i - 1 ? &views[last] : NULL;
+      bool continues = p && p->scene == v->scene && p->size == v->size && p->technique == v->technique &&
+                       p->camera == v->camera && p->frame + 1 == v->frame;
+      if (!continues && j->timed) { /* posed after the frame before (a still after itself): the */
+        job_view before = *v;         /* previous pose, for velocities, though that is not rendered */
+        before.time -= j->fps > 0 ? 1 / j->fps : 0;
+        job_pose(j, &before);
+      }
+      job_pose(j, v);
+      lm_scene_upload_deformed(s->scene);
       const char *outs[1] = {v->output};
       capture_view cv = {.camera = v->camera, .width = j->sizes[v->size][0], .height = j->sizes[v->size][1],
-                         .frames = j->frames, .outputs = outs, .output_count = 1, .quiet = true};
+                         .frames = j->frames, .outputs = outs, .output_count = 1, .quiet = true,
+                         .continues = continues};
       ok = capture_render_write(r, &cv, &res, &err);
     }
     if (ok) {
@@ -672,12 +1044,15 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     }
     if (!ok) {
       if (tty && !a->quiet) printf("\n");
-      lm_log(LM_LOG_ERROR, "%s: view %d (%s, camera '%s', %s, %dx%d): %s", j->path, i, s->name,
+      char frame[64] = "";
+      if (j->timed) snprintf(frame, sizeof frame, ", frame %d at %.3f s", v->frame, v->time);
+      lm_log(LM_LOG_ERROR, "%s: view %d (%s, camera '%s', %s, %dx%d%s): %s", j->path, i, s->name,
              s->scene->cameras[v->camera].name, j->techniques[v->technique], j->sizes[v->size][0],
-             j->sizes[v->size][1], err.msg);
+             j->sizes[v->size][1], frame, err.msg);
       rc = 1;
     } else {
       rendered++;
+      last = i;
       snprintf(what, sizeof what, "%s (%.1f ms)", v->output, res.total_ms);
       job_progress(a->quiet, tty, ++done, mine, what);
       if (kill_after > 0 && rendered == kill_after) raise(SIGKILL);

@@ -4,15 +4,23 @@
 #ifndef LIMN_JOB_H
 #define LIMN_JOB_H
 
+#include "camera_path.h"
 #include "capture.h"
 
 #define MAX_LIST 64
+#define MAX_PATH_KEYS 256
+#define MAX_FRAMES 100000
+#define MAX_VIEWS 200000 /* a job's views, frames counted (about 1 KB each) */
 
 typedef struct job_scene {
   char path[1024], cameras[1024], name[LM_NAME_MAX];
   lm_scene *scene;
   int first_camera, camera_count;
   uint64_t hash;
+  int animation;      /* the job's `animation` in this scene (LM_ANIM_ALL by default) */
+  int path_camera;    /* the camera a `path` or `turntable` moves (-1: none) */
+  float centre[3], radius; /* of the scene's bounds as loaded: the orbit, near and far */
+  float orbit;        /* a turntable's distance from the centre */
 } job_scene;
 
 typedef struct job {
@@ -27,6 +35,17 @@ typedef struct job {
   int set_count;
   int frames;
   uint64_t hash;
+  /* `time`: timed false leaves the scenes as loaded. A sequence has
+   * frame_count frames at time_start + k / fps; a still (fps 0) one. */
+  bool timed;
+  double time_start, time_stop, fps;
+  int frame_count;
+  char animation[LM_NAME_MAX];
+  /* `path` (keys) or `turntable`: each scene's one view is a camera they move. */
+  camera_key keys[MAX_PATH_KEYS];
+  int key_count;
+  bool turntable;
+  double turns, elevation, distance; /* degrees; distance 0: auto (the scene framed) */
 } job;
 
 typedef struct job_view {
@@ -43,8 +62,9 @@ typedef struct job_view {
 
 /* Reads and checks the job file (Lua data); false with a message naming it. */
 bool job_read(job *j, const char *path, lm_error *err);
-/* Loads every scene and camera list (once) and lists the views in the job's
- * order: scene, size, technique, camera, with their outputs. Without
+/* Loads every scene and camera list (once; a path or turntable adds its
+ * camera instead) and lists the views in the job's order: scene, size,
+ * technique, camera, frame, with their outputs. Without
  * all_techniques, the places only (technique 0, no output): what does not
  * depend on the technique, as a reference render. *out is malloc'd. */
 bool job_views(job *j, bool all_techniques, job_view **out, int *count, lm_error *err);
@@ -53,6 +73,14 @@ void job_free_scenes(job *j);
  * with check_techniques its techniques must exist (an empty list becomes
  * the script's first). NULL after logging what is wrong. */
 lm_pipeline *job_pipeline(job *j, const char *const *sets, int set_count, bool check_techniques);
+/* Poses view v's scene at the view's time (lm_scene_set_time, when the job
+ * is timed) and moves the path's or turntable's camera there. The caller
+ * uploads deformed meshes where there is a GL context. */
+void job_pose(const job *j, const job_view *v);
+/* The shard (of `shards`) that renders view i of `count`: i % shards for
+ * stills; for sequences contiguous runs of views, so that a shard renders
+ * consecutive frames and temporal histories carry from frame to frame. */
+int job_shard_of(const job *j, int i, int count, int shards);
 /* Creates the folders above `file`. */
 bool job_make_parent(const char *file, lm_error *err);
 /* A progress bar on a terminal (tty), else one line per item. */

@@ -148,7 +148,7 @@ static int merge(const merge_args *a, job *j) {
         count++;
       }
     describe(j, &views[i], i, true, what, sizeof what);
-    int shard = i % a->shards;
+    int shard = job_shard_of(j, i, n, a->shards);
     if (count > 1) {
       if (++duplicated <= SHOWN) lm_log(LM_LOG_ERROR, "%s %s: rendered %d times, in %s", what, views[i].output, count,
                                         where.data);
@@ -174,8 +174,9 @@ static int merge(const merge_args *a, job *j) {
       refs_missing++;
     } else if (!lm_file_exists(path)) {
       if (++refs_missing <= SHOWN)
-        lm_log(LM_LOG_ERROR, "reference of %s %s: missing (shard %d/%d)", what, path, p % a->shards, a->shards);
-      rerun[p % a->shards] = true;
+        lm_log(LM_LOG_ERROR, "reference of %s %s: missing (shard %d/%d)", what, path,
+               job_shard_of(j, p, place_count, a->shards), a->shards);
+      rerun[job_shard_of(j, p, place_count, a->shards)] = true;
     }
   }
 

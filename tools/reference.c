@@ -23,7 +23,9 @@ static const char reference_usage[] =
     "a capture job: each scene, camera and size (techniques do not matter here).\n"
     "Each reference is DIR/<scene>/<camera>_<WxH>-<hash>.exr, the hash that of\n"
     "the exported scene text: a view whose export has not changed is not\n"
-    "rendered again. POV-Ray runs in parallel, up to the core count.\n"
+    "rendered again. A sequence's frames are posed at their times, each\n"
+    "DIR/<scene>/<camera>_<WxH>-<frame>-<time>-<hash>.exr. POV-Ray runs in\n"
+    "parallel, up to the core count.\n"
     "\n"
     "options:\n"
     "  --job FILE           the capture job (README: Scenes and capture jobs)\n"
@@ -32,7 +34,8 @@ static const char reference_usage[] =
     "  --jobs N             POV-Ray runs at once (default: the core count)\n"
     "  --povray PROGRAM     the POV-Ray program (default povray)\n"
     "  --shard I/N          views I, I+N, I+2N ... only (numbered as capture's,\n"
-    "                       without techniques: scene, size, camera)\n"
+    "                       without techniques: scene, size, camera, frame; a\n"
+    "                       sequence's in N contiguous runs, as capture's)\n"
     "  --shard auto[/N]     the shard from a job array (as limn capture --shard)\n"
     "  --quiet              no progress\n"
     "  --radiosity, --count, --error-bound, --pretrace-start, --pretrace-end,\n"
@@ -57,6 +60,7 @@ static void clean(const char *s, char *out, size_t cap) {
 bool reference_export(const reference_args *a, const job *j, const job_view *v, lm_buf *sdl, char *path,
                       size_t cap, lm_error *err) {
   const job_scene *s = &j->scenes[v->scene];
+  job_pose(j, v); /* the scene and a path's camera at the view's time */
   lm_pov_desc d = a->pov;
   d.camera = v->camera;
   d.width = j->sizes[v->size][0];
@@ -78,11 +82,17 @@ bool reference_export(const reference_args *a, const job *j, const job_view *v, 
   char cmd[64];
   snprintf(cmd, sizeof cmd, "+FE +W%d +H%d -A", d.width, d.height);
   uint64_t h = lm_hash(sdl->data, (size_t)sdl->len, lm_hash(cmd, strlen(cmd), LM_HASH_SEED));
+  /* A sequence's frames: each its own file, the frame in its name and hash. */
+  char frame[64] = "";
+  if (j->timed) {
+    snprintf(frame, sizeof frame, "-" CAPTURE_FRAME_FORMAT "-" CAPTURE_TIME_FORMAT, v->frame, v->time);
+    h = lm_hash(frame, strlen(frame), h);
+  }
   char scene[LM_NAME_MAX], camera[LM_NAME_MAX];
   clean(s->name, scene, sizeof scene);
   clean(s->scene->cameras[v->camera].name, camera, sizeof camera);
-  snprintf(path, cap, "%s/%s/%s_%dx%d-%016llx.exr", a->refs, scene, camera[0] ? camera : "camera", d.width,
-           d.height, (unsigned long long)h);
+  snprintf(path, cap, "%s/%s/%s_%dx%d%s-%016llx.exr", a->refs, scene, camera[0] ? camera : "camera", d.width,
+           d.height, j->frame_count > 1 ? frame : "", (unsigned long long)h);
   return true;
 }
 
@@ -159,7 +169,7 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
   bool tty = isatty(STDOUT_FILENO);
   pov_run *runs = lm_alloc(sizeof *runs * (size_t)jobs);
   char what[1200];
-  for (int i = 0; i < n; i++) mine += i % a->shards == a->shard;
+  for (int i = 0; i < n; i++) mine += job_shard_of(j, i, n, a->shards) == a->shard;
   char in_shard[64] = "";
   if (a->shards > 1) snprintf(in_shard, sizeof in_shard, " (%d in shard %d/%d)", mine, a->shard, a->shards);
   if (!a->quiet) printf("references of %s: %d view%s%s, up to %d POV-Ray run%s at once; %s\n", j->path, n,
@@ -199,7 +209,7 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
       *r = runs[--running];
     }
     if (i == n) break;
-    if (i % a->shards != a->shard) continue;
+    if (job_shard_of(j, i, n, a->shards) != a->shard) continue;
     const job_view *v = &places[i];
     const job_scene *s = &j->scenes[v->scene];
     lm_buf sdl = {0};

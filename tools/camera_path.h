@@ -1,0 +1,24 @@
+/* Camera paths of capture jobs (tools/job.c): keyed views (eye, target,
+ * vertical field of view at times) interpolated smoothly for fly-throughs,
+ * and the look-at transform that turns a view into a camera node's world. */
+#ifndef LIMN_CAMERA_PATH_H
+#define LIMN_CAMERA_PATH_H
+
+typedef struct camera_key {
+  double t;            /* seconds; strictly increasing along a path */
+  float eye[3], target[3];
+  float fov;           /* vertical, degrees */
+} camera_key;
+
+/* The view at `t` on the path through keys[0 .. n-1] (n >= 1): eye, target
+ * and fov each on a centripetal Catmull-Rom curve (alpha 0.5), held at the
+ * first and last key outside their times. Always finite from finite keys. */
+void camera_path_eval(const camera_key *keys, int n, double t, float eye[3], float target[3], float *fov);
+
+/* The world transform of a camera at `eye` looking at `target` (-Z forward,
+ * +Y up as glTF; straight up or down takes -Z for up), as camera lists make
+ * it (engine/scene/camlist.c), so a path's key renders as that list's view.
+ * An eye at the target looks down -Z. */
+void camera_look_at(const float eye[3], const float target[3], float world[16]);
+
+#endif
