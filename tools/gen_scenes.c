@@ -604,11 +604,13 @@ static void finish(doc *d, const char *dir, const char *name) {
   snprintf(path, sizeof path, "%s/%s.glb", dir, name);
   write_file(path, glb.data, glb.len);
   buf cams = {0};
-  putf(&cams, "# Views of %s.glb for capture jobs (written by tools/gen_scenes.c).\n"
-              "# name      eye (x y z)                  target (x y z)               fov_y (degrees)\n", name);
-  put(&cams, d->cams.data, d->cams.len);
-  snprintf(path, sizeof path, "%s/%s.cams", dir, name);
-  write_file(path, cams.data, cams.len);
+  if (d->cams.len > 0) { /* none: jobs take the file's cameras */
+    putf(&cams, "# Views of %s.glb for capture jobs (written by tools/gen_scenes.c).\n"
+                "# name      eye (x y z)                  target (x y z)               fov_y (degrees)\n", name);
+    put(&cams, d->cams.data, d->cams.len);
+    snprintf(path, sizeof path, "%s/%s.cams", dir, name);
+    write_file(path, cams.data, cams.len);
+  }
   printf("%s: %zu bytes, %d nodes, %d meshes, %d textures\n", name, glb.len, d->node_count, d->mesh_count,
          d->image_count);
   free(j.data), free(glb.data), free(cams.data), free(d->bin.data), free(d->views.data);
@@ -1153,14 +1155,15 @@ static void night(const char *dir) {
 
 /* The Cornell box seen from a camera that orbits it once in 4 s: a rotation
  * channel (LINEAR, a key every quarter turn) on a pivot at the box's centre,
- * the camera its child 3.4 in front. The camera list holds the still front
- * view. */
+ * the camera its child 3.4 in front. No camera list: a job over it renders
+ * the file's own cameras, the orbit first. */
 static void turntable(const char *dir) {
   doc d = {0};
   cornell_box(&d);
   int pivot = add_node(&d, "pivot", -1, 0, 1, 0);
   camera(&d, add_node(&d, "orbit", pivot, 0, 0, 3.4f), "orbit", 45, 20);
   view(&d, "front", 0, 1, 3.4f, 0, 1, 0, 45, 20);
+  d.cams.len = 0; /* the front view stays a glTF camera, not a list line */
   float times[5], q[5][4];
   for (int k = 0; k < 5; k++) times[k] = (float)k, axis_quat(0, 1, 0, 90.0f * (float)k, q[k]);
   anim a = {0};

@@ -127,6 +127,7 @@ static bool each_scene(lua_State *L, job *j, int i, lm_error *err) {
     return false;
   }
   resolve(j, given, s->path, sizeof s->path);
+  s->cameras_given = cams[0] != '\0';
   if (cams[0]) {
     resolve(j, cams, s->cameras, sizeof s->cameras);
   } else { /* beside the scene, .cams for .glb/.gltf */
@@ -455,7 +456,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
     return false;
   }
   static const char *const known[] = {"script", "scenes", "techniques", "sizes", "set", "frames", "output",
-                                      "manifest", "time", "animation", "path", "turntable", NULL};
+                                      "manifest", "time", "animation", "path", "turntable", "events", NULL};
   lua_pushnil(L);
   while (ok && lua_next(L, -2)) {
     lua_pop(L, 1);
@@ -463,7 +464,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
     for (const char *const *k = known; *k && lua_type(L, -1) == LUA_TSTRING; k++) found |= !strcmp(*k, lua_tostring(L, -1));
     if (!found) {
       lm_error_set(err, "%s: unknown field '%s' (known: script, scenes, techniques, sizes, set, frames, output, "
-                   "manifest, time, animation, path, turntable)", path, lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : luaL_typename(L, -1));
+                   "manifest, time, animation, path, turntable, events)", path, lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : luaL_typename(L, -1));
       ok = false;
       lua_pop(L, 1);
     }
@@ -805,6 +806,11 @@ static bool add_cameras(const job *j, job_scene *s, lm_error *err) {
   for (int k = 0; k < 3; k++) s->centre[k] = 0.5f * (lo[k] + hi[k]), d2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
   s->radius = d2 > 0 ? 0.5f * sqrtf(d2) : 1;
   if (!j->key_count && !j->turntable) {
+    if (!s->cameras_given && access(s->cameras, F_OK) != 0) { /* no list beside it: the file's own cameras */
+      s->first_camera = 0;
+      s->camera_count = sc->camera_count;
+      return true;
+    }
     s->first_camera = lm_scene_add_camera_list(sc, s->cameras, &s->camera_count, err);
     return s->first_camera >= 0;
   }

@@ -14,6 +14,7 @@
 
 typedef struct job_scene {
   char path[1024], cameras[1024], name[LM_NAME_MAX];
+  bool cameras_given; /* named in the job; else the list beside the scene, or the file's own cameras */
   lm_scene *scene;
   int first_camera, camera_count;
   uint64_t hash;

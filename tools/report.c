@@ -668,35 +668,6 @@ static bool read_events(const char *path, int *events, int *count, lm_error *err
   return ok;
 }
 
-/* Poses a sequence's scene at its frame's time. Every animation plays: a
- * job's choice of one belongs to the sequence jobs (tools/job.c). */
-static void pose(lm_scene *scene, double seconds) {
-  lm_scene_set_time(scene, LM_ANIM_ALL, seconds);
-  lm_scene_upload_deformed(scene);
-}
-
-/* A sequence's next frame on the view its first frame set, written to
- * `out` (EXR): lm_renderer_frame alone, since capture_render_write's
- * lm_renderer_set_view would drop the history that temporal reuse
- * reprojects. One frame, so res holds that frame's pass times. */
-static bool render_next_frame(lm_renderer *r, int w, int h, const char *out, capture_result *res, lm_error *err) {
-  *res = (capture_result){0};
-  if (!lm_renderer_frame(r, err)) return false;
-  lm_graph *g = lm_renderer_graph(r);
-  res->passes = lm_alloc(sizeof *res->passes * (size_t)(lm_graph_pass_count(g) + 1));
-  for (int i = 0; i < lm_graph_pass_count(g); i++) {
-    lm_graph_pass_info p = lm_graph_pass(g, i);
-    if (p.culled || p.ms < 0) continue;
-    res->passes[res->pass_count++] = (capture_pass_time){lm_strdup(p.name), lm_pass_kind_name(p.kind), p.ms};
-    res->total_ms += p.ms;
-  }
-  res->stats = lm_renderer_draw_stats(r);
-  float *linear = lm_alloc(sizeof *linear * (size_t)w * (size_t)h * 3);
-  bool ok = lm_renderer_read(r, true, linear, err) && lm_image_write(out, w, h, 3, true, linear, err);
-  free(linear);
-  return ok;
-}
-
 /* Where setting s's image of view v goes: one a place, and in a sequence
  * one a frame. */
 static void image_path(const report_args *a, const job *j, const job_view *v, int s, bool sequence, char *out,
@@ -864,12 +835,15 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
         lm_image ref = {0}, img = {0}, base = {0}, floor_ref = {0};
         bool ok = lm_image_read(refs[p], &ref, &err);
         if (ok && sc->scene != current) ok = lm_renderer_set_scene(r, sc->scene, &err), current = sc->scene;
-        if (ok && sequence) pose(sc->scene, v->time);
+        if (ok) job_pose(j, v); /* its time, and the camera a path or turntable moves */
         if (first_frame)
           ok = ok && set_setting(pipeline, &base_options, &a->settings[s], &err) && job_make_parent(out, &err) &&
                (warm.frames == 0 || capture_render_write(r, &warm, &scratch, &err)) &&
                capture_render_write(r, &cv, &row->res, &err);
-        else ok = ok && render_next_frame(r, w, h, out, &row->res, &err);
+        else ok = ok && capture_render_write(r, &(capture_view){.camera = v->camera, .width = w, .height = h,
+                                                                .frames = 1, .outputs = outs, .output_count = 1,
+                                                                .quiet = true, .continues = true},
+                                             &row->res, &err);
         capture_result_free(&scratch);
         if (ok) ok = lm_image_read(out, &img, &err) && lm_metrics_check(&img, out, &ref, refs[p], &err);
         if (ok) lm_metrics_compute(&img, &ref, &row->m);
