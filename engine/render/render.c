@@ -45,7 +45,13 @@ struct lm_renderer {
   lm_trace *trace; /* the scene's BVH, built by the first CPU "trace" pass */
   uint64_t trace_hash; /* geometry_hash when it was built or refitted */
   tile_cache tiles;
-  uint64_t casters_hash; /* this frame's caster_hash */
+  uint64_t casters_hash; /* this frame's material_hash */
+  float *prev_world; /* each node's world transform in the previous frame (velocities) */
+  int prev_world_count, prev_world_cap; /* nodes it holds (another count than the scene's: a first frame) */
+  int deformed;    /* meshes lm_scene_upload_deformed changed in this frame */
+  uint64_t pose;   /* frames in which deformed meshes changed (geometry_hash) */
+  uint64_t *deforms; /* per mesh: the frames in which it deformed (tile_casters) */
+  int deform_count, deform_cap;
   uint64_t world;  /* the last frame's world_hash */
   int still;       /* frames in a row before this one whose world_hash was this one's */
   long executions; /* frames executed, never reset (tile_cache.execution) */
@@ -77,6 +83,8 @@ void lm_renderer_destroy(lm_renderer *r) {
   lm_shadow_plan_free(&r->shadows);
   lm_light_grid_free(&r->light_grid);
   lm_trace_destroy(r->trace);
+  free(r->prev_world);
+  free(r->deforms);
   free(r);
 }
 
@@ -135,7 +143,7 @@ static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, lm_error *err) {
   lm_scene_draw_desc d = {.program = sp->program, .variant = scene_variant, .ctx = (void *)sp,
                           .view_proj = r->desc.no_culling ? NULL : view_proj,
                           .pancake = sp->view && sp->view->depth[3] == 0,
-                          .params = params, .param_count = n};
+                          .params = params, .param_count = n, .prev_world = r->prev_world};
   return lm_scene_draw(r->desc.scene, &d, sp->view ? &r->shadow_stats : &r->stats, err);
 }
 
@@ -149,14 +157,35 @@ static int pass_textures(const lm_scene_pass *sp, lm_graph_target_info out[LM_MA
   return n;
 }
 
+/* The casters a tile draws: each mesh node its cull volume keeps (as
+ * draw_pass culls: a cascade keeps those before its near plane), with its
+ * mesh, material, world transform and deformation count. A caster that moves
+ * changes the key of the tiles it touches now and of those it touched last
+ * frame (it left their set); the others stay cached. */
+static uint64_t tile_casters(const lm_renderer *r, const lm_pass_view *v, uint64_t h) {
+  const lm_scene *s = r->desc.scene;
+  bool pancake = v->depth[3] == 0;
+  for (int i = 0; i < s->node_count; i++) {
+    const lm_node *n = &s->nodes[i];
+    if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
+    if (!r->desc.no_culling && lm_scene_node_culled(s, i, v->cull, pancake)) continue;
+    int k[3] = {i, n->mesh, n->material};
+    h = lm_hash(k, sizeof k, h);
+    h = lm_hash(n->world, sizeof n->world, h);
+    if (n->mesh < r->deform_count) h = lm_hash(&r->deforms[n->mesh], sizeof r->deforms[n->mesh], h);
+  }
+  return h;
+}
+
 /* What a shadow tile's texels follow from: the view (place, matrices, cull
  * volume), the pass (technique's program, defines, clear colour, material
- * overrides) and the casters (caster_hash). */
+ * overrides), the scene's materials (casters_hash) and the casters in the
+ * tile (tile_casters). */
 static uint64_t tile_key(const lm_renderer *r, const lm_scene_pass *sp) {
   const lm_pass_view *v = sp->view;
   const lm_pass_desc *d = sp->desc;
   int place[4] = {v->x, v->y, v->width, v->height};
-  uint64_t h = lm_hash(place, sizeof place, r->casters_hash);
+  uint64_t h = lm_hash(place, sizeof place, tile_casters(r, v, r->casters_hash));
   h = lm_hash(v->view_proj, sizeof v->view_proj, h);
   h = lm_hash(v->depth, sizeof v->depth, h);
   h = lm_hash(v->cull, sizeof v->cull, h);
@@ -291,9 +320,13 @@ bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
   return true;
 }
 
-/* A hash of what the BVH is built from: mesh nodes, their meshes and world transforms. */
-static uint64_t geometry_hash(const lm_scene *s) {
-  uint64_t h = lm_hash(&s->node_count, sizeof s->node_count, 0);
+/* A hash of what the BVH is built from: mesh nodes, their meshes and world
+ * transforms, and the pose of deformed meshes (a counter of the frames in
+ * which the scene's time, animation or deformed vertices changed: cheaper
+ * than hashing the vertices). */
+static uint64_t geometry_hash(const lm_renderer *r) {
+  const lm_scene *s = r->desc.scene;
+  uint64_t h = lm_hash(&s->node_count, sizeof s->node_count, lm_hash(&r->pose, sizeof r->pose, 0));
   for (int i = 0; i < s->node_count; i++) {
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0) continue;
@@ -303,14 +336,11 @@ static uint64_t geometry_hash(const lm_scene *s) {
   return h;
 }
 
-/* A hash of what shadow tiles are drawn from beside their views: the scene,
- * its mesh nodes (mesh, material, world transform) and what the shadow and
- * RSM shaders read of the materials (colour, factors, base-colour texture,
- * alpha mask and texture transforms). */
-static uint64_t caster_hash(const lm_scene *s) {
-  uint64_t h = lm_hash(&s, sizeof s, geometry_hash(s));
-  for (int i = 0; i < s->node_count; i++)
-    if (s->nodes[i].mesh >= 0) h = lm_hash(&s->nodes[i].material, sizeof s->nodes[i].material, h);
+/* A hash of the scene and what the shadow and RSM shaders read of its
+ * materials (colour, factors, base-colour texture, alpha mask and texture
+ * transforms). */
+static uint64_t material_hash(const lm_scene *s) {
+  uint64_t h = lm_hash(&s, sizeof s, 0);
   for (int i = 0; i < s->material_count; i++) {
     const lm_material *m = &s->materials[i];
     const lm_material_pbr *p = &s->material_pbr[i];
@@ -324,6 +354,16 @@ static uint64_t caster_hash(const lm_scene *s) {
     h = lm_hash(p->uv_transform, sizeof p->uv_transform, h);
   }
   return h;
+}
+
+/* A hash of what shadow tiles are drawn from beside their views: the
+ * materials, and the mesh nodes (mesh, material, world transform, pose). */
+static uint64_t caster_hash(const lm_renderer *r) {
+  const lm_scene *s = r->desc.scene;
+  uint64_t h = lm_hash(&s, sizeof s, geometry_hash(r));
+  for (int i = 0; i < s->node_count; i++)
+    if (s->nodes[i].mesh >= 0) h = lm_hash(&s->nodes[i].material, sizeof s->nodes[i].material, h);
+  return lm_hash(&h, sizeof h, material_hash(s));
 }
 
 static float srgb_to_linear(unsigned char c) {
@@ -367,7 +407,7 @@ static bool run_trace(lm_renderer *r, const lm_cpu_pass *cp, lm_error *err) {
     return false;
   }
   const lm_scene *s = r->desc.scene;
-  uint64_t h = geometry_hash(s);
+  uint64_t h = geometry_hash(r);
   if (!r->trace) r->trace = lm_trace_create(s, NULL);
   else if (h != r->trace_hash) lm_trace_update(r->trace, s, NULL); /* nodes moved: refit (or rebuild) */
   r->trace_hash = h;
@@ -445,7 +485,7 @@ static uint64_t world_hash(const lm_renderer *r, const lm_pipeline *p, const lm_
   lm_light_data lights[MAX_LIGHTS];
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
   unsigned shaders = lm_programs_generation();
-  uint64_t h = lm_hash(&p, sizeof p, caster_hash(r->desc.scene));
+  uint64_t h = lm_hash(&p, sizeof p, caster_hash(r));
   h = lm_hash(lights, sizeof *lights * (size_t)n, lm_hash(&n, sizeof n, h));
   h = lm_hash(frame->view_proj, sizeof frame->view_proj, h);
   h = lm_hash(frame->camera_pos, sizeof frame->camera_pos, h);
@@ -461,6 +501,13 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
   lm_frame_data *frame = &r->camera;
   lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, frame);
   lm_shadow_plan_free(&r->shadows);
+  /* Deformed meshes' new poses, before anything hashes or draws them. */
+  const lm_scene *s = r->desc.scene;
+  r->deforms = lm_grow(r->deforms, &r->deform_cap, s->mesh_count, sizeof *r->deforms);
+  r->deform_count = s->mesh_count;
+  for (int i = 0; i < s->mesh_count; i++) r->deforms[i] += s->meshes[i].dirty;
+  r->deformed = lm_scene_upload_deformed(r->desc.scene);
+  r->pose += r->deformed > 0;
   uint64_t world = world_hash(r, p, frame);
   r->still = r->frame > 0 && world == r->world ? r->still + 1 : 0;
   r->world = world;
@@ -483,6 +530,13 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   r->tiles.in_place = false;
   memcpy(frame->prev_view_proj, r->frame ? r->prev_view_proj : frame->view_proj, sizeof frame->prev_view_proj);
   memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
+  /* A first frame (after a cut, or another scene) has no previous transforms: nothing moved. */
+  const lm_scene *s = r->desc.scene;
+  if (r->frame == 0 || r->prev_world_count != s->node_count) {
+    r->prev_world = lm_grow(r->prev_world, &r->prev_world_cap, s->node_count, 16 * sizeof(float));
+    r->prev_world_count = s->node_count;
+    for (int i = 0; i < s->node_count; i++) memcpy(r->prev_world + (size_t)i * 16, s->nodes[i].world, 16 * sizeof(float));
+  }
   frame->time[1] = (float)r->frame++;
   lm_light_data lights[MAX_LIGHTS];
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
@@ -491,13 +545,15 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_light_grid_build(&r->light_grid, frame, lights, n, !r->desc.no_light_culling);
   lm_storage_upload(4, r->light_grid.data, r->light_grid.count * sizeof *r->light_grid.data);
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
-  if (r->shadows.view_count > 0 && r->shadows.settings.cache) r->casters_hash = caster_hash(r->desc.scene);
+  if (r->shadows.view_count > 0 && r->shadows.settings.cache) r->casters_hash = material_hash(r->desc.scene);
   r->fit_ms = 0;
   lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene, .fit_views = fit_views,
                           .keeps_views = keeps_views, .run_cpu = run_cpu,
                           .scene_owns_uniform = lm_scene_owns_uniform, .user = r,
                           .check_finite = r->desc.check_finite};
-  return lm_graph_execute(g, &x, err);
+  bool ok = lm_graph_execute(g, &x, err);
+  for (int i = 0; i < s->node_count; i++) memcpy(r->prev_world + (size_t)i * 16, s->nodes[i].world, 16 * sizeof(float));
+  return ok;
 }
 
 bool lm_renderer_frame(lm_renderer *r, lm_error *err) {
