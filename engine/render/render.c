@@ -48,7 +48,6 @@ struct lm_renderer {
   uint64_t casters_hash; /* this frame's material_hash */
   float *prev_world; /* each node's world transform in the previous frame (velocities) */
   int prev_world_count, prev_world_cap; /* nodes it holds (another count than the scene's: a first frame) */
-  int deformed;    /* meshes lm_scene_upload_deformed changed in this frame */
   uint64_t pose;   /* frames in which deformed meshes changed (geometry_hash) */
   uint64_t *deforms; /* per mesh: the frames in which it deformed (tile_casters) */
   int deform_count, deform_cap;
@@ -321,9 +320,8 @@ bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
 }
 
 /* A hash of what the BVH is built from: mesh nodes, their meshes and world
- * transforms, and the pose of deformed meshes (a counter of the frames in
- * which the scene's time, animation or deformed vertices changed: cheaper
- * than hashing the vertices). */
+ * transforms, and the pose of deformed meshes (a count of the frames in
+ * which any deformed: cheaper than hashing their vertices). */
 static uint64_t geometry_hash(const lm_renderer *r) {
   const lm_scene *s = r->desc.scene;
   uint64_t h = lm_hash(&s->node_count, sizeof s->node_count, lm_hash(&r->pose, sizeof r->pose, 0));
@@ -501,13 +499,13 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
   lm_frame_data *frame = &r->camera;
   lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, frame);
   lm_shadow_plan_free(&r->shadows);
-  /* Deformed meshes' new poses, before anything hashes or draws them. */
+  /* Deformed meshes' new poses, before anything hashes or draws them (the
+   * renderer alone calls lm_scene_upload_deformed: it clears their marks). */
   const lm_scene *s = r->desc.scene;
   r->deforms = lm_grow(r->deforms, &r->deform_cap, s->mesh_count, sizeof *r->deforms);
   r->deform_count = s->mesh_count;
   for (int i = 0; i < s->mesh_count; i++) r->deforms[i] += s->meshes[i].dirty;
-  r->deformed = lm_scene_upload_deformed(r->desc.scene);
-  r->pose += r->deformed > 0;
+  r->pose += lm_scene_upload_deformed(r->desc.scene) > 0;
   uint64_t world = world_hash(r, p, frame);
   r->still = r->frame > 0 && world == r->world ? r->still + 1 : 0;
   r->world = world;
@@ -522,6 +520,14 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
   return true;
 }
 
+/* Keeps each node's world transform for the next frame's velocities (lm_scene_draw_desc.prev_world). */
+static void remember_world(lm_renderer *r) {
+  const lm_scene *s = r->desc.scene;
+  r->prev_world = lm_grow(r->prev_world, &r->prev_world_cap, s->node_count, 16 * sizeof(float));
+  r->prev_world_count = s->node_count;
+  for (int i = 0; i < s->node_count; i++) memcpy(r->prev_world + (size_t)i * 16, s->nodes[i].world, 16 * sizeof(float));
+}
+
 /* Runs what record() compiled into g (the camera and shadow plan it made). */
 static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_frame_data *frame = &r->camera;
@@ -531,12 +537,7 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   memcpy(frame->prev_view_proj, r->frame ? r->prev_view_proj : frame->view_proj, sizeof frame->prev_view_proj);
   memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
   /* A first frame (after a cut, or another scene) has no previous transforms: nothing moved. */
-  const lm_scene *s = r->desc.scene;
-  if (r->frame == 0 || r->prev_world_count != s->node_count) {
-    r->prev_world = lm_grow(r->prev_world, &r->prev_world_cap, s->node_count, 16 * sizeof(float));
-    r->prev_world_count = s->node_count;
-    for (int i = 0; i < s->node_count; i++) memcpy(r->prev_world + (size_t)i * 16, s->nodes[i].world, 16 * sizeof(float));
-  }
+  if (r->frame == 0 || r->prev_world_count != r->desc.scene->node_count) remember_world(r);
   frame->time[1] = (float)r->frame++;
   lm_light_data lights[MAX_LIGHTS];
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
@@ -552,7 +553,7 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
                           .scene_owns_uniform = lm_scene_owns_uniform, .user = r,
                           .check_finite = r->desc.check_finite};
   bool ok = lm_graph_execute(g, &x, err);
-  for (int i = 0; i < s->node_count; i++) memcpy(r->prev_world + (size_t)i * 16, s->nodes[i].world, 16 * sizeof(float));
+  remember_world(r);
   return ok;
 }
 
