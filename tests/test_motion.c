@@ -407,6 +407,44 @@ static void moving_object_leaves_no_ghost(void **state) {
   gl_result_free(&ref);
 }
 
+/* Shadow tiles, the RSM and the LPV follow a moving caster: a renderer that
+ * keeps its tiles (shadow.cache) and one that draws them all run the same
+ * frames, the tall box moving, then the cube both boxes draw deforming (its
+ * vertices shifted, marked dirty); each frame is the same in both, and the
+ * cached one draws again only some of its tiles. */
+static void shadows_follow_moving_casters(void **state) {
+  (void)state;
+  static const char *const techs[] = {"rsm+esm", "lpv+esm"};
+  const char *off[] = {"shadow.cache=false", NULL};
+  lm_scene *s = gl_cornell();
+  lm_scene_mesh *m = &s->meshes[s->nodes[lm_scene_find_node(s, "tall_box")].mesh];
+  for (size_t t = 0; t < sizeof techs / sizeof *techs; t++) {
+    gl_result c = start(techs[t], NULL, 128, 96), u = start(techs[t], off, 128, 96);
+    for (int step = 0; step < 4; step++) {
+      if (step == 1) move("tall_box", 0.1f);
+      if (step == 2 || step == 3) { /* deform, then take it back */
+        for (int i = 0; i < m->vertex_count; i++) m->vertices[(size_t)i * 8] += step == 2 ? 0.05f : -0.05f;
+        m->dirty = true;
+      }
+      frame(&c);
+      frame(&u);
+      lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(c.renderer);
+      int views = lm_renderer_shadows(c.renderer)->view_count;
+      double worst = 0;
+      for (int i = 0; i < c.width * c.height * 3; i++) worst = fmax(worst, fabs(c.rgb[i] - u.rgb[i]));
+      print_message("%s, %s: %d of %d tiles kept; worst difference from drawing them all %.2e\n", techs[t],
+                    (const char *[]){"still", "box moved", "cube deformed", "cube back"}[step], kept.kept, views, worst);
+      assert_true(worst == 0);
+      assert_true(views > 1);
+      if (step == 0) assert_int_equal(kept.kept, views);
+      else assert_true(kept.kept < views);
+    }
+    move("tall_box", -0.1f);
+    gl_result_free(&c);
+    gl_result_free(&u);
+  }
+}
+
 /* Extreme motion: the box flung 1e4 away and the camera turned about between
  * frames, with motion blur and ISR's temporal reuse on: every velocity finite
  * and within the half float's clamp, every pixel finite. */
@@ -451,6 +489,7 @@ int main(void) {
       cmocka_unit_test(no_velocity_target_unless_read),
       cmocka_unit_test(motion_blur_smears_a_moving_object),
       cmocka_unit_test(moving_object_leaves_no_ghost),
+      cmocka_unit_test(shadows_follow_moving_casters),
       cmocka_unit_test(extreme_motion_stays_finite),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
