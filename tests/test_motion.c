@@ -409,9 +409,10 @@ static void moving_object_leaves_no_ghost(void **state) {
 
 /* Shadow tiles, the RSM and the LPV follow a moving caster: a renderer that
  * keeps its tiles (shadow.cache) and one that draws them all run the same
- * frames, the tall box moving, then the cube both boxes draw deforming (its
- * vertices shifted, marked dirty); each frame is the same in both, and the
- * cached one draws again only some of its tiles. */
+ * frames, the tall box moving twice, then the cube both boxes draw deforming
+ * (its vertices shifted, marked dirty); each frame is the same in both, and
+ * the cached one draws again only some of its tiles; the second move draws
+ * them over their kept static layers: only the box, once a tile at most. */
 static void shadows_follow_moving_casters(void **state) {
   (void)state;
   static const char *const techs[] = {"rsm+esm", "lpv+esm"};
@@ -420,10 +421,10 @@ static void shadows_follow_moving_casters(void **state) {
   lm_scene_mesh *m = &s->meshes[s->nodes[lm_scene_find_node(s, "tall_box")].mesh];
   for (size_t t = 0; t < sizeof techs / sizeof *techs; t++) {
     gl_result c = start(techs[t], NULL, 128, 96), u = start(techs[t], off, 128, 96);
-    for (int step = 0; step < 4; step++) {
-      if (step == 1) move("tall_box", 0.1f);
-      if (step == 2 || step == 3) { /* deform, then take it back */
-        for (int i = 0; i < m->vertex_count; i++) m->vertices[(size_t)i * 8] += step == 2 ? 0.05f : -0.05f;
+    for (int step = 0; step < 5; step++) {
+      if (step == 1 || step == 2) move("tall_box", 0.05f);
+      if (step == 3 || step == 4) { /* deform, then take it back */
+        for (int i = 0; i < m->vertex_count; i++) m->vertices[(size_t)i * 8] += step == 3 ? 0.05f : -0.05f;
         m->dirty = true;
       }
       frame(&c);
@@ -432,12 +433,15 @@ static void shadows_follow_moving_casters(void **state) {
       int views = lm_renderer_shadows(c.renderer)->view_count;
       double worst = 0;
       for (int i = 0; i < c.width * c.height * 3; i++) worst = fmax(worst, fabs(c.rgb[i] - u.rgb[i]));
-      print_message("%s, %s: %d of %d tiles kept; worst difference from drawing them all %.2e\n", techs[t],
-                    (const char *[]){"still", "box moved", "cube deformed", "cube back"}[step], kept.kept, views, worst);
+      print_message("%s, %s: %d of %d tiles kept, %d drawn over their static layer, %d nodes drawn; worst "
+                    "difference from drawing them all %.2e\n", techs[t],
+                    (const char *[]){"still", "box moved", "box moved again", "cube deformed", "cube back"}[step],
+                    kept.kept, views, kept.layered, kept.drawn, worst);
       assert_true(worst == 0);
       assert_true(views > 1);
       if (step == 0) assert_int_equal(kept.kept, views);
       else assert_true(kept.kept < views);
+      if (step == 2) assert_true(kept.layered == views - kept.kept && kept.drawn <= views - kept.kept);
     }
     move("tall_box", -0.1f);
     gl_result_free(&c);

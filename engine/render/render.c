@@ -10,6 +10,10 @@ enum { MAX_LIGHTS = 256 };
 
 /* Shadow tiles kept from frame to frame: a copy of every output of the
  * shadow pass (and its depth), and per tile drawn the key of what drew it.
+ * While casters move, a second copy keeps each drawn tile's static layer
+ * (its casters that did not move this frame, and their key): a tile a moving
+ * caster touches copies that layer back and draws the moving casters over it
+ * (the depth test merges them as one draw would).
  * A view whose key matches the tile in its place copies the texels back
  * instead of drawing (lm_shadow_settings.cache). When the pass's outputs
  * are the very textures it left last frame, which nothing else wrote since
@@ -20,7 +24,12 @@ typedef struct tile_cache {
   lm_texture tex[LM_MAX_COLOR_OUTPUTS + 1];
   lm_format format[LM_MAX_COLOR_OUTPUTS + 1];
   int count, width, height;
-  struct cached_tile { int x, y, width, height; bool drawn; uint64_t key; } *tiles;
+  struct cached_tile {
+    int x, y, width, height;
+    bool drawn, layered; /* its texels, its static layer kept */
+    uint64_t key, static_key;
+  } *tiles;
+  lm_texture layer[LM_MAX_COLOR_OUTPUTS + 1]; /* the static layers (made when a caster first moves) */
   int tile_count, tile_cap;
   uint32_t left[LM_MAX_COLOR_OUTPUTS + 1]; /* the textures the pass left, 0 where another may write */
   long execution;  /* lm_renderer.executions when it left them */
@@ -51,6 +60,9 @@ struct lm_renderer {
   uint64_t pose;   /* frames in which deformed meshes changed (geometry_hash) */
   uint64_t *deforms; /* per mesh: the frames in which it deformed (tile_casters) */
   int deform_count, deform_cap;
+  bool *dynamic;   /* per node: a mesh node that moved or deformed since the last frame */
+  int dynamic_cap;
+  bool any_dynamic;
   uint64_t world;  /* the last frame's world_hash */
   int still;       /* frames in a row before this one whose world_hash was this one's */
   long executions; /* frames executed, never reset (tile_cache.execution) */
@@ -70,7 +82,7 @@ lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
 }
 
 static void tile_cache_free(tile_cache *c) {
-  for (int i = 0; i < c->count; i++) lm_texture_destroy(&c->tex[i]);
+  for (int i = 0; i < c->count; i++) lm_texture_destroy(&c->tex[i]), lm_texture_destroy(&c->layer[i]);
   free(c->tiles);
   *c = (tile_cache){.execution = -1};
 }
@@ -84,6 +96,7 @@ void lm_renderer_destroy(lm_renderer *r) {
   lm_trace_destroy(r->trace);
   free(r->prev_world);
   free(r->deforms);
+  free(r->dynamic);
   free(r);
 }
 
@@ -125,8 +138,9 @@ static const lm_program *scene_variant(void *ctx, const char *defines, lm_error 
   return lm_scene_pass_variant(ctx, defines, err);
 }
 
-/* Draws the scene for a scene pass: the camera's, or one shadow tile's. */
-static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, lm_error *err) {
+/* Draws the scene for a scene pass: the camera's, or one shadow tile's
+ * (layer: lm_scene_draw_desc's, 0 all its casters). */
+static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, int layer, lm_error *err) {
   enum { MAX_PARAMS = 256 };
   lm_material_param params[MAX_PARAMS];
   int n = sp->desc->material_param_count < MAX_PARAMS ? sp->desc->material_param_count : MAX_PARAMS;
@@ -142,7 +156,8 @@ static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, lm_error *err) {
   lm_scene_draw_desc d = {.program = sp->program, .variant = scene_variant, .ctx = (void *)sp,
                           .view_proj = r->desc.no_culling ? NULL : view_proj,
                           .pancake = sp->view && sp->view->depth[3] == 0,
-                          .params = params, .param_count = n, .prev_world = r->prev_world};
+                          .params = params, .param_count = n, .prev_world = r->prev_world,
+                          .dynamic = r->dynamic, .layer = layer};
   return lm_scene_draw(r->desc.scene, &d, sp->view ? &r->shadow_stats : &r->stats, err);
 }
 
@@ -161,12 +176,12 @@ static int pass_textures(const lm_scene_pass *sp, lm_graph_target_info out[LM_MA
  * mesh, material, world transform and deformation count. A caster that moves
  * changes the key of the tiles it touches now and of those it touched last
  * frame (it left their set); the others stay cached. */
-static uint64_t tile_casters(const lm_renderer *r, const lm_pass_view *v, uint64_t h) {
+static uint64_t tile_casters(const lm_renderer *r, const lm_pass_view *v, bool static_only, uint64_t h) {
   const lm_scene *s = r->desc.scene;
   bool pancake = v->depth[3] == 0;
   for (int i = 0; i < s->node_count; i++) {
     const lm_node *n = &s->nodes[i];
-    if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
+    if (n->mesh < 0 || n->mesh >= s->mesh_count || (static_only && r->dynamic[i])) continue;
     if (!r->desc.no_culling && lm_scene_node_culled(s, i, v->cull, pancake)) continue;
     int k[3] = {i, n->mesh, n->material};
     h = lm_hash(k, sizeof k, h);
@@ -179,12 +194,12 @@ static uint64_t tile_casters(const lm_renderer *r, const lm_pass_view *v, uint64
 /* What a shadow tile's texels follow from: the view (place, matrices, cull
  * volume), the pass (technique's program, defines, clear colour, material
  * overrides), the scene's materials (casters_hash) and the casters in the
- * tile (tile_casters). */
-static uint64_t tile_key(const lm_renderer *r, const lm_scene_pass *sp) {
+ * tile (tile_casters; static_only: those that did not move, its static layer's). */
+static uint64_t tile_key(const lm_renderer *r, const lm_scene_pass *sp, bool static_only) {
   const lm_pass_view *v = sp->view;
   const lm_pass_desc *d = sp->desc;
   int place[4] = {v->x, v->y, v->width, v->height};
-  uint64_t h = lm_hash(place, sizeof place, tile_casters(r, v, r->casters_hash));
+  uint64_t h = lm_hash(place, sizeof place, tile_casters(r, v, static_only, r->casters_hash));
   h = lm_hash(v->view_proj, sizeof v->view_proj, h);
   h = lm_hash(v->depth, sizeof v->depth, h);
   h = lm_hash(v->cull, sizeof v->cull, h);
@@ -230,7 +245,7 @@ static struct cached_tile *tile_at(tile_cache *c, const lm_pass_view *v) {
     if (t->x == v->x && t->y == v->y && t->width == v->width && t->height == v->height) return t;
   }
   struct cached_tile *t = LM_PUSH(c->tiles, c->tile_count, c->tile_cap);
-  *t = (struct cached_tile){v->x, v->y, v->width, v->height, false, 0};
+  *t = (struct cached_tile){.x = v->x, .y = v->y, .width = v->width, .height = v->height};
   return t;
 }
 
@@ -242,7 +257,7 @@ static void tile_cache_drawn(tile_cache *c, struct cached_tile *t, uint64_t key)
     struct cached_tile *o = &c->tiles[i];
     if (o != t && o->x < t->x + t->width && t->x < o->x + o->width && o->y < t->y + t->height &&
         t->y < o->y + o->height)
-      o->drawn = false;
+      o->drawn = o->layered = false;
   }
   t->drawn = true, t->key = key;
 }
@@ -272,6 +287,46 @@ static bool keeps_views(void *user, const lm_scene_pass *sp) {
   return same;
 }
 
+/* Copies the rectangle of tile t between the pass's textures and a copy of them. */
+static void copy_tile(const lm_graph_target_info *t, const lm_texture *copy, int n, const struct cached_tile *at,
+                      bool to_copy) {
+  for (int i = 0; i < n; i++) {
+    lm_texture dst = to_copy ? copy[i] : t[i].texture, src = to_copy ? t[i].texture : copy[i];
+    lm_texture_copy_rect(dst, src, at->x, at->y, at->width, at->height);
+  }
+}
+
+/* Makes the static layers' textures, like the cache's; false when one cannot be made. */
+static bool tile_cache_layers(tile_cache *c, lm_error *err) {
+  for (int i = 0; i < c->count; i++)
+    if (!c->layer[i].id && !lm_texture_create(&c->layer[i], &(lm_texture_desc){c->format[i], c->width, c->height, false},
+                                              "shadow tile static layers", err))
+      return false;
+  return true;
+}
+
+/* Draws a tile that changed while casters move (or whose static layer is
+ * kept): its static layer, drawn again only when its own casters changed,
+ * then the moving casters over it. */
+static bool draw_layered(lm_renderer *r, const lm_scene_pass *sp, const lm_graph_target_info *t, int nt,
+                         struct cached_tile *cached, bool in_place, lm_error *err) {
+  tile_cache *c = &r->tiles;
+  if (!tile_cache_layers(c, err)) return false;
+  uint64_t key = tile_key(r, sp, true);
+  if (cached->layered && cached->static_key == key) {
+    copy_tile(t, c->layer, nt, cached, false);
+    r->shadow_stats.layered++;
+  } else {
+    if (in_place)
+      lm_clear_rect(cached->x, cached->y, cached->width, cached->height, sp->desc->output_count,
+                    sp->desc->clear_color, sp->desc->depth >= 0, lm_scene_clear_depth(true));
+    if (!draw_pass(r, sp, 1, err)) return false;
+    copy_tile(t, c->layer, nt, cached, true);
+    cached->layered = true, cached->static_key = key;
+  }
+  return !r->any_dynamic || draw_pass(r, sp, 2, err);
+}
+
 static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   lm_renderer *r = user;
   /* A shadow tile drawn last frame from the same view and casters: copy it back. */
@@ -283,27 +338,31 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   if (nt > 0) {
     bool in_place = c->in_place;
     if (!tile_cache_fit(c, t, nt, err)) return false;
-    key = tile_key(r, sp);
+    key = tile_key(r, sp, false);
     cached = tile_at(c, sp->view);
     /* What the pass leaves for the next frame (whether or not it was in place). */
     for (int i = 0; i < nt; i++) c->left[i] = t[i].alone ? t[i].texture.id : 0;
     c->execution = r->executions;
     c->layout = view_layout(sp, t);
     if (cached->drawn && cached->key == key) {
-      for (int i = 0; i < nt && !in_place; i++)
-        lm_texture_copy_rect(t[i].texture, c->tex[i], cached->x, cached->y, cached->width, cached->height);
+      if (!in_place) copy_tile(t, c->tex, nt, cached, false);
       r->shadow_stats.kept++;
       r->shadow_stats.in_place += in_place;
+      return true;
+    }
+    if (r->any_dynamic || cached->layered) {
+      if (!draw_layered(r, sp, t, nt, cached, in_place, err)) return false;
+      copy_tile(t, c->tex, nt, cached, true);
+      tile_cache_drawn(c, cached, key);
       return true;
     }
     if (in_place) /* the pass cleared nothing: this tile alone */
       lm_clear_rect(cached->x, cached->y, cached->width, cached->height, sp->desc->output_count,
                     sp->desc->clear_color, sp->desc->depth >= 0, lm_scene_clear_depth(true));
   }
-  if (!draw_pass(r, sp, err)) return false;
+  if (!draw_pass(r, sp, 0, err)) return false;
   if (cached) {
-    for (int i = 0; i < nt; i++)
-      lm_texture_copy_rect(c->tex[i], t[i].texture, cached->x, cached->y, cached->width, cached->height);
+    copy_tile(t, c->tex, nt, cached, true);
     tile_cache_drawn(c, cached, key);
   }
   return true;
@@ -505,6 +564,17 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
   r->deforms = lm_grow(r->deforms, &r->deform_cap, s->mesh_count, sizeof *r->deforms);
   r->deform_count = s->mesh_count;
   for (int i = 0; i < s->mesh_count; i++) r->deforms[i] += s->meshes[i].dirty;
+  /* The mesh nodes that moved or deformed since the last frame (none on a first one). */
+  r->dynamic = lm_grow(r->dynamic, &r->dynamic_cap, s->node_count, sizeof *r->dynamic);
+  r->any_dynamic = false;
+  bool known = r->frame > 0 && r->prev_world_count == s->node_count;
+  for (int i = 0; i < s->node_count; i++) {
+    const lm_node *n = &s->nodes[i];
+    bool mesh = n->mesh >= 0 && n->mesh < s->mesh_count;
+    r->dynamic[i] = mesh && known &&
+                    (s->meshes[n->mesh].dirty || memcmp(n->world, r->prev_world + (size_t)i * 16, sizeof n->world));
+    r->any_dynamic |= r->dynamic[i];
+  }
   r->pose += lm_scene_upload_deformed(r->desc.scene) > 0;
   uint64_t world = world_hash(r, p, frame);
   r->still = r->frame > 0 && world == r->world ? r->still + 1 : 0;

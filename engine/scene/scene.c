@@ -688,6 +688,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
   for (int i = 0; i < s->node_count; i++) {
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
+    if (d->dynamic && d->layer && d->dynamic[i] != (d->layer == 2)) continue;
     if (d->view_proj) {
       float lo[3], hi[3];
       world_bounds(n->world, s->meshes[n->mesh].bounds, lo, hi);

@@ -364,12 +364,18 @@ typedef struct lm_scene_draw_desc {
    * node_count of them): lm_instance.prev_model, for velocities. NULL: the
    * current ones (nothing moved). */
   const float *prev_world;
+  /* With `dynamic` (a flag a node) and `layer` 1, only the nodes not flagged
+   * are drawn, with layer 2 only those flagged (a shadow tile's static layer,
+   * and the moving casters drawn over it); layer 0 or dynamic NULL: all. */
+  const bool *dynamic;
+  int layer;
 } lm_scene_draw_desc;
 typedef struct lm_scene_draw_stats {
   int drawn, culled; /* mesh nodes drawn, and left out by the frustum test */
   int calls;         /* draw calls: one for the nodes of a mesh and material in view */
   int kept;          /* views (shadow tiles) kept from the last frame instead of drawn */
   int in_place;      /* of those, the ones still in the pass's outputs: neither cleared nor copied */
+  int layered;       /* views drawn again over their kept static layer: only their moving casters drawn */
   long triangles;    /* triangles drawn */
 } lm_scene_draw_stats;
 /* Draws every mesh node whose bounds reach into the frustum, the nodes of one
