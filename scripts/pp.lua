@@ -75,12 +75,14 @@ local function direct(G, tech, shadows, ambient, name, skylight, indirect)
                out = target{ name, format = "rgba16f" } }
 end
 
--- Does the frame read the G-buffer's velocity (motion blur, or the temporal
--- reuse of the technique's lighting)? A frame that does not declares none.
+-- Does the frame read the G-buffer's velocity (motion blur, unless nothing
+-- moved since the last frame: scripts/motion_blur.lua; or the temporal reuse
+-- of the technique's lighting)? A frame that does not declares none.
 local function reads_velocity(tech, lighting)
   local gi = ({ isr = tech.isr, rsm = tech.rsm, ssdo = tech.ssdo })[lighting]
   local function on(t) return type(t) == "table" and t.enabled == true end
-  return on(tech.motion_blur) or (gi ~= nil and on(gi.temporal) and gi.temporal.velocity ~= false)
+  return (on(tech.motion_blur) and still_frames() == 0) or
+         (gi ~= nil and on(gi.temporal) and gi.temporal.velocity ~= false)
 end
 
 local rules = { ambient = options.number(0, 1e6), background = options.number(0, 1e6) }

@@ -1,8 +1,8 @@
 // Motion blur along each pixel's screen motion (scripts/motion_blur.lua), in
 // three passes of this file:
-//   TILES:      each texel of a grid of `tile`-pixel tiles takes the longest
+//   TILES:      each texel of a grid of 4-pixel tiles takes the longest
 //               streak of its tile (the last row and column of tiles reach
-//               the image's edge);
+//               the image's edge), then (BLOCKS) of `tile`-pixel ones from it;
 //   NEIGHBOURS: each tile the longest of its own and its 8 neighbours';
 //   (neither):  each pixel gathers along its tile's longest streak near.
 // A pixel's motion comes from the G-buffer's velocity target (VELOCITY;
@@ -30,16 +30,16 @@ uniform sampler2D vel;
 uniform float strength = 0.5;    // 0..4
 uniform float max_length = 32.0; // pixels, >= 0
 uniform int samples = 12;        // 1..64
-uniform int tile = 16;           // pixels a side of the tiles (TILES; the gather's grid)
+uniform int tile = 16;           // pixels a side of the tiles (TILES: pixels or, BLOCKS, texels of near)
 
 out vec4 dst;
 
+// Does the camera move this frame? (Set by main: one test, not one a read.)
+bool camera_moves = false;
+
 // The camera's motion (output pixels, now minus then) of the point at uv
-// with depth d (0: the background, taken at the far plane).
+// (its depth 0: the background, taken at the far plane).
 vec2 camera_motion(vec2 at) {
-  // A still camera moves nothing (the far plane's reprojection alone is off
-  // by a fraction of a pixel).
-  if (frame.view_proj == frame.prev_view_proj) return vec2(0.0);
   float d = texture(dpt, at).r;
   vec3 p = position_from_depth(at, d > 0.0 ? clamp(d, 0.0, 1.0) : 1.0);
   vec4 prev = frame.prev_view_proj * vec4(p, 1.0);
@@ -48,13 +48,16 @@ vec2 camera_motion(vec2 at) {
 }
 
 // The streak (pixels, scaled by the shutter and capped) of the pixel at uv.
+// A still camera moves nothing (the far plane's reprojection alone is off by
+// a fraction of a pixel).
 vec2 streak(vec2 at) {
-  vec2 m;
+  vec2 m = vec2(0.0);
 #ifdef VELOCITY
   vec4 v = texture(vel, at);
-  m = v.a > 0.5 ? v.xy : camera_motion(at);
+  if (v.a > 0.5) m = v.xy;
+  else if (camera_moves) m = camera_motion(at);
 #else
-  m = camera_motion(at);
+  if (camera_moves) m = camera_motion(at);
 #endif
   m *= clamp(strength, 0.0, 4.0);
   float len = length(m), cap = max(max_length, 0.0);
@@ -63,14 +66,26 @@ vec2 streak(vec2 at) {
 }
 
 #if defined(TILES)
+// With BLOCKS the texels of `near` (a finer grid of tiles) stand for pixels:
+// the grid is reduced in two steps, each texel reading a few (a single step
+// of 16 x 16 reads a texel left llvmpipe's cores idle: 3.1 ms at 256x192).
 void main() {
-  ivec2 q = ivec2(gl_FragCoord.xy), tiles = ivec2(frame.output_size.xy) / max(tile, 1);
-  ivec2 lo = q * tile, hi = min(q == max(tiles, 1) - 1 ? ivec2(frame.output_size.xy) : lo + tile,
-                                ivec2(frame.output_size.xy));
+  camera_moves = frame.view_proj != frame.prev_view_proj;
+#ifdef BLOCKS
+  ivec2 size = textureSize(near, 0);
+#else
+  ivec2 size = ivec2(frame.output_size.xy);
+#endif
+  ivec2 q = ivec2(gl_FragCoord.xy), tiles = max(size / max(tile, 1), ivec2(1));
+  ivec2 lo = q * tile, hi = min(mix(lo + tile, size, equal(q, tiles - 1)), size);
   vec2 best = vec2(0.0);
   for (int y = lo.y; y < hi.y; y++)
     for (int x = lo.x; x < hi.x; x++) {
+#ifdef BLOCKS
+      vec2 m = texelFetch(near, ivec2(x, y), 0).xy;
+#else
       vec2 m = streak((vec2(x, y) + 0.5) * frame.output_size.zw);
+#endif
       if (dot(m, m) > dot(best, best)) best = m;
     }
   dst = vec4(best, 0.0, 1.0);
@@ -113,6 +128,7 @@ vec3 gather(vec3 centre, vec2 far, float len_far) {
 }
 
 void main() {
+  camera_moves = frame.view_proj != frame.prev_view_proj;
   vec3 centre = hdr_clamp(texelFetch(src, ivec2(gl_FragCoord.xy), 0).rgb, HALF_MAX);
   ivec2 size = textureSize(near, 0);
   vec2 far = texelFetch(near, clamp(ivec2(gl_FragCoord.xy) / max(tile, 1), ivec2(0), size - 1), 0).xy;
