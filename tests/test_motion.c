@@ -212,7 +212,8 @@ static void no_velocity_without_motion(void **state) {
   if (!t.ok) fail_msg("%s", t.err.msg);
   float *v = gl_read_target(&t, "vel.copy", &w, &h);
   assert_non_null(v);
-  for (int i = 0; i < W * H; i++) assert_true(v[(size_t)i * 4] == 0 && v[(size_t)i * 4 + 1] == 0 && v[(size_t)i * 4 + 3] < 1.5f);
+  for (int i = 0; i < W * H; i++)
+    assert_true(v[(size_t)i * 4] == 0 && v[(size_t)i * 4 + 1] == 0 && v[(size_t)i * 4 + 3] < 1.5f);
   free(v);
   gl_result_free(&t);
   move("camera", 0.5f);
@@ -265,7 +266,7 @@ static void gradients(const float *img, int x0, int y0, int x1, int y1, double *
     }
 }
 
-/* The tall box's screen rectangle (rows from the top), grown by `margin`. */
+/* Node `name`'s screen rectangle in the box's view (rows from the top), grown by `margin`. */
 static void box_rect(const char *name, int margin, int rect[4]) {
   lm_scene *s = gl_cornell();
   float lo[3], hi[3];
@@ -278,7 +279,8 @@ static void box_rect(const char *name, int margin, int rect[4]) {
     rect[2] = col > rect[2] ? col : rect[2], rect[3] = row > rect[3] ? row : rect[3];
   }
   rect[0] = rect[0] - margin > 0 ? rect[0] - margin : 0, rect[1] = rect[1] - margin > 0 ? rect[1] - margin : 0;
-  rect[2] = rect[2] + margin < W - 1 ? rect[2] + margin : W - 2, rect[3] = rect[3] + margin < H - 1 ? rect[3] + margin : H - 2;
+  rect[2] = rect[2] + margin < W - 1 ? rect[2] + margin : W - 2;
+  rect[3] = rect[3] + margin < H - 1 ? rect[3] + margin : H - 2;
 }
 
 /* Still, motion blur changes no pixel (1e-6); with the tall box moving 0.2

@@ -722,7 +722,8 @@ static void unchanged_tiles_are_kept_and_changed_ones_drawn(void **state) {
   const lm_shadow_plan *plan = lm_renderer_shadows(c.renderer);
   bool away[64] = {false};
   assert_true(views <= 64);
-  for (int v = 0; v < views; v++) away[v] = lm_scene_node_culled(s, box, plan->views[v].cull, plan->views[v].depth[3] == 0);
+  for (int v = 0; v < views; v++)
+    away[v] = lm_scene_node_culled(s, box, plan->views[v].cull, plan->views[v].depth[3] == 0);
   w[3][0] += 0.05f;
   lm_scene_node_set_world(s, box, (float *)w);
   int untouched = 0;

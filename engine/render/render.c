@@ -299,8 +299,9 @@ static void copy_tile(const lm_graph_target_info *t, const lm_texture *copy, int
 /* Makes the static layers' textures, like the cache's; false when one cannot be made. */
 static bool tile_cache_layers(tile_cache *c, lm_error *err) {
   for (int i = 0; i < c->count; i++)
-    if (!c->layer[i].id && !lm_texture_create(&c->layer[i], &(lm_texture_desc){c->format[i], c->width, c->height, false},
-                                              "shadow tile static layers", err))
+    if (!c->layer[i].id &&
+        !lm_texture_create(&c->layer[i], &(lm_texture_desc){c->format[i], c->width, c->height, false},
+                           "shadow tile static layers", err))
       return false;
   return true;
 }
