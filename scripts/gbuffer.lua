@@ -3,8 +3,11 @@
 local gbuffer = {}
 
 -- Targets at `scale` of the output (1 by default). Fields: clr, nrm, dpt, mat, depth;
--- for material technique "pbr" also emi (emitted radiance, added after lighting).
-function gbuffer.targets(scale, technique)
+-- for material technique "pbr" also emi (emitted radiance, added after lighting);
+-- with `velocity` also vel (shaders/velocity.glsl: screen motion since the previous
+-- frame in output pixels, the previous view depth, coverage), only for a frame that
+-- reads it (motion blur, temporal reuse).
+function gbuffer.targets(scale, technique, velocity)
   scale = scale or 1
   local G = {
     clr = target{ "gbuffer.clr", format = "rgba8", scale = scale },      -- albedo, rho
@@ -14,6 +17,7 @@ function gbuffer.targets(scale, technique)
     depth = target{ "gbuffer.depth", format = "depth32f", scale = scale },
   }
   if technique == "pbr" then G.emi = target{ "gbuffer.emi", format = "rgba16f", scale = scale } end
+  if velocity then G.vel = target{ "gbuffer.vel", format = "rgba16f", scale = scale } end
   return G
 end
 
@@ -22,7 +26,13 @@ end
 -- `materials` (optional) overrides material parameters by name:
 -- { wall = { color = { 1, 0, 0 }, ks = 0.2 } }.
 function gbuffer.render(G, technique, materials)
-  scene{ "gbuffer", technique = technique or "std", out = { G.clr, G.nrm, G.dpt, G.mat, G.emi },
+  local out, defines = { G.clr, G.nrm, G.dpt, G.mat }, {}
+  if G.emi then out[#out + 1] = G.emi end
+  if G.vel then
+    defines.VELOCITY = #out -- its output location
+    out[#out + 1] = G.vel
+  end
+  scene{ "gbuffer", technique = technique or "std", out = out, defines = defines,
          depth = G.depth, clear = { 0, 0, 0, 0 }, materials = materials }
   G.phong_only = (technique or "std") == "std" -- no pixel carries the pbr technique's mark
   return G

@@ -75,6 +75,16 @@ local function direct(G, tech, shadows, ambient, name, skylight, indirect)
                out = target{ name, format = "rgba16f" } }
 end
 
+-- Does the frame read the G-buffer's velocity (motion blur, unless nothing
+-- moved since the last frame: scripts/motion_blur.lua; or the temporal reuse
+-- of the technique's lighting)? A frame that does not declares none.
+local function reads_velocity(tech, lighting)
+  local gi = ({ isr = tech.isr, rsm = tech.rsm, ssdo = tech.ssdo })[lighting]
+  local function on(t) return type(t) == "table" and t.enabled == true end
+  return (on(tech.motion_blur) and still_frames() == 0) or
+         (gi ~= nil and on(gi.temporal) and gi.temporal.velocity ~= false)
+end
+
 local rules = { ambient = options.number(0, 1e6), background = options.number(0, 1e6) }
 
 function OnCreate()
@@ -99,7 +109,8 @@ function OnRender(tech)
   end
   local materials = ({ phong = "std", pbr = "pbr" })[tech.materials]
   if not materials then error('materials must be "phong" or "pbr" (got "' .. tostring(tech.materials) .. '")') end
-  local G = gbuffer.render(gbuffer.targets(1, materials), materials)
+  local G = gbuffer.render(gbuffer.targets(1, materials, reads_velocity(tech, lighting)), materials)
+  temporal.velocity(G.vel)
   -- Shadows after the G-buffer: their cascades fit the depths it sees.
   -- The RSM's options, when the technique reads one (the shadow pass then writes it).
   local o_rsm = lighting == "vpl" and vpl.check(tech.vpl) or tech.name:find("rsm+", 1, true) and rsm.check(tech.rsm)

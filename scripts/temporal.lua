@@ -34,6 +34,9 @@ temporal.defaults = {
                     -- After a 12-frame slide (test_rsm) ISR's frame lay 0.82%, 1.18%, 1.61% and 1.91%
                     -- of the image's mean from a still camera's at 2, 4, 8 and 16, 2.44% at 0; 4
                     -- keeps the moving image's noise near a 4-frame average
+  velocity = true,  -- reproject a surface that moved on its own (a node, a deformed mesh) along the
+                    -- G-buffer's velocity target, to its depth then (false: through the previous
+                    -- camera alone, as if the world stood still)
   skip = true,      -- a settled frame (the world and settings unchanged for `frames` frames: every
                     -- pixel converged) keeps the last result and runs none of the GI passes (ISR's;
                     -- false: they run, each pixel keeping its history)
@@ -48,8 +51,10 @@ local rules = {
   refresh = options.whole(0, 1024),
   moving = options.number(0, 1024),
   skip = options.boolean,
+  velocity = options.boolean,
 }
 
+local velocity = nil -- this frame's G-buffer velocity target (temporal.velocity), or nil
 local histories = {} -- user -> { view = bool, at = { [coarse factor] = { targets = {a, b}, turn = 0, kept = } } }
 local settings, restart = nil, false -- a copy of the last frame's settings (temporal.begin), and whether they changed
 local quiet = 0 -- frames in a row before this one with the same world and settings
@@ -89,6 +94,12 @@ function temporal.begin(settings_now)
   if restart or not settings then settings = copy(settings_now) end
   quiet = (restart or still_frames() == 0) and 0 or quiet + 1
 end
+
+-- This frame's G-buffer velocity target (gbuffer.targets' vel), or nil: with
+-- it, a history reprojects each pixel along its surface's own motion (a
+-- moving object keeps its history and leaves none behind); without, through
+-- the previous camera alone, as if the world stood still.
+function temporal.velocity(vel) velocity = vel end
 
 -- May a user keep last frame's result instead of running its passes? When
 -- the world and the settings have stayed the same for `frames` frames in a
@@ -163,6 +174,7 @@ function temporal.bind(user, inputs, defines, params, o, f)
   params.frames, params.epsilon, params.refresh = o.frames, o.epsilon, o.refresh
   params.bias, params.confidence, params.restart = o.bias, o.confidence, restart and 1 or 0
   params.moving = histories[user].view and o.moving or 0
+  if velocity and o.velocity then inputs.velocity, defines.VELOCITY = velocity, true end
   return next
 end
 

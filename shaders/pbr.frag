@@ -7,6 +7,7 @@
 // pbr_reflect gets roughness and F0 = mix(0.04, clr, metallic) back.
 // Location 4 (when the pass gives it) takes the emitted radiance.
 #include "gbuffer.glsl"
+#include "velocity.glsl"
 
 in vec3 world_normal;
 in vec3 world_pos;
@@ -106,4 +107,5 @@ void main() {
   out_mat = vec4(saturate(occlusion), 1.0 - metallic, max(max(f0.r, f0.g), f0.b),
                  mat_alpha_encode(material_reflectivity, true));
   out_emi = vec4(finite_or_zero(emissive), 1.0);
+  write_velocity();
 }

@@ -3,6 +3,7 @@
 //   dpt = linear depth / far    mat = k_a, k_d, k_s, coverage and reflectivity
 //   (mat_alpha_encode: >= 0.5 = geometry)
 #include "common.glsl"
+#include "velocity.glsl"
 
 in vec3 world_normal;
 in float view_depth;
@@ -38,4 +39,5 @@ void main() {
   out_nrm = vec4(n, max(material_k.w, 0.0));
   out_dpt = dpt_encode(view_depth);
   out_mat = vec4(saturate(material_k.xyz), mat_alpha_encode(material_reflectivity, false));
+  write_velocity();
 }

@@ -13,6 +13,12 @@ out vec3 world_pos;     // for derivative tangent frames (pbr.frag)
 out vec4 world_tangent; // w: the handedness, +-1, or 0 when the mesh has no tangents
 out float view_depth;
 out vec2 tex_uv;
+#ifdef VELOCITY // the G-buffer's velocity target (velocity.glsl)
+layout(location = 11) in mat4 instance_prev_model; // the node's in the previous frame
+layout(location = 15) in vec4 in_prev_position;    // a deformed mesh's then; (0, 0, 0, 0): in_position
+out vec4 clip_now, clip_prev;
+flat out float self_moved;
+#endif
 
 void main() {
   vec4 world = instance_model * vec4(in_position, 1.0);
@@ -24,4 +30,10 @@ void main() {
   view_depth = -(frame.view * world).z; // OpenGL looks down -z
   tex_uv = in_uv;
   gl_Position = frame.view_proj * world;
+#ifdef VELOCITY
+  vec3 then = in_prev_position.w > 0.0 ? in_prev_position.xyz : in_position;
+  clip_now = gl_Position;
+  clip_prev = frame.prev_view_proj * (instance_prev_model * vec4(then, 1.0));
+  self_moved = instance_prev_model != instance_model || in_prev_position.w > 0.0 ? 1.0 : 0.0;
+#endif
 }

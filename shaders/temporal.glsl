@@ -26,6 +26,14 @@ uniform float epsilon = 0.02, frames = 36.0, bias = 0.1, confidence = 0.25;
 uniform int refresh = 32;
 uniform int restart = 0; // 1: the settings changed (temporal.begin), no history is kept
 uniform float moving = 0.0; // > 0: a view-dependent result's most frames while the view changes
+#ifdef VELOCITY
+// The G-buffer's velocity target (velocity.glsl): a pixel whose surface moved
+// on its own (a = 2) reprojects along its motion, to the view depth it had.
+uniform sampler2D velocity;
+#endif
+// Set by temporal_history: the pixel's surface moved on its own since the
+// last frame (a node or a deformation), so its light may have changed.
+bool temporal_self_moved = false;
 
 // Does the view change this frame, for a result that depends on it
 // (`moving` > 0: ISR's and SSDO's light at a point depends on what the
@@ -33,14 +41,19 @@ uniform float moving = 0.0; // > 0: a view-dependent result's most frames while 
 // `moving` frames, so that it follows the view with about that lag, and no
 // pixel counts as converged (a converged one would keep the old view's
 // light until its tile's refresh).
-bool temporal_moving() { return moving > 0.0 && frame.view_proj != frame.prev_view_proj; }
+bool temporal_moving() {
+  return moving > 0.0 && (frame.view_proj != frame.prev_view_proj || temporal_self_moved);
+}
 
 // The history of the pixel at uv whose coarse depth is d (dpt): the
 // pixel's world position through the previous frame's view-projection; kept
 // where the previous frame stored a depth that matches the reprojected
 // clip w (the view depth there) within `epsilon` of it (relative: any
-// unit), else dropped (off the last frame, disoccluded). False: none; else
-// h its value and n the frames it holds.
+// unit), else dropped (off the last frame, disoccluded). With VELOCITY, a
+// surface that moved on its own is looked up where its motion says it lay,
+// against the view depth it had then; a still one as above, so that a still
+// world reprojects exactly as without. False: none; else h its value and n
+// the frames it holds.
 bool temporal_history(vec2 uv, float d, out vec4 h, out float n) {
   h = vec4(0.0);
   n = 0.0;
@@ -48,12 +61,23 @@ bool temporal_history(vec2 uv, float d, out vec4 h, out float n) {
   vec4 c = frame.prev_view_proj * vec4(position_from_depth(uv, d), 1.0);
   if (c.w <= 1e-12) return false;
   vec2 q = c.xy / c.w * 0.5 + 0.5;
+  float then = c.w;
+#ifdef VELOCITY
+  ivec2 vsize = textureSize(velocity, 0);
+  vec4 v = texelFetch(velocity, clamp(ivec2(uv * vec2(vsize)), ivec2(0), vsize - 1), 0);
+  temporal_self_moved = v.a > 1.5;
+  if (temporal_self_moved) {
+    if (!(v.b > 0.0)) return false; // behind the last camera: no history
+    q = uv - v.xy * frame.output_size.zw;
+    then = v.b;
+  }
+#endif
   if (any(lessThan(q, vec2(0.0))) || any(greaterThan(q, vec2(1.0)))) return false;
   ivec2 size = textureSize(history, 0), t = clamp(ivec2(q * vec2(size)), ivec2(0), size - 1);
   h = texelFetch(history, t, 0);
   vec2 state = texelFetch(history_state, t, 0).rg;
   n = state.g;
-  return state.r > 0.0 && abs(state.r - c.w) <= epsilon * state.r && n >= 1.0;
+  return state.r > 0.0 && abs(state.r - then) <= epsilon * state.r && n >= 1.0;
 }
 
 // Does pixel px take fresh samples this frame although it has converged?
@@ -74,14 +98,14 @@ bool temporal_refresh(ivec2 px) {
 // frame's samples would not change it? It holds `frames` frames and is not
 // being refreshed. The accumulation then keeps the history as it is.
 bool temporal_converged(float n, ivec2 px) {
-  return n >= max(frames, 1.0) && !temporal_refresh(px) && !temporal_moving();
+  return n >= max(frames, 1.0) && !temporal_refresh(px) && !temporal_moving() && !temporal_self_moved;
 }
 
 // The value to store for a pixel that took fresh samples `cur`: the running
 // mean with its history h of n frames (found: temporal_history) while the
 // confidence holds, else cur alone; `seen` the frames it then holds.
 vec4 temporal_accumulate(vec4 cur, bool found, vec4 h, float n, out float seen) {
-  bool moved = temporal_moving();
+  bool moved = temporal_moving();  // (a surface that moved alone, as a moving view)
   float most = moved ? clamp(moving, 1.0, max(frames, 1.0)) : max(frames, 1.0);
   if (found) {
     vec3 a = h.rgb / (1.0 + h.rgb), b = cur.rgb / (1.0 + cur.rgb), diff = abs(a - b);

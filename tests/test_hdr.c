@@ -477,7 +477,7 @@ static void degenerate_settings_stay_finite(void **state) {
 static void an_effect_off_records_no_pass(void **state) {
   (void)state;
   static const char *const passes[EFFECTS] = {
-      "motion_blur ", "dof.coc dof.reduce dof.tiles dof.dilate dof.gather dof.composite ", "bloom.bright bloom.blur_x bloom.blur_y bloom.add ",
+      "motion_blur.tiles4 motion_blur.tiles motion_blur.near motion_blur ", "dof.coc dof.reduce dof.tiles dof.dilate dof.gather dof.composite ", "bloom.bright bloom.blur_x bloom.blur_y bloom.add ",
       "hdr.reduce1 hdr.reduce2 hdr.reduce3 hdr.adapt hdr.tonemap ", "radial_blur ", "glass ", "tiles ", "sepia "};
   char names[1024], want[1024];
   gl_result r = start(pp_lua, "dl", NULL);

@@ -694,9 +694,10 @@ static void cascades_draw_the_casters_of_their_slice(void **state) {
  * its place keeps its texels: the box's second frame draws no tile, and as
  * the pass's outputs are the textures it left last frame, which nothing
  * else writes, every tile is still in place (neither cleared nor copied);
- * the image is the one every tile drawn gives. Moving a caster redraws them
- * all, each cleared alone in the outputs in place, and the frame is the one
- * an uncached renderer gives; the next frame keeps them all in place again.
+ * the image is the one every tile drawn gives. Moving a caster redraws the
+ * tiles it touches now or touched before (each cleared alone in the outputs
+ * in place) and keeps the others, and the frame is the one an uncached
+ * renderer gives; the next frame keeps them all in place again.
  * With shadow.cache=false every frame draws. */
 static void unchanged_tiles_are_kept_and_changed_ones_drawn(void **state) {
   (void)state;
@@ -717,15 +718,24 @@ static void unchanged_tiles_are_kept_and_changed_ones_drawn(void **state) {
   assert_true(box >= 0);
   mat4 w;
   memcpy(w, s->nodes[box].world, sizeof w);
+  /* The tiles the box touches neither before nor after the move stay. */
+  const lm_shadow_plan *plan = lm_renderer_shadows(c.renderer);
+  bool away[64] = {false};
+  assert_true(views <= 64);
+  for (int v = 0; v < views; v++)
+    away[v] = lm_scene_node_culled(s, box, plan->views[v].cull, plan->views[v].depth[3] == 0);
   w[3][0] += 0.05f;
   lm_scene_node_set_world(s, box, (float *)w);
+  int untouched = 0;
+  for (int v = 0; v < views; v++)
+    untouched += away[v] && lm_scene_node_culled(s, box, plan->views[v].cull, plan->views[v].depth[3] == 0);
   assert_true(gl_render_again(&c));
   gl_result fresh = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = off});
   assert_true(fresh.ok);
   kept = lm_renderer_shadow_draw_stats(c.renderer);
-  printf("after moving the tall box: %d tiles kept, %d nodes drawn; %.3f%% of pixels differ from a fresh frame\n",
-         kept.kept, kept.drawn, 100.0 * share_different(&c, &fresh));
-  assert_true(kept.kept == 0 && kept.drawn > 0 && share_different(&c, &fresh) == 0.0f);
+  printf("after moving the tall box: %d of %d tiles kept (%d untouched by it), %d nodes drawn; %.3f%% of pixels "
+         "differ from a fresh frame\n", kept.kept, views, untouched, kept.drawn, 100.0 * share_different(&c, &fresh));
+  assert_true(kept.kept == untouched && kept.kept < views && kept.drawn > 0 && share_different(&c, &fresh) == 0.0f);
   assert_true(gl_render_again(&c));
   kept = lm_renderer_shadow_draw_stats(c.renderer);
   printf("the frame after: %d tiles kept, %d in place; %.3f%% of pixels differ from a fresh frame\n", kept.kept,

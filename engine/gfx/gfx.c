@@ -306,13 +306,16 @@ void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const f
     glVertexArrayAttribFormat(m->vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a] * sizeof(float));
     glVertexArrayAttribBinding(m->vao, a, 0);
   }
-  /* Binding 1: lm_instance, one an instance (its buffer is bound at draw time). */
-  for (int a = 3; a < 10; a++) {
-    bool model = a < 7;
-    size_t offset = model ? offsetof(lm_instance, model) + (size_t)(a - 3) * 4 * sizeof(float)
-                          : offsetof(lm_instance, normal) + (size_t)(a - 7) * 3 * sizeof(float);
+  /* Binding 1: lm_instance, one an instance (its buffer is bound at draw time):
+   * model 3-6, normal 7-9, prev_model 11-14. */
+  for (int a = 3; a < 15; a++) {
+    if (a == 10) continue;
+    bool normal = a >= 7 && a < 10;
+    size_t offset = a < 7 ? offsetof(lm_instance, model) + (size_t)(a - 3) * 4 * sizeof(float)
+                    : normal ? offsetof(lm_instance, normal) + (size_t)(a - 7) * 3 * sizeof(float)
+                             : offsetof(lm_instance, prev_model) + (size_t)(a - 11) * 4 * sizeof(float);
     glEnableVertexArrayAttrib(m->vao, (GLuint)a);
-    glVertexArrayAttribFormat(m->vao, (GLuint)a, model ? 4 : 3, GL_FLOAT, GL_FALSE, (GLuint)offset);
+    glVertexArrayAttribFormat(m->vao, (GLuint)a, normal ? 3 : 4, GL_FLOAT, GL_FALSE, (GLuint)offset);
     glVertexArrayAttribBinding(m->vao, (GLuint)a, 1);
   }
   glVertexArrayBindingDivisor(m->vao, 1, 1);
@@ -331,7 +334,27 @@ void lm_mesh_update_vertices(lm_mesh *m, const float *vertices, int vertex_count
   glNamedBufferSubData(m->vbo, 0, (GLsizeiptr)vertex_count * 8 * sizeof(float), vertices);
 }
 
+void lm_mesh_set_prev_positions(lm_mesh *m, const float *positions, int vertex_count) {
+  if (!positions) {
+    if (m->prev) glDisableVertexArrayAttrib(m->vao, 15);
+    m->prev = false;
+    return;
+  }
+  GLsizeiptr bytes = (GLsizeiptr)vertex_count * 3 * sizeof(float);
+  if (!m->pbo) { /* binding 3, made on the first deformation */
+    glCreateBuffers(1, &m->pbo);
+    glNamedBufferData(m->pbo, bytes, NULL, GL_DYNAMIC_DRAW);
+    glVertexArrayVertexBuffer(m->vao, 3, m->pbo, 0, 3 * sizeof(float));
+    glVertexArrayAttribFormat(m->vao, 15, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(m->vao, 15, 3);
+  }
+  glNamedBufferSubData(m->pbo, 0, bytes, positions);
+  if (!m->prev) glEnableVertexArrayAttrib(m->vao, 15);
+  m->prev = true;
+}
+
 void lm_mesh_destroy(lm_mesh *m) {
+  if (m->pbo) glDeleteBuffers(1, &m->pbo);
   if (m->vao) glDeleteVertexArrays(1, &m->vao);
   if (m->vbo) glDeleteBuffers(1, &m->vbo);
   if (m->tbo) glDeleteBuffers(1, &m->tbo);
@@ -354,6 +377,9 @@ void lm_instances_upload(const lm_instance *instances, int count) {
 void lm_mesh_draw_instances(const lm_mesh *m, int first, int count) {
   if (count <= 0 || !instance_vbo) return;
   glVertexArrayVertexBuffer(m->vao, 1, instance_vbo, 0, sizeof(lm_instance));
+  /* A disabled attribute reads the context's current value, not the VAO's:
+   * (0, 0, 0, 0) tells the shader that the mesh has no previous positions. */
+  if (!m->prev) glVertexAttrib4f(15, 0, 0, 0, 0);
   glBindVertexArray(m->vao);
   glDrawElementsInstancedBaseInstance(GL_TRIANGLES, m->index_count, GL_UNSIGNED_INT, NULL, count, (GLuint)first);
 }

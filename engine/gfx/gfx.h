@@ -185,7 +185,7 @@ typedef struct lm_light_data {
 void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, int light_count);
 
 /* ---- meshes ------------------------------------------------------------ */
-typedef struct lm_mesh { uint32_t vao, vbo, tbo, ibo; int index_count; } lm_mesh;
+typedef struct lm_mesh { uint32_t vao, vbo, tbo, ibo, pbo; int index_count; bool prev; } lm_mesh;
 /* Interleaved position(3) normal(3) uv(2) floats (attributes 0, 1, 2); 32-bit indices.
  * tangents (may be NULL): xyz and handedness w a vertex, attribute 10; without,
  * the attribute reads (0, 0, 0, 1), which shaders take for "none". */
@@ -194,10 +194,16 @@ void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const f
 void lm_mesh_destroy(lm_mesh *m);
 /* Replaces the interleaved vertices (the same count as created): a deformed mesh's new pose. */
 void lm_mesh_update_vertices(lm_mesh *m, const float *vertices, int vertex_count);
+/* A deformed mesh's positions in the previous frame (xyz a vertex, the same
+ * count as created), attribute 15 (in_prev_position, w 1) for velocities;
+ * NULL: the mesh did not deform since, and attribute 15 reads (0, 0, 0, 0),
+ * which shaders take for "the current position". */
+void lm_mesh_set_prev_positions(lm_mesh *m, const float *positions, int vertex_count);
 /* One instance of a drawn mesh: attributes 3-6 (mat4 instance_model, the
- * columns) and 7-9 (mat3 instance_normal, the model matrix's inverse
- * transpose), stepping once an instance. */
-typedef struct lm_instance { float model[16]; float normal[9]; } lm_instance;
+ * columns), 7-9 (mat3 instance_normal, the model matrix's inverse
+ * transpose) and 11-14 (mat4 instance_prev_model, the node's model matrix
+ * in the previous frame, for velocities), stepping once an instance. */
+typedef struct lm_instance { float model[16]; float normal[9]; float prev_model[16]; } lm_instance;
 /* Replaces the instances the next draws read (grows the buffer as needed). */
 void lm_instances_upload(const lm_instance *instances, int count);
 /* Draws m once for each of the uploaded instances first .. first + count - 1:

@@ -10,6 +10,10 @@ enum { MAX_LIGHTS = 256 };
 
 /* Shadow tiles kept from frame to frame: a copy of every output of the
  * shadow pass (and its depth), and per tile drawn the key of what drew it.
+ * While casters move, a second copy keeps each drawn tile's static layer
+ * (its casters that did not move this frame, and their key): a tile a moving
+ * caster touches copies that layer back and draws the moving casters over it
+ * (the depth test merges them as one draw would).
  * A view whose key matches the tile in its place copies the texels back
  * instead of drawing (lm_shadow_settings.cache). When the pass's outputs
  * are the very textures it left last frame, which nothing else wrote since
@@ -20,7 +24,12 @@ typedef struct tile_cache {
   lm_texture tex[LM_MAX_COLOR_OUTPUTS + 1];
   lm_format format[LM_MAX_COLOR_OUTPUTS + 1];
   int count, width, height;
-  struct cached_tile { int x, y, width, height; bool drawn; uint64_t key; } *tiles;
+  struct cached_tile {
+    int x, y, width, height;
+    bool drawn, layered; /* its texels, its static layer kept */
+    uint64_t key, static_key;
+  } *tiles;
+  lm_texture layer[LM_MAX_COLOR_OUTPUTS + 1]; /* the static layers (made when a caster first moves) */
   int tile_count, tile_cap;
   uint32_t left[LM_MAX_COLOR_OUTPUTS + 1]; /* the textures the pass left, 0 where another may write */
   long execution;  /* lm_renderer.executions when it left them */
@@ -45,7 +54,15 @@ struct lm_renderer {
   lm_trace *trace; /* the scene's BVH, built by the first CPU "trace" pass */
   uint64_t trace_hash; /* geometry_hash when it was built or refitted */
   tile_cache tiles;
-  uint64_t casters_hash; /* this frame's caster_hash */
+  uint64_t casters_hash; /* this frame's material_hash */
+  float *prev_world; /* each node's world transform in the previous frame (velocities) */
+  int prev_world_count, prev_world_cap; /* nodes it holds (another count than the scene's: a first frame) */
+  uint64_t pose;   /* frames in which deformed meshes changed (geometry_hash) */
+  uint64_t *deforms; /* per mesh: the frames in which it deformed (tile_casters) */
+  int deform_count, deform_cap;
+  bool *dynamic;   /* per node: a mesh node that moved or deformed since the last frame */
+  int dynamic_cap;
+  bool any_dynamic;
   uint64_t world;  /* the last frame's world_hash */
   int still;       /* frames in a row before this one whose world_hash was this one's */
   long executions; /* frames executed, never reset (tile_cache.execution) */
@@ -65,7 +82,7 @@ lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
 }
 
 static void tile_cache_free(tile_cache *c) {
-  for (int i = 0; i < c->count; i++) lm_texture_destroy(&c->tex[i]);
+  for (int i = 0; i < c->count; i++) lm_texture_destroy(&c->tex[i]), lm_texture_destroy(&c->layer[i]);
   free(c->tiles);
   *c = (tile_cache){.execution = -1};
 }
@@ -77,6 +94,9 @@ void lm_renderer_destroy(lm_renderer *r) {
   lm_shadow_plan_free(&r->shadows);
   lm_light_grid_free(&r->light_grid);
   lm_trace_destroy(r->trace);
+  free(r->prev_world);
+  free(r->deforms);
+  free(r->dynamic);
   free(r);
 }
 
@@ -118,8 +138,9 @@ static const lm_program *scene_variant(void *ctx, const char *defines, lm_error 
   return lm_scene_pass_variant(ctx, defines, err);
 }
 
-/* Draws the scene for a scene pass: the camera's, or one shadow tile's. */
-static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, lm_error *err) {
+/* Draws the scene for a scene pass: the camera's, or one shadow tile's
+ * (layer: lm_scene_draw_desc's, 0 all its casters). */
+static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, int layer, lm_error *err) {
   enum { MAX_PARAMS = 256 };
   lm_material_param params[MAX_PARAMS];
   int n = sp->desc->material_param_count < MAX_PARAMS ? sp->desc->material_param_count : MAX_PARAMS;
@@ -135,7 +156,8 @@ static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, lm_error *err) {
   lm_scene_draw_desc d = {.program = sp->program, .variant = scene_variant, .ctx = (void *)sp,
                           .view_proj = r->desc.no_culling ? NULL : view_proj,
                           .pancake = sp->view && sp->view->depth[3] == 0,
-                          .params = params, .param_count = n};
+                          .params = params, .param_count = n, .prev_world = r->prev_world,
+                          .dynamic = r->dynamic, .layer = layer};
   return lm_scene_draw(r->desc.scene, &d, sp->view ? &r->shadow_stats : &r->stats, err);
 }
 
@@ -149,14 +171,35 @@ static int pass_textures(const lm_scene_pass *sp, lm_graph_target_info out[LM_MA
   return n;
 }
 
+/* The casters a tile draws: each mesh node its cull volume keeps (as
+ * draw_pass culls: a cascade keeps those before its near plane), with its
+ * mesh, material, world transform and deformation count. A caster that moves
+ * changes the key of the tiles it touches now and of those it touched last
+ * frame (it left their set); the others stay cached. */
+static uint64_t tile_casters(const lm_renderer *r, const lm_pass_view *v, bool static_only, uint64_t h) {
+  const lm_scene *s = r->desc.scene;
+  bool pancake = v->depth[3] == 0;
+  for (int i = 0; i < s->node_count; i++) {
+    const lm_node *n = &s->nodes[i];
+    if (n->mesh < 0 || n->mesh >= s->mesh_count || (static_only && r->dynamic[i])) continue;
+    if (!r->desc.no_culling && lm_scene_node_culled(s, i, v->cull, pancake)) continue;
+    int k[3] = {i, n->mesh, n->material};
+    h = lm_hash(k, sizeof k, h);
+    h = lm_hash(n->world, sizeof n->world, h);
+    if (n->mesh < r->deform_count) h = lm_hash(&r->deforms[n->mesh], sizeof r->deforms[n->mesh], h);
+  }
+  return h;
+}
+
 /* What a shadow tile's texels follow from: the view (place, matrices, cull
  * volume), the pass (technique's program, defines, clear colour, material
- * overrides) and the casters (caster_hash). */
-static uint64_t tile_key(const lm_renderer *r, const lm_scene_pass *sp) {
+ * overrides), the scene's materials (casters_hash) and the casters in the
+ * tile (tile_casters; static_only: those that did not move, its static layer's). */
+static uint64_t tile_key(const lm_renderer *r, const lm_scene_pass *sp, bool static_only) {
   const lm_pass_view *v = sp->view;
   const lm_pass_desc *d = sp->desc;
   int place[4] = {v->x, v->y, v->width, v->height};
-  uint64_t h = lm_hash(place, sizeof place, r->casters_hash);
+  uint64_t h = lm_hash(place, sizeof place, tile_casters(r, v, static_only, r->casters_hash));
   h = lm_hash(v->view_proj, sizeof v->view_proj, h);
   h = lm_hash(v->depth, sizeof v->depth, h);
   h = lm_hash(v->cull, sizeof v->cull, h);
@@ -202,7 +245,7 @@ static struct cached_tile *tile_at(tile_cache *c, const lm_pass_view *v) {
     if (t->x == v->x && t->y == v->y && t->width == v->width && t->height == v->height) return t;
   }
   struct cached_tile *t = LM_PUSH(c->tiles, c->tile_count, c->tile_cap);
-  *t = (struct cached_tile){v->x, v->y, v->width, v->height, false, 0};
+  *t = (struct cached_tile){.x = v->x, .y = v->y, .width = v->width, .height = v->height};
   return t;
 }
 
@@ -214,7 +257,7 @@ static void tile_cache_drawn(tile_cache *c, struct cached_tile *t, uint64_t key)
     struct cached_tile *o = &c->tiles[i];
     if (o != t && o->x < t->x + t->width && t->x < o->x + o->width && o->y < t->y + t->height &&
         t->y < o->y + o->height)
-      o->drawn = false;
+      o->drawn = o->layered = false;
   }
   t->drawn = true, t->key = key;
 }
@@ -244,6 +287,47 @@ static bool keeps_views(void *user, const lm_scene_pass *sp) {
   return same;
 }
 
+/* Copies the rectangle of tile t between the pass's textures and a copy of them. */
+static void copy_tile(const lm_graph_target_info *t, const lm_texture *copy, int n, const struct cached_tile *at,
+                      bool to_copy) {
+  for (int i = 0; i < n; i++) {
+    lm_texture dst = to_copy ? copy[i] : t[i].texture, src = to_copy ? t[i].texture : copy[i];
+    lm_texture_copy_rect(dst, src, at->x, at->y, at->width, at->height);
+  }
+}
+
+/* Makes the static layers' textures, like the cache's; false when one cannot be made. */
+static bool tile_cache_layers(tile_cache *c, lm_error *err) {
+  for (int i = 0; i < c->count; i++)
+    if (!c->layer[i].id &&
+        !lm_texture_create(&c->layer[i], &(lm_texture_desc){c->format[i], c->width, c->height, false},
+                           "shadow tile static layers", err))
+      return false;
+  return true;
+}
+
+/* Draws a tile that changed while casters move (or whose static layer is
+ * kept): its static layer, drawn again only when its own casters changed,
+ * then the moving casters over it. */
+static bool draw_layered(lm_renderer *r, const lm_scene_pass *sp, const lm_graph_target_info *t, int nt,
+                         struct cached_tile *cached, bool in_place, lm_error *err) {
+  tile_cache *c = &r->tiles;
+  if (!tile_cache_layers(c, err)) return false;
+  uint64_t key = tile_key(r, sp, true);
+  if (cached->layered && cached->static_key == key) {
+    copy_tile(t, c->layer, nt, cached, false);
+    r->shadow_stats.layered++;
+  } else {
+    if (in_place)
+      lm_clear_rect(cached->x, cached->y, cached->width, cached->height, sp->desc->output_count,
+                    sp->desc->clear_color, sp->desc->depth >= 0, lm_scene_clear_depth(true));
+    if (!draw_pass(r, sp, 1, err)) return false;
+    copy_tile(t, c->layer, nt, cached, true);
+    cached->layered = true, cached->static_key = key;
+  }
+  return !r->any_dynamic || draw_pass(r, sp, 2, err);
+}
+
 static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   lm_renderer *r = user;
   /* A shadow tile drawn last frame from the same view and casters: copy it back. */
@@ -255,27 +339,31 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   if (nt > 0) {
     bool in_place = c->in_place;
     if (!tile_cache_fit(c, t, nt, err)) return false;
-    key = tile_key(r, sp);
+    key = tile_key(r, sp, false);
     cached = tile_at(c, sp->view);
     /* What the pass leaves for the next frame (whether or not it was in place). */
     for (int i = 0; i < nt; i++) c->left[i] = t[i].alone ? t[i].texture.id : 0;
     c->execution = r->executions;
     c->layout = view_layout(sp, t);
     if (cached->drawn && cached->key == key) {
-      for (int i = 0; i < nt && !in_place; i++)
-        lm_texture_copy_rect(t[i].texture, c->tex[i], cached->x, cached->y, cached->width, cached->height);
+      if (!in_place) copy_tile(t, c->tex, nt, cached, false);
       r->shadow_stats.kept++;
       r->shadow_stats.in_place += in_place;
+      return true;
+    }
+    if (r->any_dynamic || cached->layered) {
+      if (!draw_layered(r, sp, t, nt, cached, in_place, err)) return false;
+      copy_tile(t, c->tex, nt, cached, true);
+      tile_cache_drawn(c, cached, key);
       return true;
     }
     if (in_place) /* the pass cleared nothing: this tile alone */
       lm_clear_rect(cached->x, cached->y, cached->width, cached->height, sp->desc->output_count,
                     sp->desc->clear_color, sp->desc->depth >= 0, lm_scene_clear_depth(true));
   }
-  if (!draw_pass(r, sp, err)) return false;
+  if (!draw_pass(r, sp, 0, err)) return false;
   if (cached) {
-    for (int i = 0; i < nt; i++)
-      lm_texture_copy_rect(c->tex[i], t[i].texture, cached->x, cached->y, cached->width, cached->height);
+    copy_tile(t, c->tex, nt, cached, true);
     tile_cache_drawn(c, cached, key);
   }
   return true;
@@ -291,9 +379,12 @@ bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
   return true;
 }
 
-/* A hash of what the BVH is built from: mesh nodes, their meshes and world transforms. */
-static uint64_t geometry_hash(const lm_scene *s) {
-  uint64_t h = lm_hash(&s->node_count, sizeof s->node_count, 0);
+/* A hash of what the BVH is built from: mesh nodes, their meshes and world
+ * transforms, and the pose of deformed meshes (a count of the frames in
+ * which any deformed: cheaper than hashing their vertices). */
+static uint64_t geometry_hash(const lm_renderer *r) {
+  const lm_scene *s = r->desc.scene;
+  uint64_t h = lm_hash(&s->node_count, sizeof s->node_count, lm_hash(&r->pose, sizeof r->pose, 0));
   for (int i = 0; i < s->node_count; i++) {
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0) continue;
@@ -303,14 +394,11 @@ static uint64_t geometry_hash(const lm_scene *s) {
   return h;
 }
 
-/* A hash of what shadow tiles are drawn from beside their views: the scene,
- * its mesh nodes (mesh, material, world transform) and what the shadow and
- * RSM shaders read of the materials (colour, factors, base-colour texture,
- * alpha mask and texture transforms). */
-static uint64_t caster_hash(const lm_scene *s) {
-  uint64_t h = lm_hash(&s, sizeof s, geometry_hash(s));
-  for (int i = 0; i < s->node_count; i++)
-    if (s->nodes[i].mesh >= 0) h = lm_hash(&s->nodes[i].material, sizeof s->nodes[i].material, h);
+/* A hash of the scene and what the shadow and RSM shaders read of its
+ * materials (colour, factors, base-colour texture, alpha mask and texture
+ * transforms). */
+static uint64_t material_hash(const lm_scene *s) {
+  uint64_t h = lm_hash(&s, sizeof s, 0);
   for (int i = 0; i < s->material_count; i++) {
     const lm_material *m = &s->materials[i];
     const lm_material_pbr *p = &s->material_pbr[i];
@@ -324,6 +412,16 @@ static uint64_t caster_hash(const lm_scene *s) {
     h = lm_hash(p->uv_transform, sizeof p->uv_transform, h);
   }
   return h;
+}
+
+/* A hash of what shadow tiles are drawn from beside their views: the
+ * materials, and the mesh nodes (mesh, material, world transform, pose). */
+static uint64_t caster_hash(const lm_renderer *r) {
+  const lm_scene *s = r->desc.scene;
+  uint64_t h = lm_hash(&s, sizeof s, geometry_hash(r));
+  for (int i = 0; i < s->node_count; i++)
+    if (s->nodes[i].mesh >= 0) h = lm_hash(&s->nodes[i].material, sizeof s->nodes[i].material, h);
+  return lm_hash(&h, sizeof h, material_hash(s));
 }
 
 static float srgb_to_linear(unsigned char c) {
@@ -367,7 +465,7 @@ static bool run_trace(lm_renderer *r, const lm_cpu_pass *cp, lm_error *err) {
     return false;
   }
   const lm_scene *s = r->desc.scene;
-  uint64_t h = geometry_hash(s);
+  uint64_t h = geometry_hash(r);
   if (!r->trace) r->trace = lm_trace_create(s, NULL);
   else if (h != r->trace_hash) lm_trace_update(r->trace, s, NULL); /* nodes moved: refit (or rebuild) */
   r->trace_hash = h;
@@ -445,7 +543,7 @@ static uint64_t world_hash(const lm_renderer *r, const lm_pipeline *p, const lm_
   lm_light_data lights[MAX_LIGHTS];
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
   unsigned shaders = lm_programs_generation();
-  uint64_t h = lm_hash(&p, sizeof p, caster_hash(r->desc.scene));
+  uint64_t h = lm_hash(&p, sizeof p, caster_hash(r));
   h = lm_hash(lights, sizeof *lights * (size_t)n, lm_hash(&n, sizeof n, h));
   h = lm_hash(frame->view_proj, sizeof frame->view_proj, h);
   h = lm_hash(frame->camera_pos, sizeof frame->camera_pos, h);
@@ -461,6 +559,24 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
   lm_frame_data *frame = &r->camera;
   lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, frame);
   lm_shadow_plan_free(&r->shadows);
+  /* Deformed meshes' new poses, before anything hashes or draws them (the
+   * renderer alone calls lm_scene_upload_deformed: it clears their marks). */
+  const lm_scene *s = r->desc.scene;
+  r->deforms = lm_grow(r->deforms, &r->deform_cap, s->mesh_count, sizeof *r->deforms);
+  r->deform_count = s->mesh_count;
+  for (int i = 0; i < s->mesh_count; i++) r->deforms[i] += s->meshes[i].dirty;
+  /* The mesh nodes that moved or deformed since the last frame (none on a first one). */
+  r->dynamic = lm_grow(r->dynamic, &r->dynamic_cap, s->node_count, sizeof *r->dynamic);
+  r->any_dynamic = false;
+  bool known = r->frame > 0 && r->prev_world_count == s->node_count;
+  for (int i = 0; i < s->node_count; i++) {
+    const lm_node *n = &s->nodes[i];
+    bool mesh = n->mesh >= 0 && n->mesh < s->mesh_count;
+    r->dynamic[i] = mesh && known &&
+                    (s->meshes[n->mesh].dirty || memcmp(n->world, r->prev_world + (size_t)i * 16, sizeof n->world));
+    r->any_dynamic |= r->dynamic[i];
+  }
+  r->pose += lm_scene_upload_deformed(r->desc.scene) > 0;
   uint64_t world = world_hash(r, p, frame);
   r->still = r->frame > 0 && world == r->world ? r->still + 1 : 0;
   r->world = world;
@@ -475,6 +591,14 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
   return true;
 }
 
+/* Keeps each node's world transform for the next frame's velocities (lm_scene_draw_desc.prev_world). */
+static void remember_world(lm_renderer *r) {
+  const lm_scene *s = r->desc.scene;
+  r->prev_world = lm_grow(r->prev_world, &r->prev_world_cap, s->node_count, 16 * sizeof(float));
+  r->prev_world_count = s->node_count;
+  for (int i = 0; i < s->node_count; i++) memcpy(r->prev_world + (size_t)i * 16, s->nodes[i].world, 16 * sizeof(float));
+}
+
 /* Runs what record() compiled into g (the camera and shadow plan it made). */
 static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_frame_data *frame = &r->camera;
@@ -483,6 +607,8 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   r->tiles.in_place = false;
   memcpy(frame->prev_view_proj, r->frame ? r->prev_view_proj : frame->view_proj, sizeof frame->prev_view_proj);
   memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
+  /* A first frame (after a cut, or another scene) has no previous transforms: nothing moved. */
+  if (r->frame == 0 || r->prev_world_count != r->desc.scene->node_count) remember_world(r);
   frame->time[1] = (float)r->frame++;
   lm_light_data lights[MAX_LIGHTS];
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
@@ -491,13 +617,15 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_light_grid_build(&r->light_grid, frame, lights, n, !r->desc.no_light_culling);
   lm_storage_upload(4, r->light_grid.data, r->light_grid.count * sizeof *r->light_grid.data);
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
-  if (r->shadows.view_count > 0 && r->shadows.settings.cache) r->casters_hash = caster_hash(r->desc.scene);
+  if (r->shadows.view_count > 0 && r->shadows.settings.cache) r->casters_hash = material_hash(r->desc.scene);
   r->fit_ms = 0;
   lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene, .fit_views = fit_views,
                           .keeps_views = keeps_views, .run_cpu = run_cpu,
                           .scene_owns_uniform = lm_scene_owns_uniform, .user = r,
                           .check_finite = r->desc.check_finite};
-  return lm_graph_execute(g, &x, err);
+  bool ok = lm_graph_execute(g, &x, err);
+  remember_world(r);
+  return ok;
 }
 
 bool lm_renderer_frame(lm_renderer *r, lm_error *err) {

@@ -255,14 +255,21 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
   return true;
 }
 
-void lm_scene_upload_deformed(lm_scene *s) {
-  if (!s->uploaded) return;
+int lm_scene_upload_deformed(lm_scene *s) {
+  if (!s->uploaded) return 0;
+  int changed = 0;
   for (int i = 0; i < s->mesh_count; i++) {
     lm_scene_mesh *m = &s->meshes[i];
-    if (!m->dirty) continue;
+    if (!m->dirty) {
+      lm_mesh_set_prev_positions(&m->gpu, NULL, m->vertex_count);
+      continue;
+    }
     lm_mesh_update_vertices(&m->gpu, m->vertices, m->vertex_count);
+    lm_mesh_set_prev_positions(&m->gpu, m->prev_positions, m->vertex_count);
     m->dirty = false;
+    changed++;
   }
+  return changed;
 }
 
 bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err) {
@@ -614,6 +621,11 @@ bool lm_scene_node_bounds(const lm_scene *s, int node, float lo[3], float hi[3])
   return isfinite(lo[0] + lo[1] + lo[2] + hi[0] + hi[1] + hi[2]);
 }
 
+bool lm_scene_node_culled(const lm_scene *s, int node, const float view_proj[16], bool pancake) {
+  float lo[3], hi[3];
+  return lm_scene_node_bounds(s, node, lo, hi) && box_outside(view_proj, lo, hi, pancake);
+}
+
 /* A visible mesh node, sorted so that nodes of one mesh and material lie together. */
 typedef struct drawn_node { int material, mesh, node; } drawn_node;
 
@@ -648,11 +660,13 @@ static void bind_material(const lm_scene *s, const lm_program *p, const lm_mater
   }
 }
 
-/* A node's model matrix and normal matrix (the inverse transpose's 3x3). */
-static void node_instance(const lm_node *n, lm_instance *out) {
+/* A node's model matrix, normal matrix (the inverse transpose's 3x3) and
+ * model matrix in the previous frame (`prev`, NULL: the current one). */
+static void node_instance(const lm_node *n, const float *prev, lm_instance *out) {
   mat4 model, inv;
   mat3 normal;
   memcpy(model, n->world, sizeof model);
+  memcpy(out->prev_model, prev ? prev : n->world, sizeof out->prev_model);
   glm_mat4_inv(model, inv);
   glm_mat4_transpose(inv);
   glm_mat4_pick3(inv, normal);
@@ -677,6 +691,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
   for (int i = 0; i < s->node_count; i++) {
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
+    if (d->dynamic && d->layer && d->dynamic[i] != (d->layer == 2)) continue;
     if (d->view_proj) {
       float lo[3], hi[3];
       world_bounds(n->world, s->meshes[n->mesh].bounds, lo, hi);
@@ -689,7 +704,10 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
   }
   qsort(nodes, (size_t)count, sizeof *nodes, drawn_node_order);
   lm_instance *instances = lm_alloc(sizeof *instances * (size_t)(count > 0 ? count : 1));
-  for (int i = 0; i < count; i++) node_instance(&s->nodes[nodes[i].node], &instances[i]);
+  for (int i = 0; i < count; i++) {
+    int k = nodes[i].node;
+    node_instance(&s->nodes[k], d->prev_world ? d->prev_world + (size_t)k * 16 : NULL, &instances[i]);
+  }
   lm_instances_upload(instances, count);
   free(instances);
   char bound[160] = ""; /* the defines of the variant that is bound */

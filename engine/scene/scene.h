@@ -297,8 +297,11 @@ bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err)
 
 /* ---- rendering (needs a GL context) ------------------------------------ */
 bool lm_scene_upload(lm_scene *s, lm_error *err);
-/* Uploads the vertices of the deformed meshes that lm_scene_set_time changed. */
-void lm_scene_upload_deformed(lm_scene *s);
+/* Uploads the vertices of the deformed meshes that lm_scene_set_time changed,
+ * with their prev_positions (lm_mesh_set_prev_positions); a mesh that did not
+ * change since the last call draws its current positions as the previous
+ * ones (it stood still for a frame). Returns how many meshes changed. */
+int lm_scene_upload_deformed(lm_scene *s);
 /* Frame block for camera `cam` at an output of width x height. */
 void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_frame_data *out);
 /* Fills up to `max` lights; returns how many. */
@@ -359,12 +362,22 @@ typedef struct lm_scene_draw_desc {
   bool pancake; /* an orthographic shadow tile: nodes before its near plane still cast, so stay */
   const lm_material_param *params; /* overrides (checked by lm_scene_check_params) */
   int param_count;
+  /* Each node's world transform in the previous frame (16 floats a node,
+   * node_count of them): lm_instance.prev_model, for velocities. NULL: the
+   * current ones (nothing moved). */
+  const float *prev_world;
+  /* With `dynamic` (a flag a node) and `layer` 1, only the nodes not flagged
+   * are drawn, with layer 2 only those flagged (a shadow tile's static layer,
+   * and the moving casters drawn over it); layer 0 or dynamic NULL: all. */
+  const bool *dynamic;
+  int layer;
 } lm_scene_draw_desc;
 typedef struct lm_scene_draw_stats {
   int drawn, culled; /* mesh nodes drawn, and left out by the frustum test */
   int calls;         /* draw calls: one for the nodes of a mesh and material in view */
   int kept;          /* views (shadow tiles) kept from the last frame instead of drawn */
   int in_place;      /* of those, the ones still in the pass's outputs: neither cleared nor copied */
+  int layered;       /* views drawn again over their kept static layer: only their moving casters drawn */
   long triangles;    /* triangles drawn */
 } lm_scene_draw_stats;
 /* Draws every mesh node whose bounds reach into the frustum, the nodes of one
@@ -378,6 +391,9 @@ typedef struct lm_scene_draw_stats {
 bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err);
 /* True when the world-space box lo..hi lies wholly outside one clip plane of view_proj. */
 bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const float hi[3]);
+/* Would lm_scene_draw with this view_proj and pancake cull mesh node `node`?
+ * False for a node whose bounds are not finite (it is drawn). */
+bool lm_scene_node_culled(const lm_scene *s, int node, const float view_proj[16], bool pancake);
 /* Uniforms a scene draw sets itself; scripts may not bind them. */
 bool lm_scene_owns_uniform(const char *name);
 
