@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "camera_path.h"
 #include "render/render.h"
 #include "scene/gltf.h"
 #include "trace/trace.h"
@@ -81,8 +82,9 @@ static const char bench_usage[] =
     "  --time START:STOP   play the scene's animation over the moving frames at\n"
     "                      --fps (implies --motion; sets the timed frames'\n"
     "                      count; warm-up frames come before START): its pose\n"
-    "                      (lm_scene_set_time, timed as \"animate (cpu)\") and the\n"
-    "                      deformed vertices' upload before each frame\n"
+    "                      (lm_scene_set_time, timed as \"animate (cpu)\") before\n"
+    "                      each frame; the deformed vertices' upload is the\n"
+    "                      renderer's, in \"outside the passes\"\n"
     "  --fps N             frames a second of --time (default 24)\n"
     "  --animation NAME|INDEX|all  which animation --time plays (default all)\n"
     "  --json              one JSON object on stdout instead of the tables\n"
@@ -689,38 +691,22 @@ static bool node_animated(const lm_scene *s, int anim, int node) {
 /* The world transform of a camera at `eye` looking at `at`, +Y up (a camera
  * looks along its -Z). The orbit's elevation stays within 89 degrees, so the
  * view is never along Y. */
-static void look_at(const float eye[3], const float at[3], float m[16]) {
-  float f[3] = {at[0] - eye[0], at[1] - eye[1], at[2] - eye[2]};
-  float fl = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-  if (!(fl > 0)) f[0] = 0, f[1] = 0, f[2] = -1, fl = 1;
-  for (int i = 0; i < 3; i++) f[i] /= fl;
-  float x[3] = {-f[2], 0, f[0]}; /* f x (0, 1, 0) */
-  float xl = sqrtf(x[0] * x[0] + x[2] * x[2]);
-  if (!(xl > 0)) x[0] = 1, x[2] = 0, xl = 1;
-  x[0] /= xl, x[2] /= xl;
-  float y[3] = {x[1] * f[2] - x[2] * f[1], x[2] * f[0] - x[0] * f[2], x[0] * f[1] - x[1] * f[0]};
-  float w[16] = {x[0], x[1], x[2], 0, y[0], y[1], y[2], 0, -f[0], -f[1], -f[2], 0, eye[0], eye[1], eye[2], 1};
-  memcpy(m, w, sizeof w);
-}
-
 /* Poses s's scene for frame f of the path (f < 0: the warm-up before its
  * start): the orbit camera at f steps, and the animation at START + f / fps
- * with the deformed vertices uploaded. Returns the milliseconds that
+ * (the renderer uploads the deformed vertices at the frame's start). Returns the milliseconds that
  * lm_scene_set_time took (0 without --time). */
 static double pose(const motion *m, stream *s, int f) {
   if (m->orbit) {
     double az = m->step * f * M_PI / 180, el = m->elevation * M_PI / 180;
     float eye[3] = {m->centre[0] + (float)(m->radius * cos(el) * sin(az)), m->centre[1] + (float)(m->radius * sin(el)),
                     m->centre[2] + (float)(m->radius * cos(el) * cos(az))}, w[16];
-    look_at(eye, m->centre, w);
+    camera_look_at(eye, m->centre, w);
     lm_scene_node_set_world(s->scene, s->node, w);
   }
   if (!m->timed) return 0;
   double t0 = lm_now_ms();
   lm_scene_set_time(s->scene, m->anim, m->start + f / m->fps);
-  double ms = lm_now_ms() - t0;
-  lm_scene_upload_deformed(s->scene);
-  return ms;
+  return lm_now_ms() - t0;
 }
 
 /* Turns off what p keeps from frame to frame: shadow.cache and every
@@ -870,7 +856,7 @@ static void print_motion(const bench *b) {
   else
     printf("  camera: the scene's camera '%s', moved by the animation\n", m->camera);
   if (m->timed)
-    printf("  animation '%s' from %.4g to %.4g s at %.4g fps: lm_scene_set_time and the deformed vertices' upload "
+    printf("  animation '%s' from %.4g to %.4g s at %.4g fps: lm_scene_set_time "
            "before each frame, in its time\n", b->motion.animation, m->start, m->stop, m->fps);
   printf("  still: the path's first view held; moving: the path, every cache on, histories carried;\n"
          "  alone: each moving frame again with every cache off (every shadow tile drawn, no temporal history\n"

@@ -542,7 +542,6 @@ int limn_capture(int argc, char **argv) {
       if (k == 0) /* the previous pose (velocities): the frame before's, a still's own */
         lm_scene_set_time(scene, animation, a.frame_count > 1 ? t - 1 / a.fps : t);
       lm_scene_set_time(scene, animation, t);
-      lm_scene_upload_deformed(scene);
     }
     for (int i = 0; i < a.output_count; i++) {
       frame_name(a.outputs[i], k, t, names[i], sizeof names[i]);

@@ -1036,7 +1036,6 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
         job_pose(j, &before);
       }
       job_pose(j, v);
-      lm_scene_upload_deformed(s->scene);
       const char *outs[1] = {v->output};
       capture_view cv = {.camera = v->camera, .width = j->sizes[v->size][0], .height = j->sizes[v->size][1],
                          .frames = j->frames, .outputs = outs, .output_count = 1, .quiet = true,

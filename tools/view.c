@@ -321,7 +321,6 @@ static void pose(viewer *v) {
   float *local = node >= 0 ? v->scene->nodes[node].local : NULL;
   if (v->camera_user && local) memcpy(local, v->camera_local, sizeof v->camera_local);
   lm_scene_set_time(v->scene, v->anim, v->time);
-  lm_scene_upload_deformed(v->scene);
   if (v->camera_user && local) {
     memcpy(v->camera_local, local, sizeof v->camera_local);
     fly_to_camera(v);
