@@ -10,6 +10,7 @@
 #include <math.h>
 
 #include "camera_path.h"
+#include "scene/scene.h"
 
 static void eval(const camera_key *k, int n, double t, float eye[3], float target[3], float *fov) {
   camera_path_eval(k, n, t, eye, target, fov);
@@ -111,7 +112,7 @@ static void look_at(void **state) {
   (void)state;
   const float eye[3] = {1, 2, 3}, target[3] = {4, -2, 3};
   float w[16];
-  camera_look_at(eye, target, w);
+  lm_camera_look_at(eye, target, w);
   /* -Z (column 2 negated) points at the target; columns orthonormal; +X level. */
   assert_true(fabsf(-w[8] - 0.6f) < 1e-6f && fabsf(-w[9] + 0.8f) < 1e-6f && fabsf(w[10]) < 1e-6f);
   for (int a = 0; a < 3; a++)
@@ -123,9 +124,9 @@ static void look_at(void **state) {
   assert_true(w[12] == 1 && w[13] == 2 && w[14] == 3 && w[15] == 1);
   /* Straight down, and at the target itself: still a rotation, finite. */
   const float below[3] = {1, -5, 3};
-  camera_look_at(eye, below, w);
+  lm_camera_look_at(eye, below, w);
   assert_true(fabsf(w[9] - 1) < 1e-6f);
-  camera_look_at(eye, eye, w);
+  lm_camera_look_at(eye, eye, w);
   for (int i = 0; i < 16; i++) assert_true(isfinite(w[i]));
   assert_true(fabsf(w[10] - 1) < 1e-6f);
 }

@@ -9,7 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "camera_path.h"
 #include "render/render.h"
 #include "scene/gltf.h"
 #include "trace/trace.h"
@@ -700,7 +699,7 @@ static double pose(const motion *m, stream *s, int f) {
     double az = m->step * f * M_PI / 180, el = m->elevation * M_PI / 180;
     float eye[3] = {m->centre[0] + (float)(m->radius * cos(el) * sin(az)), m->centre[1] + (float)(m->radius * sin(el)),
                     m->centre[2] + (float)(m->radius * cos(el) * cos(az))}, w[16];
-    camera_look_at(eye, m->centre, w);
+    lm_camera_look_at(eye, m->centre, w);
     lm_scene_node_set_world(s->scene, s->node, w);
   }
   if (!m->timed) return 0;

@@ -16,7 +16,6 @@
  * dozen lines of arithmetic that no Debian library offers in this form. */
 #include "camera_path.h"
 
-#include <cglm/cglm.h>
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
@@ -76,16 +75,4 @@ void camera_path_eval(const camera_key *keys, int n, double t, float eye[3], flo
   channel(keys, n, i, u, offsetof(camera_key, target), 3, target);
   channel(keys, n, i, u, offsetof(camera_key, fov), 1, fov);
   *fov = fminf(fmaxf(*fov, 0.1f), 179.0f); /* a field of view the projection takes */
-}
-
-void camera_look_at(const float eye[3], const float target[3], float world[16]) {
-  vec3 f, up = {0, 1, 0}, r, u;
-  glm_vec3_sub((float *)target, (float *)eye, f);
-  if (!(glm_vec3_norm(f) > 0)) glm_vec3_copy((vec3){0, 0, -1}, f);
-  glm_vec3_normalize(f);
-  if (fabsf(f[1]) > 0.999f) up[1] = 0, up[2] = -1; /* straight down or up: any other up */
-  glm_vec3_crossn(f, up, r);
-  glm_vec3_cross(r, f, u);
-  float m[16] = {r[0], r[1], r[2], 0, u[0], u[1], u[2], 0, -f[0], -f[1], -f[2], 0, eye[0], eye[1], eye[2], 1};
-  memcpy(world, m, sizeof m);
 }

@@ -15,10 +15,4 @@ typedef struct camera_key {
  * first and last key outside their times. Always finite from finite keys. */
 void camera_path_eval(const camera_key *keys, int n, double t, float eye[3], float target[3], float *fov);
 
-/* The world transform of a camera at `eye` looking at `target` (-Z forward,
- * +Y up as glTF; straight up or down takes -Z for up), as camera lists make
- * it (engine/scene/camlist.c), so a path's key renders as that list's view.
- * An eye at the target looks down -Z. */
-void camera_look_at(const float eye[3], const float target[3], float world[16]);
-
 #endif

@@ -846,7 +846,7 @@ void job_pose(const job *j, const job_view *v) {
   } else {
     camera_path_eval(j->keys, j->key_count, v->time, eye, target, &fov);
   }
-  camera_look_at(eye, target, world);
+  lm_camera_look_at(eye, target, world);
   lm_camera *c = &sc->cameras[s->path_camera];
   lm_scene_node_set_world(sc, c->node, world);
   c->fov_y = fov * (float)(M_PI / 180);

@@ -37,16 +37,16 @@ static void scene_sphere(const lm_scene *s, vec3 centre, float *radius) {
   if (!(*radius > 0)) *radius = glm_vec3_norm(centre) > 0 ? 1e-3f * glm_vec3_norm(centre) : 1; /* one point */
 }
 
-/* World transform of an eye at `eye` looking at `target` (-Z forward, +Y up). */
-static void look_at_world(const vec3 eye, const vec3 target, float out[16]) {
+void lm_camera_look_at(const float eye[3], const float target[3], float world[16]) {
   vec3 f, up = {0, 1, 0}, r, u;
   glm_vec3_sub((float *)target, (float *)eye, f);
+  if (!(glm_vec3_norm(f) > 0)) glm_vec3_copy((vec3){0, 0, -1}, f);
   glm_vec3_normalize(f);
   if (fabsf(f[1]) > 0.999f) up[1] = 0, up[2] = -1; /* straight down or up: any other up */
   glm_vec3_crossn(f, up, r);
   glm_vec3_cross(r, f, u);
   float m[16] = {r[0], r[1], r[2], 0, u[0], u[1], u[2], 0, -f[0], -f[1], -f[2], 0, eye[0], eye[1], eye[2], 1};
-  memcpy(out, m, sizeof m);
+  memcpy(world, m, sizeof m);
 }
 
 int lm_scene_add_camera_list(lm_scene *s, const char *path, int *count, lm_error *err) {
@@ -116,7 +116,7 @@ int lm_scene_add_camera_list(lm_scene *s, const char *path, int *count, lm_error
     }
     if (!ok) break;
     float world[16];
-    look_at_world(eye, target, world);
+    lm_camera_look_at(eye, target, world);
     lm_camera c = {.fov_y = glm_rad(v[6]), .znear = v[7], .zfar = v[8]};
     if (n == 8) { /* far enough for the whole scene, near a small part of that (any unit: */
       c.zfar = 1.5f * (glm_vec3_distance(eye, centre) + radius); /* reversed float depth */

@@ -275,6 +275,10 @@ bool lm_scene_camera_check(const lm_scene *s, int cam, lm_error *err);
  * camera added and the count in *count; -1 with "file:line: ..." and the
  * scene unchanged. Without near and far, far covers the whole scene. */
 int lm_scene_add_camera_list(lm_scene *s, const char *path, int *count, lm_error *err);
+/* The world transform of a camera at `eye` looking at `target` (-Z forward,
+ * +Y up as glTF; straight up or down takes -Z for up; an eye at the target
+ * looks down -Z), as camera lists, job paths and turntables place cameras. */
+void lm_camera_look_at(const float eye[3], const float target[3], float world[16]);
 
 
 /* The node's material, or the engine's default one (material -1 or out of range). */
