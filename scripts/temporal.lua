@@ -27,7 +27,7 @@ temporal.defaults = {
   refresh = 32,     -- a converged pixel's 4 x 4 tile takes fresh samples one frame in this many,
                     -- so that a change of its light shows within as many frames, 0..1024 (0: never;
                     -- the seed: one 16 x 16 tile a frame, 1 in 256 at its half of 512 x 512)
-  moving = 4,       -- while the camera moves, a view-dependent result's history (ISR's, SSDO's: their
+  moving = 4,       -- while the camera or the world moves, a view-dependent result's history (ISR's, SSDO's: their
                     -- light at a point depends on what the screen shows) holds at most this many
                     -- frames, and no pixel counts as converged, 0..1024 (0: as a still camera, the
                     -- old view's light kept until a refresh; RSM's light does not depend on the view).
@@ -174,6 +174,7 @@ function temporal.bind(user, inputs, defines, params, o, f)
   params.frames, params.epsilon, params.refresh = o.frames, o.epsilon, o.refresh
   params.bias, params.confidence, params.restart = o.bias, o.confidence, restart and 1 or 0
   params.moving = histories[user].view and o.moving or 0
+  params.world_moved = still_frames() == 0 and 1 or 0 -- the world hash changed (camera included)
   if velocity and o.velocity then inputs.velocity, defines.VELOCITY = velocity, true end
   return next
 end

@@ -26,6 +26,7 @@ uniform float epsilon = 0.02, frames = 36.0, bias = 0.1, confidence = 0.25;
 uniform int refresh = 32;
 uniform int restart = 0; // 1: the settings changed (temporal.begin), no history is kept
 uniform float moving = 0.0; // > 0: a view-dependent result's most frames while the view changes
+uniform int world_moved = 0; // 1: something in the world (a caster, a light) changed since the last frame
 #ifdef VELOCITY
 // The G-buffer's velocity target (velocity.glsl): a pixel whose surface moved
 // on its own (a = 2) reprojects along its motion, to the view depth it had.
@@ -37,12 +38,13 @@ bool temporal_self_moved = false;
 
 // Does the view change this frame, for a result that depends on it
 // (`moving` > 0: ISR's and SSDO's light at a point depends on what the
-// screen shows, where RSM's does not)? Its history then counts at most
-// `moving` frames, so that it follows the view with about that lag, and no
-// pixel counts as converged (a converged one would keep the old view's
-// light until its tile's refresh).
+// screen shows, where RSM's does not), or the world that lights it (a door
+// opening onto the sun changes the light on walls that stood still)? Its
+// history then counts at most `moving` frames, so that it follows the
+// change with about that lag, and no pixel counts as converged (a converged
+// one would keep the old light until its tile's refresh).
 bool temporal_moving() {
-  return moving > 0.0 && (frame.view_proj != frame.prev_view_proj || temporal_self_moved);
+  return moving > 0.0 && (frame.view_proj != frame.prev_view_proj || temporal_self_moved || world_moved != 0);
 }
 
 // The history of the pixel at uv whose coarse depth is d (dpt): the
