@@ -110,10 +110,12 @@ static void every_scene_renders_every_view_with_content(void **state) {
     snprintf(path, sizeof path, "%s/%s.glb", scenes_dir, names[i]);
     lm_scene *s = lm_scene_load_gltf(path, &err);
     assert_non_null(s);
-    int first = s->camera_count, n;
+    int first = s->camera_count, n = 0;
     snprintf(path, sizeof path, "%s/%s.cams", scenes_dir, names[i]);
-    assert_true(lm_scene_add_camera_list(s, path, &n, &err) >= 0);
-    assert_true(n >= 3); /* several views per scene */
+    if (access(path, F_OK) == 0) assert_true(lm_scene_add_camera_list(s, path, &n, &err) >= 0);
+    else first = 0, n = s->camera_count; /* no list: the file's own cameras, as jobs take them */
+    assert_true(n >= (lm_scene_animated(s) ? 1 : 3)); /* several views per still scene; one that moves
+                                                        shows itself over time */
     /* The reference: each textured material's colour times its texture's
      * mean (linear) colour, no texture: the same light, without the detail. */
     bool textured = s->texture_count > 0;
