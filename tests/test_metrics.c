@@ -221,7 +221,7 @@ static void lag_of_an_exponential_return_by_hand(void **state) {
   for (int t = 0; t < 20; t++) e[t] = t < 5 ? 0.1 : 0.1 + 0.4 / pow(2, t - 5);
   lm_lag lag;
   lm_error err;
-  assert_true(lm_metrics_lag(e, 5, 20, &lag, &err));
+  assert_true(lm_metrics_lag(e, 5, 20, -1, &lag, &err));
   assert_int_equal(lag.frames, 6);
   assert_true(lag.returned);
   assert_float_equal(lag.settled, 0.1 + 0.4 / 4096, 1e-15);
@@ -229,12 +229,23 @@ static void lag_of_an_exponential_return_by_hand(void **state) {
    * settled is the median of frames 7 .. 11, 0.1 + 0.4 / 2^4 = 0.125, and
    * the last frame, 0.10625, is 0.01875 below it, past the tolerance
    * 0.0125: never settled, the lag is the window's 7 frames. */
-  assert_true(lm_metrics_lag(e, 5, 12, &lag, &err));
+  assert_true(lm_metrics_lag(e, 5, 12, -1, &lag, &err));
   assert_false(lag.returned);
   assert_int_equal(lag.frames, 7);
   assert_float_equal(lag.settled, 0.125, 1e-15);
+  /* The same cut window against the converged value 0.1 (a still frame
+   * rendered until it settled): the error falls within 0.01 of it only at
+   * frame 11 (0.1 + 0.4 / 2^6 = 0.10625 is 0.00625 off; frame 10's
+   * 0.1125 is 0.0125 off): the tail alone hid a lag of 6 frames. */
+  assert_true(lm_metrics_lag(e, 5, 12, 0.1, &lag, &err));
+  assert_true(lag.returned);
+  assert_int_equal(lag.frames, 6);
+  assert_float_equal(lag.settled, 0.1, 0);
+  /* A settled error that is not finite is refused. */
+  assert_false(lm_metrics_lag(e, 5, 12, NAN, &lag, &err));
+  assert_non_null(strstr(err.msg, "settled"));
   /* No change at all: lag 0. */
-  assert_true(lm_metrics_lag(e, 0, 5, &lag, &err));
+  assert_true(lm_metrics_lag(e, 0, 5, -1, &lag, &err));
   assert_int_equal(lag.frames, 0);
   assert_true(lag.returned);
 }
@@ -247,31 +258,31 @@ static void lag_that_swings_or_never_settles(void **state) {
   double swing[] = {0.5, 0.2, 0.05, 0.2, 0.2, 0.3, 0.2, 0.2};
   lm_lag lag;
   lm_error err;
-  assert_true(lm_metrics_lag(swing, 0, 8, &lag, &err));
+  assert_true(lm_metrics_lag(swing, 0, 8, -1, &lag, &err));
   assert_int_equal(lag.frames, 6); /* frame 5 (0.3) is off */
   assert_true(lag.returned);
   /* last 5: 0.2 0.1 0.2 0.2 0.1, median 0.2, the last frame 0.1 is off */
   double noisy[] = {0.9, 0.5, 0.2, 0.1, 0.2, 0.2, 0.1};
-  assert_true(lm_metrics_lag(noisy, 1, 7, &lag, &err));
+  assert_true(lm_metrics_lag(noisy, 1, 7, -1, &lag, &err));
   assert_false(lag.returned);
   assert_int_equal(lag.frames, 6);
   assert_float_equal(lag.settled, 0.2, 0);
   /* a settled error of 0 tolerates nothing, and never divides */
   double zero[] = {0.3, 0, 0, 0, 0, 0};
-  assert_true(lm_metrics_lag(zero, 0, 6, &lag, &err));
+  assert_true(lm_metrics_lag(zero, 0, 6, -1, &lag, &err));
   assert_int_equal(lag.frames, 1);
   assert_float_equal(lag.settled, 0, 0);
   /* Bad input is refused by name. */
-  assert_false(lm_metrics_lag(zero, 6, 6, &lag, &err));
+  assert_false(lm_metrics_lag(zero, 6, 6, -1, &lag, &err));
   assert_string_equal(err.msg, "event at frame 6: not among the sequence's frames 0 .. 5");
-  assert_false(lm_metrics_lag(zero, -1, 6, &lag, &err));
+  assert_false(lm_metrics_lag(zero, -1, 6, -1, &lag, &err));
   zero[3] = NAN;
-  assert_false(lm_metrics_lag(zero, 0, 6, &lag, &err));
+  assert_false(lm_metrics_lag(zero, 0, 6, -1, &lag, &err));
   assert_string_equal(err.msg, "frame 3: error nan is not a finite value >= 0");
   zero[3] = -0.5;
-  assert_false(lm_metrics_lag(zero, 2, 6, &lag, &err));
+  assert_false(lm_metrics_lag(zero, 2, 6, -1, &lag, &err));
   assert_string_equal(err.msg, "frame 3: error -0.5 is not a finite value >= 0");
-  assert_true(lm_metrics_lag(zero, 4, 6, &lag, &err)); /* frame 3 is outside that window */
+  assert_true(lm_metrics_lag(zero, 4, 6, -1, &lag, &err)); /* frame 3 is outside that window */
 }
 
 /* Band error: pixels 0 and 2 of 4 are in the band, off by 0.3 in every

@@ -164,7 +164,7 @@ static void sequence_summary_by_hand(void **state) {
   int events[] = {1, 3};
   report_sequence s;
   lm_error err;
-  assert_true(report_sequence_summarize(10, error, flicker, events, 2, &s, &err));
+  assert_true(report_sequence_summarize(10, error, flicker, events, NULL, 2, &s, &err));
   assert_int_equal(s.frames, 10);
   assert_float_equal(s.mean_error, 0.231, 1e-12);
   assert_float_equal(s.flicker, 0.1 / 9, 1e-12);
@@ -175,18 +175,25 @@ static void sequence_summary_by_hand(void **state) {
   assert_int_equal(s.lags[1].frames, 2);
   assert_true(s.lags[1].returned);
   assert_float_equal(s.lags[1].settled, 0.2, 1e-12);
+  /* Event 3 against a converged error of 0.3 (given): 0.21 and 0.2 are off
+   * by more than 0.03 from frame 5 on, so it never returns. */
+  double settled[] = {-1, 0.3};
+  assert_true(report_sequence_summarize(10, error, flicker, events, settled, 2, &s, &err));
+  assert_float_equal(s.lags[0].settled, 0.1, 1e-12);
+  assert_false(s.lags[1].returned);
+  assert_int_equal(s.lags[1].frames, 7);
   /* No events: no lags; one frame: flicker 0, not 0/0. */
-  assert_true(report_sequence_summarize(1, error, flicker, NULL, 0, &s, &err));
+  assert_true(report_sequence_summarize(1, error, flicker, NULL, NULL, 0, &s, &err));
   assert_int_equal(s.event_count, 0);
   assert_float_equal(s.flicker, 0, 0);
   assert_float_equal(s.mean_error, 0.1, 1e-12);
   /* A non-finite value is refused naming its frame. */
   error[4] = INFINITY;
-  assert_false(report_sequence_summarize(10, error, flicker, events, 2, &s, &err));
+  assert_false(report_sequence_summarize(10, error, flicker, events, NULL, 2, &s, &err));
   assert_non_null(strstr(err.msg, "frame 4:"));
   error[4] = 0.4;
   flicker[7] = NAN;
-  assert_false(report_sequence_summarize(10, error, flicker, NULL, 0, &s, &err));
+  assert_false(report_sequence_summarize(10, error, flicker, NULL, NULL, 0, &s, &err));
   assert_non_null(strstr(err.msg, "frame 7:"));
 }
 

@@ -43,8 +43,9 @@ static const char report_usage[] =
     "warm-up, and adds per setting and sequence: the mean error over frames,\n"
     "flicker (mean |(L_t - L_t-1) - (R_t - R_t-1)|, the change the reference\n"
     "does not have) and the lag after each of the job's events = { frame, ... }\n"
-    "(frames until the error stays within 10% of its settled value), with\n"
-    "error against frame plotted under report.svg's scatter.\n"
+    "(frames until the error stays within 10% of its settled value: the\n"
+    "error of the window's last pose rendered still until converged, 48\n"
+    "frames), with error against frame plotted under report.svg's scatter.\n"
     "\n"
     "SPEC: TECH, or TECH:OPTION=V1,V2,...;OPTION=V1,... for every combination,\n"
     "  e.g. --sweep \"isr:isr.samples=8,16,32;isr.coarse=1,2\" --sweep ssao\n"
@@ -90,9 +91,17 @@ typedef struct report_args {
 /* The places in runs (report_sequences) and, with sequences, each setting's
  * error over each run: summary[run * settings + setting] (frames 0 for a
  * run of one view). */
+/* Frames a still pose renders before its error counts as the settled one:
+ * more than any temporal history holds by default (temporal.frames 36). */
+#define REPORT_SETTLE_FRAMES 48
+
 typedef struct report_runs {
   int *first, count;
   report_sequence *summary;
+  /* settled[(run * settings + setting) * REPORT_MAX_EVENTS + event]: the
+   * error of the event window's last pose rendered still until converged
+   * (settle_pose), what the lag measures the return to; -1: not rendered. */
+  double *settled;
 } report_runs;
 
 static int usage_error(const char *fmt, const char *arg) {
@@ -441,12 +450,13 @@ static void md_sequences(lm_buf *b, const report_args *a, const job *j, const jo
                 "sequence's frames. Flicker: the mean over frames t >= 1 and values of |(L_t - L_t-1) - "
                 "(R_t - R_t-1)|, the frame-to-frame change the reference does not have (0 for a still scene). "
                 "Lag after each of the job's events (frame: frames): the frames from the event until the error "
-                "stays within %g%% of its settled value, the median of the last %d frames before the next event "
-                "or the end; N+ where even the last is off; - without events. A sequence's frames render once each, "
+                "stays within %g%% of its settled value: the error of the window's last pose (the frame before "
+                "the next event, or the last) rendered still for %d frames from no history, so that a history "
+                "fading out slowly counts as lag; N+ where even the last is off; - without events. A sequence's frames render once each, "
                 "in order (the first after the warm-up), so that temporal reuse sees them as a viewer would: "
                 "their times are single frames'.\n\n"
                 "| setting | sequence | frames | mean error | flicker | lag |\n|---|---|---|---|---|---|\n",
-                100 * LM_LAG_TOLERANCE, LM_LAG_SETTLED_FRAMES);
+                100 * LM_LAG_TOLERANCE, REPORT_SETTLE_FRAMES);
   for (int k = 0; k < runs->count; k++)
     for (int s = 0; s < a->setting_count; s++) {
       const report_sequence *q = &runs->summary[k * a->setting_count + s];
@@ -683,6 +693,34 @@ static void image_path(const report_args *a, const job *j, const job_view *v, in
     snprintf(out + len, cap - (size_t)len, sequence ? "_%04d.exr" : ".exr", v->frame);
 }
 
+/* The error that setting s settles to at view v (the last pose of an event's
+ * window): v posed and rendered still, from no history, REPORT_SETTLE_FRAMES
+ * frames, against the reference ref. Written beside the frames as
+ * <image>_settled.exr. -1 (logged) when it fails. */
+static double settle_pose(lm_renderer *r, const report_args *a, const job *j, const job_view *v, int s,
+                          const char *ref) {
+  char out[1400];
+  image_path(a, j, v, s, true, out, sizeof out);
+  snprintf(out + strlen(out) - strlen(".exr"), sizeof out - strlen(out) + strlen(".exr"), "_settled.exr");
+  const char *outs[1] = {out};
+  int w = j->sizes[v->size][0], h = j->sizes[v->size][1];
+  capture_view cv = {.camera = v->camera, .width = w, .height = h, .frames = 1, .warmup = REPORT_SETTLE_FRAMES,
+                     .outputs = outs, .output_count = 1, .quiet = true};
+  capture_result res = {0};
+  lm_image img = {0}, reference = {0};
+  lm_error err;
+  job_pose(j, v);
+  bool ok = capture_render_write(r, &cv, &res, &err) && lm_image_read(out, &img, &err) &&
+            lm_image_read(ref, &reference, &err) && lm_metrics_check(&img, out, &reference, ref, &err);
+  lm_metrics m = {0};
+  if (ok) lm_metrics_compute(&img, &reference, &m);
+  else lm_log(LM_LOG_ERROR, "%s: the settled frame at view %s: %s", j->path, out, err.msg);
+  capture_result_free(&res);
+  lm_image_free(&img);
+  lm_image_free(&reference);
+  return ok ? m.mean_error : -1;
+}
+
 /* Each setting's error over each sequence (runs of two frames or more) and
  * its error-against-frame curve (curve[setting * curve_frames + t], the
  * longest run's frames); false after logging a frame whose error is not
@@ -711,7 +749,9 @@ static bool summarize_runs(const report_args *a, const report_row *rows, int pla
       *q = (report_sequence){0};
       if (len < 2) continue;
       lm_error err;
-      ok = report_sequence_summarize(len, error + first, flicker + first, a->events, a->event_count, q, &err);
+      ok = report_sequence_summarize(len, error + first, flicker + first, a->events,
+                                     runs->settled + (size_t)(k * sn + s) * REPORT_MAX_EVENTS, a->event_count, q,
+                                     &err);
       if (!ok) lm_log(LM_LOG_ERROR, "%s, sequence from view %d: %s", a->settings[s].label, first, err.msg);
       errors[seqs] = error + first; /* report_frame_curve reads them before the next setting */
       lengths[seqs++] = len;
@@ -735,6 +775,9 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
   /* Runs of frames (a still job's places are runs of one) and the job's events in each. */
   report_runs runs = {.first = lm_alloc(sizeof(int) * (size_t)(place_count + 1))};
   runs.count = report_sequences(places, place_count, runs.first);
+  size_t settled_count = (size_t)runs.count * (size_t)a->setting_count * REPORT_MAX_EVENTS;
+  runs.settled = lm_alloc(sizeof *runs.settled * (settled_count + 1));
+  for (size_t i = 0; i < settled_count; i++) runs.settled[i] = -1;
   a->sequences = runs.count < place_count;
   bool events_ok = read_events(j->path, a->events, &a->event_count, &err);
   if (events_ok && a->event_count && !a->sequences) {
@@ -748,6 +791,7 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
   if (!events_ok) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     free(runs.first);
+    free(runs.settled);
     free(places);
     return 2;
   }
@@ -759,6 +803,7 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
       lm_log(LM_LOG_ERROR, "--sweep %s: %s", a->settings[s].label, err.msg);
       base_free(&base_options);
       free(runs.first);
+      free(runs.settled);
       free(places);
       return 2;
     }
@@ -772,6 +817,7 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
   if (rc) {
     free(refs);
     free(runs.first);
+    free(runs.settled);
     free(places);
     base_free(&base_options);
     return rc;
@@ -781,6 +827,7 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     free(refs);
     free(runs.first);
+    free(runs.settled);
     free(places);
     base_free(&base_options);
     return 1;
@@ -893,6 +940,15 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
       }
       lm_image_free(&prev);
       lm_image_free(&prev_ref);
+      /* Each event window's last pose, still until converged: what its lag
+       * measures the return to (after the frames: it restarts the history). */
+      for (int e = 0; sequence && !rc && e < a->event_count; e++) {
+        int end = e + 1 < a->event_count ? a->events[e + 1] : runs.first[k + 1] - runs.first[k];
+        int last = runs.first[k] + end - 1;
+        double settled = settle_pose(r, a, j, &places[last], s, refs[last]);
+        if (settled < 0) rc = 1;
+        runs.settled[(size_t)(k * sn + s) * REPORT_MAX_EVENTS + (size_t)e] = settled;
+      }
     }
   }
   double *curve = NULL;
@@ -944,6 +1000,7 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
   free(curve);
   free(runs.summary);
   free(runs.first);
+  free(runs.settled);
   lm_renderer_destroy(r);
   lm_programs_clear();
   job_free_scenes(j); /* GL objects go before the context */

@@ -188,7 +188,7 @@ bool report_events_check(const char *path, const int *events, int count, int fra
 }
 
 bool report_sequence_summarize(int frames, const double *error, const double *flicker, const int *events,
-                               int event_count, report_sequence *out, lm_error *err) {
+                               const double *settled, int event_count, report_sequence *out, lm_error *err) {
   *out = (report_sequence){.frames = frames, .event_count = event_count};
   for (int t = 0; t < frames; t++)
     if (!(isfinite(error[t]) && error[t] >= 0) || (t > 0 && !(isfinite(flicker[t]) && flicker[t] >= 0))) {
@@ -200,7 +200,7 @@ bool report_sequence_summarize(int frames, const double *error, const double *fl
   for (int t = 1; t < frames; t++) out->flicker += flicker[t] / (frames - 1);
   for (int e = 0; e < event_count; e++) {
     int end = e + 1 < event_count ? events[e + 1] : frames;
-    if (!lm_metrics_lag(error, events[e], end, &out->lags[e], err)) return false;
+    if (!lm_metrics_lag(error, events[e], end, settled ? settled[e] : -1, &out->lags[e], err)) return false;
   }
   return true;
 }

@@ -90,10 +90,11 @@ typedef struct report_sequence {
 
 /* From per-frame errors error[t] and flickers flicker[t] (of frames t - 1
  * and t; flicker[0] is not read) over `frames` frames, and the job's events
- * (checked by report_events_check). False with a message naming the frame
+ * (checked by report_events_check) with the error each settles to (settled[e]:
+ * lm_metrics_lag's; NULL or < 0: the window's tail). False with a message naming the frame
  * whose error or flicker is not a finite value >= 0. */
 bool report_sequence_summarize(int frames, const double *error, const double *flicker, const int *events,
-                               int event_count, report_sequence *out, lm_error *err);
+                               const double *settled, int event_count, report_sequence *out, lm_error *err);
 
 /* The error-against-frame curve of one setting over several sequences:
  * curve[t] is the mean of frame t's error over the runs that have a frame t

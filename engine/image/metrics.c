@@ -227,7 +227,7 @@ double lm_metrics_flicker(const lm_image *a_prev, const lm_image *a, const lm_im
   return sum / ((double)px * nc); /* checked images: px, nc > 0 */
 }
 
-bool lm_metrics_lag(const double *error, int event, int end, lm_lag *out, lm_error *err) {
+bool lm_metrics_lag(const double *error, int event, int end, double settled, lm_lag *out, lm_error *err) {
   if (event < 0 || event >= end) {
     lm_error_set(err, "event at frame %d: not among the sequence's frames 0 .. %d", event, end - 1);
     return false;
@@ -237,16 +237,21 @@ bool lm_metrics_lag(const double *error, int event, int end, lm_lag *out, lm_err
       lm_error_set(err, "frame %d: error %g is not a finite value >= 0", t, error[t]);
       return false;
     }
-  /* The median of the last k frames: a sorted copy, k is small. */
-  int k = end - event < LM_LAG_SETTLED_FRAMES ? end - event : LM_LAG_SETTLED_FRAMES;
-  double last[LM_LAG_SETTLED_FRAMES];
-  for (int i = 0; i < k; i++) {
-    double v = error[end - k + i];
-    int j = i;
-    for (; j > 0 && last[j - 1] > v; j--) last[j] = last[j - 1];
-    last[j] = v;
+  if (isnan(settled) || isinf(settled)) {
+    lm_error_set(err, "event at frame %d: settled error %g is not finite", event, settled);
+    return false;
   }
-  double settled = k % 2 ? last[k / 2] : 0.5 * (last[k / 2 - 1] + last[k / 2]);
+  if (settled < 0) { /* the median of the last k frames: a sorted copy, k is small */
+    int k = end - event < LM_LAG_SETTLED_FRAMES ? end - event : LM_LAG_SETTLED_FRAMES;
+    double last[LM_LAG_SETTLED_FRAMES];
+    for (int i = 0; i < k; i++) {
+      double v = error[end - k + i];
+      int j = i;
+      for (; j > 0 && last[j - 1] > v; j--) last[j] = last[j - 1];
+      last[j] = v;
+    }
+    settled = k % 2 ? last[k / 2] : 0.5 * (last[k / 2 - 1] + last[k / 2]);
+  }
   /* Walk back from the end while the error stays within the tolerance. */
   int first = end;
   while (first > event && fabs(error[first - 1] - settled) <= LM_LAG_TOLERANCE * settled) first--;

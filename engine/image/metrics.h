@@ -83,7 +83,10 @@ double lm_metrics_flicker(const lm_image *a_prev, const lm_image *a, const lm_im
 /* Lag after an event (a light switched, a door opened, an object stopped)
  * at frame `event`, from per-frame errors (eq 19) error[event .. end - 1],
  * end being the next event or the sequence's end.
- * - settled: the error the technique settles to after the event, the median
+ * - settled: the error the technique settles to after the event: `settled`
+ *   when it is >= 0 (limn report renders the window's last pose as a still
+ *   frame until it has converged: a history that fades out slowly, as
+ *   1 / frames, never looks settled against its own tail), else the median
  *   of the window's last LM_LAG_SETTLED_FRAMES frames (all of them in a
  *   shorter window). After the event, not before: the change alters the
  *   image, so the error before it is no target.
@@ -103,8 +106,8 @@ typedef struct lm_lag {
   double settled;
 } lm_lag;
 /* False with a message when event is not in 0 .. end - 1 or an error of the
- * window is negative, NaN or Inf (naming its frame). */
-bool lm_metrics_lag(const double *error, int event, int end, lm_lag *out, lm_error *err);
+ * window (or a given settled error) is NaN or Inf, or negative (naming its frame). */
+bool lm_metrics_lag(const double *error, int event, int end, double settled, lm_lag *out, lm_error *err);
 
 /* Eq 19's mean error over a band of pixels only: mask[i] != 0 marks pixel i
  * (w * h bytes, top row first). Ghosting is this error in the band a moving
