@@ -157,6 +157,33 @@ check "bench motion table" run 0 bench --tech dl+esm --sizes 32x24 --frames 2 --
 check "bench motion table columns" out_has "still     moving      alone  moving/still  moving/alone"
 check "bench motion table moved" out_has "the moving camera moved in 2 of 2 frames"
 check "bench motion table target" grep -qE "^target: a frame of a sequence within 1.2x .*: (PASS|FAIL)$" "$tmp/out"
+# bench --time on scenes that move: the skinned tube bends under a still camera (its sun's tiles are
+# drawn again each moving frame, none when still), the turntable's animated camera is followed.
+motion_animated() {  # $1: "tube" or "turntable"
+  python3 - "$1" "$tmp/out" <<'PY'
+import json, sys
+which, m = sys.argv[1], json.load(open(sys.argv[2]))["motion"]
+bad = []
+if m["frames"] != 9: bad.append(f"frames {m['frames']}, want 9 (0 to 1 s at 8 fps)")
+if not all(m[k].get("animate_ms", -1) >= 0 for k in ("moving", "alone")): bad.append("no animate_ms")
+if which == "tube":
+    if m["moved"] != 0: bad.append(f"the camera moved in {m['moved']} frames under --orbit 0")
+    if m["moving"]["shadow_tiles_drawn"] <= 0 or m["still"]["shadow_tiles_drawn"] != 0:
+        bad.append(f"tiles: moving {m['moving']['shadow_tiles_drawn']}, still {m['still']['shadow_tiles_drawn']}")
+else:
+    # the warm-up frame before 0 s holds the first key's pose, so frame 0 has not moved yet
+    if m["camera"] != {"scene": "orbit"} or m["moved"] != m["frames"] - 1:
+        bad.append(f"camera {m['camera']}, moved {m['moved']} of {m['frames']}")
+for b in bad: print("  " + b)
+sys.exit(1 if bad else 0)
+PY
+}
+check "bench motion tube" run 0 bench --scene "$root/data/scenes/bending_tube.glb" --tech dl+esm --sizes 32x24 \
+  --time 0:1 --fps 8 --warmup 1 --orbit 0 --json
+check "bench motion tube figures" motion_animated tube
+check "bench motion turntable" run 0 bench --scene "$root/data/scenes/turntable.glb" --tech dl --sizes 32x24 \
+  --time 0:1 --fps 8 --warmup 1 --json
+check "bench motion turntable camera" motion_animated turntable
 check "bench bad orbit" run 2 bench --orbit 400
 check "bench bad orbit message" err_has "--orbit wants STEP[,RADIUS[,ELEVATION]]"
 check "bench still orbit" run 2 bench --orbit 0
