@@ -71,6 +71,28 @@ mean=$(grep -o '"mean_error": [-0-9.e+]*' m.json | awk '{print $2}')
 awk -v m="$mean" 'BEGIN { exit !(m > 0.005) }' || { cat m.json; fail "the frames' references are equal (mean error $mean)"; }
 "$limn" reference --job path.lua "${fast[@]}" --refs refs-seq >log7 2>&1 || { cat log7; fail "references of a sequence again"; }
 grep -q "0 rendered, 2 cached" log7 || { cat log7; fail "a sequence's references were not cached per frame"; }
+# Report over it: flicker, and the lag after the job's event against the settled still frame.
+sed 's/output = /events = { 1 }, output = /' path.lua >events.lua
+"$limn" report --job events.lua "${fast[@]}" --refs refs-seq --out rep-seq --sweep dl >log8 2>&1 \
+  || { cat log8; fail "report over a sequence"; }
+grep -qE "^dl over ball/path/48x36 \(2 frames\): mean error [0-9.]+, flicker [0-9.]+, lag 1: 0$" log8 \
+  || { cat log8; fail "no sequence line with a lag of 0 for dl"; }
+grep -q '"settled_error": ' rep-seq/report.json || fail "report.json has no settled error"
+[ -e rep-seq/images/ball_path_48x36_0_0001_settled.exr ] || { ls rep-seq/images; fail "no settled frame"; }
+# A camera that stands still over a still scene: both frames alike, reference and Limn, flicker exactly 0.
+sed -e 's/t = 1, eye = { 2, 1.2, 2 }/t = 1, eye = { 0, 1.5, 3 }/' path.lua >still.lua
+"$limn" reference --job still.lua "${fast[@]}" --refs refs-still >/dev/null 2>&1 || fail "references of a still sequence"
+"$limn" report --job still.lua "${fast[@]}" --refs refs-still --out rep-still --sweep dl >log8 2>&1 \
+  || { cat log8; fail "report over a still sequence"; }
+grep -qE "^dl over ball/path/48x36 \(2 frames\): mean error [0-9.]+, flicker 0.000000, lag -$" log8 \
+  || { cat log8; fail "a still sequence flickers"; }
+# An event past the frames, or not a frame number, is refused naming it.
+sed 's/output = /events = { 2 }, output = /' path.lua >bad-events.lua
+"$limn" report --job bad-events.lua "${fast[@]}" --refs refs-seq --out rep-bad --sweep dl >log8 2>&1
+[ $? = 2 ] && grep -q "events\[1\]" log8 || { cat log8; fail "an event past the frames was not refused by name"; }
+sed 's/output = /events = { 0.5 }, output = /' path.lua >bad-events.lua
+"$limn" report --job bad-events.lua "${fast[@]}" --refs refs-seq --out rep-bad --sweep dl >log8 2>&1
+[ $? != 0 ] && grep -q "events\[1\]: 0.5 is not a frame number" log8 || { cat log8; fail "a fractional event was not refused"; }
 
 # 2. a failing POV-Ray run: named by view, its error lines shown, exit 1
 cat > fakepov <<'FAKE'

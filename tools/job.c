@@ -35,6 +35,7 @@
 #include <signal.h>
 #include <lauxlib.h>
 #include <lua.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -149,6 +150,20 @@ static bool each_technique(lua_State *L, job *j, int i, lm_error *err) {
   }
   snprintf(j->techniques[i - 1], sizeof j->techniques[0], "%s", lua_tostring(L, -1));
   return true;
+}
+
+/* events = { 12, 30 }: frame numbers (limn report checks them against the
+ * job's sequences). */
+static bool each_event(lua_State *L, job *j, int i, lm_error *err) {
+  lua_Integer f = lua_isinteger(L, -1) ? lua_tointeger(L, -1) : -1;
+  if (f >= 0 && f <= INT_MAX) {
+    j->events[i - 1] = (int)f;
+    return true;
+  }
+  if (lua_type(L, -1) == LUA_TNUMBER)
+    lm_error_set(err, "%s: events[%d]: %g is not a frame number (0, 1, ...)", j->path, i, lua_tonumber(L, -1));
+  else lm_error_set(err, "%s: events[%d]: a frame number (0, 1, ...), not a %s", j->path, i, luaL_typename(L, -1));
+  return false;
 }
 
 static bool each_size(lua_State *L, job *j, int i, lm_error *err) {
@@ -476,7 +491,8 @@ bool job_read(job *j, const char *path, lm_error *err) {
        read_list(L, -1, "scenes", path, &j->scene_count, err, each_scene, j) &&
        read_list(L, -1, "techniques", path, &j->technique_count, err, each_technique, j) &&
        read_list(L, -1, "sizes", path, &j->size_count, err, each_size, j) && read_sets(L, j, err) &&
-       read_time(L, j, err) && read_path(L, j, err) && read_turntable(L, j, err);
+       read_list(L, -1, "events", path, &j->event_count, err, each_event, j) && read_time(L, j, err) &&
+       read_path(L, j, err) && read_turntable(L, j, err);
   if (ok) { /* a name, or an index as a number */
     lua_getfield(L, -1, "animation");
     if (lua_isinteger(L, -1)) lua_pushfstring(L, "%d", (int)lua_tointeger(L, -1)), lua_setfield(L, -3, "animation");

@@ -34,6 +34,7 @@ typedef struct job {
   int size_count;
   char set_names[MAX_LIST][128], set_values[MAX_LIST][256];
   int set_count;
+  int events[MAX_LIST], event_count; /* frames where a light, door or object changes: limn report's lags */
   int frames;
   uint64_t hash;
   /* `time`: timed false leaves the scenes as loaded. A sequence has

@@ -7,9 +7,6 @@
  * frames, flicker and lag after the job's events, and error against frame. */
 #define _GNU_SOURCE
 #include <getopt.h>
-#include <lauxlib.h>
-#include <limits.h>
-#include <lua.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -85,7 +82,7 @@ typedef struct report_args {
   bool require_refs;
   reference_args ref;
   bool sequences; /* the job has a run of two frames or more: views are named with their frame */
-  int events[REPORT_MAX_EVENTS], event_count; /* the job's events (read_events) */
+  int events[REPORT_MAX_EVENTS], event_count; /* the job's events (job.events) */
 } report_args;
 
 /* The places in runs (report_sequences) and, with sequences, each setting's
@@ -634,50 +631,6 @@ static int get_refs(const report_args *a, const reference_args *ref, const job *
   return rc;
 }
 
-/* The job's `events = { 12, 30 }`: frames of its sequences where a light,
- * a door or an object changes, the starts of the lags. Read here on its
- * own, the job file run again as job_read runs it (data in an empty
- * environment; job_read's budget has already let it finish once). */
-static bool read_events(const char *path, int *events, int *count, lm_error *err) {
-  *count = 0;
-  lua_State *L = luaL_newstate();
-  bool ok = luaL_loadfilex(L, path, "t") == LUA_OK;
-  if (ok) {
-    lua_newtable(L);
-    lua_setupvalue(L, -2, 1);
-    ok = lua_pcall(L, 0, 1, 0) == LUA_OK;
-  }
-  if (!ok) {
-    lm_error_set(err, "%s", lua_tostring(L, -1));
-    lua_close(L);
-    return false;
-  }
-  if (lua_istable(L, -1)) lua_getfield(L, -1, "events");
-  else lua_pushnil(L);
-  if (lua_istable(L, -1)) {
-    int n = (int)lua_rawlen(L, -1);
-    if (n > REPORT_MAX_EVENTS) {
-      lm_error_set(err, "%s: events: %d of them, at most %d", path, n, REPORT_MAX_EVENTS);
-      ok = false;
-    }
-    for (int i = 1; i <= n && ok; i++) {
-      lua_rawgeti(L, -1, i);
-      lua_Integer f = lua_isinteger(L, -1) ? lua_tointeger(L, -1) : -1;
-      if (f >= 0 && f <= INT_MAX) events[(*count)++] = (int)f;
-      else if (lua_type(L, -1) == LUA_TNUMBER)
-        lm_error_set(err, "%s: events[%d]: %g is not a frame number (0, 1, ...)", path, i, lua_tonumber(L, -1));
-      else lm_error_set(err, "%s: events[%d]: a frame number (0, 1, ...), not a %s", path, i, luaL_typename(L, -1));
-      ok = f >= 0 && f <= INT_MAX;
-      lua_pop(L, 1);
-    }
-  } else if (!lua_isnil(L, -1)) {
-    lm_error_set(err, "%s: events: a list of frame numbers, not a %s", path, luaL_typename(L, -1));
-    ok = false;
-  }
-  lua_close(L);
-  return ok;
-}
-
 /* Where setting s's image of view v goes: one a place, and in a sequence
  * one a frame. */
 static void image_path(const report_args *a, const job *j, const job_view *v, int s, bool sequence, char *out,
@@ -779,7 +732,9 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
   runs.settled = lm_alloc(sizeof *runs.settled * (settled_count + 1));
   for (size_t i = 0; i < settled_count; i++) runs.settled[i] = -1;
   a->sequences = runs.count < place_count;
-  bool events_ok = read_events(j->path, a->events, &a->event_count, &err);
+  bool events_ok = j->event_count <= REPORT_MAX_EVENTS;
+  a->event_count = events_ok ? j->event_count : 0;
+  memcpy(a->events, j->events, sizeof *a->events * (size_t)a->event_count);
   if (events_ok && a->event_count && !a->sequences) {
     lm_error_set(&err, "%s: events: the job has no sequence (time = { start, stop, fps })",
                  j->path);
