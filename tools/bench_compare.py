@@ -67,13 +67,17 @@ def parse_case(text):
     return {"label": text, "scene": scene, "tech": tech, "sets": sets}
 
 
+def case_flags(case, sets):
+    """A case's technique and --set flags, then the run's own sets."""
+    flags = ["--tech", case["tech"]] if case["tech"] else []
+    for s in case["sets"] + sets:
+        flags += ["--set", s]
+    return flags
+
+
 def capture(limn, case, args, image, sets):
     cmd = [limn, "capture", "--scene", case["scene"], "--size", args.size, "--frames", str(args.frames),
-           "--output", image]
-    if case["tech"]:
-        cmd += ["--tech", case["tech"]]
-    for s in case["sets"] + sets:
-        cmd += ["--set", s]
+           "--output", image] + case_flags(case, sets)
     p = subprocess.run(cmd, text=True, capture_output=True)
     if p.returncode != 0:
         fail(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stderr.strip()}")
@@ -104,11 +108,7 @@ def bench_motion(limn, case, args, sets, who):
     """One `limn bench --motion` run: its moving column's pass medians, its
     moving frame as "total" and its still frame as "frame (still)"."""
     cmd = [limn, "bench", "--scene", case["scene"], "--sizes", args.size, "--frames", str(args.frames),
-           "--json"] + motion_flags(args)
-    if case["tech"]:
-        cmd += ["--tech", case["tech"]]
-    for s in case["sets"] + sets:
-        cmd += ["--set", s]
+           "--json"] + motion_flags(args) + case_flags(case, sets)
     p = subprocess.run(cmd, text=True, capture_output=True)
     if p.returncode != 0:
         if "unknown flag '--" in p.stderr:
