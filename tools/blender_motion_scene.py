@@ -1,13 +1,14 @@
 # Blender (3.4) script for tools/blender_motion_check.sh: builds a small scene
 # that moves (a floor, a box keyed with Blender's default Bezier keys on
 # location, rotation and scale, a box with linear location and constant
-# rotation keys, a camera dolly, a sun), exports it with Blender's own glTF
+# rotation keys, a box keyed with quaternions, a camera dolly, a sun), exports it with Blender's own glTF
 # exporter (its defaults: sampled animation, y-up) and writes, at each of the
 # given times, every object's world matrix as Blender evaluates it, and as
 # the export's per-frame samples hold it, carried into glTF's space, to
 # poses.json; with --render also a Workbench frame (flat object colours, no
 # anti-aliasing) of each time, blender_N.png.
 #   blender -b --factory-startup -P tools/blender_motion_scene.py -- --out DIR --times 0,0.5,1 [--render]
+#     [--unsampled]  (the keys as they are: Bezier as CUBICSPLINE; no samples in poses.json)
 # glTF is y-up, Blender z-up: the exporter maps (x, y, z) to (x, z, -y) (C, a
 # -90 degree turn about x). A mesh's vertices go through C as well, so its
 # node's world matrix is C M C^-1; a camera or light keeps its own axes (both
@@ -19,7 +20,7 @@ import os
 import sys
 
 import bpy
-from mathutils import Matrix
+from mathutils import Matrix, Quaternion
 
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 ap = argparse.ArgumentParser()
@@ -28,6 +29,7 @@ ap.add_argument("--times", default="0,0.5,1,1.37,2")
 ap.add_argument("--fps", type=int, default=24)
 ap.add_argument("--size", default="160x120")
 ap.add_argument("--render", action="store_true")
+ap.add_argument("--unsampled", action="store_true", help="export keys as they are, not sampled each frame")
 args = ap.parse_args(argv)
 times = [float(t) for t in args.times.split(",")]
 width, height = (int(v) for v in args.size.split("x"))
@@ -89,6 +91,13 @@ linear = box("box_linear", (0.3, 0.3, 1.0))
 keys(linear, "location", [(0, (1.5, -1.0, 0.4)), (20, (1.5, 1.0, 0.4)), (40, (1.0, 0.0, 0.9))], "LINEAR")
 keys(linear, "rotation_euler", [(0, (0.0, 0.0, 0.0)), (20, (0.0, 0.0, 0.8)), (40, (0.0, 0.0, 1.6))], "CONSTANT")
 
+# Keyed as quaternions (Bezier on each component, normalized), as glTF keys rotations.
+quat = box("box_quat", (0.3, 1.0, 0.3))
+quat.rotation_mode = "QUATERNION"
+keys(quat, "location", [(0, (0.0, -2.0, 0.5)), (2 * f, (0.0, -2.0, 0.5))])
+keys(quat, "rotation_quaternion", [(0, Quaternion()), (f, Quaternion((0.3, 0.2, 1.0), 1.4)),
+                                   (2 * f, Quaternion((1.0, 0.0, 0.2), 2.6))])
+
 cam_data = bpy.data.cameras.new("camera")
 camera = bpy.data.objects.new("camera", cam_data)
 scene.collection.objects.link(camera)
@@ -103,10 +112,11 @@ sun.rotation_euler = (0.6, 0.0, 0.3)  # from behind the camera: the faces it see
 scene.collection.objects.link(sun)
 
 glb = os.path.join(args.out, "motion.glb")
-bpy.ops.export_scene.gltf(filepath=glb, export_format="GLB", export_cameras=True, export_lights=True)
+bpy.ops.export_scene.gltf(filepath=glb, export_format="GLB", export_cameras=True, export_lights=True,
+                          export_force_sampling=not args.unsampled)
 
 C = Matrix.Rotation(-math.pi / 2, 4, "X")
-objects = [floor, bezier, linear, camera, sun]
+objects = [floor, bezier, linear, quat, camera, sun]
 
 
 def set_frame(frame):
@@ -167,7 +177,7 @@ fov_y = fov_x if height > width else 2 * math.atan(math.tan(fov_x / 2) / aspect)
 with open(os.path.join(args.out, "poses.json"), "w") as out:
     json.dump({"blender": bpy.app.version_string, "fps": f, "times": times, "glb": glb,
                "camera": {"name": camera.name, "fov_y": fov_y, "aspect": aspect}, "nodes": poses,
-               "sampled": samples}, out, indent=1)
+               "sampled": None if args.unsampled else samples}, out, indent=1)
 
 if args.render:
     scene.render.engine = "BLENDER_WORKBENCH"
