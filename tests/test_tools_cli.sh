@@ -184,6 +184,20 @@ check "bench motion tube figures" motion_animated tube
 check "bench motion turntable" run 0 bench --scene "$root/data/scenes/turntable.glb" --tech dl --sizes 32x24 \
   --time 0:1 --fps 8 --warmup 1 --json
 check "bench motion turntable camera" motion_animated turntable
+# gltf_pose (tools/blender_motion_check.sh's Limn side): the turntable's orbiting camera node a quarter
+# turn round at 1 s (its world x axis from +x to -z), its walls where they stand.
+pose_turntable() {
+  "$(dirname "$limn")/gltf_pose" "$root/data/scenes/turntable.glb" 0 1 >"$tmp/pose.json" 2>"$tmp/err" || return 1
+  python3 - "$tmp/pose.json" <<'PY'
+import json, sys
+n = json.load(open(sys.argv[1]))["nodes"]
+o0, o1, w = n["orbit"][0], n["orbit"][1], n["walls"]
+ok = abs(o0[0] - 1) < 1e-5 and abs(o1[0]) < 1e-5 and abs(abs(o1[2]) - 1) < 1e-5 and w[0] == w[1]
+if not ok: print(f"  orbit x axis {o0[:3]} -> {o1[:3]}, walls {w[0] == w[1]}")
+sys.exit(0 if ok else 1)
+PY
+}
+check "gltf_pose turntable" pose_turntable
 check "bench bad orbit" run 2 bench --orbit 400
 check "bench bad orbit message" err_has "--orbit wants STEP[,RADIUS[,ELEVATION]]"
 check "bench still orbit" run 2 bench --orbit 0
