@@ -54,7 +54,7 @@ struct lm_renderer {
   lm_trace *trace; /* the scene's BVH, built by the first CPU "trace" pass */
   uint64_t trace_hash; /* geometry_hash when it was built or refitted */
   tile_cache tiles;
-  uint64_t casters_hash; /* this frame's material_hash */
+  uint64_t casters_hash; /* this frame's material_hash (record) */
   float *prev_world; /* each node's world transform in the previous frame (velocities) */
   int prev_world_count, prev_world_cap; /* nodes it holds (another count than the scene's: a first frame) */
   uint64_t pose;   /* frames in which deformed meshes changed (geometry_hash) */
@@ -421,7 +421,7 @@ static uint64_t caster_hash(const lm_renderer *r) {
   uint64_t h = lm_hash(&s, sizeof s, geometry_hash(r));
   for (int i = 0; i < s->node_count; i++)
     if (s->nodes[i].mesh >= 0) h = lm_hash(&s->nodes[i].material, sizeof s->nodes[i].material, h);
-  return lm_hash(&h, sizeof h, material_hash(s));
+  return lm_hash(&h, sizeof h, r->casters_hash);
 }
 
 static float srgb_to_linear(unsigned char c) {
@@ -577,6 +577,7 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
     r->any_dynamic |= r->dynamic[i];
   }
   r->pose += lm_scene_upload_deformed(r->desc.scene) > 0;
+  r->casters_hash = material_hash(s); /* once a frame: the world hash and the tile keys read it */
   uint64_t world = world_hash(r, p, frame);
   r->still = r->frame > 0 && world == r->world ? r->still + 1 : 0;
   r->world = world;
@@ -617,7 +618,6 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_light_grid_build(&r->light_grid, frame, lights, n, !r->desc.no_light_culling);
   lm_storage_upload(4, r->light_grid.data, r->light_grid.count * sizeof *r->light_grid.data);
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
-  if (r->shadows.view_count > 0 && r->shadows.settings.cache) r->casters_hash = material_hash(r->desc.scene);
   r->fit_ms = 0;
   lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene, .fit_views = fit_views,
                           .keeps_views = keeps_views, .run_cpu = run_cpu,
