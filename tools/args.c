@@ -23,6 +23,13 @@ bool limn_parse_double(const char *s, double *out) {
   return true;
 }
 
+bool limn_parse_time(const char *s, double *start, double *stop) {
+  const char *colon = strchr(s, ':');
+  char first[64];
+  snprintf(first, sizeof first, "%.*s", colon ? (int)(colon - s) : 63, s);
+  return limn_parse_double(first, start) && limn_parse_double(colon ? colon + 1 : first, stop);
+}
+
 bool limn_parse_size(const char *s, int *w, int *h) {
   char buf[64];
   snprintf(buf, sizeof buf, "%s", s);

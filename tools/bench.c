@@ -261,16 +261,11 @@ static int parse_args(int argc, char **argv, bench *b) {
       m->on = m->orbit_given = true;
       break;
     }
-    case 'I': {
-      const char *colon = strchr(optarg, ':');
-      char start[64];
-      snprintf(start, sizeof start, "%.*s", colon ? (int)(colon - optarg) : 0, optarg);
-      if (!colon || !limn_parse_double(start, &m->start) || !limn_parse_double(colon + 1, &m->stop) ||
-          m->stop < m->start)
+    case 'I':
+      if (!strchr(optarg, ':') || !limn_parse_time(optarg, &m->start, &m->stop) || m->stop < m->start)
         return usage_error("--time wants START:STOP in seconds, STOP >= START, not '%s'", optarg);
       m->on = m->timed = true;
       break;
-    }
     case 'F':
       if (!limn_parse_double(optarg, &m->fps) || !(m->fps > 0 && m->fps <= 1000))
         return usage_error("--fps wants frames a second in (0, 1000], not '%s'", optarg);

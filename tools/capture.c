@@ -256,16 +256,12 @@ static int parse_args(int argc, char **argv, capture_args *a) {
         return usage_error("--egl wants auto, device or surfaceless, not '%s'", optarg);
       a->egl = optarg;
       break;
-    case 'T': {
-      char start[64];
-      const char *colon = strchr(optarg, ':');
-      snprintf(start, sizeof start, "%.*s", colon ? (int)(colon - optarg) : 63, optarg);
-      if (!limn_parse_double(start, &a->time_start) || !limn_parse_double(colon ? colon + 1 : start, &a->time_stop))
+    case 'T':
+      if (!limn_parse_time(optarg, &a->time_start, &a->time_stop))
         return usage_error("--time wants SECONDS or START:STOP (finite numbers), not '%s'", optarg);
       if (a->time_stop < a->time_start) return usage_error("--time START:STOP wants STOP >= START, not '%s'", optarg);
       a->time_flag = optarg;
       break;
-    }
     case 'F':
       if (!limn_parse_double(optarg, &a->fps) || !(a->fps > 0) || a->fps > 1e6)
         return usage_error("--fps wants frames a second above 0, not '%s'", optarg);

@@ -22,6 +22,8 @@ int limn_farm(int argc, char **argv);
 /* Flag values (tools/args.c): false when `s` is not one. */
 bool limn_parse_int(const char *s, int lo, int hi, int *out);
 bool limn_parse_double(const char *s, double *out); /* finite */
+/* --time: SECONDS (start = stop) or START:STOP, finite; the order is the caller's to check. */
+bool limn_parse_time(const char *s, double *start, double *stop);
 bool limn_parse_size(const char *s, int *w, int *h); /* WxH, each 1..65536 */
 bool limn_parse_on_off(const char *s, bool *out);
 /* --shard I/N, auto or auto/N. `auto` takes the index from the scheduler:
