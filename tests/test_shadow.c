@@ -238,6 +238,52 @@ static void cascades_fit_the_depths_the_frame_sees(void **state) {
   lm_scene_destroy(s);
 }
 
+/* The least and greatest depth (world units) the G-buffer holds. */
+static void gbuffer_range(gl_result *r, float far, float out[2]) {
+  int w, h;
+  float *dpt = gl_read_target(r, "gbuffer.dpt", &w, &h);
+  assert_non_null(dpt);
+  out[0] = INFINITY, out[1] = 0;
+  for (size_t i = 0; i < (size_t)w * h; i++)
+    if (dpt[i * 4] > 0) out[0] = fminf(out[0], dpt[i * 4] * far), out[1] = fmaxf(out[1], dpt[i * 4] * far);
+  free(dpt);
+}
+
+/* shadow.fit=previous: a view's first frame fits to its own depths, later
+ * ones to the last frame's (read without a stall), each widened by
+ * fit_margin; a camera move shows in the fit one frame later. */
+static void cascades_fit_the_last_frames_depths_widened(void **state) {
+  (void)state;
+  lm_scene *s = builtin("field");
+  static const char *const sets[] = {"shadow.cache=false", "shadow.fit=previous", "shadow.fit_margin=0.5", NULL};
+  gl_result r = render_ok(s, "dl+esm", sets);
+  lm_renderer_set_sharing(r.renderer, false); /* keep gbuffer.dpt readable */
+  assert_true(gl_render_again(&r));
+  lm_frame_data cam;
+  lm_scene_frame_data(s, 0, r.width, r.height, &cam);
+  float a[2], b[2];
+  gbuffer_range(&r, cam.clip[1], a);
+  const lm_shadow_plan *plan = lm_renderer_shadows(r.renderer);
+  assert_float_equal(plan->seen[0], a[0] / 1.5f, 1e-4f * a[0]);
+  assert_float_equal(plan->seen[1], a[1] * 1.5f, 1e-4f * a[1]);
+  /* Back off along the view: the nearest depth grows. */
+  float *m = s->nodes[s->cameras[0].node].local;
+  for (int i = 0; i < 3; i++) m[12 + i] += 0.2f * a[0] * m[8 + i];
+  lm_scene_update(s);
+  assert_true(gl_render_again(&r));
+  plan = lm_renderer_shadows(r.renderer);
+  gbuffer_range(&r, cam.clip[1], b);
+  printf("near depth %g before the move, %g after; fitted to %g\n", a[0], b[0], plan->seen[0] * 1.5f);
+  assert_true(b[0] > 1.02f * a[0]);
+  assert_float_equal(plan->seen[0], a[0] / 1.5f, 1e-4f * a[0]); /* the last frame's */
+  assert_true(gl_render_again(&r));
+  plan = lm_renderer_shadows(r.renderer);
+  assert_float_equal(plan->seen[0], b[0] / 1.5f, 1e-4f * b[0]); /* now this view's */
+  assert_float_equal(plan->seen[1], fminf(b[1] * 1.5f, cam.clip[1]), 1e-4f * b[1]);
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+}
+
 /* Mean difference between the first cascade's tile in two maps, at the best
  * whole-texel shift: a stabilized map only ever moves by whole texels. */
 static double tile_change(const float *a, const float *b, int width, int height, int tile) {
@@ -808,6 +854,7 @@ int main(void) {
       cmocka_unit_test(extreme_exponents_stay_finite_and_on_the_right_side),
       cmocka_unit_test(the_sun_casts_cascaded_shadows_at_any_depth_range),
       cmocka_unit_test(cascades_fit_the_depths_the_frame_sees),
+      cmocka_unit_test(cascades_fit_the_last_frames_depths_widened),
       cmocka_unit_test(stabilized_cascades_do_not_shimmer),
       cmocka_unit_test(pcss_penumbra_widens_with_blocker_distance),
       cmocka_unit_test(cube_faces_no_pixel_samples_are_not_drawn),

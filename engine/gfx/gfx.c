@@ -451,6 +451,40 @@ void lm_texture_read(lm_texture tex, int width, int height, bool floats, void *o
   free(tmp);
 }
 
+void lm_readback_start(lm_readback *rb, lm_texture tex, int width, int height) {
+  size_t size = sizeof(float) * 4 * (size_t)width * (size_t)height;
+  if (!rb->buffer || rb->width != width || rb->height != height) {
+    lm_readback_free(rb);
+    glCreateBuffers(1, &rb->buffer);
+    glNamedBufferStorage(rb->buffer, (GLsizeiptr)size, NULL, GL_MAP_READ_BIT);
+  }
+  if (rb->fence) glDeleteSync(rb->fence);
+  rb->width = width, rb->height = height;
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, rb->buffer);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(tex.id, 0, GL_RGBA, GL_FLOAT, (GLsizei)size, NULL); /* into the buffer */
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  rb->fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+}
+
+bool lm_readback_collect(lm_readback *rb, float *out) {
+  if (!rb->fence) return false;
+  /* Flushes, then waits: a second is far beyond a frame, and on expiry the
+   * map below waits anyway. */
+  glClientWaitSync(rb->fence, GL_SYNC_FLUSH_COMMANDS_BIT, 1000000000u);
+  glDeleteSync(rb->fence);
+  rb->fence = NULL;
+  size_t size = sizeof(float) * 4 * (size_t)rb->width * (size_t)rb->height;
+  glGetNamedBufferSubData(rb->buffer, 0, (GLsizeiptr)size, out);
+  return true;
+}
+
+void lm_readback_free(lm_readback *rb) {
+  if (rb->fence) glDeleteSync(rb->fence);
+  if (rb->buffer) glDeleteBuffers(1, &rb->buffer);
+  *rb = (lm_readback){0};
+}
+
 /* ---- uploads, copies and the window's framebuffer ---------------------- */
 void lm_texture_upload(lm_texture tex, int width, int height, const uint8_t *rgba) {
   /* GL's row 0 is the image's last: flip into a copy, then one upload. */

@@ -227,6 +227,19 @@ void lm_finish(void);
 /* ---- readback ---------------------------------------------------------- */
 /* RGBA rows, top row first. `floats` selects float32 or uint8 output. */
 void lm_texture_read(lm_texture tex, int width, int height, bool floats, void *out);
+/* A read-back that does not stall: started after the passes that write the
+ * texture (RGBA floats into a buffer, with a fence), collected later, by
+ * then finished (a frame on), into rows bottom first as GL keeps them. */
+typedef struct lm_readback {
+  unsigned buffer;
+  void *fence;
+  int width, height;
+} lm_readback;
+void lm_readback_start(lm_readback *rb, lm_texture tex, int width, int height);
+/* Copies the started read into out (width * height RGBA floats), waiting for
+ * it if the GPU has not finished it; false (out untouched) if none was started. */
+bool lm_readback_collect(lm_readback *rb, float *out);
+void lm_readback_free(lm_readback *rb);
 
 /* ---- uploads, copies and the window's framebuffer ---------------------- */
 /* Replaces level 0 of an rgba8 texture with RGBA bytes, top row first. */

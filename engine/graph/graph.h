@@ -97,6 +97,11 @@ typedef struct lm_pass_desc {
    * like an input. */
   bool fits_views;
   int fit_target;
+  /* Fit to the previous frame's target instead (read without a stall; this
+   * frame's is read on the first frame of a view), its range widened by
+   * fit_margin while the world or camera moves. */
+  bool fit_previous;
+  float fit_margin;
   const lm_pass_material_param *material_params; /* scene passes */
   int material_param_count;
 } lm_pass_desc;

@@ -48,6 +48,8 @@ struct lm_renderer {
   lm_shadow_plan shadows;
   lm_light_grid light_grid;
   double record_ms, compile_ms, fit_ms;
+  lm_readback fit_read; /* the shadow fit's depth range, read for the next frame (fit_views) */
+  float fit_far;        /* the far plane it was read under */
   lm_scene_draw_stats stats;  /* this frame's camera draws */
   lm_scene_draw_stats shadow_stats; /* and its shadow tiles' */
   bool sharing;
@@ -92,6 +94,7 @@ void lm_renderer_destroy(lm_renderer *r) {
   tile_cache_free(&r->tiles);
   lm_graph_destroy(r->graph);
   lm_shadow_plan_free(&r->shadows);
+  lm_readback_free(&r->fit_read);
   lm_light_grid_free(&r->light_grid);
   lm_trace_destroy(r->trace);
   free(r->prev_world);
@@ -113,9 +116,12 @@ double lm_renderer_fit_ms(const lm_renderer *r) { return r->fit_ms; }
 const lm_shadow_plan *lm_renderer_shadows(const lm_renderer *r) { return &r->shadows; }
 
 /* The shadow pass fits its views to the camera depths the G-buffer holds
- * (the script's reduction: min in r, max in g, as depth / far). Reading them
- * back waits for the passes before it; the frame accepts that wait (it is
- * timed: lm_renderer_fit_ms) rather than fit to last frame's depths. */
+ * (the script's reduction: min in r, max in g, as depth / far). Reading this
+ * frame's waits for the passes before it (timed: lm_renderer_fit_ms); with
+ * fit_previous the frame fits to the last frame's, read without a stall
+ * (lm_readback; a view's first frame reads its own), widened by fit_margin
+ * for what came into view since: on still frames too, so that cascades do
+ * not jump when the camera starts or stops. */
 static bool fit_views(void *user, const lm_pass_desc *d, lm_texture fit, int w, int h, lm_pass_view *views,
                       lm_error *err) {
   (void)err;
@@ -123,11 +129,21 @@ static bool fit_views(void *user, const lm_pass_desc *d, lm_texture fit, int w, 
   lm_shadow_plan *plan = &r->shadows;
   if (d->view_count != plan->view_count || w < 1 || h < 1) return true;
   double t0 = lm_now_ms();
+  float far = r->camera.clip[1], seen_far = far;
   float *px = lm_alloc(sizeof(float) * 4 * (size_t)w * (size_t)h);
-  lm_texture_read(fit, w, h, true, px);
-  float far = r->camera.clip[1];
-  lm_shadow_plan_fit(plan, r->desc.scene, &r->camera, px[0] * far, px[1] * far);
+  if (d->fit_previous && r->frame > 1 && r->fit_read.width == w && r->fit_read.height == h &&
+      lm_readback_collect(&r->fit_read, px))
+    seen_far = r->fit_far;
+  else
+    lm_texture_read(fit, w, h, true, px);
+  float widen = d->fit_previous ? 1 + d->fit_margin : 1;
+  float zmin = px[0] * seen_far / widen, zmax = px[1] * seen_far * widen;
   free(px);
+  if (d->fit_previous) {
+    lm_readback_start(&r->fit_read, fit, w, h);
+    r->fit_far = far;
+  }
+  lm_shadow_plan_fit(plan, r->desc.scene, &r->camera, zmin, zmax);
   for (int v = 0; v < plan->view_count; v++) views[v] = plan->views[v];
   lm_shadow_plan_upload(plan, plan->light_count);
   r->fit_ms += lm_now_ms() - t0;

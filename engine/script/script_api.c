@@ -552,7 +552,7 @@ static int l_scene(lua_State *L) {
   int top = lua_gettop(L);
   begin_pass(L, &b, LM_PASS_SCENE, "scene");
   static const char *const fields[] = {"technique", "out", "depth", "clear", "params", "defines",
-                                       "materials", "views", "fit", NULL};
+                                       "materials", "views", "fit", "fit_margin", NULL};
   check_fields(L, 1, b.what, fields);
   b.desc.shader = opt_string(L, 1, "technique", b.what);
   if (!b.desc.shader) b.desc.shader = "std";
@@ -588,6 +588,16 @@ static int l_scene(lua_State *L) {
     if (!b.desc.view_count) return luaL_error(L, "%s: fit is for a pass with views (a shadow plan)", b.what);
     b.desc.fits_views = true;
     b.desc.fit_target = to_target(L, -1, b.what)->id;
+  }
+  lua_pop(L, 1);
+  lua_getfield(L, 1, "fit_margin"); /* a number: fit to the previous frame's depths (lm_pass_desc) */
+  if (!lua_isnil(L, -1)) {
+    lua_Number m = lua_tonumber(L, -1);
+    if (!lua_isnumber(L, -1) || !(m >= 0 && m <= 10))
+      return luaL_error(L, "%s: fit_margin must be a number in 0..10", b.what);
+    if (!b.desc.fits_views) return luaL_error(L, "%s: fit_margin needs fit", b.what);
+    b.desc.fit_previous = true;
+    b.desc.fit_margin = (float)m;
   }
   lua_pop(L, 1);
   read_materials(L, 1, &b);
