@@ -46,6 +46,8 @@ static const char report_usage[] =
     "\n"
     "SPEC: TECH, or TECH:OPTION=V1,V2,...;OPTION=V1,... for every combination,\n"
     "  e.g. --sweep \"isr:isr.samples=8,16,32;isr.coarse=1,2\" --sweep ssao\n"
+    "  (the last option varies fastest; at most 256 settings). Each setting starts\n"
+    "  from the script's defaults and the job's set, inheriting nothing.\n"
     "\n"
     "options:\n"
     "  --job FILE           the capture job (its `set` applies to every setting;\n"
