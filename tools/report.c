@@ -62,7 +62,9 @@ static const char report_usage[] =
     "  --require-refs       fail, naming the command, when a reference is missing,\n"
     "                       instead of rendering it\n"
     "  --jobs N, --povray PROGRAM, --force: as limn reference, for missing ones\n"
-    "  --radiosity, --count, ... --approximate: as export-pov (the references')\n"
+    "  --radiosity, --count, --error-bound, --pretrace-start, --pretrace-end,\n"
+    "  --recursion-limit, --brightness, --shadows, --approximate: as export-pov\n"
+    "                       (the references')\n"
     "  --quiet              no progress\n"
     "\n"
     "exit codes: 0 written, 1 a render, reference or file failed, 2 bad usage.\n";
