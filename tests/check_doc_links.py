@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Every relative link of the docs resolves: README.md, docs/*.md and
 scripts/README.md under ROOT (default: this checkout). A link names a file
-that exists; a #anchor names a heading of its page (GitHub's slugs). Prints
-each broken link as file:line and exits 1 when there is one.
+that exists; a #anchor names a heading of its page (GitHub's slugs); and
+README.md links every docs/*.md page. Prints each broken link as file:line
+(and each page README.md does not link) and exits 1 when there is one.
 
 usage: check_doc_links.py [ROOT]"""
 import glob
@@ -85,6 +86,7 @@ def check(root):
         pages.append(scripts_readme)
     broken = []
     links = 0
+    linked = set()  # the files README.md links
     for page in pages:
         if not os.path.exists(page):
             broken.append('%s: missing' % os.path.relpath(page, root))
@@ -102,6 +104,8 @@ def check(root):
                 file_part, _, anchor = target.partition('#')
                 dest = page if not file_part else os.path.normpath(
                     os.path.join(os.path.dirname(page), file_part))
+                if page == pages[0]:
+                    linked.add(dest)
                 if os.path.relpath(dest, root).startswith('..'):
                     broken.append('%s: %s: outside the checkout' % (where, target))
                 elif not os.path.exists(dest):
@@ -109,6 +113,9 @@ def check(root):
                 elif anchor and dest.endswith('.md') and anchor not in anchors(dest):
                     broken.append('%s: %s: no heading #%s in %s'
                                   % (where, target, anchor, os.path.relpath(dest, root)))
+    for page in pages[1:]:
+        if page.startswith(os.path.join(root, 'docs', '')) and page not in linked:
+            broken.append('%s: not linked from README.md' % os.path.relpath(page, root))
     return links, broken
 
 
@@ -118,7 +125,7 @@ def main():
     for b in broken:
         print(b)
     if broken:
-        print('%d of %d relative links broken' % (len(broken), links))
+        print('%d problems; %d relative links checked' % (len(broken), links))
         return 1
     print('%d relative links resolve' % links)
     return 0

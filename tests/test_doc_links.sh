@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# The docs' relative links resolve (tests/check_doc_links.py on this
-# checkout), and the checker fails, naming file:line, on a link to a missing
-# file and on an anchor no heading has. Skipped (77) without python3.
+# The docs' relative links resolve and README.md links every docs page
+# (tests/check_doc_links.py on this checkout), and the checker fails, naming
+# file:line, on a link to a missing file, outside the checkout or to an
+# anchor no heading has, and names a page README.md does not link. Skipped
+# (77) without python3.
 set -euo pipefail
 root=${1:?usage: test_doc_links.sh ROOT}
 command -v python3 >/dev/null || { echo "skipped: python3 not installed"; exit 77; }
@@ -49,6 +51,13 @@ expect_broken 'see [the heading](docs/page.md#no-such-heading)' \
   'README.md:9: docs/page.md#no-such-heading: no heading #no-such-heading in docs/page.md'
 expect_broken '[up](../outside.md)' 'README.md:9: ../outside.md: outside the checkout'
 expect_broken '[self](#nowhere)' 'README.md:9: #nowhere: no heading #nowhere in README.md'
+
+# A docs page README.md does not link is named.
+echo '# Alone' >"$tmp/docs/alone.md"
+if out=$($check "$tmp"); then echo "FAIL: a page README.md does not link passed"; exit 1; fi
+echo "$out"
+grep -qxF 'docs/alone.md: not linked from README.md' <<<"$out" || { echo "FAIL: docs/alone.md not named"; exit 1; }
+rm "$tmp/docs/alone.md"
 
 # A broken link in a docs page and in scripts/README.md is found too.
 echo '[back](../READ.md)' >>"$tmp/docs/page.md"
