@@ -55,7 +55,7 @@ static const char capture_usage[] =
     "  --list-options       print the script's techniques and options, and exit\n"
     "  --job FILE           run a capture job (a Lua table of scenes, camera lists,\n"
     "                       techniques, sizes, options and an output pattern; see\n"
-    "                       README.md); --set adds to the job's options\n"
+    "                       docs/capture-jobs.md); --set adds to the job's options\n"
     "  --force              with --job: render images that exist already\n"
     "  --shard I/N          with --job: render views I, I+N, I+2N ... only; of a\n"
     "                       sequence, the I-th of N contiguous runs of frames\n"
@@ -64,7 +64,11 @@ static const char capture_usage[] =
     "                       or Kubernetes' JOB_COMPLETION_INDEX (auto/N)\n"
     "  --quiet              no times, errors only\n"
     "  --verbose            debug messages (targets left out, GL messages)\n"
-    "  --help               this text\n";
+    "  --help               this text\n"
+    "\n"
+    "exit codes: 0 done, 1 failed (script, shader or GL error: the first line names\n"
+    "script:line or the pass), 2 bad usage (a bad technique, option, scene, camera\n"
+    "or animation too).\n";
 
 typedef struct capture_args {
   const char *scene, *script, *tech, *egl, *job;

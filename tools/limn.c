@@ -22,7 +22,9 @@ static const char usage[] =
     "  help      this text; `limn <command> --help` describes a command's flags\n"
     "\n"
     "example:\n"
-    "  limn capture --scene cornell --script scripts/pp.lua --tech dl --size 256x192 --output out.png\n";
+    "  limn capture --scene cornell --script scripts/pp.lua --tech dl --size 256x192 --output out.png\n"
+    "\n"
+    "every command and flag, with what lies behind them: docs/commands.md\n";
 
 int main(int argc, char **argv) {
   if (argc < 2) {

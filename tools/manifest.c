@@ -31,6 +31,9 @@ static const char manifest_usage[] =
     "  --output FILE        the merged manifest (default: the job's manifest)\n"
     "  --refs DIR           check too that every view's reference (limn reference)\n"
     "                       is in DIR, exported with the export-pov flags given\n"
+    "  --radiosity, --count, --error-bound, --pretrace-start, --pretrace-end,\n"
+    "  --recursion-limit, --brightness, --shadows, --approximate: as export-pov\n"
+    "                       (the references', with --refs)\n"
     "  --quiet              errors only\n"
     "\n"
     "exit codes: 0 merged, 1 something missing, duplicated or from another run, 2 bad usage.\n";

@@ -67,7 +67,11 @@ static const char view_usage[] =
     "  the script declares, a boolean or a table with `enabled`)\n"
     "  F1/Tab overlay; PageDown/PageUp step through targets, Home the frame again;\n"
     "  C channel (rgb r g b a), V false colour, Up/Down exposure;\n"
-    "  P writes the shown target (EXR) and the frame (PNG); Escape quits\n";
+    "  P writes the shown target (EXR) and the frame (PNG); Escape quits\n"
+    "\n"
+    "environment: LIMN_FONT, the overlay's font file (default DejaVu Sans Mono)\n"
+    "exit codes: 0 closed, 1 failed (the script's first load, the font, window or\n"
+    "renderer), 2 bad usage or a bad technique, option, scene, camera or animation.\n";
 
 /* ---- command line ------------------------------------------------------ */
 static int usage_error(const char *fmt, const char *arg) {
