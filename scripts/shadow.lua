@@ -36,6 +36,9 @@ shadow.defaults = {
                       -- angular diameter, radians); <= 0: each light's own (glTF extras.size, else
                       -- 0.0093 rad for directional lights, 1% of the shadow map's range for others)
   penumbra = 16,      -- PCSS: the widest penumbra radius (and blocker search), texels, 1..64
+  simplify = 0.5,     -- a caster whose simplified copy (made at load: meshoptimizer, 1% of the mesh's
+                      -- extent) errs by at most this many texels of a tile draws that copy there:
+                      -- far cascades and small tiles draw fewer triangles; 0..64, 0: never
   debug = false,      -- present the shadow atlas instead of the image
 }
 
