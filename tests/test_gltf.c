@@ -877,6 +877,78 @@ static void mutated_glb_never_crashes(void **state) {
   lm_log_set_level(level);
 }
 
+/* EXT_mesh_gpu_instancing: a triangle placed three times by a node moved to
+ * x = 10; each copy a child node holding the mesh, its world transform the
+ * node's times its own TRS. `attrs` is the extension's attributes object;
+ * accessors 1 (SCALAR, 3), 2 (TRANSLATION, 3), 3 (ROTATION, 3), 4 (SCALE, 3), 5 (ROTATION, 2). */
+static const char *write_instanced(const char *name, const char *attrs) {
+  static const float t[9] = {0, 0, 0, 1, 2, 3, -4, 0, 0}, sc[9] = {1, 1, 1, 2, 2, 2, 1, 1, 1};
+  const float h = 0.70710678f; /* a quarter turn about z, then none, then a half turn about y */
+  const float r[12] = {0, 0, h, h, 0, 0, 0, 1, 0, 1, 0, 0};
+  blob b = {0};
+  blob_add(&b, tri_pos, sizeof tri_pos);
+  size_t ot = blob_add(&b, t, sizeof t), orr = blob_add(&b, r, sizeof r), os = blob_add(&b, sc, sizeof sc);
+  char json[4096];
+  snprintf(json, sizeof json,
+           "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\"],"
+           "\"extensionsRequired\":[\"EXT_mesh_gpu_instancing\"],\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+           "\"nodes\":[{\"name\":\"row\",\"mesh\":0,\"translation\":[10,0,0],"
+           "\"extensions\":{\"EXT_mesh_gpu_instancing\":{\"attributes\":%s}}}],"
+           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+           "\"buffers\":[{\"uri\":\"%%s\",\"byteLength\":%%zu}],"
+           "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36},"
+           "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":48},"
+           "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":36}],"
+           "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+           "{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"SCALAR\"},"
+           "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+           "{\"bufferView\":2,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"},"
+           "{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+           "{\"bufferView\":2,\"componentType\":5126,\"count\":2,\"type\":\"VEC4\"}]}",
+           attrs, ot, orr, os);
+  return write_gltf(name, json, &b);
+}
+
+static void gpu_instancing_places_copies(void **state) {
+  (void)state;
+  lm_error err = {""};
+  lm_scene *s = lm_scene_load_gltf(write_instanced("inst.gltf", "{\"TRANSLATION\":2,\"ROTATION\":3,\"SCALE\":4}"), &err);
+  if (!s) fail_msg("%s", err.msg);
+  assert_int_equal(s->mesh_count, 1); /* the copies share it */
+  assert_string_equal(s->nodes[0].name, "row");
+  assert_int_equal(s->nodes[0].mesh, -1); /* the node itself draws nothing */
+  /* Where each copy puts the triangle's vertex (1, 0, 0): node x 10, then the instance's TRS. */
+  const float want[3][3] = {{10, 1, 0}, {10 + 1 + 2, 2, 3}, {10 - 4 - 1, 0, 0}};
+  for (int i = 0; i < 3; i++) {
+    const lm_node *n = &s->nodes[1 + i];
+    char name[16];
+    snprintf(name, sizeof name, "row[%d]", i);
+    assert_string_equal(n->name, name);
+    assert_int_equal(n->parent, 0);
+    assert_int_equal(n->mesh, 0);
+    for (int k = 0; k < 3; k++) assert_float_equal(n->world[k] + n->world[12 + k], want[i][k], 1e-5);
+  }
+  lm_scene_destroy(s);
+  /* Bad data names the node, the extension and the attribute. */
+  static const struct { const char *attrs, *want; } bad[] = {
+      {"{\"TRANSLATION\":2,\"ROTATION\":5}", "attributes.ROTATION: accessor 5 has 2 elements, the other attributes 3"},
+      {"{\"ROTATION\":2}", "attributes.ROTATION: accessor 2 has 3 components per element, want 4"},
+      {"{\"SCALE\":9}", "attributes.SCALE: accessor 9 does not exist"},
+      {"{\"SCALE\":\"4\"}", "attributes.SCALE: want an accessor index"},
+      {"{\"ROTATION\":3,\"SCALE\":1}", "attributes.SCALE: accessor 1 has 1 components per element, want 3"},
+      {"{\"COLOR\":2}", "attributes names none of TRANSLATION, ROTATION, SCALE"},
+      {"[]", "attributes: want an object"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    const char *path = write_instanced("bad_inst.gltf", bad[i].attrs);
+    s = lm_scene_load_gltf(path, &err);
+    if (s) fail_msg("%s loaded", bad[i].attrs);
+    if (!strstr(err.msg, path) || !strstr(err.msg, "node 0 ('row'): EXT_mesh_gpu_instancing: ") ||
+        !strstr(err.msg, bad[i].want))
+      fail_msg("%s: want '%s', got: %s", bad[i].attrs, bad[i].want, err.msg);
+  }
+}
+
 static void names_pick_files_or_builtins(void **state) {
   (void)state;
   assert_true(lm_scene_is_gltf_name("a/b.gltf"));
@@ -915,6 +987,7 @@ int main(void) {
       cmocka_unit_test(truncated_and_missing_files_are_refused),
       cmocka_unit_test(mutated_glb_never_crashes),
       cmocka_unit_test(names_pick_files_or_builtins),
+      cmocka_unit_test(gpu_instancing_places_copies),
   };
   return cmocka_run_group_tests(tests, gltf_test_setup, gltf_test_teardown);
 }

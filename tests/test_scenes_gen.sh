@@ -107,8 +107,54 @@ check(doc["accessors"][prim["indices"]]["count"] // 3 < 1000, "tube: a few hundr
 ibm, _ = floats(doc, binary, skins[0]["inverseBindMatrices"])
 check(near(ibm[16 + 12:16 + 15], [0, -1, 0]), "tube: bend's inverse bind matrix undoes its height 1")
 
+# The big scene (benchmarks) and its small size (tests): triangles drawn over
+# every mesh node (instances counted), nodes, shared meshes, lights, views;
+# the instanced form places the same spheres (translation, yaw, scale) as
+# the one of a node each.
+def big_stats(path):
+    doc, binary = glb(path)
+    nodes, meshes = doc["nodes"], doc["meshes"]
+    tris = 0
+    places = []
+    for n in nodes:
+        if "mesh" not in n: continue
+        per = sum(doc["accessors"][p["indices"]]["count"] // 3 for p in meshes[n["mesh"]]["primitives"])
+        inst = n.get("extensions", {}).get("EXT_mesh_gpu_instancing")
+        if inst:
+            t, _ = floats(doc, binary, inst["attributes"]["TRANSLATION"])
+            r, _ = floats(doc, binary, inst["attributes"]["ROTATION"])
+            s, _ = floats(doc, binary, inst["attributes"]["SCALE"])
+            for i in range(len(t) // 3):
+                places.append((n["mesh"], t[i * 3:i * 3 + 3], r[i * 4:i * 4 + 4], s[i * 3:i * 3 + 3]))
+            tris += per * (len(t) // 3)
+        else:
+            if n["name"].startswith("ball"):
+                places.append((n["mesh"], n["translation"], n["rotation"], n["scale"]))
+            tris += per
+    lights = doc["extensions"]["KHR_lights_punctual"]["lights"]
+    return doc, tris, places, lights
+
+d = sys.argv[1] + "/big/"
+doc, tris, places, lights = big_stats(d + "big.glb")
+check(tris >= 1500000, "big: %d triangles drawn, want 1.5 M or more" % tris)
+check(len(doc["nodes"]) >= 400 and len(places) == 400, "big: 400 spheres, hundreds of nodes")
+check(len(doc["meshes"]) <= 5, "big: the spheres share a few meshes")
+check([l["type"] for l in lights].count("directional") == 1 and [l["type"] for l in lights].count("point") == 8,
+      "big: a sun and eight point lights")
+check(len([l for l in open(d + "big.cams") if not l.startswith("#")]) == 3, "big: three views in big.cams")
+doc, small_tris, small_places, lights = big_stats(d + "big_small.glb")
+check(10000 < small_tris < 40000 and len(small_places) == 64 and len(lights) == 9,
+      "big_small: 64 spheres, tens of thousands of triangles (%d), the same lights" % small_tris)
+doc, inst_tris, inst_places, _ = big_stats(d + "big_small_instanced.glb")
+check("EXT_mesh_gpu_instancing" in doc.get("extensionsRequired", []), "big_small_instanced: requires the extension")
+check(inst_tris == small_tris and len(doc["nodes"]) < 20, "big_small_instanced: the same triangles from a node a mesh")
+check(len(inst_places) == len(small_places) and
+      all(any(p[0] == q[0] and near(p[1], q[1], 1e-4) and near(p[2], q[2], 1e-4) and near(p[3], q[3], 1e-4)
+              for q in small_places)
+          for p in inst_places), "big_small_instanced: each instance is a sphere of big_small")
+
 if fails:
     print("FAIL: " + "\nFAIL: ".join(fails))
     sys.exit(1)
-print("ok: turntable, door, bending_tube and moving_light have their animations and skin")
+print("ok: turntable, door, bending_tube and moving_light have their animations and skin; big has %d triangles" % tris)
 PY

@@ -90,6 +90,7 @@ check "bench names the clock" out_has '"clock": "'
 check "bench has overhead" out_has '"overhead_ms": '
 check "bench fits the direct pass" out_has '{"name": "direct", "ms": ['
 check "bench fit per pixel" out_has '"ns_per_pixel": '
+check "bench peak memory" out_has '"peak_rss_kib": '
 check "bench table" run 0 bench --sizes 32x24,64x48 --frames 1 --warmup 0
 check "bench table names the fit" out_has "fit: a ms + b ns/pixel"
 check "bench cpu pass" run 0 bench --scene cornell_mirror --tech dl --set reflections=true --sizes 32x24 --frames 1 --warmup 0

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 
 #include "render/render.h"
 #include "scene/gltf.h"
@@ -578,7 +579,16 @@ static bool cpu_pass_ms(const bench *b, int s, double *ms) {
   return any;
 }
 
+/* The process's peak resident memory so far, KiB (getrusage's ru_maxrss: on
+ * llvmpipe the GPU's buffers and textures are in it too); -1 when unknown. */
+static long peak_rss_kib(void) {
+  struct rusage u;
+  return getrusage(RUSAGE_SELF, &u) == 0 ? u.ru_maxrss : -1;
+}
+
 static void print_tables(const bench *b, lm_clock clock) {
+  printf("peak memory: %.1f MiB resident (getrusage ru_maxrss, the whole run; with llvmpipe GPU memory is in it)\n",
+         (double)peak_rss_kib() / 1024);
   printf("frame (wall clock, glFinish before and after) and compositor overhead (CPU: Lua + graph compile);\n"
          "passes: clock %s; medians of %d frames after %d warm-up\n", lm_clock_name(clock), b->frames, b->warmup);
   printf("  %-12s %10s %12s %12s %9s\n", "size", "pixels", "frame ms", "overhead ms", "overhead");
@@ -924,6 +934,7 @@ static void print_motion_json(const bench *b) {
 static void print_json(const bench *b, lm_clock clock) {
   printf("{\"clock\": ");
   limn_json_string(lm_clock_name(clock));
+  printf(", \"peak_rss_kib\": %ld", peak_rss_kib());
   printf(", \"frames\": %d, \"warmup\": %d, \"sizes\": [", b->frames, b->warmup);
   for (int s = 0; s < b->size_count; s++) {
     printf("%s{\"width\": %d, \"height\": %d, \"frame_ms\": %.6g, \"overhead_ms\": %.6g", s ? ", " : "",

@@ -256,6 +256,7 @@ typedef struct node {
   int parent;
   float t[3], r[4], s[3];
   int mesh, camera, light, skin;
+  int instances[3]; /* EXT_mesh_gpu_instancing's TRANSLATION, ROTATION, SCALE accessors; -1: none */
 } node;
 
 typedef struct doc {
@@ -396,6 +397,7 @@ static int add_node(doc *d, const char *name, int parent, float x, float y, floa
   n->r[3] = 1;
   n->s[0] = n->s[1] = n->s[2] = 1;
   n->mesh = n->camera = n->light = n->skin = -1;
+  n->instances[0] = n->instances[1] = n->instances[2] = -1;
   return d->node_count++;
 }
 
@@ -545,7 +547,13 @@ static void write_file(const char *path, const void *data, size_t len) {
 static void finish(doc *d, const char *dir, const char *name) {
   buf j = {0};
   putf(&j, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"limn tools/gen_scenes.c\"}");
-  if (d->light_count) putf(&j, ",\"extensionsUsed\":[\"KHR_lights_punctual\"]");
+  bool instanced = false;
+  for (int i = 0; i < d->node_count; i++) instanced |= d->nodes[i].instances[0] >= 0;
+  if (instanced) /* required: a reader without it would draw one copy of each mesh */
+    putf(&j, ",\"extensionsUsed\":[%s\"EXT_mesh_gpu_instancing\"],\"extensionsRequired\":[\"EXT_mesh_gpu_instancing\"]",
+         d->light_count ? "\"KHR_lights_punctual\"," : "");
+  else if (d->light_count)
+    putf(&j, ",\"extensionsUsed\":[\"KHR_lights_punctual\"]");
   putf(&j, ",\"scene\":0,\"scenes\":[{\"name\":\"%s\",\"nodes\":[", name);
   int first = 1;
   for (int i = 0; i < d->node_count; i++)
@@ -561,6 +569,9 @@ static void finish(doc *d, const char *dir, const char *name) {
     if (n->skin >= 0) putf(&j, ",\"skin\":%d", n->skin);
     if (n->camera >= 0) putf(&j, ",\"camera\":%d", n->camera);
     if (n->light >= 0) putf(&j, ",\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}", n->light);
+    if (n->instances[0] >= 0)
+      putf(&j, ",\"extensions\":{\"EXT_mesh_gpu_instancing\":{\"attributes\":{\"TRANSLATION\":%d,"
+           "\"ROTATION\":%d,\"SCALE\":%d}}}", n->instances[0], n->instances[1], n->instances[2]);
     int kids = 0;
     for (int k = i + 1; k < d->node_count; k++)
       if (d->nodes[k].parent == i) putf(&j, kids++ ? ",%d" : ",\"children\":[%d", k);
@@ -1290,6 +1301,85 @@ static void moving_light(const char *dir) {
   finish(&d, dir, "moving_light");
 }
 
+/* ---- the big scene (benchmarks; tests take its small size) -------------------
+ * Spheres in a square grid on a ground plane, each a node of one of four
+ * shared sphere meshes (a material each) with its own yaw and scale, under a
+ * sun and eight point lights, all casting shadows. Written under OUTDIR/big/,
+ * where the capture test of every scene does not look: big (20 x 20 spheres
+ * of 64 x 30 quads: 3,840 triangles each, 1.54 M drawn, 415 kB as the meshes
+ * are shared) for benchmarks; big_small (8 x 8 of 16 x 8: 16.4 k triangles)
+ * for tests, and big_small_instanced, the same spheres as one node a mesh
+ * carrying EXT_mesh_gpu_instancing (it must draw the same image). */
+typedef struct big_size {
+  const char *name;
+  int side, seg, rings;
+} big_size;
+
+static void big(const char *dir, const big_size *z, bool instanced) {
+  enum { MESHES = 4 };
+  rng_state = 4242; /* its own sequence: every size and form places the spheres alike */
+  doc d = {0};
+  float spacing = 3, H = (float)z->side * spacing / 2; /* the grid's half width */
+  int ground = diffuse(&d, "ground", 0.55f, 0.53f, 0.5f);
+  mesh m = {0};
+  slab(&m, 0, true, -H - 4, H + 4, -H - 4, H + 4);
+  mesh_node(&d, "ground", -1, add_mesh1(&d, "ground", &m, ground), 0, 0, 0, 0, 1);
+  static const float colors[MESHES][3] = {{0.8f, 0.25f, 0.2f}, {0.25f, 0.6f, 0.3f}, {0.25f, 0.35f, 0.8f},
+                                          {0.85f, 0.75f, 0.3f}};
+  int meshes[MESHES];
+  for (int k = 0; k < MESHES; k++) {
+    char nm[32];
+    snprintf(nm, sizeof nm, "sphere%d", k);
+    int mat = add_material(&d, nm, colors[k][0], colors[k][1], colors[k][2], 0, 0.5f + 0.1f * (float)k, -1);
+    sphere(&m, 1, z->seg, z->rings);
+    meshes[k] = add_mesh1(&d, nm, &m, mat);
+  }
+  int count = z->side * z->side, per[MESHES] = {0};
+  float *t = malloc(sizeof(float) * 3 * (size_t)count * MESHES), *r = malloc(sizeof(float) * 4 * (size_t)count * MESHES);
+  float *sc = malloc(sizeof(float) * 3 * (size_t)count * MESHES);
+  for (int k = 0; k < count; k++) {
+    int i = k % z->side, j = k / z->side, which = (int)(rnd() * MESHES) % MESHES;
+    float s = 0.5f + 0.5f * rnd(), yaw = rnd() * 360;
+    float x = -H + spacing * ((float)i + 0.5f) + (rnd() - 0.5f), zz = -H + spacing * ((float)j + 0.5f) + (rnd() - 0.5f);
+    if (!instanced) {
+      char nm[32];
+      snprintf(nm, sizeof nm, "ball%d", k);
+      mesh_node(&d, nm, -1, meshes[which], x, s, zz, yaw, s);
+      continue;
+    }
+    int at = which * count + per[which]++;
+    float *tt = t + at * 3, *rr = r + at * 4, *ss = sc + at * 3;
+    tt[0] = x, tt[1] = s, tt[2] = zz;
+    axis_quat(0, 1, 0, yaw, rr);
+    ss[0] = ss[1] = ss[2] = s;
+  }
+  for (int k = 0; instanced && k < MESHES; k++) {
+    if (!per[k]) continue;
+    char nm[32];
+    snprintf(nm, sizeof nm, "balls%d", k);
+    int n = mesh_node(&d, nm, -1, meshes[k], 0, 0, 0, 0, 1);
+    int *acc = d.nodes[n].instances;
+    acc[0] = add_accessor(&d, add_view(&d, t + k * count * 3, (size_t)per[k] * 12, 0), 5126, per[k], "VEC3", NULL, NULL);
+    acc[1] = add_accessor(&d, add_view(&d, r + k * count * 4, (size_t)per[k] * 16, 0), 5126, per[k], "VEC4", NULL, NULL);
+    acc[2] = add_accessor(&d, add_view(&d, sc + k * count * 3, (size_t)per[k] * 12, 0), 5126, per[k], "VEC3", NULL, NULL);
+  }
+  free(t), free(r), free(sc);
+  light(&d, "sun", "directional", 0, 30, 0, (float[]){0.5f, -0.75f, -0.35f}, 1, 0.96f, 0.9f, 2 * LUX, 0);
+  for (int k = 0; k < 8; k++) { /* four inside the grid, four over its edges' middles */
+    float a = (float)k * PI / 4, rad = k % 2 ? H * 0.5f * 1.41f : H * 0.9f, y = k % 2 ? 4 : 5;
+    char nm[32];
+    snprintf(nm, sizeof nm, "lamp%d", k);
+    light(&d, nm, "point", rad * cosf(a), y, rad * sinf(a), NULL, 1, 0.9f - 0.05f * (float)(k % 3), 0.8f, 1500,
+          3 * spacing * 2);
+  }
+  view(&d, "overview", 0, H * 0.8f, H * 1.5f, 0, 0, 0, 50, H * 6);
+  view(&d, "street", -H - 2, 2, spacing * 0.5f, H, 1, spacing * 0.5f, 60, H * 6);
+  view(&d, "corner", H * 1.1f, 6, H * 1.1f, 0, 0.5f, 0, 55, H * 6);
+  char name[64];
+  snprintf(name, sizeof name, "%s%s", z->name, instanced ? "_instanced" : "");
+  finish(&d, dir, name);
+}
+
 int main(int argc, char **argv) {
   if (argc != 2) {
     fprintf(stderr, "usage: gen_scenes OUTDIR\n");
@@ -1300,10 +1390,11 @@ int main(int argc, char **argv) {
   office(argv[1]);
   garage(argv[1]);
   outdoor(argv[1]);
-  char ref[1024];
+  char ref[1024], bigdir[1024];
   snprintf(ref, sizeof ref, "%s/reference", argv[1]);
-  if (mkdir(ref, 0777) != 0 && errno != EEXIST) {
-    fprintf(stderr, "gen_scenes: cannot make %s: %s\n", ref, strerror(errno));
+  snprintf(bigdir, sizeof bigdir, "%s/big", argv[1]);
+  if ((mkdir(ref, 0777) != 0 && errno != EEXIST) || (mkdir(bigdir, 0777) != 0 && errno != EEXIST)) {
+    fprintf(stderr, "gen_scenes: cannot make %s and %s: %s\n", ref, bigdir, strerror(errno));
     return 1;
   }
   ref_room(ref);
@@ -1314,5 +1405,9 @@ int main(int argc, char **argv) {
   door(argv[1]);
   bending_tube(argv[1]);
   moving_light(argv[1]);
+  static const big_size full = {"big", 20, 64, 30}, small = {"big_small", 8, 16, 8};
+  big(bigdir, &full, false); /* its own random sequence: the scenes above stay as they were */
+  big(bigdir, &small, false);
+  big(bigdir, &small, true);
   return 0;
 }

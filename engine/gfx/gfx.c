@@ -374,14 +374,16 @@ void lm_instances_upload(const lm_instance *instances, int count) {
   glNamedBufferSubData(instance_vbo, 0, (GLsizeiptr)((size_t)count * sizeof(lm_instance)), instances);
 }
 
-void lm_mesh_draw_instances(const lm_mesh *m, int first, int count) {
-  if (count <= 0 || !instance_vbo) return;
+void lm_mesh_draw_instances(const lm_mesh *m, int first_index, int index_count, int first, int count) {
+  if (count <= 0 || !instance_vbo || first_index < 0 || index_count <= 0 || first_index + index_count > m->index_count)
+    return;
   glVertexArrayVertexBuffer(m->vao, 1, instance_vbo, 0, sizeof(lm_instance));
   /* A disabled attribute reads the context's current value, not the VAO's:
    * (0, 0, 0, 0) tells the shader that the mesh has no previous positions. */
   if (!m->prev) glVertexAttrib4f(15, 0, 0, 0, 0);
   glBindVertexArray(m->vao);
-  glDrawElementsInstancedBaseInstance(GL_TRIANGLES, m->index_count, GL_UNSIGNED_INT, NULL, count, (GLuint)first);
+  glDrawElementsInstancedBaseInstance(GL_TRIANGLES, index_count, GL_UNSIGNED_INT,
+                                      (const void *)((size_t)first_index * sizeof(uint32_t)), count, (GLuint)first);
 }
 
 /* ---- timers ------------------------------------------------------------ */

@@ -206,9 +206,11 @@ void lm_mesh_set_prev_positions(lm_mesh *m, const float *positions, int vertex_c
 typedef struct lm_instance { float model[16]; float normal[9]; float prev_model[16]; } lm_instance;
 /* Replaces the instances the next draws read (grows the buffer as needed). */
 void lm_instances_upload(const lm_instance *instances, int count);
-/* Draws m once for each of the uploaded instances first .. first + count - 1:
- * one draw call however many there are. */
-void lm_mesh_draw_instances(const lm_mesh *m, int first, int count);
+/* Draws indices first_index .. first_index + index_count - 1 of m (a range of
+ * its index buffer: the whole mesh, or a simplified copy stored after it)
+ * once for each of the uploaded instances first .. first + count - 1: one
+ * draw call however many there are. */
+void lm_mesh_draw_instances(const lm_mesh *m, int first_index, int index_count, int first, int count);
 
 /* ---- timers ------------------------------------------------------------ */
 typedef enum lm_clock { LM_CLOCK_AUTO, LM_CLOCK_GPU, LM_CLOCK_CPU } lm_clock;

@@ -174,6 +174,9 @@ static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, int layer, lm_err
                           .pancake = sp->view && sp->view->depth[3] == 0,
                           .params = params, .param_count = n, .prev_world = r->prev_world,
                           .dynamic = r->dynamic, .layer = layer};
+  if (sp->view && r->shadows.settings.simplify > 0) /* simplified casters where a tile's texels hide them */
+    d.lod_view_proj = sp->view->view_proj, d.lod_size[0] = sp->view->width, d.lod_size[1] = sp->view->height,
+    d.lod_texels = r->shadows.settings.simplify;
   return lm_scene_draw(r->desc.scene, &d, sp->view ? &r->shadow_stats : &r->stats, err);
 }
 
@@ -223,6 +226,7 @@ static uint64_t tile_key(const lm_renderer *r, const lm_scene_pass *sp, bool sta
   h = lm_hash(d->shader, strlen(d->shader), h);
   h = lm_hash(d->defines, strlen(d->defines), h);
   h = lm_hash(d->clear_color, sizeof d->clear_color, h);
+  h = lm_hash(&r->shadows.settings.simplify, sizeof r->shadows.settings.simplify, h);
   for (int i = 0; i < d->material_param_count; i++) {
     const lm_pass_material_param *q = &d->material_params[i];
     h = lm_hash(q->material, strlen(q->material), h);

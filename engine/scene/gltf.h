@@ -6,7 +6,8 @@
  * What comes over, and how:
  * - extensionsRequired first: a file that requires an extension other than
  *   those the loader reads (KHR_lights_punctual, KHR_texture_transform,
- *   KHR_materials_emissive_strength) is refused, naming it.
+ *   KHR_materials_emissive_strength, EXT_mesh_gpu_instancing) is refused,
+ *   naming it.
  * - Nodes of the file's default scene (scene 0 when it names none; every
  *   root node when it has no scenes), parents before children. A node's
  *   local transform is its matrix, or T * R * S. Every world transform must
@@ -16,6 +17,13 @@
  *   primitive holds it itself; a node whose mesh has several gets one child
  *   node per primitive ("<node>.<i>", identity transform), so that each node
  *   keeps one material. Nodes sharing a mesh share its lm meshes.
+ * - EXT_mesh_gpu_instancing: a node's TRANSLATION, ROTATION, SCALE accessors
+ *   (the same count; floats, or normalized integers) place one child node
+ *   "<node>[i]" a copy, holding the mesh as above, under the node's own
+ *   transform; the renderer draws the copies of a mesh in one instanced
+ *   draw as it does any nodes sharing a mesh. A node without a mesh, an
+ *   attribute of the wrong width or count, a non-finite value or a zero
+ *   rotation fails the file naming the node and the attribute.
  * - Triangles, triangle strips and fans (modes 4, 5, 6, indexed by
  *   u8/u16/u32 or not indexed); strips and fans become triangle lists with
  *   their winding kept. Points and lines (modes 0 to 3) are skipped, with one

@@ -841,6 +841,67 @@ bool add_mesh(Loader &L, int ni, int mi, int lm_node) {
   return true;
 }
 
+// EXT_mesh_gpu_instancing: the node's mesh drawn once per instance, each
+// placed by the node's transform times its own TRS. Each instance becomes a
+// child node ("<node>[i]") holding the mesh, so that the instanced draw of
+// nodes sharing a mesh (lm_scene_draw) draws them, channels on the node move
+// them all, and the bounds and the tracer see each copy. false (and nothing
+// added) when the node has none; bad data fails naming the node and field.
+bool add_instances(Loader &L, int ni, int lm_node, bool *instanced) {
+  const tinygltf::Node &n = L.m.nodes[ni];
+  auto it = n.extensions.find("EXT_mesh_gpu_instancing");
+  *instanced = it != n.extensions.end();
+  if (!*instanced) return true;
+  char where[LM_NAME_MAX + 64];
+  snprintf(where, sizeof where, "node %d ('%s'): EXT_mesh_gpu_instancing", ni, L.s->nodes[lm_node].name);
+  const tinygltf::Value &ext = it->second;
+  if (n.mesh < 0) return fail(L, "%s: the node has no mesh to instance", where);
+  if (!ext.IsObject() || !ext.Has("attributes") || !ext.Get("attributes").IsObject())
+    return fail(L, "%s: attributes: want an object of TRANSLATION, ROTATION, SCALE accessors", where);
+  const tinygltf::Value &attrs = ext.Get("attributes");
+  static const char *const names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+  View views[3];
+  bool present[3] = {false, false, false};
+  size_t count = 0;
+  for (int k = 0; k < 3; k++) {
+    if (!attrs.Has(names[k])) continue;
+    char what[LM_NAME_MAX + 96];
+    snprintf(what, sizeof what, "%s: attributes.%s", where, names[k]);
+    const tinygltf::Value &a = attrs.Get(names[k]);
+    double index = a.IsNumber() ? a.GetNumberAsDouble() : -1;
+    if (!(index >= 0 && index < 1e9 && index == std::floor(index)))
+      return fail(L, "%s: want an accessor index", what);
+    if (!accessor_view(L, what, (int)index, k == 1 ? 4 : 3, &views[k])) return false;
+    if (count && views[k].count != count)
+      return fail(L, "%s: accessor %d has %zu elements, the other attributes %zu", what, (int)index,
+                  views[k].count, count);
+    count = views[k].count;
+    present[k] = true;
+  }
+  if (!count) return fail(L, "%s: attributes names none of TRANSLATION, ROTATION, SCALE", where);
+  for (size_t i = 0; i < count; i++) {
+    float v[3][4] = {{0, 0, 0, 0}, {0, 0, 0, 1}, {1, 1, 1, 0}};
+    for (int k = 0; k < 3; k++)
+      for (int c = 0; present[k] && c < (k == 1 ? 4 : 3); c++) {
+        double x = view_get(views[k], i, c);
+        if (!std::isfinite(x) || std::fabs(x) > LM_GLTF_MAX_COORD)
+          return fail(L, "%s: attributes.%s: element %zu has a non-finite or huge value (%g)", where, names[k], i, x);
+        v[k][c] = (float)x;
+      }
+    double len = std::sqrt((double)v[1][0] * v[1][0] + (double)v[1][1] * v[1][1] + (double)v[1][2] * v[1][2] +
+                           (double)v[1][3] * v[1][3]);
+    if (!(len > 1e-6)) return fail(L, "%s: attributes.ROTATION: element %zu is not a usable quaternion", where, i);
+    for (int c = 0; c < 4; c++) v[1][c] = (float)(v[1][c] / len);
+    float local[16];
+    lm_scene_trs_matrix(v[0], v[1], v[2], local);
+    char name[LM_NAME_MAX];
+    snprintf(name, sizeof name, "%.40s[%zu]", L.s->nodes[lm_node].name, i);
+    int child = lm_scene_add_node(L.s, name, lm_node, local, -1, -1);
+    if (!add_mesh(L, ni, n.mesh, child)) return false;
+  }
+  return true;
+}
+
 bool add_node(Loader &L, int ni, int parent, int *out) {
   const tinygltf::Node &n = L.m.nodes[ni];
   lm_node pose = {};
@@ -856,7 +917,9 @@ bool add_node(Loader &L, int ni, int parent, int *out) {
   memcpy(node->rotation, pose.rotation, sizeof pose.rotation);
   memcpy(node->scale, pose.scale, sizeof pose.scale);
   L.nodes[ni] = id;
-  if (n.mesh >= 0 && !add_mesh(L, ni, n.mesh, id)) return false;
+  bool instanced;
+  if (!add_instances(L, ni, id, &instanced)) return false;
+  if (n.mesh >= 0 && !instanced && !add_mesh(L, ni, n.mesh, id)) return false;
   if (n.camera >= 0 && !add_camera(L, ni, n.camera, id)) return false;
   int li = node_light(n);
   if (li == -2) return fail(L, "node %d: KHR_lights_punctual wants {\"light\": index}", ni);
@@ -1272,7 +1335,7 @@ std::string locate_bad_indices(const unsigned char *text, size_t len) {
 // The extensions this loader reads: a file that requires any other is refused
 // before tinygltf sees it (which would fail later, on data it cannot decode).
 const char *const kSupportedExtensions[] = {"KHR_lights_punctual", "KHR_texture_transform",
-                                            "KHR_materials_emissive_strength"};
+                                            "KHR_materials_emissive_strength", "EXT_mesh_gpu_instancing"};
 
 // The first name in the file's extensionsRequired that is not supported, or "".
 std::string unsupported_required(const unsigned char *text, size_t len) {

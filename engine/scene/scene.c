@@ -2,6 +2,7 @@
 
 #include <cglm/cglm.h>
 #include <float.h>
+#include <meshoptimizer.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -236,6 +237,30 @@ bool lm_scene_camera_check(const lm_scene *s, int cam, lm_error *err) {
   return true;
 }
 
+/* Makes m's simplified shadow casters (lm_scene_mesh.caster_index_count):
+ * the mesh's indices followed by the copy's, malloc'd, or NULL when it gets
+ * none. Positions alone matter to a caster, so the indices are first made
+ * to share vertices that differ only in normal or uv (a seam would stop the
+ * simplifier there). */
+static uint32_t *simplify_casters(lm_scene_mesh *m) {
+  m->caster_index_count = 0, m->caster_error = 0;
+  size_t n = (size_t)m->index_count, nv = (size_t)m->vertex_count, stride = 8 * sizeof(float);
+  if (m->rest || n / 3 < LM_CASTER_MIN_TRIANGLES) return NULL; /* a deformed mesh moves its vertices */
+  uint32_t *out = lm_alloc(sizeof *out * n * 2), *shared = lm_alloc(sizeof *shared * n);
+  memcpy(out, m->indices, sizeof *out * n);
+  meshopt_generateShadowIndexBuffer(shared, m->indices, n, m->vertices, nv, 3 * sizeof(float), stride);
+  float error = 0;
+  size_t kept = meshopt_simplify(out + n, shared, n, m->vertices, nv, stride, n / 4, LM_CASTER_ERROR, 0, &error);
+  free(shared);
+  if (kept == 0 || kept > n * 3 / 4 || !(error >= 0)) {
+    free(out);
+    return NULL;
+  }
+  m->caster_index_count = (int)kept;
+  m->caster_error = error * meshopt_simplifyScale(m->vertices, nv, stride);
+  return out;
+}
+
 bool lm_scene_upload(lm_scene *s, lm_error *err) {
   if (s->uploaded) return true;
   for (int i = 0; i < s->texture_count; i++) {
@@ -246,11 +271,21 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
       return false;
     }
   }
+  double t0 = lm_now_ms();
+  long whole = 0, simple = 0;
+  int simplified = 0;
   for (int i = 0; i < s->mesh_count; i++) {
     lm_scene_mesh *m = &s->meshes[i];
-    lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, m->indices, m->index_count);
+    uint32_t *indices = simplify_casters(m);
+    lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, indices ? indices : m->indices,
+                   m->index_count + m->caster_index_count);
+    free(indices);
     m->dirty = false;
+    if (m->caster_index_count) simplified++, whole += m->index_count / 3, simple += m->caster_index_count / 3;
   }
+  if (simplified)
+    lm_info("scene '%s': %d meshes simplified for shadow casters, %ld to %ld triangles (%.0f ms)", s->name, simplified,
+            whole, simple, lm_now_ms() - t0);
   s->uploaded = true;
   return true;
 }
@@ -626,14 +661,41 @@ bool lm_scene_node_culled(const lm_scene *s, int node, const float view_proj[16]
   return lm_scene_node_bounds(s, node, lo, hi) && box_outside(view_proj, lo, hi, pancake);
 }
 
-/* A visible mesh node, sorted so that nodes of one mesh and material lie together. */
-typedef struct drawn_node { int material, mesh, node; } drawn_node;
+/* A visible mesh node, sorted so that nodes of one mesh, material and
+ * simplification (lod 1: its caster copy) lie together. */
+typedef struct drawn_node { int material, mesh, lod, node; } drawn_node;
 
 static int drawn_node_order(const void *pa, const void *pb) {
   const drawn_node *a = pa, *b = pb;
   if (a->material != b->material) return a->material < b->material ? -1 : 1;
   if (a->mesh != b->mesh) return a->mesh < b->mesh ? -1 : 1;
+  if (a->lod != b->lod) return a->lod - b->lod;
   return (a->node > b->node) - (a->node < b->node);
+}
+
+/* Does node n (world bounds lo..hi) draw its mesh's simplified casters in
+ * d's shadow view? The copy's error times the node's largest axis scale,
+ * against the world size of the view's finer texel where the bounds come
+ * nearest the light: 2 w / (|row| * texels) for the x and y rows of
+ * lod_view_proj, w its clip w there (1 for an orthographic tile; a
+ * perspective one's texels grow with distance, and a node reaching behind
+ * the light is drawn whole). */
+static bool node_simplified(const lm_scene_draw_desc *d, const lm_node *n, const lm_scene_mesh *m, const float lo[3],
+                            const float hi[3]) {
+  if (!d->lod_view_proj || !(d->lod_texels > 0) || m->caster_index_count <= 0) return false;
+  const float *v = d->lod_view_proj, *w = n->world;
+  float scale = 0, w_near = v[15], radius = 0;
+  for (int c = 0; c < 3; c++) {
+    scale = fmaxf(scale, sqrtf(w[4 * c] * w[4 * c] + w[4 * c + 1] * w[4 * c + 1] + w[4 * c + 2] * w[4 * c + 2]));
+    w_near += v[4 * c + 3] * (lo[c] + hi[c]) / 2;
+    radius += (hi[c] - lo[c]) * (hi[c] - lo[c]) / 4;
+  }
+  w_near -= sqrtf(v[3] * v[3] + v[7] * v[7] + v[11] * v[11]) * sqrtf(radius);
+  float rows = fmaxf(sqrtf(v[0] * v[0] + v[4] * v[4] + v[8] * v[8]) * (float)d->lod_size[0],
+                     sqrtf(v[1] * v[1] + v[5] * v[5] + v[9] * v[9]) * (float)d->lod_size[1]);
+  if (!(w_near > 0) || !(rows > 0)) return false;
+  float texel = 2 * w_near / rows;
+  return isfinite(texel) && m->caster_error * scale <= d->lod_texels * texel;
 }
 
 /* Sets the material uniforms and textures of material m for program p. */
@@ -692,15 +754,13 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
     if (d->dynamic && d->layer && d->dynamic[i] != (d->layer == 2)) continue;
-    if (d->view_proj) {
-      float lo[3], hi[3];
-      world_bounds(n->world, s->meshes[n->mesh].bounds, lo, hi);
-      if (box_outside(d->view_proj, lo, hi, d->pancake)) {
-        if (stats) stats->culled++;
-        continue;
-      }
+    float lo[3] = {0}, hi[3] = {0};
+    if (d->view_proj || d->lod_view_proj) world_bounds(n->world, s->meshes[n->mesh].bounds, lo, hi);
+    if (d->view_proj && box_outside(d->view_proj, lo, hi, d->pancake)) {
+      if (stats) stats->culled++;
+      continue;
     }
-    nodes[count++] = (drawn_node){n->material, n->mesh, i};
+    nodes[count++] = (drawn_node){n->material, n->mesh, node_simplified(d, n, &s->meshes[n->mesh], lo, hi), i};
   }
   qsort(nodes, (size_t)count, sizeof *nodes, drawn_node_order);
   lm_instance *instances = lm_alloc(sizeof *instances * (size_t)(count > 0 ? count : 1));
@@ -714,7 +774,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
   bool ok = true;
   for (int first = 0, last; first < count && ok; first = last) {
     for (last = first + 1; last < count && nodes[last].material == nodes[first].material &&
-                           nodes[last].mesh == nodes[first].mesh;)
+                           nodes[last].mesh == nodes[first].mesh && nodes[last].lod == nodes[first].lod;)
       last++;
     const lm_node *n = &s->nodes[nodes[first].node];
     const lm_scene_mesh *mesh = &s->meshes[n->mesh];
@@ -740,9 +800,13 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
       snprintf(bound, sizeof bound, "%s", defines);
     }
     bind_material(s, p, &m, &mp, defines);
-    lm_mesh_draw_instances(&mesh->gpu, first, last - first);
-    if (stats)
-      stats->calls++, stats->drawn += last - first, stats->triangles += (long)(last - first) * (mesh->index_count / 3);
+    bool lod = nodes[first].lod;
+    int index_count = lod ? mesh->caster_index_count : mesh->index_count;
+    lm_mesh_draw_instances(&mesh->gpu, lod ? mesh->index_count : 0, index_count, first, last - first);
+    if (stats) {
+      stats->calls++, stats->drawn += last - first, stats->triangles += (long)(last - first) * (index_count / 3);
+      stats->simplified += lod ? last - first : 0;
+    }
   }
   free(nodes);
   return ok;

@@ -137,7 +137,18 @@ typedef struct lm_scene_mesh {
                               the skin's joints */
   float *joint_weights;    /* the same layout, normalized to sum 1 a vertex */
   bool dirty;              /* vertices (or prev_positions) changed since the last upload (lm_scene_upload_deformed) */
+  /* Shadow casters: a simplified copy made by lm_scene_upload (meshoptimizer's
+   * meshopt_simplify over positions alone, target error LM_CASTER_ERROR of the
+   * mesh's extent), caster_index_count indices stored after the mesh's own in
+   * its GPU index buffer; its surface lies within caster_error (local units,
+   * meshoptimizer's measure) of the mesh's. 0: none (a deformed mesh, one of
+   * fewer than LM_CASTER_MIN_TRIANGLES, or one that would lose under a quarter
+   * of its triangles). */
+  int caster_index_count;
+  float caster_error;
 } lm_scene_mesh;
+#define LM_CASTER_ERROR 0.01f       /* simplified casters' target error, a share of the mesh's extent */
+#define LM_CASTER_MIN_TRIANGLES 64  /* meshes below this are drawn whole in every tile */
 
 typedef struct lm_node {
   char name[LM_NAME_MAX];
@@ -375,6 +386,14 @@ typedef struct lm_scene_draw_desc {
    * and the moving casters drawn over it); layer 0 or dynamic NULL: all. */
   const bool *dynamic;
   int layer;
+  /* Shadow tiles: a node whose mesh has a simplified caster copy draws it
+   * when the copy's error, times the node's largest scale, is at most
+   * lod_texels texels of this view (lod_view_proj, lod_size texels wide and
+   * high) where the node's bounds come nearest the light. NULL or
+   * lod_texels 0: every mesh whole. */
+  const float *lod_view_proj;
+  int lod_size[2];
+  float lod_texels;
 } lm_scene_draw_desc;
 typedef struct lm_scene_draw_stats {
   int drawn, culled; /* mesh nodes drawn, and left out by the frustum test */
@@ -383,6 +402,7 @@ typedef struct lm_scene_draw_stats {
   int in_place;      /* of those, the ones still in the pass's outputs: neither cleared nor copied */
   int layered;       /* views drawn again over their kept static layer: only their moving casters drawn */
   long triangles;    /* triangles drawn */
+  int simplified;    /* of drawn, nodes drawn with their simplified caster copy */
 } lm_scene_draw_stats;
 /* Draws every mesh node whose bounds reach into the frustum, the nodes of one
  * mesh and material in one instanced draw (each node's matrices in the

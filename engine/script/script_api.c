@@ -169,7 +169,7 @@ static float opt_number(lua_State *L, int idx, const char *field, float def, flo
 }
 
 /* shadow_plan{ technique, resolution, c, blur, cascades, lambda, bias, distance,
- * blend, radius, stabilize, size, penumbra, rsm, rsm_resolution, cache, coverage }: tiles for every light that casts shadows, or nil
+ * blend, radius, stabilize, size, penumbra, rsm, rsm_resolution, cache, coverage, simplify }: tiles for every light that casts shadows, or nil
  * when none does. scene{ views = plan } draws them; scene{ views = plan, fit =
  * T } first fits them to the camera depths T's first texel holds (min in r,
  * max in g, as depth / far). */
@@ -181,7 +181,7 @@ static int l_shadow_plan(lua_State *L) {
   luaL_checktype(L, 1, LUA_TTABLE);
   static const char *const fields[] = {"technique", "resolution", "c", "blur", "cascades", "lambda",
                                        "bias", "distance", "blend", "radius", "stabilize", "size",
-                                       "penumbra", "rsm", "rsm_resolution", "cache", "coverage", NULL};
+                                       "penumbra", "rsm", "rsm_resolution", "cache", "coverage", "simplify", NULL};
   check_fields(L, 1, "shadow_plan", fields);
   lm_shadow_settings st;
   lm_shadow_settings_default(&st);
@@ -203,6 +203,7 @@ static int l_shadow_plan(lua_State *L) {
   st.radius = opt_number(L, 1, "radius", st.radius, 0, 32, what);
   st.size = opt_number(L, 1, "size", st.size, -1, 1e30f, what);
   st.penumbra = opt_number(L, 1, "penumbra", st.penumbra, 1, 64, what);
+  st.simplify = opt_number(L, 1, "simplify", st.simplify, 0, 64, what);
   lua_getfield(L, 1, "stabilize");
   if (!lua_isnil(L, -1)) st.stabilize = lua_toboolean(L, -1);
   lua_pop(L, 1);

@@ -19,7 +19,7 @@ void lm_shadow_settings_default(lm_shadow_settings *s) {
   *s = (lm_shadow_settings){.technique = LM_SHADOW_ESM, .resolution = 512, .c = 16.0f, .blur = 0,
                             .cascades = 3, .lambda = 0.75f, .distance = 0.0f,
                             .blend = 0.1f, .radius = 2.5f, .stabilize = true, .cache = true, .coverage = true,
-                            .size = -1.0f, .penumbra = 16.0f, .rsm_resolution = 8192};
+                            .size = -1.0f, .penumbra = 16.0f, .rsm_resolution = 8192, .simplify = 0.5f};
   s->bias = 1.0f; /* texels; the seed has 0: lit slanted surfaces then lose 1-2% to ESM */
 }
 

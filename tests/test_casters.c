@@ -1,0 +1,191 @@
+/* Shadow casters at scale: nodes placed by EXT_mesh_gpu_instancing draw as
+ * the same nodes written one by one (the G-buffer, the shadow atlas and the
+ * image), and simplified casters (meshoptimizer, lm_scene_mesh.caster_*)
+ * draw fewer triangles into the shadow tiles and leave the image within a
+ * stated error of the whole meshes'. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <cglm/cglm.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl_test.h"
+#include "scene/gltf.h"
+
+static lm_scene *load(const char *name) {
+  char path[1024];
+  snprintf(path, sizeof path, "%s/../data/scenes/big/%s", LIMN_TEST_DIR, name);
+  lm_error err;
+  lm_scene *s = lm_scene_load_gltf(path, &err);
+  if (!s) fail_msg("%s", err.msg);
+  return s;
+}
+
+/* Mean |a - b| over a target of both runs, against b's mean |value|; max |a - b| in *worst. */
+static double target_diff(gl_result *a, gl_result *b, const char *name, double *worst) {
+  int wa, ha, wb, hb;
+  float *ta = gl_read_target(a, name, &wa, &ha), *tb = gl_read_target(b, name, &wb, &hb);
+  if (!ta || !tb) fail_msg("no target %s", name);
+  assert_int_equal(wa, wb);
+  assert_int_equal(ha, hb);
+  double diff = 0, mean = 0;
+  *worst = 0;
+  for (size_t i = 0; i < (size_t)wa * ha * 4; i++) {
+    double d = fabs((double)ta[i] - tb[i]);
+    diff += d, mean += fabs((double)tb[i]), *worst = fmax(*worst, d);
+  }
+  free(ta), free(tb);
+  return mean > 0 ? diff / mean : diff;
+}
+
+/* big_small: 64 spheres as 64 nodes of four meshes; big_small_instanced: the
+ * same spheres as four nodes carrying EXT_mesh_gpu_instancing. The loader
+ * makes each instance a child node, so both draw the spheres in one call a
+ * mesh. Tolerance: the node form's transforms went through JSON at 6
+ * significant digits, the instanced one's are the floats themselves, so
+ * positions differ by up to ~1e-5 of a unit: a pixel on an edge may flip.
+ * Mean difference at most 1e-4 of the mean value in each target, and in
+ * the image. */
+static void instanced_nodes_render_as_the_nodes(void **state) {
+  (void)state;
+  lm_scene *nodes = load("big_small.glb"), *instanced = load("big_small_instanced.glb");
+  int spheres = 0;
+  for (int i = 0; i < instanced->node_count; i++) spheres += instanced->nodes[i].parent >= 0 && instanced->nodes[i].mesh >= 0;
+  assert_int_equal(spheres, 64);
+  const char *sets[] = {"shadow.simplify=0", NULL}; /* the instancing alone */
+  gl_result a = gl_render_ok(&(gl_run){.scene = instanced, .tech = "dl+esm", .sets = sets, .width = 128, .height = 96});
+  gl_result b = gl_render_ok(&(gl_run){.scene = nodes, .tech = "dl+esm", .sets = sets, .width = 128, .height = 96});
+  lm_scene_draw_stats sa = lm_renderer_draw_stats(a.renderer), sb = lm_renderer_draw_stats(b.renderer);
+  lm_scene_draw_stats ha = lm_renderer_shadow_draw_stats(a.renderer), hb = lm_renderer_shadow_draw_stats(b.renderer);
+  print_message("camera: %d nodes in %d calls (instanced) and %d in %d; shadow tiles: %d in %d and %d in %d\n",
+                sa.drawn, sa.calls, sb.drawn, sb.calls, ha.drawn, ha.calls, hb.drawn, hb.calls);
+  assert_int_equal(sa.drawn, sb.drawn);
+  assert_int_equal(sa.triangles, sb.triangles);
+  assert_int_equal(sa.calls, sb.calls); /* at most one a mesh either way */
+  assert_true(sa.calls <= 5);
+  assert_int_equal(ha.triangles, hb.triangles);
+  assert_true(ha.drawn > 64);
+  static const char *const targets[] = {"gbuffer.clr", "gbuffer.nrm", "gbuffer.dpt", "shadow.map"};
+  for (size_t t = 0; t < sizeof targets / sizeof targets[0]; t++) {
+    double worst, d = target_diff(&a, &b, targets[t], &worst);
+    print_message("%-12s mean difference %.2g of the mean, largest %.3g\n", targets[t], d, worst);
+    assert_true(d <= 1e-4);
+  }
+  int n = a.width * a.height * 3;
+  double mean = 0;
+  for (int i = 0; i < n; i++) mean += b.rgb[i];
+  mean /= n;
+  double d = gl_mean_abs_diff(a.rgb, b.rgb, n) / mean;
+  print_message("image        mean difference %.2g of the mean\n", d);
+  assert_true(mean > 0.05 && d <= 1e-4);
+  gl_result_free(&a), gl_result_free(&b);
+  lm_scene_destroy(nodes), lm_scene_destroy(instanced);
+}
+
+/* A node of mesh `mesh` and material `mat` at (x, y, z). */
+static void sphere(lm_scene *s, int mesh, int mat, float x, float y, float z) {
+  mat4 m;
+  glm_translate_make(m, (vec3){x, y, z});
+  lm_scene_add_node(s, "ball", -1, (float *)m, mesh, mat);
+}
+
+/* A UV sphere of radius r, seg x rings quads (a seam of doubled vertices, as exporters write). */
+static int sphere_mesh(lm_scene *s, float r, int seg, int rings) {
+  int nv = (seg + 1) * (rings + 1), ni = seg * rings * 6, k = 0;
+  float *v = malloc(sizeof(float) * 8 * (size_t)nv);
+  uint32_t *ix = malloc(sizeof(uint32_t) * (size_t)ni);
+  for (int j = 0; j <= rings; j++)
+    for (int i = 0; i <= seg; i++) {
+      float t = GLM_PIf * (float)j / (float)rings, p = 2 * GLM_PIf * (float)i / (float)seg;
+      float n[3] = {sinf(t) * cosf(p), cosf(t), sinf(t) * sinf(p)}, *o = v + 8 * (j * (seg + 1) + i);
+      o[0] = r * n[0], o[1] = r * n[1], o[2] = r * n[2], o[3] = n[0], o[4] = n[1], o[5] = n[2];
+      o[6] = (float)i / (float)seg, o[7] = (float)j / (float)rings;
+    }
+  for (int j = 0; j < rings; j++)
+    for (int i = 0; i < seg; i++) {
+      uint32_t a = (uint32_t)(j * (seg + 1) + i), b = a + (uint32_t)seg + 1;
+      uint32_t q[6] = {a, a + 1, b + 1, a, b + 1, b};
+      memcpy(ix + k, q, sizeof q), k += 6;
+    }
+  int id = lm_scene_add_mesh(s, "sphere", v, nv, ix, ni);
+  free(v), free(ix);
+  return id;
+}
+
+/* Nine finely cut spheres (64 x 32 quads) on a floor under a sun and a point
+ * light, seen from above at 45 degrees. */
+static lm_scene *spheres_scene(void) {
+  lm_scene *s = lm_scene_create("spheres");
+  int floor = gl_material(s, "floor", 0.7f, 0.7f, 0.7f), paint = gl_material(s, "paint", 0.8f, 0.3f, 0.2f);
+  gl_quad(s, "floor", floor, (const float[4][3]){{-8, 0, 8}, {8, 0, 8}, {8, 0, -8}, {-8, 0, -8}}, (const float[3]){0, 1, 0});
+  int mesh = sphere_mesh(s, 0.6f, 64, 32);
+  for (int k = 0; k < 9; k++) sphere(s, mesh, paint, 2.0f * (float)(k % 3 - 1), 0.6f, 2.0f * (float)(k / 3 - 1));
+  float w[16];
+  lm_camera_look_at((float[]){-3, -4, -2}, (float[]){0, 0, 0}, w); /* the sun shines along (3, -4, 2) */
+  for (int c = 0; c < 3; c++) w[12 + c] = 0;
+  int sun = lm_scene_add_node(s, "sun", -1, w, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 1,
+                                    .casts_shadows = true, .node = sun});
+  float at[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 1.0f, 3, 1.0f, 1};
+  int lamp = lm_scene_add_node(s, "lamp", -1, at, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "lamp", .type = LM_LIGHT_POINT, .color = {1, 0.9f, 0.8f}, .power = 2,
+                                    .radius = 12, .casts_shadows = true, .node = lamp});
+  lm_camera_look_at((float[]){0, 7, 7}, (float[]){0, 0, 0}, w);
+  int cam = lm_scene_add_node(s, "camera", -1, w, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "view", .fov_y = glm_rad(50.0f), .znear = 0.1f, .zfar = 40, .node = cam});
+  lm_scene_update(s);
+  return s;
+}
+
+/* Simplified casters: the sphere's copy has at least a quarter fewer
+ * triangles and errs by at most LM_CASTER_ERROR of its extent;
+ * with shadow.simplify at its default (0.5 texel) the tiles whose texels
+ * hide that error draw it, and the image stays within 0.5% (mean absolute
+ * difference over the mean) of the one with every caster whole
+ * (shadow.simplify=0); tiles of 128 texels make the copy's error small
+ * against a texel, as far cascades and small tiles are. */
+static void simplified_casters_keep_the_shadows(void **state) {
+  (void)state;
+  lm_scene *s = spheres_scene();
+  const char *whole_sets[] = {"shadow.resolution=128", "shadow.simplify=0", "ambient=0.05", NULL};
+  const char *simple_sets[] = {"shadow.resolution=128", "ambient=0.05", NULL};
+  gl_result whole = gl_render_ok(&(gl_run){.scene = s, .tech = "dl+esm", .sets = whole_sets, .width = 128, .height = 96});
+  const lm_scene_mesh *m = &s->meshes[1];
+  float extent = 0;
+  for (int k = 0; k < 3; k++) extent = fmaxf(extent, m->bounds[1][k] - m->bounds[0][k]);
+  print_message("sphere: %d triangles, its caster copy %d, error %.4g (%.3g%% of its extent)\n", m->index_count / 3,
+                m->caster_index_count / 3, (double)m->caster_error, 100.0 * m->caster_error / extent);
+  assert_true(m->caster_index_count > 0 && m->caster_index_count <= m->index_count * 3 / 4);
+  assert_true(m->caster_error >= 0 && m->caster_error <= LM_CASTER_ERROR * extent * 1.001f);
+  assert_int_equal(s->meshes[0].caster_index_count, 0); /* the floor: two triangles, drawn whole */
+  lm_scene_draw_stats sw = lm_renderer_shadow_draw_stats(whole.renderer);
+  gl_result simple = gl_render_ok(&(gl_run){.scene = s, .tech = "dl+esm", .sets = simple_sets, .width = 128, .height = 96});
+  lm_scene_draw_stats ss = lm_renderer_shadow_draw_stats(simple.renderer);
+  print_message("shadow tiles: %ld triangles whole, %ld with %d of %d nodes simplified\n", sw.triangles, ss.triangles,
+                ss.simplified, ss.drawn);
+  assert_int_equal(sw.simplified, 0);
+  assert_int_equal(sw.drawn, ss.drawn);
+  assert_true(ss.simplified > 0 && ss.triangles < sw.triangles);
+  int n = whole.width * whole.height * 3;
+  double mean = 0, worst = 0;
+  for (int i = 0; i < n; i++) mean += whole.rgb[i], worst = fmax(worst, fabs(whole.rgb[i] - simple.rgb[i]));
+  mean /= n;
+  double d = gl_mean_abs_diff(whole.rgb, simple.rgb, n) / mean;
+  print_message("image: mean difference %.3g%% of the mean (%.3g), largest %.3g\n", 100 * d, mean, worst);
+  assert_true(mean > 0.05 && d <= 0.005);
+  gl_result_free(&whole), gl_result_free(&simple);
+  lm_scene_destroy(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(instanced_nodes_render_as_the_nodes),
+      cmocka_unit_test(simplified_casters_keep_the_shadows),
+  };
+  return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
+}
