@@ -123,7 +123,8 @@ function rsm.indirect(G, shadows, R, o)
     if temporal.settled(o.temporal) then return { C = C, E = kept.value, k = o.k } end
   end
   local E, history = rsm.gather(C, f, R, shadows, o, kept)
-  return { C = C, E = isr.blur(E, C, f, o.blur, history and history.state, kept and kept.value), k = o.k }
+  return { C = C, E = isr.blur(E, C, f, o.blur, history and history.state, kept and kept.value, o.temporal.narrow),
+           k = o.k }
 end
 
 return rsm

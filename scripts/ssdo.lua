@@ -109,7 +109,7 @@ function ssdo.render(G, lit, o, light)
               defines = { BOUNCE = true, ADAPTIVE = o.adaptive },
               out = target{ "ssdo.indirect", format = "rgba16f" } }
   end
-  a, b = filters.smooth({ a, b }, G, o, "ssdo", "rgba16f", f, history and history.state)
+  a, b = filters.smooth({ a, b }, G, o, "ssdo", "rgba16f", f, history and history.state, o.temporal.narrow)
   local inputs_, params_, defines = { lit = lit, clr = G.clr, mat = G.mat, a = a, b = b }, { ambient = light.ambient },
     { PHYSICAL = physical, MERGED = merged, TWO_STEP = o.variant == "two_step" }
   sky.bind(light.sky, params_, defines, inputs_, G)

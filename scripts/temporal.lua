@@ -44,6 +44,11 @@ temporal.defaults = {
                     -- at once; the history then only saves work). RSM's light does not depend on the view:
                     -- "moving" turns it while anything moves. isr.temporal's default is "moving" (the door
                     -- sequence, docs/motion.md)
+  narrow = 0.25,    -- the GI blur's reach for a pixel whose history holds n frames: blur / n^narrow,
+                    -- 0..1 (0: the full blur at any age; 1/4: a converged pixel of 36 frames keeps
+                    -- 2/5 of it, less blur where the noise averaged out). isr.temporal's is 0 (the door
+                    -- sequence, docs/motion.md: the narrowing blur changed the image each frame as
+                    -- the history grew, flicker)
   skip = true,      -- a settled frame (the world and settings unchanged for `frames` frames: every
                     -- pixel converged) keeps the last result and runs none of the GI passes (ISR's,
                     -- RSM's, SSDO's; false: they run, each pixel keeping its history)
@@ -58,6 +63,7 @@ local rules = {
   refresh = options.whole(0, 1024),
   moving = options.number(0, 1024),
   turn = options.one_of("always", "moving"),
+  narrow = options.number(0, 1),
   skip = options.boolean,
   velocity = options.boolean,
 }

@@ -29,7 +29,9 @@ uniform float moving = 0.0; // > 0: a view-dependent result's most frames while 
 uniform int world_moved = 0; // 1: something in the world (a caster, a light) changed since the last frame
 uniform int view_dependent = 0; // 1: the result depends on the view (ISR, SSDO), so a moving view caps it too
 uniform int turn = 1; // 1: the pass's pattern turns every frame; 0: only while the view moves (temporal.turn)
-uniform int gather_turns = 0; // 1: another gather in the pass turns every frame (isr+rsm+esm's RSM)
+uniform int gather_turns = 0; // 1: another gather in the pass turns every frame (isr+rsm+esm's RSM): the
+                              // history averages anyway, so the pass's own pattern turns too (kept, a
+                              // fixed pattern would lose the blur it needs as the history grows)
 #ifdef VELOCITY
 // The G-buffer's velocity target (velocity.glsl): a pixel whose surface moved
 // on its own (a = 2) reprojects along its motion, to the view depth it had.
@@ -65,7 +67,7 @@ bool temporal_moving() {
 // off's, without the flicker of a running mean that moves by its noise each
 // frame until it converges. A moving view turns it: the reprojected history
 // then holds other samples of the same surface.
-bool temporal_turning() { return turn != 0 || frame.view_proj != frame.prev_view_proj; }
+bool temporal_turning() { return turn != 0 || gather_turns != 0 || frame.view_proj != frame.prev_view_proj; }
 int temporal_turn() { return temporal_turning() ? int(uint(frame.time.y) & 65535u) : 0; }
 
 // The history of the pixel at uv whose coarse depth is d (dpt): the

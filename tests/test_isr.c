@@ -138,6 +138,8 @@ static void bad_options_name_themselves(void **state) {
       {"isr", "isr.k=-1", "isr.k must be a finite number in 0..16 (got -1)"},
       {"isr", "ambient=-1", "ambient must be a finite number in 0..1e+06 (got -1)"},
       {"isr", "isr.temporal.frames=0", "isr.temporal.frames must be"},
+      {"isr", "isr.temporal.turn=never", "isr.temporal.turn must be one of always, moving (got never)"},
+      {"isr", "isr.temporal.narrow=2", "isr.temporal.narrow must be a finite number in 0..1 (got 2)"},
   };
   gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
 }
