@@ -357,9 +357,9 @@ static void a_light_change_reaches_converged_pixels_at_once(void **state) {
  * bound of the image's mean, edges (ceiling and walls, the lit patch)
  * included, where a ghost trail would show the old ones: reprojection keeps
  * what is still seen, the disocclusion test drops what was not. Measured
- * (bound): rsm+esm 0.50% (0.7%; 0.87% at rsm.temporal.epsilon = 1, which
- * keeps the ghost), isr+rsm+esm with isr.temporal 0.44% (0.6%), isr+esm
- * 1.02% (1.5%): ISR's light at a point depends on what the screen shows,
+ * (bound): rsm+esm 0.52% (0.7%; 0.87% at rsm.temporal.epsilon = 1, which
+ * keeps the ghost), isr+rsm+esm with isr.temporal 0.34% (0.6%), isr+esm
+ * 0.67% (1.5%): ISR's light at a point depends on what the screen shows,
  * and a reprojected pixel holds the old view's estimate, which the new
  * frames replace as they accumulate, the history capped at
  * isr.temporal.moving frames while the view changes (1.20% without the
@@ -432,8 +432,8 @@ static void place_camera(lm_scene *s, float x) {
  * always, so that the history converged) and a slide of 12 frames, the last
  * differs from 40 still frames at the new place by less than with the cap
  * off (moving = 0).
- * Measured: isr+esm 1.18% of the image's mean against 2.44%, ssdo+esm
- * 0.32% against 0.65%. */
+ * Measured: isr+esm 0.92% of the image's mean against 2.35% (isr.temporal.
+ * moving 3), ssdo+esm 0.32% against 0.65%. */
 static void a_moving_camera_keeps_screen_space_light_current(void **state) {
   (void)state;
   static const struct { const char *tech, *on, *turn, *off; } cases[] = {
