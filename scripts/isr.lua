@@ -292,9 +292,9 @@ end
 -- G-buffer C (a copy, or a view with its depth z: passes "<user>.blur_x"
 -- and _y) that skips background and does not cross depth edges. age
 -- (optional): temporal reuse's history state (g: the frames a pixel holds,
--- temporal.bind), whose pixels of n frames take radius / n^(1/4) taps
--- (blur.frag): a new pixel is blurred in full, a converged one a little;
--- narrow: that exponent (temporal.narrow; 0: the full blur at any age).
+-- temporal.bind), whose pixels of n frames take a reach of radius / n^narrow
+-- (blur.frag; temporal.narrow, 0: the full blur at any age): a new pixel is
+-- blurred in full, a converged one a little.
 -- out (optional): the target the last pass writes.
 function isr.blur(E, C, f, radius, age, out, narrow)
   if radius == 0 then return E end

@@ -11,7 +11,8 @@
 -- state (r: view depth, 0 none; g: the frames it holds); the viewer's reload
 -- keeps them by name, format and size. The GI pass turns its sampling
 -- pattern each frame (rsm.rotate, ISR's next rays of its sequence) so the
--- accumulation averages different samples.
+-- accumulation averages different samples, or only while the view moves
+-- (the `turn` option; temporal.glsl's temporal_turn).
 local options = require "options"
 
 local temporal = {}
