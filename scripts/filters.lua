@@ -43,9 +43,9 @@ local function list_of(src)
 end
 
 -- Blurs src (a target or {a, b}) at 1/o.factor of G's size.
--- o = { name =, format =, factor = 1, blur =, sigma_space =, sigma_depth =, sigma_normal =, age = }
+-- o = { name =, format =, factor = 1, blur =, sigma_space =, sigma_depth =, sigma_normal =, age =, narrow = }
 -- age (optional): temporal reuse's history state at that size, whose
--- pixels of n frames take fewer taps (bilateral.frag's AGE).
+-- pixels of n frames take fewer taps (bilateral.frag's AGE): n^-narrow of them.
 function filters.blur(src, G, o)
   local list, f = list_of(src), o.factor or 1
   if o.blur <= 1 then return table.unpack(list) end
@@ -57,7 +57,8 @@ function filters.blur(src, G, o)
     pass{ name, shader = "bilateral.frag",
           inputs = { src = list[1], src2 = list[2], nrm = G.nrm, dpt = G.dpt, mat = G.mat, age = o.age },
           params = { axis = axis[2], radius = (o.blur - 1) // 2, sigma_space = o.sigma_space,
-                     sigma_depth = o.sigma_depth, sigma_normal = o.sigma_normal, factor = f },
+                     sigma_depth = o.sigma_depth, sigma_normal = o.sigma_normal, factor = f,
+                     narrow = o.age and o.narrow or nil },
           defines = { PAIR = #list == 2, AGE = o.age ~= nil }, out = outs }
     list = outs
   end
@@ -79,11 +80,12 @@ end
 
 -- Blurs src (a target or {a, b}) at 1/factor of G's size and brings it to
 -- full size, with the filter fields of an effect's checked options o; age
--- as filters.blur's. Passes and targets are named "<prefix>.blur_x" ...
+-- and narrow as filters.blur's. Passes and targets are named "<prefix>.blur_x" ...
 -- and "<prefix>.upsample".
-function filters.smooth(src, G, o, prefix, format, factor, age)
+function filters.smooth(src, G, o, prefix, format, factor, age, narrow)
   local fo = { name = prefix .. ".blur", format = format, factor = factor, blur = o.blur,
-               sigma_space = o.sigma_space, sigma_depth = o.sigma_depth, sigma_normal = o.sigma_normal, age = age }
+               sigma_space = o.sigma_space, sigma_depth = o.sigma_depth, sigma_normal = o.sigma_normal, age = age,
+               narrow = narrow }
   local blurred = { filters.blur(src, G, fo) }
   fo.name = prefix .. ".upsample"
   return filters.upsample(blurred, G, fo)

@@ -53,7 +53,8 @@ isr.defaults = {
                      -- in every view of the reference set (4: 14 of 15)
   view = "lit",      -- "lit"; "indirect" (the indirect light) or "ao" (accessibility) to inspect
   temporal = {},     -- temporal reuse (scripts/temporal.lua), physical mode: enabled, frames, epsilon,
-                     -- bias, confidence, refresh; with it a converged pixel's blur shrinks as rsm's
+                     -- bias, confidence, refresh, moving, turn, narrow, ...; its defaults here differ
+                     -- in turn, moving and narrow (below)
   seed = {           -- mode "seed": the dissertation's parameters
     samples = 48,      -- N samples a pixel, 1..256 (the seed timed 48; 80 after its fig 5.7)
     radius = 0.5,      -- sampling disc radius in world units, > 0
@@ -65,6 +66,13 @@ isr.defaults = {
 }
 
 for k, v in pairs(temporal.defaults) do isr.defaults.temporal[k] = v end
+-- A still view keeps reuse off's pattern: on the door sequence (docs/motion.md) the turning pattern's
+-- running mean flickered by its noise on every still frame and converged further from POV-Ray than
+-- the fixed pattern (0.0491 against 0.0472 at the open door).
+isr.defaults.temporal.turn = "moving"
+-- isr+rsm+esm (whose RSM turns every frame, and its rays with it) on the door sequence: 0.01131 mean
+-- error, 0.002267 flicker, lag 0 against reuse off's 0.01179, 0.002365; at moving 4 and narrow 1/4 lag 5.
+isr.defaults.temporal.moving, isr.defaults.temporal.narrow = 3, 0
 
 local views = { lit = 0, indirect = 1, ao = 2 }
 
@@ -219,7 +227,7 @@ function isr.render(G, direct, o, light)
   -- Temporal reuse: every step reads the history (all skip the same converged pixels), the last
   -- accumulates and writes the next one after its other outputs (NEXT).
   local T, history = { inputs = {}, defines = {}, params = {} }, nil
-  if not seed then history = temporal.bind("isr", T.inputs, T.defines, T.params, o.temporal, f) end
+  if not seed then history = temporal.bind("isr", T.inputs, T.defines, T.params, o.temporal, f, light.rsm ~= nil) end
   local function with_history(inputs, defines, params, out, last)
     if not history then return end
     for k, v in pairs(T.inputs) do inputs[k] = v end
@@ -276,7 +284,7 @@ function isr.render(G, direct, o, light)
             fetches = fetches }
     end
   end
-  E = isr.blur(E, C, f, o.blur, history and history.state, kept and kept.value)
+  E = isr.blur(E, C, f, o.blur, history and history.state, kept and kept.value, o.temporal.narrow)
   return isr.composite(G, direct, C, E, params, seed ~= nil, light.sky)
 end
 
@@ -284,17 +292,18 @@ end
 -- G-buffer C (a copy, or a view with its depth z: passes "<user>.blur_x"
 -- and _y) that skips background and does not cross depth edges. age
 -- (optional): temporal reuse's history state (g: the frames a pixel holds,
--- temporal.bind), whose pixels of n frames take radius / n^(1/4) taps
--- (blur.frag): a new pixel is blurred in full, a converged one a little.
+-- temporal.bind), whose pixels of n frames take a reach of radius / n^narrow
+-- (blur.frag; temporal.narrow, 0: the full blur at any age): a new pixel is
+-- blurred in full, a converged one a little.
 -- out (optional): the target the last pass writes.
-function isr.blur(E, C, f, radius, age, out)
+function isr.blur(E, C, f, radius, age, out, narrow)
   if radius == 0 then return E end
   local mask = not C.z and C.mat or nil -- a view's depth is its mask too
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
     local name = (C.user or "isr") .. ".blur_" .. axis[1]
     E = pass{ name, shader = "blur.frag",
               inputs = { src = E, mask = mask, depth = C.z or C.dpt, age = age },
-              params = { axis = axis[2], radius = radius },
+              params = { axis = axis[2], radius = radius, narrow = age and narrow or nil },
               defines = { MASK = mask ~= nil, DEPTH = true, AGE = age ~= nil },
               out = axis[1] == "y" and out or coarse_target(name, f) }
   end

@@ -89,10 +89,10 @@ local rules = { ambient = options.number(0, 1e6), background = options.number(0,
 
 function OnCreate()
   post.create()
-  temporal.create("rsm", { 1, 2, 3, 4 })       -- rsm.temporal's, at each coarse factor (one is made)
+  temporal.create("rsm", { 1, 2, 3, 4 }, { keep = true }) -- rsm.temporal's, at each coarse factor (one is made)
   temporal.create("isr", { 1, 2, 3, 4 }, { view = true, keep = true }) -- isr.temporal's, at each coarse
                                                                        -- factor (one is made)
-  temporal.create("ssdo", { 1, 2, 4 }, { view = true })                -- ssdo.temporal's, at each resolution
+  temporal.create("ssdo", { 1, 2, 4 }, { view = true, keep = "output" }) -- ssdo.temporal's, at each resolution
 end
 
 function OnRender(tech)

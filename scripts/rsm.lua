@@ -95,11 +95,12 @@ end
 -- whose depth it writes, from the RSM targets R (shadow.render's second
 -- result) and the atlas `shadows`. Returns the coarse E and, with temporal
 -- reuse, the history it wrote (temporal.bind).
-function rsm.gather(C, f, R, shadows, o)
+function rsm.gather(C, f, R, shadows, o, kept)
   local inputs, defines, params = gbuffer.inputs(C), { STRIDE = C.stride, Z = true }, {}
-  local fetches = rsm.bind(inputs, defines, params, R, shadows, o, f, o.temporal.enabled)
+  local turning = o.temporal.enabled and (o.temporal.turn == "always" or still_frames() == 0)
+  local fetches = rsm.bind(inputs, defines, params, R, shadows, o, f, turning)
   local history = temporal.bind("rsm", inputs, defines, params, o.temporal, f)
-  local E = target{ "rsm.e", format = "rgba16f", scale = 1 / f }
+  local E = kept and o.blur == 0 and kept.value or target{ "rsm.e", format = "rgba16f", scale = 1 / f }
   pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines, params = params,
         fetches = 4 + fetches, out = { E, C.z, history and history.value, history and history.state } }
   return E, history
@@ -110,11 +111,20 @@ end
 -- over a coarse view of G (no pass averages its blocks first), temporal
 -- reuse and the blur. Returns what the direct pass adds (pp.lua's direct:
 -- INDIRECT in direct.frag): { C = the coarse grid, E = the coarse result, k }.
+-- With temporal reuse the blurred E and the grid's depth are kept
+-- (temporal.kept, as ISR's); a settled frame (temporal.settled) returns
+-- them and records neither the gather nor the blur.
 function rsm.indirect(G, shadows, R, o)
   local f = o.coarse
   local C = isr.coarse_view(G, nil, f, "rsm")
-  local E, history = rsm.gather(C, f, R, shadows, o)
-  return { C = C, E = isr.blur(E, C, f, o.blur, history and history.state), k = o.k }
+  local kept = o.temporal.enabled and temporal.kept("rsm", f) or nil
+  if kept then
+    C.z = kept.z
+    if temporal.settled(o.temporal) then return { C = C, E = kept.value, k = o.k } end
+  end
+  local E, history = rsm.gather(C, f, R, shadows, o, kept)
+  return { C = C, E = isr.blur(E, C, f, o.blur, history and history.state, kept and kept.value, o.temporal.narrow),
+           k = o.k }
 end
 
 return rsm

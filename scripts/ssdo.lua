@@ -68,7 +68,8 @@ filters.expose(ssdo.defaults, rules)
 
 -- Records SSDO for G lit by `lit` (direct light, no ambient term) with
 -- options o (see ssdo.defaults) and light = { ambient = {r, g, b} }.
--- Returns the result, a full-size rgba16f target "ssdo.lit".
+-- Returns the result, a full-size rgba16f target "ssdo.lit" (with temporal reuse the kept one,
+-- temporal.kept).
 function ssdo.render(G, lit, o, light)
   o = options.check("ssdo", ssdo.defaults, o, rules, 2)
   o.temporal = temporal.check("ssdo.temporal", o.temporal)
@@ -86,6 +87,10 @@ function ssdo.render(G, lit, o, light)
     t.sender, t.edges = sender, edges
     return t
   end
+  -- With temporal reuse the composite is kept (temporal.kept); a settled frame (temporal.settled: the
+  -- world and settings unchanged, every pixel converged) returns it without recording SSDO's passes.
+  local kept = physical and o.temporal.enabled and temporal.kept("ssdo", f) or nil
+  if kept and temporal.settled(o.temporal) then return kept.value end
   local a, b, history
   if merged or physical then
     a = target{ "ssdo.m", format = "rgba16f", scale = 1 / f }
@@ -104,12 +109,12 @@ function ssdo.render(G, lit, o, light)
               defines = { BOUNCE = true, ADAPTIVE = o.adaptive },
               out = target{ "ssdo.indirect", format = "rgba16f" } }
   end
-  a, b = filters.smooth({ a, b }, G, o, "ssdo", "rgba16f", f, history and history.state)
+  a, b = filters.smooth({ a, b }, G, o, "ssdo", "rgba16f", f, history and history.state, o.temporal.narrow)
   local inputs_, params_, defines = { lit = lit, clr = G.clr, mat = G.mat, a = a, b = b }, { ambient = light.ambient },
     { PHYSICAL = physical, MERGED = merged, TWO_STEP = o.variant == "two_step" }
   sky.bind(light.sky, params_, defines, inputs_, G)
   return pass{ "ssdo.apply", shader = "gi_apply.frag", inputs = inputs_, params = params_, defines = defines,
-               out = target{ "ssdo.lit", format = "rgba16f" } }
+               out = kept and kept.value or target{ "ssdo.lit", format = "rgba16f" } }
 end
 
 return ssdo

@@ -11,7 +11,8 @@
 -- state (r: view depth, 0 none; g: the frames it holds); the viewer's reload
 -- keeps them by name, format and size. The GI pass turns its sampling
 -- pattern each frame (rsm.rotate, ISR's next rays of its sequence) so the
--- accumulation averages different samples.
+-- accumulation averages different samples, or only while the view moves
+-- (the `turn` option; temporal.glsl's temporal_turn).
 local options = require "options"
 
 local temporal = {}
@@ -37,9 +38,21 @@ temporal.defaults = {
   velocity = true,  -- reproject a surface that moved on its own (a node, a deformed mesh) along the
                     -- G-buffer's velocity target, to its depth then (false: through the previous
                     -- camera alone, as if the world stood still)
+  turn = "always",  -- "always": the sampling pattern turns every frame, so that a still view's history
+                    -- averages ever more samples (less noise; each frame differs from the last by that
+                    -- noise until it converges); "moving": only while the view moves (a still view keeps
+                    -- the pattern reuse off takes: its image is reuse off's, and a change of the world shows
+                    -- at once; the history then only saves work). RSM's light does not depend on the view:
+                    -- "moving" turns it while anything moves. isr.temporal's default is "moving" (the door
+                    -- sequence, docs/motion.md)
+  narrow = 0.25,    -- the GI blur's reach for a pixel whose history holds n frames: blur / n^narrow,
+                    -- 0..1 (0: the full blur at any age; 1/4: a converged pixel of 36 frames keeps
+                    -- 2/5 of it, less blur where the noise averaged out). isr.temporal's is 0 (the door
+                    -- sequence, docs/motion.md: the narrowing blur changed the image each frame as
+                    -- the history grew, flicker)
   skip = true,      -- a settled frame (the world and settings unchanged for `frames` frames: every
-                    -- pixel converged) keeps the last result and runs none of the GI passes (ISR's;
-                    -- false: they run, each pixel keeping its history)
+                    -- pixel converged) keeps the last result and runs none of the GI passes (ISR's,
+                    -- RSM's, SSDO's; false: they run, each pixel keeping its history)
 }
 
 local rules = {
@@ -50,6 +63,8 @@ local rules = {
   confidence = options.number(0, 1),
   refresh = options.whole(0, 1024),
   moving = options.number(0, 1024),
+  turn = options.one_of("always", "moving"),
+  narrow = options.number(0, 1),
   skip = options.boolean,
   velocity = options.boolean,
 }
@@ -117,7 +132,9 @@ function temporal.settled(o) return o.enabled and o.skip and quiet >= o.frames e
 -- has no texture. how (optional): { view = the result depends on the view
 -- (a screen-space gather), so a moving camera caps its history (the
 -- `moving` option); keep = the user's final result and its grid's depth are
--- kept too (temporal.kept), so that a settled frame can skip its passes }.
+-- kept too (temporal.kept), so that a settled frame can skip its passes;
+-- keep = "output": a full-size result instead (kept.value at scale 1, no
+-- z: SSDO keeps its composite) }.
 function temporal.create(user, factors, how)
   if type(factors) == "number" then factors = { factors } end
   how = how or {}
@@ -128,9 +145,14 @@ function temporal.create(user, factors, how)
       return { value = target{ name .. "value" .. i, format = "rgba32f", scale = 1 / f },
                state = target{ name .. "state" .. i, format = "rg32f", scale = 1 / f } }
     end
-    histories[user].at[f] = { turn = 0, targets = { history(0), history(1) },
-                              kept = how.keep and { value = target{ name .. "kept", format = "rgba16f", scale = 1 / f },
-                                                    z = target{ name .. "z", format = "r32f", scale = 1 / f } } }
+    local kept
+    if how.keep == "output" then
+      kept = { value = target{ name .. "kept", format = "rgba16f" } }
+    elseif how.keep then
+      kept = { value = target{ name .. "kept", format = "rgba16f", scale = 1 / f },
+               z = target{ name .. "z", format = "r32f", scale = 1 / f } }
+    end
+    histories[user].at[f] = { turn = 0, targets = { history(0), history(1) }, kept = kept }
   end
 end
 
@@ -164,7 +186,9 @@ function temporal.kept(user, f) return history_of(user, f).kept end
 -- pixel holds) is what isr.blur's age reads. Nothing when off. A result
 -- made in several passes gives each of them these inputs (so all agree on
 -- which pixels have converged) and writes the next history from its last.
-function temporal.bind(user, inputs, defines, params, o, f)
+-- gather_turns: another gather in the pass turns its pattern every frame
+-- whatever o.turn says (isr+rsm+esm's RSM), so the history averages it.
+function temporal.bind(user, inputs, defines, params, o, f, gather_turns)
   if not o.enabled then return nil end
   local h = history_of(user, f)
   local previous, next = h.targets[h.turn + 1], h.targets[2 - h.turn]
@@ -173,8 +197,10 @@ function temporal.bind(user, inputs, defines, params, o, f)
   defines.TEMPORAL = true
   params.frames, params.epsilon, params.refresh = o.frames, o.epsilon, o.refresh
   params.bias, params.confidence, params.restart = o.bias, o.confidence, restart and 1 or 0
-  params.moving = histories[user].view and o.moving or 0
+  params.moving, params.view_dependent = o.moving, histories[user].view and 1 or 0
   params.world_moved = still_frames() == 0 and 1 or 0 -- the world hash changed (camera included)
+  params.turn = (o.turn == "always" or not histories[user].view and still_frames() == 0) and 1 or 0
+  params.gather_turns = gather_turns and 1 or 0
   if velocity and o.velocity then inputs.velocity, defines.VELOCITY = velocity, true end
   return next
 end

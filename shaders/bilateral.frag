@@ -6,7 +6,7 @@
 // modulation factor and bounce, blurred together as the seed suggests).
 // The pass may run at 1/factor of the G-buffer's size. With AGE (temporal
 // reuse's history state at this size), a pixel of n frames takes
-// aged_radius(radius, n) taps each side (common.glsl; blur.frag's AGE).
+// aged_radius(radius, n, narrow) taps each side (common.glsl; blur.frag's AGE).
 #include "filters.glsl"
 
 uniform sampler2D src;
@@ -22,6 +22,7 @@ uniform float sigma_normal = 0.2;  // 1 - cos of the angle between normals
 uniform int factor = 1;
 #ifdef AGE
 uniform sampler2D age;
+uniform float narrow = 0.25; // temporal.narrow
 #endif
 
 layout(location = 0) out vec4 dst;
@@ -37,7 +38,7 @@ void main() {
 #endif
   Geometry c = geometry_at(nrm, dpt, mat, p, factor);
 #ifdef AGE
-  int r = clamp(aged_radius(radius, texelFetch(age, p, 0).g), 0, 32);
+  int r = clamp(aged_radius(radius, texelFetch(age, p, 0).g, narrow), 0, 32);
 #else
   int r = clamp(radius, 0, 32);
 #endif

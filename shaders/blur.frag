@@ -8,12 +8,13 @@
 // a floor seen at a grazing angle still blurs along its length. With DEPTH
 // and no MASK, a depth of 0 (nothing drawn) is the mask. With AGE (temporal
 // reuse's history state, g: the frames a pixel holds), a pixel of n frames takes
-// radius / n^(1/4) taps each side, rounded: a new or disoccluded pixel is
-// blurred in full, a converged one (36 frames) with 2 taps at radius 4,
-// which still smooths the 4 x 4 pattern's grain (1 tap left it visible on
-// the room's walls). (radius /
-// sqrt(n), the same noise for n frames of samples, left converged pixels
-// unblurred: more error against the references, docs/gi-combined.md.)
+// a Gaussian of reach radius / n^narrow (sigma half of it; temporal.narrow):
+// a new or disoccluded pixel is blurred in full, at narrow 1/4 a converged
+// one (36 frames) with a reach of 1.6 (2 taps) at radius 4, which still
+// smooths the 4 x 4 pattern's grain (1 tap left it visible on the room's
+// walls). (radius / sqrt(n), the same noise for n frames of samples, left
+// converged pixels unblurred: more error against the references,
+// docs/gi-combined.md.)
 #include "common.glsl"
 
 in vec2 uv;
@@ -29,6 +30,7 @@ uniform ivec2 axis = ivec2(1, 0); // (1, 0) horizontal, (0, 1) vertical
 uniform int radius = 4;           // taps each side; sigma = radius / 2
 #ifdef AGE
 uniform sampler2D age;
+uniform float narrow = 0.25; // the reach shrinks as n^-narrow (temporal.narrow)
 #endif
 
 out vec4 dst;
@@ -52,8 +54,13 @@ void main() {
   ivec2 p = ivec2(gl_FragCoord.xy), last = textureSize(src, 0) - 1;
   vec4 centre = texelFetch(src, p, 0);
 #ifdef AGE
-  int taps = aged_radius(radius, texelFetch(age, p, 0).g);
+  // Its Gaussian narrows smoothly as the history grows: whole taps (sigma half of them, as without AGE)
+  // made the image jump where the rounding stepped (on the door sequence, a flicker spike a few frames
+  // after the door stopped; rsm+esm's flicker 0.00270 against 0.00265 with this).
+  float reach = aged_reach(radius, texelFetch(age, p, 0).g, narrow);
+  int taps = int(ceil(reach - 0.01));
 #else
+  float reach = float(radius);
   int taps = radius;
 #endif
   if (taps < 1) {
@@ -72,7 +79,7 @@ void main() {
     dst = centre;
     return;
   }
-  float sigma = 0.5 * float(taps), inv2s2 = 0.5 / (sigma * sigma);
+  float sigma = 0.5 * reach, inv2s2 = 0.5 / (sigma * sigma);
   vec4 sum = wsum * centre;
   for (int i = -taps; i <= taps; i++) {
     if (i == 0) continue;

@@ -73,11 +73,13 @@ float dpt_view_depth(float dpt) { return max(dpt, 0.0) * frame.clip.y; }
 // (a coarse pass reads the G-buffer there instead of an averaged copy).
 ivec2 block_centre(ivec2 q, int factor, ivec2 size) { return clamp(q * factor + factor / 2, ivec2(0), size - 1); }
 
-// The taps each side a blur of `radius` gives a pixel whose temporal
-// history holds n frames (temporal.glsl's state .g): radius / n^(1/4),
-// rounded (blur.frag's AGE explains the choice): all of it for a new pixel,
-// about 2/5 of it for a converged one of 36 frames.
-int aged_radius(int radius, float n) { return int(round(float(radius) * sqrt(inversesqrt(max(n, 1.0))))); }
+// The reach of a blur of `radius` for a pixel whose temporal history holds
+// n frames (temporal.glsl's state .g): radius / n^narrow (temporal.narrow;
+// blur.frag's AGE explains the choice): all of it for a new pixel, at the
+// default 1/4 about 2/5 of it for a converged one of 36 frames.
+// aged_radius: rounded to whole taps each side.
+float aged_reach(int radius, float n, float narrow) { return float(radius) * pow(max(n, 1.0), -max(narrow, 0.0)); }
+int aged_radius(int radius, float n, float narrow) { return int(round(aged_reach(radius, n, narrow))); }
 
 // World position from dpt (linear depth / far) and the far-plane rays (seed 000, eq 23-24).
 vec3 position_from_depth(vec2 uv, float depth01) {

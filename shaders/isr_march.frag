@@ -233,7 +233,7 @@ void main() {
   mat3 basis = tangent_frame(s.n);
   int first = interleave_index(px, 4) * n;
 #ifdef TEMPORAL
-  first += int(uint(frame.time.y) & 65535u) * 16 * n; // this frame's points (below 2^28: no overflow)
+  first += temporal_turn() * 16 * n; // this frame's points (below 2^28: no overflow)
 #endif
   vec4 a = frame.view_proj * vec4(s.p, 1.0);
   vec3 gathered = vec3(0.0);

@@ -144,7 +144,7 @@ void main() {
   mat3 frame_n = tangent_frame(s.n);
   vec3 offset = halton_offset(px, clamp(interleave, 1, 4));
 #ifdef TEMPORAL
-  offset = r3_sample(int(frame.time.y), offset); // this frame's turn of the pattern
+  if (temporal_turning()) offset = r3_sample(temporal_turn(), offset); // this frame's turn of the pattern
 #endif
   vec3 visible = vec3(0.0), total = vec3(0.0), gathered = vec3(0.0);
   float open = 0.0;

@@ -27,6 +27,11 @@ uniform int refresh = 32;
 uniform int restart = 0; // 1: the settings changed (temporal.begin), no history is kept
 uniform float moving = 0.0; // > 0: a view-dependent result's most frames while the view changes
 uniform int world_moved = 0; // 1: something in the world (a caster, a light) changed since the last frame
+uniform int view_dependent = 0; // 1: the result depends on the view (ISR, SSDO), so a moving view caps it too
+uniform int turn = 1; // 1: the pass's pattern turns every frame; 0: only while the view moves (temporal.turn)
+uniform int gather_turns = 0; // 1: another gather in the pass turns every frame (isr+rsm+esm's RSM): the
+                              // history averages anyway, so the pass's own pattern turns too (kept, a
+                              // fixed pattern would lose the blur it needs as the history grows)
 #ifdef VELOCITY
 // The G-buffer's velocity target (velocity.glsl): a pixel whose surface moved
 // on its own (a = 2) reprojects along its motion, to the view depth it had.
@@ -37,15 +42,33 @@ uniform sampler2D velocity;
 bool temporal_self_moved = false;
 
 // Does the view change this frame, for a result that depends on it
-// (`moving` > 0: ISR's and SSDO's light at a point depends on what the
+// (`view_dependent`: ISR's and SSDO's light at a point depends on what the
 // screen shows, where RSM's does not), or the world that lights it (a door
-// opening onto the sun changes the light on walls that stood still)? Its
-// history then counts at most `moving` frames, so that it follows the
-// change with about that lag, and no pixel counts as converged (a converged
-// one would keep the old light until its tile's refresh).
+// opening onto the sun changes the light on walls that stood still; a
+// light or caster that moves changes the RSM)? Its history then counts at
+// most `moving` frames, so that it follows the change with about that lag,
+// and no pixel counts as converged (a converged one would keep the old
+// light until its tile's refresh). `moving` 0: never. world_moved counts
+// the camera too (the renderer's world hash): for a result that does not
+// depend on the view it counts only on a still view, so a camera moving
+// while a light or caster moves leaves RSM's history uncapped there.
 bool temporal_moving() {
-  return moving > 0.0 && (frame.view_proj != frame.prev_view_proj || temporal_self_moved || world_moved != 0);
+  bool view = frame.view_proj != frame.prev_view_proj;
+  bool world = world_moved != 0 && (view_dependent != 0 || !view);
+  return moving > 0.0 && ((view_dependent != 0 && view) || temporal_self_moved || world);
 }
+
+// The frame by which the pass turns its sampling pattern: the frame's
+// number, or with `turn` 0 on a still view 0, the pattern reuse off takes.
+// A still view then keeps one pattern: each frame takes the samples the
+// last took, so the history holds nothing new (temporal_accumulate keeps
+// the fresh value, which follows a change of the world at once) and serves
+// only to skip converged pixels and settled frames, and the image is reuse
+// off's, without the flicker of a running mean that moves by its noise each
+// frame until it converges. A moving view turns it: the reprojected history
+// then holds other samples of the same surface.
+bool temporal_turning() { return turn != 0 || gather_turns != 0 || frame.view_proj != frame.prev_view_proj; }
+int temporal_turn() { return temporal_turning() ? int(uint(frame.time.y) & 65535u) : 0; }
 
 // The history of the pixel at uv whose coarse depth is d (dpt): the
 // pixel's world position through the previous frame's view-projection; kept
@@ -109,7 +132,9 @@ bool temporal_converged(float n, ivec2 px) {
 vec4 temporal_accumulate(vec4 cur, bool found, vec4 h, float n, out float seen) {
   bool moved = temporal_moving();  // (a surface that moved alone, as a moving view)
   float most = moved ? clamp(moving, 1.0, max(frames, 1.0)) : max(frames, 1.0);
-  if (found) {
+  // The same samples as the history's (a still view's kept pattern): nothing to average, and one
+  // frame's samples held (so the blur's age stays that of a fresh frame, the one reuse off blurs).
+  if (found && (temporal_turning() || gather_turns != 0)) {
     vec3 a = h.rgb / (1.0 + h.rgb), b = cur.rgb / (1.0 + cur.rgb), diff = abs(a - b);
     float conf = 1.0 - saturate(max(diff.r, max(diff.g, diff.b))) / (1.0 + bias);
     if (conf >= confidence) {
