@@ -65,9 +65,10 @@ function techniques.add(row)
   if row.joins == "march" and not row.lighting then refuse('joins = "march" needs a lighting module') end
   -- What the pipeline calls of each (scripts/README.md's contract).
   local need = { lighting = { "render" }, offscreen = { "check", row.joins == "march" and "march" or "render" } }
-  for k, names in pairs(need) do
-    for _, f in ipairs(row[k] and names or {}) do
-      if type(techniques.modules[row[k]][f]) ~= "function" then refuse(string.format("%s: %s has no %s", k, row[k], f)) end
+  for _, k in ipairs{ "lighting", "offscreen" } do
+    for _, f in ipairs(row[k] and need[k] or {}) do
+      local m = techniques.modules[row[k]]
+      if type(m[f]) ~= "function" then refuse(string.format("%s: %s has no %s", k, row[k], f)) end
     end
   end
   if row.key then keys[row.key] = row[1] end
