@@ -24,9 +24,11 @@ local rules = {
   downsample = options.one_of(1, 2, 4),
 }
 
+bloom.check = options.checker("bloom", bloom.defaults, rules)
+
 -- Records bloom over `src` (output-sized). Returns the sum, or src when off.
 function bloom.render(src, o)
-  o = options.check("bloom", bloom.defaults, o, rules, 2)
+  o = bloom.check(o, 2)
   if not o.enabled then return src end
   local f = o.downsample
   local function small(name) return target{ name, format = "rgba16f", scale = 1 / f } end

@@ -43,12 +43,15 @@ local rules = {
   sensor = options.number(0, 1e30),
 }
 
--- Records depth of field over `src` (output-sized) with the G-buffer G.
+dof.check = options.checker("dof", dof.defaults, rules)
+
+-- Records depth of field over `src` (output-sized) with the frame's G-buffer (frame.G).
 -- Returns the blurred image, or src when off.
-function dof.render(src, o, G)
-  o = options.check("dof", dof.defaults, o, rules, 2)
+function dof.render(src, o, frame)
+  o = dof.check(o, 2)
+  local G = frame and frame.G
   if not o.enabled then return src end
-  if not (G and G.dpt) then error("dof: needs the G-buffer's depth (G.dpt)", 2) end
+  if not (G and G.dpt) then error("dof: needs the G-buffer's depth (frame.G.dpt)", 2) end
   local coc = pass{ "dof.coc", shader = "dof_coc.frag", inputs = { dpt = G.dpt },
                     params = o.mode == "lens"
                       and { focus = o.focus, max_radius = o.max_radius, focal_length = o.focal_length,

@@ -18,8 +18,10 @@ local rules = {
   tint = options.number(0, 1),
 }
 
+glass.check = options.checker("glass", glass.defaults, rules)
+
 function glass.render(src, o)
-  o = options.check("glass", glass.defaults, o, rules, 2)
+  o = glass.check(o, 2)
   if not o.enabled then return src end
   return pass{ "glass", shader = "glass.frag", inputs = { src = src },
                params = { strength = o.strength, scale = o.scale, tint = { o.tint, o.tint, o.tint } },

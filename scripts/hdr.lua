@@ -45,10 +45,12 @@ function hdr.create()
   }
 end
 
+hdr.check = options.checker("hdr", hdr.defaults, rules)
+
 -- Records tone mapping of `src` (an output-sized float target) with options
 -- o (see hdr.defaults). Returns the display-referred target, or src when off.
 function hdr.render(src, o)
-  o = options.check("hdr", hdr.defaults, o, rules, 2)
+  o = hdr.check(o, 2)
   if not o.enabled then return src end
   if not adapted then error("hdr: call hdr.create() from OnCreate (it declares the adaptation targets)", 2) end
   local w, h = output_size()

@@ -186,11 +186,24 @@ local function march_params(o)
   return params
 end
 
--- Records ISR lighting of G given its direct light `direct` (lights only, no
+-- Checked options (scripts/README.md): errors name the option and point at
+-- the caller `level` calls up (1: check's).
+function isr.check(o, level)
+  level = (level or 1) + 1
+  o = options.check("isr", isr.defaults, o, rules, level)
+  o.seed = options.check("isr.seed", isr.defaults.seed, o.seed, seed_rules, level) -- checked in either mode
+  o.temporal = temporal.check("isr.temporal", o.temporal)
+  return o
+end
+
+-- Declares the temporal reuse history at each coarse factor (one is made); from OnCreate.
+function isr.create() temporal.create("isr", { 1, 2, 3, 4 }, { view = true, keep = true }) end
+
+-- Records ISR lighting of frame.G given its direct light `direct` (lights only, no
 -- ambient term: a target from direct.frag with ambient 0; isr+lpv+esm's
 -- also holds the off-screen senders' light), with options o (see
--- isr.defaults) and light = { ambient = {r, g, b}, background = {r, g, b},
--- rsm = }. light.rsm (isr+rsm+esm): { bind = function(inputs, defines,
+-- isr.defaults) and frame.light = { ambient = {r, g, b}, background = {r, g, b},
+-- sky, rsm = }. light.rsm (isr+rsm+esm): { bind = function(inputs, defines,
 -- params, f, temporal) that binds the RSM's gather into the first march
 -- (rsm.bind) and returns its fetches, coarse = the RSM's own coarse factor };
 -- its light joins E (isr_march.frag's RSM_GATHER), and with `coarse` 0 the
@@ -199,11 +212,10 @@ end
 -- dl+esm's indirect error on the reference set, the RSM's grid (3) with its
 -- own samples 75.3% in less time (ISR alone: 43.2% and 43.1%).
 -- Returns the lit target.
-function isr.render(G, direct, o, light)
-  o = options.check("isr", isr.defaults, o, rules, 2)
-  local seed = options.check("isr.seed", isr.defaults.seed, o.seed, seed_rules, 2) -- checked in either mode
-  o.temporal = temporal.check("isr.temporal", o.temporal)
-  if o.mode ~= "seed" then seed = nil end
+function isr.render(direct, o, frame)
+  local G, light = frame.G, frame.light
+  o = isr.check(o, 2)
+  local seed = o.mode == "seed" and o.seed or nil
   if seed and o.temporal.enabled then error("isr.temporal is for isr.mode \"physical\"", 2) end
   if seed and light.rsm then error("isr+rsm+esm needs isr.mode \"physical\" (its march gathers the RSM)", 2) end
   local f = factor(o)

@@ -70,9 +70,7 @@ local rules = {
   blur = options.whole(0, 32),
 }
 
--- Checked options (errors name the option, pointing at the caller's caller);
--- shadow.render(..., o) then writes the maps.
-function lpv.check(o) return options.check("lpv", lpv.defaults, o, rules, 3) end
+lpv.check = options.checker("lpv", lpv.defaults, rules)
 
 -- Cascade 0's cell side: o.cell, or the coarsest cascade spanning extent
 -- times the scene's diagonal (a scene without extent: a unit, as the
@@ -204,14 +202,16 @@ function lpv.gather(C, f, V, o)
   return E
 end
 
--- Records the LPV's indirect light over G from the RSM targets R, with
--- checked options o; exclude_seen as lpv.volume. Returns what the direct
--- pass adds (pp.lua's direct: INDIRECT in direct.frag): { C = the coarse
--- grid, E = the coarse result, k }.
-function lpv.indirect(G, R, o, exclude_seen)
-  local f = o.coarse
+-- Records the LPV's indirect light over frame.G from the RSM targets
+-- frame.R, with options o; no input. With the row's split, VPLs the camera
+-- sees are left to the frame's lighting (lpv.volume's exclude_seen).
+-- Returns what the direct pass adds (pp.lua's direct: INDIRECT in
+-- direct.frag): { C = the coarse grid, E = the coarse result, k }.
+function lpv.render(_, o, frame)
+  o = lpv.check(o, 2)
+  local G, f, split = frame.G, o.coarse, frame.technique and frame.technique.split
   local C = isr.coarse_view(G, nil, f, "lpv")
-  return { C = C, E = isr.blur(lpv.gather(C, f, lpv.volume(G, R, o, exclude_seen), o), C, f, o.blur), k = o.k }
+  return { C = C, E = isr.blur(lpv.gather(C, f, lpv.volume(G, frame.R, o, split), o), C, f, o.blur), k = o.k }
 end
 
 return lpv

@@ -34,12 +34,15 @@ local function tile_side(max_length)
   return t
 end
 
--- Records motion blur of `src` (output-sized) using G.dpt, and G.vel when
--- the G-buffer has it. Returns src when off.
-function motion_blur.render(src, o, G)
-  o = options.check("motion_blur", motion_blur.defaults, o, rules, 2)
+motion_blur.check = options.checker("motion_blur", motion_blur.defaults, rules)
+
+-- Records motion blur of `src` (output-sized) using the frame's G-buffer
+-- (frame.G): its dpt, and its vel when it has one. Returns src when off.
+function motion_blur.render(src, o, frame)
+  o = motion_blur.check(o, 2)
+  local G = frame and frame.G
   if not o.enabled then return src end
-  if not (G and G.dpt) then error("motion_blur: needs the G-buffer's depth (G.dpt)", 2) end
+  if not (G and G.dpt) then error("motion_blur: needs the G-buffer's depth (frame.G.dpt)", 2) end
   -- Nothing moved since the last frame (the renderer's world hash holds the
   -- camera, the nodes and the deformations): no pixel would change.
   if still_frames() > 0 then return src end

@@ -89,6 +89,15 @@ function options.check(name, defaults, o, rules, level)
   return c
 end
 
+-- A module's check(o, level) (scripts/README.md): o over `defaults`, checked
+-- by `rules`; errors point at the caller `level` calls up (1: check's).
+function options.checker(name, defaults, rules)
+  return function(o, level)
+    local c = options.check(name, defaults, o, rules, (level or 1) + 1) -- not a tail call: it keeps its level
+    return c
+  end
+end
+
 -- A deep copy, for putting a module's defaults into a pipeline's Options.
 function options.copy(t)
   local c = {}

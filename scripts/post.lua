@@ -3,9 +3,9 @@
 --   bloom                      added before tone mapping (seed 001)
 --   hdr                        tone mapping with eye adaptation
 --   radial_blur, glass, tiles, sepia    display-referred stylization
--- Each effect is a module with `defaults` and `render(src, o, G)`; an effect
--- whose `enabled` is false records no pass. Any pipeline can use the chain
--- (post.render) or the modules one by one.
+-- Each effect is a module as scripts/README.md says (`defaults`, `check`,
+-- `render(src, o, frame)`); an effect whose `enabled` is false records no
+-- pass. Any pipeline can use the chain (post.render) or the modules one by one.
 local options = require "options"
 
 local post = {}
@@ -28,12 +28,12 @@ function post.create()
 end
 
 -- Records the chain over `lit` with o = { bloom = {...}, dof = {...}, ... }
--- (missing tables take the defaults) and the G-buffer G (for dof and
--- motion_blur). Returns the final target.
-function post.render(lit, o, G)
+-- (missing tables take the defaults) and the frame (frame.G, the G-buffer,
+-- for dof and motion_blur). Returns the final target.
+function post.render(lit, o, frame)
   o = o or {}
   local img = lit
-  for _, name in ipairs(post.order) do img = modules[name].render(img, o[name], G) end
+  for _, name in ipairs(post.order) do img = modules[name].render(img, o[name], frame) end
   return img
 end
 

@@ -19,8 +19,10 @@ local rules = {
   samples = options.whole(1, 64),
 }
 
+radial_blur.check = options.checker("radial_blur", radial_blur.defaults, rules)
+
 function radial_blur.render(src, o)
-  o = options.check("radial_blur", radial_blur.defaults, o, rules, 2)
+  o = radial_blur.check(o, 2)
   if not o.enabled then return src end
   return pass{ "radial_blur", shader = "radial_blur.frag", inputs = { src = src },
                params = { centre = { o.centre_x, o.centre_y }, strength = o.strength, samples = o.samples },

@@ -29,11 +29,14 @@ local rules = {
   sigma_normal = options.number(1e-6, 1e6),
 }
 
--- Adds reflections to `lit` (full size) for G-buffer G with options o;
--- light = { ambient =, background =, shadows =, sky = } as the camera's lighting.
--- Returns a full-size rgba16f target "reflect.out".
-function reflections.render(G, lit, o, light)
-  o = options.check("reflections", reflections.defaults, o, rules, 2)
+reflections.check = options.checker("reflections", reflections.defaults, rules)
+
+-- Adds reflections to `lit` (full size) for frame.G with options o, lit as
+-- the camera's view is (frame.light = { ambient =, background =, sky = },
+-- frame.shadows). Returns a full-size rgba16f target "reflect.out".
+function reflections.render(lit, o, frame)
+  local G, light = frame.G, frame.light
+  o = reflections.check(o, 2)
   local f = math.floor(1 / o.scale + 0.5)
   local function half(name, format) return target{ name, format = format, scale = 1 / f } end
   local rays_o, rays_d = half("reflect.rays_o", "rgba32f"), half("reflect.rays_d", "rgba32f")
@@ -43,7 +46,7 @@ function reflections.render(G, lit, o, light)
               pos = half("reflect.hit_pos", "rgba32f"), mat = half("reflect.hit_mat", "rgba8") }
   cpu{ "reflect.trace", fn = "trace", inputs = { rays_o = rays_o, rays_d = rays_d },
        out = { H.clr, H.nrm, H.pos, H.mat } }
-  local inputs, defines = shadow.bind(light.shadows, { hit_clr = H.clr, hit_nrm = H.nrm, hit_pos = H.pos,
+  local inputs, defines = shadow.bind(frame.shadows, { hit_clr = H.clr, hit_nrm = H.nrm, hit_pos = H.pos,
                                                        hit_mat = H.mat, rays_o = rays_o, rays_d = rays_d }, {})
   local params = sky.bind(light.sky, { ambient = light.ambient, background = light.background }, defines)
   local refl = pass{ "reflect.light", shader = "reflect_light.frag", inputs = inputs, defines = defines,

@@ -63,11 +63,11 @@ local rules = {
   temporal = function(v) if type(v) ~= "table" then return "a table of temporal reuse options" end end,
 }
 
--- Checked options (errors name the option, pointing at the caller's caller),
--- with the auto coarse factor resolved for this output size;
--- shadow.render(..., o) then writes the maps.
-function rsm.check(o)
-  o = options.check("rsm", rsm.defaults, o, rules, 3)
+-- Checked options (scripts/README.md: errors name the option and point at
+-- the caller `level` calls up, 1: check's), with the auto coarse factor
+-- resolved for this output size; shadow.render(..., o) then writes the maps.
+function rsm.check(o, level)
+  o = options.check("rsm", rsm.defaults, o, rules, (level or 1) + 1)
   o.temporal = temporal.check("rsm.temporal", o.temporal)
   o.coarse = isr.gather_factor(o.coarse)
   return o
@@ -106,25 +106,47 @@ function rsm.gather(C, f, R, shadows, o, kept)
   return E, history
 end
 
--- Records the RSM's indirect light over G from the shadow atlas and RSM
--- targets (shadow.render(..., o)), with checked options o: the gather
--- over a coarse view of G (no pass averages its blocks first), temporal
--- reuse and the blur. Returns what the direct pass adds (pp.lua's direct:
--- INDIRECT in direct.frag): { C = the coarse grid, E = the coarse result, k }.
--- With temporal reuse the blurred E and the grid's depth are kept
--- (temporal.kept, as ISR's); a settled frame (temporal.settled) returns
--- them and records neither the gather nor the blur.
-function rsm.indirect(G, shadows, R, o)
+-- Declares the temporal reuse history at each coarse factor (one is made); from OnCreate.
+function rsm.create() temporal.create("rsm", { 1, 2, 3, 4 }, { keep = true }) end
+
+-- Records the RSM's indirect light over frame.G from the shadow atlas and
+-- RSM targets (frame.shadows, frame.R: shadow.render(..., o)), with options
+-- o: the gather over a coarse view of G (no pass averages its blocks
+-- first), temporal reuse and the blur. No input. Returns what the direct
+-- pass adds (pp.lua's direct: INDIRECT in direct.frag): { C = the coarse
+-- grid, E = the coarse result, k }. With temporal reuse the blurred E and
+-- the grid's depth are kept (temporal.kept, as ISR's); a settled frame
+-- (temporal.settled) returns them and records neither the gather nor the blur.
+function rsm.render(_, o, frame)
+  o = rsm.check(o, 2)
   local f = o.coarse
-  local C = isr.coarse_view(G, nil, f, "rsm")
+  local C = isr.coarse_view(frame.G, nil, f, "rsm")
   local kept = o.temporal.enabled and temporal.kept("rsm", f) or nil
   if kept then
     C.z = kept.z
     if temporal.settled(o.temporal) then return { C = C, E = kept.value, k = o.k } end
   end
-  local E, history = rsm.gather(C, f, R, shadows, o, kept)
+  local E, history = rsm.gather(C, f, frame.R, frame.shadows, o, kept)
   return { C = C, E = isr.blur(E, C, f, o.blur, history and history.state, kept and kept.value, o.temporal.narrow),
            k = o.k }
+end
+
+-- The gather as the first march of the frame's lighting takes it (isr.render's
+-- light.rsm; pp.lua's joins = "march"), with options o: { coarse = the RSM's
+-- coarse factor, bind = function(inputs, defines, params, f, temporal_on) that
+-- binds it (rsm.bind) and returns its fetches }. With split, the senders the
+-- camera sees are the march's. Its temporal reuse is the march's.
+function rsm.march(o, frame)
+  o = rsm.check(o, 2)
+  local row = frame.technique
+  if o.temporal.enabled then
+    error(string.format("%s takes temporal reuse from %s.temporal (one pass gathers both); rsm.temporal is for "
+                        .. "rsm's own gather", row[1], row.lighting), 2)
+  end
+  return { coarse = o.coarse, bind = function(inputs, defines, params, f, temporal_on)
+    params.rsm_k = o.k
+    return rsm.bind(inputs, defines, params, frame.R, frame.shadows, o, f, temporal_on, row.split == true)
+  end }
 end
 
 return rsm

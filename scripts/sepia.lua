@@ -10,8 +10,10 @@ sepia.defaults = {
 
 local rules = { enabled = options.boolean, strength = options.number(0, 1) }
 
+sepia.check = options.checker("sepia", sepia.defaults, rules)
+
 function sepia.render(src, o)
-  o = options.check("sepia", sepia.defaults, o, rules, 2)
+  o = sepia.check(o, 2)
   if not o.enabled then return src end
   return pass{ "sepia", shader = "sepia.frag", inputs = { src = src }, params = { strength = o.strength },
                out = target{ "sepia", format = "rgba16f" } }

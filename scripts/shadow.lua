@@ -52,6 +52,7 @@ shadow.defaults = {
 -- shadow_plan{} checks the rest (engine/script/script_api.c).
 local rules = { technique = options.one_of("esm", "pcf", "poisson", "hard", "pcss"),
                 fit = options.one_of("current", "previous"), fit_margin = options.number(0, 10) }
+shadow.check = options.checker("shadow", shadow.defaults, rules)
 
 local BLOCK = 8
 
@@ -86,7 +87,7 @@ end
 -- is seen, its radius times reach, of `resolution` texels a side (shadow_plan's rsm_resolution).
 -- Without, no RSM target or tile exists.
 function shadow.render(o, G, rsm)
-  o = options.check("shadow", shadow.defaults, o, rules, 2)
+  o = shadow.check(o, 2)
   local settings = {}
   for k, v in pairs(o) do
     if k ~= "debug" and k ~= "fit" and k ~= "fit_margin" then settings[k] = v end

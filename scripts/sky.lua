@@ -46,11 +46,12 @@ local rules = {
   intensity = options.number(0, 1e6),
   map = function(v) if type(v) ~= "string" then return "a file name (\"\": the gradient)" end end,
 }
+sky.check = options.checker("sky", sky.defaults, rules)
 
 -- The sky's pass parameters (sky_r, sky_g, sky_b: shaders/sky.glsl), or nil
 -- when it is off.
 function sky.light(o)
-  o = options.check("sky", sky.defaults, o, rules, 2)
+  o = sky.check(o, 2)
   if not o.enabled then return nil end
   local sh = sky_sh{ zenith = colour(o.zenith), horizon = colour(o.horizon), intensity = o.intensity,
                      map = o.map ~= "" and o.map or nil }

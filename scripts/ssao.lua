@@ -36,11 +36,14 @@ local rules = {
 }
 filters.expose(ssao.defaults, rules)
 
--- Records SSAO of G applied to `lit` (direct light, no ambient term) with
--- options o (see ssao.defaults) and light = { ambient = {r, g, b} }.
+ssao.check = options.checker("ssao", ssao.defaults, rules)
+
+-- Records SSAO of frame.G applied to `lit` (direct light, no ambient term)
+-- with options o (see ssao.defaults) and frame.light = { ambient = {r, g, b}, sky }.
 -- Returns the result, a full-size rgba16f target "ssao.lit".
-function ssao.render(G, lit, o, light)
-  o = options.check("ssao", ssao.defaults, o, rules, 2)
+function ssao.render(lit, o, frame)
+  local G, light = frame.G, frame.light
+  o = ssao.check(o, 2)
   local f = o.resolution
   local ao = pass{ "ssao.ao", shader = "ssao.frag", inputs = { nrm = G.nrm, dpt = G.dpt, mat = G.mat },
                    params = { samples = o.samples, radius = o.radius, tolerance = o.tolerance, reach = o.reach,

@@ -66,15 +66,31 @@ local rules = {
 }
 filters.expose(ssdo.defaults, rules)
 
--- Records SSDO for G lit by `lit` (direct light, no ambient term) with
--- options o (see ssdo.defaults) and light = { ambient = {r, g, b} }.
--- Returns the result, a full-size rgba16f target "ssdo.lit" (with temporal reuse the kept one,
--- temporal.kept).
-function ssdo.render(G, lit, o, light)
-  o = options.check("ssdo", ssdo.defaults, o, rules, 2)
+-- Checked options (scripts/README.md: errors name the option and point at
+-- the caller `level` calls up, 1: check's).
+function ssdo.check(o, level)
+  o = options.check("ssdo", ssdo.defaults, o, rules, (level or 1) + 1)
   o.temporal = temporal.check("ssdo.temporal", o.temporal)
+  if o.temporal.enabled and o.variant ~= "physical" then
+    error('ssdo.temporal is for ssdo.variant "physical"', (level or 1) + 1)
+  end
+  return o
+end
+
+-- Declares the temporal reuse history at each resolution (one is made); from OnCreate.
+function ssdo.create() temporal.create("ssdo", { 1, 2, 4 }, { view = true, keep = "output" }) end
+
+-- Records SSDO for frame.G lit by `lit` (direct light, no ambient term) with
+-- options o (see ssdo.defaults) and frame.light = { ambient = {r, g, b}, sky }.
+-- A shadowed row (frame.technique.shadows) cannot take the two-step variant.
+-- Returns the result, a full-size rgba16f target "ssdo.lit".
+function ssdo.render(lit, o, frame)
+  local G, light, row = frame.G, frame.light, frame.technique or {}
+  o = ssdo.check(o, 2)
+  if row.shadows and o.variant == "two_step" then
+    error(row[1] .. ' cannot take ssdo.variant = "two_step" (it relights without shadows)', 2)
+  end
   local f, merged, physical = o.resolution, o.variant == "merged", o.variant == "physical"
-  if o.temporal.enabled and not physical then error('ssdo.temporal is for ssdo.variant "physical"', 2) end
   local edges
   if o.adaptive then
     edges = pass{ "ssdo.edges", shader = "ssdo_edges.frag", inputs = { nrm = G.nrm, dpt = G.dpt, mat = G.mat },

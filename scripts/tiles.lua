@@ -17,8 +17,10 @@ local rules = {
   grout_grey = options.number(0, 1e4),
 }
 
+tiles.check = options.checker("tiles", tiles.defaults, rules)
+
 function tiles.render(src, o)
-  o = options.check("tiles", tiles.defaults, o, rules, 2)
+  o = tiles.check(o, 2)
   if not o.enabled then return src end
   local g = o.grout_grey
   return pass{ "tiles", shader = "tiles.frag", inputs = { src = src },

@@ -60,19 +60,22 @@ local rules = {
   k = options.number(0, 16),
 }
 
--- Checked options (errors point at the caller's caller), with the auto
--- coarse factor resolved for this output size.
-function vpl.check(o)
-  o = options.check("vpl", vpl.defaults, o, rules, 3)
+-- Checked options (scripts/README.md: errors name the option and point at
+-- the caller `level` calls up, 1: check's), with the auto coarse factor
+-- resolved for this output size.
+function vpl.check(o, level)
+  o = options.check("vpl", vpl.defaults, o, rules, (level or 1) + 1)
   o.coarse = isr.gather_factor(o.coarse)
   return o
 end
 
--- Records VPL lighting of G from the shadow atlas and RSM targets R, with
--- checked options o and light = { ambient = {r, g, b}, background = {r, g,
--- b}, sky }: the refinement is the frame's direct pass too. Returns the lit
--- target.
-function vpl.render(G, shadows, R, o, light)
+-- Records VPL lighting of frame.G from the shadow atlas and RSM targets
+-- (frame.shadows, frame.R), with options o and frame.light = { ambient =
+-- {r, g, b}, background = {r, g, b}, sky }: the refinement is the frame's
+-- direct pass too (pp.lua's joins = "lit"); no input. Returns the lit target.
+function vpl.render(_, o, frame)
+  o = vpl.check(o, 2)
+  local G, shadows, R, light = frame.G, frame.shadows, frame.R, frame.light
   local f = o.coarse
   local C = isr.coarse_view(G, nil, f, "vpl")
   local params = { indirect_count = o.lights, negative = o.negative, threshold = o.threshold,

@@ -62,7 +62,8 @@ static const char view_usage[] =
     "  W/S/A/D move, left mouse drag looks around, 1-9 the scene's cameras\n"
     "  Space pauses and plays, Left/Right step a frame (and pause); an animated\n"
     "  camera follows its animation until moved, 0 gives it back\n"
-    "  F2 isr+esm  F3 isr  F4 dl+esm  F5 dl (techniques the script lists)\n"
+    "  F2-F5, F10 the techniques whose rows name them (pp.lua's F2 isr+esm  F3 isr\n"
+    "  F4 dl+esm  F5 dl; a script of names alone gets these four)\n"
     "  F6 bloom  F7 dof  F8 glass  F9 radial_blur  F11 sepia  F12 tiles (options\n"
     "  the script declares, a boolean or a table with `enabled`)\n"
     "  F1/Tab overlay; PageDown/PageUp step through targets, Home the frame again;\n"
@@ -501,11 +502,17 @@ static bool handle_changes(viewer *v) {
 
 /* ---- keys -------------------------------------------------------------- */
 static void handle_key(viewer *v, const char *key) {
+  /* A technique's row names its key (pp.lua's `key`); a key no row names
+   * picks the seed viewer's technique for it. */
   static const struct { const char *key, *tech; } techs[] = {
       {"F2", "isr+esm"}, {"F3", "isr"}, {"F4", "dl+esm"}, {"F5", "dl"}};
   static const struct { const char *key, *option; } toggles[] = {
       {"F6", "bloom"}, {"F7", "dof"},   {"F8", "glass"}, {"F9", "radial_blur"},
       {"F11", "sepia"}, {"F12", "tiles"}};
+  for (int i = 0; i < lm_pipeline_technique_count(v->pipeline); i++) {
+    const char *row_key = lm_pipeline_technique_key(v->pipeline, i);
+    if (row_key && !strcmp(key, row_key)) return set_technique(v, lm_pipeline_technique_name(v->pipeline, i));
+  }
   for (size_t i = 0; i < sizeof techs / sizeof *techs; i++)
     if (!strcmp(key, techs[i].key)) return set_technique(v, techs[i].tech);
   for (size_t i = 0; i < sizeof toggles / sizeof *toggles; i++)

@@ -313,10 +313,31 @@ bool lm_pipeline_set_option(lm_pipeline *p, const char *name, const char *value,
 }
 
 /* ---- techniques -------------------------------------------------------- */
+/* Techniques lists names, or rows { name, field = value, ... } (pp.lua's:
+ * the script reads the rest of a row; the engine its name and viewer key). */
 static int techniques(const lm_pipeline *p) {
   lua_getglobal(p->L, "Techniques");
   int n = lua_istable(p->L, -1) ? (int)lua_rawlen(p->L, -1) : 0;
   return n;
+}
+
+/* The field of technique i (NULL: its name) when it is a string, else
+ * NULL; the string stays valid while Techniques holds it. */
+static const char *technique_field(const lm_pipeline *p, int i, const char *field) {
+  lua_State *L = p->L;
+  techniques(p);
+  lua_rawgeti(L, -1, i + 1);
+  if (lua_istable(L, -1)) {
+    if (field) lua_getfield(L, -1, field);
+    else lua_rawgeti(L, -1, 1);
+  } else if (field) {
+    lua_pushnil(L); /* a name alone has no fields */
+  } else {
+    lua_pushvalue(L, -1);
+  }
+  const char *s = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : NULL;
+  lua_pop(L, 3);
+  return s;
 }
 
 int lm_pipeline_technique_count(const lm_pipeline *p) {
@@ -326,12 +347,11 @@ int lm_pipeline_technique_count(const lm_pipeline *p) {
 }
 
 const char *lm_pipeline_technique_name(const lm_pipeline *p, int i) {
-  techniques(p);
-  lua_rawgeti(p->L, -1, i + 1);
-  const char *s = lua_tostring(p->L, -1); /* interned in Techniques: stays valid */
-  lua_pop(p->L, 2);
+  const char *s = technique_field(p, i, NULL);
   return s ? s : "?";
 }
+
+const char *lm_pipeline_technique_key(const lm_pipeline *p, int i) { return technique_field(p, i, "key"); }
 
 const char *lm_pipeline_technique(const lm_pipeline *p) { return p->technique; }
 
@@ -406,6 +426,13 @@ lm_pipeline *lm_pipeline_load(const lm_pipeline_desc *desc, lm_error *err) {
                  desc->path);
     lm_pipeline_destroy(p);
     return NULL;
+  }
+  for (int i = 0; i < lm_pipeline_technique_count(p); i++) {
+    if (!technique_field(p, i, NULL)) {
+      lm_error_set(err, "%s: Techniques[%d] must be a name or a row { \"name\", ... }", desc->path, i + 1);
+      lm_pipeline_destroy(p);
+      return NULL;
+    }
   }
   snprintf(p->technique, sizeof p->technique, "%s", lm_pipeline_technique_name(p, 0));
   return p;

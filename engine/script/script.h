@@ -19,9 +19,12 @@ typedef struct lm_pipeline_desc {
 lm_pipeline *lm_pipeline_load(const lm_pipeline_desc *desc, lm_error *err);
 void lm_pipeline_destroy(lm_pipeline *p);
 
-/* Techniques the script lists in `Techniques`; the first is the default. */
+/* Techniques the script lists in `Techniques`, names or rows { name, ... };
+ * the first is the default. A row's `key` is the viewer's key for it ("F2"),
+ * NULL when it names none. */
 int lm_pipeline_technique_count(const lm_pipeline *p);
 const char *lm_pipeline_technique_name(const lm_pipeline *p, int i);
+const char *lm_pipeline_technique_key(const lm_pipeline *p, int i);
 bool lm_pipeline_set_technique(lm_pipeline *p, const char *name, lm_error *err);
 const char *lm_pipeline_technique(const lm_pipeline *p);
 
