@@ -11,6 +11,9 @@
                     one light of each KHR_lights_punctual type, placed behind
                     the camera; engine powers 1, 2 and 4 (candela or lux times
                     683 pi)
+  sky, skyball      a white plane and a white sphere lit by no light (a spot
+                    aimed at nothing), for sky.lua's gradient and map; sky.hdr,
+                    the map (write_map)
   spheres           a rough gold metal and a rough red dielectric sphere under
                     a sun, for materials=pbr (one light: Cycles, which picks one
                     light a sample, is then free of noise)
@@ -150,6 +153,31 @@ def sphere(g, centre, radius, material, rings=24, segments=48):
     g.node(name="sphere", mesh=g.mesh(pos, nrm, idx, material))
 
 
+def write_map(path, width=64, height=32):
+    """An equirectangular Radiance RGBE map (flat scanlines): a dim blue sky
+    (0.05, 0.08, 0.12) over dark ground (0.02), and a bright warm patch
+    (3, 2.5, 2) around the column looking along +X (3/4 of the width), 30
+    degrees up: a sphere lit by it shows which way the map is turned."""
+    def rgbe(c):
+        m = max(c)
+        if m < 1e-32:
+            return bytes(4)
+        e = math.frexp(m)[1]
+        return bytes([int(x / 2.0 ** e * 256) for x in c] + [e + 128])
+    rows = []
+    for r in range(height):
+        elevation = 90.0 - 180.0 * (r + 0.5) / height
+        for c in range(width):
+            azimuth = 360.0 * ((c + 0.5) / width - 0.75)  # 0 at +X
+            if abs(azimuth) < 25.0 and abs(elevation - 30.0) < 20.0:
+                rows.append(rgbe((3.0, 2.5, 2.0)))
+            else:
+                rows.append(rgbe((0.05, 0.08, 0.12) if elevation > 0 else (0.02, 0.02, 0.02)))
+    with open(path, "wb") as f:
+        f.write(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n" % (height, width))
+        f.write(b"".join(rows))
+
+
 def main(folder, width, height, samples):
     eye, target = [0.0, 3.0, 3.0], [0.0, 0.0, 0.0]
     lights = {
@@ -170,6 +198,17 @@ def main(folder, width, height, samples):
     sphere(g, [0.6, 0.5, 0.0], 0.5, g.material("red", [0.7, 0.1, 0.1], 0.0, 0.6))
     g.light({"type": "directional", "intensity": 2 * PHOTOMETRIC}, [-2.0, 3.0, 2.0], [0.0, 0.5, 0.0])
     specs["spheres"] = (g, g.camera([0.0, 0.8, 3.0], [0.0, 0.5, 0.0], 35.0))
+    # Lit by the sky alone: a spot aimed up, at nothing, stands in for Limn's default light.
+    away = ({"type": "spot", "intensity": 1.0, "spot": {"outerConeAngle": 0.1}}, [0.0, 20.0, 0.0], [0.0, 30.0, 0.0])
+    g = Gltf()
+    plane(g, g.material("white", [0.8, 0.8, 0.8], 0.0, 0.0))
+    g.light(*away)
+    specs["sky"] = (g, g.camera(eye, target, 40.0))
+    g = Gltf()
+    sphere(g, [0.0, 0.0, 0.0], 0.5, g.material("white", [0.8, 0.8, 0.8], 0.0, 0.0))
+    g.light(*away)
+    specs["skyball"] = (g, g.camera([0.0, 0.0, 1.2], [0.0, 0.0, 0.0], 35.0))  # the sphere fills the view
+    write_map(os.path.join(folder, "sky.hdr"))
     for name, (g, cam) in specs.items():
         path = os.path.join(folder, name + ".gltf")
         g.write(path)

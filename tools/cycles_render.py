@@ -625,8 +625,10 @@ def configure(spec):
     c.light_sampling_threshold = 0.0  # no light sample dropped at random
     c.sample_clamp_direct = c.sample_clamp_indirect = 0.0  # no clamping: unbiased
     c.caustics_reflective = c.caustics_refractive = True
-    c.pixel_filter_type = "BOX"
-    c.filter_width = 0.01  # Blender's least: a point at the pixel centre, as Limn shades
+    # Limn shades each pixel's centre once. Blender gives Cycles' box filter a width of 1 pixel
+    # whatever filter_width says; a Gaussian takes the width: 0.01 (Blender's least) is the centre.
+    c.pixel_filter_type = "GAUSSIAN"
+    c.filter_width = 0.01
     c.film_exposure = 1.0
     scene.render.film_transparent = False
     scene.render.use_motion_blur = False
