@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
-# tools/cycles_render.py against Limn (docs/cycles.md): a white plane under a
-# KHR sun, point and spot light, Cycles direct light (bounces 0) against
-# `limn capture --tech dl` (ambient 0), mean brightness within 1% for each;
-# two PBR spheres (a rough gold metal, a rough red dielectric) against
-# materials=pbr, mean brightness within 1% and mean |difference| within 3% of
-# the mean; a corrupt glTF and a bad spec fail naming the view and the part,
-# exit 1, and leave no image. Linear EXR on both sides, compared by
-# `limn compare` (mean |value| is the mean error against a black image).
+# tools/cycles_render.py against Limn (docs/cycles.md), 64x48, Cycles direct
+# light (bounces 0) against `limn capture --tech dl` (ambient 0), linear EXR
+# on both sides compared by `limn compare` (the mean |value| is the mean error
+# against a black image):
+# - a white plane under a KHR sun, point and spot light: mean within 1%;
+# - a rough gold metal and a rough red dielectric sphere, materials=pbr: mean
+#   within 1%, mean |difference| within 3% of the mean;
+# - sky.lua's sky: the gradient on a plane within 2%, an HDR map on the plane
+#   within 5%, the map on a sphere within 15% mean |difference| (its bright
+#   patch on the sphere's +X side: a map turned wrong gives 86% or more);
+# - a corrupt glTF, a missing scene, a bad spec field and a required extension
+#   Limn lacks: each named by view and part, exit 1, no image from them, the
+#   good view of the same run rendered, no temporary file left.
 # Skipped (77) without Blender.
 set -u
 limn=$1
@@ -37,37 +42,10 @@ within() { # within NAME VALUE LO HI
 }
 
 python3 "$root/tests/cycles_map_scenes.py" "$tmp" 64 48 2 || exit 1
-limn_dl() { # limn_dl SCENE OUT [SETS...]
-  local scene=$1 out=$2; shift 2
-  "$limn" capture --scene "$tmp/$scene.gltf" --tech dl --set ambient=0 --size 64x48 --quiet --output "$out" "$@" ||
-    echo "  limn capture $scene failed"
-}
-limn_dl sun "$tmp/black.exr" --camera 1
-for s in sun point spot; do limn_dl $s "$tmp/limn_$s.exr"; done
-limn_dl spheres "$tmp/limn_spheres.exr" --set materials=pbr
-
-cycles "$tmp/sun_phong.json" "$tmp/cycles_sun.exr" "$tmp/point_phong.json" "$tmp/cycles_point.exr" \
-  "$tmp/spot_phong.json" "$tmp/cycles_spot.exr" "$tmp/spheres_pbr.json" "$tmp/cycles_spheres.exr"
-check "cycles renders the four views" test "$rc" -eq 0 -a -f "$tmp/cycles_spheres.exr"
-[ "$rc" -eq 0 ] || sed 's/^/  | /' "$tmp/err.txt" | tail -5
-check "black is black" within "black mean" "$(mean "$tmp/black.exr")" 0 0
-for s in sun point spot; do
-  c=$(mean "$tmp/cycles_$s.exr") l=$(mean "$tmp/limn_$s.exr")
-  ratio=$(python3 -c "print($c / $l if $l > 0 else 0)")
-  echo "$s: Cycles direct mean $c, Limn dl $l, ratio $ratio"
-  check "$s light: Cycles within 1% of dl" within "$s ratio" "$ratio" 0.99 1.01
-done
-c=$(mean "$tmp/cycles_spheres.exr") l=$(mean "$tmp/limn_spheres.exr")
-d=$(field "$("$limn" compare "$tmp/cycles_spheres.exr" "$tmp/limn_spheres.exr" --json)" mean_error)
-ratio=$(python3 -c "print($c / $l if $l > 0 else 0)") share=$(python3 -c "print($d / $l if $l > 0 else 1)")
-echo "pbr spheres: Cycles mean $c, Limn pbr $l, ratio $ratio, mean |difference| $share of the mean"
-check "pbr spheres: mean within 1%" within "pbr ratio" "$ratio" 0.99 1.01
-check "pbr spheres: mean |difference| within 3% of the mean" within "pbr difference" "$share" 0 0.03
-
 # sky.lua's sky as Cycles' world, against Limn's dl with the sky (its 3-band spherical harmonics):
 # the gradient on a plane facing up; the map on the plane (up is up) and on a sphere filling the
 # view, lit from +X by the map's bright patch (a map turned the wrong way lights the other side).
-python3 - "$tmp" <<'PYEOF2' || exit 1
+python3 - "$tmp" <<'EOF' || exit 1
 import json, sys
 d = sys.argv[1]
 grad = {"zenith": [0.1, 0.15, 0.3], "horizon": [0.3, 0.32, 0.35], "intensity": 2.0, "map": ""}
@@ -76,42 +54,82 @@ for scene, sky, name in (("sky", grad, "grad"), ("sky", hdr, "map"), ("skyball",
     s = json.load(open("%s/%s_phong.json" % (d, scene)))
     s["samples"], s["sky"] = 64, sky  # the sky is sampled: 64 paths a pixel keep the noise near 1%
     json.dump(s, open("%s/%s.json" % (d, name), "w"))
-PYEOF2
-grad=(--set sky.enabled=true --set sky.zenith=0.1,0.15,0.3 --set sky.horizon=0.3,0.32,0.35 --set sky.intensity=2)
-limn_dl sky "$tmp/limn_grad.exr" "${grad[@]}"
+EOF
+limn_dl() { # limn_dl SCENE OUT [SETS...]
+  local scene=$1 out=$2; shift 2
+  "$limn" capture --scene "$tmp/$scene.gltf" --tech dl --set ambient=0 --size 64x48 --quiet --output "$out" "$@" ||
+    echo "  limn capture $scene failed"
+}
+limn_dl sun "$tmp/black.exr" --camera 1
+for s in sun point spot; do limn_dl $s "$tmp/limn_$s.exr"; done
+limn_dl spheres "$tmp/limn_spheres.exr" --set materials=pbr
+limn_dl sky "$tmp/limn_grad.exr" --set sky.enabled=true --set sky.zenith=0.1,0.15,0.3 \
+  --set sky.horizon=0.3,0.32,0.35 --set sky.intensity=2
 limn_dl sky "$tmp/limn_map.exr" --set sky.enabled=true --set "sky.map=$tmp/sky.hdr"
 limn_dl skyball "$tmp/limn_ballmap.exr" --set sky.enabled=true --set "sky.map=$tmp/sky.hdr"
-cycles "$tmp/grad.json" "$tmp/cycles_grad.exr" "$tmp/map.json" "$tmp/cycles_map.exr" \
-  "$tmp/ballmap.json" "$tmp/cycles_ballmap.exr"
-check "cycles renders the sky views" test "$rc" -eq 0 -a -f "$tmp/cycles_ballmap.exr"
-[ "$rc" -eq 0 ] || sed 's/^/  | /' "$tmp/err.txt" | tail -5
-for v in grad:0.98:1.02 map:0.95:1.05; do
-  IFS=: read -r name lo hi <<<"$v"
-  c=$(mean "$tmp/cycles_$name.exr") l=$(mean "$tmp/limn_$name.exr")
-  ratio=$(python3 -c "print($c / $l if $l > 0 else 0)")
-  echo "sky $name on a plane: Cycles mean $c, Limn dl $l, ratio $ratio"
-  check "sky $name: plane within $lo..$hi of dl" within "sky $name ratio" "$ratio" "$lo" "$hi"
-done
-l=$(mean "$tmp/limn_ballmap.exr")
-d=$(field "$("$limn" compare "$tmp/cycles_ballmap.exr" "$tmp/limn_ballmap.exr" --json)" mean_error)
-share=$(python3 -c "print($d / $l if $l > 0 else 1)")
-echo "sky map on a sphere: mean |difference| $share of Limn's mean"
-check "sky map on a sphere: mean |difference| within 15%" within "sky map sphere difference" "$share" 0 0.15
 
-# A corrupt glTF: named, exit 1, no image.
+# Every view in one Blender run (its start costs seconds).
+views=(sun_phong:sun point_phong:point spot_phong:spot spheres_pbr:spheres grad:grad map:map ballmap:ballmap)
+args=()
+for v in "${views[@]}"; do args+=("$tmp/${v%%:*}.json" "$tmp/cycles_${v##*:}.exr"); done
+cycles "${args[@]}"
+check "cycles renders the views" test "$rc" -eq 0 -a -f "$tmp/cycles_ballmap.exr"
+[ "$rc" -eq 0 ] || sed 's/^/  | /' "$tmp/err.txt" | tail -5
+check "black is black" within "black mean" "$(mean "$tmp/black.exr")" 0 0
+ratio() { # ratio NAME LO HI: Cycles' mean over Limn's, within LO..HI
+  local c l r
+  c=$(mean "$tmp/cycles_$1.exr") l=$(mean "$tmp/limn_$1.exr")
+  r=$(python3 -c "print($c / $l if $l > 0 else 0)")
+  echo "$1: Cycles mean $c, Limn dl $l, ratio $r"
+  check "$1: Cycles / Limn within $2..$3" within "$1 ratio" "$r" "$2" "$3"
+}
+difference() { # difference NAME MAX: mean |Cycles - Limn| over Limn's mean, at most MAX
+  local d l r
+  d=$(field "$("$limn" compare "$tmp/cycles_$1.exr" "$tmp/limn_$1.exr" --json)" mean_error)
+  l=$(mean "$tmp/limn_$1.exr")
+  r=$(python3 -c "print($d / $l if $l > 0 else 1)")
+  echo "$1: mean |difference| $r of Limn's mean"
+  check "$1: mean |difference| within $2 of the mean" within "$1 difference" "$r" 0 "$2"
+}
+ratio sun 0.99 1.01
+ratio point 0.99 1.01
+ratio spot 0.99 1.01
+ratio spheres 0.99 1.01
+difference spheres 0.03
+ratio grad 0.98 1.02
+ratio map 0.95 1.05
+difference ballmap 0.15
+
+# Bad views in one run: each named (view and part), exit 1, no image from them, a good view's image.
 head -c 300 "$tmp/sun.gltf" >"$tmp/corrupt.gltf"
-sed "s|$tmp/sun.gltf|$tmp/corrupt.gltf|; s|\"view\": \"sun\"|\"view\": \"broken\"|" "$tmp/sun_phong.json" \
-  >"$tmp/corrupt.json"
-cycles "$tmp/corrupt.json" "$tmp/corrupt.exr"
-check "corrupt glTF: exit 1" test "$rc" -eq 1
-check "corrupt glTF: named" grep -qF "limn cycles: view 'broken': scene $tmp/corrupt.gltf: not glTF JSON" "$tmp/err.txt"
-check "corrupt glTF: no image" test ! -e "$tmp/corrupt.exr"
-# A bad spec field, named; and a view after a good one that fails leaves the good one only.
-sed 's|"samples": 2|"samples": -3|' "$tmp/point_phong.json" >"$tmp/bad.json"
-cycles "$tmp/sun_phong.json" "$tmp/good.exr" "$tmp/bad.json" "$tmp/bad.exr"
-check "bad spec: exit 1" test "$rc" -eq 1
-check "bad spec: named" grep -qF "limn cycles: view 'point': samples: wants an integer in 1..1048576, not -3" "$tmp/err.txt"
-check "bad spec: no image, the good view's image" test ! -e "$tmp/bad.exr" -a -s "$tmp/good.exr"
+python3 - "$tmp" <<'EOF' || exit 1
+import json, sys
+d = sys.argv[1]
+base = json.load(open(d + "/sun_phong.json"))
+def spec(name, **kw):
+    s = dict(base, view=name, **kw)
+    json.dump(s, open("%s/%s.json" % (d, name), "w"))
+spec("corrupt", scene=d + "/corrupt.gltf")
+spec("missing", scene=d + "/nosuch.glb")
+spec("badsamples", samples=-3)
+doc = json.load(open(d + "/sun.gltf"))
+doc["extensionsUsed"] = doc["extensionsRequired"] = ["KHR_draco_mesh_compression"]
+json.dump(doc, open(d + "/draco.gltf", "w"))
+spec("draco", scene=d + "/draco.gltf")
+EOF
+bad=(corrupt missing badsamples draco)
+args=("$tmp/sun_phong.json" "$tmp/good.exr")
+for v in "${bad[@]}"; do args+=("$tmp/$v.json" "$tmp/$v.exr"); done
+cycles "${args[@]}"
+check "bad views: exit 1" test "$rc" -eq 1
+has() { grep -qF -- "$1" "$tmp/err.txt" || { echo "  stderr lacks '$1':"; sed 's/^/  | /' "$tmp/err.txt" | tail -5; return 1; }; }
+check "corrupt glTF named" has "limn cycles: view 'corrupt': scene $tmp/corrupt.gltf: not glTF JSON"
+check "missing scene named" has "limn cycles: view 'missing': scene $tmp/nosuch.glb: no such file"
+check "bad samples named" has "limn cycles: view 'badsamples': samples: wants an integer in 1..1048576, not -3"
+check "unmapped extension named" has \
+  "limn cycles: view 'draco': scene $tmp/draco.gltf: requires extension KHR_draco_mesh_compression"
+for v in "${bad[@]}"; do check "$v: no image" test ! -e "$tmp/$v.exr"; done
+check "the good view among them is rendered" test -s "$tmp/good.exr"
 check "no temporary file left" test -z "$(find "$tmp" -name '.cycles-*')"
 
 echo "$passed passed, $failed failed"

@@ -4,8 +4,8 @@
 #   blender -b --factory-startup -noaudio --python-exit-code 1 \
 #           --python tools/cycles_render.py -- SPEC.json OUT.exr [SPEC.json OUT.exr ...]
 #
-# (several pairs in one run save Blender's start, seconds a view; the first
-# that fails stops the run, the views before it are written).
+# Several pairs in one run save Blender's start (seconds) a view; each fails
+# or renders on its own, and the run exits 1 when any failed.
 #
 # SPEC.json, one object (every key required unless marked optional):
 #   scene      absolute path of the .glb/.gltf file (Limn's coordinates: +Y up)
@@ -651,12 +651,12 @@ def render(spec, out):
     folder = os.path.dirname(os.path.abspath(out))
     if not os.path.isdir(folder):
         fail("output %s" % out, "no such folder")
-    fd, tmp = tempfile.mkstemp(prefix=".cycles-", suffix=".exr", dir=folder)
-    os.close(fd)
+    # Not created before Blender writes it (at the render's end): a render killed midway leaves nothing.
+    tmp = os.path.join(folder, ".cycles-%s-%d.exr" % (os.path.basename(out), os.getpid()))
     try:
         bpy.context.scene.render.filepath = tmp
         bpy.ops.render.render(write_still=True)
-        if os.path.getsize(tmp) == 0:
+        if not os.path.isfile(tmp) or os.path.getsize(tmp) == 0:
             fail("render", "Cycles wrote no image")
         os.replace(tmp, out)
     finally:
@@ -664,30 +664,45 @@ def render(spec, out):
             os.remove(tmp)
 
 
+def render_view(spec_path, out):
+    global VIEW
+    VIEW = "?"
+    WARNED.clear()
+    spec = read_spec(spec_path)
+    with tempfile.TemporaryDirectory(prefix="limn-cycles-") as folder:
+        doc, lights = import_scene(spec, folder)
+        map_lights(lights)
+        map_materials(doc, spec["materials"])
+        map_world(spec)
+        set_camera(spec)
+        configure(spec)
+        render(spec, out)
+
+
 def main(argv):
+    """Renders each SPEC OUT pair; 1 when any failed (each failure named, the others rendered)."""
     args = argv[argv.index("--") + 1:] if "--" in argv else []
     if len(args) < 2 or len(args) % 2:
-        fail("usage", "blender -b --factory-startup -noaudio --python-exit-code 1 --python "
-             "tools/cycles_render.py -- SPEC.json OUT.exr [SPEC.json OUT.exr ...]")
-    # Several views in one run save Blender's start (seconds) a view; the first that fails stops the run.
-    for i in range(0, len(args), 2):
-        WARNED.clear()
-        spec = read_spec(args[i])
-        with tempfile.TemporaryDirectory(prefix="limn-cycles-") as folder:
-            doc, lights = import_scene(spec, folder)
-            map_lights(lights)
-            map_materials(doc, spec["materials"])
-            map_world(spec)
-            set_camera(spec)
-            configure(spec)
-            render(spec, args[i + 1])
+        print("%s: usage: blender -b --factory-startup -noaudio --python-exit-code 1 --python "
+              "tools/cycles_render.py -- SPEC.json OUT.exr [SPEC.json OUT.exr ...]" % PREFIX, file=sys.stderr)
+        return 1
+    failed = 0
+    for i in range(0, len(args), 2):  # several views in one run save Blender's start (seconds) a view
+        try:
+            render_view(args[i], args[i + 1])
+        except SpecError as e:
+            print("%s: view '%s': %s" % (PREFIX, VIEW, e), file=sys.stderr)
+            failed += 1
+        except Exception as e:  # a fault of this script or of Blender's: still named by view
+            print("%s: view '%s': %s: %s" % (PREFIX, VIEW, type(e).__name__, e), file=sys.stderr)
+            failed += 1
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":
-    try:
-        main(sys.argv)
-    except SpecError as e:
-        print("%s: view '%s': %s" % (PREFIX, VIEW, e), file=sys.stderr)
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(1)  # sys.exit from a --python script leaves Blender running on
+    status = main(sys.argv)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    # The status at once; with 0 Blender quits as usual.
+    if status:
+        os._exit(status)
