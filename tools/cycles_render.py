@@ -309,7 +309,8 @@ def unfold_spot(light):
     """Cycles 3.4 weighs a spot's light by the cosine to its axis as well as
     by the cone's smoothstep; KHR_lights_punctual (and Limn) by the cone
     alone: the light's strength is divided by that cosine (the light's local
-    -Z, its Normal coordinate), never below cos(outer) inside the cone."""
+    -Z, its Normal coordinate; at least cos(outer) inside the cone, and the
+    division kept finite outside it)."""
     light.use_nodes = True
     nodes, links = light.node_tree.nodes, light.node_tree.links
     emission = next(n for n in nodes if n.type == "EMISSION")
@@ -399,20 +400,17 @@ def glossy_of_phong(shininess):
     return (1.0 / (2.0 * shininess + 1.0)) ** 0.25
 
 
-def build_phong(t, base, normal, pv):
+def build_phong(t, base, pv):
     """Lambert k_d albedo + a GGX lobe carrying the Phong lobe's energy at
-    normal incidence, 2 k_s / (n + 2) (Limn's Phong is not normalized)."""
+    normal incidence, 2 k_s / (n + 2) (Limn's Phong is not normalized). The
+    geometric normal: Limn's std technique reads no normal map."""
     albedo = t.mix("MULTIPLY", 1.0, base, 1.0, clamp=True)
     diffuse = t.node("ShaderNodeBsdfDiffuse", Color=t.mix("MULTIPLY", 1.0, albedo, pv["kd"]), Roughness=0.0)
-    if normal is not None:
-        t.set(diffuse.inputs["Normal"], normal)
     if pv["ks"] <= 0.0:
         return diffuse.outputs[0]
     n = pv["shininess"]
     glossy = t.node("ShaderNodeBsdfGlossy", Color=2.0 * pv["ks"] / (n + 2.0), Roughness=glossy_of_phong(n))
     glossy.distribution = "GGX"
-    if normal is not None:
-        t.set(glossy.inputs["Normal"], normal)
     warn("phong", "materials=phong: Phong's specular lobe (k_s (r.v)^n) is approximated by a GGX lobe of "
          "the same energy at normal incidence (docs/cycles.md)")
     return add(t, diffuse.outputs[0], glossy.outputs[0])
@@ -459,7 +457,7 @@ def map_material(mat, gm, mode):
     base = t.source(inp["Base Color"])
     normal = inp["Normal"].links[0].from_socket if inp["Normal"].is_linked else None
     if mode == "phong":
-        shader = build_phong(t, base, normal, phong_values(gm))
+        shader = build_phong(t, base, phong_values(gm))
         em = gm.get("emissiveFactor", [0, 0, 0]) if gm else [0, 0, 0]
         if max(em) > 0.0 or (gm and "emissiveTexture" in gm):
             warn("phong emissive", "materials=phong: emissive materials are dark in Limn's Phong: left dark")
@@ -487,7 +485,7 @@ def default_material(mode):
     t = Tree(mat)
     output = next(n for n in t.nodes if n.type == "OUTPUT_MATERIAL")
     if mode == "phong":
-        shader = build_phong(t, DEFAULT_PHONG["color"], None, DEFAULT_PHONG)
+        shader = build_phong(t, DEFAULT_PHONG["color"], DEFAULT_PHONG)
     else:  # Limn derives metallic 1 - k_d and the roughness of the exponent
         s = DEFAULT_PHONG["shininess"]
         shader = build_pbr(t, DEFAULT_PHONG["color"], 1.0 - DEFAULT_PHONG["kd"], (2.0 / (s + 2.0)) ** 0.25, None)
