@@ -424,27 +424,26 @@ def add(t, a, b):
 
 
 def build_pbr(t, base, metallic, roughness, normal):
-    """glTF's BRDF: Lambert (1 - F)(1 - metallic) base + GGX with Schlick's F,
-    F0 = mix(0.04, base, metallic). Nodes see n.v, not v.h: F is Schlick's
-    at n.v (see docs/cycles.md for what that leaves)."""
+    """glTF's BRDF: Lambert (1 - F)(1 - metallic) base + GGX with F at v.h,
+    F0 = mix(0.04, base, metallic). The GGX lobe is Blender's Principled BSDF
+    at metallic 1 and base F0: its Fresnel runs from F0 at v.h = 1 to 1 at
+    grazing (a dielectric's curve of ior 1.5 rescaled, not Schlick's), and
+    its diffuse part is 0. Nodes do not see v.h: the diffuse weight is
+    1 - F0, F where light and view meet head on (docs/cycles.md)."""
     base = t.mix("MULTIPLY", 1.0, base, 1.0, clamp=True)
     metallic = t.math("MULTIPLY", metallic, 1.0, clamp=True)
     rough = t.math("MAXIMUM", t.math("MULTIPLY", roughness, 1.0, clamp=True), PBR_MIN_ROUGHNESS)
     f0 = t.mix("MIX", metallic, 0.04, base)
-    facing = t.node("ShaderNodeLayerWeight", Blend=0.5)
-    if normal is not None:
-        t.set(facing.inputs["Normal"], normal)
-    fc = t.math("POWER", facing.outputs["Facing"], 5.0)
-    f = t.mix("MIX", fc, f0, 1.0)
     diffuse_colour = t.mix("MULTIPLY", 1.0, t.mix("MULTIPLY", 1.0, base, t.math("SUBTRACT", 1.0, metallic)),
-                           t.mix("SUBTRACT", 1.0, 1.0, f))
+                           t.mix("SUBTRACT", 1.0, 1.0, f0))
     diffuse = t.node("ShaderNodeBsdfDiffuse", Color=diffuse_colour, Roughness=0.0)
-    glossy = t.node("ShaderNodeBsdfGlossy", Color=f, Roughness=rough)
-    glossy.distribution = "GGX"
-    for n in (diffuse, glossy):
+    specular = t.node("ShaderNodeBsdfPrincipled", **{"Base Color": f0, "Metallic": 1.0, "Roughness": rough,
+                                                     "Specular": 0.5})
+    specular.distribution = "GGX"  # single scattering, as glTF's
+    for n in (diffuse, specular):
         if normal is not None:
             t.set(n.inputs["Normal"], normal)
-    return add(t, diffuse.outputs[0], glossy.outputs[0])
+    return add(t, diffuse.outputs[0], specular.outputs[0])
 
 
 def map_material(mat, gm, mode):
