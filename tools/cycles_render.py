@@ -23,6 +23,8 @@
 #                 column looking along -Z)}
 #   ambient    optional: Limn's uniform ambient radiance ([r,g,b] or x, 0 when
 #              absent), added to the sky as a uniform sky of that radiance
+#   time       optional: seconds into the file's animation (0 when absent);
+#              Blender's importer plays the file's first animation only
 #
 # OUT.exr: linear RGB float OpenEXR (32-bit), rendered under a temporary name
 # in OUT's folder and renamed on success. Errors print one line naming the
@@ -104,7 +106,7 @@ def read_spec(path):
     global VIEW
     VIEW = str(spec.get("view", "?"))
     known = {"scene", "camera", "width", "height", "samples", "bounces", "seed", "materials", "view", "sky",
-             "ambient"}
+             "ambient", "time"}
     for k in spec:
         if k not in known:
             fail("spec", "unknown key '%s' (known: %s)" % (k, ", ".join(sorted(known))))
@@ -134,6 +136,7 @@ def read_spec(path):
         fail("materials", 'wants "phong" or "pbr", not %s' % json.dumps(spec.get("materials")))
     s["materials"] = spec["materials"]
     s["ambient"] = colour(spec["ambient"], "ambient") if "ambient" in spec else [0.0, 0.0, 0.0]
+    s["time"] = number(spec, "time", -1e6, 1e6) if "time" in spec else 0.0
     sky = spec.get("sky")
     if sky is None:
         s["sky"] = None
@@ -252,6 +255,9 @@ def import_scene(spec, folder):
     path = spec["scene"]
     doc, binary = read_gltf(path)
     lights = check_and_tag(doc, path)
+    if len(doc.get("animations", [])) > 1:
+        warn("animations", "scene %s: %d animations: Blender's importer plays the first only (Limn all of them)"
+             % (path, len(doc["animations"])))
     tagged = write_tagged(doc, binary, path, folder)
     # An empty start: the factory scene's cube, light and camera, or the previous view's scene.
     for kind in ("objects", "meshes", "materials", "lights", "cameras", "images", "worlds", "node_groups",
@@ -605,6 +611,9 @@ def set_camera(spec):
 
 def configure(spec):
     scene = bpy.context.scene
+    # The importer keys glTF time t at frame t * fps: the pose at the spec's time, not Blender's frame 1.
+    frame = spec["time"] * scene.render.fps / scene.render.fps_base
+    scene.frame_set(math.floor(frame), subframe=frame - math.floor(frame))
     scene.render.engine = "CYCLES"
     c = scene.cycles
     c.device = "CPU"
