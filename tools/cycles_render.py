@@ -1,4 +1,4 @@
-# Renders one Limn view with Blender's Cycles, the path-traced reference of
+# Renders Limn views with Blender's Cycles, the path-traced references of
 # `limn reference --renderer cycles` (docs/cycles.md states the mapping):
 #
 #   blender -b --factory-startup -noaudio --python-exit-code 1 \
