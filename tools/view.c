@@ -190,26 +190,6 @@ static void on_signal(int sig) {
   stop_requested = 1;
 }
 
-void say(viewer *v, const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(v->message, sizeof v->message, fmt, ap);
-  va_end(ap);
-  v->message_until = lm_now_ms() + 4000;
-  lm_info("%s", v->message);
-}
-
-/* An error shows once on stderr when it appears and once more when it clears. */
-void set_error(char *slot, size_t cap, const char *msg, const char *cleared) {
-  if (!msg) msg = "";
-  if (!strcmp(slot, msg)) return;
-  if (*msg)
-    lm_log(LM_LOG_ERROR, "%s", msg);
-  else if (*slot)
-    lm_info("%s", cleared);
-  snprintf(slot, cap, "%s", msg);
-}
-
 /* ---- camera ------------------------------------------------------------ */
 static int camera_node(const viewer *v) {
   return v->camera < v->scene->camera_count ? v->scene->cameras[v->camera].node : -1;
@@ -282,12 +262,6 @@ static void move_camera(viewer *v, double dt_ms) {
 }
 
 /* ---- time ------------------------------------------------------------- */
-long view_frame(const viewer *v) { return (long)floor(v->time * v->args->fps + 1e-6); }
-
-const char *view_animation_name(const viewer *v) {
-  return v->anim >= 0 && v->anim < v->scene->animation_count ? v->scene->animations[v->anim].name : "all";
-}
-
 /* One line a test can parse: "time 1.250000 s, frame 30, animation 'all', paused (why)". */
 static void report_time(const viewer *v, const char *why) {
   lm_info("time %.6f s, frame %ld, animation '%s'%s (%s)", v->time, view_frame(v), view_animation_name(v),

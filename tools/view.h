@@ -1,5 +1,6 @@
 /* The viewer's state, shared by view.c (command line, keys, reloading, the
- * loop) and view_display.c (inspector, overlay, what reaches the window). */
+ * loop) and view_display.c (messages, inspector, overlay, what reaches the
+ * window), which view.c calls and which calls nothing of view.c. */
 #ifndef LIMN_VIEW_H
 #define LIMN_VIEW_H
 
@@ -80,6 +81,7 @@ typedef struct viewer {
   int captures;
 } viewer;
 
+/* view_display.c */
 /* A note on screen for a few seconds and on stderr. */
 void say(viewer *v, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* An error shows once on stderr when it appears and once (as `cleared`) when it goes. */
@@ -88,8 +90,6 @@ void set_error(char *slot, size_t cap, const char *msg, const char *cleared);
 /* The frame number at the viewer's time (--fps frames a second) and its animation's name. */
 long view_frame(const viewer *v);
 const char *view_animation_name(const viewer *v);
-
-/* view_display.c */
 bool make_window_textures(viewer *v, lm_error *err);
 /* Draws the frame (or the inspected target) and the overlay into the back buffer. */
 void display(viewer *v);

@@ -1,6 +1,6 @@
-/* What reaches the viewer's window: the frame or an inspected target of the
- * frame graph (exposure, channel, false colour) under the text overlay;
- * captures and screenshots. */
+/* What reaches the viewer's user: messages and errors, the frame or an
+ * inspected target of the frame graph (exposure, channel, false colour)
+ * under the text overlay in the window; captures and screenshots. */
 #define _GNU_SOURCE
 #include <math.h>
 #include <stdarg.h>
@@ -10,6 +10,33 @@
 
 #include "image/image.h"
 #include "view.h"
+
+/* ---- messages and the time's names ------------------------------------- */
+void say(viewer *v, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(v->message, sizeof v->message, fmt, ap);
+  va_end(ap);
+  v->message_until = lm_now_ms() + 4000;
+  lm_info("%s", v->message);
+}
+
+/* An error shows once on stderr when it appears and once more when it clears. */
+void set_error(char *slot, size_t cap, const char *msg, const char *cleared) {
+  if (!msg) msg = "";
+  if (!strcmp(slot, msg)) return;
+  if (*msg)
+    lm_log(LM_LOG_ERROR, "%s", msg);
+  else if (*slot)
+    lm_info("%s", cleared);
+  snprintf(slot, cap, "%s", msg);
+}
+
+long view_frame(const viewer *v) { return (long)floor(v->time * v->args->fps + 1e-6); }
+
+const char *view_animation_name(const viewer *v) {
+  return v->anim >= 0 && v->anim < v->scene->animation_count ? v->scene->animations[v->anim].name : "all";
+}
 
 /* ---- inspector and overlay --------------------------------------------- */
 static const char *channel_name(int c) {

@@ -13,41 +13,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-void lm_scene_mesh_free_deform(lm_scene_mesh *m) {
-  free(m->rest);
-  free(m->prev_positions);
-  free(m->target_positions);
-  free(m->target_normals);
-  free(m->default_weights);
-  free(m->joints);
-  free(m->joint_weights);
-}
-
-void lm_scene_free_animations(lm_scene *s) {
-  for (int a = 0; a < s->animation_count; a++) {
-    for (int c = 0; c < s->animations[a].channel_count; c++) {
-      free(s->animations[a].channels[c].times);
-      free(s->animations[a].channels[c].values);
-    }
-    free(s->animations[a].channels);
-  }
-  free(s->animations);
-  for (int k = 0; k < s->skin_count; k++) {
-    free(s->skins[k].joints);
-    free(s->skins[k].inverse_bind);
-  }
-  free(s->skins);
-}
-
-void lm_scene_shift_animation_nodes(lm_scene *s, int from, int by) {
-  for (int a = 0; a < s->animation_count; a++)
-    for (int c = 0; c < s->animations[a].channel_count; c++)
-      if (s->animations[a].channels[c].node >= from) s->animations[a].channels[c].node += by;
-  for (int k = 0; k < s->skin_count; k++)
-    for (int j = 0; j < s->skins[k].joint_count; j++)
-      if (s->skins[k].joints[j] >= from) s->skins[k].joints[j] += by;
-}
-
 bool lm_scene_animated(const lm_scene *s) { return s->animation_count > 0; }
 
 int lm_scene_find_animation(const lm_scene *s, const char *spec, lm_error *err) {
