@@ -19,6 +19,7 @@ packages=(
   clang libclang-rt-14-dev povray valgrind libxml2-utils
   slurmctld slurmd slurm-client munge    # tests/test_slurm.sh starts a one-node cluster
   python3                                # tests read JSON and GLB with it (test_scenes_gen, test_tools_cli)
+  blender                                # Cycles references (limn reference --renderer cycles, tools/cycles_render.py)
 )
 
 deps() {
