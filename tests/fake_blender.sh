@@ -8,7 +8,8 @@
 # folder). --version prints
 # "Blender $FAKE_BLENDER_VERSION" (default 0.0). On demand:
 #   FAKE_BLENDER_FAIL=1    prints an error naming the view and exits 1, writing nothing
-#   FAKE_BLENDER_SLEEP=S   writes half a file to OUT, then sleeps S seconds (to be killed)
+#   FAKE_BLENDER_SLEEP=S   writes half a file to OUT and a temporary beside it, then sleeps S seconds
+#                          (to be killed)
 set -u
 if [ "${1:-}" = --version ]; then
   echo "Blender ${FAKE_BLENDER_VERSION:-0.0} (limn test double)"
@@ -43,8 +44,9 @@ if [ -n "${FAKE_BLENDER_FAIL:-}" ]; then
   echo "Error: cycles_render: view $view: cannot import the scene (a test double's failure)"
   exit 1
 fi
-if [ -n "${FAKE_BLENDER_SLEEP:-}" ]; then
+if [ -n "${FAKE_BLENDER_SLEEP:-}" ]; then # half an output, and a temporary of its own beside it
   head -c 100 /dev/zero > "$out"
+  head -c 100 /dev/zero > "$(dirname "$out")/.cycles-render.exr"
   sleep "$FAKE_BLENDER_SLEEP"
 fi
 # One capture a size (kept in $FAKE_BLENDER_CACHE when set): the image itself matters less than its size.

@@ -120,8 +120,8 @@ stop_mid_view() { # signal
   rm -f calls
   FAKE_BLENDER_SLEEP=30 "$limn" reference --job job.lua "${cy[@]}" --refs refs-kill >log 2>&1 &
   local pid=$! i
-  for i in $(seq 100); do [ -s calls ] && [ -n "$(ls refs-kill/ball/*.tmp-* 2>/dev/null)" ] && break; sleep 0.1; done
-  [ -s calls ] || fail "the render did not start"
+  for i in $(seq 100); do [ -n "$(ls -A refs-kill/ball/*.tmp-*/.cycles-render.exr 2>/dev/null)" ] && break; sleep 0.1; done
+  [ -s calls ] && [ -n "$(ls -A refs-kill/ball/*.tmp-*/)" ] || fail "the render did not start"
   fake=$(pgrep -f "fake_blender.sh .*refs-kill" | head -1)
   [ -n "$fake" ] || fail "no Blender running"
   kill -"$1" "$pid"
@@ -132,13 +132,13 @@ stop_mid_view() { # signal
   return 0
 }
 stop_mid_view TERM
-ls refs-kill/ball/ | grep -q tmp && fail "SIGTERM left a partial file: $(ls refs-kill/ball)"
+[ -z "$(find refs-kill -name "*tmp*" -o -name ".cycles*")" ] || fail "SIGTERM left partial files: $(find refs-kill)"
 grep -q "stopped by signal 15; no partial reference left" log || { cat log; fail "SIGTERM is not said"; }
 stop_mid_view KILL
-ls refs-kill/ball/*.tmp-* >/dev/null 2>&1 || fail "the partial file of a SIGKILLed run is not there to clear"
+[ -n "$(ls -A refs-kill/ball/*.tmp-*/ 2>/dev/null)" ] || fail "the partial files of a SIGKILLed run are not there to clear"
 "$limn" reference --job job.lua "${cy[@]}" --refs refs-kill >log 2>&1 || { cat log; fail "run after a kill"; }
-[ "$(ls refs-kill/ball/)" = "$(basename "${ref%.exr}").exr
-$(basename "${ref%.exr}").json" ] || fail "after a kill and a rerun: $(ls refs-kill/ball)"
+[ "$(ls -A refs-kill/ball/)" = "$(basename "${ref%.exr}").exr
+$(basename "${ref%.exr}").json" ] || fail "after a kill and a rerun: $(ls -A refs-kill/ball)"
 
 # 6. Shards split the views: 0/2 renders the first camera, 1/2 the second, then both are cached.
 sed 's/one.cams/ball.cams/' job.lua > two.lua

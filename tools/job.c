@@ -629,7 +629,9 @@ bool job_make_parent(const char *file, lm_error *err) {
   return true;
 }
 
-void job_remove_stale_temps(const char *output) {
+/* A killed run can leave its temporary files (lm_image_write's
+ * "<stem>.tmp-<pid><ext>"): remove those of this output. */
+static void remove_stale_temps(const char *output) {
   char pattern[1200];
   const char *dot = strrchr(output, '.'), *slash = strrchr(output, '/');
   if (!dot || (slash && dot < slash)) return;
@@ -1037,7 +1039,7 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     const job_view *v = &views[i];
     const job_scene *s = &j->scenes[v->scene];
     char what[1200];
-    job_remove_stale_temps(v->output);
+    remove_stale_temps(v->output);
     if (!a->force && lm_file_exists(v->output)) {
       skipped++;
       snprintf(what, sizeof what, "%s: exists, skipped", v->output);

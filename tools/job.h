@@ -84,9 +84,6 @@ void job_pose(const job *j, const job_view *v);
  * stills; for sequences contiguous runs of views, so that a shard renders
  * consecutive frames and temporal histories carry from frame to frame. */
 int job_shard_of(const job *j, int i, int count, int shards);
-/* A killed run can leave its temporary files (lm_image_write's and the
- * references' "<stem>.tmp-<pid><ext>"): removes those of this output. */
-void job_remove_stale_temps(const char *output);
 /* Creates the folders above `file`. */
 bool job_make_parent(const char *file, lm_error *err);
 /* A progress bar on a terminal (tty), else one line per item. */

@@ -6,15 +6,18 @@
  * Debian's povray.conf lets it write only below the current directory. A
  * renderer's output goes to a log beside its input, shown when it fails. */
 #define _GNU_SOURCE
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <getopt.h>
+#include <glob.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -271,7 +274,8 @@ typedef struct render_run {
   pid_t pid;
   int place;
   char base[1024]; /* the reference's path without .exr */
-  char tmp[1100];
+  char tmp[1100];  /* <base>.tmp-<pid>: POV-Ray's output (.exr), or Blender's folder (its output and temporaries) */
+  char out[1200];  /* what the renderer writes: tmp, or tmp/out.exr */
 } render_run;
 
 /* SIGINT or SIGTERM while renders run: they are killed here, and the loop,
@@ -285,12 +289,26 @@ static void on_stop(int sig) {
   for (int k = 0; k < running_count; k++) kill(running_runs[k].pid, SIGKILL);
 }
 
-/* A failed or stopped render: its partial output removed, and any a killed run left. */
-static void discard(const render_run *r) {
-  char final[1100];
-  remove(r->tmp);
-  snprintf(final, sizeof final, "%s.exr", r->base);
-  job_remove_stale_temps(final);
+/* A render's temporary: a file, or a folder with what the renderer left in it. */
+static void remove_temp(const char *path) {
+  DIR *d = opendir(path);
+  for (struct dirent *e; d && (e = readdir(d));) {
+    char file[2400];
+    snprintf(file, sizeof file, "%s/%s", path, e->d_name);
+    if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) remove(file);
+  }
+  if (d) closedir(d);
+  remove(path); /* a file, or the folder now empty */
+}
+
+/* Every temporary of the reference at base: a failed or stopped render's, and any a killed run left. */
+static void clear_temps(const char *base) {
+  char pattern[1100];
+  snprintf(pattern, sizeof pattern, "%s.tmp-*", base);
+  glob_t g;
+  if (glob(pattern, GLOB_NOSORT, NULL, &g) == 0)
+    for (size_t i = 0; i < g.gl_pathc; i++) remove_temp(g.gl_pathv[i]);
+  globfree(&g);
 }
 
 static void view_error(const job *j, const job_view *places, int place, bool newline, const char *fmt, ...)
@@ -347,17 +365,18 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
       char final[1100], log[1100];
       snprintf(final, sizeof final, "%s.exr", r->base);
       snprintf(log, sizeof log, "%s.log", r->base);
-      bool ok = !stop_signal && WIFEXITED(status) && WEXITSTATUS(status) == 0 && lm_file_exists(r->tmp) &&
-                rename(r->tmp, final) == 0;
+      bool ok = !stop_signal && WIFEXITED(status) && WEXITSTATUS(status) == 0 && lm_file_exists(r->out) &&
+                rename(r->out, final) == 0;
       if (ok) {
+        clear_temps(r->base);
         remove(log);
         rendered++;
         snprintf(what, sizeof what, "%s", final);
         job_progress(a->quiet, tty, ++done, mine, what);
       } else if (stop_signal) {
-        discard(r);
+        clear_temps(r->base);
       } else {
-        discard(r);
+        clear_temps(r->base);
         if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
           view_error(j, places, r->place, tty && !a->quiet, "%s exited 0 but wrote no image; its log %s:", name, log);
         else
@@ -389,17 +408,21 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
     char in[1100];
     if (ok) {
       snprintf(r->base, sizeof r->base, "%.*s", (int)(strlen(path) - 4), path);
-      snprintf(r->tmp, sizeof r->tmp, "%s.tmp-%ld.exr", r->base, (long)getpid());
+      snprintf(r->tmp, sizeof r->tmp, "%s.tmp-%ld%s", r->base, (long)getpid(), cycles ? "" : ".exr");
+      snprintf(r->out, sizeof r->out, "%s%s", r->tmp, cycles ? "/out.exr" : "");
       snprintf(in, sizeof in, "%s.%s", r->base, cycles ? "json" : "pov");
       ok = job_make_parent(path, &err) && limn_write_whole(in, input.data, (size_t)input.len, &err);
-      if (ok) job_remove_stale_temps(path);
+      if (ok) clear_temps(r->base);
+      /* Blender's own folder: whatever it writes beside its output goes with it. */
+      if (ok && cycles && mkdir(r->tmp, 0777) != 0)
+        lm_error_set(&err, "%s: cannot make folder (%s)", r->tmp, strerror(errno)), ok = false;
     }
     lm_buf_free(&input);
     if (ok) {
       char log[1100];
       snprintf(log, sizeof log, "%s.log", r->base);
       int w = j->sizes[v->size][0], h = j->sizes[v->size][1];
-      r->pid = cycles ? reference_cycles_start(&a->cycles, in, r->tmp, log, threads)
+      r->pid = cycles ? reference_cycles_start(&a->cycles, in, r->out, log, threads)
                       : start_povray(a, r->base, r->tmp, w, h, threads);
       if (r->pid < 0) lm_error_set(&err, "cannot start %s: %s", name, strerror(errno)), ok = false;
     }
