@@ -152,6 +152,8 @@ static void clean(const char *s, char *out, size_t cap) {
   out[i] = '\0';
 }
 
+/* ---- POV-Ray's part ------------------------------------------------------ */
+
 /* POV-Ray's input: the exported scene text; its hash covers that and the command line's settings. */
 static bool pov_export(const reference_args *a, const job *j, const job_view *v, lm_buf *sdl, uint64_t *hash,
                        lm_error *err) {
@@ -178,6 +180,28 @@ static bool pov_export(const reference_args *a, const job *j, const job_view *v,
   *hash = lm_hash(sdl->data, (size_t)sdl->len, lm_hash(cmd, strlen(cmd), LM_HASH_SEED));
   return true;
 }
+
+static const char *file_part(const char *p) {
+  const char *s = strrchr(p, '/');
+  return s ? s + 1 : p;
+}
+
+/* POV-Ray on <base>.pov in the reference's folder, writing tmp. */
+static pid_t start_povray(const reference_args *a, const char *base, const char *tmp, int width, int height,
+                          int threads) {
+  char dir[1024], in[1100], out[1100], log[1100], w[32], h[32], wt[32];
+  lm_dirname(base, dir, sizeof dir);
+  snprintf(in, sizeof in, "+I%s.pov", file_part(base));
+  snprintf(out, sizeof out, "+O%s", file_part(tmp));
+  snprintf(log, sizeof log, "%s.log", base);
+  snprintf(w, sizeof w, "+W%d", width);
+  snprintf(h, sizeof h, "+H%d", height);
+  snprintf(wt, sizeof wt, "+WT%d", threads);
+  const char *argv[] = {a->povray, "-D", "-V", in, out, "+FE", w, h, "-A", wt, NULL};
+  return reference_spawn(argv, dir, log);
+}
+
+/* ---- the renderers' shared part --------------------------------------- */
 
 bool reference_export(const reference_args *a, const job *j, const job_view *v, lm_buf *input, char *path,
                       size_t cap, lm_error *err) {
@@ -223,26 +247,6 @@ pid_t reference_spawn(const char *const *argv, const char *dir, const char *log)
   execvp(argv[0], (char *const *)argv);
   fprintf(stderr, "cannot run %s: %s\n", argv[0], strerror(errno));
   _exit(127);
-}
-
-static const char *file_part(const char *p) {
-  const char *s = strrchr(p, '/');
-  return s ? s + 1 : p;
-}
-
-/* POV-Ray on <base>.pov in the reference's folder, writing tmp. */
-static pid_t start_povray(const reference_args *a, const char *base, const char *tmp, int width, int height,
-                          int threads) {
-  char dir[1024], in[1100], out[1100], log[1100], w[32], h[32], wt[32];
-  lm_dirname(base, dir, sizeof dir);
-  snprintf(in, sizeof in, "+I%s.pov", file_part(base));
-  snprintf(out, sizeof out, "+O%s", file_part(tmp));
-  snprintf(log, sizeof log, "%s.log", base);
-  snprintf(w, sizeof w, "+W%d", width);
-  snprintf(h, sizeof h, "+H%d", height);
-  snprintf(wt, sizeof wt, "+WT%d", threads);
-  const char *argv[] = {a->povray, "-D", "-V", in, out, "+FE", w, h, "-A", wt, NULL};
-  return reference_spawn(argv, dir, log);
 }
 
 /* The renderer's error lines: from its first line that mentions an error to
