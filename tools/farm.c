@@ -1,4 +1,4 @@
-/* limn farm slurm: a capture job (and its POV-Ray references) as a Slurm job
+/* limn farm slurm: a capture job (and its references) as a Slurm job
  * array. The script it writes is both the array's batch script (a task
  * renders shard SLURM_ARRAY_TASK_ID with `--shard auto/N`) and, run with
  * bash outside Slurm, what submits the array and a merge task that waits for
@@ -13,14 +13,14 @@
 #include <unistd.h>
 
 #include "job.h"
-#include "scene/pov.h"
+#include "reference.h"
 #include "tools.h"
 
 static const char farm_usage[] =
     "usage: limn farm slurm --job FILE --shards N [--partition P] [--time T] [--mem M]\n"
     "                       [--cpus-per-task C] [--gres G] [--account A] [--sbatch FLAG]...\n"
     "                       [--set NAME=VALUE]... [--references [--refs DIR] [--povray PROGRAM]\n"
-    "                       [export-pov flags]]\n"
+    "                       [--renderer pov|cycles] [Cycles flags] [export-pov flags]]\n"
     "                       [--dir DIR] [--name NAME] [--submit]\n"
     "\n"
     "Writes DIR/NAME.sbatch, a Slurm job array of N tasks: task I renders shard I/N\n"
@@ -39,7 +39,9 @@ static const char farm_usage[] =
     "                       the sbatch options of that name, for every task\n"
     "  --sbatch FLAG        any other sbatch option, as in \"--qos=high\" (repeatable)\n"
     "  --set NAME=VALUE     added to the job's options (repeatable)\n"
-    "  --references         render the job's POV-Ray references too\n"
+    "  --references         render the job's references too (POV-Ray's, or Cycles' with\n"
+    "                       --renderer cycles or the job's renderer = \"cycles\"; the\n"
+    "                       flags of limn reference pass through)\n"
     "  --refs DIR           where they go (default out/reference)\n"
     "  --povray PROGRAM     the POV-Ray program on the nodes (default povray)\n"
     "  --radiosity, --count, --error-bound, --pretrace-start, --pretrace-end,\n"
@@ -64,7 +66,7 @@ typedef struct farm_args {
   int sbatch_count;
   const char *sets[64];
   int set_count;
-  const char *pov_names[64], *pov_values[64]; /* export-pov flags as given, for reference and merge */
+  const char *pov_names[64], *pov_values[64]; /* export-pov and renderer flags as given, for reference and merge */
   int pov_count;
   int shards;
   bool references, submit;
@@ -225,9 +227,10 @@ int limn_farm(int argc, char **argv) {
   farm_args a = {.dir = "farm", .refs = "out/reference"};
   char sbatch_flags[6][1100] = {{0}}; /* --partition=P ... (at most one of each) */
   static const char *const named[6] = {"partition", "time", "mem", "cpus-per-task", "gres", "account"};
-  lm_pov_desc pov;
-  limn_pov_defaults(&pov);
-  struct option opts[19 + LIMN_POV_OPTION_COUNT] = {
+  reference_args ref; /* the flags checked here, passed on as given */
+  reference_defaults(&ref);
+  lm_pov_desc *pov = &ref.pov;
+  struct option opts[18 + LIMN_POV_OPTION_COUNT - 1 + REFERENCE_OPTION_COUNT] = {
       {"job", required_argument, 0, 'J'},       {"shards", required_argument, 0, 'K'},
       {"partition", required_argument, 0, '0'}, {"time", required_argument, 0, '1'},
       {"mem", required_argument, 0, '2'},       {"cpus-per-task", required_argument, 0, '3'},
@@ -237,17 +240,21 @@ int limn_farm(int argc, char **argv) {
       {"dir", required_argument, 0, 'd'},       {"name", required_argument, 0, 'N'},
       {"submit", no_argument, 0, 's'},          {"help", no_argument, 0, 'h'},
       {"povray", required_argument, 0, 'P'}};
-  memcpy(opts + 17, limn_pov_options, sizeof(struct option) * LIMN_POV_OPTION_COUNT);
+  memcpy(opts + 17, limn_pov_options, sizeof(struct option) * (LIMN_POV_OPTION_COUNT - 1));
+  memcpy(opts + 17 + LIMN_POV_OPTION_COUNT - 1, reference_options, sizeof(struct option) * REFERENCE_OPTION_COUNT);
   opterr = 0;
   optind = 1;
   int c, rc = -1;
   char name[256];
   while (rc < 0 && (c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
-    int taken = limn_pov_flag("farm slurm", c, optarg, &pov);
+    int taken = limn_pov_flag("farm slurm", c, optarg, pov);
+    if (taken == 1) taken = reference_flag("farm slurm", c, optarg, &ref);
     if (taken == 2) rc = 2;
-    if (taken == 0 && a.pov_count == 64) rc = usage_error("%s", "at most 64 export-pov flags");
+    if (taken == 0 && a.pov_count == 64) rc = usage_error("%s", "at most 64 export-pov and renderer flags");
     if (taken == 0 && rc < 0) { /* kept as given, for reference and merge */
       for (const struct option *o = limn_pov_options; o->name; o++)
+        if (o->val == c) a.pov_names[a.pov_count] = o->name;
+      for (const struct option *o = reference_options; o->name; o++)
         if (o->val == c) a.pov_names[a.pov_count] = o->name;
       a.pov_values[a.pov_count++] = optarg;
       continue;
@@ -285,7 +292,7 @@ int limn_farm(int argc, char **argv) {
     }
   }
   if (rc >= 0) return rc;
-  const char *bad = pov.radiosity ? lm_pov_radiosity_check(&pov.rad) : NULL;
+  const char *bad = pov->radiosity ? lm_pov_radiosity_check(&pov->rad) : NULL;
   if (bad) return usage_error("radiosity setting out of range: %s", bad);
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
   if (!a.job || !a.shards) return usage_error("%s", "--job FILE and --shards N are required");

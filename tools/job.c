@@ -14,6 +14,8 @@
  *     time = { 0, 2, 24 },                        -- a sequence: start, stop (seconds), fps;
  *                                                 -- or time = 1.5, a still at that time
  *     animation = "walk",                         -- name or index (default all)
+ *     renderer = "cycles",                        -- the references' (limn reference, report):
+ *                                                 -- "pov" (default) or "cycles"
  *     path = { { t = 0, eye = { 0, 1, 5 }, target = { 0, 1, 0 }, fov = 45 }, ... },
  *                                                 -- or "file.cams" / { cameras = "file.cams",
  *                                                 -- times = {...} }; or instead
@@ -471,7 +473,8 @@ bool job_read(job *j, const char *path, lm_error *err) {
     return false;
   }
   static const char *const known[] = {"script", "scenes", "techniques", "sizes", "set", "frames", "output",
-                                      "manifest", "time", "animation", "path", "turntable", "events", NULL};
+                                      "manifest", "time", "animation", "path", "turntable", "events",
+                                      "renderer", NULL};
   lua_pushnil(L);
   while (ok && lua_next(L, -2)) {
     lua_pop(L, 1);
@@ -479,7 +482,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
     for (const char *const *k = known; *k && lua_type(L, -1) == LUA_TSTRING; k++) found |= !strcmp(*k, lua_tostring(L, -1));
     if (!found) {
       lm_error_set(err, "%s: unknown field '%s' (known: script, scenes, techniques, sizes, set, frames, output, "
-                   "manifest, time, animation, path, turntable, events)", path, lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : luaL_typename(L, -1));
+                   "manifest, time, animation, path, turntable, events, renderer)", path, lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : luaL_typename(L, -1));
       ok = false;
       lua_pop(L, 1);
     }
@@ -488,6 +491,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
   ok = ok && field_string(L, -1, "script", script, sizeof script, path, err) &&
        field_string(L, -1, "output", j->output, sizeof j->output, path, err) &&
        field_string(L, -1, "manifest", manifest, sizeof manifest, path, err) &&
+       field_string(L, -1, "renderer", j->renderer, sizeof j->renderer, path, err) &&
        read_list(L, -1, "scenes", path, &j->scene_count, err, each_scene, j) &&
        read_list(L, -1, "techniques", path, &j->technique_count, err, each_technique, j) &&
        read_list(L, -1, "sizes", path, &j->size_count, err, each_size, j) && read_sets(L, j, err) &&
@@ -512,6 +516,10 @@ bool job_read(job *j, const char *path, lm_error *err) {
   }
   lua_close(L);
   if (!ok) return false;
+  if (j->renderer[0] && strcmp(j->renderer, "pov") && strcmp(j->renderer, "cycles")) {
+    lm_error_set(err, "%s: renderer: \"pov\" or \"cycles\", not \"%s\"", path, j->renderer);
+    return false;
+  }
   if (!j->scene_count) {
     lm_error_set(err, "%s: scenes: the job names no scene", path);
     return false;

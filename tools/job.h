@@ -26,6 +26,7 @@ typedef struct job_scene {
 
 typedef struct job {
   char path[1024], dir[1024], script[1024], output[1024], manifest[1024];
+  char renderer[16]; /* the references' renderer: "pov", "cycles" or "" (not given; tools/reference.h) */
   job_scene scenes[MAX_LIST];
   int scene_count;
   char techniques[MAX_LIST][64];

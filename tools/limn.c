@@ -12,9 +12,10 @@ static const char usage[] =
     "commands:\n"
     "  capture   render headless (EGL, no window) to PNG or EXR and print per-pass times\n"
     "  export-pov  one view of a scene as POV-Ray 3.7 scene description (references)\n"
+    "  export-gltf  a scene as Limn loads it, as glTF (for Blender: Cycles references)\n"
     "  compare   mean error, RMSE, PSNR, Pearson, SSIM of two images; difference image\n"
-    "  reference  POV-Ray references (radiosity) of a capture job's views, cached by hash\n"
-    "  report    error against POV-Ray references and run time for a sweep of techniques\n"
+    "  reference  POV-Ray (radiosity) or Cycles references of a capture job's views, cached by hash\n"
+    "  report    error against POV-Ray or Cycles references and run time for a sweep of techniques\n"
     "  farm      a capture job (and its references) as a Slurm job array: limn farm slurm\n"
     "  manifest  merge the manifests of a sharded capture job: limn manifest merge\n"
     "  bench     compositor overhead per frame and pass times against resolution\n"
@@ -39,6 +40,7 @@ int main(int argc, char **argv) {
   if (!strcmp(cmd, "capture")) return limn_capture(argc - 1, argv + 1);
   if (!strcmp(cmd, "view")) return limn_view(argc - 1, argv + 1);
   if (!strcmp(cmd, "export-pov")) return limn_export_pov(argc - 1, argv + 1);
+  if (!strcmp(cmd, "export-gltf")) return limn_export_gltf(argc - 1, argv + 1);
   if (!strcmp(cmd, "compare")) return limn_compare(argc - 1, argv + 1);
   if (!strcmp(cmd, "reference")) return limn_reference(argc - 1, argv + 1);
   if (!strcmp(cmd, "report")) return limn_report(argc - 1, argv + 1);

@@ -14,7 +14,8 @@
 
 static const char manifest_usage[] =
     "usage: limn manifest merge --job FILE --shards N [--set NAME=VALUE]... [--output FILE]\n"
-    "                           [--refs DIR [export-pov flags]] [--quiet]\n"
+    "                           [--refs DIR [--renderer pov|cycles] [Cycles flags] [export-pov flags]]\n"
+    "                           [--quiet]\n"
     "\n"
     "Joins the shard manifests of `limn capture --job FILE --shard I/N` (beside the\n"
     "job's manifest: <stem>.shard-I-of-N.json) into the job's manifest. It checks\n"
@@ -30,7 +31,8 @@ static const char manifest_usage[] =
     "  --set NAME=VALUE     the --set flags the shards were given (repeatable)\n"
     "  --output FILE        the merged manifest (default: the job's manifest)\n"
     "  --refs DIR           check too that every view's reference (limn reference)\n"
-    "                       is in DIR, exported with the export-pov flags given\n"
+    "                       is in DIR, made with the renderer and flags given\n"
+    REFERENCE_OPTIONS_HELP
     "  --radiosity, --count, --error-bound, --pretrace-start, --pretrace-end,\n"
     "  --recursion-limit, --brightness, --shadows, --approximate: as export-pov\n"
     "                       (the references', with --refs)\n"
@@ -231,17 +233,19 @@ int limn_manifest(int argc, char **argv) {
   argc--, argv++;
   merge_args a = {0};
   reference_defaults(&a.ref);
-  struct option opts[7 + LIMN_POV_OPTION_COUNT] = {
+  struct option opts[7 + LIMN_POV_OPTION_COUNT - 1 + REFERENCE_OPTION_COUNT] = {
       {"job", required_argument, 0, 'J'},    {"shards", required_argument, 0, 'K'},
       {"set", required_argument, 0, 'D'},    {"output", required_argument, 0, 'o'},
       {"refs", required_argument, 0, 'R'},   {"quiet", no_argument, 0, 'q'},
       {"help", no_argument, 0, 'h'}};
-  memcpy(opts + 7, limn_pov_options, sizeof(struct option) * LIMN_POV_OPTION_COUNT);
+  memcpy(opts + 7, limn_pov_options, sizeof(struct option) * (LIMN_POV_OPTION_COUNT - 1));
+  memcpy(opts + 7 + LIMN_POV_OPTION_COUNT - 1, reference_options, sizeof(struct option) * REFERENCE_OPTION_COUNT);
   opterr = 0;
   optind = 1;
   int c;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
     int pov = limn_pov_flag("manifest merge", c, optarg, &a.ref.pov);
+    if (pov == 1) pov = reference_flag("manifest merge", c, optarg, &a.ref);
     if (pov == 2) return 2;
     if (pov == 0) continue;
     switch (c) {
@@ -271,6 +275,10 @@ int limn_manifest(int argc, char **argv) {
   if (!job_read(j, a.job, &err)) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     rc = 2;
+  }
+  if (!rc && a.refs && !reference_prepare(&a.ref, j, &err)) { /* Cycles' names need Blender's version */
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    rc = 1;
   }
   if (!rc) rc = merge(&a, j);
   job_free_scenes(j);

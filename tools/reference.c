@@ -1,14 +1,23 @@
-/* limn reference --job FILE: POV-Ray references of a capture job's views
- * (tools/reference.h). POV-Ray runs as a child process in the reference's
- * folder, since Debian's povray.conf lets it write only below the current
- * directory; its output goes to a log beside the .pov, shown when it fails. */
+/* limn reference --job FILE: references of a capture job's views from
+ * POV-Ray or Cycles (tools/reference.h). This file is the part they share
+ * (flags, file names, the cache, running at most --jobs renders at once,
+ * renaming finished ones into place) and POV-Ray's own part; Cycles' is
+ * tools/reference_cycles.c. POV-Ray runs in the reference's folder, since
+ * Debian's povray.conf lets it write only below the current directory. A
+ * renderer's output goes to a log beside its input, shown when it fails. */
 #define _GNU_SOURCE
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <getopt.h>
+#include <glob.h>
+#include <signal.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -17,22 +26,29 @@
 
 static const char reference_usage[] =
     "usage: limn reference --job FILE [--refs DIR] [--force] [--jobs N] [--shard I/N|auto[/N]]\n"
-    "                      [export-pov flags]\n"
+    "                      [--renderer pov|cycles] [Cycles flags] [export-pov flags]\n"
     "\n"
-    "Renders a POV-Ray reference (radiosity on, OpenEXR, linear) of every view of\n"
-    "a capture job: each scene, camera and size (techniques do not matter here).\n"
-    "Each reference is DIR/<scene>/<camera>_<WxH>-<hash>.exr, the hash that of\n"
-    "the exported scene text: a view whose export has not changed is not\n"
-    "rendered again. A sequence's frames are posed at their times, each\n"
-    "DIR/<scene>/<camera>_<WxH>-<frame>-<time>-<hash>.exr. POV-Ray runs in\n"
-    "parallel, up to the core count.\n"
+    "Renders a reference (linear OpenEXR) of every view of a capture job: each\n"
+    "scene, camera and size (techniques do not matter here), with POV-Ray\n"
+    "radiosity (the default) or Blender's Cycles path tracer (--renderer cycles,\n"
+    "or the job's renderer = \"cycles\"). A POV-Ray reference is\n"
+    "DIR/<scene>/<camera>_<WxH>-<hash>.exr, the hash that of the exported scene\n"
+    "text; a Cycles one DIR/<scene>/<camera>_<WxH>-cycles-<hash>.exr, the hash\n"
+    "that of the scene file, the camera, size, samples, bounces, seed, materials\n"
+    "and sky, tools/cycles_render.py and Blender's version. A view whose hash\n"
+    "has not changed is not rendered again. A sequence's frames are posed at\n"
+    "their times, each DIR/<scene>/<camera>_<WxH>-<frame>-<time>-...exr.\n"
+    "POV-Ray runs in parallel, up to the core count; Cycles one view at a time\n"
+    "on every core.\n"
     "\n"
     "options:\n"
     "  --job FILE           the capture job (README: Scenes and capture jobs)\n"
     "  --refs DIR           where the references go (default out/reference)\n"
     "  --force              render again even what exists\n"
-    "  --jobs N             POV-Ray runs at once (default: the core count)\n"
+    "  --jobs N             renders at once (default: POV-Ray the core count,\n"
+    "                       Cycles 1, its threads the cores)\n"
     "  --povray PROGRAM     the POV-Ray program (default povray)\n"
+    REFERENCE_OPTIONS_HELP
     "  --shard I/N          views I, I+N, I+2N ... only (numbered as capture's,\n"
     "                       without techniques: scene, size, camera, frame; a\n"
     "                       sequence's in N contiguous runs, as capture's)\n"
@@ -41,13 +57,92 @@ static const char reference_usage[] =
     "  --radiosity, --count, --error-bound, --pretrace-start, --pretrace-end,\n"
     "  --recursion-limit, --brightness, --shadows, --approximate: as export-pov\n"
     "                       (defaults: the seed's radiosity settings)\n"
+    "  --materials, --sky   as export-pov, for either renderer\n"
     "\n"
-    "exit codes: 0 all references there, 1 an export or POV-Ray run failed, 2 bad usage.\n";
+    "exit codes: 0 all references there, 1 an export or a render failed, 2 bad usage.\n";
 
 void reference_defaults(reference_args *a) {
-  *a = (reference_args){.refs = "out/reference", .povray = "povray", .shards = 1};
+  *a = (reference_args){.refs = "out/reference", .povray = "povray", .shards = 1,
+                        .cycles = {.blender = "blender", .samples = REFERENCE_CYCLES_SAMPLES, .bounces = 8}};
   limn_pov_defaults(&a->pov);
-  a->jobs = lm_cpu_count();
+}
+
+const char *reference_renderer_name(reference_renderer r) { return r == REFERENCE_CYCLES ? "Cycles" : "POV-Ray"; }
+
+void reference_describe(const reference_args *a, char *out, size_t cap) {
+  if (a->renderer == REFERENCE_CYCLES)
+    snprintf(out, cap, "Cycles (%d samples, %d bounces, seed %d, materials %s%s)", a->cycles.samples,
+             a->cycles.bounces, a->cycles.seed, a->pov.pbr_materials ? "pbr" : "phong", a->pov.has_sky ? ", sky" : "");
+  else if (a->pov.radiosity)
+    snprintf(out, cap, "POV-Ray (radiosity count %d, recursion limit %d, materials %s)", a->pov.rad.count,
+             a->pov.rad.recursion_limit, a->pov.pbr_materials ? "pbr" : "phong");
+  else snprintf(out, cap, "POV-Ray (direct light only, materials %s)", a->pov.pbr_materials ? "pbr" : "phong");
+}
+
+enum { RENDERER_FLAG = 0x200, SAMPLES_FLAG, BOUNCES_FLAG, SEED_FLAG, BLENDER_FLAG, SCRIPT_FLAG };
+
+const struct option reference_options[] = {
+    {"renderer", required_argument, 0, RENDERER_FLAG}, {"samples", required_argument, 0, SAMPLES_FLAG},
+    {"bounces", required_argument, 0, BOUNCES_FLAG},   {"seed", required_argument, 0, SEED_FLAG},
+    {"blender", required_argument, 0, BLENDER_FLAG},   {"cycles-script", required_argument, 0, SCRIPT_FLAG},
+    {0, 0, 0, 0}};
+_Static_assert(sizeof reference_options / sizeof *reference_options == REFERENCE_OPTION_COUNT,
+               "REFERENCE_OPTION_COUNT (reference.h) counts reference_options");
+
+static bool parse_renderer(const char *s, reference_renderer *out) {
+  if (!strcmp(s, "pov") || !strcmp(s, "povray")) *out = REFERENCE_POV;
+  else if (!strcmp(s, "cycles")) *out = REFERENCE_CYCLES;
+  else return false;
+  return true;
+}
+
+int reference_flag(const char *cmd, int c, const char *arg, reference_args *a) {
+  reference_cycles *y = &a->cycles;
+  const char *bad = NULL;
+  switch (c) {
+  case RENDERER_FLAG:
+    if (parse_renderer(arg, &a->renderer)) a->renderer_given = true;
+    else bad = "--renderer wants pov or cycles, not '%s'";
+    break;
+  case SAMPLES_FLAG: if (!limn_parse_int(arg, 1, 1 << 20, &y->samples)) bad = "--samples wants 1..1048576, not '%s'"; break;
+  case BOUNCES_FLAG: if (!limn_parse_int(arg, 0, 1024, &y->bounces)) bad = "--bounces wants 0..1024, not '%s'"; break;
+  case SEED_FLAG: if (!limn_parse_int(arg, 0, 1 << 30, &y->seed)) bad = "--seed wants 0..1073741824, not '%s'"; break;
+  case BLENDER_FLAG: y->blender = arg; break;
+  case SCRIPT_FLAG: y->script = arg; break;
+  default: return 1;
+  }
+  if (!bad) return 0;
+  fprintf(stderr, "limn %s: ", cmd);
+  fprintf(stderr, bad, arg);
+  fprintf(stderr, "\n(see limn %s --help)\n", cmd);
+  return 2;
+}
+
+bool reference_prepare(reference_args *a, const job *j, lm_error *err) {
+  if (!a->renderer_given && j->renderer[0]) parse_renderer(j->renderer, &a->renderer); /* job_read checked it */
+  if (a->renderer == REFERENCE_POV) return true;
+  /* What only POV-Ray has: refused rather than ignored, so no one compares with a reference they did not ask for. */
+  if (!a->pov.radiosity) {
+    lm_error_set(err, "--radiosity off is POV-Ray's; Cycles' direct light only is --bounces 0");
+    return false;
+  }
+  if (!a->pov.shadows) {
+    lm_error_set(err, "--shadows off is POV-Ray's; Cycles' lights always cast shadows");
+    return false;
+  }
+  return reference_cycles_prepare(&a->cycles, err);
+}
+
+bool reference_direct(const reference_args *a, reference_args *direct, const char **flags) {
+  *direct = *a;
+  if (a->renderer == REFERENCE_CYCLES) {
+    direct->cycles.bounces = 0;
+    *flags = " --renderer cycles --bounces 0";
+    return a->cycles.bounces > 0;
+  }
+  direct->pov.radiosity = false;
+  *flags = " --radiosity off";
+  return a->pov.radiosity;
 }
 
 /* A name part without slashes or spaces. */
@@ -57,10 +152,12 @@ static void clean(const char *s, char *out, size_t cap) {
   out[i] = '\0';
 }
 
-bool reference_export(const reference_args *a, const job *j, const job_view *v, lm_buf *sdl, char *path,
-                      size_t cap, lm_error *err) {
+/* ---- POV-Ray's part ------------------------------------------------------ */
+
+/* POV-Ray's input: the exported scene text; its hash covers that and the command line's settings. */
+static bool pov_export(const reference_args *a, const job *j, const job_view *v, lm_buf *sdl, uint64_t *hash,
+                       lm_error *err) {
   const job_scene *s = &j->scenes[v->scene];
-  job_pose(j, v); /* the scene and a path's camera at the view's time */
   lm_pov_desc d = a->pov;
   d.camera = v->camera;
   d.width = j->sizes[v->size][0];
@@ -78,10 +175,42 @@ bool reference_export(const reference_args *a, const job *j, const job_view *v, 
     lm_error_prefix(err, "%s", s->path);
     return false;
   }
-  /* The hash covers what POV-Ray is given: the text and the command line's settings. */
   char cmd[64];
   snprintf(cmd, sizeof cmd, "+FE +W%d +H%d -A", d.width, d.height);
-  uint64_t h = lm_hash(sdl->data, (size_t)sdl->len, lm_hash(cmd, strlen(cmd), LM_HASH_SEED));
+  *hash = lm_hash(sdl->data, (size_t)sdl->len, lm_hash(cmd, strlen(cmd), LM_HASH_SEED));
+  return true;
+}
+
+static const char *file_part(const char *p) {
+  const char *s = strrchr(p, '/');
+  return s ? s + 1 : p;
+}
+
+/* POV-Ray on <base>.pov in the reference's folder, writing tmp. */
+static pid_t start_povray(const reference_args *a, const char *base, const char *tmp, int width, int height,
+                          int threads) {
+  char dir[1024], in[1100], out[1100], log[1100], w[32], h[32], wt[32];
+  lm_dirname(base, dir, sizeof dir);
+  snprintf(in, sizeof in, "+I%s.pov", file_part(base));
+  snprintf(out, sizeof out, "+O%s", file_part(tmp));
+  snprintf(log, sizeof log, "%s.log", base);
+  snprintf(w, sizeof w, "+W%d", width);
+  snprintf(h, sizeof h, "+H%d", height);
+  snprintf(wt, sizeof wt, "+WT%d", threads);
+  const char *argv[] = {a->povray, "-D", "-V", in, out, "+FE", w, h, "-A", wt, NULL};
+  return reference_spawn(argv, dir, log);
+}
+
+/* ---- the renderers' shared part --------------------------------------- */
+
+bool reference_export(const reference_args *a, const job *j, const job_view *v, lm_buf *input, char *path,
+                      size_t cap, lm_error *err) {
+  const job_scene *s = &j->scenes[v->scene];
+  job_pose(j, v); /* the scene and a path's camera at the view's time */
+  uint64_t h;
+  bool cycles = a->renderer == REFERENCE_CYCLES;
+  if (!(cycles ? reference_cycles_spec(a, j, v, input, &h, err) : pov_export(a, j, v, input, &h, err)))
+    return false;
   /* A sequence's frames: each its own file, the frame in its name and hash. */
   char frame[64] = "";
   if (j->timed) {
@@ -91,53 +220,37 @@ bool reference_export(const reference_args *a, const job *j, const job_view *v, 
   char scene[LM_NAME_MAX], camera[LM_NAME_MAX];
   clean(s->name, scene, sizeof scene);
   clean(s->scene->cameras[v->camera].name, camera, sizeof camera);
-  snprintf(path, cap, "%s/%s/%s_%dx%d%s-%016llx.exr", a->refs, scene, camera[0] ? camera : "camera", d.width,
-           d.height, j->frame_count > 1 ? frame : "", (unsigned long long)h);
+  snprintf(path, cap, "%s/%s/%s_%dx%d%s-%s%016llx.exr", a->refs, scene, camera[0] ? camera : "camera",
+           j->sizes[v->size][0], j->sizes[v->size][1], j->frame_count > 1 ? frame : "", cycles ? "cycles-" : "",
+           (unsigned long long)h);
   return true;
 }
 
-typedef struct pov_run {
-  pid_t pid;
-  int place;
-  char base[1024]; /* the reference's path without .exr */
-  char tmp[1100];
-} pov_run;
-
-static const char *file_part(const char *p) {
-  const char *s = strrchr(p, '/');
-  return s ? s + 1 : p;
-}
-
-static pid_t start_povray(const reference_args *a, const pov_run *r, int width, int height, int threads) {
-  char dir[1024], in[1100], out[1100], log[1100], w[32], h[32], wt[32];
-  lm_dirname(r->base, dir, sizeof dir);
-  snprintf(in, sizeof in, "+I%s.pov", file_part(r->base));
-  snprintf(out, sizeof out, "+O%s", file_part(r->tmp));
-  snprintf(log, sizeof log, "%s.log", r->base);
-  snprintf(w, sizeof w, "+W%d", width);
-  snprintf(h, sizeof h, "+H%d", height);
-  snprintf(wt, sizeof wt, "+WT%d", threads);
+pid_t reference_spawn(const char *const *argv, const char *dir, const char *log) {
   fflush(stdout);
   fflush(stderr);
-  pid_t pid = fork();
+  pid_t parent = getpid(), pid = fork();
   if (pid != 0) return pid;
+  /* A killed limn takes its renders with it: nothing renders on into a file no one will rename. */
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (getppid() != parent) _exit(127);
   int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0666);
   if (fd >= 0) {
     dup2(fd, STDOUT_FILENO);
     dup2(fd, STDERR_FILENO);
     close(fd);
   }
-  if (chdir(dir) != 0) {
+  if (dir && chdir(dir) != 0) {
     fprintf(stderr, "cannot enter %s: %s\n", dir, strerror(errno));
     _exit(127);
   }
-  execlp(a->povray, a->povray, "-D", "-V", in, out, "+FE", w, h, "-A", wt, (char *)NULL);
-  fprintf(stderr, "cannot run %s: %s\n", a->povray, strerror(errno));
+  execvp(argv[0], (char *const *)argv);
+  fprintf(stderr, "cannot run %s: %s\n", argv[0], strerror(errno));
   _exit(127);
 }
 
-/* POV-Ray's error lines: from its first line that mentions an error to the
- * end (at most 20), else its last 10 lines. */
+/* The renderer's error lines: from its first line that mentions an error to
+ * the end (at most 20), else its last 10 lines. */
 static void show_log(const char *log) {
   size_t len;
   lm_error err;
@@ -161,92 +274,179 @@ static void show_log(const char *log) {
   free(text);
 }
 
+typedef struct render_run {
+  pid_t pid;
+  int place;
+  char base[1024]; /* the reference's path without .exr */
+  char tmp[1100];  /* <base>.tmp-<pid>: POV-Ray's output (.exr), or Blender's folder (its output and temporaries) */
+  char out[1200];  /* what the renderer writes: tmp, or tmp/out.exr */
+} render_run;
+
+/* SIGINT or SIGTERM while renders run: they are killed here, and the loop,
+ * woken from wait(), removes their partial files and stops. */
+static volatile sig_atomic_t stop_signal;
+static render_run *volatile running_runs;
+static volatile int running_count;
+
+static void on_stop(int sig) {
+  stop_signal = sig;
+  for (int k = 0; k < running_count; k++) kill(running_runs[k].pid, SIGKILL);
+}
+
+/* A render's temporary: a file, or a folder with what the renderer left in it. */
+static void remove_temp(const char *path) {
+  DIR *d = opendir(path);
+  for (struct dirent *e; d && (e = readdir(d));) {
+    char file[2400];
+    snprintf(file, sizeof file, "%s/%s", path, e->d_name);
+    if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) remove(file);
+  }
+  if (d) closedir(d);
+  remove(path); /* a file, or the folder now empty */
+}
+
+/* Every temporary of the reference at base: a failed or stopped render's, and any a killed run left. */
+static void clear_temps(const char *base) {
+  char pattern[1100];
+  snprintf(pattern, sizeof pattern, "%s.tmp-*", base);
+  glob_t g;
+  if (glob(pattern, GLOB_NOSORT, NULL, &g) == 0)
+    for (size_t i = 0; i < g.gl_pathc; i++) remove_temp(g.gl_pathv[i]);
+  globfree(&g);
+}
+
+static void view_error(const job *j, const job_view *places, int place, bool newline, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+static void view_error(const job *j, const job_view *places, int place, bool newline, const char *fmt, ...) {
+  const job_view *v = &places[place];
+  const job_scene *s = &j->scenes[v->scene];
+  char what[1536];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(what, sizeof what, fmt, ap);
+  va_end(ap);
+  if (newline) printf("\n");
+  char frame[64] = "";
+  if (j->timed) snprintf(frame, sizeof frame, ", frame %d at %.3f s", v->frame, v->time);
+  lm_log(LM_LOG_ERROR, "%s: view %d (%s, camera '%s', %dx%d%s): %s", j->path, place, s->name,
+         s->scene->cameras[v->camera].name, j->sizes[v->size][0], j->sizes[v->size][1], frame, what);
+}
+
 int reference_run(const reference_args *a, const job *j, const job_view *places, int n, char (*paths)[1024]) {
   lm_error err;
   int rc = 0, done = 0, rendered = 0, cached = 0, running = 0, mine = 0;
-  int jobs = a->jobs > 0 ? a->jobs : 1;
-  int cores = lm_cpu_count(), threads = cores > jobs ? cores / jobs : 1;
+  bool cycles = a->renderer == REFERENCE_CYCLES;
+  const char *name = reference_renderer_name(a->renderer);
+  int cores = lm_cpu_count(), jobs = a->jobs > 0 ? a->jobs : cycles ? 1 : cores;
+  int threads = cores > jobs ? cores / jobs : 1;
   bool tty = isatty(STDOUT_FILENO);
-  pov_run *runs = lm_alloc(sizeof *runs * (size_t)jobs);
-  char what[1200];
+  render_run *runs = lm_alloc(sizeof *runs * (size_t)jobs);
+  char what[1200], describe[256];
+  reference_describe(a, describe, sizeof describe);
   for (int i = 0; i < n; i++) mine += job_shard_of(j, i, n, a->shards) == a->shard;
   char in_shard[64] = "";
   if (a->shards > 1) snprintf(in_shard, sizeof in_shard, " (%d in shard %d/%d)", mine, a->shard, a->shards);
-  if (!a->quiet) printf("references of %s: %d view%s%s, up to %d POV-Ray run%s at once; %s\n", j->path, n,
-                        n == 1 ? "" : "s", in_shard, jobs, jobs == 1 ? "" : "s", a->refs);
+  if (!a->quiet) printf("references of %s: %d view%s%s, %s, up to %d run%s at once; %s\n", j->path, n,
+                        n == 1 ? "" : "s", in_shard, describe, jobs, jobs == 1 ? "" : "s", a->refs);
+  struct sigaction stop = {.sa_handler = on_stop}, old_int, old_term; /* no SA_RESTART: wait() wakes */
+  sigemptyset(&stop.sa_mask);
+  stop_signal = 0;
+  running_runs = runs;
+  running_count = 0;
+  sigaction(SIGINT, &stop, &old_int);
+  sigaction(SIGTERM, &stop, &old_term);
   for (int i = 0; i <= n; i++) {
     /* Start place i when a slot is free; after the last, wait for the rest. */
-    while (running > 0 && (running == jobs || i == n)) {
+    while (running > 0 && (running == jobs || i == n || stop_signal)) {
       int status;
       pid_t pid = wait(&status);
+      if (pid < 0 && errno == EINTR) continue;
       if (pid < 0) break;
-      pov_run *r = NULL;
+      render_run *r = NULL;
       for (int k = 0; k < running && !r; k++)
         if (runs[k].pid == pid) r = &runs[k];
       if (!r) continue;
-      const job_view *v = &places[r->place];
-      const job_scene *s = &j->scenes[v->scene];
       char final[1100], log[1100];
       snprintf(final, sizeof final, "%s.exr", r->base);
       snprintf(log, sizeof log, "%s.log", r->base);
-      bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && lm_file_exists(r->tmp) &&
-                rename(r->tmp, final) == 0;
+      bool ok = !stop_signal && WIFEXITED(status) && WEXITSTATUS(status) == 0 && lm_file_exists(r->out) &&
+                rename(r->out, final) == 0;
       if (ok) {
+        clear_temps(r->base);
         remove(log);
         rendered++;
         snprintf(what, sizeof what, "%s", final);
         job_progress(a->quiet, tty, ++done, mine, what);
+      } else if (stop_signal) {
+        clear_temps(r->base);
       } else {
-        remove(r->tmp);
-        if (tty && !a->quiet) printf("\n");
-        lm_log(LM_LOG_ERROR, "%s: view %d (%s, camera '%s', %dx%d): POV-Ray failed (%s %d); its log %s:", j->path,
-               r->place, s->name, s->scene->cameras[v->camera].name, j->sizes[v->size][0], j->sizes[v->size][1],
-               WIFEXITED(status) ? "exit status" : "signal",
-               WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status), log);
+        clear_temps(r->base);
+        if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
+          view_error(j, places, r->place, tty && !a->quiet, "%s exited 0 but wrote no image; its log %s:", name, log);
+        else
+          view_error(j, places, r->place, tty && !a->quiet, "%s failed (%s %d); its log %s:", name,
+                     WIFEXITED(status) ? "exit status" : "signal",
+                     WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status), log);
         show_log(log);
         rc = 1;
       }
       *r = runs[--running];
+      running_count = running;
     }
-    if (i == n) break;
+    if (i == n || stop_signal) break;
     if (job_shard_of(j, i, n, a->shards) != a->shard) continue;
     const job_view *v = &places[i];
-    const job_scene *s = &j->scenes[v->scene];
-    lm_buf sdl = {0};
+    lm_buf input = {0};
     char path[1024];
-    bool ok = reference_export(a, j, v, &sdl, path, sizeof path, &err);
+    bool ok = reference_export(a, j, v, &input, path, sizeof path, &err);
     if (ok && paths) snprintf(paths[i], sizeof paths[i], "%s", path);
     if (ok && !a->force && lm_file_exists(path)) {
       cached++;
       snprintf(what, sizeof what, "%s: unchanged, cached", path);
       job_progress(a->quiet, tty, ++done, mine, what);
-      lm_buf_free(&sdl);
+      lm_buf_free(&input);
       continue;
     }
-    pov_run *r = &runs[running];
-    *r = (pov_run){.place = i};
+    render_run *r = &runs[running];
+    *r = (render_run){.place = i};
+    char in[1100];
     if (ok) {
       snprintf(r->base, sizeof r->base, "%.*s", (int)(strlen(path) - 4), path);
-      snprintf(r->tmp, sizeof r->tmp, "%s.tmp-%ld.exr", r->base, (long)getpid());
-      char pov[1100];
-      snprintf(pov, sizeof pov, "%s.pov", r->base);
-      ok = job_make_parent(path, &err) && limn_write_whole(pov, sdl.data, (size_t)sdl.len, &err);
+      snprintf(r->tmp, sizeof r->tmp, "%s.tmp-%ld%s", r->base, (long)getpid(), cycles ? "" : ".exr");
+      snprintf(r->out, sizeof r->out, "%s%s", r->tmp, cycles ? "/out.exr" : "");
+      snprintf(in, sizeof in, "%s.%s", r->base, cycles ? "json" : "pov");
+      ok = job_make_parent(path, &err) && limn_write_whole(in, input.data, (size_t)input.len, &err);
+      if (ok) clear_temps(r->base);
+      /* Blender's own folder: whatever it writes beside its output goes with it. */
+      if (ok && cycles && mkdir(r->tmp, 0777) != 0)
+        lm_error_set(&err, "%s: cannot make folder (%s)", r->tmp, strerror(errno)), ok = false;
     }
-    lm_buf_free(&sdl);
+    lm_buf_free(&input);
     if (ok) {
-      r->pid = start_povray(a, r, j->sizes[v->size][0], j->sizes[v->size][1], threads);
-      if (r->pid < 0) lm_error_set(&err, "cannot start %s: %s", a->povray, strerror(errno)), ok = false;
+      char log[1100];
+      snprintf(log, sizeof log, "%s.log", r->base);
+      int w = j->sizes[v->size][0], h = j->sizes[v->size][1];
+      r->pid = cycles ? reference_cycles_start(&a->cycles, in, r->out, log, threads)
+                      : start_povray(a, r->base, r->tmp, w, h, threads);
+      if (r->pid < 0) lm_error_set(&err, "cannot start %s: %s", name, strerror(errno)), ok = false;
     }
     if (!ok) {
-      if (tty && !a->quiet) printf("\n");
-      lm_log(LM_LOG_ERROR, "%s: view %d (%s, camera '%s', %dx%d): %s", j->path, i, s->name,
-             s->scene->cameras[v->camera].name, j->sizes[v->size][0], j->sizes[v->size][1], err.msg);
+      view_error(j, places, i, tty && !a->quiet, "%s", err.msg);
       rc = 1;
       continue;
     }
-    running++;
+    running_count = ++running;
   }
+  sigaction(SIGINT, &old_int, NULL);
+  sigaction(SIGTERM, &old_term, NULL);
+  running_count = 0;
   free(runs);
+  if (stop_signal) { /* the renders are gone and so are their files: die of the signal, as without the handler */
+    if (tty && !a->quiet) printf("\n");
+    lm_log(LM_LOG_ERROR, "%s: stopped by signal %d; no partial reference left", j->path, (int)stop_signal);
+    raise(stop_signal);
+    return 1;
+  }
   if (!a->quiet) printf("references of %s: %d rendered, %d cached (unchanged; --force redoes them)%s\n", j->path,
                         rendered, cached, rc ? ", some failed" : "");
   return rc;
@@ -264,17 +464,19 @@ int limn_reference(int argc, char **argv) {
   reference_defaults(&a);
   const char *job_path = NULL;
   char shard_from[256] = "";
-  struct option opts[9 + LIMN_POV_OPTION_COUNT] = {
+  struct option opts[8 + LIMN_POV_OPTION_COUNT - 1 + REFERENCE_OPTION_COUNT] = {
       {"job", required_argument, 0, 'J'},    {"refs", required_argument, 0, 'R'},
       {"force", no_argument, 0, 'F'},        {"jobs", required_argument, 0, 'j'},
       {"povray", required_argument, 0, 'P'}, {"quiet", no_argument, 0, 'q'},
       {"help", no_argument, 0, 'h'},         {"shard", required_argument, 0, 'I'}};
-  memcpy(opts + 8, limn_pov_options, sizeof(struct option) * LIMN_POV_OPTION_COUNT);
+  memcpy(opts + 8, limn_pov_options, sizeof(struct option) * (LIMN_POV_OPTION_COUNT - 1));
+  memcpy(opts + 8 + LIMN_POV_OPTION_COUNT - 1, reference_options, sizeof(struct option) * REFERENCE_OPTION_COUNT);
   opterr = 0;
   optind = 1;
   int c;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
     int pov = limn_pov_flag("reference", c, optarg, &a.pov);
+    if (pov == 1) pov = reference_flag("reference", c, optarg, &a);
     if (pov == 2) return 2;
     if (pov == 0) continue;
     switch (c) {
@@ -307,6 +509,10 @@ int limn_reference(int argc, char **argv) {
   if (!job_read(j, job_path, &err) || !job_views(j, false, &places, &n, &err)) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     rc = 2;
+  }
+  if (!rc && !reference_prepare(&a, j, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    rc = 1;
   }
   if (!rc) rc = reference_run(&a, j, places, n, NULL);
   free(places);

@@ -1,4 +1,4 @@
-/* limn report --job FILE --sweep SPEC: error against POV-Ray references and
+/* limn report --job FILE --sweep SPEC: error against references (POV-Ray's or Cycles') and
  * run time for every technique and setting of a sweep, on every view of a
  * capture job. Writes report.csv, report.json, report.svg and report.md
  * (seed 000 chapter 5.3: mean error eq 19, Pearson eq 20, gain over direct
@@ -25,16 +25,19 @@ static const char report_usage[] =
     "\n"
     "Renders every view of a capture job (scenes, cameras, sizes; the job's\n"
     "techniques are replaced by the sweep's) with each technique and setting,\n"
-    "compares each image with the view's POV-Ray reference (limn reference;\n"
+    "compares each image with the view's reference (limn reference: POV-Ray's, or\n"
+    "Cycles' with --renderer cycles or the job's renderer = \"cycles\";\n"
     "missing ones are rendered first) and writes DIR/report.csv, report.json,\n"
     "report.svg (mean error against milliseconds, Pareto front marked) and\n"
     "report.md (gain over direct light per view, mean and median gain, share\n"
     "of views and pixels improved, Pearson before and after). The baseline\n"
     "(--baseline, default direct light: " BASELINE ") is always rendered.\n"
-    "With radiosity on, each view's direct-only reference (POV-Ray without\n"
-    "radiosity, cached too) gives its floor, the baseline's error against it,\n"
+    "Each view's direct-only reference (POV-Ray without radiosity, Cycles with 0\n"
+    "bounces; cached too) gives its floor, the baseline's error against it,\n"
     "and each setting's share of the baseline's indirect error removed:\n"
     "100 (e_base - e) / (e_base - floor), n/a where the floor is not below.\n"
+    "Against Cycles each view's reference is rendered again at the next --seed:\n"
+    "the mean error between the two is the reference's noise (reference_noise).\n"
     "A job with sequences (time = { start, stop, fps }) renders each setting\n"
     "through each sequence's frames in order, one frame each after the first's\n"
     "warm-up, and adds per setting and sequence: the mean error over frames,\n"
@@ -62,6 +65,7 @@ static const char report_usage[] =
     "  --require-refs       fail, naming the command, when a reference is missing,\n"
     "                       instead of rendering it\n"
     "  --jobs N, --povray PROGRAM, --force: as limn reference, for missing ones\n"
+    REFERENCE_OPTIONS_HELP
     "  --radiosity, --count, --error-bound, --pretrace-start, --pretrace-end,\n"
     "  --recursion-limit, --brightness, --shadows, --approximate: as export-pov\n"
     "                       (the references')\n"
@@ -72,7 +76,8 @@ static const char report_usage[] =
 typedef struct report_row {
   int setting, place;
   lm_metrics m;      /* against the reference */
-  double floor;      /* the view's direct-only floor: the baseline against POV-Ray without radiosity */
+  double floor;      /* the view's direct-only floor: the baseline against the direct-only reference */
+  double noise;      /* the reference's own: its mean error against the same render at the next seed; -1: none */
   double closer;     /* share of pixels closer to the reference than the baseline's */
   double flicker;    /* of this frame and the one before in its sequence (lm_metrics_flicker); 0 for a first */
   double total_ms;
@@ -85,6 +90,13 @@ typedef struct report_args {
   int setting_count, frames, warmup;
   bool require_refs;
   reference_args ref;
+  reference_args direct; /* the direct-only references' (reference_direct) */
+  bool has_floor;        /* the references hold indirect light: the direct-only ones give the floor */
+  const char *direct_flags; /* how `limn reference` says direct */
+  char against[256];     /* what the references are (reference_describe) */
+  bool has_noise;        /* Cycles: the same references at the next seed measure their noise */
+  reference_args second; /* those references' */
+  char second_flags[96];
   bool sequences; /* the job has a run of two frames or more: views are named with their frame */
   int events[REPORT_MAX_EVENTS], event_count; /* the job's events (job.events) */
 } report_args;
@@ -150,7 +162,7 @@ static void view_name(const report_args *a, const job *j, const job_view *v, cha
 static void write_csv(lm_buf *b, const report_args *a, const job *j, const job_view *places,
                       const report_row *rows, int n) {
   lm_buf_append(b, "technique,setting,view,scene,camera,width,height,mean_error,rmse,psnr,pearson,ssim,"
-                   "closer_than_baseline,total_ms,passes_ms,direct_floor,indirect_removed\n", -1);
+                   "closer_than_baseline,total_ms,passes_ms,direct_floor,indirect_removed,reference,reference_noise\n", -1);
   for (int i = 0; i < n; i++) {
     const report_row *r = &rows[i];
     const report_setting *s = &a->settings[r->setting];
@@ -178,7 +190,10 @@ static void write_csv(lm_buf *b, const report_args *a, const job *j, const job_v
     if (r->setting > 0 && report_indirect_removed(r[-r->setting].m.mean_error, r->floor, r->m.mean_error, &share))
       lm_buf_printf(b, "%.4f", share);
     else lm_buf_append(b, "n/a", -1);
-    lm_buf_append(b, "\n", -1);
+    lm_buf_append(b, ",", 1);
+    csv_str(b, reference_renderer_name(a->ref.renderer));
+    if (r->noise >= 0) lm_buf_printf(b, ",%.9g\n", r->noise);
+    else lm_buf_append(b, ",n/a\n", -1);
   }
 }
 
@@ -211,6 +226,10 @@ static void write_json(lm_buf *b, const report_args *a, const job *j, const job_
   limn_json_append(b, j->path);
   lm_buf_printf(b, ",\n  \"clock\": \"%s\",\n  \"renderer\": ", clock);
   limn_json_append(b, lm_gl_renderer());
+  lm_buf_append(b, ",\n  \"reference\": ", -1); /* what every error is measured against */
+  limn_json_append(b, reference_renderer_name(a->ref.renderer));
+  lm_buf_append(b, ",\n  \"reference_settings\": ", -1);
+  limn_json_append(b, a->against);
   lm_buf_printf(b, ",\n  \"frames\": %d,\n  \"warmup\": %d,\n  \"baseline\": ", frames, warmup);
   limn_json_append(b, a->baseline);
   lm_buf_append(b, ",\n  \"rows\": [\n", -1);
@@ -250,6 +269,8 @@ static void write_json(lm_buf *b, const report_args *a, const job *j, const job_
     if (r->setting > 0 && report_indirect_removed(r[-r->setting].m.mean_error, r->floor, r->m.mean_error, &share))
       lm_buf_printf(b, "%.4f", share);
     else lm_buf_append(b, "null", -1);
+    if (r->noise >= 0) lm_buf_printf(b, ", \"reference_noise\": %.9g", r->noise);
+    else lm_buf_append(b, ", \"reference_noise\": null", -1);
     lm_buf_printf(b, ", \"total_ms\": %.3f, \"passes\": [", r->total_ms);
     for (int p = 0; p < r->res.pass_count; p++) {
       lm_buf_append(b, p ? ", {\"name\": " : "{\"name\": ", -1);
@@ -318,7 +339,8 @@ static void write_svg_frames(lm_buf *b, const report_args *a, const double *curv
   }
   lm_buf_printf(b, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">frame</text>\n", (L + W - R) / 2, top + H - 14);
   lm_buf_printf(b, "<text x=\"16\" y=\"%.1f\" transform=\"rotate(-90 16 %.1f)\" text-anchor=\"middle\">"
-                "mean error against POV-Ray</text>\n", top + (T + H - B) / 2, top + (T + H - B) / 2);
+                "mean error against %s</text>\n", top + (T + H - B) / 2, top + (T + H - B) / 2,
+                reference_renderer_name(a->ref.renderer));
   for (int e = 0; e < a->event_count; e++)
     lm_buf_printf(b, "<line class=\"event\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#888\" "
                   "stroke-dasharray=\"4 3\"><title>event at frame %d</title></line>\n", PX(a->events[e]), PY(0),
@@ -381,11 +403,13 @@ static void write_svg(lm_buf *b, const report_args *a, const double *err, const 
   lm_buf_printf(b, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">total ms per frame (median; clock: %s)</text>\n",
                 (L + W - R) / 2, H - 16, clock);
   lm_buf_printf(b, "<text x=\"16\" y=\"%.1f\" transform=\"rotate(-90 16 %.1f)\" text-anchor=\"middle\">"
-                "mean error against POV-Ray</text>\n", (T + H - B) / 2, (T + H - B) / 2);
+                "mean error against %s</text>\n", (T + H - B) / 2, (T + H - B) / 2,
+                reference_renderer_name(a->ref.renderer));
   if (floor >= 0)
     lm_buf_printf(b, "<line class=\"floor\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#888\" "
-                  "stroke-width=\"2\"><title>direct-only floor: the baseline against POV-Ray without radiosity, "
-                  "mean error %.4g</title></line>\n", L, PY(floor), W - R, PY(floor), floor);
+                  "stroke-width=\"2\"><title>direct-only floor: the baseline against %s direct light only, "
+                  "mean error %.4g</title></line>\n", L, PY(floor), W - R, PY(floor),
+                  reference_renderer_name(a->ref.renderer), floor);
   /* the Pareto front: a step line through its points by time */
   int *order = calloc((size_t)n + 1, sizeof *order), fn = 0;
   for (int i = 0; i < n; i++)
@@ -477,18 +501,28 @@ static void md_sequences(lm_buf *b, const report_args *a, const job *j, const jo
 static void write_md(lm_buf *b, const report_args *a, const job *j, const job_view *places, int place_count,
                      const report_row *rows, int n, const report_runs *runs, const double *err, const double *ms,
                      const bool *front, double floor, const char *clock, int frames, int warmup) {
-  lm_buf_append(b, "# Error against POV-Ray and run time\n\nJob `", -1);
+  const char *name = reference_renderer_name(a->ref.renderer);
+  lm_buf_printf(b, "# Error against %s and run time\n\nJob `", name);
   xml_str(b, j->path);
   lm_buf_printf(b, "`, %d view%s; renderer ", place_count, place_count == 1 ? "" : "s");
   xml_str(b, lm_gl_renderer());
   lm_buf_printf(b, "; times are medians of %d frame%s after %d warm-up frame%s (clock: %s). Mean error is seed eq "
-                "19 (sum of |dR|+|dG|+|dB| over 3wh), against POV-Ray radiosity references. Gain over the "
+                "19 (sum of |dR|+|dG|+|dB| over 3wh), against %s references: %s. Gain over the "
                 "baseline %s = 100 (e_base - e) / e_base. The direct-only floor of a view is the baseline's "
-                "error against POV-Ray without radiosity: what is left when indirect light is perfect. Indirect "
+                "error against %s's direct light only (%s): what is left when indirect light is perfect. Indirect "
                 "error removed = 100 (e_base - e) / (e_base - floor), the mean over the views where the floor is "
                 "below the baseline (n/a where none is).\n\n",
-                frames, frames == 1 ? "" : "s", warmup, warmup == 1 ? "" : "s", clock, a->baseline);
+                frames, frames == 1 ? "" : "s", warmup, warmup == 1 ? "" : "s", clock, name, a->against, a->baseline,
+                name, a->direct_flags + 1);
   if (floor >= 0) lm_buf_printf(b, "Direct-only floor, mean over the views: %.5f.\n\n", floor);
+  if (a->has_noise) { /* the baseline's rows: one a view */
+    double noise = 0, base = 0;
+    for (int i = 0; i < n; i++)
+      if (rows[i].setting == 0) noise += rows[i].noise, base += rows[i].m.mean_error;
+    lm_buf_printf(b, "Reference noise (the mean error between the references at seeds %d and %d), mean over the "
+                  "views: %.5f, %.1f%% of the baseline's mean error against the reference.\n\n", a->ref.cycles.seed,
+                  a->second.cycles.seed, place_count ? noise / place_count : 0, base > 0 ? 100 * noise / base : 0);
+  }
   lm_buf_append(b, "| setting | mean error | ms | mean gain % | median gain % | indirect error removed % | views "
                    "improved | views Pearson rose | pixels closer | Pearson baseline -> setting | Pareto |\n"
                    "|---|---|---|---|---|---|---|---|---|---|---|\n", -1);
@@ -767,12 +801,11 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
       return 2;
     }
   /* The references, then (with radiosity on) the direct-only ones that give each view's floor. */
-  char (*refs)[1024] = lm_alloc(sizeof *refs * (size_t)(place_count + 1) * 2);
-  char (*direct)[1024] = refs + place_count + 1;
-  reference_args direct_args = a->ref;
-  direct_args.pov.radiosity = false;
-  int rc = get_refs(a, &a->ref, j, places, place_count, refs, "");
-  if (!rc && a->ref.pov.radiosity) rc = get_refs(a, &direct_args, j, places, place_count, direct, " --radiosity off");
+  char (*refs)[1024] = lm_alloc(sizeof *refs * (size_t)(place_count + 1) * 3);
+  char (*direct)[1024] = refs + place_count + 1, (*second)[1024] = direct + place_count + 1;
+  int rc = get_refs(a, &a->ref, j, places, place_count, refs, a->ref.renderer == REFERENCE_CYCLES ? " --renderer cycles" : "");
+  if (!rc && a->has_floor) rc = get_refs(a, &a->direct, j, places, place_count, direct, a->direct_flags);
+  if (!rc && a->has_noise) rc = get_refs(a, &a->second, j, places, place_count, second, a->second_flags);
   if (rc) {
     free(refs);
     free(runs.first);
@@ -801,7 +834,7 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
   /* rows[place * settings + setting]: place by place, the baseline first */
   report_row *rows = lm_alloc(sizeof *rows * (size_t)(total + 1));
   memset(rows, 0, sizeof *rows * (size_t)(total + 1));
-  double *floors = lm_alloc(sizeof *floors * (size_t)(place_count + 1));
+  double *floors = lm_alloc(sizeof *floors * (size_t)(place_count + 1) * 2), *noises = floors + place_count + 1;
   bool tty = isatty(STDOUT_FILENO);
   const lm_scene *current = j->scenes[0].scene;
   if (r && !a->ref.quiet) printf("report of %s: %d setting%s x %d view%s on %s\n", j->path, sn,
@@ -854,13 +887,21 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
         if (ok) ok = lm_image_read(out, &img, &err) && lm_metrics_check(&img, out, &ref, refs[p], &err);
         if (ok) lm_metrics_compute(&img, &ref, &row->m);
         if (ok && s == 0) {
-          floors[p] = row->m.mean_error; /* without radiosity the reference is direct-only: no indirect error */
-          if (a->ref.pov.radiosity) {
+          floors[p] = row->m.mean_error; /* a direct-only reference: no indirect error */
+          if (a->has_floor) {
             ok = lm_image_read(direct[p], &floor_ref, &err) &&
                  lm_metrics_check(&floor_ref, direct[p], &ref, refs[p], &err);
             lm_metrics fm;
             if (ok) lm_metrics_compute(&img, &floor_ref, &fm), floors[p] = fm.mean_error;
           }
+          noises[p] = -1;
+          lm_image other = {0};
+          if (ok && a->has_noise) {
+            ok = lm_image_read(second[p], &other, &err) && lm_metrics_check(&other, second[p], &ref, refs[p], &err);
+            lm_metrics nm;
+            if (ok) lm_metrics_compute(&other, &ref, &nm), noises[p] = nm.mean_error;
+          }
+          lm_image_free(&other);
         } else if (ok) {
           ok = lm_image_read(base_out, &base, &err) && lm_metrics_check(&base, base_out, &ref, refs[p], &err);
           lm_metrics closer = row->m;
@@ -873,12 +914,13 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
         }
         if (ok) {
           row->floor = floors[p];
+          row->noise = noises[p];
           row->total_ms = row->res.total_ms;
           n++;
           view_name(a, j, v, view, sizeof view);
           char what[1200];
-          snprintf(what, sizeof what, "%s %s: error %.5f, %.2f ms", a->settings[s].label, view, row->m.mean_error,
-                   row->total_ms);
+          snprintf(what, sizeof what, "%s %s: error %.5f against %s, %.2f ms", a->settings[s].label, view,
+                   row->m.mean_error, reference_renderer_name(a->ref.renderer), row->total_ms);
           job_progress(a->ref.quiet, tty, n, total, what);
           lm_image_free(&prev);
           lm_image_free(&prev_ref);
@@ -931,8 +973,8 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
     double *err_mean = lm_alloc(sizeof(double) * (size_t)sn * 2), *ms_mean = err_mean + sn;
     bool *front = lm_alloc(sizeof(bool) * (size_t)sn);
     setting_means(rows, n, sn, err_mean, ms_mean);
-    double floor = -1; /* none without radiosity */
-    if (a->ref.pov.radiosity && place_count > 0) {
+    double floor = -1; /* none against direct-only references */
+    if (a->has_floor && place_count > 0) {
       floor = 0;
       for (int i = 0; i < n; i++) floor += rows[i].setting == 0 ? rows[i].floor / place_count : 0;
     }
@@ -977,7 +1019,7 @@ int limn_report(int argc, char **argv) {
   a.settings = settings;
   lm_error err;
   const char *sweeps_given[REPORT_MAX_SETTINGS];
-  struct option opts[15 + LIMN_POV_OPTION_COUNT] = {
+  struct option opts[14 + LIMN_POV_OPTION_COUNT - 1 + REFERENCE_OPTION_COUNT] = {
       {"job", required_argument, 0, 'J'},    {"sweep", required_argument, 0, 'W'},
       {"out", required_argument, 0, 'o'},    {"frames", required_argument, 0, 'f'},
       {"warmup", required_argument, 0, 'u'}, {"refs", required_argument, 0, 'R'},
@@ -985,12 +1027,14 @@ int limn_report(int argc, char **argv) {
       {"povray", required_argument, 0, 'P'}, {"force", no_argument, 0, 'F'},
       {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
       {"baseline", required_argument, 0, 'B'}};
-  memcpy(opts + 13, limn_pov_options, sizeof(struct option) * LIMN_POV_OPTION_COUNT);
+  memcpy(opts + 13, limn_pov_options, sizeof(struct option) * (LIMN_POV_OPTION_COUNT - 1));
+  memcpy(opts + 13 + LIMN_POV_OPTION_COUNT - 1, reference_options, sizeof(struct option) * REFERENCE_OPTION_COUNT);
   opterr = 0;
   optind = 1;
   int c, rc = 0, sweeps = 0;
   while (!rc && (c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
     int pov = limn_pov_flag("report", c, optarg, &a.ref.pov);
+    if (pov == 1) pov = reference_flag("report", c, optarg, &a.ref);
     if (pov == 2) rc = 2;
     if (pov != 1) continue;
     switch (c) {
@@ -1039,6 +1083,18 @@ int limn_report(int argc, char **argv) {
   if (j && !job_read(j, a.job, &err)) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     rc = 2;
+  }
+  if (!rc && !reference_prepare(&a.ref, j, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    rc = 1;
+  }
+  if (!rc) {
+    a.has_floor = reference_direct(&a.ref, &a.direct, &a.direct_flags);
+    reference_describe(&a.ref, a.against, sizeof a.against);
+    a.has_noise = a.ref.renderer == REFERENCE_CYCLES;
+    a.second = a.ref;
+    a.second.cycles.seed = a.ref.cycles.seed + 1;
+    snprintf(a.second_flags, sizeof a.second_flags, " --renderer cycles --seed %d", a.second.cycles.seed);
   }
   lm_pipeline *pipeline = rc ? NULL : job_pipeline(j, NULL, 0, false);
   if (!rc && !pipeline) rc = 2;

@@ -138,6 +138,32 @@ bool lm_scene_is_gltf_name(const char *name);
 /* A glTF file when lm_scene_is_gltf_name(name), else a built-in scene. */
 lm_scene *lm_scene_load(const char *name, lm_error *err);
 
+/* Writes the scene as it stands to a .glb (binary, told by the name) or
+ * .gltf file (buffers embedded), whole or not at all (a temporary name
+ * renamed), so that another program (Blender) sees what Limn renders and
+ * lm_scene_load_gltf reads the same scene back:
+ * - every node with its local matrix (the current pose), parents before
+ *   children; a mesh node one primitive of its mesh as it is now (a
+ *   deformed one: posed), POSITION, NORMAL, TEXCOORD_0 (and TANGENT), u32
+ *   indices. Animations and skins are not written (one warning).
+ * - materials as glTF metallic-roughness: the material's own when it came
+ *   from glTF, else lm_scene_material_pbr's inverse of the loader's Phong
+ *   mapping (metallic 1 - kd, roughness from the exponent); Limn's Phong
+ *   values always in extras.limn {color, ka, kd, ks, shininess, rho} and
+ *   reflectivity in extras.reflectivity. A Phong material the loader would
+ *   not read back (ks other than mix(0.04, max(color), metallic), ka not 1)
+ *   warns, naming it. Textures as PNG files beside the file, named
+ *   texture-<hash of the texels>.png; KHR_texture_transform is not written.
+ * - lights as KHR_lights_punctual in glTF's units: intensity = power /
+ *   LM_GLTF_EXPOSURE (candela, lux), range the radius of a range falloff,
+ *   the cone half-angles; a falloff glTF has not (window, none) warns and is
+ *   kept in extras.limn_falloff, a light without shadows in
+ *   extras.casts_shadows. extras.size as the loader reads it.
+ * - cameras, perspective or orthographic, on their nodes (a node with two
+ *   gets a child).
+ * `warnings` gets a line per thing glTF cannot hold as Limn has it. */
+bool lm_scene_write_gltf(const lm_scene *s, const char *path, lm_buf *warnings, lm_error *err);
+
 #ifdef __cplusplus
 }
 #endif
