@@ -29,6 +29,9 @@ Options = {
   ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
   background = 0.0,        -- radiance where no geometry is
   materials = "phong",     -- "phong" (the std technique) or "pbr" (glTF metallic-roughness, GGX)
+  light_variants = 16,     -- lighting passes compile a variant for the scene's light set when it has at
+                           -- most this many lights (0..16), each light evaluated for its kind alone;
+                           -- more lights, or 0, take the general loop over the light grid
   isr = {},                -- see isr.defaults in scripts/isr.lua
   rsm = {},                -- see rsm.defaults in scripts/rsm.lua
   vpl = {},                -- see vpl.defaults in scripts/vpl.lua
@@ -85,7 +88,8 @@ local function reads_velocity(tech, lighting)
          (gi ~= nil and on(gi.temporal) and gi.temporal.velocity ~= false)
 end
 
-local rules = { ambient = options.number(0, 1e6), background = options.number(0, 1e6) }
+local rules = { ambient = options.number(0, 1e6), background = options.number(0, 1e6),
+                light_variants = options.whole(0, 16) }
 
 function OnCreate()
   post.create()
@@ -96,7 +100,7 @@ function OnCreate()
 end
 
 function OnRender(tech)
-  for _, k in ipairs{ "ambient", "background" } do
+  for _, k in ipairs{ "ambient", "background", "light_variants" } do
     local want = rules[k](tech[k])
     if want then error(string.format("%s must be %s (got %s)", k, want, tostring(tech[k])), 2) end
   end
@@ -110,6 +114,7 @@ function OnRender(tech)
   local materials = ({ phong = "std", pbr = "pbr" })[tech.materials]
   if not materials then error('materials must be "phong" or "pbr" (got "' .. tostring(tech.materials) .. '")') end
   local G = gbuffer.render(gbuffer.targets(1, materials, reads_velocity(tech, lighting)), materials)
+  G.lights = light_set(tech.light_variants) -- nil: the general light loop (gbuffer.defines)
   temporal.velocity(G.vel)
   -- Shadows after the G-buffer: their cascades fit the depths it sees.
   -- The RSM's options, when the technique reads one (the shadow pass then writes it).
