@@ -29,9 +29,10 @@ Options = {
   ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
   background = 0.0,        -- radiance where no geometry is
   materials = "phong",     -- "phong" (the std technique) or "pbr" (glTF metallic-roughness, GGX)
-  light_variants = 16,     -- lighting passes compile a variant for the scene's light set when it has at
+  light_variants = 12,     -- lighting passes compile a variant for the scene's light set when it has at
                            -- most this many lights (0..16), each light evaluated for its kind alone;
-                           -- more lights, or 0, take the general loop over the light grid
+                           -- more lights, or 0, take the general loop over the light grid (which culls
+                           -- lights of small reach: office with 9 more such lights, the two cost alike)
   isr = {},                -- see isr.defaults in scripts/isr.lua
   rsm = {},                -- see rsm.defaults in scripts/rsm.lua
   vpl = {},                -- see vpl.defaults in scripts/vpl.lua
