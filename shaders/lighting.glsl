@@ -158,7 +158,8 @@ vec3 reflect_light(Reflector m, vec3 n, vec3 v, vec3 l, float ndl) {
 bool light_set_has(int mask, int i) { return ((mask >> i) & 1) != 0; }
 
 // Light i of the set reflected toward v: what reflected_light's loop adds
-// for it, in the same order of operations (the same image).
+// for it, by the same operations (the same value; only the loop's order of
+// summing, light grid first, may differ in the last bits).
 vec3 light_set_reflected(int i, Reflector m, vec3 n, vec3 v, vec3 p) {
   int type = light_set_has(LIGHT_SUNS, i) ? 2 : light_set_has(LIGHT_SPOTS, i) ? 1 : 0;
   int falloff = light_set_has(LIGHT_FALLOFF_NONE, i) ? 1 : light_set_has(LIGHT_FALLOFF_SQUARE, i) ? 2
