@@ -38,11 +38,20 @@ function gbuffer.render(G, technique, materials)
   return G
 end
 
+-- Adds to a lighting pass's defines the scene's light set, when the pipeline
+-- put one in G.lights (light_set(): lighting.glsl then evaluates each light
+-- unrolled, for its kind alone, instead of the general loop).
+function gbuffer.lights(G, defines)
+  for k, v in pairs(G.lights or {}) do defines[k] = v end
+  return defines
+end
+
 -- Adds to a lighting pass's defines what G says of its pixels: PHONG_ONLY when
--- the std technique drew them all (gbuffer.glsl then compiles no GGX).
+-- the std technique drew them all (gbuffer.glsl then compiles no GGX); and
+-- the light set (gbuffer.lights).
 function gbuffer.defines(G, defines)
   defines.PHONG_ONLY = G.phong_only
-  return defines
+  return gbuffer.lights(G, defines)
 end
 
 -- The inputs table a lighting pass takes.

@@ -15,6 +15,7 @@ Options = {
   ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
   background = 0.0,        -- radiance where no geometry is
   materials = "phong",     -- "phong" (the std technique) or "pbr" (glTF metallic-roughness, GGX)
+  light_variants = 12,     -- up to this many lights (0..16) lighting passes unroll them; more, 0: grid loop
   shadow = options.copy(shadow.defaults),
   sky = options.copy(sky.defaults),                -- off by default
   reflections = options.copy(reflections.defaults),
@@ -73,6 +74,7 @@ local function frame(tech, row)
   local materials = ({ phong = "std", pbr = "pbr" })[tech.materials]
   if not materials then error('materials must be "phong" or "pbr" (got "' .. tostring(tech.materials) .. '")') end
   local G = gbuffer.render(gbuffer.targets(1, materials, reads_velocity(tech, row)), materials)
+  G.lights = light_set(tech.light_variants) -- nil: the general light loop (gbuffer.defines)
   temporal.velocity(G.vel)
   local o = S and S.check(tech[row.offscreen]) -- shadows after the G-buffer: cascades fit what it sees
   local F = { G = G, technique = row, light = { ambient = grey(tech.ambient), background = grey(tech.background) } }
@@ -94,7 +96,8 @@ local function frame(tech, row)
   return post.render(lit, tech, F)
 end
 
-local rules = { ambient = options.number(0, 1e6), background = options.number(0, 1e6) }
+local rules = { ambient = options.number(0, 1e6), background = options.number(0, 1e6),
+                light_variants = options.whole(0, 16) }
 
 function OnCreate()
   post.create()
@@ -104,7 +107,7 @@ function OnCreate()
 end
 
 function OnRender(tech)
-  for _, k in ipairs{ "ambient", "background" } do
+  for _, k in ipairs{ "ambient", "background", "light_variants" } do
     local want = rules[k](tech[k])
     if want then error(string.format("%s must be %s (got %s)", k, want, tostring(tech[k])), 2) end
   end
@@ -114,4 +117,3 @@ function OnRender(tech)
   temporal.begin(settings)
   present(frame(tech, techniques.row(tech.name)))
 end
-

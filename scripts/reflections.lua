@@ -7,6 +7,7 @@
 -- of filters.lua and adds them weighted by each pixel's reflectivity
 -- (reflect_apply.frag). One bounce: a mirror seen in a mirror shows unlit.
 local filters = require "filters"
+local gbuffer = require "gbuffer"
 local options = require "options"
 local shadow = require "shadow"
 local sky = require "sky"
@@ -47,7 +48,8 @@ function reflections.render(lit, o, frame)
   cpu{ "reflect.trace", fn = "trace", inputs = { rays_o = rays_o, rays_d = rays_d },
        out = { H.clr, H.nrm, H.pos, H.mat } }
   local inputs, defines = shadow.bind(frame.shadows, { hit_clr = H.clr, hit_nrm = H.nrm, hit_pos = H.pos,
-                                                       hit_mat = H.mat, rays_o = rays_o, rays_d = rays_d }, {})
+                                                       hit_mat = H.mat, rays_o = rays_o, rays_d = rays_d },
+                                       gbuffer.lights(frame.G, {}))
   local params = sky.bind(light.sky, { ambient = light.ambient, background = light.background }, defines)
   local refl = pass{ "reflect.light", shader = "reflect_light.frag", inputs = inputs, defines = defines,
                      params = params,

@@ -25,10 +25,11 @@ float light_falloff(int mode, float d, float radius) {
   return saturate(1.0 - (d / radius_safe) * (d / radius_safe));
 }
 
-// Light arriving at p from light li: direction to the light in *l, radiance
-// returned. A loop over many points of one light reads li once, outside it.
-vec3 light_arriving(Light li, vec3 p, out vec3 l) {
-  int type = int(li.position.w + 0.5);
+// Light arriving at p from light li of kind `type` (0 point, 1 spot, 2
+// directional) and falloff `falloff` (light_falloff's mode): direction to the
+// light in *l, radiance returned. Constant kind and falloff (a light-set
+// variant, LIGHT_SET) leave one kind's code, no branch.
+vec3 light_arriving_as(Light li, int type, int falloff, vec3 p, out vec3 l) {
   if (type == 2) {
     l = safe_normalize(-li.direction.xyz, vec3(0.0, 1.0, 0.0));
     return li.color.rgb;
@@ -36,13 +37,19 @@ vec3 light_arriving(Light li, vec3 p, out vec3 l) {
   vec3 to_light = li.position.xyz - p;
   float d = length(to_light);
   l = d > 1e-12 ? to_light / d : vec3(0.0, 1.0, 0.0);
-  float fall = light_falloff(int(li.params.y + 0.5), d, li.color.w);
+  float fall = light_falloff(falloff, d, li.color.w);
   if (type == 1) {
     float cos_angle = dot(-l, li.direction.xyz);
     float inner = li.params.x, outer = li.direction.w;
     fall *= smoothstep(outer, max(inner, outer + 1e-4), cos_angle);
   }
   return li.color.rgb * fall;
+}
+
+// Light arriving at p from light li, its kind and falloff read from it. A
+// loop over many points of one light reads li once, outside it.
+vec3 light_arriving(Light li, vec3 p, out vec3 l) {
+  return light_arriving_as(li, int(li.position.w + 0.5), int(li.params.y + 0.5), p, l);
 }
 
 // Light arriving at p from light i (light_arriving).
@@ -119,21 +126,90 @@ vec3 phong_reflect(Reflector m, vec3 n, vec3 v, vec3 l, float ndl) {
   return m.k.y * m.albedo * ndl + m.k.z * spec;
 }
 
+// The surface's reflection of light arriving along l with n.l = ndl.
+vec3 reflect_light(Reflector m, vec3 n, vec3 v, vec3 l, float ndl) {
+  return m.pbr ? pbr_reflect(m, n, v, l, ndl) : phong_reflect(m, n, v, l, ndl);
+}
+
+#ifdef LIGHT_SET
+// A variant for the scene's light set (light_set() in the pipeline API):
+// LIGHT_SET lights, bit i of each mask saying light i's kind, falloff and
+// whether it casts shadows. Each light is evaluated for its kind alone, at a
+// constant index: a software rasterizer runs every branch of the general
+// loop (every kind, every shadow kind) for every light; this runs one.
+#ifndef LIGHT_SPOTS
+#define LIGHT_SPOTS 0
+#endif
+#ifndef LIGHT_SUNS
+#define LIGHT_SUNS 0
+#endif
+#ifndef LIGHT_SHADOWED
+#define LIGHT_SHADOWED 0
+#endif
+#ifndef LIGHT_FALLOFF_NONE
+#define LIGHT_FALLOFF_NONE 0
+#endif
+#ifndef LIGHT_FALLOFF_SQUARE
+#define LIGHT_FALLOFF_SQUARE 0
+#endif
+#ifndef LIGHT_FALLOFF_RANGE
+#define LIGHT_FALLOFF_RANGE 0
+#endif
+bool light_set_has(int mask, int i) { return ((mask >> i) & 1) != 0; }
+
+// Light i of the set reflected toward v: what reflected_light's loop adds
+// for it, by the same operations (the same value; only the loop's order of
+// summing, light grid first, may differ in the last bits).
+vec3 light_set_reflected(int i, Reflector m, vec3 n, vec3 v, vec3 p) {
+  int type = light_set_has(LIGHT_SUNS, i) ? 2 : light_set_has(LIGHT_SPOTS, i) ? 1 : 0;
+  int falloff = light_set_has(LIGHT_FALLOFF_NONE, i) ? 1 : light_set_has(LIGHT_FALLOFF_SQUARE, i) ? 2
+              : light_set_has(LIGHT_FALLOFF_RANGE, i) ? 3 : 0;
+  vec3 l;
+  vec3 radiance = light_arriving_as(lights[i], type, falloff, p, l);
+  float ndl = dot(n, l);
+  if (ndl <= 0.0 || max(radiance.r, max(radiance.g, radiance.b)) <= 0.0) return vec3(0.0);
+#ifdef SHADOWS
+  // the shadow kind follows the light's (engine/shadow: cascades, spot, cube)
+  if (light_set_has(LIGHT_SHADOWED, i)) radiance *= shadow_factor_as(i, type == 2 ? 1 : type == 1 ? 2 : 3, p, n, l);
+#endif
+  return radiance * reflect_light(m, n, v, l, ndl);
+}
+#endif
+
 // The light of every light that may reach p reflected toward v (unit n and v),
 // one loop for both models. The loop tests at its end: a software rasterizer
-// would run a head-tested loop's body once more for its last test.
+// would run a head-tested loop's body once more for its last test. With
+// LIGHT_SET, each light of the set unrolled instead (up to 16,
+// LM_LIGHT_SET_MAX; four at a time, the compiler drops those past the count).
 vec3 reflected_light(Reflector m, vec3 n, vec3 v, vec3 p) {
   vec3 sum = vec3(0.0);
+#ifdef LIGHT_SET
+#define LIGHT_SET_AT(i) if ((i) < LIGHT_SET) sum += light_set_reflected(i, m, n, v, p);
+#define LIGHT_SET_FROM(i) LIGHT_SET_AT(i) LIGHT_SET_AT(i + 1) LIGHT_SET_AT(i + 2) LIGHT_SET_AT(i + 3)
+#if LIGHT_SET > 0
+  LIGHT_SET_FROM(0)
+#endif
+#if LIGHT_SET > 4
+  LIGHT_SET_FROM(4)
+#endif
+#if LIGHT_SET > 8
+  LIGHT_SET_FROM(8)
+#endif
+#if LIGHT_SET > 12
+  LIGHT_SET_FROM(12)
+#endif
+  return sum;
+#else
   LightList near = lights_near(p);
   if (near.count <= 0) return sum;
   int j = 0;
   do {
     vec3 l, radiance;
     float ndl;
-    if (light_on_surface(light_index(near, j), p, n, l, ndl, radiance))
-      sum += radiance * (m.pbr ? pbr_reflect(m, n, v, l, ndl) : phong_reflect(m, n, v, l, ndl));
+    if (light_on_surface(light_index(near, j), p, n, l, ndl, radiance)) sum += radiance * reflect_light(m, n, v, l, ndl);
   } while (++j < near.count);
   return sum;
+#endif
 }
 
 // k = (k_a, k_d, k_s), shininess >= 0; n and v unit vectors (v toward the eye).

@@ -141,9 +141,12 @@ float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
   return r - bias <= shadow_texel(ivec2(floor(texel + 0.5)), lo, hi) ? 1.0 : 0.0;
 }
 
-float shadow_factor(int light, vec3 p, vec3 n, vec3 l) {
+// Shadow factor of light `light` at p, whose shadow is of kind `kind`
+// (ShadowLight.info.z): a constant kind (a light-set variant, lighting.glsl)
+// compiles that kind's lookup alone.
+float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
   ShadowLight s = shadow_lights[light];
-  int first = s.info.x, count = s.info.y, kind = s.info.z;
+  int first = s.info.x, count = s.info.y;
   if (count <= 0) return 1.0;
   // The view to read, and for cascades the next one's weight t: one lookup
   // whatever the kind (a software rasterizer runs every kind's branch).
@@ -173,5 +176,9 @@ float shadow_factor(int light, vec3 p, vec3 n, vec3 l) {
   do vis = mix(vis, shadow_view_lookup(v + j, s, p, ndl), j == 0 ? 1.0 : t);
   while (++j < (t > 0.0 ? 2 : 1));
   return vis;
+}
+
+float shadow_factor(int light, vec3 p, vec3 n, vec3 l) {
+  return shadow_factor_as(light, shadow_lights[light].info.z, p, n, l);
 }
 #endif

@@ -31,6 +31,9 @@ static const char bench_usage[] =
     "passes plus reading their result back) is shown as a share of the frame.\n"
     "CPU passes (cpu{}, e.g. reflections' ray tracing, with their read-back and\n"
     "upload) are shown against the rest of the frame as a ratio.\n"
+    "The shader programs the run compiled are counted, with the wall time their\n"
+    "compiles and links took, and among them the lighting passes' variants for the\n"
+    "scene's light set (light_set(), pp.lua's light_variants; one per light set).\n"
     "With --trace, the CPU ray tracer (engine/trace) on the scene: its build, its\n"
     "rate on the reflection rays of a view where every surface is a mirror at\n"
     "800x450 (the seed's quarter of 1600x900), and the same at a quarter of the\n"
@@ -595,6 +598,10 @@ static void print_tables(const bench *b, lm_clock clock) {
   for (int s = 0; s < b->size_count; s++)
     printf("  %5dx%-6d %10d %12.3f %12.3f %8.1f%%\n", b->sizes[s][0], b->sizes[s][1], b->sizes[s][0] * b->sizes[s][1],
            b->frame_ms[s], b->overhead_ms[s], b->frame_ms[s] > 0 ? 100 * b->overhead_ms[s] / b->frame_ms[s] : 0);
+  double all_ms, set_ms;
+  int all = lm_programs_stats(NULL, &all_ms), sets = lm_programs_stats("LIGHT_SET", &set_ms);
+  printf("  programs: %d compiled and linked in %.1f ms (wall clock), of which light-set variants %d in %.1f ms\n",
+         all, all_ms, sets, set_ms);
   double fp, fr;
   for (int s = 0; s < b->size_count; s++)
     if (shadow_fit_ms(b, s, &fp, &fr))
@@ -991,6 +998,10 @@ static void print_json(const bench *b, lm_clock clock) {
            b->trace_stats.build_ms, b->trace_rays, b->trace_ms, b->trace_cpu_ms, rays_per_s(b->trace_rays, b->trace_ms), b->frame_rays,
            b->frame_trace_ms, frame > 0 ? b->frame_trace_ms / frame : 0);
   }
+  double all_ms, set_ms;
+  int all = lm_programs_stats(NULL, &all_ms), sets = lm_programs_stats("LIGHT_SET", &set_ms);
+  printf(", \"programs\": {\"count\": %d, \"build_ms\": %.6g, \"light_set_variants\": %d, \"light_set_build_ms\": %.6g}",
+         all, all_ms, sets, set_ms);
   if (b->ns_per_fetch > 0) printf(", \"calibration\": {\"ns_per_fetch\": %.6g}", b->ns_per_fetch);
   else printf(", \"calibration\": null");
   if (b->motion.on) print_motion_json(b);

@@ -162,6 +162,11 @@ unsigned lm_programs_generation(void);
 /* The first failed rebuild's message since the last invalidation, or NULL. */
 const char *lm_programs_error(void);
 int lm_program_count(void);
+/* The cached programs whose defines name `define` (NULL: all), e.g. the
+ * lighting passes' light-set variants (LIGHT_SET); *build_ms (may be NULL)
+ * gets the wall milliseconds their compiles and links took (CLOCK_MONOTONIC;
+ * a driver may finish compiling at the first draw, which is not counted). */
+int lm_programs_stats(const char *define, double *build_ms);
 /* The directory shader paths are relative to: <root>/shaders. */
 const char *lm_shader_dir(void);
 

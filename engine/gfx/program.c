@@ -12,6 +12,7 @@ typedef struct cached_program {
   lm_program *program;
   bool stale;  /* its files changed: rebuild on next use */
   char *error; /* why the last rebuild failed (the old program stays) */
+  double build_ms; /* wall time of its builds, rebuilds included */
 } cached_program;
 static cached_program *cache;
 static int cache_count, cache_cap;
@@ -224,7 +225,9 @@ lm_program *lm_program_get(const char *vert, const char *frag, const char *defin
       /* Rebuilt once per invalidation; a failure keeps the last good program running. */
       c->stale = false;
       lm_error why;
+      double t0 = lm_now_ms();
       lm_program *p = build(vert, frag, defines, &why);
+      c->build_ms += lm_now_ms() - t0;
       if (p) {
         program_free(c->program);
         c->program = p;
@@ -234,11 +237,13 @@ lm_program *lm_program_get(const char *vert, const char *frag, const char *defin
     }
     return c->program;
   }
+  double t0 = lm_now_ms();
   lm_program *p = build(vert, frag, defines, err);
   if (!p) return NULL;
   cached_program *c = LM_PUSH(cache, cache_count, cache_cap);
   snprintf(c->key, sizeof c->key, "%s", key);
   c->program = p;
+  c->build_ms = lm_now_ms() - t0;
   return p;
 }
 
@@ -319,3 +324,25 @@ void lm_programs_clear(void) {
 }
 
 int lm_program_count(void) { return cache_count; }
+
+/* Does the defines part of a cache key ("vert|frag|A;B=1") name `define`? */
+static bool key_defines(const char *key, const char *define) {
+  const char *p = strrchr(key, '|');
+  size_t n = strlen(define);
+  for (p = p ? p + 1 : key; *p;) {
+    size_t len = strcspn(p, "=;");
+    if (len == n && !strncmp(p, define, n)) return true;
+    p += strcspn(p, ";");
+    if (*p == ';') p++;
+  }
+  return false;
+}
+
+int lm_programs_stats(const char *define, double *build_ms) {
+  int n = 0;
+  double ms = 0;
+  for (int i = 0; i < cache_count; i++)
+    if (!define || key_defines(cache[i].key, define)) n++, ms += cache[i].build_ms;
+  if (build_ms) *build_ms = ms;
+  return n;
+}

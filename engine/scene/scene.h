@@ -97,6 +97,11 @@ typedef struct lm_light {
 #define LM_LIGHT_SUN_SIZE 0.0093f  /* the sun's angular diameter, radians (0.53 degrees) */
 #define LM_LIGHT_SIZE_SHARE 0.01f  /* a local light's default size as a share of its range */
 
+/* The most lights a lighting shader evaluates unrolled, a variant compiled
+ * for the scene's light set (light_set() in the pipeline API,
+ * shaders/lighting.glsl); scenes with more take the general loop. */
+#define LM_LIGHT_SET_MAX 16
+
 /* Distance beyond which a point or spot light adds nothing (the window's or
  * range's radius); INFINITY for directional lights and unbounded falloffs. */
 float lm_light_reach(const lm_light *l);

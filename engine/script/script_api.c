@@ -695,6 +695,47 @@ static int l_scene_reflective(lua_State *L) {
   return 1;
 }
 
+/* light_set(max): the scene's lights as a lighting pass's defines, which
+ * shaders/lighting.glsl reads to evaluate each light unrolled, its kind,
+ * falloff and shadow fixed, instead of the general loop: { LIGHT_SET = count,
+ * LIGHT_SPOTS, LIGHT_SUNS (directional), LIGHT_SHADOWED (casts shadows),
+ * LIGHT_FALLOFF_NONE, LIGHT_FALLOFF_SQUARE, LIGHT_FALLOFF_RANGE = masks,
+ * bit i for light i } (zero masks left out: one variant, one cache key). nil
+ * when the scene has more than max lights (0 .. LM_LIGHT_SET_MAX): the
+ * general loop, with light culling. */
+static int l_light_set(lua_State *L) {
+  lm_pipeline *p = recording(L, "light_set");
+  lua_Integer max = luaL_checkinteger(L, 1);
+  if (max < 0 || max > LM_LIGHT_SET_MAX)
+    return luaL_error(L, "light_set: max must be an integer in 0 .. %d (got %d)", LM_LIGHT_SET_MAX, (int)max);
+  int n = p->scene ? p->scene->light_count : 0;
+  if (n > max) {
+    lua_pushnil(L);
+    return 1;
+  }
+  unsigned spots = 0, suns = 0, shadowed = 0, falloff[4] = {0};
+  for (int i = 0; i < n; i++) {
+    const lm_light *l = &p->scene->lights[i];
+    spots |= (unsigned)(l->type == LM_LIGHT_SPOT) << i;
+    suns |= (unsigned)(l->type == LM_LIGHT_DIRECTIONAL) << i;
+    shadowed |= (unsigned)l->casts_shadows << i;
+    if ((unsigned)l->falloff < 4) falloff[l->falloff] |= 1u << i;
+  }
+  const struct { const char *name; unsigned mask; } masks[] = {
+      {"LIGHT_SPOTS", spots}, {"LIGHT_SUNS", suns}, {"LIGHT_SHADOWED", shadowed},
+      {"LIGHT_FALLOFF_NONE", falloff[LM_FALLOFF_NONE]}, {"LIGHT_FALLOFF_SQUARE", falloff[LM_FALLOFF_INVERSE_SQUARE]},
+      {"LIGHT_FALLOFF_RANGE", falloff[LM_FALLOFF_RANGE]}};
+  lua_createtable(L, 0, 7);
+  lua_pushinteger(L, n);
+  lua_setfield(L, -2, "LIGHT_SET");
+  for (size_t k = 0; k < sizeof masks / sizeof *masks; k++) {
+    if (!masks[k].mask) continue;
+    lua_pushinteger(L, masks[k].mask);
+    lua_setfield(L, -2, masks[k].name);
+  }
+  return 1;
+}
+
 static int l_present(lua_State *L) {
   lm_pipeline *p = recording(L, "present");
   if (p->in_create) return luaL_error(L, "present() is called from OnRender");
@@ -736,7 +777,8 @@ void lm_script_open_api(lua_State *L) {
                                  {"present", l_present}, {"output_size", l_output_size}, {"still_frames", l_still_frames},
                                  {"shadow_plan", l_shadow_plan}, {"sky_sh", l_sky_sh}, {"cpu", l_cpu},
                                  {"scene_reflective", l_scene_reflective}, {"points", l_points},
-                                 {"scene_bounds", l_scene_bounds}, {NULL, NULL}};
+                                 {"scene_bounds", l_scene_bounds}, {"light_set", l_light_set},
+                                 {NULL, NULL}};
   lua_pushglobaltable(L);
   luaL_setfuncs(L, api, 0);
   lua_pop(L, 1);
