@@ -35,11 +35,18 @@ prepare() {
         -e '/pkg_check_modules(OIIO/d' -e '/add_subdirectory(tests)/d' "$wt/CMakeLists.txt"
     fi
     build_without_images "$wt" "$wt/build-device"
-    mkdir -p "$dir/base" && cp "$wt/build-device/limn" "$dir/base/"
+    mkdir -p "$dir/base/root" && cp "$wt/build-device/limn" "$dir/base/"
+    # Its own scripts and shaders (LIMN_ROOT): the working tree's may not suit it.
+    git archive "$1" scripts shaders | tar -x -C "$dir/base/root"
     git worktree remove --force "$wt"
   fi
   ldd "$dir"/*/limn | awk '/=> \// {print $3}' | sort -u | grep -v -e 'libc\.so' -e 'libm\.so' -e 'ld-linux' |
     xargs -r cp -L -t "$dir/lib"
+  # libepoxy opens GL and EGL at run time (not in ldd): glvnd's, which load the machine's driver.
+  local gl
+  for gl in libEGL.so.1 libGL.so.1 libGLX.so.0 libGLdispatch.so.0 libOpenGL.so.0; do
+    cp -L "/usr/lib/$(gcc -print-multiarch)/$gl" "$dir/lib/"
+  done
   du -sh "$dir"
   echo "device: run with carry [\"$dir\"]: tools/device_bench.sh run"
 }
@@ -62,7 +69,9 @@ run() {
         echo "== $rev round $round: $scene isr+esm $size moving"
         # Whole tables to $OUT (the device tool brings them back); here the moving column.
         local log="$out/$(basename "$scene" .glb)-$rev-$round.txt"
-        timeout 150 "$dir/$rev/limn" bench --motion --clock gpu --scene "$scene" --tech isr+esm --sizes "$size" \
+        local root=$PWD
+        [ -d "$dir/$rev/root" ] && root=$PWD/$dir/$rev/root
+        LIMN_ROOT=$root timeout 150 "$dir/$rev/limn" bench --motion --clock gpu --scene "$scene" --tech isr+esm --sizes "$size" \
           --frames 24 --warmup 4 >"$log" 2>&1 || echo "  failed: $(tail -1 "$log")"
         awk '/^motion at/ {on=1} on && /pass \(ms\)/ {t=1; next} /shadow tiles drawn/ {t=0}
              t { name=$1; for (i=2; i<=NF-5; i++) name=name " " $i; printf "  %-24s %s\n", name, $(NF-3) }' "$log"
