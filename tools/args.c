@@ -154,3 +154,10 @@ void limn_json_string(const char *s) {
   fputs(b.data, stdout);
   lm_buf_free(&b);
 }
+
+int limn_usage_error(const char *cmd, const char *fmt, const char *arg) {
+  fprintf(stderr, "limn %s: ", cmd);
+  fprintf(stderr, fmt, arg);
+  fprintf(stderr, "\n(see limn %s --help)\n", cmd);
+  return 2;
+}

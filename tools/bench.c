@@ -159,12 +159,7 @@ typedef struct bench {
   motion motion;
 } bench;
 
-static int usage_error(const char *fmt, const char *arg) {
-  fprintf(stderr, "limn bench: ");
-  fprintf(stderr, fmt, arg);
-  fprintf(stderr, "\n(see limn bench --help)\n");
-  return 2;
-}
+static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("bench", fmt, arg); }
 
 static int parse_args(int argc, char **argv, bench *b) {
   *b = (bench){.frames = 5, .warmup = 2, .scene = "cornell", .light_reach = 0.08, .trace_threads = 2};

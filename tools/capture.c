@@ -90,13 +90,7 @@ typedef struct capture_args {
   bool list_options, quiet, verbose, check_nan;
 } capture_args;
 
-static int usage_error(const char *fmt, const char *arg) {
-  fprintf(stderr, "limn capture: ");
-  fprintf(stderr, fmt, arg);
-  fprintf(stderr, "\n(see limn capture --help)\n");
-  return 2;
-}
-
+static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("capture", fmt, arg); }
 
 bool capture_known_extension(const char *path, bool *linear) {
   const char *dot = strrchr(path, '.');

@@ -47,12 +47,7 @@ typedef struct compare_args {
   bool json;
 } compare_args;
 
-static int usage_error(const char *fmt, const char *arg) {
-  fprintf(stderr, "limn compare: ");
-  fprintf(stderr, fmt, arg);
-  fprintf(stderr, "\n(see limn compare --help)\n");
-  return 2;
-}
+static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("compare", fmt, arg); }
 
 static bool has_extension(const char *path, const char *ext) {
   const char *dot = strrchr(path, '.');

@@ -35,12 +35,7 @@ static const char export_gltf_usage[] =
     "\n"
     "exit codes: 0 written, 1 not written, 2 bad usage or a scene that does not load.\n";
 
-static int usage_error(const char *fmt, const char *arg) {
-  fprintf(stderr, "limn export-gltf: ");
-  fprintf(stderr, fmt, arg);
-  fprintf(stderr, "\n(see limn export-gltf --help)\n");
-  return 2;
-}
+static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("export-gltf", fmt, arg); }
 
 int limn_export_gltf(int argc, char **argv) {
   const char *scene_name = "cornell", *output = NULL, *animation = NULL, *time_flag = NULL;

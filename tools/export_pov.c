@@ -56,12 +56,7 @@ typedef struct export_args {
   lm_pov_desc desc;
 } export_args;
 
-static int usage_error(const char *fmt, const char *arg) {
-  fprintf(stderr, "limn export-pov: ");
-  fprintf(stderr, fmt, arg);
-  fprintf(stderr, "\n(see limn export-pov --help)\n");
-  return 2;
-}
+static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("export-pov", fmt, arg); }
 
 enum { SKY_FLAG = 0x100 }; /* beyond any one-letter flag */
 
@@ -148,11 +143,7 @@ int limn_pov_flag(const char *cmd, int c, const char *arg, lm_pov_desc *d) {
     break;
   default: return 1;
   }
-  if (!bad) return 0;
-  fprintf(stderr, "limn %s: ", cmd);
-  fprintf(stderr, bad, arg);
-  fprintf(stderr, "\n(see limn %s --help)\n", cmd);
-  return 2;
+  return bad ? limn_usage_error(cmd, bad, arg) : 0;
 }
 
 /* Returns 0 to go on, -1 after --help, else the exit code. */

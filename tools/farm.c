@@ -53,12 +53,7 @@ static const char farm_usage[] =
     "\n"
     "exit codes: 0 written (and submitted), 1 failed, 2 bad usage or a bad job.\n";
 
-static int usage_error(const char *fmt, const char *arg) {
-  fprintf(stderr, "limn farm slurm: ");
-  fprintf(stderr, fmt, arg);
-  fprintf(stderr, "\n(see limn farm slurm --help)\n");
-  return 2;
-}
+static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("farm slurm", fmt, arg); }
 
 typedef struct farm_args {
   const char *job, *dir, *name, *refs, *povray;

@@ -40,12 +40,7 @@ static const char manifest_usage[] =
     "\n"
     "exit codes: 0 merged, 1 something missing, duplicated or from another run, 2 bad usage.\n";
 
-static int usage_error(const char *fmt, const char *arg) {
-  fprintf(stderr, "limn manifest merge: ");
-  fprintf(stderr, fmt, arg);
-  fprintf(stderr, "\n(see limn manifest merge --help)\n");
-  return 2;
-}
+static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("manifest merge", fmt, arg); }
 
 /* At most this many lines of one kind of problem; then a count. */
 #define SHOWN 20

@@ -111,11 +111,7 @@ int reference_flag(const char *cmd, int c, const char *arg, reference_args *a) {
   case SCRIPT_FLAG: y->script = arg; break;
   default: return 1;
   }
-  if (!bad) return 0;
-  fprintf(stderr, "limn %s: ", cmd);
-  fprintf(stderr, bad, arg);
-  fprintf(stderr, "\n(see limn %s --help)\n", cmd);
-  return 2;
+  return bad ? limn_usage_error(cmd, bad, arg) : 0;
 }
 
 bool reference_prepare(reference_args *a, const job *j, lm_error *err) {
@@ -452,12 +448,7 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
   return rc;
 }
 
-static int usage_error(const char *fmt, const char *arg) {
-  fprintf(stderr, "limn reference: ");
-  fprintf(stderr, fmt, arg);
-  fprintf(stderr, "\n(see limn reference --help)\n");
-  return 2;
-}
+static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("reference", fmt, arg); }
 
 int limn_reference(int argc, char **argv) {
   reference_args a;

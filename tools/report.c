@@ -117,12 +117,7 @@ typedef struct report_runs {
   double *settled;
 } report_runs;
 
-static int usage_error(const char *fmt, const char *arg) {
-  fprintf(stderr, "limn report: ");
-  fprintf(stderr, fmt, arg);
-  fprintf(stderr, "\n(see limn report --help)\n");
-  return 2;
-}
+static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("report", fmt, arg); }
 
 /* ---- writing ------------------------------------------------------------ */
 

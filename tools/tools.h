@@ -22,6 +22,9 @@ int limn_farm(int argc, char **argv);
 
 /* Flag values (tools/args.c): false when `s` is not one. */
 bool limn_parse_int(const char *s, int lo, int hi, int *out);
+/* Prints "limn CMD: " then fmt with arg, and where to read more, to stderr;
+ * returns 2 (bad usage). */
+int limn_usage_error(const char *cmd, const char *fmt, const char *arg);
 bool limn_parse_double(const char *s, double *out); /* finite */
 /* --time: SECONDS (start = stop) or START:STOP, finite; the order is the caller's to check. */
 bool limn_parse_time(const char *s, double *start, double *stop);

@@ -75,12 +75,7 @@ static const char view_usage[] =
     "renderer), 2 bad usage or a bad technique, option, scene, camera or animation.\n";
 
 /* ---- command line ------------------------------------------------------ */
-static int usage_error(const char *fmt, const char *arg) {
-  fprintf(stderr, "limn view: ");
-  fprintf(stderr, fmt, arg);
-  fprintf(stderr, "\n(see limn view --help)\n");
-  return 2;
-}
+static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("view", fmt, arg); }
 
 /* "5:F5,10:F3,12:resize=1x1" */
 static bool parse_script_keys(const char *list, view_args *a) {
