@@ -1,4 +1,4 @@
-/* What `limn capture` (tools/capture.c) and capture jobs (tools/job.c)
+/* What `limn capture` (cli/capture.c) and capture jobs (cli/job.c)
  * share: one path that renders a view and writes its images. */
 #ifndef LIMN_CAPTURE_H
 #define LIMN_CAPTURE_H

@@ -1,4 +1,4 @@
-/* Capture jobs (tools/job.c) as `limn capture --job`, `limn reference` and
+/* Capture jobs (cli/job.c) as `limn capture --job`, `limn reference` and
  * `limn report` share them: the job file read, its views enumerated, its
  * pipeline set up, the progress line. */
 #ifndef LIMN_JOB_H
@@ -26,7 +26,7 @@ typedef struct job_scene {
 
 typedef struct job {
   char path[1024], dir[1024], script[1024], output[1024], manifest[1024];
-  char renderer[16]; /* the references' renderer: "pov", "cycles" or "" (not given; tools/reference.h) */
+  char renderer[16]; /* the references' renderer: "pov", "cycles" or "" (not given; cli/reference.h) */
   job_scene scenes[MAX_LIST];
   int scene_count;
   char techniques[MAX_LIST][64];

@@ -1,8 +1,8 @@
 /* limn reference --job FILE: references of a capture job's views from
- * POV-Ray or Cycles (tools/reference.h). This file is the part they share
+ * POV-Ray or Cycles (cli/reference.h). This file is the part they share
  * (flags, file names, the cache, running at most --jobs renders at once,
  * renaming finished ones into place) and POV-Ray's own part; Cycles' is
- * tools/reference_cycles.c. POV-Ray runs in the reference's folder, since
+ * cli/reference_cycles.c. POV-Ray runs in the reference's folder, since
  * Debian's povray.conf lets it write only below the current directory. A
  * renderer's output goes to a log beside its input, shown when it fails. */
 #define _GNU_SOURCE
@@ -35,7 +35,7 @@ static const char reference_usage[] =
     "DIR/<scene>/<camera>_<WxH>-<hash>.exr, the hash that of the exported scene\n"
     "text; a Cycles one DIR/<scene>/<camera>_<WxH>-cycles-<hash>.exr, the hash\n"
     "that of the scene file, the camera, size, samples, bounces, seed, materials\n"
-    "and sky, tools/cycles_render.py and Blender's version. A view whose hash\n"
+    "and sky, cli/cycles_render.py and Blender's version. A view whose hash\n"
     "has not changed is not rendered again. A sequence's frames are posed at\n"
     "their times, each DIR/<scene>/<camera>_<WxH>-<frame>-<time>-...exr.\n"
     "POV-Ray runs in parallel, up to the core count; Cycles one view at a time\n"
