@@ -99,17 +99,15 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
 
 /* ---- the renderers' own parts ------------------------------------------ */
 
-/* Starts argv[0] with argv, its output into `log`, in folder dir (NULL:
- * here); the child dies with this process. -1 when it cannot fork. */
-pid_t reference_spawn(const char *const *argv, const char *dir, const char *log);
-
 /* Cycles (cli/reference_cycles.c). */
 bool reference_cycles_prepare(reference_cycles *c, lm_error *err);
 /* Place v's spec into `spec` and its hash (everything that decides the image). */
 bool reference_cycles_spec(const reference_args *a, const job *j, const job_view *v, lm_buf *spec, uint64_t *hash,
                            lm_error *err);
-/* Blender on the spec file, rendering into out with `threads` threads. */
-pid_t reference_cycles_start(const reference_cycles *c, const char *spec, const char *out, const char *log,
-                             int threads);
+/* Blender's command line on the spec file, rendering into out with `threads`
+ * threads (a number as text); reference.c runs it. argv ends with NULL. */
+#define REFERENCE_CYCLES_ARGC 14
+void reference_cycles_argv(const reference_cycles *c, const char *spec, const char *out, const char *threads,
+                           const char *argv[REFERENCE_CYCLES_ARGC]);
 
 #endif

@@ -207,11 +207,9 @@ bool reference_cycles_spec(const reference_args *a, const job *j, const job_view
   return true;
 }
 
-pid_t reference_cycles_start(const reference_cycles *c, const char *spec, const char *out, const char *log,
-                             int threads) {
-  char t[32];
-  snprintf(t, sizeof t, "%d", threads);
-  const char *argv[] = {c->blender, "-b", "--factory-startup", "-noaudio", "--threads", t, "--python-exit-code",
-                        "1", "--python", c->script, "--", spec, out, NULL};
-  return reference_spawn(argv, NULL, log);
+void reference_cycles_argv(const reference_cycles *c, const char *spec, const char *out, const char *threads,
+                           const char *argv[REFERENCE_CYCLES_ARGC]) {
+  const char *args[REFERENCE_CYCLES_ARGC] = {c->blender, "-b", "--factory-startup", "-noaudio", "--threads", threads,
+                                             "--python-exit-code", "1", "--python", c->script, "--", spec, out, NULL};
+  memcpy(argv, args, sizeof args);
 }
