@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the scenes of tests/test_cycles_map.sh into DIR: for each, a .gltf
 (buffers as data URIs) with one camera, and the Cycles spec of that camera
-(tools/cycles_render.py), NAME_phong.json and NAME_pbr.json, direct light only.
+(cli/cycles_render.py), NAME_phong.json and NAME_pbr.json, direct light only.
 
     cycles_map_scenes.py DIR WIDTH HEIGHT SAMPLES
 

@@ -1,4 +1,4 @@
-/* Camera paths (tools/camera_path.h): the curve passes through its keys
+/* Camera paths (cli/camera_path.h): the curve passes through its keys
  * exactly, is C1 in time at them (one-sided differences agree), does not
  * blow up past its keys with uneven spacing, holds still between coincident
  * keys, and the look-at transform is orthonormal and looks at the target. */

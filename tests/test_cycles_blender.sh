@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # limn reference --renderer cycles end to end, with the real Blender and
-# tools/cycles_render.py, on one small view (data/scenes/pov_ball.gltf at
+# cli/cycles_render.py, on one small view (data/scenes/pov_ball.gltf at
 # 32x24, 16 samples): the reference is written under its hash at the view's
 # size (limn compare reads it beside Limn's own image), a second run is a
 # cache hit, and the direct-only render (0 bounces) differs from the one
@@ -10,7 +10,7 @@ set -u
 limn=$1
 root=$2
 command -v blender >/dev/null || { echo "blender not installed: skipped (tools/dev.sh installs it)"; exit 77; }
-[ -f "$root/tools/cycles_render.py" ] || { echo "no tools/cycles_render.py: skipped"; exit 77; }
+[ -f "$root/cli/cycles_render.py" ] || { echo "no cli/cycles_render.py: skipped"; exit 77; }
 tmp=$(mktemp -d /tmp/limn-blender-XXXXXX)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }

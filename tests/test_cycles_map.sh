@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# tools/cycles_render.py against Limn (docs/cycles.md), 64x48, Cycles direct
+# cli/cycles_render.py against Limn (docs/cycles.md), 64x48, Cycles direct
 # light (bounces 0) against `limn capture --tech dl` (ambient 0), linear EXR
 # on both sides compared by `limn compare` (the mean |value| is the mean error
 # against a black image):
@@ -30,7 +30,7 @@ check() { # check NAME CONDITION...
   if "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $name"; fi
 }
 cycles() { # cycles SPEC OUT [SPEC OUT ...]: stderr in $tmp/err.txt, status in rc
-  "$blender" -b --factory-startup -noaudio --python-exit-code 1 --python "$root/tools/cycles_render.py" -- "$@" \
+  "$blender" -b --factory-startup -noaudio --python-exit-code 1 --python "$root/cli/cycles_render.py" -- "$@" \
     >"$tmp/log.txt" 2>"$tmp/err.txt"
   rc=$?
 }

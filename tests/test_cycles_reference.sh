@@ -37,7 +37,7 @@ return {
   output = "out/{camera}_{technique}.png",
 }
 JOB
-echo "# stands in for tools/cycles_render.py" > script.py
+echo "# stands in for cli/cycles_render.py" > script.py
 cy=(--renderer cycles --blender "$root/tests/fake_blender.sh" --cycles-script script.py --samples 16 --refs refs)
 
 # Blender missing: the package and the command, exit 1, nothing written.

@@ -1,4 +1,4 @@
-/* The scenes that move (tools/gen_scenes.c) as the glTF loader reads them:
+/* The scenes that move (data/gen_scenes.c) as the glTF loader reads them:
  * their nodes, cameras and lights; their animations, channels, key ranges
  * and skin; and, posed at known times, where the orbiting camera, the door,
  * the bent tube and the light are. The animation parts skip, saying why,

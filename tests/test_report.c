@@ -1,4 +1,4 @@
-/* The report's arithmetic (tools/report_math.h): the Pareto front of a
+/* The report's arithmetic (cli/report_math.h): the Pareto front of a
  * crafted set of points, the gains and summary against hand values, the
  * sweep syntax with its errors, and sequences (views grouped into runs, a
  * setting's mean error, flicker and lag over one) on synthetic data. */

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# data/scenes is what tools/gen_scenes.c writes, byte for byte: regenerate
+# data/scenes is what data/gen_scenes.c writes, byte for byte: regenerate
 # into a scratch folder and compare every file (the reference set's scenes
 # under reference/ included).
 set -euo pipefail

@@ -1,4 +1,4 @@
--- The door scene (tools/gen_scenes.c) as a sequence against POV-Ray
+-- The door scene (data/gen_scenes.c) as a sequence against POV-Ray
 -- references, one a frame: the door swings open from 0.5 to 1.5 s (frames 4
 -- to 12 at 8 fps), letting the sun in. `limn report` over it prints each
 -- setting's mean error over the frames, flicker, and the lag after frame 12,

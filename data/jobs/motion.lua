@@ -1,4 +1,4 @@
--- The scenes that move (tools/gen_scenes.c), each a short sequence: from 0
+-- The scenes that move (data/gen_scenes.c), each a short sequence: from 0
 -- to 1 s at 8 frames a second, 160x120. In that second the turntable's
 -- camera goes a quarter round, the door starts to open (0.5 to 1.5 s), the
 -- tube bends 45 degrees and the light crosses a third of the room. The views

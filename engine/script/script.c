@@ -9,15 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define PIPELINE_KEY "limn.pipeline"
 #define LOADED_KEY "limn.loaded"
-
-lm_pipeline *lm_script_pipeline(lua_State *L) {
-  lua_getfield(L, LUA_REGISTRYINDEX, PIPELINE_KEY);
-  lm_pipeline *p = lua_touserdata(L, -1);
-  lua_pop(L, 1);
-  return p;
-}
 
 /* ---- sandbox ----------------------------------------------------------- */
 static void budget_hook(lua_State *L, lua_Debug *ar) {
@@ -380,7 +372,7 @@ lm_pipeline *lm_pipeline_load(const lm_pipeline_desc *desc, lm_error *err) {
   p->L = luaL_newstate();
   lua_State *L = p->L;
   lua_pushlightuserdata(L, p);
-  lua_setfield(L, LUA_REGISTRYINDEX, PIPELINE_KEY);
+  lua_setfield(L, LUA_REGISTRYINDEX, LM_SCRIPT_PIPELINE_KEY);
   open_sandbox(L);
   lm_script_open_api(L);
   char *text = lm_read_file(desc->path, NULL, err);

@@ -1,5 +1,6 @@
 /* Shared by script.c (state, sandbox, options) and script_api.c (the
- * functions scripts call to record a frame). */
+ * functions scripts call to record a frame). script.c opens the API;
+ * the API finds its pipeline here, never by calling back into script.c. */
 #ifndef LIMN_SCRIPT_INTERNAL_H
 #define LIMN_SCRIPT_INTERNAL_H
 
@@ -33,7 +34,15 @@ struct lm_pipeline {
 /* Registers target, scene, pass, cpu, points, present, output_size, shadow_plan, sky_sh, scene_reflective
  * and scene_bounds in the global table. */
 void lm_script_open_api(lua_State *L);
+/* The registry key under which lm_pipeline_load keeps the pipeline that owns L. */
+#define LM_SCRIPT_PIPELINE_KEY "limn.pipeline"
+
 /* The pipeline that owns L. */
-lm_pipeline *lm_script_pipeline(lua_State *L);
+static inline lm_pipeline *lm_script_pipeline(lua_State *L) {
+  lua_getfield(L, LUA_REGISTRYINDEX, LM_SCRIPT_PIPELINE_KEY);
+  lm_pipeline *p = lua_touserdata(L, -1);
+  lua_pop(L, 1);
+  return p;
+}
 
 #endif

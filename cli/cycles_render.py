@@ -2,7 +2,7 @@
 # `limn reference --renderer cycles` (docs/cycles.md states the mapping):
 #
 #   blender -b --factory-startup -noaudio --python-exit-code 1 \
-#           --python tools/cycles_render.py -- SPEC.json OUT.exr [SPEC.json OUT.exr ...]
+#           --python cli/cycles_render.py -- SPEC.json OUT.exr [SPEC.json OUT.exr ...]
 #
 # Several pairs in one run save Blender's start (seconds) a view; each fails
 # or renders on its own, and the run exits 1 when any failed.
@@ -690,7 +690,7 @@ def main(argv):
     args = argv[argv.index("--") + 1:] if "--" in argv else []
     if len(args) < 2 or len(args) % 2:
         print("%s: usage: blender -b --factory-startup -noaudio --python-exit-code 1 --python "
-              "tools/cycles_render.py -- SPEC.json OUT.exr [SPEC.json OUT.exr ...]" % PREFIX, file=sys.stderr)
+              "cli/cycles_render.py -- SPEC.json OUT.exr [SPEC.json OUT.exr ...]" % PREFIX, file=sys.stderr)
         return 1
     failed = 0
     for i in range(0, len(args), 2):  # several views in one run save Blender's start (seconds) a view

@@ -1,4 +1,4 @@
-/* Camera paths of capture jobs (tools/job.c): keyed views (eye, target,
+/* Camera paths of capture jobs (cli/job.c): keyed views (eye, target,
  * vertical field of view at times) interpolated smoothly for fly-throughs,
  * and the look-at transform that turns a view into a camera node's world. */
 #ifndef LIMN_CAMERA_PATH_H

@@ -20,7 +20,7 @@ int limn_report(int argc, char **argv);
 int limn_manifest(int argc, char **argv);
 int limn_farm(int argc, char **argv);
 
-/* Flag values (tools/args.c): false when `s` is not one. */
+/* Flag values (cli/args.c): false when `s` is not one. */
 bool limn_parse_int(const char *s, int lo, int hi, int *out);
 /* Prints "limn CMD: " then fmt with arg, and where to read more, to stderr;
  * returns 2 (bad usage). */
@@ -47,7 +47,7 @@ int limn_camera_resolve(struct lm_scene *s, int camera, int width, int height);
 void limn_json_string(const char *s);          /* a quoted, escaped JSON string to stdout */
 void limn_json_append(lm_buf *b, const char *s); /* the same, appended to b */
 
-/* export-pov's flags (tools/export_pov.c), shared by reference and report:
+/* export-pov's flags (cli/export_pov.c), shared by reference and report:
  * limn_pov_options ends with a zero entry (12 entries in all);
  * limn_pov_flag returns 0 when it took getopt's c, 1 when c is not one of
  * them, 2 after printing a usage error for `limn CMD`. */

@@ -1,4 +1,4 @@
-/* The report's arithmetic (tools/report_math.h). */
+/* The report's arithmetic (cli/report_math.h). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

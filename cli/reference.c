@@ -1,8 +1,8 @@
 /* limn reference --job FILE: references of a capture job's views from
- * POV-Ray or Cycles (tools/reference.h). This file is the part they share
+ * POV-Ray or Cycles (cli/reference.h). This file is the part they share
  * (flags, file names, the cache, running at most --jobs renders at once,
  * renaming finished ones into place) and POV-Ray's own part; Cycles' is
- * tools/reference_cycles.c. POV-Ray runs in the reference's folder, since
+ * cli/reference_cycles.c. POV-Ray runs in the reference's folder, since
  * Debian's povray.conf lets it write only below the current directory. A
  * renderer's output goes to a log beside its input, shown when it fails. */
 #define _GNU_SOURCE
@@ -35,7 +35,7 @@ static const char reference_usage[] =
     "DIR/<scene>/<camera>_<WxH>-<hash>.exr, the hash that of the exported scene\n"
     "text; a Cycles one DIR/<scene>/<camera>_<WxH>-cycles-<hash>.exr, the hash\n"
     "that of the scene file, the camera, size, samples, bounces, seed, materials\n"
-    "and sky, tools/cycles_render.py and Blender's version. A view whose hash\n"
+    "and sky, cli/cycles_render.py and Blender's version. A view whose hash\n"
     "has not changed is not rendered again. A sequence's frames are posed at\n"
     "their times, each DIR/<scene>/<camera>_<WxH>-<frame>-<time>-...exr.\n"
     "POV-Ray runs in parallel, up to the core count; Cycles one view at a time\n"
@@ -182,6 +182,31 @@ static const char *file_part(const char *p) {
   return s ? s + 1 : p;
 }
 
+/* Starts argv[0] with argv, its output into `log`, in folder dir (NULL:
+ * here); the child dies with this process. -1 when it cannot fork. */
+static pid_t reference_spawn(const char *const *argv, const char *dir, const char *log) {
+  fflush(stdout);
+  fflush(stderr);
+  pid_t parent = getpid(), pid = fork();
+  if (pid != 0) return pid;
+  /* A killed limn takes its renders with it: nothing renders on into a file no one will rename. */
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (getppid() != parent) _exit(127);
+  int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0666);
+  if (fd >= 0) {
+    dup2(fd, STDOUT_FILENO);
+    dup2(fd, STDERR_FILENO);
+    close(fd);
+  }
+  if (dir && chdir(dir) != 0) {
+    fprintf(stderr, "cannot enter %s: %s\n", dir, strerror(errno));
+    _exit(127);
+  }
+  execvp(argv[0], (char *const *)argv);
+  fprintf(stderr, "cannot run %s: %s\n", argv[0], strerror(errno));
+  _exit(127);
+}
+
 /* POV-Ray on <base>.pov in the reference's folder, writing tmp. */
 static pid_t start_povray(const reference_args *a, const char *base, const char *tmp, int width, int height,
                           int threads) {
@@ -195,6 +220,16 @@ static pid_t start_povray(const reference_args *a, const char *base, const char 
   snprintf(wt, sizeof wt, "+WT%d", threads);
   const char *argv[] = {a->povray, "-D", "-V", in, out, "+FE", w, h, "-A", wt, NULL};
   return reference_spawn(argv, dir, log);
+}
+
+/* Blender on the spec file, rendering into out. */
+static pid_t start_cycles(const reference_args *a, const char *spec, const char *out, const char *log,
+                          int threads) {
+  char t[32];
+  snprintf(t, sizeof t, "%d", threads);
+  const char *argv[REFERENCE_CYCLES_ARGC];
+  reference_cycles_argv(&a->cycles, spec, out, t, argv);
+  return reference_spawn(argv, NULL, log);
 }
 
 /* ---- the renderers' shared part --------------------------------------- */
@@ -222,28 +257,6 @@ bool reference_export(const reference_args *a, const job *j, const job_view *v, 
   return true;
 }
 
-pid_t reference_spawn(const char *const *argv, const char *dir, const char *log) {
-  fflush(stdout);
-  fflush(stderr);
-  pid_t parent = getpid(), pid = fork();
-  if (pid != 0) return pid;
-  /* A killed limn takes its renders with it: nothing renders on into a file no one will rename. */
-  prctl(PR_SET_PDEATHSIG, SIGKILL);
-  if (getppid() != parent) _exit(127);
-  int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0666);
-  if (fd >= 0) {
-    dup2(fd, STDOUT_FILENO);
-    dup2(fd, STDERR_FILENO);
-    close(fd);
-  }
-  if (dir && chdir(dir) != 0) {
-    fprintf(stderr, "cannot enter %s: %s\n", dir, strerror(errno));
-    _exit(127);
-  }
-  execvp(argv[0], (char *const *)argv);
-  fprintf(stderr, "cannot run %s: %s\n", argv[0], strerror(errno));
-  _exit(127);
-}
 
 /* The renderer's error lines: from its first line that mentions an error to
  * the end (at most 20), else its last 10 lines. */
@@ -422,7 +435,7 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
       char log[1100];
       snprintf(log, sizeof log, "%s.log", r->base);
       int w = j->sizes[v->size][0], h = j->sizes[v->size][1];
-      r->pid = cycles ? reference_cycles_start(&a->cycles, in, r->out, log, threads)
+      r->pid = cycles ? start_cycles(a, in, r->out, log, threads)
                       : start_povray(a, r->base, r->tmp, w, h, threads);
       if (r->pid < 0) lm_error_set(&err, "cannot start %s: %s", name, strerror(errno)), ok = false;
     }

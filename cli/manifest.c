@@ -1,5 +1,5 @@
 /* limn manifest merge: joins the manifests of a sharded capture job (one a
- * shard, tools/job.c) into the job's manifest, after checking that every
+ * shard, cli/job.c) into the job's manifest, after checking that every
  * view was rendered exactly once, its image is there, and every shard ran
  * with the same job, script and shader hashes; optionally that every view's
  * POV-Ray reference is there. Nothing is written unless all of it holds. */

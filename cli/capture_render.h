@@ -1,7 +1,8 @@
-/* What `limn capture` (tools/capture.c) and capture jobs (tools/job.c)
- * share: one path that renders a view and writes its images. */
-#ifndef LIMN_CAPTURE_H
-#define LIMN_CAPTURE_H
+/* What `limn capture` (cli/capture.c), capture jobs (cli/job.c), `limn
+ * report` and the viewer share (cli/capture_render.c): one path that renders
+ * a view and writes its images. */
+#ifndef LIMN_CAPTURE_RENDER_H
+#define LIMN_CAPTURE_RENDER_H
 
 #include "render/render.h"
 
@@ -40,17 +41,5 @@ void capture_result_free(capture_result *res);
 bool capture_known_extension(const char *path, bool *linear);
 /* A relative path that does not exist here is looked up under the engine's root. */
 void capture_resolve(const char *given, char *out, size_t cap);
-
-typedef struct capture_job_args {
-  const char *path;
-  const char *const *sets; /* extra NAME=VALUE options, after the job's own */
-  int set_count;
-  int shard, shards;       /* render views v with v % shards == shard */
-  bool force, quiet, verbose;
-  const char *egl;
-  lm_clock clock;
-} capture_job_args;
-/* `limn capture --job FILE`: the exit code. */
-int capture_job_run(const capture_job_args *a);
 
 #endif

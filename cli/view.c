@@ -18,7 +18,7 @@ size_t __sanitizer_get_current_allocated_bytes(void);
 #include <strings.h>
 #include <unistd.h>
 
-#include "capture.h"
+#include "capture_render.h"
 #include "image/image.h"
 #include "render/render.h"
 #include "scene/gltf.h"

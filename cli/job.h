@@ -1,11 +1,11 @@
-/* Capture jobs (tools/job.c) as `limn capture --job`, `limn reference` and
+/* Capture jobs (cli/job.c) as `limn capture --job`, `limn reference` and
  * `limn report` share them: the job file read, its views enumerated, its
  * pipeline set up, the progress line. */
 #ifndef LIMN_JOB_H
 #define LIMN_JOB_H
 
 #include "camera_path.h"
-#include "capture.h"
+#include "capture_render.h"
 
 #define MAX_LIST 64
 #define MAX_PATH_KEYS 256
@@ -26,7 +26,7 @@ typedef struct job_scene {
 
 typedef struct job {
   char path[1024], dir[1024], script[1024], output[1024], manifest[1024];
-  char renderer[16]; /* the references' renderer: "pov", "cycles" or "" (not given; tools/reference.h) */
+  char renderer[16]; /* the references' renderer: "pov", "cycles" or "" (not given; cli/reference.h) */
   job_scene scenes[MAX_LIST];
   int scene_count;
   char techniques[MAX_LIST][64];
@@ -112,5 +112,17 @@ bool job_manifest_write(const char *path, const job_manifest *m, int count, lm_e
 /* A string or number field of the header ("job_hash"), unquoted, into out;
  * false when it is not there. */
 bool job_manifest_field(const job_manifest *m, const char *key, char *out, size_t cap);
+
+typedef struct capture_job_args {
+  const char *path;
+  const char *const *sets; /* extra NAME=VALUE options, after the job's own */
+  int set_count;
+  int shard, shards;       /* render views v with v % shards == shard */
+  bool force, quiet, verbose;
+  const char *egl;
+  lm_clock clock;
+} capture_job_args;
+/* `limn capture --job FILE`: the exit code. */
+int capture_job_run(const capture_job_args *a);
 
 #endif

@@ -1,9 +1,9 @@
-/* Cycles references (tools/reference.h): a view is a spec, a small JSON
- * file beside the reference, that tools/cycles_render.py reads inside
+/* Cycles references (cli/reference.h): a view is a spec, a small JSON
+ * file beside the reference, that cli/cycles_render.py reads inside
  * `blender -b`:
  *
  *   blender -b --factory-startup -noaudio --threads T --python-exit-code 1
- *           --python tools/cycles_render.py -- SPEC.json OUT.exr
+ *           --python cli/cycles_render.py -- SPEC.json OUT.exr
  *
  *   {"scene": "/abs/scene.glb", "view": "room/front 160x120",
  *    "camera": {"eye": [x,y,z], "target": [x,y,z], "up": [x,y,z], "fov_y": degrees},
@@ -82,7 +82,7 @@ static bool blender_version(const char *program, char *out, size_t cap, lm_error
 bool reference_cycles_prepare(reference_cycles *c, lm_error *err) {
   static char script[PATH_MAX];
   if (!c->script) {
-    snprintf(script, sizeof script, "%s/tools/cycles_render.py", lm_root_dir());
+    snprintf(script, sizeof script, "%s/cli/cycles_render.py", lm_root_dir());
     c->script = script;
   }
   size_t len;
@@ -207,11 +207,9 @@ bool reference_cycles_spec(const reference_args *a, const job *j, const job_view
   return true;
 }
 
-pid_t reference_cycles_start(const reference_cycles *c, const char *spec, const char *out, const char *log,
-                             int threads) {
-  char t[32];
-  snprintf(t, sizeof t, "%d", threads);
-  const char *argv[] = {c->blender, "-b", "--factory-startup", "-noaudio", "--threads", t, "--python-exit-code",
-                        "1", "--python", c->script, "--", spec, out, NULL};
-  return reference_spawn(argv, NULL, log);
+void reference_cycles_argv(const reference_cycles *c, const char *spec, const char *out, const char *threads,
+                           const char *argv[REFERENCE_CYCLES_ARGC]) {
+  const char *args[REFERENCE_CYCLES_ARGC] = {c->blender, "-b", "--factory-startup", "-noaudio", "--threads", threads,
+                                             "--python-exit-code", "1", "--python", c->script, "--", spec, out, NULL};
+  memcpy(argv, args, sizeof args);
 }

@@ -5,8 +5,8 @@
  * - POV-Ray (radiosity; the default): each view exported (engine/scene/pov.h)
  *   into REFS/<scene>/<camera>_<WxH>-<hash>.exr, the hash being lm_hash of
  *   the exported text and the command line's settings.
- * - Cycles, Blender's path tracer (tools/reference_cycles.c): each view a
- *   spec (JSON) for tools/cycles_render.py, run by `blender -b`, into
+ * - Cycles, Blender's path tracer (cli/reference_cycles.c): each view a
+ *   spec (JSON) for cli/cycles_render.py, run by `blender -b`, into
  *   REFS/<scene>/<camera>_<WxH>-cycles-<hash>.exr, the hash covering the
  *   scene file's bytes, the spec's settings, the script and Blender's version.
  * An unchanged view is never rendered twice and a changed one gets a new file;
@@ -24,7 +24,7 @@ typedef enum reference_renderer { REFERENCE_POV, REFERENCE_CYCLES } reference_re
 
 typedef struct reference_cycles {
   const char *blender; /* the program (default blender) */
-  const char *script;  /* the Blender script (default <root>/tools/cycles_render.py) */
+  const char *script;  /* the Blender script (default <root>/cli/cycles_render.py) */
   int samples;         /* a pixel (default REFERENCE_CYCLES_SAMPLES) */
   int bounces;         /* diffuse bounces (default 8); 0: direct light only */
   int seed;            /* Cycles' seed (default 0) */
@@ -73,7 +73,7 @@ extern const struct option reference_options[];
   "  --bounces N          Cycles: diffuse bounces (default 8; 0: direct light only)\n"                   \
   "  --seed N             Cycles: the noise pattern's seed (default 0)\n"                                \
   "  --blender PROGRAM    Cycles: the Blender program (default blender)\n"                               \
-  "  --cycles-script FILE Cycles: the script Blender runs (default tools/cycles_render.py)\n"
+  "  --cycles-script FILE Cycles: the script Blender runs (default cli/cycles_render.py)\n"
 int reference_flag(const char *cmd, int c, const char *arg, reference_args *a);
 
 /* Before any view, once a run: takes the job's `renderer` unless one was
@@ -99,17 +99,15 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
 
 /* ---- the renderers' own parts ------------------------------------------ */
 
-/* Starts argv[0] with argv, its output into `log`, in folder dir (NULL:
- * here); the child dies with this process. -1 when it cannot fork. */
-pid_t reference_spawn(const char *const *argv, const char *dir, const char *log);
-
-/* Cycles (tools/reference_cycles.c). */
+/* Cycles (cli/reference_cycles.c). */
 bool reference_cycles_prepare(reference_cycles *c, lm_error *err);
 /* Place v's spec into `spec` and its hash (everything that decides the image). */
 bool reference_cycles_spec(const reference_args *a, const job *j, const job_view *v, lm_buf *spec, uint64_t *hash,
                            lm_error *err);
-/* Blender on the spec file, rendering into out with `threads` threads. */
-pid_t reference_cycles_start(const reference_cycles *c, const char *spec, const char *out, const char *log,
-                             int threads);
+/* Blender's command line on the spec file, rendering into out with `threads`
+ * threads (a number as text); reference.c runs it. argv ends with NULL. */
+#define REFERENCE_CYCLES_ARGC 14
+void reference_cycles_argv(const reference_cycles *c, const char *spec, const char *out, const char *threads,
+                           const char *argv[REFERENCE_CYCLES_ARGC]);
 
 #endif

@@ -1,0 +1,120 @@
+/* Rendering a view and writing its images: the one path that `limn capture`
+ * (cli/capture.c), capture jobs (cli/job.c), `limn report` and the viewer
+ * share. It calls none of them. */
+#define _GNU_SOURCE
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "image/image.h"
+#include "capture_render.h"
+
+bool capture_known_extension(const char *path, bool *linear) {
+  const char *dot = strrchr(path, '.');
+  if (!dot || strchr(dot, '/')) return false;
+  *linear = !strcasecmp(dot, ".exr") || !strcasecmp(dot, ".hdr");
+  return *linear || !strcasecmp(dot, ".png") || !strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".tif");
+}
+
+/* A relative script path that does not exist here is looked up under the root. */
+void capture_resolve(const char *given, char *out, size_t cap) {
+  if (!given) {
+    snprintf(out, cap, "%s/scripts/pp.lua", lm_root_dir());
+  } else if (given[0] != '/' && !lm_file_exists(given)) {
+    snprintf(out, cap, "%s/%s", lm_root_dir(), given);
+    if (!lm_file_exists(out)) snprintf(out, cap, "%s", given);
+  } else {
+    snprintf(out, cap, "%s", given);
+  }
+}
+
+typedef struct pass_samples {
+  const char *name, *kind;
+  double *ms;
+  int count;
+} pass_samples;
+
+static int compare_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static double median(double *v, int n) {
+  if (n == 0) return 0;
+  qsort(v, (size_t)n, sizeof *v, compare_double);
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static void collect_times(lm_graph *g, pass_samples **times, int *count, int frames) {
+  for (int i = 0; i < lm_graph_pass_count(g); i++) {
+    lm_graph_pass_info p = lm_graph_pass(g, i);
+    if (p.culled || p.ms < 0) continue;
+    pass_samples *t = NULL;
+    for (int k = 0; k < *count && !t; k++)
+      if (!strcmp((*times)[k].name, p.name)) t = &(*times)[k];
+    if (!t) {
+      *times = lm_realloc(*times, sizeof **times * (size_t)(*count + 1));
+      t = &(*times)[(*count)++];
+      *t = (pass_samples){lm_strdup(p.name), lm_pass_kind_name(p.kind),
+                          lm_alloc(sizeof(double) * (size_t)frames), 0};
+    }
+    if (t->count < frames) t->ms[t->count++] = p.ms;
+  }
+}
+
+static bool write_outputs(lm_renderer *r, int width, int height, const char *const *outputs, int count,
+                          bool quiet, lm_error *err) {
+  size_t px = (size_t)width * height;
+  unsigned char *srgb = NULL;
+  float *linear = NULL;
+  bool ok = true;
+  for (int i = 0; i < count && ok; i++) {
+    bool want_linear = false;
+    capture_known_extension(outputs[i], &want_linear);
+    if (want_linear && !linear) {
+      linear = lm_alloc(px * 3 * sizeof(float));
+      ok = lm_renderer_read(r, true, linear, err);
+    } else if (!want_linear && !srgb) {
+      srgb = lm_alloc(px * 3);
+      ok = lm_renderer_read(r, false, srgb, err);
+    }
+    if (ok)
+      ok = lm_image_write(outputs[i], width, height, 3, want_linear,
+                          want_linear ? (void *)linear : (void *)srgb, err);
+    if (ok && !quiet) lm_info("wrote %s", outputs[i]);
+  }
+  free(srgb);
+  free(linear);
+  return ok;
+}
+
+bool capture_render_write(lm_renderer *r, const capture_view *v, capture_result *res, lm_error *err) {
+  *res = (capture_result){0};
+  pass_samples *samples = NULL;
+  int n = 0;
+  if (!v->continues) lm_renderer_set_view(r, v->camera, v->width, v->height);
+  bool ok = true;
+  for (int f = 0; f < v->warmup + v->frames && ok; f++) {
+    ok = lm_renderer_frame(r, err);
+    if (ok && f >= v->warmup) collect_times(lm_renderer_graph(r), &samples, &n, v->frames);
+  }
+  if (ok) ok = write_outputs(r, v->width, v->height, v->outputs, v->output_count, v->quiet, err);
+  res->passes = lm_alloc(sizeof *res->passes * (size_t)(n + 1));
+  for (int i = 0; i < n; i++) {
+    res->passes[i] = (capture_pass_time){samples[i].name, samples[i].kind, median(samples[i].ms, samples[i].count)};
+    res->total_ms += res->passes[i].ms;
+    free(samples[i].ms);
+  }
+  res->pass_count = n;
+  res->stats = lm_renderer_draw_stats(r);
+  free(samples);
+  return ok;
+}
+
+void capture_result_free(capture_result *res) {
+  for (int i = 0; i < res->pass_count; i++) free((char *)res->passes[i].name);
+  free(res->passes);
+  *res = (capture_result){0};
+}
+
