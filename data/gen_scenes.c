@@ -546,7 +546,7 @@ static void write_file(const char *path, const void *data, size_t len) {
 
 static void finish(doc *d, const char *dir, const char *name) {
   buf j = {0};
-  putf(&j, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"limn tools/gen_scenes.c\"}");
+  putf(&j, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"limn data/gen_scenes.c\"}");
   bool instanced = false;
   for (int i = 0; i < d->node_count; i++) instanced |= d->nodes[i].instances[0] >= 0;
   if (instanced) /* required: a reader without it would draw one copy of each mesh */
@@ -616,7 +616,7 @@ static void finish(doc *d, const char *dir, const char *name) {
   write_file(path, glb.data, glb.len);
   buf cams = {0};
   if (d->cams.len > 0) { /* none: jobs take the file's cameras */
-    putf(&cams, "# Views of %s.glb for capture jobs (written by tools/gen_scenes.c).\n"
+    putf(&cams, "# Views of %s.glb for capture jobs (written by data/gen_scenes.c).\n"
                 "# name      eye (x y z)                  target (x y z)               fov_y (degrees)\n", name);
     put(&cams, d->cams.data, d->cams.len);
     snprintf(path, sizeof path, "%s/%s.cams", dir, name);
