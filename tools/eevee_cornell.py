@@ -93,6 +93,7 @@ scene.render.resolution_x, scene.render.resolution_y = width, height
 scene.render.resolution_percentage = 100
 ee = scene.eevee
 ee.taa_render_samples = 1
+ee.gi_cubemap_resolution = "64"  # the world probe: the smallest, as the comparison's fair set-up
 ee.use_gtao = True
 ee.use_soft_shadows = True
 ee.use_bloom = True
