@@ -321,7 +321,7 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
     if (m->caster_index_count) simplified++, whole += m->index_count / 3, simple += m->caster_index_count / 3;
   }
   if (simplified)
-    lm_info("scene '%s': %d meshes simplified for shadow casters, %ld to %ld triangles (%.0f ms)", s->name, simplified,
+    lm_debug("scene '%s': %d meshes simplified for shadow casters, %ld to %ld triangles (%.0f ms)", s->name, simplified,
             whole, simple, lm_now_ms() - t0);
   s->uploaded = true;
   return true;
