@@ -16,6 +16,7 @@ Options = {
   background = 0.0,        -- radiance where no geometry is
   materials = "phong",     -- "phong" (the std technique) or "pbr" (glTF metallic-roughness, GGX)
   light_variants = 12,     -- up to this many lights (0..16) lighting passes unroll them; more, 0: grid loop
+  light_cull = true,       -- yet more than one light and one the grid culls (cone, range): the grid's loop
   shadow = options.copy(shadow.defaults),
   sky = options.copy(sky.defaults),                -- off by default
   reflections = options.copy(reflections.defaults),
@@ -44,7 +45,6 @@ technique{ "lpv+esm", shadows = true, offscreen = "lpv" } -- light propagation v
 technique{ "isr+lpv+esm", lighting = "isr", shadows = true, offscreen = "lpv", split = true, temporal = "isr" }
 
 local function grey(x) return { x, x, x } end
-
 -- The frame's direct light (direct.frag), with the ambient term given and
 -- an off-screen source's coarse light `indirect` ({ C, E, k }) upsampled.
 local function direct(F, ambient, name, skylight, indirect)
@@ -74,7 +74,7 @@ local function frame(tech, row)
   local materials = ({ phong = "std", pbr = "pbr" })[tech.materials]
   if not materials then error('materials must be "phong" or "pbr" (got "' .. tostring(tech.materials) .. '")') end
   local G = gbuffer.render(gbuffer.targets(1, materials, reads_velocity(tech, row)), materials)
-  G.lights = light_set(tech.light_variants) -- nil: the general light loop (gbuffer.defines)
+  G.lights = light_set(tech.light_variants, tech.light_cull) -- nil: the general light loop (gbuffer.defines)
   temporal.velocity(G.vel)
   local o = S and S.check(tech[row.offscreen]) -- shadows after the G-buffer: cascades fit what it sees
   local F = { G = G, technique = row, light = { ambient = grey(tech.ambient), background = grey(tech.background) } }
@@ -97,7 +97,7 @@ local function frame(tech, row)
 end
 
 local rules = { ambient = options.number(0, 1e6), background = options.number(0, 1e6),
-                light_variants = options.whole(0, 16) }
+                light_variants = options.whole(0, 16), light_cull = options.boolean }
 
 function OnCreate()
   post.create()
@@ -107,7 +107,7 @@ function OnCreate()
 end
 
 function OnRender(tech)
-  for _, k in ipairs{ "ambient", "background", "light_variants" } do
+  for _, k in ipairs{ "ambient", "background", "light_variants", "light_cull" } do
     local want = rules[k](tech[k])
     if want then error(string.format("%s must be %s (got %s)", k, want, tostring(tech[k])), 2) end
   end

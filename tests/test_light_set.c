@@ -60,7 +60,7 @@ static lm_scene *box_with_eight_lights(void) {
  * variant) and =0 (the general loop); returns the largest difference of the
  * linear output relative to max(value, 0.05), and its radiance in *sum. */
 static double variant_against_loop(lm_scene *s, const char *tech, const char *extra, double *sum) {
-  const char *on[] = {"ambient=0.02", extra, "light_variants=16", NULL};
+  const char *on[] = {"ambient=0.02", extra, "light_variants=16", "light_cull=false", NULL};
   const char *off[] = {"ambient=0.02", extra, "light_variants=0", NULL};
   double ms;
   int before = lm_programs_stats("LIGHT_SET", &ms);
@@ -81,6 +81,27 @@ static double variant_against_loop(lm_scene *s, const char *tech, const char *ex
   gl_result_free(&a);
   gl_result_free(&b);
   return worst;
+}
+
+/* With light_cull (pp.lua's default) a scene of several lights one of which
+ * the grid can cull (a spot's cone, a finite reach) keeps the grid's loop:
+ * the eight lights' box compiles no variant; the Cornell box's one light does. */
+static void lights_the_grid_culls_keep_its_loop(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *one = lm_scene_builtin("cornell", &err), *eight = box_with_eight_lights();
+  /* A filter no other test here compiles: a variant of it is new. */
+  const char *sets[] = {"light_variants=16", "shadow.technique=poisson", NULL};
+  double ms;
+  int before = lm_programs_stats("LIGHT_SET", &ms);
+  gl_result r = gl_render_ok(&(gl_run){.scene = eight, .tech = "dl+esm", .sets = sets, .width = W, .height = H});
+  assert_int_equal(lm_programs_stats("LIGHT_SET", &ms), before);
+  gl_result_free(&r);
+  r = gl_render_ok(&(gl_run){.scene = one, .tech = "dl+esm", .sets = sets, .width = W, .height = H});
+  assert_true(lm_programs_stats("LIGHT_SET", &ms) > before);
+  gl_result_free(&r);
+  lm_scene_destroy(one);
+  lm_scene_destroy(eight);
 }
 
 static void variants_render_as_the_general_loop(void **state) {
@@ -110,7 +131,7 @@ static void adding_a_light_compiles_a_new_variant(void **state) {
   lm_error err;
   lm_scene *s = lm_scene_builtin("cornell", &err);
   assert_non_null(s);
-  const char *sets[] = {"ambient=0", "light_variants=2", NULL};
+  const char *sets[] = {"ambient=0", "light_variants=2", "light_cull=false", NULL};
   double ms;
   lm_programs_clear(); /* none cached from the test before */
   gl_result r = gl_render_ok(&(gl_run){.scene = s, .tech = "dl+esm", .sets = sets, .width = W, .height = H});
@@ -145,6 +166,7 @@ static void adding_a_light_compiles_a_new_variant(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(variants_render_as_the_general_loop),
+      cmocka_unit_test(lights_the_grid_culls_keep_its_loop),
       cmocka_unit_test(adding_a_light_compiles_a_new_variant),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
