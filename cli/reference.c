@@ -42,7 +42,7 @@ static const char reference_usage[] =
     "on every core.\n"
     "\n"
     "options:\n"
-    "  --job FILE           the capture job (README: Scenes and capture jobs)\n"
+    "  --job FILE           the capture job (docs/capture-jobs.md)\n"
     "  --refs DIR           where the references go (default out/reference)\n"
     "  --force              render again even what exists\n"
     "  --jobs N             renders at once (default: POV-Ray the core count,\n"
