@@ -18,14 +18,13 @@ REFDEF = re.compile(r'^\s{0,3}\[[^\]]+\]:\s*<?(\S+?)>?(?:\s+"[^"]*")?\s*$')
 CODE_SPAN = re.compile(r'(`+).*?\1')
 
 
-def prose_lines(path):
-    """(line number, text) of the lines outside code blocks, code spans blanked."""
+def outside_fences(path):
+    """(line number, text without its newline) of the lines outside fenced code blocks."""
     fence = None
-    prev_blank = True
     with open(path, encoding='utf-8') as f:
         for n, line in enumerate(f, 1):
             line = line.rstrip('\n')
-            stripped = line.lstrip()
+            stripped = line.strip()
             if fence:
                 if stripped.startswith(fence):
                     fence = None
@@ -33,12 +32,19 @@ def prose_lines(path):
             if stripped.startswith('```') or stripped.startswith('~~~'):
                 fence = stripped[:3]
                 continue
-            # An indented code block starts after a blank line (a list
-            # item's continuation lines are indented too, but follow text).
-            if line.startswith('    ') and prev_blank:
-                continue
-            prev_blank = not stripped
-            yield n, CODE_SPAN.sub('', line)
+            yield n, line
+
+
+def prose_lines(path):
+    """(line number, text) of the lines outside code blocks, code spans blanked."""
+    prev_blank = True
+    for n, line in outside_fences(path):
+        # An indented code block starts after a blank line (a list item's
+        # continuation lines are indented too, but follow text).
+        if line.startswith('    ') and prev_blank:
+            continue
+        prev_blank = not line.strip()
+        yield n, CODE_SPAN.sub('', line)
 
 
 def slug(heading):
@@ -55,25 +61,15 @@ def anchors(path, cache={}):
     if path not in cache:
         seen = {}
         found = set()
-        fence = None
-        with open(path, encoding='utf-8') as f:
-            for line in f:
-                stripped = line.strip()
-                if fence:
-                    if stripped.startswith(fence):
-                        fence = None
-                    continue
-                if stripped.startswith('```') or stripped.startswith('~~~'):
-                    fence = stripped[:3]
-                    continue
-                m = re.match(r'^#{1,6}\s+(.*?)\s*#*\s*$', line)
-                if not m:
-                    continue
-                s = slug(m.group(1))
-                # A repeated heading gets -1, -2, ... as on GitHub.
-                k = seen.get(s, 0)
-                seen[s] = k + 1
-                found.add(s if k == 0 else '%s-%d' % (s, k))
+        for _, line in outside_fences(path):
+            m = re.match(r'^#{1,6}\s+(.*?)\s*#*\s*$', line)
+            if not m:
+                continue
+            s = slug(m.group(1))
+            # A repeated heading gets -1, -2, ... as on GitHub.
+            k = seen.get(s, 0)
+            seen[s] = k + 1
+            found.add(s if k == 0 else '%s-%d' % (s, k))
         cache[path] = found
     return cache[path]
 
