@@ -286,6 +286,7 @@ static void show_log(const char *log) {
 typedef struct render_run {
   pid_t pid;
   int place;
+  double start_ms; /* lm_now_ms when it started: each view's time is printed */
   char base[1024]; /* the reference's path without .exr */
   char tmp[1100];  /* <base>.tmp-<pid>: POV-Ray's output (.exr), or Blender's folder (its output and temporaries) */
   char out[1200];  /* what the renderer writes: tmp, or tmp/out.exr */
@@ -384,7 +385,7 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
         clear_temps(r->base);
         remove(log);
         rendered++;
-        snprintf(what, sizeof what, "%s", final);
+        snprintf(what, sizeof what, "%s (%.1f s)", final, (lm_now_ms() - r->start_ms) / 1000);
         job_progress(a->quiet, tty, ++done, mine, what);
       } else if (stop_signal) {
         clear_temps(r->base);
@@ -435,6 +436,7 @@ int reference_run(const reference_args *a, const job *j, const job_view *places,
       char log[1100];
       snprintf(log, sizeof log, "%s.log", r->base);
       int w = j->sizes[v->size][0], h = j->sizes[v->size][1];
+      r->start_ms = lm_now_ms();
       r->pid = cycles ? start_cycles(a, in, r->out, log, threads)
                       : start_povray(a, r->base, r->tmp, w, h, threads);
       if (r->pid < 0) lm_error_set(&err, "cannot start %s: %s", name, strerror(errno)), ok = false;
