@@ -55,17 +55,32 @@ vec3 light_arriving(Light li, vec3 p, out vec3 l) {
 // Light arriving at p from light i (light_arriving).
 vec3 light_incident(int i, vec3 p, out vec3 l) { return light_arriving(lights[i], p, l); }
 
-// Light i on a surface at p facing n: false when it arrives from behind or
-// gives nothing there (beyond its range or cone: no shadow lookup); else its
-// direction l, n.l and its radiance (shadowed with SHADOWS).
-bool light_on_surface(int i, vec3 p, vec3 n, out vec3 l, out float ndl, out vec3 radiance) {
-  radiance = light_incident(i, p, l);
+// Light i, of kind `type` and falloff `falloff` (light_arriving_as) and
+// shadow kind `shadow` (ShadowLight.info.z, 0: none), on a surface at p
+// facing n: false when it arrives from behind or gives nothing there (beyond
+// its range or cone: no shadow lookup); else its direction l, n.l and its
+// radiance (shadowed with SHADOWS). Constant kinds (a light-set variant,
+// LIGHT_SET) compile one kind's code.
+bool light_on_surface_as(int i, int type, int falloff, int shadow, vec3 p, vec3 n, out vec3 l, out float ndl,
+                         out vec3 radiance) {
+  radiance = light_arriving_as(lights[i], type, falloff, p, l);
   ndl = dot(n, l);
   if (ndl <= 0.0 || max(radiance.r, max(radiance.g, radiance.b)) <= 0.0) return false;
 #ifdef SHADOWS
-  radiance *= shadow_factor(i, p, n, l);
+  if (shadow != 0) radiance *= shadow_factor_as(i, shadow, p, n, l);
 #endif
   return true;
+}
+
+// light_on_surface_as with light i's kinds read from its records.
+bool light_on_surface(int i, vec3 p, vec3 n, out vec3 l, out float ndl, out vec3 radiance) {
+  Light li = lights[i];
+#ifdef SHADOWS
+  int shadow = shadow_lights[i].info.z;
+#else
+  int shadow = 0;
+#endif
+  return light_on_surface_as(i, int(li.position.w + 0.5), int(li.params.y + 0.5), shadow, p, n, l, ndl, radiance);
 }
 
 // The lights that may reach p: light_index(r, j) for j < r.count. Every light
@@ -164,14 +179,11 @@ vec3 light_set_reflected(int i, Reflector m, vec3 n, vec3 v, vec3 p) {
   int type = light_set_has(LIGHT_SUNS, i) ? 2 : light_set_has(LIGHT_SPOTS, i) ? 1 : 0;
   int falloff = light_set_has(LIGHT_FALLOFF_NONE, i) ? 1 : light_set_has(LIGHT_FALLOFF_SQUARE, i) ? 2
               : light_set_has(LIGHT_FALLOFF_RANGE, i) ? 3 : 0;
-  vec3 l;
-  vec3 radiance = light_arriving_as(lights[i], type, falloff, p, l);
-  float ndl = dot(n, l);
-  if (ndl <= 0.0 || max(radiance.r, max(radiance.g, radiance.b)) <= 0.0) return vec3(0.0);
-#ifdef SHADOWS
   // the shadow kind follows the light's (engine/shadow: cascades, spot, cube)
-  if (light_set_has(LIGHT_SHADOWED, i)) radiance *= shadow_factor_as(i, type == 2 ? 1 : type == 1 ? 2 : 3, p, n, l);
-#endif
+  int shadow = light_set_has(LIGHT_SHADOWED, i) ? (type == 2 ? 1 : type == 1 ? 2 : 3) : 0;
+  vec3 l, radiance;
+  float ndl;
+  if (!light_on_surface_as(i, type, falloff, shadow, p, n, l, ndl, radiance)) return vec3(0.0);
   return radiance * reflect_light(m, n, v, l, ndl);
 }
 #endif
