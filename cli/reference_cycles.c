@@ -161,15 +161,18 @@ bool reference_cycles_spec(const reference_args *a, const job *j, const job_view
     lm_error_set(err, "%s: %s", s->path, strerror(errno));
     return false;
   }
-  /* The camera's frame from its node: it looks along -Z with +Y up (glTF's). */
-  const float *m = sc->nodes[cam->node].world;
-  float eye[3] = {m[12], m[13], m[14]}, back[3] = {m[8], m[9], m[10]}, up0[3] = {m[4], m[5], m[6]};
-  float forward[3], up[3], target[3];
-  if (!unit(back, forward) || !unit(up0, up)) {
+  /* The camera as the renderer sees it (lm_scene_frame_data, as the POV-Ray
+   * export takes it): its place, the rays to the far plane's centre and up,
+   * tan(fov_y / 2) in clip[3]. */
+  lm_frame_data f;
+  lm_scene_frame_data(sc, v->camera, w, h, &f);
+  float eye[3] = {f.camera_pos[0], f.camera_pos[1], f.camera_pos[2]}, centre[3], forward[3], up[3], target[3];
+  for (int k = 0; k < 3; k++) centre[k] = f.frustum_o[k] + 0.5f * (f.frustum_u[k] + f.frustum_v[k]);
+  if (!unit(centre, forward) || !unit(f.frustum_v, up)) {
     lm_error_set(err, "camera '%s': its node's transform has no direction (a zero scale)", cam->name);
     return false;
   }
-  for (int k = 0; k < 3; k++) target[k] = eye[k] - forward[k];
+  for (int k = 0; k < 3; k++) target[k] = eye[k] + forward[k];
   /* The settings: what the hash covers beside the files. */
   lm_buf settings = {0};
   lm_buf_append(&settings, "\"camera\": {", -1);
@@ -179,7 +182,7 @@ bool reference_cycles_spec(const reference_args *a, const job *j, const job_view
   lm_buf_append(&settings, ", ", -1);
   json_vec3(&settings, "up", up);
   lm_buf_printf(&settings, ", \"fov_y\": %.9g},\n  \"width\": %d, \"height\": %d, \"samples\": %d, \"bounces\": %d, "
-                "\"seed\": %d, \"materials\": \"%s\",\n  \"sky\": ", cam->fov_y * 180.0 / M_PI, w, h,
+                "\"seed\": %d, \"materials\": \"%s\",\n  \"sky\": ", 2 * atan(f.clip[3]) * 180.0 / M_PI, w, h,
                 a->cycles.samples, a->cycles.bounces, a->cycles.seed, a->pov.pbr_materials ? "pbr" : "phong");
   if (a->pov.has_sky) {
     lm_buf_append(&settings, "{", 1);
