@@ -20,15 +20,20 @@
 //     does not see block nothing: the RSM's surfels (as the second LPV
 //     version takes) measured no better on the reference set and doubled
 //     the points, which cost llvmpipe most of the injection's time.
+//   - BOUNCE (a bounce past the first, lpv.bounces): the same VPL points and
+//     then the same surfels, each now sending the light the last bounce's
+//     volumes bring it (lpv_light.glsl) times its k_d albedo: the light
+//     that has bounced once more. A sender is counted once: with surfels,
+//     the VPLs the camera sees are left to them (EXCLUDE_SEEN).
 // EXCLUDE_SEEN (the combined technique): a VPL the camera sees is left to the
 // screen-space pass, as rsm.frag does.
 // Output, flat: the VPL's lobe per colour channel (or the blocking lobe); a
 // point that adds nothing is placed off the target.
 #include "rsm.glsl"
-#include "lpv.glsl"
+#include "lpv_light.glsl"
 
 uniform sampler2D rsm_flux, rsm_nrm, rsm_pos; // shadow.lua's RSM targets
-uniform sampler2D nrm, dpt, mat;              // the G-buffer
+uniform sampler2D clr, nrm, dpt, mat;         // the G-buffer
 uniform ivec4 vpl_sides = ivec4(64); // per cascade
 uniform int rsm_views = 0;
 uniform ivec4 surfel_cols = ivec4(0), surfel_rows = ivec4(0); // per cascade
@@ -78,20 +83,24 @@ bool vpl(int k, int c, out vec3 q, out vec3 n, out vec3 flux) {
 #ifdef EXCLUDE_SEEN
   if (rsm_seen(dpt, q)) return false;
 #endif
+#ifdef BOUNCE
+  vec3 radiance = lpv_light(q, n); // the light it receives, which the albedo below sends on
+#else
   vec3 l, radiance = light_incident(light, q, l);
+#endif
   float texels = tile * tile * (hi.x - lo.x) * (hi.y - lo.y) / float(per_view); // the RSM texels a point stands for
   flux = texelFetch(rsm_flux, a, 0).rgb * radiance * rsm_texel_area(sv, t, q, tile) * texels;
   return true;
 }
 
-// Surfel k of cascade c: the G-buffer pixel's position, normal and area (its
-// footprint over the cosine to the camera, capped); false on background.
-bool surfel(int k, int c, out vec3 p, out vec3 n, out float area) {
+// Surfel k of cascade c: the G-buffer pixel px, its position, normal and area
+// (its footprint over the cosine to the camera, capped); false on background.
+bool surfel(int k, int c, out ivec2 px, out vec3 p, out vec3 n, out float area) {
   ivec2 size = textureSize(dpt, 0), grid = max(ivec2(surfel_cols[c], surfel_rows[c]), ivec2(1));
   int columns = grid.x;
   vec2 step = vec2(size) / vec2(grid);
   vec2 uv = (vec2(k % columns, k / columns) + 0.5) * step / vec2(size);
-  ivec2 px = ivec2(uv * vec2(size));
+  px = ivec2(uv * vec2(size));
   if (texelFetch(mat, px, 0).a < 0.5) return false; // background
   float z = texelFetch(dpt, px, 0).r;
   p = position_from_depth(uv, z);
@@ -107,10 +116,13 @@ void main() {
   v_r = v_g = v_b = vec4(0.0);
   int c = 0, k = gl_VertexID;
   for (; c < lpv_cascades; c++) { // the cascade's points, and the point's index among them
+    int vpls = rsm_views * vpl_sides[c] * vpl_sides[c], surfels = surfel_cols[c] * surfel_rows[c];
 #ifdef GEOMETRY
-    int points = surfel_cols[c] * surfel_rows[c];
+    int points = surfels;
+#elif defined(BOUNCE)
+    int points = vpls + surfels;
 #else
-    int points = rsm_views * vpl_sides[c] * vpl_sides[c];
+    int points = vpls;
 #endif
     if (k < points) break;
     k -= points;
@@ -118,11 +130,20 @@ void main() {
   if (c >= lpv_cascades) return;
   vec3 p, n, flux;
   float area;
+  ivec2 px;
 #ifdef GEOMETRY
-  if (!surfel(k, c, p, n, area)) return;
+  if (!surfel(k, c, px, p, n, area)) return;
   float side = -0.5;
 #else
+#ifdef BOUNCE
+  int vpls = rsm_views * vpl_sides[c] * vpl_sides[c];
+  if (k >= vpls) { // a surfel: its k_d albedo times the light it receives, times its area
+    if (!surfel(k - vpls, c, px, p, n, area)) return;
+    flux = texelFetch(mat, px, 0).y * texelFetch(clr, px, 0).rgb * lpv_light(p, n) * area;
+  } else if (!vpl(k, c, p, n, flux)) return;
+#else
   if (!vpl(k, c, p, n, flux)) return;
+#endif
   float side = 0.5;
 #endif
   float h = lpv_cell_size(c);

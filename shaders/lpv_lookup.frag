@@ -1,43 +1,14 @@
 // The light propagation volumes' light at each pixel of the (coarse)
 // G-buffer (seed 003, section 5.3.6's lookup; scripts/lpv.lua), on POV-Ray's
 // scale (/work/shared/design/gi-scale.md): E / pi, what the composite
-// (isr_light.frag) multiplies by k_d albedo.
+// (isr_light.frag) multiplies by k_d albedo; lpv_light.glsl computes it.
 //
-// A cell's summed intensity I over the steps is the radiance through it
-// times its cross-section h^2, times the steps light spends crossing it: a
-// step moves light in w by w / (|w_x| + |w_y| + |w_z|) cells
-// (lpv_propagate.frag), so it lingers |w|_1 steps a cell. Hence
-//   E / pi = (1 / pi) int I(-w) / h^2 / |w|_1 max(0, n.w) dw
-//          ~ D max(0, A - 2/3 B.n) / h^2,  D = mean of 1 / |w|_1 = 0.674213
-// (int (A + B.w) max(0, -n.w) dw = pi A - 2 pi / 3 B.n), read trilinearly
-// 1.5 cells in front of the surface: the first layer of cells in front of a
-// lit surface holds its own VPLs' light going sideways (2 bands cannot
-// represent a Lambertian lobe's zero at grazing angles), which read there
-// would light a lit plane by itself; measured on the reference set
-// (tools/fidelity.sh), 1.5 cells took out the bright ground of the blocks
-// views that 0.5 and 1 cell left (56% of dl+esm's indirect error removed,
-// every view improved, against 55% and 14 of 15 at 1 cell).
-//
-// Cascades as distance bands: a step of cascade c carries light as far as
-// two of cascade c - 1, so cascade c's steps after the first half
-// (`late`: steps floor(S / 2) + 1 .. S) carry light from beyond what cascade
-// c - 1's S steps reach, and each path is counted once:
-//   E = all steps of the finest cascade c0 that holds p + late steps of each coarser one
-// (`all` holds steps 1 .. S; step 0, the injected VPLs in their own cells, is
-// in neither, see lpv.lua). A grid holds only the VPLs inside it: a point
-// less than S cells from c0's border would miss the light from beyond it, so
-// over those S cells the sum blends, by w from 1 inside to 0 at the border,
-// into the same sum from c0 + 1 (no seam shows either); past the coarsest
-// cascade's border the light fades to nothing. The blend shares the
-// cascades past c0 + 1:
-//   E = w all(c0) + (1 - w) all(c0 + 1) + w late(c0 + 1) + late of each cascade past c0 + 1
-// and each cascade's volumes are read once, those with weight 0 not at all.
 // Output: rgb = E / pi, a = 1 (it occludes no ambient term).
 // With STRIDE, each texel reads the G-buffer, STRIDE times finer, at its
 // block's centre (isr.coarse_view); with Z it also writes that depth / far,
 // 0 where nothing is drawn, into z (the view's depth).
 #include "gbuffer.glsl"
-#include "lpv.glsl"
+#include "lpv_light.glsl"
 
 #ifndef STRIDE
 #define STRIDE 1
@@ -45,62 +16,11 @@
 
 in vec2 uv;
 uniform sampler2D clr, nrm, dpt, mat;         // (coarse) G-buffer
-#ifdef VOLUMES
-uniform sampler2D all_r, all_g, all_b;        // sums of steps 1 .. S
-uniform sampler2D late_r, late_g, late_b;     // sums of steps floor(S / 2) + 1 .. S
-#endif
-uniform int lpv_steps = 8;
 
 layout(location = 0) out vec4 result;
 #ifdef Z
 layout(location = 1) out float z;
 #endif
-
-const float D = 0.674213;
-
-vec3 irradiance(vec4 r, vec4 g, vec4 b, vec3 n) {
-  vec3 a = vec3(r.x, g.x, b.x), bn = vec3(dot(r.yzw, n), dot(g.yzw, n), dot(b.yzw, n));
-  return D * max(a - (2.0 / 3.0) * bn, 0.0);
-}
-
-vec4 volume(sampler2D v, vec2 uv0, vec2 uv1, float f) { return mix(texture(v, uv0), texture(v, uv1), f); }
-
-// Each cascade's least corner (lpv_origin, the same for every pixel), found once a pixel.
-vec3 origins[4];
-
-// Where p facing n is read in cascade c, in cell centres (1.5 cells in front of it).
-vec3 cell_coords(int c, vec3 p, vec3 n) {
-  float h = lpv_cell_size(c);
-  return (p + 1.5 * h * n - origins[c]) / h - 0.5;
-}
-
-// How many cells u lies within cascade c's sampled range (negative:
-// outside), along the axes that follow the camera: along the others the
-// grid holds the whole scene, and no light comes from beyond it.
-float inside(vec3 u, int c) {
-  vec3 last = vec3(lpv_dims(c) - 1);
-  vec3 m = min(u, last - u);
-  bvec3 moves = bvec3((lpv_follow[c] & 1) != 0, (lpv_follow[c] & 2) != 0, (lpv_follow[c] & 4) != 0);
-  m = mix(vec3(1e30), m, moves);
-  return min(m.x, min(m.y, m.z));
-}
-
-// Cascade c's E / pi at p facing n: its sum of all steps times a plus its late sum times l.
-vec3 cascade(int c, vec3 p, vec3 n, float a, float l) {
-  vec3 e = vec3(0.0);
-#ifdef VOLUMES
-  vec3 last = vec3(lpv_dims(c) - 1);
-  vec3 u = clamp(cell_coords(c, p, n), vec3(0.0), last);
-  float z0 = floor(u.z), f = u.z - z0, z1 = min(z0 + 1.0, last.z), nx = float(lpv_nx[c]);
-  vec2 size = vec2(lpv_size), row = vec2(float(lpv_col[c]) + u.x, u.y);
-  vec2 uv0 = (row + vec2(z0 * nx, 0.0) + 0.5) / size, uv1 = (row + vec2(z1 * nx, 0.0) + 0.5) / size;
-  if (a > 0.0) e += a * irradiance(volume(all_r, uv0, uv1, f), volume(all_g, uv0, uv1, f), volume(all_b, uv0, uv1, f), n);
-  if (l > 0.0)
-    e += l * irradiance(volume(late_r, uv0, uv1, f), volume(late_g, uv0, uv1, f), volume(late_b, uv0, uv1, f), n);
-#endif
-  float h = lpv_cell_size(c);
-  return e / max(h * h, 1e-30);
-}
 
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
@@ -112,16 +32,5 @@ void main() {
     result = vec4(0.0, 0.0, 0.0, 1.0);
     return;
   }
-  for (int c = 0; c < lpv_cascades; c++) origins[c] = lpv_origin(c);
-  int c0 = lpv_cascades;
-  float margin = -1.0;
-  for (int c = 0; c < lpv_cascades && c0 == lpv_cascades; c++) {
-    margin = inside(cell_coords(c, s.p, s.n), c);
-    if (margin >= 0.0) c0 = c;
-  }
-  float w = clamp(margin / float(max(lpv_steps, 1)), 0.0, 1.0);
-  vec3 e = vec3(0.0);
-  for (int c = c0; c < lpv_cascades; c++)
-    e += cascade(c, s.p, s.n, c == c0 ? w : c == c0 + 1 ? 1.0 - w : 0.0, c == c0 ? 0.0 : c == c0 + 1 ? w : 1.0);
-  result = vec4(finite_or_zero(e), 1.0);
+  result = vec4(lpv_light(s.p, s.n), 1.0);
 }

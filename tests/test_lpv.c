@@ -231,6 +231,105 @@ static void cascades_do_not_shimmer_under_sub_cell_motion(void **state) {
   }
 }
 
+/* A rectangle on the plane axis = at (0 x, 1 y, 2 z), u and v ranges over
+ * the other two axes in order, facing `sign` along the axis. */
+static void rect(lm_scene *s, int material, int axis, float at, float sign, float u0, float u1, float v0,
+                 float v1) {
+  int a = (axis + 1) % 3, b = (axis + 2) % 3;
+  float c[4][3], n[3] = {0, 0, 0}, uv[4][2] = {{u0, v0}, {u1, v0}, {u1, v1}, {u0, v1}};
+  n[axis] = sign;
+  for (int i = 0; i < 4; i++) {
+    /* counter-clockwise seen from n: a, b, axis is a right-handed frame, so reverse for -axis */
+    int k = sign > 0 ? i : 3 - i;
+    c[i][axis] = at, c[i][a] = uv[k][0], c[i][b] = uv[k][1];
+  }
+  gl_quad(s, "room", material, (const float(*)[3])c, n);
+}
+
+/* A white room (albedo 0.8) of [-2, 2] x [0, 2.5] x [-2, 2] with a window in
+ * its +x wall (z -0.8 .. 0.8, y 1 .. 2): the sun shines in along (-1, -0.9,
+ * 0) onto a patch of the floor, the ceiling in no sun. The camera at (1.6,
+ * 0.7, 1.6) looks at the far upper corner (-2, 2.2, -2): walls, ceiling and
+ * some of the floor. */
+static lm_scene *window_room(mat4 view_proj, int w, int h) {
+  lm_scene *s = lm_scene_create("room");
+  int white = gl_material(s, "white", 0.8f, 0.8f, 0.8f);
+  rect(s, white, 1, 0, 1, -2, 2, -2, 2);        /* floor: z, x */
+  rect(s, white, 1, 2.5f, -1, -2, 2, -2, 2);    /* ceiling */
+  rect(s, white, 0, -2, 1, 0, 2.5f, -2, 2);     /* -x wall: y, z */
+  rect(s, white, 2, -2, 1, -2, 2, 0, 2.5f);     /* -z wall: x, y */
+  rect(s, white, 2, 2, -1, -2, 2, 0, 2.5f);     /* +z wall */
+  rect(s, white, 0, 2, -1, 0, 1, -2, 2);        /* +x wall under the window */
+  rect(s, white, 0, 2, -1, 2, 2.5f, -2, 2);     /* above it */
+  rect(s, white, 0, 2, -1, 1, 2, -2, -0.8f);    /* beside it */
+  rect(s, white, 0, 2, -1, 1, 2, 0.8f, 2);
+  mat4 view, m;
+  glm_lookat((vec3){0, 0, 0}, (vec3){-1, -0.9f, 0}, (vec3){0, 1, 0}, view);
+  glm_mat4_inv(view, m); /* the node's -Z along the sun's direction */
+  int sun = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 1,
+                                     .casts_shadows = true, .node = sun});
+  glm_lookat((vec3){1.6f, 0.7f, 1.6f}, (vec3){-2, 2.2f, -2}, (vec3){0, 1, 0}, view);
+  glm_mat4_inv(view, m);
+  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "corner", .fov_y = glm_rad(70.0f), .znear = 0.01f, .zfar = 100,
+                                      .node = cam});
+  lm_scene_update(s);
+  mat4 proj;
+  glm_perspective(glm_rad(70.0f), (float)w / (float)h, 0.01f, 100, proj);
+  glm_mat4_mul(proj, view, view_proj);
+  return s;
+}
+
+/* Mean linear RGB of the 7 x 7 pixels around world point p (rows top first). */
+static void around(const gl_result *r, mat4 view_proj, const float p[3], float out[3]) {
+  vec4 clip;
+  glm_mat4_mulv(view_proj, (vec4){p[0], p[1], p[2], 1}, clip);
+  int col = (int)((clip[0] / clip[3] * 0.5f + 0.5f) * r->width);
+  int row = (int)((0.5f - clip[1] / clip[3] * 0.5f) * r->height);
+  assert_true(col >= 3 && col < r->width - 3 && row >= 3 && row < r->height - 3);
+  gl_region(r, col - 3, row - 3, col + 4, row + 4, out);
+}
+
+/* Light that has bounced twice or more: the ceiling of the window room,
+ * which the sun never sees, gets more light with lpv.bounces 2 than with 1
+ * (the walls the floor lights send it on), and the light grows less with
+ * each bounce and stays under the geometric bound of albedo 0.8 (five times
+ * the first bounce's). */
+static void bounces_reach_the_ceiling_and_stay_bounded(void **state) {
+  (void)state;
+  enum { RW = 80, RH = 60 };
+  mat4 vp;
+  lm_scene *s = window_room(vp, RW, RH);
+  const float ceiling[3] = {-1.0f, 2.5f, -1.0f};
+  static const char *const dl_sets[] = {"ambient=0", NULL};
+  gl_result dl = render_ok(s, "dl+esm", dl_sets, RW, RH);
+  float dark[3];
+  around(&dl, vp, ceiling, dark);
+  assert_true(dark[0] < 1e-4f);
+  gl_result_free(&dl);
+  const int bounces[] = {1, 2, 3, 4, 8};
+  float light[5];
+  for (int i = 0; i < 5; i++) {
+    char set[32];
+    snprintf(set, sizeof set, "lpv.bounces=%d", bounces[i]);
+    const char *const sets[] = {"ambient=0", set, NULL};
+    gl_result r = render_ok(s, "lpv+esm", sets, RW, RH);
+    float v[3];
+    around(&r, vp, ceiling, v);
+    light[i] = gl_luminance(v);
+    print_message("bounces %d: ceiling %.5f\n", bounces[i], light[i]);
+    assert_true(gl_all_finite(&r));
+    gl_result_free(&r);
+  }
+  assert_true(light[0] > 1e-3f);
+  assert_true(light[1] > 1.1f * light[0]);
+  for (int i = 1; i < 5; i++) assert_true(light[i] >= light[i - 1] * (1 - 1e-4f));
+  assert_true(light[4] - light[3] < light[1] - light[0]);
+  assert_true(light[4] < 5 * light[0]);
+  lm_scene_destroy(s);
+}
+
 /* The LPV's passes and volumes exist only in a frame whose technique reads
  * them, and then none is left out; without a light that casts shadows (no
  * RSM) lpv+esm is direct light alone. */
@@ -306,6 +405,8 @@ static void extremes_stay_finite(void **state) {
       {"lpv.occlusion=0", "lpv.shift=0", NULL},
       {"lpv.coarse=8", "lpv.blur=32", "lpv.k=16", NULL},
       {"lpv.coarse=1", "lpv.blur=0", "lpv.reach=64", NULL},
+      {"lpv.bounces=8", "lpv.steps=1", NULL},
+      {"lpv.bounces=8", "lpv.surfels=0", NULL},
   };
   lm_scene *s = corner_scene(LM_LIGHT_DIRECTIONAL);
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
@@ -314,6 +415,10 @@ static void extremes_stay_finite(void **state) {
     gl_result_free(&r);
   }
   gl_result r = render_ok(s, "isr+lpv+esm", NULL, 48, 36);
+  gl_result_free(&r);
+  static const char *const bounced[] = {"lpv.bounces=8", NULL};
+  r = render_ok(s, "isr+lpv+esm", bounced, 48, 36);
+  assert_true(gl_all_finite(&r));
   gl_result_free(&r);
   lm_scene_destroy(s);
   /* A point light inside a closed box, the camera outside it. */
@@ -351,7 +456,8 @@ static void bad_options_name_themselves(void **state) {
       {"lpv+esm", "lpv.vpls=0", "lpv.vpls"},           {"lpv+esm", "lpv.surfels=-1", "lpv.surfels"},
       {"lpv+esm", "lpv.occlusion=2", "lpv.occlusion"}, {"lpv+esm", "lpv.reach=0.5", "lpv.reach"},
       {"lpv+esm", "lpv.coarse=3", "lpv.coarse"},       {"isr+lpv+esm", "lpv.blur=33", "lpv.blur"},
-      {"isr+lpv+esm", "lpv.k=17", "lpv.k"},
+      {"isr+lpv+esm", "lpv.k=17", "lpv.k"},           {"lpv+esm", "lpv.bounces=0", "lpv.bounces"},
+      {"lpv+esm", "lpv.bounces=9", "lpv.bounces"},
   };
   gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
 }
@@ -360,6 +466,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(a_lit_coloured_wall_tints_a_neighbouring_white_one),
       cmocka_unit_test(energy_does_not_grow_with_propagation_steps),
+      cmocka_unit_test(bounces_reach_the_ceiling_and_stay_bounded),
       cmocka_unit_test(cascades_do_not_shimmer_under_sub_cell_motion),
       cmocka_unit_test(a_frame_that_reads_no_lpv_records_none_of_its_passes),
       cmocka_unit_test(any_unit_gives_the_same_light),
