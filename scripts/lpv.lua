@@ -52,6 +52,9 @@ lpv.defaults = {
   bounces = 1,       -- bounces of light the volumes carry, 1..8: each past the first injects the
                      -- VPLs and surfels again with the light the volumes bring them (times their
                      -- albedo) and propagates `steps` more steps (docs/gi-multibounce.md)
+  sky_occlusion = 1.0, -- how much the geometry volume occludes the ambient term and the sky at each
+                     -- pixel, 0..1 (0: not at all, as before; docs/gi-multibounce.md)
+  sky_cells = 8,     -- cells the occlusion's directions cross, 1..64
   blur = 0,          -- Gaussian taps each side at coarse size, 0..32; the volume's light is smooth
                      -- already: 2 removed 0.4 points more of the indirect error for two passes
 }
@@ -72,6 +75,8 @@ local rules = {
   coarse = options.one_of(1, 2, 4, 8),
   blur = options.whole(0, 32),
   bounces = options.whole(1, 8),
+  sky_occlusion = options.number(0, 1),
+  sky_cells = options.whole(1, 64),
 }
 
 lpv.check = options.checker("lpv", lpv.defaults, rules)
@@ -233,23 +238,26 @@ function lpv.volume(G, R, o, exclude_seen)
                      more_late_b = last.late[3] } }
     total = { all = { out[1], out[2], out[3] }, late = { out[4], out[5], out[6] } }
   end
-  return { all = total.all, late = total.late, grids = grids, seen = R.seen }
+  return { all = total.all, late = total.late, grids = grids, seen = R.seen, geometry = geometry }
 end
 
 -- Records the lookup over the coarse view C (isr.coarse_view, factor f),
--- whose depth it writes, in the volumes V (lpv.volume). Returns the coarse E.
-function lpv.gather(C, f, V, o)
+-- whose depth it writes, in the volumes V (lpv.volume); with sky, the share
+-- of open sky in its a (o.sky_occlusion). Returns the coarse E.
+function lpv.gather(C, f, V, o, sky)
   local inputs = gbuffer.inputs(C)
   if V.late then
     inputs.all_r, inputs.all_g, inputs.all_b = V.all[1], V.all[2], V.all[3]
     inputs.late_r, inputs.late_g, inputs.late_b = V.late[1], V.late[2], V.late[3]
   end
   inputs.lpv_seen = V.seen
+  local occludes = sky and o.sky_occlusion > 0 and o.surfels > 0
+  if occludes then inputs.geometry = V.geometry end
   local E = target{ "lpv.e", format = "rgba16f", scale = 1 / f }
   pass{ "lpv.lookup", shader = "lpv_lookup.frag", inputs = inputs,
-        defines = { VOLUMES = V.late ~= nil, STRIDE = C.stride, Z = true },
-        params = grid(o, V.grids, { lpv_steps = o.steps }),
-        fetches = 4 + 6 * (o.cascades + 1), out = { E, C.z } }
+        defines = { VOLUMES = V.late ~= nil, STRIDE = C.stride, Z = true, SKY_OCCLUSION = occludes },
+        params = grid(o, V.grids, { lpv_steps = o.steps, sky_cells = o.sky_cells, sky_occlusion = o.sky_occlusion }),
+        fetches = 4 + 6 * (o.cascades + 1) + (occludes and 8 * o.sky_cells or 0), out = { E, C.z } }
   return E
 end
 
@@ -257,12 +265,15 @@ end
 -- frame.R, with options o; no input. With the row's split, VPLs the camera
 -- sees are left to the frame's lighting (lpv.volume's exclude_seen).
 -- Returns what the direct pass adds (pp.lua's direct: INDIRECT in
--- direct.frag): { C = the coarse grid, E = the coarse result, k }.
+-- direct.frag): { C = the coarse grid, E = the coarse result, k }; E's a,
+-- the share of open sky, occludes the direct pass's ambient term (without
+-- the split: there ISR's composite occludes it).
 function lpv.render(_, o, frame)
   o = lpv.check(o, 2)
   local G, f, split = frame.G, o.coarse, frame.technique and frame.technique.split
   local C = isr.coarse_view(G, nil, f, "lpv")
-  return { C = C, E = isr.blur(lpv.gather(C, f, lpv.volume(G, frame.R, o, split), o), C, f, o.blur), k = o.k }
+  local E = lpv.gather(C, f, lpv.volume(G, frame.R, o, split), o, not split)
+  return { C = C, E = isr.blur(E, C, f, o.blur), k = o.k }
 end
 
 return lpv

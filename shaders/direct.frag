@@ -2,8 +2,9 @@
 // INDIRECT: indirect light that needs no direct light of this frame (RSM,
 // LPV; vpl.frag's refinement does the same for VPLs) is added here, a
 // coarse result upsampled (coarse.glsl), rather than in a composite pass of
-// its own: L = D + k_a L_a albedo + k k_d albedo E (the physical composite
-// of isr_light.frag, with A = 1: these occlude no ambient term).
+// its own: L = D + k_a L_a albedo A + k k_d albedo E (the physical composite
+// of isr_light.frag; A = 1 from the RSM, the share of open sky from the LPV's
+// geometry volume: lpv_lookup.frag's SKY_OCCLUSION).
 #include "gbuffer.glsl"
 #ifdef INDIRECT
 #include "coarse.glsl"
@@ -25,7 +26,8 @@ void main() {
   }
   vec3 l = direct_light(s, ambient);
 #ifdef INDIRECT
-  l += gi_reflected(s, k, coarse_upsample(uv, s.depth01).rgb);
+  vec4 e = coarse_upsample(uv, s.depth01);
+  l += gi_reflected(s, k, e.rgb) - (1.0 - saturate(e.a)) * ambient_light(s, ambient);
 #endif
   lit = vec4(l, 1.0);
 }

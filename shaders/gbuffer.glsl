@@ -66,14 +66,18 @@ Surface gbuffer_fetch(sampler2D clr, sampler2D nrm, sampler2D dpt, sampler2D mat
 // Direct light leaving a covered surface toward the eye (lighting.glsl: Phong,
 // or GGX for the pbr technique's surfaces), with the sky in the ambient term
 // where SKY is defined.
+// pbr: k = (occlusion, 1 - metallic, max F0), the diffuse colour k_d albedo;
+// ambient light reaches it times occlusion, as k_a times the albedo in Phong.
+vec3 surface_diffuse(Surface s) { return s.pbr ? s.k.y * s.albedo : s.albedo; }
+
+// The ambient term (the sky's light where SKY is defined) leaving a covered
+// surface: what occlusion takes away.
+vec3 ambient_light(Surface s, vec3 ambient) { return s.k.x * sky_ambient(ambient, s.n) * surface_diffuse(s); }
+
 vec3 direct_light(Surface s, vec3 ambient) {
   vec3 v = safe_normalize(frame.camera_pos.xyz - s.p, s.n);
-  vec3 a = sky_ambient(ambient, s.n);
-  // pbr: k = (occlusion, 1 - metallic, max F0), the diffuse colour k_d albedo;
-  // ambient light reaches it times occlusion, as k_a times the albedo in Phong.
-  vec3 diffuse = s.pbr ? s.k.y * s.albedo : s.albedo;
-  Reflector m = Reflector(s.pbr, diffuse, s.k, s.shininess, s.f0, s.roughness);
-  return s.k.x * a * diffuse + reflected_light(m, s.n, v, s.p);
+  Reflector m = Reflector(s.pbr, surface_diffuse(s), s.k, s.shininess, s.f0, s.roughness);
+  return ambient_light(s, ambient) + reflected_light(m, s.n, v, s.p);
 }
 
 // Indirect irradiance E / pi (the GI passes' E, gi-scale.md) reflected by a

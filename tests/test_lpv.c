@@ -330,6 +330,54 @@ static void bounces_reach_the_ceiling_and_stay_bounded(void **state) {
   lm_scene_destroy(s);
 }
 
+/* Under a uniform sky of 0.5 (the sun's power 0: its RSM exists, but sends
+ * nothing), the ground in the corner of two walls 4 high, at (0.7, 0, 0.7),
+ * sees less sky than open ground at (6, 0, 6): with lpv.sky_occlusion at its
+ * default lpv+esm darkens the corner, with 0 (and dl+esm) it cannot. The
+ * field is 20 wide, so a cell is about 1.3: the geometry volume knows
+ * occluders of the cells' size, not a post (test_sky's). */
+static void an_outdoor_corner_sees_less_sky_than_open_ground(void **state) {
+  (void)state;
+  enum { SW = 96, SH = 72 };
+  lm_scene *s = lm_scene_create("yard");
+  int grey = gl_material(s, "grey", 0.5f, 0.5f, 0.5f);
+  rect(s, grey, 1, 0, 1, -10, 10, -10, 10); /* ground: z, x */
+  rect(s, grey, 0, 0, 1, 0, 4, 0, 8);       /* a wall facing +x: y, z */
+  rect(s, grey, 2, 0, 1, 0, 8, 0, 4);       /* one facing +z: x, y */
+  mat4 view, m, proj, vp;
+  glm_lookat((vec3){0, 0, 0}, (vec3){-0.3f, -1, -0.2f}, (vec3){0, 1, 0}, view);
+  glm_mat4_inv(view, m);
+  int sun = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 0,
+                                     .casts_shadows = true, .node = sun});
+  glm_lookat((vec3){9, 6, 9}, (vec3){3, 0, 3}, (vec3){0, 1, 0}, view);
+  glm_mat4_inv(view, m);
+  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "yard", .fov_y = glm_rad(60.0f), .znear = 0.01f, .zfar = 100,
+                                      .node = cam});
+  lm_scene_update(s);
+  glm_perspective(glm_rad(60.0f), (float)SW / SH, 0.01f, 100, proj);
+  glm_mat4_mul(proj, view, vp);
+  const float corner[3] = {0.7f, 0, 0.7f}, open[3] = {6, 0, 6};
+  const char *const techs[] = {"lpv+esm", "lpv+esm", "dl+esm"};
+  for (int t = 0; t < 3; t++) {
+    const char *const sets[] = {"ambient=0", "sky=true", "sky.zenith=0.5", "sky.horizon=0.5",
+                                t == 1 ? "lpv.sky_occlusion=0" : NULL, NULL};
+    gl_result r = gl_render_ok(&(gl_run){.scene = s, .tech = techs[t], .sets = sets, .width = SW, .height = SH});
+    float a[3], b[3];
+    around(&r, vp, corner, a);
+    around(&r, vp, open, b);
+    float ratio = gl_luminance(a) / fmaxf(gl_luminance(b), 1e-6f);
+    print_message("%s%s: corner %.4f, open ground %.4f (0.25), ratio %.3f\n", techs[t],
+                  t == 1 ? " (sky_occlusion 0)" : "", gl_luminance(a), gl_luminance(b), ratio);
+    assert_true(fabsf(gl_luminance(b) - 0.25f) < 0.03f);
+    if (t == 0) assert_true(ratio < 0.85f);
+    else assert_true(fabsf(ratio - 1) < 0.02f);
+    gl_result_free(&r);
+  }
+  lm_scene_destroy(s);
+}
+
 /* The LPV's passes and volumes exist only in a frame whose technique reads
  * them, and then none is left out; without a light that casts shadows (no
  * RSM) lpv+esm is direct light alone. */
@@ -407,11 +455,14 @@ static void extremes_stay_finite(void **state) {
       {"lpv.coarse=1", "lpv.blur=0", "lpv.reach=64", NULL},
       {"lpv.bounces=8", "lpv.steps=1", NULL},
       {"lpv.bounces=8", "lpv.surfels=0", NULL},
+      {"sky=true", "sky.intensity=1e6", "lpv.bounces=8", "lpv.sky_cells=64", NULL},
+      {"ambient=1e6", "lpv.sky_occlusion=0.5", "lpv.sky_cells=1", NULL},
   };
   lm_scene *s = corner_scene(LM_LIGHT_DIRECTIONAL);
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
     gl_result r = render_ok(s, "lpv+esm", cases[i], 48, 36);
     if (gl_has_pass(&r, "lpv.lookup") && !gl_target_finite(&r, "lpv.e")) fail_msg("case %zu: lpv.e", i);
+    if (!gl_all_finite(&r)) fail_msg("case %zu: the image", i);
     gl_result_free(&r);
   }
   gl_result r = render_ok(s, "isr+lpv+esm", NULL, 48, 36);
@@ -457,7 +508,8 @@ static void bad_options_name_themselves(void **state) {
       {"lpv+esm", "lpv.occlusion=2", "lpv.occlusion"}, {"lpv+esm", "lpv.reach=0.5", "lpv.reach"},
       {"lpv+esm", "lpv.coarse=3", "lpv.coarse"},       {"isr+lpv+esm", "lpv.blur=33", "lpv.blur"},
       {"isr+lpv+esm", "lpv.k=17", "lpv.k"},           {"lpv+esm", "lpv.bounces=0", "lpv.bounces"},
-      {"lpv+esm", "lpv.bounces=9", "lpv.bounces"},
+      {"lpv+esm", "lpv.bounces=9", "lpv.bounces"},     {"lpv+esm", "lpv.sky_occlusion=2", "lpv.sky_occlusion"},
+      {"lpv+esm", "lpv.sky_cells=0", "lpv.sky_cells"},
   };
   gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
 }
@@ -467,6 +519,7 @@ int main(void) {
       cmocka_unit_test(a_lit_coloured_wall_tints_a_neighbouring_white_one),
       cmocka_unit_test(energy_does_not_grow_with_propagation_steps),
       cmocka_unit_test(bounces_reach_the_ceiling_and_stay_bounded),
+      cmocka_unit_test(an_outdoor_corner_sees_less_sky_than_open_ground),
       cmocka_unit_test(cascades_do_not_shimmer_under_sub_cell_motion),
       cmocka_unit_test(a_frame_that_reads_no_lpv_records_none_of_its_passes),
       cmocka_unit_test(any_unit_gives_the_same_light),
