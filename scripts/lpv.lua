@@ -133,6 +133,9 @@ local function grid(o, G, params)
   return params
 end
 
+-- The width of a bounce's target of the light its points receive (lpv_bounce.frag).
+local BOUNCE_WIDTH = 64
+
 -- A volume target (one colour channel, or the geometry) over the grids.
 local function volume_target(grids, name) return target{ name, format = "rgba32f", size = grids.size } end
 
@@ -214,18 +217,30 @@ function lpv.volume(G, R, o, exclude_seen)
   local total, last = V, V
   for b = 2, o.steps > 0 and o.bounces or 1 do
     local tag = "bounce" .. b .. "."
+    local count = vpls + bounce_surfels
+    local function bounce_params(more)
+      local params = grid(o, grids, { vpl_sides = sides, rsm_views = R.views, surfel_cols = bounce_cols,
+                                      surfel_rows = rows, bounce_width = BOUNCE_WIDTH })
+      for k, v in pairs(more) do params[k] = v end
+      return params
+    end
+    local seen = exclude_seen == true or bounce_surfels > 0
     local binputs = { rsm_flux = R.flux, rsm_nrm = R.nrm, rsm_pos = R.pos, clr = G.clr, nrm = G.nrm, dpt = G.dpt,
-                      mat = G.mat, lpv_seen = R.seen, all_r = last.all[1], all_g = last.all[2],
-                      all_b = last.all[3], late_r = last.late[1], late_g = last.late[2], late_b = last.late[3] }
+                      mat = G.mat, lpv_seen = R.seen }
+    local linputs = { all_r = last.all[1], all_g = last.all[2], all_b = last.all[3], late_r = last.late[1],
+                      late_g = last.late[2], late_b = last.late[3] }
+    for k, v in pairs(binputs) do linputs[k] = v end
+    binputs.bounce_light = pass{ "lpv." .. tag .. "light", shader = "lpv_bounce.frag", inputs = linputs,
+                                 params = bounce_params{ lpv_steps = o.steps, bounce_points = count },
+                                 defines = { SHADOWS = true, BOUNCE = true, VOLUMES = true, EXCLUDE_SEEN = seen },
+                                 fetches = 5 + 6 * (o.cascades + 1),
+                                 out = target{ "lpv." .. tag .. "light", format = "rgba32f",
+                                               size = { BOUNCE_WIDTH, math.max(1, -(-count // BOUNCE_WIDTH)) } } }
     local again = {}
     for i, ch in ipairs{ "r", "g", "b" } do again[i] = volume_target(grids, "lpv." .. tag .. "inject_" .. ch) end
-    points{ "lpv." .. tag .. "inject", vertex = "lpv_inject.vert", shader = "lpv_inject.frag",
-            count = vpls + bounce_surfels, inputs = binputs,
-            params = grid(o, grids, { vpl_sides = sides, rsm_views = R.views, surfel_cols = bounce_cols,
-                                      surfel_rows = rows, lpv_steps = o.steps }),
-            defines = { SHADOWS = true, BOUNCE = true, VOLUMES = true,
-                        EXCLUDE_SEEN = exclude_seen == true or bounce_surfels > 0 },
-            fetches = 5 + 6 * (o.cascades + 1), out = again }
+    points{ "lpv." .. tag .. "inject", vertex = "lpv_inject.vert", shader = "lpv_inject.frag", count = count,
+            inputs = binputs, params = bounce_params{}, fetches = 5, out = again,
+            defines = { SHADOWS = true, BOUNCE = true, EXCLUDE_SEEN = seen } }
     last = propagate(o, grids, geometry, again, tag)
     local out = {}
     for i, name in ipairs{ "all_r", "all_g", "all_b", "late_r", "late_g", "late_b" } do

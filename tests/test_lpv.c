@@ -246,14 +246,14 @@ static void rect(lm_scene *s, int material, int axis, float at, float sign, floa
   gl_quad(s, "room", material, (const float(*)[3])c, n);
 }
 
-/* A white room (albedo 0.8) of [-2, 2] x [0, 2.5] x [-2, 2] with a window in
+/* A white room (albedo 0.8, or `albedo`) of [-2, 2] x [0, 2.5] x [-2, 2] with a window in
  * its +x wall (z -0.8 .. 0.8, y 1 .. 2): the sun shines in along (-1, -0.9,
  * 0) onto a patch of the floor, the ceiling in no sun. The camera at (1.6,
  * 0.7, 1.6) looks at the far upper corner (-2, 2.2, -2): walls, ceiling and
  * some of the floor. */
-static lm_scene *window_room(mat4 view_proj, int w, int h) {
+static lm_scene *window_room(mat4 view_proj, int w, int h, float albedo) {
   lm_scene *s = lm_scene_create("room");
-  int white = gl_material(s, "white", 0.8f, 0.8f, 0.8f);
+  int white = gl_material(s, "white", albedo, albedo, albedo);
   rect(s, white, 1, 0, 1, -2, 2, -2, 2);        /* floor: z, x */
   rect(s, white, 1, 2.5f, -1, -2, 2, -2, 2);    /* ceiling */
   rect(s, white, 0, -2, 1, 0, 2.5f, -2, 2);     /* -x wall: y, z */
@@ -295,12 +295,12 @@ static void around(const gl_result *r, mat4 view_proj, const float p[3], float o
  * which the sun never sees, gets more light with lpv.bounces 2 than with 1
  * (the walls the floor lights send it on), and the light grows less with
  * each bounce and stays under the geometric bound of albedo 0.8 (five times
- * the first bounce's). */
+ * the first bounce's); with albedo 1 it stays finite. */
 static void bounces_reach_the_ceiling_and_stay_bounded(void **state) {
   (void)state;
   enum { RW = 80, RH = 60 };
   mat4 vp;
-  lm_scene *s = window_room(vp, RW, RH);
+  lm_scene *s = window_room(vp, RW, RH, 0.8f);
   const float ceiling[3] = {-1.0f, 2.5f, -1.0f};
   static const char *const dl_sets[] = {"ambient=0", NULL};
   gl_result dl = render_ok(s, "dl+esm", dl_sets, RW, RH);
@@ -327,6 +327,16 @@ static void bounces_reach_the_ceiling_and_stay_bounded(void **state) {
   for (int i = 1; i < 5; i++) assert_true(light[i] >= light[i - 1] * (1 - 1e-4f));
   assert_true(light[4] - light[3] < light[1] - light[0]);
   assert_true(light[4] < 5 * light[0]);
+  lm_scene_destroy(s);
+  /* Albedo 1 (no bound from the albedo), every bounce: finite. */
+  s = window_room(vp, RW, RH, 1.0f);
+  static const char *const white[] = {"ambient=0", "lpv.bounces=8", NULL};
+  gl_result r = render_ok(s, "lpv+esm", white, RW, RH);
+  float v[3];
+  around(&r, vp, ceiling, v);
+  print_message("albedo 1, bounces 8: ceiling %.5f\n", gl_luminance(v));
+  assert_true(gl_all_finite(&r) && gl_target_finite(&r, "lpv.e"));
+  gl_result_free(&r);
   lm_scene_destroy(s);
 }
 
