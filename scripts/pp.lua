@@ -2,6 +2,7 @@
 -- records a frame from its row. The first row is the default; Options are
 -- what `limn capture --set` can change. Modules follow scripts/README.md.
 local gbuffer = require "gbuffer"
+local glossy = require "glossy"
 local isr = require "isr"
 local options = require "options"
 local post = require "post"
@@ -20,6 +21,7 @@ Options = {
   shadow = options.copy(shadow.defaults),
   sky = options.copy(sky.defaults),                -- off by default
   reflections = options.copy(reflections.defaults),
+  glossy = options.copy(glossy.defaults),          -- pbr materials' glossy indirect light, off by default
 }
 -- Post effects, each off by default (the seed viewer's F6 bloom, F7 dof, F8 glass, F9 radial_blur,
 -- F11 sepia, F12 tiles; and hdr, motion_blur): `--set bloom=true` turns one on (bloom.enabled),
@@ -93,6 +95,9 @@ local function frame(tech, row)
   end
   -- Ray-traced reflections on every technique, left out where no material reflects.
   if tech.reflections.enabled and scene_reflective() then lit = reflections.render(lit, tech.reflections, F) end
+  -- Glossy indirect light for pbr surfaces only: a Phong frame records none of it (its options are
+  -- checked on every frame, so a bad one is named while it is off too).
+  if glossy.check(tech.glossy, 1).enabled and materials == "pbr" then lit = glossy.render(lit, tech.glossy, F) end
   return post.render(lit, tech, F)
 end
 

@@ -121,6 +121,14 @@ struct Reflector {
 // and Schlick's Fresnel from f0. The engine's lights carry Lambert's 1 / pi
 // already (Phong has none; engine/scene/gltf.h), so the specular term is
 // pi times the BRDF.
+// Smith's height-correlated visibility G / (4 n.l n.v) for GGX of alpha^2 a2.
+float ggx_visibility(float ndl, float ndv, float a2) {
+  return 0.5 / max(ndl * sqrt(ndv * ndv * (1.0 - a2) + a2) + ndv * sqrt(ndl * ndl * (1.0 - a2) + a2), 1e-8);
+}
+
+// Schlick's Fresnel from f0 at v.h.
+vec3 ggx_fresnel(vec3 f0, float vdh) { return f0 + (1.0 - f0) * pow(1.0 - vdh, 5.0); }
+
 vec3 pbr_reflect(Reflector m, vec3 n, vec3 v, vec3 l, float ndl) {
   float a = max(m.roughness * m.roughness, 1e-3), a2 = a * a;
   float ndv = max(dot(n, v), 1e-4);
@@ -128,9 +136,8 @@ vec3 pbr_reflect(Reflector m, vec3 n, vec3 v, vec3 l, float ndl) {
   float ndh = saturate(dot(n, h)), vdh = saturate(dot(v, h));
   float dd = ndh * ndh * (a2 - 1.0) + 1.0;
   float d = a2 / max(PI * dd * dd, 1e-12);
-  float vis = 0.5 / max(ndl * sqrt(ndv * ndv * (1.0 - a2) + a2) + ndv * sqrt(ndl * ndl * (1.0 - a2) + a2), 1e-8);
-  vec3 f = m.f0 + (1.0 - m.f0) * pow(1.0 - vdh, 5.0);
-  return ndl * ((1.0 - f) * m.albedo + PI * f * d * vis);
+  vec3 f = ggx_fresnel(m.f0, vdh);
+  return ndl * ((1.0 - f) * m.albedo + PI * f * d * ggx_visibility(ndl, ndv, a2));
 }
 
 // Phong's diffuse and specular terms (k_d n.l + k_s (r.v)^shininess).

@@ -1,0 +1,175 @@
+/* Glossy indirect light (scripts/glossy.lua, shaders/glossy.frag) with
+ * materials=pbr: a mirror-like metal sphere shows the lit red wall it faces,
+ * and the sky where the screen shows nothing; Phong frames are unchanged bit
+ * for bit; extremes stay finite; bad options name themselves. Needs a GL
+ * context (llvmpipe will do). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <cglm/cglm.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "gl_test.h"
+
+enum { W = 96, H = 72 };
+
+static const float EYE[3] = {1.0f, 0.6f, 2.5f}, AT[3] = {-0.6f, 0.0f, 0.0f};
+
+/* A sphere of radius 0.5 at the origin (metal of base colour `albedo`, its
+ * roughness from `shininess`: the pbr technique's metallic 1 - k_d = 1), a
+ * red wall at x = -1.5 facing +x, lit by the sun shining along -x; the camera
+ * at EYE looks at AT. */
+static lm_scene *metal_sphere(float albedo, float shininess, mat4 vp) {
+  lm_scene *s = lm_scene_create("sphere");
+  lm_material metal = {.name = "metal", .color = {albedo, albedo, albedo}, .rho = 0.5f, .ka = 1, .kd = 0, .ks = 1,
+                       .shininess = shininess};
+  int m = lm_scene_add_material(s, &metal);
+  enum { SEG = 32, RINGS = 16 };
+  static float v[(SEG + 1) * (RINGS + 1) * 8];
+  static uint32_t idx[SEG * RINGS * 6];
+  int nv = 0, ni = 0;
+  for (int r = 0; r <= RINGS; r++)
+    for (int k = 0; k <= SEG; k++) {
+      float th = GLM_PIf * (float)r / RINGS, ph = 2 * GLM_PIf * (float)k / SEG;
+      float n[3] = {sinf(th) * cosf(ph), cosf(th), -sinf(th) * sinf(ph)};
+      float *o = v + 8 * nv++;
+      o[0] = 0.5f * n[0], o[1] = 0.5f * n[1], o[2] = 0.5f * n[2], o[3] = n[0], o[4] = n[1], o[5] = n[2];
+      o[6] = (float)k / SEG, o[7] = (float)r / RINGS;
+    }
+  for (int r = 0; r < RINGS; r++)
+    for (int k = 0; k < SEG; k++) {
+      uint32_t a = (uint32_t)(r * (SEG + 1) + k), b = a + SEG + 1;
+      uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
+      memcpy(idx + ni, q, sizeof q);
+      ni += 6;
+    }
+  mat4 id = GLM_MAT4_IDENTITY_INIT, view, world;
+  lm_scene_add_node(s, "ball", -1, (float *)id, lm_scene_add_mesh(s, "ball", v, nv, idx, ni), m);
+  int red = gl_material(s, "red", 0.8f, 0.1f, 0.1f);
+  gl_quad(s, "wall", red, (const float[4][3]){{-1.5f, -2, 3}, {-1.5f, -2, -3}, {-1.5f, 2, -3}, {-1.5f, 2, 3}},
+          (const float[3]){1, 0, 0});
+  glm_lookat((vec3){0, 0, 0}, (vec3){-1, -0.1f, 0}, (vec3){0, 1, 0}, view);
+  glm_mat4_inv(view, world);
+  int sun = lm_scene_add_node(s, "sun", -1, (float *)world, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 1,
+                                     .casts_shadows = true, .node = sun});
+  glm_lookat((vec3){EYE[0], EYE[1], EYE[2]}, (vec3){AT[0], AT[1], AT[2]}, (vec3){0, 1, 0}, view);
+  glm_mat4_inv(view, world);
+  int cam = lm_scene_add_node(s, "camera", -1, (float *)world, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "front", .fov_y = glm_rad(60.0f), .znear = 0.01f, .zfar = 100,
+                                      .node = cam});
+  lm_scene_update(s);
+  mat4 proj;
+  glm_perspective(glm_rad(60.0f), (float)W / H, 0.01f, 100, proj);
+  glm_mat4_mul(proj, view, vp);
+  return s;
+}
+
+/* Mean linear RGB of the 3 x 3 pixels around the sphere's point whose
+ * mirror reflects the camera's ray into direction d (unit). */
+static void reflecting(const gl_result *r, mat4 vp, const float d[3], float out[3]) {
+  vec3 toward, n;
+  glm_vec3_normalize_to((vec3){EYE[0], EYE[1], EYE[2]}, toward); /* from the centre: the sphere is small */
+  glm_vec3_add(toward, (vec3){d[0], d[1], d[2]}, n);
+  glm_vec3_normalize(n);
+  vec4 c;
+  glm_mat4_mulv(vp, (vec4){0.5f * n[0], 0.5f * n[1], 0.5f * n[2], 1}, c);
+  int col = (int)((c[0] / c[3] * 0.5f + 0.5f) * r->width), row = (int)((0.5f - c[1] / c[3] * 0.5f) * r->height);
+  assert_true(col >= 1 && col < r->width - 1 && row >= 1 && row < r->height - 1);
+  gl_region(r, col - 1, row - 1, col + 1, row + 1, out);
+}
+
+static gl_result render_ok(lm_scene *s, const char *const *sets) {
+  return gl_render_ok(&(gl_run){.scene = s, .tech = "dl+esm", .sets = sets, .width = W, .height = H});
+}
+
+/* The sphere's point that faces the wall (its mirror direction -x) shows
+ * the wall's red with glossy light and next to nothing without (a metal has
+ * no diffuse light and the sun's highlight lies on its other side); the
+ * point whose mirror direction is up, where the screen shows nothing, the
+ * sky's 0.5 times the metal's Fresnel (base colour 0.9). */
+static void a_metal_sphere_shows_the_lit_wall_and_the_sky(void **state) {
+  (void)state;
+  mat4 vp;
+  lm_scene *s = metal_sphere(0.9f, 1e6f, vp);
+  static const char *const on[] = {"ambient=0", "materials=pbr", "glossy=true", "sky=true", "sky.zenith=0.5",
+                                   "sky.horizon=0.5", NULL};
+  static const char *const off[] = {"ambient=0", "materials=pbr", "sky=true", "sky.zenith=0.5", "sky.horizon=0.5",
+                                    NULL};
+  gl_result a = render_ok(s, on), b = render_ok(s, off);
+  const float west[3] = {-1, 0, 0}, up[3] = {0, 1, 0};
+  float w_on[3], w_off[3], u_on[3], u_off[3];
+  reflecting(&a, vp, west, w_on);
+  reflecting(&b, vp, west, w_off);
+  reflecting(&a, vp, up, u_on);
+  reflecting(&b, vp, up, u_off);
+  print_message("facing the wall: %.4f %.4f %.4f with glossy, %.4f %.4f %.4f without\n", w_on[0], w_on[1], w_on[2],
+                w_off[0], w_off[1], w_off[2]);
+  print_message("facing up: %.4f with glossy, %.4f without (sky 0.5)\n", gl_luminance(u_on), gl_luminance(u_off));
+  assert_true(w_on[0] > 0.1f && w_on[0] > 3 * w_on[1] && w_on[0] > 3 * w_on[2]);
+  assert_true(w_off[0] < 0.02f);
+  assert_true(gl_luminance(u_on) > 0.35f && gl_luminance(u_on) < 0.55f);
+  assert_true(gl_luminance(u_off) < 0.05f);
+  gl_result_free(&a);
+  gl_result_free(&b);
+  lm_scene_destroy(s);
+}
+
+/* Phong frames record no glossy pass: the image is the same bit for bit. */
+static void phong_frames_are_unchanged(void **state) {
+  (void)state;
+  mat4 vp;
+  lm_scene *s = metal_sphere(0.9f, 100, vp);
+  static const char *const on[] = {"glossy=true", "sky=true", NULL}, *const off[] = {"sky=true", NULL};
+  gl_result a = render_ok(s, on), b = render_ok(s, off);
+  assert_false(gl_has_pass(&a, "glossy"));
+  assert_memory_equal(a.rgb, b.rgb, sizeof(float) * 3 * W * H);
+  gl_result_free(&a);
+  gl_result_free(&b);
+  lm_scene_destroy(s);
+}
+
+/* Roughness 0 (shininess 1e30) and 1 (shininess 0), albedo 1, a sky of 1e6,
+ * one sample of one step and 64 of 256: finite. */
+static void extremes_stay_finite(void **state) {
+  (void)state;
+  const float shininess[] = {1e30f, 0, 1e6f, 1e6f};
+  const char *const extra[][3] = {{"glossy.samples=64", "glossy.steps=256", NULL},
+                                  {"glossy.samples=1", "glossy.steps=1", NULL},
+                                  {"sky.intensity=1e6", "glossy.thickness=0", NULL},
+                                  {"glossy.thickness=1", "ambient=1e6", NULL}};
+  for (int i = 0; i < 4; i++) {
+    mat4 vp;
+    lm_scene *s = metal_sphere(1.0f, shininess[i], vp);
+    const char *const sets[] = {"materials=pbr", "glossy=true", "sky=true", extra[i][0], extra[i][1], NULL};
+    gl_result r = render_ok(s, sets);
+    assert_true(gl_has_pass(&r, "glossy"));
+    if (!gl_all_finite(&r) || !gl_target_finite(&r, "glossy.out")) fail_msg("case %d: not finite", i);
+    gl_result_free(&r);
+    lm_scene_destroy(s);
+  }
+}
+
+static void bad_options_name_themselves(void **state) {
+  (void)state;
+  static const gl_bad_option cases[] = {
+      {"dl+esm", "glossy.samples=0", "glossy.samples"},     {"dl+esm", "glossy.samples=65", "glossy.samples"},
+      {"dl+esm", "glossy.steps=0", "glossy.steps"},         {"dl+esm", "glossy.thickness=2", "glossy.thickness"},
+      {"dl+esm", "glossy.thickness=-1", "glossy.thickness"},
+  };
+  gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(a_metal_sphere_shows_the_lit_wall_and_the_sky),
+      cmocka_unit_test(phong_frames_are_unchanged),
+      cmocka_unit_test(extremes_stay_finite),
+      cmocka_unit_test(bad_options_name_themselves),
+  };
+  return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
+}
