@@ -9,9 +9,14 @@
 --      32 for one 32^3 grid) that follow the camera, snapped to whole cells
 --   2. `steps` propagation steps to the six neighbours, blocked by the
 --      geometry volume, with running sums (lpv_propagate.frag)
+--   2b. with `bounces` > 1, each further bounce: the light the points
+--      receive (lpv_bounce.frag), the points injected again with it times
+--      their albedo, `steps` more steps, added to the sums (lpv_add.frag)
 --   3. the lookup at each coarse pixel (lpv_lookup.frag), cascades as
---      distance bands, then ISR's blur (isr.blur); the direct pass upsamples
---      and adds it (direct.frag's INDIRECT: L = D + k_a L_a albedo + k k_d albedo E)
+--      distance bands, with the share of open sky the geometry volume leaves
+--      (`sky_occlusion`), then ISR's blur (isr.blur); the direct pass
+--      upsamples and adds it (direct.frag's INDIRECT:
+--      L = D + k_a L_a albedo A + k k_d albedo E)
 -- The combined technique (isr+lpv+esm) leaves the VPLs the camera sees to
 -- ISR's screen-space march (docs/gi-combined.md).
 local gbuffer = require "gbuffer"
@@ -51,9 +56,9 @@ lpv.defaults = {
                      -- which llvmpipe ran on one thread either way)
   bounces = 1,       -- bounces of light the volumes carry, 1..8: each past the first injects the
                      -- VPLs and surfels again with the light the volumes bring them (times their
-                     -- albedo) and propagates `steps` more steps (docs/gi-multibounce.md)
+                     -- albedo) and propagates `steps` more steps (docs/gi-combined.md)
   sky_occlusion = 1.0, -- how much the geometry volume occludes the ambient term and the sky at each
-                     -- pixel, 0..1 (0: not at all, as before; docs/gi-multibounce.md)
+                     -- pixel, 0..1 (0: not at all, as before; docs/gi-combined.md)
   sky_cells = 8,     -- cells the occlusion's directions cross, 1..64
   blur = 0,          -- Gaussian taps each side at coarse size, 0..32; the volume's light is smooth
                      -- already: 2 removed 0.4 points more of the indirect error for two passes
@@ -171,11 +176,12 @@ local function propagate(o, grids, geometry, inj, tag)
 end
 
 -- Records injection and propagation from the RSM targets R (shadow.render's
--- second result) and the G-buffer G. exclude_seen: VPLs the camera sees are
--- left out (the combined technique). Returns the volumes: { all = {r, g, b},
--- late = {r, g, b} (sums of steps 1 .. steps and of steps steps // 2 + 1 ..
--- steps, the same targets for one step, nil for none), grids = their layout,
--- seen = R.seen }.
+-- second result) and the G-buffer G, o.bounces times. exclude_seen: VPLs the
+-- camera sees are left out (the combined technique). Returns the volumes:
+-- { all = {r, g, b}, late = {r, g, b} (sums of steps 1 .. steps and of steps
+-- steps // 2 + 1 .. steps over every bounce, the same targets for one step,
+-- nil for none), grids = their layout, seen = R.seen, geometry = the
+-- geometry volume }.
 function lpv.volume(G, R, o, exclude_seen)
   local grids = layout(o, cell_size(o))
   -- Points a cascade: vpls^2 VPLs shared among the RSM views and a grid of surfels `surfels` a row. The

@@ -32,8 +32,8 @@ static void a_uniform_sky_gives_albedo_times_radiance(void **state) {
   (void)state;
   lm_scene *s = shaded_field();
   static const char *const uniform[] = {"ambient=0", "sky=true", "sky.zenith=0.5", "sky.horizon=0.5", NULL};
-  static const char *const techs[] = {"dl", "isr", "ssao", "ssdo"};
-  for (int t = 0; t < 4; t++) {
+  static const char *const techs[] = {"dl", "isr", "ssao", "ssdo", "lpv+esm"};
+  for (int t = 0; t < 5; t++) {
     gl_result r = render_ok(s, techs[t], uniform);
     float ground[3];
     gl_region(&r, 40, 66, 56, 71, ground); /* open ground at the bottom, in front of every post */

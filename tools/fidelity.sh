@@ -19,4 +19,4 @@ limn_gi_report --targets "${OUT:-out/fidelity}" "${JOB:-data/jobs/reference.lua}
   "$LIMN_BASELINE=$LIMN_BASELINE" "seed ISR=$(limn_seed_isr_spec)" "ssdo+esm=ssdo+esm" "ssao+esm=ssao+esm" \
   "default=$(limn_default_spec)" "rsm+esm=rsm+esm" "vpl+esm=vpl+esm:vpl.lights=100;vpl.negative=50" \
   "vpl 300+0=vpl+esm:vpl.lights=300;vpl.negative=0" "combined=isr+rsm+esm" "lpv+esm=lpv+esm" \
-  "isr+lpv=isr+lpv+esm"
+  "isr+lpv=isr+lpv+esm" "lpv 2 bounces=lpv+esm:lpv.bounces=2" "isr+lpv 2 b.=isr+lpv+esm:lpv.bounces=2"
