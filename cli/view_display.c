@@ -302,7 +302,7 @@ static lm_texture draw_panel(viewer *v) {
    * draw the panel's image again every frame. */
   if (lm_now_ms() >= v->panel_cost_until) {
     panel_cost(v, v->panel_cost_text, sizeof v->panel_cost_text);
-    v->panel_cost_until = lm_now_ms() + 1000;
+    v->panel_cost_until = v->panel_timed > 2 ? lm_now_ms() + 1000 : 0; /* a first figure soon */
   }
   panel_model m = {.options = v->options, .option_count = v->option_count, .techniques = names,
                    .technique_count = count, .technique = current, .animated = lm_scene_animated(v->scene),

@@ -28,6 +28,7 @@ struct lm_panel {
   bool mouse_down;
   std::vector<widget> widgets;     // the last frame's options
   std::vector<widget> techniques;  // and techniques
+  std::vector<widget> controls;    // and the buttons and the time slider
   // The panel's image, drawn again only when ImGui's draw lists change: on
   // llvmpipe drawing it costs about as much as a small frame's pass, while
   // compositing a kept image is one texture read in the viewer's display pass.
@@ -82,6 +83,12 @@ static const char *widget_kind(const lm_option_info &o) {
   if (o.type == LM_OPTION_NUMBER && o.rule == LM_RULE_NUMBER && std::isfinite(o.hi)) return "slider";
   if (o.type == LM_OPTION_NUMBER) return "drag";
   return "text";
+}
+
+// The last item's rectangle as a widget named `name` of `kind`.
+static widget last_item(const char *name, const char *kind, const char *group) {
+  ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
+  return widget{name, kind, group, {a.x, a.y, b.x - a.x, b.y - a.y}};
 }
 
 static void set_edit(panel_edits *e, const char *name, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
@@ -190,8 +197,7 @@ static void options_section(lm_panel *p, const panel_model *m, panel_edits *e) {
     ImGui::PushID(i);
     option_widget(o, w.kind.c_str(), e);
     ImGui::PopID();
-    ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
-    w.rect[0] = a.x, w.rect[1] = a.y, w.rect[2] = b.x - a.x, w.rect[3] = b.y - a.y;
+    w = last_item(o.name, w.kind.c_str(), g[0].c_str());
   }
   close_to(0);
 }
@@ -229,14 +235,18 @@ lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height,
   ImGui::SetNextWindowSize(ImVec2(w, static_cast<float>(height)), ImGuiCond_Always);
   ImGui::Begin("limn", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
   ImGui::PushItemWidth(-ImGui::GetWindowWidth() * 0.45f);
+  p->controls.clear();
   if (ImGui::Button("Write job (J)")) e->write_job = true;
+  p->controls.push_back(last_item("job", "button", "panel"));
   if (m->status) ImGui::TextWrapped("%s", m->status);
   if (m->cost) ImGui::TextDisabled("%s", m->cost);
   if (m->animated && ImGui::CollapsingHeader("time", ImGuiTreeNodeFlags_DefaultOpen)) {
     if (ImGui::Button(m->paused ? "Play (Space)" : "Pause (Space)")) e->play = true;
+    p->controls.push_back(last_item("play", "button", "time"));
     float t = static_cast<float>(m->time);
     float lo = static_cast<float>(m->time_lo), hi = static_cast<float>(std::fmax(m->time_hi, m->time_lo + 1e-3));
     if (ImGui::SliderFloat("time##scrub", &t, lo, hi, "%.3f s")) e->scrub = true, e->scrub_time = t;
+    p->controls.push_back(last_item("time", "slider", "time"));
   }
   p->techniques.assign(m->technique_count, widget{});
   if (ImGui::CollapsingHeader("techniques", ImGuiTreeNodeFlags_DefaultOpen) &&
@@ -244,8 +254,7 @@ lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height,
     for (int i = 0; i < m->technique_count; i++) {
       if (ImGui::Selectable(m->techniques[i], i == m->technique)) e->technique = i;
       if (i == m->technique && ImGui::IsWindowAppearing()) ImGui::SetScrollHereY();
-      ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
-      p->techniques[i] = widget{m->techniques[i], "technique", "techniques", {a.x, a.y, b.x - a.x, b.y - a.y}};
+      p->techniques[i] = last_item(m->techniques[i], "technique", "techniques");
     }
     ImGui::EndListBox();
   }
@@ -277,8 +286,9 @@ void panel_list_widgets(const lm_panel *p, FILE *out) {
   for (const widget &w : p->widgets)
     fprintf(out, "panel widget %s %s %s %.0f %.0f %.0f %.0f\n", w.name.c_str(), w.kind.c_str(), w.group.c_str(),
             w.rect[0], w.rect[1], w.rect[2], w.rect[3]);
-  for (const widget &w : p->techniques)
-    fprintf(out, "panel technique %s %.0f %.0f %.0f %.0f\n", w.name.c_str(), w.rect[0], w.rect[1], w.rect[2],
-            w.rect[3]);
+  for (const std::vector<widget> *list : {&p->techniques, &p->controls})
+    for (const widget &w : *list)
+      fprintf(out, "panel %s %s %.0f %.0f %.0f %.0f\n", w.kind == "technique" ? "technique" : "control",
+              w.name.c_str(), w.rect[0], w.rect[1], w.rect[2], w.rect[3]);
   fflush(out);
 }

@@ -57,7 +57,8 @@ bool panel_wants_mouse(const lm_panel *p);
 bool panel_wants_keyboard(const lm_panel *p);
 /* One line per option of the last frame's model: "panel widget NAME KIND
  * GROUP X Y W H" (the rectangle 0 0 0 0 where a closed group hides it),
- * then "panel technique NAME X Y W H" per technique. */
+ * then "panel technique NAME X Y W H" per technique and "panel control NAME
+ * X Y W H" for the buttons and the time slider ("job", "play", "time"). */
 void panel_list_widgets(const lm_panel *p, FILE *out);
 
 #ifdef __cplusplus

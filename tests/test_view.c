@@ -1136,6 +1136,59 @@ static void inspector_order_and_grey_depth(void **state) {
   lm_image_free(&img);
 }
 
+/* A "panel control NAME X Y W H" line's rectangle. */
+static void find_control(const char *log, const char *name, double rect[4]) {
+  char *s = read_text(log), key[64];
+  snprintf(key, sizeof key, "panel control %s ", name);
+  char *line = strstr(s, key);
+  if (!line) print_log(log);
+  assert_non_null(line);
+  assert_int_equal(sscanf(line + strlen(key), "%lf %lf %lf %lf", &rect[0], &rect[1], &rect[2], &rect[3]), 4);
+  free(s);
+}
+
+/* The panel's time controls: its button pauses an animation that plays, and
+ * dragging its slider to the left end scrubs to the animation's first key. */
+static void panel_plays_pauses_and_scrubs(void **state) {
+  (void)state;
+  char log[512], scene[512], keys[512];
+  log_path(log, "panel_time");
+  snprintf(scene, sizeof scene, "%s/data/scenes/door.glb", LIMN_SOURCE_ROOT);
+  pid_t pid = spawn_view(log, "--panel", "on", "--scene", scene, "--tech", "dl", "--size", "384x288",
+                         "--exit-after", "6", "--script-keys", "5:widgets", NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  double play[4], slider[4], lo, hi;
+  find_control(log, "play", play);
+  find_control(log, "time", slider);
+  char *s = read_text(log), *keys_line = strstr(s, "': keys ");
+  assert_non_null(keys_line);
+  assert_int_equal(sscanf(keys_line, "': keys %lf..%lf s", &lo, &hi), 2);
+  free(s);
+  int px = (int)(play[0] + play[2] / 2), py = (int)(play[1] + play[3] / 2);
+  int sy = (int)(slider[1] + slider[3] / 2), sx = (int)(slider[0] + slider[2] / 3);
+  snprintf(keys, sizeof keys, "3:mouse=%d;%d,4:button=down,5:button=up,8:mouse=%d;%d,9:button=down,10:mouse=%d;%d,"
+           "11:button=up", px, py, sx, sy, (int)slider[0] - 60, sy);
+  pid = spawn_view(log, "--panel", "on", "--scene", scene, "--tech", "dl", "--size", "384x288", "--exit-after", "14",
+                   "--script-keys", keys, NULL);
+  rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  s = read_text(log);
+  assert_non_null(strstr(s, ", paused (play button)"));
+  double t = -1;
+  for (char *line = s; line && *line; line = strchr(line, '\n') ? strchr(line, '\n') + 1 : NULL) {
+    char *time = strstr(line, "limn: time "), *eol = strchr(line, '\n');
+    char *scrubbed = strstr(line, ", paused (scrubbed)");
+    if (time == line && scrubbed && (!eol || scrubbed < eol)) sscanf(time, "limn: time %lf", &t); /* the last */
+  }
+  free(s);
+  if (t < 0) print_log(log);
+  fprintf(stderr, "scrubbed to %g (keys %g..%g)\n", t, lo, hi);
+  assert_true(fabs(t - lo) < 1e-4); /* the slider's left end: the first key */
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_teardown(command_line_errors, stop_leftover),
@@ -1155,6 +1208,7 @@ int main(void) {
       cmocka_unit_test_teardown(panel_shows_unsupported_option_read_only, stop_leftover),
       cmocka_unit_test_teardown(job_leaves_and_comes_back, stop_leftover),
       cmocka_unit_test_teardown(inspector_order_and_grey_depth, stop_leftover),
+      cmocka_unit_test_teardown(panel_plays_pauses_and_scrubs, stop_leftover),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }
