@@ -441,7 +441,11 @@ static void apply_panel(viewer *v) {
     report_time(v, "scrubbed");
   }
   if (e->write_job) write_job(v);
-  *e = (panel_edits){.technique = -1};
+  if (e->inspect >= 0) {
+    v->inspect = e->inspect;
+    lm_renderer_set_sharing(v->renderer, false); /* every target readable after the frame */
+  }
+  *e = (panel_edits){.technique = -1, .inspect = -1};
 }
 
 /* ---- reloading --------------------------------------------------------- */
@@ -864,7 +868,7 @@ int limn_view(int argc, char **argv) {
   signal(SIGINT, on_signal);
   signal(SIGTERM, on_signal);
   viewer v = {.args = &a, .inspect = -1, .inspect_logged = -1, .channel = 4, .overlay_on = a.overlay, .panel_on = a.panel,
-              .range = {0, 1}, .edits = {.technique = -1}};
+              .range = {0, 1}, .edits = {.technique = -1, .inspect = -1}};
   capture_resolve(a.script, v.script, sizeof v.script);
   rc = run(&v);
   viewer_free(&v);

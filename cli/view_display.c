@@ -304,16 +304,42 @@ static lm_texture draw_panel(viewer *v) {
     panel_cost(v, v->panel_cost_text, sizeof v->panel_cost_text);
     v->panel_cost_until = v->panel_timed > 2 ? lm_now_ms() + 1000 : 0; /* a first figure soon */
   }
+  /* The frame graph: passes with their targets as indices. */
+  lm_graph *g = lm_renderer_graph(v->renderer);
+  int pass_count = lm_graph_pass_count(g), target_count = lm_graph_target_count(g), ends = 0;
+  for (int i = 0; i < pass_count; i++) {
+    const lm_pass_desc *d = lm_graph_pass(g, i).desc;
+    ends += d->input_count + d->output_count + 1;
+  }
+  panel_pass *passes = lm_alloc(sizeof *passes * (size_t)(pass_count + 1));
+  int *targets_of = lm_alloc(sizeof *targets_of * (size_t)(ends + 1)), used = 0;
+  const char **target_names = lm_alloc(sizeof *target_names * (size_t)(target_count + 1));
+  for (int i = 0; i < target_count; i++) target_names[i] = lm_graph_target(g, i).name;
+  for (int i = 0; i < pass_count; i++) {
+    lm_graph_pass_info info = lm_graph_pass(g, i);
+    panel_pass *pp = &passes[i];
+    *pp = (panel_pass){.name = info.name, .culled = info.culled, .ms = info.ms, .inputs = targets_of + used};
+    for (int k = 0; k < info.desc->input_count; k++) targets_of[used++] = info.desc->inputs[k].target;
+    pp->input_count = info.desc->input_count;
+    pp->outputs = targets_of + used;
+    for (int k = 0; k < info.desc->output_count; k++) targets_of[used++] = info.desc->outputs[k];
+    if (info.desc->depth >= 0) targets_of[used++] = info.desc->depth;
+    pp->output_count = (int)(targets_of + used - pp->outputs);
+  }
   panel_model m = {.options = v->options, .option_count = v->option_count, .techniques = names,
                    .technique_count = count, .technique = current, .animated = lm_scene_animated(v->scene),
                    .time = v->time, .time_lo = v->anim_range[0], .time_hi = v->anim_range[1],
                    .paused = v->paused, .status = v->status[0] ? v->status : NULL,
-                   .cost = v->frames_timed[1] ? v->panel_cost_text : NULL};
+                   .cost = v->frames_timed[1] ? v->panel_cost_text : NULL, .passes = passes,
+                   .pass_count = pass_count, .targets = target_names, .target_count = target_count};
   lm_finish();
   double t0 = lm_now_ms();
   lm_texture image = panel_frame(v->panel, &m, v->width, v->height, &v->edits);
   lm_finish();
   v->panel_times[v->panel_timed++ % PANEL_TIMES] = lm_now_ms() - t0;
+  free(passes);
+  free(targets_of);
+  free(target_names);
   return image;
 }
 

@@ -202,6 +202,48 @@ static void options_section(lm_panel *p, const panel_model *m, panel_edits *e) {
   close_to(0);
 }
 
+// The frame graph: each pass with its time as a bar (culled ones grey), and
+// its inputs and outputs as buttons that show the target in the inspector.
+// Closed by default: open, its bars change every frame, and so the panel's image.
+static void graph_section(lm_panel *p, const panel_model *m, panel_edits *e) {
+  if (!m->pass_count) return;
+  bool open = ImGui::CollapsingHeader("frame graph");
+  p->controls.push_back(last_item("graph", "header", "panel"));
+  if (!open) return;
+  double longest = 0;
+  for (int i = 0; i < m->pass_count; i++) longest = std::fmax(longest, m->passes[i].ms);
+  for (int i = 0; i < m->pass_count; i++) {
+    const panel_pass &pass = m->passes[i];
+    ImGui::PushID(i);
+    if (pass.culled) {
+      ImGui::TextDisabled("%s (culled: nothing it writes reaches the output)", pass.name);
+    } else {
+      char ms[32];
+      snprintf(ms, sizeof ms, "%.2f ms", pass.ms);
+      ImGui::TextUnformatted(pass.name);
+      ImGui::ProgressBar(longest > 0 && pass.ms > 0 ? static_cast<float>(pass.ms / longest) : 0.0f, ImVec2(-FLT_MIN, 0),
+                         ms);
+    }
+    if (pass.culled) ImGui::PushStyleVar(ImGuiStyleVar_Alpha, 0.5f);
+    for (int k = 0; k < pass.input_count + pass.output_count; k++) {
+      bool input = k < pass.input_count;
+      int t = input ? pass.inputs[k] : pass.outputs[k - pass.input_count];
+      if (t < 0 || t >= m->target_count) continue;
+      if (k == 0 || k == pass.input_count) ImGui::TextDisabled(input ? " in " : " out");
+      // On the line while the button fits, else on the next.
+      float width = ImGui::CalcTextSize(m->targets[t]).x + 2 * ImGui::GetStyle().FramePadding.x;
+      float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
+      if (ImGui::GetItemRectMax().x + ImGui::GetStyle().ItemSpacing.x + width <= right) ImGui::SameLine();
+      ImGui::PushID(k);
+      if (ImGui::SmallButton(m->targets[t])) e->inspect = t;
+      p->controls.push_back(last_item(m->targets[t], "target", pass.name));
+      ImGui::PopID();
+    }
+    if (pass.culled) ImGui::PopStyleVar();
+    ImGui::PopID();
+  }
+}
+
 // What the draw lists draw: vertices, indices, commands and the display size.
 static uint64_t draw_hash(const ImDrawData *d) {
   uint64_t h = lm_hash(&d->DisplaySize, sizeof d->DisplaySize, 14695981039346656037ull);
@@ -221,7 +263,7 @@ static uint64_t draw_hash(const ImDrawData *d) {
 
 lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height, panel_edits *e) {
   *e = panel_edits{};
-  e->technique = -1;
+  e->technique = -1, e->inspect = -1;
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGuiIO &io = ImGui::GetIO();
@@ -258,6 +300,7 @@ lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height,
     }
     ImGui::EndListBox();
   }
+  graph_section(p, m, e);
   options_section(p, m, e);
   ImGui::PopItemWidth();
   ImGui::End();
@@ -288,7 +331,8 @@ void panel_list_widgets(const lm_panel *p, FILE *out) {
             w.rect[0], w.rect[1], w.rect[2], w.rect[3]);
   for (const std::vector<widget> *list : {&p->techniques, &p->controls})
     for (const widget &w : *list)
-      fprintf(out, "panel %s %s %.0f %.0f %.0f %.0f\n", w.kind == "technique" ? "technique" : "control",
-              w.name.c_str(), w.rect[0], w.rect[1], w.rect[2], w.rect[3]);
+      fprintf(out, "panel %s %s %.0f %.0f %.0f %.0f\n",
+              w.kind == "technique" || w.kind == "target" ? w.kind.c_str() : "control", w.name.c_str(), w.rect[0],
+              w.rect[1], w.rect[2], w.rect[3]);
   fflush(out);
 }

@@ -19,6 +19,16 @@ extern "C" {
 
 typedef struct lm_panel lm_panel;
 
+/* A pass of the frame graph as the panel draws it: its targets are indices
+ * into panel_model.targets. */
+typedef struct panel_pass {
+  const char *name;
+  bool culled;
+  double ms;                      /* its time last frame, < 0: not run */
+  const int *inputs, *outputs;    /* outputs: colour targets, then the depth target */
+  int input_count, output_count;
+} panel_pass;
+
 /* What the panel shows this frame (borrowed for the call). */
 typedef struct panel_model {
   const lm_option_info *options;
@@ -30,6 +40,10 @@ typedef struct panel_model {
   bool paused;
   const char *status;             /* a line under the buttons ("wrote out/view.lua"), or NULL */
   const char *cost;               /* the panel's share of the frame, or NULL */
+  const panel_pass *passes;       /* the frame graph, in recording order */
+  int pass_count;
+  const char *const *targets;
+  int target_count;
 } panel_model;
 
 /* What the user did this frame (at most one of each: one widget is active at a time). */
@@ -40,6 +54,7 @@ typedef struct panel_edits {
   bool play, write_job;           /* the play/pause and job buttons */
   bool scrub;                     /* the time slider moved to scrub_time */
   double scrub_time;
+  int inspect;                    /* a target clicked in the frame graph, or -1 */
 } panel_edits;
 
 lm_panel *panel_create(lm_window *w, lm_error *err);
@@ -57,8 +72,10 @@ bool panel_wants_mouse(const lm_panel *p);
 bool panel_wants_keyboard(const lm_panel *p);
 /* One line per option of the last frame's model: "panel widget NAME KIND
  * GROUP X Y W H" (the rectangle 0 0 0 0 where a closed group hides it),
- * then "panel technique NAME X Y W H" per technique and "panel control NAME
- * X Y W H" for the buttons and the time slider ("job", "play", "time"). */
+ * then "panel technique NAME X Y W H" per technique, "panel control NAME X Y
+ * W H" for the buttons, the time slider and the frame graph's header ("job",
+ * "play", "time", "graph") and, while that is open, "panel target NAME X Y W
+ * H" for each target button of each pass. */
 void panel_list_widgets(const lm_panel *p, FILE *out);
 
 #ifdef __cplusplus

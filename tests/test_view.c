@@ -1189,6 +1189,38 @@ static void panel_plays_pauses_and_scrubs(void **state) {
   assert_true(fabs(t - lo) < 1e-4); /* the slider's left end: the first key */
 }
 
+/* The frame graph in the panel: opening it lists each pass's targets as
+ * buttons, and clicking one shows that target in the inspector. */
+static void panel_graph_button_inspects_target(void **state) {
+  (void)state;
+  char log[512], keys[512];
+  log_path(log, "panel_graph");
+  pid_t pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "4",
+                         "--script-keys", "3:widgets", NULL);
+  assert_int_equal(wait_exit(pid, 30000), 0);
+  double header[4], button[4];
+  find_control(log, "graph", header);
+  snprintf(keys, sizeof keys, "3:mouse=%d;%d,4:button=down,5:button=up,7:widgets", (int)(header[0] + header[2] / 2),
+           (int)(header[1] + header[3] / 2));
+  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "8", "--script-keys",
+                   keys, NULL);
+  assert_int_equal(wait_exit(pid, 30000), 0);
+  char *s = read_text(log), *line = strstr(s, "panel target gbuffer.clr ");
+  if (!line) print_log(log);
+  assert_non_null(line);
+  assert_int_equal(sscanf(line, "panel target gbuffer.clr %lf %lf %lf %lf", &button[0], &button[1], &button[2],
+                          &button[3]), 4);
+  free(s);
+  snprintf(keys + strlen(keys), sizeof keys - strlen(keys), ",8:mouse=%d;%d,9:button=down,10:button=up",
+           (int)(button[0] + button[2] / 2), (int)(button[1] + button[3] / 2));
+  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "13", "--script-keys",
+                   keys, NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  assert_true(file_has(log, "inspecting 'gbuffer.clr' rgba8"));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_teardown(command_line_errors, stop_leftover),
@@ -1209,6 +1241,7 @@ int main(void) {
       cmocka_unit_test_teardown(job_leaves_and_comes_back, stop_leftover),
       cmocka_unit_test_teardown(inspector_order_and_grey_depth, stop_leftover),
       cmocka_unit_test_teardown(panel_plays_pauses_and_scrubs, stop_leftover),
+      cmocka_unit_test_teardown(panel_graph_button_inspects_target, stop_leftover),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }
