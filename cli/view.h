@@ -83,8 +83,7 @@ typedef struct viewer {
    * overlay prints. */
   double panel_times[PANEL_TIMES], frame_ms_sum[2];
   long panel_timed, frames_timed[2]; /* [0] panel off, [1] on */
-  char panel_cost_text[200]; /* the panel's line of it, */
-  double panel_cost_until;   /* kept until then */
+  char panel_cost_text[200]; /* the panel's line of it */
   int inspect;              /* target index, -1: the frame */
   int inspect_logged;       /* the target the log last named (a line a test reads) */
   int channel;              /* 0 r, 1 g, 2 b, 3 a, 4 rgb */

@@ -298,12 +298,10 @@ static lm_texture draw_panel(viewer *v) {
     names[i] = lm_pipeline_technique_name(v->pipeline, i);
     if (!strcmp(names[i], lm_pipeline_technique(v->pipeline))) current = i;
   }
-  /* The cost line changes once a second: a line changing every frame would
-   * draw the panel's image again every frame. */
-  if (lm_now_ms() >= v->panel_cost_until) {
+  /* The cost line changes once in PANEL_TIMES frames (after a first figure):
+   * a line changing every frame would draw the panel's image every frame. */
+  if (v->panel_timed == 3 || v->panel_timed % PANEL_TIMES == 0)
     panel_cost(v, v->panel_cost_text, sizeof v->panel_cost_text);
-    v->panel_cost_until = v->panel_timed > 2 ? lm_now_ms() + 1000 : 0; /* a first figure soon */
-  }
   /* The frame graph: passes with their targets as indices. */
   lm_graph *g = lm_renderer_graph(v->renderer);
   int pass_count = lm_graph_pass_count(g), target_count = lm_graph_target_count(g), ends = 0;
