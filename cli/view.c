@@ -135,6 +135,7 @@ static int parse_args(int argc, char **argv, view_args *a) {
   opterr = 0;
   optind = 1;
   int c, n;
+  bool view_given = false;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
     switch (c) {
     case 's': a->scene = optarg; break;
@@ -162,6 +163,7 @@ static int parse_args(int argc, char **argv, view_args *a) {
     case 'J': a->job = optarg; break;
     case 'V':
       if (!limn_parse_int(optarg, 0, 1 << 30, &a->job_view)) return usage_error("--view wants a view number, not '%s'", optarg);
+      view_given = true;
       break;
     case 'A': a->animation = optarg; break;
     case 'T':
@@ -197,6 +199,7 @@ static int parse_args(int argc, char **argv, view_args *a) {
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
+  if (view_given && !a->job) return usage_error("%s", "--view N needs --job FILE");
   return a->job && !load_view_job(a) ? 2 : 0;
 }
 

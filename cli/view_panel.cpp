@@ -45,9 +45,10 @@ lm_panel *panel_create(lm_window *w, lm_error *err) {
   ImGui::StyleColorsDark();
   ImGui::GetStyle().Alpha = 0.92f;
   // The backends chain GLFW's callbacks: the viewer's key queue still gets every key.
-  if (!ImGui_ImplGlfw_InitForOpenGL(static_cast<GLFWwindow *>(lm_window_handle(w)), true) ||
-      !ImGui_ImplOpenGL3_Init("#version 410 core")) {
+  bool glfw = ImGui_ImplGlfw_InitForOpenGL(static_cast<GLFWwindow *>(lm_window_handle(w)), true);
+  if (!glfw || !ImGui_ImplOpenGL3_Init("#version 410 core")) {
     lm_error_set(err, "the panel (Dear ImGui) could not start on this OpenGL context");
+    if (glfw) ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext(p->context);
     delete p;
     return nullptr;

@@ -539,6 +539,10 @@ static void command_line_errors(void **state) {
       {{"--time", "soon"}, "--time wants seconds", 2},
       {{"--fps", "0"}, "--fps wants 1..1000", 2},
       {{"--script-keys", "4:time=later"}, "--script-keys wants FRAME:KEY", 2},
+      {{"--panel", "maybe"}, "--panel wants on or off", 2},
+      {{"--view", "2"}, "--view N needs --job FILE", 2},
+      {{"--job", "nope.lua"}, "--job nope.lua", 2},
+      {{"--script-keys", "3:mouse=10"}, "--script-keys wants FRAME:KEY", 2},
       {{"--help"}, "F2 isr+esm", 0},
   };
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
