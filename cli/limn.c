@@ -20,6 +20,7 @@ static const char usage[] =
     "  manifest  merge the manifests of a sharded capture job: limn manifest merge\n"
     "  bench     compositor overhead per frame and pass times against resolution\n"
     "  view      a window with live reload of scripts and shaders, timings, target inspector\n"
+    "  graph     one frame's frame graph (passes, targets, culled passes, times) as SVG or DOT\n"
     "  help      this text; `limn <command> --help` describes a command's flags\n"
     "\n"
     "example:\n"
@@ -39,6 +40,7 @@ int main(int argc, char **argv) {
   }
   if (!strcmp(cmd, "capture")) return limn_capture(argc - 1, argv + 1);
   if (!strcmp(cmd, "view")) return limn_view(argc - 1, argv + 1);
+  if (!strcmp(cmd, "graph")) return limn_graph(argc - 1, argv + 1);
   if (!strcmp(cmd, "export-pov")) return limn_export_pov(argc - 1, argv + 1);
   if (!strcmp(cmd, "export-gltf")) return limn_export_gltf(argc - 1, argv + 1);
   if (!strcmp(cmd, "compare")) return limn_compare(argc - 1, argv + 1);

@@ -11,6 +11,7 @@
 
 int limn_capture(int argc, char **argv);
 int limn_view(int argc, char **argv);
+int limn_graph(int argc, char **argv);
 int limn_export_pov(int argc, char **argv);
 int limn_export_gltf(int argc, char **argv);
 int limn_compare(int argc, char **argv);

@@ -45,13 +45,20 @@ static const char view_usage[] =
     "  --fps N              frames a second of Left/Right steps and of the frame\n"
     "                       number on the overlay (default 24)\n"
     "  --overlay on|off     show the overlay at start (default on; F1/Tab toggles)\n"
+    "  --panel on|off       show the panel of options at start (default on; M toggles)\n"
+    "  --job FILE           start at a view of a capture job: its script, scene,\n"
+    "                       camera, size, technique, time and options\n"
+    "  --view N             which view of --job (default 0; as capture numbers them)\n"
     "  --capture-dir DIR    where P writes images (default .)\n"
     "  --exit-after N       close after N frames\n"
     "  --screenshot FILE    write the window's content at exit (PNG)\n"
     "  --script-keys LIST   press keys at frames, e.g. \"5:F5,10:F3\" (for tests);\n"
     "                       also resize=WxH, hold=W|A|S|D, release=W|A|S|D and\n"
     "                       drag=DX;DY (a left-button drag, pixels) and time=SECONDS;\n"
-    "                       camera and animation steps are then 1/60 s a frame\n"
+    "                       camera and animation steps are then 1/60 s a frame;\n"
+    "                       mouse=X;Y and button=down|up drive the panel's mouse,\n"
+    "                       widgets prints the panel's widgets and where they are,\n"
+    "                       inspect=NAME shows a target of the frame graph\n"
     "  --reload-test N      test hook: N edits of a copy of the script, each one\n"
     "                       reloaded through the file watch; prints GL object and\n"
     "                       heap counts and fails when any grew\n"
@@ -68,7 +75,9 @@ static const char view_usage[] =
     "  the script declares, a boolean or a table with `enabled`)\n"
     "  F1/Tab overlay; PageDown/PageUp step through targets, Home the frame again;\n"
     "  C channel (rgb r g b a), V false colour, Up/Down exposure;\n"
-    "  P writes the shown target (EXR) and the frame (PNG); Escape quits\n"
+    "  P writes the shown target (EXR) and the frame (PNG); M the panel;\n"
+    "  J writes the technique and changed options as a capture job (and the\n"
+    "  limn capture command line); Escape quits\n"
     "\n"
     "environment: LIMN_FONT, the overlay's font file (default DejaVu Sans Mono)\n"
     "exit codes: 0 closed, 1 failed (the script's first load, the font, window or\n"
@@ -91,8 +100,10 @@ static bool parse_script_keys(const char *list, view_args *a) {
     k->frame = frame;
     snprintf(k->key, sizeof k->key, "%s", colon + 1);
     int w, h;
-    double t;
+    double t, x, y;
     if (!strncmp(k->key, "resize=", 7) && !limn_parse_size(k->key + 7, &w, &h)) return false;
+    if (!strncmp(k->key, "mouse=", 6) && sscanf(k->key + 6, "%lf;%lf", &x, &y) != 2) return false;
+    if (!strncmp(k->key, "button=", 7) && strcmp(k->key + 7, "down") && strcmp(k->key + 7, "up")) return false;
     if (!strncmp(k->key, "time=", 5) && !limn_parse_double(k->key + 5, &t)) return false;
   }
   return true;
@@ -101,12 +112,14 @@ static bool parse_script_keys(const char *list, view_args *a) {
 static void free_args(view_args *a) {
   for (int i = 0; i < a->set_count; i++) free(a->sets[i]);
   a->set_count = 0;
+  lm_scene_destroy(a->job_loaded); /* not adopted: the run stopped before the scene */
+  a->job_loaded = NULL;
 }
 
 /* Returns 0 to go on, -1 when done (help), else the exit code. */
 static int parse_args(int argc, char **argv, view_args *a) {
   *a = (view_args){.scene = "cornell", .capture_dir = ".", .width = 512, .height = 384, .overlay = true,
-                   .animation = "all", .fps = 24};
+                   .panel = true, .animation = "all", .fps = 24};
   static const struct option opts[] = {
       {"scene", required_argument, 0, 's'},      {"script", required_argument, 0, 'p'},
       {"tech", required_argument, 0, 't'},       {"set", required_argument, 0, 'D'},
@@ -115,12 +128,14 @@ static int parse_args(int argc, char **argv, view_args *a) {
       {"exit-after", required_argument, 0, 'n'}, {"screenshot", required_argument, 0, 'S'},
       {"script-keys", required_argument, 0, 'k'}, {"reload-test", required_argument, 0, 'R'},
       {"animation", required_argument, 0, 'A'},  {"time", required_argument, 0, 'T'},
-      {"fps", required_argument, 0, 'F'},
+      {"fps", required_argument, 0, 'F'},        {"panel", required_argument, 0, 'P'},
+      {"job", required_argument, 0, 'J'},        {"view", required_argument, 0, 'V'},
       {"quiet", no_argument, 0, 'q'},            {"verbose", no_argument, 0, 'v'},
       {"help", no_argument, 0, 'h'},             {0, 0, 0, 0}};
   opterr = 0;
   optind = 1;
   int c, n;
+  bool view_given = false;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
     switch (c) {
     case 's': a->scene = optarg; break;
@@ -142,6 +157,14 @@ static int parse_args(int argc, char **argv, view_args *a) {
       if (!limn_parse_on_off(optarg, &a->overlay)) return usage_error("--overlay wants on or off, not '%s'", optarg);
       break;
     case 'C': a->capture_dir = optarg; break;
+    case 'P':
+      if (!limn_parse_on_off(optarg, &a->panel)) return usage_error("--panel wants on or off, not '%s'", optarg);
+      break;
+    case 'J': a->job = optarg; break;
+    case 'V':
+      if (!limn_parse_int(optarg, 0, 1 << 30, &a->job_view)) return usage_error("--view wants a view number, not '%s'", optarg);
+      view_given = true;
+      break;
     case 'A': a->animation = optarg; break;
     case 'T':
       if (!limn_parse_double(optarg, &a->time)) return usage_error("--time wants seconds, not '%s'", optarg);
@@ -176,7 +199,8 @@ static int parse_args(int argc, char **argv, view_args *a) {
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
-  return 0;
+  if (view_given && !a->job) return usage_error("%s", "--view N needs --job FILE");
+  return a->job && !load_view_job(a) ? 2 : 0;
 }
 
 static volatile sig_atomic_t stop_requested;
@@ -230,6 +254,7 @@ static bool key_down(const viewer *v, const char *key) {
 static void move_camera(viewer *v, double dt_ms) {
   double dx, dy;
   lm_window_mouse_drag(v->window, &dx, &dy);
+  if (v->panel_on && panel_wants_mouse(v->panel)) dx = dy = 0; /* a drag on the panel moves its widget */
   dx += v->drag[0], dy += v->drag[1];
   v->drag[0] = v->drag[1] = 0;
   /* 0.45 of the scene's diagonal a second (1.5 units in the Cornell box), in
@@ -356,6 +381,18 @@ static bool apply_sets(viewer *v, lm_pipeline *p, lm_error *err) {
   return true;
 }
 
+/* Sets an option as --set does (and keeps it for a reloaded script). */
+static void set_option(viewer *v, const char *name, const char *value) {
+  lm_error err;
+  if (!lm_pipeline_set_option(v->pipeline, name, value, &err)) {
+    say(v, "%s", err.msg);
+    return;
+  }
+  remember_set(v, name, value);
+  v->options_stale = true;
+  say(v, "%s = %s", name, value);
+}
+
 static void toggle_option(viewer *v, const char *name) {
   char value[64], field[128];
   snprintf(field, sizeof field, "%s", name);
@@ -366,14 +403,7 @@ static void toggle_option(viewer *v, const char *name) {
     say(v, "%s declares no option '%s' (a boolean, or a table with enabled)", v->script, name);
     return;
   }
-  const char *flipped = strcmp(value, "true") ? "true" : "false";
-  lm_error err;
-  if (!lm_pipeline_set_option(v->pipeline, field, flipped, &err)) {
-    say(v, "%s", err.msg);
-    return;
-  }
-  remember_set(v, field, flipped);
-  say(v, "%s = %s", field, flipped);
+  set_option(v, field, strcmp(value, "true") ? "true" : "false");
 }
 
 static void set_technique(viewer *v, const char *name) {
@@ -382,7 +412,43 @@ static void set_technique(viewer *v, const char *name) {
     say(v, "%s", err.msg);
     return;
   }
+  v->options_stale = true; /* a row may name a module new to Options */
   say(v, "technique %s", name);
+}
+
+/* The settings as a capture job and a command line (J, the panel's button). */
+static void write_job(viewer *v) {
+  char path[1024];
+  lm_error err;
+  if (!write_view_job(v, path, sizeof path, &err)) {
+    say(v, "%s", err.msg);
+    return;
+  }
+  snprintf(v->status, sizeof v->status, "wrote %s (and its limn capture line beside it)", path);
+  say(v, "%s", v->status);
+}
+
+/* What the user did in the panel last frame, applied before this frame renders. */
+static void apply_panel(viewer *v) {
+  panel_edits *e = &v->edits;
+  if (e->option) set_option(v, e->option_name, e->option_value);
+  if (e->technique >= 0 && e->technique < lm_pipeline_technique_count(v->pipeline))
+    set_technique(v, lm_pipeline_technique_name(v->pipeline, e->technique));
+  if (e->play) {
+    v->paused = !v->paused;
+    report_time(v, "play button");
+  }
+  if (e->scrub) {
+    v->time = e->scrub_time;
+    v->paused = true;
+    report_time(v, "scrubbed");
+  }
+  if (e->write_job) write_job(v);
+  if (e->inspect >= 0) {
+    v->inspect = e->inspect;
+    lm_renderer_set_sharing(v->renderer, false); /* every target readable after the frame */
+  }
+  *e = (panel_edits){.technique = -1, .inspect = -1};
 }
 
 /* ---- reloading --------------------------------------------------------- */
@@ -405,6 +471,7 @@ static bool reload_script(viewer *v) {
   }
   lm_pipeline_destroy(v->pipeline);
   v->pipeline = p;
+  v->options_stale = true;
   v->frame_error[0] = '\0';
   set_error(v->script_error, sizeof v->script_error, "", "script reloaded: error cleared");
   lm_info("reloaded %s", v->script);
@@ -494,6 +561,17 @@ static void handle_key(viewer *v, const char *key) {
     const char *k = strchr(key, '=') + 1;
     for (int i = 0; i < 4; i++)
       if (!strcmp(k, (const char *[]){"W", "A", "S", "D"}[i])) v->held[i] = key[0] == 'h';
+  } else if (!strncmp(key, "mouse=", 6) || !strncmp(key, "button=", 7)) {
+    v->mouse_scripted = true;
+    if (!strncmp(key, "mouse=", 6)) sscanf(key + 6, "%lf;%lf", &v->mouse[0], &v->mouse[1]);
+    else v->mouse_down = !strcmp(key + 7, "down");
+    if (v->panel) panel_set_mouse(v->panel, v->mouse[0], v->mouse[1], v->mouse_down);
+  } else if (!strcmp(key, "widgets")) {
+    if (v->panel) panel_list_widgets(v->panel, stdout);
+  } else if (!strcmp(key, "M")) {
+    v->panel_on = !v->panel_on;
+  } else if (!strcmp(key, "J")) {
+    write_job(v);
   } else if (!strncmp(key, "drag=", 5)) {
     double dx, dy;
     if (sscanf(key + 5, "%lf;%lf", &dx, &dy) == 2) v->drag[0] += dx, v->drag[1] += dy;
@@ -529,10 +607,23 @@ static void handle_key(viewer *v, const char *key) {
   } else if (!strcmp(key, "F1") || !strcmp(key, "Tab")) {
     v->overlay_on = !v->overlay_on;
   } else if (!strcmp(key, "PageDown") || !strcmp(key, "PageUp")) {
-    if (targets < 1) return;
-    int step = !strcmp(key, "PageDown") ? 1 : -1;
-    v->inspect = v->inspect < 0 ? (step > 0 ? 0 : targets - 1) : (v->inspect + step + targets) % targets;
+    /* From the frame: its output first; then through the targets the frame
+     * used, and last those it did not (inspect_order). */
+    int *order = lm_alloc(sizeof *order * (size_t)(targets > 0 ? targets : 1)), n = inspect_order(v, order, targets);
+    int at = 0;
+    while (at < n && order[at] != v->inspect) at++;
+    if (n > 0)
+      v->inspect = v->inspect < 0 ? order[0] : order[(at + (!strcmp(key, "PageDown") ? 1 : n - 1)) % n];
+    free(order);
     lm_renderer_set_sharing(v->renderer, false); /* every target readable after the frame */
+  } else if (!strncmp(key, "inspect=", 8)) { /* tests: a target by name */
+    int t = lm_graph_find_target(lm_renderer_graph(v->renderer), key + 8);
+    if (t < 0) {
+      say(v, "the frame graph has no target '%s'", key + 8);
+      return;
+    }
+    v->inspect = t;
+    lm_renderer_set_sharing(v->renderer, false);
   } else if (!strcmp(key, "Home")) {
     v->inspect = -1;
     lm_renderer_set_sharing(v->renderer, true);
@@ -660,6 +751,8 @@ static void viewer_free(viewer *v) {
   lm_texture_destroy(&v->overlay_tex);
   lm_texture_destroy(&v->probe);
   free(v->overlay);
+  free(v->options);
+  panel_destroy(v->panel); /* before the window: it restores the window's callbacks */
   lm_renderer_destroy(v->renderer);
   lm_programs_clear();
   lm_scene_destroy(v->scene);
@@ -681,7 +774,8 @@ static int run(viewer *v) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 2;
   }
-  v->scene = lm_scene_load(a->scene, &err);
+  v->scene = a->job_loaded ? a->job_loaded : lm_scene_load(a->scene, &err);
+  a->job_loaded = NULL;
   if (!v->scene) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 2;
@@ -711,6 +805,8 @@ static int run(viewer *v) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 1;
   }
+  if (!(v->panel = panel_create(v->window, &err))) lm_warn("no panel: %s", err.msg);
+  v->options_stale = true;
   fly_from_camera(v);
   lm_info("renderer: %s (%s); scene %s; script %s; technique %s; %dx%d", lm_gl_renderer(), lm_gl_version(),
           a->scene, v->script, lm_pipeline_technique(v->pipeline), v->width, v->height);
@@ -723,11 +819,18 @@ static int run(viewer *v) {
   for (v->frame = 0; !stop_requested && !lm_window_should_close(v->window); v->frame++) {
     lm_window_poll(v->window);
     char key[64];
-    while (lm_window_next_key(v->window, key, sizeof key)) handle_key(v, key);
+    while (lm_window_next_key(v->window, key, sizeof key))
+      if (!panel_wants_keyboard(v->panel) || !v->panel_on) handle_key(v, key); /* text typed into the panel */
+    apply_panel(v);
     for (int i = 0; i < a->key_count; i++)
       if (a->keys[i].frame == v->frame) handle_key(v, a->keys[i].key);
     double now = lm_now_ms();
     v->frame_ms = now - last;
+    if (v->frame > 1) { /* the panel's share: frames with it on and off, and its own time */
+      bool on = v->panel && v->panel_on;
+      v->frame_ms_sum[on] += v->frame_ms;
+      v->frames_timed[on]++;
+    }
     /* Real time, a frame's stall (a shader rebuild) counted at most 0.25 s;
      * scripted runs (tests) 1/60 s a frame. The first frame shows --time. */
     if (!v->paused && v->frame > 0) advance(v, a->key_count ? 1.0 / 60.0 : fmin(now - last, 250.0) * 1e-3);
@@ -746,6 +849,11 @@ static int run(viewer *v) {
   }
   if (stop_requested || lm_window_should_close(v->window)) display(v); /* the back buffer after a swap is undefined */
   lm_info("%ld frames", v->frame + 1);
+  if (v->frames_timed[1] > 0) {
+    char cost[200];
+    panel_cost(v, cost, sizeof cost);
+    lm_info("%s; %ld frames on, %ld off (glFinish + CLOCK_MONOTONIC)", cost, v->frames_timed[1], v->frames_timed[0]);
+  }
   report_time(v, "at exit");
   if (a->screenshot && !screenshot(v, a->screenshot)) return 1;
   return 0;
@@ -762,7 +870,8 @@ int limn_view(int argc, char **argv) {
   if (a.quiet) lm_log_set_level(LM_LOG_WARN);
   signal(SIGINT, on_signal);
   signal(SIGTERM, on_signal);
-  viewer v = {.args = &a, .inspect = -1, .channel = 4, .overlay_on = a.overlay, .range = {0, 1}};
+  viewer v = {.args = &a, .inspect = -1, .inspect_logged = -1, .channel = 4, .overlay_on = a.overlay, .panel_on = a.panel,
+              .range = {0, 1}, .edits = {.technique = -1, .inspect = -1}};
   capture_resolve(a.script, v.script, sizeof v.script);
   rc = run(&v);
   viewer_free(&v);

@@ -7,9 +7,10 @@
 #include <stdint.h>
 
 #include "render/render.h"
+#include "view_panel.h"
 #include "view_text.h"
 
-enum { MAX_SETS = 64, MAX_SCRIPT_KEYS = 256 };
+enum { MAX_SETS = 64, MAX_SCRIPT_KEYS = 256, PANEL_TIMES = 64 };
 
 typedef struct script_key {
   long frame;
@@ -26,7 +27,11 @@ typedef struct view_args {
   bool time_given;
   int fps;               /* frames a second: what Left/Right step and the overlay counts */
   long exit_after, reload_test;
-  bool overlay, quiet, verbose;
+  bool overlay, panel, quiet, verbose;
+  const char *job;       /* --job: start at view `job_view` of this capture job */
+  int job_view;
+  char job_script[1024], job_scene[1024], job_tech[64], job_animation[64]; /* what the job's view names */
+  lm_scene *job_loaded;  /* the view's scene as the job loaded it (its camera list's cameras too) */
   script_key keys[MAX_SCRIPT_KEYS];
   int key_count;
 } view_args;
@@ -63,12 +68,32 @@ typedef struct viewer {
   float camera_local[16];   /* meanwhile, the camera node's local transform as the animation poses it */
   bool held[4];             /* W A S D held by --script-keys */
   double drag[2];           /* a scripted drag not yet applied */
+  double mouse[2];          /* the scripted mouse (mouse=, button=) */
+  bool mouse_down;
   bool overlay_on;
+  lm_panel *panel;          /* NULL when it could not start */
+  bool panel_on;
+  lm_option_info *options;  /* the panel's list, read again when options_stale */
+  int option_count;
+  bool options_stale;
+  panel_edits edits;        /* the panel's last frame: applied before the next */
+  char status[1200];        /* the panel's note: the job last written */
+  /* The panel's cost: its own milliseconds in its last frames (glFinish on
+   * both sides) and the frames' with it on and off, for the share the
+   * overlay prints. */
+  double panel_times[PANEL_TIMES], frame_ms_sum[2];
+  long panel_timed, frames_timed[2]; /* [0] panel off, [1] on */
+  char panel_cost_text[200]; /* the panel's line of it */
   int inspect;              /* target index, -1: the frame */
+  int inspect_logged;       /* the target the log last named (a line a test reads) */
   int channel;              /* 0 r, 1 g, 2 b, 3 a, 4 rgb */
   bool false_colour;
   float exposure;
-  float range[2];           /* of the inspected target, for false colour */
+  float range[2];           /* of the inspected target's shown channel (grey and false colour) */
+  bool cursor_in;           /* the cursor over the window while inspecting: its texel's value */
+  int cursor_px[2];
+  float cursor_value[4];
+  bool mouse_scripted;
   char script_error[2048];  /* the last reload's error ("" when it loaded) */
   char frame_error[2048];   /* the current pipeline's last frame error */
   char shader_error[2048];  /* a shader rebuild that failed */
@@ -93,9 +118,22 @@ const char *view_animation_name(const viewer *v);
 bool make_window_textures(viewer *v, lm_error *err);
 /* Draws the frame (or the inspected target) and the overlay into the back buffer. */
 void display(viewer *v);
+/* "panel 0.61 ms, 0.9% of the frame (frames 70.2 ms on, 69.8 off)". */
+void panel_cost(const viewer *v, char *out, size_t cap);
 /* The inspected target as EXR and the frame as PNG, into --capture-dir. */
 void write_captures(viewer *v);
 /* The back buffer as a PNG. */
 bool screenshot(viewer *v, const char *path);
+/* The inspector's targets in the order PageDown steps: those the frame used
+ * first, the frame's output ("output.srgb") among them, then the others. */
+int inspect_order(viewer *v, int *order, int cap);
+bool target_used(viewer *v, int target);
+
+/* view_job.c: the viewer's settings as a capture job and as a command line,
+ * and a capture job's view as the viewer's start. */
+bool write_view_job(viewer *v, char *job_path, size_t cap, lm_error *err);
+/* Fills a->script, scene, tech, camera, size, time and sets from view
+ * a->job_view of job a->job; false (logged) when it has no such view. */
+bool load_view_job(view_args *a);
 
 #endif

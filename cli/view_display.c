@@ -65,17 +65,49 @@ static bool probe_target(viewer *v, lm_graph_target_info t, lm_error *err) {
   return true;
 }
 
-static void update_range(viewer *v) {
+/* Depth and one-channel targets show grey over their range (sampled, they
+ * fill red alone). */
+static bool single_channel(lm_format f) {
+  return f == LM_FORMAT_R16F || f == LM_FORMAT_R32F || f == LM_FORMAT_DEPTH32F;
+}
+
+/* Reads the probe back: the range of channel c (finite values) and the
+ * value of the texel under the cursor. */
+static void read_probe(viewer *v, int c) {
   size_t n = (size_t)v->probe_w * v->probe_h;
   float *px = lm_alloc(n * 16), lo = INFINITY, hi = -INFINITY;
-  lm_texture_read(v->probe, v->probe_w, v->probe_h, true, px);
-  int c = v->channel < 4 ? v->channel : 0;
+  lm_texture_read(v->probe, v->probe_w, v->probe_h, true, px); /* top row first, as the window */
   for (size_t i = 0; i < n; i++) {
     float x = px[i * 4 + c];
     if (isfinite(x)) lo = fminf(lo, x), hi = fmaxf(hi, x);
   }
-  free(px);
   v->range[0] = isfinite(lo) ? lo : 0, v->range[1] = isfinite(hi) ? hi : 1;
+  double x, y;
+  if (v->mouse_scripted)
+    x = v->mouse[0], y = v->mouse[1];
+  else
+    lm_window_cursor(v->window, &x, &y);
+  v->cursor_in = x >= 0 && y >= 0 && x < v->width && y < v->height;
+  if (v->cursor_in) {
+    v->cursor_px[0] = (int)(x * v->probe_w / v->width), v->cursor_px[1] = (int)(y * v->probe_h / v->height);
+    memcpy(v->cursor_value, px + ((size_t)v->cursor_px[1] * v->probe_w + v->cursor_px[0]) * 4, sizeof v->cursor_value);
+  }
+  free(px);
+}
+
+bool target_used(viewer *v, int target) {
+  lm_graph_target_info t = lm_graph_target(lm_renderer_graph(v->renderer), target);
+  return t.used && t.texture.id;
+}
+
+int inspect_order(viewer *v, int *order, int cap) {
+  lm_graph *g = lm_renderer_graph(v->renderer);
+  int count = lm_graph_target_count(g), out = lm_graph_find_target(g, "output.srgb"), n = 0;
+  if (out >= 0 && n < cap) order[n++] = out;
+  for (int used = 1; used >= 0; used--)
+    for (int i = 0; i < count && n < cap; i++)
+      if (i != out && target_used(v, i) == used) order[n++] = i;
+  return n;
 }
 
 /* Writes the inspected target (EXR, raw values) and the frame (PNG). */
@@ -159,11 +191,18 @@ static void draw_overlay(viewer *v) {
               view_animation_name(v), v->anim_range[0], v->anim_range[1], v->paused ? " | paused" : "");
   if (v->overlay_on && v->inspect >= 0 && v->inspect < lm_graph_target_count(g)) {
     lm_graph_target_info t = lm_graph_target(g, v->inspect);
-    draw_line(v, &y, yellow, "target %d/%d '%s' %s %dx%d%s | %s | exposure %+.1f%s", v->inspect + 1,
-              lm_graph_target_count(g), t.name, lm_format_name(t.format), t.width, t.height,
-              t.texture.id ? "" : " (not used this frame)", channel_name(v->channel), v->exposure,
-              v->false_colour ? " | false colour" : "");
-    if (v->false_colour && t.texture.id) draw_line(v, &y, yellow, "range %g .. %g", v->range[0], v->range[1]);
+    int *order = lm_alloc(sizeof *order * (size_t)lm_graph_target_count(g));
+    int n = inspect_order(v, order, lm_graph_target_count(g)), at = 0;
+    while (at < n && order[at] != v->inspect) at++;
+    free(order);
+    bool used = target_used(v, v->inspect), grey = single_channel(t.format);
+    draw_line(v, &y, yellow, "target %d/%d '%s' %s %dx%d%s | %s | exposure %+.1f%s", at + 1, n, t.name,
+              lm_format_name(t.format), t.width, t.height, used ? "" : " | NOT WRITTEN this frame",
+              grey ? "grey" : channel_name(v->channel), v->exposure, v->false_colour ? " | false colour" : "");
+    if (used && (v->false_colour || grey)) draw_line(v, &y, yellow, "range %g .. %g", v->range[0], v->range[1]);
+    if (used && v->cursor_in)
+      draw_line(v, &y, yellow, "at %d,%d: %g %g %g %g", v->cursor_px[0], v->cursor_px[1], v->cursor_value[0],
+                v->cursor_value[1], v->cursor_value[2], v->cursor_value[3]);
   }
   if (*error) {
     char text[2100];
@@ -177,6 +216,11 @@ static void draw_overlay(viewer *v) {
     draw_line(v, &y, white, "frame %.2f ms, render %.2f (Lua %.2f, graph %.2f)", v->frame_ms, v->render_ms,
               rec, comp);
     draw_line(v, &y, white, "clock: %s", lm_clock_name(lm_renderer_clock(v->renderer)));
+    if (v->frames_timed[1] > 0) {
+      char cost[200];
+      panel_cost(v, cost, sizeof cost);
+      draw_line(v, &y, white, "%s", cost);
+    }
     double total = 0;
     for (int i = 0; i < lm_graph_pass_count(g); i++) {
       lm_graph_pass_info p = lm_graph_pass(g, i);
@@ -217,6 +261,86 @@ static void set_int(const lm_program *p, const char *name, int x) {
   if (u) lm_program_set_int(p, u, &x);
 }
 
+/* ---- the panel --------------------------------------------------------- */
+static int by_value(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* The panel's own time is the median of its last frames: on llvmpipe a
+ * glFinish now and then waits for the rasterizer threads to be scheduled
+ * (milliseconds on a loaded machine), which a mean would count as the panel's. */
+void panel_cost(const viewer *v, char *out, size_t cap) {
+  double on = v->frames_timed[1] ? v->frame_ms_sum[1] / v->frames_timed[1] : 0;
+  double off = v->frames_timed[0] ? v->frame_ms_sum[0] / v->frames_timed[0] : 0;
+  double t[PANEL_TIMES], own = 0;
+  int n = v->panel_timed < PANEL_TIMES ? (int)v->panel_timed : PANEL_TIMES;
+  memcpy(t, v->panel_times, sizeof *t * (size_t)n);
+  qsort(t, (size_t)n, sizeof *t, by_value);
+  if (n) own = t[n / 2];
+  n = snprintf(out, cap, "panel %.2f ms, %.1f%% of the frame", own, on > 0 ? 100.0 * own / on : 0.0);
+  if (off > 0 && n > 0 && (size_t)n < cap)
+    snprintf(out + n, cap - (size_t)n, " (frames %.1f ms on, %.1f off)", on, off);
+}
+
+/* The panel's image; its own time (glFinish on both sides, CLOCK_MONOTONIC) into v->panel_times. */
+static lm_texture draw_panel(viewer *v) {
+  if (v->options_stale) {
+    free(v->options);
+    v->option_count = lm_pipeline_options(v->pipeline, &v->options);
+    v->options_stale = false;
+  }
+  enum { MAX_TECHNIQUES = 256 };
+  const char *names[MAX_TECHNIQUES];
+  int count = lm_pipeline_technique_count(v->pipeline), current = 0;
+  if (count > MAX_TECHNIQUES) count = MAX_TECHNIQUES;
+  for (int i = 0; i < count; i++) {
+    names[i] = lm_pipeline_technique_name(v->pipeline, i);
+    if (!strcmp(names[i], lm_pipeline_technique(v->pipeline))) current = i;
+  }
+  /* The cost line changes once in PANEL_TIMES frames (after a first figure):
+   * a line changing every frame would draw the panel's image every frame. */
+  if (v->panel_timed == 3 || v->panel_timed % PANEL_TIMES == 0)
+    panel_cost(v, v->panel_cost_text, sizeof v->panel_cost_text);
+  /* The frame graph: passes with their targets as indices. */
+  lm_graph *g = lm_renderer_graph(v->renderer);
+  int pass_count = lm_graph_pass_count(g), target_count = lm_graph_target_count(g), ends = 0;
+  for (int i = 0; i < pass_count; i++) {
+    const lm_pass_desc *d = lm_graph_pass(g, i).desc;
+    ends += d->input_count + d->output_count + 1;
+  }
+  panel_pass *passes = lm_alloc(sizeof *passes * (size_t)(pass_count + 1));
+  int *targets_of = lm_alloc(sizeof *targets_of * (size_t)(ends + 1)), used = 0;
+  const char **target_names = lm_alloc(sizeof *target_names * (size_t)(target_count + 1));
+  for (int i = 0; i < target_count; i++) target_names[i] = lm_graph_target(g, i).name;
+  for (int i = 0; i < pass_count; i++) {
+    lm_graph_pass_info info = lm_graph_pass(g, i);
+    panel_pass *pp = &passes[i];
+    *pp = (panel_pass){.name = info.name, .culled = info.culled, .ms = info.ms, .inputs = targets_of + used};
+    for (int k = 0; k < info.desc->input_count; k++) targets_of[used++] = info.desc->inputs[k].target;
+    pp->input_count = info.desc->input_count;
+    pp->outputs = targets_of + used;
+    for (int k = 0; k < info.desc->output_count; k++) targets_of[used++] = info.desc->outputs[k];
+    if (info.desc->depth >= 0) targets_of[used++] = info.desc->depth;
+    pp->output_count = (int)(targets_of + used - pp->outputs);
+  }
+  panel_model m = {.options = v->options, .option_count = v->option_count, .techniques = names,
+                   .technique_count = count, .technique = current, .animated = lm_scene_animated(v->scene),
+                   .time = v->time, .time_lo = v->anim_range[0], .time_hi = v->anim_range[1],
+                   .paused = v->paused, .status = v->status[0] ? v->status : NULL,
+                   .cost = v->frames_timed[1] ? v->panel_cost_text : NULL, .passes = passes,
+                   .pass_count = pass_count, .targets = target_names, .target_count = target_count};
+  lm_finish();
+  double t0 = lm_now_ms();
+  lm_texture image = panel_frame(v->panel, &m, v->width, v->height, &v->edits);
+  lm_finish();
+  v->panel_times[v->panel_timed++ % PANEL_TIMES] = lm_now_ms() - t0;
+  free(passes);
+  free(targets_of);
+  free(target_names);
+  return image;
+}
+
 void display(viewer *v) {
   lm_error err;
   lm_texture src = v->shown;
@@ -224,15 +348,21 @@ void display(viewer *v) {
   lm_graph *g = lm_renderer_graph(v->renderer);
   if (v->inspect >= 0 && v->inspect < lm_graph_target_count(g)) {
     lm_graph_target_info t = lm_graph_target(g, v->inspect);
+    bool grey = single_channel(t.format);
     if (probe_target(v, t, &err)) {
       src = v->probe;
-      mode = v->false_colour ? 2 : 1;
-      if (v->false_colour) update_range(v);
+      mode = v->false_colour ? 2 : grey ? 4 : 1;
+      read_probe(v, grey || v->channel > 3 ? 0 : v->channel);
     } else {
       mode = 3; /* a target with no texture this frame: black, not the frame */
     }
+    if (v->inspect_logged != v->inspect)
+      lm_info("inspecting '%s' %s %dx%d%s, range %g .. %g", t.name, lm_format_name(t.format), t.width, t.height,
+              mode == 3 ? " (not written this frame)" : grey ? " grey" : "", v->range[0], v->range[1]);
+    v->inspect_logged = v->inspect;
   }
   draw_overlay(v);
+  lm_texture panel = v->panel && v->panel_on ? draw_panel(v) : (lm_texture){0};
   lm_program *p = lm_program_get("fullscreen.vert", "view.frag", "", &err);
   lm_screen_bind(v->width, v->height);
   if (!p) { /* view.frag itself is broken: show what can be shown */
@@ -242,6 +372,8 @@ void display(viewer *v) {
   lm_program_use(p);
   lm_program_bind_texture(lm_program_uniform(p, "src"), src);
   lm_program_bind_texture(lm_program_uniform(p, "overlay"), v->overlay_tex);
+  lm_program_bind_texture(lm_program_uniform(p, "panel"), panel.id ? panel : v->overlay_tex);
+  set_int(p, "show_panel", panel.id != 0);
   set_int(p, "mode", mode);
   set_int(p, "channel", v->channel);
   set_float(p, "exposure", &v->exposure);

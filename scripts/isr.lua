@@ -84,6 +84,7 @@ local seed_rules = {
   sender = options.one_of("albedo", "lit"),
   bounces = options.whole(1, 4),
 }
+options.declare("isr.seed", seed_rules)
 
 local rules = {
   mode = options.one_of("physical", "seed"),
@@ -99,6 +100,7 @@ local rules = {
   seed = function(v) if type(v) ~= "table" then return "a table of the seed mode's options" end end,
   temporal = function(v) if type(v) ~= "table" then return "a table of temporal reuse options" end end,
 }
+options.declare("isr", rules) -- checked only when a technique runs it: declared for the viewer's panel
 
 -- The coarse G-buffer and direct light, each texel its block's average: G
 -- itself at factor 1 (the seed mode's).

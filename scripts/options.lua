@@ -5,55 +5,88 @@ local options = {}
 
 local function finite(v) return type(v) == "number" and v == v and v > -math.huge and v < math.huge end
 
+-- What each rule asks, for tools that show an option (the viewer's panel,
+-- through options.describe): rule -> { kind = "number" | "whole" | "boolean"
+-- | "one_of" | "colour", lo, hi, step, values }. Weak keys: a rule made for
+-- one check goes with it.
+local about = setmetatable({}, { __mode = "k" })
+local function described(what, rule)
+  about[rule] = what
+  return rule
+end
+
 -- Rules: each returns nil when v is fine, else what v must be. A rule gets
 -- the option's value v and all the checked options c, for rules that join
 -- two options (see ssdo.lua's resolution).
 function options.number(lo, hi) -- lo <= v <= hi, finite
-  return function(v)
+  return described({ kind = "number", lo = lo, hi = hi }, function(v)
     if not (finite(v) and v >= lo and v <= hi) then
       return string.format("a finite number in %g..%g", lo, hi)
     end
-  end
+  end)
 end
 
 function options.positive(hi) -- 0 < v <= hi, finite; no bound without hi
-  return function(v)
+  return described({ kind = "number", lo = 0, hi = hi or math.huge }, function(v)
     if not (finite(v) and v > 0 and v <= (hi or math.huge)) then
       return hi and string.format("a number in (0, %g]", hi) or "a positive finite number"
     end
-  end
+  end)
 end
 
 local function whole(v, lo, hi) return finite(v) and v == math.floor(v) and v >= lo and v <= hi end
 
 function options.whole(lo, hi)
-  return function(v)
+  return described({ kind = "whole", lo = lo, hi = hi, step = 1 }, function(v)
     if not whole(v, lo, hi) then return string.format("a whole number in %d..%d", lo, hi) end
-  end
+  end)
 end
 
 function options.multiple(m, lo, hi) -- a whole multiple of m in lo..hi
-  return function(v)
+  local first = math.ceil(lo / m) * m
+  return described({ kind = "whole", lo = first, hi = hi, step = m }, function(v)
     if not (whole(v, lo, hi) and v % m == 0) then return string.format("a multiple of %d in %d..%d", m, lo, hi) end
-  end
+  end)
 end
 
 function options.odd(lo, hi)
-  return function(v)
+  return described({ kind = "whole", lo = lo % 2 == 1 and lo or lo + 1, hi = hi, step = 2 }, function(v)
     if not (whole(v, lo, hi) and v % 2 == 1) then return string.format("an odd whole number in %d..%d", lo, hi) end
-  end
+  end)
 end
 
 function options.boolean(v)
   if type(v) ~= "boolean" then return "true or false" end
 end
+about[options.boolean] = { kind = "boolean" }
 
 function options.one_of(...)
   local list = { ... }
-  return function(v)
+  return described({ kind = "one_of", values = list }, function(v)
     for _, x in ipairs(list) do if v == x then return nil end end
     return "one of " .. table.concat(list, ", ")
+  end)
+end
+
+-- "r,g,b" or "x" (grey) as a list of 3 numbers, each in 0..hi; nil when it is neither.
+function options.rgb(v, hi)
+  if type(v) == "number" then v = tostring(v) end
+  if type(v) ~= "string" then return nil end
+  local c = {}
+  for x in (v .. ","):gmatch("([^,]*),") do c[#c + 1] = tonumber(x) end
+  if #c == 1 then c[2], c[3] = c[1], c[1] end
+  if #c ~= 3 then return nil end
+  for i = 1, 3 do
+    if not (finite(c[i]) and c[i] >= 0 and c[i] <= hi) then return nil end
   end
+  return c
+end
+
+-- A colour as text, "r,g,b" or one grey number, each in 0..hi (text, so that --set takes it).
+function options.colour(hi)
+  return described({ kind = "colour", lo = 0, hi = hi }, function(v)
+    if not options.rgb(v, hi) then return '"r,g,b" or one number, each in 0..' .. string.format("%g", hi):gsub("e%+0*", "e") end
+  end)
 end
 
 -- A copy of `defaults` with the fields of `o` over it, checked by `rules`
@@ -61,6 +94,7 @@ end
 -- checked by what it is passed to). `name` prefixes messages; `level` is how
 -- many calls up the effect's caller is (1: whoever called check).
 function options.check(name, defaults, o, rules, level)
+  options.declare(name, rules)
   level = (level or 1) + 1
   o = o or {}
   if type(o) ~= "table" then error(name .. " options must be a table", level) end
@@ -92,9 +126,33 @@ end
 -- A module's check(o, level) (scripts/README.md): o over `defaults`, checked
 -- by `rules`; errors point at the caller `level` calls up (1: check's).
 function options.checker(name, defaults, rules)
+  options.declare(name, rules)
   return function(o, level)
     local c = options.check(name, defaults, o, rules, (level or 1) + 1) -- not a tail call: it keeps its level
     return c
+  end
+end
+
+-- Rules by the name of the options they check ("dof", "isr.seed"; "" the
+-- pipeline's own), for options.describe. check and checker declare theirs;
+-- a module whose check runs only when a technique uses it declares at load.
+local declared = {}
+function options.declare(name, rules) declared[name] = rules end
+
+-- What the rule of option `path` ("isr.temporal.frames") asks (see `about`),
+-- or nil when no declared rule describes it. Rules declared under a shorter
+-- name serve a table nested under any module ("temporal" for "isr.temporal").
+function options.describe(path)
+  local table_name, field = path:match("^(.*)%.([^.]+)$")
+  if not table_name then table_name, field = "", path end
+  while true do
+    local rules = declared[table_name]
+    local rule = rules and rules[field]
+    for _, r in ipairs(type(rule) == "table" and rule or { rule }) do
+      if about[r] then return about[r] end
+    end
+    table_name = not rule and table_name:match("^[^.]+%.(.+)$")
+    if not table_name then return nil end
   end
 end
 

@@ -102,7 +102,9 @@ local function frame(tech, row)
 end
 
 local rules = { ambient = options.number(0, 1e6), background = options.number(0, 1e6),
-                light_variants = options.whole(0, 16), light_cull = options.boolean }
+                light_variants = options.whole(0, 16), light_cull = options.boolean,
+                materials = options.one_of("phong", "pbr") }
+options.declare("", rules) -- the viewer's panel shows each option by its rule
 
 function OnCreate()
   post.create()

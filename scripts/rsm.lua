@@ -62,6 +62,7 @@ local rules = {
   blur = options.whole(0, 32),
   temporal = function(v) if type(v) ~= "table" then return "a table of temporal reuse options" end end,
 }
+options.declare("rsm", rules) -- checked only when a technique runs it: declared for the viewer's panel
 
 -- Checked options (scripts/README.md: errors name the option and point at
 -- the caller `level` calls up, 1: check's), with the auto coarse factor

@@ -21,28 +21,12 @@ sky.defaults = {
                             -- top row the zenith, the middle column looking along -Z
 }
 
--- "r,g,b" or "x" (grey) as a list of 3 numbers; nil when it is neither.
-local function colour(v)
-  if type(v) == "number" then return { v, v, v } end
-  if type(v) ~= "string" then return nil end
-  local c = {}
-  for x in (v .. ","):gmatch("([^,]*),") do c[#c + 1] = tonumber(x) end
-  if #c == 1 then c[2], c[3] = c[1], c[1] end
-  if #c ~= 3 then return nil end
-  for i = 1, 3 do
-    if not (c[i] and c[i] >= 0 and c[i] <= 1e6) then return nil end
-  end
-  return c
-end
-
-local function colour_rule(v)
-  if not colour(v) then return '"r,g,b" or one number, each in 0..1e6' end
-end
+local function colour(v) return options.rgb(v, 1e6) end
 
 local rules = {
   enabled = options.boolean,
-  zenith = colour_rule,
-  horizon = colour_rule,
+  zenith = options.colour(1e6),
+  horizon = options.colour(1e6),
   intensity = options.number(0, 1e6),
   map = function(v) if type(v) ~= "string" then return "a file name (\"\": the gradient)" end end,
 }

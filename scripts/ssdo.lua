@@ -64,6 +64,7 @@ local rules = {
   interleave = options.one_of(1, 2, 4),
   temporal = function(v) if type(v) ~= "table" then return "a table of temporal reuse options" end end,
 }
+options.declare("ssdo", rules) -- checked only when a technique runs it: declared for the viewer's panel
 filters.expose(ssdo.defaults, rules)
 
 -- Checked options (scripts/README.md: errors name the option and point at

@@ -68,6 +68,7 @@ local rules = {
   skip = options.boolean,
   velocity = options.boolean,
 }
+options.declare("temporal", rules) -- serves every module's <module>.temporal (options.describe)
 
 local velocity = nil -- this frame's G-buffer velocity target (temporal.velocity), or nil
 local histories = {} -- user -> { view = bool, at = { [coarse factor] = { targets = {a, b}, turn = 0, kept = } } }

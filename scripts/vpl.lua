@@ -59,6 +59,7 @@ local rules = {
   focus = options.number(0.05, 64),
   k = options.number(0, 16),
 }
+options.declare("vpl", rules) -- checked only when a technique runs it: declared for the viewer's panel
 
 -- Checked options (scripts/README.md: errors name the option and point at
 -- the caller `level` calls up, 1: check's), with the auto coarse factor

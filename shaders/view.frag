@@ -6,10 +6,13 @@
 in vec2 uv;
 uniform sampler2D src;     // the frame (sRGB-encoded bytes) or a target (linear values)
 uniform sampler2D overlay; // text, premultiplied alpha
-uniform int mode = 0;      // 0: the frame; 1: a target; 2: a target in false colour; 3: black
+uniform sampler2D panel;   // the panel (cli/view_panel.cpp), premultiplied alpha, when show_panel
+uniform int show_panel = 0;
+uniform int mode = 0;      // 0: the frame; 1: a target; 2: a target in false colour; 3: black;
+                           // 4: a one-channel or depth target, grey over its range
 uniform int channel = 4;   // 0 r, 1 g, 2 b, 3 a, 4 rgb
 uniform float exposure = 0.0;          // stops
-uniform vec2 range = vec2(0.0, 1.0);   // false colour: min and max shown
+uniform vec2 range = vec2(0.0, 1.0);   // false colour and grey: min and max shown
 
 out vec4 color;
 
@@ -39,15 +42,22 @@ void main() {
     c = vec3(0.0);
   } else if (mode > 0) {
     float one = channel < 4 ? v[channel] : v.r;
+    float span = range.y - range.x, t = span > 1e-20 ? (one - range.x) / span : 0.5;
     if (mode == 2) {
-      float span = range.y - range.x;
-      c = false_colour(span > 1e-20 ? (one - range.x) / span : 0.5);
+      c = false_colour(t);
+    } else if (mode == 4) {
+      c = vec3(saturate(t));
     } else {
       c = (channel < 4 ? vec3(one) : v.rgb) * exp2(clamp(exposure, -40.0, 40.0));
       c = srgb_encode(c);
     }
   }
   vec4 o = texture(overlay, uv);
-  color = vec4(c * (1.0 - o.a) + o.rgb, 1.0);
+  c = c * (1.0 - o.a) + o.rgb;
+  if (show_panel != 0) {
+    vec4 q = texture(panel, uv);
+    c = c * (1.0 - q.a) + q.rgb;
+  }
+  color = vec4(c, 1.0);
 #endif
 }

@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -70,10 +71,11 @@ static bool wait_for(const char *path, const char *needle, int timeout_ms) {
   return false;
 }
 
-/* Starts `limn view ARGS...` with stdout and stderr into log (NULL-terminated args). */
+/* Starts `limn view ARGS...` with stdout and stderr into log (NULL-terminated
+ * args); the panel off unless ARGS turn it on (screenshots see the frame). */
 static pid_t spawn_view(const char *log, ...) {
-  const char *argv[64] = {LIMN_EXE, "view"};
-  int n = 2;
+  const char *argv[64] = {LIMN_EXE, "view", "--panel", "off"};
+  int n = 4;
   va_list ap;
   va_start(ap, log);
   for (const char *a; (a = va_arg(ap, const char *)) && n < 63;) argv[n++] = a;
@@ -537,6 +539,10 @@ static void command_line_errors(void **state) {
       {{"--time", "soon"}, "--time wants seconds", 2},
       {{"--fps", "0"}, "--fps wants 1..1000", 2},
       {{"--script-keys", "4:time=later"}, "--script-keys wants FRAME:KEY", 2},
+      {{"--panel", "maybe"}, "--panel wants on or off", 2},
+      {{"--view", "2"}, "--view N needs --job FILE", 2},
+      {{"--job", "nope.lua"}, "--job nope.lua", 2},
+      {{"--script-keys", "3:mouse=10"}, "--script-keys wants FRAME:KEY", 2},
       {{"--help"}, "F2 isr+esm", 0},
   };
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
@@ -896,6 +902,329 @@ static void reload_loop_leaks_nothing(void **state) {
   free(s);
 }
 
+
+/* ---- the panel ----------------------------------------------------------- */
+typedef struct widget_line {
+  char name[128], kind[32], group[64];
+  double x, y, w, h;
+} widget_line;
+
+/* The "panel widget ..." lines of a log (the script key `widgets`). */
+static int read_widgets(const char *log, widget_line *out, int cap) {
+  char *s = read_text(log);
+  int n = 0;
+  for (char *p = s; (p = strstr(p, "panel widget ")) && n < cap; p++) {
+    widget_line *w = &out[n];
+    if (sscanf(p, "panel widget %127s %31s %63s %lf %lf %lf %lf", w->name, w->kind, w->group, &w->x, &w->y, &w->w,
+               &w->h) == 7)
+      n++;
+  }
+  free(s);
+  return n;
+}
+
+static const widget_line *find_widget(const widget_line *w, int n, const char *name) {
+  for (int i = 0; i < n; i++)
+    if (!strcmp(w[i].name, name)) return &w[i];
+  fail_msg("the panel has no widget for option %s", name);
+  return NULL;
+}
+
+/* Every option `limn capture --list-options` names has a widget, chosen by
+ * its rule: a slider with the rule's range, a checkbox, a drop-down for
+ * one_of, a colour for a colour; the pipeline's own group is open. */
+static void panel_has_every_option(void **state) {
+  (void)state;
+  char log[512], list[512], cmd[2048];
+  log_path(log, "panel_widgets");
+  log_path(list, "list_options");
+  snprintf(cmd, sizeof cmd, "%s capture --script %s/scripts/pp.lua --list-options > %s 2>&1", LIMN_EXE, root, list);
+  assert_int_equal(system(cmd), 0);
+  pid_t pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "4",
+                         "--script-keys", "3:widgets", NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  static widget_line w[1024];
+  int n = read_widgets(log, w, 1024), listed = 0;
+  char *text = read_text(list);
+  /* "options: a=1, b.c=x, sky.zenith=0.1,0.15,0.3, ..." after the techniques line */
+  char *opts = strstr(text, "options:");
+  assert_non_null(opts);
+  for (char *p = opts + 8; p && *p; p = strstr(p, ", ")) {
+    p += strspn(p, " ,\n");
+    size_t len = strcspn(p, "=\n");
+    if (p[len] != '=') break;
+    char name[128];
+    snprintf(name, sizeof name, "%.*s", (int)len, p);
+    find_widget(w, n, name);
+    listed++;
+  }
+  free(text);
+  fprintf(stderr, "%d options listed, %d widgets\n", listed, n);
+  assert_true(listed > 50 && n >= listed);
+  static const struct { const char *name, *kind; } kinds[] = {
+      {"ambient", "slider"},          {"light_cull", "checkbox"}, {"materials", "combo"},
+      {"light_variants", "slider-int"}, {"sky.zenith", "colour"}, {"bloom.enabled", "checkbox"},
+      {"dof.mode", "combo"},          {"isr.temporal.frames", "slider"}, {"sky.map", "text"},
+      {"isr.seed.radius", "drag"}};
+  for (size_t i = 0; i < sizeof kinds / sizeof *kinds; i++)
+    assert_string_equal(find_widget(w, n, kinds[i].name)->kind, kinds[i].kind);
+  const widget_line *ambient = find_widget(w, n, "ambient");
+  assert_true(ambient->w > 20 && ambient->h > 5 && ambient->x > 384 / 2); /* shown, on the right */
+  assert_true(find_widget(w, n, "bloom.strength")->w == 0);             /* its group closed */
+}
+
+/* Dragging the ambient slider to its right end sets ambient as --set would
+ * (the log says so) and brightens the next frames. */
+static void panel_slider_changes_option_and_image(void **state) {
+  (void)state;
+  char log[512], keys[256], dragged[512];
+  log_path(log, "panel_drag");
+  snprintf(dragged, sizeof dragged, "%s/dragged", root);
+  mkdir(dragged, 0755);
+  pid_t pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "6",
+                         "--script-keys", "5:widgets", "--capture-dir", root, "--script-keys", "4:P", NULL);
+  assert_int_equal(wait_exit(pid, 30000), 0);
+  static widget_line w[1024];
+  int n = read_widgets(log, w, 1024);
+  const widget_line *a = find_widget(w, n, "ambient");
+  int y = (int)(a->y + a->h / 2), x0 = (int)(a->x + 2), x1 = (int)(a->x + a->w + 40);
+  snprintf(keys, sizeof keys, "3:mouse=%d;%d,4:button=down,5:mouse=%d;%d,6:button=up,9:P", x0, y, x1, y);
+  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "10",
+                   "--capture-dir", dragged, "--script-keys", keys, NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  char *s = read_text(log), *set = strstr(s, "ambient = ");
+  if (!set) print_log(log);
+  assert_non_null(set);
+  double value = 0;
+  for (char *p = set; p; p = strstr(p + 1, "ambient = ")) sscanf(p, "ambient = %lf", &value); /* the last */
+  free(s);
+  fprintf(stderr, "ambient dragged to %g\n", value);
+  assert_true(value > 1000); /* the right end of 0..1e6 */
+  lm_image before, after;
+  load("limn-frame-0001.png", &before);
+  load("dragged/limn-frame-0001.png", &after);
+  assert_true(image_mean(&after) > image_mean(&before) + 0.2);
+  lm_image_free(&before);
+  lm_image_free(&after);
+}
+
+/* An option of a type the panel cannot set (a list) shows read-only, not a crash. */
+static void panel_shows_unsupported_option_read_only(void **state) {
+  (void)state;
+  char log[512], script[512];
+  log_path(log, "panel_list");
+  write_file("scripts/listed.lua",
+             "local gbuffer = require \"gbuffer\"\n"
+             "Techniques = { \"plain\" }\n"
+             "Options = { weights = { 1, 2, 3, 4 }, gain = 0.5 }\n"
+             "function OnRender(tech)\n"
+             "  local G = gbuffer.render(gbuffer.targets())\n"
+             "  local lit = target{ \"lit\", format = \"rgba16f\" }\n"
+             "  present(pass{ \"direct\", shader = \"direct.frag\", inputs = gbuffer.inputs(G),\n"
+             "                params = { ambient = { tech.gain, tech.gain, tech.gain } }, out = lit })\n"
+             "end\n");
+  path_in_root(script, sizeof script, "scripts/listed.lua");
+  pid_t pid = spawn_view(log, "--panel", "on", "--script", script, "--size", "256x192", "--exit-after", "4",
+                         "--script-keys", "3:widgets", NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  static widget_line w[16];
+  int n = read_widgets(log, w, 16);
+  assert_string_equal(find_widget(w, n, "weights")->kind, "read-only");
+  assert_string_equal(find_widget(w, n, "gain")->kind, "drag"); /* no rule: any number */
+}
+
+/* J writes the technique, the changed options and the view as a capture job
+ * and a command line; `limn capture` renders from each the frame the viewer
+ * showed, and --job FILE --view 0 opens the viewer on it again. */
+static void job_leaves_and_comes_back(void **state) {
+  (void)state;
+  char log[512], scene[512], job[512], cmd[2048], dir2[512];
+  log_path(log, "job");
+  snprintf(scene, sizeof scene, "%s/data/scenes/cornell.glb", LIMN_SOURCE_ROOT);
+  pid_t pid = spawn_view(log, "--scene", scene, "--tech", "dl", "--set", "ambient=0.3", "--size", "128x96",
+                         "--exit-after", "6", "--capture-dir", root, "--script-keys", "3:J,4:P", NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  snprintf(job, sizeof job, "%s/limn-view-0001.lua", root);
+  assert_true(file_has(job, "[\"ambient\"] = \"0.3\""));
+  assert_true(file_has(job, "\"dl\""));
+  snprintf(cmd, sizeof cmd, "%s capture --job %s --quiet", LIMN_EXE, job);
+  assert_int_equal(system(cmd), 0);
+  lm_image frame, rendered;
+  load("limn-frame-0001.png", &frame);
+  load("limn-view-0001.png", &rendered);
+  assert_true(image_diff(&frame, &rendered) < 0.004);
+  lm_image_free(&rendered);
+  /* The command line: the scene's camera, which the viewer did not move. */
+  snprintf(cmd, sizeof cmd, "cd %s && PATH=%.*s:$PATH sh limn-view-0001.sh >/dev/null 2>&1", root,
+           (int)(strrchr(LIMN_EXE, '/') - LIMN_EXE), LIMN_EXE);
+  assert_int_equal(system(cmd), 0);
+  load("limn-view-0001.png", &rendered);
+  assert_true(image_diff(&frame, &rendered) < 0.004);
+  lm_image_free(&rendered);
+  /* Back into the viewer: the job's scene, camera list, size, technique and options. */
+  snprintf(dir2, sizeof dir2, "%s/back", root);
+  mkdir(dir2, 0755);
+  pid = spawn_view(log, "--job", job, "--view", "0", "--exit-after", "4", "--capture-dir", dir2, "--script-keys",
+                   "3:P", NULL);
+  rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  load("back/limn-frame-0001.png", &rendered);
+  assert_int_equal(rendered.width, 128);
+  assert_true(image_diff(&frame, &rendered) < 0.004);
+  lm_image_free(&rendered);
+  lm_image_free(&frame);
+  pid = spawn_view(log, "--job", job, "--view", "1", "--exit-after", "2", NULL);
+  assert_int_equal(wait_exit(pid, 30000), 2); /* one view: 0 */
+  assert_true(file_has(log, "--view 1: job"));
+}
+
+/* The inspector starts on the frame's output, lists the targets the frame
+ * did not write last, and shows a depth target grey with its range. */
+static void inspector_order_and_grey_depth(void **state) {
+  (void)state;
+  char log[512], shot[512];
+  log_path(log, "inspect_order");
+  shot_path(shot, "depth.png");
+  /* Through every target (more PageDowns than targets), then to the G-buffer's depth. */
+  char keys[1024] = "2:PageDown";
+  for (int i = 3; i < 40; i++) snprintf(keys + strlen(keys), sizeof keys - strlen(keys), ",%d:PageDown", i);
+  snprintf(keys + strlen(keys), sizeof keys - strlen(keys), ",41:inspect=gbuffer.dpt");
+  pid_t pid = spawn_view(log, "--tech", "dl", "--size", "96x72", "--overlay", "off", "--exit-after", "44",
+                         "--script-keys", keys, "--screenshot", shot, NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  char *s = read_text(log), *first = strstr(s, "inspecting '");
+  assert_non_null(first);
+  assert_true(!strncmp(first, "inspecting 'output.srgb'", 24));
+  /* After the first target not written this frame, only such targets until the cycle starts again. */
+  bool unwritten = false;
+  for (char *p = first; (p = strstr(p, "inspecting '")); p++) {
+    char line[256];
+    snprintf(line, sizeof line, "%.*s", (int)strcspn(p, "\n"), p);
+    bool marked = strstr(line, "not written") != NULL;
+    if (!strncmp(p, "inspecting 'output.srgb'", 24) || !strncmp(p, "inspecting 'gbuffer.dpt'", 24)) {
+      unwritten = false;
+      continue;
+    }
+    assert_true(marked || !unwritten);
+    unwritten |= marked;
+  }
+  char *dpt = strstr(s, "inspecting 'gbuffer.dpt' r32f 96x72 grey, range ");
+  assert_non_null(dpt);
+  double lo, hi;
+  assert_int_equal(sscanf(dpt, "inspecting 'gbuffer.dpt' r32f 96x72 grey, range %lf .. %lf", &lo, &hi), 2);
+  assert_true(lo >= 0 && hi > lo && hi <= 1);
+  free(s);
+  lm_image img;
+  load("depth.png", &img);
+  int greys = 0, n = img.width * img.height, levels = 0;
+  float seen_lo = 1, seen_hi = 0;
+  for (int i = 0; i < n; i++) {
+    const float *p = img.pixels + (size_t)i * 3;
+    greys += fabsf(p[0] - p[1]) < 0.01f && fabsf(p[1] - p[2]) < 0.01f;
+    seen_lo = fminf(seen_lo, p[0]), seen_hi = fmaxf(seen_hi, p[0]);
+  }
+  levels = seen_hi - seen_lo > 0.5f;
+  assert_int_equal(greys, n);  /* grey, not red */
+  assert_int_equal(levels, 1); /* over its range: near and far apart */
+  lm_image_free(&img);
+}
+
+/* A "panel control NAME X Y W H" line's rectangle. */
+static void find_control(const char *log, const char *name, double rect[4]) {
+  char *s = read_text(log), key[64];
+  snprintf(key, sizeof key, "panel control %s ", name);
+  char *line = strstr(s, key);
+  if (!line) print_log(log);
+  assert_non_null(line);
+  assert_int_equal(sscanf(line + strlen(key), "%lf %lf %lf %lf", &rect[0], &rect[1], &rect[2], &rect[3]), 4);
+  free(s);
+}
+
+/* The panel's time controls: its button pauses an animation that plays, and
+ * dragging its slider to the left end scrubs to the animation's first key. */
+static void panel_plays_pauses_and_scrubs(void **state) {
+  (void)state;
+  char log[512], scene[512], keys[512];
+  log_path(log, "panel_time");
+  snprintf(scene, sizeof scene, "%s/data/scenes/door.glb", LIMN_SOURCE_ROOT);
+  pid_t pid = spawn_view(log, "--panel", "on", "--scene", scene, "--tech", "dl", "--size", "384x288",
+                         "--exit-after", "6", "--script-keys", "5:widgets", NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  double play[4], slider[4], lo, hi;
+  find_control(log, "play", play);
+  find_control(log, "time", slider);
+  char *s = read_text(log), *keys_line = strstr(s, "': keys ");
+  assert_non_null(keys_line);
+  assert_int_equal(sscanf(keys_line, "': keys %lf..%lf s", &lo, &hi), 2);
+  free(s);
+  int px = (int)(play[0] + play[2] / 2), py = (int)(play[1] + play[3] / 2);
+  int sy = (int)(slider[1] + slider[3] / 2), sx = (int)(slider[0] + slider[2] / 3);
+  snprintf(keys, sizeof keys, "3:mouse=%d;%d,4:button=down,5:button=up,8:mouse=%d;%d,9:button=down,10:mouse=%d;%d,"
+           "11:button=up", px, py, sx, sy, (int)slider[0] - 60, sy);
+  pid = spawn_view(log, "--panel", "on", "--scene", scene, "--tech", "dl", "--size", "384x288", "--exit-after", "14",
+                   "--script-keys", keys, NULL);
+  rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  s = read_text(log);
+  assert_non_null(strstr(s, ", paused (play button)"));
+  double t = -1;
+  for (char *line = s; line && *line; line = strchr(line, '\n') ? strchr(line, '\n') + 1 : NULL) {
+    char *time = strstr(line, "limn: time "), *eol = strchr(line, '\n');
+    char *scrubbed = strstr(line, ", paused (scrubbed)");
+    if (time == line && scrubbed && (!eol || scrubbed < eol)) sscanf(time, "limn: time %lf", &t); /* the last */
+  }
+  free(s);
+  if (t < 0) print_log(log);
+  fprintf(stderr, "scrubbed to %g (keys %g..%g)\n", t, lo, hi);
+  assert_true(fabs(t - lo) < 1e-4); /* the slider's left end: the first key */
+}
+
+/* The frame graph in the panel: opening it lists each pass's targets as
+ * buttons, and clicking one shows that target in the inspector. */
+static void panel_graph_button_inspects_target(void **state) {
+  (void)state;
+  char log[512], keys[512];
+  log_path(log, "panel_graph");
+  pid_t pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "4",
+                         "--script-keys", "3:widgets", NULL);
+  assert_int_equal(wait_exit(pid, 30000), 0);
+  double header[4], button[4];
+  find_control(log, "graph", header);
+  snprintf(keys, sizeof keys, "3:mouse=%d;%d,4:button=down,5:button=up,7:widgets", (int)(header[0] + header[2] / 2),
+           (int)(header[1] + header[3] / 2));
+  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "8", "--script-keys",
+                   keys, NULL);
+  assert_int_equal(wait_exit(pid, 30000), 0);
+  char *s = read_text(log), *line = strstr(s, "panel target gbuffer.clr ");
+  if (!line) print_log(log);
+  assert_non_null(line);
+  assert_int_equal(sscanf(line, "panel target gbuffer.clr %lf %lf %lf %lf", &button[0], &button[1], &button[2],
+                          &button[3]), 4);
+  free(s);
+  snprintf(keys + strlen(keys), sizeof keys - strlen(keys), ",8:mouse=%d;%d,9:button=down,10:button=up",
+           (int)(button[0] + button[2] / 2), (int)(button[1] + button[3] / 2));
+  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "13", "--script-keys",
+                   keys, NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  assert_true(file_has(log, "inspecting 'gbuffer.clr' rgba8"));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_teardown(command_line_errors, stop_leftover),
@@ -910,6 +1239,13 @@ int main(void) {
       cmocka_unit_test_teardown(time_survives_reload, stop_leftover),
       cmocka_unit_test_teardown(animation_moves_light_and_camera, stop_leftover),
       cmocka_unit_test_teardown(reload_loop_leaks_nothing, stop_leftover),
+      cmocka_unit_test_teardown(panel_has_every_option, stop_leftover),
+      cmocka_unit_test_teardown(panel_slider_changes_option_and_image, stop_leftover),
+      cmocka_unit_test_teardown(panel_shows_unsupported_option_read_only, stop_leftover),
+      cmocka_unit_test_teardown(job_leaves_and_comes_back, stop_leftover),
+      cmocka_unit_test_teardown(inspector_order_and_grey_depth, stop_leftover),
+      cmocka_unit_test_teardown(panel_plays_pauses_and_scrubs, stop_leftover),
+      cmocka_unit_test_teardown(panel_graph_button_inspects_target, stop_leftover),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -16,6 +16,7 @@ packages=(
   liblua5.4-dev libcglm-dev libopenimageio-dev libepoxy-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri libcmocka-dev libtinygltf-dev nlohmann-json3-dev
   libglfw3-dev libfreetype-dev fonts-dejavu-core xvfb xauth
+  libimgui-dev                           # the viewer's panel (cli/view_panel.cpp, Dear ImGui)
   clang libclang-rt-14-dev povray valgrind libxml2-utils
   slurmctld slurmd slurm-client munge    # tests/test_slurm.sh starts a one-node cluster
   python3                                # tests read JSON and GLB with it (test_scenes_gen, test_tools_cli)

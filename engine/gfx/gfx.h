@@ -287,5 +287,9 @@ bool lm_window_next_key(lm_window *w, char *name, size_t cap);
 bool lm_window_key_down(const lm_window *w, const char *name);
 /* Cursor movement in pixels since the last call while the left button is held. */
 void lm_window_mouse_drag(lm_window *w, double *dx, double *dy);
+/* Where the cursor is, window pixels from the top left (outside: beyond the size). */
+void lm_window_cursor(const lm_window *w, double *x, double *y);
+/* The GLFWwindow, for a user interface library's GLFW backend (the viewer's panel). */
+void *lm_window_handle(lm_window *w);
 
 #endif

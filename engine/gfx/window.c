@@ -137,3 +137,6 @@ void lm_window_mouse_drag(lm_window *w, double *dx, double *dy) {
   w->dragging = down;
   w->last_x = x, w->last_y = y;
 }
+
+void lm_window_cursor(const lm_window *w, double *x, double *y) { glfwGetCursorPos(w->glfw, x, y); }
+void *lm_window_handle(lm_window *w) { return w->glfw; }

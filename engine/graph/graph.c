@@ -368,7 +368,7 @@ lm_graph_pass_info lm_graph_pass(const lm_graph *g, int i) {
   int t = p->desc.output_count > 0 ? p->desc.outputs[0] : p->desc.depth;
   return (lm_graph_pass_info){p->desc.name, p->desc.where, p->desc.shader, p->desc.kind, p->culled,
                               p->ms, p->desc.fetches, t >= 0 ? g->targets[t].width : 0,
-                              t >= 0 ? g->targets[t].height : 0};
+                              t >= 0 ? g->targets[t].height : 0, &p->desc};
 }
 
 int lm_graph_target_count(const lm_graph *g) { return g->target_count; }

@@ -131,6 +131,7 @@ typedef struct lm_graph_pass_info {
   double ms;        /* last execution, -1 when not run */
   double fetches;   /* texture fetches a pixel the script declared, 0: not said */
   int width, height; /* its first output's size */
+  const lm_pass_desc *desc; /* as recorded: its inputs, outputs and depth target (the frame graph drawn) */
 } lm_graph_pass_info;
 int lm_graph_pass_count(const lm_graph *g);
 lm_graph_pass_info lm_graph_pass(const lm_graph *g, int i);

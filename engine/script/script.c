@@ -164,9 +164,12 @@ static void deep_copy(lua_State *L, int idx) {
   }
 }
 
-static void list_options(lua_State *L, int idx, const char *prefix, lm_buf *out) {
+/* Calls leaf(L, name, user) with each option's value on the stack top, in
+ * name order; a table with string keys holds options, any other table is
+ * one option's value. Sorted, so messages and lists read the same every time. */
+static void walk_options(lua_State *L, int idx, const char *prefix,
+                         void (*leaf)(lua_State *L, const char *name, void *user), void *user) {
   idx = lua_absindex(L, idx);
-  /* Sorted, so messages read the same every time. */
   lua_newtable(L);
   int keys = lua_absindex(L, -1), n = 0;
   lua_pushnil(L);
@@ -188,21 +191,114 @@ static void list_options(lua_State *L, int idx, const char *prefix, lm_buf *out)
     char full[256];
     snprintf(full, sizeof full, "%s%s%s", prefix, *prefix ? "." : "", k);
     lua_gettable(L, idx);
+    bool options = false;
     if (lua_istable(L, -1)) {
-      list_options(L, -1, full, out);
-    } else {
-      lm_buf_printf(out, "%s%s=%s", out->len ? ", " : "", full, luaL_tolstring(L, -1, NULL));
-      lua_pop(L, 1);
+      lua_pushnil(L);
+      while (!options && lua_next(L, -2)) {
+        options = lua_type(L, -2) == LUA_TSTRING;
+        lua_pop(L, lua_type(L, -2) == LUA_TSTRING ? 2 : 1);
+      }
     }
+    if (options)
+      walk_options(L, -1, full, leaf, user);
+    else
+      leaf(L, full, user);
     lua_pop(L, 1);
   }
   lua_pop(L, 1);
 }
 
+static void list_leaf(lua_State *L, const char *name, void *user) {
+  lm_buf *out = user;
+  if (lua_istable(L, -1)) return; /* a list: --set cannot set it */
+  lm_buf_printf(out, "%s%s=%s", out->len ? ", " : "", name, luaL_tolstring(L, -1, NULL));
+  lua_pop(L, 1);
+}
+
 void lm_pipeline_list_options(const lm_pipeline *p, lm_buf *out) {
   lua_rawgeti(p->L, LUA_REGISTRYINDEX, p->options_ref);
-  list_options(p->L, -1, "", out);
+  walk_options(p->L, -1, "", list_leaf, out);
   lua_pop(p->L, 1);
+}
+
+typedef struct option_list {
+  lm_option_info *items;
+  int count, cap;
+} option_list;
+
+static void info_leaf(lua_State *L, const char *name, void *user) {
+  option_list *list = user;
+  if (list->count == list->cap) {
+    list->cap = list->cap ? list->cap * 2 : 64;
+    list->items = lm_realloc(list->items, (size_t)list->cap * sizeof *list->items);
+  }
+  lm_option_info *o = &list->items[list->count++];
+  *o = (lm_option_info){.rule = LM_RULE_NONE};
+  snprintf(o->name, sizeof o->name, "%s", name);
+  switch (lua_type(L, -1)) {
+  case LUA_TBOOLEAN: o->type = LM_OPTION_BOOLEAN; break;
+  case LUA_TNUMBER: o->type = LM_OPTION_NUMBER; break;
+  case LUA_TSTRING: o->type = LM_OPTION_STRING; break;
+  default: o->type = LM_OPTION_OTHER;
+  }
+  if (o->type == LM_OPTION_OTHER)
+    snprintf(o->value, sizeof o->value, "%s", luaL_typename(L, -1));
+  else {
+    snprintf(o->value, sizeof o->value, "%s", luaL_tolstring(L, -1, NULL));
+    lua_pop(L, 1);
+  }
+}
+
+/* describe(info, name): the script's options.describe(name) into info (run by pcall). */
+static int describe_rule(lua_State *L) {
+  lm_option_info *o = lua_touserdata(L, 1);
+  lua_getfield(L, LUA_REGISTRYINDEX, LOADED_KEY);
+  lua_getfield(L, -1, "options");
+  if (!lua_istable(L, -1)) return 0; /* the script never required options.lua */
+  lua_getfield(L, -1, "describe");
+  if (!lua_isfunction(L, -1)) return 0;
+  lua_pushvalue(L, 2);
+  lua_call(L, 1, 1);
+  if (!lua_istable(L, -1)) return 0;
+  static const char *kinds[] = {"number", "whole", "boolean", "one_of", "colour"};
+  static const lm_option_rule rules[] = {LM_RULE_NUMBER, LM_RULE_WHOLE, LM_RULE_BOOLEAN, LM_RULE_ONE_OF,
+                                         LM_RULE_COLOUR};
+  lua_getfield(L, -1, "kind");
+  const char *kind = lua_tostring(L, -1);
+  for (int i = 0; kind && i < 5; i++)
+    if (!strcmp(kind, kinds[i])) o->rule = rules[i];
+  lua_pop(L, 1);
+  double *bounds[] = {&o->lo, &o->hi, &o->step};
+  const char *fields[] = {"lo", "hi", "step"};
+  for (int i = 0; i < 3; i++) {
+    lua_getfield(L, -1, fields[i]);
+    *bounds[i] = lua_isnumber(L, -1) ? lua_tonumber(L, -1) : 0;
+    lua_pop(L, 1);
+  }
+  lua_getfield(L, -1, "values");
+  for (int i = 1; lua_istable(L, -1) && o->choice_count < LM_OPTION_CHOICES; i++) {
+    lua_rawgeti(L, -1, i);
+    if (lua_isnil(L, -1)) break;
+    snprintf(o->choices[o->choice_count++], sizeof o->choices[0], "%s", luaL_tolstring(L, -1, NULL));
+    lua_pop(L, 2);
+  }
+  return 0;
+}
+
+int lm_pipeline_options(lm_pipeline *p, lm_option_info **out) {
+  option_list list = {0};
+  lua_rawgeti(p->L, LUA_REGISTRYINDEX, p->options_ref);
+  walk_options(p->L, -1, "", info_leaf, &list);
+  lua_pop(p->L, 1);
+  for (int i = 0; i < list.count; i++) {
+    lm_error err;
+    lua_pushcfunction(p->L, describe_rule);
+    lua_pushlightuserdata(p->L, &list.items[i]);
+    lua_pushstring(p->L, list.items[i].name);
+    if (!pcall(p, 2, &err)) lm_warn("%s: describing option %s: %s", p->path, list.items[i].name, err.msg);
+  }
+  *out = list.items;
+  return list.count;
 }
 
 bool lm_pipeline_get_option(const lm_pipeline *p, const char *name, char *value, size_t cap) {

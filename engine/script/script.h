@@ -38,6 +38,27 @@ bool lm_pipeline_get_option(const lm_pipeline *p, const char *name, char *value,
 /* "name=default" lines of every option. */
 void lm_pipeline_list_options(const lm_pipeline *p, lm_buf *out);
 
+/* Each option as a tool shows it (the viewer's panel): its value's type and
+ * text, and what its rule asks when the script's `options` module describes
+ * it (scripts/options.lua's options.describe). */
+typedef enum lm_option_type { LM_OPTION_BOOLEAN, LM_OPTION_NUMBER, LM_OPTION_STRING, LM_OPTION_OTHER } lm_option_type;
+typedef enum lm_option_rule {
+  LM_RULE_NONE, LM_RULE_NUMBER, LM_RULE_WHOLE, LM_RULE_BOOLEAN, LM_RULE_ONE_OF, LM_RULE_COLOUR
+} lm_option_rule;
+#define LM_OPTION_CHOICES 16
+typedef struct lm_option_info {
+  char name[128];       /* dotted, as --set takes it */
+  lm_option_type type;
+  char value[256];      /* as text (LM_OPTION_OTHER: Lua's name of its type, "table", "function") */
+  lm_option_rule rule;
+  double lo, hi, step;  /* NUMBER, WHOLE (step > 0), COLOUR (each channel); hi may be HUGE_VAL */
+  int choice_count;     /* ONE_OF */
+  char choices[LM_OPTION_CHOICES][64];
+} lm_option_info;
+/* Every option the script declares, in lm_pipeline_list_options' order, and
+ * lists (tables without names) too; *out is malloc'd. Returns the count. */
+int lm_pipeline_options(lm_pipeline *p, lm_option_info **out);
+
 /* What shadow_plan() plans from: the scene, the camera's frame block, and
  * where the plan goes (owned by the caller, kept until the frame executes);
  * still: how many frames in a row before this one drew the same world

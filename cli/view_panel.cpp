@@ -1,0 +1,339 @@
+// The viewer's panel through Dear ImGui (view_panel.h says what it shows).
+// A thin bridge: the model comes from C each frame, the edit goes back as
+// text that the viewer sets as --set would; nothing here keeps settings.
+#include "view_panel.h"
+
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+
+#include <cfloat>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+struct widget {
+  std::string name, kind, group;
+  float rect[4]; // x y w h; zero while a closed group hides it
+};
+
+struct lm_panel {
+  ImGuiContext *context;
+  bool scripted;           // panel_set_mouse took over the mouse
+  double mouse[2];
+  bool mouse_down;
+  std::vector<widget> widgets;     // the last frame's options
+  std::vector<widget> techniques;  // and techniques
+  std::vector<widget> controls;    // and the buttons and the time slider
+  // The panel's image, drawn again only when ImGui's draw lists change: on
+  // llvmpipe drawing it costs about as much as a small frame's pass, while
+  // compositing a kept image is one texture read in the viewer's display pass.
+  lm_texture image;
+  int image_w, image_h;
+  uint64_t drawn;                  // the draw lists' hash in `image`
+};
+
+lm_panel *panel_create(lm_window *w, lm_error *err) {
+  IMGUI_CHECKVERSION();
+  lm_panel *p = new lm_panel();
+  p->context = ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr; // no imgui.ini in the user's folder
+  ImGui::StyleColorsDark();
+  ImGui::GetStyle().Alpha = 0.92f;
+  // The backends chain GLFW's callbacks: the viewer's key queue still gets every key.
+  bool glfw = ImGui_ImplGlfw_InitForOpenGL(static_cast<GLFWwindow *>(lm_window_handle(w)), true);
+  if (!glfw || !ImGui_ImplOpenGL3_Init("#version 410 core")) {
+    lm_error_set(err, "the panel (Dear ImGui) could not start on this OpenGL context");
+    if (glfw) ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext(p->context);
+    delete p;
+    return nullptr;
+  }
+  return p;
+}
+
+void panel_destroy(lm_panel *p) {
+  if (!p) return;
+  lm_texture_destroy(&p->image);
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext(p->context);
+  delete p;
+}
+
+void panel_set_mouse(lm_panel *p, double x, double y, bool down) {
+  p->scripted = true;
+  p->mouse[0] = x, p->mouse[1] = y;
+  p->mouse_down = down;
+}
+
+bool panel_wants_mouse(const lm_panel *p) { return p && ImGui::GetIO().WantCaptureMouse; }
+bool panel_wants_keyboard(const lm_panel *p) { return p && ImGui::GetIO().WantCaptureKeyboard; }
+
+// The widget an option gets: its rule decides, else its value's type.
+static const char *widget_kind(const lm_option_info &o) {
+  if (o.type == LM_OPTION_OTHER) return "read-only";
+  if (o.type == LM_OPTION_BOOLEAN) return "checkbox";
+  if (o.rule == LM_RULE_ONE_OF && o.choice_count > 0) return "combo";
+  if (o.rule == LM_RULE_COLOUR) return "colour";
+  if (o.type == LM_OPTION_NUMBER && o.rule == LM_RULE_WHOLE && std::isfinite(o.hi)) return "slider-int";
+  if (o.type == LM_OPTION_NUMBER && o.rule == LM_RULE_NUMBER && std::isfinite(o.hi)) return "slider";
+  if (o.type == LM_OPTION_NUMBER) return "drag";
+  return "text";
+}
+
+// The last item's rectangle as a widget named `name` of `kind`.
+static widget last_item(const char *name, const char *kind, const char *group) {
+  ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
+  return widget{name, kind, group, {a.x, a.y, b.x - a.x, b.y - a.y}};
+}
+
+static void set_edit(panel_edits *e, const char *name, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static void set_edit(panel_edits *e, const char *name, const char *fmt, ...) {
+  e->option = true;
+  snprintf(e->option_name, sizeof e->option_name, "%s", name);
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(e->option_value, sizeof e->option_value, fmt, ap);
+  va_end(ap);
+}
+
+// One option's widget, labelled by its last name part; an edit goes into *e.
+static void option_widget(const lm_option_info &o, const char *kind, panel_edits *e) {
+  const char *field = strrchr(o.name, '.') ? strrchr(o.name, '.') + 1 : o.name;
+  std::string label = std::string(field) + "##" + o.name;
+  double value = atof(o.value);
+  if (!strcmp(kind, "read-only")) {
+    ImGui::TextDisabled("%s: a %s (not settable here: set it in the script)", field, o.value);
+  } else if (!strcmp(kind, "checkbox")) {
+    bool b = !strcmp(o.value, "true");
+    if (ImGui::Checkbox(label.c_str(), &b)) set_edit(e, o.name, "%s", b ? "true" : "false");
+  } else if (!strcmp(kind, "combo")) {
+    if (ImGui::BeginCombo(label.c_str(), o.value)) {
+      for (int i = 0; i < o.choice_count; i++)
+        if (ImGui::Selectable(o.choices[i], !strcmp(o.choices[i], o.value))) set_edit(e, o.name, "%s", o.choices[i]);
+      ImGui::EndCombo();
+    }
+  } else if (!strcmp(kind, "colour")) {
+    float c[3] = {0, 0, 0};
+    int n = sscanf(o.value, "%f,%f,%f", &c[0], &c[1], &c[2]);
+    if (n == 1) c[1] = c[2] = c[0];
+    ImGuiColorEditFlags flags = ImGuiColorEditFlags_Float | (o.hi > 1 ? ImGuiColorEditFlags_HDR : 0);
+    if (ImGui::ColorEdit3(label.c_str(), c, flags)) {
+      for (float &x : c) x = std::fmin(std::fmax(x, 0.0f), static_cast<float>(o.hi));
+      set_edit(e, o.name, "%g,%g,%g", c[0], c[1], c[2]);
+    }
+  } else if (!strcmp(kind, "slider-int")) {
+    int step = o.step > 0 ? static_cast<int>(o.step) : 1, lo = static_cast<int>(o.lo);
+    int hi = static_cast<int>(std::fmin(o.hi, 1e9)), v = static_cast<int>(value);
+    ImGuiSliderFlags flags = ImGuiSliderFlags_AlwaysClamp | (hi - lo > 1000 ? ImGuiSliderFlags_Logarithmic : 0);
+    if (ImGui::SliderInt(label.c_str(), &v, lo, hi, "%d", flags)) {
+      v = lo + (v - lo) / step * step; // the rule's multiples (odd, multiple)
+      set_edit(e, o.name, "%d", v);
+    }
+  } else if (!strcmp(kind, "slider")) {
+    // Wide ranges (0..1e6) slide logarithmically: a linear one would leave
+    // every useful value in its first pixel.
+    float v = static_cast<float>(value), lo = static_cast<float>(o.lo), hi = static_cast<float>(o.hi);
+    bool wide = hi - lo > 100 || (lo > 0 && hi / lo > 100);
+    ImGuiSliderFlags flags = ImGuiSliderFlags_AlwaysClamp | (wide ? ImGuiSliderFlags_Logarithmic : 0);
+    if (ImGui::SliderFloat(label.c_str(), &v, lo, hi, "%.4g", flags)) set_edit(e, o.name, "%.6g", v);
+  } else if (!strcmp(kind, "drag")) {
+    // No upper bound (options.positive() or no rule): a drag whose speed follows the value.
+    float v = static_cast<float>(value), lo = o.rule == LM_RULE_NONE ? -FLT_MAX : static_cast<float>(o.lo);
+    float speed = std::fmax(std::fabs(v) * 0.01f, 0.001f);
+    if (ImGui::DragFloat(label.c_str(), &v, speed, lo, FLT_MAX, "%.4g", ImGuiSliderFlags_AlwaysClamp))
+      set_edit(e, o.name, "%.6g", v);
+  } else { // text, applied on Enter (a file name half typed is no setting); ImGui keeps it while edited
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", o.value);
+    if (ImGui::InputText(label.c_str(), buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue))
+      set_edit(e, o.name, "%s", buf);
+  }
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("%s = %s%s", o.name, o.value, o.rule == LM_RULE_NONE ? " (no rule in the script)" : "");
+}
+
+// Groups: the first name part (the module), nested tables as tree nodes;
+// the pipeline's own options (no dot) under "pipeline".
+static std::vector<std::string> groups_of(const char *name) {
+  std::vector<std::string> g;
+  const char *s = name;
+  for (const char *dot; (dot = strchr(s, '.')); s = dot + 1) g.emplace_back(s, dot - s);
+  if (g.empty()) g.emplace_back("pipeline");
+  return g;
+}
+
+static void options_section(lm_panel *p, const panel_model *m, panel_edits *e) {
+  p->widgets.assign(m->option_count, widget{});
+  std::vector<std::string> path; // groups now open or skipped
+  std::vector<bool> shown;        // each level's contents shown
+  auto close_to = [&](size_t depth) {
+    while (path.size() > depth) {
+      if (path.size() > 1 && shown.back()) ImGui::TreePop();
+      path.pop_back(), shown.pop_back();
+    }
+  };
+  for (int i = 0; i < m->option_count; i++) {
+    const lm_option_info &o = m->options[i];
+    std::vector<std::string> g = groups_of(o.name);
+    size_t common = 0;
+    while (common < path.size() && common < g.size() && path[common] == g[common]) common++;
+    close_to(common);
+    for (size_t d = path.size(); d < g.size(); d++) {
+      bool parent = d == 0 || shown.back(), open = false;
+      if (parent && d == 0)
+        open = ImGui::CollapsingHeader(g[d].c_str(), g[d] == "pipeline" ? ImGuiTreeNodeFlags_DefaultOpen : 0);
+      else if (parent)
+        open = ImGui::TreeNode(g[d].c_str());
+      path.push_back(g[d]), shown.push_back(open);
+    }
+    widget &w = p->widgets[i];
+    w.name = o.name, w.kind = widget_kind(o), w.group = g[0];
+    if (!shown.back()) continue;
+    ImGui::PushID(i);
+    option_widget(o, w.kind.c_str(), e);
+    ImGui::PopID();
+    w = last_item(o.name, w.kind.c_str(), g[0].c_str());
+  }
+  close_to(0);
+}
+
+// The frame graph: each pass with its time as a bar (culled ones grey), and
+// its inputs and outputs as buttons that show the target in the inspector.
+// Closed by default: open, its bars change every frame, and so the panel's image.
+static void graph_section(lm_panel *p, const panel_model *m, panel_edits *e) {
+  if (!m->pass_count) return;
+  bool open = ImGui::CollapsingHeader("frame graph");
+  p->controls.push_back(last_item("graph", "header", "panel"));
+  if (!open) return;
+  double longest = 0;
+  for (int i = 0; i < m->pass_count; i++) longest = std::fmax(longest, m->passes[i].ms);
+  for (int i = 0; i < m->pass_count; i++) {
+    const panel_pass &pass = m->passes[i];
+    ImGui::PushID(i);
+    if (pass.culled) {
+      ImGui::TextDisabled("%s (culled: nothing it writes reaches the output)", pass.name);
+    } else {
+      char ms[32];
+      snprintf(ms, sizeof ms, "%.2f ms", pass.ms);
+      ImGui::TextUnformatted(pass.name);
+      ImGui::ProgressBar(longest > 0 && pass.ms > 0 ? static_cast<float>(pass.ms / longest) : 0.0f, ImVec2(-FLT_MIN, 0),
+                         ms);
+    }
+    if (pass.culled) ImGui::PushStyleVar(ImGuiStyleVar_Alpha, 0.5f);
+    for (int k = 0; k < pass.input_count + pass.output_count; k++) {
+      bool input = k < pass.input_count;
+      int t = input ? pass.inputs[k] : pass.outputs[k - pass.input_count];
+      if (t < 0 || t >= m->target_count) continue;
+      if (k == 0 || k == pass.input_count) ImGui::TextDisabled(input ? " in " : " out");
+      // On the line while the button fits, else on the next.
+      float width = ImGui::CalcTextSize(m->targets[t]).x + 2 * ImGui::GetStyle().FramePadding.x;
+      float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
+      if (ImGui::GetItemRectMax().x + ImGui::GetStyle().ItemSpacing.x + width <= right) ImGui::SameLine();
+      ImGui::PushID(k);
+      if (ImGui::SmallButton(m->targets[t])) e->inspect = t;
+      p->controls.push_back(last_item(m->targets[t], "target", pass.name));
+      ImGui::PopID();
+    }
+    if (pass.culled) ImGui::PopStyleVar();
+    ImGui::PopID();
+  }
+}
+
+// What the draw lists draw: vertices, indices, commands and the display size.
+static uint64_t draw_hash(const ImDrawData *d) {
+  uint64_t h = lm_hash(&d->DisplaySize, sizeof d->DisplaySize, 14695981039346656037ull);
+  for (int i = 0; i < d->CmdListsCount; i++) {
+    const ImDrawList *l = d->CmdLists[i];
+    h = lm_hash(l->VtxBuffer.Data, sizeof(ImDrawVert) * static_cast<size_t>(l->VtxBuffer.Size), h);
+    h = lm_hash(l->IdxBuffer.Data, sizeof(ImDrawIdx) * static_cast<size_t>(l->IdxBuffer.Size), h);
+    for (const ImDrawCmd &c : l->CmdBuffer) {
+      h = lm_hash(&c.ClipRect, sizeof c.ClipRect, h);
+      h = lm_hash(&c.TextureId, sizeof c.TextureId, h);
+      unsigned counts[3] = {c.ElemCount, c.IdxOffset, c.VtxOffset};
+      h = lm_hash(counts, sizeof counts, h);
+    }
+  }
+  return h;
+}
+
+lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height, panel_edits *e) {
+  *e = panel_edits{};
+  e->technique = -1, e->inspect = -1;
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGuiIO &io = ImGui::GetIO();
+  if (p->scripted) {
+    io.MousePos = ImVec2(static_cast<float>(p->mouse[0]), static_cast<float>(p->mouse[1]));
+    io.MouseDown[0] = p->mouse_down;
+  }
+  ImGui::NewFrame();
+  float w = std::fmin(320.0f, 0.45f * static_cast<float>(width));
+  ImGui::SetNextWindowPos(ImVec2(static_cast<float>(width) - w, 0), ImGuiCond_Always);
+  ImGui::SetNextWindowSize(ImVec2(w, static_cast<float>(height)), ImGuiCond_Always);
+  ImGui::Begin("limn", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  ImGui::PushItemWidth(-ImGui::GetWindowWidth() * 0.45f);
+  p->controls.clear();
+  if (ImGui::Button("Write job (J)")) e->write_job = true;
+  p->controls.push_back(last_item("job", "button", "panel"));
+  if (m->status) ImGui::TextWrapped("%s", m->status);
+  if (m->cost) ImGui::TextDisabled("%s", m->cost);
+  if (m->animated && ImGui::CollapsingHeader("time", ImGuiTreeNodeFlags_DefaultOpen)) {
+    if (ImGui::Button(m->paused ? "Play (Space)" : "Pause (Space)")) e->play = true;
+    p->controls.push_back(last_item("play", "button", "time"));
+    float t = static_cast<float>(m->time);
+    float lo = static_cast<float>(m->time_lo), hi = static_cast<float>(std::fmax(m->time_hi, m->time_lo + 1e-3));
+    if (ImGui::SliderFloat("time##scrub", &t, lo, hi, "%.3f s")) e->scrub = true, e->scrub_time = t;
+    p->controls.push_back(last_item("time", "slider", "time"));
+  }
+  p->techniques.assign(m->technique_count, widget{});
+  if (ImGui::CollapsingHeader("techniques", ImGuiTreeNodeFlags_DefaultOpen) &&
+      ImGui::BeginListBox("##techniques", ImVec2(-FLT_MIN, 5.5f * ImGui::GetTextLineHeightWithSpacing()))) {
+    for (int i = 0; i < m->technique_count; i++) {
+      if (ImGui::Selectable(m->techniques[i], i == m->technique)) e->technique = i;
+      if (i == m->technique && ImGui::IsWindowAppearing()) ImGui::SetScrollHereY();
+      p->techniques[i] = last_item(m->techniques[i], "technique", "techniques");
+    }
+    ImGui::EndListBox();
+  }
+  graph_section(p, m, e);
+  options_section(p, m, e);
+  ImGui::PopItemWidth();
+  ImGui::End();
+  ImGui::Render();
+  ImDrawData *d = ImGui::GetDrawData();
+  if (!p->image.id || p->image_w != width || p->image_h != height) {
+    lm_texture_destroy(&p->image);
+    lm_texture_desc desc = {LM_FORMAT_RGBA8, width, height, false};
+    lm_error err;
+    if (!lm_texture_create(&p->image, &desc, "viewer panel", &err)) return p->image;
+    p->image_w = width, p->image_h = height, p->drawn = 0;
+  }
+  uint64_t h = draw_hash(d);
+  if (h != p->drawn) { // premultiplied: ImGui blends alpha as "over" into the cleared image
+    lm_attachments att = {{p->image}, 1, {0}, width, height};
+    lm_error err;
+    if (!lm_attachments_bind(&att, &err)) return lm_texture{0};
+    lm_texture_clear(p->image);
+    ImGui_ImplOpenGL3_RenderDrawData(d);
+    p->drawn = h;
+  }
+  return p->image;
+}
+
+void panel_list_widgets(const lm_panel *p, FILE *out) {
+  for (const widget &w : p->widgets)
+    fprintf(out, "panel widget %s %s %s %.0f %.0f %.0f %.0f\n", w.name.c_str(), w.kind.c_str(), w.group.c_str(),
+            w.rect[0], w.rect[1], w.rect[2], w.rect[3]);
+  for (const std::vector<widget> *list : {&p->techniques, &p->controls})
+    for (const widget &w : *list)
+      fprintf(out, "panel %s %s %.0f %.0f %.0f %.0f\n",
+              w.kind == "technique" || w.kind == "target" ? w.kind.c_str() : "control", w.name.c_str(), w.rect[0],
+              w.rect[1], w.rect[2], w.rect[3]);
+  fflush(out);
+}

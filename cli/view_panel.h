@@ -1,0 +1,85 @@
+/* The viewer's panel: a widget for every option of the script, chosen by its
+ * rule (options.lua), grouped by module; the techniques as a list; the time
+ * (play, pause, scrub); a button that writes the settings as a capture job.
+ * Dear ImGui (Debian's libimgui-dev, with its GLFW and OpenGL 3 backends)
+ * behind this C header, in view_panel.cpp. The panel knows nothing of
+ * pipelines: the viewer hands it a model each frame and applies the edit it
+ * returns as --set would. */
+#ifndef LIMN_VIEW_PANEL_H
+#define LIMN_VIEW_PANEL_H
+
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#include "gfx/gfx.h"
+#include "script/script.h"
+
+typedef struct lm_panel lm_panel;
+
+/* A pass of the frame graph as the panel draws it: its targets are indices
+ * into panel_model.targets. */
+typedef struct panel_pass {
+  const char *name;
+  bool culled;
+  double ms;                      /* its time last frame, < 0: not run */
+  const int *inputs, *outputs;    /* outputs: colour targets, then the depth target */
+  int input_count, output_count;
+} panel_pass;
+
+/* What the panel shows this frame (borrowed for the call). */
+typedef struct panel_model {
+  const lm_option_info *options;
+  int option_count;
+  const char *const *techniques;
+  int technique_count, technique; /* the current one's index */
+  bool animated;                  /* the time controls show */
+  double time, time_lo, time_hi;  /* seconds: now and the animation's keys' range */
+  bool paused;
+  const char *status;             /* a line under the buttons ("wrote out/view.lua"), or NULL */
+  const char *cost;               /* the panel's share of the frame, or NULL */
+  const panel_pass *passes;       /* the frame graph, in recording order */
+  int pass_count;
+  const char *const *targets;
+  int target_count;
+} panel_model;
+
+/* What the user did this frame (at most one of each: one widget is active at a time). */
+typedef struct panel_edits {
+  bool option;                    /* option_name = option_value, as --set takes it */
+  char option_name[128], option_value[256];
+  int technique;                  /* a technique picked, or -1 */
+  bool play, write_job;           /* the play/pause and job buttons */
+  bool scrub;                     /* the time slider moved to scrub_time */
+  double scrub_time;
+  int inspect;                    /* a target clicked in the frame graph, or -1 */
+} panel_edits;
+
+lm_panel *panel_create(lm_window *w, lm_error *err);
+void panel_destroy(lm_panel *p);
+/* Lays the panel out along the right edge of a width x height window, fills
+ * *edits, and returns the panel's image (RGBA8, premultiplied alpha, drawn
+ * again only when it changed) to composite over the frame; id 0 on a GL error. */
+lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height, panel_edits *edits);
+/* Scripted mouse input (tests): from this call on the panel sees the cursor
+ * at (x, y) window pixels and the left button as `down`, not the real mouse. */
+void panel_set_mouse(lm_panel *p, double x, double y, bool down);
+/* Does the panel take the mouse or the keyboard now (the cursor over it, a
+ * widget dragged, text typed)? The viewer then leaves them alone. */
+bool panel_wants_mouse(const lm_panel *p);
+bool panel_wants_keyboard(const lm_panel *p);
+/* One line per option of the last frame's model: "panel widget NAME KIND
+ * GROUP X Y W H" (the rectangle 0 0 0 0 where a closed group hides it),
+ * then "panel technique NAME X Y W H" per technique, "panel control NAME X Y
+ * W H" for the buttons, the time slider and the frame graph's header ("job",
+ * "play", "time", "graph") and, while that is open, "panel target NAME X Y W
+ * H" for each target button of each pass. */
+void panel_list_widgets(const lm_panel *p, FILE *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
