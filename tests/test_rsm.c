@@ -472,6 +472,60 @@ static void a_moving_camera_keeps_screen_space_light_current(void **state) {
   lm_scene_destroy(s);
 }
 
+/* The most frames any pixel of RSM's history holds after the last frame of
+ * r: the larger of the two state targets' g (the one written last and the
+ * one before it), at rsm's coarse factor 3 (auto below 256 pixels wide). */
+static float rsm_history_most(gl_result *r) {
+  float most = 0;
+  for (int i = 0; i < 2; i++) {
+    char name[64];
+    snprintf(name, sizeof name, "temporal.rsm3.state%d", i);
+    int w, h;
+    float *px = gl_read_target(r, name, &w, &h);
+    assert_non_null(px);
+    for (int k = 0; k < w * h; k++) most = fmaxf(most, px[4 * k + 1]);
+    free(px);
+  }
+  return most;
+}
+
+/* RSM's light is seen from the lights, so a moving camera alone leaves its
+ * history to grow (it reprojects), while a light that moves caps it at
+ * rsm.temporal.moving frames (4) and keeps every pixel unconverged, the
+ * camera moving or not: the cap reads the scene's own change
+ * (still_frames("scene"): lights, nodes, pose), not the world hash, which
+ * counts the camera too (a moving camera with a moving light left the
+ * history uncapped, the old light kept up to 36 frames). 12 frames of a
+ * slide, from the first frame. */
+static void a_moving_light_caps_the_history_under_a_moving_camera(void **state) {
+  (void)state;
+  static const char *const sets[] = {"ambient=0", "rsm.temporal.enabled=true", NULL};
+  float most[2];
+  for (int light = 0; light < 2; light++) {
+    lm_scene *s = closed_room(LM_LIGHT_POINT);
+    place_camera(s, -0.3f);
+    gl_result r = gl_render(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = sets, .width = W, .height = H});
+    assert_true(r.ok);
+    for (int f = 1; f <= 12; f++) {
+      place_camera(s, -0.3f + 0.02f * (float)f);
+      if (light) {
+        float *lamp = s->nodes[s->lights[0].node].local;
+        lamp[12] = 0.02f * (float)f; /* its translation's x */
+        lm_scene_update(s);
+      }
+      assert_true(gl_render_again(&r));
+    }
+    most[light] = rsm_history_most(&r);
+    assert_true(gl_all_finite(&r));
+    gl_result_free(&r);
+    lm_scene_destroy(s);
+  }
+  print_message("after 12 moving frames RSM's history holds at most %.0f frames (camera), %.0f (camera and light)\n",
+                most[0], most[1]);
+  assert_true(most[0] >= 12.0f);
+  assert_true(most[1] >= 1.0f && most[1] <= 4.0f);
+}
+
 static void bad_options_name_themselves(void **state) {
   (void)state;
   static const gl_bad_option cases[] = {
@@ -499,6 +553,7 @@ int main(void) {
       cmocka_unit_test(a_frame_that_reads_no_rsm_renders_none),
       cmocka_unit_test(rsm_tiles_are_kept_and_give_the_drawn_image),
       cmocka_unit_test(still_frames_with_temporal_reuse_converge),
+      cmocka_unit_test(a_moving_light_caps_the_history_under_a_moving_camera),
       cmocka_unit_test(a_light_change_reaches_converged_pixels_at_once),
       cmocka_unit_test(a_camera_move_leaves_no_ghost_edge),
       cmocka_unit_test(a_moving_camera_keeps_screen_space_light_current),
