@@ -75,7 +75,7 @@ isr.defaults.temporal.turn = "moving"
 -- 0.002058). Reuse lowers flicker only while the world moves (a few turned patterns average out the
 -- noise a fixed one drags along); on still frames a running mean changes by its noise each frame until it
 -- converges, which reuse off never does: 36 frames (0.01154, 0.002601) paid that at the start and after
--- the door stopped, 4 little (still frames' error 0.0067 against 0.0065 at 36 and 0.0068 off). At
+-- the door stopped, 4 little (still frames' error 0.0067, converged at 36 0.0067, reuse off 0.0068). At
 -- moving 3 and narrow 1/4 lag 5; at moving 2 0.01123, 0.002397 (noisier while moving).
 isr.defaults.temporal.frames, isr.defaults.temporal.moving, isr.defaults.temporal.narrow = 4, 2.5, 0
 
