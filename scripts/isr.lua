@@ -70,9 +70,14 @@ for k, v in pairs(temporal.defaults) do isr.defaults.temporal[k] = v end
 -- running mean flickered by its noise on every still frame and converged further from POV-Ray than
 -- the fixed pattern (0.0491 against 0.0472 at the open door).
 isr.defaults.temporal.turn = "moving"
--- isr+rsm+esm (whose RSM turns every frame, and its rays with it) on the door sequence: 0.01131 mean
--- error, 0.002267 flicker, lag 0 against reuse off's 0.01179, 0.002365; at moving 4 and narrow 1/4 lag 5.
-isr.defaults.temporal.moving, isr.defaults.temporal.narrow = 3, 0
+-- isr+rsm+esm (whose RSM turns every frame, and its rays with it) on the door sequence from a cold start:
+-- 0.01147 mean error, 0.002347 flicker, lag 0 against reuse off's 0.01179, 0.002365 (warmed up: 0.01117,
+-- 0.002058). Reuse lowers flicker only while the world moves (a few turned patterns average out the
+-- noise a fixed one drags along); on still frames a running mean changes by its noise each frame until it
+-- converges, which reuse off never does: 36 frames (0.01154, 0.002601) paid that at the start and after
+-- the door stopped, 4 little (still frames' error 0.0067, converged at 36 0.0067, reuse off 0.0068). At
+-- moving 3 and narrow 1/4 lag 5; at moving 2 0.01123, 0.002397 (noisier while moving).
+isr.defaults.temporal.frames, isr.defaults.temporal.moving, isr.defaults.temporal.narrow = 4, 2.5, 0
 
 local views = { lit = 0, indirect = 1, ao = 2 }
 

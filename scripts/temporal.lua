@@ -199,7 +199,10 @@ function temporal.bind(user, inputs, defines, params, o, f, gather_turns)
   params.frames, params.epsilon, params.refresh = o.frames, o.epsilon, o.refresh
   params.bias, params.confidence, params.restart = o.bias, o.confidence, restart and 1 or 0
   params.moving, params.view_dependent = o.moving, histories[user].view and 1 or 0
-  params.world_moved = still_frames() == 0 and 1 or 0 -- the world hash changed (camera included)
+  -- The world changed since the last frame: for a view-dependent result anything, camera included; for
+  -- another (RSM's light, seen from the lights) the scene alone, so that a moving camera keeps its history
+  -- and a light or caster moving under a moving camera still caps it.
+  params.world_moved = (histories[user].view and still_frames() or still_frames("scene")) == 0 and 1 or 0
   params.turn = (o.turn == "always" or not histories[user].view and still_frames() == 0) and 1 or 0
   params.gather_turns = gather_turns and 1 or 0
   if velocity and o.velocity then inputs.velocity, defines.VELOCITY = velocity, true end

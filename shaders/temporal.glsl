@@ -26,7 +26,8 @@ uniform float epsilon = 0.02, frames = 36.0, bias = 0.1, confidence = 0.25;
 uniform int refresh = 32;
 uniform int restart = 0; // 1: the settings changed (temporal.begin), no history is kept
 uniform float moving = 0.0; // > 0: a view-dependent result's most frames while the view changes
-uniform int world_moved = 0; // 1: something in the world (a caster, a light) changed since the last frame
+uniform int world_moved = 0; // 1: the world changed since the last frame (a view-dependent result: the camera
+                             // too; another: the scene alone, still_frames("scene"))
 uniform int view_dependent = 0; // 1: the result depends on the view (ISR, SSDO), so a moving view caps it too
 uniform int turn = 1; // 1: the pass's pattern turns every frame; 0: only while the view moves (temporal.turn)
 uniform int gather_turns = 0; // 1: another gather in the pass turns every frame (isr+rsm+esm's RSM): the
@@ -48,14 +49,12 @@ bool temporal_self_moved = false;
 // light or caster that moves changes the RSM)? Its history then counts at
 // most `moving` frames, so that it follows the change with about that lag,
 // and no pixel counts as converged (a converged one would keep the old
-// light until its tile's refresh). `moving` 0: never. world_moved counts
-// the camera too (the renderer's world hash): for a result that does not
-// depend on the view it counts only on a still view, so a camera moving
-// while a light or caster moves leaves RSM's history uncapped there.
+// light until its tile's refresh). `moving` 0: never. For a result that
+// does not depend on the view, world_moved is the scene's change alone
+// (temporal.bind), so a camera moving while a light moves caps it too.
 bool temporal_moving() {
   bool view = frame.view_proj != frame.prev_view_proj;
-  bool world = world_moved != 0 && (view_dependent != 0 || !view);
-  return moving > 0.0 && ((view_dependent != 0 && view) || temporal_self_moved || world);
+  return moving > 0.0 && ((view_dependent != 0 && view) || temporal_self_moved || world_moved != 0);
 }
 
 // The frame by which the pass turns its sampling pattern: the frame's

@@ -67,6 +67,8 @@ struct lm_renderer {
   bool any_dynamic;
   uint64_t world;  /* the last frame's world_hash */
   int still;       /* frames in a row before this one whose world_hash was this one's */
+  uint64_t scene;  /* the last frame's scene_hash (the world without the camera) */
+  int scene_still; /* the same count for scene_hash */
   long executions; /* frames executed, never reset (tile_cache.execution) */
 };
 
@@ -555,21 +557,28 @@ static bool add_output_stage(lm_renderer *r, lm_graph *g, lm_pipeline *p, int pr
   return true;
 }
 
-/* A hash of what a frame draws besides its script's settings: the pipeline,
- * the scene's casters and materials (caster_hash), its lights, the camera,
- * the output size and the shaders' generation (not the time: a GI pass's
- * pattern turns each frame, but a still world's converged result stays). */
-static uint64_t world_hash(const lm_renderer *r, const lm_pipeline *p, const lm_frame_data *frame) {
+/* A hash of what a frame draws besides its script's settings and the
+ * camera: the pipeline, the scene's casters and materials (caster_hash, the
+ * nodes' transforms and pose with them), its lights and the shaders'
+ * generation. What a light's view (shadow tiles, RSM) sees depends on
+ * nothing else. */
+static uint64_t scene_hash(const lm_renderer *r, const lm_pipeline *p) {
   lm_light_data lights[MAX_LIGHTS];
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
   unsigned shaders = lm_programs_generation();
   uint64_t h = lm_hash(&p, sizeof p, caster_hash(r));
   h = lm_hash(lights, sizeof *lights * (size_t)n, lm_hash(&n, sizeof n, h));
-  h = lm_hash(frame->view_proj, sizeof frame->view_proj, h);
+  return lm_hash(&shaders, sizeof shaders, h);
+}
+
+/* The scene's hash with the camera and the output size: all a frame draws
+ * besides its script's settings (not the time: a GI pass's pattern turns
+ * each frame, but a still world's converged result stays). */
+static uint64_t world_hash(uint64_t scene, const lm_frame_data *frame) {
+  uint64_t h = lm_hash(frame->view_proj, sizeof frame->view_proj, scene);
   h = lm_hash(frame->camera_pos, sizeof frame->camera_pos, h);
   h = lm_hash(frame->clip, sizeof frame->clip, h);
-  h = lm_hash(frame->output_size, sizeof frame->output_size, h);
-  return lm_hash(&shaders, sizeof shaders, h);
+  return lm_hash(frame->output_size, sizeof frame->output_size, h);
 }
 
 /* Records (OnRender) and compiles one frame of pipeline p into g. */
@@ -598,10 +607,12 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
   }
   r->pose += lm_scene_upload_deformed(r->desc.scene) > 0;
   r->casters_hash = material_hash(s); /* once a frame: the world hash and the tile keys read it */
-  uint64_t world = world_hash(r, p, frame);
+  uint64_t scene = scene_hash(r, p), world = world_hash(scene, frame);
   r->still = r->frame > 0 && world == r->world ? r->still + 1 : 0;
+  r->scene_still = r->frame > 0 && scene == r->scene ? r->scene_still + 1 : 0;
   r->world = world;
-  lm_pipeline_set_scene(p, r->desc.scene, frame, &r->shadows, r->still);
+  r->scene = scene;
+  lm_pipeline_set_scene(p, r->desc.scene, frame, &r->shadows, r->still, r->scene_still);
   double t0 = lm_cpu_ms();
   int presented = -1;
   if (!lm_pipeline_record(p, g, &presented, err)) return false;

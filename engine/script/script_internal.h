@@ -27,6 +27,7 @@ struct lm_pipeline {
   lm_shadow_plan *shadows;
   unsigned shadows_frame; /* frame serial of the plan in *shadows */
   int still;              /* frames in a row before this one that drew the same world (still_frames) */
+  int scene_still;        /* the same without the camera (still_frames("scene")) */
   char sky_map[1024];     /* the sky map sky_sh{} read last ("" none) and its coefficients */
   float sky_map_sh[LM_SKY_SH];
 };
