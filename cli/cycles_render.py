@@ -5,7 +5,9 @@
 #           --python cli/cycles_render.py -- SPEC.json OUT.exr [SPEC.json OUT.exr ...]
 #
 # Several pairs in one run save Blender's start (seconds) a view; each fails
-# or renders on its own, and the run exits 1 when any failed.
+# or renders on its own, and the run exits 1 when any failed. With
+# $LIMN_PROGRESS_FD set (limn reference), the pair's index (0, 1, ...) and a
+# newline are written to that file descriptor as each OUT is complete.
 #
 # SPEC.json, one object (every key required unless marked optional):
 #   scene      absolute path of the .glb/.gltf file (Limn's coordinates: +Y up)
@@ -692,10 +694,15 @@ def main(argv):
         print("%s: usage: blender -b --factory-startup -noaudio --python-exit-code 1 --python "
               "cli/cycles_render.py -- SPEC.json OUT.exr [SPEC.json OUT.exr ...]" % PREFIX, file=sys.stderr)
         return 1
+    # limn reference's pipe: the pair's index once its OUT is complete (each view's time, and a view
+    # known complete even when a later one kills Blender).
+    progress = os.environ.get("LIMN_PROGRESS_FD")
     failed = 0
     for i in range(0, len(args), 2):  # several views in one run save Blender's start (seconds) a view
         try:
             render_view(args[i], args[i + 1])
+            if progress:
+                os.write(int(progress), b"%d\n" % (i // 2))
         except SpecError as e:
             print("%s: view '%s': %s" % (PREFIX, VIEW, e), file=sys.stderr)
             failed += 1
