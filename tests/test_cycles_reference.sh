@@ -178,6 +178,23 @@ kill -TERM $pid
 [ "$(ls refs-stop/ball/*.exr | wc -l)" = 1 ] && [ -z "$(find refs-stop -name "*tmp*" -o -name ".cycles*")" ] \
   || fail "a batch stopped in its second view: $(find refs-stop)"
 
+# 5c. A file camera whose aspectRatio (1) is not the output's (2:1): the spec keeps its yfov (0.75 rad),
+# as Limn's frame does (test_gltf), and Blender's vertical sensor fit widens x.
+python3 - "$root/data/scenes/pov_ball.gltf" square.gltf <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["cameras"][0]["perspective"]["aspectRatio"] = 1.0
+json.dump(d, open(sys.argv[2], "w"))
+PY
+sed -n 's#"ball.gltf", cameras = "one.cams"#"square.gltf"#; s/"32x24"/"32x16"/; p' job.lua > square.lua
+"$limn" reference --job square.lua "${cy[@]}" --refs refs-square >log 2>&1 || { cat log; fail "a square camera"; }
+python3 - refs-square/square/*.json <<'PY' || fail "the spec does not keep the camera's yfov on a wider output"
+import json, math, sys
+s = json.load(open(sys.argv[1]))
+assert (s["width"], s["height"]) == (32, 16), s
+assert abs(s["camera"]["fov_y"] - math.degrees(0.75)) < 1e-4, s["camera"]
+PY
+
 # 6. Shards split the views: 0/2 renders the first camera, 1/2 the second, then both are cached.
 sed 's/one.cams/ball.cams/' job.lua > two.lua
 rm -f calls
