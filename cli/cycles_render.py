@@ -5,7 +5,9 @@
 #           --python cli/cycles_render.py -- SPEC.json OUT.exr [SPEC.json OUT.exr ...]
 #
 # Several pairs in one run save Blender's start (seconds) a view; each fails
-# or renders on its own, and the run exits 1 when any failed.
+# or renders on its own, and the run exits 1 when any failed. With
+# $LIMN_PROGRESS_FD set (limn reference), the pair's index (0, 1, ...) and a
+# newline are written to that file descriptor as each OUT is complete.
 #
 # SPEC.json, one object (every key required unless marked optional):
 #   scene      absolute path of the .glb/.gltf file (Limn's coordinates: +Y up)
@@ -220,9 +222,6 @@ def check_and_tag(doc, path):
     lights = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
     for i, l in enumerate(lights):
         l["name"] = "limn_l%d" % i
-        if l.get("range"):
-            warn("range", "%s: light %d has range %g: Cycles has no range window, the light falls off "
-                 "as 1/d^2 past it (Limn's window clamp(1 - (d/range)^4, 0, 1) is left out)" % (part, i, l["range"]))
     return lights
 
 
@@ -288,7 +287,8 @@ def map_lights(lights):
     """Punctual lights stay punctual (radius and angle 0). Blender's importer
     converts the units (SPEC mode: W = cd * 4 pi / 683, W/m^2 = lux / 683);
     the spot's smooth edge is set so that Cycles' smoothstep over the cosine
-    runs from cos(outer) to cos(inner), as Limn's does."""
+    runs from cos(outer) to cos(inner), as Limn's does; a range gets Limn's
+    window (range_window)."""
     for obj in bpy.context.scene.objects:
         if obj.type != "LIGHT":
             continue
@@ -309,6 +309,47 @@ def map_lights(lights):
             light.spot_size = 2.0 * outer
             light.spot_blend = (ci - co) / (1.0 - co) if co < 1.0 else 0.0
             unfold_spot(light)
+        if light.type in ("POINT", "SPOT") and gl.get("range", 0) > 0:
+            range_window(light, float(gl["range"]))
+
+
+def scale_strength(light):
+    """The light's node tree (made when it has none) and a Multiply node
+    whose first input is what fed its Emission's Strength and whose output
+    now feeds it: link or set a factor into its second input."""
+    light.use_nodes = True
+    nodes, links = light.node_tree.nodes, light.node_tree.links
+    strength = next(n for n in nodes if n.type == "EMISSION").inputs["Strength"]
+    product = nodes.new("ShaderNodeMath")
+    product.operation = "MULTIPLY"
+    if strength.is_linked:
+        links.new(strength.links[0].from_socket, product.inputs[0])
+    else:
+        product.inputs[0].default_value = strength.default_value
+    links.new(product.outputs[0], strength)
+    return nodes, links, product.inputs[1]
+
+
+def range_window(light, reach):
+    """KHR_lights_punctual's range as Limn windows it (engine/scene/scene.c
+    lm_light_falloff): the light times clamp(1 - (d / range)^4, 0, 1) over
+    its 1/d^2, d the distance from the light, which Cycles gives a light's
+    shader as the Light Path's Ray Length."""
+    nodes, links, factor = scale_strength(light)
+    path = nodes.new("ShaderNodeLightPath")
+    ratio = nodes.new("ShaderNodeMath")
+    ratio.operation = "DIVIDE"
+    links.new(path.outputs["Ray Length"], ratio.inputs[0])
+    ratio.inputs[1].default_value = reach
+    fourth = nodes.new("ShaderNodeMath")
+    fourth.operation = "POWER"
+    links.new(ratio.outputs[0], fourth.inputs[0])
+    fourth.inputs[1].default_value = 4.0
+    window = nodes.new("ShaderNodeMath")
+    window.operation, window.use_clamp = "SUBTRACT", True
+    window.inputs[0].default_value = 1.0
+    links.new(fourth.outputs[0], window.inputs[1])
+    links.new(window.outputs[0], factor)
 
 
 def unfold_spot(light):
@@ -317,9 +358,7 @@ def unfold_spot(light):
     alone: the light's strength is divided by that cosine (the light's local
     -Z, its Normal coordinate; at least cos(outer) inside the cone, and the
     division kept finite outside it)."""
-    light.use_nodes = True
-    nodes, links = light.node_tree.nodes, light.node_tree.links
-    emission = next(n for n in nodes if n.type == "EMISSION")
+    nodes, links, factor = scale_strength(light)
     coords = nodes.new("ShaderNodeTexCoord")
     split = nodes.new("ShaderNodeSeparateXYZ")
     links.new(coords.outputs["Normal"], split.inputs[0])
@@ -335,7 +374,7 @@ def unfold_spot(light):
     inverse.operation = "DIVIDE"
     inverse.inputs[0].default_value = 1.0
     links.new(floor.outputs[0], inverse.inputs[1])
-    links.new(inverse.outputs[0], emission.inputs["Strength"])
+    links.new(inverse.outputs[0], factor)
 
 
 # ---------------------------------------------------------------- materials
@@ -692,10 +731,15 @@ def main(argv):
         print("%s: usage: blender -b --factory-startup -noaudio --python-exit-code 1 --python "
               "cli/cycles_render.py -- SPEC.json OUT.exr [SPEC.json OUT.exr ...]" % PREFIX, file=sys.stderr)
         return 1
+    # limn reference's pipe: the pair's index once its OUT is complete (each view's time, and a view
+    # known complete even when a later one kills Blender).
+    progress = os.environ.get("LIMN_PROGRESS_FD")
     failed = 0
     for i in range(0, len(args), 2):  # several views in one run save Blender's start (seconds) a view
         try:
             render_view(args[i], args[i + 1])
+            if progress:
+                os.write(int(progress), b"%d\n" % (i // 2))
         except SpecError as e:
             print("%s: view '%s': %s" % (PREFIX, VIEW, e), file=sys.stderr)
             failed += 1

@@ -11,6 +11,7 @@
 #include <fcntl.h>
 #include <getopt.h>
 #include <glob.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -38,15 +39,17 @@ static const char reference_usage[] =
     "and sky, cli/cycles_render.py and Blender's version. A view whose hash\n"
     "has not changed is not rendered again. A sequence's frames are posed at\n"
     "their times, each DIR/<scene>/<camera>_<WxH>-<frame>-<time>-...exr.\n"
-    "POV-Ray runs in parallel, up to the core count; Cycles one view at a time\n"
-    "on every core.\n"
+    "POV-Ray runs in parallel, up to the core count; Blender renders a scene's\n"
+    "missing views in one run on every core (its start is seconds), each view's\n"
+    "reference in place as soon as it is complete.\n"
     "\n"
     "options:\n"
     "  --job FILE           the capture job (docs/capture-jobs.md)\n"
     "  --refs DIR           where the references go (default out/reference)\n"
     "  --force              render again even what exists\n"
     "  --jobs N             renders at once (default: POV-Ray the core count,\n"
-    "                       Cycles 1, its threads the cores)\n"
+    "                       Cycles 1, its threads the cores; N Blender runs\n"
+    "                       share a scene's views)\n"
     "  --povray PROGRAM     the POV-Ray program (default povray)\n"
     REFERENCE_OPTIONS_HELP
     "  --shard I/N          views I, I+N, I+2N ... only (numbered as capture's,\n"
@@ -183,8 +186,10 @@ static const char *file_part(const char *p) {
 }
 
 /* Starts argv[0] with argv, its output into `log`, in folder dir (NULL:
- * here); the child dies with this process. -1 when it cannot fork. */
-static pid_t reference_spawn(const char *const *argv, const char *dir, const char *log) {
+ * here), holding `progress` (a pipe's write end, named by
+ * $LIMN_PROGRESS_FD) until it exits; the child dies with this process. -1
+ * when it cannot fork. */
+static pid_t reference_spawn(const char *const *argv, const char *dir, const char *log, int progress) {
   fflush(stdout);
   fflush(stderr);
   pid_t parent = getpid(), pid = fork();
@@ -198,6 +203,9 @@ static pid_t reference_spawn(const char *const *argv, const char *dir, const cha
     dup2(fd, STDERR_FILENO);
     close(fd);
   }
+  char number[16];
+  snprintf(number, sizeof number, "%d", progress);
+  if (fcntl(progress, F_SETFD, 0) != 0 || setenv("LIMN_PROGRESS_FD", number, 1) != 0) _exit(127);
   if (dir && chdir(dir) != 0) {
     fprintf(stderr, "cannot enter %s: %s\n", dir, strerror(errno));
     _exit(127);
@@ -209,7 +217,7 @@ static pid_t reference_spawn(const char *const *argv, const char *dir, const cha
 
 /* POV-Ray on <base>.pov in the reference's folder, writing tmp. */
 static pid_t start_povray(const reference_args *a, const char *base, const char *tmp, int width, int height,
-                          int threads) {
+                          int threads, int progress) {
   char dir[1024], in[1100], out[1100], log[1100], w[32], h[32], wt[32];
   lm_dirname(base, dir, sizeof dir);
   snprintf(in, sizeof in, "+I%s.pov", file_part(base));
@@ -219,17 +227,7 @@ static pid_t start_povray(const reference_args *a, const char *base, const char 
   snprintf(h, sizeof h, "+H%d", height);
   snprintf(wt, sizeof wt, "+WT%d", threads);
   const char *argv[] = {a->povray, "-D", "-V", in, out, "+FE", w, h, "-A", wt, NULL};
-  return reference_spawn(argv, dir, log);
-}
-
-/* Blender on the spec file, rendering into out. */
-static pid_t start_cycles(const reference_args *a, const char *spec, const char *out, const char *log,
-                          int threads) {
-  char t[32];
-  snprintf(t, sizeof t, "%d", threads);
-  const char *argv[REFERENCE_CYCLES_ARGC];
-  reference_cycles_argv(&a->cycles, spec, out, t, argv);
-  return reference_spawn(argv, NULL, log);
+  return reference_spawn(argv, dir, log, progress);
 }
 
 /* ---- the renderers' shared part --------------------------------------- */
@@ -258,42 +256,53 @@ bool reference_export(const reference_args *a, const job *j, const job_view *v, 
 }
 
 
-/* The renderer's error lines: from its first line that mentions an error to
- * the end (at most 20), else its last 10 lines. */
-static void show_log(const char *log) {
+/* The renderer's error lines: from the first line that holds `needle`
+ * (NULL: none), else the first that mentions an error, to the end (at most
+ * 20), else its last 10 lines. */
+static void show_log(const char *log, const char *needle) {
   size_t len;
   lm_error err;
   char *text = lm_read_file(log, &len, &err);
   if (!text) return;
   char *lines[4096];
-  int n = 0, first = -1;
+  int n = 0, first = -1, named = -1;
   for (char *p = text; *p && n < 4096;) {
     lines[n] = p;
     char *nl = strchr(p, '\n');
     if (nl) *nl = '\0';
+    if (named < 0 && needle && strstr(p, needle)) named = n;
     if (first < 0 && (strstr(p, "rror") || strstr(p, "cannot "))) first = n;
     n++;
     if (!nl) break;
     p = nl + 1;
   }
-  int from = first >= 0 ? first : (n > 10 ? n - 10 : 0);
+  int from = named >= 0 ? named : first >= 0 ? first : (n > 10 ? n - 10 : 0);
   int to = from + 20 < n ? from + 20 : n;
   for (int i = from; i < to; i++)
     if (lines[i][0]) fprintf(stderr, "  | %s\n", lines[i]);
   free(text);
 }
 
+/* A view to render: its place and its reference's path less ".exr". */
+typedef struct render_view {
+  int place;
+  bool done;
+  char base[1024];
+} render_view;
+
+/* One renderer process and the views it renders, todo[first .. first + count). */
 typedef struct render_run {
   pid_t pid;
-  int place;
-  double start_ms; /* lm_now_ms when it started: each view's time is printed */
-  char base[1024]; /* the reference's path without .exr */
-  char tmp[1100];  /* <base>.tmp-<pid>: POV-Ray's output (.exr), or Blender's folder (its output and temporaries) */
-  char out[1200];  /* what the renderer writes: tmp, or tmp/out.exr */
+  int progress;    /* the read end of the pipe it holds: Blender writes "K\n" as its view K is complete */
+  int first, count;
+  double last_ms;  /* lm_now_ms at its start or its last view's end: each view's time is printed */
+  char tmp[1100];  /* <first base>.tmp-<pid>: POV-Ray's output (.exr), or Blender's folder (its outputs) */
+  char line[32];   /* a progress line read in part */
+  int line_len;
 } render_run;
 
 /* SIGINT or SIGTERM while renders run: they are killed here, and the loop,
- * woken from wait(), removes their partial files and stops. */
+ * woken from poll(), removes their partial files and stops. */
 static volatile sig_atomic_t stop_signal;
 static render_run *volatile running_runs;
 static volatile int running_count;
@@ -342,125 +351,238 @@ static void view_error(const job *j, const job_view *places, int place, bool new
          s->scene->cameras[v->camera].name, j->sizes[v->size][0], j->sizes[v->size][1], frame, what);
 }
 
+/* What reference_run shares with the helpers below. */
+typedef struct render_state {
+  const reference_args *a;
+  const job *j;
+  const job_view *places;
+  render_view *todo;
+  int done, mine, rendered, rc;
+  bool cycles, tty;
+} render_state;
+
+/* Where run r's renderer writes its view k (k counted within the run). */
+static void run_output(const render_state *st, const render_run *r, int k, char *out, size_t cap) {
+  if (st->cycles) snprintf(out, cap, "%s/%d.exr", r->tmp, k);
+  else snprintf(out, cap, "%s", r->tmp);
+}
+
+/* View k of run r is complete: into place, with its time. */
+static void view_done(render_state *st, render_run *r, int k) {
+  render_view *t = &st->todo[r->first + k];
+  char out[1200], final[1100], what[1200];
+  run_output(st, r, k, out, sizeof out);
+  snprintf(final, sizeof final, "%s.exr", t->base);
+  if (rename(out, final) != 0) {
+    view_error(st->j, st->places, t->place, st->tty && !st->a->quiet, "cannot rename %s to %s: %s", out, final,
+               strerror(errno));
+    st->rc = 1;
+    return;
+  }
+  t->done = true;
+  double now = lm_now_ms();
+  st->rendered++;
+  snprintf(what, sizeof what, "%s (%.1f s)", final, (now - r->last_ms) / 1000);
+  r->last_ms = now;
+  job_progress(st->a->quiet, st->tty, ++st->done, st->mine, what);
+}
+
+/* Reads run r's progress; false at its end (the renderer has exited or closed it). */
+static bool read_progress(render_state *st, render_run *r) {
+  char buf[256];
+  ssize_t got = read(r->progress, buf, sizeof buf);
+  if (got < 0 && (errno == EINTR || errno == EAGAIN)) return true;
+  for (ssize_t i = 0; i < got; i++) {
+    if (buf[i] != '\n') {
+      if (r->line_len + 1 < (int)sizeof r->line) r->line[r->line_len++] = buf[i];
+      continue;
+    }
+    r->line[r->line_len] = '\0';
+    r->line_len = 0;
+    int k;
+    if (limn_parse_int(r->line, 0, r->count - 1, &k) && !st->todo[r->first + k].done) view_done(st, r, k);
+  }
+  return got > 0;
+}
+
+/* Run r has ended (its exit status): POV-Ray's view is complete when it
+ * exited 0 and wrote its file; each view Blender did not report failed. The
+ * log goes with the first failed view (a rerun of it replaces it), or away. */
+static void run_end(render_state *st, render_run *r, int status) {
+  const char *name = reference_renderer_name(st->a->renderer);
+  bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  char out[1200], log[1100], kept[1100] = "";
+  run_output(st, r, 0, out, sizeof out);
+  if (!st->cycles && !stop_signal && ok && lm_file_exists(out)) view_done(st, r, 0);
+  snprintf(log, sizeof log, "%s.log", st->todo[r->first].base);
+  for (int k = 0; k < r->count && !kept[0]; k++)
+    if (!st->todo[r->first + k].done) snprintf(kept, sizeof kept, "%s.log", st->todo[r->first + k].base);
+  if (!kept[0] || stop_signal) remove(log);
+  else if (strcmp(kept, log) != 0 && rename(log, kept) != 0) snprintf(kept, sizeof kept, "%s", log);
+  for (int k = 0; k < r->count && !stop_signal; k++) {
+    render_view *t = &st->todo[r->first + k];
+    if (t->done) continue;
+    if (ok)
+      view_error(st->j, st->places, t->place, st->tty && !st->a->quiet, "%s exited 0 but wrote no image; its log %s:",
+                 name, kept);
+    else
+      view_error(st->j, st->places, t->place, st->tty && !st->a->quiet, "%s failed (%s %d); its log %s:", name,
+                 WIFEXITED(status) ? "exit status" : "signal",
+                 WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status), kept);
+    char view[LM_NAME_MAX * 2 + 128], needle[LM_NAME_MAX * 2 + 160];
+    if (st->cycles) { /* the script's lines name the view as its spec does */
+      reference_cycles_view_name(st->j, &st->places[t->place], view, sizeof view);
+      snprintf(needle, sizeof needle, "view '%s'", view);
+    }
+    show_log(kept, st->cycles ? needle : NULL);
+    st->rc = 1;
+  }
+  remove_temp(r->tmp);
+}
+
+/* Starts the renderer on todo[first .. first + count) into *r; false (the views named) when it cannot. */
+static bool run_start(render_state *st, render_run *r, int first, int count, int threads) {
+  const reference_args *a = st->a;
+  render_view *t = &st->todo[first];
+  *r = (render_run){.first = first, .count = count, .progress = -1};
+  snprintf(r->tmp, sizeof r->tmp, "%s.tmp-%ld%s", t->base, (long)getpid(), st->cycles ? "" : ".exr");
+  char log[1100], why[1400] = "";
+  snprintf(log, sizeof log, "%s.log", t->base);
+  int fd[2];
+  /* Blender's own folder: whatever it writes beside its outputs goes with it. */
+  if (st->cycles && mkdir(r->tmp, 0777) != 0) snprintf(why, sizeof why, "%s: cannot make folder (%s)", r->tmp, strerror(errno));
+  else if (pipe2(fd, O_CLOEXEC) != 0) snprintf(why, sizeof why, "cannot make a pipe: %s", strerror(errno));
+  if (!why[0]) {
+    r->last_ms = lm_now_ms();
+    if (st->cycles) {
+      char number[32], (*files)[1200] = lm_alloc(sizeof *files * 2 * (size_t)count);
+      const char **argv = lm_alloc(sizeof *argv * (REFERENCE_CYCLES_ARGS + 2 * (size_t)count + 1));
+      snprintf(number, sizeof number, "%d", threads);
+      reference_cycles_argv(&a->cycles, number, argv);
+      for (int k = 0; k < count; k++) {
+        snprintf(files[2 * k], sizeof files[0], "%s.json", t[k].base);
+        run_output(st, r, k, files[2 * k + 1], sizeof files[0]);
+        argv[REFERENCE_CYCLES_ARGS + 2 * k] = files[2 * k];
+        argv[REFERENCE_CYCLES_ARGS + 2 * k + 1] = files[2 * k + 1];
+      }
+      argv[REFERENCE_CYCLES_ARGS + 2 * count] = NULL;
+      r->pid = reference_spawn(argv, NULL, log, fd[1]);
+      free(argv);
+      free(files);
+    } else {
+      const job_view *v = &st->places[t->place];
+      r->pid = start_povray(a, t->base, r->tmp, st->j->sizes[v->size][0], st->j->sizes[v->size][1], threads, fd[1]);
+    }
+    close(fd[1]);
+    r->progress = fd[0];
+    if (r->pid < 0) {
+      snprintf(why, sizeof why, "cannot start %s: %s", reference_renderer_name(a->renderer), strerror(errno));
+      close(fd[0]);
+    }
+  }
+  if (!why[0]) return true;
+  for (int k = 0; k < count; k++) view_error(st->j, st->places, t[k].place, st->tty && !a->quiet, "%s", why);
+  if (st->cycles) remove_temp(r->tmp);
+  st->rc = 1;
+  return false;
+}
+
 int reference_run(const reference_args *a, const job *j, const job_view *places, int n, char (*paths)[1024]) {
   lm_error err;
-  int rc = 0, done = 0, rendered = 0, cached = 0, running = 0, mine = 0;
-  bool cycles = a->renderer == REFERENCE_CYCLES;
-  const char *name = reference_renderer_name(a->renderer);
-  int cores = lm_cpu_count(), jobs = a->jobs > 0 ? a->jobs : cycles ? 1 : cores;
+  render_state st = {.a = a, .j = j, .places = places, .cycles = a->renderer == REFERENCE_CYCLES,
+                     .tty = isatty(STDOUT_FILENO)};
+  int cached = 0, running = 0, count = 0;
+  int cores = lm_cpu_count(), jobs = a->jobs > 0 ? a->jobs : st.cycles ? 1 : cores;
   int threads = cores > jobs ? cores / jobs : 1;
-  bool tty = isatty(STDOUT_FILENO);
   render_run *runs = lm_alloc(sizeof *runs * (size_t)jobs);
+  struct pollfd *polls = lm_alloc(sizeof *polls * (size_t)jobs);
+  st.todo = lm_alloc(sizeof *st.todo * (size_t)(n > 0 ? n : 1));
   char what[1200], describe[256];
   reference_describe(a, describe, sizeof describe);
-  for (int i = 0; i < n; i++) mine += job_shard_of(j, i, n, a->shards) == a->shard;
+  for (int i = 0; i < n; i++) st.mine += job_shard_of(j, i, n, a->shards) == a->shard;
   char in_shard[64] = "";
-  if (a->shards > 1) snprintf(in_shard, sizeof in_shard, " (%d in shard %d/%d)", mine, a->shard, a->shards);
+  if (a->shards > 1) snprintf(in_shard, sizeof in_shard, " (%d in shard %d/%d)", st.mine, a->shard, a->shards);
   if (!a->quiet) printf("references of %s: %d view%s%s, %s, up to %d run%s at once; %s\n", j->path, n,
                         n == 1 ? "" : "s", in_shard, describe, jobs, jobs == 1 ? "" : "s", a->refs);
-  struct sigaction stop = {.sa_handler = on_stop}, old_int, old_term; /* no SA_RESTART: wait() wakes */
+  /* Each view of the shard: named, cached or its renderer's input written beside its reference. */
+  for (int i = 0; i < n; i++) {
+    if (job_shard_of(j, i, n, a->shards) != a->shard) continue;
+    lm_buf input = {0};
+    char path[1024], in[1100];
+    bool ok = reference_export(a, j, &places[i], &input, path, sizeof path, &err);
+    if (ok && paths) snprintf(paths[i], sizeof paths[i], "%s", path);
+    if (ok) { /* what a killed run left, which may be named after a view it finished */
+      char base[1024];
+      snprintf(base, sizeof base, "%.*s", (int)(strlen(path) - 4), path);
+      clear_temps(base);
+    }
+    if (ok && !a->force && lm_file_exists(path)) {
+      cached++;
+      snprintf(what, sizeof what, "%s: unchanged, cached", path);
+      job_progress(a->quiet, st.tty, ++st.done, st.mine, what);
+    } else if (ok) {
+      render_view *t = &st.todo[count];
+      *t = (render_view){.place = i};
+      snprintf(t->base, sizeof t->base, "%.*s", (int)(strlen(path) - 4), path);
+      snprintf(in, sizeof in, "%s.%s", t->base, st.cycles ? "json" : "pov");
+      ok = job_make_parent(path, &err) && limn_write_whole(in, input.data, (size_t)input.len, &err);
+      count += ok;
+    }
+    lm_buf_free(&input);
+    if (!ok) {
+      view_error(j, places, i, st.tty && !a->quiet, "%s", err.msg);
+      st.rc = 1;
+    }
+  }
+  /* Blender takes a scene's views in one run, at most an even share of them a run so that every job has work. */
+  int share = st.cycles ? (count + jobs - 1) / jobs : 1;
+  struct sigaction stop = {.sa_handler = on_stop}, old_int, old_term; /* no SA_RESTART: poll() wakes */
   sigemptyset(&stop.sa_mask);
   stop_signal = 0;
   running_runs = runs;
   running_count = 0;
   sigaction(SIGINT, &stop, &old_int);
   sigaction(SIGTERM, &stop, &old_term);
-  for (int i = 0; i <= n; i++) {
-    /* Start place i when a slot is free; after the last, wait for the rest. */
-    while (running > 0 && (running == jobs || i == n || stop_signal)) {
-      int status;
-      pid_t pid = wait(&status);
-      if (pid < 0 && errno == EINTR) continue;
-      if (pid < 0) break;
-      render_run *r = NULL;
-      for (int k = 0; k < running && !r; k++)
-        if (runs[k].pid == pid) r = &runs[k];
-      if (!r) continue;
-      char final[1100], log[1100];
-      snprintf(final, sizeof final, "%s.exr", r->base);
-      snprintf(log, sizeof log, "%s.log", r->base);
-      bool ok = !stop_signal && WIFEXITED(status) && WEXITSTATUS(status) == 0 && lm_file_exists(r->out) &&
-                rename(r->out, final) == 0;
-      if (ok) {
-        clear_temps(r->base);
-        remove(log);
-        rendered++;
-        snprintf(what, sizeof what, "%s (%.1f s)", final, (lm_now_ms() - r->start_ms) / 1000);
-        job_progress(a->quiet, tty, ++done, mine, what);
-      } else if (stop_signal) {
-        clear_temps(r->base);
-      } else {
-        clear_temps(r->base);
-        if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
-          view_error(j, places, r->place, tty && !a->quiet, "%s exited 0 but wrote no image; its log %s:", name, log);
-        else
-          view_error(j, places, r->place, tty && !a->quiet, "%s failed (%s %d); its log %s:", name,
-                     WIFEXITED(status) ? "exit status" : "signal",
-                     WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status), log);
-        show_log(log);
-        rc = 1;
-      }
+  for (int next = 0; (next < count && !stop_signal) || running > 0;) {
+    while (running < jobs && next < count && !stop_signal) {
+      int views = 1, scene = places[st.todo[next].place].scene;
+      while (views < share && next + views < count && places[st.todo[next + views].place].scene == scene) views++;
+      if (run_start(&st, &runs[running], next, views, threads)) running_count = ++running;
+      next += views;
+    }
+    if (running == 0) continue;
+    nfds_t watched = 0;
+    for (int k = 0; k < running; k++) polls[watched++] = (struct pollfd){.fd = runs[k].progress, .events = POLLIN};
+    if (!stop_signal && poll(polls, watched, -1) < 0 && errno != EINTR) break;
+    for (int k = running - 1; k >= 0; k--) {
+      render_run *r = &runs[k];
+      if (!stop_signal && !(polls[k].revents & (POLLIN | POLLHUP | POLLERR))) continue;
+      if (!stop_signal && read_progress(&st, r)) continue;
+      /* Its end, or a stop (killed here too, should it have started after on_stop ran). */
+      if (stop_signal) kill(r->pid, SIGKILL);
+      int status = 0;
+      while (waitpid(r->pid, &status, 0) < 0 && errno == EINTR) {}
+      close(r->progress);
+      run_end(&st, r, status);
       *r = runs[--running];
       running_count = running;
     }
-    if (i == n || stop_signal) break;
-    if (job_shard_of(j, i, n, a->shards) != a->shard) continue;
-    const job_view *v = &places[i];
-    lm_buf input = {0};
-    char path[1024];
-    bool ok = reference_export(a, j, v, &input, path, sizeof path, &err);
-    if (ok && paths) snprintf(paths[i], sizeof paths[i], "%s", path);
-    if (ok && !a->force && lm_file_exists(path)) {
-      cached++;
-      snprintf(what, sizeof what, "%s: unchanged, cached", path);
-      job_progress(a->quiet, tty, ++done, mine, what);
-      lm_buf_free(&input);
-      continue;
-    }
-    render_run *r = &runs[running];
-    *r = (render_run){.place = i};
-    char in[1100];
-    if (ok) {
-      snprintf(r->base, sizeof r->base, "%.*s", (int)(strlen(path) - 4), path);
-      snprintf(r->tmp, sizeof r->tmp, "%s.tmp-%ld%s", r->base, (long)getpid(), cycles ? "" : ".exr");
-      snprintf(r->out, sizeof r->out, "%s%s", r->tmp, cycles ? "/out.exr" : "");
-      snprintf(in, sizeof in, "%s.%s", r->base, cycles ? "json" : "pov");
-      ok = job_make_parent(path, &err) && limn_write_whole(in, input.data, (size_t)input.len, &err);
-      if (ok) clear_temps(r->base);
-      /* Blender's own folder: whatever it writes beside its output goes with it. */
-      if (ok && cycles && mkdir(r->tmp, 0777) != 0)
-        lm_error_set(&err, "%s: cannot make folder (%s)", r->tmp, strerror(errno)), ok = false;
-    }
-    lm_buf_free(&input);
-    if (ok) {
-      char log[1100];
-      snprintf(log, sizeof log, "%s.log", r->base);
-      int w = j->sizes[v->size][0], h = j->sizes[v->size][1];
-      r->start_ms = lm_now_ms();
-      r->pid = cycles ? start_cycles(a, in, r->out, log, threads)
-                      : start_povray(a, r->base, r->tmp, w, h, threads);
-      if (r->pid < 0) lm_error_set(&err, "cannot start %s: %s", name, strerror(errno)), ok = false;
-    }
-    if (!ok) {
-      view_error(j, places, i, tty && !a->quiet, "%s", err.msg);
-      rc = 1;
-      continue;
-    }
-    running_count = ++running;
   }
   sigaction(SIGINT, &old_int, NULL);
   sigaction(SIGTERM, &old_term, NULL);
   running_count = 0;
   free(runs);
+  free(polls);
+  free(st.todo);
   if (stop_signal) { /* the renders are gone and so are their files: die of the signal, as without the handler */
-    if (tty && !a->quiet) printf("\n");
+    if (st.tty && !a->quiet) printf("\n");
     lm_log(LM_LOG_ERROR, "%s: stopped by signal %d; no partial reference left", j->path, (int)stop_signal);
     raise(stop_signal);
     return 1;
   }
   if (!a->quiet) printf("references of %s: %d rendered, %d cached (unchanged; --force redoes them)%s\n", j->path,
-                        rendered, cached, rc ? ", some failed" : "");
-  return rc;
+                        st.rendered, cached, st.rc ? ", some failed" : "");
+  return st.rc;
 }
 
 static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("reference", fmt, arg); }

@@ -9,6 +9,7 @@
  *   spec (JSON) for cli/cycles_render.py, run by `blender -b`, into
  *   REFS/<scene>/<camera>_<WxH>-cycles-<hash>.exr, the hash covering the
  *   scene file's bytes, the spec's settings, the script and Blender's version.
+ *   A scene's missing views go to one Blender run (its start costs seconds).
  * An unchanged view is never rendered twice and a changed one gets a new file;
  * a failed or killed render leaves no reference. */
 #ifndef LIMN_REFERENCE_H
@@ -91,7 +92,11 @@ bool reference_direct(const reference_args *a, reference_args *direct, const cha
 bool reference_export(const reference_args *a, const job *j, const job_view *v, lm_buf *input, char *path,
                       size_t cap, lm_error *err);
 /* Renders every place of the shard whose reference is missing (all with
- * force): at most a->jobs renderer processes at once. paths (may be NULL)
+ * force): at most a->jobs renderer processes at once, POV-Ray one view
+ * each, Blender the views of one scene each (split to keep every job busy).
+ * A view's reference appears when it is complete, whatever happens to the
+ * others of its run; each view's progress line gives its wall time (a
+ * Blender run's first includes Blender's start). paths (may be NULL)
  * gets each place's file. The exit code: 0, 1 when an export or a render
  * failed (each named by view, with the renderer's error lines). SIGINT and
  * SIGTERM stop the renders and remove their partial files first. */
@@ -104,10 +109,13 @@ bool reference_cycles_prepare(reference_cycles *c, lm_error *err);
 /* Place v's spec into `spec` and its hash (everything that decides the image). */
 bool reference_cycles_spec(const reference_args *a, const job *j, const job_view *v, lm_buf *spec, uint64_t *hash,
                            lm_error *err);
-/* Blender's command line on the spec file, rendering into out with `threads`
- * threads (a number as text); reference.c runs it. argv ends with NULL. */
-#define REFERENCE_CYCLES_ARGC 14
-void reference_cycles_argv(const reference_cycles *c, const char *spec, const char *out, const char *threads,
-                           const char *argv[REFERENCE_CYCLES_ARGC]);
+/* Blender's command line up to its "--" (REFERENCE_CYCLES_ARGS entries),
+ * with `threads` threads (a number as text); reference.c appends a SPEC OUT
+ * pair for each view of the run and the closing NULL, and runs it. */
+#define REFERENCE_CYCLES_ARGS 11
+void reference_cycles_argv(const reference_cycles *c, const char *threads, const char *argv[REFERENCE_CYCLES_ARGS]);
+/* The name the spec gives view v ("scene/camera WxH", with " frame F" in a
+ * sequence), which cycles_render.py's error lines quote. */
+void reference_cycles_view_name(const job *j, const job_view *v, char *out, size_t cap);
 
 #endif

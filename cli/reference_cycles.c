@@ -3,15 +3,17 @@
  * `blender -b`:
  *
  *   blender -b --factory-startup -noaudio --threads T --python-exit-code 1
- *           --python cli/cycles_render.py -- SPEC.json OUT.exr
+ *           --python cli/cycles_render.py -- SPEC.json OUT.exr [SPEC.json OUT.exr ...]
  *
  *   {"scene": "/abs/scene.glb", "view": "room/front 160x120",
  *    "camera": {"eye": [x,y,z], "target": [x,y,z], "up": [x,y,z], "fov_y": degrees},
  *    "width": W, "height": H, "samples": N, "bounces": B, "seed": S,
  *    "materials": "phong" | "pbr", "sky": null | {"zenith": [r,g,b], "horizon": [r,g,b], "intensity": I}}
  *
- * The script writes OUT.exr (linear RGB float) and exits 0, or prints a
- * line naming the view and exits 1. The reference's hash covers what
+ * The script writes each OUT.exr (linear RGB float) whole (renamed into
+ * place) and then the pair's index and a newline to the file descriptor
+ * $LIMN_PROGRESS_FD names, or prints a line naming the view; it exits 1
+ * when any view failed. The reference's hash covers what
  * decides the image: the scene file's bytes (and its camera list's), the
  * spec less the scene's path and the view's name, the script, and the
  * first line of `blender --version`. An animated scene at a time is
@@ -146,6 +148,13 @@ static bool posed_scene(const reference_args *a, const job *j, const job_view *v
   return true;
 }
 
+void reference_cycles_view_name(const job *j, const job_view *v, char *out, size_t cap) {
+  const job_scene *s = &j->scenes[v->scene];
+  int n = snprintf(out, cap, "%s/%s %dx%d", s->name, s->scene->cameras[v->camera].name, j->sizes[v->size][0],
+                   j->sizes[v->size][1]);
+  if (j->timed && n >= 0 && (size_t)n < cap) snprintf(out + n, cap - (size_t)n, " frame %d", v->frame);
+}
+
 bool reference_cycles_spec(const reference_args *a, const job *j, const job_view *v, lm_buf *spec, uint64_t *hash,
                            lm_error *err) {
   const job_scene *s = &j->scenes[v->scene];
@@ -194,8 +203,7 @@ bool reference_cycles_spec(const reference_args *a, const job *j, const job_view
     lm_buf_append(&settings, "null", -1);
   }
   char view[LM_NAME_MAX * 2 + 128], files[128];
-  snprintf(view, sizeof view, "%s/%s %dx%d", s->name, cam->name, w, h);
-  if (j->timed) snprintf(view + strlen(view), sizeof view - strlen(view), " frame %d", v->frame);
+  reference_cycles_view_name(j, v, view, sizeof view);
   lm_buf_append(spec, "{\"scene\": ", -1);
   limn_json_append(spec, scene);
   lm_buf_append(spec, ", \"view\": ", -1);
@@ -210,9 +218,8 @@ bool reference_cycles_spec(const reference_args *a, const job *j, const job_view
   return true;
 }
 
-void reference_cycles_argv(const reference_cycles *c, const char *spec, const char *out, const char *threads,
-                           const char *argv[REFERENCE_CYCLES_ARGC]) {
-  const char *args[REFERENCE_CYCLES_ARGC] = {c->blender, "-b", "--factory-startup", "-noaudio", "--threads", threads,
-                                             "--python-exit-code", "1", "--python", c->script, "--", spec, out, NULL};
+void reference_cycles_argv(const reference_cycles *c, const char *threads, const char *argv[REFERENCE_CYCLES_ARGS]) {
+  const char *args[REFERENCE_CYCLES_ARGS] = {c->blender, "-b",         "--factory-startup", "-noaudio", "--threads", threads,
+                                             "--python-exit-code", "1", "--python", c->script, "--"};
   memcpy(argv, args, sizeof args);
 }

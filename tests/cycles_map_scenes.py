@@ -11,6 +11,9 @@
                     one light of each KHR_lights_punctual type, placed behind
                     the camera; engine powers 1, 2 and 4 (candela or lux times
                     683 pi)
+  range             the point light with range 6: its window clamp(1 -
+                    (d/6)^4, 0, 1) runs from about 0.5 at the view's centre
+                    to 0 before its far edge
   sky, skyball      a white plane and a white sphere lit by no light (a spot
                     aimed at nothing), for sky.lua's gradient and map; sky.hdr,
                     the map (write_map)
@@ -183,6 +186,7 @@ def main(folder, width, height, samples):
     lights = {
         "sun": ({"type": "directional", "intensity": PHOTOMETRIC}, [0.0, 5.0, 5.0], [0.0, 0.0, 0.0]),
         "point": ({"type": "point", "intensity": 2 * PHOTOMETRIC}, [1.0, 3.5, 3.5], None),
+        "range": ({"type": "point", "intensity": 2 * PHOTOMETRIC, "range": 6.0}, [1.0, 3.5, 3.5], None),
         "spot": ({"type": "spot", "intensity": 4 * PHOTOMETRIC,
                   "spot": {"innerConeAngle": 0.15, "outerConeAngle": 0.35}}, [0.0, 4.0, 4.0], [0.0, 0.0, 0.5]),
     }

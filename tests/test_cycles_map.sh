@@ -3,7 +3,9 @@
 # light (bounces 0) against `limn capture --tech dl` (ambient 0), linear EXR
 # on both sides compared by `limn compare` (the mean |value| is the mean error
 # against a black image):
-# - a white plane under a KHR sun, point and spot light: mean within 1%;
+# - a white plane under a KHR sun, point and spot light: mean within 1%; a
+#   point light with a range (its window): mean within 1%, mean |difference|
+#   within 2%;
 # - a rough gold metal and a rough red dielectric sphere, materials=pbr: mean
 #   within 1%, mean |difference| within 1.5% of the mean;
 # - sky.lua's sky: the gradient on a plane within 2%, an HDR map on the plane
@@ -71,7 +73,7 @@ limn_dl() { # limn_dl SCENE OUT [SETS...]
     echo "  limn capture $scene failed"
 }
 limn_dl sun "$tmp/black.exr" --camera 1
-for s in sun point spot; do limn_dl $s "$tmp/limn_$s.exr"; done
+for s in sun point spot range; do limn_dl $s "$tmp/limn_$s.exr"; done
 limn_dl spheres "$tmp/limn_spheres.exr" --set materials=pbr
 limn_dl sky "$tmp/limn_grad.exr" --set sky.enabled=true --set sky.zenith=0.1,0.15,0.3 \
   --set sky.horizon=0.3,0.32,0.35 --set sky.intensity=2
@@ -84,7 +86,7 @@ done
 cp "$tmp/limn_tube1.exr" "$tmp/limn_tube.exr"
 
 # Every view in one Blender run (its start costs seconds).
-views=(sun_phong:sun point_phong:point spot_phong:spot spheres_pbr:spheres grad:grad map:map ballmap:ballmap
+views=(sun_phong:sun point_phong:point spot_phong:spot range_phong:range spheres_pbr:spheres grad:grad map:map ballmap:ballmap
   tube:tube)
 args=()
 for v in "${views[@]}"; do args+=("$tmp/${v%%:*}.json" "$tmp/cycles_${v##*:}.exr"); done
@@ -110,6 +112,8 @@ difference() { # difference NAME MAX: mean |Cycles - Limn| over Limn's mean, at 
 ratio sun 0.99 1.01
 ratio point 0.99 1.01
 ratio spot 0.99 1.01
+ratio range 0.99 1.01
+difference range 0.02
 ratio spheres 0.99 1.01
 difference spheres 0.015
 ratio grad 0.98 1.02

@@ -7,7 +7,8 @@
 #   second run is a cache hit that starts no render;
 # - Blender gets every core when one view renders at a time;
 # - a failing render names the view, shows Blender's error line, exits 1 and
-#   leaves no file; a run stopped by SIGTERM leaves no file and no Blender;
+#   leaves no file; a scene's views go to one Blender run (two with --jobs
+#   2), a failed view among them fails alone and a rerun renders only it; a run stopped by SIGTERM leaves no file and no Blender;
 #   one killed by SIGKILL takes its render with it, and the next run removes
 #   its partial file;
 # - a missing Blender names the Debian package and the install command;
@@ -106,12 +107,12 @@ grep -q "0 rendered, 1 cached" log && grep -q "$ref" log || { cat log; fail "the
 ls refs/ball | grep -q tmp && fail "a temporary file was left: $(ls refs/ball)"
 
 # 4. A failing render: named by view, Blender's line shown, exit 1, no file.
-FAKE_BLENDER_FAIL=1 "$limn" reference --job job.lua "${cy[@]}" --refs refs-fail >log 2>&1
+FAKE_BLENDER_FAIL='*' "$limn" reference --job job.lua "${cy[@]}" --refs refs-fail >log 2>&1
 rc=$?
 cat log
 [ $rc = 1 ] || fail "a failing render exited $rc, not 1"
 grep -q "view 0 (ball, camera 'front', 32x24): Cycles failed (exit status 1)" log || fail "the failure does not name the view"
-grep -q "  | Error: cycles_render: view ball/front_32x24: cannot import" log || fail "Blender's error line is not shown"
+grep -q "  | limn cycles: view 'ball/front 32x24': scene: cannot import it" log || fail "Blender's error line is not shown"
 find refs-fail -name "*.exr" | grep -q . && fail "a failed render left an image: $(find refs-fail)"
 
 # 5. Stopped mid-view: SIGTERM leaves no file and no Blender; SIGKILL takes the render with it and the
@@ -139,6 +140,60 @@ stop_mid_view KILL
 "$limn" reference --job job.lua "${cy[@]}" --refs refs-kill >log 2>&1 || { cat log; fail "run after a kill"; }
 [ "$(ls -A refs-kill/ball/)" = "$(basename "${ref%.exr}").exr
 $(basename "${ref%.exr}").json" ] || fail "after a kill and a rerun: $(ls -A refs-kill/ball)"
+
+# 5b. A scene's views go to one Blender run, each view's time in its progress line; a failed view is
+# named, leaves no file and fails the command while the others are kept; the rerun renders only it.
+# --jobs 2 splits the scene's views over two runs.
+sed 's/one.cams/ball.cams/; s/"32x24"/"32x24", "16x12"/' job.lua > four.lua
+views_of() { awk '{print $3}' calls | sort | uniq -c | awk '{print $1}' | sort -n | tr '\n' ' '; }
+rm -f calls
+FAKE_BLENDER_FAIL='ball/side 32x24' "$limn" reference --job four.lua "${cy[@]}" --refs refs-batch >log 2>&1
+rc=$?
+[ $rc = 1 ] || { cat log; fail "a failed view in a batch exited $rc, not 1"; }
+[ "$(views_of)" = "4 " ] || fail "four views did not go to one Blender run: $(cat calls)"
+grep -q "view 1 (ball, camera 'side', 32x24): Cycles failed (exit status 1)" log \
+  && grep -q "  | limn cycles: view 'ball/side 32x24': scene: cannot import it" log || { cat log; fail "the failed view is not named"; }
+[ "$(grep -c "^\[[0-9]/4\] refs-batch/ball/.*-cycles-[0-9a-f]*\.exr ([0-9.]* s)$" log)" = 3 ] \
+  || { cat log; fail "not three views' progress lines, each with its time"; }
+[ "$(ls refs-batch/ball/*.exr | wc -l)" = 3 ] && ! ls refs-batch/ball/side_32x24-*.exr 2>/dev/null \
+  || fail "not the three good views' references alone: $(ls refs-batch/ball)"
+[ -z "$(find refs-batch -name "*tmp*" -o -name ".cycles*")" ] || fail "a failed batch left temporaries: $(find refs-batch)"
+rm -f calls
+"$limn" reference --job four.lua "${cy[@]}" --refs refs-batch >log 2>&1 && grep -q "1 rendered, 3 cached" log \
+  || { cat log; fail "the rerun after a failed view"; }
+grep -q "side_32x24" calls && [ "$(calls)" = 1 ] || fail "the rerun rendered more than the missing view: $(cat calls)"
+[ -z "$(find refs-batch -name "*.log")" ] || fail "a successful run left its log"
+rm -f calls
+"$limn" reference --job four.lua "${cy[@]}" --refs refs-jobs --jobs 2 >log 2>&1 && grep -q "4 rendered" log \
+  || { cat log; fail "--jobs 2"; }
+[ "$(views_of)" = "2 2 " ] || fail "--jobs 2 did not split the four views over two runs: $(cat calls)"
+# Stopped in a batch's second view: the first view's reference is kept, the second leaves nothing.
+rm -f calls
+FAKE_BLENDER_SLEEP="30:ball/side 32x24" "$limn" reference --job four.lua "${cy[@]}" --refs refs-stop >log 2>&1 &
+pid=$!
+for i in $(seq 100); do [ -n "$(ls -A refs-stop/ball/*.tmp-*/.cycles-render.exr 2>/dev/null)" ] && break; sleep 0.1; done
+ls refs-stop/ball/front_32x24-cycles-*.exr >/dev/null 2>&1 || { kill $pid; fail "the first view is not in place before the second ends"; }
+kill -TERM $pid
+{ wait $pid; } 2>/dev/null
+[ "$(ls refs-stop/ball/*.exr | wc -l)" = 1 ] && [ -z "$(find refs-stop -name "*tmp*" -o -name ".cycles*")" ] \
+  || fail "a batch stopped in its second view: $(find refs-stop)"
+
+# 5c. A file camera whose aspectRatio (1) is not the output's (2:1): the spec keeps its yfov (0.75 rad),
+# as Limn's frame does (test_gltf), and Blender's vertical sensor fit widens x.
+python3 - "$root/data/scenes/pov_ball.gltf" square.gltf <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["cameras"][0]["perspective"]["aspectRatio"] = 1.0
+json.dump(d, open(sys.argv[2], "w"))
+PY
+sed -n 's#"ball.gltf", cameras = "one.cams"#"square.gltf"#; s/"32x24"/"32x16"/; p' job.lua > square.lua
+"$limn" reference --job square.lua "${cy[@]}" --refs refs-square >log 2>&1 || { cat log; fail "a square camera"; }
+python3 - refs-square/square/*.json <<'PY' || fail "the spec does not keep the camera's yfov on a wider output"
+import json, math, sys
+s = json.load(open(sys.argv[1]))
+assert (s["width"], s["height"]) == (32, 16), s
+assert abs(s["camera"]["fov_y"] - math.degrees(0.75)) < 1e-4, s["camera"]
+PY
 
 # 6. Shards split the views: 0/2 renders the first camera, 1/2 the second, then both are cached.
 sed 's/one.cams/ball.cams/' job.lua > two.lua

@@ -528,6 +528,15 @@ static void assert_lights_and_cameras(const lm_scene *s) {
   assert_float_equal(s->cameras[0].zfar, 50, 0);
   assert_string_equal(s->nodes[s->cameras[0].node].name, "cam_node");
   assert_float_equal(s->cameras[1].zfar, LM_GLTF_INFINITE_ZFAR_RATIO * 0.1f, 1e-2);
+  /* aspectRatio 1.5 is kept (for export), but a 2:1 output keeps yfov and
+   * widens x, as Blender does (so Cycles references agree): not stretched to 1.5. */
+  assert_float_equal(s->cameras[0].aspect, 1.5, 1e-6);
+  lm_frame_data f;
+  lm_scene_frame_data(s, 0, 64, 32, &f);
+  float u = sqrtf(f.frustum_u[0] * f.frustum_u[0] + f.frustum_u[1] * f.frustum_u[1] + f.frustum_u[2] * f.frustum_u[2]);
+  float v = sqrtf(f.frustum_v[0] * f.frustum_v[0] + f.frustum_v[1] * f.frustum_v[1] + f.frustum_v[2] * f.frustum_v[2]);
+  assert_float_equal(f.clip[3], tanf(0.35f), 1e-6);
+  assert_float_equal(u / v, 2, 1e-5);
 }
 
 static void lights_and_cameras_come_over(void **state) {

@@ -82,7 +82,10 @@
  *   with its KHR_texture_transform (TEXCOORD_0 only; another set warns).
  *   Colour images (base colour, emissive) are sampled as sRGB, data images
  *   as they are (one image used both ways is uploaded twice).
- * - Perspective cameras: yfov, znear, zfar; the aspect ratio is the output's.
+ * - Perspective cameras: yfov, znear, zfar; the aspect ratio is the output's:
+ *   aspectRatio is kept (lm_camera.aspect, written back by export-gltf) but an
+ *   output of another shape keeps yfov and widens or narrows x, as Blender
+ *   does, never stretching the image.
  *   An infinite far plane (zfar absent) becomes LM_GLTF_INFINITE_ZFAR_RATIO
  *   times znear: relative, so any unit works (reversed float depth holds it).
  *   Orthographic cameras are kept (so camera indices stay the file's) and

@@ -14,7 +14,7 @@
  *   frustum (lm_scene_frame_data): direction = the ray to the centre of the
  *   far plane, right/up = its frustum_u/frustum_v. POV-Ray builds a ray as
  *   direction + (x - 1/2) right + (1/2 - y) up, which is the engine's ray for
- *   the same pixel; so vertical fov, aspect (the camera's, else the output's)
+ *   the same pixel; so vertical fov, aspect (the output's: lm_scene_frame_data)
  *   and looking down the node's -Z carry over exactly. The scene stays in the
  *   engine's right-handed coordinates: POV-Ray's left-handedness only shows
  *   in its look_at/angle shortcuts, which are not used.

@@ -426,8 +426,11 @@ void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_f
   if (!(isfinite(c.znear) && c.znear > 0 && c.znear < 1e30f)) c.znear = far_ok ? c.zfar * 1e-4f : 0.1f;
   c.znear = fmaxf(c.znear, far_ok ? c.zfar * 1e-12f : 1e-30f);
   c.zfar = far_ok && c.zfar > c.znear * 1.001f ? c.zfar : c.znear * 1.001f;
-  float aspect = c.aspect > 0 && isfinite(c.aspect) ? c.aspect
-                                                   : (float)(width > 0 ? width : 1) / (float)(height > 0 ? height : 1);
+  /* The output's aspect, whatever the camera's aspectRatio says: glTF's is
+   * the camera's own, and an output of another shape keeps fov_y and sees
+   * more or less at the sides, as Blender (and so a Cycles reference) does,
+   * rather than stretching the image. */
+  float aspect = (float)(width > 0 ? width : 1) / (float)(height > 0 ? height : 1);
   glm_mat4_inv(world, view);
   /* Reversed depth (near 1, far 0, with glClipControl's 0..1 range: gfx
    * lm_set_scene_state): float depth then keeps the same relative precision

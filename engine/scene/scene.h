@@ -112,7 +112,8 @@ typedef struct lm_camera {
   float fov_y; /* radians, vertical */
   float znear, zfar;
   int node;
-  float aspect; /* width / height; 0: the output's */
+  float aspect; /* glTF's aspectRatio (width / height; 0: none), kept for export-gltf: the
+                   projection keeps fov_y and takes the output's aspect (lm_scene_frame_data) */
   float ortho[2]; /* glTF orthographic xmag, ymag; 0, 0: perspective. Kept so that a
                      file's camera indices hold, refused by lm_scene_camera_check. */
 } lm_camera;
