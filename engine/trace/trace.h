@@ -9,6 +9,18 @@
  * limited to static geometry (seed 003 lines 2486-2489); and every triangle
  * sits in exactly one leaf, so memory is bounded by the triangle count.
  *
+ * Against Embree 3 (tools/trace_compare.c; build/trace_compare
+ * data/scenes/big/big.glb: 1.54 M triangles, 2 threads on the shared 2-core
+ * machine, medians of 3, wall clock, 2026-11-26): build 35.5 s here against
+ * Embree's 3.7 s; camera rays 0.85 against 2.57 million a second, random
+ * rays 0.23 against 0.90; after every node moved, lm_trace_update 18.6 s (it
+ * rebuilt: the set of kept triangles changed) against Embree's refit 2.5 s;
+ * both find the same hits (5 of 360,000 camera rays differ, at edges).
+ * Embree wins every figure. This BVH stays until the tracer is moved onto
+ * Embree behind this same header (not done yet: its threads under the
+ * sanitized suite, its hit order for lm_trace_surface_at and the
+ * degenerate-triangle rules above are to be checked first).
+ *
  * Triangles whose corners are not finite, or whose area is zero or not
  * finite, are skipped (counted in lm_trace_stats.skipped), never an error.
  * Depth is capped at LM_TRACE_MAX_DEPTH whatever the geometry, so traversal
