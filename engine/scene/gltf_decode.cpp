@@ -51,6 +51,9 @@ std::string lm_draco_decode(const unsigned char *data, size_t size, std::vector<
   for (lm_draco_attribute &want : attributes) {
     const draco::PointAttribute *a = want.unique_id >= 0 ? mesh.GetAttributeByUniqueId(want.unique_id) : nullptr;
     if (!a) return std::string(want.name) + ": Draco attribute " + std::to_string(want.unique_id) + " does not exist";
+    if (want.components < 1 || want.components > 4)
+      return std::string(want.name) + ": an accessor of " + std::to_string(want.components) +
+             " components (Draco attributes have 1 to 4)";
     if (a->num_components() != want.components)
       return std::string(want.name) + ": Draco attribute " + std::to_string(want.unique_id) + " has " +
              std::to_string(a->num_components()) + " components, the accessor " + std::to_string(want.components);

@@ -1726,7 +1726,8 @@ bool parse(const char *path, Source &src, tinygltf::Model *model, lm_error *err)
   if (len >= 4 && !memcmp(bytes, "glTF", 4)) {
     uint32_t head[5] = {0};
     if (len >= 20) memcpy(head, bytes, 20);
-    if (len < 20 || head[1] != 2 || head[2] > len || memcmp(&head[4], "JSON", 4) || head[3] > head[2] - 20)
+    if (len < 20 || head[1] != 2 || head[2] > len || head[2] < 20 || memcmp(&head[4], "JSON", 4) ||
+        head[3] > head[2] - 20)
       return lm_error_set(err, "%s: not a glTF 2.0 binary (its header or JSON chunk does not fit its %zu bytes)",
                           path, len), false;
     text = bytes + 20, text_len = head[3];
