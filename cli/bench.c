@@ -157,6 +157,11 @@ typedef struct bench {
   double trace_ms, frame_trace_ms; /* medians of tracing them (wall clock) */
   double trace_cpu_ms;         /* median CPU time (all threads) of the 800x450 rays */
   motion motion;
+  /* Loading (wall clock from the command's start): the scene read, the first
+   * frame finished (glFinish), the peak resident memory then (KiB), and the
+   * most GPU memory the driver reported in use (MiB; -1: it reports none). */
+  double start_ms, load_ms, first_frame_ms, gpu_mib;
+  long first_frame_rss_kib;
 } bench;
 
 static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("bench", fmt, arg); }
@@ -377,6 +382,13 @@ static double collect_passes(bench *b, lm_renderer *r, bool largest, double *pas
   return sum;
 }
 
+/* The process's peak resident memory so far, KiB (getrusage's ru_maxrss: on
+ * llvmpipe the GPU's buffers and textures are in it too); -1 when unknown. */
+static long peak_rss_kib(void) {
+  struct rusage u;
+  return getrusage(RUSAGE_SELF, &u) == 0 ? u.ru_maxrss : -1;
+}
+
 /* One configuration (size si, or column si of another series): warm-up,
  * then medians of frame wall time, overhead and passes. */
 static bool run_size(bench *b, int si, int series, lm_scene *scene, lm_pipeline *pipe, lm_clock *used,
@@ -401,6 +413,7 @@ static bool run_size(bench *b, int si, int series, lm_scene *scene, lm_pipeline 
     ok = lm_renderer_frame(r, err);
     lm_finish();
     double t1 = lm_now_ms();
+    if (ok && !b->first_frame_ms) b->first_frame_ms = t1 - b->start_ms, b->first_frame_rss_kib = peak_rss_kib();
     if (!ok || f < b->warmup) continue;
     int k = f - b->warmup;
     double rec, comp;
@@ -410,6 +423,7 @@ static bool run_size(bench *b, int si, int series, lm_scene *scene, lm_pipeline 
     readback[k] = lm_renderer_fit_ms(r);
     collect_passes(b, r, !vary && size == b->largest, pass_ms, pass_n, b->frames);
   }
+  b->gpu_mib = fmax(b->gpu_mib, lm_gpu_memory_used_mib());
   if (ok && !vary) {
     b->frame_ms[si] = median(wall, b->frames);
     b->overhead_ms[si] = median(over, b->frames);
@@ -577,16 +591,14 @@ static bool cpu_pass_ms(const bench *b, int s, double *ms) {
   return any;
 }
 
-/* The process's peak resident memory so far, KiB (getrusage's ru_maxrss: on
- * llvmpipe the GPU's buffers and textures are in it too); -1 when unknown. */
-static long peak_rss_kib(void) {
-  struct rusage u;
-  return getrusage(RUSAGE_SELF, &u) == 0 ? u.ru_maxrss : -1;
-}
-
 static void print_tables(const bench *b, lm_clock clock) {
   printf("peak memory: %.1f MiB resident (getrusage ru_maxrss, the whole run; with llvmpipe GPU memory is in it)\n",
          (double)peak_rss_kib() / 1024);
+  printf("time to first frame: %.1f ms, of which reading the scene %.1f ms (wall clock, from the command's start to "
+         "the first frame's glFinish); peak memory by then %.1f MiB resident\n", b->first_frame_ms, b->load_ms,
+         (double)b->first_frame_rss_kib / 1024);
+  if (b->gpu_mib >= 0) printf("GPU memory: %.1f MiB in use at most (the driver's GL_NVX_gpu_memory_info, whole GPU)\n", b->gpu_mib);
+  else printf("GPU memory: not reported by this driver (llvmpipe's textures and buffers are in the resident memory)\n");
   printf("frame (wall clock, glFinish before and after) and compositor overhead (CPU: Lua + graph compile);\n"
          "passes: clock %s; medians of %d frames after %d warm-up\n", lm_clock_name(clock), b->frames, b->warmup);
   printf("  %-12s %10s %12s %12s %9s\n", "size", "pixels", "frame ms", "overhead ms", "overhead");
@@ -936,7 +948,9 @@ static void print_motion_json(const bench *b) {
 static void print_json(const bench *b, lm_clock clock) {
   printf("{\"clock\": ");
   limn_json_string(lm_clock_name(clock));
-  printf(", \"peak_rss_kib\": %ld", peak_rss_kib());
+  printf(", \"peak_rss_kib\": %ld, \"first_frame_ms\": %.6g, \"load_ms\": %.6g, \"first_frame_rss_kib\": %ld",
+         peak_rss_kib(), b->first_frame_ms, b->load_ms, b->first_frame_rss_kib);
+  if (b->gpu_mib >= 0) printf(", \"gpu_memory_mib\": %.6g", b->gpu_mib);
   printf(", \"frames\": %d, \"warmup\": %d, \"sizes\": [", b->frames, b->warmup);
   for (int s = 0; s < b->size_count; s++) {
     printf("%s{\"width\": %d, \"height\": %d, \"frame_ms\": %.6g, \"overhead_ms\": %.6g", s ? ", " : "",
@@ -1095,6 +1109,8 @@ int limn_bench(int argc, char **argv) {
   static bench b; /* large: keep it off the stack */
   int rc = parse_args(argc, argv, &b);
   if (rc) return rc < 0 ? 0 : rc;
+  b.start_ms = lm_now_ms();
+  b.gpu_mib = -1;
   lm_error err;
   int prc;
   lm_pipeline *pipe = load_pipeline(&b, &prc, &err);
@@ -1102,7 +1118,9 @@ int limn_bench(int argc, char **argv) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return prc;
   }
+  double t0 = lm_now_ms();
   lm_scene *scene = lm_scene_load(b.scene, &err);
+  b.load_ms = lm_now_ms() - t0;
   if (!scene) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     lm_pipeline_destroy(pipe);

@@ -295,7 +295,7 @@ static int add_accessor(doc *d, int view, int ctype, int count, const char *type
   putf(&d->accessors, "{\"bufferView\":%d,\"componentType\":%d,\"count\":%d,\"type\":\"%s\"", view, ctype,
        count, type);
   if (mn)
-    putf(&d->accessors, ",\"min\":[%.6g,%.6g,%.6g],\"max\":[%.6g,%.6g,%.6g]", mn[0], mn[1], mn[2], mx[0],
+    putf(&d->accessors, ",\"min\":[%.9g,%.9g,%.9g],\"max\":[%.9g,%.9g,%.9g]", mn[0], mn[1], mn[2], mx[0],
          mx[1], mx[2]);
   put(&d->accessors, "}", 1);
   return d->accessor_count++;

@@ -223,7 +223,7 @@ static void strips_and_fans_become_triangles(void **state) {
 
 /* A required extension the engine lacks is named, in .gltf and .glb alike,
  * before any of the data it governs is read (here: an accessor with no
- * bufferView, as Draco leaves them). (pbr_materials_come_over requires a
+ * bufferView, as a compression extension would leave them). (pbr_materials_come_over requires a
  * supported one.) */
 static void unsupported_required_extension_is_named(void **state) {
   (void)state;
@@ -234,15 +234,15 @@ static void unsupported_required_extension_is_named(void **state) {
       "\"accessors\":[{\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
       "{\"bufferView\":7,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}";
   char text[2048];
-  snprintf(text, sizeof text, json, "KHR_draco_mesh_compression", "KHR_draco_mesh_compression");
+  snprintf(text, sizeof text, json, "EXT_mesh_features", "EXT_mesh_features");
   lm_error err = {""};
-  assert_null(lm_scene_load_gltf(write_bytes("draco.gltf", text, strlen(text)), &err));
-  assert_non_null(strstr(err.msg, "draco.gltf: extensionsRequired names 'KHR_draco_mesh_compression', which "));
+  assert_null(lm_scene_load_gltf(write_bytes("features.gltf", text, strlen(text)), &err));
+  assert_non_null(strstr(err.msg, "features.gltf: extensionsRequired names 'EXT_mesh_features', which "));
   blob b = {0};
   unsigned char glb[4096];
   size_t n = make_glb(text, &b, glb, sizeof glb);
-  assert_null(lm_scene_load_gltf(write_bytes("draco.glb", glb, n), &err));
-  assert_non_null(strstr(err.msg, "draco.glb: extensionsRequired names 'KHR_draco_mesh_compression'"));
+  assert_null(lm_scene_load_gltf(write_bytes("features.glb", glb, n), &err));
+  assert_non_null(strstr(err.msg, "features.glb: extensionsRequired names 'EXT_mesh_features'"));
 }
 
 /* Every corner of the scene's bounds, seen through camera `cam` at w x h,

@@ -91,6 +91,9 @@ check "bench has overhead" out_has '"overhead_ms": '
 check "bench fits the direct pass" out_has '{"name": "direct", "ms": ['
 check "bench fit per pixel" out_has '"ns_per_pixel": '
 check "bench peak memory" out_has '"peak_rss_kib": '
+# The scene is read before the first frame ends, and the peak memory by then is within the run's.
+check "bench time to first frame" python3 -c 'import json, sys; d = json.load(open(sys.argv[1]))
+sys.exit(not (0 <= d["load_ms"] < d["first_frame_ms"] and 0 < d["first_frame_rss_kib"] <= d["peak_rss_kib"]))' "$tmp/out"
 check "bench table" run 0 bench --sizes 32x24,64x48 --frames 1 --warmup 0
 check "bench table names the fit" out_has "fit: a ms + b ns/pixel"
 check "bench cpu pass" run 0 bench --scene cornell_mirror --tech dl --set reflections=true --sizes 32x24 --frames 1 --warmup 0

@@ -21,6 +21,8 @@ packages=(
   slurmctld slurmd slurm-client munge    # tests/test_slurm.sh starts a one-node cluster
   python3                                # tests read JSON and GLB with it (test_scenes_gen, test_tools_cli)
   libmeshoptimizer-dev                   # simplified shadow casters (engine/scene/scene.c)
+  libdraco-dev                           # Draco-compressed glTF meshes (engine/scene/gltf_decode.cpp)
+  libembree-dev                          # tools/trace_compare.c: the tracer's BVH against Embree
   blender                                # Cycles references (limn reference --renderer cycles, cli/cycles_render.py)
 )
 

@@ -436,6 +436,14 @@ void lm_timer_destroy(lm_timer *t) {
 
 void lm_finish(void) { glFinish(); }
 
+double lm_gpu_memory_used_mib(void) {
+  if (!epoxy_has_gl_extension("GL_NVX_gpu_memory_info")) return -1;
+  GLint total = 0, available = 0; /* KiB */
+  glGetIntegerv(GL_GPU_MEMORY_INFO_DEDICATED_VIDMEM_NVX, &total);
+  glGetIntegerv(GL_GPU_MEMORY_INFO_CURRENT_AVAILABLE_VIDMEM_NVX, &available);
+  return total > 0 && available <= total ? (total - available) / 1024.0 : -1;
+}
+
 /* ---- readback ---------------------------------------------------------- */
 void lm_texture_read(lm_texture tex, int width, int height, bool floats, void *out) {
   size_t texel = floats ? 16 : 4, row = (size_t)width * texel;

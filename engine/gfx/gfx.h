@@ -230,6 +230,10 @@ void lm_timer_end(lm_timer *t);
 double lm_timer_read(lm_timer *t);
 void lm_timer_destroy(lm_timer *t);
 void lm_finish(void);
+/* GPU memory in use, MiB, as the driver reports it (GL_NVX_gpu_memory_info:
+ * dedicated memory less what is available, the whole GPU's); -1 when it
+ * reports none (llvmpipe: textures and buffers are the process's memory). */
+double lm_gpu_memory_used_mib(void);
 
 /* ---- readback ---------------------------------------------------------- */
 /* RGBA rows, top row first. `floats` selects float32 or uint8 output. */

@@ -6,8 +6,26 @@
  * What comes over, and how:
  * - extensionsRequired first: a file that requires an extension other than
  *   those the loader reads (KHR_lights_punctual, KHR_texture_transform,
- *   KHR_materials_emissive_strength, EXT_mesh_gpu_instancing) is refused,
- *   naming it.
+ *   KHR_materials_emissive_strength, EXT_mesh_gpu_instancing,
+ *   KHR_draco_mesh_compression, EXT_meshopt_compression,
+ *   KHR_mesh_quantization) is refused, naming it.
+ * - Buffers are read where they lie, not copied: the file is mapped, a
+ *   GLB's BIN chunk and each .bin beside a .gltf are read in place (data
+ *   URIs are decoded); tinygltf parses the JSON only. The images materials
+ *   use are decoded on all cores before the materials are read; mip levels
+ *   are built once, at upload.
+ * - Compressed meshes: KHR_draco_mesh_compression primitives through Draco
+ *   (the attributes it names, and the indices; the others as stored),
+ *   EXT_meshopt_compression bufferViews through meshoptimizer's decoders
+ *   and filters (each view once; a fallback buffer holds no data), and
+ *   KHR_mesh_quantization's integer attributes (normalized or not; the
+ *   node transform dequantizes). Data that does not decode fails the file
+ *   naming the mesh, primitive, accessor and bufferView.
+ * - A memory budget: the loader adds up what the scene will hold (vertices
+ *   and indices, decoded images with their mip levels, each in memory and
+ *   on the GPU) before building it and refuses a file over the budget,
+ *   naming it: LIMN_MEMORY_BUDGET (MiB) in the environment, else 3/4 of the
+ *   machine's physical memory.
  * - Nodes of the file's default scene (scene 0 when it names none; every
  *   root node when it has no scenes), parents before children. A node's
  *   local transform is its matrix, or T * R * S. Every world transform must
@@ -104,8 +122,8 @@
  *   corner of the bounds in view on any output at least as wide as high
  *   (`--camera auto` fits the output's own aspect).
  * - A material's baseColorTexture (TEXCOORD_0) becomes a scene texture:
- *   the bridge's image loader (no stb_image) keeps every image's bytes
- *   encoded; the images a material uses are decoded through OpenImageIO
+ *   tinygltf never sees the images (no stb_image); the images a material
+ *   uses are decoded through OpenImageIO
  *   (engine/image) to RGBA8 as stored, and uploaded as sRGB so that shaders
  *   sample linear colour, multiplied by baseColorFactor. An image that does
  *   not decode, or an external one that is missing, fails the scene with a

@@ -9,19 +9,115 @@
 
 #include "image/image.h"
 #include "scene/gltf.h"
+#include "scene/gltf_decode.h"
 #include "scene/scene_internal.h"
 
+#include <fcntl.h>
 #include <strings.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
+#include <map>
+#include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace {
+
+// ---- the file's bytes --------------------------------------------------------
+
+// A file mapped read-only. tinygltf would read the file into memory and copy
+// each buffer out of it again; mapped, its bytes are the page cache's, read
+// where they lie and dropped when the load ends.
+struct Mapping {
+  void *addr = MAP_FAILED;
+  size_t len = 0;
+  Mapping() = default;
+  Mapping(const Mapping &) = delete;
+  Mapping &operator=(const Mapping &) = delete;
+  ~Mapping() {
+    if (addr != MAP_FAILED) munmap(addr, len);
+  }
+  const unsigned char *bytes() const { return addr == MAP_FAILED ? nullptr : (const unsigned char *)addr; }
+};
+
+// Maps regular file `path`; false with "path: why" in err.
+bool map_file(const char *path, Mapping &m, lm_error *err) {
+  int fd = open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return lm_error_set(err, "%s: cannot open: %s", path, strerror(errno)), false;
+  struct stat st;
+  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    close(fd);
+    return lm_error_set(err, "%s: not a regular file", path), false;
+  }
+  m.len = (size_t)st.st_size;
+  if (m.len) m.addr = mmap(nullptr, m.len, PROT_READ, MAP_PRIVATE, fd, 0);
+  int why = errno;
+  close(fd);
+  if (m.len && m.addr == MAP_FAILED) return lm_error_set(err, "%s: cannot map: %s", path, strerror(why)), false;
+  return true;
+}
+
+// A glTF buffer's bytes where they lie: in the GLB's BIN chunk or a mapped
+// .bin file, or decoded from a data URI into `owned`. An
+// EXT_meshopt_compression fallback buffer has no bytes, only its size.
+struct Buffer {
+  const unsigned char *data = nullptr;
+  size_t size = 0;
+  bool fallback = false;
+};
+
+// An image as the file names it; its bytes are read when a texture uses it.
+struct ImageRef {
+  std::string name, uri;
+  int buffer_view = -1;
+};
+
+// What the file's buffers and images come from; tinygltf sees only the
+// rest of the JSON.
+struct Source {
+  std::string dir;
+  Mapping file;
+  std::vector<std::unique_ptr<Mapping>> bins;
+  std::vector<std::unique_ptr<std::vector<unsigned char>>> owned;
+  std::vector<Buffer> buffers;
+  std::vector<ImageRef> images;
+  // [mesh, primitive] -> the indices accessor of a KHR_draco_mesh_compression
+  // primitive, kept from tinygltf, which refuses an indices accessor without
+  // a bufferView (as Draco's are)
+  std::map<std::pair<size_t, size_t>, int> draco_indices;
+};
+
+// An image decoded ahead of its first use (decode_images), until the scene
+// takes its pixels.
+struct Pending {
+  bool wanted = false, done = false, ok = false;
+  int width = 0, height = 0;
+  unsigned char *rgba = nullptr;
+  std::string error;
+  Pending() = default;
+  Pending(const Pending &) = delete;
+  Pending &operator=(const Pending &) = delete;
+  Pending(Pending &&o) noexcept : wanted(o.wanted), done(o.done), ok(o.ok), width(o.width), height(o.height),
+                                  rgba(o.rgba), error(std::move(o.error)) { o.rgba = nullptr; }
+  ~Pending() { free(rgba); }
+};
+
+// Bytes decoded from compressed data, read as an accessor's or a
+// bufferView's own: `type` is the component type they hold.
+struct Decoded {
+  std::vector<unsigned char> bytes;
+  int type = 0;
+  bool done = false;
+};
 
 struct Loader {
   const char *path;
@@ -38,6 +134,10 @@ struct Loader {
   // What is skipped or mended with one warning a file: the count and the first case.
   int skipped_channels = 0, ignored_targets = 0, mended_weights = 0;
   std::string first_channel, first_target, first_weights;
+  const Source *src;                   // the buffers and images
+  std::vector<Decoded> views;          // [bufferView] -> EXT_meshopt_compression's bytes, once decoded
+  std::map<int, Decoded> draco;        // [accessor] -> the current primitive's Draco-decoded elements
+  std::vector<Pending> decoded;        // [image] -> decoded by decode_images
 };
 
 // Every failure goes through here: "path: what".
@@ -98,6 +198,73 @@ struct View {
   bool normalized;
 };
 
+// An unsigned integer `key` of extension object `o` into *out (`fallback` when absent).
+bool ext_size(const tinygltf::Value &o, const char *key, size_t fallback, size_t *out) {
+  if (!o.Has(key)) return *out = fallback, true;
+  const tinygltf::Value &v = o.Get(key);
+  double x = v.IsNumber() ? v.GetNumberAsDouble() : -1;
+  if (!(x >= 0 && x <= 9e15) || x != std::floor(x)) return false;
+  *out = (size_t)x;
+  return true;
+}
+
+// Bytes [offset, offset + length) of buffer `index` (for `what`); false
+// (error set) when they are not all there.
+bool buffer_range(Loader &L, const char *what, int index, size_t offset, size_t length, const unsigned char **data) {
+  const std::vector<Buffer> &buffers = L.src->buffers;
+  if (index < 0 || (size_t)index >= buffers.size())
+    return fail(L, "%s: buffer %d does not exist (the file has %zu)", what, index, buffers.size());
+  const Buffer &b = buffers[index];
+  if (b.fallback)
+    return fail(L, "%s: buffer %d is EXT_meshopt_compression's fallback, which holds no data", what, index);
+  if (offset > b.size || length > b.size - offset)
+    return fail(L, "%s (%zu bytes from %zu) runs past the end of buffer %d (%zu bytes)", what, length, offset, index,
+                b.size);
+  *data = b.data + offset;
+  return true;
+}
+
+// The bytes of bufferView `index` (for `what`, "mesh 0 primitive 1:
+// POSITION: accessor 3"), decoded first (once) when EXT_meshopt_compression
+// compressed them; false (error set) when they are not all in their buffer
+// or do not decode.
+bool view_bytes(Loader &L, const char *what, int index, const unsigned char **data, size_t *size) {
+  const tinygltf::Model &m = L.m;
+  if (index < 0 || (size_t)index >= m.bufferViews.size())
+    return fail(L, "%s: bufferView %d does not exist (the file has %zu)", what, index, m.bufferViews.size());
+  const tinygltf::BufferView &bv = m.bufferViews[index];
+  char at[256];
+  snprintf(at, sizeof at, "%s: bufferView %d", what, index);
+  *size = bv.byteLength;
+  auto ext = bv.extensions.find("EXT_meshopt_compression");
+  if (ext == bv.extensions.end()) return buffer_range(L, at, bv.buffer, bv.byteOffset, bv.byteLength, data);
+
+  Decoded &d = L.views[index];
+  if (!d.done) {
+    const tinygltf::Value &o = ext->second;
+    size_t buffer, offset, length, stride, count;
+    if (!o.IsObject() || !ext_size(o, "buffer", SIZE_MAX, &buffer) || !ext_size(o, "byteOffset", 0, &offset) ||
+        !ext_size(o, "byteLength", SIZE_MAX, &length) || !ext_size(o, "byteStride", SIZE_MAX, &stride) ||
+        !ext_size(o, "count", SIZE_MAX, &count) || buffer > INT32_MAX || length == SIZE_MAX ||
+        stride == SIZE_MAX || count == SIZE_MAX || !o.Get("mode").IsString() ||
+        (o.Has("filter") && !o.Get("filter").IsString()))
+      return fail(L, "%s: EXT_meshopt_compression wants buffer, byteLength, byteStride, count (integers) and mode",
+                  at);
+    const unsigned char *compressed;
+    if (!buffer_range(L, at, (int)buffer, offset, length, &compressed)) return false;
+    std::string filter = o.Has("filter") ? o.Get("filter").Get<std::string>() : "NONE";
+    std::string why = lm_meshopt_decode(compressed, length, count, stride, o.Get("mode").Get<std::string>(), filter,
+                                        d.bytes);
+    if (!why.empty()) return fail(L, "%s: EXT_meshopt_compression: %s", at, why.c_str());
+    d.done = true;
+  }
+  if (bv.byteLength > d.bytes.size())
+    return fail(L, "%s: byteLength %zu is more than EXT_meshopt_compression's %zu decoded bytes", at, bv.byteLength,
+                d.bytes.size());
+  *data = d.bytes.data();
+  return true;
+}
+
 // Checks accessor `index` (for `what`, e.g. "mesh 0 primitive 1: POSITION")
 // down to the buffer's last byte.
 bool accessor_view(Loader &L, const char *what, int index, int ncomp, View *v) {
@@ -120,32 +287,35 @@ bool accessor_view(Loader &L, const char *what, int index, int ncomp, View *v) {
                 LM_GLTF_MAX_ELEMENTS);
   size_t elem = (size_t)csize * (size_t)ncomp;
   *v = View{nullptr, elem, a.count, a.componentType, ncomp, a.normalized};
+  auto decoded = L.draco.find(index);
+  if (decoded != L.draco.end()) { // KHR_draco_mesh_compression's: tightly packed, its own type
+    v->type = decoded->second.type;
+    v->stride = (size_t)component_size(v->type) * (size_t)ncomp;
+    v->base = decoded->second.bytes.data();
+    if (decoded->second.bytes.size() != v->stride * a.count)
+      return fail(L, "%s: accessor %d has %zu elements, but its Draco data %zu", what, index, a.count,
+                  decoded->second.bytes.size() / v->stride);
+    return true;
+  }
   if (a.bufferView < 0) return true;
 
-  if ((size_t)a.bufferView >= m.bufferViews.size())
-    return fail(L, "%s: accessor %d: bufferView %d does not exist (the file has %zu)", what, index,
-                a.bufferView, m.bufferViews.size());
+  char at[192];
+  snprintf(at, sizeof at, "%s: accessor %d", what, index);
+  const unsigned char *bytes;
+  size_t room;
+  if (!view_bytes(L, at, a.bufferView, &bytes, &room)) return false;
   const tinygltf::BufferView &bv = m.bufferViews[a.bufferView];
-  if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size())
-    return fail(L, "%s: accessor %d: bufferView %d: buffer %d does not exist (the file has %zu)",
-                what, index, a.bufferView, bv.buffer, m.buffers.size());
-  size_t size = m.buffers[bv.buffer].data.size();
-  if (bv.byteOffset > size || bv.byteLength > size - bv.byteOffset)
-    return fail(L, "%s: accessor %d: bufferView %d (%zu bytes from %zu) runs past the end of "
-                "buffer %d (%zu bytes)", what, index, a.bufferView, bv.byteLength, bv.byteOffset,
-                bv.buffer, size);
   size_t stride = bv.byteStride ? bv.byteStride : elem;
   if (stride < elem || stride % (size_t)csize)
     return fail(L, "%s: accessor %d: bufferView %d has byteStride %zu, which does not fit "
                 "%zu-byte elements", what, index, a.bufferView, bv.byteStride, elem);
   // The last element ends at byteOffset + stride * (count - 1) + elem; divide, never overflow.
-  size_t room = bv.byteLength;
   if (a.byteOffset > room || room - a.byteOffset < elem ||
       (a.count - 1) > (room - a.byteOffset - elem) / stride)
     return fail(L, "%s: accessor %d: %zu elements of %zu bytes (stride %zu) from byteOffset %zu "
                 "run past the end of bufferView %d (%zu bytes)", what, index, a.count, elem,
                 stride, a.byteOffset, a.bufferView, room);
-  v->base = m.buffers[bv.buffer].data.data() + bv.byteOffset + a.byteOffset;
+  v->base = bytes + a.byteOffset;
   v->stride = stride;
   return true;
 }
@@ -444,6 +614,56 @@ bool deformable(const tinygltf::Mesh &mesh) {
   return false;
 }
 
+// A KHR_draco_mesh_compression primitive's indices and the attributes the
+// extension names, decoded into L.draco for accessor_view to read as the
+// accessors' own; the other attributes stay where their accessors point.
+bool decode_draco(Loader &L, const char *where, const tinygltf::Primitive &p, int indices_accessor,
+                  const tinygltf::Value &o) {
+  char what[128];
+  snprintf(what, sizeof what, "%s: KHR_draco_mesh_compression", where);
+  if (!o.IsObject() || !o.Get("bufferView").IsInt() || !o.Get("attributes").IsObject())
+    return fail(L, "%s wants {\"bufferView\": index, \"attributes\": {name: id}}", what);
+  if (indices_accessor < 0) return fail(L, "%s: the primitive has no indices accessor for the decoded triangles", what);
+  std::vector<lm_draco_attribute> wanted;
+  std::vector<int> accessors;
+  std::vector<std::string> names = o.Get("attributes").Keys(); // wanted[i].name points into it
+  for (const std::string &name : names) {
+    const tinygltf::Value &id = o.Get("attributes").Get(name);
+    auto it = p.attributes.find(name);
+    if (!id.IsInt() || it == p.attributes.end())
+      return fail(L, "%s: attribute %s wants an integer id and the primitive's own %s accessor", what, name.c_str(),
+                  name.c_str());
+    if (it->second < 0 || (size_t)it->second >= L.m.accessors.size())
+      return fail(L, "%s: %s: accessor %d does not exist (the file has %zu)", what, name.c_str(), it->second,
+                  L.m.accessors.size());
+    const tinygltf::Accessor &a = L.m.accessors[it->second];
+    wanted.push_back({name.c_str(), id.Get<int>(), a.componentType, component_count(a.type), {}});
+    accessors.push_back(it->second);
+  }
+  const unsigned char *bytes;
+  size_t size, points;
+  std::vector<uint32_t> indices;
+  if (!view_bytes(L, what, o.Get("bufferView").Get<int>(), &bytes, &size)) return false;
+  std::string why = lm_draco_decode(bytes, size, indices, &points, wanted);
+  if (!why.empty()) return fail(L, "%s: %s", what, why.c_str());
+  Decoded &ix = L.draco[indices_accessor];
+  ix.type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+  ix.bytes.resize(indices.size() * sizeof(uint32_t));
+  memcpy(ix.bytes.data(), indices.data(), ix.bytes.size());
+  for (size_t i = 0; i < wanted.size(); i++) {
+    Decoded &d = L.draco[accessors[i]];
+    d.type = wanted[i].component_type;
+    d.bytes = std::move(wanted[i].bytes);
+  }
+  return true;
+}
+
+// The indices accessor of primitive pi of mesh mi (-1: none), a Draco one's too.
+int indices_of(const Loader &L, int mi, int pi) {
+  auto d = L.src->draco_indices.find({(size_t)mi, (size_t)pi});
+  return d != L.src->draco_indices.end() ? d->second : L.m.meshes[mi].primitives[pi].indices;
+}
+
 // lm mesh of primitive pi of mesh mi; -2 when skipped, -1 on error.
 int load_primitive(Loader &L, int mi, int pi) {
   const tinygltf::Mesh &mesh = L.m.meshes[mi];
@@ -460,6 +680,10 @@ int load_primitive(Loader &L, int mi, int pi) {
     return fail(L, "%s: mode %d is not a glTF primitive mode (0 to 6)", where, mode), -1;
   auto pos = p.attributes.find("POSITION");
   if (pos == p.attributes.end()) return fail(L, "%s: no POSITION attribute", where), -1;
+  L.draco.clear(); // the previous primitive's
+  int indices = indices_of(L, mi, pi);
+  auto draco = p.extensions.find("KHR_draco_mesh_compression");
+  if (draco != p.extensions.end() && !decode_draco(L, where, p, indices, draco->second)) return -1;
   char what[160];
   snprintf(what, sizeof what, "%s: POSITION", where);
   View v; // POSITION's count first: every other attribute must match it
@@ -476,20 +700,20 @@ int load_primitive(Loader &L, int mi, int pi) {
     return -1;
 
   std::vector<uint32_t> idx;
-  if (p.indices >= 0) {
-    if (!read_indices(L, where, p.indices, count, idx)) return -1;
+  if (indices >= 0) {
+    if (!read_indices(L, where, indices, count, idx)) return -1;
   } else {
     idx.resize(count);
     for (size_t i = 0; i < count; i++) idx[i] = (uint32_t)i;
   }
   if (mode == TINYGLTF_MODE_TRIANGLES && idx.size() % 3)
     return fail(L, "%s: %zu %s, not a multiple of 3 (triangles)", where, idx.size(),
-                p.indices >= 0 ? "indices" : "vertices"), -1;
+                indices >= 0 ? "indices" : "vertices"), -1;
   if (mode != TINYGLTF_MODE_TRIANGLES) {
     if (idx.size() < 3)
       return fail(L, "%s: a triangle %s of %zu %s, fewer than 3", where,
                   mode == TINYGLTF_MODE_TRIANGLE_STRIP ? "strip" : "fan", idx.size(),
-                  p.indices >= 0 ? "indices" : "vertices"), -1;
+                  indices >= 0 ? "indices" : "vertices"), -1;
     idx = triangle_list(mode, idx);
   }
   if (has_normals) normalize_normals(verts);
@@ -511,36 +735,117 @@ int load_primitive(Loader &L, int mi, int pi) {
 
 // ---- materials -------------------------------------------------------------
 
-// lm texture of texture `index` (for material `material`'s `what`), decoded
-// on first use through OpenImageIO (the bytes stayed encoded since parsing);
-// colour images are sampled as sRGB, data images (`linear`) as they are.
-// -1 on error.
+// Image `src`'s encoded bytes into *bytes, *size: a view of its buffer, a
+// data URI decoded into `storage` or the file beside the glTF read into it.
+// 1 when read, 0 when there are none (a missing file), -1 with the error set
+// when its bufferView is bad (messages start with `at`).
+int image_bytes(Loader &L, const char *at, int src, const unsigned char **bytes, size_t *size,
+                 std::vector<unsigned char> &storage) {
+  const ImageRef &img = L.src->images[src];
+  *bytes = nullptr, *size = 0;
+  if (img.buffer_view >= 0) return view_bytes(L, at, img.buffer_view, bytes, size) ? 1 : -1;
+  if (tinygltf::IsDataURI(img.uri)) {
+    std::string mime;
+    if (!tinygltf::DecodeDataURI(&storage, mime, img.uri, 0, false)) return 0;
+  } else {
+    std::string full = L.src->dir + "/" + tinygltf::dlib::urldecode(img.uri);
+    lm_error ignored;
+    char *file = lm_read_file(full.c_str(), size, &ignored);
+    if (!file) return 0;
+    storage.assign(file, file + *size);
+    free(file);
+  }
+  *bytes = storage.data(), *size = storage.size();
+  return *size > 0;
+}
+
+// "image N ('name or uri')" for messages and labels.
+std::string image_label(const Loader &L, int src) {
+  const ImageRef &img = L.src->images[src];
+  std::string named = img.name.empty() ? img.uri.substr(0, 40) : img.name;
+  return "image " + std::to_string(src) + (named.empty() ? "" : " ('" + named + "')");
+}
+
+// Every image a material names, decoded on all cores before the materials
+// are read (texture_for takes them from L.decoded). An image whose bytes
+// cannot be had is left to texture_for, which names the material.
+void decode_images(Loader &L) {
+  const tinygltf::Model &m = L.m;
+  L.decoded.resize(L.src->images.size());
+  std::vector<int> todo;
+  std::vector<std::vector<unsigned char>> storage(L.src->images.size());
+  std::vector<const unsigned char *> bytes(L.src->images.size());
+  std::vector<size_t> sizes(L.src->images.size());
+  for (const tinygltf::Material &gm : m.materials)
+    for (int t : {gm.pbrMetallicRoughness.baseColorTexture.index, gm.pbrMetallicRoughness.metallicRoughnessTexture.index,
+                  gm.normalTexture.index, gm.occlusionTexture.index, gm.emissiveTexture.index}) {
+      int src = t >= 0 && (size_t)t < m.textures.size() ? m.textures[t].source : -1;
+      if (src < 0 || (size_t)src >= L.src->images.size() || L.decoded[src].wanted) continue;
+      L.decoded[src].wanted = true;
+      lm_error quiet = {""};
+      lm_error *err = L.err;
+      L.err = &quiet; // a bad bufferView is named by texture_for, with its material
+      if (image_bytes(L, "", src, &bytes[src], &sizes[src], storage[src]) == 1) todo.push_back(src);
+      L.err = err;
+    }
+  std::atomic<size_t> next{0};
+  auto work = [&]() {
+    for (size_t i; (i = next++) < todo.size();) {
+      int src = todo[i];
+      Pending &d = L.decoded[src];
+      lm_error why = {""};
+      d.ok = lm_image_decode_rgba8(bytes[src], sizes[src], image_label(L, src).c_str(), &d.width, &d.height, &d.rgba,
+                                   &why);
+      d.error = why.msg;
+      d.done = true;
+    }
+  };
+  unsigned cores = std::max(1u, std::min(std::thread::hardware_concurrency(), (unsigned)todo.size()));
+  std::vector<std::thread> threads;
+  for (unsigned i = 1; i < cores; i++) threads.emplace_back(work);
+  work();
+  for (std::thread &t : threads) t.join();
+}
+
+// lm texture of texture `index` (for material `material`'s `what`): its
+// image as decode_images left it (decoded here when it did not, as for a
+// second use of one image, as colour and as data); colour images are
+// sampled as sRGB, data images (`linear`) as they are. -1 on error.
 int texture_for(Loader &L, int material, const char *what, int index, bool linear) {
   const tinygltf::Model &m = L.m;
   if (index < 0 || (size_t)index >= m.textures.size())
     return fail(L, "material %d: %s: texture %d does not exist (the file has %zu)", material, what, index,
                 m.textures.size()), -1;
   int src = m.textures[index].source;
-  if (src < 0 || (size_t)src >= m.images.size())
+  const std::vector<ImageRef> &images = L.src->images;
+  if (src < 0 || (size_t)src >= images.size())
     return fail(L, "material %d: %s: texture %d: image %d does not exist (the file has %zu)", material, what,
-                index, src, m.images.size()), -1;
+                index, src, images.size()), -1;
   int &cached = L.textures[(size_t)src * 2 + linear];
   if (cached >= 0) return cached;
-  const tinygltf::Image &img = m.images[src];
-  char name[LM_NAME_MAX + 64];
-  snprintf(name, sizeof name, "image %d%s%s%s", src, img.name.empty() && img.uri.empty() ? "" : " ('",
-           img.name.empty() ? img.uri.substr(0, 40).c_str() : img.name.c_str(),
-           img.name.empty() && img.uri.empty() ? "" : "')");
-  if (img.image.empty())
-    return fail(L, "material %d: %s: texture %d: %s: no image data (a missing file?)", material, what, index,
-                name), -1;
-  int w, h;
-  unsigned char *rgba;
-  lm_error why;
-  if (!lm_image_decode_rgba8(img.image.data(), img.image.size(), name, &w, &h, &rgba, &why))
-    return fail(L, "material %d: %s: texture %d: %s", material, what, index, why.msg), -1;
+  const ImageRef &img = images[src];
+  std::string name = image_label(L, src);
+  char at[LM_NAME_MAX + 160];
+  snprintf(at, sizeof at, "material %d: %s: texture %d: %s", material, what, index, name.c_str());
+  bool ahead = (size_t)src < L.decoded.size() && L.decoded[src].done && (L.decoded[src].rgba || !L.decoded[src].ok);
+  Pending none, &d = ahead ? L.decoded[src] : none;
+  if (!d.done) {
+    const unsigned char *bytes;
+    size_t size;
+    std::vector<unsigned char> storage;
+    int read = image_bytes(L, at, src, &bytes, &size, storage);
+    if (read < 0) return -1;
+    if (!read) return fail(L, "%s: no image data (a missing file?)", at), -1;
+    lm_error why = {""};
+    d.ok = lm_image_decode_rgba8(bytes, size, name.c_str(), &d.width, &d.height, &d.rgba, &why);
+    d.error = why.msg;
+  }
+  if (!d.ok) return fail(L, "material %d: %s: texture %d: %s", material, what, index, d.error.c_str()), -1;
+  int w = d.width, h = d.height;
+  unsigned char *rgba = d.rgba;
+  d.rgba = nullptr; // the scene's now
   char label[LM_NAME_MAX];
-  snprintf(label, sizeof label, "%s", img.name.empty() ? name : img.name.c_str());
+  snprintf(label, sizeof label, "%s", img.name.empty() ? name.c_str() : img.name.c_str());
   cached = lm_scene_add_texture(L.s, label, w, h, rgba);
   L.s->textures[cached].linear = linear;
   return cached;
@@ -1286,16 +1591,6 @@ void add_defaults(lm_scene *s) {
 
 // ---- parsing ---------------------------------------------------------------
 
-// Keeps each image's bytes encoded: texture_for decodes (through OpenImageIO)
-// only the images a material uses, so that no stb_image runs and a broken
-// image nobody reads cannot fail the scene.
-bool keep_image_undecoded(tinygltf::Image *image, const int, std::string *, std::string *, int, int,
-                          const unsigned char *bytes, int size, void *) {
-  if (bytes && size > 0) image->image.assign(bytes, bytes + size);
-  image->as_is = true;
-  return true;
-}
-
 // tinygltf's message, first line only, with any data URI it quotes (a whole
 // buffer in base64) cut to its head.
 std::string first_line(const std::string &s) {
@@ -1310,10 +1605,9 @@ std::string first_line(const std::string &s) {
 
 // tinygltf refuses a primitive whose indices accessor does not exist before
 // we see the model, with a message that names no mesh: find the primitive in
-// the JSON ourselves. `json` is the text tinygltf parsed (the GLB's chunk 0).
-std::string locate_bad_indices(const unsigned char *text, size_t len) {
+// the JSON ourselves.
+std::string locate_bad_indices(const nlohmann::json &doc) {
   using nlohmann::json;
-  json doc = json::parse(text, text + len, nullptr, false);
   if (!doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array()) return "";
   size_t accessors = doc.contains("accessors") && doc["accessors"].is_array() ? doc["accessors"].size() : 0;
   const json &meshes = doc["meshes"];
@@ -1335,14 +1629,14 @@ std::string locate_bad_indices(const unsigned char *text, size_t len) {
 // The extensions this loader reads: a file that requires any other is refused
 // before tinygltf sees it (which would fail later, on data it cannot decode).
 const char *const kSupportedExtensions[] = {"KHR_lights_punctual", "KHR_texture_transform",
-                                            "KHR_materials_emissive_strength", "EXT_mesh_gpu_instancing"};
+                                            "KHR_materials_emissive_strength", "EXT_mesh_gpu_instancing",
+                                            "KHR_draco_mesh_compression", "EXT_meshopt_compression",
+                                            "KHR_mesh_quantization"};
 
 // The first name in the file's extensionsRequired that is not supported, or "".
-std::string unsupported_required(const unsigned char *text, size_t len) {
+std::string unsupported_required(const nlohmann::json &doc) {
   using nlohmann::json;
-  json doc = json::parse(text, text + len, nullptr, false);
-  if (!doc.is_object() || !doc.contains("extensionsRequired") || !doc["extensionsRequired"].is_array())
-    return "";
+  if (!doc.contains("extensionsRequired") || !doc["extensionsRequired"].is_array()) return "";
   for (const json &e : doc["extensionsRequired"]) {
     std::string name = e.is_string() ? e.get<std::string>() : e.dump();
     bool known = false;
@@ -1352,32 +1646,108 @@ std::string unsupported_required(const unsigned char *text, size_t len) {
   return "";
 }
 
-bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
-  size_t len;
-  char *data = lm_read_file(path, &len, err);
-  if (!data) return false;
-  if (len > 0x7fffff00u) {
-    free(data);
-    lm_error_set(err, "%s: larger than 2 GiB", path);
-    return false;
+// Buffer i of the file (its JSON `b`) into src.buffers: the GLB's BIN chunk
+// (`bin`, NULL without one) for a first buffer without a uri, a data URI
+// decoded, or a file beside the glTF mapped.
+bool load_buffer(const char *path, Source &src, size_t i, const nlohmann::json &b, const unsigned char *bin,
+                 size_t bin_len, lm_error *err) {
+  Buffer out;
+  if (!b.is_object() || !b.contains("byteLength") || !b["byteLength"].is_number_unsigned())
+    return lm_error_set(err, "%s: buffer %zu: byteLength is missing or not an unsigned integer", path, i), false;
+  out.size = b["byteLength"].get<size_t>();
+  bool has_uri = b.contains("uri") && b["uri"].is_string();
+  const nlohmann::json *ext = b.contains("extensions") && b["extensions"].is_object() &&
+                                      b["extensions"].contains("EXT_meshopt_compression")
+                                  ? &b["extensions"]["EXT_meshopt_compression"]
+                                  : nullptr;
+  out.fallback = !has_uri && ext && ext->is_object() && ext->value("fallback", false) == true;
+  if (out.fallback) {
+  } else if (!has_uri) {
+    if (i != 0 || !bin)
+      return lm_error_set(err, "%s: buffer %zu has no uri (only a GLB's first buffer may go without)", path, i), false;
+    if (out.size > bin_len)
+      return lm_error_set(err, "%s: buffer 0: byteLength %zu is more than the GLB's BIN chunk (%zu bytes)", path,
+                          out.size, bin_len), false;
+    out.data = bin;
+  } else {
+    std::string uri = b["uri"].get<std::string>();
+    if (tinygltf::IsDataURI(uri)) {
+      auto bytes = std::make_unique<std::vector<unsigned char>>();
+      std::string mime;
+      if (!tinygltf::DecodeDataURI(bytes.get(), mime, uri, out.size, true))
+        return lm_error_set(err, "%s: buffer %zu: its data URI does not decode to byteLength %zu bytes", path, i,
+                            out.size), false;
+      out.data = bytes->data();
+      src.owned.push_back(std::move(bytes));
+    } else {
+      std::string full = src.dir + "/" + tinygltf::dlib::urldecode(uri);
+      auto bin_file = std::make_unique<Mapping>();
+      lm_error why;
+      if (!map_file(full.c_str(), *bin_file, &why))
+        return lm_error_set(err, "%s: buffer %zu: %s", path, i, why.msg), false;
+      if (bin_file->len < out.size)
+        return lm_error_set(err, "%s: buffer %zu: %s has %zu bytes, byteLength says %zu", path, i, full.c_str(),
+                            bin_file->len, out.size), false;
+      out.data = bin_file->bytes();
+      src.bins.push_back(std::move(bin_file));
+    }
   }
-  // tinygltf 2.7.0 checks a GLB's BIN chunk length without its 8-byte header
-  // and can read that far past the end: hand it zero padding to read.
-  std::vector<unsigned char> bytes(len + 16, 0);
-  memcpy(bytes.data(), data, len);
-  free(data);
+  src.buffers.push_back(out);
+  return true;
+}
+
+// Image i of the file (its JSON `o`) into src.images.
+bool load_image_ref(const char *path, Source &src, size_t i, const nlohmann::json &o, lm_error *err) {
+  ImageRef img;
+  bool has_uri = o.is_object() && o.contains("uri") && o["uri"].is_string();
+  bool has_view = o.is_object() && o.contains("bufferView") && o["bufferView"].is_number_integer();
+  if (has_uri == has_view)
+    return lm_error_set(err, "%s: image %zu wants a uri or a bufferView (one of them)", path, i), false;
+  if (has_uri) img.uri = o["uri"].get<std::string>();
+  if (has_view) img.buffer_view = (int)std::clamp(o["bufferView"].get<long long>(), -1LL, (long long)INT32_MAX);
+  if (o.contains("name") && o["name"].is_string()) img.name = o["name"].get<std::string>();
+  src.images.push_back(img);
+  return true;
+}
+
+// Reads `path`: its buffers and images into src (mapped where they lie),
+// the rest of its JSON into *model through tinygltf.
+bool parse(const char *path, Source &src, tinygltf::Model *model, lm_error *err) {
+  using nlohmann::json;
+  if (!map_file(path, src.file, err)) return false;
   char dir[4096];
   lm_dirname(path, dir, sizeof dir);
-
-  bool glb = len >= 4 && !memcmp(bytes.data(), "glTF", 4);
-  // The JSON: a GLB's chunk 0 (when its length fits the file), else the whole text.
-  uint32_t json_len = (uint32_t)len;
-  if (glb) {
-    json_len = 0;
-    if (len >= 20) memcpy(&json_len, bytes.data() + 12, 4);
-    if (json_len > len - std::min(len, (size_t)20)) json_len = 0;
+  src.dir = dir;
+  const unsigned char *bytes = src.file.bytes();
+  size_t len = src.file.len;
+  // A GLB: header (magic, version, length), a JSON chunk, an optional BIN chunk.
+  const unsigned char *text = bytes, *bin = nullptr;
+  size_t text_len = len, bin_len = 0;
+  if (len >= 4 && !memcmp(bytes, "glTF", 4)) {
+    uint32_t head[5] = {0};
+    if (len >= 20) memcpy(head, bytes, 20);
+    if (len < 20 || head[1] != 2 || head[2] > len || head[2] < 20 || memcmp(&head[4], "JSON", 4) ||
+        head[3] > head[2] - 20)
+      return lm_error_set(err, "%s: not a glTF 2.0 binary (its header or JSON chunk does not fit its %zu bytes)",
+                          path, len), false;
+    text = bytes + 20, text_len = head[3];
+    size_t at = 20 + (size_t)head[3];
+    uint32_t chunk[2];
+    if (at + 8 <= head[2]) {
+      memcpy(chunk, bytes + at, 8);
+      if (memcmp(&chunk[1], "BIN", 4) || chunk[0] > head[2] - at - 8)
+        return lm_error_set(err, "%s: the GLB's second chunk is not a BIN chunk that fits the file", path), false;
+      bin = bytes + at + 8, bin_len = chunk[0];
+    }
   }
-  std::string missing = unsupported_required(bytes.data() + (glb ? 20 : 0), json_len);
+  json doc;
+  try {
+    doc = text ? json::parse(text, text + text_len) : json();
+  } catch (const json::exception &e) {
+    return lm_error_set(err, "%s: not JSON (%s)", path, e.what()), false;
+  }
+  if (!doc.is_object()) return lm_error_set(err, "%s: not a glTF file (its JSON is not an object)", path), false;
+  std::string missing = unsupported_required(doc);
   if (!missing.empty()) {
     std::string known;
     for (const char *k : kSupportedExtensions) known += std::string(known.empty() ? "" : ", ") + k;
@@ -1385,32 +1755,99 @@ bool parse(const char *path, tinygltf::Model *model, lm_error *err) {
                  path, missing.c_str(), known.c_str());
     return false;
   }
-
+  if (doc.contains("buffers")) {
+    if (!doc["buffers"].is_array()) return lm_error_set(err, "%s: buffers is not an array", path), false;
+    for (size_t i = 0; i < doc["buffers"].size(); i++)
+      if (!load_buffer(path, src, i, doc["buffers"][i], bin, bin_len, err)) return false;
+    doc.erase("buffers");
+  }
+  if (doc.contains("images")) {
+    if (!doc["images"].is_array()) return lm_error_set(err, "%s: images is not an array", path), false;
+    for (size_t i = 0; i < doc["images"].size(); i++)
+      if (!load_image_ref(path, src, i, doc["images"][i], err)) return false;
+    doc.erase("images");
+  }
+  if (doc.contains("meshes") && doc["meshes"].is_array())
+    for (size_t mi = 0; mi < doc["meshes"].size(); mi++) {
+      json &mesh = doc["meshes"][mi];
+      if (!mesh.is_object() || !mesh.contains("primitives")) continue;
+      json &prims = mesh["primitives"];
+      for (size_t pi = 0; prims.is_array() && pi < prims.size(); pi++) {
+        json &p = prims[pi];
+        if (!p.is_object() || !p.contains("indices") || !p["indices"].is_number_integer() ||
+            !p.contains("extensions") || !p["extensions"].is_object() ||
+            !p["extensions"].contains("KHR_draco_mesh_compression"))
+          continue;
+        src.draco_indices[{mi, pi}] = (int)std::clamp(p["indices"].get<long long>(), -1LL, (long long)INT32_MAX);
+        p.erase("indices");
+      }
+    }
+  std::string rest = doc.dump();
   tinygltf::TinyGLTF gltf;
-  gltf.SetImageLoader(keep_image_undecoded, nullptr);
   std::string why, warn;
-  bool ok = glb ? gltf.LoadBinaryFromMemory(model, &why, &warn, bytes.data(), (unsigned)len, dir)
-                : gltf.LoadASCIIFromString(model, &why, &warn, (const char *)bytes.data(),
-                                           (unsigned)len, dir);
+  bool ok = gltf.LoadASCIIFromString(model, &why, &warn, rest.data(), (unsigned)rest.size(), src.dir);
   if (!warn.empty()) lm_debug("%s: tinygltf: %s", path, first_line(warn).c_str());
   // Some of tinygltf's checks (a baseColorFactor of 2 numbers) report into
   // `why` and carry on with a default: a wrong file all the same.
   if (ok && why.empty()) return true;
   std::string what = first_line(why);
   if (what.find("primitive indices accessor out of bounds") != std::string::npos) {
-    std::string where = locate_bad_indices(bytes.data() + (glb ? 20 : 0), json_len);
+    std::string where = locate_bad_indices(doc);
     if (!where.empty()) what = where;
   }
   lm_error_set(err, "%s: %s", path, what.c_str());
   return false;
 }
 
+// The memory budget in bytes (gltf.h): LIMN_MEMORY_BUDGET MiB, else 3/4 of
+// physical memory; *from says which.
+double memory_budget(const char **from) {
+  const char *env = getenv("LIMN_MEMORY_BUDGET");
+  char *end;
+  double mib = env ? strtod(env, &end) : 0;
+  if (env && end != env && !*end && mib > 0 && std::isfinite(mib)) return *from = "LIMN_MEMORY_BUDGET", mib * 1048576;
+  *from = "the default, 3/4 of physical memory; LIMN_MEMORY_BUDGET=MiB sets another";
+  return 0.75 * (double)sysconf(_SC_PHYS_PAGES) * (double)sysconf(_SC_PAGESIZE);
+}
+
+// What the scene will hold, in bytes, against the budget: every primitive's
+// vertices (32 bytes, 48 with tangents) and indices (4 bytes) once in the
+// scene and once as GPU buffers, the decoded images once in the scene and
+// once on the GPU with their mip levels (4/3). Checked before the images
+// are decoded and again after (their size is known then), before a mesh is
+// made.
+bool within_budget(Loader &L) {
+  double geometry = 0, images = 0;
+  for (size_t mi = 0; mi < L.m.meshes.size(); mi++)
+    for (size_t pi = 0; pi < L.m.meshes[mi].primitives.size(); pi++) {
+      const tinygltf::Primitive &p = L.m.meshes[mi].primitives[pi];
+      int indices = indices_of(L, (int)mi, (int)pi);
+      auto pos = p.attributes.find("POSITION");
+      auto count = [&](int a) { return a >= 0 && (size_t)a < L.m.accessors.size() ? (double)L.m.accessors[a].count : 0; };
+      double vertices = pos == p.attributes.end() ? 0 : count(pos->second);
+      double stride = p.attributes.count("TANGENT") ? 48 : 32;
+      geometry += 2 * (vertices * stride + (indices >= 0 ? count(indices) : vertices) * 4);
+    }
+  for (const Pending &d : L.decoded)
+    if (d.rgba) images += (1 + 4.0 / 3) * 4 * (double)d.width * (double)d.height;
+  const char *from;
+  double budget = memory_budget(&from);
+  if (geometry + images <= budget) return true;
+  return fail(L, "the scene needs about %.4g MiB (vertices and indices %.4g MiB, textures %.4g MiB, in memory and on "
+              "the GPU), more than the memory budget of %.4g MiB (%s)", (geometry + images) / 1048576,
+              geometry / 1048576, images / 1048576, budget / 1048576, from);
+}
+
 // Fills `s` from the parsed model; false (message in L.err) on bad input.
-bool convert(const char *path, const tinygltf::Model &model, lm_scene *s, lm_error *err) {
-  Loader L{path, model, s, err, {}, {}, {}, {}, 0, {}, {}, 0, 0, 0, {}, {}, {}};
+bool convert(const char *path, const Source &src, const tinygltf::Model &model, lm_scene *s, lm_error *err) {
+  Loader L{path, model, s, err, {}, {}, {}, {}, 0, {}, {}, 0, 0, 0, {}, {}, {}, &src, {}, {}, {}};
+  L.views.resize(model.bufferViews.size());
+  if (!within_budget(L)) return false; // the geometry, before an image is decoded
+  decode_images(L);
+  if (!within_budget(L)) return false;
   L.meshes.resize(model.meshes.size());
   L.materials.assign(model.materials.size(), -1);
-  L.textures.assign(model.images.size() * 2, -1);
+  L.textures.assign(src.images.size() * 2, -1);
   L.nodes.assign(model.nodes.size(), -1);
   L.holders.resize(model.nodes.size());
   if (!load_nodes(L) || !load_skins(L) || !load_animations(L)) return false;
@@ -1440,10 +1877,11 @@ extern "C" lm_scene *lm_scene_load_gltf(const char *path, lm_error *err) {
   lm_scene *s = nullptr;
   try {
     tinygltf::Model model;
-    if (!parse(path, &model, err)) return nullptr;
+    Source src;
+    if (!parse(path, src, &model, err)) return nullptr;
     const char *base = strrchr(path, '/');
     s = lm_scene_create(base ? base + 1 : path);
-    if (convert(path, model, s, err)) return s;
+    if (convert(path, src, model, s, err)) return s;
   } catch (const std::exception &e) { // tinygltf throws on some malformed input
     lm_error_set(err, "%s: malformed glTF (%s)", path, e.what());
   } catch (...) {

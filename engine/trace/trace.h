@@ -9,6 +9,20 @@
  * limited to static geometry (seed 003 lines 2486-2489); and every triangle
  * sits in exactly one leaf, so memory is bounded by the triangle count.
  *
+ * Against Embree 3 (tools/trace_compare.c; build/trace_compare
+ * data/scenes/big/big.glb: 1.54 M triangles, 2 threads on the shared 2-core
+ * machine, medians of 3, wall clock, 2026-11-26): build 17.9 s here against
+ * Embree's 1.85 s; camera rays 0.93 against 2.81 million a second, random
+ * rays 0.23 against 0.92; after every node moved, lm_trace_update 18.0 s
+ * against Embree's refit 2.35 s: it rebuilt, because 94 near-degenerate
+ * triangles (sphere poles) passed tri_usable after the move that did not
+ * before, so the kept set changed; both find the same hits (5 of 360,000
+ * camera rays differ, at edges). Embree wins every figure. This BVH stays
+ * until the tracer is moved onto Embree behind this same header (not done
+ * yet: its threads under the sanitized suite, the stats and refit flag the
+ * tests read and the degenerate-triangle rules below are to be settled
+ * first).
+ *
  * Triangles whose corners are not finite, or whose area is zero or not
  * finite, are skipped (counted in lm_trace_stats.skipped), never an error.
  * Depth is capped at LM_TRACE_MAX_DEPTH whatever the geometry, so traversal
