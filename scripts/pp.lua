@@ -10,6 +10,7 @@ local shadow = require "shadow"
 local sky = require "sky"
 local techniques = require "techniques"
 local temporal = require "temporal"
+local transparent = require "transparent"
 
 Options = {
   ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
@@ -93,6 +94,7 @@ local function frame(tech, row)
   end
   -- Ray-traced reflections on every technique, left out where no material reflects.
   if tech.reflections.enabled and scene_reflective() then lit = reflections.render(lit, tech.reflections, F) end
+  lit = transparent.render(lit, tech, F) -- blended materials (glass), where the scene has any
   return post.render(lit, tech, F)
 end
 

@@ -10,7 +10,7 @@
 
 in vec3 world_pos;
 uniform vec4 pass_depth;
-#if defined(RSM) || defined(ALPHA_MASK)
+#if defined(RSM) || defined(ALPHA_MASK) || defined(ALPHA_BLEND)
 in vec2 tex_uv;
 #ifdef BASE_COLOR_TEXTURE
 uniform sampler2D base_color_tex;
@@ -28,14 +28,39 @@ layout(location = 3) out vec4 rsm_pos;
 
 layout(location = 0) out float depth01;
 
+#ifdef ALPHA_BLEND
+// A blended material (alphaMode BLEND) casts a lighter shadow: the share of
+// light it stops, glass_opacity, of its texels are drawn, in a 4x4 ordered
+// dither that the shadow filter (ESM's blur, PCF's taps) averages. Untinted:
+// the map holds depth alone.
+#ifndef RSM
+uniform vec3 material_color;
+#endif
+uniform vec4 material_glass; // transmission, ior, attenuation distance, thickness
+#ifndef ALPHA_MASK
+uniform vec2 material_alpha;
+#endif
+bool glass_dithered_out(vec4 texel) {
+  const float bayer[16] = float[](0.0, 8.0, 2.0, 10.0, 12.0, 4.0, 14.0, 6.0, 3.0, 11.0, 1.0, 9.0, 15.0, 7.0, 13.0, 5.0);
+  ivec2 q = ivec2(gl_FragCoord.xy) & 3;
+  vec3 base = saturate(material_color * texel.rgb);
+  float passes = saturate(material_glass.x) * (base.r + base.g + base.b) / 3.0;
+  float opacity = saturate(material_alpha.x * texel.a) * (1.0 - passes);
+  return (bayer[q.y * 4 + q.x] + 0.5) / 16.0 >= opacity;
+}
+#endif
+
 void main() {
-#if defined(BASE_COLOR_TEXTURE) && (defined(RSM) || defined(ALPHA_MASK))
+#if defined(BASE_COLOR_TEXTURE) && (defined(RSM) || defined(ALPHA_MASK) || defined(ALPHA_BLEND))
   vec4 texel = texture(base_color_tex, (base_color_xform * vec3(tex_uv, 1.0)).xy);
 #else
   vec4 texel = vec4(1.0);
 #endif
 #ifdef ALPHA_MASK
   if (alpha_masked(texel.a)) discard;
+#endif
+#ifdef ALPHA_BLEND
+  if (glass_dithered_out(texel)) discard;
 #endif
   if (pass_depth.w > 0.0) // perspective: distance from the light / range
     depth01 = saturate(length(world_pos - pass_depth.xyz) * pass_depth.w);

@@ -277,6 +277,18 @@ void lm_set_scene_state(bool on, bool shadow_caster) {
   }
 }
 
+void lm_set_blend_state(bool on) {
+  if (on) {
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_SRC1_COLOR);
+  } else {
+    glDisable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ZERO); /* llvmpipe keeps reading the second source while the factor names it */
+  }
+  glDepthMask(on ? GL_FALSE : GL_TRUE);
+}
+
 /* ---- frame block ------------------------------------------------------- */
 static GLuint frame_ubo;
 

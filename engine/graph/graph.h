@@ -104,6 +104,11 @@ typedef struct lm_pass_desc {
   float fit_margin;
   const lm_pass_material_param *material_params; /* scene passes */
   int material_param_count;
+  /* Scene passes: draws the alphaMode BLEND materials alone, back to front,
+   * over what its one output holds (it does not clear): the output becomes
+   * colour + transmittance * output (dual-source blending: the technique's
+   * second output, index 1, is the transmittance), depth tested, not written. */
+  bool blend;
 } lm_pass_desc;
 
 lm_graph *lm_graph_create(void);

@@ -319,6 +319,7 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
   bool ok = true;
   if (d->kind == LM_PASS_SCENE) {
     lm_set_scene_state(true, d->view_count > 0); /* tiles are shadow maps */
+    lm_set_blend_state(d->blend);
     scene_pass_ctx c = {{d, p, g, NULL}, x};
     bool kept = d->view_count > 0 && x->keeps_views && x->keeps_views(x->user, &c.pub);
     if (d->clear && !kept)
@@ -330,6 +331,7 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
       set_view(p, c.pub.view);
       if (x->draw_scene) ok = x->draw_scene(x->user, &c.pub, err);
     }
+    lm_set_blend_state(false);
     lm_set_scene_state(false, false);
     if (!ok) lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
   } else if (d->kind == LM_PASS_POINTS) {

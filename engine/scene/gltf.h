@@ -6,8 +6,9 @@
  * What comes over, and how:
  * - extensionsRequired first: a file that requires an extension other than
  *   those the loader reads (KHR_lights_punctual, KHR_texture_transform,
- *   KHR_materials_emissive_strength, EXT_mesh_gpu_instancing) is refused,
- *   naming it.
+ *   KHR_materials_emissive_strength, EXT_mesh_gpu_instancing,
+ *   KHR_materials_transmission, KHR_materials_ior, KHR_materials_volume)
+ *   is refused, naming it.
  * - Nodes of the file's default scene (scene 0 when it names none; every
  *   root node when it has no scenes), parents before children. A node's
  *   local transform is its matrix, or T * R * S. Every world transform must
@@ -82,6 +83,19 @@
  *   with its KHR_texture_transform (TEXCOORD_0 only; another set warns).
  *   Colour images (base colour, emissive) are sampled as sRGB, data images
  *   as they are (one image used both ways is uploaded twice).
+ *   baseColorFactor's alpha outside [0, 1] fails the file naming the
+ *   material. Glass, as Blender writes it: KHR_materials_transmission's
+ *   transmissionFactor (0..1), KHR_materials_ior's ior (1..10; default 1.5)
+ *   and KHR_materials_volume's thicknessFactor, attenuationDistance (absent:
+ *   no absorption) and attenuationColor (each in 0..1) go to
+ *   lm_material_pbr's glass fields; a value out of range or not finite fails
+ *   the file naming the material, extension and field. Their textures
+ *   (transmissionTexture, thicknessTexture) are not read: one warning a
+ *   file for each. A material with transmission is drawn blended: an
+ *   OPAQUE one becomes BLEND with alpha 1 (Blender writes glass OPAQUE); on
+ *   a MASK one transmission is not drawn (one warning a file). alphaMode
+ *   BLEND materials are drawn by the forward pass over the lit image
+ *   (scripts/transparent.lua), never into the G-buffer.
  * - Perspective cameras: yfov, znear, zfar; the aspect ratio is the output's.
  *   An infinite far plane (zfar absent) becomes LM_GLTF_INFINITE_ZFAR_RATIO
  *   times znear: relative, so any unit works (reversed float depth holds it).
