@@ -470,13 +470,29 @@ def glass_of(gm):
     return t, ext.get("KHR_materials_ior", {}).get("ior", 1.5), absorbed
 
 
+def schlick(t, ior):
+    """Limn's Fresnel (shaders/transparent.frag): Schlick's r0 + (1 - r0)(1 - |n.v|)^5
+    of the ior, the same from either side. (Blender's Fresnel node inverts the
+    ior from behind, whose total internal reflection would stop the shadow
+    rays that reach a surface through the glass.)"""
+    r0 = ((ior - 1.0) / (ior + 1.0)) ** 2
+    geometry = t.node("ShaderNodeNewGeometry")
+    dot = t.node("ShaderNodeVectorMath")
+    dot.operation = "DOT_PRODUCT"
+    t.links.new(geometry.outputs["Normal"], dot.inputs[0])
+    t.links.new(geometry.outputs["Incoming"], dot.inputs[1])
+    grazing = t.math("SUBTRACT", 1.0, t.math("ABSOLUTE", dot.outputs["Value"]))
+    return t.math("ADD", t.math("MULTIPLY", t.math("POWER", grazing, 5.0), 1.0 - r0), r0)
+
+
 def add_glass(t, shader, base, glass):
     """What Limn's forward pass lets through (shaders/transparent.frag): a
     Transparent BSDF (rays pass straight, unrefracted, as Limn's) of colour
-    t (1 - F) base absorbed, F the Fresnel of the ior at the view, added to
-    the surface's own light."""
+    t (1 - F) base absorbed, F the Fresnel of the ior at the view (schlick),
+    added to the surface's own light. Shadow rays pass it too, tinted: Limn's
+    shadow maps pass a(1 - t mean(base)) untinted (docs/scenes.md)."""
     share, ior, absorbed = glass
-    fresnel = t.node("ShaderNodeFresnel", IOR=ior).outputs[0]
+    fresnel = schlick(t, ior)
     tint = t.mix("MULTIPLY", 1.0, t.mix("MULTIPLY", 1.0, base, [share * a for a in absorbed], clamp=True),
                  t.math("SUBTRACT", 1.0, fresnel))
     return add(t, shader, t.node("ShaderNodeBsdfTransparent", Color=tint).outputs[0])
