@@ -442,8 +442,8 @@ def build_pbr(t, base, metallic, roughness, normal, keep=1.0):
     metallic = t.math("MULTIPLY", metallic, 1.0, clamp=True)
     rough = t.math("MAXIMUM", t.math("MULTIPLY", roughness, 1.0, clamp=True), PBR_MIN_ROUGHNESS)
     f0 = t.mix("MIX", metallic, 0.04, base)
-    diffuse_colour = t.mix("MULTIPLY", 1.0, t.mix("MULTIPLY", 1.0, base, t.math("MULTIPLY", t.math("SUBTRACT", 1.0, metallic), keep)),
-                           t.mix("SUBTRACT", 1.0, 1.0, f0))
+    kept = t.math("MULTIPLY", t.math("SUBTRACT", 1.0, metallic), keep)
+    diffuse_colour = t.mix("MULTIPLY", 1.0, t.mix("MULTIPLY", 1.0, base, kept), t.mix("SUBTRACT", 1.0, 1.0, f0))
     diffuse = t.node("ShaderNodeBsdfDiffuse", Color=diffuse_colour, Roughness=0.0)
     specular = t.node("ShaderNodeBsdfPrincipled", **{"Base Color": f0, "Metallic": 1.0, "Roughness": rough,
                                                      "Specular": 0.5})

@@ -143,7 +143,8 @@ void use_extension(Writer &W, tinygltf::Material &g, const char *name, tinygltf:
 // (which glTF allows only beside transmission).
 void add_glass(Writer &W, const lm_material_pbr &p, tinygltf::Material &g) {
   if (p.transmission > 0)
-    use_extension(W, g, "KHR_materials_transmission", {{"transmissionFactor", tinygltf::Value((double)p.transmission)}});
+    use_extension(W, g, "KHR_materials_transmission",
+                  {{"transmissionFactor", tinygltf::Value((double)p.transmission)}});
   if (p.ior > 0 && p.ior != 1.5f) use_extension(W, g, "KHR_materials_ior", {{"ior", tinygltf::Value((double)p.ior)}});
   if (p.transmission > 0 && p.thickness > 0 && p.attenuation_distance > 0)
     use_extension(W, g, "KHR_materials_volume",

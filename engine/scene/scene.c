@@ -522,8 +522,8 @@ static const char *const slot_define[LM_TEX_SLOTS] = {"BASE_COLOR_TEXTURE", "MR_
                                                        "OCCLUSION_TEXTURE", "EMISSIVE_TEXTURE"};
 
 static const char *scene_uniforms[] = {"material_color", "material_rho", "material_k",
-                                       "material_reflectivity", "material_pbr", "material_emissive", "material_alpha", "material_glass",
-                                       "material_attenuation", "base_color_tex",
+                                       "material_reflectivity", "material_pbr", "material_emissive", "material_alpha",
+                                       "material_glass", "material_attenuation", "base_color_tex",
                                        "mr_tex", "normal_tex", "occlusion_tex", "emissive_tex", "base_color_xform",
                                        "mr_xform", "normal_xform", "occlusion_xform", "emissive_xform"};
 
