@@ -117,6 +117,45 @@ static void the_wall_is_seen_through_tinted_and_the_shadow_lighter(void **state)
   lm_scene_destroy(s);
 }
 
+/* Back to front: a red pane (alpha 0.5, no transmission) 0.75 behind the
+ * green one (the same), added to the scene after it. Each pane alone gives
+ * P = a S + (1 - a) W over the wall W; both, the far one drawn first, give
+ * G + (1 - a)(R - W), and drawn the other way R + (1 - a)(G - W). No
+ * shadows (dl): the panes' own light S is the same alone and together. */
+static void blended_nodes_draw_back_to_front(void **state) {
+  (void)state;
+  lm_scene *s = glass_scene();
+  lm_material_pbr *green = glass_of(s);
+  green->transmission = 0, green->alpha = 0.5f;
+  int near = lm_scene_find_node(s, "pane"), pane_mesh = s->nodes[near].mesh;
+  lm_material red_m = *lm_scene_node_material(s, &s->nodes[near]);
+  snprintf(red_m.name, sizeof red_m.name, "red");
+  red_m.color[0] = 0.9f, red_m.color[1] = 0.1f, red_m.color[2] = 0.1f;
+  int red = lm_scene_add_material(s, &red_m);
+  s->material_pbr[red] = *green;
+  const float behind[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -0.75f, 1};
+  int far = lm_scene_add_node(s, "far pane", -1, behind, pane_mesh, red);
+  lm_scene_update(s);
+  /* the wall behind them, both panes, the green alone, the red alone */
+  float wall[3], both[3], g_only[3], r_only[3];
+  static const int shown[4][2] = {{0, 0}, {1, 1}, {1, 0}, {0, 1}}; /* near, far */
+  float *out[4] = {wall, both, g_only, r_only};
+  for (int k = 0; k < 4; k++) {
+    s->nodes[near].mesh = shown[k][0] ? pane_mesh : -1;
+    s->nodes[far].mesh = shown[k][1] ? pane_mesh : -1;
+    glass_view v = render_glass(s, "dl", "materials=phong");
+    memcpy(out[k], v.through, sizeof v.through);
+  }
+  for (int c = 0; c < 3; c++) {
+    float right = g_only[c] + 0.5f * (r_only[c] - wall[c]), wrong = r_only[c] + 0.5f * (g_only[c] - wall[c]);
+    printf("channel %d: both %.4f; far first %.4f, near first %.4f\n", c, (double)both[c], (double)right,
+           (double)wrong);
+    assert_float_equal(both[c], right, 0.002f);
+  }
+  assert_true(fabsf(both[0] - (r_only[0] + 0.5f * (g_only[0] - wall[0]))) > 0.05f); /* the order shows */
+  lm_scene_destroy(s);
+}
+
 /* The GI techniques take the glass too (finite, seen through, tinted). */
 static void glass_over_gi_techniques(void **state) {
   (void)state;
@@ -261,6 +300,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(glass_extensions_are_read),
       cmocka_unit_test(the_wall_is_seen_through_tinted_and_the_shadow_lighter),
+      cmocka_unit_test(blended_nodes_draw_back_to_front),
       cmocka_unit_test(glass_over_gi_techniques),
       cmocka_unit_test(no_blended_material_no_pass),
       cmocka_unit_test(bad_glass_values_are_refused_by_name),
