@@ -46,7 +46,8 @@ VIEW = "?"
 WARNED = set()
 
 # glTF extensions Limn reads (engine/scene/gltf.h); a file requiring another is refused.
-KNOWN_REQUIRED = {"KHR_lights_punctual", "KHR_texture_transform", "KHR_materials_emissive_strength"}
+GLASS_EXTENSIONS = ("KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume")  # glass_of
+KNOWN_REQUIRED = {"KHR_lights_punctual", "KHR_texture_transform", "KHR_materials_emissive_strength", *GLASS_EXTENSIONS}
 PBR_MIN_ROUGHNESS = 0.08  # shaders/gbuffer.glsl
 # Limn's material for a primitive without one (engine/scene/scene.c's fallback).
 DEFAULT_PHONG = {"color": (0.8, 0.8, 0.8), "kd": 0.9, "ks": 0.0, "shininess": 16.0}
@@ -215,7 +216,7 @@ def check_and_tag(doc, path):
     for i, m in enumerate(materials):
         m["name"] = "limn_m%d" % i
         for e in m.get("extensions", {}):
-            if e not in ("KHR_materials_emissive_strength", "KHR_texture_transform"):
+            if e not in ("KHR_materials_emissive_strength", "KHR_texture_transform") + GLASS_EXTENSIONS:
                 warn("ext " + e, "%s: material %d uses %s, which Limn ignores: ignored here too" % (part, i, e))
     lights = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
     for i, l in enumerate(lights):
@@ -489,8 +490,8 @@ def add_glass(t, shader, base, glass):
     """What Limn's forward pass lets through (shaders/transparent.frag): a
     Transparent BSDF (rays pass straight, unrefracted, as Limn's) of colour
     t (1 - F) base absorbed, F the Fresnel of the ior at the view (schlick),
-    added to the surface's own light. Shadow rays pass it too, tinted: Limn's
-    shadow maps pass a(1 - t mean(base)) untinted (docs/scenes.md)."""
+    added to the surface's own light. Shadow rays pass it too, tinted, as
+    through Limn's shadow maps' transmittance (at normal incidence there)."""
     share, ior, absorbed = glass
     fresnel = schlick(t, ior)
     tint = t.mix("MULTIPLY", 1.0, t.mix("MULTIPLY", 1.0, base, [share * a for a in absorbed], clamp=True),

@@ -93,6 +93,12 @@ void lm_set_scene_state(bool on, bool shadow_caster);
  * fragment's first colour plus its second (index 1) times the output, per
  * channel; depth tested, not written. Off: no blending, depth written. */
 void lm_set_blend_state(bool on);
+/* Shadow casters of a pass with a transmittance output (of index `transmit`
+ * among `count`): opaque ones write every output but it (translucent off);
+ * blended ones write it alone, multiplying its rgb by theirs and keeping the
+ * least alpha (their depth), depth tested, not written (translucent on).
+ * lm_set_caster_layer(-1, count, false) gives every output back. */
+void lm_set_caster_layer(int transmit, int count, bool translucent);
 /* The depth a scene pass clears to: far, so 0 for a camera, 1 for a shadow tile. */
 float lm_scene_clear_depth(bool shadow_caster);
 /* Framebuffers cache by attachment set; drop entries that name this texture. */

@@ -109,6 +109,11 @@ typedef struct lm_pass_desc {
    * colour + transmittance * output (dual-source blending: the technique's
    * second output, index 1, is the transmittance), depth tested, not written. */
   bool blend;
+  /* Scene passes with views (shadow tiles): 1 + the index of the output
+   * that blended casters multiply with their transmittance (rgb; alpha: the
+   * least depth, lm_set_caster_layer), drawn after the opaque ones and into
+   * it alone; 0: none, they cast as opaque ones do. */
+  int transmit;
 } lm_pass_desc;
 
 lm_graph *lm_graph_create(void);

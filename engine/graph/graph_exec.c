@@ -328,6 +328,7 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
     for (int v = 0; v < d->view_count && ok; v++) {
       c.pub.view = &d->views[v];
       lm_set_viewport(c.pub.view->x, c.pub.view->y, c.pub.view->width, c.pub.view->height);
+      if (v > 0) bind_pass(g, d, p); /* the last tile may have left a material's variant bound */
       set_view(p, c.pub.view);
       if (x->draw_scene) ok = x->draw_scene(x->user, &c.pub, err);
     }

@@ -175,7 +175,8 @@ static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, int layer, lm_err
                           .params = params, .param_count = n, .prev_world = r->prev_world,
                           .dynamic = r->dynamic, .layer = layer,
                           .blend = sp->view ? LM_BLEND_CAST : sp->desc->blend ? LM_BLEND_ONLY : LM_BLEND_SKIP,
-                          .eye_view_proj = sp->desc->blend ? r->camera.view_proj : NULL};
+                          .eye_view_proj = sp->desc->blend ? r->camera.view_proj : NULL,
+                          .transmit = sp->view ? sp->desc->transmit : 0, .outputs = sp->desc->output_count};
   if (sp->view && r->shadows.settings.simplify > 0) /* simplified casters where a tile's texels hide them */
     d.lod_view_proj = sp->view->view_proj, d.lod_size[0] = sp->view->width, d.lod_size[1] = sp->view->height,
     d.lod_texels = r->shadows.settings.simplify;

@@ -95,7 +95,8 @@
  *   OPAQUE one becomes BLEND with alpha 1 (Blender writes glass OPAQUE); on
  *   a MASK one transmission is not drawn (one warning a file). alphaMode
  *   BLEND materials are drawn by the forward pass over the lit image
- *   (scripts/transparent.lua), never into the G-buffer.
+ *   (scripts/transparent.lua), never into the G-buffer, and into shadow
+ *   maps' transmittance (scripts/shadow.lua).
  * - Perspective cameras: yfov, znear, zfar; the aspect ratio is the output's.
  *   An infinite far plane (zfar absent) becomes LM_GLTF_INFINITE_ZFAR_RATIO
  *   times znear: relative, so any unit works (reversed float depth holds it).

@@ -671,9 +671,10 @@ static int slot_texture(const lm_scene *s, const lm_material *m, const lm_materi
  * slot for a pbr one, the base colour for the others), and ALPHA_MASK for a
  * glTF alphaMode MASK material in the others (std.frag, shadow.frag: a masked
  * hole is no surface and casts no shadow; pbr.frag reads material_alpha
- * always); ALPHA_BLEND for a BLEND material drawn as a shadow caster. */
+ * always); ALPHA_BLEND for a BLEND material drawn into a shadow pass's
+ * transmittance output. */
 static void material_defines(const lm_scene *s, const lm_material *m, const lm_material_pbr *p, bool pbr,
-                             lm_blend_draw blend, char *out, size_t cap) {
+                             bool translucent, char *out, size_t cap) {
   out[0] = '\0';
   for (int slot = 0; slot < LM_TEX_SLOTS; slot++) {
     if (slot_texture(s, m, p, slot) < 0 || (slot != LM_TEX_BASE_COLOR && !pbr)) continue;
@@ -684,7 +685,7 @@ static void material_defines(const lm_scene *s, const lm_material *m, const lm_m
     size_t len = strlen(out);
     snprintf(out + len, cap - len, "%sALPHA_MASK", len ? ";" : "");
   }
-  if (blend == LM_BLEND_CAST && p->alpha_mode == LM_ALPHA_BLEND) {
+  if (translucent) {
     size_t len = strlen(out);
     snprintf(out + len, cap - len, "%sALPHA_BLEND", len ? ";" : "");
   }
@@ -715,9 +716,10 @@ bool lm_scene_node_culled(const lm_scene *s, int node, const float view_proj[16]
 }
 
 /* A visible mesh node, sorted so that nodes of one mesh, material and
- * simplification (lod 1: its caster copy) lie together; blended ones by
- * the camera's depth of their bounds' centre, farthest first. */
-typedef struct drawn_node { int material, mesh, lod, node; float depth; } drawn_node;
+ * simplification (lod 1: its caster copy) lie together, translucent casters
+ * (into a transmittance output) after the others; blended ones in the
+ * forward pass by the camera's depth of their bounds' centre, farthest first. */
+typedef struct drawn_node { int translucent, material, mesh, lod, node; float depth; } drawn_node;
 
 static int back_to_front(const void *pa, const void *pb) {
   const drawn_node *a = pa, *b = pb;
@@ -727,6 +729,7 @@ static int back_to_front(const void *pa, const void *pb) {
 
 static int drawn_node_order(const void *pa, const void *pb) {
   const drawn_node *a = pa, *b = pb;
+  if (a->translucent != b->translucent) return a->translucent - b->translucent;
   if (a->material != b->material) return a->material < b->material ? -1 : 1;
   if (a->mesh != b->mesh) return a->mesh < b->mesh ? -1 : 1;
   if (a->lod != b->lod) return a->lod - b->lod;
@@ -826,7 +829,9 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     }
     float depth = 0; /* the camera's clip w of the bounds' centre: its view depth */
     for (int k = 0; k < 3 && d->eye_view_proj; k++) depth += d->eye_view_proj[4 * k + 3] * (lo[k] + hi[k]) / 2;
-    nodes[count++] = (drawn_node){n->material, n->mesh, node_simplified(d, n, &s->meshes[n->mesh], lo, hi), i, depth};
+    int translucent = d->blend == LM_BLEND_CAST && d->transmit > 0 && material_blends(s, n->material);
+    nodes[count++] =
+        (drawn_node){translucent, n->material, n->mesh, node_simplified(d, n, &s->meshes[n->mesh], lo, hi), i, depth};
   }
   bool sorted = d->blend == LM_BLEND_ONLY; /* blending needs the order, one node a draw */
   qsort(nodes, (size_t)count, sizeof *nodes, sorted ? back_to_front : drawn_node_order);
@@ -838,7 +843,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
   lm_instances_upload(instances, count);
   free(instances);
   char bound[160] = ""; /* the defines of the variant that is bound */
-  bool ok = true;
+  bool ok = true, translucent = false; /* drawing into the transmittance output */
   for (int first = 0, last; first < count && ok; first = last) {
     for (last = first + 1; !sorted && last < count && nodes[last].material == nodes[first].material &&
                            nodes[last].mesh == nodes[first].mesh && nodes[last].lod == nodes[first].lod;)
@@ -850,7 +855,11 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
       if (!strcmp(d->params[k].material, m.name)) apply_param(&m, &d->params[k]);
     lm_material_pbr mp = lm_scene_material_pbr(s, n->material, &m);
     char defines[160] = "";
-    if (d->variant) material_defines(s, &m, &mp, pbr, d->blend, defines, sizeof defines);
+    if (nodes[first].translucent && !translucent) { /* after every opaque caster */
+      translucent = true;
+      lm_set_caster_layer(d->transmit - 1, d->outputs, true);
+    }
+    if (d->variant) material_defines(s, &m, &mp, pbr, translucent, defines, sizeof defines);
     if (strcmp(defines, bound)) { /* switch programs only when the variant changes */
       p = d->variant(d->ctx, defines, err);
       if (!p) {
@@ -868,6 +877,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
       stats->simplified += lod ? last - first : 0;
     }
   }
+  if (translucent) lm_set_caster_layer(-1, d->outputs, false);
   free(nodes);
   return ok;
 }

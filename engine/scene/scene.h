@@ -378,10 +378,10 @@ bool lm_scene_check_params(const lm_scene *s, const lm_material_param *params, i
 const char *lm_material_param_list(void);
 
 /* alphaMode BLEND materials in a scene draw: left out (the G-buffer keeps the
- * opaque layer), drawn as shadow casters thinned by their opacity (define
- * ALPHA_BLEND: a dither that the shadow filter averages into a lighter
- * shadow), or drawn alone, back to front, one node a draw (the forward pass
- * over the lit image). */
+ * opaque layer), drawn as shadow casters (with a transmit output: after the
+ * opaque ones, into it alone, define ALPHA_BLEND; without, as opaque ones),
+ * or drawn alone, back to front, one node a draw (the forward pass over the
+ * lit image). */
 typedef enum lm_blend_draw { LM_BLEND_SKIP, LM_BLEND_CAST, LM_BLEND_ONLY } lm_blend_draw;
 
 typedef struct lm_scene_draw_desc {
@@ -416,6 +416,7 @@ typedef struct lm_scene_draw_desc {
   float lod_texels;
   lm_blend_draw blend; /* what becomes of alphaMode BLEND materials */
   const float *eye_view_proj; /* LM_BLEND_ONLY: the camera's, whose clip w orders the nodes */
+  int transmit, outputs;      /* LM_BLEND_CAST: lm_pass_desc.transmit, of the pass's `outputs` */
 } lm_scene_draw_desc;
 typedef struct lm_scene_draw_stats {
   int drawn, culled; /* mesh nodes drawn, and left out by the frustum test */

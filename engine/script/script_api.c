@@ -553,7 +553,8 @@ static int l_scene(lua_State *L) {
   int top = lua_gettop(L);
   begin_pass(L, &b, LM_PASS_SCENE, "scene");
   static const char *const fields[] = {"technique", "out", "depth", "clear", "params", "defines",
-                                       "materials", "views", "fit", "fit_margin", "inputs", "blend", NULL};
+                                       "materials", "views", "fit", "fit_margin", "inputs", "blend", "transmit",
+                                       NULL};
   check_fields(L, 1, b.what, fields);
   b.desc.shader = opt_string(L, 1, "technique", b.what);
   if (!b.desc.shader) b.desc.shader = "std";
@@ -587,6 +588,15 @@ static int l_scene(lua_State *L) {
     const lm_shadow_plan *plan = to_plan(L, -1, b.what);
     b.desc.views = plan->views;
     b.desc.view_count = plan->view_count;
+  }
+  lua_pop(L, 1);
+  lua_getfield(L, 1, "transmit"); /* the output blended casters multiply (lm_pass_desc) */
+  if (!lua_isnil(L, -1)) {
+    int t = to_target(L, -1, b.what)->id;
+    for (int i = 0; i < b.desc.output_count && !b.desc.transmit; i++)
+      if (b.outputs[i] == t) b.desc.transmit = i + 1;
+    if (!b.desc.transmit || !b.desc.view_count)
+      return luaL_error(L, "%s: transmit must be one of the outputs of a pass with views (a shadow plan)", b.what);
   }
   lua_pop(L, 1);
   lua_getfield(L, 1, "fit");
