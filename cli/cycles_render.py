@@ -48,7 +48,8 @@ VIEW = "?"
 WARNED = set()
 
 # glTF extensions Limn reads (engine/scene/gltf.h); a file requiring another is refused.
-KNOWN_REQUIRED = {"KHR_lights_punctual", "KHR_texture_transform", "KHR_materials_emissive_strength"}
+GLASS_EXTENSIONS = ("KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume")  # glass_of
+KNOWN_REQUIRED = {"KHR_lights_punctual", "KHR_texture_transform", "KHR_materials_emissive_strength", *GLASS_EXTENSIONS}
 PBR_MIN_ROUGHNESS = 0.08  # shaders/gbuffer.glsl
 # Limn's material for a primitive without one (engine/scene/scene.c's fallback).
 DEFAULT_PHONG = {"color": (0.8, 0.8, 0.8), "kd": 0.9, "ks": 0.0, "shininess": 16.0}
@@ -217,7 +218,7 @@ def check_and_tag(doc, path):
     for i, m in enumerate(materials):
         m["name"] = "limn_m%d" % i
         for e in m.get("extensions", {}):
-            if e not in ("KHR_materials_emissive_strength", "KHR_texture_transform"):
+            if e not in ("KHR_materials_emissive_strength", "KHR_texture_transform") + GLASS_EXTENSIONS:
                 warn("ext " + e, "%s: material %d uses %s, which Limn ignores: ignored here too" % (part, i, e))
     lights = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
     for i, l in enumerate(lights):
@@ -445,12 +446,13 @@ def glossy_of_phong(shininess):
     return (1.0 / (2.0 * shininess + 1.0)) ** 0.25
 
 
-def build_phong(t, base, pv):
+def build_phong(t, base, pv, keep=1.0):
     """Lambert k_d albedo + a GGX lobe carrying the Phong lobe's energy at
     normal incidence, 2 k_s / (n + 2) (Limn's Phong is not normalized). The
-    geometric normal: Limn's std technique reads no normal map."""
+    geometric normal: Limn's std technique reads no normal map. `keep`: the
+    share of the diffuse part glass does not transmit (glass_of)."""
     albedo = t.mix("MULTIPLY", 1.0, base, 1.0, clamp=True)
-    diffuse = t.node("ShaderNodeBsdfDiffuse", Color=t.mix("MULTIPLY", 1.0, albedo, pv["kd"]), Roughness=0.0)
+    diffuse = t.node("ShaderNodeBsdfDiffuse", Color=t.mix("MULTIPLY", 1.0, albedo, pv["kd"] * keep), Roughness=0.0)
     if pv["ks"] <= 0.0:
         return diffuse.outputs[0]
     n = pv["shininess"]
@@ -468,19 +470,20 @@ def add(t, a, b):
     return n.outputs[0]
 
 
-def build_pbr(t, base, metallic, roughness, normal):
+def build_pbr(t, base, metallic, roughness, normal, keep=1.0):
     """glTF's BRDF: Lambert (1 - F)(1 - metallic) base + GGX with F at v.h,
     F0 = mix(0.04, base, metallic). The GGX lobe is Blender's Principled BSDF
     at metallic 1 and base F0: its Fresnel runs from F0 at v.h = 1 to 1 at
     grazing (a dielectric's curve of ior 1.5 rescaled, not Schlick's), and
     its diffuse part is 0. Nodes do not see v.h: the diffuse weight is
-    1 - F0, F where light and view meet head on (docs/cycles.md)."""
+    1 - F0, F where light and view meet head on (docs/cycles.md). `keep`:
+    the share of the diffuse part glass does not transmit (glass_of)."""
     base = t.mix("MULTIPLY", 1.0, base, 1.0, clamp=True)
     metallic = t.math("MULTIPLY", metallic, 1.0, clamp=True)
     rough = t.math("MAXIMUM", t.math("MULTIPLY", roughness, 1.0, clamp=True), PBR_MIN_ROUGHNESS)
     f0 = t.mix("MIX", metallic, 0.04, base)
-    diffuse_colour = t.mix("MULTIPLY", 1.0, t.mix("MULTIPLY", 1.0, base, t.math("SUBTRACT", 1.0, metallic)),
-                           t.mix("SUBTRACT", 1.0, 1.0, f0))
+    kept = t.math("MULTIPLY", t.math("SUBTRACT", 1.0, metallic), keep)
+    diffuse_colour = t.mix("MULTIPLY", 1.0, t.mix("MULTIPLY", 1.0, base, kept), t.mix("SUBTRACT", 1.0, 1.0, f0))
     diffuse = t.node("ShaderNodeBsdfDiffuse", Color=diffuse_colour, Roughness=0.0)
     specular = t.node("ShaderNodeBsdfPrincipled", **{"Base Color": f0, "Metallic": 1.0, "Roughness": rough,
                                                      "Specular": 0.5})
@@ -489,6 +492,50 @@ def build_pbr(t, base, metallic, roughness, normal):
         if normal is not None:
             t.set(n.inputs["Normal"], normal)
     return add(t, diffuse.outputs[0], specular.outputs[0])
+
+
+def glass_of(gm):
+    """Limn's glass (engine/scene/gltf.h): KHR_materials_transmission's
+    factor t, KHR_materials_ior's ior and KHR_materials_volume's absorption
+    at normal incidence, attenuationColor ^ (thickness / attenuationDistance);
+    None for no transmission (or a MASK material, which Limn draws opaque)."""
+    ext = gm.get("extensions", {}) if gm else {}
+    t = ext.get("KHR_materials_transmission", {}).get("transmissionFactor", 0.0)
+    if t <= 0.0 or gm.get("alphaMode") == "MASK":
+        return None
+    vol = ext.get("KHR_materials_volume", {})
+    thick, dist = vol.get("thicknessFactor", 0.0), vol.get("attenuationDistance", 0.0)
+    absorbed = [c ** (thick / dist) if thick > 0.0 and dist > 0.0 else 1.0
+                for c in vol.get("attenuationColor", [1.0, 1.0, 1.0])]
+    return t, ext.get("KHR_materials_ior", {}).get("ior", 1.5), absorbed
+
+
+def schlick(t, ior):
+    """Limn's Fresnel (shaders/transparent.frag): Schlick's r0 + (1 - r0)(1 - |n.v|)^5
+    of the ior, the same from either side. (Blender's Fresnel node inverts the
+    ior from behind, whose total internal reflection would stop the shadow
+    rays that reach a surface through the glass.)"""
+    r0 = ((ior - 1.0) / (ior + 1.0)) ** 2
+    geometry = t.node("ShaderNodeNewGeometry")
+    dot = t.node("ShaderNodeVectorMath")
+    dot.operation = "DOT_PRODUCT"
+    t.links.new(geometry.outputs["Normal"], dot.inputs[0])
+    t.links.new(geometry.outputs["Incoming"], dot.inputs[1])
+    grazing = t.math("SUBTRACT", 1.0, t.math("ABSOLUTE", dot.outputs["Value"]))
+    return t.math("ADD", t.math("MULTIPLY", t.math("POWER", grazing, 5.0), 1.0 - r0), r0)
+
+
+def add_glass(t, shader, base, glass):
+    """What Limn's forward pass lets through (shaders/transparent.frag): a
+    Transparent BSDF (rays pass straight, unrefracted, as Limn's) of colour
+    t (1 - F) base absorbed, F the Fresnel of the ior at the view (schlick),
+    added to the surface's own light. Shadow rays pass it too, tinted, as
+    through Limn's shadow maps' transmittance (at normal incidence there)."""
+    share, ior, absorbed = glass
+    fresnel = schlick(t, ior)
+    tint = t.mix("MULTIPLY", 1.0, t.mix("MULTIPLY", 1.0, base, [share * a for a in absorbed], clamp=True),
+                 t.math("SUBTRACT", 1.0, fresnel))
+    return add(t, shader, t.node("ShaderNodeBsdfTransparent", Color=tint).outputs[0])
 
 
 def map_material(mat, gm, mode):
@@ -500,17 +547,23 @@ def map_material(mat, gm, mode):
     inp = principled.inputs
     base = t.source(inp["Base Color"])
     normal = inp["Normal"].links[0].from_socket if inp["Normal"].is_linked else None
+    glass = glass_of(gm)
+    keep = 1.0 - glass[0] if glass else 1.0
     if mode == "phong":
-        shader = build_phong(t, base, phong_values(gm))
+        shader = build_phong(t, base, phong_values(gm), keep)
         em = gm.get("emissiveFactor", [0, 0, 0]) if gm else [0, 0, 0]
         if max(em) > 0.0 or (gm and "emissiveTexture" in gm):
             warn("phong emissive", "materials=phong: emissive materials are dark in Limn's Phong: left dark")
     else:
-        shader = build_pbr(t, base, t.source(inp["Metallic"]), t.source(inp["Roughness"]), normal)
+        shader = build_pbr(t, base, t.source(inp["Metallic"]), t.source(inp["Roughness"]), normal, keep)
         if inp["Emission"].is_linked or max(inp["Emission"].default_value[:3]) > 0.0:
             emission = t.node("ShaderNodeEmission", Color=t.source(inp["Emission"]),
                               Strength=t.source(inp["Emission Strength"]))
             shader = add(t, shader, emission.outputs[0])
+    if glass:
+        shader = add_glass(t, shader, base, glass)
+        for link in list(output.inputs["Volume"].links):  # the importer's absorption: in the tint instead
+            t.links.remove(link)
     alpha = inp["Alpha"]
     if alpha.is_linked or alpha.default_value < 1.0:
         mixed = t.node("ShaderNodeMixShader", Fac=t.source(alpha))

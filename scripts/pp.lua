@@ -11,6 +11,7 @@ local shadow = require "shadow"
 local sky = require "sky"
 local techniques = require "techniques"
 local temporal = require "temporal"
+local transparent = require "transparent"
 
 Options = {
   ambient = 0.02,          -- ambient light L_a (grey), scaled by each material's k_a
@@ -98,6 +99,7 @@ local function frame(tech, row)
   -- Glossy indirect light for pbr surfaces only: a Phong frame records none of it (its options are
   -- checked on every frame, so a bad one is named while it is off too).
   if glossy.check(tech.glossy, 1).enabled and materials == "pbr" then lit = glossy.render(lit, tech.glossy, F) end
+  lit = transparent.render(lit, tech, F) -- blended materials (glass), where the scene has any
   return post.render(lit, tech, F)
 end
 

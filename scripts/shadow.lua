@@ -60,6 +60,7 @@ local BLOCK = 8
 -- lm_shadow_technique), kept for shadow.bind; weak keys: atlases are per frame.
 local FILTERS = { esm = 0, pcf = 1, poisson = 2, hard = 3, pcss = 4 }
 local filter_of = setmetatable({}, { __mode = "k" })
+local transmit_of = setmetatable({}, { __mode = "k" }) -- atlas -> its blended casters' transmittance
 
 -- The least and greatest camera depth the G-buffer G sees (depth / far in r
 -- and g of a 1x1 target), by BLOCK x BLOCK min/max reduction passes.
@@ -86,6 +87,9 @@ end
 -- without G); a directional light gets one more tile for them, over the sphere around all that
 -- is seen, its radius times reach, of `resolution` texels a side (shadow_plan's rsm_resolution).
 -- Without, no RSM target or tile exists.
+-- A scene with blended materials (scene_blended()) gets one more output, shadow.transmit: what
+-- its blended casters let through (rgb) beyond their least depth (a), which shadow.bind adds
+-- to lighting passes (SHADOW_TRANSMIT, shaders/shadow.glsl): lighter, tinted shadows.
 function shadow.render(o, G, rsm)
   o = shadow.check(o, 2)
   local settings = {}
@@ -102,11 +106,15 @@ function shadow.render(o, G, rsm)
                       nrm = target{ "shadow.rsm_nrm", format = "rgba16f", size = size },
                       pos = target{ "shadow.rsm_pos", format = "rgba32f", size = size },
                       views = plan.rsm_views, seen = seen } or nil
+  local out = R and { map, R.flux, R.nrm, R.pos } or { map }
+  local transmit = scene_blended() and target{ "shadow.transmit", format = "rgba16f", size = size } or nil
+  out[#out + 1] = transmit
   scene{ "shadow.depth", technique = "shadow", views = plan, fit = seen,
          fit_margin = seen and o.fit == "previous" and o.fit_margin or nil,
-         out = R and { map, R.flux, R.nrm, R.pos } or map, clear = { 1, 1, 1, 1 }, defines = { RSM = R ~= nil },
+         out = out, clear = { 1, 1, 1, 1 }, transmit = transmit,
+         defines = { RSM = R ~= nil, TRANSMIT = transmit and #out - 1 or nil },
          depth = target{ "shadow.zbuffer", format = "depth32f", size = size } }
-  filter_of[map] = FILTERS[plan.technique]
+  filter_of[map], transmit_of[map] = FILTERS[plan.technique], transmit
   if plan.technique ~= "esm" or plan.blur == 0 then return map, R end
   local blurred = map
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
@@ -114,7 +122,7 @@ function shadow.render(o, G, rsm)
                     params = { direction = axis[2], radius = plan.blur, c = plan.c, views = plan.shadow_views }, -- not the RSM's wide tiles after them
                     out = target{ "shadow.esm_" .. axis[1], format = "r32f", size = size } }
   end
-  filter_of[blurred] = filter_of[map]
+  filter_of[blurred], transmit_of[blurred] = filter_of[map], transmit
   return blurred, R
 end
 
@@ -125,6 +133,7 @@ function shadow.bind(atlas, inputs, defines)
     inputs.shadow_atlas = atlas
     defines.SHADOWS = true
     defines.SHADOW_FILTER = filter_of[atlas]
+    if transmit_of[atlas] then inputs.shadow_transmit, defines.SHADOW_TRANSMIT = transmit_of[atlas], true end
   end
   return inputs, defines
 end

@@ -67,7 +67,7 @@ bool light_on_surface_as(int i, int type, int falloff, int shadow, vec3 p, vec3 
   ndl = dot(n, l);
   if (ndl <= 0.0 || max(radiance.r, max(radiance.g, radiance.b)) <= 0.0) return false;
 #ifdef SHADOWS
-  if (shadow != 0) radiance *= shadow_factor_as(i, shadow, p, n, l);
+  if (shadow != 0) radiance *= shadow_light_as(i, shadow, p, n, l);
 #endif
   return true;
 }

@@ -10,7 +10,7 @@
 
 in vec3 world_pos;
 uniform vec4 pass_depth;
-#if defined(RSM) || defined(ALPHA_MASK)
+#if defined(RSM) || defined(ALPHA_MASK) || defined(ALPHA_BLEND)
 in vec2 tex_uv;
 #ifdef BASE_COLOR_TEXTURE
 uniform sampler2D base_color_tex;
@@ -28,8 +28,40 @@ layout(location = 3) out vec4 rsm_pos;
 
 layout(location = 0) out float depth01;
 
+#ifdef TRANSMIT
+// The transmittance output (lm_pass_desc.transmit): what a blended caster
+// (ALPHA_BLEND, drawn after the opaque ones into this output alone) lets
+// through, rgb, multiplied by blending into the light's other blended
+// casters', and its depth in alpha, the least kept; an opaque caster writes
+// nothing here. Lighting reads it beyond that depth (shadow.glsl): a lighter,
+// tinted shadow, as shaders/transparent.frag lets light through, at normal
+// incidence: (1 - a) + a t (1 - F0) base absorbed.
+layout(location = TRANSMIT) out vec4 transmit;
+#ifdef ALPHA_BLEND
+#ifndef RSM
+uniform vec3 material_color;
+#endif
+uniform vec4 material_glass;       // transmission, ior, attenuation distance, thickness
+uniform vec3 material_attenuation; // attenuation colour
+#ifndef ALPHA_MASK
+uniform vec2 material_alpha;
+#endif
+vec3 glass_transmittance(vec4 texel) {
+  vec3 base = saturate(material_color * texel.rgb);
+  float a = saturate(material_alpha.x * texel.a), ior = clamp(material_glass.y, 1.0, 10.0);
+  float r0 = (ior - 1.0) / (ior + 1.0);
+  vec3 absorbed = vec3(1.0);
+  if (material_glass.z > 0.0 && material_glass.w > 0.0) {
+    float path = min(material_glass.w / material_glass.z, 1e4); // thickness over attenuation distance
+    absorbed = exp(log(max(saturate(material_attenuation), vec3(1e-6))) * path);
+  }
+  return saturate(vec3(1.0 - a) + a * saturate(material_glass.x) * (1.0 - r0 * r0) * base * absorbed);
+}
+#endif
+#endif
+
 void main() {
-#if defined(BASE_COLOR_TEXTURE) && (defined(RSM) || defined(ALPHA_MASK))
+#if defined(BASE_COLOR_TEXTURE) && (defined(RSM) || defined(ALPHA_MASK) || defined(ALPHA_BLEND))
   vec4 texel = texture(base_color_tex, (base_color_xform * vec3(tex_uv, 1.0)).xy);
 #else
   vec4 texel = vec4(1.0);
@@ -41,6 +73,13 @@ void main() {
     depth01 = saturate(length(world_pos - pass_depth.xyz) * pass_depth.w);
   else                    // orthographic: window depth is already linear
     depth01 = saturate(gl_FragCoord.z); // casters before the near plane are clamped onto it
+#ifdef TRANSMIT
+#ifdef ALPHA_BLEND
+  transmit = vec4(glass_transmittance(texel), depth01);
+#else
+  transmit = vec4(1.0); // masked off: opaque casters leave it
+#endif
+#endif
 #ifdef RSM
   vec3 albedo = material_color * texel.rgb;
   vec3 n = safe_normalize(world_normal, vec3(0.0, 1.0, 0.0));

@@ -141,33 +141,41 @@ float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
   return r - bias <= shadow_texel(ivec2(floor(texel + 0.5)), lo, hi) ? 1.0 : 0.0;
 }
 
+// The view of light s (shadow of kind `kind`, ShadowLight.info.z) that p
+// reads, -1 for none, and for cascades the next one's weight *t: one view
+// whatever the kind (a software rasterizer runs every kind's branch).
+int shadow_view_at(ShadowLight s, int kind, vec3 p, out float t) {
+  int first = s.info.x, count = s.info.y;
+  t = 0.0;
+  if (count <= 0) return -1;
+  if (kind == 3) { // point light: the cube face of the major axis
+    vec3 d = p - shadow_views[first].depth.xyz;
+    vec3 a = abs(d);
+    int face = a.x >= a.y && a.x >= a.z ? (d.x >= 0.0 ? 0 : 1) : a.y >= a.z ? (d.y >= 0.0 ? 2 : 3) : (d.z >= 0.0 ? 4 : 5);
+    if ((s.cube.x & (1 << face)) == 0) return -1; // no visible pixel was to sample it
+    return first + bitCount(s.cube.x & ((1 << face) - 1));
+  }
+  if (kind == 1) { // cascades: by camera depth, blended over the last `blend` share of each
+    float z = -(frame.view * vec4(p, 1.0)).z;
+    int k = 0;
+    while (k < count - 1 && z > s.splits[k]) k++;
+    if (z > s.splits[count - 1]) return -1; // beyond the shadowed distance
+    float start = k > 0 ? s.splits[k - 1] : frame.clip.x;
+    float band = (s.splits[k] - start) * s.params.z;
+    if (k < count - 1 && band > 0.0 && z > s.splits[k] - band) t = saturate((z - (s.splits[k] - band)) / band);
+    return first + k;
+  }
+  return first;
+}
+
 // Shadow factor of light `light` at p, whose shadow is of kind `kind`
 // (ShadowLight.info.z): a constant kind (a light-set variant, lighting.glsl)
 // compiles that kind's lookup alone.
 float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
   ShadowLight s = shadow_lights[light];
-  int first = s.info.x, count = s.info.y;
-  if (count <= 0) return 1.0;
-  // The view to read, and for cascades the next one's weight t: one lookup
-  // whatever the kind (a software rasterizer runs every kind's branch).
-  int v = first;
-  float t = 0.0;
-  if (kind == 3) { // point light: the cube face of the major axis
-    vec3 d = p - shadow_views[first].depth.xyz;
-    vec3 a = abs(d);
-    int face = a.x >= a.y && a.x >= a.z ? (d.x >= 0.0 ? 0 : 1) : a.y >= a.z ? (d.y >= 0.0 ? 2 : 3) : (d.z >= 0.0 ? 4 : 5);
-    if ((s.cube.x & (1 << face)) == 0) return 1.0; // no visible pixel was to sample it
-    v = first + bitCount(s.cube.x & ((1 << face) - 1));
-  } else if (kind == 1) { // cascades: by camera depth, blended over the last `blend` share of each
-    float z = -(frame.view * vec4(p, 1.0)).z;
-    int k = 0;
-    while (k < count - 1 && z > s.splits[k]) k++;
-    if (z > s.splits[count - 1]) return 1.0; // beyond the shadowed distance
-    v = first + k;
-    float start = k > 0 ? s.splits[k - 1] : frame.clip.x;
-    float band = (s.splits[k] - start) * s.params.z;
-    if (k < count - 1 && band > 0.0 && z > s.splits[k] - band) t = saturate((z - (s.splits[k] - band)) / band);
-  }
+  float t;
+  int v = shadow_view_at(s, kind, p, t);
+  if (v < 0) return 1.0;
   float ndl = dot(n, l), vis = 1.0;
   // Both lookups in a loop that tests at its end, not the second in an if: a
   // software rasterizer leaves such a loop once no pixel of its group goes on,
@@ -180,5 +188,50 @@ float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
 
 float shadow_factor(int light, vec3 p, vec3 n, vec3 l) {
   return shadow_factor_as(light, shadow_lights[light].info.z, p, n, l);
+}
+
+#ifdef SHADOW_TRANSMIT
+// What blended casters let through to p from light `light` (pass input
+// shadow_transmit, the shadow pass's transmittance output: rgb, the least
+// depth in alpha; shadow.frag): each of the 4 texels around p counts where
+// p lies beyond its depth, bilinearly weighted. White where none is.
+uniform sampler2D shadow_transmit;
+
+vec3 shadow_transmittance_as(int light, int kind, vec3 p) {
+  ShadowLight s = shadow_lights[light];
+  float t;
+  int v = shadow_view_at(s, kind, p, t);
+  if (v < 0) return vec3(1.0);
+  ShadowView sv = shadow_views[v];
+  vec4 ls = sv.view_proj * vec4(p, 1.0);
+  if (ls.w <= 1e-12) return vec3(1.0);
+  vec3 ndc = ls.xyz / ls.w;
+  vec2 tuv = ndc.xy * 0.5 + 0.5;
+  if (any(lessThan(tuv, vec2(0.0))) || any(greaterThan(tuv, vec2(1.0)))) return vec3(1.0);
+  float r = sv.depth.w > 0.0 ? length(p - sv.depth.xyz) * sv.depth.w : ndc.z * 0.5 + 0.5;
+  vec2 size = vec2(textureSize(shadow_transmit, 0));
+  ivec2 lo = ivec2(sv.rect.xy * size + 0.5), hi = ivec2((sv.rect.xy + sv.rect.zw) * size + 0.5) - 1;
+  vec2 texel = (sv.rect.xy + tuv * sv.rect.zw) * size - 0.5;
+  ivec2 base = ivec2(floor(texel));
+  vec2 f = texel - vec2(base);
+  float bias = s.params.y * shadow_texel_depth(sv, r);
+  vec3 c[4];
+  for (int k = 0; k < 4; k++) {
+    vec4 tr = texelFetch(shadow_transmit, clamp(base + ivec2(k & 1, k >> 1), lo, hi), 0);
+    c[k] = r - bias > tr.a ? tr.rgb : vec3(1.0);
+  }
+  return mix(mix(c[0], c[1], f.x), mix(c[2], c[3], f.x), f.y);
+}
+#endif
+
+// The light of light `light` that reaches p, as a factor: the shadow factor,
+// tinted by the blended casters' transmittance where SHADOW_TRANSMIT is.
+vec3 shadow_light_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
+  float vis = shadow_factor_as(light, kind, p, n, l);
+#ifdef SHADOW_TRANSMIT
+  return vis * shadow_transmittance_as(light, kind, p);
+#else
+  return vec3(vis);
+#endif
 }
 #endif

@@ -4,7 +4,7 @@
 #include "common.glsl"
 
 layout(location = 0) in vec3 in_position;
-#if defined(RSM) || defined(ALPHA_MASK)
+#if defined(RSM) || defined(ALPHA_MASK) || defined(ALPHA_BLEND)
 layout(location = 2) in vec2 in_uv;
 out vec2 tex_uv;
 #endif
@@ -23,7 +23,7 @@ out vec3 world_pos;
 void main() {
   vec4 world = instance_model * vec4(in_position, 1.0);
   world_pos = world.xyz;
-#if defined(RSM) || defined(ALPHA_MASK)
+#if defined(RSM) || defined(ALPHA_MASK) || defined(ALPHA_BLEND)
   tex_uv = in_uv;
 #endif
 #ifdef RSM

@@ -277,6 +277,34 @@ void lm_set_scene_state(bool on, bool shadow_caster) {
   }
 }
 
+void lm_set_blend_state(bool on) {
+  if (on) {
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_SRC1_COLOR);
+  } else {
+    glDisable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ZERO); /* llvmpipe keeps reading the second source while the factor names it */
+  }
+  glDepthMask(on ? GL_FALSE : GL_TRUE);
+}
+
+void lm_set_caster_layer(int transmit, int count, bool translucent) {
+  for (int i = 0; i < count; i++) {
+    GLboolean on = transmit < 0 || (i == transmit) == translucent;
+    glColorMaski((GLuint)i, on, on, on, on);
+  }
+  if (!translucent) {
+    glBlendEquation(GL_FUNC_ADD);
+    lm_set_blend_state(false);
+    return;
+  }
+  glDepthMask(GL_FALSE);
+  glEnablei(GL_BLEND, (GLuint)transmit);
+  glBlendEquationSeparatei((GLuint)transmit, GL_FUNC_ADD, GL_MIN);
+  glBlendFuncSeparatei((GLuint)transmit, GL_ZERO, GL_SRC_COLOR, GL_ONE, GL_ONE);
+}
+
 /* ---- frame block ------------------------------------------------------- */
 static GLuint frame_ubo;
 

@@ -89,6 +89,16 @@ void lm_storage_upload(int binding, const void *data, size_t bytes);
  * draw both faces (a light inside a closed mesh sees its back faces) and
  * clamp depth (casters before the near plane count). */
 void lm_set_scene_state(bool on, bool shadow_caster);
+/* A blended scene pass (lm_pass_desc.blend): the output becomes the
+ * fragment's first colour plus its second (index 1) times the output, per
+ * channel; depth tested, not written. Off: no blending, depth written. */
+void lm_set_blend_state(bool on);
+/* Shadow casters of a pass with a transmittance output (of index `transmit`
+ * among `count`): opaque ones write every output but it (translucent off);
+ * blended ones write it alone, multiplying its rgb by theirs and keeping the
+ * least alpha (their depth), depth tested, not written (translucent on).
+ * lm_set_caster_layer(-1, count, false) gives every output back. */
+void lm_set_caster_layer(int transmit, int count, bool translucent);
 /* The depth a scene pass clears to: far, so 0 for a camera, 1 for a shadow tile. */
 float lm_scene_clear_depth(bool shadow_caster);
 /* Framebuffers cache by attachment set; drop entries that name this texture. */

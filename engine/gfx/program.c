@@ -211,7 +211,14 @@ static lm_program *build(const char *vert, const char *frag, const char *defines
   }
   GLint outputs = 0;
   glGetProgramInterfaceiv(prog->id, GL_PROGRAM_OUTPUT, GL_ACTIVE_RESOURCES, &outputs);
-  prog->output_count = outputs;
+  /* A dual-source blending output (index 1) writes its location's target: count those of index 0. */
+  prog->output_count = 0;
+  for (GLint i = 0; i < outputs; i++) {
+    const GLenum prop = GL_LOCATION_INDEX;
+    GLint index = 0;
+    glGetProgramResourceiv(prog->id, GL_PROGRAM_OUTPUT, (GLuint)i, 1, &prop, 1, NULL, &index);
+    prog->output_count += index == 0;
+  }
   return prog;
 }
 

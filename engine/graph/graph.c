@@ -224,6 +224,11 @@ static bool validate_pass(lm_graph *g, int pi, lm_error *err) {
     }
     w = gt->width, h = gt->height;
   }
+  if (d->blend && (d->kind != LM_PASS_SCENE || d->output_count != 1 || d->clear)) {
+    lm_error_set(err, "%s: pass '%s': a blended pass is a scene pass with one output that does not clear", where,
+                 name);
+    return false;
+  }
   if (d->kind != LM_PASS_SCENE && d->depth >= 0) {
     lm_error_set(err, "%s: pass '%s': %s passes take no depth target", where, name,
                  d->kind == LM_PASS_CPU ? "CPU" : d->kind == LM_PASS_POINTS ? "points" : "full-screen");

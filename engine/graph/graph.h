@@ -104,6 +104,16 @@ typedef struct lm_pass_desc {
   float fit_margin;
   const lm_pass_material_param *material_params; /* scene passes */
   int material_param_count;
+  /* Scene passes: draws the alphaMode BLEND materials alone, back to front,
+   * over what its one output holds (it does not clear): the output becomes
+   * colour + transmittance * output (dual-source blending: the technique's
+   * second output, index 1, is the transmittance), depth tested, not written. */
+  bool blend;
+  /* Scene passes with views (shadow tiles): 1 + the index of the output
+   * that blended casters multiply with their transmittance (rgb; alpha: the
+   * least depth, lm_set_caster_layer), drawn after the opaque ones and into
+   * it alone; 0: none, they cast as opaque ones do. */
+  int transmit;
 } lm_pass_desc;
 
 lm_graph *lm_graph_create(void);

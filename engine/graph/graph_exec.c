@@ -319,6 +319,7 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
   bool ok = true;
   if (d->kind == LM_PASS_SCENE) {
     lm_set_scene_state(true, d->view_count > 0); /* tiles are shadow maps */
+    lm_set_blend_state(d->blend);
     scene_pass_ctx c = {{d, p, g, NULL}, x};
     bool kept = d->view_count > 0 && x->keeps_views && x->keeps_views(x->user, &c.pub);
     if (d->clear && !kept)
@@ -327,9 +328,11 @@ static bool run_pass(lm_graph *g, graph_pass *gp, lm_timer *timer, const lm_grap
     for (int v = 0; v < d->view_count && ok; v++) {
       c.pub.view = &d->views[v];
       lm_set_viewport(c.pub.view->x, c.pub.view->y, c.pub.view->width, c.pub.view->height);
+      if (v > 0) bind_pass(g, d, p); /* the last tile may have left a material's variant bound */
       set_view(p, c.pub.view);
       if (x->draw_scene) ok = x->draw_scene(x->user, &c.pub, err);
     }
+    lm_set_blend_state(false);
     lm_set_scene_state(false, false);
     if (!ok) lm_error_prefix(err, "%s: pass '%s'", d->where, d->name);
   } else if (d->kind == LM_PASS_POINTS) {

@@ -175,7 +175,10 @@ static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, int layer, lm_err
                           .view_proj = r->desc.no_culling ? NULL : view_proj,
                           .pancake = sp->view && sp->view->depth[3] == 0,
                           .params = params, .param_count = n, .prev_world = r->prev_world,
-                          .dynamic = r->dynamic, .layer = layer};
+                          .dynamic = r->dynamic, .layer = layer,
+                          .blend = sp->view ? LM_BLEND_CAST : sp->desc->blend ? LM_BLEND_ONLY : LM_BLEND_SKIP,
+                          .eye_view_proj = sp->desc->blend ? r->camera.view_proj : NULL,
+                          .transmit = sp->view ? sp->desc->transmit : 0, .outputs = sp->desc->output_count};
   if (sp->view && r->shadows.settings.simplify > 0) /* simplified casters where a tile's texels hide them */
     d.lod_view_proj = sp->view->view_proj, d.lod_size[0] = sp->view->width, d.lod_size[1] = sp->view->height,
     d.lod_texels = r->shadows.settings.simplify;
@@ -425,7 +428,7 @@ static uint64_t material_hash(const lm_scene *s) {
     const lm_material *m = &s->materials[i];
     const lm_material_pbr *p = &s->material_pbr[i];
     float f[9] = {m->color[0], m->color[1], m->color[2], m->rho, m->ka, m->kd, m->ks, m->shininess, m->reflectivity};
-    float a[2] = {p->alpha, p->alpha_cutoff};
+    float a[3] = {p->alpha, p->alpha_cutoff, p->transmission};
     int k[3] = {m->base_color_texture, (int)p->alpha_mode, p->set};
     h = lm_hash(f, sizeof f, h);
     h = lm_hash(a, sizeof a, h);

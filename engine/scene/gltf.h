@@ -8,7 +8,8 @@
  *   those the loader reads (KHR_lights_punctual, KHR_texture_transform,
  *   KHR_materials_emissive_strength, EXT_mesh_gpu_instancing,
  *   KHR_draco_mesh_compression, EXT_meshopt_compression,
- *   KHR_mesh_quantization) is refused, naming it.
+ *   KHR_mesh_quantization, KHR_materials_transmission, KHR_materials_ior,
+ *   KHR_materials_volume) is refused, naming it.
  * - Buffers are read where they lie, not copied: the file is mapped, a
  *   GLB's BIN chunk and each .bin beside a .gltf are read in place (data
  *   URIs are decoded); tinygltf parses the JSON only. The images materials
@@ -100,6 +101,20 @@
  *   with its KHR_texture_transform (TEXCOORD_0 only; another set warns).
  *   Colour images (base colour, emissive) are sampled as sRGB, data images
  *   as they are (one image used both ways is uploaded twice).
+ *   baseColorFactor's alpha outside [0, 1] fails the file naming the
+ *   material. Glass, as Blender writes it: KHR_materials_transmission's
+ *   transmissionFactor (0..1), KHR_materials_ior's ior (1..10; default 1.5)
+ *   and KHR_materials_volume's thicknessFactor, attenuationDistance (absent:
+ *   no absorption) and attenuationColor (each in 0..1) go to
+ *   lm_material_pbr's glass fields; a value out of range or not finite fails
+ *   the file naming the material, extension and field. Their textures
+ *   (transmissionTexture, thicknessTexture) are not read: one warning a
+ *   file for each. A material with transmission is drawn blended: an
+ *   OPAQUE one becomes BLEND with alpha 1 (Blender writes glass OPAQUE); on
+ *   a MASK one transmission is not drawn (one warning a file). alphaMode
+ *   BLEND materials are drawn by the forward pass over the lit image
+ *   (scripts/transparent.lua), never into the G-buffer, and into shadow
+ *   maps' transmittance (scripts/shadow.lua).
  * - Perspective cameras: yfov, znear, zfar; the aspect ratio is the output's:
  *   aspectRatio is kept (lm_camera.aspect, written back by export-gltf) but an
  *   output of another shape keeps yfov and widens or narrows x, as Blender

@@ -138,6 +138,7 @@ struct Loader {
   std::vector<Decoded> views;          // [bufferView] -> EXT_meshopt_compression's bytes, once decoded
   std::map<int, Decoded> draco;        // [accessor] -> the current primitive's Draco-decoded elements
   std::vector<Pending> decoded;        // [image] -> decoded by decode_images
+  std::vector<std::string> warned_glass; // glass extension fields not read, each warned about once
 };
 
 // Every failure goes through here: "path: what".
@@ -895,6 +896,56 @@ bool material_texture(Loader &L, int material, const char *what, lm_texture_slot
   return true;
 }
 
+// Number `field` of material extension object `o` (`extension`) into *v when
+// there: finite and within lo..hi, else false naming the material and field.
+bool glass_number(Loader &L, int index, const char *name, const tinygltf::Value &o, const char *extension,
+                  const char *field, double lo, double hi, double *v) {
+  double x = *v;
+  if (!ext_numbers(o, field, &x, 1) || !(x >= lo && x <= hi))
+    return fail(L, "material %d ('%s'): %s.%s must be a number in [%g, %g]", index, name, extension, field, lo, hi);
+  *v = x;
+  return true;
+}
+
+// KHR_materials_transmission, _ior and _volume, which Blender writes for
+// glass, into p (lm_material_pbr's glass fields). Their textures are not
+// read: one warning a file for each field.
+bool glass_extensions(Loader &L, int index, const char *name, const tinygltf::ExtensionMap &ext,
+                      lm_material_pbr *p) {
+  double transmission = 0, ior = 1.5, thickness = 0, distance = 0, colour[3] = {1, 1, 1};
+  for (const char *e : {"KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"}) {
+    auto it = ext.find(e);
+    if (it == ext.end()) continue;
+    const tinygltf::Value &o = it->second;
+    if (!o.IsObject()) return fail(L, "material %d ('%s'): %s must be an object", index, name, e);
+    bool ok = !strcmp(e, "KHR_materials_transmission")
+                  ? glass_number(L, index, name, o, e, "transmissionFactor", 0, 1, &transmission)
+              : !strcmp(e, "KHR_materials_ior") ? glass_number(L, index, name, o, e, "ior", 1, 10, &ior)
+              : glass_number(L, index, name, o, e, "thicknessFactor", 0, LM_GLTF_MAX_COORD, &thickness) &&
+                    glass_number(L, index, name, o, e, "attenuationDistance", 0, INFINITY, &distance);
+    if (!ok) return false;
+    if (!strcmp(e, "KHR_materials_volume") && !ext_numbers(o, "attenuationColor", colour, 3))
+      return fail(L, "material %d ('%s'): KHR_materials_volume.attenuationColor must be 3 numbers in [0, 1]",
+                  index, name);
+    for (const char *t : {"transmissionTexture", "thicknessTexture"}) {
+      std::string field = std::string(e) + "." + t;
+      if (!o.Has(t) || std::find(L.warned_glass.begin(), L.warned_glass.end(), field) != L.warned_glass.end())
+        continue;
+      lm_warn("%s: material %d ('%s'): %s is not read (the factor alone applies)", L.path, index, name,
+              field.c_str());
+      L.warned_glass.push_back(field);
+    }
+  }
+  for (double c : colour)
+    if (!(c >= 0 && c <= 1))
+      return fail(L, "material %d ('%s'): KHR_materials_volume.attenuationColor must be 3 numbers in [0, 1]",
+                  index, name);
+  p->transmission = (float)transmission, p->ior = (float)ior, p->thickness = (float)thickness;
+  p->attenuation_distance = std::isfinite(distance) ? (float)distance : 0.0f; /* infinite: no absorption */
+  for (int c = 0; c < 3; c++) p->attenuation_color[c] = (float)colour[c];
+  return true;
+}
+
 // lm material of glTF material `index`, converted on first use; -1 on error.
 int material_for(Loader &L, const char *where, int index) {
   if (index < 0) return -1;
@@ -935,7 +986,10 @@ int material_for(Loader &L, const char *where, int index) {
   p.metallic = metal, p.roughness = rough;
   p.normal_scale = (float)gm.normalTexture.scale;
   p.occlusion_strength = clamp01(gm.occlusionTexture.strength);
-  p.alpha = clamp01(pbr.baseColorFactor[3]);
+  if (!(pbr.baseColorFactor[3] >= 0 && pbr.baseColorFactor[3] <= 1))
+    return fail(L, "material %d ('%s'): baseColorFactor's alpha must be in [0, 1] (got %g)", index, m.name,
+                pbr.baseColorFactor[3]), -1;
+  p.alpha = (float)pbr.baseColorFactor[3];
   p.alpha_mode = gm.alphaMode == "MASK" ? LM_ALPHA_MASK : gm.alphaMode == "BLEND" ? LM_ALPHA_BLEND : LM_ALPHA_OPAQUE;
   if (gm.alphaMode != "MASK" && gm.alphaMode != "BLEND" && gm.alphaMode != "OPAQUE" && !gm.alphaMode.empty())
     return fail(L, "material %d: alphaMode '%s' is none of OPAQUE, MASK, BLEND", index, gm.alphaMode.c_str()), -1;
@@ -948,6 +1002,15 @@ int material_for(Loader &L, const char *where, int index) {
                 index), -1;
   for (int c = 0; c < 3 && !gm.emissiveFactor.empty(); c++)
     p.emissive[c] = (float)(std::fmax(gm.emissiveFactor[c], 0.0) * strength);
+  if (!glass_extensions(L, index, m.name, gm.extensions, &p)) return -1;
+  // Blender writes glass as OPAQUE with transmission: seen through, so drawn blended (its alpha ignored).
+  if (p.transmission > 0 && p.alpha_mode == LM_ALPHA_OPAQUE) p.alpha_mode = LM_ALPHA_BLEND, p.alpha = 1;
+  if (p.transmission > 0 && p.alpha_mode == LM_ALPHA_MASK &&
+      std::find(L.warned_glass.begin(), L.warned_glass.end(), "MASK") == L.warned_glass.end()) {
+    lm_warn("%s: material %d ('%s'): transmission on an alphaMode MASK material is not drawn (opaque where "
+            "not masked)", L.path, index, m.name);
+    L.warned_glass.push_back("MASK");
+  }
   if (!material_texture(L, index, "baseColorTexture", LM_TEX_BASE_COLOR, pbr.baseColorTexture.index,
                         pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions, &m, &p) ||
       !material_texture(L, index, "metallicRoughnessTexture", LM_TEX_METALLIC_ROUGHNESS,
@@ -1631,7 +1694,8 @@ std::string locate_bad_indices(const nlohmann::json &doc) {
 const char *const kSupportedExtensions[] = {"KHR_lights_punctual", "KHR_texture_transform",
                                             "KHR_materials_emissive_strength", "EXT_mesh_gpu_instancing",
                                             "KHR_draco_mesh_compression", "EXT_meshopt_compression",
-                                            "KHR_mesh_quantization"};
+                                            "KHR_mesh_quantization", "KHR_materials_transmission",
+                                            "KHR_materials_ior", "KHR_materials_volume"};
 
 // The first name in the file's extensionsRequired that is not supported, or "".
 std::string unsupported_required(const nlohmann::json &doc) {
@@ -1840,7 +1904,7 @@ bool within_budget(Loader &L) {
 
 // Fills `s` from the parsed model; false (message in L.err) on bad input.
 bool convert(const char *path, const Source &src, const tinygltf::Model &model, lm_scene *s, lm_error *err) {
-  Loader L{path, model, s, err, {}, {}, {}, {}, 0, {}, {}, 0, 0, 0, {}, {}, {}, &src, {}, {}, {}};
+  Loader L{path, model, s, err, {}, {}, {}, {}, 0, {}, {}, 0, 0, 0, {}, {}, {}, &src, {}, {}, {}, {}};
   L.views.resize(model.bufferViews.size());
   if (!within_budget(L)) return false; // the geometry, before an image is decoded
   decode_images(L);

@@ -13,6 +13,7 @@
 #include <strings.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdarg>
@@ -131,6 +132,27 @@ lm_material phong_of(const float color[3], float metallic, float roughness) {
 
 bool near(float a, float b) { return std::fabs(a - b) <= 1e-3f * std::fmax(1.0f, std::fabs(b)); }
 
+// Extension `name` on the material, and in the file's extensionsUsed (once).
+void use_extension(Writer &W, tinygltf::Material &g, const char *name, tinygltf::Value::Object o) {
+  g.extensions[name] = tinygltf::Value(o);
+  auto &used = W.m.extensionsUsed;
+  if (std::find(used.begin(), used.end(), name) == used.end()) used.push_back(name);
+}
+
+// Glass as the loader reads it: KHR_materials_transmission, _ior, and _volume
+// (which glTF allows only beside transmission).
+void add_glass(Writer &W, const lm_material_pbr &p, tinygltf::Material &g) {
+  if (p.transmission > 0)
+    use_extension(W, g, "KHR_materials_transmission",
+                  {{"transmissionFactor", tinygltf::Value((double)p.transmission)}});
+  if (p.ior > 0 && p.ior != 1.5f) use_extension(W, g, "KHR_materials_ior", {{"ior", tinygltf::Value((double)p.ior)}});
+  if (p.transmission > 0 && p.thickness > 0 && p.attenuation_distance > 0)
+    use_extension(W, g, "KHR_materials_volume",
+                  {{"thicknessFactor", tinygltf::Value((double)p.thickness)},
+                   {"attenuationDistance", tinygltf::Value((double)p.attenuation_distance)},
+                   {"attenuationColor", number_array(p.attenuation_color, 3)}});
+}
+
 bool add_material(Writer &W, int i, const std::string &dir, std::vector<int> &textures, lm_error *err) {
   const lm_material &lm = W.s->materials[i];
   lm_material_pbr p = lm_scene_material_pbr(W.s, i, &lm);
@@ -160,6 +182,7 @@ bool add_material(Writer &W, int i, const std::string &dir, std::vector<int> &te
   g.occlusionTexture.index = t[LM_TEX_OCCLUSION] >= 0 ? t[LM_TEX_OCCLUSION] : -1;
   g.occlusionTexture.strength = p.occlusion_strength;
   g.emissiveTexture.index = t[LM_TEX_EMISSIVE] >= 0 ? t[LM_TEX_EMISSIVE] : -1;
+  add_glass(W, p, g);
   // Limn's Phong values always go into extras.limn; the loader reads extras.reflectivity.
   tinygltf::Value::Object limn, extras;
   limn["color"] = number_array(lm.color, 3);

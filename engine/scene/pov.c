@@ -247,6 +247,31 @@ static bool write_light(pov_ctx *c, const lm_light *l, const lm_light_data *ld, 
 
 /* The pbr technique's material as POV-Ray's closest finish (pov.h), with a
  * warning that says what is approximated. */
+/* A material's pigment (pov.h): rgb, or rgbft for a blended one. */
+static void put_pigment(pov_ctx *c, const lm_material_pbr *p, const double col[3]) {
+  if (p->alpha_mode != LM_ALPHA_BLEND) {
+    lm_buf_printf(c->out, "  pigment { rgb <%.9g, %.9g, %.9g> }\n", col[0], col[1], col[2]);
+    return;
+  }
+  double a = clamp01(p->alpha);
+  lm_buf_printf(c->out, "  pigment { rgbft <%.9g, %.9g, %.9g, %.9g, %.9g> }\n", col[0], col[1], col[2],
+                a * clamp01(p->transmission), 1.0 - a);
+}
+
+/* Does a blended material absorb in its volume (KHR_materials_volume)? */
+static bool absorbs(const lm_material_pbr *p) {
+  return p->alpha_mode == LM_ALPHA_BLEND && p->transmission > 0 && p->thickness > 0 && p->attenuation_distance > 0;
+}
+
+/* The texture's closing brace, then the absorption (pov.h) as <id>_interior. */
+static void end_material(pov_ctx *c, const lm_material_pbr *p, const char *id) {
+  lm_buf_printf(c->out, "}\n\n");
+  if (absorbs(p))
+    lm_buf_printf(c->out, "#declare %s_interior = interior {\n  fade_power 1001 fade_distance %.9g "
+                  "fade_color rgb <%.9g, %.9g, %.9g>\n}\n\n", id, p->attenuation_distance,
+                  clamp01(p->attenuation_color[0]), clamp01(p->attenuation_color[1]), clamp01(p->attenuation_color[2]));
+}
+
 static void write_pbr_material(pov_ctx *c, const lm_material *m, const lm_material_pbr *p, const char *id) {
   double metal = clamp01(p->metallic), rough = p->roughness > 0.08 ? clamp01(p->roughness) : 0.08;
   double f0 = 0.04, r4 = rough * rough * rough * rough, s = 2.0 / r4 - 2.0;
@@ -255,16 +280,18 @@ static void write_pbr_material(pov_ctx *c, const lm_material *m, const lm_materi
     lm_buf_printf(c->warnings, "material '%s': metallic-roughness written as POV-Ray's closest finish (Blinn "
                   "specular of the matching exponent, no Fresnel rise or Smith shadowing, no textures)\n", m->name);
   lm_buf_printf(c->out,
-                "// material '%s' (metallic %.3g, roughness %.3g: approximated)\n#declare %s = texture {\n"
-                "  pigment { rgb <%.9g, %.9g, %.9g> }\n"
+                "// material '%s' (metallic %.3g, roughness %.3g: approximated)\n#declare %s = texture {\n",
+                m->name, metal, rough, id);
+  put_pigment(c, p, (double[3]){clamp01(m->color[0]), clamp01(m->color[1]), clamp01(m->color[2])});
+  lm_buf_printf(c->out,
                 "  finish { ambient 0 emission rgb <%.9g, %.9g, %.9g> diffuse %.9g brilliance 1 specular %.9g "
-                "roughness %.9g metallic %.9g }\n}\n\n",
-                m->name, metal, rough, id, clamp01(m->color[0]), clamp01(m->color[1]), clamp01(m->color[2]),
+                "roughness %.9g metallic %.9g }\n",
                 p->emissive[0], p->emissive[1], p->emissive[2], 1.0 - metal, f0 * (s + 2.0) / 8.0, 1.0 / fmax(s, 1.0),
                 metal);
+  end_material(c, p, id);
 }
 
-static bool write_material(pov_ctx *c, const lm_material *m, const char *id) {
+static bool write_material(pov_ctx *c, const lm_material *m, const lm_material_pbr *p, const char *id) {
   double col[3], kd = clamp01(m->kd), ks = clamp01(m->ks);
   bool clamped = kd != m->kd || ks != m->ks;
   for (int i = 0; i < 3; i++) {
@@ -283,11 +310,11 @@ static bool write_material(pov_ctx *c, const lm_material *m, const char *id) {
   char reflection[64] = "";
   if (refl > 0) snprintf(reflection, sizeof reflection, " reflection %.9g", refl);
   lm_buf_printf(c->out,
-                "// material '%s'\n#declare %s = texture {\n"
-                "  pigment { rgb <%.9g, %.9g, %.9g> }\n"
-                "  finish { ambient 0 emission 0 diffuse %.9g brilliance 1 phong %.9g phong_size %.9g%s }\n"
-                "}\n\n",
-                m->name, id, col[0], col[1], col[2], kd, ks, size, reflection);
+                "// material '%s'\n#declare %s = texture {\n", m->name, id);
+  put_pigment(c, p, col);
+  lm_buf_printf(c->out, "  finish { ambient 0 emission 0 diffuse %.9g brilliance 1 phong %.9g phong_size %.9g%s }\n",
+                kd, ks, size, reflection);
+  end_material(c, p, id);
   return true;
 }
 
@@ -356,7 +383,10 @@ static bool write_mesh_node(pov_ctx *c, const lm_scene *s, const lm_node *n) {
     for (int t = 0; t < total; t++)
       if (keep[t])
         lm_buf_printf(b, ",\n    <%u, %u, %u>", m->indices[t * 3], m->indices[t * 3 + 1], m->indices[t * 3 + 2]);
-    lm_buf_printf(b, "\n  }\n  texture { %s }\n%s}\n\n", id, c->desc->shadows ? "" : "  no_shadow\n");
+    lm_material_pbr p = lm_scene_material_pbr(s, n->material, lm_scene_node_material(s, n));
+    char interior[96] = "";
+    if (absorbs(&p)) snprintf(interior, sizeof interior, "  interior { %s_interior }\n", id);
+    lm_buf_printf(b, "\n  }\n  texture { %s }\n%s%s}\n\n", id, interior, c->desc->shadows ? "" : "  no_shadow\n");
   }
   free(keep);
   free(wp);
@@ -402,12 +432,9 @@ bool lm_pov_export(const lm_scene *s, const lm_pov_desc *desc, lm_buf *out, lm_b
     char id[64];
     material_id(s, nd, id, sizeof id);
     const lm_material *m = lm_scene_node_material(s, nd);
-    if (desc->pbr_materials) {
-      lm_material_pbr p = lm_scene_material_pbr(s, nd->material, m);
-      write_pbr_material(&c, m, &p, id);
-    } else {
-      ok = write_material(&c, m, id);
-    }
+    lm_material_pbr p = lm_scene_material_pbr(s, nd->material, m);
+    if (desc->pbr_materials) write_pbr_material(&c, m, &p, id);
+    else ok = write_material(&c, m, &p, id);
   }
   free(declared);
   for (int i = 0; i < s->node_count && ok; i++) {

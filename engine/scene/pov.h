@@ -41,6 +41,13 @@
  *   the engine's ray-traced reflections (engine/trace). The engine's
  *   ambient term (k_a * ambient) has no counterpart: render the engine with
  *   the option ambient = 0 when comparing.
+ *   A blended material (glTF alphaMode BLEND, alpha a, transmission t) is
+ *   "rgbft <colour, a t, 1 - a>": filter a t passes tinted by the colour,
+ *   transmit 1 - a untinted, as the engine's forward pass (shaders/
+ *   transparent.frag), whose Fresnel (1 - F of the ior) POV-Ray's filter
+ *   lacks; KHR_materials_volume's absorption becomes interior { fade_power
+ *   1001 (exponential) fade_distance, fade_color }, which POV-Ray applies
+ *   inside closed meshes only. Rays pass straight (no ior), as the engine's.
  * - Lights, colour = color * power:
  *   directional -> parallel light placed outside the scene's bounds;
  *   point, LM_FALLOFF_NONE -> plain point light;

@@ -525,13 +525,25 @@ static const char *const slot_define[LM_TEX_SLOTS] = {"BASE_COLOR_TEXTURE", "MR_
                                                        "OCCLUSION_TEXTURE", "EMISSIVE_TEXTURE"};
 
 static const char *scene_uniforms[] = {"material_color", "material_rho", "material_k",
-                                       "material_reflectivity", "material_pbr", "material_emissive", "material_alpha", "base_color_tex",
+                                       "material_reflectivity", "material_pbr", "material_emissive", "material_alpha",
+                                       "material_glass", "material_attenuation", "base_color_tex",
                                        "mr_tex", "normal_tex", "occlusion_tex", "emissive_tex", "base_color_xform",
                                        "mr_xform", "normal_xform", "occlusion_xform", "emissive_xform"};
 
 bool lm_scene_owns_uniform(const char *name) {
   for (size_t i = 0; i < sizeof scene_uniforms / sizeof *scene_uniforms; i++)
     if (!strcmp(scene_uniforms[i], name)) return true;
+  return false;
+}
+
+static bool material_blends(const lm_scene *s, int material) {
+  return material >= 0 && material < s->material_count && s->material_pbr[material].set &&
+         s->material_pbr[material].alpha_mode == LM_ALPHA_BLEND;
+}
+
+bool lm_scene_has_blend(const lm_scene *s) {
+  for (int i = 0; i < s->node_count; i++)
+    if (s->nodes[i].mesh >= 0 && material_blends(s, s->nodes[i].material)) return true;
   return false;
 }
 
@@ -662,9 +674,10 @@ static int slot_texture(const lm_scene *s, const lm_material *m, const lm_materi
  * slot for a pbr one, the base colour for the others), and ALPHA_MASK for a
  * glTF alphaMode MASK material in the others (std.frag, shadow.frag: a masked
  * hole is no surface and casts no shadow; pbr.frag reads material_alpha
- * always). */
+ * always); ALPHA_BLEND for a BLEND material drawn into a shadow pass's
+ * transmittance output. */
 static void material_defines(const lm_scene *s, const lm_material *m, const lm_material_pbr *p, bool pbr,
-                             char *out, size_t cap) {
+                             bool translucent, char *out, size_t cap) {
   out[0] = '\0';
   for (int slot = 0; slot < LM_TEX_SLOTS; slot++) {
     if (slot_texture(s, m, p, slot) < 0 || (slot != LM_TEX_BASE_COLOR && !pbr)) continue;
@@ -674,6 +687,10 @@ static void material_defines(const lm_scene *s, const lm_material *m, const lm_m
   if (!pbr && p->alpha_mode == LM_ALPHA_MASK) {
     size_t len = strlen(out);
     snprintf(out + len, cap - len, "%sALPHA_MASK", len ? ";" : "");
+  }
+  if (translucent) {
+    size_t len = strlen(out);
+    snprintf(out + len, cap - len, "%sALPHA_BLEND", len ? ";" : "");
   }
 }
 
@@ -702,11 +719,20 @@ bool lm_scene_node_culled(const lm_scene *s, int node, const float view_proj[16]
 }
 
 /* A visible mesh node, sorted so that nodes of one mesh, material and
- * simplification (lod 1: its caster copy) lie together. */
-typedef struct drawn_node { int material, mesh, lod, node; } drawn_node;
+ * simplification (lod 1: its caster copy) lie together, translucent casters
+ * (into a transmittance output) after the others; blended ones in the
+ * forward pass by the camera's depth of their bounds' centre, farthest first. */
+typedef struct drawn_node { int translucent, material, mesh, lod, node; float depth; } drawn_node;
+
+static int back_to_front(const void *pa, const void *pb) {
+  const drawn_node *a = pa, *b = pb;
+  if (a->depth != b->depth) return a->depth > b->depth ? -1 : 1;
+  return (a->node > b->node) - (a->node < b->node);
+}
 
 static int drawn_node_order(const void *pa, const void *pb) {
   const drawn_node *a = pa, *b = pb;
+  if (a->translucent != b->translucent) return a->translucent - b->translucent;
   if (a->material != b->material) return a->material < b->material ? -1 : 1;
   if (a->mesh != b->mesh) return a->mesh < b->mesh ? -1 : 1;
   if (a->lod != b->lod) return a->lod - b->lod;
@@ -744,6 +770,7 @@ static void bind_material(const lm_scene *s, const lm_program *p, const lm_mater
   float k[4] = {m->ka, m->kd, m->ks, m->shininess};
   float params[4] = {mp->metallic, mp->roughness, mp->normal_scale, mp->occlusion_strength};
   float alpha[2] = {mp->alpha, mp->alpha_mode == LM_ALPHA_MASK ? mp->alpha_cutoff : -1.0f};
+  float glass[4] = {mp->transmission, mp->ior > 0 ? mp->ior : 1.5f, mp->attenuation_distance, mp->thickness};
   const lm_uniform *u;
   if ((u = lm_program_uniform(p, "material_color"))) lm_program_set(p, u, m->color);
   if ((u = lm_program_uniform(p, "material_rho"))) lm_program_set(p, u, &m->rho);
@@ -752,6 +779,8 @@ static void bind_material(const lm_scene *s, const lm_program *p, const lm_mater
   if ((u = lm_program_uniform(p, "material_pbr"))) lm_program_set(p, u, params);
   if ((u = lm_program_uniform(p, "material_emissive"))) lm_program_set(p, u, mp->emissive);
   if ((u = lm_program_uniform(p, "material_alpha"))) lm_program_set(p, u, alpha);
+  if ((u = lm_program_uniform(p, "material_glass"))) lm_program_set(p, u, glass);
+  if ((u = lm_program_uniform(p, "material_attenuation"))) lm_program_set(p, u, mp->attenuation_color);
   for (int slot = 0; slot < LM_TEX_SLOTS && defines[0]; slot++) {
     if (!strstr(defines, slot_define[slot])) continue;
     if ((u = lm_program_uniform(p, slot_sampler[slot])))
@@ -794,15 +823,21 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
     if (d->dynamic && d->layer && d->dynamic[i] != (d->layer == 2)) continue;
+    if (material_blends(s, n->material) ? d->blend == LM_BLEND_SKIP : d->blend == LM_BLEND_ONLY) continue;
     float lo[3] = {0}, hi[3] = {0};
-    if (d->view_proj || d->lod_view_proj) world_bounds(n->world, s->meshes[n->mesh].bounds, lo, hi);
+    if (d->view_proj || d->lod_view_proj || d->eye_view_proj) world_bounds(n->world, s->meshes[n->mesh].bounds, lo, hi);
     if (d->view_proj && box_outside(d->view_proj, lo, hi, d->pancake)) {
       if (stats) stats->culled++;
       continue;
     }
-    nodes[count++] = (drawn_node){n->material, n->mesh, node_simplified(d, n, &s->meshes[n->mesh], lo, hi), i};
+    float depth = 0; /* the camera's clip w of the bounds' centre: its view depth */
+    for (int k = 0; k < 3 && d->eye_view_proj; k++) depth += d->eye_view_proj[4 * k + 3] * (lo[k] + hi[k]) / 2;
+    int translucent = d->blend == LM_BLEND_CAST && d->transmit > 0 && material_blends(s, n->material);
+    nodes[count++] =
+        (drawn_node){translucent, n->material, n->mesh, node_simplified(d, n, &s->meshes[n->mesh], lo, hi), i, depth};
   }
-  qsort(nodes, (size_t)count, sizeof *nodes, drawn_node_order);
+  bool sorted = d->blend == LM_BLEND_ONLY; /* blending needs the order, one node a draw */
+  qsort(nodes, (size_t)count, sizeof *nodes, sorted ? back_to_front : drawn_node_order);
   lm_instance *instances = lm_alloc(sizeof *instances * (size_t)(count > 0 ? count : 1));
   for (int i = 0; i < count; i++) {
     int k = nodes[i].node;
@@ -811,9 +846,9 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
   lm_instances_upload(instances, count);
   free(instances);
   char bound[160] = ""; /* the defines of the variant that is bound */
-  bool ok = true;
+  bool ok = true, translucent = false; /* drawing into the transmittance output */
   for (int first = 0, last; first < count && ok; first = last) {
-    for (last = first + 1; last < count && nodes[last].material == nodes[first].material &&
+    for (last = first + 1; !sorted && last < count && nodes[last].material == nodes[first].material &&
                            nodes[last].mesh == nodes[first].mesh && nodes[last].lod == nodes[first].lod;)
       last++;
     const lm_node *n = &s->nodes[nodes[first].node];
@@ -822,15 +857,12 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     for (int k = 0; k < d->param_count; k++)
       if (!strcmp(d->params[k].material, m.name)) apply_param(&m, &d->params[k]);
     lm_material_pbr mp = lm_scene_material_pbr(s, n->material, &m);
-    if (pbr && mp.alpha_mode == LM_ALPHA_BLEND) {
-      lm_error_set(err, "material '%s' (node '%s'): alphaMode BLEND is not drawn by this technique (the "
-                   "G-buffer keeps one opaque surface a pixel); make it OPAQUE or MASK, or draw with std",
-                   m.name, n->name);
-      ok = false;
-      break;
-    }
     char defines[160] = "";
-    if (d->variant) material_defines(s, &m, &mp, pbr, defines, sizeof defines);
+    if (nodes[first].translucent && !translucent) { /* after every opaque caster */
+      translucent = true;
+      lm_set_caster_layer(d->transmit - 1, d->outputs, true);
+    }
+    if (d->variant) material_defines(s, &m, &mp, pbr, translucent, defines, sizeof defines);
     if (strcmp(defines, bound)) { /* switch programs only when the variant changes */
       p = d->variant(d->ctx, defines, err);
       if (!p) {
@@ -848,6 +880,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
       stats->simplified += lod ? last - first : 0;
     }
   }
+  if (translucent) lm_set_caster_layer(-1, d->outputs, false);
   free(nodes);
   return ok;
 }

@@ -45,6 +45,14 @@ typedef struct lm_material_pbr {
   int textures[LM_TEX_SLOTS]; /* 1 + index; 0: none (the base colour's is the material's) */
   /* KHR_texture_transform per slot: uv' = (a b c; d e f) (u v 1); all zero: identity */
   float uv_transform[LM_TEX_SLOTS][6];
+  /* Glass (KHR_materials_transmission, _ior, _volume), drawn by a blended
+   * material's forward pass: the share of light that passes through, tinted
+   * by the base colour; the index of refraction (Fresnel at normal
+   * incidence ((ior - 1) / (ior + 1))^2; 0 in a material built without
+   * one: 1.5); and the volume's absorption, attenuation_color left after
+   * attenuation_distance (0: none) over a path of `thickness`. */
+  float transmission, ior;
+  float attenuation_color[3], attenuation_distance, thickness;
 } lm_material_pbr;
 
 /* Material `material`'s metallic-roughness data (m: its Phong values, with
@@ -370,6 +378,13 @@ bool lm_scene_check_params(const lm_scene *s, const lm_material_param *params, i
 /* Names of the parameters a material has, for messages. */
 const char *lm_material_param_list(void);
 
+/* alphaMode BLEND materials in a scene draw: left out (the G-buffer keeps the
+ * opaque layer), drawn as shadow casters (with a transmit output: after the
+ * opaque ones, into it alone, define ALPHA_BLEND; without, as opaque ones),
+ * or drawn alone, back to front, one node a draw (the forward pass over the
+ * lit image). */
+typedef enum lm_blend_draw { LM_BLEND_SKIP, LM_BLEND_CAST, LM_BLEND_ONLY } lm_blend_draw;
+
 typedef struct lm_scene_draw_desc {
   const lm_program *program; /* bound: the technique's program */
   /* The technique's program with `defines` added ("BASE_COLOR_TEXTURE" for a
@@ -400,6 +415,9 @@ typedef struct lm_scene_draw_desc {
   const float *lod_view_proj;
   int lod_size[2];
   float lod_texels;
+  lm_blend_draw blend; /* what becomes of alphaMode BLEND materials */
+  const float *eye_view_proj; /* LM_BLEND_ONLY: the camera's, whose clip w orders the nodes */
+  int transmit, outputs;      /* LM_BLEND_CAST: lm_pass_desc.transmit, of the pass's `outputs` */
 } lm_scene_draw_desc;
 typedef struct lm_scene_draw_stats {
   int drawn, culled; /* mesh nodes drawn, and left out by the frustum test */
@@ -416,14 +434,16 @@ typedef struct lm_scene_draw_stats {
  * model or normal_matrix is an error), setting the material uniforms (material_color, material_rho,
  * material_k, material_reflectivity; material_pbr, material_emissive,
  * material_alpha) and the textures with their transforms (base_color_tex,
- * base_color_xform, mr_tex, ...). With a technique that declares material_pbr, a material whose
- * alphaMode is BLEND is an error naming it. Adds to *stats (may be NULL). */
+ * base_color_xform, mr_tex, ...; material_glass, material_attenuation) and
+ * BLEND materials as d->blend says. Adds to *stats (may be NULL). */
 bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err);
 /* True when the world-space box lo..hi lies wholly outside one clip plane of view_proj. */
 bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const float hi[3]);
 /* Would lm_scene_draw with this view_proj and pancake cull mesh node `node`?
  * False for a node whose bounds are not finite (it is drawn). */
 bool lm_scene_node_culled(const lm_scene *s, int node, const float view_proj[16], bool pancake);
+/* Does a mesh node of the scene have an alphaMode BLEND material? */
+bool lm_scene_has_blend(const lm_scene *s);
 /* Uniforms a scene draw sets itself; scripts may not bind them. */
 bool lm_scene_owns_uniform(const char *name);
 

@@ -1,6 +1,6 @@
 /* What pipeline scripts call: target{}, scene{}, pass{}, cpu{}, points{},
  * present(), output_size(), shadow_plan{}, sky_sh{}, scene_reflective(),
- * scene_bounds(). Each validates its table and names the field at fault. */
+ * scene_blended(), scene_bounds(). Each validates its table and names the field at fault. */
 #include "script/script_internal.h"
 
 #include <math.h>
@@ -545,7 +545,7 @@ static int add_pass_returning_output(lua_State *L, lm_pipeline *p, pass_builder 
 }
 
 /* scene{ "name", technique = "std", out = {...}, depth = T, clear = bool | {r,g,b,a}, ...,
- * views = plan, fit = T } */
+ * views = plan, fit = T, inputs = {...}, blend = bool } */
 static int l_scene(lua_State *L) {
   lm_pipeline *p = recording(L, "scene");
   if (p->in_create) return luaL_error(L, "scene() records a pass: call it from OnRender");
@@ -553,7 +553,8 @@ static int l_scene(lua_State *L) {
   int top = lua_gettop(L);
   begin_pass(L, &b, LM_PASS_SCENE, "scene");
   static const char *const fields[] = {"technique", "out", "depth", "clear", "params", "defines",
-                                       "materials", "views", "fit", "fit_margin", NULL};
+                                       "materials", "views", "fit", "fit_margin", "inputs", "blend", "transmit",
+                                       NULL};
   check_fields(L, 1, b.what, fields);
   b.desc.shader = opt_string(L, 1, "technique", b.what);
   if (!b.desc.shader) b.desc.shader = "std";
@@ -577,11 +578,25 @@ static int l_scene(lua_State *L) {
   lua_pop(L, 1);
   read_params(L, 1, &b);
   read_defines(L, 1, &b);
+  read_inputs(L, 1, &b);
+  lua_getfield(L, 1, "blend"); /* the blended materials alone, over what out holds (lm_pass_desc) */
+  if (!lua_isnil(L, -1) && !lua_isboolean(L, -1)) return luaL_error(L, "%s: blend must be true or false", b.what);
+  b.desc.blend = lua_toboolean(L, -1);
+  lua_pop(L, 1);
   lua_getfield(L, 1, "views");
   if (!lua_isnil(L, -1)) {
     const lm_shadow_plan *plan = to_plan(L, -1, b.what);
     b.desc.views = plan->views;
     b.desc.view_count = plan->view_count;
+  }
+  lua_pop(L, 1);
+  lua_getfield(L, 1, "transmit"); /* the output blended casters multiply (lm_pass_desc) */
+  if (!lua_isnil(L, -1)) {
+    int t = to_target(L, -1, b.what)->id;
+    for (int i = 0; i < b.desc.output_count && !b.desc.transmit; i++)
+      if (b.outputs[i] == t) b.desc.transmit = i + 1;
+    if (!b.desc.transmit || !b.desc.view_count)
+      return luaL_error(L, "%s: transmit must be one of the outputs of a pass with views (a shadow plan)", b.what);
   }
   lua_pop(L, 1);
   lua_getfield(L, 1, "fit");
@@ -688,6 +703,14 @@ static int l_scene_bounds(lua_State *L) {
   return 2;
 }
 
+/* scene_blended(): whether a node of the scene has an alphaMode BLEND material
+ * (the pipeline records its forward pass only then). */
+static int l_scene_blended(lua_State *L) {
+  lm_pipeline *p = recording(L, "scene_blended");
+  lua_pushboolean(L, p->scene && lm_scene_has_blend(p->scene));
+  return 1;
+}
+
 /* scene_reflective(): whether a material the scene draws is reflective. */
 static int l_scene_reflective(lua_State *L) {
   lm_pipeline *p = recording(L, "scene_reflective");
@@ -790,6 +813,7 @@ void lm_script_open_api(lua_State *L) {
                                  {"present", l_present}, {"output_size", l_output_size}, {"still_frames", l_still_frames},
                                  {"shadow_plan", l_shadow_plan}, {"sky_sh", l_sky_sh}, {"cpu", l_cpu},
                                  {"scene_reflective", l_scene_reflective}, {"points", l_points},
+                                 {"scene_blended", l_scene_blended},
                                  {"scene_bounds", l_scene_bounds}, {"light_set", l_light_set},
                                  {NULL, NULL}};
   lua_pushglobaltable(L);
