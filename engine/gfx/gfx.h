@@ -22,11 +22,11 @@ bool lm_context_adopt_current(lm_error *err);
  * the display terminated (which stops the driver's threads) and the
  * thread's EGL state released; the next create starts afresh. */
 void lm_context_destroy(void);
-/* Keeps every library loaded so far mapped until the process ends. Called
- * before a display closes: Mesa's driver keeps an allocation in a static of
- * its own, which LeakSanitizer can only see as reachable while the driver is
- * mapped (unloaded, it reports a leak in an unknown module at exit). */
-void lm_keep_libraries_loaded(void);
+/* Keeps the Mesa drivers loaded so far (in a "dri" folder) mapped until the
+ * process ends. Called before a display closes: a driver keeps an allocation
+ * in a static of its own, which LeakSanitizer can only see as reachable while
+ * the driver is mapped (unloaded, it reports a leak in an unknown module). */
+void lm_keep_drivers_loaded(void);
 const char *lm_gl_renderer(void);
 const char *lm_gl_version(void);
 const char *lm_context_platform(void); /* "egl-device", "egl-surfaceless", "window" */

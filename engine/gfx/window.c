@@ -100,8 +100,8 @@ void lm_window_destroy(lm_window *w) {
   glfwMakeContextCurrent(NULL);
   glfwDestroyWindow(w->glfw);
   /* Closing the display joins the driver's threads and unloads it: keep it
-   * mapped for LeakSanitizer (lm_keep_libraries_loaded). */
-  lm_keep_libraries_loaded();
+   * mapped for LeakSanitizer (lm_keep_drivers_loaded). */
+  lm_keep_drivers_loaded();
   glfwTerminate();
   free(w);
 }
