@@ -29,12 +29,14 @@ end
 
 -- Records the chain over `lit` with o = { bloom = {...}, dof = {...}, ... }
 -- (missing tables take the defaults) and the frame (frame.G, the G-buffer,
--- for dof and motion_blur). Returns the final target.
+-- for dof and motion_blur). Returns the final target and what it holds,
+-- present()'s second argument: "display" once hdr tone mapped it, else
+-- "scene" (pre-exposed radiance, as `lit`).
 function post.render(lit, o, frame)
   o = o or {}
   local img = lit
   for _, name in ipairs(post.order) do img = modules[name].render(img, o[name], frame) end
-  return img
+  return img, modules.hdr.check(o.hdr, 2).enabled and "display" or "scene"
 end
 
 return post

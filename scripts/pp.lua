@@ -82,7 +82,7 @@ local function frame(tech, row)
   local o = S and S.check(tech[row.offscreen]) -- shadows after the G-buffer: cascades fit what it sees
   local F = { G = G, technique = row, light = { ambient = grey(tech.ambient), background = grey(tech.background) } }
   if row.shadows then F.shadows, F.R = shadow.render(tech.shadow, G, o) end
-  if F.shadows and tech.shadow.debug then return shadow.debug(F.shadows) end
+  if F.shadows and tech.shadow.debug then return shadow.debug(F.shadows), "display" end
   F.light.sky = sky.light(tech.sky) -- nil when off: then nothing of it is recorded
   local joins = F.R and S and (row.joins or "direct") -- no caster, no RSM: no off-screen light
   local indirect = joins == "direct" and S.render(nil, o, F) or nil

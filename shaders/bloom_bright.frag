@@ -25,7 +25,7 @@ void main() {
   // Quadratic soft knee: the kept fraction rises smoothly from
   // threshold - knee to threshold + knee, then follows brightness - threshold.
   float t = max(threshold, 0.0), k = max(knee, 0.0);
-  float b = max(c.r, max(c.g, c.b));
+  float b = max(c.r, max(c.g, c.b)) * frame.exposure.y; // in radiance, as the threshold (c is pre-exposed)
   float soft = clamp(b - t + k, 0.0, 2.0 * k);
   soft = soft * soft / (4.0 * k + 1e-4);
   float kept = max(soft, b - t) / max(b, 1e-4);

@@ -11,6 +11,7 @@ layout(std140, binding = 0) uniform LimnFrame {
   vec4 time;        // seconds, frame index
   ivec4 counts;     // x: lights
   mat4 prev_view_proj; // last frame's, for reprojection and motion blur
+  vec4 exposure;    // x: the pre-exposure E, y: 1/E, z: E over the last frame's (see exposed())
 } frame;
 
 struct Light {
@@ -31,6 +32,15 @@ layout(std430, binding = 4) readonly buffer LimnLightGrid {
   uvec4 grid_global; // x: lights of infinite reach, y: where their list starts in cells
   uint cells[];      // per cluster (offset, count) into cells, then the lists
 };
+
+// Pre-exposure: lighting passes work on radiance times the frame's exposure E
+// (a power of two, engine/render's pre_exposure), so that half floats hold
+// starlight and sunlight alike. The lights arrive times E; a shader that adds
+// radiance of its own (ambient, background, sky, emission, thresholds in
+// radiance) passes it through exposed(); the output stage divides E back
+// out. A history kept from the last frame is times the last E: times
+// frame.exposure.z it is in this frame's.
+vec3 exposed(vec3 radiance) { return radiance * frame.exposure.x; }
 
 const float PI = 3.14159265358979;
 const float EPS = 1e-6;

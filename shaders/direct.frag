@@ -21,7 +21,7 @@ out vec4 lit;
 void main() {
   Surface s = gbuffer_read(clr, nrm, dpt, mat, uv);
   if (!s.covered) {
-    lit = vec4(background + sky_seen(uv), 1.0);
+    lit = vec4(background_seen(background, uv), 1.0);
     return;
   }
   vec3 l = direct_light(s, ambient);

@@ -6,7 +6,10 @@
 // count-weighted mean of the level below. Blocks cut by the image's edge
 // count only the pixels they hold, so the result is the exact mean for any
 // size (glGenerateMipmap's box filter drops or blends edge texels of odd
-// sizes). Output: r = mean ln, g = pixel count.
+// sizes). Output: r = mean ln, g = pixel count. The image is pre-exposed
+// (common.glsl's exposed()) and delta is added to it as it is: the mean is of
+// ln(delta + E L_w), hdr_adapt.frag takes ln E away, and an image lit 1e10
+// times more adapts to the same picture.
 #include "post.glsl"
 
 in vec2 uv;

@@ -24,10 +24,10 @@ void main() {
 #ifdef AUTO_KEY
   a = clamp(1.03 - 2.0 / (2.0 + log(avg + 1.0) / log(10.0)), 0.045, 0.9);
 #endif
-  float lw = luminance(c);
+  float lw = luminance(c); // pre-exposed (exposed()); avg is radiance
   // In this order no intermediate overflows: a / avg <= 1e30 * 0.9, and
-  // lw is clamped, so L is finite up to ~1e38 and is then capped.
-  float l = min(exp2(clamp(exposure, -40.0, 40.0)) * (a / avg) * lw, 1e30);
+  // lw in radiance is clamped, so L is finite up to ~1e38 and is then capped.
+  float l = min(exp2(clamp(exposure, -40.0, 40.0)) * (a / avg) * min(lw * frame.exposure.y, 1e30), 1e30);
   float w = max(white, 1e-3);
   float ld = l / (1.0 + l) * (1.0 + min(l / (w * w), 1e30));
   // rgb * ld / lw; where lw is ~0 the colour is ~0 too.

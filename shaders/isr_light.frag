@@ -30,7 +30,7 @@ out vec4 lit;
 void main() {
   Surface s = gbuffer_fetch(clr, nrm, dpt, mat, ivec2(gl_FragCoord.xy)); // unfiltered: a pass at the G-buffer's size
   if (!s.covered) {
-    lit = vec4(background + sky_seen(uv), 1.0);
+    lit = vec4(background_seen(background, uv), 1.0);
     return;
   }
   vec4 e = coarse_upsample(uv, s.depth01);

@@ -1,5 +1,8 @@
 // The engine's output stage: no NaN, Inf or negative value leaves it, in any
-// mode; out_srgb is sRGB-encoded for 8-bit files and displays.
+// mode; out_srgb is sRGB-encoded for 8-bit files and displays. Radiance
+// arrives pre-exposed (common.glsl's exposed()) and leaves as radiance, in
+// the float linear output whatever half floats would have held; DISPLAY
+// values (present(t, "display"): tone mapped) leave as they are.
 #include "common.glsl"
 
 in vec2 uv;
@@ -18,6 +21,9 @@ vec3 srgb_encode(vec3 c) {
 
 void main() {
   vec3 c = finite_or_zero(texture(src, uv).rgb);
+#ifndef DISPLAY
+  c = min(c * frame.exposure.y, vec3(3e38));
+#endif
   out_srgb = vec4(srgb_encode(c), 1.0);
 #ifdef LINEAR_OUTPUT
   out_linear = vec4(c, 1.0);

@@ -106,6 +106,6 @@ void main() {
   out_dpt = max(view_depth, 0.0) * frame.clip.z;
   out_mat = vec4(saturate(occlusion), 1.0 - metallic, max(max(f0.r, f0.g), f0.b),
                  mat_alpha_encode(material_reflectivity, true));
-  out_emi = vec4(finite_or_zero(emissive), 1.0);
+  out_emi = vec4(min(finite_or_zero(exposed(emissive)), vec3(65000.0)), 1.0); // under half's largest
   write_velocity();
 }

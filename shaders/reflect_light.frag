@@ -21,7 +21,7 @@ void main() {
   }
   vec4 m = texelFetch(hit_mat, q, 0);
   if (m.a < 0.5) { // a miss: the background and the sky along the ray
-    lit = vec4(background + sky_radiance(safe_normalize(texelFetch(rays_d, q, 0).xyz, vec3(0.0, 1.0, 0.0))), 1.0);
+    lit = vec4(exposed(background) + sky_radiance(safe_normalize(texelFetch(rays_d, q, 0).xyz, vec3(0.0, 1.0, 0.0))), 1.0);
     return;
   }
   vec4 c = texelFetch(hit_clr, q, 0), nn = texelFetch(hit_nrm, q, 0);

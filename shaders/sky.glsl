@@ -16,15 +16,16 @@ float sky_sh(mat3 c, vec3 n) {
 }
 #endif
 
-// The sky's radiance along unit direction d (black without SKY): the 3
-// bands of radiance, each band's irradiance coefficients over A_l / pi (1,
-// 2/3, 1/4), clamped as above. What background pixels and rays that miss
-// see, as POV-Ray's camera sees its sky_sphere (a smooth 3-band sky).
+// The sky's radiance along unit direction d (black without SKY), pre-exposed
+// (common.glsl's exposed()): the 3 bands of radiance, each band's irradiance
+// coefficients over A_l / pi (1, 2/3, 1/4), clamped as above. What
+// background pixels and rays that miss see, as POV-Ray's camera sees its
+// sky_sphere (a smooth 3-band sky).
 vec3 sky_radiance(vec3 d) {
 #ifdef SKY
   const mat3 band = mat3(1.0, 1.5, 1.5, 1.5, 4.0, 4.0, 4.0, 4.0, 4.0); // sky_sh's layout
-  return max(vec3(sky_sh(matrixCompMult(sky_r, band), d), sky_sh(matrixCompMult(sky_g, band), d),
-                  sky_sh(matrixCompMult(sky_b, band), d)), 0.0);
+  return exposed(max(vec3(sky_sh(matrixCompMult(sky_r, band), d), sky_sh(matrixCompMult(sky_g, band), d),
+                          sky_sh(matrixCompMult(sky_b, band), d)), 0.0));
 #else
   return vec3(0.0);
 #endif
@@ -39,12 +40,16 @@ vec3 sky_seen(vec2 uv) {
 #endif
 }
 
+// The background's radiance (a uniform colour) and the sky's through uv, pre-exposed.
+vec3 background_seen(vec3 background, vec2 uv) { return exposed(background) + sky_seen(uv); }
+
+// The ambient light on a surface facing n, pre-exposed (exposed()).
 vec3 sky_ambient(vec3 ambient, vec3 n) {
 #ifdef SKY
   // Three bands ring slightly below zero opposite a bright region: clamp.
-  return ambient + max(vec3(sky_sh(sky_r, n), sky_sh(sky_g, n), sky_sh(sky_b, n)), 0.0);
+  return exposed(ambient + max(vec3(sky_sh(sky_r, n), sky_sh(sky_g, n), sky_sh(sky_b, n)), 0.0));
 #else
-  return ambient;
+  return exposed(ambient);
 #endif
 }
 #endif

@@ -15,7 +15,8 @@
 // The history is last frame's accumulation: value (rgba, every channel
 // accumulated; the confidence reads rgb) and state (r: view depth, 0 none;
 // g: frames seen), at the coarse size of the pass; the pass writes this
-// frame's into two more outputs.
+// frame's into two more outputs. Its rgb is light (pre-exposed: the last
+// frame's exposure, rescaled to this frame's as it is read); a is not.
 #ifndef LIMN_TEMPORAL_GLSL
 #define LIMN_TEMPORAL_GLSL
 #include "common.glsl"
@@ -99,6 +100,7 @@ bool temporal_history(vec2 uv, float d, out vec4 h, out float n) {
   if (any(lessThan(q, vec2(0.0))) || any(greaterThan(q, vec2(1.0)))) return false;
   ivec2 size = textureSize(history, 0), t = clamp(ivec2(q * vec2(size)), ivec2(0), size - 1);
   h = texelFetch(history, t, 0);
+  h.rgb *= frame.exposure.z; // light under the last frame's pre-exposure, in this one's (exposed())
   vec2 state = texelFetch(history_state, t, 0).rg;
   n = state.g;
   return state.r > 0.0 && abs(state.r - then) <= epsilon * state.r && n >= 1.0;

@@ -249,7 +249,7 @@ void main() {
   result = vec4(finite_or_zero(e), 1.0);
 #elif defined(REFINE)
   if (!s.covered) {
-    result = vec4(background + sky_seen(uv), 1.0);
+    result = vec4(background_seen(background, uv), 1.0);
     return;
   }
   ivec2 csize = textureSize(coarse, 0);

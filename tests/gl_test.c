@@ -109,6 +109,7 @@ gl_result gl_render(const gl_run *run) {
                                                       .height = r.height, .linear_output = true,
                                                       .check_finite = run->check_finite,
                                                       .no_light_culling = run->no_light_culling,
+                                                      .exposure = run->exposure,
                                                       .no_culling = run->no_culling}, &r.err);
   if (!r.renderer) return r;
   r.rgb = malloc(sizeof(float) * 3 * (size_t)r.width * (size_t)r.height);

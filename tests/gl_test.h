@@ -17,6 +17,7 @@ typedef struct gl_run {
   bool check_finite;        /* the renderer's NaN/Inf attribution */
   bool no_light_culling;    /* every pixel evaluates every light */
   bool no_culling;          /* every node drawn in every view (lm_renderer_desc.no_culling) */
+  float exposure;           /* a fixed pre-exposure (lm_renderer_desc.exposure); 0: the scene's */
 } gl_run;
 
 typedef struct gl_result {

@@ -25,7 +25,6 @@ root=$2
 blender=${BLENDER:-blender}
 command -v "$blender" >/dev/null ||
   { echo "test_cycles_map: skipped: no blender (Debian package blender: apt-get install blender)"; exit 77; }
-export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0"
 tmp=$(mktemp -d /tmp/limn-cycles-map-XXXXXX)
 trap 'rm -rf "$tmp"' EXIT
 passed=0 failed=0

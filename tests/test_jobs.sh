@@ -7,11 +7,6 @@
 set -u
 limn=$1
 root=$2
-# Under AddressSanitizer, LeakSanitizer's stop-the-world at exit dies in this
-# container for some of these many short limn runs ("LeakSanitizer has
-# encountered a fatal error", no leak found), so this test checks memory
-# errors without leak checks; other tests and tools/memcheck.sh check leaks.
-export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0"
 tmp=$(mktemp -d /tmp/limn-jobs-XXXXXX)
 trap 'rm -rf "$tmp"' EXIT
 passed=0 failed=0

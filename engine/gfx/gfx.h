@@ -18,7 +18,15 @@ typedef struct lm_context_desc {
 bool lm_context_create_headless(const lm_context_desc *desc, lm_error *err);
 /* For a context somebody else made current (a GLFW window): load and check GL. */
 bool lm_context_adopt_current(lm_error *err);
+/* Releases the headless context whole: current none, the context destroyed,
+ * the display terminated (which stops the driver's threads) and the
+ * thread's EGL state released; the next create starts afresh. */
 void lm_context_destroy(void);
+/* Keeps the Mesa drivers loaded so far (in a "dri" folder) mapped until the
+ * process ends. Called before a display closes: a driver keeps an allocation
+ * in a static of its own, which LeakSanitizer can only see as reachable while
+ * the driver is mapped (unloaded, it reports a leak in an unknown module). */
+void lm_keep_drivers_loaded(void);
 const char *lm_gl_renderer(void);
 const char *lm_gl_version(void);
 const char *lm_context_platform(void); /* "egl-device", "egl-surfaceless", "window" */
@@ -190,6 +198,8 @@ typedef struct lm_frame_data {
   float time[4];        /* seconds, frame index */
   int32_t counts[4];    /* lights */
   float prev_view_proj[16]; /* the previous frame's (this frame's on the first) */
+  float exposure[4];  /* pre-exposure E (lights, sky, ambient, emission arrive times it), 1/E,
+                         E over the last frame's (what a history kept since is rescaled by), 0 */
 } lm_frame_data;
 typedef struct lm_light_data {
   float position[4];  /* xyz, w = type: 0 point, 1 spot, 2 directional */

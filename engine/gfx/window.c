@@ -99,9 +99,10 @@ void lm_window_destroy(lm_window *w) {
   if (!w) return;
   glfwMakeContextCurrent(NULL);
   glfwDestroyWindow(w->glfw);
-  /* No glfwTerminate: closing the display unloads Mesa's driver, which
-   * leaks an allocation LeakSanitizer reports against an unknown module
-   * (as eglTerminate does; see context.c). The process ends soon after. */
+  /* Closing the display joins the driver's threads and unloads it: keep it
+   * mapped for LeakSanitizer (lm_keep_drivers_loaded). */
+  lm_keep_drivers_loaded();
+  glfwTerminate();
   free(w);
 }
 

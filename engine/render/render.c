@@ -70,6 +70,7 @@ struct lm_renderer {
   uint64_t scene;  /* the last frame's scene_hash (the world without the camera) */
   int scene_still; /* the same count for scene_hash */
   long executions; /* frames executed, never reset (tile_cache.execution) */
+  float exposure;  /* the last frame's pre-exposure (pre_exposure) */
 };
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
@@ -550,8 +551,9 @@ static bool add_output_stage(lm_renderer *r, lm_graph *g, lm_pipeline *p, int pr
                                                       .format = LM_FORMAT_RGBA32F}, err);
   if (out[0] < 0 || (r->desc.linear_output && out[1] < 0)) return false;
   lm_pass_input input = {"src", presented};
+  static const char *const defines[2][2] = {{"", "DISPLAY"}, {"LINEAR_OUTPUT", "LINEAR_OUTPUT;DISPLAY"}};
   lm_pass_desc d = {.kind = LM_PASS_FULLSCREEN, .name = "output", .where = lm_pipeline_present_where(p),
-                    .shader = "output.frag", .defines = r->desc.linear_output ? "LINEAR_OUTPUT" : "",
+                    .shader = "output.frag", .defines = defines[r->desc.linear_output][lm_pipeline_present_display(p)],
                     .inputs = &input, .input_count = 1, .outputs = out,
                     .output_count = r->desc.linear_output ? 2 : 1, .depth = -1};
   if (lm_graph_add_pass(g, &d, err) < 0) return false;
@@ -634,6 +636,36 @@ static void remember_world(lm_renderer *r) {
   for (int i = 0; i < s->node_count; i++) memcpy(r->prev_world + (size_t)i * 16, s->nodes[i].world, 16 * sizeof(float));
 }
 
+/* The frame's pre-exposure (common.glsl's exposed()): a power of two that
+ * brings the brightest light (its peak radiance on a white surface facing
+ * it: a light of inverse-square falloff at the camera's distance, no nearer
+ * than the near plane) or emission of the scene to about 1, where half
+ * floats hold 11 bits either way from 6e-5 to 65504; 1 while that lies
+ * within 1/16 .. 16 (most scenes, whose images it then leaves bit for bit)
+ * or the scene has no light. A power of two scales exactly. Production
+ * engines pre-expose with the last frame's adapted exposure; this one is
+ * known from the lights before the frame, so that a first frame (or a cut)
+ * loses nothing to precision either. */
+static float pre_exposure(const lm_scene *s, const lm_frame_data *f, const lm_light_data *lights, int n) {
+  float peak = 0;
+  for (int i = 0; i < n; i++) {
+    const lm_light_data *l = &lights[i];
+    float c = fmaxf(l->color[0], fmaxf(l->color[1], l->color[2]));
+    int falloff = (int)(l->params[1] + 0.5f);
+    if ((int)(l->position[3] + 0.5f) != LM_LIGHT_DIRECTIONAL && (falloff == 2 || falloff == 3)) {
+      float d2 = 0;
+      for (int k = 0; k < 3; k++) d2 += (l->position[k] - f->camera_pos[k]) * (l->position[k] - f->camera_pos[k]);
+      c /= fmaxf(d2, f->clip[0] * f->clip[0]);
+    }
+    if (isfinite(c)) peak = fmaxf(peak, c);
+  }
+  for (int i = 0; i < s->material_count; i++)
+    for (int k = 0; k < 3; k++)
+      if (isfinite(s->material_pbr[i].emissive[k])) peak = fmaxf(peak, s->material_pbr[i].emissive[k]);
+  if (!(peak > 0) || (peak >= 1.0f / 16 && peak <= 16)) return 1;
+  return ldexpf(1, (int)lroundf(fminf(fmaxf(-log2f(peak), -64), 64)));
+}
+
 /* Runs what record() compiled into g (the camera and shadow plan it made). */
 static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_frame_data *frame = &r->camera;
@@ -648,6 +680,13 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_light_data lights[MAX_LIGHTS];
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
   frame->counts[0] = n;
+  float e = r->desc.exposure > 0 && isfinite(r->desc.exposure) ? r->desc.exposure
+                                                               : pre_exposure(r->desc.scene, frame, lights, n);
+  frame->exposure[0] = e, frame->exposure[1] = 1 / e;
+  frame->exposure[2] = r->frame > 1 && r->exposure > 0 ? e / r->exposure : 1;
+  r->exposure = e;
+  for (int i = 0; i < n; i++)
+    for (int c = 0; c < 3; c++) lights[i].color[c] *= e;
   lm_frame_upload(frame, lights, n);
   lm_light_grid_build(&r->light_grid, frame, lights, n, !r->desc.no_light_culling);
   lm_storage_upload(4, r->light_grid.data, r->light_grid.count * sizeof *r->light_grid.data);

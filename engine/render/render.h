@@ -19,6 +19,8 @@ typedef struct lm_renderer_desc {
   bool check_finite;      /* debug: name the first pass that writes a NaN or Inf */
   bool no_culling;        /* draw every node, even those outside the frustum */
   bool no_light_culling;  /* every pixel evaluates every light (the reference for light culling) */
+  float exposure;         /* the lighting passes' pre-exposure, a fixed camera's; 0: from the scene's
+                             lights each frame (common.glsl's exposed(); the outputs are radiance either way) */
 } lm_renderer_desc;
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err);

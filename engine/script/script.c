@@ -544,6 +544,7 @@ void lm_pipeline_set_scene(lm_pipeline *p, const lm_scene *scene, const lm_frame
 }
 
 const char *lm_pipeline_present_where(const lm_pipeline *p) { return p->present_where; }
+bool lm_pipeline_present_display(const lm_pipeline *p) { return p->present_display; }
 
 bool lm_pipeline_record(lm_pipeline *p, lm_graph *g, int *presented, lm_error *err) {
   static unsigned serial;

@@ -74,6 +74,10 @@ void lm_pipeline_set_scene(lm_pipeline *p, const lm_scene *scene, const lm_frame
 bool lm_pipeline_record(lm_pipeline *p, lm_graph *g, int *presented, lm_error *err);
 /* Where the last frame called present() ("scripts/pp.lua:30"). */
 const char *lm_pipeline_present_where(const lm_pipeline *p);
+/* Did it present display values (present(t, "display"): tone mapped), which
+ * the output stage takes as they are, or pre-exposed radiance (the default),
+ * which it divides by the frame's exposure (common.glsl's exposed())? */
+bool lm_pipeline_present_display(const lm_pipeline *p);
 /* True once OnCreate has run. */
 bool lm_pipeline_created(const lm_pipeline *p);
 

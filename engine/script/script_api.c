@@ -772,6 +772,9 @@ static int l_present(lua_State *L) {
   lm_pipeline *p = recording(L, "present");
   if (p->in_create) return luaL_error(L, "present() is called from OnRender");
   p->presented = to_target(L, 1, "present")->id;
+  /* What it holds: pre-exposed radiance, or display values (tone mapped) the exposure leaves alone. */
+  static const char *const referred[] = {"scene", "display", NULL};
+  p->present_display = luaL_checkoption(L, 2, "scene", referred) == 1;
   caller_where(L, p->present_where, sizeof p->present_where);
   return 0;
 }

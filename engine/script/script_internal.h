@@ -21,6 +21,7 @@ struct lm_pipeline {
   bool in_create, created;
   int presented;
   char present_where[256];
+  bool present_display; /* present(t, "display") */
   int options_ref;    /* registry: the Options table with overrides applied */
   const lm_scene *scene;
   const lm_frame_data *camera;

@@ -21,5 +21,5 @@ function OnRender(tech)
   local G = gbuffer.render(gbuffer.targets())
   present(pass{ "show", shader = "examples/show.frag", inputs = { src = G[tech.show] },
                 params = { scale = tech.scale, offset = tech.offset },
-                out = target{ "show", format = "rgba32f" } })
+                out = target{ "show", format = "rgba32f" } }, "display") -- not light: no exposure
 end
