@@ -40,7 +40,7 @@ vec3 trace(vec3 p, vec3 l, float foot) {
     if (covered && ray > seen && ray < seen * (1.0 + thickness) + t * (grow - 1.0))
       return textureLod(lit, uv, 0.0).rgb;
   }
-  return background + sky_radiance(l);
+  return exposed(background) + sky_radiance(l); // pre-exposed, as the lit frame it stands in for
 }
 
 void main() {

@@ -61,7 +61,7 @@ void main() {
   Reflector m = Reflector(false, diffuse, material_k.xyz, max(material_k.w, 0.0), vec3(0.0), 1.0);
   float ka = material_k.x;
 #endif
-  vec3 surface = ka * sky_ambient(ambient, n) * diffuse + reflected_light(m, n, v, world_pos) + material_emissive;
+  vec3 surface = ka * sky_ambient(ambient, n) * diffuse + reflected_light(m, n, v, world_pos) + exposed(material_emissive);
   // Absorption along the refracted ray through the volume's thickness.
   vec3 absorbed = vec3(1.0);
   if (material_glass.z > 0.0 && material_glass.w > 0.0) {
