@@ -136,7 +136,10 @@ vec4 temporal_accumulate(vec4 cur, bool found, vec4 h, float n, out float seen) 
   // The same samples as the history's (a still view's kept pattern): nothing to average, and one
   // frame's samples held (so the blur's age stays that of a fresh frame, the one reuse off blurs).
   if (found && (temporal_turning() || gather_turns != 0)) {
-    vec3 a = h.rgb / (1.0 + h.rgb), b = cur.rgb / (1.0 + cur.rgb), diff = abs(a - b);
+    // Judged on the scene's radiance (frame.exposure.y undoes the pre-exposure), so the exposure the
+    // renderer picks does not change what counts as a change of light.
+    vec3 ha = h.rgb * frame.exposure.y, hb = cur.rgb * frame.exposure.y;
+    vec3 a = ha / (1.0 + ha), b = hb / (1.0 + hb), diff = abs(a - b);
     float conf = 1.0 - saturate(max(diff.r, max(diff.g, diff.b))) / (1.0 + bias);
     if (conf >= confidence) {
       float held = min(n, most);
