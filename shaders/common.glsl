@@ -20,7 +20,14 @@ struct Light {
   vec4 params;    // x: cos(inner cone), y: falloff (0 seed window, 1 none, 2 inverse square,
                   //    3 inverse square with KHR_lights_punctual's range window)
 };
+#ifdef LIGHT_SET
+// A light-set variant (lighting.glsl) reads a uniform block's copy of the
+// first LIGHT_SET_MAX lights: llvmpipe reads a storage buffer lane by lane
+// (LM_LIGHT_SET_VIEWS in engine/scene/scene.h says why).
+layout(std140, binding = 1) uniform LimnLightSet { Light lights[LIGHT_SET_MAX]; };
+#else
 layout(std430, binding = 1) readonly buffer LimnLights { Light lights[]; };
+#endif
 
 // Light culling, built once a frame (engine/scene/lightgrid.c): the frustum in
 // screen tiles and depth slices, each cluster listing the lights that may

@@ -250,6 +250,26 @@ void lm_storage_upload(int binding, const void *data, size_t bytes) {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)binding, storage[binding].buffer);
 }
 
+static struct {
+  GLuint buffer;
+  size_t size;
+} uniform_blocks[STORAGE_BINDINGS];
+
+void lm_uniform_upload(int binding, const void *data, size_t bytes, size_t block) {
+  if (binding < 1 || binding >= STORAGE_BINDINGS || block == 0) return;
+  if (block != uniform_blocks[binding].size) {
+    if (uniform_blocks[binding].buffer) glDeleteBuffers(1, &uniform_blocks[binding].buffer);
+    glCreateBuffers(1, &uniform_blocks[binding].buffer);
+    glNamedBufferData(uniform_blocks[binding].buffer, (GLsizeiptr)block, NULL, GL_DYNAMIC_DRAW);
+    uniform_blocks[binding].size = block;
+  }
+  size_t copy = bytes < block ? bytes : block;
+  glClearNamedBufferSubData(uniform_blocks[binding].buffer, GL_R8, (GLintptr)copy, (GLsizeiptr)(block - copy), GL_RED,
+                            GL_UNSIGNED_BYTE, NULL);
+  if (data && copy) glNamedBufferSubData(uniform_blocks[binding].buffer, 0, (GLsizeiptr)copy, data);
+  glBindBufferBase(GL_UNIFORM_BUFFER, (GLuint)binding, uniform_blocks[binding].buffer);
+}
+
 float lm_scene_clear_depth(bool shadow_caster) { return shadow_caster ? 1.0f : 0.0f; }
 
 void lm_set_scene_state(bool on, bool shadow_caster) {

@@ -84,6 +84,10 @@ void lm_draw_points(int count);
 void lm_set_viewport(int x, int y, int width, int height);
 /* Uploads a shader storage block to `binding` (grows its buffer as needed). */
 void lm_storage_upload(int binding, const void *data, size_t bytes);
+/* Uploads the first `block` bytes of data (its `bytes`, zeros after them) to
+ * a uniform block of `block` bytes at uniform binding `binding` (1 .. 7; 0 is
+ * the frame's). */
+void lm_uniform_upload(int binding, const void *data, size_t bytes, size_t block);
 /* Depth test and back-face culling for scene passes; off for full-screen
  * ones. Camera views test reversed depth (near 1, far 0). Shadow casters
  * draw both faces (a light inside a closed mesh sees its back faces) and

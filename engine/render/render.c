@@ -635,6 +635,7 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
   frame->counts[0] = n;
   lm_frame_upload(frame, lights, n);
+  lm_uniform_upload(1, lights, sizeof *lights * (size_t)n, sizeof *lights * LM_LIGHT_SET_MAX);
   lm_light_grid_build(&r->light_grid, frame, lights, n, !r->desc.no_light_culling);
   lm_storage_upload(4, r->light_grid.data, r->light_grid.count * sizeof *r->light_grid.data);
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);

@@ -698,6 +698,7 @@ static int l_scene_reflective(lua_State *L) {
 /* light_set(max[, cull]): the scene's lights as a lighting pass's defines, which
  * shaders/lighting.glsl reads to evaluate each light unrolled, its kind,
  * falloff and shadow fixed, instead of the general loop: { LIGHT_SET = count,
+ * LIGHT_SET_MAX (the size of the uniform blocks it reads: common.glsl),
  * LIGHT_SPOTS, LIGHT_SUNS (directional), LIGHT_SHADOWED (casts shadows),
  * LIGHT_FALLOFF_NONE, LIGHT_FALLOFF_SQUARE, LIGHT_FALLOFF_RANGE = masks,
  * bit i for light i } (zero masks left out: one variant, one cache key). nil
@@ -734,9 +735,11 @@ static int l_light_set(lua_State *L) {
       {"LIGHT_SPOTS", spots}, {"LIGHT_SUNS", suns}, {"LIGHT_SHADOWED", shadowed},
       {"LIGHT_FALLOFF_NONE", falloff[LM_FALLOFF_NONE]}, {"LIGHT_FALLOFF_SQUARE", falloff[LM_FALLOFF_INVERSE_SQUARE]},
       {"LIGHT_FALLOFF_RANGE", falloff[LM_FALLOFF_RANGE]}};
-  lua_createtable(L, 0, 7);
+  lua_createtable(L, 0, 8);
   lua_pushinteger(L, n);
   lua_setfield(L, -2, "LIGHT_SET");
+  lua_pushinteger(L, LM_LIGHT_SET_MAX); /* the uniform blocks' size (common.glsl) */
+  lua_setfield(L, -2, "LIGHT_SET_MAX");
   for (size_t k = 0; k < sizeof masks / sizeof *masks; k++) {
     if (!masks[k].mask) continue;
     lua_pushinteger(L, masks[k].mask);

@@ -586,14 +586,23 @@ void lm_shadow_plan_free(lm_shadow_plan *plan) {
   *plan = (lm_shadow_plan){0};
 }
 
+/* The storage block the general light loop reads and its first `records`
+ * as the uniform block a light-set variant reads (LM_LIGHT_SET_VIEWS). */
+static void upload(int binding, const void *data, size_t bytes, size_t record, int records) {
+  lm_storage_upload(binding, data, bytes);
+  lm_uniform_upload(binding, data, bytes, record * (size_t)records);
+}
+
 void lm_shadow_plan_upload(const lm_shadow_plan *plan, int light_count) {
   if (plan && plan->lights) {
-    lm_storage_upload(2, plan->lights, sizeof *plan->lights * (size_t)plan->light_count);
-    lm_storage_upload(3, plan->view_data, sizeof *plan->view_data * (size_t)plan->view_count);
+    upload(2, plan->lights, sizeof *plan->lights * (size_t)plan->light_count, sizeof *plan->lights,
+           LM_LIGHT_SET_MAX);
+    upload(3, plan->view_data, sizeof *plan->view_data * (size_t)plan->view_count, sizeof *plan->view_data,
+           LM_LIGHT_SET_VIEWS);
     return;
   }
   lm_shadow_light_data *none = lm_alloc(sizeof *none * (size_t)(light_count + 1));
-  lm_storage_upload(2, none, sizeof *none * (size_t)light_count);
-  lm_storage_upload(3, NULL, 0);
+  upload(2, none, sizeof *none * (size_t)light_count, sizeof *none, LM_LIGHT_SET_MAX);
+  upload(3, NULL, 0, sizeof(lm_shadow_view_data), LM_LIGHT_SET_VIEWS);
   free(none);
 }
