@@ -230,6 +230,15 @@ void lm_draw_points(int count) {
 
 void lm_set_viewport(int x, int y, int width, int height) { glViewport(x, y, width, height); }
 
+void lm_set_scissor(bool on, int x, int y, int width, int height) {
+  if (!on) {
+    glDisable(GL_SCISSOR_TEST);
+    return;
+  }
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(x, y, width, height);
+}
+
 enum { STORAGE_BINDINGS = 8 };
 static struct {
   GLuint buffer;
@@ -533,7 +542,11 @@ void lm_texture_copy(lm_texture dst, lm_texture src, int width, int height) {
 }
 
 void lm_texture_copy_rect(lm_texture dst, lm_texture src, int x, int y, int width, int height) {
-  glCopyImageSubData(src.id, GL_TEXTURE_2D, 0, x, y, 0, dst.id, GL_TEXTURE_2D, 0, x, y, 0, width, height, 1);
+  lm_texture_copy_moved(dst, x, y, src, x, y, width, height);
+}
+
+void lm_texture_copy_moved(lm_texture dst, int dx, int dy, lm_texture src, int sx, int sy, int width, int height) {
+  glCopyImageSubData(src.id, GL_TEXTURE_2D, 0, sx, sy, 0, dst.id, GL_TEXTURE_2D, 0, dx, dy, 0, width, height, 1);
 }
 
 void lm_screen_bind(int width, int height) {

@@ -414,6 +414,7 @@ typedef struct lm_scene_draw_stats {
   int kept;          /* views (shadow tiles) kept from the last frame instead of drawn */
   int in_place;      /* of those, the ones still in the pass's outputs: neither cleared nor copied */
   int layered;       /* views drawn again over their kept static layer: only their moving casters drawn */
+  int scrolled;      /* views (cascades) whose last texels moved with them: only the strips they uncover drawn */
   long triangles;    /* triangles drawn */
   int simplified;    /* of drawn, nodes drawn with their simplified caster copy */
 } lm_scene_draw_stats;
