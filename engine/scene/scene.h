@@ -101,13 +101,15 @@ typedef struct lm_light {
  * for the scene's light set (light_set() in the pipeline API,
  * shaders/lighting.glsl); scenes with more take the general loop. */
 #define LM_LIGHT_SET_MAX 16
-/* A light-set variant reads the lights and their shadow records and views
- * from uniform blocks (bindings 1, 2, 3) that copy the first records of the
- * storage blocks the general loop reads: llvmpipe reads a storage buffer in a
- * fragment shader lane by lane (a loop that checks and loads each lane's
- * address, even one all lanes share), a uniform block at an index all lanes
- * share once. At most 6 shadow views a light (a cube; 4 cascades and an RSM
- * tile), LM_LIGHT_SET_VIEWS in all. */
+/* A scene of at most LM_LIGHT_SET_MAX lights (a light-set variant, or the
+ * general loop over them: light_set()) reads the lights and their shadow
+ * records and views from uniform blocks (bindings 1, 2, 3) that copy the
+ * first records of the storage blocks a scene of more lights reads: llvmpipe
+ * reads a storage buffer in a fragment shader lane by lane (a loop that
+ * checks and loads each lane's address, even one all lanes share), a uniform
+ * block at an index all lanes share once, at others in one gather. At most 6
+ * shadow views a light (a cube; 4 cascades and an RSM tile), LM_LIGHT_SET_VIEWS
+ * in all. */
 #define LM_LIGHT_SET_VIEWS (LM_LIGHT_SET_MAX * 6)
 
 /* Distance beyond which a point or spot light adds nothing (the window's or

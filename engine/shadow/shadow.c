@@ -590,7 +590,7 @@ void lm_shadow_plan_free(lm_shadow_plan *plan) {
 }
 
 /* The storage block the general light loop reads and its first `records`
- * as the uniform block a light-set variant reads (LM_LIGHT_SET_VIEWS). */
+ * as the uniform block a scene of few lights reads (LM_LIGHT_SET_VIEWS). */
 static void upload(int binding, const void *data, size_t bytes, size_t record, int records) {
   lm_storage_upload(binding, data, bytes);
   lm_uniform_upload(binding, data, bytes, record * (size_t)records);
