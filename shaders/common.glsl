@@ -21,7 +21,15 @@ struct Light {
   vec4 params;    // x: cos(inner cone), y: falloff (0 seed window, 1 none, 2 inverse square,
                   //    3 inverse square with KHR_lights_punctual's range window)
 };
+#ifdef LIGHT_BLOCKS
+// A scene of at most LIGHT_BLOCKS lights (light_set(): a light-set variant in
+// lighting.glsl, or its general loop) reads a uniform block's copy of them:
+// llvmpipe reads a storage buffer lane by lane (LM_LIGHT_SET_VIEWS in
+// engine/scene/scene.h says why).
+layout(std140, binding = 1) uniform LimnLightSet { Light lights[LIGHT_BLOCKS]; };
+#else
 layout(std430, binding = 1) readonly buffer LimnLights { Light lights[]; };
+#endif
 
 // Light culling, built once a frame (engine/scene/lightgrid.c): the frustum in
 // screen tiles and depth slices, each cluster listing the lights that may

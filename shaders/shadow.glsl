@@ -28,8 +28,15 @@ struct ShadowView {
   vec4 depth; // light position, 1 / range (0: orthographic)
   vec4 texel; // a texel's world size (orthographic) or its size per unit of distance; world depth 0..1 spans
 };
+#ifdef LIGHT_BLOCKS
+// Copies in uniform blocks, as common.glsl's lights: at most 6 views a light
+// (engine/scene/scene.h, LM_LIGHT_SET_VIEWS).
+layout(std140, binding = 2) uniform LimnLightSetShadows { ShadowLight shadow_lights[LIGHT_BLOCKS]; };
+layout(std140, binding = 3) uniform LimnLightSetShadowViews { ShadowView shadow_views[LIGHT_BLOCKS * 6]; };
+#else
 layout(std430, binding = 2) readonly buffer LimnShadowLights { ShadowLight shadow_lights[]; };
 layout(std430, binding = 3) readonly buffer LimnShadowViews { ShadowView shadow_views[]; };
+#endif
 
 uniform sampler2D shadow_atlas;
 

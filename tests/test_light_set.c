@@ -85,7 +85,9 @@ static double variant_against_loop(lm_scene *s, const char *tech, const char *ex
 
 /* With light_cull (pp.lua's default) a scene of several lights one of which
  * the grid can cull (a spot's cone, a finite reach) keeps the grid's loop:
- * the eight lights' box compiles no variant; the Cornell box's one light does. */
+ * the eight lights' box compiles no variant, its loop reads the uniform
+ * blocks and renders what the loop over storage blocks renders, exactly; the
+ * Cornell box's one light compiles a variant. */
 static void lights_the_grid_culls_keep_its_loop(void **state) {
   (void)state;
   lm_error err;
@@ -94,8 +96,18 @@ static void lights_the_grid_culls_keep_its_loop(void **state) {
   const char *sets[] = {"light_variants=16", "shadow.technique=poisson", NULL};
   double ms;
   int before = lm_programs_stats("LIGHT_SET", &ms);
+  int blocks = lm_programs_stats("LIGHT_BLOCKS", &ms);
   gl_result r = gl_render_ok(&(gl_run){.scene = eight, .tech = "dl+esm", .sets = sets, .width = W, .height = H});
   assert_int_equal(lm_programs_stats("LIGHT_SET", &ms), before);
+  /* ... reading the lights from uniform blocks: the image of the loop reading storage blocks */
+  assert_true(lm_programs_stats("LIGHT_BLOCKS", &ms) > blocks);
+  const char *storage[] = {"light_variants=0", "shadow.technique=poisson", NULL};
+  gl_result u = gl_render_ok(&(gl_run){.scene = eight, .tech = "dl+esm", .sets = storage, .width = W, .height = H});
+  double worst = 0;
+  for (int i = 0; i < 3 * W * H; i++) worst = fmax(worst, fabs(r.rgb[i] - u.rgb[i]));
+  printf("eight lights, the grid's loop over uniform blocks against storage blocks: largest difference %.2e\n", worst);
+  assert_true(worst == 0);
+  gl_result_free(&u);
   gl_result_free(&r);
   r = gl_render_ok(&(gl_run){.scene = one, .tech = "dl+esm", .sets = sets, .width = W, .height = H});
   assert_true(lm_programs_stats("LIGHT_SET", &ms) > before);

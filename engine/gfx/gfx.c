@@ -230,6 +230,15 @@ void lm_draw_points(int count) {
 
 void lm_set_viewport(int x, int y, int width, int height) { glViewport(x, y, width, height); }
 
+void lm_set_scissor(bool on, int x, int y, int width, int height) {
+  if (!on) {
+    glDisable(GL_SCISSOR_TEST);
+    return;
+  }
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(x, y, width, height);
+}
+
 enum { STORAGE_BINDINGS = 8 };
 static struct {
   GLuint buffer;
@@ -248,6 +257,26 @@ void lm_storage_upload(int binding, const void *data, size_t bytes) {
   }
   if (data && copy) glNamedBufferSubData(storage[binding].buffer, 0, (GLsizeiptr)copy, data);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)binding, storage[binding].buffer);
+}
+
+static struct {
+  GLuint buffer;
+  size_t size;
+} uniform_blocks[STORAGE_BINDINGS];
+
+void lm_uniform_upload(int binding, const void *data, size_t bytes, size_t block) {
+  if (binding < 1 || binding >= STORAGE_BINDINGS || block == 0) return;
+  if (block != uniform_blocks[binding].size) {
+    if (uniform_blocks[binding].buffer) glDeleteBuffers(1, &uniform_blocks[binding].buffer);
+    glCreateBuffers(1, &uniform_blocks[binding].buffer);
+    glNamedBufferData(uniform_blocks[binding].buffer, (GLsizeiptr)block, NULL, GL_DYNAMIC_DRAW);
+    uniform_blocks[binding].size = block;
+  }
+  size_t copy = bytes < block ? bytes : block;
+  glClearNamedBufferSubData(uniform_blocks[binding].buffer, GL_R8, (GLintptr)copy, (GLsizeiptr)(block - copy), GL_RED,
+                            GL_UNSIGNED_BYTE, NULL);
+  if (data && copy) glNamedBufferSubData(uniform_blocks[binding].buffer, 0, (GLsizeiptr)copy, data);
+  glBindBufferBase(GL_UNIFORM_BUFFER, (GLuint)binding, uniform_blocks[binding].buffer);
 }
 
 float lm_scene_clear_depth(bool shadow_caster) { return shadow_caster ? 1.0f : 0.0f; }
@@ -549,7 +578,11 @@ void lm_texture_copy(lm_texture dst, lm_texture src, int width, int height) {
 }
 
 void lm_texture_copy_rect(lm_texture dst, lm_texture src, int x, int y, int width, int height) {
-  glCopyImageSubData(src.id, GL_TEXTURE_2D, 0, x, y, 0, dst.id, GL_TEXTURE_2D, 0, x, y, 0, width, height, 1);
+  lm_texture_copy_moved(dst, x, y, src, x, y, width, height);
+}
+
+void lm_texture_copy_moved(lm_texture dst, int dx, int dy, lm_texture src, int sx, int sy, int width, int height) {
+  glCopyImageSubData(src.id, GL_TEXTURE_2D, 0, sx, sy, 0, dst.id, GL_TEXTURE_2D, 0, dx, dy, 0, width, height, 1);
 }
 
 void lm_screen_bind(int width, int height) {

@@ -90,8 +90,14 @@ void lm_draw_fullscreen(void);
  * blending, on for this draw only). */
 void lm_draw_points(int count);
 void lm_set_viewport(int x, int y, int width, int height);
+/* Draws (and clears) only within the rectangle, or everywhere when off. */
+void lm_set_scissor(bool on, int x, int y, int width, int height);
 /* Uploads a shader storage block to `binding` (grows its buffer as needed). */
 void lm_storage_upload(int binding, const void *data, size_t bytes);
+/* Uploads the first `block` bytes of data (its `bytes`, zeros after them) to
+ * a uniform block of `block` bytes at uniform binding `binding` (1 .. 7; 0 is
+ * the frame's). */
+void lm_uniform_upload(int binding, const void *data, size_t bytes, size_t block);
 /* Depth test and back-face culling for scene passes; off for full-screen
  * ones. Camera views test reversed depth (near 1, far 0). Shadow casters
  * draw both faces (a light inside a closed mesh sees its back faces) and
@@ -281,6 +287,8 @@ void lm_texture_upload_floats(lm_texture tex, int width, int height, const float
 void lm_texture_copy(lm_texture dst, lm_texture src, int width, int height);
 /* Copies the rectangle x, y, width, height of src's level 0 to the same place in dst (same format). */
 void lm_texture_copy_rect(lm_texture dst, lm_texture src, int x, int y, int width, int height);
+/* Copies src's width x height texels at (sx, sy) to dst at (dx, dy). */
+void lm_texture_copy_moved(lm_texture dst, int dx, int dy, lm_texture src, int sx, int sy, int width, int height);
 /* Binds the window's (default) framebuffer and sets the viewport. */
 void lm_screen_bind(int width, int height);
 /* The default framebuffer's back buffer as RGB bytes, top row first. */

@@ -1,5 +1,7 @@
 #include "render/render.h"
 
+#include <cglm/cglm.h>
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,6 +30,9 @@ typedef struct tile_cache {
     int x, y, width, height;
     bool drawn, layered; /* its texels, its static layer kept */
     uint64_t key, static_key;
+    uint64_t pass;               /* pass_key when its texels were last made or kept */
+    long at;                     /* lm_renderer.executions then */
+    float view_proj[16], cull[16]; /* its view then (scroll_tile) */
   } *tiles;
   lm_texture layer[LM_MAX_COLOR_OUTPUTS + 1]; /* the static layers (made when a caster first moves) */
   int tile_count, tile_cap;
@@ -158,8 +163,9 @@ static const lm_program *scene_variant(void *ctx, const char *defines, lm_error 
 }
 
 /* Draws the scene for a scene pass: the camera's, or one shadow tile's
- * (layer: lm_scene_draw_desc's, 0 all its casters). */
-static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, int layer, lm_error *err) {
+ * (layer: lm_scene_draw_desc's, 0 all its casters; cull: the clip volume
+ * outside which nodes are left out, NULL: the view's). */
+static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, int layer, const float *cull, lm_error *err) {
   enum { MAX_PARAMS = 256 };
   lm_material_param params[MAX_PARAMS];
   int n = sp->desc->material_param_count < MAX_PARAMS ? sp->desc->material_param_count : MAX_PARAMS;
@@ -171,7 +177,7 @@ static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, int layer, lm_err
   /* Cull against the camera or the tile's cull volume (a cascade's: the
    * slice it serves); a cascade tile keeps casters before its near plane,
    * which its depth clamp flattens onto it (pancaking). */
-  const float *view_proj = sp->view ? sp->view->cull : r->camera.view_proj;
+  const float *view_proj = cull ? cull : sp->view ? sp->view->cull : r->camera.view_proj;
   lm_scene_draw_desc d = {.program = sp->program, .variant = scene_variant, .ctx = (void *)sp,
                           .view_proj = r->desc.no_culling ? NULL : view_proj,
                           .pancake = sp->view && sp->view->depth[3] == 0,
@@ -216,18 +222,16 @@ static uint64_t tile_casters(const lm_renderer *r, const lm_pass_view *v, bool s
   return h;
 }
 
-/* What a shadow tile's texels follow from: the view (place, matrices, cull
- * volume), the pass (technique's program, defines, clear colour, material
- * overrides), the scene's materials (casters_hash) and the casters in the
- * tile (tile_casters; static_only: those that did not move, its static layer's). */
-static uint64_t tile_key(const lm_renderer *r, const lm_scene_pass *sp, bool static_only) {
+/* What a shadow tile's texels follow from besides its view's matrices and
+ * casters (tile_key): its place and depth mapping, the pass (technique's
+ * program, defines, clear colour, material overrides) and the scene's
+ * materials (casters_hash). */
+static uint64_t pass_key(const lm_renderer *r, const lm_scene_pass *sp) {
   const lm_pass_view *v = sp->view;
   const lm_pass_desc *d = sp->desc;
   int place[4] = {v->x, v->y, v->width, v->height};
-  uint64_t h = lm_hash(place, sizeof place, tile_casters(r, v, static_only, r->casters_hash));
-  h = lm_hash(v->view_proj, sizeof v->view_proj, h);
+  uint64_t h = lm_hash(place, sizeof place, r->casters_hash);
   h = lm_hash(v->depth, sizeof v->depth, h);
-  h = lm_hash(v->cull, sizeof v->cull, h);
   h = lm_hash(&sp->program->id, sizeof sp->program->id, h);
   h = lm_hash(d->shader, strlen(d->shader), h);
   h = lm_hash(d->defines, strlen(d->defines), h);
@@ -240,6 +244,16 @@ static uint64_t tile_key(const lm_renderer *r, const lm_scene_pass *sp, bool sta
     h = lm_hash(q->v, sizeof(float) * (size_t)q->count, h);
   }
   return h;
+}
+
+/* What a shadow tile's texels follow from: the pass (pass_key), the view's
+ * matrices and cull volume and the casters in the tile (tile_casters;
+ * static_only: those that did not move, its static layer's). */
+static uint64_t tile_key(const lm_renderer *r, const lm_scene_pass *sp, bool static_only, uint64_t pass) {
+  const lm_pass_view *v = sp->view;
+  uint64_t h = tile_casters(r, v, static_only, pass);
+  h = lm_hash(v->view_proj, sizeof v->view_proj, h);
+  return lm_hash(v->cull, sizeof v->cull, h);
 }
 
 /* Makes the cache hold textures like the pass's (forgetting every tile when
@@ -275,17 +289,21 @@ static struct cached_tile *tile_at(tile_cache *c, const lm_pass_view *v) {
   return t;
 }
 
-/* Tile t was drawn again: a cached tile of another size that overlaps it
- * (tiles resize with a light's coverage or the RSM's resolution) lost texels,
- * so it is drawn again when its view comes back, even with the same key. */
-static void tile_cache_drawn(tile_cache *c, struct cached_tile *t, uint64_t key) {
+/* Tile t was drawn again (for view v in execution `at`): a cached tile of
+ * another size that overlaps it (tiles resize with a light's coverage or the
+ * RSM's resolution) lost texels, so it is drawn again when its view comes
+ * back, even with the same key. */
+static void tile_cache_drawn(tile_cache *c, struct cached_tile *t, uint64_t key, uint64_t pass,
+                             const lm_pass_view *v, long at) {
   for (int i = 0; i < c->tile_count; i++) {
     struct cached_tile *o = &c->tiles[i];
     if (o != t && o->x < t->x + t->width && t->x < o->x + o->width && o->y < t->y + t->height &&
         t->y < o->y + o->height)
       o->drawn = o->layered = false;
   }
-  t->drawn = true, t->key = key;
+  t->drawn = true, t->key = key, t->pass = pass, t->at = at;
+  memcpy(t->view_proj, v->view_proj, sizeof t->view_proj);
+  memcpy(t->cull, v->cull, sizeof t->cull);
 }
 
 /* Where a pass's views lie in its outputs, and the outputs' size. */
@@ -336,10 +354,10 @@ static bool tile_cache_layers(tile_cache *c, lm_error *err) {
  * kept): its static layer, drawn again only when its own casters changed,
  * then the moving casters over it. */
 static bool draw_layered(lm_renderer *r, const lm_scene_pass *sp, const lm_graph_target_info *t, int nt,
-                         struct cached_tile *cached, bool in_place, lm_error *err) {
+                         struct cached_tile *cached, uint64_t pass, bool in_place, lm_error *err) {
   tile_cache *c = &r->tiles;
   if (!tile_cache_layers(c, err)) return false;
-  uint64_t key = tile_key(r, sp, true);
+  uint64_t key = tile_key(r, sp, true, pass);
   if (cached->layered && cached->static_key == key) {
     copy_tile(t, c->layer, nt, cached, false);
     r->shadow_stats.layered++;
@@ -347,11 +365,111 @@ static bool draw_layered(lm_renderer *r, const lm_scene_pass *sp, const lm_graph
     if (in_place)
       lm_clear_rect(cached->x, cached->y, cached->width, cached->height, sp->desc->output_count,
                     sp->desc->clear_color, sp->desc->depth >= 0, lm_scene_clear_depth(true));
-    if (!draw_pass(r, sp, 1, err)) return false;
+    if (!draw_pass(r, sp, 1, NULL, err)) return false;
     copy_tile(t, c->layer, nt, cached, true);
     cached->layered = true, cached->static_key = key;
   }
-  return !r->any_dynamic || draw_pass(r, sp, 2, err);
+  return !r->any_dynamic || draw_pass(r, sp, 2, NULL, err);
+}
+
+/* The texels of a w x h orthographic tile of view_proj within the box of
+ * clip volume `cull` (orthographic, over the same light view): rect x0, y0,
+ * x1, y1 (ends excluded), the texels it touches (outward) or those wholly
+ * inside it; *far: the box's far end in view_proj's clip depth. */
+static void cull_texels(const float *view_proj, const float *cull, int w, int h, bool outward, int rect[4],
+                        float *far) {
+  mat4 vp, inv, m; /* aligned copies: cglm's SIMD wants them */
+  memcpy(inv, cull, sizeof inv);
+  memcpy(vp, view_proj, sizeof vp);
+  glm_mat4_inv(inv, inv);
+  glm_mat4_mul(vp, inv, m); /* cull's clip space to view_proj's */
+  float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+  for (int c = 0; c < 8; c++) {
+    vec4 p = {c & 1 ? 1.0f : -1.0f, c & 2 ? 1.0f : -1.0f, c & 4 ? 1.0f : -1.0f, 1}, q;
+    glm_mat4_mulv(m, p, q);
+    glm_vec3_minv(lo, q, lo);
+    glm_vec3_maxv(hi, q, hi);
+  }
+  float x0 = (lo[0] + 1) * 0.5f * (float)w, x1 = (hi[0] + 1) * 0.5f * (float)w;
+  float y0 = (lo[1] + 1) * 0.5f * (float)h, y1 = (hi[1] + 1) * 0.5f * (float)h;
+  float in = outward ? -1.0f : 1.0f; /* a texel to spare: the box's edges cut texels */
+  rect[0] = (int)fmaxf(floorf(x0 + in), 0), rect[1] = (int)fmaxf(floorf(y0 + in), 0);
+  rect[2] = (int)fminf(ceilf(x1 - in), (float)w), rect[3] = (int)fminf(ceilf(y1 - in), (float)h);
+  *far = hi[2];
+}
+
+/* Same within float noise: a view's matrix made again from a moved eye
+ * (rotation rows and depth), the xy translation left out (m[12], m[13]). */
+static bool same_but_moved(const float *a, const float *b) {
+  for (int row = 0; row < 4; row++) {
+    float scale = 0;
+    for (int col = 0; col < 4; col++) scale = fmaxf(scale, fabsf(a[col * 4 + row]));
+    for (int col = 0; col < 4; col++) {
+      int i = col * 4 + row;
+      if (i != 12 && i != 13 && !(fabsf(a[i] - b[i]) <= 1e-6f * scale)) return false;
+    }
+  }
+  return true;
+}
+
+/* Scrolls a cascade's tile: when its view only moved across the light by
+ * whole texels since last frame (a moving camera: texel snapping keeps the
+ * texel grid, the snapped eye plane and depth range the depth mapping) and
+ * nothing in the scene moved, the texels both frames' lookups read (their
+ * cull volumes' boxes, xy; no deeper than last frame's) are last frame's,
+ * moved with the view, and only the strips of this frame's box that they do
+ * not cover are drawn, each a scissored draw of the casters over it.
+ * 1: scrolled, 0: the tile must be drawn whole, -1: a draw failed (err). */
+static int scroll_tile(lm_renderer *r, const lm_scene_pass *sp, const lm_graph_target_info *t, int nt,
+                       struct cached_tile *cached, uint64_t pass, bool in_place, lm_error *err) {
+  const lm_pass_view *v = sp->view;
+  int w = v->width, h = v->height;
+  if (!cached->drawn || cached->at != r->executions - 1 || cached->pass != pass || v->depth[3] != 0 ||
+      !same_but_moved(cached->view_proj, v->view_proj))
+    return 0;
+  float sx = (v->view_proj[12] - cached->view_proj[12]) * 0.5f * (float)w;
+  float sy = (v->view_proj[13] - cached->view_proj[13]) * 0.5f * (float)h;
+  int kx = (int)lroundf(sx), ky = (int)lroundf(sy); /* a world point's texel moved by (kx, ky) */
+  if (!(fabsf(sx - (float)kx) <= 0.01f && fabsf(sy - (float)ky) <= 0.01f) || abs(kx) >= w || abs(ky) >= h)
+    return 0;
+  int need[4], had[4];
+  float far, had_far;
+  cull_texels(v->view_proj, v->cull, w, h, true, need, &far);
+  cull_texels(cached->view_proj, cached->cull, w, h, false, had, &had_far);
+  int keep[4] = {had[0] + kx > need[0] ? had[0] + kx : need[0], had[1] + ky > need[1] ? had[1] + ky : need[1],
+                 had[2] + kx < need[2] ? had[2] + kx : need[2], had[3] + ky < need[3] ? had[3] + ky : need[3]};
+  if (!(far <= had_far + 1e-5f && far > -1.0f + 1e-6f) || keep[0] >= keep[2] || keep[1] >= keep[3]) return 0;
+  const lm_pass_desc *d = sp->desc;
+  float clear_depth = lm_scene_clear_depth(true);
+  if (in_place)
+    lm_clear_rect(v->x, v->y, w, h, d->output_count, d->clear_color, d->depth >= 0, clear_depth);
+  /* The whole tile moved (outside the box too: what lookups never read stays as it was) */
+  int x0 = kx > 0 ? kx : 0, y0 = ky > 0 ? ky : 0, x1 = kx < 0 ? w + kx : w, y1 = ky < 0 ? h + ky : h;
+  for (int i = 0; i < nt; i++)
+    lm_texture_copy_moved(t[i].texture, v->x + x0, v->y + y0, r->tiles.tex[i], v->x + x0 - kx, v->y + y0 - ky,
+                          x1 - x0, y1 - y0);
+  /* need less keep: below and above keep across need, then left and right of it */
+  int strips[4][4] = {{need[0], need[1], need[2], keep[1]}, {need[0], keep[3], need[2], need[3]},
+                      {need[0], keep[1], keep[0], keep[3]}, {keep[2], keep[1], need[2], keep[3]}};
+  for (int k = 0; k < 4; k++) {
+    const int *s = strips[k];
+    if (s[0] >= s[2] || s[1] >= s[3]) continue;
+    /* The strip's box in view_proj's clip space, a texel wider each way, to its far end. */
+    float x0 = 2.0f * (float)(s[0] - 1) / (float)w - 1, x1 = 2.0f * (float)(s[2] + 1) / (float)w - 1;
+    float y0 = 2.0f * (float)(s[1] - 1) / (float)h - 1, y1 = 2.0f * (float)(s[3] + 1) / (float)h - 1;
+    mat4 box, vp, cull;
+    glm_ortho(x0, x1, y0, y1, 1.0f, -far, box); /* clip z -1 .. far to -1 .. 1 */
+    memcpy(vp, v->view_proj, sizeof vp);
+    glm_mat4_mul(box, vp, cull);
+    lm_clear_rect(v->x + s[0], v->y + s[1], s[2] - s[0], s[3] - s[1], d->output_count, d->clear_color, d->depth >= 0,
+                  clear_depth);
+    lm_set_scissor(true, v->x + s[0], v->y + s[1], s[2] - s[0], s[3] - s[1]);
+    bool ok = draw_pass(r, sp, 0, (const float *)cull, err);
+    lm_set_scissor(false, 0, 0, 0, 0);
+    if (!ok) return -1;
+  }
+  r->shadow_stats.scrolled++;
+  return 1;
 }
 
 static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
@@ -360,12 +478,13 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   struct cached_tile *cached = NULL;
   lm_graph_target_info t[LM_MAX_COLOR_OUTPUTS + 1];
   int nt = sp->view && r->shadows.settings.cache ? pass_textures(sp, t) : 0;
-  uint64_t key = 0;
+  uint64_t key = 0, pass = 0;
   tile_cache *c = &r->tiles;
   if (nt > 0) {
     bool in_place = c->in_place;
     if (!tile_cache_fit(c, t, nt, err)) return false;
-    key = tile_key(r, sp, false);
+    pass = pass_key(r, sp);
+    key = tile_key(r, sp, false, pass);
     cached = tile_at(c, sp->view);
     /* What the pass leaves for the next frame (whether or not it was in place). */
     for (int i = 0; i < nt; i++) c->left[i] = t[i].alone ? t[i].texture.id : 0;
@@ -375,22 +494,30 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
       if (!in_place) copy_tile(t, c->tex, nt, cached, false);
       r->shadow_stats.kept++;
       r->shadow_stats.in_place += in_place;
+      cached->at = r->executions;
       return true;
     }
     if (r->any_dynamic || cached->layered) {
-      if (!draw_layered(r, sp, t, nt, cached, in_place, err)) return false;
+      if (!draw_layered(r, sp, t, nt, cached, pass, in_place, err)) return false;
       copy_tile(t, c->tex, nt, cached, true);
-      tile_cache_drawn(c, cached, key);
+      tile_cache_drawn(c, cached, key, pass, sp->view, r->executions);
+      return true;
+    }
+    int scrolled = scroll_tile(r, sp, t, nt, cached, pass, in_place, err);
+    if (scrolled != 0) {
+      if (scrolled < 0) return false;
+      copy_tile(t, c->tex, nt, cached, true);
+      tile_cache_drawn(c, cached, key, pass, sp->view, r->executions);
       return true;
     }
     if (in_place) /* the pass cleared nothing: this tile alone */
       lm_clear_rect(cached->x, cached->y, cached->width, cached->height, sp->desc->output_count,
                     sp->desc->clear_color, sp->desc->depth >= 0, lm_scene_clear_depth(true));
   }
-  if (!draw_pass(r, sp, 0, err)) return false;
+  if (!draw_pass(r, sp, 0, NULL, err)) return false;
   if (cached) {
     copy_tile(t, c->tex, nt, cached, true);
-    tile_cache_drawn(c, cached, key);
+    tile_cache_drawn(c, cached, key, pass, sp->view, r->executions);
   }
   return true;
 }
@@ -688,6 +815,7 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   for (int i = 0; i < n; i++)
     for (int c = 0; c < 3; c++) lights[i].color[c] *= e;
   lm_frame_upload(frame, lights, n);
+  lm_uniform_upload(1, lights, sizeof *lights * (size_t)n, sizeof *lights * LM_LIGHT_SET_MAX);
   lm_light_grid_build(&r->light_grid, frame, lights, n, !r->desc.no_light_culling);
   lm_storage_upload(4, r->light_grid.data, r->light_grid.count * sizeof *r->light_grid.data);
   lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);

@@ -109,6 +109,16 @@ typedef struct lm_light {
  * for the scene's light set (light_set() in the pipeline API,
  * shaders/lighting.glsl); scenes with more take the general loop. */
 #define LM_LIGHT_SET_MAX 16
+/* A scene of at most LM_LIGHT_SET_MAX lights (a light-set variant, or the
+ * general loop over them: light_set()) reads the lights and their shadow
+ * records and views from uniform blocks (bindings 1, 2, 3) that copy the
+ * first records of the storage blocks a scene of more lights reads: llvmpipe
+ * reads a storage buffer in a fragment shader lane by lane (a loop that
+ * checks and loads each lane's address, even one all lanes share), a uniform
+ * block at an index all lanes share once, at others in one gather. At most 6
+ * shadow views a light (a cube; 4 cascades and an RSM tile), LM_LIGHT_SET_VIEWS
+ * in all. */
+#define LM_LIGHT_SET_VIEWS (LM_LIGHT_SET_MAX * 6)
 
 /* Distance beyond which a point or spot light adds nothing (the window's or
  * range's radius); INFINITY for directional lights and unbounded falloffs. */
@@ -425,6 +435,7 @@ typedef struct lm_scene_draw_stats {
   int kept;          /* views (shadow tiles) kept from the last frame instead of drawn */
   int in_place;      /* of those, the ones still in the pass's outputs: neither cleared nor copied */
   int layered;       /* views drawn again over their kept static layer: only their moving casters drawn */
+  int scrolled;      /* views (cascades) whose last texels moved with them: only the strips they uncover drawn */
   long triangles;    /* triangles drawn */
   int simplified;    /* of drawn, nodes drawn with their simplified caster copy */
 } lm_scene_draw_stats;

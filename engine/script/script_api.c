@@ -721,15 +721,17 @@ static int l_scene_reflective(lua_State *L) {
 /* light_set(max[, cull]): the scene's lights as a lighting pass's defines, which
  * shaders/lighting.glsl reads to evaluate each light unrolled, its kind,
  * falloff and shadow fixed, instead of the general loop: { LIGHT_SET = count,
+ * LIGHT_BLOCKS (the records of the uniform blocks it reads: common.glsl),
  * LIGHT_SPOTS, LIGHT_SUNS (directional), LIGHT_SHADOWED (casts shadows),
  * LIGHT_FALLOFF_NONE, LIGHT_FALLOFF_SQUARE, LIGHT_FALLOFF_RANGE = masks,
  * bit i for light i } (zero masks left out: one variant, one cache key). nil
  * when the scene has more than max lights (0 .. LM_LIGHT_SET_MAX): the
- * general loop, with light culling. With cull true, nil too when the scene
- * has more than one light and the grid can cull one of them (a spot's cone,
- * a finite reach): unrolled, every pixel pays for every light (moving at
- * 640x480, llvmpipe: garage's four spots 0.76x, the big scene's eight
- * ranged lights 0.56x the grid's `direct`). */
+ * general loop, with light culling, reading storage blocks. With cull true,
+ * { LIGHT_BLOCKS } alone when the scene has more than one light and the grid
+ * can cull one of them (a spot's cone, a finite reach): the general loop,
+ * culled, reading the uniform blocks (unrolled, every pixel pays for every
+ * light: moving at 640x480, llvmpipe, garage's four spots 0.76x, the big
+ * scene's eight ranged lights 0.56x the grid's `direct`). */
 static int l_light_set(lua_State *L) {
   lm_pipeline *p = recording(L, "light_set");
   lua_Integer max = luaL_checkinteger(L, 1);
@@ -741,8 +743,14 @@ static int l_light_set(lua_State *L) {
     const lm_light *l = &p->scene->lights[i];
     cullable += l->type == LM_LIGHT_SPOT || isfinite(lm_light_reach(l));
   }
-  if (n > max || (n > 1 && cullable > 0)) {
+  if (n > max) {
     lua_pushnil(L);
+    return 1;
+  }
+  if (n > 1 && cullable > 0) {
+    lua_createtable(L, 0, 1);
+    lua_pushinteger(L, LM_LIGHT_SET_MAX);
+    lua_setfield(L, -2, "LIGHT_BLOCKS");
     return 1;
   }
   unsigned spots = 0, suns = 0, shadowed = 0, falloff[4] = {0};
@@ -757,9 +765,11 @@ static int l_light_set(lua_State *L) {
       {"LIGHT_SPOTS", spots}, {"LIGHT_SUNS", suns}, {"LIGHT_SHADOWED", shadowed},
       {"LIGHT_FALLOFF_NONE", falloff[LM_FALLOFF_NONE]}, {"LIGHT_FALLOFF_SQUARE", falloff[LM_FALLOFF_INVERSE_SQUARE]},
       {"LIGHT_FALLOFF_RANGE", falloff[LM_FALLOFF_RANGE]}};
-  lua_createtable(L, 0, 7);
+  lua_createtable(L, 0, 8);
   lua_pushinteger(L, n);
   lua_setfield(L, -2, "LIGHT_SET");
+  lua_pushinteger(L, LM_LIGHT_SET_MAX); /* the uniform blocks' records (common.glsl) */
+  lua_setfield(L, -2, "LIGHT_BLOCKS");
   for (size_t k = 0; k < sizeof masks / sizeof *masks; k++) {
     if (!masks[k].mask) continue;
     lua_pushinteger(L, masks[k].mask);

@@ -173,7 +173,7 @@ static int slice_in_box(const lm_frame_data *cam, float z0, float z1, const floa
  * farthest of them: cull against that box, within the tile's (l, r, b, t,
  * zn, zf). */
 static void cascade_cull(const lm_frame_data *cam, mat4 view, float zr, float z1, const float bounds[2][3],
-                         float texel, float reach, const float tile[6], mat4 cull) {
+                         float texel, float reach, float step, const float tile[6], mat4 cull) {
   vec3 p[68];
   int n = slice_in_box(cam, zr, z1, bounds[0], bounds[1], p);
   float l = FLT_MAX, r = -FLT_MAX, b = FLT_MAX, t = -FLT_MAX, far = -FLT_MAX;
@@ -185,7 +185,9 @@ static void cascade_cull(const lm_frame_data *cam, mat4 view, float zr, float z1
   }
   float pad = texel * reach;
   l = fmaxf(l - pad, tile[0]), r = fminf(r + pad, tile[1]), b = fmaxf(b - pad, tile[2]), t = fminf(t + pad, tile[3]);
-  far = fminf(far + pad, tile[5]);
+  /* The far end snapped out to the tile's depth steps: a camera moving a
+   * little keeps it, so that the tile can scroll (engine/render). */
+  far = fminf(tile[4] + ceilf((far + pad - tile[4]) / step) * step, tile[5]);
   if (!(l < r && b < t && far > tile[4])) l = tile[0], r = tile[1], b = tile[2], t = tile[3], far = tile[5];
   mat4 proj;
   glm_ortho(l, r, b, t, tile[4], far, proj);
@@ -262,7 +264,8 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
   }
   float texel = (r - l) / (float)size;
   mat4 cull;
-  if (grow <= 0) cascade_cull(cam, view, zr, z1, bounds, texel, filter_reach(st), (float[6]){l, r, b, t, zn, zf}, cull);
+  if (grow <= 0)
+    cascade_cull(cam, view, zr, z1, bounds, texel, filter_reach(st), step, (float[6]){l, r, b, t, zn, zf}, cull);
   /* A texel's world size and the world depth the tile's 0..1 spans. */
   add_view(plan, size, vp, (float[4]){0, 0, 0, 0}, (float[4]){texel, zf - zn, 0, 0}, grow <= 0 ? cull : NULL);
 }
@@ -586,14 +589,23 @@ void lm_shadow_plan_free(lm_shadow_plan *plan) {
   *plan = (lm_shadow_plan){0};
 }
 
+/* The storage block the general light loop reads and its first `records`
+ * as the uniform block a scene of few lights reads (LM_LIGHT_SET_VIEWS). */
+static void upload(int binding, const void *data, size_t bytes, size_t record, int records) {
+  lm_storage_upload(binding, data, bytes);
+  lm_uniform_upload(binding, data, bytes, record * (size_t)records);
+}
+
 void lm_shadow_plan_upload(const lm_shadow_plan *plan, int light_count) {
   if (plan && plan->lights) {
-    lm_storage_upload(2, plan->lights, sizeof *plan->lights * (size_t)plan->light_count);
-    lm_storage_upload(3, plan->view_data, sizeof *plan->view_data * (size_t)plan->view_count);
+    upload(2, plan->lights, sizeof *plan->lights * (size_t)plan->light_count, sizeof *plan->lights,
+           LM_LIGHT_SET_MAX);
+    upload(3, plan->view_data, sizeof *plan->view_data * (size_t)plan->view_count, sizeof *plan->view_data,
+           LM_LIGHT_SET_VIEWS);
     return;
   }
   lm_shadow_light_data *none = lm_alloc(sizeof *none * (size_t)(light_count + 1));
-  lm_storage_upload(2, none, sizeof *none * (size_t)light_count);
-  lm_storage_upload(3, NULL, 0);
+  upload(2, none, sizeof *none * (size_t)light_count, sizeof *none, LM_LIGHT_SET_MAX);
+  upload(3, NULL, 0, sizeof(lm_shadow_view_data), LM_LIGHT_SET_VIEWS);
   free(none);
 }
