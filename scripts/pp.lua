@@ -77,10 +77,12 @@ local function frame(tech, row)
   local materials = ({ phong = "std", pbr = "pbr" })[tech.materials]
   if not materials then error('materials must be "phong" or "pbr" (got "' .. tostring(tech.materials) .. '")') end
   local G = gbuffer.render(gbuffer.targets(1, materials, reads_velocity(tech, row)), materials)
-  G.lights = light_set(tech.light_variants, tech.light_cull) -- nil: the general light loop (gbuffer.defines)
+  G.lights = light_set(tech.light_variants, tech.light_cull) -- the light set's defines (gbuffer.defines); nil:
+                                                             -- the general loop over storage buffers
   temporal.velocity(G.vel)
   local o = S and S.check(tech[row.offscreen]) -- shadows after the G-buffer: cascades fit what it sees
   local F = { G = G, technique = row, light = { ambient = grey(tech.ambient), background = grey(tech.background) } }
+  light_peak(tech.ambient, tech.background) -- light of the frame's own, for the renderer's pre-exposure
   if row.shadows then F.shadows, F.R = shadow.render(tech.shadow, G, o) end
   if F.shadows and tech.shadow.debug then return shadow.debug(F.shadows), "display" end
   F.light.sky = sky.light(tech.sky) -- nil when off: then nothing of it is recorded

@@ -76,6 +76,7 @@ struct lm_renderer {
   int scene_still; /* the same count for scene_hash */
   long executions; /* frames executed, never reset (tile_cache.execution) */
   float exposure;  /* the last frame's pre-exposure (pre_exposure) */
+  float script_peak; /* the radiance the script's own light reaches (lm_pipeline_light_peak) */
 };
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
@@ -748,6 +749,7 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
   double t0 = lm_cpu_ms();
   int presented = -1;
   if (!lm_pipeline_record(p, g, &presented, err)) return false;
+  r->script_peak = lm_pipeline_light_peak(p);
   double t1 = lm_cpu_ms();
   if (!add_output_stage(r, g, p, presented, out, err) || !lm_graph_compile(g, err)) return false;
   r->record_ms = t1 - t0;
@@ -766,15 +768,17 @@ static void remember_world(lm_renderer *r) {
 /* The frame's pre-exposure (common.glsl's exposed()): a power of two that
  * brings the brightest light (its peak radiance on a white surface facing
  * it: a light of inverse-square falloff at the camera's distance, no nearer
- * than the near plane) or emission of the scene to about 1, where half
+ * than the near plane), emission of the scene or light the script adds
+ * (ambient, background, sky: lm_pipeline_light_peak) to about 1, where half
  * floats hold 11 bits either way from 6e-5 to 65504; 1 while that lies
  * within 1/16 .. 16 (most scenes, whose images it then leaves bit for bit)
  * or the scene has no light. A power of two scales exactly. Production
  * engines pre-expose with the last frame's adapted exposure; this one is
  * known from the lights before the frame, so that a first frame (or a cut)
  * loses nothing to precision either. */
-static float pre_exposure(const lm_scene *s, const lm_frame_data *f, const lm_light_data *lights, int n) {
-  float peak = 0;
+static float pre_exposure(const lm_scene *s, const lm_frame_data *f, const lm_light_data *lights, int n,
+                          float script_peak) {
+  float peak = isfinite(script_peak) ? fmaxf(script_peak, 0) : 0;
   for (int i = 0; i < n; i++) {
     const lm_light_data *l = &lights[i];
     float c = fmaxf(l->color[0], fmaxf(l->color[1], l->color[2]));
@@ -808,7 +812,7 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
   frame->counts[0] = n;
   float e = r->desc.exposure > 0 && isfinite(r->desc.exposure) ? r->desc.exposure
-                                                               : pre_exposure(r->desc.scene, frame, lights, n);
+                                                               : pre_exposure(r->desc.scene, frame, lights, n, r->script_peak);
   frame->exposure[0] = e, frame->exposure[1] = 1 / e;
   frame->exposure[2] = r->frame > 1 && r->exposure > 0 ? e / r->exposure : 1;
   r->exposure = e;

@@ -78,6 +78,10 @@ const char *lm_pipeline_present_where(const lm_pipeline *p);
  * the output stage takes as they are, or pre-exposed radiance (the default),
  * which it divides by the frame's exposure (common.glsl's exposed())? */
 bool lm_pipeline_present_display(const lm_pipeline *p);
+/* The largest radiance the last frame's script adds besides the scene's
+ * lights (light_peak(), sky_sh{}): the renderer's pre-exposure keeps it
+ * within half floats too. */
+float lm_pipeline_light_peak(const lm_pipeline *p);
 /* True once OnCreate has run. */
 bool lm_pipeline_created(const lm_pipeline *p);
 

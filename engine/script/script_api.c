@@ -302,6 +302,8 @@ static int l_sky_sh(lua_State *L) {
     opt_colour(L, 1, "horizon", sky.horizon);
     lm_sky_sh_gradient(&sky, sh);
   }
+  for (int k = 0; k < 3; k++) /* the sky's mean radiance (band 0) counts as light the frame adds */
+    if (sh[k * 9] * 0.282095f > p->light_peak && isfinite(sh[k * 9])) p->light_peak = sh[k * 9] * 0.282095f;
   lua_createtable(L, 3, 0);
   for (int k = 0; k < 3; k++) {
     lua_createtable(L, 9, 0);
@@ -811,6 +813,18 @@ static int l_still_frames(lua_State *L) {
   return 1;
 }
 
+/* light_peak(x, ...): radiances the frame's script adds besides the scene's
+ * lights (ambient, background), so that the renderer's pre-exposure, which
+ * brightens a dim scene before half floats store it, keeps them in range. */
+static int l_light_peak(lua_State *L) {
+  lm_pipeline *p = recording(L, "light_peak");
+  for (int i = 1, n = lua_gettop(L); i <= n; i++) {
+    double x = luaL_checknumber(L, i);
+    if (x > p->light_peak && isfinite(x)) p->light_peak = (float)x;
+  }
+  return 0;
+}
+
 void lm_script_open_api(lua_State *L) {
   luaL_newmetatable(L, PLAN_META);
   lua_pushcfunction(L, l_plan_index);
@@ -824,6 +838,7 @@ void lm_script_open_api(lua_State *L) {
   lua_pop(L, 1);
   static const luaL_Reg api[] = {{"target", l_target}, {"scene", l_scene}, {"pass", l_pass},
                                  {"present", l_present}, {"output_size", l_output_size}, {"still_frames", l_still_frames},
+                                 {"light_peak", l_light_peak},
                                  {"shadow_plan", l_shadow_plan}, {"sky_sh", l_sky_sh}, {"cpu", l_cpu},
                                  {"scene_reflective", l_scene_reflective}, {"points", l_points},
                                  {"scene_blended", l_scene_blended},
