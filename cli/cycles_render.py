@@ -213,7 +213,8 @@ def check_and_tag(doc, path):
     part = "scene %s" % path
     for e in doc.get("extensionsRequired", []):
         if e not in KNOWN_REQUIRED:
-            fail(part, "requires extension %s, which Limn does not read" % e)
+            fail(part, "requires extension %s, which the Cycles export does not take (limn export-gltf writes "
+                 "a copy without it)" % e)
     materials = doc.get("materials", [])
     for i, m in enumerate(materials):
         m["name"] = "limn_m%d" % i
