@@ -123,7 +123,8 @@ typedef struct motion {
   char caches_off[512];  /* the alone pipeline's options turned off */
   int anim;              /* lm_scene_find_animation's index */
   float centre[3];
-  double frame_ms[STREAMS], animate_ms[STREAMS], tiles[STREAMS]; /* medians; tiles: shadow tiles drawn */
+  double frame_ms[STREAMS], animate_ms[STREAMS], tiles[STREAMS], scrolled[STREAMS]; /* medians; tiles: shadow tiles
+                                                                      drawn, scrolled: of them, cascades scrolled */
   double outside_ms[STREAMS]; /* median of the frame's wall time less its passes' (record, compile, uploads) */
   double ratio_worst;    /* the largest moving / alone of one frame */
   float (*eye)[3];       /* the moving camera's position each timed frame */
@@ -791,8 +792,8 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
   m->orbit = !m->timed || m->orbit_given || first->camera_count == 0 || !node_animated(first, m->anim, cams[0].node);
   int n = m->frames;
   stream st[STREAMS] = {{0}};
-  double *wall = lm_alloc(sizeof(double) * STREAMS * 4 * (size_t)n), *anim = wall + STREAMS * n,
-         *tiles = anim + STREAMS * n, *outside = tiles + STREAMS * n;
+  double *wall = lm_alloc(sizeof(double) * STREAMS * 5 * (size_t)n), *anim = wall + STREAMS * n,
+         *tiles = anim + STREAMS * n, *outside = tiles + STREAMS * n, *scrolled = outside + STREAMS * n;
   double *pass_ms = lm_alloc(sizeof(double) * STREAMS * MAX_PASSES * (size_t)n);
   int pass_n[STREAMS][MAX_PASSES] = {{0}};
   m->eye = lm_alloc(sizeof *m->eye * (size_t)n);
@@ -815,7 +816,9 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
       if (ok && f >= 0) {
         wall[k * n + f] = t1 - t0;
         anim[k * n + f] = a;
-        tiles[k * n + f] = lm_renderer_shadows(s->r)->view_count - lm_renderer_shadow_draw_stats(s->r).kept;
+        lm_scene_draw_stats ds = lm_renderer_shadow_draw_stats(s->r);
+        tiles[k * n + f] = lm_renderer_shadows(s->r)->view_count - ds.kept;
+        scrolled[k * n + f] = ds.scrolled;
         outside[k * n + f] = t1 - t0 - collect_passes(b, s->r, false, pass_ms + (size_t)k * MAX_PASSES * n, pass_n[k], n);
       }
       if (ok && k == STREAM_MOVING) {
@@ -838,6 +841,7 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
       m->frame_ms[k] = median(wall + k * n, n);
       m->animate_ms[k] = median(anim + k * n, n);
       m->tiles[k] = median(tiles + k * n, n);
+      m->scrolled[k] = median(scrolled + k * n, n);
       m->outside_ms[k] = median(outside + k * n, n);
       for (int i = 0; i < b->pass_count; i++)
         if (pass_n[k][i]) b->passes[i].motion_ms[k] = median(pass_ms + ((size_t)k * MAX_PASSES + i) * n, pass_n[k][i]);
@@ -890,6 +894,7 @@ static void print_motion(const bench *b) {
     if (t[0] >= 0 || t[1] >= 0 || t[2] >= 0) motion_row(b->passes[i].name, t);
   }
   printf("  %-24s %10.0f %10.0f %10.0f\n", "shadow tiles drawn", m->tiles[0], m->tiles[1], m->tiles[2]);
+  printf("  %-24s %10.0f %10.0f %10.0f\n", "  of them scrolled", m->scrolled[0], m->scrolled[1], m->scrolled[2]);
   printf("  (-: the pass did not run there; outside the passes: the frame's wall time less its passes'\n"
          "  times, with the pass clock cpu: Lua, graph compilation, uploads)\n");
   printf("  the moving camera moved in %d of %d frames\n", m->moved, m->frames);
@@ -919,8 +924,8 @@ static void print_motion_json(const bench *b) {
     printf(", \"time\": null");
   }
   for (int k = 0; k < STREAMS; k++) {
-    printf(", \"%s\": {\"frame_ms\": %.6g, \"outside_passes_ms\": %.6g, \"shadow_tiles_drawn\": %.6g", stream_names[k],
-           m->frame_ms[k], m->outside_ms[k], m->tiles[k]);
+    printf(", \"%s\": {\"frame_ms\": %.6g, \"outside_passes_ms\": %.6g, \"shadow_tiles_drawn\": %.6g, \"shadow_tiles_scrolled\": %.6g",
+           stream_names[k], m->frame_ms[k], m->outside_ms[k], m->tiles[k], m->scrolled[k]);
     if (m->timed && k != STREAM_STILL) printf(", \"animate_ms\": %.6g", m->animate_ms[k]);
     printf("}");
   }

@@ -143,6 +143,9 @@ if len(eyes) != m["frames"] or len(set(eyes)) != len(eyes) or m["moved"] != m["f
 tiles = {k: m[k]["shadow_tiles_drawn"] for k in ("still", "moving", "alone")}
 if tiles["still"] != 0 or tiles["alone"] <= 0 or (tiles["moving"] == 0) != (want == "0"):
     bad.append(f"shadow tiles drawn {tiles}")
+scrolled = {k: m[k]["shadow_tiles_scrolled"] for k in ("still", "moving", "alone")}
+if scrolled["still"] != 0 or scrolled["alone"] != 0 or not 0 <= scrolled["moving"] <= tiles["moving"]:
+    bad.append(f"shadow tiles scrolled {scrolled} of {tiles}")  # alone draws whole; scrolled ones count as drawn
 if "shadow.cache=false" not in m["alone_options"].split() or "isr.temporal.enabled=false" not in m["alone_options"].split():
     bad.append(f"alone options {m['alone_options']}")
 r = m["target"]["moving_over_alone"]
