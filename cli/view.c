@@ -46,6 +46,9 @@ static const char view_usage[] =
     "                       number on the overlay (default 24)\n"
     "  --overlay on|off     show the overlay at start (default on; F1/Tab toggles)\n"
     "  --panel on|off       show the panel of options at start (default on; M toggles)\n"
+    "  --compare TECH       A/B: the frame also through technique TECH, shown right\n"
+    "                       of a split a left drag moves (B toggles the wipe)\n"
+    "  --compare-set NAME=VALUE  an option of the --compare side alone (repeatable)\n"
     "  --job FILE           start at a view of a capture job: its script, scene,\n"
     "                       camera, size, technique, time and options\n"
     "  --view N             which view of --job (default 0; as capture numbers them)\n"
@@ -77,7 +80,7 @@ static const char view_usage[] =
     "  C channel (rgb r g b a), V false colour, Up/Down exposure;\n"
     "  P writes the shown target (EXR) and the frame (PNG); M the panel;\n"
     "  J writes the technique and changed options as a capture job (and the\n"
-    "  limn capture command line); Escape quits\n"
+    "  limn capture command line); B the A/B wipe (--compare); Escape quits\n"
     "\n"
     "environment: LIMN_FONT, the overlay's font file (default DejaVu Sans Mono)\n"
     "exit codes: 0 closed, 1 failed (the script's first load, the font, window or\n"
@@ -111,7 +114,8 @@ static bool parse_script_keys(const char *list, view_args *a) {
 
 static void free_args(view_args *a) {
   for (int i = 0; i < a->set_count; i++) free(a->sets[i]);
-  a->set_count = 0;
+  for (int i = 0; i < a->compare_set_count; i++) free(a->compare_sets[i]);
+  a->set_count = a->compare_set_count = 0;
   lm_scene_destroy(a->job_loaded); /* not adopted: the run stopped before the scene */
   a->job_loaded = NULL;
 }
@@ -130,6 +134,7 @@ static int parse_args(int argc, char **argv, view_args *a) {
       {"animation", required_argument, 0, 'A'},  {"time", required_argument, 0, 'T'},
       {"fps", required_argument, 0, 'F'},        {"panel", required_argument, 0, 'P'},
       {"job", required_argument, 0, 'J'},        {"view", required_argument, 0, 'V'},
+      {"compare", required_argument, 0, 'B'},    {"compare-set", required_argument, 0, 'E'},
       {"quiet", no_argument, 0, 'q'},            {"verbose", no_argument, 0, 'v'},
       {"help", no_argument, 0, 'h'},             {0, 0, 0, 0}};
   opterr = 0;
@@ -145,6 +150,13 @@ static int parse_args(int argc, char **argv, view_args *a) {
       if (!strchr(optarg, '=') || optarg[0] == '=') return usage_error("--set wants NAME=VALUE, not '%s'", optarg);
       if (a->set_count == MAX_SETS) return usage_error("%s", "at most 64 --set flags");
       a->sets[a->set_count++] = lm_strdup(optarg);
+      break;
+    case 'B': a->compare = optarg; break;
+    case 'E':
+      if (!strchr(optarg, '=') || optarg[0] == '=')
+        return usage_error("--compare-set wants NAME=VALUE, not '%s'", optarg);
+      if (a->compare_set_count == MAX_SETS) return usage_error("%s", "at most 64 --compare-set flags");
+      a->compare_sets[a->compare_set_count++] = lm_strdup(optarg);
       break;
     case 'z':
       if (!limn_parse_size(optarg, &a->width, &a->height))
@@ -200,6 +212,7 @@ static int parse_args(int argc, char **argv, view_args *a) {
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
   if (view_given && !a->job) return usage_error("%s", "--view N needs --job FILE");
+  if (a->compare_set_count && !a->compare) return usage_error("%s", "--compare-set needs --compare TECH");
   return a->job && !load_view_job(a) ? 2 : 0;
 }
 
@@ -251,10 +264,33 @@ static bool key_down(const viewer *v, const char *key) {
   return lm_window_key_down(v->window, key);
 }
 
+/* A left drag that starts on the A/B wipe's split (within 6 pixels) moves
+ * it; true while it does. The window reports a held button only as motion. */
+static bool drag_split(viewer *v, double dx, double dy) {
+  if (!v->compare_on) return false;
+  double x, y;
+  bool down;
+  if (v->mouse_scripted) {
+    x = v->mouse[0], down = v->mouse_down;
+  } else {
+    lm_window_cursor(v->window, &x, &y);
+    down = dx || dy;
+  }
+  if (!down) {
+    v->split_held = false;
+    return false;
+  }
+  if (!v->split_held && fabs(x - dx - v->split * v->width) > 6) return false;
+  v->split_held = true;
+  v->split = (float)fmax(0.0, fmin(1.0, x / v->width));
+  return true;
+}
+
 static void move_camera(viewer *v, double dt_ms) {
   double dx, dy;
   lm_window_mouse_drag(v->window, &dx, &dy);
   if (v->panel_on && panel_wants_mouse(v->panel)) dx = dy = 0; /* a drag on the panel moves its widget */
+  else if (drag_split(v, dx, dy)) dx = dy = 0;                 /* one on the A/B line moves it */
   dx += v->drag[0], dy += v->drag[1];
   v->drag[0] = v->drag[1] = 0;
   /* 0.45 of the scene's diagonal a second (1.5 units in the Cornell box), in
@@ -370,15 +406,40 @@ static void remember_set(viewer *v, const char *name, const char *value) {
     free(entry);
 }
 
-/* Applies --set and toggled options; returns false (err) on the first bad one. */
-static bool apply_sets(viewer *v, lm_pipeline *p, lm_error *err) {
-  for (int i = 0; i < v->args->set_count; i++) {
+/* Applies NAME=VALUE entries; returns false (err) on the first bad one. */
+static bool apply_set_list(lm_pipeline *p, char *const *sets, int count, lm_error *err) {
+  for (int i = 0; i < count; i++) {
     char name[256];
-    const char *s = v->args->sets[i], *eq = strchr(s, '=');
+    const char *s = sets[i], *eq = strchr(s, '=');
     snprintf(name, sizeof name, "%.*s", (int)(eq - s), s);
     if (!lm_pipeline_set_option(p, name, eq + 1, err)) return false;
   }
   return true;
+}
+
+/* Applies --set and toggled options. */
+static bool apply_sets(viewer *v, lm_pipeline *p, lm_error *err) {
+  return apply_set_list(p, v->args->sets, v->args->set_count, err);
+}
+
+/* The A/B wipe's other side: the script again with the --compare technique,
+ * the viewer's options, then --compare-set's; NULL with err. */
+static lm_pipeline *load_compare(viewer *v, lm_error *err) {
+  lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = v->script}, err);
+  if (p && (!lm_pipeline_set_technique(p, v->args->compare, err) || !apply_sets(v, p, err) ||
+            !apply_set_list(p, v->args->compare_sets, v->args->compare_set_count, err))) {
+    lm_pipeline_destroy(p);
+    return NULL;
+  }
+  return p;
+}
+
+/* Does --compare-set give the other side its own value of this option? */
+static bool compare_sets_option(const viewer *v, const char *name) {
+  size_t n = strlen(name);
+  for (int i = 0; i < v->args->compare_set_count; i++)
+    if (!strncmp(v->args->compare_sets[i], name, n) && v->args->compare_sets[i][n] == '=') return true;
+  return false;
 }
 
 /* Sets an option as --set does (and keeps it for a reloaded script). */
@@ -389,6 +450,10 @@ static void set_option(viewer *v, const char *name, const char *value) {
     return;
   }
   remember_set(v, name, value);
+  /* The other side follows the edit unless it compares that very option. */
+  if (v->compare_pipeline && !compare_sets_option(v, name) &&
+      !lm_pipeline_set_option(v->compare_pipeline, name, value, &err))
+    say(v, "--compare side: %s", err.msg);
   v->options_stale = true;
   say(v, "%s = %s", name, value);
 }
@@ -471,6 +536,17 @@ static bool reload_script(viewer *v) {
   }
   lm_pipeline_destroy(v->pipeline);
   v->pipeline = p;
+  if (v->compare_renderer) { /* the other side reloads too; on an error it keeps its last good pipeline */
+    lm_pipeline *b = load_compare(v, &err);
+    if (b && lm_renderer_swap_pipeline(v->compare_renderer, b, &err)) {
+      lm_pipeline_destroy(v->compare_pipeline);
+      v->compare_pipeline = b;
+      set_error(v->compare_error, sizeof v->compare_error, "", "--compare side reloaded: error cleared");
+    } else {
+      lm_pipeline_destroy(b);
+      set_error(v->compare_error, sizeof v->compare_error, err.msg, "");
+    }
+  }
   v->options_stale = true;
   v->frame_error[0] = '\0';
   set_error(v->script_error, sizeof v->script_error, "", "script reloaded: error cleared");
@@ -499,6 +575,7 @@ static void reload_scene(viewer *v) {
   lm_scene_destroy(s);
   if (v->camera >= v->scene->camera_count) v->camera = 0;
   lm_renderer_set_camera(v->renderer, v->camera);
+  if (v->compare_renderer) lm_renderer_set_camera(v->compare_renderer, v->camera);
   if (!find_animation(v, &err)) { /* the file lost it: play them all */
     say(v, "%s: playing all", err.msg);
     v->args->animation = "all";
@@ -568,6 +645,13 @@ static void handle_key(viewer *v, const char *key) {
     if (v->panel) panel_set_mouse(v->panel, v->mouse[0], v->mouse[1], v->mouse_down);
   } else if (!strcmp(key, "widgets")) {
     if (v->panel) panel_list_widgets(v->panel, stdout);
+  } else if (!strcmp(key, "B")) {
+    if (!v->compare_renderer) {
+      say(v, "%s", "no A/B wipe: start with --compare TECH");
+      return;
+    }
+    v->compare_on = !v->compare_on;
+    say(v, "A/B wipe %s", v->compare_on ? "on" : "off");
   } else if (!strcmp(key, "M")) {
     v->panel_on = !v->panel_on;
   } else if (!strcmp(key, "J")) {
@@ -600,6 +684,7 @@ static void handle_key(viewer *v, const char *key) {
     if (v->camera_animated) give_camera_back(v);
     v->camera = c;
     lm_renderer_set_camera(v->renderer, c);
+    if (v->compare_renderer) lm_renderer_set_camera(v->compare_renderer, c);
     v->camera_user = false;
     v->camera_animated = node_animated(v, camera_node(v));
     fly_from_camera(v);
@@ -654,6 +739,12 @@ static void render(viewer *v, bool already_rendered) {
   if (ok && lm_renderer_output(v->renderer, &out, &w, &h) && w == v->width && h == v->height) {
     lm_texture_copy(v->shown, out, w, h);
   }
+  if (ok && v->compare_on) {
+    bool b = lm_renderer_frame(v->compare_renderer, &err);
+    set_error(v->compare_error, sizeof v->compare_error, b ? "" : err.msg, "--compare side: frame error cleared");
+    if (b && lm_renderer_output(v->compare_renderer, &out, &w, &h) && w == v->width && h == v->height)
+      lm_texture_copy(v->compare_shown, out, w, h);
+  }
 }
 
 /* Follows the window's framebuffer; false while it is 0x0 (minimized). */
@@ -664,6 +755,7 @@ static bool follow_size(viewer *v) {
   if (w == v->width && h == v->height) return true;
   v->width = w, v->height = h;
   lm_renderer_resize(v->renderer, w, h);
+  if (v->compare_renderer) lm_renderer_resize(v->compare_renderer, w, h);
   lm_error err;
   if (!make_window_textures(v, &err)) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
@@ -750,10 +842,13 @@ static void viewer_free(viewer *v) {
   lm_texture_destroy(&v->shown);
   lm_texture_destroy(&v->overlay_tex);
   lm_texture_destroy(&v->probe);
+  lm_texture_destroy(&v->compare_shown);
   free(v->overlay);
   free(v->options);
   panel_destroy(v->panel); /* before the window: it restores the window's callbacks */
   lm_renderer_destroy(v->renderer);
+  lm_renderer_destroy(v->compare_renderer);
+  lm_pipeline_destroy(v->compare_pipeline);
   lm_programs_clear();
   lm_scene_destroy(v->scene);
   lm_pipeline_destroy(v->pipeline);
@@ -801,7 +896,26 @@ static int run(viewer *v) {
   v->renderer = lm_renderer_create(&(lm_renderer_desc){.scene = v->scene, .pipeline = v->pipeline,
                                                        .width = v->width, .height = v->height,
                                                        .camera = v->camera}, &err);
-  if (!v->renderer || !make_window_textures(v, &err)) {
+  if (!v->renderer) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    return 1;
+  }
+  if (a->compare) {
+    if (!(v->compare_pipeline = load_compare(v, &err))) {
+      lm_log(LM_LOG_ERROR, "--compare %s: %s", a->compare, err.msg);
+      return 2;
+    }
+    v->compare_renderer = lm_renderer_create(&(lm_renderer_desc){.scene = v->scene, .pipeline = v->compare_pipeline,
+                                                                 .width = v->width, .height = v->height,
+                                                                 .camera = v->camera}, &err);
+    if (!v->compare_renderer) {
+      lm_log(LM_LOG_ERROR, "--compare %s: %s", a->compare, err.msg);
+      return 1;
+    }
+    v->compare_on = true;
+    v->split = 0.5f;
+  }
+  if (!make_window_textures(v, &err)) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 1;
   }

@@ -30,6 +30,9 @@ typedef struct view_args {
   bool overlay, panel, quiet, verbose;
   const char *job;       /* --job: start at view `job_view` of this capture job */
   int job_view;
+  const char *compare;   /* --compare TECH: the A/B wipe's right side */
+  char *compare_sets[MAX_SETS]; /* --compare-set NAME=VALUE: that side's own options (owned) */
+  int compare_set_count;
   char job_script[1024], job_scene[1024], job_tech[64], job_animation[64]; /* what the job's view names */
   lm_scene *job_loaded;  /* the view's scene as the job loaded it (its camera list's cameras too) */
   script_key keys[MAX_SCRIPT_KEYS];
@@ -71,6 +74,14 @@ typedef struct viewer {
   double mouse[2];          /* the scripted mouse (mouse=, button=) */
   bool mouse_down;
   bool overlay_on;
+  /* A/B: the same frame through a second pipeline (--compare), shown right
+   * of a split at `split` (a share of the width) that a left drag moves. */
+  lm_pipeline *compare_pipeline;
+  lm_renderer *compare_renderer;
+  lm_texture compare_shown;
+  bool compare_on, split_held;
+  float split;
+  char compare_error[2048];
   lm_panel *panel;          /* NULL when it could not start */
   bool panel_on;
   lm_option_info *options;  /* the panel's list, read again when options_stale */

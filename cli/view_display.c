@@ -179,13 +179,17 @@ static void draw_overlay(viewer *v) {
   const char *error = v->script_error[0]   ? v->script_error
                       : v->scene_error[0]  ? v->scene_error
                       : v->shader_error[0] ? v->shader_error
-                                           : v->frame_error;
+                      : v->frame_error[0]  ? v->frame_error
+                                           : v->compare_error;
   lm_graph *g = lm_renderer_graph(v->renderer);
   int y = 2;
   /* What matters most first: a small window cuts the list at its bottom. */
   if (v->overlay_on)
     draw_line(v, &y, white, "%s | %s | %s | %dx%d", lm_pipeline_technique(v->pipeline), v->scene->name,
               strrchr(v->script, '/') ? strrchr(v->script, '/') + 1 : v->script, v->width, v->height);
+  if (v->overlay_on && v->compare_on)
+    draw_line(v, &y, white, "A/B: left %s | right %s%s (B toggles; drag the line)", lm_pipeline_technique(v->pipeline),
+              lm_pipeline_technique(v->compare_pipeline), v->args->compare_set_count ? " with --compare-set" : "");
   if (v->overlay_on && lm_scene_animated(v->scene))
     draw_line(v, &y, white, "time %.3f s | frame %ld | animation %s (%.3g..%.3g s)%s", v->time, view_frame(v),
               view_animation_name(v), v->anim_range[0], v->anim_range[1], v->paused ? " | paused" : "");
@@ -246,6 +250,11 @@ bool make_window_textures(viewer *v, lm_error *err) {
       !lm_texture_create(&v->overlay_tex, &d, "viewer overlay", err))
     return false;
   lm_texture_clear(v->shown);
+  if (v->compare_renderer) {
+    lm_texture_destroy(&v->compare_shown);
+    if (!lm_texture_create(&v->compare_shown, &d, "viewer frame (compare)", err)) return false;
+    lm_texture_clear(v->compare_shown);
+  }
   free(v->overlay);
   v->overlay = lm_alloc((size_t)v->width * v->height * 4);
   return true;
@@ -374,6 +383,10 @@ void display(viewer *v) {
   lm_program_bind_texture(lm_program_uniform(p, "overlay"), v->overlay_tex);
   lm_program_bind_texture(lm_program_uniform(p, "panel"), panel.id ? panel : v->overlay_tex);
   set_int(p, "show_panel", panel.id != 0);
+  /* The A/B wipe: the other side right of the split (the frame only, not a target). */
+  float split = v->compare_on && mode == 0 ? v->split * (float)v->width : -1.0f;
+  lm_program_bind_texture(lm_program_uniform(p, "other"), v->compare_on ? v->compare_shown : src);
+  set_float(p, "split", &split);
   set_int(p, "mode", mode);
   set_int(p, "channel", v->channel);
   set_float(p, "exposure", &v->exposure);

@@ -1225,6 +1225,77 @@ static void panel_graph_button_inspects_target(void **state) {
   assert_true(file_has(log, "inspecting 'gbuffer.clr' rgba8"));
 }
 
+/* Mean absolute difference per value over columns x0..x1-1 of the lower half
+ * (a message may show at the top). */
+static double band_diff(const lm_image *a, const lm_image *b, int x0, int x1) {
+  assert_int_equal(a->width, b->width);
+  assert_int_equal(a->height, b->height);
+  double sum = 0;
+  int n = 0;
+  for (int y = a->height / 2; y < a->height; y++)
+    for (int x = x0; x < x1; x++)
+      for (int c = 0; c < 3; c++, n++)
+        sum += fabs(a->pixels[((size_t)y * a->width + x) * a->channels + c] -
+                    b->pixels[((size_t)y * b->width + x) * b->channels + c]);
+  return sum / (n > 0 ? n : 1);
+}
+
+/* A 128x96 dl run's screenshot as name.png, with up to two more flag pairs
+ * (NULL ends them early). */
+static void run_shot(const char *name, const char *keys, const char *flag1, const char *value1, const char *flag2,
+                     const char *value2) {
+  char log[512], shot[512];
+  log_path(log, name);
+  snprintf(shot, sizeof shot, "%s/%s.png", root, name);
+  pid_t pid = spawn_view(log, "--tech", "dl", "--size", "128x96", "--overlay", "off", "--exit-after", "8",
+                         "--screenshot", shot, "--script-keys", keys, flag1, value1, flag2, value2, NULL);
+  int rc = wait_exit(pid, 60000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+}
+
+/* --compare: dl left of the split, dl with a bright ambient right of it; a
+ * drag on the line moves it, B turns the wipe off. Each side matches the
+ * viewer run with that setting alone. */
+static void compare_wipe_shows_both_sides(void **state) {
+  (void)state;
+  run_shot("ab_left", "1:F5", NULL, NULL, NULL, NULL);
+  run_shot("ab_right", "1:F5", "--set", "ambient=5", NULL, NULL);
+  run_shot("ab_wipe", "1:F5", "--compare", "dl", "--compare-set", "ambient=5");
+  run_shot("ab_drag", "2:mouse=64;60,3:button=down,4:mouse=96;60,5:button=up", "--compare", "dl", "--compare-set",
+           "ambient=5");
+  run_shot("ab_off", "2:B", "--compare", "dl", "--compare-set", "ambient=5");
+  lm_image left, right, wipe, drag, off;
+  load("ab_left.png", &left);
+  load("ab_right.png", &right);
+  load("ab_wipe.png", &wipe);
+  load("ab_drag.png", &drag);
+  load("ab_off.png", &off);
+  double apart = band_diff(&left, &right, 0, 128), wl = band_diff(&wipe, &left, 0, 60),
+         wr = band_diff(&wipe, &right, 68, 128), dl = band_diff(&drag, &left, 0, 92),
+         dr = band_diff(&drag, &right, 100, 128), ol = band_diff(&off, &left, 0, 128);
+  fprintf(stderr, "A/B: sides apart %.4f; wipe left %.4f right %.4f; dragged left %.4f right %.4f; off %.4f\n",
+          apart, wl, wr, dl, dr, ol);
+  assert_true(apart > 0.1); /* the two settings differ visibly */
+  assert_true(wl < 0.01 && wr < 0.01);
+  assert_true(dl < 0.01 && dr < 0.01);
+  assert_true(ol < 0.01);
+  double line[3];
+  box_mean(&wipe, 64.0 / 128, 0.5, 65.0 / 128, 1, line); /* the split's white line */
+  assert_true(line[0] > 0.99 && line[1] > 0.99 && line[2] > 0.99);
+  lm_image_free(&left);
+  lm_image_free(&right);
+  lm_image_free(&wipe);
+  lm_image_free(&drag);
+  lm_image_free(&off);
+  char log[512];
+  log_path(log, "ab_bad");
+  assert_int_equal(wait_exit(spawn_view(log, "--compare", "nosuch", "--exit-after", "2", NULL), 30000), 2);
+  assert_true(file_has(log, "--compare nosuch"));
+  assert_int_equal(wait_exit(spawn_view(log, "--compare-set", "ambient=1", NULL), 30000), 2);
+  assert_true(file_has(log, "--compare-set needs --compare"));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_teardown(command_line_errors, stop_leftover),
@@ -1246,6 +1317,7 @@ int main(void) {
       cmocka_unit_test_teardown(inspector_order_and_grey_depth, stop_leftover),
       cmocka_unit_test_teardown(panel_plays_pauses_and_scrubs, stop_leftover),
       cmocka_unit_test_teardown(panel_graph_button_inspects_target, stop_leftover),
+      cmocka_unit_test_teardown(compare_wipe_shows_both_sides, stop_leftover),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }
