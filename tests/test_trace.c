@@ -514,6 +514,37 @@ static void degenerate_scene_geometry(void **state) {
   lm_scene_destroy(s);
 }
 
+/* A deformed mesh (one with a rest pose, as lm_scene_set_time poses morph
+ * targets and skins): its new pose is traced after an update in place. */
+static void deformed_mesh_follows_its_pose(void **state) {
+  (void)state;
+  lm_scene *s = lm_scene_create("deformed");
+  int box = add_box(s);
+  float m[16];
+  translate_scale(m, 0, 0, 0, 1, 1, 1);
+  lm_scene_add_node(s, "box", -1, m, box, -1);
+  lm_scene_add_node(s, "still", -1, m, -1, -1);
+  lm_scene_mesh *mesh = &s->meshes[box];
+  size_t bytes = (size_t)mesh->vertex_count * 8 * sizeof(float);
+  mesh->rest = malloc(bytes); /* freed with the scene */
+  memcpy(mesh->rest, mesh->vertices, bytes);
+  lm_scene_update(s);
+  lm_trace_stats st;
+  lm_trace *t = lm_trace_create(s, &st);
+  lm_trace_ray down = {{0.2f, 5, 0.3f}, 0, {0, -1, 0}, INFINITY};
+  lm_trace_hit h;
+  assert_true(lm_trace_intersect(t, &down, &h));
+  assert_float_equal(h.t, 4, 1e-5);
+  for (int i = 0; i < mesh->vertex_count; i++) mesh->vertices[i * 8 + 1] *= 2; /* the pose: twice as tall */
+  lm_trace_update(t, s, &st);
+  assert_true(st.refitted);
+  assert_int_equal(st.moved, 1);
+  assert_true(lm_trace_intersect(t, &down, &h));
+  assert_float_equal(h.t, 3, 1e-5);
+  lm_trace_destroy(t);
+  lm_scene_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(bvh_agrees_with_brute_force),
@@ -522,6 +553,7 @@ int main(void) {
       cmocka_unit_test(mirror_shows_the_known_object),
       cmocka_unit_test(moving_nodes_are_refitted),
       cmocka_unit_test(degenerate_scene_geometry),
+      cmocka_unit_test(deformed_mesh_follows_its_pose),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
