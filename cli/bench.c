@@ -570,8 +570,8 @@ static double rays_per_s(int rays, double ms) { return ms > 0 ? rays / (ms * 1e-
 static void print_trace(const bench *b) {
   const lm_trace_stats *st = &b->trace_stats;
   double frame = b->frame_ms[b->largest];
-  printf("ray tracer (engine/trace, %d threads): %d triangles (%d skipped), BVH of %d nodes, depth %d, "
-         "built in %.1f ms\n", b->trace_threads, st->triangles, st->skipped, st->nodes, st->depth, st->build_ms);
+  printf("ray tracer (engine/trace on Embree, %d threads): %d triangles (%d skipped), %d meshes as %d instances, "
+         "built in %.1f ms\n", b->trace_threads, st->triangles, st->skipped, st->meshes, st->instances, st->build_ms);
   printf("  every surface a mirror, 800x450: %d reflection rays in %.3f ms = %.2f million rays/s (wall clock)\n",
          b->trace_rays, b->trace_ms, rays_per_s(b->trace_rays, b->trace_ms) * 1e-6);
   /* on a shared machine the wall clock counts other processes' time too */
@@ -1005,10 +1005,10 @@ static void print_json(const bench *b, lm_clock clock) {
   }
   if (b->trace) {
     double frame = b->frame_ms[b->largest];
-    printf(", \"trace\": {\"threads\": %d, \"triangles\": %d, \"skipped\": %d, \"nodes\": %d, \"build_ms\": %.6g, "
+    printf(", \"trace\": {\"threads\": %d, \"triangles\": %d, \"skipped\": %d, \"meshes\": %d, \"instances\": %d, \"build_ms\": %.6g, "
            "\"rays\": %d, \"ms\": %.6g, \"cpu_ms\": %.6g, \"rays_per_second\": %.6g, \"frame_rays\": %d, \"frame_trace_ms\": %.6g, "
            "\"ratio_to_frame\": %.6g}",
-           b->trace_threads, b->trace_stats.triangles, b->trace_stats.skipped, b->trace_stats.nodes,
+           b->trace_threads, b->trace_stats.triangles, b->trace_stats.skipped, b->trace_stats.meshes, b->trace_stats.instances,
            b->trace_stats.build_ms, b->trace_rays, b->trace_ms, b->trace_cpu_ms, rays_per_s(b->trace_rays, b->trace_ms), b->frame_rays,
            b->frame_trace_ms, frame > 0 ? b->frame_trace_ms / frame : 0);
   }

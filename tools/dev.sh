@@ -22,7 +22,7 @@ packages=(
   python3                                # tests read JSON and GLB with it (test_scenes_gen, test_tools_cli)
   libmeshoptimizer-dev                   # simplified shadow casters (engine/scene/scene.c)
   libdraco-dev                           # Draco-compressed glTF meshes (engine/scene/gltf_decode.cpp)
-  libembree-dev                          # tools/trace_compare.c: the tracer's BVH against Embree
+  libembree-dev                          # the ray tracer's acceleration structure (engine/trace, Embree 3)
   blender                                # Cycles references (limn reference --renderer cycles, cli/cycles_render.py)
 )
 

@@ -1,42 +1,37 @@
-/* trace: a CPU ray tracer over a scene's world-space triangles (no GL), for
- * the hybrid reflections of seed 003 chapter 6: the GPU writes ray origins
- * and directions, the CPU finds what they hit, the GPU lights the hits.
+/* trace: a CPU ray tracer over a scene's triangles (no GL), for the hybrid
+ * reflections of seed 003 chapter 6: the GPU writes ray origins and
+ * directions, the CPU finds what they hit, the GPU lights the hits.
  *
- * The acceleration structure is a bounding volume hierarchy built with the
- * surface area heuristic (binned, 16 bins per axis), not the seed's kd-tree
- * (seed 003 lines 1966-1976): a BVH is refitted in linear time when nodes
- * move, where a kd-tree must be rebuilt, which is why the seed's tracer was
- * limited to static geometry (seed 003 lines 2486-2489); and every triangle
- * sits in exactly one leaf, so memory is bounded by the triangle count.
+ * The acceleration structure is Embree's (Debian libembree-dev, Embree 3),
+ * not the seed's kd-tree (seed 003 lines 1966-1976), which must be rebuilt
+ * when anything moves. Each mesh is an Embree scene in its own space, built
+ * once however many nodes use it, and each mesh node an instance of it under
+ * a top-level scene: when nodes move, lm_trace_update sets their transforms
+ * and rebuilds only the top level over the instances (a deformed mesh's own
+ * scene is rebuilt at its new pose). Embree's refit of world-space geometry
+ * (RTC_BUILD_QUALITY_REFIT) was tried first: Embree 3.13 honours it only in
+ * its two-level mode, whose commit took as long as a full build whatever
+ * moved. Embree replaced a hand-written binned-SAH BVH; figures against it on
+ * the big scene in docs/benchmarks.md ("The ray tracer").
  *
- * Against Embree 3 (tools/trace_compare.c; build/trace_compare
- * data/scenes/big/big.glb: 1.54 M triangles, 2 threads on the shared 2-core
- * machine, medians of 3, wall clock, 2026-11-26): build 17.9 s here against
- * Embree's 1.85 s; camera rays 0.93 against 2.81 million a second, random
- * rays 0.23 against 0.92; after every node moved, lm_trace_update 18.0 s
- * against Embree's refit 2.35 s: it rebuilt, because 94 near-degenerate
- * triangles (sphere poles) passed tri_usable after the move that did not
- * before, so the kept set changed; both find the same hits (5 of 360,000
- * camera rays differ, at edges). Embree wins every figure. This BVH stays
- * until the tracer is moved onto Embree behind this same header (not done
- * yet: its threads under the sanitized suite, the stats and refit flag the
- * tests read and the degenerate-triangle rules below are to be settled
- * first).
- *
- * Triangles whose corners are not finite, or whose area is zero or not
- * finite, are skipped (counted in lm_trace_stats.skipped), never an error.
- * Depth is capped at LM_TRACE_MAX_DEPTH whatever the geometry, so traversal
- * uses a fixed stack. A scene of no triangles traces: every ray misses. */
+ * Which triangles are kept is decided in the mesh's own space, where moving
+ * a node cannot change it: a triangle is kept when its corner indices are in
+ * range and its corners (a deformed mesh's at rest) are finite, within what
+ * Embree holds (magnitude below 1e18) and with a finite, non-zero cross
+ * product. A mesh node is traced when its transform is finite and invertible
+ * and puts the mesh within that range; the triangles of a node that is not
+ * (a node scaled to zero) are skipped until it is. Skipped triangles are
+ * counted in lm_trace_stats.skipped, never an error. A scene of no triangles
+ * traces: every ray misses. */
 #ifndef LIMN_TRACE_H
 #define LIMN_TRACE_H
 
 #include "scene/scene.h"
 
-#define LM_TRACE_MAX_DEPTH 48
-
 typedef struct lm_trace lm_trace;
 
-/* A ray: hits at t in (tmin, tmax) along origin + t * dir count. dir need not
+/* A ray: hits at t in (tmin, tmax) along origin + t * dir count (a tmin below
+ * 0 counts as 0: Embree finds no hits behind the origin). dir need not
  * be unit length (t is then in its units). A ray with a non-finite origin or
  * direction, a zero direction, or tmax <= tmin misses. tmax may be INFINITY. */
 typedef struct lm_trace_ray {
@@ -52,9 +47,11 @@ typedef struct lm_trace_hit {
 
 typedef struct lm_trace_stats {
   int triangles;  /* kept */
-  int skipped;    /* degenerate or not finite */
-  int nodes, leaves, depth;
-  bool refitted;  /* lm_trace_update: refitted in place (false: rebuilt) */
+  int skipped;    /* degenerate, not finite, or beyond what Embree holds */
+  int meshes;     /* meshes with kept triangles: an Embree scene (and BVH) each */
+  int instances;  /* mesh nodes instancing them */
+  int moved;      /* lm_trace_update: instances moved (their node moved or their mesh deformed) */
+  bool refitted;  /* lm_trace_update: updated in place (false: rebuilt) */
   double build_ms;
 } lm_trace_stats;
 
@@ -68,13 +65,18 @@ typedef struct lm_trace_surface {
 } lm_trace_surface;
 
 /* Builds over every mesh node of `s` (world transforms as lm_scene_update left
- * them). Never fails for bad geometry; stats may be NULL. */
+ * them). Never fails for bad geometry; stats may be NULL. `s` must outlive the
+ * tracer: lm_trace_surface_at reads its meshes' normals and texture
+ * coordinates. Embree's build threads: one an online core. */
 lm_trace *lm_trace_create(const lm_scene *s, lm_trace_stats *stats);
 /* Builds over `count` triangles given as 9 floats each (three corners). */
 lm_trace *lm_trace_create_triangles(const float *xyz, int count, lm_trace_stats *stats);
-/* After nodes moved: refits the boxes in place when `s` has the same mesh
- * nodes and the same triangles stay valid, else rebuilds. */
+/* After nodes moved or meshes deformed: moves the instances of those that
+ * did (stats->refitted) when `s` has the same mesh nodes over meshes of the
+ * same sizes, else rebuilds. Meshes other than deformed ones are taken to be
+ * as they were built. */
 void lm_trace_update(lm_trace *t, const lm_scene *s, lm_trace_stats *stats);
+/* Releases the structure and its Embree device (and so the device's threads). */
 void lm_trace_destroy(lm_trace *t);
 
 /* The nearest hit of one ray; false (hit->tri = -1) when it misses. */
