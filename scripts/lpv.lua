@@ -283,7 +283,8 @@ function lpv.gather(C, f, V, o, sky)
 end
 
 -- Records the LPV's indirect light over frame.G from the RSM targets
--- frame.R, with options o; no input. With the row's split, VPLs the camera
+-- frame.R, with options o; no input. frame.volume gets what binds the
+-- volumes to another pass (blended materials: transparent.lua). With the row's split, VPLs the camera
 -- sees are left to the frame's lighting (lpv.volume's exclude_seen).
 -- Returns what the direct pass adds (pp.lua's direct: INDIRECT in
 -- direct.frag): { C = the coarse grid, E = the coarse result, k }; E's a,
@@ -293,7 +294,17 @@ function lpv.render(_, o, frame)
   o = lpv.check(o, 2)
   local G, f, split = frame.G, o.coarse, frame.technique and frame.technique.split
   local C = isr.coarse_view(G, nil, f, "lpv")
-  local E = lpv.gather(C, f, lpv.volume(G, frame.R, o, split), o, not split)
+  local V = lpv.volume(G, frame.R, o, split)
+  frame.volume = { k = o.k, bind = function(inputs, params, defines) -- lpv_light() at points of a pass's own
+    if V.late then
+      inputs.all_r, inputs.all_g, inputs.all_b = V.all[1], V.all[2], V.all[3]
+      inputs.late_r, inputs.late_g, inputs.late_b = V.late[1], V.late[2], V.late[3]
+    end
+    inputs.lpv_seen = V.seen
+    grid(o, V.grids, params).lpv_steps = o.steps
+    defines.VOLUMES = V.late ~= nil
+  end }
+  local E = lpv.gather(C, f, V, o, not split)
   return { C = C, E = isr.blur(E, C, f, o.blur), k = o.k }
 end
 

@@ -102,6 +102,7 @@ local function frame(tech, row)
   -- checked on every frame, so a bad one is named while it is off too).
   if glossy.check(tech.glossy, 1).enabled and materials == "pbr" then lit = glossy.render(lit, tech.glossy, F) end
   lit = transparent.render(lit, tech, F) -- blended materials (glass), where the scene has any
+  meter(lit) -- its brightness sets the next frame's pre-exposure (tone mapping presents display values)
   return post.render(lit, tech, F)
 end
 

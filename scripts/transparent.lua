@@ -11,13 +11,19 @@ local sky = require "sky"
 local transparent = {}
 
 -- Draws the blended materials over `lit` (frame F, pp.lua's: F.G, F.shadows,
--- F.light) and returns it; `tech` gives ambient and materials.
+-- F.light) and returns it; `tech` gives ambient and materials. Where the
+-- frame has light propagation volumes (F.volume: lpv.render), their indirect
+-- light too, read at the surface (transparent.frag says why no screen-space GI).
 function transparent.render(lit, tech, F)
   if not scene_blended() then return lit end
   local inputs, defines = shadow.bind(F.shadows, {}, gbuffer.lights(F.G, {}))
   defines.PBR_MATERIALS = tech.materials == "pbr" or nil
   local a = tech.ambient
   local params = sky.bind(F.light.sky, { ambient = { a, a, a } }, defines)
+  if F.volume then
+    F.volume.bind(inputs, params, defines)
+    defines.LPV, params.k = true, F.volume.k
+  end
   scene{ "transparent", technique = "transparent", out = lit, depth = F.G.depth, clear = false, blend = true,
          inputs = inputs, defines = defines, params = params }
   return lit

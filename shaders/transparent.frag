@@ -12,7 +12,18 @@
 // along the refracted ray) and less the Fresnel reflection of the ior
 // (KHR_materials_ior): T = t (1 - F) base absorption. No refraction: the
 // background is seen straight through.
+// LPV: indirect light as the frame's light propagation volumes give opaque
+// surfaces (k k_d albedo E, gbuffer.glsl's gi_reflected), read at the
+// surface itself (lpv_light: world space). Screen-space GI (ISR, the RSM's
+// gather) holds E only at the opaque surfaces the G-buffer sees; the E of
+// the one behind a pane is another surface's (a pane in the Cornell box
+// facing its open side took 18 times what it takes opaque), so there the
+// pane keeps ambient and sky light alone.
 #include "gbuffer.glsl"
+#ifdef LPV
+#include "lpv_light.glsl"
+uniform float k = 1.0; // the LPV's indirect light factor
+#endif
 
 in vec3 world_normal;
 in vec3 world_pos;
@@ -62,6 +73,14 @@ void main() {
   float ka = material_k.x;
 #endif
   vec3 surface = ka * sky_ambient(ambient, n) * diffuse + reflected_light(m, n, v, world_pos) + exposed(material_emissive);
+#ifdef LPV
+#ifdef PBR_MATERIALS
+  float kd = 1.0; // diffuse holds 1 - metallic already
+#else
+  float kd = material_k.y;
+#endif
+  surface += max(k, 0.0) * kd * diffuse * lpv_light(world_pos, n);
+#endif
   // Absorption along the refracted ray through the volume's thickness.
   vec3 absorbed = vec3(1.0);
   if (material_glass.z > 0.0 && material_glass.w > 0.0) {

@@ -131,10 +131,68 @@ static void tone_mapping_gives_one_picture_from_starlight_to_3e7_lux(void **stat
   lm_scene_destroy(one);
 }
 
+/* A light 1e6 times the sun's peak that lights nothing in view (a spot above
+ * the room's roof, its cone turned up into the empty sky) leaves the image
+ * as it is: within 1% mean relative difference of the room without it, for
+ * dl+esm, the default and isr+rsm+esm, on the first frame and the second.
+ * The pre-exposure the lights alone give would bring that light to 1 and
+ * the room down by 2^-21, where half floats hold a few bits (that image must
+ * differ by more, or the case could not fail); the exposure meter sees the
+ * room and brings it back up as far as the light allows (its peak within
+ * 2^14 after exposure: E = 2^-7 here), and a first frame found that far off
+ * is drawn again (lm_renderer_frame). */
+static void a_bright_light_that_lights_nothing_in_view_changes_nothing(void **state) {
+  (void)state;
+  static const char *const techs[] = {"dl+esm", NULL /* the default */, "isr+rsm+esm"};
+  bool ok = true;
+  double worst_lights = 1;
+  for (int t = 0; t < 3; t++) {
+    lm_scene *plain = room(SUN_LUX), *s = room(SUN_LUX);
+    float lo[3], hi[3];
+    assert_true(lm_scene_bounds(s, lo, hi));
+    const float *eye = s->nodes[s->cameras[0].node].world + 12;
+    float up[16] = {1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 0, /* -Z (the spot's axis) turned to +Y */
+                    (lo[0] + hi[0]) / 2, hi[1] + (hi[1] - lo[1]), (lo[2] + hi[2]) / 2, 1};
+    float d2 = 0;
+    for (int k = 0; k < 3; k++) d2 += (up[12 + k] - eye[k]) * (up[12 + k] - eye[k]);
+    float peak = 1e6f * s->lights[0].power; /* the sun's radiance on a white surface facing it, 1e6 times */
+    lm_scene_add_light(s, &(lm_light){.name = "beacon", .type = LM_LIGHT_SPOT, .color = {1, 1, 1},
+                                      .power = peak * d2, .inner_cone = 0.2f, .outer_cone = 0.3f,
+                                      .falloff = LM_FALLOFF_INVERSE_SQUARE, .casts_shadows = true,
+                                      .node = lm_scene_add_node(s, "beacon", -1, up, -1, -1)});
+    lm_scene_update(s);
+    const char *sets[] = {"ambient=0.02", "background=0.05", NULL};
+    gl_run run = {.scene = plain, .tech = techs[t], .sets = sets, .width = W, .height = H, .frames = 2};
+    gl_result ref = gl_render_ok(&run);
+    run.scene = s;
+    gl_result second = gl_render_ok(&run);
+    run.frames = 1;
+    gl_result first = gl_render_ok(&run);
+    run.exposure = ldexpf(1, -(int)lroundf(log2f(peak)));
+    gl_result lights = gl_render_ok(&run);
+    double d2nd = relative_difference(&second, 1, &ref), d1st = relative_difference(&first, 1, &ref);
+    double dl = relative_difference(&lights, 1, &ref);
+    printf("%-11s a light of 1e6 suns above the roof: mean relative difference %.4f (first frame), %.4f (second); "
+           "exposed by the lights alone (%g) %.4f\n", techs[t] ? techs[t] : "(default)", d1st, d2nd,
+           run.exposure, dl);
+    ok &= d1st < 0.01 && d2nd < 0.01;
+    worst_lights = fmin(worst_lights, dl);
+    gl_result_free(&ref);
+    gl_result_free(&second);
+    gl_result_free(&first);
+    gl_result_free(&lights);
+    lm_scene_destroy(plain);
+    lm_scene_destroy(s);
+  }
+  if (!ok) fail_msg("a light that lights nothing in view changed the image by 1%% or more");
+  if (!(worst_lights > 0.01)) fail_msg("exposed by the lights alone an image held too (%.4f): the case sees nothing", worst_lights);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(the_room_at_any_light_level),
       cmocka_unit_test(tone_mapping_gives_one_picture_from_starlight_to_3e7_lux),
+      cmocka_unit_test(a_bright_light_that_lights_nothing_in_view_changes_nothing),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

@@ -64,7 +64,7 @@ static void cornell_box_has_light_and_colour_where_it_must(void **state) {
   assert_true(gl_luminance(outside) < 1e-3f);
   char names[256];
   gl_pass_names(&fr, names, sizeof names);
-  assert_string_equal(names, "gbuffer direct output ");
+  assert_string_equal(names, "gbuffer direct output exposure.meter ");
   gl_result_free(&fr);
 }
 
@@ -189,9 +189,10 @@ static void textures_are_pooled_across_frames(void **state) {
     assert_true(lm_renderer_frame(r, &err));
     lm_graph_pool_stats(lm_renderer_graph(r), &textures[f], &bytes);
   }
-  /* G-buffer (5) + lit; the rgba8 output reuses a G-buffer texture whose
-   * last reader has run. Made on the first frame, then reused. */
-  assert_int_equal(textures[0], 6);
+  /* G-buffer (5) + lit + the exposure meter's 16x16; the rgba8 output
+   * reuses a G-buffer texture whose last reader has run. Made on the first
+   * frame, then reused. */
+  assert_int_equal(textures[0], 7);
   assert_int_equal(textures[3], textures[0]);
   assert_int_equal(lm_program_count() > 0, 1);
   lm_renderer_destroy(r);

@@ -182,6 +182,7 @@ static void script_errors_name_the_field(void **state) {
       {"pass{ 'p', shader = 'x.frag', params = { k = 0/0 }, out = target{ 't', format = 'rgba8' } }",
        "bad.lua:3: pass 'p': parameter 'k' is not finite"},
       {"present(3)", "bad.lua:3: present: expected a target"},
+      {"meter('lit')", "bad.lua:3: meter: expected a target"},
       {"scene{ 's', out = target{ 't', format = 'rgba8' }, fit = target{ 'r', format = 'rg32f' } }",
        "bad.lua:3: pass 's': fit is for a pass with views (a shadow plan)"},
       {"local t = target{ 't', format = 'rgba8' }\n"

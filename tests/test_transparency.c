@@ -177,6 +177,59 @@ static void glass_over_gi_techniques(void **state) {
   lm_scene_destroy(s);
 }
 
+/* Blended materials get the indirect light opaque ones get from light
+ * propagation volumes: in the Cornell box a white pane faces the camera with
+ * the ceiling light behind its plane, so with ambient 0 only bounce light
+ * reaches its face. Blended (alpha 1, no transmission: all its light its
+ * own) it is black without GI (dl+esm), and lpv+esm lights it as it lights
+ * the same pane opaque (the volumes read at the pane itself): within 25%
+ * (measured 9%), finite. */
+static void a_blended_pane_takes_the_bounce_light(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *s = lm_scene_builtin("cornell", &err);
+  assert_non_null(s);
+  int m = lm_scene_add_material(s, &(lm_material){.name = "pane", .color = {0.8f, 0.8f, 0.8f}, .rho = 0.8f,
+                                                  .ka = 1, .kd = 1, .shininess = 1});
+  lm_material_pbr *pbr = &s->material_pbr[m];
+  *pbr = lm_scene_material_pbr(s, m, &s->materials[m]);
+  pbr->set = true, pbr->ior = 1.5f;
+  const float corners[4][3] = {{-0.5f, 0.3f, 0.6f}, {0.5f, 0.3f, 0.6f}, {0.5f, 1.1f, 0.6f}, {-0.5f, 1.1f, 0.6f}};
+  float v[4 * 8];
+  for (int i = 0; i < 4; i++) {
+    float *o = v + i * 8;
+    memcpy(o, corners[i], sizeof corners[i]);
+    o[3] = 0, o[4] = 0, o[5] = 1; /* facing the camera; the light (y 1.85, z 0) lies behind its plane */
+    o[6] = (float)(i == 1 || i == 2), o[7] = (float)(i >= 2);
+  }
+  static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+  float id[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  lm_scene_add_node(s, "pane", -1, id, lm_scene_add_mesh(s, "pane", v, 4, idx, 6), m);
+  lm_scene_update(s);
+  static const char *const techs[] = {"dl+esm", "lpv+esm"};
+  for (int t = 0; t < 2; t++) {
+    float pane[2];
+    for (int blend = 0; blend < 2; blend++) {
+      s->material_pbr[m].alpha_mode = blend ? LM_ALPHA_BLEND : LM_ALPHA_OPAQUE;
+      const char *sets[] = {"ambient=0", NULL};
+      gl_result g = gl_render(&(gl_run){.scene = s, .tech = techs[t], .sets = sets, .width = W, .height = H,
+                                        .frames = 2, .check_finite = true});
+      if (!g.ok) fail_msg("%s: %s", techs[t], g.err.msg);
+      assert_true(gl_all_finite(&g));
+      float rgb[3];
+      gl_mean_around(&g, 0, 0.7f, 0.6f, 2, rgb);
+      pane[blend] = gl_luminance(rgb);
+      gl_result_free(&g);
+    }
+    printf("%-8s the pane's bounce light: opaque %.5f, blended %.5f\n", techs[t], pane[0], pane[1]);
+    if (t == 0)
+      assert_true(pane[1] < 1e-5f); /* no direct light, no ambient: black without GI */
+    else if (!(fabsf(pane[1] - pane[0]) < 0.25f * pane[0] && pane[0] > 1e-3f))
+      fail_msg("%s: the blended pane gets %g, the opaque one %g", techs[t], pane[1], pane[0]);
+  }
+  lm_scene_destroy(s);
+}
+
 /* A scene without blended materials records no forward pass and no target
  * for it: the same frame as with the glass, less the pass "transparent" and
  * the shadow pass's transmittance target. */
@@ -312,6 +365,7 @@ int main(void) {
       cmocka_unit_test(the_wall_is_seen_through_tinted_and_the_shadow_lighter),
       cmocka_unit_test(blended_nodes_draw_back_to_front),
       cmocka_unit_test(glass_over_gi_techniques),
+      cmocka_unit_test(a_blended_pane_takes_the_bounce_light),
       cmocka_unit_test(no_blended_material_no_pass),
       cmocka_unit_test(bad_glass_values_are_refused_by_name),
       cmocka_unit_test(exports_carry_the_glass),

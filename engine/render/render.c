@@ -3,6 +3,7 @@
 #include <cglm/cglm.h>
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -75,7 +76,11 @@ struct lm_renderer {
   uint64_t scene;  /* the last frame's scene_hash (the world without the camera) */
   int scene_still; /* the same count for scene_hash */
   long executions; /* frames executed, never reset (tile_cache.execution) */
-  float exposure;  /* the last frame's pre-exposure (pre_exposure) */
+  float exposure;  /* the last frame's pre-exposure (frame_exposure) */
+  lm_readback meter_read; /* the last frame's exposure meter, read for this one's pre-exposure */
+  float meter_exposure;   /* the pre-exposure it was metered under (0: none started) */
+  struct meter { bool valid; float key, brightest; } meter; /* what it read (read_meter) */
+  float peak;             /* this frame's light_peak */
   float script_peak; /* the radiance the script's own light reaches (lm_pipeline_light_peak) */
 };
 
@@ -104,6 +109,7 @@ void lm_renderer_destroy(lm_renderer *r) {
   lm_graph_destroy(r->graph);
   lm_shadow_plan_free(&r->shadows);
   lm_readback_free(&r->fit_read);
+  lm_readback_free(&r->meter_read);
   lm_light_grid_free(&r->light_grid);
   lm_trace_destroy(r->trace);
   free(r->prev_world);
@@ -690,6 +696,33 @@ static bool add_output_stage(lm_renderer *r, lm_graph *g, lm_pipeline *p, int pr
   return true;
 }
 
+enum { METER_SIDE = 16, METER_SAMPLES = 8 }; /* exposure_meter.frag's SIDE and SAMPLES */
+
+/* lm_renderer_desc.exposure fixes the pre-exposure: no meter. */
+static bool fixed_exposure(const lm_renderer *r) { return r->desc.exposure > 0 && isfinite(r->desc.exposure); }
+
+/* The exposure meter (shaders/exposure_meter.frag) over the image the script
+ * metered (meter(t)), or else what it presented when that is radiance;
+ * *meter gets its target (-1: none, display values alone). */
+static bool add_meter_stage(const lm_renderer *r, lm_graph *g, lm_pipeline *p, int presented, int *meter,
+                            lm_error *err) {
+  int src = lm_pipeline_metered(p) >= 0 ? lm_pipeline_metered(p) : lm_pipeline_present_display(p) ? -1 : presented;
+  *meter = -1;
+  if (src < 0 || fixed_exposure(r)) return true;
+  *meter = lm_graph_add_target(g, &(lm_target_desc){.name = "exposure.meter", .format = LM_FORMAT_RGBA32F,
+                                                    .width = METER_SIDE, .height = METER_SIDE}, err);
+  if (*meter < 0) return false;
+  char defines[64];
+  snprintf(defines, sizeof defines, "SIDE=%d;SAMPLES=%d", METER_SIDE, METER_SAMPLES);
+  lm_pass_input input = {"src", src};
+  lm_pass_desc d = {.kind = LM_PASS_FULLSCREEN, .name = "exposure.meter", .where = lm_pipeline_present_where(p),
+                    .shader = "exposure_meter.frag", .defines = defines, .inputs = &input, .input_count = 1,
+                    .outputs = meter, .output_count = 1, .depth = -1};
+  if (lm_graph_add_pass(g, &d, err) < 0) return false;
+  lm_graph_mark_output(g, *meter);
+  return true;
+}
+
 /* A hash of what a frame draws besides its script's settings and the
  * camera: the pipeline, the scene's casters and materials (caster_hash, the
  * nodes' transforms and pose with them), its lights and the shaders'
@@ -714,8 +747,9 @@ static uint64_t world_hash(uint64_t scene, const lm_frame_data *frame) {
   return lm_hash(frame->output_size, sizeof frame->output_size, h);
 }
 
-/* Records (OnRender) and compiles one frame of pipeline p into g. */
-static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_error *err) {
+/* Records (OnRender) and compiles one frame of pipeline p into g; out gets
+ * the sRGB and linear outputs and the exposure meter (-1: none). */
+static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[3], lm_error *err) {
   if (!lm_scene_camera_check(r->desc.scene, r->desc.camera, err)) return false;
   lm_graph_begin(g, r->desc.width, r->desc.height);
   lm_frame_data *frame = &r->camera;
@@ -751,7 +785,9 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[2], lm_e
   if (!lm_pipeline_record(p, g, &presented, err)) return false;
   r->script_peak = lm_pipeline_light_peak(p);
   double t1 = lm_cpu_ms();
-  if (!add_output_stage(r, g, p, presented, out, err) || !lm_graph_compile(g, err)) return false;
+  if (!add_output_stage(r, g, p, presented, out, err) || !add_meter_stage(r, g, p, presented, &out[2], err) ||
+      !lm_graph_compile(g, err))
+    return false;
   r->record_ms = t1 - t0;
   r->compile_ms = lm_cpu_ms() - t1;
   return true;
@@ -765,19 +801,12 @@ static void remember_world(lm_renderer *r) {
   for (int i = 0; i < s->node_count; i++) memcpy(r->prev_world + (size_t)i * 16, s->nodes[i].world, 16 * sizeof(float));
 }
 
-/* The frame's pre-exposure (common.glsl's exposed()): a power of two that
- * brings the brightest light (its peak radiance on a white surface facing
- * it: a light of inverse-square falloff at the camera's distance, no nearer
- * than the near plane), emission of the scene or light the script adds
- * (ambient, background, sky: lm_pipeline_light_peak) to about 1, where half
- * floats hold 11 bits either way from 6e-5 to 65504; 1 while that lies
- * within 1/16 .. 16 (most scenes, whose images it then leaves bit for bit)
- * or the scene has no light. A power of two scales exactly. Production
- * engines pre-expose with the last frame's adapted exposure; this one is
- * known from the lights before the frame, so that a first frame (or a cut)
- * loses nothing to precision either. */
-static float pre_exposure(const lm_scene *s, const lm_frame_data *f, const lm_light_data *lights, int n,
-                          float script_peak) {
+/* The brightest light the frame may show: a light's peak radiance on a
+ * white surface facing it (a light of inverse-square falloff at the
+ * camera's distance, no nearer than the near plane), emission of the scene
+ * or light the script adds (ambient, background, sky: lm_pipeline_light_peak). */
+static float light_peak(const lm_scene *s, const lm_frame_data *f, const lm_light_data *lights, int n,
+                        float script_peak) {
   float peak = isfinite(script_peak) ? fmaxf(script_peak, 0) : 0;
   for (int i = 0; i < n; i++) {
     const lm_light_data *l = &lights[i];
@@ -793,12 +822,82 @@ static float pre_exposure(const lm_scene *s, const lm_frame_data *f, const lm_li
   for (int i = 0; i < s->material_count; i++)
     for (int k = 0; k < 3; k++)
       if (isfinite(s->material_pbr[i].emissive[k])) peak = fmaxf(peak, s->material_pbr[i].emissive[k]);
-  if (!(peak > 0) || (peak >= 1.0f / 16 && peak <= 16)) return 1;
-  return ldexpf(1, (int)lroundf(fminf(fmaxf(-log2f(peak), -64), 64)));
+  return peak;
+}
+
+/* The power of two that brings radiance x to about 1; 1 while x lies within
+ * 1/16 .. 16 (most scenes, whose images it then leaves bit for bit) or is
+ * no light at all. A power of two scales exactly. */
+static float exposure_for(float x) {
+  if (!(x > 0) || (x >= 1.0f / 16 && x <= 16)) return 1;
+  return ldexpf(1, (int)lroundf(fminf(fmaxf(-log2f(x), -64), 64)));
+}
+
+/* The largest power of two E at most `ceiling` (itself a bound on E). */
+static float power_at_most(float ceiling) {
+  return ldexpf(1, (int)floorf(fminf(fmaxf(log2f(ceiling), -64), 64)));
+}
+
+static int compare_floats(const void *a, const void *b) {
+  float x = *(const float *)a, y = *(const float *)b;
+  return (x > y) - (x < y);
+}
+
+/* Collects the exposure meter started last (r->meter.valid: it saw light
+ * or an overflow), as radiance: its key, the median of its
+ * blocks' brightest pixels among the blocks that are lit, and the brightest
+ * (at least what overflowed, where a pixel did). */
+static void read_meter(lm_renderer *r) {
+  float texels[METER_SIDE * METER_SIDE * 4], lit[METER_SIDE * METER_SIDE];
+  float metered = r->meter_exposure;
+  r->meter_exposure = 0;
+  r->meter.valid = false;
+  if (!lm_readback_collect(&r->meter_read, texels)) return;
+  int count = 0;
+  float brightest = 0, over = 0;
+  for (int i = 0; i < METER_SIDE * METER_SIDE; i++) {
+    float m = texels[4 * i] / metered;
+    over += texels[4 * i + 1];
+    if (!(m > 0) || !isfinite(m)) continue;
+    lit[count++] = m;
+    brightest = fmaxf(brightest, m);
+  }
+  if (over > 0) brightest = fmaxf(brightest, 65504 / metered);
+  if (count == 0 && !(over > 0)) return; /* nothing lit in view */
+  qsort(lit, (size_t)count, sizeof *lit, compare_floats);
+  r->meter = (struct meter){true, count ? lit[count / 2] : brightest, brightest};
+}
+
+/* The frame's pre-exposure E (common.glsl's exposed()), a power of two, so
+ * that half floats (11 bits from 6e-5 to 65504) hold the frame's light at
+ * any level. Production engines pre-expose with the last frame's adapted
+ * exposure; so does this one, from the last frame's exposure meter
+ * (exposure_meter.frag, read back without a stall; read_meter): its key is
+ * kept within 2^-8 .. 2^8 after exposure, and when it leaves that band E
+ * brings it back to about 1 (exposure_for: hysteresis, no pumping while it
+ * drifts). Two ceilings keep half floats from overflowing before the next
+ * meter sees it: the brightest pixel metered stays under 2^13 (2^12 when E
+ * is chosen anew) and the brightest light the frame may show (r->peak,
+ * light_peak) under 2^15 (2^14), below 65504; a metered overflow brings
+ * the metered image down 16-fold. A frame with no meter behind it (a view's
+ * first, or one presenting display values alone) takes E from the lights
+ * (light_peak to about 1, as bright as any pixel they light at the camera's
+ * distance), which a bright light that lights nothing in view makes far too
+ * dark: lm_renderer_frame then draws a view's first frame again. */
+static float frame_exposure(const lm_renderer *r) {
+  float guess = exposure_for(r->peak), e = r->exposure > 0 ? r->exposure : guess;
+  const struct meter *m = &r->meter;
+  if (!m->valid) return guess;
+  if (m->key * e >= 0x1p-8f && m->key * e <= 0x1p8f && m->brightest * e <= 0x1p13f && r->peak * e <= 0x1p15f)
+    return e;
+  e = exposure_for(m->key);
+  if (m->brightest > 0) e = fminf(e, power_at_most(0x1p12f / m->brightest));
+  if (r->peak > 0) e = fminf(e, power_at_most(0x1p14f / r->peak));
+  return e;
 }
 
 /* Runs what record() compiled into g (the camera and shadow plan it made). */
-static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
+static bool execute(lm_renderer *r, lm_graph *g, int meter, lm_error *err) {
   lm_frame_data *frame = &r->camera;
   r->stats = r->shadow_stats = (lm_scene_draw_stats){0};
   r->executions++;
@@ -811,8 +910,11 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
   lm_light_data lights[MAX_LIGHTS];
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
   frame->counts[0] = n;
-  float e = r->desc.exposure > 0 && isfinite(r->desc.exposure) ? r->desc.exposure
-                                                               : pre_exposure(r->desc.scene, frame, lights, n, r->script_peak);
+  r->peak = light_peak(r->desc.scene, frame, lights, n, r->script_peak);
+  if (r->meter_exposure > 0) read_meter(r); /* else a view's first frame read it at once */
+  if (r->frame < 2) r->meter.valid = false; /* a view's first frame: the meter saw another */
+  float e = fixed_exposure(r) ? r->desc.exposure : frame_exposure(r);
+  r->meter.valid = false;
   frame->exposure[0] = e, frame->exposure[1] = 1 / e;
   frame->exposure[2] = r->frame > 1 && r->exposure > 0 ? e / r->exposure : 1;
   r->exposure = e;
@@ -829,26 +931,41 @@ static bool execute(lm_renderer *r, lm_graph *g, lm_error *err) {
                           .scene_owns_uniform = lm_scene_owns_uniform, .user = r,
                           .check_finite = r->desc.check_finite};
   bool ok = lm_graph_execute(g, &x, err);
+  if (ok && meter >= 0) { /* read while the next frame records */
+    lm_graph_target_info t = lm_graph_target(g, meter);
+    if (t.texture.id && t.width == METER_SIDE && t.height == METER_SIDE) {
+      lm_readback_start(&r->meter_read, t.texture, METER_SIDE, METER_SIDE);
+      r->meter_exposure = e;
+      if (r->frame == 1) read_meter(r); /* at once: lm_renderer_frame may draw it again */
+    }
+  }
   remember_world(r);
   return ok;
 }
 
 bool lm_renderer_frame(lm_renderer *r, lm_error *err) {
-  int out[2];
-  if (!record(r, r->graph, r->desc.pipeline, out, err)) return false;
-  r->output_srgb = out[0], r->output_linear = out[1];
-  return execute(r, r->graph, err);
+  for (int again = 0;; again++) {
+    int out[3];
+    if (!record(r, r->graph, r->desc.pipeline, out, err)) return false;
+    r->output_srgb = out[0], r->output_linear = out[1];
+    if (!execute(r, r->graph, out[2], err)) return false;
+    /* A view's first frame, exposed by its lights alone, where its meter
+     * finds the exposure far off (a bright light that lights nothing in
+     * view: frame_exposure), is drawn again as the second frame would be,
+     * so a capture of one frame loses no more to precision than a longer one. */
+    if (again || r->frame != 1 || !r->meter.valid || frame_exposure(r) == r->exposure) return true;
+  }
 }
 
 bool lm_renderer_swap_pipeline(lm_renderer *r, lm_pipeline *p, lm_error *err) {
   lm_graph *g = lm_graph_create();
   lm_graph_set_sharing(g, r->sharing);
-  int out[2];
+  int out[3];
   bool ok = record(r, g, p, out, err);
   if (ok) {
     int kept = lm_graph_take_persistent(g, r->graph);
     lm_debug("new pipeline: %d persistent target(s) kept their textures", kept);
-    ok = execute(r, g, err);
+    ok = execute(r, g, out[2], err);
     if (!ok) lm_graph_take_persistent(r->graph, g); /* give the history back */
   }
   if (!ok) {

@@ -464,7 +464,7 @@ lm_pipeline *lm_pipeline_load(const lm_pipeline_desc *desc, lm_error *err) {
   snprintf(p->path, sizeof p->path, "%s", desc->path);
   lm_dirname(desc->path, p->dir, sizeof p->dir);
   p->budget = desc->instruction_budget > 0 ? desc->instruction_budget : 100000000L;
-  p->presented = -1;
+  p->presented = p->metered = -1;
   p->L = luaL_newstate();
   lua_State *L = p->L;
   lua_pushlightuserdata(L, p);
@@ -546,12 +546,13 @@ void lm_pipeline_set_scene(lm_pipeline *p, const lm_scene *scene, const lm_frame
 const char *lm_pipeline_present_where(const lm_pipeline *p) { return p->present_where; }
 bool lm_pipeline_present_display(const lm_pipeline *p) { return p->present_display; }
 float lm_pipeline_light_peak(const lm_pipeline *p) { return p->light_peak; }
+int lm_pipeline_metered(const lm_pipeline *p) { return p->metered; }
 
 bool lm_pipeline_record(lm_pipeline *p, lm_graph *g, int *presented, lm_error *err) {
   static unsigned serial;
   lua_State *L = p->L;
   p->graph = g;
-  p->presented = -1;
+  p->presented = p->metered = -1;
   bool ok = true;
   if (!p->created) {
     p->in_create = true;

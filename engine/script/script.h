@@ -82,6 +82,10 @@ bool lm_pipeline_present_display(const lm_pipeline *p);
  * lights (light_peak(), sky_sh{}): the renderer's pre-exposure keeps it
  * within half floats too. */
 float lm_pipeline_light_peak(const lm_pipeline *p);
+/* The target the last frame's script named with meter(t): pre-exposed
+ * radiance whose brightness sets the next frame's pre-exposure; -1: none
+ * (the renderer meters what it presented, unless display values). */
+int lm_pipeline_metered(const lm_pipeline *p);
 /* True once OnCreate has run. */
 bool lm_pipeline_created(const lm_pipeline *p);
 

@@ -791,6 +791,16 @@ static int l_present(lua_State *L) {
   return 0;
 }
 
+/* meter(t): the lit image (pre-exposed radiance) whose brightness the
+ * renderer reads back for the next frame's pre-exposure, where what the
+ * frame presents is display values (tone mapped) or not the whole scene. */
+static int l_meter(lua_State *L) {
+  lm_pipeline *p = recording(L, "meter");
+  if (p->in_create) return luaL_error(L, "meter() is called from OnRender");
+  p->metered = to_target(L, 1, "meter")->id;
+  return 0;
+}
+
 static int l_output_size(lua_State *L) {
   lm_pipeline *p = recording(L, "output_size");
   int w, h;
@@ -838,7 +848,7 @@ void lm_script_open_api(lua_State *L) {
   lua_pop(L, 1);
   static const luaL_Reg api[] = {{"target", l_target}, {"scene", l_scene}, {"pass", l_pass},
                                  {"present", l_present}, {"output_size", l_output_size}, {"still_frames", l_still_frames},
-                                 {"light_peak", l_light_peak},
+                                 {"light_peak", l_light_peak}, {"meter", l_meter},
                                  {"shadow_plan", l_shadow_plan}, {"sky_sh", l_sky_sh}, {"cpu", l_cpu},
                                  {"scene_reflective", l_scene_reflective}, {"points", l_points},
                                  {"scene_blended", l_scene_blended},

@@ -22,6 +22,7 @@ struct lm_pipeline {
   int presented;
   char present_where[256];
   bool present_display; /* present(t, "display") */
+  int metered;        /* meter(t)'s target, -1: none */
   int options_ref;    /* registry: the Options table with overrides applied */
   const lm_scene *scene;
   const lm_frame_data *camera;
