@@ -114,12 +114,12 @@ limn_gi_report() {
     }
     printf "%d views; direct-only floor (%s against POV-Ray without radiosity): mean error %.5f", V[0], b, FL[0]
     if (refs == 2) printf "; %d views against Cycles, with 0 bounces: %.5f", V[1], FL[1]
-    printf "\n\n%-10s %-26s %8s", "technique", "setting", "ms"
+    printf "\n\n%-13s %-40s %8s", "technique", "setting", "ms"
     for (r = 0; r < refs; r++) printf " | %-8s %9s %7s %8s %8s", rname[r], "mean err", "indir.%", "improved", "Pearson+"
     printf " | %6s\n", "time x"
     for (i = 1; i <= n; i++) {
       s = ix[i]
-      printf "%-10s %-26s %8.2f", nm[i], sp[i], M[s]
+      printf "%-13s %-40s %8.2f", nm[i], sp[i], M[s]
       for (r = 0; r < refs; r++)
         if (s == 0) printf " | %-8s %9.5f %7s %8s %8s", "", E[r, s], "", "", ""
         else printf " | %-8s %9.5f %7s %4d/%-3d %4d/%-3d", "", E[r, s], (SN[r, s] ? sprintf("%.1f", SH[r, s]) : "n/a"),
