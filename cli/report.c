@@ -64,6 +64,9 @@ static const char report_usage[] =
     "  --refs DIR           the references (default out/reference)\n"
     "  --require-refs       fail, naming the command, when a reference is missing,\n"
     "                       instead of rendering it\n"
+    "  --cached-refs        render no reference: leave out (and name) the views\n"
+    "                       whose reference or direct-only floor is not cached;\n"
+    "                       a missing second seed's leaves the noise n/a\n"
     "  --jobs N, --povray PROGRAM, --force: as limn reference, for missing ones\n"
     REFERENCE_OPTIONS_HELP
     "  --radiosity, --count, --error-bound, --pretrace-start, --pretrace-end,\n"
@@ -89,6 +92,7 @@ typedef struct report_args {
   report_setting *settings;
   int setting_count, frames, warmup;
   bool require_refs;
+  bool cached_refs; /* leave out the views whose references are not cached */
   reference_args ref;
   reference_args direct; /* the direct-only references' (reference_direct) */
   bool has_floor;        /* the references hold indirect light: the direct-only ones give the floor */
@@ -646,7 +650,7 @@ static bool set_setting(lm_pipeline *p, const report_base *base, const report_se
  * them (flags: what that command needs besides the job and the folder). */
 static int get_refs(const report_args *a, const reference_args *ref, const job *j, const job_view *places, int n,
                     char (*refs)[1024], const char *flags) {
-  if (!a->require_refs) return reference_run(ref, j, places, n, refs);
+  if (!a->require_refs && !a->cached_refs) return reference_run(ref, j, places, n, refs);
   lm_error err;
   int rc = 0;
   for (int i = 0; i < n && !rc; i++) {
@@ -654,6 +658,8 @@ static int get_refs(const report_args *a, const reference_args *ref, const job *
     if (!reference_export(ref, j, &places[i], &sdl, refs[i], sizeof refs[i], &err)) {
       lm_log(LM_LOG_ERROR, "%s", err.msg);
       rc = 1;
+    } else if (!lm_file_exists(refs[i]) && a->cached_refs && ref == &a->second) {
+      refs[i][0] = '\0'; /* only the noise is missing: n/a */
     } else if (!lm_file_exists(refs[i])) {
       lm_log(LM_LOG_ERROR, "%s: view %d: no reference %s (make them with: limn reference --job %s --refs %s%s, "
              "with the same export flags)", j->path, i, refs[i], j->path, ref->refs, flags);
@@ -750,6 +756,38 @@ static bool summarize_runs(const report_args *a, const report_row *rows, int pla
   return ok;
 }
 
+/* --cached-refs: keeps the places whose reference (and, with a floor, its
+ * direct-only one) is cached, naming those left out; their count, 0 when
+ * none is (logged with the command that renders them), -1 on an error. */
+static int cached_places(const report_args *a, const job *j, job_view *places, int n) {
+  int kept = 0;
+  for (int i = 0; i < n; i++) {
+    char path[1024] = "", direct[1024] = "", place[512];
+    lm_buf sdl = {0};
+    lm_error err;
+    bool ok = reference_export(&a->ref, j, &places[i], &sdl, path, sizeof path, &err);
+    lm_buf_free(&sdl);
+    if (ok && a->has_floor) {
+      ok = reference_export(&a->direct, j, &places[i], &sdl, direct, sizeof direct, &err);
+      lm_buf_free(&sdl);
+    }
+    if (!ok) {
+      lm_log(LM_LOG_ERROR, "%s", err.msg);
+      return -1;
+    }
+    const char *missing = !lm_file_exists(path) ? path : direct[0] && !lm_file_exists(direct) ? direct : NULL;
+    place_name(j, &places[i], place, sizeof place);
+    if (missing) lm_warn("%s: %s left out: no cached reference %s", j->path, place, missing);
+    else places[kept++] = places[i];
+  }
+  if (!kept)
+    lm_log(LM_LOG_ERROR, "%s: no view has its references cached in %s (make them with: limn reference --job %s "
+           "--refs %s%s%s)", j->path, a->ref.refs, j->path, a->ref.refs,
+           a->ref.renderer == REFERENCE_CYCLES ? " --renderer cycles" : "",
+           a->has_floor ? ", then again for the direct-only floor" : "");
+  return kept;
+}
+
 static int run(report_args *a, job *j, lm_pipeline *pipeline) {
   lm_error err;
   job_view *places = NULL;
@@ -765,6 +803,19 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
   runs.settled = lm_alloc(sizeof *runs.settled * (settled_count + 1));
   for (size_t i = 0; i < settled_count; i++) runs.settled[i] = -1;
   a->sequences = runs.count < place_count;
+  if (a->cached_refs) {
+    int kept = a->sequences ? -2 : cached_places(a, j, places, place_count);
+    if (kept == -2) lm_log(LM_LOG_ERROR, "%s: --cached-refs: the job has sequences, whose every frame needs its "
+                           "reference (--require-refs)", j->path);
+    if (kept <= 0) {
+      free(runs.first);
+      free(runs.settled);
+      free(places);
+      return kept == -2 ? 2 : 1;
+    }
+    place_count = kept;
+    runs.count = report_sequences(places, place_count, runs.first);
+  }
   bool events_ok = j->event_count <= REPORT_MAX_EVENTS;
   a->event_count = events_ok ? j->event_count : 0;
   memcpy(a->events, j->events, sizeof *a->events * (size_t)a->event_count);
@@ -891,7 +942,7 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
           }
           noises[p] = -1;
           lm_image other = {0};
-          if (ok && a->has_noise) {
+          if (ok && a->has_noise && second[p][0]) {
             ok = lm_image_read(second[p], &other, &err) && lm_metrics_check(&other, second[p], &ref, refs[p], &err);
             lm_metrics nm;
             if (ok) lm_metrics_compute(&other, &ref, &nm), noises[p] = nm.mean_error;
@@ -1014,16 +1065,16 @@ int limn_report(int argc, char **argv) {
   a.settings = settings;
   lm_error err;
   const char *sweeps_given[REPORT_MAX_SETTINGS];
-  struct option opts[14 + LIMN_POV_OPTION_COUNT - 1 + REFERENCE_OPTION_COUNT] = {
+  struct option opts[15 + LIMN_POV_OPTION_COUNT - 1 + REFERENCE_OPTION_COUNT] = {
       {"job", required_argument, 0, 'J'},    {"sweep", required_argument, 0, 'W'},
       {"out", required_argument, 0, 'o'},    {"frames", required_argument, 0, 'f'},
       {"warmup", required_argument, 0, 'u'}, {"refs", required_argument, 0, 'R'},
       {"require-refs", no_argument, 0, 'Q'}, {"jobs", required_argument, 0, 'j'},
       {"povray", required_argument, 0, 'P'}, {"force", no_argument, 0, 'F'},
       {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
-      {"baseline", required_argument, 0, 'B'}};
-  memcpy(opts + 13, limn_pov_options, sizeof(struct option) * (LIMN_POV_OPTION_COUNT - 1));
-  memcpy(opts + 13 + LIMN_POV_OPTION_COUNT - 1, reference_options, sizeof(struct option) * REFERENCE_OPTION_COUNT);
+      {"baseline", required_argument, 0, 'B'}, {"cached-refs", no_argument, 0, 'K'}};
+  memcpy(opts + 14, limn_pov_options, sizeof(struct option) * (LIMN_POV_OPTION_COUNT - 1));
+  memcpy(opts + 14 + LIMN_POV_OPTION_COUNT - 1, reference_options, sizeof(struct option) * REFERENCE_OPTION_COUNT);
   opterr = 0;
   optind = 1;
   int c, rc = 0, sweeps = 0;
@@ -1048,6 +1099,7 @@ int limn_report(int argc, char **argv) {
       break;
     case 'R': a.ref.refs = optarg; break;
     case 'Q': a.require_refs = true; break;
+    case 'K': a.cached_refs = true; break;
     case 'j':
       if (!limn_parse_int(optarg, 1, 1024, &a.ref.jobs)) rc = usage_error("--jobs wants 1..1024, not '%s'", optarg);
       break;

@@ -12,6 +12,8 @@
 #   direct-only reference of the view, whose error against the baseline is
 #   the floor of the share of indirect error removed;
 # - each setting starts from the job's options, inheriting none from the one before.
+# - --require-refs and --cached-refs render nothing: the first names the command, the second
+#   leaves out (and names) the views without cached references.
 # Skipped (77) where povray is not installed (tools/dev.sh installs it).
 set -u
 limn=$1
@@ -237,4 +239,17 @@ mkdir -p refs-rad/ball && cp $(grep -l "radiosity {" refs/ball/*.pov | sed 's/po
 "$limn" report --job job.lua "${fast[@]}" --refs refs-rad --require-refs --out rep3 --sweep dl >log9 2>&1
 [ $? = 1 ] || { cat log9; fail "--require-refs without direct-only references did not fail"; }
 grep -q "limn reference --job job.lua --refs refs-rad --radiosity off" log9 || { cat log9; fail "the direct-only command is not named"; }
+# 5. --cached-refs renders nothing: a view whose references are not cached is left out and named,
+# the others reported; with none cached it fails naming the command
+printf '# name eye target fov\nfront 0 1.5 3  0 0.3 0  45\nside 3 1.5 0  0 0.3 0  45\n' > two.cams
+sed 's/ball.cams/two.cams/' job.lua > two.lua
+"$limn" report --job two.lua "${fast[@]}" --cached-refs --out rep5 --sweep dl --frames 1 --warmup 0 >log12 2>&1 \
+  || { cat log12; fail "--cached-refs with one of two views cached"; }
+grep -q "ball/side/48x36 left out: no cached reference" log12 || { cat log12; fail "the view left out is not named"; }
+[ "$(wc -l < rep5/report.csv)" = 2 ] && grep -q '"ball/front/48x36"' rep5/report.csv || fail "not the cached view alone"
+ls refs/ball | grep -q "^side" && fail "--cached-refs rendered a reference"
+"$limn" report --job job.lua "${fast[@]}" --refs refs-rad --cached-refs --out rep6 --sweep dl >log13 2>&1
+[ $? = 1 ] || { cat log13; fail "--cached-refs without a direct-only reference did not fail"; }
+grep -q "no view has its references cached in refs-rad (make them with: limn reference --job job.lua --refs refs-rad" \
+  log13 || { cat log13; fail "--cached-refs with none cached does not name the command"; }
 echo "passed"

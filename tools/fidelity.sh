@@ -1,21 +1,26 @@
 #!/usr/bin/env bash
-# tools/fidelity.sh: how close each GI technique comes to POV-Ray on the
-# reference set (data/jobs/reference.lua), and at what cost. A benchmark, not
-# a test: it prints figures and the targets of the project's GI work with
-# PASS or FAIL, and exits 0 when the run completes.
+# tools/fidelity.sh: how close each GI technique comes to POV-Ray and to Cycles
+# on the reference set (data/jobs/reference.lua), and at what cost. A
+# benchmark, not a test: it prints figures and the targets of the project's GI
+# work with PASS or FAIL, and exits 0 when the run completes.
 #   BUILD_DIR  the build (default build)
 #   OUT        the report's folder (default out/fidelity)
 #   FRAMES     timed frames per image, after one warm-up (default 3)
 #   JOB        the job (default data/jobs/reference.lua)
-# References (radiosity and direct-only) are rendered once and cached under
-# out/reference; `limn report` writes report.md/.csv/.json/.svg to OUT.
+#   REFS       the references' folder (default out/reference)
+# POV-Ray's references (radiosity and direct-only) are rendered once and cached
+# under REFS; `limn report` writes report.md/.csv/.json/.svg to OUT. The Cycles
+# column needs Cycles' references cached there (8 bounces, 0 bounces for the
+# floor, a second seed for the noise: minutes a view on 2 cores, so never
+# rendered here); without them one line names the command that renders them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 LIMN=${BUILD_DIR:-build}/limn
 [ -x "$LIMN" ] || { echo "fidelity: no $LIMN (build first: tools/dev.sh build)" >&2; exit 2; }
 # shellcheck source=tools/techniques.sh
 . tools/techniques.sh
-limn_gi_report --targets "${OUT:-out/fidelity}" "${JOB:-data/jobs/reference.lua}" "${FRAMES:-3}" \
+limn_gi_report --targets --cycles --refs "${REFS:-out/reference}" "${OUT:-out/fidelity}" \
+  "${JOB:-data/jobs/reference.lua}" "${FRAMES:-3}" \
   "$LIMN_BASELINE=$LIMN_BASELINE" "seed ISR=$(limn_seed_isr_spec)" "ssdo+esm=ssdo+esm" "ssao+esm=ssao+esm" \
   "default=$(limn_default_spec)" "rsm+esm=rsm+esm" "vpl+esm=vpl+esm:vpl.lights=100;vpl.negative=50" \
   "vpl 300+0=vpl+esm:vpl.lights=300;vpl.negative=0" "combined=isr+rsm+esm" "lpv+esm=lpv+esm" \
