@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "gl_test.h"
+#include "scene/gltf.h"
 
 enum { W = 256, H = 192 };
 
@@ -456,6 +457,42 @@ static void moving_object_leaves_no_ghost(void **state) {
   }
 }
 
+/* A glTF animation moving a caster (the door scene's door opening from 0.5
+ * s): the tile cache makes its static layers on the first frame (render.c
+ * casters_animated) and every frame equals drawing every tile; from the
+ * door's second moving frame on, its tiles are drawn over their layers. */
+static void an_animated_caster_draws_over_static_layers(void **state) {
+  (void)state;
+  char path[4096];
+  snprintf(path, sizeof path, "%s/data/scenes/door.glb", LIMN_SOURCE_ROOT);
+  lm_error err;
+  lm_scene *s = lm_scene_load_gltf(path, &err);
+  if (!s) fail_msg("%s", err.msg);
+  const char *off[] = {"shadow.cache=false", NULL};
+  lm_scene_set_time(s, LM_ANIM_ALL, 0.4);
+  gl_result c = gl_render(&(gl_run){.scene = s, .tech = "rsm+esm", .width = 64, .height = 48}),
+            u = gl_render(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = off, .width = 64, .height = 48});
+  if (!c.ok || !u.ok) fail_msg("%s", c.ok ? u.err.msg : c.err.msg);
+  int layered = 0;
+  for (int f = 0; f < 4; f++) {
+    lm_scene_set_time(s, LM_ANIM_ALL, 0.5 + 0.05 * f);
+    frame(&c);
+    frame(&u);
+    lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(c.renderer);
+    double worst = 0;
+    for (int i = 0; i < c.width * c.height * 3; i++) worst = fmax(worst, fabs(c.rgb[i] - u.rgb[i]));
+    print_message("door at %.2f s: %d of %d tiles kept, %d drawn over their static layer; worst difference from "
+                  "drawing them all %.2e\n", 0.5 + 0.05 * f, kept.kept, lm_renderer_shadows(c.renderer)->view_count,
+                  kept.layered, worst);
+    assert_true(worst == 0);
+    if (f > 0) layered += kept.layered;
+  }
+  assert_true(layered > 0);
+  gl_result_free(&c);
+  gl_result_free(&u);
+  lm_scene_destroy(s);
+}
+
 /* Shadow tiles, the RSM and the LPV follow a moving caster: a renderer that
  * keeps its tiles (shadow.cache) and one that draws them all run the same
  * frames, the tall box moving twice, then the cube both boxes draw deforming
@@ -543,6 +580,7 @@ int main(void) {
       cmocka_unit_test(motion_blur_smears_a_moving_object),
       cmocka_unit_test(moving_object_leaves_no_ghost),
       cmocka_unit_test(shadows_follow_moving_casters),
+      cmocka_unit_test(an_animated_caster_draws_over_static_layers),
       cmocka_unit_test(extreme_motion_stays_finite),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);

@@ -352,10 +352,11 @@ static bool tile_cache_layers(tile_cache *c, lm_error *err) {
 }
 
 /* May a caster move: does an animation move a node no camera sits on (a
- * mesh's, a joint's, one above them)? Then the static layers are made with
- * the cache, on the first frame, not on the frame a caster first moves: their
- * first allocation and touch made that frame 1.28x the same frame drawn with
- * no cache (door, 256x192, llvmpipe: CPU time). */
+ * mesh's, a joint's, one above them; a light's too, whose layers then go
+ * unused)? Then the static layers are made with the cache, on the first
+ * frame, not on the frame a caster first moves: their first allocation and
+ * touch made that frame 1.28x the same frame drawn with no cache (door,
+ * 256x192, llvmpipe: CPU time). */
 static bool casters_animated(const lm_scene *s) {
   for (int a = 0; a < s->animation_count; a++)
     for (int k = 0; k < s->animations[a].channel_count; k++) {
