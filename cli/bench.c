@@ -133,8 +133,9 @@ typedef struct motion {
   char caches_off[512];  /* the alone pipeline's options turned off */
   int anim;              /* lm_scene_find_animation's index */
   float centre[3];
-  double frame_ms[STREAMS], animate_ms[STREAMS], tiles[STREAMS], scrolled[STREAMS], *tiles_drawn; /* medians; tiles: shadow tiles
+  double frame_ms[STREAMS], animate_ms[STREAMS], tiles[STREAMS], scrolled[STREAMS]; /* medians; tiles: shadow tiles
                                                                       drawn, scrolled: of them, cascades scrolled */
+  double *tiles_drawn;   /* per timed frame and renderer: the shadow tiles drawn */
   double outside_ms[STREAMS]; /* median of the frame's wall time less its passes' (record, compile, uploads) */
   double ratio_worst;    /* the largest moving / alone of one frame */
   double cpu_ratio, cpu_worst; /* median and largest over frames of moving / alone in process CPU time */
@@ -383,10 +384,9 @@ static double lights_per_pixel(lm_renderer *r, int light_count) {
 }
 
 /* Appends the last frame's time of each pass that ran to that pass's row of
- * pass_ms (`cap` a row, counts in pass_n); `largest` also keeps its declared
- * fetches and output size. Returns the sum of those times. */
-/* Collects the last frame's pass times into pass_ms (cap samples a pass, pass_n
- * counting them) and, when `row` is given, adds each to row[its slot]. */
+ * pass_ms (`cap` a row, counts in pass_n) and, when `row` is given, adds it
+ * to row[the pass's slot]; `largest` also keeps its declared fetches and
+ * output size. Returns the sum of those times. */
 static double collect_passes(bench *b, lm_renderer *r, bool largest, double *pass_ms, int *pass_n, int cap,
                              double *row) {
   double sum = 0;
@@ -848,7 +848,8 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
         if (ok && f >= 0) {
           size_t at = (size_t)k * n + f;
           double row[MAX_PASSES] = {0}, *least = m->by_pass + at * MAX_PASSES;
-          double in_passes = collect_passes(b, s->r, false, pass_ms + (size_t)k * MAX_PASSES * cap, pass_n[k], cap, row);
+          double in_passes =
+              collect_passes(b, s->r, false, pass_ms + (size_t)k * MAX_PASSES * cap, pass_n[k], cap, row);
           for (int i = 0; i < MAX_PASSES; i++) least[i] = round ? fmin(least[i], row[i]) : row[i];
           wall[at] = round ? fmin(wall[at], t1 - t0) : t1 - t0;
           m->cpu[at] = round ? fmin(m->cpu[at], c1 - c0) : c1 - c0;
@@ -893,7 +894,8 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
       m->scrolled[k] = median(scrolled + k * n, n);
       m->outside_ms[k] = median(outside + k * n, n);
       for (int i = 0; i < b->pass_count; i++)
-        if (pass_n[k][i]) b->passes[i].motion_ms[k] = median(pass_ms + ((size_t)k * MAX_PASSES + i) * cap, pass_n[k][i]);
+        if (pass_n[k][i])
+          b->passes[i].motion_ms[k] = median(pass_ms + ((size_t)k * MAX_PASSES + i) * cap, pass_n[k][i]);
     }
     free(sorted);
   }
@@ -986,7 +988,8 @@ static void print_motion(const bench *b) {
   print_motion_frames(b);
   double r = ratio_of(m->frame_ms[1], m->frame_ms[2]);
   printf("target: a frame of a sequence within %.1fx of the same frame alone with every cache off: moving / alone "
-         "%.3f (frame medians, wall), worst frame %.3f wall, %.3f process CPU time (median %.3f), judged on the %s: %s\n",
+         "%.3f (frame medians, wall), worst frame %.3f wall, %.3f process CPU time (median %.3f), "
+         "judged on the %s: %s\n",
          MOTION_TARGET, r, m->ratio_worst, m->cpu_worst, m->cpu_ratio, m->software ? "CPU time" : "wall time",
          motion_pass(m) ? "PASS" : "FAIL");
 }
@@ -1041,8 +1044,8 @@ static void print_motion_json(const bench *b) {
   printf("]}, \"alone_options\": ");
   limn_json_string(m->caches_off);
   printf(", \"moved\": %d, \"target\": {\"limit\": %.6g, \"moving_over_alone\": %.6g, \"worst_frame\": %.6g, "
-         "\"worst_frame_cpu\": %.6g, \"cpu_median\": %.6g, \"judged_on\": \"%s\", \"pass\": %s}}", m->moved, MOTION_TARGET, r,
-         m->ratio_worst, m->cpu_worst, m->cpu_ratio, m->software ? "cpu" : "wall", motion_pass(m) ? "true" : "false");
+         "\"worst_frame_cpu\": %.6g, \"cpu_median\": %.6g, \"judged_on\": \"%s\", \"pass\": %s}}", m->moved,
+         MOTION_TARGET, r, m->ratio_worst, m->cpu_worst, m->cpu_ratio, m->software ? "cpu" : "wall", motion_pass(m) ? "true" : "false");
 }
 
 static void print_json(const bench *b, lm_clock clock) {
