@@ -376,8 +376,8 @@ static void a_still_view_with_temporal_reuse_is_reuse_off(void **state) {
  * image is the last frame's, bit for bit, and lies within 1% of the image's
  * mean of the one the passes give when they run on (<gi>.temporal.skip =
  * false: there a refreshed tile whose fresh samples' noise drops the
- * confidence starts again; measured 0-0.5%). Moving the camera, or a light,
- * runs them again; they stop again 8 frames later. */
+ * confidence starts again; measured 0-0.5%). Moving the camera, a light or a
+ * node runs them again; they stop again 8 frames later. */
 static void a_settled_still_frame_skips_the_gi_passes(void **state) {
   (void)state;
   static const struct {
@@ -417,13 +417,23 @@ static void a_settled_still_frame_skips_the_gi_passes(void **state) {
     assert_true(gl_has_pass(&u, cases[t].gather));
     if (cases[t].composite) assert_true(gl_has_pass(&r, cases[t].composite));
     assert_true(same == 0.0 && d < 0.01 * mean);
-    /* A camera move, then a light's colour: the passes run again. */
+    /* A camera move, then a light's colour, then a node under the still camera: the passes run again. */
     s->cameras[0].znear *= 1.01f;
     assert_true(gl_render_again(&r) && gl_has_pass(&r, cases[t].gather));
     for (int f = 0; f < 8; f++) assert_true(gl_render_again(&r));
     assert_false(gl_has_pass(&r, cases[t].gather));
     s->lights[0].color[0] *= 0.5f;
     assert_true(gl_render_again(&r) && gl_has_pass(&r, cases[t].gather));
+    /* Settled again, then a node moves under the still camera: again. */
+    for (int f = 0; f < 8; f++) assert_true(gl_render_again(&r));
+    assert_false(gl_has_pass(&r, cases[t].gather));
+    int box = lm_scene_find_node(s, "tall_box");
+    assert_true(box >= 0);
+    s->nodes[box].local[12] += 0.01f;
+    lm_scene_update(s);
+    assert_true(gl_render_again(&r) && gl_has_pass(&r, cases[t].gather) && gl_has_pass(&r, cases[t].blur));
+    s->nodes[box].local[12] -= 0.01f;
+    lm_scene_update(s);
     assert_true(gl_all_finite(&r));
     gl_result_free(&r);
     gl_result_free(&u);

@@ -148,9 +148,16 @@ if scrolled["still"] != 0 or scrolled["alone"] != 0 or not 0 <= scrolled["moving
     bad.append(f"shadow tiles scrolled {scrolled} of {tiles}")  # alone draws whole; scrolled ones count as drawn
 if "shadow.cache=false" not in m["alone_options"].split() or "isr.temporal.enabled=false" not in m["alone_options"].split():
     bad.append(f"alone options {m['alone_options']}")
-r = m["target"]["moving_over_alone"]
-if not (math.isfinite(r) and r > 0) or m["target"]["pass"] != (r <= m["target"]["limit"]):
-    bad.append(f"target {m['target']}")
+r, t = m["target"]["moving_over_alone"], m["target"]
+# Per frame: wall and CPU times; the worst frames are their largest ratios, the verdict judges one of them.
+pf = m["per_frame"]
+for k in ("moving_ms", "alone_ms", "moving_cpu_ms", "alone_cpu_ms"):
+    if len(pf[k]) != m["frames"] or not all(math.isfinite(v) and v > 0 for v in pf[k]): bad.append(f"per_frame {k} {pf[k]}")
+for key, (a, b) in (("worst_frame", ("moving_ms", "alone_ms")), ("worst_frame_cpu", ("moving_cpu_ms", "alone_cpu_ms"))):
+    if not bad and abs(t[key] - max(x / y for x, y in zip(pf[a], pf[b]))) > 1e-4 * t[key]: bad.append(f"{key} {t[key]}")
+worst = t["worst_frame_cpu"] if t["judged_on"] == "cpu" else t["worst_frame"]
+if not (math.isfinite(r) and r > 0) or t["judged_on"] not in ("cpu", "wall") or t["pass"] != (r <= t["limit"] and worst <= t["limit"]):
+    bad.append(f"target {t}")
 for b in bad: print("  " + b)
 sys.exit(1 if bad else 0)
 PY
@@ -160,9 +167,12 @@ check "bench motion figures, tiles kept" motion_json 0
 check "bench motion field" run 0 bench --scene field --tech dl+esm --sizes 48x32 --frames 3 --warmup 1 --orbit 5,0,30 --json
 check "bench motion field figures, cascades drawn" motion_json some
 check "bench motion orbit stated" out_has '"orbit": {"centre": [0, 1, 0], "radius": '
+check "bench motion rounds" run 0 bench --tech dl+esm --sizes 32x24 --frames 2 --warmup 1 --rounds 2 --json
+check "bench motion rounds figures" motion_json 0
 check "bench motion table" run 0 bench --tech dl+esm --sizes 32x24 --frames 2 --warmup 1 --motion
 check "bench motion table columns" out_has "still     moving      alone  moving/still  moving/alone"
 check "bench motion table moved" out_has "the moving camera moved in 2 of 2 frames"
+check "bench motion table per frame" out_has "frame   moving    alone  ratio  cpu mov cpu alone  ratio built   tiles"
 check "bench motion table target" grep -qE "^target: a frame of a sequence within 1.2x .*: (PASS|FAIL)$" "$tmp/out"
 # bench --time on scenes that move: the skinned tube bends under a still camera (its sun's tiles are
 # drawn again each moving frame, none when still), the turntable's animated camera is followed.

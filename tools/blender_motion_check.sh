@@ -17,18 +17,20 @@
 # curves on a frame or from the samples at any time, or the camera does.
 # Unless --no-render, Blender (Workbench, flat object colours, no
 # anti-aliasing) and `limn capture` (dl, the exported materials emitting
-# those colours) render each time at 160x120 through the file's camera; it
+# those colours) render each time at SIZE through the file's camera; it
 # prints the frames' mean absolute error (sRGB, 0..1) and, for each box's
 # silhouette (the pixels of its colour's hue), the distance between the two
 # centroids in pixels and the share of their union the two do not have in
 # common; more than a pixel between centroids fails.
 # BUILD_DIR (default build), BLENDER (default blender), TIMES (seconds,
-# comma-separated) pass through.
+# comma-separated) and SIZE (the frames' WxH, default 160x120: the camera's
+# aspect is Blender's output's) pass through.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${BUILD_DIR:-build}
 blender=${BLENDER:-blender}
 times=${TIMES:-0,0.5,0.8125,1,1.37,2}
+size=${SIZE:-160x120}
 render=--render
 unsampled=
 while [ $# -gt 0 ]; do
@@ -46,7 +48,7 @@ for exe in gltf_pose limn; do
 done
 mkdir -p "$out"
 
-"$blender" -b --factory-startup -P tools/blender_motion_scene.py -- --out "$out" --times "$times" $render $unsampled \
+"$blender" -b --factory-startup -P tools/blender_motion_scene.py -- --out "$out" --times "$times" --size "$size" $render $unsampled \
   >"$out/blender.log" 2>&1 || { tail -20 "$out/blender.log" >&2; exit 1; }
 [ -s "$out/poses.json" ] || { echo "blender_motion_check: Blender wrote no poses (see $out/blender.log)" >&2; exit 1; }
 "$build/gltf_pose" "$out/motion.glb" --animation all ${times//,/ } >"$out/limn_poses.json"
@@ -125,7 +127,7 @@ POSES
 if [ -n "$render" ]; then
   i=0
   for t in ${times//,/ }; do
-    "$build/limn" capture --scene "$out/motion.glb" --tech dl --set materials=pbr --size 160x120 --camera 0 \
+    "$build/limn" capture --scene "$out/motion.glb" --tech dl --set materials=pbr --size "$size" --camera 0 \
       --time "$t" --quiet --output "$out/limn_$i.png"
     i=$((i + 1))
   done
