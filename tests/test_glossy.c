@@ -162,6 +162,27 @@ static void the_volumes_show_what_the_screen_cannot(void **state) {
   lm_scene_destroy(s);
 }
 
+/* A metal has no diffuse colour: ISR's composite gives it no ambient term,
+ * as the direct pass does (isr_light.frag's ambient_light; it gave the
+ * metal its base colour times the ambient light). */
+static void isr_gives_a_metal_no_ambient_term(void **state) {
+  (void)state;
+  mat4 vp;
+  lm_scene *s = metal_sphere(0.9f, 1e6f, vp);
+  static const char *const sets[] = {"ambient=0.5", "materials=pbr", NULL};
+  const float up[3] = {0, 1, 0};
+  float isr[3], dl[3];
+  gl_result a = gl_render_ok(&(gl_run){.scene = s, .tech = "isr+esm", .sets = sets, .width = W, .height = H});
+  gl_result b = render_ok(s, sets);
+  reflecting(&a, vp, up, isr);
+  reflecting(&b, vp, up, dl);
+  print_message("metal facing up, ambient 0.5: isr+esm %.4f, dl+esm %.4f\n", gl_luminance(isr), gl_luminance(dl));
+  assert_true(gl_luminance(isr) < 0.02f && gl_luminance(dl) < 0.02f);
+  gl_result_free(&a);
+  gl_result_free(&b);
+  lm_scene_destroy(s);
+}
+
 /* Phong frames record no glossy pass: the image is the same bit for bit. */
 static void phong_frames_are_unchanged(void **state) {
   (void)state;
@@ -216,6 +237,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(a_metal_sphere_shows_the_lit_wall_and_the_sky),
       cmocka_unit_test(the_volumes_show_what_the_screen_cannot),
+      cmocka_unit_test(isr_gives_a_metal_no_ambient_term),
       cmocka_unit_test(phong_frames_are_unchanged),
       cmocka_unit_test(extremes_stay_finite),
       cmocka_unit_test(bad_options_name_themselves),
