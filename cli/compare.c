@@ -11,7 +11,7 @@
 #include "tools.h"
 
 static const char compare_usage[] =
-    "usage: limn compare A B [--ref R] [--json] [--diff FILE [--diff-scale X]]\n"
+    "usage: limn compare A B [--ref R] [--mask M] [--json] [--diff FILE [--diff-scale X]]\n"
     "\n"
     "Compares images A and B (PNG, EXR or anything OpenImageIO reads) value by\n"
     "value over their colour channels (alpha left out), as stored: linear for\n"
@@ -29,6 +29,9 @@ static const char compare_usage[] =
     "options:\n"
     "  --ref R           reference: the share of pixels where A is closer to R than\n"
     "                    B is (sum over channels of absolute differences), and ties\n"
+    "  --mask M          also the mean error over the pixels whose first channel\n"
+    "                    in image M (the same size) exceeds 0.5, and their count\n"
+    "                    (say, a material's pixels: scripts/examples/mask.lua)\n"
     "  --json            one JSON object on stdout instead of the table\n"
     "  --diff FILE       difference image: .png is a heat map of the per-pixel mean\n"
     "                    |A - B| (black, blue, red, yellow, white); .exr holds |A - B|\n"
@@ -39,11 +42,14 @@ static const char compare_usage[] =
     "\n"
     "exit codes: 0 compared, 1 the difference image could not be written,\n"
     "2 bad usage, an unreadable file, images that differ in size or channels, or a\n"
-    "NaN or Inf among the values (named by pixel and channel).\n";
+    "NaN or Inf among the values (named by pixel and channel), a mask of another\n"
+    "size or with no pixel in it.\n";
 
 typedef struct compare_args {
-  const char *a, *b, *ref, *diff;
+  const char *a, *b, *ref, *diff, *mask;
   double diff_scale;
+  double masked_error; /* over the mask's pixels, with mask */
+  size_t masked_pixels;
   bool json;
 } compare_args;
 
@@ -57,6 +63,7 @@ static bool has_extension(const char *path, const char *ext) {
 static int parse_args(int argc, char **argv, compare_args *a) {
   *a = (compare_args){.diff_scale = -1};
   static const struct option opts[] = {{"ref", required_argument, 0, 'r'},   {"json", no_argument, 0, 'j'},
+                                       {"mask", required_argument, 0, 'm'},
                                        {"diff", required_argument, 0, 'd'},  {"diff-scale", required_argument, 0, 's'},
                                        {"help", no_argument, 0, 'h'},        {0, 0, 0, 0}};
   opterr = 0;
@@ -66,6 +73,7 @@ static int parse_args(int argc, char **argv, compare_args *a) {
     switch (c) {
     case 'r': a->ref = optarg; break;
     case 'j': a->json = true; break;
+    case 'm': a->mask = optarg; break;
     case 'd':
       if (!has_extension(optarg, ".png") && !has_extension(optarg, ".exr"))
         return usage_error("--diff '%s': use a .png (heat map) or .exr (|A - B|) file", optarg);
@@ -99,6 +107,7 @@ static void print_json(const compare_args *a, const lm_metrics *m, double scale)
   if (m->identical) printf(", \"psnr\": null, \"identical\": true");
   else printf(", \"psnr\": %.9g, \"identical\": false", m->psnr);
   printf(", \"pearson\": %.9g, \"ssim\": %.9g", m->pearson, m->ssim);
+  if (a->mask) printf(", \"masked_error\": %.9g, \"masked_pixels\": %zu", a->masked_error, a->masked_pixels);
   if (a->ref) printf(", \"closer\": %.9g, \"ties\": %.9g", m->closer, m->ties);
   else printf(", \"closer\": null, \"ties\": null");
   if (a->diff) {
@@ -119,6 +128,7 @@ static void print_table(const compare_args *a, const lm_metrics *m, double scale
   else printf("  PSNR                %.3f dB\n", m->psnr);
   printf("  Pearson (eq 20)     %.6f\n", m->pearson);
   printf("  SSIM                %.6f\n", m->ssim);
+  if (a->mask) printf("  masked mean error   %.6f over %zu pixels of %s\n", a->masked_error, a->masked_pixels, a->mask);
   if (a->ref)
     printf("  closer to %s: A on %.2f%% of pixels, B on %.2f%%, ties %.2f%%\n", a->ref, 100 * m->closer,
            100 * (1 - m->closer - m->ties), 100 * m->ties);
@@ -144,6 +154,24 @@ static bool write_diff(const compare_args *a, const lm_image *ia, const lm_image
   return ok;
 }
 
+/* The mean error of A against B over the pixels whose first channel in the
+ * mask image exceeds 0.5 (lm_metrics_band_error). */
+static bool masked_error(compare_args *a, const lm_image *ia, const lm_image *ib, lm_error *err) {
+  lm_image im = {0};
+  if (!lm_image_read(a->mask, &im, err)) return false;
+  bool ok = im.width == ia->width && im.height == ia->height;
+  if (!ok) lm_error_set(err, "%s is %dx%d, %s %dx%d: a mask must be the images' size", a->mask, im.width,
+                        im.height, a->a, ia->width, ia->height);
+  size_t px = (size_t)ia->width * ia->height;
+  unsigned char *band = lm_alloc(px + 1);
+  for (size_t i = 0; ok && i < px; i++) band[i] = im.pixels[i * im.channels] > 0.5f;
+  if (ok && !lm_metrics_band_error(ia, ib, band, &a->masked_error, &a->masked_pixels))
+    ok = false, lm_error_set(err, "%s: no pixel of the mask exceeds 0.5", a->mask);
+  free(band);
+  lm_image_free(&im);
+  return ok;
+}
+
 int limn_compare(int argc, char **argv) {
   compare_args a;
   int rc = parse_args(argc, argv, &a);
@@ -160,7 +188,8 @@ int limn_compare(int argc, char **argv) {
   if (!rc) {
     lm_metrics_compute(&ia, &ib, &m);
     if (a.ref) lm_metrics_closer(&ia, &ib, &ir, &m);
-    if (a.diff) {
+    if (a.mask && !masked_error(&a, &ia, &ib, &err)) rc = 2;
+    if (!rc && a.diff) {
       scale = a.diff_scale > 0 ? a.diff_scale : lm_metrics_max_pixel_error(&ia, &ib);
       if (!(scale > 0) || !isfinite(scale)) scale = 1; /* identical images: any scale shows black */
       if (!write_diff(&a, &ia, &ib, scale, &err)) rc = 1;

@@ -1105,6 +1105,98 @@ static void ref_blocks(const char *dir) {
   finish(&d, dir, "blocks");
 }
 
+/* ---- held-out scenes (data/jobs/holdout.lua) --------------------------------
+ * Two scenes of kinds the reference set lacks, written after the GI
+ * techniques' defaults were chosen and never tuned against: they tell how the
+ * figures hold on scenes the project has not seen. Written under
+ * OUTDIR/holdout/. */
+
+/* A loft, 6 x 3 x 5, lit by a sun through a skylight and an open door: a
+ * patch of sun on the table and the floor, an alcove behind a partition and
+ * the ceiling lit by bounce light only. Its shell is of boxes T thick that
+ * overlap at the corners, so that no shadow leaks along an edge. */
+static void holdout_loft(const char *dir) {
+  doc d = {0};
+  int wall = diffuse(&d, "limewash", 0.82f, 0.8f, 0.75f), floor = diffuse(&d, "oak", 0.55f, 0.38f, 0.22f);
+  int ceiling = diffuse(&d, "ceiling", 0.88f, 0.88f, 0.86f), table = diffuse(&d, "table", 0.7f, 0.25f, 0.15f);
+  int cabinet = diffuse(&d, "cabinet", 0.2f, 0.5f, 0.45f), rug = diffuse(&d, "rug", 0.75f, 0.65f, 0.2f);
+  int partition = diffuse(&d, "partition", 0.3f, 0.35f, 0.7f);
+  float W = 3, H = 3, D = 2.5f, T = 0.2f;               /* inside: x in [-W, W], z in [-D, D] */
+  float sx0 = -0.6f, sx1 = 0.6f, sz0 = 0, sz1 = 1.2f;   /* the skylight in the ceiling */
+  float dx0 = -2.2f, dx1 = -1.2f, dy1 = 2.2f;           /* the door in the z = D wall */
+  float X = W + T, Z = D + T;                           /* outside */
+  mesh m = {0};
+  box(&m, 0, -T / 2, 0, X, T / 2, Z);
+  mesh_node(&d, "floor", -1, add_mesh1(&d, "floor", &m, floor), 0, 0, 0, 0, 1);
+  box(&m, 0, H + T / 2, (sz0 - Z) / 2, X, T / 2, (sz0 + Z) / 2);
+  box(&m, 0, H + T / 2, (sz1 + Z) / 2, X, T / 2, (Z - sz1) / 2);
+  box(&m, (sx0 - X) / 2, H + T / 2, (sz0 + sz1) / 2, (sx0 + X) / 2, T / 2, (sz1 - sz0) / 2);
+  box(&m, (sx1 + X) / 2, H + T / 2, (sz0 + sz1) / 2, (X - sx1) / 2, T / 2, (sz1 - sz0) / 2);
+  mesh_node(&d, "ceiling", -1, add_mesh1(&d, "ceiling", &m, ceiling), 0, 0, 0, 0, 1);
+  box(&m, -W - T / 2, H / 2, 0, T / 2, H / 2, Z);
+  box(&m, W + T / 2, H / 2, 0, T / 2, H / 2, Z);
+  box(&m, 0, H / 2, -D - T / 2, X, H / 2, T / 2);
+  box(&m, (dx0 - X) / 2, H / 2, D + T / 2, (dx0 + X) / 2, H / 2, T / 2); /* beside the door */
+  box(&m, (dx1 + X) / 2, H / 2, D + T / 2, (X - dx1) / 2, H / 2, T / 2);
+  box(&m, (dx0 + dx1) / 2, (dy1 + H) / 2, D + T / 2, (dx1 - dx0) / 2, (H - dy1) / 2, T / 2); /* over it */
+  mesh_node(&d, "walls", -1, add_mesh1(&d, "walls", &m, wall), 0, 0, 0, 0, 1);
+  box(&m, 2.4f, 1.1f, -0.45f, 0.6f, 1.1f, 0.05f); /* the alcove's partition, x > 1.8, z < -0.5 */
+  mesh_node(&d, "partition", -1, add_mesh1(&d, "partition", &m, partition), 0, 0, 0, 0, 1);
+  box(&m, -1.0f, 0.74f, -1.2f, 0.7f, 0.03f, 0.45f);
+  box(&m, -1.0f, 0.36f, -1.2f, 0.1f, 0.35f, 0.1f);
+  mesh_node(&d, "table", -1, add_mesh1(&d, "table", &m, table), 0, 0, 0, 0, 1);
+  box(&m, -2.65f, 0.9f, -1.6f, 0.3f, 0.9f, 0.6f);
+  box(&m, 2.6f, 0.45f, -2.1f, 0.35f, 0.45f, 0.35f); /* in the alcove */
+  mesh_node(&d, "cabinets", -1, add_mesh1(&d, "cabinets", &m, cabinet), 0, 0, 0, 0, 1);
+  box(&m, 0.2f, 0.01f, 0.9f, 1.0f, 0.01f, 0.7f);
+  mesh_node(&d, "rug", -1, add_mesh1(&d, "rug", &m, rug), 0, 0, 0, 0, 1);
+  light(&d, "sun", "directional", 0, 10, 0, (float[]){-0.3f, -0.8f, -0.5f}, 1, 0.95f, 0.88f, 3 * LUX, 0);
+  view(&d, "entry", -1.7f, 1.6f, 2.1f, 0.5f, 1.0f, -1.5f, 65, 20);
+  view(&d, "up", -1.5f, 0.5f, 1.5f, 0.8f, 3.0f, -1.0f, 65, 20);
+  view(&d, "alcove", 0.5f, 1.5f, 1.8f, 2.6f, 1.0f, -2.0f, 60, 20);
+  view(&d, "back", 2.5f, 1.7f, 2.2f, -1.5f, 0.8f, -1.5f, 65, 20);
+  finish(&d, dir, "loft");
+}
+
+/* A courtyard under a low sun behind its back building (jobs add the sky):
+ * the back facade and a portico in shade, lit by the sunlit side building,
+ * the ground and the sky; a mirror-like steel sphere, a brushed steel bench
+ * and a copper door for glossy indirect light (materials = pbr). */
+static void holdout_yard(const char *dir) {
+  doc d = {0};
+  int ground = diffuse(&d, "paving", 0.6f, 0.58f, 0.54f), back = diffuse(&d, "stucco", 0.85f, 0.82f, 0.75f);
+  int side = diffuse(&d, "brick", 0.7f, 0.35f, 0.22f), stone = diffuse(&d, "stone", 0.75f, 0.72f, 0.65f);
+  int planter = diffuse(&d, "planter", 0.2f, 0.45f, 0.25f);
+  int steel = add_material(&d, "steel", 0.9f, 0.9f, 0.92f, 1, 0.05f, -1);
+  int brushed = add_material(&d, "brushed", 0.7f, 0.7f, 0.72f, 1, 0.35f, -1);
+  int copper = add_material(&d, "copper", 0.95f, 0.64f, 0.54f, 1, 0.2f, -1);
+  mesh m = {0};
+  slab(&m, 0, true, -20, 20, -20, 20);
+  mesh_node(&d, "ground", -1, add_mesh1(&d, "ground", &m, ground), 0, 0, 0, 0, 1);
+  box(&m, 0, 3, -8, 8, 3, 3);       /* back building: its +z facade at z = -5 */
+  mesh_node(&d, "back", -1, add_mesh1(&d, "back", &m, back), 0, 0, 0, 0, 1);
+  box(&m, -7, 2.5f, -1, 2, 2.5f, 5); /* side building: its +x facade at x = -5 */
+  mesh_node(&d, "side", -1, add_mesh1(&d, "side", &m, side), 0, 0, 0, 0, 1);
+  box(&m, 0, 3.1f, -4, 4, 0.1f, 1);  /* the portico's roof on four pillars */
+  for (int k = 0; k < 4; k++) box(&m, -3.7f + 2.47f * (float)k, 1.5f, -3.2f, 0.15f, 1.5f, 0.15f);
+  box(&m, 1.5f, 0.15f, -0.5f, 0.6f, 0.15f, 0.6f); /* the sphere's plinth */
+  mesh_node(&d, "stone", -1, add_mesh1(&d, "stone", &m, stone), 0, 0, 0, 0, 1);
+  box(&m, 5, 0.4f, -2, 0.6f, 0.4f, 2);
+  mesh_node(&d, "planter", -1, add_mesh1(&d, "planter", &m, planter), 0, 0, 0, 0, 1);
+  sphere(&m, 0.8f, 48, 24);
+  mesh_node(&d, "sphere", -1, add_mesh1(&d, "sphere", &m, steel), 1.5f, 1.1f, -0.5f, 0, 1);
+  box(&m, -2.5f, 0.25f, 1.5f, 1.2f, 0.25f, 0.3f);
+  mesh_node(&d, "bench", -1, add_mesh1(&d, "bench", &m, brushed), 0, 0, 0, 0, 1);
+  box(&m, 2.5f, 1.2f, -4.97f, 0.6f, 1.2f, 0.03f);
+  mesh_node(&d, "door", -1, add_mesh1(&d, "door", &m, copper), 0, 0, 0, 0, 1);
+  light(&d, "sun", "directional", 0, 20, 0, (float[]){-0.55f, -0.6f, 0.58f}, 1, 0.95f, 0.86f, 3 * LUX, 0);
+  view(&d, "court", 0.5f, 1.7f, 9, 0, 1.5f, -4, 60, 80);
+  view(&d, "portico", -2.8f, 1.5f, -0.5f, 0.5f, 1.4f, -5, 65, 80);
+  view(&d, "sphere", 3.8f, 1.4f, 2.5f, 1.5f, 1.0f, -0.5f, 45, 80);
+  view(&d, "facade", 3.5f, 1.6f, 3, -1.5f, 2.2f, -5, 60, 80);
+  finish(&d, dir, "yard");
+}
+
 /* A street at night: 16 lamps with a range (KHR_lights_punctual's), each
  * casting shadows, along 80 m between blocks of houses, under a dim moon.
  * Lamps far down the street cover few pixels: their shadow tiles are small
@@ -1409,5 +1501,13 @@ int main(int argc, char **argv) {
   big(bigdir, &full, false); /* its own random sequence: the scenes above stay as they were */
   big(bigdir, &small, false);
   big(bigdir, &small, true);
+  char holdout[1024];
+  snprintf(holdout, sizeof holdout, "%s/holdout", argv[1]);
+  if (mkdir(holdout, 0777) != 0 && errno != EEXIST) {
+    fprintf(stderr, "gen_scenes: cannot make %s: %s\n", holdout, strerror(errno));
+    return 1;
+  }
+  holdout_loft(holdout);
+  holdout_yard(holdout);
   return 0;
 }

@@ -1,8 +1,10 @@
 -- Glossy indirect light for the pbr technique's surfaces (shaders/glossy.frag):
 -- screen-space reflections of the lit frame, roughness-aware, the sky where
--- the screen shows nothing. Recorded only for materials = "pbr": Phong
--- frames are left as they were. docs/gi-combined.md.
+-- the screen shows nothing (through the light propagation volumes where the
+-- technique has them). Recorded only for materials = "pbr": Phong frames are
+-- left as they were. docs/gi-combined.md.
 local gbuffer = require "gbuffer"
+local lpv = require "lpv"
 local options = require "options"
 local sky = require "sky"
 
@@ -13,6 +15,9 @@ glossy.defaults = {
   samples = 4,        -- GGX directions a pixel, 1..64
   steps = 24,         -- march steps a direction, 1..256 (geometric, a pixel's footprint to the scene's diagonal)
   thickness = 0.05,   -- how far behind the depth buffer's surface a step still meets it, share of its depth, 0..1
+  fallback = "volume", -- what a ray the screen cannot follow brings: "volume", the light propagation
+                       -- volumes' light along it and the sky they let through, where the technique has
+                       -- them (lpv+esm, isr+lpv+esm; else the sky); "sky", the sky unoccluded
 }
 
 local rules = {
@@ -20,6 +25,7 @@ local rules = {
   samples = options.whole(1, 64),
   steps = options.whole(1, 256),
   thickness = options.number(0, 1),
+  fallback = options.one_of("volume", "sky"),
 }
 
 glossy.check = options.checker("glossy", glossy.defaults, rules)
@@ -37,8 +43,16 @@ function glossy.render(lit, o, frame)
   local defines = {}
   local params = sky.bind(light.sky, { background = light.background, samples = o.samples, steps = o.steps,
                                        thickness = o.thickness, reach = d }, defines)
+  local fetches = 4 + o.samples * o.steps * 3
+  local volumes = o.fallback == "volume" and frame.lpv -- lpv.render's, this frame
+  if volumes then
+    defines.LPV = true
+    local v = volumes.o
+    local occludes = lpv.bind(volumes.V, v, true, inputs, defines, params) -- the background's light too
+    fetches = fetches + o.samples * (6 * (v.cascades + 1) + (occludes and v.sky_cells or 0))
+  end
   return pass{ "glossy", shader = "glossy.frag", inputs = inputs, defines = defines, params = params,
-               fetches = 4 + o.samples * o.steps * 3, out = target{ "glossy.out", format = "rgba16f" } }
+               fetches = fetches, out = target{ "glossy.out", format = "rgba16f" } }
 end
 
 return glossy

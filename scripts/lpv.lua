@@ -262,11 +262,10 @@ function lpv.volume(G, R, o, exclude_seen)
   return { all = total.all, late = total.late, grids = grids, seen = R.seen, geometry = geometry }
 end
 
--- Records the lookup over the coarse view C (isr.coarse_view, factor f),
--- whose depth it writes, in the volumes V (lpv.volume); with sky, the share
--- of open sky in its a (o.sky_occlusion). Returns the coarse E.
-function lpv.gather(C, f, V, o, sky)
-  local inputs = gbuffer.inputs(C)
+-- Adds what a pass needs to read the volumes V (lpv.volume) with options o
+-- (lpv_light.glsl's lpv_light_from; with sky, lpv_sky_through) to its
+-- inputs, defines and params. Returns whether the sky is occluded.
+function lpv.bind(V, o, sky, inputs, defines, params)
   if V.late then
     inputs.all_r, inputs.all_g, inputs.all_b = V.all[1], V.all[2], V.all[3]
     inputs.late_r, inputs.late_g, inputs.late_b = V.late[1], V.late[2], V.late[3]
@@ -274,37 +273,40 @@ function lpv.gather(C, f, V, o, sky)
   inputs.lpv_seen = V.seen
   local occludes = sky and o.sky_occlusion > 0 and o.surfels > 0
   if occludes then inputs.geometry = V.geometry end
+  defines.VOLUMES, defines.SKY_OCCLUSION = V.late ~= nil, occludes
+  params.lpv_steps, params.sky_cells, params.sky_occlusion = o.steps, o.sky_cells, o.sky_occlusion
+  grid(o, V.grids, params)
+  return occludes
+end
+
+-- Records the lookup over the coarse view C (isr.coarse_view, factor f),
+-- whose depth it writes, in the volumes V (lpv.volume); with sky, the share
+-- of open sky in its a (o.sky_occlusion). Returns the coarse E.
+function lpv.gather(C, f, V, o, sky)
+  local inputs, defines, params = gbuffer.inputs(C), { STRIDE = C.stride, Z = true }, {}
+  local occludes = lpv.bind(V, o, sky, inputs, defines, params)
   local E = target{ "lpv.e", format = "rgba16f", scale = 1 / f }
-  pass{ "lpv.lookup", shader = "lpv_lookup.frag", inputs = inputs,
-        defines = { VOLUMES = V.late ~= nil, STRIDE = C.stride, Z = true, SKY_OCCLUSION = occludes },
-        params = grid(o, V.grids, { lpv_steps = o.steps, sky_cells = o.sky_cells, sky_occlusion = o.sky_occlusion }),
+  pass{ "lpv.lookup", shader = "lpv_lookup.frag", inputs = inputs, defines = defines, params = params,
         fetches = 4 + 6 * (o.cascades + 1) + (occludes and 8 * o.sky_cells or 0), out = { E, C.z } }
   return E
 end
 
 -- Records the LPV's indirect light over frame.G from the RSM targets
--- frame.R, with options o; no input. frame.volume gets what binds the
--- volumes to another pass (blended materials: transparent.lua). With the row's split, VPLs the camera
+-- frame.R, with options o; no input. frame.lpv keeps the volumes and options
+-- for other passes that read them (lpv.bind: glossy.lua, transparent.lua). With the row's split, VPLs the camera
 -- sees are left to the frame's lighting (lpv.volume's exclude_seen).
 -- Returns what the direct pass adds (pp.lua's direct: INDIRECT in
 -- direct.frag): { C = the coarse grid, E = the coarse result, k }; E's a,
 -- the share of open sky, occludes the direct pass's ambient term (without
--- the split: there ISR's composite occludes it).
+-- the split: there ISR's composite occludes it). Leaves the volumes and
+-- options in frame.lpv ({ V, o }) for later passes (glossy.lua's fallback).
 function lpv.render(_, o, frame)
   o = lpv.check(o, 2)
   local G, f, split = frame.G, o.coarse, frame.technique and frame.technique.split
   local C = isr.coarse_view(G, nil, f, "lpv")
   local V = lpv.volume(G, frame.R, o, split)
-  frame.volume = { k = o.k, bind = function(inputs, params, defines) -- lpv_light() at points of a pass's own
-    if V.late then
-      inputs.all_r, inputs.all_g, inputs.all_b = V.all[1], V.all[2], V.all[3]
-      inputs.late_r, inputs.late_g, inputs.late_b = V.late[1], V.late[2], V.late[3]
-    end
-    inputs.lpv_seen = V.seen
-    grid(o, V.grids, params).lpv_steps = o.steps
-    defines.VOLUMES = V.late ~= nil
-  end }
   local E = lpv.gather(C, f, V, o, not split)
+  frame.lpv = { V = V, o = o } -- for passes that read the volumes too (lpv.bind: glossy, transparent)
   return { C = C, E = isr.blur(E, C, f, o.blur), k = o.k }
 end
 

@@ -8,13 +8,21 @@
 // scene's diagonal; where a step passes behind the buffer's surface within
 // `thickness` of its depth, the ray met that surface and brings the lit
 // frame's radiance there; a ray that leaves the screen or passes behind
-// everything brings the sky's radiance (sky.glsl's sky_radiance, plus the
-// background), as the camera would see it. The estimate of
+// everything brings what the screen cannot show (unseen): with LPV (the
+// frame's technique has light propagation volumes, scripts/lpv.lua) the
+// volumes' light arriving along the ray (lpv_light_from, band 1 whole: the
+// GGX directions sampled are what makes it roughness-aware), plus the sky's
+// radiance (sky.glsl's sky_radiance, plus the background) times the share
+// the geometry volume lets through along the ray (SKY_OCCLUSION,
+// lpv_sky_through); without, the sky as the camera would see it. The estimate of
 // int L(l) f_spec(v, l) n.l dl is the mean of L(l) F(v.h) 4 Vis n.l v.h / n.h
 // (Smith height-correlated Vis, Schlick F): a mirror (alpha -> 0) reflects F
 // L(r). Phong pixels and background keep the lit frame bit for bit.
 #include "gbuffer.glsl"
 #include "halton.glsl"
+#ifdef LPV
+#include "lpv_light.glsl"
+#endif
 
 uniform sampler2D clr, nrm, dpt, mat, lit;
 uniform vec3 background = vec3(0.0);
@@ -24,9 +32,24 @@ uniform float reach = 1.0;      // the march's length, world units (the scene's 
 
 out vec4 result;
 
-// The lit frame's radiance along the ray from p in unit direction l, or the
-// sky's where the screen does not show what it meets.
-vec3 trace(vec3 p, vec3 l, float foot) {
+// The light arriving at p facing n along unit direction l from what the
+// screen does not show, pre-exposed as the lit frame it stands in for.
+vec3 unseen(vec3 p, vec3 n, vec3 l) {
+  vec3 sky = exposed(background) + sky_radiance(l);
+#ifdef LPV
+  vec3 bounce = lpv_light_from(p, n, l, 1.0); // sets lpv_origins, which lpv_sky_through reads
+#ifdef SKY_OCCLUSION
+  sky *= lpv_sky_through(p, n, l);
+#endif
+  return bounce + sky;
+#else
+  return sky;
+#endif
+}
+
+// The lit frame's radiance along the ray from p (facing n) in unit direction
+// l, or unseen's where the screen does not show what it meets.
+vec3 trace(vec3 p, vec3 n, vec3 l, float foot) {
   float t0 = max(foot, 1e-6 * reach), t1 = max(reach, 2.0 * t0);
   float grow = pow(t1 / t0, 1.0 / float(max(steps - 1, 1)));
   float t = t0;
@@ -40,7 +63,7 @@ vec3 trace(vec3 p, vec3 l, float foot) {
     if (covered && ray > seen && ray < seen * (1.0 + thickness) + t * (grow - 1.0))
       return textureLod(lit, uv, 0.0).rgb;
   }
-  return exposed(background) + sky_radiance(l); // pre-exposed, as the lit frame it stands in for
+  return unseen(p, n, l);
 }
 
 void main() {
@@ -64,7 +87,7 @@ void main() {
     float ndl = dot(s.n, l), vdh = saturate(dot(v, h)), ndh = max(dot(s.n, h), 1e-4);
     if (ndl <= 0.0) continue;
     vec3 weight = ggx_fresnel(s.f0, vdh) * (4.0 * ggx_visibility(ndl, ndv, a2) * ndl * vdh / ndh);
-    sum += weight * trace(s.p + s.n * foot, l, foot);
+    sum += weight * trace(s.p + s.n * foot, s.n, l, foot);
   }
   result.rgb = base + finite_or_zero(sum / float(max(samples, 1)));
 }

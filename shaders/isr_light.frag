@@ -34,7 +34,8 @@ void main() {
     return;
   }
   vec4 e = coarse_upsample(uv, s.depth01);
-  vec3 d = texelFetch(direct, ivec2(gl_FragCoord.xy), 0).rgb, sky = s.k.x * sky_ambient(ambient, s.n) * s.albedo;
+  // the ambient term as the direct pass's (ambient_light): k_d albedo, which a pbr metal lacks
+  vec3 d = texelFetch(direct, ivec2(gl_FragCoord.xy), 0).rgb, sky = ambient_light(s, ambient);
 #ifdef SEED
   vec3 indirect = s.rho * e.rgb;
   vec3 l = (d + sky) * saturate(e.a + 1.0 - k_ssao) + k_isr * indirect;

@@ -45,9 +45,12 @@ uniform int lpv_steps = 8;
 
 const float LPV_D = 0.674213;
 
-vec3 lpv_irradiance(vec4 r, vec4 g, vec4 b, vec3 n) {
-  vec3 a = vec3(r.x, g.x, b.x), bn = vec3(dot(r.yzw, n), dot(g.yzw, n), dot(b.yzw, n));
-  return LPV_D * max(a - (2.0 / 3.0) * bn, 0.0);
+// D max(0, A - k B.d) per channel: the light arriving from around d, band 1
+// weighted by k: 2/3 for the cosine lobe of E / pi (d = n), 1 for the
+// radiance arriving along d alone (glossy.frag's fallback).
+vec3 lpv_read(vec4 r, vec4 g, vec4 b, vec3 d, float k) {
+  vec3 a = vec3(r.x, g.x, b.x), bd = vec3(dot(r.yzw, d), dot(g.yzw, d), dot(b.yzw, d));
+  return LPV_D * max(a - k * bd, 0.0);
 }
 
 vec4 lpv_sample(sampler2D v, vec2 uv0, vec2 uv1, float f) { return mix(textureLod(v, uv0, 0.0), textureLod(v, uv1, 0.0), f); }
@@ -72,8 +75,9 @@ float lpv_margin(vec3 u, int c) {
   return min(m.x, min(m.y, m.z));
 }
 
-// Cascade c's E / pi at p facing n: its sum of all steps times a plus its late sum times l.
-vec3 lpv_cascade_light(int c, vec3 p, vec3 n, float a, float l) {
+// Cascade c's light at p facing n from around d (lpv_read's k): its sum of
+// all steps times a plus its late sum times l.
+vec3 lpv_cascade_light(int c, vec3 p, vec3 n, vec3 d, float k, float a, float l) {
   vec3 e = vec3(0.0);
 #ifdef VOLUMES
   vec3 last = vec3(lpv_dims(c) - 1);
@@ -81,16 +85,17 @@ vec3 lpv_cascade_light(int c, vec3 p, vec3 n, float a, float l) {
   float z0 = floor(u.z), f = u.z - z0, z1 = min(z0 + 1.0, last.z), nx = float(lpv_nx[c]);
   vec2 size = vec2(lpv_size), row = vec2(float(lpv_col[c]) + u.x, u.y);
   vec2 uv0 = (row + vec2(z0 * nx, 0.0) + 0.5) / size, uv1 = (row + vec2(z1 * nx, 0.0) + 0.5) / size;
-  if (a > 0.0) e += a * lpv_irradiance(lpv_sample(all_r, uv0, uv1, f), lpv_sample(all_g, uv0, uv1, f), lpv_sample(all_b, uv0, uv1, f), n);
+  if (a > 0.0) e += a * lpv_read(lpv_sample(all_r, uv0, uv1, f), lpv_sample(all_g, uv0, uv1, f), lpv_sample(all_b, uv0, uv1, f), d, k);
   if (l > 0.0)
-    e += l * lpv_irradiance(lpv_sample(late_r, uv0, uv1, f), lpv_sample(late_g, uv0, uv1, f), lpv_sample(late_b, uv0, uv1, f), n);
+    e += l * lpv_read(lpv_sample(late_r, uv0, uv1, f), lpv_sample(late_g, uv0, uv1, f), lpv_sample(late_b, uv0, uv1, f), d, k);
 #endif
   float h = lpv_cell_size(c);
   return e / max(h * h, 1e-30);
 }
 
-// E / pi at p facing n (the finest cascade that holds p, blended into the next over its border's steps).
-vec3 lpv_light(vec3 p, vec3 n) {
+// The light at p facing n from around d (lpv_read's k): the finest cascade
+// that holds p, blended into the next over its border's steps.
+vec3 lpv_light_from(vec3 p, vec3 n, vec3 d, float k) {
   for (int c = 0; c < lpv_cascades; c++) lpv_origins[c] = lpv_origin(c);
   int c0 = lpv_cascades;
   float margin = -1.0;
@@ -101,8 +106,44 @@ vec3 lpv_light(vec3 p, vec3 n) {
   float w = clamp(margin / float(max(lpv_steps, 1)), 0.0, 1.0);
   vec3 e = vec3(0.0);
   for (int c = c0; c < lpv_cascades; c++)
-    e += lpv_cascade_light(c, p, n, c == c0 ? w : c == c0 + 1 ? 1.0 - w : 0.0, c == c0 ? 0.0 : c == c0 + 1 ? w : 1.0);
+    e += lpv_cascade_light(c, p, n, d, k, c == c0 ? w : c == c0 + 1 ? 1.0 - w : 0.0, c == c0 ? 0.0 : c == c0 + 1 ? w : 1.0);
   return finite_or_zero(e);
 }
+
+// E / pi at p facing n.
+vec3 lpv_light(vec3 p, vec3 n) { return lpv_light_from(p, n, n, 2.0 / 3.0); }
+
+#ifdef SKY_OCCLUSION
+uniform sampler2D geometry;      // blocking lobes (lpv_inject.vert)
+uniform int sky_cells = 8;       // cells each direction crosses
+uniform float sky_occlusion = 1.0;
+
+// The share of the sky's light along unit direction w that reaches p facing
+// n past the geometry volume's surfaces: the light that crosses `sky_cells`
+// cells of the finest cascade holding the march's start, each cell letting
+// through 1 - sky_occlusion times its blocking for that direction
+// (lpv_propagate.frag's gather); past the cascade's border nothing blocks.
+// The march starts a cell in front of p: p's own surface blocks in the cell
+// half a cell behind it. The volume holds only the surfaces the camera sees
+// (lpv_inject.vert). Needs lpv_origins (lpv_light).
+float lpv_sky_through(vec3 p, vec3 n, vec3 w) {
+  int c = 0;
+  vec3 start = vec3(0.0);
+  for (; c < lpv_cascades; c++) {
+    float h = lpv_cell_size(c);
+    start = (p + h * n - lpv_origins[c]) / h;
+    if (lpv_inside(ivec3(floor(start)), c)) break;
+  }
+  if (c >= lpv_cascades) return 1.0;
+  float through = 1.0;
+  for (int k = 0; k < sky_cells; k++) {
+    ivec3 cell = ivec3(floor(start + float(k) * w));
+    if (!lpv_inside(cell, c)) break;
+    vec4 g = texelFetch(geometry, lpv_texel(cell, c), 0);
+    through *= 1.0 - saturate(sky_occlusion) * saturate(g.x + dot(g.yzw, w));
+  }
+  return through;
+}
+#endif
 
 #endif

@@ -21,43 +21,17 @@ uniform sampler2D clr, nrm, dpt, mat;         // (coarse) G-buffer
 
 #ifdef SKY_OCCLUSION
 #include "halton.glsl"
-uniform sampler2D geometry;      // blocking lobes (lpv_inject.vert)
-uniform int sky_cells = 8;       // cells each direction crosses
-uniform float sky_occlusion = 1.0;
 
 const int SKY_DIRECTIONS = 8;
 
 // The cosine-weighted share of the sky p facing n sees past the geometry
-// volume's surfaces: along SKY_DIRECTIONS fixed cosine-weighted directions
-// (a golden-angle spiral), the light that crosses `sky_cells` cells of the
-// finest cascade holding the march's start, each cell letting through 1 -
-// sky_occlusion times its blocking for that direction (lpv_propagate.frag's
-// gather); past the cascade's border nothing blocks. The march starts a cell
-// in front of p: p's own surface blocks in the cell half a cell behind it.
-// The volume holds only the surfaces the camera sees (lpv_inject.vert).
-// Needs lpv_origins (lpv_light).
+// volume's surfaces: lpv_sky_through along SKY_DIRECTIONS fixed
+// cosine-weighted directions (a golden-angle spiral).
 float open_sky(vec3 p, vec3 n) {
-  int c = 0;
-  vec3 start = vec3(0.0);
-  for (; c < lpv_cascades; c++) {
-    float h = lpv_cell_size(c);
-    start = (p + h * n - lpv_origins[c]) / h;
-    if (lpv_inside(ivec3(floor(start)), c)) break;
-  }
-  if (c >= lpv_cascades) return 1.0;
   mat3 around = tangent_frame(n);
   float open = 0.0;
-  for (int i = 0; i < SKY_DIRECTIONS; i++) {
-    vec3 w = around * hemisphere_cosine(vec2(fract(0.618034 * float(i)), (float(i) + 0.5) / float(SKY_DIRECTIONS)));
-    float through = 1.0;
-    for (int k = 0; k < sky_cells; k++) {
-      ivec3 cell = ivec3(floor(start + float(k) * w));
-      if (!lpv_inside(cell, c)) break;
-      vec4 g = texelFetch(geometry, lpv_texel(cell, c), 0);
-      through *= 1.0 - saturate(sky_occlusion) * saturate(g.x + dot(g.yzw, w));
-    }
-    open += through;
-  }
+  for (int i = 0; i < SKY_DIRECTIONS; i++)
+    open += lpv_sky_through(p, n, around * hemisphere_cosine(vec2(fract(0.618034 * float(i)), (float(i) + 0.5) / float(SKY_DIRECTIONS))));
   return open / float(SKY_DIRECTIONS);
 }
 #endif

@@ -1,8 +1,9 @@
 /* Glossy indirect light (scripts/glossy.lua, shaders/glossy.frag) with
  * materials=pbr: a mirror-like metal sphere shows the lit red wall it faces,
- * and the sky where the screen shows nothing; Phong frames are unchanged bit
- * for bit; extremes stay finite; bad options name themselves. Needs a GL
- * context (llvmpipe will do). */
+ * and the sky where the screen shows nothing; a lit wall behind the camera
+ * through the light propagation volumes (glossy.fallback); Phong frames are
+ * unchanged bit for bit; extremes stay finite; bad options name themselves.
+ * Needs a GL context (llvmpipe will do). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -18,12 +19,17 @@
 enum { W = 96, H = 72 };
 
 static const float EYE[3] = {1.0f, 0.6f, 2.5f}, AT[3] = {-0.6f, 0.0f, 0.0f};
+/* The camera of the wall behind it (metal_sphere's behind) */
+static const float BACK_EYE[3] = {2.0f, 0.3f, 0.3f}, BACK_AT[3] = {0.0f, 0.0f, 0.0f};
 
 /* A sphere of radius 0.5 at the origin (metal of base colour `albedo`, its
  * roughness from `shininess`: the pbr technique's metallic 1 - k_d = 1), a
  * red wall at x = -1.5 facing +x, lit by the sun shining along -x; the camera
- * at EYE looks at AT. */
-static lm_scene *metal_sphere(float albedo, float shininess, mat4 vp) {
+ * at EYE looks at AT. With behind, the wall stands at x = 3 facing -x, behind
+ * the camera at BACK_EYE looking at BACK_AT, and the sun shines along
+ * (1, -0.6, 0): the sphere's shadow falls low on the wall, and the side of
+ * the sphere the camera sees is in shade. */
+static lm_scene *metal_sphere_at(float albedo, float shininess, bool behind, mat4 vp) {
   lm_scene *s = lm_scene_create("sphere");
   lm_material metal = {.name = "metal", .color = {albedo, albedo, albedo}, .rho = 0.5f, .ka = 1, .kd = 0, .ks = 1,
                        .shininess = shininess};
@@ -50,14 +56,19 @@ static lm_scene *metal_sphere(float albedo, float shininess, mat4 vp) {
   mat4 id = GLM_MAT4_IDENTITY_INIT, view, world;
   lm_scene_add_node(s, "ball", -1, (float *)id, lm_scene_add_mesh(s, "ball", v, nv, idx, ni), m);
   int red = gl_material(s, "red", 0.8f, 0.1f, 0.1f);
-  gl_quad(s, "wall", red, (const float[4][3]){{-1.5f, -2, 3}, {-1.5f, -2, -3}, {-1.5f, 2, -3}, {-1.5f, 2, 3}},
-          (const float[3]){1, 0, 0});
-  glm_lookat((vec3){0, 0, 0}, (vec3){-1, -0.1f, 0}, (vec3){0, 1, 0}, view);
+  if (behind)
+    gl_quad(s, "wall", red, (const float[4][3]){{3, -3, -3}, {3, -3, 3}, {3, 3, 3}, {3, 3, -3}},
+            (const float[3]){-1, 0, 0});
+  else
+    gl_quad(s, "wall", red, (const float[4][3]){{-1.5f, -2, 3}, {-1.5f, -2, -3}, {-1.5f, 2, -3}, {-1.5f, 2, 3}},
+            (const float[3]){1, 0, 0});
+  glm_lookat((vec3){0, 0, 0}, behind ? (vec3){1, -0.6f, 0} : (vec3){-1, -0.1f, 0}, (vec3){0, 1, 0}, view);
   glm_mat4_inv(view, world);
   int sun = lm_scene_add_node(s, "sun", -1, (float *)world, -1, -1);
   lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 1,
                                      .casts_shadows = true, .node = sun});
-  glm_lookat((vec3){EYE[0], EYE[1], EYE[2]}, (vec3){AT[0], AT[1], AT[2]}, (vec3){0, 1, 0}, view);
+  const float *eye = behind ? BACK_EYE : EYE, *at = behind ? BACK_AT : AT;
+  glm_lookat((vec3){eye[0], eye[1], eye[2]}, (vec3){at[0], at[1], at[2]}, (vec3){0, 1, 0}, view);
   glm_mat4_inv(view, world);
   int cam = lm_scene_add_node(s, "camera", -1, (float *)world, -1, -1);
   lm_scene_add_camera(s, &(lm_camera){.name = "front", .fov_y = glm_rad(60.0f), .znear = 0.01f, .zfar = 100,
@@ -69,11 +80,15 @@ static lm_scene *metal_sphere(float albedo, float shininess, mat4 vp) {
   return s;
 }
 
+static lm_scene *metal_sphere(float albedo, float shininess, mat4 vp) {
+  return metal_sphere_at(albedo, shininess, false, vp);
+}
+
 /* Mean linear RGB of the 3 x 3 pixels around the sphere's point whose
- * mirror reflects the camera's ray into direction d (unit). */
-static void reflecting(const gl_result *r, mat4 vp, const float d[3], float out[3]) {
+ * mirror reflects the ray of the camera at eye into direction d (unit). */
+static void reflecting_from(const gl_result *r, mat4 vp, const float eye[3], const float d[3], float out[3]) {
   vec3 toward, n;
-  glm_vec3_normalize_to((vec3){EYE[0], EYE[1], EYE[2]}, toward); /* from the centre: the sphere is small */
+  glm_vec3_normalize_to((vec3){eye[0], eye[1], eye[2]}, toward); /* from the centre: the sphere is small */
   glm_vec3_add(toward, (vec3){d[0], d[1], d[2]}, n);
   glm_vec3_normalize(n);
   vec4 c;
@@ -81,6 +96,10 @@ static void reflecting(const gl_result *r, mat4 vp, const float d[3], float out[
   int col = (int)((c[0] / c[3] * 0.5f + 0.5f) * r->width), row = (int)((0.5f - c[1] / c[3] * 0.5f) * r->height);
   assert_true(col >= 1 && col < r->width - 1 && row >= 1 && row < r->height - 1);
   gl_region(r, col - 1, row - 1, col + 1, row + 1, out);
+}
+
+static void reflecting(const gl_result *r, mat4 vp, const float d[3], float out[3]) {
+  reflecting_from(r, vp, EYE, d, out);
 }
 
 static gl_result render_ok(lm_scene *s, const char *const *sets) {
@@ -119,6 +138,51 @@ static void a_metal_sphere_shows_the_lit_wall_and_the_sky(void **state) {
   lm_scene_destroy(s);
 }
 
+/* The sphere's point that faces the camera mirrors the lit red wall behind
+ * it, which the screen cannot show: lpv+esm's volumes bring its red
+ * (glossy.fallback=volume, the default), the sky fallback nothing (no sky). */
+static void the_volumes_show_what_the_screen_cannot(void **state) {
+  (void)state;
+  mat4 vp;
+  lm_scene *s = metal_sphere_at(0.9f, 1e6f, true, vp);
+  static const char *const volume[] = {"ambient=0", "materials=pbr", "glossy=true", NULL};
+  static const char *const sky[] = {"ambient=0", "materials=pbr", "glossy=true", "glossy.fallback=sky", NULL};
+  gl_result a = gl_render_ok(&(gl_run){.scene = s, .tech = "lpv+esm", .sets = volume, .width = W, .height = H});
+  gl_result b = gl_render_ok(&(gl_run){.scene = s, .tech = "lpv+esm", .sets = sky, .width = W, .height = H});
+  float back[3], v[3], k[3];
+  glm_vec3_normalize_to((vec3){BACK_EYE[0], BACK_EYE[1], BACK_EYE[2]}, back);
+  reflecting_from(&a, vp, BACK_EYE, back, v);
+  reflecting_from(&b, vp, BACK_EYE, back, k);
+  print_message("facing the camera: %.4f %.4f %.4f through the volumes, %.4f %.4f %.4f the sky\n", v[0], v[1], v[2],
+                k[0], k[1], k[2]);
+  assert_true(v[0] > 0.02f && v[0] > 3 * v[1] && v[0] > 3 * v[2]);
+  assert_true(k[0] < 0.5f * v[0]);
+  gl_result_free(&a);
+  gl_result_free(&b);
+  lm_scene_destroy(s);
+}
+
+/* A metal has no diffuse colour: ISR's composite gives it no ambient term,
+ * as the direct pass does (isr_light.frag's ambient_light; it gave the
+ * metal its base colour times the ambient light). */
+static void isr_gives_a_metal_no_ambient_term(void **state) {
+  (void)state;
+  mat4 vp;
+  lm_scene *s = metal_sphere(0.9f, 1e6f, vp);
+  static const char *const sets[] = {"ambient=0.5", "materials=pbr", NULL};
+  const float up[3] = {0, 1, 0};
+  float isr[3], dl[3];
+  gl_result a = gl_render_ok(&(gl_run){.scene = s, .tech = "isr+esm", .sets = sets, .width = W, .height = H});
+  gl_result b = render_ok(s, sets);
+  reflecting(&a, vp, up, isr);
+  reflecting(&b, vp, up, dl);
+  print_message("metal facing up, ambient 0.5: isr+esm %.4f, dl+esm %.4f\n", gl_luminance(isr), gl_luminance(dl));
+  assert_true(gl_luminance(isr) < 0.02f && gl_luminance(dl) < 0.02f);
+  gl_result_free(&a);
+  gl_result_free(&b);
+  lm_scene_destroy(s);
+}
+
 /* Phong frames record no glossy pass: the image is the same bit for bit. */
 static void phong_frames_are_unchanged(void **state) {
   (void)state;
@@ -134,19 +198,24 @@ static void phong_frames_are_unchanged(void **state) {
 }
 
 /* Roughness 0 (shininess 1e30) and 1 (shininess 0), albedo 1, a sky of 1e6,
- * one sample of one step and 64 of 256: finite. */
+ * one sample of one step and 64 of 256, each also through the volumes'
+ * fallback (lpv+esm): finite. */
 static void extremes_stay_finite(void **state) {
   (void)state;
-  const float shininess[] = {1e30f, 0, 1e6f, 1e6f};
+  const float shininess[] = {1e30f, 0, 1e6f, 1e6f, 1e30f, 0, 1e6f};
+  const char *const tech[] = {"dl+esm", "dl+esm", "dl+esm", "dl+esm", "lpv+esm", "lpv+esm", "lpv+esm"};
   const char *const extra[][3] = {{"glossy.samples=64", "glossy.steps=256", NULL},
                                   {"glossy.samples=1", "glossy.steps=1", NULL},
                                   {"sky.intensity=1e6", "glossy.thickness=0", NULL},
-                                  {"glossy.thickness=1", "ambient=1e6", NULL}};
-  for (int i = 0; i < 4; i++) {
+                                  {"glossy.thickness=1", "ambient=1e6", NULL},
+                                  {"sky.intensity=1e6", "lpv.bounces=8", NULL},
+                                  {"glossy.samples=1", "lpv.sky_occlusion=0", NULL},
+                                  {"sky.intensity=1e6", "lpv.steps=0", NULL}};
+  for (int i = 0; i < 7; i++) {
     mat4 vp;
-    lm_scene *s = metal_sphere(1.0f, shininess[i], vp);
+    lm_scene *s = metal_sphere_at(1.0f, shininess[i], i >= 4, vp);
     const char *const sets[] = {"materials=pbr", "glossy=true", "sky=true", extra[i][0], extra[i][1], NULL};
-    gl_result r = render_ok(s, sets);
+    gl_result r = gl_render_ok(&(gl_run){.scene = s, .tech = tech[i], .sets = sets, .width = W, .height = H});
     assert_true(gl_has_pass(&r, "glossy"));
     if (!gl_all_finite(&r) || !gl_target_finite(&r, "glossy.out")) fail_msg("case %d: not finite", i);
     gl_result_free(&r);
@@ -159,7 +228,7 @@ static void bad_options_name_themselves(void **state) {
   static const gl_bad_option cases[] = {
       {"dl+esm", "glossy.samples=0", "glossy.samples"},     {"dl+esm", "glossy.samples=65", "glossy.samples"},
       {"dl+esm", "glossy.steps=0", "glossy.steps"},         {"dl+esm", "glossy.thickness=2", "glossy.thickness"},
-      {"dl+esm", "glossy.thickness=-1", "glossy.thickness"},
+      {"dl+esm", "glossy.thickness=-1", "glossy.thickness"}, {"dl+esm", "glossy.fallback=tracer", "glossy.fallback"},
   };
   gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
 }
@@ -167,6 +236,8 @@ static void bad_options_name_themselves(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(a_metal_sphere_shows_the_lit_wall_and_the_sky),
+      cmocka_unit_test(the_volumes_show_what_the_screen_cannot),
+      cmocka_unit_test(isr_gives_a_metal_no_ambient_term),
       cmocka_unit_test(phong_frames_are_unchanged),
       cmocka_unit_test(extremes_stay_finite),
       cmocka_unit_test(bad_options_name_themselves),

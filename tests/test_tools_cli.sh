@@ -80,6 +80,19 @@ check "heat map written" test -s "$tmp/d.png"
 check "compare png with exr diff" run 0 compare "$tmp/a.png" "$tmp/b.png" --diff "$tmp/d.exr"
 check "table names eq 19" out_has "mean error (eq 19)"
 check "diff exr written" test -s "$tmp/d.exr"
+# --mask: the mean error over the mask's pixels (its first channel over 0.5): a's bright pixels, a
+# mask of the metallic surfaces that the Cornell box lacks (scripts/examples/mask.lua: refused, empty)
+"$limn" capture --script "$root/scripts/examples/mask.lua" --scene cornell --size 32x24 --output "$tmp/metal.png" --quiet
+check "compare masked" run 0 compare "$tmp/a.exr" "$tmp/b.exr" --mask "$tmp/a.png" --json
+masked_within() { python3 -c 'import json, sys; d = json.load(open(sys.argv[1]))
+sys.exit(not (0 < d["masked_pixels"] < 32 * 24 and 0 < d["masked_error"] < 1e3))' "$tmp/out"; }
+check "masked error over some pixels" masked_within
+check "compare masked table" run 0 compare "$tmp/a.exr" "$tmp/b.exr" --mask "$tmp/a.png"
+check "masked table line" out_has "masked mean error"
+check "compare empty mask" run 2 compare "$tmp/a.exr" "$tmp/b.exr" --mask "$tmp/metal.png"
+check "empty mask message" err_has "no pixel of the mask exceeds 0.5"
+check "compare mask of another size" run 2 compare "$tmp/a.exr" "$tmp/b.exr" --mask "$tmp/small.png"
+check "mask size message" err_has "a mask must be the images' size"
 
 # bench: two sizes, one frame each; the clock named, a fit per pass
 check "bench help" run 0 bench --help
