@@ -122,7 +122,7 @@ static void free_args(view_args *a) {
 
 /* Returns 0 to go on, -1 when done (help), else the exit code. */
 static int parse_args(int argc, char **argv, view_args *a) {
-  *a = (view_args){.scene = "cornell", .capture_dir = ".", .width = 512, .height = 384, .overlay = true,
+  *a = (view_args){.common = {.scene = "cornell", .width = 512, .height = 384}, .capture_dir = ".", .overlay = true,
                    .panel = true, .animation = "all", .fps = 24};
   static const struct option opts[] = {
       {"scene", required_argument, 0, 's'},      {"script", required_argument, 0, 'p'},
@@ -143,27 +143,12 @@ static int parse_args(int argc, char **argv, view_args *a) {
   bool view_given = false;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
     switch (c) {
-    case 's': a->scene = optarg; break;
-    case 'p': a->script = optarg; break;
-    case 't': a->tech = optarg; break;
-    case 'D':
-      if (!strchr(optarg, '=') || optarg[0] == '=') return usage_error("--set wants NAME=VALUE, not '%s'", optarg);
-      if (a->set_count == MAX_SETS) return usage_error("%s", "at most 64 --set flags");
-      a->sets[a->set_count++] = lm_strdup(optarg);
-      break;
     case 'B': a->compare = optarg; break;
     case 'E':
       if (!strchr(optarg, '=') || optarg[0] == '=')
         return usage_error("--compare-set wants NAME=VALUE, not '%s'", optarg);
       if (a->compare_set_count == MAX_SETS) return usage_error("%s", "at most 64 --compare-set flags");
       a->compare_sets[a->compare_set_count++] = lm_strdup(optarg);
-      break;
-    case 'z':
-      if (!limn_parse_size(optarg, &a->width, &a->height))
-        return usage_error("--size wants WxH with both in 1..65536, not '%s'", optarg);
-      break;
-    case 'c':
-      if (!limn_parse_int(optarg, 0, 1 << 20, &a->camera)) return usage_error("--camera wants an index, not '%s'", optarg);
       break;
     case 'o':
       if (!limn_parse_on_off(optarg, &a->overlay)) return usage_error("--overlay wants on or off, not '%s'", optarg);
@@ -206,11 +191,13 @@ static int parse_args(int argc, char **argv, view_args *a) {
     case 'q': a->quiet = true; break;
     case 'v': a->verbose = true; break;
     case 'h': fputs(view_usage, stdout); return -1;
-    case ':': return usage_error("%s needs a value", argv[optind - 1]);
-    default: return usage_error("unknown flag '%s'", argv[optind - 1]);
+    default:
+      if (limn_common_flag("view", c, argv, &a->common)) return 2;
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
+  /* The viewer's own copies: toggles and the panel replace entries. */
+  for (int i = 0; i < a->common.set_count; i++) a->sets[a->set_count++] = lm_strdup(a->common.sets[i]);
   if (view_given && !a->job) return usage_error("%s", "--view N needs --job FILE");
   if (a->compare_set_count && !a->compare) return usage_error("%s", "--compare-set needs --compare TECH");
   return a->job && !load_view_job(a) ? 2 : 0;
@@ -408,12 +395,8 @@ static void remember_set(viewer *v, const char *name, const char *value) {
 
 /* Applies NAME=VALUE entries; returns false (err) on the first bad one. */
 static bool apply_set_list(lm_pipeline *p, char *const *sets, int count, lm_error *err) {
-  for (int i = 0; i < count; i++) {
-    char name[256];
-    const char *s = sets[i], *eq = strchr(s, '=');
-    snprintf(name, sizeof name, "%.*s", (int)(eq - s), s);
-    if (!lm_pipeline_set_option(p, name, eq + 1, err)) return false;
-  }
+  for (int i = 0; i < count; i++)
+    if (!capture_set_option(p, sets[i], err)) return false;
   return true;
 }
 
@@ -557,7 +540,7 @@ static bool reload_script(viewer *v) {
 
 static void reload_scene(viewer *v) {
   lm_error err;
-  lm_scene *s = lm_scene_load(v->args->scene, &err);
+  lm_scene *s = lm_scene_load(v->args->common.scene, &err);
   if (s && !lm_scene_upload(s, &err)) {
     lm_scene_destroy(s);
     s = NULL;
@@ -584,7 +567,7 @@ static void reload_scene(viewer *v) {
   v->camera_user = false; /* the file's camera again, as for a still scene; its animation drives it */
   fly_from_camera(v);
   pose(v);
-  lm_info("reloaded scene %s", v->args->scene);
+  lm_info("reloaded scene %s", v->args->common.scene);
   report_time(v, "scene reloaded");
 }
 
@@ -603,7 +586,7 @@ static bool handle_changes(viewer *v) {
     if (name[0] == '.') continue; /* editors' temporary files */
     if (has_suffix(name, ".lua")) script = true;
     else if (has_suffix(name, ".glsl") || has_suffix(name, ".frag") || has_suffix(name, ".vert")) shaders = true;
-    else if (lm_scene_is_gltf_name(v->args->scene) && !strcmp(name, strrchr(v->args->scene, '/') ? strrchr(v->args->scene, '/') + 1 : v->args->scene)) scene = true;
+    else if (lm_scene_is_gltf_name(v->args->common.scene) && !strcmp(name, strrchr(v->args->common.scene, '/') ? strrchr(v->args->common.scene, '/') + 1 : v->args->common.scene)) scene = true;
   }
   if (shaders) {
     lm_programs_invalidate();
@@ -831,8 +814,8 @@ static bool watch_dirs(viewer *v, lm_error *err) {
   if (lm_file_exists(dir) && !lm_watch_dir(v->watch, dir, err)) return false;
   lm_dirname(v->script, dir, sizeof dir);
   if (!lm_watch_dir(v->watch, dir, err)) return false;
-  if (lm_scene_is_gltf_name(v->args->scene)) {
-    lm_dirname(v->args->scene, dir, sizeof dir);
+  if (lm_scene_is_gltf_name(v->args->common.scene)) {
+    lm_dirname(v->args->common.scene, dir, sizeof dir);
     if (!lm_watch_dir(v->watch, dir, err)) return false;
   }
   return true;
@@ -865,21 +848,21 @@ static int run(viewer *v) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 1;
   }
-  if ((a->tech && !lm_pipeline_set_technique(v->pipeline, a->tech, &err)) || !apply_sets(v, v->pipeline, &err)) {
+  if ((a->common.tech && !lm_pipeline_set_technique(v->pipeline, a->common.tech, &err)) || !apply_sets(v, v->pipeline, &err)) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 2;
   }
-  v->scene = a->job_loaded ? a->job_loaded : lm_scene_load(a->scene, &err);
+  v->scene = a->job_loaded ? a->job_loaded : lm_scene_load(a->common.scene, &err);
   a->job_loaded = NULL;
   if (!v->scene) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 2;
   }
-  if (a->camera > 0 && a->camera >= v->scene->camera_count) {
-    lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a->camera, a->scene, v->scene->camera_count);
+  if (a->common.camera > 0 && a->common.camera >= v->scene->camera_count) {
+    lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a->common.camera, a->common.scene, v->scene->camera_count);
     return 2;
   }
-  v->camera = a->camera;
+  v->camera = a->common.camera;
   if (!find_animation(v, &err)) {
     lm_log(LM_LOG_ERROR, "--animation: %s", err.msg);
     return 2;
@@ -887,12 +870,12 @@ static int run(viewer *v) {
   v->time = a->time_given ? a->time : v->anim_range[0];
   v->font = lm_font_open(11, &err);
   if (!v->font || !watch_dirs(v, &err) ||
-      !(v->window = lm_window_create("limn view", a->width, a->height, &err))) {
+      !(v->window = lm_window_create("limn view", a->common.width, a->common.height, &err))) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 1;
   }
   lm_window_size(v->window, &v->width, &v->height);
-  if (v->width < 1 || v->height < 1) v->width = a->width, v->height = a->height;
+  if (v->width < 1 || v->height < 1) v->width = a->common.width, v->height = a->common.height;
   v->renderer = lm_renderer_create(&(lm_renderer_desc){.scene = v->scene, .pipeline = v->pipeline,
                                                        .width = v->width, .height = v->height,
                                                        .camera = v->camera}, &err);
@@ -923,7 +906,7 @@ static int run(viewer *v) {
   v->options_stale = true;
   fly_from_camera(v);
   lm_info("renderer: %s (%s); scene %s; script %s; technique %s; %dx%d", lm_gl_renderer(), lm_gl_version(),
-          a->scene, v->script, lm_pipeline_technique(v->pipeline), v->width, v->height);
+          a->common.scene, v->script, lm_pipeline_technique(v->pipeline), v->width, v->height);
   if (lm_scene_animated(v->scene))
     lm_info("animation '%s': keys %.6g..%.6g s%s", view_animation_name(v), v->anim_range[0], v->anim_range[1],
             v->camera_animated ? "; it moves the camera" : "");
@@ -986,7 +969,7 @@ int limn_view(int argc, char **argv) {
   signal(SIGTERM, on_signal);
   viewer v = {.args = &a, .inspect = -1, .inspect_logged = -1, .channel = 4, .overlay_on = a.overlay, .panel_on = a.panel,
               .range = {0, 1}, .edits = {.technique = -1, .inspect = -1}};
-  capture_resolve(a.script, v.script, sizeof v.script);
+  capture_resolve(a.common.script, v.script, sizeof v.script);
   rc = run(&v);
   viewer_free(&v);
   free_args(&a);

@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "render/render.h"
+#include "tools.h"
 #include "view_panel.h"
 #include "view_text.h"
 
@@ -18,10 +19,10 @@ typedef struct script_key {
 } script_key;
 
 typedef struct view_args {
-  const char *scene, *script, *tech, *screenshot, *capture_dir;
-  char *sets[MAX_SETS]; /* owned: toggles add and replace entries */
+  limn_common_args common; /* --scene, --script, --tech, --size, --camera; --set as given */
+  const char *screenshot, *capture_dir;
+  char *sets[MAX_SETS]; /* --set's, owned: toggles add and replace entries */
   int set_count;
-  int width, height, camera;
   const char *animation; /* NAME, INDEX or "all" */
   double time;           /* --time; with time_given */
   bool time_given;
