@@ -199,6 +199,9 @@ bool load_view_job(view_args *a) {
       sprintf(a->sets[i], "%s=%s", j->set_names[i], j->set_values[i]);
     }
     a->set_count += j->set_count;
+    /* Its views with a cached reference: the error against it while the camera is at one. */
+    find_places(a, j, views, count, jv->scene);
+    job_pose(j, jv);
     /* The scene as the job loaded it: its camera list's views are cameras of it. */
     a->job_loaded = j->scenes[jv->scene].scene;
     j->scenes[jv->scene].scene = NULL;
