@@ -12,7 +12,7 @@
 #include "view_panel.h"
 #include "view_text.h"
 
-enum { MAX_SETS = 64, MAX_SCRIPT_KEYS = 256, PANEL_TIMES = 64 };
+enum { MAX_SETS = 64, MAX_SCRIPT_KEYS = 256, PANEL_TIMES = 64, PANEL_EVERY = 8 };
 enum { ERROR_VIEW_OFF, ERROR_VIEW_REFERENCE, ERROR_VIEW_HEAT, ERROR_VIEWS };
 
 typedef struct script_key {
@@ -113,9 +113,9 @@ typedef struct viewer {
   bool options_stale;
   panel_edits edits;        /* the panel's last frame: applied before the next */
   char status[1200];        /* the panel's note: the job last written */
-  /* The panel's cost: its own milliseconds in its last frames (glFinish on
-   * both sides) and the frames' with it on and off, for the share the
-   * overlay prints. */
+  /* The panel's cost: its own milliseconds in its last timed frames (one in
+   * PANEL_EVERY, glFinish on both sides) and the frames' with it on and off,
+   * for the share the overlay prints. */
   double panel_times[PANEL_TIMES], frame_ms_sum[2];
   long panel_timed, frames_timed[2]; /* [0] panel off, [1] on */
   char panel_cost_text[200]; /* the panel's line of it */

@@ -315,9 +315,13 @@ static lm_texture draw_panel(viewer *v) {
   const lm_option_info *compare_option = NULL; /* the option the A/B sets apart, as that side has it */
   for (int i = 0; i < v->compare_option_count && v->compare_option[0]; i++)
     if (!strcmp(v->compare_options[i].name, v->compare_option)) compare_option = &v->compare_options[i];
-  /* The cost line changes once in PANEL_TIMES frames (after a first figure):
-   * a line changing every frame would draw the panel's image every frame. */
-  if (v->panel_timed == 3 || v->panel_timed % PANEL_TIMES == 0)
+  /* Its own time, one frame in PANEL_EVERY: the glFinish on both sides
+   * stalls llvmpipe's pipelining, a cost of the timing the other frames
+   * spare. The cost line changes once in PANEL_EVERY timed frames (after a
+   * first figure): a line changing every frame would draw the panel's image
+   * every frame. */
+  bool timed = v->frame % PANEL_EVERY == 0;
+  if (timed && (v->panel_timed == 3 || v->panel_timed % PANEL_EVERY == 0))
     panel_cost(v, v->panel_cost_text, sizeof v->panel_cost_text);
   /* The frame graph: passes with their targets as indices. */
   lm_graph *g = lm_renderer_graph(v->renderer);
@@ -350,11 +354,13 @@ static lm_texture draw_panel(viewer *v) {
                    .compare_technique = compare, .compare_on = v->compare_on, .compare_option = compare_option,
                    .reference = v->args->job ? v->reference_text : NULL, .reference_here = v->place_ready,
                    .error_view = v->error_view};
-  lm_finish();
+  if (timed) lm_finish();
   double t0 = lm_now_ms();
   lm_texture image = panel_frame(v->panel, &m, v->width, v->height, &v->edits);
-  lm_finish();
-  v->panel_times[v->panel_timed++ % PANEL_TIMES] = lm_now_ms() - t0;
+  if (timed) {
+    lm_finish();
+    v->panel_times[v->panel_timed++ % PANEL_TIMES] = lm_now_ms() - t0;
+  }
   free(passes);
   free(targets_of);
   free(target_names);

@@ -3,6 +3,8 @@
 // text that the viewer sets as --set would; nothing here keeps settings.
 #include "view_panel.h"
 
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
@@ -24,6 +26,8 @@ struct widget {
 
 struct lm_panel {
   ImGuiContext *context;
+  GLFWwindow *window;
+  double last_ms;          // the last frame's start, for ImGui's time step
   bool scripted;           // panel_set_mouse took over the mouse
   double mouse[2];
   bool mouse_down;
@@ -38,6 +42,30 @@ struct lm_panel {
   uint64_t drawn;                  // the draw lists' hash in `image`
 };
 
+// The mouse without the GLFW backend's per-frame queries: its NewFrame asks
+// the X server for the window's size twice, its focus and the cursor, and
+// sets the cursor's shape, every frame (4-5 ms a frame under Xvfb on a loaded
+// machine, most of the panel's cost). panel_frame takes the size from the
+// viewer, the buttons from GLFW's event state with a press shorter than a
+// frame kept by on_button, and the cursor from its motion events (these two
+// chained before the backend's callbacks, which feed keys, text and the
+// wheel as before). One panel per process: GLFW's callbacks carry no
+// pointer of ours.
+static GLFWmousebuttonfun chained_button;
+static GLFWcursorposfun chained_cursor;
+static bool pressed[ImGuiMouseButton_COUNT]; // a press since the last frame
+static double cursor[2];
+
+static void on_button(GLFWwindow *w, int button, int action, int mods) {
+  if (action == GLFW_PRESS && button >= 0 && button < ImGuiMouseButton_COUNT) pressed[button] = true;
+  if (chained_button) chained_button(w, button, action, mods);
+}
+
+static void on_cursor(GLFWwindow *w, double x, double y) {
+  cursor[0] = x, cursor[1] = y;
+  if (chained_cursor) chained_cursor(w, x, y);
+}
+
 lm_panel *panel_create(lm_window *w, lm_error *err) {
   IMGUI_CHECKVERSION();
   lm_panel *p = new lm_panel();
@@ -46,7 +74,8 @@ lm_panel *panel_create(lm_window *w, lm_error *err) {
   ImGui::StyleColorsDark();
   ImGui::GetStyle().Alpha = 0.92f;
   // The backends chain GLFW's callbacks: the viewer's key queue still gets every key.
-  bool glfw = ImGui_ImplGlfw_InitForOpenGL(static_cast<GLFWwindow *>(lm_window_handle(w)), true);
+  p->window = static_cast<GLFWwindow *>(lm_window_handle(w));
+  bool glfw = ImGui_ImplGlfw_InitForOpenGL(p->window, true);
   if (!glfw || !ImGui_ImplOpenGL3_Init("#version 410 core")) {
     lm_error_set(err, "the panel (Dear ImGui) could not start on this OpenGL context");
     if (glfw) ImGui_ImplGlfw_Shutdown();
@@ -54,12 +83,17 @@ lm_panel *panel_create(lm_window *w, lm_error *err) {
     delete p;
     return nullptr;
   }
+  chained_button = glfwSetMouseButtonCallback(p->window, on_button);
+  chained_cursor = glfwSetCursorPosCallback(p->window, on_cursor);
+  glfwGetCursorPos(p->window, &cursor[0], &cursor[1]); // until it moves
   return p;
 }
 
 void panel_destroy(lm_panel *p) {
   if (!p) return;
   lm_texture_destroy(&p->image);
+  glfwSetMouseButtonCallback(p->window, chained_button); // the backend's, which its shutdown restores in turn
+  glfwSetCursorPosCallback(p->window, chained_cursor);
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext(p->context);
@@ -403,11 +437,20 @@ lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height,
   *e = panel_edits{};
   e->technique = -1, e->inspect = -1, e->error_view = -1, e->compare_technique = -1, e->compare_pick = -1;
   ImGui_ImplOpenGL3_NewFrame();
-  ImGui_ImplGlfw_NewFrame();
   ImGuiIO &io = ImGui::GetIO();
+  double now = lm_now_ms();
+  io.DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
+  io.DeltaTime = p->last_ms > 0 ? static_cast<float>(std::fmax((now - p->last_ms) * 1e-3, 1e-4)) : 1.0f / 60.0f;
+  p->last_ms = now;
   if (p->scripted) {
     io.MousePos = ImVec2(static_cast<float>(p->mouse[0]), static_cast<float>(p->mouse[1]));
     io.MouseDown[0] = p->mouse_down;
+  } else {
+    io.MousePos = ImVec2(static_cast<float>(cursor[0]), static_cast<float>(cursor[1]));
+    for (int i = 0; i < ImGuiMouseButton_COUNT; i++) {
+      io.MouseDown[i] = pressed[i] || glfwGetMouseButton(p->window, i) == GLFW_PRESS;
+      pressed[i] = false;
+    }
   }
   ImGui::NewFrame();
   float w = std::fmin(320.0f, 0.45f * static_cast<float>(width));
