@@ -374,14 +374,14 @@ static void compare_section(lm_panel *p, const panel_model *m, panel_edits *e) {
   if (!open) return;
   bool on = m->compare_on;
   if (m->compare_technique >= 0 && ImGui::Checkbox("wipe (B)", &on)) e->compare_toggle = true;
-  const char *tech = m->compare_technique >= 0 && m->compare_technique < m->technique_count
-                         ? m->techniques[m->compare_technique] : "none";
-  if (ImGui::BeginCombo("B technique", tech)) {
-    for (int i = 0; i < m->technique_count; i++)
+  ImGui::TextDisabled("right of the line:");
+  if (ImGui::BeginListBox("##B technique", ImVec2(-FLT_MIN, 4.5f * ImGui::GetTextLineHeightWithSpacing()))) {
+    for (int i = 0; i < m->technique_count; i++) {
       if (ImGui::Selectable(m->techniques[i], i == m->compare_technique)) e->compare_technique = i;
-    ImGui::EndCombo();
+      p->controls.push_back(last_item((std::string("ab=") + m->techniques[i]).c_str(), "list", "A/B"));
+    }
+    ImGui::EndListBox();
   }
-  p->controls.push_back(last_item("ab-technique", "combo", "A/B"));
   if (m->compare_technique < 0) return;
   if (ImGui::BeginCombo("B differs in", m->compare_option ? m->compare_option->name : "nothing")) {
     for (int i = 0; i < m->option_count; i++)

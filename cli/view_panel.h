@@ -88,8 +88,8 @@ bool panel_wants_keyboard(const lm_panel *p);
  * GROUP X Y W H" (the rectangle 0 0 0 0 where a closed group hides it),
  * then "panel technique NAME X Y W H" per technique, "panel control NAME X Y
  * W H" for the buttons, the time slider and the frame graph's header ("job",
- * "play", "time", "graph", the A/B section's "ab", "ab-technique",
- * "ab-option", "ab-value", and the reference's "error") and, while the
+ * "play", "time", "graph", the A/B section's "ab", "ab=TECHNIQUE" for each
+ * of its list, "ab-option", "ab-value", and the reference's "error") and, while the
  * frame graph is open, "panel target NAME X Y W H" for each target button of
  * each pass (0 0 0 0 where it is scrolled out of sight). */
 void panel_list_widgets(const lm_panel *p, FILE *out);

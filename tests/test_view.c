@@ -1438,6 +1438,54 @@ static void reference_error_and_wipe(void **state) {
   assert_true(file_has(log, "no reference here"));
 }
 
+/* The panel's A/B: opening it and picking dl+esm in its list starts the
+ * wipe's right side live; with the panel then closed (M) the left half is
+ * dl's frame and the right half dl+esm's. */
+static void panel_picks_compare_technique(void **state) {
+  (void)state;
+  char log[512], keys[512], shot[512];
+  log_path(log, "panel_ab");
+  pid_t pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "6",
+                         "--script-keys", "5:widgets", NULL);
+  assert_int_equal(wait_exit(pid, 30000), 0);
+  double header[4], item[4];
+  find_control(log, "ab", header);
+  snprintf(keys, sizeof keys, "6:mouse=%d;%d,7:button=down,8:button=up,11:widgets", (int)(header[0] + header[2] / 2),
+           (int)(header[1] + header[3] / 2));
+  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "12", "--script-keys",
+                   keys, NULL);
+  assert_int_equal(wait_exit(pid, 30000), 0);
+  find_control(log, "ab=dl+esm", item);
+  snprintf(keys + strlen(keys), sizeof keys - strlen(keys), ",12:mouse=%d;%d,13:button=down,14:button=up,16:M",
+           (int)(item[0] + item[2] / 2), (int)(item[1] + item[3] / 2));
+  shot_path(shot, "panel_ab.png");
+  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--overlay", "off", "--exit-after",
+                   "20", "--screenshot", shot, "--script-keys", keys, NULL);
+  int rc = wait_exit(pid, 60000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  assert_true(file_has(log, "A/B: dl+esm on the right"));
+  char left_shot[512], right_shot[512];
+  shot_path(left_shot, "ab_dl.png");
+  shot_path(right_shot, "ab_dlesm.png");
+  assert_int_equal(wait_exit(spawn_view(log, "--tech", "dl", "--size", "384x288", "--overlay", "off", "--exit-after",
+                                        "8", "--screenshot", left_shot, NULL), 60000), 0);
+  assert_int_equal(wait_exit(spawn_view(log, "--tech", "dl+esm", "--size", "384x288", "--overlay", "off",
+                                        "--exit-after", "8", "--screenshot", right_shot, NULL), 60000), 0);
+  lm_image wipe, left, right;
+  load("panel_ab.png", &wipe);
+  load("ab_dl.png", &left);
+  load("ab_dlesm.png", &right);
+  double apart = band_diff(&left, &right, 200, 384), wl = band_diff(&wipe, &left, 0, 184),
+         wr = band_diff(&wipe, &right, 200, 384);
+  fprintf(stderr, "panel A/B: dl and dl+esm apart %.4f right of the line; wipe left %.4f, right %.4f\n", apart, wl, wr);
+  assert_true(apart > 0.005);
+  assert_true(wl < 0.002 && wr < 0.002);
+  lm_image_free(&wipe);
+  lm_image_free(&left);
+  lm_image_free(&right);
+}
+
 /* An argument runs only the cases it matches (cmocka's filter: "reference_*"). */
 int main(int argc, char **argv) {
   const struct CMUnitTest tests[] = {
@@ -1462,6 +1510,7 @@ int main(int argc, char **argv) {
       cmocka_unit_test_teardown(panel_graph_button_inspects_target, stop_leftover),
       cmocka_unit_test_teardown(compare_wipe_shows_both_sides, stop_leftover),
       cmocka_unit_test_teardown(reference_error_and_wipe, stop_leftover),
+      cmocka_unit_test_teardown(panel_picks_compare_technique, stop_leftover),
   };
   if (argc > 1) cmocka_set_test_filter(argv[1]);
   return cmocka_run_group_tests(tests, setup, teardown);
