@@ -1152,6 +1152,34 @@ static void find_control(const char *log, const char *name, double rect[4]) {
   free(s);
 }
 
+/* A 384x288 dl run with the panel on, `frames` frames long, pressing keys. */
+static void panel_run(const char *log, const char *frames, const char *keys) {
+  pid_t pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", frames,
+                         "--script-keys", keys, NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+}
+
+/* Appends the keys that click the middle of rect: move at `frame`, press and release on the next two. */
+static void click_keys(char *keys, size_t cap, int frame, const double rect[4]) {
+  size_t n = strlen(keys);
+  snprintf(keys + n, cap - n, "%s%d:mouse=%d;%d,%d:button=down,%d:button=up", n ? "," : "", frame,
+           (int)(rect[0] + rect[2] / 2), (int)(rect[1] + rect[3] / 2), frame + 1, frame + 2);
+}
+
+/* Opens the panel's section `header` (a control) at frame 6; keys gets the
+ * click and a widgets listing at frame 11, whose lines the run leaves in log. */
+static void open_section(const char *log, const char *header, char *keys, size_t cap) {
+  double rect[4];
+  panel_run(log, "6", "5:widgets");
+  find_control(log, header, rect);
+  keys[0] = '\0';
+  click_keys(keys, cap, 6, rect);
+  strncat(keys, ",11:widgets", cap - strlen(keys) - 1);
+  panel_run(log, "12", keys);
+}
+
 /* The panel's time controls: its button pauses an animation that plays, and
  * dragging its slider to the left end scrubs to the animation's first key. */
 static void panel_plays_pauses_and_scrubs(void **state) {
@@ -1200,29 +1228,16 @@ static void panel_graph_button_inspects_target(void **state) {
   (void)state;
   char log[512], keys[512];
   log_path(log, "panel_graph");
-  pid_t pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "4",
-                         "--script-keys", "3:widgets", NULL);
-  assert_int_equal(wait_exit(pid, 30000), 0);
-  double header[4], button[4];
-  find_control(log, "graph", header);
-  snprintf(keys, sizeof keys, "3:mouse=%d;%d,4:button=down,5:button=up,7:widgets", (int)(header[0] + header[2] / 2),
-           (int)(header[1] + header[3] / 2));
-  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "8", "--script-keys",
-                   keys, NULL);
-  assert_int_equal(wait_exit(pid, 30000), 0);
+  open_section(log, "graph", keys, sizeof keys);
+  double button[4];
   char *s = read_text(log), *line = strstr(s, "panel target gbuffer.clr ");
   if (!line) print_log(log);
   assert_non_null(line);
   assert_int_equal(sscanf(line, "panel target gbuffer.clr %lf %lf %lf %lf", &button[0], &button[1], &button[2],
                           &button[3]), 4);
   free(s);
-  snprintf(keys + strlen(keys), sizeof keys - strlen(keys), ",8:mouse=%d;%d,9:button=down,10:button=up",
-           (int)(button[0] + button[2] / 2), (int)(button[1] + button[3] / 2));
-  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "13", "--script-keys",
-                   keys, NULL);
-  int rc = wait_exit(pid, 30000);
-  if (rc) print_log(log);
-  assert_int_equal(rc, 0);
+  click_keys(keys, sizeof keys, 12, button);
+  panel_run(log, "17", keys);
   assert_true(file_has(log, "inspecting 'gbuffer.clr' rgba8"));
 }
 
@@ -1445,22 +1460,14 @@ static void panel_picks_compare_technique(void **state) {
   (void)state;
   char log[512], keys[512], shot[512];
   log_path(log, "panel_ab");
-  pid_t pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "6",
-                         "--script-keys", "5:widgets", NULL);
-  assert_int_equal(wait_exit(pid, 30000), 0);
-  double header[4], item[4];
-  find_control(log, "ab", header);
-  snprintf(keys, sizeof keys, "6:mouse=%d;%d,7:button=down,8:button=up,11:widgets", (int)(header[0] + header[2] / 2),
-           (int)(header[1] + header[3] / 2));
-  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "12", "--script-keys",
-                   keys, NULL);
-  assert_int_equal(wait_exit(pid, 30000), 0);
+  open_section(log, "ab", keys, sizeof keys);
+  double item[4];
   find_control(log, "ab=dl+esm", item);
-  snprintf(keys + strlen(keys), sizeof keys - strlen(keys), ",12:mouse=%d;%d,13:button=down,14:button=up,16:M",
-           (int)(item[0] + item[2] / 2), (int)(item[1] + item[3] / 2));
+  click_keys(keys, sizeof keys, 12, item);
+  strcat(keys, ",16:M");
   shot_path(shot, "panel_ab.png");
-  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--overlay", "off", "--exit-after",
-                   "20", "--screenshot", shot, "--script-keys", keys, NULL);
+  pid_t pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--overlay", "off", "--exit-after",
+                         "20", "--screenshot", shot, "--script-keys", keys, NULL);
   int rc = wait_exit(pid, 60000);
   if (rc) print_log(log);
   assert_int_equal(rc, 0);
