@@ -137,6 +137,31 @@ bool limn_parse_shard(const char *s, int *shard, int *shards, char *msg, size_t 
   return true;
 }
 
+int limn_common_flag(const char *cmd, int c, char **argv, limn_common_args *a) {
+  const char *arg = optarg;
+  switch (c) {
+  case 's': a->scene = arg; return 0;
+  case 'p': a->script = arg; return 0;
+  case 't': a->tech = arg; return 0;
+  case 'D':
+    if (!strchr(arg, '=') || arg[0] == '=') return limn_usage_error(cmd, "--set wants NAME=VALUE, not '%s'", arg);
+    if (a->set_count == LIMN_MAX_SETS) return limn_usage_error(cmd, "%s", "at most 64 --set flags");
+    a->sets[a->set_count++] = arg;
+    return 0;
+  case 'z':
+    if (!limn_parse_size(arg, &a->width, &a->height))
+      return limn_usage_error(cmd, "--size wants WxH with both in 1..65536, not '%s'", arg);
+    return 0;
+  case 'c':
+    if (a->camera_auto ? !limn_parse_camera(arg, &a->camera) : !limn_parse_int(arg, 0, 1 << 20, &a->camera))
+      return limn_usage_error(cmd, a->camera_auto ? "--camera wants an index or auto, not '%s'"
+                                                  : "--camera wants an index, not '%s'", arg);
+    return 0;
+  case ':': return limn_usage_error(cmd, "%s needs a value", argv[optind - 1]);
+  default: return limn_usage_error(cmd, "unknown flag '%s'", argv[optind - 1]);
+  }
+}
+
 void limn_json_append(lm_buf *b, const char *s) {
   lm_buf_append(b, "\"", 1);
   for (; *s; s++) {

@@ -10,6 +10,7 @@
 #include <string.h>
 #include <sys/resource.h>
 
+#include "capture_render.h"
 #include "render/render.h"
 #include "scene/gltf.h"
 #include "trace/trace.h"
@@ -149,9 +150,7 @@ typedef struct motion {
 
 typedef struct bench {
   int sizes[MAX_SIZES][2], size_count, frames, warmup;
-  const char *scene, *script, *tech;
-  const char *sets[64];
-  int set_count;
+  limn_common_args common; /* --scene, --script, --tech, --set (--sizes is bench's own) */
   char vary_name[128];
   char vary_text[MAX_SIZES][64];
   double vary[MAX_SIZES];
@@ -184,15 +183,15 @@ typedef struct bench {
 static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("bench", fmt, arg); }
 
 static int parse_args(int argc, char **argv, bench *b) {
-  *b = (bench){.frames = 5, .warmup = 2, .scene = "cornell", .light_reach = 0.08, .trace_threads = 2};
+  *b = (bench){.frames = 5, .warmup = 2, .common = {.scene = "cornell"}, .light_reach = 0.08, .trace_threads = 2};
   const char *sizes = "64x48,128x96,256x192";
   static const struct option opts[] = {
       {"scene", required_argument, 0, 's'}, {"script", required_argument, 0, 'p'},
-      {"tech", required_argument, 0, 't'},  {"sizes", required_argument, 0, 'z'},
+      {"tech", required_argument, 0, 't'},  {"sizes", required_argument, 0, 'Z'},
       {"frames", required_argument, 0, 'n'}, {"warmup", required_argument, 0, 'w'},
       {"clock", required_argument, 0, 'k'}, {"json", no_argument, 0, 'j'},
       {"vary", required_argument, 0, 'V'},  {"help", no_argument, 0, 'h'},
-      {"set", required_argument, 0, 'S'},   {"lights", required_argument, 0, 'L'}, {"light-reach", required_argument, 0, 'R'},
+      {"set", required_argument, 0, 'D'},   {"lights", required_argument, 0, 'L'}, {"light-reach", required_argument, 0, 'R'},
       {"trace", no_argument, 0, 'r'},       {"trace-threads", required_argument, 0, 'T'},
       {"motion", no_argument, 0, 'M'},      {"orbit", required_argument, 0, 'O'},
       {"time", required_argument, 0, 'I'},  {"fps", required_argument, 0, 'F'},
@@ -206,10 +205,7 @@ static int parse_args(int argc, char **argv, bench *b) {
   int c;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
     switch (c) {
-    case 's': b->scene = optarg; break;
-    case 'p': b->script = optarg; break;
-    case 't': b->tech = optarg; break;
-    case 'z': sizes = optarg; break;
+    case 'Z': sizes = optarg; break;
     case 'n':
       if (!limn_parse_int(optarg, 1, 10000, &b->frames)) return usage_error("--frames wants 1..10000, not '%s'", optarg);
       break;
@@ -243,11 +239,6 @@ static int parse_args(int argc, char **argv, bench *b) {
       }
       break;
     }
-    case 'S':
-      if (!strchr(optarg, '=') || optarg[0] == '=') return usage_error("--set wants NAME=VALUE, not '%s'", optarg);
-      if (b->set_count == 64) return usage_error("%s", "at most 64 --set");
-      b->sets[b->set_count++] = optarg;
-      break;
     case 'L': {
       char values[1024];
       snprintf(values, sizeof values, "%s", optarg);
@@ -298,8 +289,8 @@ static int parse_args(int argc, char **argv, bench *b) {
       m->on = true;
       break;
     case 'h': fputs(bench_usage, stdout); return -1;
-    case ':': return usage_error("%s needs a value", argv[optind - 1]);
-    default: return usage_error("unknown flag '%s'", argv[optind - 1]);
+    default:
+      if (limn_common_flag("bench", c, argv, &b->common)) return 2;
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
@@ -690,19 +681,14 @@ static void print_tables(const bench *b, lm_clock clock) {
  * technique (the user's flags). */
 static lm_pipeline *load_pipeline(const bench *b, int *rc, lm_error *err) {
   char script[2048];
-  if (b->script) snprintf(script, sizeof script, "%s", b->script);
+  if (b->common.script) snprintf(script, sizeof script, "%s", b->common.script);
   else snprintf(script, sizeof script, "%s/scripts/pp.lua", lm_root_dir());
   *rc = 1;
   lm_pipeline *pipe = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, err);
   if (!pipe) return NULL;
   bool ok = true;
-  for (int i = 0; i < b->set_count && ok; i++) {
-    char name[256];
-    const char *eq = strchr(b->sets[i], '=');
-    snprintf(name, sizeof name, "%.*s", (int)(eq - b->sets[i]), b->sets[i]);
-    ok = lm_pipeline_set_option(pipe, name, eq + 1, err);
-  }
-  if (!ok || (b->tech && !lm_pipeline_set_technique(pipe, b->tech, err))) {
+  for (int i = 0; i < b->common.set_count && ok; i++) ok = capture_set_option(pipe, b->common.sets[i], err);
+  if (!ok || (b->common.tech && !lm_pipeline_set_technique(pipe, b->common.tech, err))) {
     lm_pipeline_destroy(pipe);
     *rc = 2;
     return NULL;
@@ -778,7 +764,7 @@ static bool caches_off(lm_pipeline *p, char *off, size_t cap, lm_error *err) {
 static bool stream_open(bench *b, int k, stream *s, lm_error *err) {
   motion *m = &b->motion;
   int rc;
-  s->scene = lm_scene_load(b->scene, err);
+  s->scene = lm_scene_load(b->common.scene, err);
   s->pipe = s->scene ? load_pipeline(b, &rc, err) : NULL;
   if (!s->pipe || !lm_scene_upload(s->scene, err)) return false;
   if (k == STREAM_ALONE && !caches_off(s->pipe, m->caches_off, sizeof m->caches_off, err)) return false;
@@ -1222,7 +1208,7 @@ int limn_bench(int argc, char **argv) {
     return prc;
   }
   double t0 = lm_now_ms();
-  lm_scene *scene = lm_scene_load(b.scene, &err);
+  lm_scene *scene = lm_scene_load(b.common.scene, &err);
   b.load_ms = lm_now_ms() - t0;
   if (!scene) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);

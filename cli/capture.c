@@ -72,7 +72,8 @@ static const char capture_usage[] =
     "or animation too).\n";
 
 typedef struct capture_args {
-  const char *scene, *script, *tech, *egl, *job;
+  limn_common_args common; /* --scene, --script, --tech, --set, --size, --camera */
+  const char *egl, *job;
   int shard, shards;
   char shard_from[256]; /* where --shard auto found the shard */
   bool force;
@@ -81,9 +82,7 @@ typedef struct capture_args {
   int output_count;
   const char *videos[16]; /* .mp4, .webm */
   int video_count;
-  const char *sets[64];
-  int set_count;
-  int width, height, frames, warmup, camera;
+  int frames, warmup;
   const char *animation, *time_flag;
   double time_start, time_stop, fps; /* fps 0: one frame at time_start */
   int frame_count;
@@ -182,8 +181,8 @@ static bool video_close(video *v, bool ok, lm_error *err) {
 
 /* Returns 0 to go on, else the exit code. */
 static int parse_args(int argc, char **argv, capture_args *a) {
-  *a = (capture_args){.scene = "cornell", .script = NULL, .egl = "auto", .width = 256,
-                      .height = 192, .frames = 1};
+  *a = (capture_args){.common = {.scene = "cornell", .width = 256, .height = 192, .camera_auto = true},
+                      .egl = "auto", .frames = 1};
   static const struct option opts[] = {
       {"scene", required_argument, 0, 's'},  {"script", required_argument, 0, 'p'},
       {"tech", required_argument, 0, 't'},   {"set", required_argument, 0, 'D'},
@@ -206,26 +205,11 @@ static int parse_args(int argc, char **argv, capture_args *a) {
     for (const struct option *o = opts; o->name && c && strchr("sptznwcTFA", c); o++)
       if (o->val == c) a->single_flag = o->name;
     switch (c) {
-    case 's': a->scene = optarg; break;
-    case 'p': a->script = optarg; break;
-    case 't': a->tech = optarg; break;
-    case 'D':
-      if (!strchr(optarg, '=') || optarg[0] == '=') return usage_error("--set wants NAME=VALUE, not '%s'", optarg);
-      if (a->set_count == 64) return usage_error("%s", "at most 64 --set flags");
-      a->sets[a->set_count++] = optarg;
-      break;
-    case 'z':
-      if (!limn_parse_size(optarg, &a->width, &a->height))
-        return usage_error("--size wants WxH with both in 1..65536, not '%s'", optarg);
-      break;
     case 'n':
       if (!limn_parse_int(optarg, 1, 100000, &a->frames)) return usage_error("--frames wants 1..100000, not '%s'", optarg);
       break;
     case 'w':
       if (!limn_parse_int(optarg, 0, 100000, &a->warmup)) return usage_error("--warmup wants 0..100000, not '%s'", optarg);
-      break;
-    case 'c':
-      if (!limn_parse_camera(optarg, &a->camera)) return usage_error("--camera wants an index or auto, not '%s'", optarg);
       break;
     case 'o': {
       bool linear;
@@ -270,8 +254,8 @@ static int parse_args(int argc, char **argv, capture_args *a) {
     case 'v': a->verbose = true; break;
     case 'N': a->check_nan = true; break;
     case 'h': printf(capture_usage, lm_scene_builtin_list()); return -1;
-    case ':': return usage_error("%s needs a value", argv[optind - 1]);
-    default: return usage_error("unknown flag '%s'", argv[optind - 1]);
+    default:
+      if (limn_common_flag("capture", c, argv, &a->common)) return 2;
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
@@ -328,17 +312,18 @@ int limn_capture(int argc, char **argv) {
   capture_args a;
   int rc = parse_args(argc, argv, &a);
   if (rc) return rc < 0 ? 0 : rc;
+  limn_common_args *o = &a.common;
   if (a.verbose) lm_log_set_level(LM_LOG_DEBUG);
   if (a.quiet) lm_log_set_level(LM_LOG_WARN);
   if (a.shard_from[0]) lm_info("shard %d/%d from %s", a.shard, a.shards, a.shard_from);
   if (a.job)
-    return capture_job_run(&(capture_job_args){.path = a.job, .sets = a.sets, .set_count = a.set_count,
+    return capture_job_run(&(capture_job_args){.path = a.job, .sets = o->sets, .set_count = o->set_count,
                                                .shard = a.shard, .shards = a.shards ? a.shards : 1,
                                                .force = a.force, .quiet = a.quiet, .verbose = a.verbose,
                                                .egl = a.egl, .clock = a.clock});
 
   char script[2048];
-  capture_resolve(a.script, script, sizeof script);
+  capture_resolve(o->script, script, sizeof script);
   lm_error err;
   lm_pipeline *pipeline = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, &err);
   if (!pipeline) {
@@ -346,13 +331,9 @@ int limn_capture(int argc, char **argv) {
     return 1;
   }
   rc = 0;
-  if (a.tech && !lm_pipeline_set_technique(pipeline, a.tech, &err)) rc = 2;
-  for (int i = 0; i < a.set_count && !rc; i++) {
-    char name[256];
-    const char *eq = strchr(a.sets[i], '=');
-    snprintf(name, sizeof name, "%.*s", (int)(eq - a.sets[i]), a.sets[i]);
-    if (!lm_pipeline_set_option(pipeline, name, eq + 1, &err)) rc = 2;
-  }
+  if (o->tech && !lm_pipeline_set_technique(pipeline, o->tech, &err)) rc = 2;
+  for (int i = 0; i < o->set_count && !rc; i++)
+    if (!capture_set_option(pipeline, o->sets[i], &err)) rc = 2;
   if (rc) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     lm_pipeline_destroy(pipeline);
@@ -370,7 +351,7 @@ int limn_capture(int argc, char **argv) {
     return 0;
   }
 
-  lm_scene *scene = lm_scene_load(a.scene, &err);
+  lm_scene *scene = lm_scene_load(o->scene, &err);
   if (!scene) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     lm_pipeline_destroy(pipeline);
@@ -383,9 +364,9 @@ int limn_capture(int argc, char **argv) {
     lm_pipeline_destroy(pipeline);
     return 2;
   }
-  a.camera = limn_camera_resolve(scene, a.camera, a.width, a.height);
-  if (a.camera > 0 && a.camera >= scene->camera_count) {
-    lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a.camera, a.scene, scene->camera_count);
+  o->camera = limn_camera_resolve(scene, o->camera, o->width, o->height);
+  if (o->camera > 0 && o->camera >= scene->camera_count) {
+    lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", o->camera, o->scene, scene->camera_count);
     lm_scene_destroy(scene);
     lm_pipeline_destroy(pipeline);
     return 2;
@@ -403,26 +384,26 @@ int limn_capture(int argc, char **argv) {
     any_linear |= l;
   }
   lm_renderer *r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = pipeline,
-                                                          .width = a.width, .height = a.height,
-                                                          .camera = a.camera, .clock = a.clock,
+                                                          .width = o->width, .height = o->height,
+                                                          .camera = o->camera, .clock = a.clock,
                                                           .linear_output = any_linear,
                                                           .check_finite = a.check_nan}, &err);
   bool ok = r != NULL;
   if (ok && !a.quiet)
     lm_info("renderer: %s (%s, %s); scene %s; script %s; technique %s; %dx%d", lm_gl_renderer(),
-            lm_gl_version(), lm_context_platform(), a.scene, script, lm_pipeline_technique(pipeline),
-            a.width, a.height);
+            lm_gl_version(), lm_context_platform(), o->scene, script, lm_pipeline_technique(pipeline),
+            o->width, o->height);
   capture_result res = {0};
   /* A sequence renders its frames through one renderer, so that temporal
    * histories carry from frame to frame as they would live. */
   char names[16][2048];
   const char *outputs[16];
   video videos[16];
-  unsigned char *rgb = a.video_count ? lm_alloc((size_t)a.width * a.height * 3) : NULL;
+  unsigned char *rgb = a.video_count ? lm_alloc((size_t)o->width * o->height * 3) : NULL;
   int opened = 0;
   if (a.video_count) signal(SIGPIPE, SIG_IGN); /* a failed ffmpeg is an error from write, not a kill */
   for (int i = 0; i < a.video_count && ok; i++)
-    if ((ok = video_open(&videos[i], a.videos[i], a.width, a.height, a.fps, &err))) opened++;
+    if ((ok = video_open(&videos[i], a.videos[i], o->width, o->height, a.fps, &err))) opened++;
   for (int k = 0; k < a.frame_count && ok; k++) {
     double t = a.frame_count > 1 ? a.time_start + k / a.fps : a.time_start;
     if (a.time_flag || a.animation) {
@@ -434,13 +415,13 @@ int limn_capture(int argc, char **argv) {
       frame_name(a.outputs[i], k, t, names[i], sizeof names[i]);
       outputs[i] = names[i];
     }
-    capture_view v = {.camera = a.camera, .width = a.width, .height = a.height, .frames = a.frames,
+    capture_view v = {.camera = o->camera, .width = o->width, .height = o->height, .frames = a.frames,
                       .warmup = k ? 0 : a.warmup, .outputs = outputs, .output_count = a.output_count,
                       .quiet = a.quiet, .continues = k > 0};
     capture_result_free(&res);
     ok = capture_render_write(r, &v, &res, &err);
     if (ok && a.video_count) ok = lm_renderer_read(r, false, rgb, &err);
-    for (int i = 0; i < a.video_count && ok; i++) ok = video_write(&videos[i], rgb, (size_t)a.width * a.height * 3, &err);
+    for (int i = 0; i < a.video_count && ok; i++) ok = video_write(&videos[i], rgb, (size_t)o->width * o->height * 3, &err);
     if (!ok && a.frame_count > 1) lm_error_prefix(&err, "frame %d at %.3f s", k, t);
   }
   for (int i = 0; i < opened; i++) {

@@ -118,3 +118,13 @@ void capture_result_free(capture_result *res) {
   *res = (capture_result){0};
 }
 
+bool capture_set_option(lm_pipeline *p, const char *name_value, lm_error *err) {
+  char name[256];
+  const char *eq = strchr(name_value, '=');
+  if (!eq) {
+    lm_error_set(err, "'%s' is not NAME=VALUE", name_value);
+    return false;
+  }
+  snprintf(name, sizeof name, "%.*s", (int)(eq - name_value), name_value);
+  return lm_pipeline_set_option(p, name, eq + 1, err);
+}

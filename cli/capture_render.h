@@ -39,6 +39,8 @@ bool capture_render_write(lm_renderer *r, const capture_view *v, capture_result 
 void capture_result_free(capture_result *res);
 /* True for an image extension capture writes; *linear for float formats (EXR, HDR). */
 bool capture_known_extension(const char *path, bool *linear);
+/* Sets NAME=VALUE, as --set and a job's `set` give an option, on p. */
+bool capture_set_option(lm_pipeline *p, const char *name_value, lm_error *err);
 /* A relative path that does not exist here is looked up under the engine's root. */
 void capture_resolve(const char *given, char *out, size_t cap);
 

@@ -35,12 +35,10 @@ static const char graph_usage[] =
     "\n"
     "exit codes: 0 written, 1 failed (script, shader or GL error), 2 bad usage.\n";
 
-enum { MAX_GRAPH_SETS = 64 };
-
 typedef struct graph_args {
-  const char *scene, *script, *tech, *output;
-  const char *sets[MAX_GRAPH_SETS];
-  int set_count, width, height, camera, frames;
+  limn_common_args common; /* --scene, --script, --tech, --set, --size, --camera */
+  const char *output;
+  int frames;
   bool dot, quiet;
 } graph_args;
 
@@ -48,7 +46,8 @@ static int usage_error(const char *fmt, const char *arg) { return limn_usage_err
 
 /* Returns 0 to go on, -1 when done (help), else the exit code. */
 static int parse_args(int argc, char **argv, graph_args *a) {
-  *a = (graph_args){.scene = "cornell", .script = "scripts/pp.lua", .width = 256, .height = 192, .frames = 2};
+  *a = (graph_args){.common = {.scene = "cornell", .script = "scripts/pp.lua", .width = 256, .height = 192},
+                    .frames = 2};
   static const struct option opts[] = {
       {"scene", required_argument, 0, 's'}, {"script", required_argument, 0, 'p'},
       {"tech", required_argument, 0, 't'},  {"set", required_argument, 0, 'D'},
@@ -61,21 +60,6 @@ static int parse_args(int argc, char **argv, graph_args *a) {
   int c;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
     switch (c) {
-    case 's': a->scene = optarg; break;
-    case 'p': a->script = optarg; break;
-    case 't': a->tech = optarg; break;
-    case 'D':
-      if (!strchr(optarg, '=') || optarg[0] == '=') return usage_error("--set wants NAME=VALUE, not '%s'", optarg);
-      if (a->set_count == MAX_GRAPH_SETS) return usage_error("%s", "at most 64 --set flags");
-      a->sets[a->set_count++] = optarg;
-      break;
-    case 'z':
-      if (!limn_parse_size(optarg, &a->width, &a->height))
-        return usage_error("--size wants WxH with both in 1..65536, not '%s'", optarg);
-      break;
-    case 'c':
-      if (!limn_parse_int(optarg, 0, 1 << 20, &a->camera)) return usage_error("--camera wants an index, not '%s'", optarg);
-      break;
     case 'n':
       if (!limn_parse_int(optarg, 1, 1000, &a->frames)) return usage_error("--frames wants 1..1000, not '%s'", optarg);
       break;
@@ -89,8 +73,8 @@ static int parse_args(int argc, char **argv, graph_args *a) {
     }
     case 'q': a->quiet = true; break;
     case 'h': fputs(graph_usage, stdout); return -1;
-    case ':': return usage_error("%s needs a value", argv[optind - 1]);
-    default: return usage_error("unknown flag '%s'", argv[optind - 1]);
+    default:
+      if (limn_common_flag("graph", c, argv, &a->common)) return 2;
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
@@ -204,32 +188,29 @@ int limn_graph(int argc, char **argv) {
   graph_args a;
   int rc = parse_args(argc, argv, &a);
   if (rc) return rc < 0 ? 0 : rc;
+  const limn_common_args *o = &a.common;
   if (a.quiet) lm_log_set_level(LM_LOG_WARN);
   char script[2048];
-  capture_resolve(a.script, script, sizeof script);
+  capture_resolve(o->script, script, sizeof script);
   lm_error err;
   lm_pipeline *pipeline = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, &err);
   if (!pipeline) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 1;
   }
-  if (a.tech && !lm_pipeline_set_technique(pipeline, a.tech, &err)) rc = 2;
-  for (int i = 0; i < a.set_count && !rc; i++) {
-    char name[256];
-    const char *eq = strchr(a.sets[i], '=');
-    snprintf(name, sizeof name, "%.*s", (int)(eq - a.sets[i]), a.sets[i]);
-    if (!lm_pipeline_set_option(pipeline, name, eq + 1, &err)) rc = 2;
-  }
-  lm_scene *scene = rc ? NULL : lm_scene_load(a.scene, &err);
+  if (o->tech && !lm_pipeline_set_technique(pipeline, o->tech, &err)) rc = 2;
+  for (int i = 0; i < o->set_count && !rc; i++)
+    if (!capture_set_option(pipeline, o->sets[i], &err)) rc = 2;
+  lm_scene *scene = rc ? NULL : lm_scene_load(o->scene, &err);
   if (!rc && !scene) rc = 2;
-  if (!rc && a.camera > 0 && a.camera >= scene->camera_count) {
-    lm_error_set(&err, "--camera %d: scene '%s' has %d camera(s)", a.camera, a.scene, scene->camera_count);
+  if (!rc && o->camera > 0 && o->camera >= scene->camera_count) {
+    lm_error_set(&err, "--camera %d: scene '%s' has %d camera(s)", o->camera, o->scene, scene->camera_count);
     rc = 2;
   }
   if (!rc && !lm_context_create_headless(&(lm_context_desc){0}, &err)) rc = 1;
   lm_renderer *r = NULL;
-  if (!rc && !(r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = pipeline, .width = a.width,
-                                                           .height = a.height, .camera = a.camera}, &err)))
+  if (!rc && !(r = lm_renderer_create(&(lm_renderer_desc){.scene = scene, .pipeline = pipeline, .width = o->width,
+                                                           .height = o->height, .camera = o->camera}, &err)))
     rc = 1;
   for (int i = 0; i < a.frames && !rc; i++)
     if (!lm_renderer_frame(r, &err)) rc = 1;
@@ -250,7 +231,7 @@ int limn_graph(int argc, char **argv) {
       rc = 1;
     } else if (!a.quiet) {
       lm_info("wrote %s: %d passes of %s on %s at %dx%d", a.output, lm_graph_pass_count(lm_renderer_graph(r)),
-              lm_pipeline_technique(pipeline), a.scene, a.width, a.height);
+              lm_pipeline_technique(pipeline), o->scene, o->width, o->height);
     }
   }
   if (rc) lm_log(LM_LOG_ERROR, "%s", err.msg);

@@ -1127,15 +1127,11 @@ lm_pipeline *job_pipeline(job *j, const char *const *sets, int set_count, bool c
       lm_log(LM_LOG_ERROR, "%s: set.%s: %s", j->path, j->set_names[i], err.msg);
       rc = 2;
     }
-  for (int i = 0; i < set_count && !rc; i++) {
-    char name[256];
-    const char *eq = strchr(sets[i], '=');
-    snprintf(name, sizeof name, "%.*s", (int)(eq - sets[i]), sets[i]);
-    if (!lm_pipeline_set_option(pipeline, name, eq + 1, &err)) {
+  for (int i = 0; i < set_count && !rc; i++)
+    if (!capture_set_option(pipeline, sets[i], &err)) {
       lm_log(LM_LOG_ERROR, "--set %s: %s", sets[i], err.msg);
       rc = 2;
     }
-  }
   if (rc) {
     lm_pipeline_destroy(pipeline);
     return NULL;

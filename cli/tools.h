@@ -44,6 +44,22 @@ bool limn_parse_shard(const char *s, int *shard, int *shards, char *msg, size_t 
 bool limn_parse_camera(const char *s, int *out);
 struct lm_scene;
 int limn_camera_resolve(struct lm_scene *s, int camera, int width, int height);
+/* The flags capture, view, bench and graph share: --scene, --script, --tech,
+ * --set NAME=VALUE (at most LIMN_MAX_SETS), --size WxH, --camera N (or
+ * "auto" where camera_auto). Each command lists those it takes in its own
+ * option table with these getopt values: 's', 'p', 't', 'D', 'z', 'c', and
+ * hands limn_common_flag every getopt_long result its own cases do not take
+ * (optarg and optind as getopt_long left them): 0 when it took c, else 2
+ * after printing the usage error for `limn CMD` (a bad value, a flag
+ * without its value, an unknown flag). */
+enum { LIMN_MAX_SETS = 64 };
+typedef struct limn_common_args {
+  const char *scene, *script, *tech;
+  const char *sets[LIMN_MAX_SETS]; /* NAME=VALUE, as given */
+  int set_count, width, height, camera;
+  bool camera_auto; /* the command resolves --camera auto */
+} limn_common_args;
+int limn_common_flag(const char *cmd, int c, char **argv, limn_common_args *a);
 /* Prints s as a JSON string (quotes, backslashes and control characters escaped). */
 void limn_json_string(const char *s);          /* a quoted, escaped JSON string to stdout */
 void limn_json_append(lm_buf *b, const char *s); /* the same, appended to b */

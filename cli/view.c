@@ -52,6 +52,9 @@ static const char view_usage[] =
     "  --job FILE           start at a view of a capture job: its script, scene,\n"
     "                       camera, size, technique, time and options\n"
     "  --view N             which view of --job (default 0; as capture numbers them)\n"
+    "  --refs DIR           the job's references (default out/reference): at a view\n"
+    "                       of the job whose reference limn reference cached, E shows\n"
+    "                       the error against it\n"
     "  --capture-dir DIR    where P writes images (default .)\n"
     "  --exit-after N       close after N frames\n"
     "  --screenshot FILE    write the window's content at exit (PNG)\n"
@@ -80,7 +83,9 @@ static const char view_usage[] =
     "  C channel (rgb r g b a), V false colour, Up/Down exposure;\n"
     "  P writes the shown target (EXR) and the frame (PNG); M the panel;\n"
     "  J writes the technique and changed options as a capture job (and the\n"
-    "  limn capture command line); B the A/B wipe (--compare); Escape quits\n"
+    "  limn capture command line); B the A/B wipe (--compare); E the error view at\n"
+    "  a job's view with a reference (a wipe with the reference, with the error\n"
+    "  heat map, off); Escape quits\n"
     "\n"
     "environment: LIMN_FONT, the overlay's font file (default DejaVu Sans Mono)\n"
     "exit codes: 0 closed, 1 failed (the script's first load, the font, window or\n"
@@ -115,14 +120,17 @@ static bool parse_script_keys(const char *list, view_args *a) {
 static void free_args(view_args *a) {
   for (int i = 0; i < a->set_count; i++) free(a->sets[i]);
   for (int i = 0; i < a->compare_set_count; i++) free(a->compare_sets[i]);
-  a->set_count = a->compare_set_count = 0;
+  for (int i = 0; i < a->job_set_count; i++) free(a->job_sets[i]);
+  a->set_count = a->compare_set_count = a->job_set_count = 0;
+  free(a->places);
+  a->places = NULL;
   lm_scene_destroy(a->job_loaded); /* not adopted: the run stopped before the scene */
   a->job_loaded = NULL;
 }
 
 /* Returns 0 to go on, -1 when done (help), else the exit code. */
 static int parse_args(int argc, char **argv, view_args *a) {
-  *a = (view_args){.scene = "cornell", .capture_dir = ".", .width = 512, .height = 384, .overlay = true,
+  *a = (view_args){.common = {.scene = "cornell", .width = 512, .height = 384}, .capture_dir = ".", .overlay = true,
                    .panel = true, .animation = "all", .fps = 24};
   static const struct option opts[] = {
       {"scene", required_argument, 0, 's'},      {"script", required_argument, 0, 'p'},
@@ -134,6 +142,7 @@ static int parse_args(int argc, char **argv, view_args *a) {
       {"animation", required_argument, 0, 'A'},  {"time", required_argument, 0, 'T'},
       {"fps", required_argument, 0, 'F'},        {"panel", required_argument, 0, 'P'},
       {"job", required_argument, 0, 'J'},        {"view", required_argument, 0, 'V'},
+      {"refs", required_argument, 0, 'r'},
       {"compare", required_argument, 0, 'B'},    {"compare-set", required_argument, 0, 'E'},
       {"quiet", no_argument, 0, 'q'},            {"verbose", no_argument, 0, 'v'},
       {"help", no_argument, 0, 'h'},             {0, 0, 0, 0}};
@@ -143,27 +152,12 @@ static int parse_args(int argc, char **argv, view_args *a) {
   bool view_given = false;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
     switch (c) {
-    case 's': a->scene = optarg; break;
-    case 'p': a->script = optarg; break;
-    case 't': a->tech = optarg; break;
-    case 'D':
-      if (!strchr(optarg, '=') || optarg[0] == '=') return usage_error("--set wants NAME=VALUE, not '%s'", optarg);
-      if (a->set_count == MAX_SETS) return usage_error("%s", "at most 64 --set flags");
-      a->sets[a->set_count++] = lm_strdup(optarg);
-      break;
     case 'B': a->compare = optarg; break;
     case 'E':
       if (!strchr(optarg, '=') || optarg[0] == '=')
         return usage_error("--compare-set wants NAME=VALUE, not '%s'", optarg);
       if (a->compare_set_count == MAX_SETS) return usage_error("%s", "at most 64 --compare-set flags");
       a->compare_sets[a->compare_set_count++] = lm_strdup(optarg);
-      break;
-    case 'z':
-      if (!limn_parse_size(optarg, &a->width, &a->height))
-        return usage_error("--size wants WxH with both in 1..65536, not '%s'", optarg);
-      break;
-    case 'c':
-      if (!limn_parse_int(optarg, 0, 1 << 20, &a->camera)) return usage_error("--camera wants an index, not '%s'", optarg);
       break;
     case 'o':
       if (!limn_parse_on_off(optarg, &a->overlay)) return usage_error("--overlay wants on or off, not '%s'", optarg);
@@ -173,6 +167,7 @@ static int parse_args(int argc, char **argv, view_args *a) {
       if (!limn_parse_on_off(optarg, &a->panel)) return usage_error("--panel wants on or off, not '%s'", optarg);
       break;
     case 'J': a->job = optarg; break;
+    case 'r': a->refs = optarg; break;
     case 'V':
       if (!limn_parse_int(optarg, 0, 1 << 30, &a->job_view)) return usage_error("--view wants a view number, not '%s'", optarg);
       view_given = true;
@@ -206,12 +201,15 @@ static int parse_args(int argc, char **argv, view_args *a) {
     case 'q': a->quiet = true; break;
     case 'v': a->verbose = true; break;
     case 'h': fputs(view_usage, stdout); return -1;
-    case ':': return usage_error("%s needs a value", argv[optind - 1]);
-    default: return usage_error("unknown flag '%s'", argv[optind - 1]);
+    default:
+      if (limn_common_flag("view", c, argv, &a->common)) return 2;
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
+  /* The viewer's own copies: toggles and the panel replace entries. */
+  for (int i = 0; i < a->common.set_count; i++) a->sets[a->set_count++] = lm_strdup(a->common.sets[i]);
   if (view_given && !a->job) return usage_error("%s", "--view N needs --job FILE");
+  if (a->refs && !a->job) return usage_error("%s", "--refs DIR needs --job FILE");
   if (a->compare_set_count && !a->compare) return usage_error("%s", "--compare-set needs --compare TECH");
   return a->job && !load_view_job(a) ? 2 : 0;
 }
@@ -264,10 +262,10 @@ static bool key_down(const viewer *v, const char *key) {
   return lm_window_key_down(v->window, key);
 }
 
-/* A left drag that starts on the A/B wipe's split (within 6 pixels) moves
+/* A left drag that starts on the wipe's split (A/B or the reference; within 6 pixels) moves
  * it; true while it does. The window reports a held button only as motion. */
 static bool drag_split(viewer *v, double dx, double dy) {
-  if (!v->compare_on) return false;
+  if (!v->compare_on && !reference_shown(v)) return false;
   double x, y;
   bool down;
   if (v->mouse_scripted) {
@@ -387,33 +385,29 @@ static void advance(viewer *v, double dt) {
 }
 
 /* ---- options and techniques -------------------------------------------- */
-/* Records NAME=VALUE so a reloaded script gets it again. */
-static void remember_set(viewer *v, const char *name, const char *value) {
-  view_args *a = v->args;
+/* Records NAME=VALUE in a list of them (--set's, --compare-set's) so a
+ * reloaded script gets it again. */
+static void remember_set(char **sets, int *count, const char *name, const char *value) {
   size_t n = strlen(name);
   char *entry = lm_alloc(n + strlen(value) + 2);
   sprintf(entry, "%s=%s", name, value);
-  for (int i = 0; i < a->set_count; i++) {
-    if (!strncmp(a->sets[i], name, n) && a->sets[i][n] == '=') {
-      free(a->sets[i]);
-      a->sets[i] = entry;
+  for (int i = 0; i < *count; i++) {
+    if (!strncmp(sets[i], name, n) && sets[i][n] == '=') {
+      free(sets[i]);
+      sets[i] = entry;
       return;
     }
   }
-  if (a->set_count < MAX_SETS)
-    a->sets[a->set_count++] = entry;
+  if (*count < MAX_SETS)
+    sets[(*count)++] = entry;
   else
     free(entry);
 }
 
 /* Applies NAME=VALUE entries; returns false (err) on the first bad one. */
 static bool apply_set_list(lm_pipeline *p, char *const *sets, int count, lm_error *err) {
-  for (int i = 0; i < count; i++) {
-    char name[256];
-    const char *s = sets[i], *eq = strchr(s, '=');
-    snprintf(name, sizeof name, "%.*s", (int)(eq - s), s);
-    if (!lm_pipeline_set_option(p, name, eq + 1, err)) return false;
-  }
+  for (int i = 0; i < count; i++)
+    if (!capture_set_option(p, sets[i], err)) return false;
   return true;
 }
 
@@ -426,12 +420,52 @@ static bool apply_sets(viewer *v, lm_pipeline *p, lm_error *err) {
  * the viewer's options, then --compare-set's; NULL with err. */
 static lm_pipeline *load_compare(viewer *v, lm_error *err) {
   lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = v->script}, err);
-  if (p && (!lm_pipeline_set_technique(p, v->args->compare, err) || !apply_sets(v, p, err) ||
+  if (p && (!lm_pipeline_set_technique(p, v->compare_tech, err) || !apply_sets(v, p, err) ||
             !apply_set_list(p, v->args->compare_sets, v->args->compare_set_count, err))) {
     lm_pipeline_destroy(p);
     return NULL;
   }
   return p;
+}
+
+/* The A/B wipe's other side with technique `tech`, turned on: its pipeline
+ * and renderer made the first time (--compare, or a technique the panel's
+ * A/B picks), the technique set on them after. False with err. */
+static bool start_compare(viewer *v, const char *tech, lm_error *err) {
+  if (v->compare_pipeline) {
+    if (!lm_pipeline_set_technique(v->compare_pipeline, tech, err)) return false;
+    snprintf(v->compare_tech, sizeof v->compare_tech, "%s", tech);
+  } else {
+    snprintf(v->compare_tech, sizeof v->compare_tech, "%s", tech);
+    lm_texture_desc d = {LM_FORMAT_RGBA8, v->width, v->height, false};
+    if (!(v->compare_pipeline = load_compare(v, err)) ||
+        !(v->compare_renderer = lm_renderer_create(&(lm_renderer_desc){.scene = v->scene,
+                                                                       .pipeline = v->compare_pipeline,
+                                                                       .width = v->width, .height = v->height,
+                                                                       .camera = v->camera}, err)) ||
+        !lm_texture_create(&v->compare_shown, &d, "viewer frame (compare)", err)) {
+      lm_renderer_destroy(v->compare_renderer);
+      lm_pipeline_destroy(v->compare_pipeline);
+      v->compare_renderer = NULL, v->compare_pipeline = NULL;
+      return false;
+    }
+    lm_texture_clear(v->compare_shown);
+  }
+  v->compare_on = true;
+  v->options_stale = true;
+  return true;
+}
+
+/* An option of the other side alone, kept for reloads as --compare-set's. */
+static void set_compare_option(viewer *v, const char *name, const char *value) {
+  lm_error err;
+  if (!v->compare_pipeline || !lm_pipeline_set_option(v->compare_pipeline, name, value, &err)) {
+    say(v, "A/B: %s", v->compare_pipeline ? err.msg : "no other side: pick its technique first");
+    return;
+  }
+  remember_set(v->args->compare_sets, &v->args->compare_set_count, name, value);
+  v->options_stale = true;
+  say(v, "A/B: %s = %s on the right", name, value);
 }
 
 /* Does --compare-set give the other side its own value of this option? */
@@ -449,7 +483,7 @@ static void set_option(viewer *v, const char *name, const char *value) {
     say(v, "%s", err.msg);
     return;
   }
-  remember_set(v, name, value);
+  remember_set(v->args->sets, &v->args->set_count, name, value);
   /* The other side follows the edit unless it compares that very option. */
   if (v->compare_pipeline && !compare_sets_option(v, name) &&
       !lm_pipeline_set_option(v->compare_pipeline, name, value, &err))
@@ -493,6 +527,10 @@ static void write_job(viewer *v) {
   say(v, "%s", v->status);
 }
 
+static panel_edits no_edits(void) {
+  return (panel_edits){.technique = -1, .inspect = -1, .error_view = -1, .compare_technique = -1, .compare_pick = -1};
+}
+
 /* What the user did in the panel last frame, applied before this frame renders. */
 static void apply_panel(viewer *v) {
   panel_edits *e = &v->edits;
@@ -509,11 +547,26 @@ static void apply_panel(viewer *v) {
     report_time(v, "scrubbed");
   }
   if (e->write_job) write_job(v);
+  if (e->error_view >= 0 && v->place >= 0) v->error_view = e->error_view;
+  lm_error err;
+  if (e->compare_technique >= 0 && e->compare_technique < lm_pipeline_technique_count(v->pipeline)) {
+    const char *tech = lm_pipeline_technique_name(v->pipeline, e->compare_technique);
+    if (start_compare(v, tech, &err)) say(v, "A/B: %s on the right", tech);
+    else say(v, "A/B %s: %s", tech, err.msg);
+  }
+  if (e->compare_toggle && v->compare_renderer) v->compare_on = !v->compare_on;
+  if (e->compare_pick >= 0 && e->compare_pick < v->option_count) {
+    /* Set apart from this side at its value now: edits here no longer reach it there. */
+    const lm_option_info *o = &v->options[e->compare_pick];
+    snprintf(v->compare_option, sizeof v->compare_option, "%s", o->name);
+    set_compare_option(v, o->name, o->value);
+  }
+  if (e->compare_set) set_compare_option(v, e->compare_name, e->compare_value);
   if (e->inspect >= 0) {
     v->inspect = e->inspect;
     lm_renderer_set_sharing(v->renderer, false); /* every target readable after the frame */
   }
-  *e = (panel_edits){.technique = -1, .inspect = -1};
+  *e = no_edits();
 }
 
 /* ---- reloading --------------------------------------------------------- */
@@ -557,7 +610,7 @@ static bool reload_script(viewer *v) {
 
 static void reload_scene(viewer *v) {
   lm_error err;
-  lm_scene *s = lm_scene_load(v->args->scene, &err);
+  lm_scene *s = lm_scene_load(v->args->common.scene, &err);
   if (s && !lm_scene_upload(s, &err)) {
     lm_scene_destroy(s);
     s = NULL;
@@ -584,7 +637,7 @@ static void reload_scene(viewer *v) {
   v->camera_user = false; /* the file's camera again, as for a still scene; its animation drives it */
   fly_from_camera(v);
   pose(v);
-  lm_info("reloaded scene %s", v->args->scene);
+  lm_info("reloaded scene %s", v->args->common.scene);
   report_time(v, "scene reloaded");
 }
 
@@ -603,7 +656,7 @@ static bool handle_changes(viewer *v) {
     if (name[0] == '.') continue; /* editors' temporary files */
     if (has_suffix(name, ".lua")) script = true;
     else if (has_suffix(name, ".glsl") || has_suffix(name, ".frag") || has_suffix(name, ".vert")) shaders = true;
-    else if (lm_scene_is_gltf_name(v->args->scene) && !strcmp(name, strrchr(v->args->scene, '/') ? strrchr(v->args->scene, '/') + 1 : v->args->scene)) scene = true;
+    else if (lm_scene_is_gltf_name(v->args->common.scene) && !strcmp(name, strrchr(v->args->common.scene, '/') ? strrchr(v->args->common.scene, '/') + 1 : v->args->common.scene)) scene = true;
   }
   if (shaders) {
     lm_programs_invalidate();
@@ -647,11 +700,18 @@ static void handle_key(viewer *v, const char *key) {
     if (v->panel) panel_list_widgets(v->panel, stdout);
   } else if (!strcmp(key, "B")) {
     if (!v->compare_renderer) {
-      say(v, "%s", "no A/B wipe: start with --compare TECH");
+      say(v, "%s", "no A/B wipe: start with --compare TECH, or pick the right side's technique in the panel's A/B");
       return;
     }
     v->compare_on = !v->compare_on;
     say(v, "A/B wipe %s", v->compare_on ? "on" : "off");
+  } else if (!strcmp(key, "E")) {
+    if (v->place < 0) {
+      say(v, "%s", v->reference_text[0] ? v->reference_text : "no reference here");
+      return;
+    }
+    v->error_view = (v->error_view + 1) % ERROR_VIEWS;
+    say(v, "error view: %s", (const char *[]){"off", "wipe with the reference", "wipe with the error heat map"}[v->error_view]);
   } else if (!strcmp(key, "M")) {
     v->panel_on = !v->panel_on;
   } else if (!strcmp(key, "J")) {
@@ -831,8 +891,8 @@ static bool watch_dirs(viewer *v, lm_error *err) {
   if (lm_file_exists(dir) && !lm_watch_dir(v->watch, dir, err)) return false;
   lm_dirname(v->script, dir, sizeof dir);
   if (!lm_watch_dir(v->watch, dir, err)) return false;
-  if (lm_scene_is_gltf_name(v->args->scene)) {
-    lm_dirname(v->args->scene, dir, sizeof dir);
+  if (lm_scene_is_gltf_name(v->args->common.scene)) {
+    lm_dirname(v->args->common.scene, dir, sizeof dir);
     if (!lm_watch_dir(v->watch, dir, err)) return false;
   }
   return true;
@@ -845,6 +905,8 @@ static void viewer_free(viewer *v) {
   lm_texture_destroy(&v->compare_shown);
   free(v->overlay);
   free(v->options);
+  free(v->compare_options);
+  reference_free(v);
   panel_destroy(v->panel); /* before the window: it restores the window's callbacks */
   lm_renderer_destroy(v->renderer);
   lm_renderer_destroy(v->compare_renderer);
@@ -865,21 +927,21 @@ static int run(viewer *v) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 1;
   }
-  if ((a->tech && !lm_pipeline_set_technique(v->pipeline, a->tech, &err)) || !apply_sets(v, v->pipeline, &err)) {
+  if ((a->common.tech && !lm_pipeline_set_technique(v->pipeline, a->common.tech, &err)) || !apply_sets(v, v->pipeline, &err)) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 2;
   }
-  v->scene = a->job_loaded ? a->job_loaded : lm_scene_load(a->scene, &err);
+  v->scene = a->job_loaded ? a->job_loaded : lm_scene_load(a->common.scene, &err);
   a->job_loaded = NULL;
   if (!v->scene) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 2;
   }
-  if (a->camera > 0 && a->camera >= v->scene->camera_count) {
-    lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a->camera, a->scene, v->scene->camera_count);
+  if (a->common.camera > 0 && a->common.camera >= v->scene->camera_count) {
+    lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", a->common.camera, a->common.scene, v->scene->camera_count);
     return 2;
   }
-  v->camera = a->camera;
+  v->camera = a->common.camera;
   if (!find_animation(v, &err)) {
     lm_log(LM_LOG_ERROR, "--animation: %s", err.msg);
     return 2;
@@ -887,12 +949,12 @@ static int run(viewer *v) {
   v->time = a->time_given ? a->time : v->anim_range[0];
   v->font = lm_font_open(11, &err);
   if (!v->font || !watch_dirs(v, &err) ||
-      !(v->window = lm_window_create("limn view", a->width, a->height, &err))) {
+      !(v->window = lm_window_create("limn view", a->common.width, a->common.height, &err))) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 1;
   }
   lm_window_size(v->window, &v->width, &v->height);
-  if (v->width < 1 || v->height < 1) v->width = a->width, v->height = a->height;
+  if (v->width < 1 || v->height < 1) v->width = a->common.width, v->height = a->common.height;
   v->renderer = lm_renderer_create(&(lm_renderer_desc){.scene = v->scene, .pipeline = v->pipeline,
                                                        .width = v->width, .height = v->height,
                                                        .camera = v->camera}, &err);
@@ -900,20 +962,9 @@ static int run(viewer *v) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return 1;
   }
-  if (a->compare) {
-    if (!(v->compare_pipeline = load_compare(v, &err))) {
-      lm_log(LM_LOG_ERROR, "--compare %s: %s", a->compare, err.msg);
-      return 2;
-    }
-    v->compare_renderer = lm_renderer_create(&(lm_renderer_desc){.scene = v->scene, .pipeline = v->compare_pipeline,
-                                                                 .width = v->width, .height = v->height,
-                                                                 .camera = v->camera}, &err);
-    if (!v->compare_renderer) {
-      lm_log(LM_LOG_ERROR, "--compare %s: %s", a->compare, err.msg);
-      return 1;
-    }
-    v->compare_on = true;
-    v->split = 0.5f;
+  if (a->compare && !start_compare(v, a->compare, &err)) {
+    lm_log(LM_LOG_ERROR, "--compare %s: %s", a->compare, err.msg);
+    return 2;
   }
   if (!make_window_textures(v, &err)) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
@@ -923,7 +974,7 @@ static int run(viewer *v) {
   v->options_stale = true;
   fly_from_camera(v);
   lm_info("renderer: %s (%s); scene %s; script %s; technique %s; %dx%d", lm_gl_renderer(), lm_gl_version(),
-          a->scene, v->script, lm_pipeline_technique(v->pipeline), v->width, v->height);
+          a->common.scene, v->script, lm_pipeline_technique(v->pipeline), v->width, v->height);
   if (lm_scene_animated(v->scene))
     lm_info("animation '%s': keys %.6g..%.6g s%s", view_animation_name(v), v->anim_range[0], v->anim_range[1],
             v->camera_animated ? "; it moves the camera" : "");
@@ -957,6 +1008,7 @@ static int run(viewer *v) {
       continue;
     }
     render(v, handle_changes(v));
+    update_reference(v);
     display(v);
     if (a->exit_after && v->frame + 1 >= a->exit_after) break;
     lm_window_swap(v->window);
@@ -969,6 +1021,7 @@ static int run(viewer *v) {
     lm_info("%s; %ld frames on, %ld off (glFinish + CLOCK_MONOTONIC)", cost, v->frames_timed[1], v->frames_timed[0]);
   }
   report_time(v, "at exit");
+  if (v->live_ok) describe_reference(v, true);
   if (a->screenshot && !screenshot(v, a->screenshot)) return 1;
   return 0;
 }
@@ -985,8 +1038,8 @@ int limn_view(int argc, char **argv) {
   signal(SIGINT, on_signal);
   signal(SIGTERM, on_signal);
   viewer v = {.args = &a, .inspect = -1, .inspect_logged = -1, .channel = 4, .overlay_on = a.overlay, .panel_on = a.panel,
-              .range = {0, 1}, .edits = {.technique = -1, .inspect = -1}};
-  capture_resolve(a.script, v.script, sizeof v.script);
+              .range = {0, 1}, .edits = no_edits(), .place = -1, .split = 0.5f};
+  capture_resolve(a.common.script, v.script, sizeof v.script);
   rc = run(&v);
   viewer_free(&v);
   free_args(&a);

@@ -6,22 +6,35 @@
 
 #include <stdint.h>
 
+#include "image/metrics.h"
+#include "tools.h"
 #include "render/render.h"
 #include "view_panel.h"
 #include "view_text.h"
 
-enum { MAX_SETS = 64, MAX_SCRIPT_KEYS = 256, PANEL_TIMES = 64 };
+enum { MAX_SETS = 64, MAX_SCRIPT_KEYS = 256, PANEL_TIMES = 64, PANEL_EVERY = 8 };
+enum { ERROR_VIEW_OFF, ERROR_VIEW_REFERENCE, ERROR_VIEW_HEAT, ERROR_VIEWS };
 
 typedef struct script_key {
   long frame;
   char key[32];
 } script_key;
 
+/* A view of the --job whose reference is cached (view_reference.c): the
+ * viewer shows the error against it while its camera is there. */
+typedef struct view_place {
+  int view;                  /* the job's view number (--view N) */
+  int camera, width, height;
+  double time;               /* the view's time, when the job is timed */
+  char reference[1024];      /* the reference's file (limn reference) */
+  char direct[1024];         /* its direct-only reference, "" when none is cached */
+} view_place;
+
 typedef struct view_args {
-  const char *scene, *script, *tech, *screenshot, *capture_dir;
-  char *sets[MAX_SETS]; /* owned: toggles add and replace entries */
+  limn_common_args common; /* --scene, --script, --tech, --size, --camera; --set as given */
+  const char *screenshot, *capture_dir;
+  char *sets[MAX_SETS]; /* --set's, owned: toggles add and replace entries */
   int set_count;
-  int width, height, camera;
   const char *animation; /* NAME, INDEX or "all" */
   double time;           /* --time; with time_given */
   bool time_given;
@@ -35,6 +48,13 @@ typedef struct view_args {
   int compare_set_count;
   char job_script[1024], job_scene[1024], job_tech[64], job_animation[64]; /* what the job's view names */
   lm_scene *job_loaded;  /* the view's scene as the job loaded it (its camera list's cameras too) */
+  const char *refs;      /* --refs: the references' folder (default out/reference) */
+  view_place *places;    /* the job's views of that scene with a cached reference (owned) */
+  int place_count;
+  bool job_timed;        /* the places' times count */
+  char *job_sets[MAX_SETS]; /* the job's `set`: the baseline's options, as limn report renders it (owned) */
+  int job_set_count;
+  char against[32];      /* "POV-Ray" or "Cycles" */
   script_key keys[MAX_SCRIPT_KEYS];
   int key_count;
 } view_args;
@@ -79,6 +99,10 @@ typedef struct viewer {
   lm_pipeline *compare_pipeline;
   lm_renderer *compare_renderer;
   lm_texture compare_shown;
+  char compare_tech[64];      /* its technique (--compare, or the panel's A/B) */
+  char compare_option[128];   /* the option the panel's A/B sets apart there ("" none) */
+  lm_option_info *compare_options; /* that side's options, read again when options_stale */
+  int compare_option_count;
   bool compare_on, split_held;
   float split;
   char compare_error[2048];
@@ -89,12 +113,28 @@ typedef struct viewer {
   bool options_stale;
   panel_edits edits;        /* the panel's last frame: applied before the next */
   char status[1200];        /* the panel's note: the job last written */
-  /* The panel's cost: its own milliseconds in its last frames (glFinish on
-   * both sides) and the frames' with it on and off, for the share the
-   * overlay prints. */
+  /* The panel's cost: its own milliseconds in its last timed frames (one in
+   * PANEL_EVERY, glFinish on both sides) and the frames' with it on and off,
+   * for the share the overlay prints. */
   double panel_times[PANEL_TIMES], frame_ms_sum[2];
   long panel_timed, frames_timed[2]; /* [0] panel off, [1] on */
   char panel_cost_text[200]; /* the panel's line of it */
+  /* Live error against the reference (view_reference.c) while the camera
+   * is at a place of the --job: E steps the error view (a wipe with the
+   * reference, one with the error heat map, off). The frame's linear
+   * output is kept and read back only while the error view is on. */
+  int error_view;           /* ERROR_VIEW_* */
+  int place;                /* index into args->places the camera is at, -1: none */
+  bool place_ready;         /* its reference loaded and its baseline measured */
+  lm_image reference;       /* the place's reference, linear */
+  lm_texture reference_tex; /* the same, rgba32f, for the wipe */
+  lm_texture heat_tex;      /* this frame's error heat map, rgba8 */
+  double base_error, floor; /* the baseline's error against the reference and against the direct-only one
+                               (floor < 0: no direct-only reference cached) */
+  double heat_scale;        /* the heat map's white: the baseline's largest pixel error */
+  lm_metrics live;          /* this frame's against the reference; live_ok once measured */
+  bool live_ok;
+  char reference_text[512]; /* what the panel and the overlay say about it */
   int inspect;              /* target index, -1: the frame */
   int inspect_logged;       /* the target the log last named (a line a test reads) */
   int channel;              /* 0 r, 1 g, 2 b, 3 a, 4 rgb */
@@ -146,5 +186,22 @@ bool write_view_job(viewer *v, char *job_path, size_t cap, lm_error *err);
 /* Fills a->script, scene, tech, camera, size, time and sets from view
  * a->job_view of job a->job; false (logged) when it has no such view. */
 bool load_view_job(view_args *a);
+
+/* view_reference.c: the error against the reference at the job's places. */
+struct job;
+struct job_view;
+/* The places of job j's views of scene `scene` whose references exist
+ * under a->refs, into a->places; the job's `set` into a->job_sets. */
+void find_places(view_args *a, struct job *j, const struct job_view *views, int count, int scene);
+/* After each frame: the place the camera is at (arriving: its reference
+ * read and the baseline rendered once), and with the error view on this
+ * frame's error against the reference. */
+void update_reference(viewer *v);
+/* Is the wipe showing the reference or its heat map now? */
+bool reference_shown(const viewer *v);
+/* The place's line for the panel and the overlay (reference_text); with
+ * log, the figures in full on stderr ("reference error: view N, mean ..."). */
+void describe_reference(viewer *v, bool log);
+void reference_free(viewer *v);
 
 #endif

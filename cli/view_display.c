@@ -189,7 +189,8 @@ static void draw_overlay(viewer *v) {
               strrchr(v->script, '/') ? strrchr(v->script, '/') + 1 : v->script, v->width, v->height);
   if (v->overlay_on && v->compare_on)
     draw_line(v, &y, white, "A/B: left %s | right %s%s (B toggles; drag the line)", lm_pipeline_technique(v->pipeline),
-              lm_pipeline_technique(v->compare_pipeline), v->args->compare_set_count ? " with --compare-set" : "");
+              lm_pipeline_technique(v->compare_pipeline), v->args->compare_set_count ? " with its own options" : "");
+  if (v->overlay_on && v->args->job && v->reference_text[0]) draw_line(v, &y, white, "%s", v->reference_text);
   if (v->overlay_on && lm_scene_animated(v->scene))
     draw_line(v, &y, white, "time %.3f s | frame %ld | animation %s (%.3g..%.3g s)%s", v->time, view_frame(v),
               view_animation_name(v), v->anim_range[0], v->anim_range[1], v->paused ? " | paused" : "");
@@ -297,19 +298,30 @@ static lm_texture draw_panel(viewer *v) {
   if (v->options_stale) {
     free(v->options);
     v->option_count = lm_pipeline_options(v->pipeline, &v->options);
+    free(v->compare_options);
+    v->compare_options = NULL;
+    v->compare_option_count = v->compare_pipeline ? lm_pipeline_options(v->compare_pipeline, &v->compare_options) : 0;
     v->options_stale = false;
   }
   enum { MAX_TECHNIQUES = 256 };
   const char *names[MAX_TECHNIQUES];
-  int count = lm_pipeline_technique_count(v->pipeline), current = 0;
+  int count = lm_pipeline_technique_count(v->pipeline), current = 0, compare = -1;
   if (count > MAX_TECHNIQUES) count = MAX_TECHNIQUES;
   for (int i = 0; i < count; i++) {
     names[i] = lm_pipeline_technique_name(v->pipeline, i);
     if (!strcmp(names[i], lm_pipeline_technique(v->pipeline))) current = i;
+    if (v->compare_pipeline && !strcmp(names[i], v->compare_tech)) compare = i;
   }
-  /* The cost line changes once in PANEL_TIMES frames (after a first figure):
-   * a line changing every frame would draw the panel's image every frame. */
-  if (v->panel_timed == 3 || v->panel_timed % PANEL_TIMES == 0)
+  const lm_option_info *compare_option = NULL; /* the option the A/B sets apart, as that side has it */
+  for (int i = 0; i < v->compare_option_count && v->compare_option[0]; i++)
+    if (!strcmp(v->compare_options[i].name, v->compare_option)) compare_option = &v->compare_options[i];
+  /* Its own time, one frame in PANEL_EVERY: the glFinish on both sides
+   * stalls llvmpipe's pipelining, a cost of the timing the other frames
+   * spare. The cost line changes once in PANEL_EVERY timed frames (after a
+   * first figure): a line changing every frame would draw the panel's image
+   * every frame. */
+  bool timed = v->frame % PANEL_EVERY == 0;
+  if (timed && (v->panel_timed == 3 || v->panel_timed % PANEL_EVERY == 0))
     panel_cost(v, v->panel_cost_text, sizeof v->panel_cost_text);
   /* The frame graph: passes with their targets as indices. */
   lm_graph *g = lm_renderer_graph(v->renderer);
@@ -338,12 +350,17 @@ static lm_texture draw_panel(viewer *v) {
                    .time = v->time, .time_lo = v->anim_range[0], .time_hi = v->anim_range[1],
                    .paused = v->paused, .status = v->status[0] ? v->status : NULL,
                    .cost = v->frames_timed[1] ? v->panel_cost_text : NULL, .passes = passes,
-                   .pass_count = pass_count, .targets = target_names, .target_count = target_count};
-  lm_finish();
+                   .pass_count = pass_count, .targets = target_names, .target_count = target_count,
+                   .compare_technique = compare, .compare_on = v->compare_on, .compare_option = compare_option,
+                   .reference = v->args->job ? v->reference_text : NULL, .reference_here = v->place_ready,
+                   .error_view = v->error_view};
+  if (timed) lm_finish();
   double t0 = lm_now_ms();
   lm_texture image = panel_frame(v->panel, &m, v->width, v->height, &v->edits);
-  lm_finish();
-  v->panel_times[v->panel_timed++ % PANEL_TIMES] = lm_now_ms() - t0;
+  if (timed) {
+    lm_finish();
+    v->panel_times[v->panel_timed++ % PANEL_TIMES] = lm_now_ms() - t0;
+  }
   free(passes);
   free(targets_of);
   free(target_names);
@@ -383,9 +400,16 @@ void display(viewer *v) {
   lm_program_bind_texture(lm_program_uniform(p, "overlay"), v->overlay_tex);
   lm_program_bind_texture(lm_program_uniform(p, "panel"), panel.id ? panel : v->overlay_tex);
   set_int(p, "show_panel", panel.id != 0);
-  /* The A/B wipe: the other side right of the split (the frame only, not a target). */
-  float split = v->compare_on && mode == 0 ? v->split * (float)v->width : -1.0f;
-  lm_program_bind_texture(lm_program_uniform(p, "other"), v->compare_on ? v->compare_shown : src);
+  /* The wipe: the other side right of the split (the frame only, not a
+   * target): the reference or its heat map while the error view is on,
+   * else the A/B --compare side. */
+  bool reference = reference_shown(v);
+  lm_texture other = !reference                             ? (v->compare_on ? v->compare_shown : src)
+                     : v->error_view == ERROR_VIEW_REFERENCE ? v->reference_tex
+                                                             : v->heat_tex;
+  float split = (v->compare_on || reference) && mode == 0 ? v->split * (float)v->width : -1.0f;
+  lm_program_bind_texture(lm_program_uniform(p, "other"), other);
+  set_int(p, "other_linear", reference && v->error_view == ERROR_VIEW_REFERENCE);
   set_float(p, "split", &split);
   set_int(p, "mode", mode);
   set_int(p, "channel", v->channel);

@@ -59,11 +59,11 @@ static int changed_options(viewer *v, char (**out)[400], lm_error *err) {
 
 bool write_view_job(viewer *v, char *job_path, size_t cap, lm_error *err) {
   char scene[4096], script[4096];
-  if (!realpath(v->args->scene, scene)) snprintf(scene, sizeof scene, "%s", v->args->scene);
+  if (!realpath(v->args->common.scene, scene)) snprintf(scene, sizeof scene, "%s", v->args->common.scene);
   if (!realpath(v->script, script)) snprintf(script, sizeof script, "%s", v->script);
   if (!lm_scene_is_gltf_name(scene)) {
     lm_error_set(err, "a capture job renders glTF files, not the built-in '%s' (data/scenes/%s.glb is its file)",
-                 v->args->scene, v->args->scene);
+                 v->args->common.scene, v->args->common.scene);
     return false;
   }
   int camera_node = v->camera < v->scene->camera_count ? v->scene->cameras[v->camera].node : -1;
@@ -181,13 +181,13 @@ bool load_view_job(view_args *a) {
     job_pose(j, jv); /* a path's camera where the view has it */
     snprintf(a->job_script, sizeof a->job_script, "%s", j->script);
     snprintf(a->job_scene, sizeof a->job_scene, "%s", s->path);
-    a->script = a->job_script, a->scene = a->job_scene;
+    a->common.script = a->job_script, a->common.scene = a->job_scene;
     if (j->technique_count) {
       snprintf(a->job_tech, sizeof a->job_tech, "%s", j->techniques[jv->technique]);
-      a->tech = a->job_tech;
+      a->common.tech = a->job_tech;
     }
-    a->width = j->sizes[jv->size][0], a->height = j->sizes[jv->size][1];
-    a->camera = jv->camera;
+    a->common.width = j->sizes[jv->size][0], a->common.height = j->sizes[jv->size][1];
+    a->common.camera = jv->camera;
     if (j->timed) a->time = jv->time, a->time_given = true;
     if (j->animation[0]) snprintf(a->job_animation, sizeof a->job_animation, "%s", j->animation), a->animation = a->job_animation;
     /* The job's options first: --set flags given with --job come after and win. */
@@ -199,11 +199,14 @@ bool load_view_job(view_args *a) {
       sprintf(a->sets[i], "%s=%s", j->set_names[i], j->set_values[i]);
     }
     a->set_count += j->set_count;
+    /* Its views with a cached reference: the error against it while the camera is at one. */
+    find_places(a, j, views, count, jv->scene);
+    job_pose(j, jv);
     /* The scene as the job loaded it: its camera list's views are cameras of it. */
     a->job_loaded = j->scenes[jv->scene].scene;
     j->scenes[jv->scene].scene = NULL;
-    lm_info("job %s, view %d: %s, camera %d, %s, %dx%d", a->job, a->job_view, a->scene, a->camera,
-            a->tech ? a->tech : "(the script's first technique)", a->width, a->height);
+    lm_info("job %s, view %d: %s, camera %d, %s, %dx%d", a->job, a->job_view, a->common.scene, a->common.camera,
+            a->common.tech ? a->common.tech : "(the script's first technique)", a->common.width, a->common.height);
   } else {
     lm_log(LM_LOG_ERROR, "--job %s: %s", a->job, err.msg);
   }

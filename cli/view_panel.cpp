@@ -3,10 +3,13 @@
 // text that the viewer sets as --set would; nothing here keeps settings.
 #include "view_panel.h"
 
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstdarg>
@@ -23,6 +26,8 @@ struct widget {
 
 struct lm_panel {
   ImGuiContext *context;
+  GLFWwindow *window;
+  double last_ms;          // the last frame's start, for ImGui's time step
   bool scripted;           // panel_set_mouse took over the mouse
   double mouse[2];
   bool mouse_down;
@@ -37,6 +42,30 @@ struct lm_panel {
   uint64_t drawn;                  // the draw lists' hash in `image`
 };
 
+// The mouse without the GLFW backend's per-frame queries: its NewFrame asks
+// the X server for the window's size twice, its focus and the cursor, and
+// sets the cursor's shape, every frame (4-5 ms a frame under Xvfb on a loaded
+// machine, most of the panel's cost). panel_frame takes the size from the
+// viewer, the buttons from GLFW's event state with a press shorter than a
+// frame kept by on_button, and the cursor from its motion events (these two
+// chained before the backend's callbacks, which feed keys, text and the
+// wheel as before). One panel per process: GLFW's callbacks carry no
+// pointer of ours.
+static GLFWmousebuttonfun chained_button;
+static GLFWcursorposfun chained_cursor;
+static bool pressed[ImGuiMouseButton_COUNT]; // a press since the last frame
+static double cursor[2];
+
+static void on_button(GLFWwindow *w, int button, int action, int mods) {
+  if (action == GLFW_PRESS && button >= 0 && button < ImGuiMouseButton_COUNT) pressed[button] = true;
+  if (chained_button) chained_button(w, button, action, mods);
+}
+
+static void on_cursor(GLFWwindow *w, double x, double y) {
+  cursor[0] = x, cursor[1] = y;
+  if (chained_cursor) chained_cursor(w, x, y);
+}
+
 lm_panel *panel_create(lm_window *w, lm_error *err) {
   IMGUI_CHECKVERSION();
   lm_panel *p = new lm_panel();
@@ -45,7 +74,8 @@ lm_panel *panel_create(lm_window *w, lm_error *err) {
   ImGui::StyleColorsDark();
   ImGui::GetStyle().Alpha = 0.92f;
   // The backends chain GLFW's callbacks: the viewer's key queue still gets every key.
-  bool glfw = ImGui_ImplGlfw_InitForOpenGL(static_cast<GLFWwindow *>(lm_window_handle(w)), true);
+  p->window = static_cast<GLFWwindow *>(lm_window_handle(w));
+  bool glfw = ImGui_ImplGlfw_InitForOpenGL(p->window, true);
   if (!glfw || !ImGui_ImplOpenGL3_Init("#version 410 core")) {
     lm_error_set(err, "the panel (Dear ImGui) could not start on this OpenGL context");
     if (glfw) ImGui_ImplGlfw_Shutdown();
@@ -53,12 +83,17 @@ lm_panel *panel_create(lm_window *w, lm_error *err) {
     delete p;
     return nullptr;
   }
+  chained_button = glfwSetMouseButtonCallback(p->window, on_button);
+  chained_cursor = glfwSetCursorPosCallback(p->window, on_cursor);
+  glfwGetCursorPos(p->window, &cursor[0], &cursor[1]); // until it moves
   return p;
 }
 
 void panel_destroy(lm_panel *p) {
   if (!p) return;
   lm_texture_destroy(&p->image);
+  glfwSetMouseButtonCallback(p->window, chained_button); // the backend's, which its shutdown restores in turn
+  glfwSetCursorPosCallback(p->window, chained_cursor);
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext(p->context);
@@ -203,46 +238,182 @@ static void options_section(lm_panel *p, const panel_model *m, panel_edits *e) {
   close_to(0);
 }
 
-// The frame graph: each pass with its time as a bar (culled ones grey), and
-// its inputs and outputs as buttons that show the target in the inspector.
-// Closed by default: open, its bars change every frame, and so the panel's image.
-static void graph_section(lm_panel *p, const panel_model *m, panel_edits *e) {
-  if (!m->pass_count) return;
+// The frame graph, while its header is open: a window left of the panel
+// with each pass as a box (its name, its time as a bar, its inputs on the
+// left and outputs on the right as buttons that show the target in the
+// inspector), a column for each depth (a pass stands right of every pass
+// whose output it reads) and an edge from each output to each later pass
+// that reads it; culled passes grey. Its bars change every frame, and so
+// the panel's image: closed by default.
+static bool graph_header(lm_panel *p, const panel_model *m) {
+  if (!m->pass_count) return false;
   bool open = ImGui::CollapsingHeader("frame graph");
   p->controls.push_back(last_item("graph", "header", "panel"));
-  if (!open) return;
-  double longest = 0;
-  for (int i = 0; i < m->pass_count; i++) longest = std::fmax(longest, m->passes[i].ms);
-  for (int i = 0; i < m->pass_count; i++) {
+  if (open) ImGui::TextDisabled("left of the panel: a target's button inspects it");
+  return open;
+}
+
+static void graph_window(lm_panel *p, const panel_model *m, panel_edits *e, float left_width, float height) {
+  int n = m->pass_count;
+  // Columns: one right of the last pass that wrote any of its inputs.
+  std::vector<int> column(n, 0), writer(m->target_count, -1);
+  int columns = 1;
+  for (int i = 0; i < n; i++) {
     const panel_pass &pass = m->passes[i];
-    ImGui::PushID(i);
-    if (pass.culled) {
-      ImGui::TextDisabled("%s (culled: nothing it writes reaches the output)", pass.name);
-    } else {
-      char ms[32];
-      snprintf(ms, sizeof ms, "%.2f ms", pass.ms);
-      ImGui::TextUnformatted(pass.name);
-      ImGui::ProgressBar(longest > 0 && pass.ms > 0 ? static_cast<float>(pass.ms / longest) : 0.0f, ImVec2(-FLT_MIN, 0),
-                         ms);
+    for (int k = 0; k < pass.input_count; k++) {
+      int t = pass.inputs[k];
+      if (t >= 0 && t < m->target_count && writer[t] >= 0) column[i] = std::max(column[i], column[writer[t]] + 1);
     }
-    if (pass.culled) ImGui::PushStyleVar(ImGuiStyleVar_Alpha, 0.5f);
+    for (int k = 0; k < pass.output_count; k++)
+      if (pass.outputs[k] >= 0 && pass.outputs[k] < m->target_count) writer[pass.outputs[k]] = i;
+    columns = std::max(columns, column[i] + 1);
+  }
+  const ImGuiStyle &style = ImGui::GetStyle();
+  float line = ImGui::GetTextLineHeightWithSpacing(), pad = style.FramePadding.x, gap = 36;
+  // Each box's size, each column's width, and the boxes' places within their column.
+  std::vector<ImVec2> size(n), at(n);
+  std::vector<float> width(columns, 0), bottom(columns, 0);
+  for (int i = 0; i < n; i++) {
+    const panel_pass &pass = m->passes[i];
+    float w = ImGui::CalcTextSize(pass.name).x;
+    for (int k = 0; k < pass.input_count + pass.output_count; k++) {
+      int t = k < pass.input_count ? pass.inputs[k] : pass.outputs[k - pass.input_count];
+      if (t >= 0 && t < m->target_count) w = std::max(w, ImGui::CalcTextSize(m->targets[t]).x);
+    }
+    size[i] = ImVec2(w + 4 * pad, (2 + pass.input_count + pass.output_count) * line + 2 * pad);
+    width[column[i]] = std::max(width[column[i]], size[i].x);
+  }
+  std::vector<float> x(columns, pad);
+  for (int c = 1; c < columns; c++) x[c] = x[c - 1] + width[c - 1] + gap;
+  for (int i = 0; i < n; i++) {
+    at[i] = ImVec2(x[column[i]], bottom[column[i]] + pad);
+    bottom[column[i]] = at[i].y + size[i].y + line;
+  }
+  float content_h = *std::max_element(bottom.begin(), bottom.end());
+  ImGui::SetNextWindowPos(ImVec2(0, 0), ImGuiCond_Always);
+  ImGui::SetNextWindowSize(ImVec2(left_width, height), ImGuiCond_Always);
+  ImGui::SetNextWindowContentSize(ImVec2(x[columns - 1] + width[columns - 1] + pad, content_h));
+  ImGui::SetNextWindowBgAlpha(0.8f);
+  ImGui::Begin("frame graph", nullptr,
+               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
+                   ImGuiWindowFlags_HorizontalScrollbar);
+  ImVec2 origin = ImGui::GetCursorScreenPos();
+  ImDrawList *draw = ImGui::GetWindowDrawList();
+  double longest = 0;
+  for (int i = 0; i < n; i++) longest = std::fmax(longest, m->passes[i].ms);
+  // A target's slot: its row's middle at the box's left (inputs) or right (outputs) edge.
+  auto slot = [&](int i, int row, bool input) {
+    return ImVec2(origin.x + at[i].x + (input ? 0 : size[i].x), origin.y + at[i].y + (2 + row + 0.5f) * line + pad);
+  };
+  // Edges first, under the boxes: from the pass that last wrote a target before each reader.
+  std::fill(writer.begin(), writer.end(), -1);
+  std::vector<int> writer_row(m->target_count, 0);
+  for (int i = 0; i < n; i++) {
+    const panel_pass &pass = m->passes[i];
+    for (int k = 0; k < pass.input_count; k++) {
+      int t = pass.inputs[k];
+      if (t < 0 || t >= m->target_count || writer[t] < 0) continue;
+      ImVec2 a = slot(writer[t], writer_row[t], false), b = slot(i, k, true);
+      float bend = std::fmax(gap, 0.4f * std::fabs(b.x - a.x));
+      bool grey = pass.culled || m->passes[writer[t]].culled;
+      draw->AddBezierCubic(a, ImVec2(a.x + bend, a.y), ImVec2(b.x - bend, b.y), b,
+                           ImGui::GetColorU32(grey ? ImGuiCol_TextDisabled : ImGuiCol_PlotLines), 1.5f);
+    }
+    for (int k = 0; k < pass.output_count; k++) {
+      int t = pass.outputs[k];
+      if (t >= 0 && t < m->target_count) writer[t] = i, writer_row[t] = pass.input_count + k;
+    }
+  }
+  ImVec2 clip_lo = ImGui::GetWindowPos(), clip_hi = ImVec2(clip_lo.x + left_width, clip_lo.y + height);
+  for (int i = 0; i < n; i++) {
+    const panel_pass &pass = m->passes[i];
+    ImVec2 lo(origin.x + at[i].x, origin.y + at[i].y), hi(lo.x + size[i].x, lo.y + size[i].y);
+    ImGui::PushID(i);
+    if (pass.culled) ImGui::PushStyleVar(ImGuiStyleVar_Alpha, 0.45f);
+    draw->AddRectFilled(lo, hi, ImGui::GetColorU32(ImGuiCol_FrameBg), 4);
+    draw->AddRect(lo, hi, ImGui::GetColorU32(pass.culled ? ImGuiCol_TextDisabled : ImGuiCol_Border), 4);
+    ImGui::SetCursorScreenPos(ImVec2(lo.x + pad, lo.y + pad));
+    if (pass.culled) ImGui::TextDisabled("%s", pass.name);
+    else ImGui::TextUnformatted(pass.name);
+    // The time bar: its share of the longest pass's, the milliseconds on it.
+    ImVec2 bar(lo.x + pad, lo.y + pad + line), bar_hi(hi.x - pad, bar.y + line - style.ItemSpacing.y);
+    float share = longest > 0 && pass.ms > 0 ? static_cast<float>(pass.ms / longest) : 0.0f;
+    draw->AddRectFilled(bar, ImVec2(bar.x + share * (bar_hi.x - bar.x), bar_hi.y),
+                        ImGui::GetColorU32(ImGuiCol_PlotHistogram));
+    char ms[32];
+    if (pass.culled) snprintf(ms, sizeof ms, "culled");
+    else snprintf(ms, sizeof ms, "%.2f ms", pass.ms);
+    draw->AddText(ImVec2(bar.x + 2, bar.y), ImGui::GetColorU32(ImGuiCol_Text), ms);
     for (int k = 0; k < pass.input_count + pass.output_count; k++) {
       bool input = k < pass.input_count;
       int t = input ? pass.inputs[k] : pass.outputs[k - pass.input_count];
       if (t < 0 || t >= m->target_count) continue;
-      if (k == 0 || k == pass.input_count) ImGui::TextDisabled(input ? " in " : " out");
-      // On the line while the button fits, else on the next.
-      float width = ImGui::CalcTextSize(m->targets[t]).x + 2 * ImGui::GetStyle().FramePadding.x;
-      float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
-      if (ImGui::GetItemRectMax().x + ImGui::GetStyle().ItemSpacing.x + width <= right) ImGui::SameLine();
+      float label = ImGui::CalcTextSize(m->targets[t]).x + 2 * pad;
+      ImVec2 s = slot(i, k, input);
+      ImGui::SetCursorScreenPos(ImVec2(input ? lo.x + pad : hi.x - pad - label, s.y - 0.5f * line));
       ImGui::PushID(k);
       if (ImGui::SmallButton(m->targets[t])) e->inspect = t;
-      p->controls.push_back(last_item(m->targets[t], "target", pass.name));
+      widget w = last_item(m->targets[t], "target", pass.name);
+      ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
+      if (a.x < clip_lo.x || a.y < clip_lo.y || b.x > clip_hi.x || b.y > clip_hi.y) w.rect[0] = w.rect[1] = w.rect[2] = w.rect[3] = 0;
+      p->controls.push_back(w);
       ImGui::PopID();
     }
     if (pass.culled) ImGui::PopStyleVar();
     ImGui::PopID();
   }
+  ImGui::SetCursorScreenPos(ImVec2(origin.x, origin.y + content_h));
+  ImGui::End();
+}
+
+// A/B: the wipe's other side rendered live, its technique and the one
+// option it sets apart (with this option's widget, showing that side's value).
+static void compare_section(lm_panel *p, const panel_model *m, panel_edits *e) {
+  bool open = ImGui::CollapsingHeader("A/B");
+  p->controls.push_back(last_item("ab", "header", "panel"));
+  if (!open) return;
+  bool on = m->compare_on;
+  if (m->compare_technique >= 0 && ImGui::Checkbox("wipe (B)", &on)) e->compare_toggle = true;
+  ImGui::TextDisabled("right of the line:");
+  if (ImGui::BeginListBox("##B technique", ImVec2(-FLT_MIN, 4.5f * ImGui::GetTextLineHeightWithSpacing()))) {
+    for (int i = 0; i < m->technique_count; i++) {
+      if (ImGui::Selectable(m->techniques[i], i == m->compare_technique)) e->compare_technique = i;
+      p->controls.push_back(last_item((std::string("ab=") + m->techniques[i]).c_str(), "list", "A/B"));
+    }
+    ImGui::EndListBox();
+  }
+  if (m->compare_technique < 0) return;
+  if (ImGui::BeginCombo("B differs in", m->compare_option ? m->compare_option->name : "nothing")) {
+    for (int i = 0; i < m->option_count; i++)
+      if (m->options[i].type != LM_OPTION_OTHER &&
+          ImGui::Selectable(m->options[i].name, m->compare_option && !strcmp(m->options[i].name, m->compare_option->name)))
+        e->compare_pick = i;
+    ImGui::EndCombo();
+  }
+  p->controls.push_back(last_item("ab-option", "combo", "A/B"));
+  if (!m->compare_option) return;
+  panel_edits b{};
+  ImGui::PushID("B side");
+  option_widget(*m->compare_option, widget_kind(*m->compare_option), &b);
+  ImGui::PopID();
+  p->controls.push_back(last_item("ab-value", widget_kind(*m->compare_option), "A/B"));
+  if (b.option) {
+    e->compare_set = true;
+    snprintf(e->compare_name, sizeof e->compare_name, "%s", b.option_name);
+    snprintf(e->compare_value, sizeof e->compare_value, "%s", b.option_value);
+  }
+}
+
+// The error against the reference at a job's view: its figures and the
+// error view's choice (view.h's ERROR_VIEW_* order).
+static void reference_section(lm_panel *p, const panel_model *m, panel_edits *e) {
+  if (!m->reference || !ImGui::CollapsingHeader("reference", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  ImGui::TextWrapped("%s", m->reference);
+  if (!m->reference_here) return;
+  static const char *const views[] = {"off", "wipe: reference", "wipe: error heat map"};
+  int view = m->error_view;
+  if (ImGui::Combo("error view (E)", &view, views, 3)) e->error_view = view;
+  p->controls.push_back(last_item("error", "combo", "reference"));
 }
 
 // What the draw lists draw: vertices, indices, commands and the display size.
@@ -264,13 +435,22 @@ static uint64_t draw_hash(const ImDrawData *d) {
 
 lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height, panel_edits *e) {
   *e = panel_edits{};
-  e->technique = -1, e->inspect = -1;
+  e->technique = -1, e->inspect = -1, e->error_view = -1, e->compare_technique = -1, e->compare_pick = -1;
   ImGui_ImplOpenGL3_NewFrame();
-  ImGui_ImplGlfw_NewFrame();
   ImGuiIO &io = ImGui::GetIO();
+  double now = lm_now_ms();
+  io.DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
+  io.DeltaTime = p->last_ms > 0 ? static_cast<float>(std::fmax((now - p->last_ms) * 1e-3, 1e-4)) : 1.0f / 60.0f;
+  p->last_ms = now;
   if (p->scripted) {
     io.MousePos = ImVec2(static_cast<float>(p->mouse[0]), static_cast<float>(p->mouse[1]));
     io.MouseDown[0] = p->mouse_down;
+  } else {
+    io.MousePos = ImVec2(static_cast<float>(cursor[0]), static_cast<float>(cursor[1]));
+    for (int i = 0; i < ImGuiMouseButton_COUNT; i++) {
+      io.MouseDown[i] = pressed[i] || glfwGetMouseButton(p->window, i) == GLFW_PRESS;
+      pressed[i] = false;
+    }
   }
   ImGui::NewFrame();
   float w = std::fmin(320.0f, 0.45f * static_cast<float>(width));
@@ -301,10 +481,13 @@ lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height,
     }
     ImGui::EndListBox();
   }
-  graph_section(p, m, e);
+  compare_section(p, m, e);
+  reference_section(p, m, e);
+  bool graph = graph_header(p, m);
   options_section(p, m, e);
   ImGui::PopItemWidth();
   ImGui::End();
+  if (graph) graph_window(p, m, e, static_cast<float>(width) - w, static_cast<float>(height));
   ImGui::Render();
   ImDrawData *d = ImGui::GetDrawData();
   if (!p->image.id || p->image_w != width || p->image_h != height) {

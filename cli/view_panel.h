@@ -44,6 +44,14 @@ typedef struct panel_model {
   int pass_count;
   const char *const *targets;
   int target_count;
+  /* A/B: the wipe's other side, its technique (-1: none yet) and the one
+   * option it sets apart from this side (NULL: none), as that side has it. */
+  int compare_technique;
+  bool compare_on;
+  const lm_option_info *compare_option;
+  const char *reference;          /* the error against the reference here, or why there is none; NULL: no job */
+  bool reference_here;            /* the error view's choice shows */
+  int error_view;                 /* ERROR_VIEW_* */
 } panel_model;
 
 /* What the user did this frame (at most one of each: one widget is active at a time). */
@@ -55,6 +63,12 @@ typedef struct panel_edits {
   bool scrub;                     /* the time slider moved to scrub_time */
   double scrub_time;
   int inspect;                    /* a target clicked in the frame graph, or -1 */
+  int error_view;                 /* the error view picked (ERROR_VIEW_*), or -1 */
+  int compare_technique;          /* a technique picked for the A/B wipe's other side, or -1 */
+  bool compare_toggle;            /* the wipe's checkbox clicked */
+  int compare_pick;               /* an option (index into options) picked to differ on that side, or -1 */
+  bool compare_set;               /* that side's value of it: compare_name = compare_value */
+  char compare_name[128], compare_value[256];
 } panel_edits;
 
 lm_panel *panel_create(lm_window *w, lm_error *err);
@@ -74,8 +88,10 @@ bool panel_wants_keyboard(const lm_panel *p);
  * GROUP X Y W H" (the rectangle 0 0 0 0 where a closed group hides it),
  * then "panel technique NAME X Y W H" per technique, "panel control NAME X Y
  * W H" for the buttons, the time slider and the frame graph's header ("job",
- * "play", "time", "graph") and, while that is open, "panel target NAME X Y W
- * H" for each target button of each pass. */
+ * "play", "time", "graph", the A/B section's "ab", "ab=TECHNIQUE" for each
+ * of its list, "ab-option", "ab-value", and the reference's "error") and, while the
+ * frame graph is open, "panel target NAME X Y W H" for each target button of
+ * each pass (0 0 0 0 where it is scrolled out of sight). */
 void panel_list_widgets(const lm_panel *p, FILE *out);
 
 #ifdef __cplusplus

@@ -8,7 +8,8 @@ uniform sampler2D src;     // the frame (sRGB-encoded bytes) or a target (linear
 uniform sampler2D overlay; // text, premultiplied alpha
 uniform sampler2D panel;   // the panel (cli/view_panel.cpp), premultiplied alpha, when show_panel
 uniform int show_panel = 0;
-uniform sampler2D other;   // the A/B wipe's other side (sRGB-encoded bytes), right of split
+uniform sampler2D other;   // the wipe's other side (sRGB-encoded bytes), right of split
+uniform int other_linear = 0; // other holds linear radiance (a reference): encoded as the output stage does
 uniform float split = -1.0; // the wipe's line, window pixels from the left; < 0: no wipe
 uniform int mode = 0;      // 0: the frame; 1: a target; 2: a target in false colour; 3: black;
                            // 4: a one-channel or depth target, grey over its range
@@ -40,7 +41,8 @@ void main() {
   color = v;
 #else
   vec3 c = v.rgb;
-  if (split >= 0.0 && gl_FragCoord.x >= split) c = texture(other, uv).rgb;
+  if (split >= 0.0 && gl_FragCoord.x >= split)
+    c = other_linear != 0 ? srgb_encode(finite_or_zero(texture(other, uv).rgb)) : texture(other, uv).rgb;
   if (split >= 0.0 && abs(gl_FragCoord.x - split) < 1.0) c = vec3(1.0); // the line to drag
   if (mode == 3) {
     c = vec3(0.0);

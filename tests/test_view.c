@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include "image/image.h"
+#include "image/metrics.h"
 #include "scene/gltf.h"
 
 static char root[256];
@@ -1151,6 +1152,34 @@ static void find_control(const char *log, const char *name, double rect[4]) {
   free(s);
 }
 
+/* A 384x288 dl run with the panel on, `frames` frames long, pressing keys. */
+static void panel_run(const char *log, const char *frames, const char *keys) {
+  pid_t pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", frames,
+                         "--script-keys", keys, NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+}
+
+/* Appends the keys that click the middle of rect: move at `frame`, press and release on the next two. */
+static void click_keys(char *keys, size_t cap, int frame, const double rect[4]) {
+  size_t n = strlen(keys);
+  snprintf(keys + n, cap - n, "%s%d:mouse=%d;%d,%d:button=down,%d:button=up", n ? "," : "", frame,
+           (int)(rect[0] + rect[2] / 2), (int)(rect[1] + rect[3] / 2), frame + 1, frame + 2);
+}
+
+/* Opens the panel's section `header` (a control) at frame 6; keys gets the
+ * click and a widgets listing at frame 11, whose lines the run leaves in log. */
+static void open_section(const char *log, const char *header, char *keys, size_t cap) {
+  double rect[4];
+  panel_run(log, "6", "5:widgets");
+  find_control(log, header, rect);
+  keys[0] = '\0';
+  click_keys(keys, cap, 6, rect);
+  strncat(keys, ",11:widgets", cap - strlen(keys) - 1);
+  panel_run(log, "12", keys);
+}
+
 /* The panel's time controls: its button pauses an animation that plays, and
  * dragging its slider to the left end scrubs to the animation's first key. */
 static void panel_plays_pauses_and_scrubs(void **state) {
@@ -1199,29 +1228,16 @@ static void panel_graph_button_inspects_target(void **state) {
   (void)state;
   char log[512], keys[512];
   log_path(log, "panel_graph");
-  pid_t pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "4",
-                         "--script-keys", "3:widgets", NULL);
-  assert_int_equal(wait_exit(pid, 30000), 0);
-  double header[4], button[4];
-  find_control(log, "graph", header);
-  snprintf(keys, sizeof keys, "3:mouse=%d;%d,4:button=down,5:button=up,7:widgets", (int)(header[0] + header[2] / 2),
-           (int)(header[1] + header[3] / 2));
-  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "8", "--script-keys",
-                   keys, NULL);
-  assert_int_equal(wait_exit(pid, 30000), 0);
+  open_section(log, "graph", keys, sizeof keys);
+  double button[4];
   char *s = read_text(log), *line = strstr(s, "panel target gbuffer.clr ");
   if (!line) print_log(log);
   assert_non_null(line);
   assert_int_equal(sscanf(line, "panel target gbuffer.clr %lf %lf %lf %lf", &button[0], &button[1], &button[2],
                           &button[3]), 4);
   free(s);
-  snprintf(keys + strlen(keys), sizeof keys - strlen(keys), ",8:mouse=%d;%d,9:button=down,10:button=up",
-           (int)(button[0] + button[2] / 2), (int)(button[1] + button[3] / 2));
-  pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--exit-after", "13", "--script-keys",
-                   keys, NULL);
-  int rc = wait_exit(pid, 30000);
-  if (rc) print_log(log);
-  assert_int_equal(rc, 0);
+  click_keys(keys, sizeof keys, 12, button);
+  panel_run(log, "17", keys);
   assert_true(file_has(log, "inspecting 'gbuffer.clr' rgba8"));
 }
 
@@ -1296,7 +1312,189 @@ static void compare_wipe_shows_both_sides(void **state) {
   assert_true(file_has(log, "--compare-set needs --compare"));
 }
 
-int main(void) {
+/* sRGB-encoded as the output stage writes 8-bit images (saturated first). */
+static double srgb(double c) {
+  c = c < 0 ? 0 : c > 1 ? 1 : c;
+  return c <= 0.0031308 ? c * 12.92 : 1.055 * pow(c, 1 / 2.4) - 0.055;
+}
+
+/* Mean |shot - expected| per value over columns x0..x1-1 of the lower half
+ * (messages show at the top); expected holds linear values (encoded to sRGB
+ * first) or, without linear, 8-bit values. */
+static double band_vs(const lm_image *shot, const float *expected, int channels, bool linear, int x0, int x1) {
+  double sum = 0;
+  int n = 0;
+  for (int y = shot->height / 2; y < shot->height; y++)
+    for (int x = x0; x < x1; x++)
+      for (int c = 0; c < 3; c++, n++) {
+        double e = expected[((size_t)y * shot->width + x) * channels + c];
+        sum += fabs(shot->pixels[((size_t)y * shot->width + x) * shot->channels + c] - (linear ? srgb(e) : e / 255));
+      }
+  return sum / (n > 0 ? n : 1);
+}
+
+/* The file whose name `limn report` gives setting s's image of the job's one view. */
+static void report_image(int s, lm_image *img) {
+  char cmd[600], path[512] = "";
+  snprintf(cmd, sizeof cmd, "ls %s/rep/images/*_%d.exr", root, s);
+  FILE *p = popen(cmd, "r");
+  assert_non_null(p);
+  if (!fgets(path, sizeof path, p)) path[0] = '\0';
+  pclose(p);
+  path[strcspn(path, "\n")] = '\0';
+  lm_error err;
+  if (!lm_image_read(path, img, &err)) fail_msg("%s", err.msg);
+}
+
+/* The last "reference error: view N, mean M, pearson P, indirect removed R" line. */
+static bool reference_line(const char *log, double *mean, double *pearson, double *removed) {
+  char *text = read_text(log), *at = NULL;
+  for (char *p = text; (p = strstr(p, "reference error: view ")); p++) at = p;
+  int view;
+  bool ok = at && sscanf(at, "reference error: view %d, mean %lf, pearson %lf, indirect removed %lf", &view, mean,
+                         pearson, removed) == 4;
+  free(text);
+  return ok;
+}
+
+/* At a view of a job whose POV-Ray references are cached, E shows the
+ * frame's error against the reference: the figures limn report gives for
+ * that view, a wipe with the reference on its right (pixels) and one with
+ * the error heat map; the camera moved away, none. */
+static void reference_error_and_wipe(void **state) {
+  (void)state;
+  if (system("command -v povray >/dev/null 2>&1") != 0) skip(); /* Debian's povray */
+  char job[512], cams[600], cmd[2048], log[512], shot[512], refs[512];
+  snprintf(cams, sizeof cams, "%s/one.cams", root);
+  write_file("one.cams", "front 0 1 3.4 0 1 0 45\n");
+  snprintf(job, sizeof job, "%s/refjob.lua", root);
+  snprintf(cmd, sizeof cmd,
+           "return { scenes = { { scene = \"%s/data/scenes/cornell.glb\", cameras = \"%s\" } },\n"
+           "  techniques = { \"dl\" }, sizes = { \"128x96\" }, set = { ambient = 0 },\n"
+           "  output = \"%s/refjob/{camera}_{technique}.png\" }\n", LIMN_SOURCE_ROOT, cams, root);
+  write_file("refjob.lua", cmd);
+  snprintf(refs, sizeof refs, "%s/refs", root);
+  snprintf(cmd, sizeof cmd, "%s report --job %s --sweep dl --baseline dl+esm --out %s/rep --refs %s --quiet", LIMN_EXE,
+           job, root, refs);
+  assert_int_equal(system(cmd), 0);
+  /* report.csv's dl row: mean_error (8th field), pearson (11th), indirect_removed (17th). */
+  char path[512], *csv;
+  snprintf(path, sizeof path, "%s/rep/report.csv", root);
+  csv = read_text(path);
+  char *row = strstr(csv, "\n\"dl\",");
+  assert_non_null(row);
+  double want[3] = {0};
+  int field = 0;
+  for (char *p = row + 1; *p && *p != '\n' && field < 17; p++) {
+    if (*p == '"') p = strchr(p + 1, '"'); /* passes_ms: quoted */
+    if (*p != ',') continue;
+    field++;
+    if (field == 7 || field == 10 || field == 16) want[field == 7 ? 0 : field == 10 ? 1 : 2] = atof(p + 1);
+  }
+  free(csv);
+  fprintf(stderr, "report: mean %.6f pearson %.6f removed %.3f%%\n", want[0], want[1], want[2]);
+  assert_true(want[0] > 0 && want[1] > 0);
+  /* The wipe with the reference, then with the heat map, then moved away. */
+  log_path(log, "ref_wipe");
+  shot_path(shot, "ref_wipe.png");
+  pid_t pid = spawn_view(log, "--job", job, "--view", "0", "--refs", refs, "--overlay", "off", "--exit-after", "8",
+                         "--screenshot", shot, "--script-keys", "2:E", NULL);
+  int rc = wait_exit(pid, 60000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  double got[3];
+  assert_true(reference_line(log, &got[0], &got[1], &got[2]));
+  fprintf(stderr, "viewer: mean %.6f pearson %.6f removed %.3f%%\n", got[0], got[1], got[2]);
+  assert_true(fabs(got[0] - want[0]) <= 1e-3 * want[0]);
+  assert_true(fabs(got[1] - want[1]) <= 1e-4);
+  assert_true(fabs(got[2] - want[2]) <= 0.1);
+  lm_image wipe, limn, base, ref;
+  load("ref_wipe.png", &wipe);
+  report_image(1, &limn);
+  report_image(0, &base);
+  char *text = read_text(log), *at = strstr(text, ": reference ");
+  assert_non_null(at);
+  char ref_path[512];
+  assert_int_equal(sscanf(at, ": reference %511[^,]", ref_path), 1);
+  free(text);
+  lm_error err;
+  if (!lm_image_read(ref_path, &ref, &err)) fail_msg("%s", err.msg);
+  assert_int_equal(wipe.width, 128);
+  double left = band_vs(&wipe, limn.pixels, limn.channels, true, 0, 60),
+         right = band_vs(&wipe, ref.pixels, ref.channels, true, 68, 128),
+         apart = band_vs(&wipe, limn.pixels, limn.channels, true, 68, 128);
+  fprintf(stderr, "wipe: left vs Limn %.4f, right vs the reference %.4f (vs Limn %.4f)\n", left, right, apart);
+  assert_true(left < 0.01 && right < 0.01 && apart > 0.03);
+  lm_image_free(&wipe);
+  /* The heat map: the frame's error against the reference, white at the baseline's largest pixel error. */
+  shot_path(shot, "ref_heat.png");
+  pid = spawn_view(log, "--job", job, "--view", "0", "--refs", refs, "--overlay", "off", "--exit-after", "8",
+                   "--screenshot", shot, "--script-keys", "2:E,3:E", NULL);
+  assert_int_equal(wait_exit(pid, 60000), 0);
+  lm_image heat;
+  load("ref_heat.png", &heat);
+  unsigned char *rgb = malloc((size_t)128 * 96 * 3);
+  lm_metrics_heatmap(&limn, &ref, lm_metrics_max_pixel_error(&base, &ref), rgb);
+  float *bytes = malloc(sizeof(float) * 128 * 96 * 3);
+  for (int i = 0; i < 128 * 96 * 3; i++) bytes[i] = rgb[i];
+  double hot = band_vs(&heat, bytes, 3, false, 68, 128);
+  fprintf(stderr, "heat map: right vs lm_metrics_heatmap %.4f\n", hot);
+  assert_true(hot < 0.01);
+  free(rgb);
+  free(bytes);
+  lm_image_free(&heat);
+  lm_image_free(&limn);
+  lm_image_free(&base);
+  lm_image_free(&ref);
+  /* A drag turns the camera: no reference there. */
+  pid = spawn_view(log, "--job", job, "--view", "0", "--refs", refs, "--overlay", "off", "--exit-after", "8",
+                   "--script-keys", "2:E,4:drag=40;0", NULL);
+  assert_int_equal(wait_exit(pid, 60000), 0);
+  assert_true(file_has(log, "no reference here"));
+}
+
+/* The panel's A/B: opening it and picking dl+esm in its list starts the
+ * wipe's right side live; with the panel then closed (M) the left half is
+ * dl's frame and the right half dl+esm's. */
+static void panel_picks_compare_technique(void **state) {
+  (void)state;
+  char log[512], keys[512], shot[512];
+  log_path(log, "panel_ab");
+  open_section(log, "ab", keys, sizeof keys);
+  double item[4];
+  find_control(log, "ab=dl+esm", item);
+  click_keys(keys, sizeof keys, 12, item);
+  strcat(keys, ",16:M");
+  shot_path(shot, "panel_ab.png");
+  pid_t pid = spawn_view(log, "--panel", "on", "--tech", "dl", "--size", "384x288", "--overlay", "off", "--exit-after",
+                         "20", "--screenshot", shot, "--script-keys", keys, NULL);
+  int rc = wait_exit(pid, 60000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  assert_true(file_has(log, "A/B: dl+esm on the right"));
+  char left_shot[512], right_shot[512];
+  shot_path(left_shot, "ab_dl.png");
+  shot_path(right_shot, "ab_dlesm.png");
+  assert_int_equal(wait_exit(spawn_view(log, "--tech", "dl", "--size", "384x288", "--overlay", "off", "--exit-after",
+                                        "8", "--screenshot", left_shot, NULL), 60000), 0);
+  assert_int_equal(wait_exit(spawn_view(log, "--tech", "dl+esm", "--size", "384x288", "--overlay", "off",
+                                        "--exit-after", "8", "--screenshot", right_shot, NULL), 60000), 0);
+  lm_image wipe, left, right;
+  load("panel_ab.png", &wipe);
+  load("ab_dl.png", &left);
+  load("ab_dlesm.png", &right);
+  double apart = band_diff(&left, &right, 200, 384), wl = band_diff(&wipe, &left, 0, 184),
+         wr = band_diff(&wipe, &right, 200, 384);
+  fprintf(stderr, "panel A/B: dl and dl+esm apart %.4f right of the line; wipe left %.4f, right %.4f\n", apart, wl, wr);
+  assert_true(apart > 0.005);
+  assert_true(wl < 0.002 && wr < 0.002);
+  lm_image_free(&wipe);
+  lm_image_free(&left);
+  lm_image_free(&right);
+}
+
+/* An argument runs only the cases it matches (cmocka's filter: "reference_*"). */
+int main(int argc, char **argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_teardown(command_line_errors, stop_leftover),
       cmocka_unit_test_teardown(window_shows_the_box, stop_leftover),
@@ -1318,6 +1516,9 @@ int main(void) {
       cmocka_unit_test_teardown(panel_plays_pauses_and_scrubs, stop_leftover),
       cmocka_unit_test_teardown(panel_graph_button_inspects_target, stop_leftover),
       cmocka_unit_test_teardown(compare_wipe_shows_both_sides, stop_leftover),
+      cmocka_unit_test_teardown(reference_error_and_wipe, stop_leftover),
+      cmocka_unit_test_teardown(panel_picks_compare_technique, stop_leftover),
   };
+  if (argc > 1) cmocka_set_test_filter(argv[1]);
   return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -144,7 +144,7 @@ static double ssim(const lm_image *a, const lm_image *b, int nc) {
   return total / ((double)px * nc);
 }
 
-void lm_metrics_compute(const lm_image *a, const lm_image *b, lm_metrics *m) {
+void lm_metrics_compute_fast(const lm_image *a, const lm_image *b, lm_metrics *m) {
   memset(m, 0, sizeof *m);
   int nc = compared_channels(a);
   size_t px = (size_t)a->width * a->height;
@@ -164,8 +164,12 @@ void lm_metrics_compute(const lm_image *a, const lm_image *b, lm_metrics *m) {
   m->identical = sum_sq == 0;
   m->psnr = m->identical ? INFINITY : 10.0 * log10(1.0 / mse);
   m->pearson = pearson(a, b, px, nc);
-  m->ssim = ssim(a, b, nc);
-  m->closer = m->ties = -1;
+  m->ssim = m->closer = m->ties = -1;
+}
+
+void lm_metrics_compute(const lm_image *a, const lm_image *b, lm_metrics *m) {
+  lm_metrics_compute_fast(a, b, m);
+  m->ssim = ssim(a, b, m->channels);
 }
 
 void lm_metrics_closer(const lm_image *a, const lm_image *b, const lm_image *r, lm_metrics *m) {

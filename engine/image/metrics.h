@@ -55,6 +55,9 @@ bool lm_metrics_check(const lm_image *a, const char *a_name, const lm_image *b, 
                       lm_error *err);
 /* Every metric but closer/ties (set to -1). The images must pass lm_metrics_check. */
 void lm_metrics_compute(const lm_image *a, const lm_image *b, lm_metrics *m);
+/* The same but SSIM (set to -1), whose window costs tens of times the rest:
+ * cheap enough for every frame of a viewer. */
+void lm_metrics_compute_fast(const lm_image *a, const lm_image *b, lm_metrics *m);
 /* Fills m->closer and m->ties against reference r (all three must match). */
 void lm_metrics_closer(const lm_image *a, const lm_image *b, const lm_image *r, lm_metrics *m);
 

@@ -1008,6 +1008,8 @@ void lm_renderer_set_sharing(lm_renderer *r, bool on) {
   lm_graph_set_sharing(r->graph, on);
 }
 
+void lm_renderer_set_linear_output(lm_renderer *r, bool on) { r->desc.linear_output = on; }
+
 bool lm_renderer_output(lm_renderer *r, lm_texture *tex, int *width, int *height) {
   if (r->output_srgb < 0 || r->output_srgb >= lm_graph_target_count(r->graph)) return false;
   lm_graph_target_info t = lm_graph_target(r->graph, r->output_srgb);

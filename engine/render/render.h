@@ -57,6 +57,9 @@ void lm_renderer_set_camera(lm_renderer *r, int camera);
 /* Targets share textures where lifetimes allow (default); off keeps every
  * target's content readable after the frame (lm_graph_set_sharing). */
 void lm_renderer_set_sharing(lm_renderer *r, bool on);
+/* Keep the float linear output (lm_renderer_desc.linear_output) from the
+ * next frame on, or stop: a viewer reads it only while it shows an error. */
+void lm_renderer_set_linear_output(lm_renderer *r, bool on);
 /* Renders a frame with pipeline p (a reloaded script) into a new frame
  * graph. On success p replaces the pipeline (the caller still owns both),
  * and persistent targets with the same name, format and size rule keep their
