@@ -40,7 +40,7 @@ typedef struct lm_shadow_settings {
                     * place keeps that tile's texels (engine/render: copied, not drawn) */
   bool coverage;   /* spot and point tiles as fine as the screen needs (lm_shadow_plan.levels);
                     * false: every tile at resolution */
-  float simplify;  /* a caster whose simplified copy (lm_scene_mesh.caster_error) errs by at most this
+  float simplify;  /* a caster whose simplified copy (lm_scene_mesh.casters) errs by at most this
                     * many texels of a tile draws that copy there (far cascades, small tiles); 0: none */
   float rsm;       /* > 0: a frame reads reflective shadow maps (seed 004's senders); each
                     * directional light gets one more tile, over the sphere around all
