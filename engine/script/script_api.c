@@ -215,9 +215,14 @@ static int l_shadow_plan(lua_State *L) {
   lua_pop(L, 1);
   st.rsm = opt_number(L, 1, "rsm", 0, 0, 64, what);
   st.rsm_resolution = (int)opt_number(L, 1, "rsm_resolution", (float)st.rsm_resolution, 16, 8192, what);
+  st.last_levels = p->shadow_levels, st.last_light_count = p->shadow_level_count;
   lm_shadow_plan_free(p->shadows);
   lm_error err;
   if (!lm_shadow_plan_make(p->shadows, p->scene, p->camera, &st, &err)) return luaL_error(L, "shadow_plan: %s", err.msg);
+  int n = p->shadows->light_count; /* the levels, kept for the next plan (lm_shadow_settings.last_levels) */
+  p->shadow_levels = lm_realloc(p->shadow_levels, sizeof *p->shadow_levels * (size_t)(n + 1));
+  memcpy(p->shadow_levels, p->shadows->levels, sizeof *p->shadow_levels * (size_t)n);
+  p->shadow_level_count = n;
   p->shadows_frame = p->frame;
   if (p->shadows->view_count == 0) {
     lm_info("left out: shadows (no light in scene '%s' casts shadows)", p->scene->name);
