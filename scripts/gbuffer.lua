@@ -24,8 +24,10 @@ end
 -- Draws the scene with material technique `technique` ("std" Phong, or "pbr"
 -- glTF metallic-roughness, which writes the same channels) into G;
 -- `materials` (optional) overrides material parameters by name:
--- { wall = { color = { 1, 0, 0 }, ks = 0.2 } }.
-function gbuffer.render(G, technique, materials)
+-- { wall = { color = { 1, 0, 0 }, ks = 0.2 } }; `simplify` (optional, pixels): a mesh
+-- node draws its coarsest simplified copy (made at load) that errs by at most that
+-- many pixels where it comes nearest the camera (0 or nil: every mesh whole).
+function gbuffer.render(G, technique, materials, simplify)
   local out, defines = { G.clr, G.nrm, G.dpt, G.mat }, {}
   if G.emi then out[#out + 1] = G.emi end
   if G.vel then
@@ -33,7 +35,7 @@ function gbuffer.render(G, technique, materials)
     out[#out + 1] = G.vel
   end
   scene{ "gbuffer", technique = technique or "std", out = out, defines = defines,
-         depth = G.depth, clear = { 0, 0, 0, 0 }, materials = materials }
+         depth = G.depth, clear = { 0, 0, 0, 0 }, materials = materials, simplify = simplify }
   G.phong_only = (technique or "std") == "std" -- no pixel carries the pbr technique's mark
   return G
 end

@@ -19,6 +19,8 @@ Options = {
   materials = "phong",     -- "phong" (the std technique) or "pbr" (glTF metallic-roughness, GGX)
   light_variants = 12,     -- up to this many lights (0..16) lighting passes unroll them; more, 0: grid loop
   light_cull = true,       -- yet more than one light and one the grid culls (cone, range): the grid's loop
+  simplify = 0.1,          -- a mesh node draws its simplified copy (made at load) that errs by at most this
+                           -- many pixels where it comes nearest the camera; 0..64, 0: every mesh whole
   shadow = options.copy(shadow.defaults),
   sky = options.copy(sky.defaults),                -- off by default
   reflections = options.copy(reflections.defaults),
@@ -83,7 +85,8 @@ local function frame(tech, row)
   local L, S = techniques.modules[row.lighting], techniques.modules[row.offscreen]
   local materials = ({ phong = "std", pbr = "pbr" })[tech.materials]
   if not materials then error('materials must be "phong" or "pbr" (got "' .. tostring(tech.materials) .. '")') end
-  local G = gbuffer.render(gbuffer.targets(1, materials, reads_velocity(tech, row)), materials)
+  local G = gbuffer.render(gbuffer.targets(1, materials, reads_velocity(tech, row)), materials, nil,
+                           tech.simplify)
   G.lights = light_set(tech.light_variants, tech.light_cull) -- the light set's defines (gbuffer.defines); nil:
                                                              -- the general loop over storage buffers
   temporal.velocity(G.vel)
@@ -114,7 +117,7 @@ local function frame(tech, row)
 end
 
 local rules = { ambient = options.number(0, 1e6), background = options.number(0, 1e6),
-                light_variants = options.whole(0, 16), light_cull = options.boolean,
+                light_variants = options.whole(0, 16), light_cull = options.boolean, simplify = options.number(0, 64),
                 materials = options.one_of("phong", "pbr") }
 options.declare("", rules) -- the viewer's panel shows each option by its rule
 

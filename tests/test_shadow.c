@@ -483,6 +483,48 @@ static void check_packing(const lm_shadow_plan *plan) {
   }
 }
 
+/* A light's tile size at output height h (width 4h/3), made with the last
+ * plan's levels `last` (NULL: none); its levels into `levels` when given. */
+static int face_size(lm_scene *s, int h, const int *last, int *levels) {
+  lm_shadow_settings st;
+  lm_shadow_settings_default(&st);
+  st.last_levels = last, st.last_light_count = last ? s->light_count : 0;
+  lm_frame_data cam;
+  lm_scene_frame_data(s, 0, h * 4 / 3, h, &cam);
+  lm_shadow_plan plan;
+  lm_error err;
+  assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+  int size = plan.views[0].width;
+  if (levels) memcpy(levels, plan.levels, sizeof *levels * (size_t)s->light_count);
+  lm_shadow_plan_free(&plan);
+  return size;
+}
+
+/* A camera moving to and fro near the boundary between two tile sizes keeps
+ * the last one (LM_SHADOW_LEVEL_SLACK), so its tiles are not drawn again
+ * and the atlas does not move; a move beyond the slack changes it. */
+static void local_tiles_keep_their_size_near_a_boundary(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  s->lights[0].falloff = LM_FALLOFF_WINDOW;
+  s->lights[0].radius = 1.6f;
+  int h = 120;
+  while (h < 600 && face_size(s, h + 3, NULL, NULL) == face_size(s, h, NULL, NULL)) h += 3;
+  int below = face_size(s, h, NULL, NULL), above = face_size(s, h + 3, NULL, NULL);
+  printf("faces of %d texels at %d pixels high, %d at %d\n", below, h, above, h + 3);
+  assert_true(h < 600 && above == 2 * below);
+  int levels[8], kept[8];
+  face_size(s, h, NULL, levels);
+  for (int k = 0; k < 4; k++) { /* to and fro across the boundary */
+    assert_int_equal(face_size(s, h + 3 * (k % 2 == 0), levels, kept), below);
+    memcpy(levels, kept, sizeof levels);
+  }
+  int far = face_size(s, h * 2, NULL, NULL); /* well past it: what a plan without history makes */
+  assert_true(far > below);
+  assert_int_equal(face_size(s, h * 2, levels, NULL), far);
+  lm_scene_destroy(s);
+}
+
 static void local_tiles_follow_their_screen_coverage(void **state) {
   (void)state;
   lm_scene *s = builtin("cornell");
@@ -896,6 +938,7 @@ int main(void) {
       cmocka_unit_test(pcss_penumbra_widens_with_blocker_distance),
       cmocka_unit_test(cube_faces_no_pixel_samples_are_not_drawn),
       cmocka_unit_test(local_tiles_follow_their_screen_coverage),
+      cmocka_unit_test(local_tiles_keep_their_size_near_a_boundary),
       cmocka_unit_test(nothing_casts_or_nothing_reads_means_no_shadow_pass),
       cmocka_unit_test(the_atlas_can_be_viewed),
       cmocka_unit_test(esm_keeps_the_rooms_sun_patch_and_does_not_leak),

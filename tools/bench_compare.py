@@ -4,6 +4,7 @@
     tools/bench_compare.py REV [--case SCENE[:TECH[:NAME=VALUE,...]]] ... [options]
     (--set-this NAME=VALUE: an option for this checkout alone, one REV lacks)
     tools/bench_compare.py REV --motion [--orbit ...] [--time START:STOP --fps N --animation A] ...
+    tools/bench_compare.py REV --walk [N1,N2] [--walk-keys KEYS] ...
 
 Builds REV's `limn` in a scratch git worktree (under /tmp, removed at the end
 unless --keep), then renders every case with both builds in turn, round after
@@ -16,18 +17,27 @@ so that a speed-up that changes the picture shows. With --motion (or --orbit,
 --time: passed to `limn bench`, which both revisions must have), each run is
 `limn bench --motion --json` at the size instead, and the times compared are
 its moving column (the camera on its path, the animation playing), with the
-still frame's as one more row; no images, so no mean error. Standard library
+still frame's as one more row; no images, so no mean error. With --walk (for
+revisions older than `bench --motion`), each run is the viewer flying through
+the scene as a user would (`limn view --script-keys 1:hold=W --exit-after N`
+under one Xvfb server started for the whole comparison), timed whole by the
+wall clock (CLOCK_MONOTONIC) and in CPU time (getrusage: user + system of
+all its threads, which load from other work stretches less); a moving frame
+is (t(N2) - t(N1)) / (N2 - N1) of the same round, so start-up and loading
+cancel out: frame times per case, no passes, no images. Standard library
 only.
 """
 import argparse
 import json
 import os
 import re
+import resource
 import shutil
 import statistics
 import subprocess
 import sys
 import tempfile
+import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEFAULT_CASES = ["garage:isr+esm", "office:isr+esm", "outdoor:isr+esm"]
@@ -122,6 +132,48 @@ def bench_motion(limn, case, args, sets, who):
     return passes
 
 
+def start_xvfb(size):
+    """An Xvfb server on a free display for the whole comparison: (process, DISPLAY)."""
+    if not shutil.which("Xvfb"):
+        fail("--walk needs Xvfb (Debian's xvfb) for the viewer's window")
+    read, write = os.pipe()
+    w, h = size.split("x")
+    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", f"{int(w) + 64}x{int(h) + 64}x24",
+                             "-nolisten", "tcp"], pass_fds=(write,), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    os.close(write)
+    with os.fdopen(read) as f:
+        number = f.readline().strip()
+    if not number:
+        proc.kill()
+        fail("Xvfb did not start")
+    return proc, ":" + number
+
+
+def walk_run(limn, case, args, sets, frames, display):
+    """Seconds of one viewer run that flies for `frames` frames: (wall, CPU of
+    all its threads: user + system, getrusage of the waited-for child)."""
+    panel = "--panel" in subprocess.run([limn, "view", "--help"], text=True, capture_output=True).stdout
+    cmd = [limn, "view", "--scene", case["scene"], "--size", args.size, "--overlay", "off",
+           "--script-keys", args.walk_keys, "--exit-after", str(frames)] + (["--panel", "off"] if panel else [])
+    cmd += case_flags(case, sets)
+    r0, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.monotonic()
+    p = subprocess.run(cmd, text=True, capture_output=True, env=dict(os.environ, DISPLAY=display))
+    t, r1 = time.monotonic() - t0, resource.getrusage(resource.RUSAGE_CHILDREN)
+    if p.returncode != 0:
+        fail(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stderr.strip()}")
+    return t, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+
+
+def walk_frame(limn, case, args, sets, display):
+    """One round's moving frame in ms, the difference of two viewer runs: by
+    the wall clock ("total") and in CPU time (a machine that other work loads
+    stretches the first more than the second)."""
+    n1, n2 = args.walk
+    (w2, c2), (w1, c1) = walk_run(limn, case, args, sets, n2, display), walk_run(limn, case, args, sets, n1, display)
+    return {"frame (cpu time)": 1000.0 * (c2 - c1) / (n2 - n1), "total": 1000.0 * (w2 - w1) / (n2 - n1)}
+
+
 def mean_error(limn, a, b):
     p = subprocess.run([limn, "compare", a, b, "--json"], text=True, capture_output=True)
     try:
@@ -151,6 +203,12 @@ def main():
     ap.add_argument("--time", metavar="START:STOP", help="limn bench --time: the animation played (implies --motion)")
     ap.add_argument("--fps", help="limn bench --fps (with --time)")
     ap.add_argument("--animation", metavar="NAME|INDEX|all", help="limn bench --animation (with --time)")
+    ap.add_argument("--walk", nargs="?", const="10,40", metavar="N1,N2",
+                    help="time the viewer flying through the scene instead (limn view under Xvfb; a moving frame\n"
+                         "= (wall time of N2 frames - of N1) / (N2 - N1); default 10,40): for revisions without\n"
+                         "`bench --motion`")
+    ap.add_argument("--walk-keys", default="1:hold=W",
+                    help="the viewer's --script-keys for --walk (default 1:hold=W: forward, 1/60 s a frame)")
     args = ap.parse_args()
     if args.frames < 1 or args.rounds < 1:
         fail("--frames and --rounds want at least 1")
@@ -158,6 +216,16 @@ def main():
     if (args.fps or args.animation) and not args.time:
         fail("--fps and --animation play an animation: they need --time START:STOP")
     moving = motion_flags(args) != []
+    if args.walk is not None:
+        try:
+            args.walk = [int(v) for v in args.walk.split(",")]
+        except ValueError:
+            args.walk = []
+        if len(args.walk) != 2 or not 0 < args.walk[0] < args.walk[1]:
+            fail("--walk wants N1,N2 with 0 < N1 < N2")
+        if moving:
+            fail("--walk times the viewer: it does not go with --motion, --orbit or --time")
+    xvfb, display = start_xvfb(args.size) if args.walk else (None, None)
     try:
         sha = run(["git", "-C", ROOT, "rev-parse", "--verify", args.rev + "^{commit}"],
                   capture_output=True).stdout.strip()
@@ -187,9 +255,13 @@ def main():
                     print(f"  {case['label']}: round {r + 1}/{args.rounds}, {who}", file=log)
                     img = os.path.join(images, f"{len(results)}-{who}.exr")
                     sets = args.set + (args.set_this if who == "this" else [])
-                    times[who].append(bench_motion(limn[who], case, args, sets, who) if moving
-                                      else capture(limn[who], case, args, img, sets))
-            err = None if moving else mean_error(limn["this"], os.path.join(images, f"{len(results)}-base.exr"),
+                    if args.walk:
+                        times[who].append(walk_frame(limn[who], case, args, sets, display))
+                    elif moving:
+                        times[who].append(bench_motion(limn[who], case, args, sets, who))
+                    else:
+                        times[who].append(capture(limn[who], case, args, img, sets))
+            err = None if moving or args.walk else mean_error(limn["this"], os.path.join(images, f"{len(results)}-base.exr"),
                                                  os.path.join(images, f"{len(results)}-this.exr"))
             names = [n for n in times["base"][0] if n != "total"]
             names += [n for n in times["this"][0] if n != "total" and n not in names]
@@ -203,6 +275,9 @@ def main():
                 rows.append(row)
             results.append({"case": case["label"], "passes": rows, "mean_error": err})
     finally:
+        if xvfb:
+            xvfb.terminate()
+            xvfb.wait()
         shutil.rmtree(images, ignore_errors=True)
         if not args.keep:
             subprocess.run(["git", "-C", ROOT, "worktree", "remove", "--force", tree],
@@ -211,15 +286,20 @@ def main():
     label = here + (" (uncommitted changes)" if dirty else "")
     if args.json:
         print(json.dumps({"base": sha, "this": label, "size": args.size, "frames": args.frames,
-                          "motion": motion_flags(args),
+                          "motion": motion_flags(args), "walk": args.walk, "walk_keys": args.walk_keys,
                           "rounds": args.rounds, "sets": args.set, "sets_this": args.set_this, "cases": results},
                          indent=1))
         return
+    runs = "rounds of two viewer runs" if args.walk else f"runs of {args.frames} frames"
     print(f"base {args.rev} ({sha[:10]}) against this checkout {label}; {args.size}, medians of "
-          f"{args.rounds} alternated runs of {args.frames} frames; ratio = base / this (> 1: faster now)")
+          f"{args.rounds} alternated {runs}; ratio = base / this (> 1: faster now)")
     if moving:
         print(f"moving frames: limn bench {' '.join(motion_flags(args))} (its moving column; 'frame' is the moving "
               "frame, 'frame (still)' the still one)")
+    if args.walk:
+        print(f"moving frames: the viewer under Xvfb, --script-keys {args.walk_keys}, (wall time of {args.walk[1]} "
+              f"frames - of {args.walk[0]}) / {args.walk[1] - args.walk[0]}, CLOCK_MONOTONIC; 'frame' is the moving frame, "
+              "'frame (cpu time)' the same difference in the process's CPU time (user + system, all threads)")
     if args.set_this:
         print(f"this checkout only: {', '.join(args.set_this)}")
     fmt = "  {:<26} {:>10} {:>10} {:>8}"

@@ -114,6 +114,11 @@ typedef struct lm_pass_desc {
    * least depth, lm_set_caster_layer), drawn after the opaque ones and into
    * it alone; 0: none, they cast as opaque ones do. */
   int transmit;
+  /* Camera scene passes: a node whose mesh has simplified copies
+   * (lm_scene_mesh.lods) draws the coarsest that errs by at most this many
+   * pixels of the pass's outputs where the node comes nearest the camera;
+   * 0: every mesh whole. */
+  float simplify;
 } lm_pass_desc;
 
 lm_graph *lm_graph_create(void);

@@ -165,6 +165,8 @@ static bool fit_views(void *user, const lm_pass_desc *d, lm_texture fit, int w, 
   return true;
 }
 
+static int pass_textures(const lm_scene_pass *sp, lm_graph_target_info out[LM_MAX_COLOR_OUTPUTS + 1]);
+
 static const lm_program *scene_variant(void *ctx, const char *defines, lm_error *err) {
   return lm_scene_pass_variant(ctx, defines, err);
 }
@@ -191,11 +193,15 @@ static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, int layer, const 
                           .params = params, .param_count = n, .prev_world = r->prev_world,
                           .dynamic = r->dynamic, .layer = layer,
                           .blend = sp->view ? LM_BLEND_CAST : sp->desc->blend ? LM_BLEND_ONLY : LM_BLEND_SKIP,
-                          .eye_view_proj = sp->desc->blend ? r->camera.view_proj : NULL,
+                          .eye_view_proj = sp->view ? NULL : r->camera.view_proj,
                           .transmit = sp->view ? sp->desc->transmit : 0, .outputs = sp->desc->output_count};
   if (sp->view && r->shadows.settings.simplify > 0) /* simplified casters where a tile's texels hide them */
     d.lod_view_proj = sp->view->view_proj, d.lod_size[0] = sp->view->width, d.lod_size[1] = sp->view->height,
     d.lod_texels = r->shadows.settings.simplify;
+  lm_graph_target_info t[LM_MAX_COLOR_OUTPUTS + 1];
+  if (!sp->view && sp->desc->simplify > 0 && pass_textures(sp, t) > 0) /* and where pixels hide them */
+    d.lod_view_proj = r->camera.view_proj, d.lod_size[0] = t[0].width, d.lod_size[1] = t[0].height,
+    d.lod_texels = sp->desc->simplify, d.lod_camera = true;
   return lm_scene_draw(r->desc.scene, &d, sp->view ? &r->shadow_stats : &r->stats, err);
 }
 

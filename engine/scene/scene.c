@@ -274,28 +274,35 @@ bool lm_scene_camera_check(const lm_scene *s, int cam, lm_error *err) {
   return true;
 }
 
-/* Makes m's simplified shadow casters (lm_scene_mesh.caster_index_count):
- * the mesh's indices followed by the copy's, malloc'd, or NULL when it gets
- * none. Positions alone matter to a caster, so the indices are first made
- * to share vertices that differ only in normal or uv (a seam would stop the
- * simplifier there). */
-static uint32_t *simplify_casters(lm_scene_mesh *m) {
-  m->caster_index_count = 0, m->caster_error = 0;
+/* Makes up to LM_LOD_LEVELS simplified copies of m, each from the last,
+ * appended to `indices` (*len of them; room for 5 times the mesh's own:
+ * meshopt_simplify writes up to its input's count, and each copy keeps at
+ * most 3/4 of the last's), into lods; returns how many. A level whose
+ * budget (LM_LOD_ERROR times 4^k of the extent) keeps over 3/4 of the
+ * last's triangles is left out. Over positions alone (casters), the indices
+ * are first made to share vertices that differ only in normal or uv (a seam
+ * would stop the simplifier there); otherwise the seams stay, and so the
+ * normals and uvs the camera sees. */
+static int simplify_levels(const lm_scene_mesh *m, bool positions, uint32_t *indices, size_t *len,
+                           lm_mesh_lod lods[LM_LOD_LEVELS]) {
   size_t n = (size_t)m->index_count, nv = (size_t)m->vertex_count, stride = 8 * sizeof(float);
-  if (m->rest || n / 3 < LM_CASTER_MIN_TRIANGLES) return NULL; /* a deformed mesh moves its vertices */
-  uint32_t *out = lm_alloc(sizeof *out * n * 2), *shared = lm_alloc(sizeof *shared * n);
-  memcpy(out, m->indices, sizeof *out * n);
-  meshopt_generateShadowIndexBuffer(shared, m->indices, n, m->vertices, nv, 3 * sizeof(float), stride);
-  float error = 0;
-  size_t kept = meshopt_simplify(out + n, shared, n, m->vertices, nv, stride, n / 4, LM_CASTER_ERROR, 0, &error);
-  free(shared);
-  if (kept == 0 || kept > n * 3 / 4 || !(error >= 0)) {
-    free(out);
-    return NULL;
+  uint32_t *from = lm_alloc(sizeof *from * n);
+  if (positions) meshopt_generateShadowIndexBuffer(from, m->indices, n, m->vertices, nv, 3 * sizeof(float), stride);
+  else memcpy(from, m->indices, sizeof *from * n);
+  float scale = meshopt_simplifyScale(m->vertices, nv, stride), error = 0, budget = LM_LOD_ERROR;
+  int levels = 0;
+  for (int k = 0; k < LM_LOD_LEVELS; k++, budget *= 4) { /* a budget too tight for a level: the next one */
+    uint32_t *to = indices + *len;
+    float step = 0; /* meshoptimizer's error, relative to the extent as its target is */
+    size_t kept = meshopt_simplify(to, from, n, m->vertices, nv, stride, n / 4, budget - error, 0, &step);
+    if (kept == 0 || kept > n * 3 / 4 || !(step >= 0)) continue;
+    error += step;
+    lods[levels++] = (lm_mesh_lod){(int)*len, (int)kept, error * scale};
+    memcpy(from, to, sizeof *to * kept);
+    *len += kept, n = kept;
   }
-  m->caster_index_count = (int)kept;
-  m->caster_error = error * meshopt_simplifyScale(m->vertices, nv, stride);
-  return out;
+  free(from);
+  return levels;
 }
 
 bool lm_scene_upload(lm_scene *s, lm_error *err) {
@@ -309,20 +316,30 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
     }
   }
   double t0 = lm_now_ms();
-  long whole = 0, simple = 0;
+  long whole = 0, casters = 0, camera = 0;
   int simplified = 0;
   for (int i = 0; i < s->mesh_count; i++) {
     lm_scene_mesh *m = &s->meshes[i];
-    uint32_t *indices = simplify_casters(m);
-    lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, indices ? indices : m->indices,
-                   m->index_count + m->caster_index_count);
+    size_t n = (size_t)m->index_count, len = n;
+    uint32_t *indices = NULL;
+    m->caster_levels = m->lod_levels = 0;
+    if (!m->rest && n / 3 >= LM_LOD_MIN_TRIANGLES) { /* a deformed mesh moves its vertices */
+      indices = memcpy(lm_alloc(sizeof *indices * n * 5), m->indices, sizeof *indices * n);
+      m->caster_levels = simplify_levels(m, true, indices, &len, m->casters);
+      m->lod_levels = simplify_levels(m, false, indices, &len, m->lods);
+    }
+    lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, indices ? indices : m->indices, (int)len);
     free(indices);
     m->dirty = false;
-    if (m->caster_index_count) simplified++, whole += m->index_count / 3, simple += m->caster_index_count / 3;
+    if (m->caster_levels || m->lod_levels) {
+      simplified++, whole += m->index_count / 3;
+      casters += m->caster_levels ? m->casters[m->caster_levels - 1].count / 3 : m->index_count / 3;
+      camera += m->lod_levels ? m->lods[m->lod_levels - 1].count / 3 : m->index_count / 3;
+    }
   }
   if (simplified)
-    lm_debug("scene '%s': %d meshes simplified for shadow casters, %ld to %ld triangles (%.0f ms)", s->name, simplified,
-            whole, simple, lm_now_ms() - t0);
+    lm_debug("scene '%s': %d meshes simplified, %ld triangles to %ld at the coarsest caster level, %ld at the "
+             "camera's (%.0f ms)", s->name, simplified, whole, casters, camera, lm_now_ms() - t0);
   s->uploaded = true;
   return true;
 }
@@ -720,7 +737,7 @@ bool lm_scene_node_culled(const lm_scene *s, int node, const float view_proj[16]
 }
 
 /* A visible mesh node, sorted so that nodes of one mesh, material and
- * simplification (lod 1: its caster copy) lie together, translucent casters
+ * simplification (lod: 1 + the level of its simplified copy) lie together, translucent casters
  * (into a transmittance output) after the others; blended ones in the
  * forward pass by the camera's depth of their bounds' centre, farthest first. */
 typedef struct drawn_node { int translucent, material, mesh, lod, node; float depth; } drawn_node;
@@ -737,19 +754,22 @@ static int drawn_node_order(const void *pa, const void *pb) {
   if (a->material != b->material) return a->material < b->material ? -1 : 1;
   if (a->mesh != b->mesh) return a->mesh < b->mesh ? -1 : 1;
   if (a->lod != b->lod) return a->lod - b->lod;
+  if (a->depth != b->depth) return a->depth < b->depth ? -1 : 1; /* nearest first: the depth test then
+                                                                    spares the shading of what they hide */
   return (a->node > b->node) - (a->node < b->node);
 }
 
-/* Does node n (world bounds lo..hi) draw its mesh's simplified casters in
- * d's shadow view? The copy's error times the node's largest axis scale,
- * against the world size of the view's finer texel where the bounds come
- * nearest the light: 2 w / (|row| * texels) for the x and y rows of
- * lod_view_proj, w its clip w there (1 for an orthographic tile; a
- * perspective one's texels grow with distance, and a node reaching behind
- * the light is drawn whole). */
-static bool node_simplified(const lm_scene_draw_desc *d, const lm_node *n, const lm_scene_mesh *m, const float lo[3],
-                            const float hi[3]) {
-  if (!d->lod_view_proj || !(d->lod_texels > 0) || m->caster_index_count <= 0) return false;
+/* The simplified copy node n (world bounds lo..hi) draws in d's view: 1 +
+ * the coarsest level whose error times the node's largest axis scale is at
+ * most d->lod_texels of the view's finer texel (pixel) where the bounds come
+ * nearest its eye: 2 w / (|row| * texels) for the x and y rows of
+ * lod_view_proj, w its clip w there (1 for an orthographic tile; in a
+ * perspective view texels grow with distance, and a node reaching behind
+ * the eye is drawn whole); 0: the mesh whole. */
+static int node_lod(const lm_scene_draw_desc *d, const lm_node *n, const lm_scene_mesh *m, const float lo[3],
+                    const float hi[3]) {
+  int levels = d->lod_camera ? m->lod_levels : m->caster_levels;
+  if (!d->lod_view_proj || !(d->lod_texels > 0) || levels <= 0) return 0;
   const float *v = d->lod_view_proj, *w = n->world;
   float scale = 0, w_near = v[15], radius = 0;
   for (int c = 0; c < 3; c++) {
@@ -760,9 +780,13 @@ static bool node_simplified(const lm_scene_draw_desc *d, const lm_node *n, const
   w_near -= sqrtf(v[3] * v[3] + v[7] * v[7] + v[11] * v[11]) * sqrtf(radius);
   float rows = fmaxf(sqrtf(v[0] * v[0] + v[4] * v[4] + v[8] * v[8]) * (float)d->lod_size[0],
                      sqrtf(v[1] * v[1] + v[5] * v[5] + v[9] * v[9]) * (float)d->lod_size[1]);
-  if (!(w_near > 0) || !(rows > 0)) return false;
-  float texel = 2 * w_near / rows;
-  return isfinite(texel) && m->caster_error * scale <= d->lod_texels * texel;
+  if (!(w_near > 0) || !(rows > 0)) return 0;
+  float texel = 2 * w_near / rows, allowed = d->lod_texels * texel;
+  if (!isfinite(allowed)) return 0;
+  const lm_mesh_lod *lods = d->lod_camera ? m->lods : m->casters;
+  int level = 0;
+  while (level < levels && lods[level].error * scale <= allowed) level++;
+  return level;
 }
 
 /* Sets the material uniforms and textures of material m for program p. */
@@ -835,7 +859,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     for (int k = 0; k < 3 && d->eye_view_proj; k++) depth += d->eye_view_proj[4 * k + 3] * (lo[k] + hi[k]) / 2;
     int translucent = d->blend == LM_BLEND_CAST && d->transmit > 0 && material_blends(s, n->material);
     nodes[count++] =
-        (drawn_node){translucent, n->material, n->mesh, node_simplified(d, n, &s->meshes[n->mesh], lo, hi), i, depth};
+        (drawn_node){translucent, n->material, n->mesh, node_lod(d, n, &s->meshes[n->mesh], lo, hi), i, depth};
   }
   bool sorted = d->blend == LM_BLEND_ONLY; /* blending needs the order, one node a draw */
   qsort(nodes, (size_t)count, sizeof *nodes, sorted ? back_to_front : drawn_node_order);
@@ -873,9 +897,10 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
       snprintf(bound, sizeof bound, "%s", defines);
     }
     bind_material(s, p, &m, &mp, defines);
-    bool lod = nodes[first].lod;
-    int index_count = lod ? mesh->caster_index_count : mesh->index_count;
-    lm_mesh_draw_instances(&mesh->gpu, lod ? mesh->index_count : 0, index_count, first, last - first);
+    int lod = nodes[first].lod;
+    const lm_mesh_lod *copy = lod ? &(d->lod_camera ? mesh->lods : mesh->casters)[lod - 1] : NULL;
+    int index_count = copy ? copy->count : mesh->index_count;
+    lm_mesh_draw_instances(&mesh->gpu, copy ? copy->first : 0, index_count, first, last - first);
     if (stats) {
       stats->calls++, stats->drawn += last - first, stats->triangles += (long)(last - first) * (index_count / 3);
       stats->simplified += lod ? last - first : 0;

@@ -136,6 +136,13 @@ typedef struct lm_camera {
                      file's camera indices hold, refused by lm_scene_camera_check. */
 } lm_camera;
 
+/* A simplified copy of a mesh (lm_scene_mesh.casters, .lods). */
+#define LM_LOD_LEVELS 3
+typedef struct lm_mesh_lod {
+  int first, count; /* its indices in the mesh's GPU index buffer */
+  float error;      /* how far it may lie from the mesh, local units */
+} lm_mesh_lod;
+
 typedef struct lm_scene_mesh {
   char name[LM_NAME_MAX];
   float *vertices; /* position(3) normal(3) uv(2); a deformed mesh's: its pose at the scene's time */
@@ -161,18 +168,20 @@ typedef struct lm_scene_mesh {
                               the skin's joints */
   float *joint_weights;    /* the same layout, normalized to sum 1 a vertex */
   bool dirty;              /* vertices (or prev_positions) changed since the last upload (lm_scene_upload_deformed) */
-  /* Shadow casters: a simplified copy made by lm_scene_upload (meshoptimizer's
-   * meshopt_simplify over positions alone, target error LM_CASTER_ERROR of the
-   * mesh's extent), caster_index_count indices stored after the mesh's own in
-   * its GPU index buffer; its surface lies within caster_error (local units,
-   * meshoptimizer's measure) of the mesh's. 0: none (a deformed mesh, one of
-   * fewer than LM_CASTER_MIN_TRIANGLES, or one that would lose under a quarter
-   * of its triangles). */
-  int caster_index_count;
-  float caster_error;
+  /* Simplified copies made by lm_scene_upload (meshoptimizer), each level
+   * about a quarter of the last's triangles within LM_LOD_ERROR times 4^level
+   * of the mesh's extent, stored after the mesh's own indices in its GPU
+   * index buffer: `casters` over positions alone (shadow tiles), `lods` with
+   * the seams of normals and uvs kept (the camera's passes). A level's error
+   * (local units, meshoptimizer's measure, summed over the levels it was
+   * made from) bounds how far its surface lies from the mesh's. None (0
+   * levels) for a deformed mesh, one of fewer than LM_LOD_MIN_TRIANGLES, and
+   * no level that keeps over 3/4 of the last's triangles. */
+  lm_mesh_lod casters[LM_LOD_LEVELS], lods[LM_LOD_LEVELS];
+  int caster_levels, lod_levels;
 } lm_scene_mesh;
-#define LM_CASTER_ERROR 0.01f       /* simplified casters' target error, a share of the mesh's extent */
-#define LM_CASTER_MIN_TRIANGLES 64  /* meshes below this are drawn whole in every tile */
+#define LM_LOD_ERROR 0.01f          /* the first level's target error, a share of the mesh's extent */
+#define LM_LOD_MIN_TRIANGLES 64     /* meshes below this are always drawn whole */
 
 typedef struct lm_node {
   char name[LM_NAME_MAX];
@@ -417,16 +426,19 @@ typedef struct lm_scene_draw_desc {
    * and the moving casters drawn over it); layer 0 or dynamic NULL: all. */
   const bool *dynamic;
   int layer;
-  /* Shadow tiles: a node whose mesh has a simplified caster copy draws it
-   * when the copy's error, times the node's largest scale, is at most
-   * lod_texels texels of this view (lod_view_proj, lod_size texels wide and
-   * high) where the node's bounds come nearest the light. NULL or
-   * lod_texels 0: every mesh whole. */
+  /* A node whose mesh has simplified copies draws the coarsest whose error,
+   * times the node's largest scale, is at most lod_texels texels of this
+   * view (lod_view_proj, lod_size texels wide and high) where the node's
+   * bounds come nearest its eye (the light's for a shadow tile: `casters`;
+   * the camera's for camera passes, lod_camera: `lods`). NULL or lod_texels
+   * 0: every mesh whole. */
   const float *lod_view_proj;
   int lod_size[2];
   float lod_texels;
+  bool lod_camera;
   lm_blend_draw blend; /* what becomes of alphaMode BLEND materials */
-  const float *eye_view_proj; /* LM_BLEND_ONLY: the camera's, whose clip w orders the nodes */
+  const float *eye_view_proj; /* the camera's, whose clip w orders the nodes: LM_BLEND_ONLY farthest first,
+                                 * the others nearest first within a run of one mesh (NULL: by index) */
   int transmit, outputs;      /* LM_BLEND_CAST: lm_pass_desc.transmit, of the pass's `outputs` */
 } lm_scene_draw_desc;
 typedef struct lm_scene_draw_stats {
@@ -437,7 +449,7 @@ typedef struct lm_scene_draw_stats {
   int layered;       /* views drawn again over their kept static layer: only their moving casters drawn */
   int scrolled;      /* views (cascades) whose last texels moved with them: only the strips they uncover drawn */
   long triangles;    /* triangles drawn */
-  int simplified;    /* of drawn, nodes drawn with their simplified caster copy */
+  int simplified;    /* of drawn, nodes drawn with a simplified copy */
 } lm_scene_draw_stats;
 /* Draws every mesh node whose bounds reach into the frustum, the nodes of one
  * mesh and material in one instanced draw (each node's matrices in the

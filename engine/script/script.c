@@ -529,6 +529,7 @@ lm_pipeline *lm_pipeline_load(const lm_pipeline_desc *desc, lm_error *err) {
 void lm_pipeline_destroy(lm_pipeline *p) {
   if (!p) return;
   if (p->L) lua_close(p->L);
+  free(p->shadow_levels);
   free(p);
 }
 

@@ -215,9 +215,14 @@ static int l_shadow_plan(lua_State *L) {
   lua_pop(L, 1);
   st.rsm = opt_number(L, 1, "rsm", 0, 0, 64, what);
   st.rsm_resolution = (int)opt_number(L, 1, "rsm_resolution", (float)st.rsm_resolution, 16, 8192, what);
+  st.last_levels = p->shadow_levels, st.last_light_count = p->shadow_level_count;
   lm_shadow_plan_free(p->shadows);
   lm_error err;
   if (!lm_shadow_plan_make(p->shadows, p->scene, p->camera, &st, &err)) return luaL_error(L, "shadow_plan: %s", err.msg);
+  int n = p->shadows->light_count; /* the levels, kept for the next plan (lm_shadow_settings.last_levels) */
+  p->shadow_levels = lm_realloc(p->shadow_levels, sizeof *p->shadow_levels * (size_t)(n + 1));
+  memcpy(p->shadow_levels, p->shadows->levels, sizeof *p->shadow_levels * (size_t)n);
+  p->shadow_level_count = n;
   p->shadows_frame = p->frame;
   if (p->shadows->view_count == 0) {
     lm_info("left out: shadows (no light in scene '%s' casts shadows)", p->scene->name);
@@ -547,7 +552,7 @@ static int add_pass_returning_output(lua_State *L, lm_pipeline *p, pass_builder 
 }
 
 /* scene{ "name", technique = "std", out = {...}, depth = T, clear = bool | {r,g,b,a}, ...,
- * views = plan, fit = T, inputs = {...}, blend = bool } */
+ * views = plan, fit = T, inputs = {...}, blend = bool, simplify = pixels } */
 static int l_scene(lua_State *L) {
   lm_pipeline *p = recording(L, "scene");
   if (p->in_create) return luaL_error(L, "scene() records a pass: call it from OnRender");
@@ -556,7 +561,7 @@ static int l_scene(lua_State *L) {
   begin_pass(L, &b, LM_PASS_SCENE, "scene");
   static const char *const fields[] = {"technique", "out", "depth", "clear", "params", "defines",
                                        "materials", "views", "fit", "fit_margin", "inputs", "blend", "transmit",
-                                       NULL};
+                                       "simplify", NULL};
   check_fields(L, 1, b.what, fields);
   b.desc.shader = opt_string(L, 1, "technique", b.what);
   if (!b.desc.shader) b.desc.shader = "std";
@@ -584,6 +589,14 @@ static int l_scene(lua_State *L) {
   lua_getfield(L, 1, "blend"); /* the blended materials alone, over what out holds (lm_pass_desc) */
   if (!lua_isnil(L, -1) && !lua_isboolean(L, -1)) return luaL_error(L, "%s: blend must be true or false", b.what);
   b.desc.blend = lua_toboolean(L, -1);
+  lua_pop(L, 1);
+  lua_getfield(L, 1, "simplify"); /* pixels a simplified copy may err by (lm_pass_desc) */
+  if (!lua_isnil(L, -1)) {
+    lua_Number px = lua_tonumber(L, -1);
+    if (!lua_isnumber(L, -1) || !(px >= 0 && px <= 64))
+      return luaL_error(L, "%s: simplify must be a number of pixels in 0..64", b.what);
+    b.desc.simplify = (float)px;
+  }
   lua_pop(L, 1);
   lua_getfield(L, 1, "views");
   if (!lua_isnil(L, -1)) {

@@ -28,6 +28,8 @@ struct lm_pipeline {
   const lm_frame_data *camera;
   lm_shadow_plan *shadows;
   unsigned shadows_frame; /* frame serial of the plan in *shadows */
+  int *shadow_levels;     /* the last plan's levels (lm_shadow_settings.last_levels), one a light */
+  int shadow_level_count;
   int still;              /* frames in a row before this one that drew the same world (still_frames) */
   int scene_still;        /* the same without the camera (still_frames("scene")) */
   float light_peak;       /* the largest radiance the script's own light reaches this frame (light_peak, sky_sh) */

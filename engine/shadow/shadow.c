@@ -389,10 +389,18 @@ enum { MIN_TILE = 32 };
  * texel a pixel over the disc that its reach (a sphere of `range` around
  * pos) covers on screen, a cube face about half of it, never below
  * MIN_TILE texels; a light whose reach holds the camera keeps the full
- * resolution, one whose reach lies outside the view gets the least. The
- * measure is in pixels, so a scene's unit changes nothing. */
+ * resolution, one whose reach lies outside the view gets the least; `last`
+ * (the last frame's level, -1: none) stays while it is near enough
+ * (lm_shadow_settings.last_levels). The measure is in pixels, so a scene's
+ * unit changes nothing. */
+static int pixels_level(const lm_shadow_plan *plan, float pixels) {
+  int level = 0;
+  while (tile_size(plan->tile, level + 1) >= MIN_TILE && (float)tile_size(plan->tile, level + 1) >= pixels) level++;
+  return level;
+}
+
 static int coverage_level(const lm_shadow_plan *plan, const lm_frame_data *cam, const vec3 pos, float range,
-                          bool cube) {
+                          bool cube, int last) {
   if (!plan->settings.coverage) return 0;
   float d = glm_vec3_distance((float *)cam->camera_pos, (float *)pos), pixels = 0;
   if (!(d > range)) return 0; /* inside, or not a number */
@@ -403,9 +411,10 @@ static int coverage_level(const lm_shadow_plan *plan, const lm_frame_data *cam, 
     pixels = cam->output_size[1] * sin_a / sqrtf(fmaxf(1.0f - sin_a * sin_a, 1e-12f)) / fmaxf(cam->clip[3], 1e-6f);
     if (cube) pixels *= 0.5f;
   }
-  int level = 0;
-  while (tile_size(plan->tile, level + 1) >= MIN_TILE && (float)tile_size(plan->tile, level + 1) >= pixels) level++;
-  return level;
+  /* The last level, while it lies between those for a little more and a little less. */
+  if (last >= pixels_level(plan, pixels * LM_SHADOW_LEVEL_SLACK) && last <= pixels_level(plan, pixels / LM_SHADOW_LEVEL_SLACK))
+    return last;
+  return pixels_level(plan, pixels);
 }
 
 static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam, int i,
@@ -550,7 +559,8 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
     if (l->type != LM_LIGHT_DIRECTIONAL) {
       vec3 pos = {ld[i].position[0], ld[i].position[1], ld[i].position[2]};
       float range = light_range(s, l, pos);
-      plan->levels[i] = coverage_level(plan, cam, pos, range, l->type == LM_LIGHT_POINT);
+      int last = st->last_levels && st->last_light_count == s->light_count ? st->last_levels[i] : -1;
+      plan->levels[i] = coverage_level(plan, cam, pos, range, l->type == LM_LIGHT_POINT, last);
       /* An RSM needs every face: a sender off screen lights what is seen. */
       if (l->type == LM_LIGHT_POINT) plan->lights[i].cube[0] = st->rsm > 0 ? 63 : cube_faces_seen(plan, s, cam, pos, range);
       views = l->type == LM_LIGHT_SPOT ? 1 : __builtin_popcount((unsigned)plan->lights[i].cube[0]);

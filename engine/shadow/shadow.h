@@ -40,7 +40,7 @@ typedef struct lm_shadow_settings {
                     * place keeps that tile's texels (engine/render: copied, not drawn) */
   bool coverage;   /* spot and point tiles as fine as the screen needs (lm_shadow_plan.levels);
                     * false: every tile at resolution */
-  float simplify;  /* a caster whose simplified copy (lm_scene_mesh.caster_error) errs by at most this
+  float simplify;  /* a caster whose simplified copy (lm_scene_mesh.casters) errs by at most this
                     * many texels of a tile draws that copy there (far cascades, small tiles); 0: none */
   float rsm;       /* > 0: a frame reads reflective shadow maps (seed 004's senders); each
                     * directional light gets one more tile, over the sphere around all
@@ -48,7 +48,15 @@ typedef struct lm_shadow_settings {
   int rsm_resolution; /* texels a side of that tile (16 .. 8192): the cell's tile halved whole times,
                        * the least at or above this (the gathers' cost grows with the texels they
                        * scatter over, not their count) */
+  /* The last frame's plan's levels (lm_shadow_plan.levels), last_light_count
+   * of them, or NULL: with coverage, a local light keeps its last level
+   * while that level's tile is within LM_SHADOW_LEVEL_SLACK of the size the
+   * screen asks for, so that a camera moving near a boundary neither resizes
+   * (redraws) its tiles nor moves every other tile in the atlas. */
+  const int *last_levels;
+  int last_light_count;
 } lm_shadow_settings;
+#define LM_SHADOW_LEVEL_SLACK 1.25f
 void lm_shadow_settings_default(lm_shadow_settings *s);
 
 /* std430 layouts mirrored by shaders/shadow.glsl. */
