@@ -75,7 +75,7 @@ limn_gi_report() {
     if "${report[@]}" --out "$out/cycles" --renderer cycles --cached-refs 2>"$out/cycles/stderr"; then
       csvs+=("$out/cycles/report.csv")
       local left
-      left=$(grep -c " left out: " "$out/cycles/stderr")
+      left=$(grep -c " left out: " "$out/cycles/stderr" || true) # grep -c exits 1 on none
       [ "$left" = 0 ] || note="Cycles: $left views without cached references left out; render them with $render"
     elif grep -q "no view has its references cached" "$out/cycles/stderr"; then
       note="Cycles: no references cached in $refs (POV-Ray alone below); render them with $render"
