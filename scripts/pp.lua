@@ -38,7 +38,8 @@ local technique = techniques.add
 -- frame at 256x192 with a moving camera (docs/techniques.md#the-default-error-against-time). Against
 -- POV-Ray (reference set, 256x192) isr+rsm+esm removes 74.5% of dl+esm's indirect error, rsm+esm 62.2%,
 -- isr+esm 43.2%; but while the camera moves, every technique that reads an RSM costs 4-5x dl+esm's frame
--- (the shadow tiles' cache scrolls and copies the atlas-sized RSM targets: isr+rsm+esm on the street,
+-- (the shadow tiles' cache clears each moving tile's five RSM targets with a scissored clear, slow on
+-- llvmpipe: isr+rsm+esm on the street,
 -- shadow.depth 243 ms cached against 31 ms drawn) and isr+esm about 2.4x (a loaded machine): isr+esm stays
 -- until RSM frames pay no more moving than drawn afresh.
 technique{ "isr+esm", lighting = "isr", shadows = true, temporal = "isr", key = "F2" } -- image-space radiosity
