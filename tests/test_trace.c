@@ -197,6 +197,13 @@ static void translate_scale(float m[16], float x, float y, float z, float sx, fl
   m[12] = x, m[13] = y, m[14] = z;
 }
 
+/* Gives node its local matrix m and updates the scene and the tracer (*st). */
+static void move_node(lm_scene *s, lm_trace *t, int node, const float m[16], lm_trace_stats *st) {
+  memcpy(s->nodes[node].local, m, 16 * sizeof(float));
+  lm_scene_update(s);
+  lm_trace_update(t, s, st);
+}
+
 /* Where the segment from `o` along `d` enters the box lo..hi; -1 when it misses. */
 static float slab(const float o[3], const float d[3], const float lo[3], const float hi[3]) {
   float t0 = 0, t1 = INFINITY;
@@ -275,9 +282,7 @@ static void mirror_shows_the_known_object(void **state) {
 
   /* the cube moves: a refit, and the reflection follows it */
   translate_scale(m, -1.0f, 1.0f, -0.5f, half[0], half[1], half[2]);
-  memcpy(s->nodes[cube].local, m, sizeof m);
-  lm_scene_update(s);
-  lm_trace_update(t, s, &st);
+  move_node(s, t, cube, m, &st);
   assert_true(st.refitted);
   lm_trace_ray down = {{-1.0f, 5, -0.5f}, 0, {0, -1, 0}, INFINITY};
   lm_trace_hit h;
@@ -469,9 +474,7 @@ static void degenerate_scene_geometry(void **state) {
 
   /* far comes back: traced again, in place */
   translate_scale(m, 0, 0, 5, 1, 1, 1);
-  memcpy(s->nodes[far].local, m, sizeof m);
-  lm_scene_update(s);
-  lm_trace_update(t, s, &st);
+  move_node(s, t, far, m, &st);
   assert_true(st.refitted);
   assert_int_equal(st.moved, 1);
   assert_int_equal(st.triangles, 2);
@@ -482,9 +485,7 @@ static void degenerate_scene_geometry(void **state) {
 
   /* flat is scaled up: in place, and now it is hit, facing the ray */
   translate_scale(m, 5, 0, 0, 1, 1, 1);
-  memcpy(s->nodes[flat].local, m, sizeof m);
-  lm_scene_update(s);
-  lm_trace_update(t, s, &st);
+  move_node(s, t, flat, m, &st);
   assert_true(st.refitted);
   assert_int_equal(st.moved, 1);
   at_flat.origin[0] = 5.2f;
@@ -497,9 +498,7 @@ static void degenerate_scene_geometry(void **state) {
 
   /* scaled to nothing along y (no inverse for its normals): not traced, even where it lies */
   translate_scale(m, 5, 0, 0, 1, 0, 1);
-  memcpy(s->nodes[flat].local, m, sizeof m);
-  lm_scene_update(s);
-  lm_trace_update(t, s, &st);
+  move_node(s, t, flat, m, &st);
   assert_true(st.refitted);
   assert_int_equal(st.triangles, 2);
   assert_false(lm_trace_intersect(t, &at_flat, &h));
