@@ -1,5 +1,6 @@
 -- Checking an effect's options against its defaults and rules, shared by the
--- effect modules (isr.lua, ssdo.lua, bloom.lua, dof.lua ...). Errors name the
+-- effect modules (isr.lua, ssdo.lua, bloom.lua, dof.lua ...), whose tables
+-- of defaults and rules are data that reads alike from module to module. Errors name the
 -- option ("dof.focus must be ...") and point at the code that called the effect.
 local options = {}
 
@@ -121,6 +122,16 @@ function options.check(name, defaults, o, rules, level)
     end
   end
   return c
+end
+
+-- A pipeline's own options: each field of `keys` in `o` checked by its rule
+-- in `rules`; the first bad one an error naming it ("ambient must be ...")
+-- that points at the caller `level` calls up (1: whoever called fields).
+function options.fields(o, rules, keys, level)
+  for _, k in ipairs(keys) do
+    local want = rules[k](o[k])
+    if want then error(string.format("%s must be %s (got %s)", k, want, tostring(o[k])), (level or 1) + 1) end
+  end
 end
 
 -- A module's check(o, level) (scripts/README.md): o over `defaults`, checked

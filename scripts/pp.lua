@@ -1,9 +1,9 @@
 -- The default pipeline: each technique a row, and one function (frame) that
 -- records a frame from its row. The first row is the default; Options are
 -- what `limn capture --set` can change. Modules follow scripts/README.md.
+local direct = require "direct"
 local gbuffer = require "gbuffer"
 local glossy = require "glossy"
-local isr = require "isr"
 local options = require "options"
 local post = require "post"
 local reflections = require "reflections"
@@ -58,35 +58,12 @@ technique{ "lpv+esm", shadows = true, offscreen = "lpv" } -- light propagation v
 technique{ "isr+lpv+esm", lighting = "isr", shadows = true, offscreen = "lpv", split = true, temporal = "isr" }
 
 local function grey(x) return { x, x, x } end
--- The frame's direct light (direct.frag), with the ambient term given and
--- an off-screen source's coarse light `indirect` ({ C, E, k }) upsampled.
-local function direct(F, ambient, name, skylight, indirect)
-  local inputs, defines = shadow.bind(F.shadows, gbuffer.inputs(F.G), gbuffer.defines(F.G, {}))
-  local params = sky.bind(skylight, { ambient = grey(ambient), background = F.light.background }, defines)
-  if indirect then
-    isr.bind_coarse(inputs, defines, indirect.C, indirect.E)
-    defines.INDIRECT, params.k = true, indirect.k
-  end
-  return pass{ "direct", shader = "direct.frag", inputs = inputs, defines = defines,
-               fetches = not F.shadows and 4 or nil, -- the G-buffer; shadow lookups vary with the lights
-               params = params, out = target{ name, format = "rgba16f" } }
-end
-
--- Does the frame read the G-buffer's velocity (motion blur while things
--- move, or the row's temporal reuse)? A frame that does not declares none.
-local function reads_velocity(tech, row)
-  local function on(t) return type(t) == "table" and t.enabled == true end
-  local gi = row.temporal and tech[row.temporal]
-  return (on(tech.motion_blur) and still_frames() == 0) or
-         (gi ~= nil and on(gi.temporal) and gi.temporal.velocity ~= false)
-end
-
 -- Records the frame of technique `row` with options `tech`; returns what to present.
 local function frame(tech, row)
   local L, S = techniques.modules[row.lighting], techniques.modules[row.offscreen]
   local materials = ({ phong = "std", pbr = "pbr" })[tech.materials]
   if not materials then error('materials must be "phong" or "pbr" (got "' .. tostring(tech.materials) .. '")') end
-  local G = gbuffer.render(gbuffer.targets(1, materials, reads_velocity(tech, row)), materials, nil,
+  local G = gbuffer.render(gbuffer.targets(1, materials, techniques.reads_velocity(tech, row)), materials, nil,
                            tech.simplify)
   G.lights = light_set(tech.light_variants, tech.light_cull) -- the light set's defines (gbuffer.defines); nil:
                                                              -- the general loop over storage buffers
@@ -101,8 +78,8 @@ local function frame(tech, row)
   local indirect = joins == "direct" and S.render(nil, o, F) or nil
   if joins == "march" then F.light.rsm = S.march(o, F) end
   local lit = joins == "lit" and S.render(nil, o, F) -- the source lights the frame
-              or L and L.render(direct(F, 0, "direct", nil, indirect), tech[row.lighting], F)
-              or direct(F, tech.ambient, "lit", F.light.sky, indirect)
+              or L and L.render(direct.render(F, 0, "direct", nil, indirect), tech[row.lighting], F)
+              or direct.render(F, tech.ambient, "lit", F.light.sky, indirect)
   if G.emi then -- emitted light, after the lighting that never sees it
     lit = pass{ "emissive", shader = "bloom_add.frag", inputs = { src = lit, bloom = G.emi },
                 out = target{ "lit.emissive", format = "rgba16f" } }
@@ -124,19 +101,13 @@ options.declare("", rules) -- the viewer's panel shows each option by its rule
 
 function OnCreate()
   post.create()
-  for _, name in ipairs(techniques.order) do
-    if techniques.modules[name].create then techniques.modules[name].create() end
-  end
+  techniques.create()
 end
 
 function OnRender(tech)
-  for _, k in ipairs{ "ambient", "background", "light_variants", "light_cull" } do
-    local want = rules[k](tech[k])
-    if want then error(string.format("%s must be %s (got %s)", k, want, tostring(tech[k])), 2) end
-  end
+  options.fields(tech, rules, { "ambient", "background", "light_variants", "light_cull" }, 2)
   -- What the GI histories depend on (temporal.lua): a change starts them again.
-  local settings = { tech.name, tech.ambient, tech.background, tech.materials, tech.shadow, tech.sky }
-  for _, name in ipairs(techniques.order) do settings[#settings + 1] = tech[name] end
-  temporal.begin(settings)
+  temporal.begin(techniques.settings(tech, { tech.name, tech.ambient, tech.background, tech.materials,
+                                             tech.shadow, tech.sky }))
   present(frame(tech, techniques.row(tech.name)))
 end

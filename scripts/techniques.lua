@@ -77,4 +77,29 @@ function techniques.add(row)
   return row
 end
 
+-- Declares the persistent targets of every module a row names (their
+-- create(), scripts/README.md): the pipeline's OnCreate calls it.
+function techniques.create()
+  for _, name in ipairs(techniques.order) do
+    if techniques.modules[name].create then techniques.modules[name].create() end
+  end
+end
+
+-- `list` with the options `tech` holds for each module a row names added:
+-- with the pipeline's own, what the GI histories depend on (temporal.begin).
+function techniques.settings(tech, list)
+  for _, name in ipairs(techniques.order) do list[#list + 1] = tech[name] end
+  return list
+end
+
+-- Does the frame of `row` with options `tech` read the G-buffer's velocity
+-- (motion blur while things move, or the row's temporal reuse)? A frame
+-- that does not declares none.
+function techniques.reads_velocity(tech, row)
+  local function on(t) return type(t) == "table" and t.enabled == true end
+  local gi = row.temporal and tech[row.temporal]
+  return (on(tech.motion_blur) and still_frames() == 0) or
+         (gi ~= nil and on(gi.temporal) and gi.temporal.velocity ~= false)
+end
+
 return techniques

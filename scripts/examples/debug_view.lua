@@ -14,10 +14,7 @@ local rules = { show = options.one_of("clr", "nrm", "dpt", "mat"), scale = optio
                 offset = options.number(-1e6, 1e6) }
 
 function OnRender(tech)
-  for _, k in ipairs{ "show", "scale", "offset" } do
-    local want = rules[k](tech[k])
-    if want then error(string.format("%s must be %s (got %s)", k, want, tostring(tech[k]))) end
-  end
+  options.fields(tech, rules, { "show", "scale", "offset" })
   local G = gbuffer.render(gbuffer.targets())
   present(pass{ "show", shader = "examples/show.frag", inputs = { src = G[tech.show] },
                 params = { scale = tech.scale, offset = tech.offset },

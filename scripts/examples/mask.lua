@@ -12,8 +12,7 @@ Options = { metallic = 0.5 }
 local rules = { metallic = options.number(0, 1) }
 
 function OnRender(tech)
-  local want = rules.metallic(tech.metallic)
-  if want then error(string.format("metallic must be %s (got %s)", want, tostring(tech.metallic))) end
+  options.fields(tech, rules, { "metallic" })
   local G = gbuffer.render(gbuffer.targets(1, "pbr"), "pbr")
   present(pass{ "mask", shader = "examples/mask.frag", inputs = gbuffer.inputs(G),
                 params = { metallic = tech.metallic }, out = target{ "mask", format = "rgba8" } },
