@@ -676,26 +676,6 @@ static void print_tables(const bench *b, lm_clock clock) {
   }
 }
 
-/* The script with the --set options and --tech. NULL with err set and *rc
- * the exit status: 1 when the script does not load, 2 for a bad option or
- * technique (the user's flags). */
-static lm_pipeline *load_pipeline(const bench *b, int *rc, lm_error *err) {
-  char script[2048];
-  if (b->common.script) snprintf(script, sizeof script, "%s", b->common.script);
-  else snprintf(script, sizeof script, "%s/scripts/pp.lua", lm_root_dir());
-  *rc = 1;
-  lm_pipeline *pipe = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, err);
-  if (!pipe) return NULL;
-  bool ok = true;
-  for (int i = 0; i < b->common.set_count && ok; i++) ok = capture_set_option(pipe, b->common.sets[i], err);
-  if (!ok || (b->common.tech && !lm_pipeline_set_technique(pipe, b->common.tech, err))) {
-    lm_pipeline_destroy(pipe);
-    *rc = 2;
-    return NULL;
-  }
-  return pipe;
-}
-
 /* ---- --motion -------------------------------------------------------- */
 
 /* One of the --motion run's renderers with its own scene and pipeline (a
@@ -765,7 +745,7 @@ static bool stream_open(bench *b, int k, stream *s, lm_error *err) {
   motion *m = &b->motion;
   int rc;
   s->scene = lm_scene_load(b->common.scene, err);
-  s->pipe = s->scene ? load_pipeline(b, &rc, err) : NULL;
+  s->pipe = s->scene ? capture_load_pipeline(&b->common, &rc, err) : NULL;
   if (!s->pipe || !lm_scene_upload(s->scene, err)) return false;
   if (k == STREAM_ALONE && !caches_off(s->pipe, m->caches_off, sizeof m->caches_off, err)) return false;
   if (m->orbit) {
@@ -1202,7 +1182,7 @@ int limn_bench(int argc, char **argv) {
   b.gpu_mib = -1;
   lm_error err;
   int prc;
-  lm_pipeline *pipe = load_pipeline(&b, &prc, &err);
+  lm_pipeline *pipe = capture_load_pipeline(&b.common, &prc, &err);
   if (!pipe) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return prc;

@@ -322,21 +322,10 @@ int limn_capture(int argc, char **argv) {
                                                .force = a.force, .quiet = a.quiet, .verbose = a.verbose,
                                                .egl = a.egl, .clock = a.clock});
 
-  char script[2048];
-  capture_resolve(o->script, script, sizeof script);
   lm_error err;
-  lm_pipeline *pipeline = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, &err);
+  lm_pipeline *pipeline = capture_load_pipeline(o, &rc, &err);
   if (!pipeline) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
-    return 1;
-  }
-  rc = 0;
-  if (o->tech && !lm_pipeline_set_technique(pipeline, o->tech, &err)) rc = 2;
-  for (int i = 0; i < o->set_count && !rc; i++)
-    if (!capture_set_option(pipeline, o->sets[i], &err)) rc = 2;
-  if (rc) {
-    lm_log(LM_LOG_ERROR, "%s", err.msg);
-    lm_pipeline_destroy(pipeline);
     return rc;
   }
   if (a.list_options) {
@@ -391,7 +380,7 @@ int limn_capture(int argc, char **argv) {
   bool ok = r != NULL;
   if (ok && !a.quiet)
     lm_info("renderer: %s (%s, %s); scene %s; script %s; technique %s; %dx%d", lm_gl_renderer(),
-            lm_gl_version(), lm_context_platform(), o->scene, script, lm_pipeline_technique(pipeline),
+            lm_gl_version(), lm_context_platform(), o->scene, lm_pipeline_path(pipeline), lm_pipeline_technique(pipeline),
             o->width, o->height);
   capture_result res = {0};
   /* A sequence renders its frames through one renderer, so that temporal

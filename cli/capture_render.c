@@ -9,6 +9,7 @@
 
 #include "image/image.h"
 #include "capture_render.h"
+#include "tools.h"
 
 bool capture_known_extension(const char *path, bool *linear) {
   const char *dot = strrchr(path, '.');
@@ -127,4 +128,21 @@ bool capture_set_option(lm_pipeline *p, const char *name_value, lm_error *err) {
   }
   snprintf(name, sizeof name, "%.*s", (int)(eq - name_value), name_value);
   return lm_pipeline_set_option(p, name, eq + 1, err);
+}
+
+lm_pipeline *capture_load_pipeline(const limn_common_args *a, int *rc, lm_error *err) {
+  char script[2048];
+  capture_resolve(a->script, script, sizeof script);
+  *rc = 1;
+  lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, err);
+  if (!p) return NULL;
+  bool ok = !a->tech || lm_pipeline_set_technique(p, a->tech, err);
+  for (int i = 0; i < a->set_count && ok; i++) ok = capture_set_option(p, a->sets[i], err);
+  if (!ok) {
+    lm_pipeline_destroy(p);
+    *rc = 2;
+    return NULL;
+  }
+  *rc = 0;
+  return p;
 }

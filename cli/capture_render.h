@@ -1,6 +1,7 @@
 /* What `limn capture` (cli/capture.c), capture jobs (cli/job.c), `limn
  * report` and the viewer share (cli/capture_render.c): one path that renders
- * a view and writes its images. */
+ * a view and writes its images; and the pipeline capture, bench and graph
+ * load from their flags. */
 #ifndef LIMN_CAPTURE_RENDER_H
 #define LIMN_CAPTURE_RENDER_H
 
@@ -43,5 +44,11 @@ bool capture_known_extension(const char *path, bool *linear);
 bool capture_set_option(lm_pipeline *p, const char *name_value, lm_error *err);
 /* A relative path that does not exist here is looked up under the engine's root. */
 void capture_resolve(const char *given, char *out, size_t cap);
+/* The pipeline capture, bench and graph's flags name: --script (pp.lua
+ * without it; capture_resolve), --tech, then each --set. *rc the exit
+ * status: 0, or with NULL and err 1 when the script does not load, 2 for a
+ * bad technique or option (the user's flags). */
+struct limn_common_args;
+lm_pipeline *capture_load_pipeline(const struct limn_common_args *a, int *rc, lm_error *err);
 
 #endif

@@ -190,18 +190,13 @@ int limn_graph(int argc, char **argv) {
   if (rc) return rc < 0 ? 0 : rc;
   const limn_common_args *o = &a.common;
   if (a.quiet) lm_log_set_level(LM_LOG_WARN);
-  char script[2048];
-  capture_resolve(o->script, script, sizeof script);
   lm_error err;
-  lm_pipeline *pipeline = lm_pipeline_load(&(lm_pipeline_desc){.path = script}, &err);
+  lm_pipeline *pipeline = capture_load_pipeline(o, &rc, &err);
   if (!pipeline) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
-    return 1;
+    return rc;
   }
-  if (o->tech && !lm_pipeline_set_technique(pipeline, o->tech, &err)) rc = 2;
-  for (int i = 0; i < o->set_count && !rc; i++)
-    if (!capture_set_option(pipeline, o->sets[i], &err)) rc = 2;
-  lm_scene *scene = rc ? NULL : lm_scene_load(o->scene, &err);
+  lm_scene *scene = lm_scene_load(o->scene, &err);
   if (!rc && !scene) rc = 2;
   if (!rc && o->camera > 0 && o->camera >= scene->camera_count) {
     lm_error_set(&err, "--camera %d: scene '%s' has %d camera(s)", o->camera, o->scene, scene->camera_count);

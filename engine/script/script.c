@@ -442,6 +442,7 @@ const char *lm_pipeline_technique_name(const lm_pipeline *p, int i) {
 const char *lm_pipeline_technique_key(const lm_pipeline *p, int i) { return technique_field(p, i, "key"); }
 
 const char *lm_pipeline_technique(const lm_pipeline *p) { return p->technique; }
+const char *lm_pipeline_path(const lm_pipeline *p) { return p->path; }
 
 bool lm_pipeline_set_technique(lm_pipeline *p, const char *name, lm_error *err) {
   int n = lm_pipeline_technique_count(p);

@@ -18,6 +18,8 @@ typedef struct lm_pipeline_desc {
 /* Runs the script's top level and reads its Techniques and Options tables. */
 lm_pipeline *lm_pipeline_load(const lm_pipeline_desc *desc, lm_error *err);
 void lm_pipeline_destroy(lm_pipeline *p);
+/* The script's file, as lm_pipeline_load was given it. */
+const char *lm_pipeline_path(const lm_pipeline *p);
 
 /* Techniques the script lists in `Techniques`, names or rows { name, ... };
  * the first is the default. A row's `key` is the viewer's key for it ("F2"),
