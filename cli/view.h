@@ -167,6 +167,8 @@ void set_error(char *slot, size_t cap, const char *msg, const char *cleared);
 long view_frame(const viewer *v);
 const char *view_animation_name(const viewer *v);
 bool make_window_textures(viewer *v, lm_error *err);
+/* Is the wipe showing the reference or its heat map now (the error view on at a place ready)? */
+bool reference_shown(const viewer *v);
 /* Draws the frame (or the inspected target) and the overlay into the back buffer. */
 void display(viewer *v);
 /* "panel 0.61 ms, 0.9% of the frame (frames 70.2 ms on, 69.8 off)". */
@@ -197,8 +199,6 @@ void find_places(view_args *a, struct job *j, const struct job_view *views, int 
  * read and the baseline rendered once), and with the error view on this
  * frame's error against the reference. */
 void update_reference(viewer *v);
-/* Is the wipe showing the reference or its heat map now? */
-bool reference_shown(const viewer *v);
 /* The place's line for the panel and the overlay (reference_text); with
  * log, the figures in full on stderr ("reference error: view N, mean ..."). */
 void describe_reference(viewer *v, bool log);

@@ -367,6 +367,8 @@ static lm_texture draw_panel(viewer *v) {
   return image;
 }
 
+bool reference_shown(const viewer *v) { return v->error_view != ERROR_VIEW_OFF && v->place_ready; }
+
 void display(viewer *v) {
   lm_error err;
   lm_texture src = v->shown;

@@ -60,8 +60,6 @@ void find_places(view_args *a, job *j, const job_view *views, int count, int sce
           a->against, ref.refs);
 }
 
-bool reference_shown(const viewer *v) { return v->error_view != ERROR_VIEW_OFF && v->place_ready; }
-
 /* The place the camera is at: a place's camera, not moved by the user, at
  * the place's size (and time, in a timed job); -1 when none. */
 static int place_here(const viewer *v) {
