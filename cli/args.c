@@ -15,6 +15,16 @@ bool limn_parse_int(const char *s, int lo, int hi, int *out) {
   return true;
 }
 
+int limn_subcommand(int argc, char **argv, const char *sub, const char *usage, const char *why) {
+  if (argc >= 2 && !strcmp(argv[1], sub)) return -1;
+  if (argc >= 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
+    fputs(usage, stdout);
+    return 0;
+  }
+  fprintf(stderr, "%s\n\n%s", why, usage);
+  return 2;
+}
+
 bool limn_parse_double(const char *s, double *out) {
   char *end;
   double v = strtod(s, &end);

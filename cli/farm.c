@@ -210,14 +210,9 @@ static int farm(const farm_args *a) {
 }
 
 int limn_farm(int argc, char **argv) {
-  if (argc < 2 || strcmp(argv[1], "slurm")) {
-    if (argc >= 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
-      fputs(farm_usage, stdout);
-      return 0;
-    }
-    fprintf(stderr, "limn farm: the scheduler is slurm (limn farm slurm --job FILE --shards N)\n\n%s", farm_usage);
-    return 2;
-  }
+  int sub = limn_subcommand(argc, argv, "slurm", farm_usage,
+                            "limn farm: the scheduler is slurm (limn farm slurm --job FILE --shards N)");
+  if (sub >= 0) return sub;
   argc--, argv++;
   farm_args a = {.dir = "farm", .refs = "out/reference"};
   char sbatch_flags[6][1100] = {{0}}; /* --partition=P ... (at most one of each) */

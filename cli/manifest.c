@@ -217,14 +217,8 @@ static int merge(const merge_args *a, job *j) {
 }
 
 int limn_manifest(int argc, char **argv) {
-  if (argc < 2 || strcmp(argv[1], "merge")) {
-    if (argc >= 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
-      fputs(manifest_usage, stdout);
-      return 0;
-    }
-    fprintf(stderr, "limn manifest: the subcommand is merge\n\n%s", manifest_usage);
-    return 2;
-  }
+  int sub = limn_subcommand(argc, argv, "merge", manifest_usage, "limn manifest: the subcommand is merge");
+  if (sub >= 0) return sub;
   argc--, argv++;
   merge_args a = {0};
   reference_defaults(&a.ref);

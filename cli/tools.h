@@ -31,6 +31,10 @@ bool limn_parse_double(const char *s, double *out); /* finite */
 bool limn_parse_time(const char *s, double *start, double *stop);
 bool limn_parse_size(const char *s, int *w, int *h); /* WxH, each 1..65536 */
 bool limn_parse_on_off(const char *s, bool *out);
+/* A command of one subcommand (limn farm slurm, limn manifest merge): -1
+ * when argv[1] is `sub`; else the exit status, 0 after printing `usage` for
+ * --help or -h, 2 after printing `why` and `usage` to stderr. */
+int limn_subcommand(int argc, char **argv, const char *sub, const char *usage, const char *why);
 /* --shard I/N, auto or auto/N. `auto` takes the index from the scheduler:
  * Slurm's SLURM_ARRAY_TASK_ID less SLURM_ARRAY_TASK_MIN, of
  * SLURM_ARRAY_TASK_COUNT (or MAX - MIN + 1) shards; `auto/N` takes
@@ -44,7 +48,10 @@ bool limn_parse_shard(const char *s, int *shard, int *shards, char *msg, size_t 
 bool limn_parse_camera(const char *s, int *out);
 struct lm_scene;
 int limn_camera_resolve(struct lm_scene *s, int camera, int width, int height);
-/* The flags capture, view, bench and graph share: --scene, --script, --tech,
+/* Each command keeps its own getopt table and loop (its flags as its
+ * --help and docs/commands.md list them), so the loops read alike; what the
+ * commands share is parsed here and in limn_pov_flag.
+ * The flags capture, view, bench and graph share: --scene, --script, --tech,
  * --set NAME=VALUE (at most LIMN_MAX_SETS), --size WxH, --camera N (or
  * "auto" where camera_auto). Each command lists those it takes in its own
  * option table with these getopt values: 's', 'p', 't', 'D', 'z', 'c', and

@@ -170,27 +170,6 @@ static void degenerate_triangles_are_skipped(void **state) {
   lm_trace_destroy(t);
 }
 
-/* A box mesh of half-size 1 about the origin, normals per face. */
-static int add_box(lm_scene *s) {
-  float v[24 * 8];
-  uint32_t idx[36];
-  for (int f = 0; f < 6; f++) {
-    int ax = f / 2;
-    float sg = f % 2 ? -1.0f : 1.0f;
-    int a = (ax + 1) % 3, b = (ax + 2) % 3;
-    static const float corner[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-    for (int c = 0; c < 4; c++) {
-      float *p = v + (f * 4 + c) * 8;
-      memset(p, 0, 8 * sizeof(float));
-      p[ax] = sg, p[a] = corner[c][0], p[b] = corner[c][1] * sg;
-      p[3 + ax] = sg;
-    }
-    static const int tri[6] = {0, 1, 2, 0, 2, 3};
-    for (int k = 0; k < 6; k++) idx[f * 6 + k] = (uint32_t)(f * 4 + tri[k]);
-  }
-  return lm_scene_add_mesh(s, "box", v, 24, idx, 36);
-}
-
 static void translate_scale(float m[16], float x, float y, float z, float sx, float sy, float sz) {
   memset(m, 0, 16 * sizeof(float));
   m[0] = sx, m[5] = sy, m[10] = sz, m[15] = 1;
@@ -202,6 +181,19 @@ static void move_node(lm_scene *s, lm_trace *t, int node, const float m[16], lm_
   memcpy(s->nodes[node].local, m, 16 * sizeof(float));
   lm_scene_update(s);
   lm_trace_update(t, s, st);
+}
+
+/* Node `node` loses its mesh: the tracer rebuilds (no refit) and then holds
+ * `triangles`. Frees the tracer and the scene: the tests end with it. */
+static void drop_mesh_rebuilds(lm_scene *s, lm_trace *t, int node, int triangles) {
+  lm_trace_stats st;
+  s->nodes[node].mesh = -1;
+  lm_scene_update(s);
+  lm_trace_update(t, s, &st);
+  assert_false(st.refitted);
+  assert_int_equal(st.triangles, triangles);
+  lm_trace_destroy(t);
+  lm_scene_destroy(s);
 }
 
 /* Where the segment from `o` along `d` enters the box lo..hi; -1 when it misses. */
@@ -224,7 +216,7 @@ static float slab(const float o[3], const float d[3], const float lo[3], const f
 static void mirror_shows_the_known_object(void **state) {
   (void)state;
   lm_scene *s = lm_scene_create("mirror");
-  int box = add_box(s);
+  int box = lm_scene_add_cube(s, "box", 1);
   int mirror_mat = lm_scene_add_material(s, &(lm_material){.name = "mirror", .color = {1, 1, 1}, .kd = 1});
   int red = lm_scene_add_material(s, &(lm_material){.name = "red", .color = {1, 0, 0}, .kd = 1});
   float m[16];
@@ -293,13 +285,7 @@ static void mirror_shows_the_known_object(void **state) {
   assert_float_equal(h.t, 5, 1e-5); /* where the cube was: the mirror */
 
   /* a node gains no mesh but loses one: a rebuild */
-  s->nodes[cube].mesh = -1;
-  lm_scene_update(s);
-  lm_trace_update(t, s, &st);
-  assert_false(st.refitted);
-  assert_int_equal(st.triangles, 12);
-  lm_trace_destroy(t);
-  lm_scene_destroy(s);
+  drop_mesh_rebuilds(s, t, cube, 12);
 }
 
 /* A sphere of radius 1 from rings x segments quads, each pole quad split as
@@ -504,13 +490,7 @@ static void degenerate_scene_geometry(void **state) {
   assert_false(lm_trace_intersect(t, &at_flat, &h));
 
   /* a node loses its mesh: a rebuild */
-  s->nodes[s->node_count - 1].mesh = -1;
-  lm_scene_update(s);
-  lm_trace_update(t, s, &st);
-  assert_false(st.refitted);
-  assert_int_equal(st.triangles, 2);
-  lm_trace_destroy(t);
-  lm_scene_destroy(s);
+  drop_mesh_rebuilds(s, t, s->node_count - 1, 2);
 }
 
 /* A deformed mesh (one with a rest pose, as lm_scene_set_time poses morph
@@ -518,7 +498,7 @@ static void degenerate_scene_geometry(void **state) {
 static void deformed_mesh_follows_its_pose(void **state) {
   (void)state;
   lm_scene *s = lm_scene_create("deformed");
-  int box = add_box(s);
+  int box = lm_scene_add_cube(s, "box", 1);
   float m[16];
   translate_scale(m, 0, 0, 0, 1, 1, 1);
   lm_scene_add_node(s, "box", -1, m, box, -1);

@@ -79,6 +79,20 @@ static void glass_extensions_are_read(void **state) {
   lm_scene_destroy(s);
 }
 
+/* `got`, the wall seen through the glass or in its shadow, is the open
+ * wall's light times the glass's transmittance: (1 - F) base absorbed, per
+ * channel (absorbed: 0.9^0.2 in r and b); tinted: green against red, three
+ * times the open wall's ratio. */
+static void assert_transmitted(const char *materials, const char *where, const float got[3], const float open[3]) {
+  const float base[3] = {0.3f, 0.9f, 0.4f}, absorbed[3] = {0.979f, 1.0f, 0.979f};
+  for (int c = 0; c < 3; c++) {
+    float want = 0.96f * base[c] * absorbed[c] * open[c];
+    if (fabsf(got[c] - want) > 0.06f * open[c] + 0.002f)
+      fail_msg("%s: channel %d %s %.4f, want %.4f", materials, c, where, (double)got[c], (double)want);
+  }
+  assert_true(got[1] / got[0] > 2.5f * open[1] / open[0]);
+}
+
 /* Through the pane the wall keeps its light times the glass's
  * transmittance, (1 - F) base absorbed, F the Fresnel of ior 1.5 (0.04 at
  * normal incidence; the view is within 20 degrees of it); in the pane's
@@ -102,25 +116,10 @@ static void the_wall_is_seen_through_tinted_and_the_shadow_lighter(void **state)
            (double)glass.shadow[0], (double)glass.shadow[1], (double)glass.shadow[2],
            (double)gl_luminance(opaque.shadow));
     assert_true(open > 0.1f);
-    /* seen through: the wall times (1 - F) base absorbed, per channel (absorbed: 0.9^0.2 in r and b) */
-    const float base[3] = {0.3f, 0.9f, 0.4f}, absorbed[3] = {0.979f, 1.0f, 0.979f};
-    for (int c = 0; c < 3; c++) {
-      float want = 0.96f * base[c] * absorbed[c] * glass.open[c];
-      if (fabsf(glass.through[c] - want) > 0.06f * glass.open[c] + 0.002f)
-        fail_msg("%s: channel %d through the glass %.4f, want %.4f", materials[k], c, (double)glass.through[c],
-                 (double)want);
-    }
-    /* tinted: green against red, three times the open wall's ratio */
-    assert_true(glass.through[1] / glass.through[0] > 2.5f * glass.open[1] / glass.open[0]);
+    assert_transmitted(materials[k], "through the glass", glass.through, glass.open);
     /* the opaque pane stops the sun; the glass lets its transmittance through, tinted */
     assert_true(gl_luminance(opaque.shadow) < 0.05f * open);
-    for (int c = 0; c < 3; c++) {
-      float want = 0.96f * base[c] * absorbed[c] * glass.open[c];
-      if (fabsf(glass.shadow[c] - want) > 0.06f * glass.open[c] + 0.002f)
-        fail_msg("%s: channel %d in the glass's shadow %.4f, want %.4f", materials[k], c, (double)glass.shadow[c],
-                 (double)want);
-    }
-    assert_true(glass.shadow[1] / glass.shadow[0] > 2.5f * glass.open[1] / glass.open[0]);
+    assert_transmitted(materials[k], "in the glass's shadow", glass.shadow, glass.open);
   }
   lm_scene_destroy(s);
 }

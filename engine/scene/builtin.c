@@ -23,8 +23,7 @@ static int quad_mesh(lm_scene *s, const char *name, const float p[4][3]) {
   return lm_scene_add_mesh(s, name, v, 4, idx, 6);
 }
 
-/* Unit cube centred on the origin, outward normals, 24 vertices. */
-static int cube_mesh(lm_scene *s) {
+int lm_scene_add_cube(lm_scene *s, const char *name, float half) {
   float v[24 * 8];
   uint32_t idx[36];
   for (int face = 0; face < 6; face++) {
@@ -38,7 +37,7 @@ static int cube_mesh(lm_scene *s) {
     static const float corner[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
     for (int c = 0; c < 4; c++) {
       float *o = v + (face * 4 + c) * 8;
-      for (int k = 0; k < 3; k++) o[k] = 0.5f * (n[k] + a[k] * corner[c][0] + b[k] * corner[c][1]);
+      for (int k = 0; k < 3; k++) o[k] = half * (n[k] + a[k] * corner[c][0] + b[k] * corner[c][1]);
       memcpy(o + 3, n, 12);
       o[6] = corner[c][0] * 0.5f + 0.5f;
       o[7] = corner[c][1] * 0.5f + 0.5f;
@@ -46,7 +45,7 @@ static int cube_mesh(lm_scene *s) {
     static const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
     for (int k = 0; k < 6; k++) idx[face * 6 + k] = (uint32_t)(face * 4) + q[k];
   }
-  return lm_scene_add_mesh(s, "cube", v, 24, idx, 36);
+  return lm_scene_add_mesh(s, name, v, 24, idx, 36);
 }
 
 static void trs(vec3 t, float yaw_deg, vec3 scale, mat4 out) {
@@ -97,7 +96,7 @@ static lm_scene *cornell(bool pov, bool mirror) {
     lm_scene_add_node(s, walls[i].name, -1, (float *)id, quad_mesh(s, walls[i].name, walls[i].p),
                       walls[i].material);
 
-  int cube = cube_mesh(s);
+  int cube = lm_scene_add_cube(s, "cube", 0.5f);
   mat4 m;
   trs((vec3){0.35f, 0.3f, 0.3f}, -17.0f, (vec3){0.6f, 0.6f, 0.6f}, m);
   lm_scene_add_node(s, "short_box", -1, (float *)m, cube, m_box);
@@ -148,7 +147,7 @@ static lm_scene *field(void) {
   const float g[4][3] = {{-100, 0, 100}, {100, 0, 100}, {100, 0, -100}, {-100, 0, -100}};
   mat4 id = GLM_MAT4_IDENTITY_INIT, m;
   lm_scene_add_node(s, "ground", -1, (float *)id, quad_mesh(s, "ground", g), m_ground);
-  int cube = cube_mesh(s);
+  int cube = lm_scene_add_cube(s, "cube", 0.5f);
   for (int row = 0; row < 12; row++) {
     for (int col = -2; col <= 2; col++) {
       char name[32];

@@ -273,6 +273,9 @@ int lm_scene_add_material(lm_scene *s, const lm_material *m);
 /* Copies the arrays. */
 int lm_scene_add_mesh(lm_scene *s, const char *name, const float *vertices, int vertex_count,
                       const uint32_t *indices, int index_count);
+/* A cube of half-size `half` about the origin as mesh `name`: 24 vertices,
+ * outward normals per face, UVs 0..1 on each face (engine/scene/builtin.c). */
+int lm_scene_add_cube(lm_scene *s, const char *name, float half);
 /* Gives mesh `mesh` tangents (4 floats a vertex, copied), before the upload. */
 void lm_scene_mesh_set_tangents(lm_scene *s, int mesh, const float *tangents);
 int lm_scene_add_node(lm_scene *s, const char *name, int parent, const float local[16], int mesh,
