@@ -3,7 +3,9 @@
  * under data/scenes/reference. Deterministic: no clock, no
  * libraries, a fixed pseudo-random sequence and fixed float formatting, so
  * that running it again gives the same bytes (tests/test_gen_scenes.sh
- * checks). Usage: gen_scenes OUTDIR */
+ * checks). Usage: gen_scenes OUTDIR
+ * Each scene is a function of calls placing its materials, meshes, lights
+ * and views: data written as code, so scenes read alike line by line. */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>

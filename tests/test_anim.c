@@ -1,5 +1,5 @@
 /* glTF animation (engine/scene/anim.c and the loader): small files written
- * by the test, posed at times whose nodes, morphed and skinned vertices are
+ * by the test (each test's document whole in it, so they read alike), posed at times whose nodes, morphed and skinned vertices are
  * computed by hand here; bad animation data refused naming the animation,
  * channel and field; nothing non-finite whatever the keys and times; the
  * tracer's refit follows deformed vertices. No GL needed. */

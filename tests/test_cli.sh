@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The limn command as a user meets it: help, bad flags (exit 2), broken
 # scripts (exit 1 with script:line or the pass), and whole files or none.
+# Each case is its script and its checks, written out: cases read alike.
 set -u
 limn=$1
 root=$2
@@ -65,6 +66,8 @@ check "unknown scene" run 2 capture --scene nope
 check "bad option value" run 2 capture --set ambient=bright
 check "list options" run 0 capture --list-options
 check "list options shows techniques" out_has "techniques: isr+esm isr dl+esm dl"
+rows=$(sed -n 's/^technique{ "\([^"]*\)".*/\1/p' "$root/scripts/pp.lua" | tr '\n' ' ')
+check "list options lists pp.lua's rows, no more" grep -qxF "techniques: ${rows% }" "$tmp/out"
 
 # a good capture: both files, per-pass times with the clock named
 check "capture" run 0 capture --scene cornell --script scripts/pp.lua --tech dl --size 64x48 --frames 2 \

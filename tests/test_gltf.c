@@ -1,5 +1,5 @@
 /* glTF loading: small files written by the test itself (JSON with base64
- * data URIs, and GLB), what they load into, the malformed ones each refused
+ * data URIs, and GLB; each test's document whole in it, so they read alike), what they load into, the malformed ones each refused
  * with a message naming the file and the element, and a mutation loop that
  * must never crash. No GL needed. */
 #define _DEFAULT_SOURCE /* mkdtemp */

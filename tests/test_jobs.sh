@@ -3,7 +3,8 @@
 # merging shard manifests, --shard auto, limn farm slurm's script (its tasks
 # run here without Slurm), the manifest, a killed job completed by a rerun,
 # and bad job files and camera lists (a message naming the file and entry or
-# line, exit non-zero).
+# line, exit non-zero). Each case is its file and its checks, written out:
+# cases read alike.
 set -u
 limn=$1
 root=$2

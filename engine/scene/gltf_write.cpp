@@ -33,6 +33,7 @@ struct Writer {
   std::vector<int> mesh_accessors; // [lm mesh] -> first of its accessors (position, normal, uv, indices[, tangent])
 };
 
+// A line of the writer's warnings (the loader's fail() is alike, into its error).
 __attribute__((format(printf, 2, 3))) void warn(Writer &W, const char *fmt, ...) {
   char line[1024];
   va_list ap;
