@@ -532,6 +532,9 @@ static void extremes_stay_finite(void **state) {
       {"lpv.bounces=8", "lpv.surfels=0", NULL},
       {"sky=true", "sky.intensity=1e6", "lpv.bounces=8", "lpv.sky_cells=64", NULL},
       {"ambient=1e6", "lpv.sky_occlusion=0.5", "lpv.sky_cells=1", NULL},
+      {"lpv.fit=view", "lpv.view_extent=1e-3", NULL},
+      {"lpv.fit=view", "lpv.view_extent=64", "sky=true", "sky.intensity=1e6", NULL},
+      {"lpv.max_cell=1e-30", NULL},
   };
   lm_scene *s = corner_scene(LM_LIGHT_DIRECTIONAL);
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {

@@ -267,6 +267,13 @@ static void extremes_stay_finite(void **state) {
     gl_result r = render_ok(room, "vpl+esm", vpl_cases[i]);
     gl_result_free(&r);
   }
+  /* The sky's occlusion at its extremes, under a sky or an ambient term of 1e6. */
+  static const char *const sky_cases[][4] = {{"sky=true", "sky.intensity=1e6", "rsm.sky_reach=100", NULL},
+                                             {"ambient=1e6", "rsm.sky_reach=1e-3", NULL}};
+  for (size_t i = 0; i < sizeof sky_cases / sizeof *sky_cases; i++) {
+    gl_result r = render_ok(room, "rsm+esm", sky_cases[i]);
+    gl_result_free(&r);
+  }
   lm_scene_destroy(room);
   lm_scene *closed = closed_room(LM_LIGHT_SPOT);
   closed->lights[0].outer_cone = closed->lights[0].inner_cone = 1e-6f;
