@@ -38,6 +38,16 @@ filters.expose(ssao.defaults, rules)
 
 ssao.check = options.checker("ssao", ssao.defaults, rules)
 
+-- Records the accessibility of the G-buffer G (ssao.frag: r = A, 1 open)
+-- at 1/f a side with checked options o, unfiltered, into the target `name`:
+-- ssao.render's, and other modules' that occlude the sky by it (rsm.lua).
+function ssao.occlusion(G, o, f, name)
+  return pass{ name, shader = "ssao.frag", inputs = { nrm = G.nrm, dpt = G.dpt, mat = G.mat },
+               params = { samples = o.samples, radius = o.radius, tolerance = o.tolerance, reach = o.reach,
+                          strength = o.strength, bias = o.bias, interleave = o.interleave, factor = f },
+               out = target{ name, format = "r16f", scale = 1 / f } }
+end
+
 -- Records SSAO of frame.G applied to `lit` (direct light, no ambient term)
 -- with options o (see ssao.defaults) and frame.light = { ambient = {r, g, b}, sky }.
 -- Returns the result, a full-size rgba16f target "ssao.lit".
@@ -45,11 +55,7 @@ function ssao.render(lit, o, frame)
   local G, light = frame.G, frame.light
   o = ssao.check(o, 2)
   local f = o.resolution
-  local ao = pass{ "ssao.ao", shader = "ssao.frag", inputs = { nrm = G.nrm, dpt = G.dpt, mat = G.mat },
-                   params = { samples = o.samples, radius = o.radius, tolerance = o.tolerance, reach = o.reach,
-                              strength = o.strength, bias = o.bias, interleave = o.interleave, factor = f },
-                   out = target{ "ssao.ao", format = "r16f", scale = 1 / f } }
-  ao = filters.smooth(ao, G, o, "ssao", "r16f", f)
+  local ao = filters.smooth(ssao.occlusion(G, o, f, "ssao.ao"), G, o, "ssao", "r16f", f)
   local inputs, params, defines = { lit = lit, clr = G.clr, mat = G.mat, a = ao }, { ambient = light.ambient },
     { AO = true, AO_LIT = o.apply == "lit" }
   sky.bind(light.sky, params, defines, inputs, G)

@@ -1,15 +1,16 @@
 // Applies a screen-space GI result, already at full size, to the frame's
 // direct light `lit` (lights and shadows, no ambient term; seed 001, lines
 // 1301-1313). sky = k_a L_a albedo is the ambient term, the light of the sky
-// in the physical variants, the only light occlusion may take away.
+// in the physical variants, the only light occlusion may take away: the
+// direct pass's (gbuffer.glsl's ambient_light), k_d albedo for a pbr surface,
+// so a metal gets none.
 // Background keeps the lit colour, plus the sky seen there. One of:
 //  PHYSICAL  out = lit + A sky + B     SSDO: accessibility and bounce
 //  MERGED    out = M (lit + sky + B)   SSDO modulation factor and bounce (the seed's)
 //  TWO_STEP  out = L_dir + L_ind       the original SSDO's two results
 //  AO        out = lit + A sky         SSAO's accessibility (a.r) on the sky alone;
 //            with AO_LIT out = A (lit + sky), seed 001's darkening of everything
-#include "common.glsl"
-#include "sky.glsl"
+#include "gbuffer.glsl"
 
 in vec2 uv;
 uniform sampler2D lit, clr, mat;
@@ -33,11 +34,12 @@ void main() {
     return;
   }
 #ifdef SKY
-  vec3 n = safe_normalize(texelFetch(nrm, p, 0).xyz, vec3(0.0, 1.0, 0.0));
+  vec4 n = texelFetch(nrm, p, 0);
 #else
-  vec3 n = vec3(0.0, 1.0, 0.0);
+  vec4 n = vec4(0.0, 1.0, 0.0, 0.0); // no sky: the ambient term is the same every way
 #endif
-  vec3 sky = m.x * sky_ambient(ambient, n) * texelFetch(clr, p, 0).rgb;
+  Surface s = gbuffer_decode(texelFetch(clr, p, 0), n, 0.0, m, uv); // no position is needed
+  vec3 sky = ambient_light(s, ambient);
   vec4 x = texelFetch(a, p, 0);
 #if defined(PHYSICAL)
   vec3 c = l + saturate(x.r) * sky + texelFetch(b, p, 0).rgb;

@@ -13,7 +13,10 @@
 // TEMPORAL: temporal reuse (temporal.glsl): the result is the accumulation,
 // and the history for the next frame goes to `next` and `next_state`; a
 // pixel whose accumulation has converged takes no samples and keeps it.
-// Output: rgb = E, a = 1 (RSM light occludes no ambient term).
+// Output: rgb = E, a = 1 (RSM light occludes no ambient term), or with
+// ACCESS the share of open sky the direct pass leaves the ambient term and
+// the sky: 1 - sky_occlusion (1 - A), A from `access` (ssao.frag at this
+// grid; scripts/rsm.lua), which the history does not keep (it is taken afresh).
 // With STRIDE, each texel reads the G-buffer, STRIDE times finer, at its
 // block's centre (isr.coarse_view); with Z it also writes that depth / far,
 // 0 where nothing is drawn, into z (the view's depth).
@@ -29,6 +32,10 @@
 
 in vec2 uv;
 uniform sampler2D clr, nrm, dpt, mat; // G-buffer, STRIDE times finer than the output
+#ifdef ACCESS
+uniform sampler2D access;             // r = A at this grid (ssao.frag)
+uniform float sky_occlusion = 1.0;
+#endif
 
 layout(location = 0) out vec4 result;
 #ifdef Z
@@ -54,6 +61,11 @@ void main() {
     result = none;
     return;
   }
+#ifdef ACCESS
+  float open = 1.0 - saturate(sky_occlusion) * (1.0 - saturate(texelFetch(access, px, 0).r));
+#else
+  float open = 1.0;
+#endif
 #ifdef TEMPORAL
   vec4 h;
   float held;
@@ -61,7 +73,7 @@ void main() {
   if (found && temporal_converged(held, px)) { // kept as it is
     next = vec4(h.rgb, 1.0);
     next_state.y = max(frames, 1.0);
-    result = next;
+    result = vec4(next.rgb, open);
     return;
   }
 #endif
@@ -71,5 +83,5 @@ void main() {
   next = temporal_accumulate(vec4(v, 1.0), found, h, held, next_state.y);
   v = next.rgb;
 #endif
-  result = vec4(v, 1.0);
+  result = vec4(v, open);
 }

@@ -35,10 +35,11 @@
 //                the bounce from `sender`, the scene without SSDO darkening.
 //                out0 = (M, accessibility), out1 = (bounce, 0).
 //  DIRECT        the original first step (eq 3.3): uniform directions
-//                (p = 1 / 2 pi, dw = 2 pi / K). L_dir = Phong's diffuse
-//                light times M, its ambient times the accessibility, its
+//                (p = 1 / 2 pi, dw = 2 pi / K). L_dir = the diffuse light
+//                times M, the ambient term times the accessibility, the
 //                specular unoccluded (a lobe far narrower than the samples
-//                resolve).
+//                resolve); Phong's terms, or for a pbr surface GGX's
+//                (lighting.glsl's reflected_light, as the direct pass).
 //  BOUNCE        the original second step (eq 3.4) from `sender` = L_dir.
 // Bounce (eq 3.4), in both variants the same sum
 //   L_ind = (rho / pi) sum_i L_i (1 - V_i) (N.w_i) (N_i.(-w_i)) A_s / d_i^2
@@ -228,9 +229,14 @@ void main() {
   out1 = vec4(rho / PI * gathered, 0.0);
 #elif defined(DIRECT)
   vec3 v = safe_normalize(frame.camera_pos.xyz - s.p, s.n);
-  vec3 diffuse = phong(s.albedo, vec3(0.0, s.k.y, 0.0), s.shininess, s.n, v, s.p, vec3(0.0));
-  vec3 specular = phong(s.albedo, vec3(0.0, 0.0, s.k.z), s.shininess, s.n, v, s.p, vec3(0.0));
-  out0 = vec4(s.k.x * sky_ambient(ambient, s.n) * s.albedo * access + specular + diffuse * m, 1.0);
+  // The direct pass's reflector; without its diffuse colour, the specular term alone (Phong's k_d
+  // albedo and GGX's Lambert part both scale with it), and without k_s, Phong's diffuse term alone.
+  Reflector r = Reflector(s.pbr, surface_diffuse(s), s.k, s.shininess, s.f0, s.roughness), glossy = r, matte = r;
+  glossy.albedo = vec3(0.0);
+  matte.k.z = 0.0;
+  vec3 specular = reflected_light(glossy, s.n, v, s.p);
+  vec3 diffuse = s.pbr ? max(reflected_light(r, s.n, v, s.p) - specular, 0.0) : reflected_light(matte, s.n, v, s.p);
+  out0 = vec4(ambient_light(s, ambient) * access + specular + diffuse * m, 1.0);
 #else
   out0 = vec4(rho / PI * gathered, 0.0);
 #endif

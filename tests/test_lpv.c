@@ -1,7 +1,8 @@
 /* Light propagation volumes (scripts/lpv.lua, shaders/lpv_*.{vert,frag})
  * through pp.lua: a sunlit red wall tints the white wall beside it, on the
  * scale of the RSM gather; propagation never adds energy; a sub-cell camera
- * move leaves the volumes where they were; a frame that reads no LPV records
+ * move leaves the volumes where they were; cells follow the box the camera
+ * sees (lpv.fit) or a cap; a frame that reads no LPV records
  * none of its passes; any unit gives the same image; extremes stay finite;
  * bad options name themselves. Needs a GL context (llvmpipe will do). */
 #define _POSIX_C_SOURCE 200809L
@@ -185,7 +186,10 @@ static double aligned_difference(const float *a, const float *b, int w, int h, i
  * the sun (whose RSM tile follows what the camera sees, in whole texels),
  * with grids that hold the whole corner (the default: they stay put) and
  * with cascades 0 and 1 too small for it (lpv.extent 1: they follow the
- * camera, cascade 2 stays put): without the geometry volume's surfels (which sample the
+ * camera, cascade 2 stays put; so too fitted to the view, lpv.fit "view"
+ * with view_extent 1, whose cells of 1/32 are the power of two nearest the corner's diagonal
+ * over 128, and which a sub-cell move leaves as they were): without the
+ * geometry volume's surfels (which sample the
  * G-buffer, so move with the camera) every cascade's light stays exactly
  * where it was (no grid moved, and the VPLs sit on the same world points);
  * with them, within 2%; the image's indirect light on the white wall within
@@ -195,10 +199,11 @@ static double aligned_difference(const float *a, const float *b, int w, int h, i
 static void cascades_do_not_shimmer_under_sub_cell_motion(void **state) {
   (void)state;
   const lm_light_type types[] = {LM_LIGHT_SPOT, LM_LIGHT_DIRECTIONAL};
-  for (int k = 0; k < 8; k++) {
-    bool surfels = k & 1, follow = k & 4;
+  for (int k = 0; k < 12; k++) {
+    bool surfels = k & 1, follow = k >= 4, view = k >= 8;
     /* 8 steps: lpv.sum_r8 below is the last step's sum */
-    const char *const sets[] = {"ambient=0", "lpv.coarse=2", "lpv.steps=8", follow ? "lpv.extent=1" : "lpv.extent=3",
+    const char *const sets[] = {"ambient=0", "lpv.coarse=2", "lpv.steps=8", view ? "lpv.view_extent=1" : "ambient=0",
+                                view ? "lpv.fit=view" : follow ? "lpv.extent=1" : "lpv.extent=3",
                                 surfels ? NULL : "lpv.surfels=0", NULL};
     lm_scene *s = corner_scene(types[k / 2 % 2]);
     gl_result r = render_ok(s, "lpv+esm", sets, W, H);
@@ -220,7 +225,8 @@ static void cascades_do_not_shimmer_under_sub_cell_motion(void **state) {
     if (follow) assert_true(w > 2 * 32 * 32 && h == 32); /* two 32^3 blocks, then cascade 2's */
     double volume = aligned_difference(before, after, w, h, follow ? 32 : 0, 2);
     print_message("%s%s, grids %s, sub-cell move: volume change %.2e, white wall %.5f -> %.5f\n",
-                  k / 2 % 2 ? "sun" : "spot", surfels ? "" : " (no surfels)", follow ? "following" : "kept",
+                  k / 2 % 2 ? "sun" : "spot", surfels ? "" : " (no surfels)",
+                  view ? "fitted to the view" : follow ? "following" : "kept",
                   volume, lit0[0], lit1[0]);
     assert_true(volume < (surfels ? 0.02 : 1e-5));
     assert_true(fabsf(lit1[0] - lit0[0]) < 0.02f * lit0[0]);
@@ -388,6 +394,65 @@ static void an_outdoor_corner_sees_less_sky_than_open_ground(void **state) {
   lm_scene_destroy(s);
 }
 
+/* A hut [-1, 1] x [0, 2] x [-1, 1] on ground 40 wide, seen from inside
+ * toward the far edge: the cells follow what is asked of them, seen in the
+ * volumes' layout (lpv.lua: a cascade keeps just the cells that hold the
+ * scene along an axis where it fits, here the height, one cell either side).
+ * Fitted to the scene's box (diagonal 56.6), cascade 0's cell is 6 x 56.6 /
+ * 128 = 2.65: 3 rows, blocks of 18^2, 10^2 and 6^2 cells (every cascade
+ * holds the ground). Fitted to the view (lpv.fit "view", view_extent 1: the
+ * frustum, up to the ground's far corner 20.4 ahead, clipped to the scene's
+ * box, is 31.4 x 2 x 20.6, diagonal 37.6, over 128 cells: 0.294, whose nearest power
+ * of two is 1/4): 2 / 0.25 + 2 = 10 rows and three 32^2 blocks that follow
+ * the camera. Capped (lpv.max_cell 0.1): 22 rows. */
+static void cells_follow_the_box_the_camera_sees(void **state) {
+  (void)state;
+  enum { HW = 64, HH = 48 };
+  lm_scene *s = lm_scene_create("hut");
+  int grey = gl_material(s, "grey", 0.5f, 0.5f, 0.5f);
+  rect(s, grey, 1, 0, 1, -20, 20, -20, 20); /* ground: z, x */
+  for (int k = 0; k < 2; k++) {
+    float o = k ? 0.9f : 1.0f, in = k ? -1.0f : 1.0f, top = k ? 1.8f : 2.0f; /* inner faces face in */
+    rect(s, grey, 1, top, k ? -1.0f : 1.0f, -o, o, -o, o);    /* roof (ceiling): z, x */
+    rect(s, grey, 0, -o, -in, 0, top, -o, o);                 /* -x wall: y, z */
+    rect(s, grey, 0, o, in, 0, top, -o, o);                   /* +x wall */
+    rect(s, grey, 2, -o, -in, -o, o, 0, top);                 /* -z wall: x, y */
+    rect(s, grey, 2, o, in, -o, o, 0, top);                   /* +z wall */
+  }
+  mat4 view, m;
+  glm_lookat((vec3){0, 0, 0}, (vec3){-0.3f, -1, -0.2f}, (vec3){0, 1, 0}, view);
+  glm_mat4_inv(view, m);
+  int sun = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 1,
+                                     .casts_shadows = true, .node = sun});
+  glm_lookat((vec3){0, 0.9f, 0.6f}, (vec3){0, 0.6f, -0.9f}, (vec3){0, 1, 0}, view);
+  glm_mat4_inv(view, m);
+  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "inside", .fov_y = glm_rad(60.0f), .znear = 0.01f, .zfar = 100,
+                                      .node = cam});
+  lm_scene_update(s);
+  const struct {
+    const char *set, *extent;
+    int width, rows;
+  } fits[] = {{NULL, NULL, 18 * 18 + 10 * 10 + 6 * 6, 3},
+              {"lpv.fit=view", "lpv.view_extent=1", 3 * 32 * 32, 10},
+              {"lpv.max_cell=0.1", NULL, 3 * 32 * 32, 22}};
+  for (int t = 0; t < 3; t++) {
+    const char *const sets[] = {"ambient=0", fits[t].extent ? fits[t].extent : "ambient=0", fits[t].set, NULL};
+    gl_result r = render_ok(s, "lpv+esm", sets, HW, HH);
+    int w, h;
+    float *v = gl_read_target(&r, "lpv.inject_r", &w, &h);
+    assert_non_null(v);
+    print_message("%s: volumes %d x %d\n", fits[t].set ? fits[t].set : "lpv.fit=scene", w, h);
+    assert_int_equal(w, fits[t].width);
+    assert_int_equal(h, fits[t].rows);
+    assert_true(gl_all_finite(&r));
+    free(v);
+    gl_result_free(&r);
+  }
+  lm_scene_destroy(s);
+}
+
 /* The LPV's passes and volumes exist only in a frame whose technique reads
  * them, and then none is left out; without a light that casts shadows (no
  * RSM) lpv+esm is direct light alone. */
@@ -467,6 +532,9 @@ static void extremes_stay_finite(void **state) {
       {"lpv.bounces=8", "lpv.surfels=0", NULL},
       {"sky=true", "sky.intensity=1e6", "lpv.bounces=8", "lpv.sky_cells=64", NULL},
       {"ambient=1e6", "lpv.sky_occlusion=0.5", "lpv.sky_cells=1", NULL},
+      {"lpv.fit=view", "lpv.view_extent=1e-3", NULL},
+      {"lpv.fit=view", "lpv.view_extent=64", "sky=true", "sky.intensity=1e6", NULL},
+      {"lpv.max_cell=1e-30", NULL},
   };
   lm_scene *s = corner_scene(LM_LIGHT_DIRECTIONAL);
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
@@ -519,7 +587,8 @@ static void bad_options_name_themselves(void **state) {
       {"lpv+esm", "lpv.coarse=3", "lpv.coarse"},       {"isr+lpv+esm", "lpv.blur=33", "lpv.blur"},
       {"isr+lpv+esm", "lpv.k=17", "lpv.k"},           {"lpv+esm", "lpv.bounces=0", "lpv.bounces"},
       {"lpv+esm", "lpv.bounces=9", "lpv.bounces"},     {"lpv+esm", "lpv.sky_occlusion=2", "lpv.sky_occlusion"},
-      {"lpv+esm", "lpv.sky_cells=0", "lpv.sky_cells"},
+      {"lpv+esm", "lpv.sky_cells=0", "lpv.sky_cells"},     {"lpv+esm", "lpv.fit=box", "lpv.fit"},
+      {"lpv+esm", "lpv.view_extent=0", "lpv.view_extent"}, {"lpv+esm", "lpv.max_cell=-1", "lpv.max_cell"},
   };
   gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
 }
@@ -531,6 +600,7 @@ int main(void) {
       cmocka_unit_test(bounces_reach_the_ceiling_and_stay_bounded),
       cmocka_unit_test(an_outdoor_corner_sees_less_sky_than_open_ground),
       cmocka_unit_test(cascades_do_not_shimmer_under_sub_cell_motion),
+      cmocka_unit_test(cells_follow_the_box_the_camera_sees),
       cmocka_unit_test(a_frame_that_reads_no_lpv_records_none_of_its_passes),
       cmocka_unit_test(any_unit_gives_the_same_light),
       cmocka_unit_test(extremes_stay_finite),

@@ -2,7 +2,8 @@
  * point lights in them (scripts/vpl.lua) through pp.lua: colour bleeding from a sunlit floor onto a ceiling the sun cannot
  * reach and the camera sees alone (present with rsm, absent with isr), on
  * POV-Ray's scale; a closed room lit by one spot patch lights its ceiling;
- * a frame that reads no RSM renders none; extremes stay finite. Needs a GL
+ * a frame that reads no RSM renders none; an outdoor corner sees less sky
+ * than open ground; extremes stay finite. Needs a GL
  * context (llvmpipe will do). */
 #include <cglm/cglm.h>
 #define _POSIX_C_SOURCE 200809L
@@ -264,6 +265,13 @@ static void extremes_stay_finite(void **state) {
   }
   for (size_t i = 0; i < sizeof vpl_cases / sizeof *vpl_cases; i++) {
     gl_result r = render_ok(room, "vpl+esm", vpl_cases[i]);
+    gl_result_free(&r);
+  }
+  /* The sky's occlusion at its extremes, under a sky or an ambient term of 1e6. */
+  static const char *const sky_cases[][4] = {{"sky=true", "sky.intensity=1e6", "rsm.sky_reach=100", NULL},
+                                             {"ambient=1e6", "rsm.sky_reach=1e-3", NULL}};
+  for (size_t i = 0; i < sizeof sky_cases / sizeof *sky_cases; i++) {
+    gl_result r = render_ok(room, "rsm+esm", sky_cases[i]);
     gl_result_free(&r);
   }
   lm_scene_destroy(room);
@@ -532,6 +540,59 @@ static void a_moving_light_caps_the_history_under_a_moving_camera(void **state) 
   assert_true(most[1] >= 1.0f && most[1] <= 4.0f);
 }
 
+/* Under a uniform sky of 0.5 (the sun's power 0: its RSM sends nothing),
+ * the ground in the corner of two walls 4 high, at (0.7, 0, 0.7), sees less
+ * sky than open ground at (6, 0, 6): with rsm.sky_occlusion at its default
+ * rsm+esm darkens the corner below the open ground, with 0 it cannot (the
+ * bounce would then add to an open sky). */
+static void an_outdoor_corner_sees_less_sky_than_open_ground(void **state) {
+  (void)state;
+  lm_scene *s = lm_scene_create("yard");
+  int grey = gl_material(s, "grey", 0.5f, 0.5f, 0.5f);
+  gl_quad(s, "ground", grey, (const float[4][3]){{-10, 0, 10}, {10, 0, 10}, {10, 0, -10}, {-10, 0, -10}},
+          (const float[3]){0, 1, 0});
+  gl_quad(s, "wall x", grey, (const float[4][3]){{0, 0, 8}, {0, 0, 0}, {0, 4, 0}, {0, 4, 8}}, (const float[3]){1, 0, 0});
+  gl_quad(s, "wall z", grey, (const float[4][3]){{0, 0, 0}, {8, 0, 0}, {8, 4, 0}, {0, 4, 0}}, (const float[3]){0, 0, 1});
+  mat4 view, m;
+  glm_lookat((vec3){0, 0, 0}, (vec3){-0.3f, -1, -0.2f}, (vec3){0, 1, 0}, view);
+  glm_mat4_inv(view, m);
+  int sun = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 0,
+                                     .casts_shadows = true, .node = sun});
+  glm_lookat((vec3){9, 6, 9}, (vec3){3, 0, 3}, (vec3){0, 1, 0}, view);
+  glm_mat4_inv(view, m);
+  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "yard", .fov_y = glm_rad(60.0f), .znear = 0.01f, .zfar = 100,
+                                      .node = cam});
+  lm_scene_update(s);
+  mat4 proj, vp;
+  glm_perspective(glm_rad(60.0f), 96.0f / 72, 0.01f, 100, proj);
+  glm_mat4_mul(proj, view, vp);
+  const float points[2][3] = {{0.7f, 0, 0.7f}, {6, 0, 6}}; /* the corner, open ground */
+  for (int t = 0; t < 2; t++) {
+    const char *const sets[] = {"ambient=0", "sky=true", "sky.zenith=0.5", "sky.horizon=0.5",
+                                t ? "rsm.sky_occlusion=0" : NULL, NULL};
+    gl_result r = gl_render_ok(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = sets, .width = 96, .height = 72});
+    float c[2][3];
+    for (int k = 0; k < 2; k++) { /* the 5 x 5 pixels around each point */
+      vec4 p;
+      glm_mat4_mulv(vp, (vec4){points[k][0], points[k][1], points[k][2], 1}, p);
+      int col = (int)((p[0] / p[3] * 0.5f + 0.5f) * r.width), row = (int)((0.5f - p[1] / p[3] * 0.5f) * r.height);
+      assert_true(col >= 2 && col < r.width - 2 && row >= 2 && row < r.height - 2);
+      gl_region(&r, col - 2, row - 2, col + 2, row + 2, c[k]);
+    }
+    const float *a = c[0], *b = c[1];
+    float ratio = gl_luminance(a) / fmaxf(gl_luminance(b), 1e-6f);
+    print_message("rsm+esm%s: corner %.4f, open ground %.4f (0.25), ratio %.3f\n", t ? " (sky_occlusion 0)" : "",
+                  gl_luminance(a), gl_luminance(b), ratio);
+    assert_true(gl_all_finite(&r));
+    if (t == 0) assert_true(ratio < 0.85f);
+    else assert_true(fabsf(ratio - 1) < 0.02f && fabsf(gl_luminance(b) - 0.25f) < 0.03f);
+    gl_result_free(&r);
+  }
+  lm_scene_destroy(s);
+}
+
 static void bad_options_name_themselves(void **state) {
   (void)state;
   static const gl_bad_option cases[] = {
@@ -545,6 +606,7 @@ static void bad_options_name_themselves(void **state) {
       {"rsm+esm", "rsm.resolution=8", "rsm.resolution"}, {"vpl+esm", "vpl.resolution=16.5", "vpl.resolution"},
       {"lpv+esm", "lpv.resolution=9000", "lpv.resolution"},
       {"isr+esm", "isr.temporal.moving=-1", "isr.temporal.moving"},
+      {"rsm+esm", "rsm.sky_occlusion=2", "rsm.sky_occlusion"}, {"rsm+esm", "rsm.sky_reach=0", "rsm.sky_reach"},
       {"isr+rsm+esm", "rsm.temporal.enabled=true", "isr+rsm+esm takes temporal reuse from isr.temporal"},
       {"isr+rsm+esm", "isr.mode=seed", "isr+rsm+esm needs isr.mode \"physical\""},
   };
@@ -563,6 +625,7 @@ int main(void) {
       cmocka_unit_test(a_light_change_reaches_converged_pixels_at_once),
       cmocka_unit_test(a_camera_move_leaves_no_ghost_edge),
       cmocka_unit_test(a_moving_camera_keeps_screen_space_light_current),
+      cmocka_unit_test(an_outdoor_corner_sees_less_sky_than_open_ground),
       cmocka_unit_test(extremes_stay_finite),
       cmocka_unit_test(bad_options_name_themselves),
   };

@@ -126,6 +126,38 @@ static void a_script_records_a_frame(void **state) {
   lm_pipeline_destroy(p);
 }
 
+/* camera_view() gives the frame's camera (eye, unit axes from the inverse
+ * view, near, far, tan(fov_y / 2), aspect), nil in OnCreate and without one;
+ * the script reports what it got through an error message. */
+static void camera_view_gives_the_frames_camera(void **state) {
+  (void)state;
+  lm_error err;
+  lm_pipeline *p = load("camera.lua",
+                        "Techniques = { 'dl' }\n"
+                        "function OnCreate() assert(camera_view() == nil) end\n"
+                        "function OnRender(tech)\n"
+                        "  local c = camera_view()\n"
+                        "  if c then\n"
+                        "    local function v(t) return string.format('%g %g %g', t[1], t[2], t[3]) end\n"
+                        "    error(string.format('camera %s | %s | %s | %s | %g %g %g %g', v(c.eye), v(c.forward),\n"
+                        "                        v(c.up), v(c.right), c.near, c.far, c.tan_y, c.aspect), 0)\n"
+                        "  end\n"
+                        "  present(pass{ 'copy', shader = 'x.frag', out = target{ 'a', format = 'rgba8' } })\n"
+                        "end\n", &err);
+  assert_non_null(p);
+  lm_graph *g = lm_graph_create();
+  if (!frame(p, g, &err)) fail_msg("%s", err.msg); /* no camera given: nil */
+  /* A camera at (1, 2, 3) turned 90 degrees about y: it looks along -x, its right is -z. */
+  lm_frame_data f = {.camera_pos = {1, 2, 3, 1}, .clip = {0.1f, 50, 0.02f, 0.5f}, .output_size = {64, 48}};
+  const float inv_view[16] = {0, 0, -1, 0, 0, 1, 0, 0, 1, 0, 0, 0, 1, 2, 3, 1};
+  memcpy(f.inv_view, inv_view, sizeof inv_view);
+  lm_pipeline_set_scene(p, NULL, &f, NULL, 0, 0);
+  assert_false(frame(p, g, &err));
+  assert_non_null(strstr(err.msg, "camera 1 2 3 | -1 -0 -0 | 0 1 0 | 0 0 -1 | 0.1 50 0.5 1.33333"));
+  lm_graph_destroy(g);
+  lm_pipeline_destroy(p);
+}
+
 static void options_are_typed_and_listed(void **state) {
   (void)state;
   lm_error err;
@@ -278,6 +310,7 @@ int main(void) {
       cmocka_unit_test(syntax_errors_name_script_and_line),
       cmocka_unit_test(runtime_errors_carry_a_traceback),
       cmocka_unit_test(a_script_records_a_frame),
+      cmocka_unit_test(camera_view_gives_the_frames_camera),
       cmocka_unit_test(options_are_typed_and_listed),
       cmocka_unit_test(script_errors_name_the_field),
       cmocka_unit_test(the_sandbox_holds),

@@ -3,8 +3,8 @@
  * synthetic depth step: contact darkening, open planes left alone, the
  * bounce's colour, edges the filters must not cross, reduced resolution
  * against full, the two SSDO variants against each other, finite results
- * at extreme parameters, option errors, and that dl records no SSDO or SSAO
- * pass. Needs a GL context (llvmpipe will do). */
+ * at extreme parameters, option errors, the two-step variant's pbr light,
+ * and that dl records no SSDO or SSAO pass. Needs a GL context (llvmpipe will do). */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>
@@ -328,6 +328,24 @@ static void occlusion_never_darkens_direct_light(void **state) {
   scene->light_count = lights;
 }
 
+/* With materials=pbr the two-step variant's direct light is GGX's, as the
+ * direct pass's (ssdo.frag's DIRECT drew Phong's terms from the pbr
+ * channels): on the open back wall and floor, where the light lobe's
+ * estimate is exact, it matches dl within 1%, as with Phong materials. */
+static void two_step_lights_pbr_surfaces_as_the_direct_pass(void **state) {
+  (void)state;
+  static const char *const pbr[] = {"materials=pbr", "ambient=0", NULL};
+  static const char *const two_step[] = {"materials=pbr", "ambient=0", "ssdo.variant=two_step", "ssdo.r_max=0.3",
+                                         "ssdo.bounce=0", NULL};
+  gl_result dl = render_ok("dl", pbr), im = render_ok("ssdo", two_step);
+  double wall = ratio_at(&im, &dl, 0.3f, 1.45f, -1.0f), floor_ = ratio_at(&im, &dl, -0.5f, 0.0f, 0.65f);
+  print_message("pbr, two_step over dl: open back wall %.4f, open floor %.4f\n", wall, floor_);
+  assert_true(fabs(wall - 1) < 0.01);
+  assert_true(fabs(floor_ - 1) < 0.01);
+  gl_result_free(&dl);
+  gl_result_free(&im);
+}
+
 /* The adaptive count's edge map (1/16 a side) gives 10 samples on open
  * planes and 30 where the boxes stand on the floor, nothing but 10, 20 and
  * 30; and the adaptive image still darkens contacts. (At 256 x 192 a texel
@@ -485,6 +503,7 @@ int main(void) {
       cmocka_unit_test(rotation_beats_raw_pattern),
       cmocka_unit_test(variants_agree_under_white_light),
       cmocka_unit_test(occlusion_never_darkens_direct_light),
+      cmocka_unit_test(two_step_lights_pbr_surfaces_as_the_direct_pass),
       cmocka_unit_test(adaptive_counts_follow_edges),
       cmocka_unit_test(extreme_parameters_stay_finite),
       cmocka_unit_test(bad_options_name_themselves),

@@ -718,6 +718,39 @@ static int l_scene_bounds(lua_State *L) {
   return 2;
 }
 
+/* camera_view(): the camera of the frame being recorded, { eye, forward,
+ * up, right = world {x, y, z} (unit), near, far, tan_y = tan(fov_y / 2),
+ * aspect = width / height }; nil from OnCreate (no camera yet). A script
+ * fits what the frame needs to it (lpv.lua's volumes). */
+static int l_camera_view(lua_State *L) {
+  lm_pipeline *p = recording(L, "camera_view");
+  const lm_frame_data *f = p->camera;
+  if (p->in_create || !f) {
+    lua_pushnil(L);
+    return 1;
+  }
+  /* inv_view's columns: right, up, back (the camera looks down -z). */
+  const struct { const char *name; const float *v; float sign; } axes[] = {
+      {"eye", f->camera_pos, 1}, {"right", f->inv_view, 1}, {"up", f->inv_view + 4, 1}, {"forward", f->inv_view + 8, -1}};
+  lua_createtable(L, 0, 8);
+  for (size_t k = 0; k < sizeof axes / sizeof *axes; k++) {
+    lua_createtable(L, 3, 0);
+    for (int i = 0; i < 3; i++) {
+      lua_pushnumber(L, axes[k].sign * axes[k].v[i]);
+      lua_rawseti(L, -2, i + 1);
+    }
+    lua_setfield(L, -2, axes[k].name);
+  }
+  float h = f->output_size[1];
+  const struct { const char *name; float v; } numbers[] = {
+      {"near", f->clip[0]}, {"far", f->clip[1]}, {"tan_y", f->clip[3]}, {"aspect", h > 0 ? f->output_size[0] / h : 1}};
+  for (size_t k = 0; k < sizeof numbers / sizeof *numbers; k++) {
+    lua_pushnumber(L, numbers[k].v);
+    lua_setfield(L, -2, numbers[k].name);
+  }
+  return 1;
+}
+
 /* scene_blended(): whether a node of the scene has an alphaMode BLEND material
  * (the pipeline records its forward pass only then). */
 static int l_scene_blended(lua_State *L) {
@@ -866,6 +899,7 @@ void lm_script_open_api(lua_State *L) {
                                  {"scene_reflective", l_scene_reflective}, {"points", l_points},
                                  {"scene_blended", l_scene_blended},
                                  {"scene_bounds", l_scene_bounds}, {"light_set", l_light_set},
+                                 {"camera_view", l_camera_view},
                                  {NULL, NULL}};
   lua_pushglobaltable(L);
   luaL_setfuncs(L, api, 0);

@@ -38,7 +38,7 @@ struct lm_pipeline {
 };
 
 /* Registers target, scene, pass, cpu, points, present, output_size, shadow_plan, sky_sh, scene_reflective,
- * scene_blended and scene_bounds in the global table. */
+ * scene_blended, scene_bounds and camera_view in the global table. */
 void lm_script_open_api(lua_State *L);
 /* The registry key under which lm_pipeline_load keeps the pipeline that owns L. */
 #define LM_SCRIPT_PIPELINE_KEY "limn.pipeline"
