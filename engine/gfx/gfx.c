@@ -136,6 +136,17 @@ void lm_texture_clear(lm_texture tex) {
                   zero);
 }
 
+/* A texture's clear, not a scissored glClear: llvmpipe clears a 512x512
+ * rectangle of five targets (r32f, two rgba16f, rgba32f, depth32f) in 3 ms
+ * so against 40-50 ms scissored (its clear of a whole 1024x1024 framebuffer
+ * took 55 ms; CPU clock around glFinish, a loaded 2-core machine). */
+void lm_texture_clear_rect(lm_texture tex, lm_format format, int x, int y, int width, int height,
+                           const float value[4]) {
+  if (width <= 0 || height <= 0) return;
+  glClearTexSubImage(tex.id, 0, x, y, 0, width, height, 1, lm_format_is_depth(format) ? GL_DEPTH_COMPONENT : GL_RGBA,
+                     GL_FLOAT, value);
+}
+
 /* ---- framebuffers: cached by attachment set ---------------------------- */
 typedef struct fbo_entry {
   lm_attachments att;
@@ -199,14 +210,6 @@ void lm_clear(int color_count, const float rgba[4], bool clear_depth, float dept
     glDepthMask(GL_TRUE);
     glClearBufferfv(GL_DEPTH, 0, &depth);
   }
-}
-
-void lm_clear_rect(int x, int y, int width, int height, int color_count, const float rgba[4], bool clear_depth,
-                   float depth) {
-  glEnable(GL_SCISSOR_TEST);
-  glScissor(x, y, width, height);
-  lm_clear(color_count, rgba, clear_depth, depth);
-  glDisable(GL_SCISSOR_TEST);
 }
 
 static GLuint empty_vao;

@@ -68,6 +68,10 @@ bool lm_texture_upload_rgba8(lm_texture *tex, int width, int height, const unsig
 void lm_texture_destroy(lm_texture *tex);
 void lm_texture_generate_mips(lm_texture tex);
 void lm_texture_clear(lm_texture tex); /* zero every texel of level 0 */
+/* Sets the rectangle x, y, width, height of level 0 to value (a depth
+ * format's texels to value[0]), whatever framebuffer is bound. */
+void lm_texture_clear_rect(lm_texture tex, lm_format format, int x, int y, int width, int height,
+                           const float value[4]);
 int lm_texture_max_size(void);
 
 /* ---- framebuffers and passes ------------------------------------------ */
@@ -81,9 +85,6 @@ typedef struct lm_attachments {
 /* Binds (a cached) framebuffer for these attachments and sets the viewport. */
 bool lm_attachments_bind(const lm_attachments *att, lm_error *err);
 void lm_clear(int color_count, const float rgba[4], bool clear_depth, float depth);
-/* lm_clear within the rectangle x, y, width, height alone. */
-void lm_clear_rect(int x, int y, int width, int height, int color_count, const float rgba[4], bool clear_depth,
-                   float depth);
 void lm_draw_fullscreen(void);
 /* Draws `count` points from no vertex data (the vertex shader numbers them by
  * gl_VertexID), each one pixel, added to what the outputs hold (additive
