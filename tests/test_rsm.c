@@ -545,6 +545,8 @@ static void bad_options_name_themselves(void **state) {
       {"rsm+esm", "rsm.resolution=8", "rsm.resolution"}, {"vpl+esm", "vpl.resolution=16.5", "vpl.resolution"},
       {"lpv+esm", "lpv.resolution=9000", "lpv.resolution"},
       {"isr+esm", "isr.temporal.moving=-1", "isr.temporal.moving"},
+      {"rsm+esm", "rsm.temporal.clamp=17", "rsm.temporal.clamp"},
+      {"isr+esm", "isr.temporal.clamp=-1", "isr.temporal.clamp"},
       {"isr+rsm+esm", "rsm.temporal.enabled=true", "isr+rsm+esm takes temporal reuse from isr.temporal"},
       {"isr+rsm+esm", "isr.mode=seed", "isr+rsm+esm needs isr.mode \"physical\""},
   };
