@@ -204,7 +204,7 @@ function isr.check(o, level)
 end
 
 -- Declares the temporal reuse history at each coarse factor (one is made); from OnCreate.
-function isr.create() temporal.create("isr", { 1, 2, 3, 4 }, { view = true, keep = true }) end
+function isr.create() temporal.create("isr", { 1, 2, 3, 4 }, { view = true, keep = true, clamp = true }) end
 
 -- Records ISR lighting of frame.G given its direct light `direct` (lights only, no
 -- ambient term: a target from direct.frag with ambient 0; isr+lpv+esm's
@@ -255,6 +255,7 @@ function isr.render(direct, o, frame)
     if last then
       defines.TEMPORAL_NEXT, defines.NEXT = true, #out
       out[#out + 1], out[#out + 2] = history.value, history.state
+      if history.fresh then defines.TEMPORAL_CLAMP, out[#out + 1] = true, history.fresh end
     end
   end
   local steps = seed and seed.bounces or o.bounces
@@ -303,6 +304,7 @@ function isr.render(direct, o, frame)
             fetches = fetches }
     end
   end
+  E = temporal.clamp("isr", history, E)
   E = isr.blur(E, C, f, o.blur, history and history.state, kept and kept.value, o.temporal.narrow)
   return isr.composite(G, direct, C, E, params, seed ~= nil, light.sky)
 end

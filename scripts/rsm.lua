@@ -60,6 +60,11 @@ for k, v in pairs(temporal.defaults) do rsm.defaults.temporal[k] = v end
 -- 0.01729, 0.002844, lag 4 (9 warmed up): 24 samples are noisy, so a running mean over many still
 -- frames changes by that noise each frame, and a history kept 4 frames while the light changes lags it.
 rsm.defaults.temporal.frames, rsm.defaults.temporal.moving, rsm.defaults.temporal.narrow = 3, 2.5, 0
+-- Clamping (docs/motion.md "Clamping"): a spot dimmed to a quarter left the ceiling 153% too bright 6
+-- frames later unclamped (converged on part of the old light, and kept), 11.9% at 6, 7.5% at 4 (test_rsm);
+-- on the door sequence 6 gives 0.01638, 0.002364, lag 1 (warmed up 0.01661, 0.002257, 0), under reuse
+-- off's 0.01674, 0.002399; at 4 warmed up 0.01684, over it; 2 and 3 flicker more than off.
+rsm.defaults.temporal.clamp = 6
 
 local rules = {
   samples = options.whole(1, 4096),
@@ -118,14 +123,16 @@ function rsm.gather(C, f, R, shadows, o, kept, access)
   local turning = o.temporal.enabled and (o.temporal.turn == "always" or still_frames() == 0)
   local fetches = rsm.bind(inputs, defines, params, R, shadows, o, f, turning)
   local history = temporal.bind("rsm", inputs, defines, params, o.temporal, f)
+  if history and history.fresh then defines.TEMPORAL_CLAMP = true end
   local E = kept and o.blur == 0 and kept.value or target{ "rsm.e", format = "rgba16f", scale = 1 / f }
   pass{ "rsm.gather", shader = "rsm.frag", inputs = inputs, defines = defines, params = params,
-        fetches = 4 + fetches, out = { E, C.z, history and history.value, history and history.state } }
-  return E, history
+        fetches = 4 + fetches, out = { E, C.z, history and history.value, history and history.state,
+                                       history and history.fresh } }
+  return temporal.clamp("rsm", history, E), history
 end
 
 -- Declares the temporal reuse history at each coarse factor (one is made); from OnCreate.
-function rsm.create() temporal.create("rsm", { 1, 2, 3, 4 }, { keep = true }) end
+function rsm.create() temporal.create("rsm", { 1, 2, 3, 4 }, { keep = true, clamp = true }) end
 
 -- Records the RSM's indirect light over frame.G from the shadow atlas and
 -- RSM targets (frame.shadows, frame.R: shadow.render(..., o)), with options

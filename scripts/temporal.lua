@@ -50,6 +50,12 @@ temporal.defaults = {
                     -- 2/5 of it, less blur where the noise averaged out). isr.temporal's is 0 (the door
                     -- sequence, docs/motion.md: the narrowing blur changed the image each frame as
                     -- the history grew, flicker)
+  clamp = 0,        -- neighbourhood clamping: the reprojected history's luminance is held within
+                    -- mean +- clamp standard deviations of the log luminance of this frame's fresh
+                    -- estimates in the pixel's 3 x 3 neighbourhood (temporal_clamp.frag), so that after
+                    -- a change of light it cannot lag behind what the frame sees by more than the noise,
+                    -- 0..16 (0: off; ISR's and RSM's histories, RSM's default 6; SSDO's has none:
+                    -- docs/motion.md "Clamping")
   skip = true,      -- a settled frame (the world and settings unchanged for `frames` frames: every
                     -- pixel converged) keeps the last result and runs none of the GI passes (ISR's,
                     -- RSM's, SSDO's; false: they run, each pixel keeping its history)
@@ -65,6 +71,7 @@ local rules = {
   moving = options.number(0, 1024),
   turn = options.one_of("always", "moving"),
   narrow = options.number(0, 1),
+  clamp = options.number(0, 16),
   skip = options.boolean,
   velocity = options.boolean,
 }
@@ -135,11 +142,12 @@ function temporal.settled(o) return o.enabled and o.skip and quiet >= o.frames e
 -- `moving` option); keep = the user's final result and its grid's depth are
 -- kept too (temporal.kept), so that a settled frame can skip its passes;
 -- keep = "output": a full-size result instead (kept.value at scale 1, no
--- z: SSDO keeps its composite) }.
+-- z: SSDO keeps its composite); clamp = the user's accumulating pass writes
+-- TEMPORAL_CLAMP's `fresh` and calls temporal.clamp (the `clamp` option) }.
 function temporal.create(user, factors, how)
   if type(factors) == "number" then factors = { factors } end
   how = how or {}
-  histories[user] = { view = how.view == true, at = {} }
+  histories[user] = { view = how.view == true, clamp = how.clamp == true, at = {} }
   for _, f in ipairs(factors) do
     local name = string.format("temporal.%s%d.", user, f)
     local function history(i)
@@ -189,6 +197,10 @@ function temporal.kept(user, f) return history_of(user, f).kept end
 -- which pixels have converged) and writes the next history from its last.
 -- gather_turns: another gather in the pass turns its pattern every frame
 -- whatever o.turn says (isr+rsm+esm's RSM), so the history averages it.
+-- With o.clamp the pass that accumulates also gets TEMPORAL_CLAMP and writes
+-- `fresh` after value and state (its outputs NEXT, NEXT + 1, NEXT + 2), its
+-- value going to a frame target that temporal.clamp then clamps into the
+-- history.
 function temporal.bind(user, inputs, defines, params, o, f, gather_turns)
   if not o.enabled then return nil end
   local h = history_of(user, f)
@@ -206,7 +218,28 @@ function temporal.bind(user, inputs, defines, params, o, f, gather_turns)
   params.turn = (o.turn == "always" or not histories[user].view and still_frames() == 0) and 1 or 0
   params.gather_turns = gather_turns and 1 or 0
   if velocity and o.velocity then inputs.velocity, defines.VELOCITY = velocity, true end
+  if o.clamp > 0 and not histories[user].clamp then
+    error(string.format("%s.temporal.clamp: %s's history has no clamping (0, or leave it out)", user, user), 3)
+  end
+  if o.clamp > 0 then
+    local name = string.format("temporal.%s%d.", user, f)
+    return { value = target{ name .. "raw", format = "rgba32f", scale = 1 / f }, state = next.state,
+             fresh = target{ name .. "fresh", format = "rgba32f", scale = 1 / f }, clamped = next.value,
+             k = o.clamp }
+  end
   return next
+end
+
+-- After the pass that accumulated `next` (temporal.bind's, with
+-- TEMPORAL_CLAMP where next.fresh is set): pass "<user>.clamp" holds each
+-- pixel's history within its fresh neighbourhood (temporal_clamp.frag) and
+-- writes the result to E (the pass's own E, written again) and to the
+-- history. Returns E. Nothing without clamping.
+function temporal.clamp(user, next, E)
+  if not (next and next.fresh) then return E end
+  pass{ user .. ".clamp", shader = "temporal_clamp.frag", inputs = { raw = next.value, fresh = next.fresh },
+        params = { k = next.k }, out = { E, next.clamped }, fetches = 11 }
+  return E
 end
 
 return temporal

@@ -66,6 +66,9 @@ void main() {
   vec4 hit0 = texelFetch(hits0, px, 0);
 #ifdef TEMPORAL
   float d = texelFetch(z, px, 0).r;
+#ifdef TEMPORAL_CLAMP
+  temporal_fresh = vec4(0.0, 0.0, 0.0, -1.0);
+#endif
 #ifdef TEMPORAL_NEXT
   next = vec4(0.0);
   next_state = vec2(dpt_view_depth(d), 0.0);

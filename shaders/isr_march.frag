@@ -202,6 +202,9 @@ void main() {
   hits5 = vec4(0.0);
 #endif
 #endif
+#ifdef TEMPORAL_CLAMP
+  temporal_fresh = vec4(0.0, 0.0, 0.0, -1.0);
+#endif
 #ifdef TEMPORAL_NEXT
   next = vec4(0.0);
   next_state = vec2(s.covered ? dpt_view_depth(s.depth01) : 0.0, 0.0);

@@ -23,6 +23,7 @@
 #define RSM_GATHER
 #include "rsm.glsl"
 #ifdef TEMPORAL
+#define NEXT 2 // where the history's outputs start (temporal.glsl's TEMPORAL_CLAMP)
 #include "temporal.glsl"
 #endif
 
@@ -56,6 +57,9 @@ void main() {
 #ifdef TEMPORAL
   next = vec4(0.0);
   next_state = vec2(s.covered ? dpt_view_depth(s.depth01) : 0.0, 0.0);
+#endif
+#ifdef TEMPORAL_CLAMP
+  temporal_fresh = vec4(0.0, 0.0, 0.0, -1.0);
 #endif
   if (!s.covered) {
     result = none;

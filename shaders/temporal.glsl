@@ -39,6 +39,13 @@ uniform int gather_turns = 0; // 1: another gather in the pass turns every frame
 // on its own (a = 2) reprojects along its motion, to the view depth it had.
 uniform sampler2D velocity;
 #endif
+#ifdef TEMPORAL_CLAMP
+// Neighbourhood clamping (temporal.clamp, temporal_clamp.frag): the pass also
+// writes this frame's fresh estimate (rgb) and the weight its history took
+// (a: raw = mix(fresh, h, w); -1 where no fresh samples were taken), after
+// its other outputs (NEXT + 2). A pass sets it to (0, 0, 0, -1) first.
+layout(location = NEXT + 2) out vec4 temporal_fresh;
+#endif
 // Set by temporal_history: the pixel's surface moved on its own since the
 // last frame (a node or a deformation), so its light may have changed.
 bool temporal_self_moved = false;
@@ -145,10 +152,16 @@ vec4 temporal_accumulate(vec4 cur, bool found, vec4 h, float n, out float seen) 
       float held = min(n, most);
       float w = held >= frames && !moved ? 1.0 : held / (held + 1.0);
       seen = min(held + 1.0, most);
+#ifdef TEMPORAL_CLAMP
+      temporal_fresh = vec4(finite_or_zero(cur.rgb), w);
+#endif
       return finite_or_zero(mix(cur, h, w));
     }
   }
   seen = 1.0;
+#ifdef TEMPORAL_CLAMP
+  temporal_fresh = vec4(finite_or_zero(cur.rgb), 0.0);
+#endif
   return finite_or_zero(cur);
 }
 #endif

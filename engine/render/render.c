@@ -121,6 +121,7 @@ void lm_renderer_destroy(lm_renderer *r) {
 
 lm_graph *lm_renderer_graph(lm_renderer *r) { return r->graph; }
 lm_clock lm_renderer_clock(const lm_renderer *r) { return r->clock; }
+float lm_renderer_exposure(const lm_renderer *r) { return r->exposure; }
 const lm_light_grid *lm_renderer_light_grid(const lm_renderer *r) { return &r->light_grid; }
 
 void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compile_ms) {

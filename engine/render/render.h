@@ -37,6 +37,8 @@ lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r); /* camera pass
 /* The same for the last frame's shadow tiles, summed over the tiles. */
 lm_scene_draw_stats lm_renderer_shadow_draw_stats(const lm_renderer *r);
 lm_clock lm_renderer_clock(const lm_renderer *r);
+/* The last frame's pre-exposure E (common.glsl's exposed(); frame_exposure in render.c). */
+float lm_renderer_exposure(const lm_renderer *r);
 /* The last frame's light grid (lm_light_grid_build), read by the lighting shaders. */
 const lm_light_grid *lm_renderer_light_grid(const lm_renderer *r);
 /* CPU milliseconds of the last frame spent in Lua (OnRender) and in compiling the graph. */
