@@ -77,7 +77,8 @@ function dof.render(src, o, frame)
   tiles = pass{ "dof.dilate", shader = "dof_tiles.frag", inputs = { src = tiles },
                 params = { max_radius = radius }, defines = { TILE = tile, DILATE = true },
                 out = target{ "dof.dilate", format = "r16f", scale = 1 / (tile * f) } }
-  local gathered = pass{ "dof.gather", shader = "dof_gather.frag", inputs = { src = image, coc = circles, tiles = tiles },
+  local gathered = pass{ "dof.gather", shader = "dof_gather.frag",
+                         inputs = { src = image, coc = f == 1 and circles or nil, tiles = tiles }, -- else image.a
                          params = { max_radius = radius, samples = math.max(1, o.samples // f) },
                          defines = { TILE = tile, FOREIGN = f > 1 },
                          out = target{ "dof.gather", format = "rgba16f", scale = 1 / f } }

@@ -3,7 +3,8 @@
 // confusion of the nearest of them (scaled to the reduced pixels), so a
 // foreground's blur still spreads and a sharp foreground still shields what
 // lies behind it. The circle comes from the G-buffer's depth here (dof.glsl):
-// no full-size circle target is written or read.
+// no full-size circle target is written or read. It goes to the image's
+// alpha too, so that each of the gather's taps is one read.
 #include "dof.glsl"
 
 uniform sampler2D src;
@@ -18,6 +19,7 @@ void main() {
   // The block's depths in one gather at its centre (clamped at the border, as the colours are).
   vec4 d = textureGather(dpt, vec2(base + 1) / vec2(textureSize(dpt, 0)), 0);
   float nearest = min(min(eye_depth(d.x), eye_depth(d.y)), min(eye_depth(d.z), eye_depth(d.w)));
-  dst = vec4(hdr_clamp(c * 0.25, HALF_MAX), 1.0);
-  dst_coc = vec4(dof_coc(nearest, dof_focus()) * 0.5, nearest, 0.0, 0.0);
+  float circle = dof_coc(nearest, dof_focus()) * 0.5;
+  dst = vec4(hdr_clamp(c * 0.25, HALF_MAX), circle);
+  dst_coc = vec4(circle, nearest, 0.0, 0.0);
 }

@@ -439,17 +439,28 @@ static void motion_blur_follows_the_camera(void **state) {
 static const char *const effects[] = {"motion_blur", "dof", "bloom", "hdr", "radial_blur", "glass", "tiles", "sepia"};
 enum { EFFECTS = sizeof effects / sizeof *effects };
 
+/* Targets that may hold negative values: a signed circle of confusion
+ * (dof.small's alpha too), mean logarithms of luminance. */
+static bool holds_signed(const char *name) {
+  return !strcmp(name, "dof.coc") || !strcmp(name, "dof.small_coc") || !strcmp(name, "dof.small") ||
+         !strncmp(name, "hdr.reduce", 10);
+}
+
 /* Every float target the frame used holds finite values (read before the
- * output stage, which would hide a NaN); colour targets are not negative. */
+ * output stage, which would hide a NaN); colour targets are not negative.
+ * Targets whose passes never overlap share a texture (the graph's aliasing),
+ * which then holds what the last of them wrote: signed if any of them is. */
 static void assert_targets_finite(lm_graph *g, const char *what) {
   float *px = malloc(sizeof(float) * 4 * W * H);
   for (int t = 0; t < lm_graph_target_count(g); t++) {
     lm_graph_target_info ti = lm_graph_target(g, t);
     if (!ti.used || lm_format_is_depth(ti.format) || ti.format == LM_FORMAT_RGBA8 || !ti.texture.id) continue;
     lm_texture_read(ti.texture, ti.width, ti.height, true, px);
-    /* A signed circle of confusion; mean logarithms of luminance. */
-    bool signed_ok = !strcmp(ti.name, "dof.coc") || !strcmp(ti.name, "dof.small_coc") ||
-                     !strncmp(ti.name, "hdr.reduce", 10);
+    bool signed_ok = false;
+    for (int u = 0; u < lm_graph_target_count(g); u++) {
+      lm_graph_target_info tu = lm_graph_target(g, u);
+      signed_ok |= tu.used && tu.texture.id == ti.texture.id && holds_signed(tu.name);
+    }
     for (int i = 0; i < ti.width * ti.height * 4; i++)
       if (!isfinite(px[i]) || (!signed_ok && px[i] < 0))
         fail_msg("%s: target '%s' holds %g at %d", what, ti.name, px[i], i / 4);
