@@ -1,5 +1,5 @@
 -- Depth of field over the G-buffer's linear depth: the circle of confusion
--- (dof_coc.frag: focus and range, or a thin lens) and a gather blur that
+-- (dof.glsl: focus and range, or a thin lens) and a gather blur that
 -- keeps a sharp foreground from bleeding onto a blurred background and lets
 -- a blurred foreground spread over a sharp one (dof_gather.frag).
 -- The gather covers, per 8 x 8 tile, only the largest circle reaching it
@@ -8,7 +8,8 @@
 -- taps (a quarter gave visibly more noise for little gain), and only the
 -- light it moves between pixels comes back to full size, through ISR's
 -- depth-aware upsampling, so sharp pixels keep their full-size detail
--- (dof_reduce.frag, dof_composite.frag).
+-- (dof_reduce.frag, which computes the reduced circles from the depth, and
+-- dof_composite.frag).
 local options = require "options"
 
 local dof = {}
@@ -52,20 +53,21 @@ function dof.render(src, o, frame)
   local G = frame and frame.G
   if not o.enabled then return src end
   if not (G and G.dpt) then error("dof: needs the G-buffer's depth (frame.G.dpt)", 2) end
-  local coc = pass{ "dof.coc", shader = "dof_coc.frag", inputs = { dpt = G.dpt },
-                    params = o.mode == "lens"
-                      and { focus = o.focus, max_radius = o.max_radius, focal_length = o.focal_length,
-                            f_number = o.f_number, sensor = o.sensor }
-                      or { focus = o.focus, range = o.range, max_radius = o.max_radius },
-                    defines = { LENS = o.mode == "lens" },
-                    out = target{ "dof.coc", format = "rg32f" } }
+  local params = o.mode == "lens"
+    and { focus = o.focus, max_radius = o.max_radius, focal_length = o.focal_length, f_number = o.f_number,
+          sensor = o.sensor }
+    or { focus = o.focus, range = o.range, max_radius = o.max_radius }
   local f = o.downsample
-  local image, circles = src, coc
+  local image, circles = src, target{ f > 1 and "dof.small_coc" or "dof.coc", format = "rg32f", scale = 1 / f }
   if f > 1 then
+    -- The circles of the reduced image straight from the depth (dof_reduce.frag):
+    -- a full-size pass and target fewer.
     image = target{ "dof.small", format = "rgba16f", scale = 1 / f }
-    circles = target{ "dof.small_coc", format = "rg32f", scale = 1 / f }
-    pass{ "dof.reduce", shader = "dof_reduce.frag", inputs = { src = src, coc = coc }, defines = { FACTOR = f },
-          out = { image, circles } }
+    pass{ "dof.reduce", shader = "dof_reduce.frag", inputs = { src = src, dpt = G.dpt }, params = params,
+          defines = { LENS = o.mode == "lens" }, out = { image, circles } }
+  else
+    pass{ "dof.coc", shader = "dof_coc.frag", inputs = { dpt = G.dpt }, params = params,
+          defines = { LENS = o.mode == "lens" }, out = circles }
   end
   -- The largest circle reaching each 8 x 8 tile: the gather spreads its taps
   -- over that radius, as many as keep the density of `samples` over max_radius.
@@ -75,13 +77,14 @@ function dof.render(src, o, frame)
   tiles = pass{ "dof.dilate", shader = "dof_tiles.frag", inputs = { src = tiles },
                 params = { max_radius = radius }, defines = { TILE = tile, DILATE = true },
                 out = target{ "dof.dilate", format = "r16f", scale = 1 / (tile * f) } }
-  local gathered = pass{ "dof.gather", shader = "dof_gather.frag", inputs = { src = image, coc = circles, tiles = tiles },
+  local gathered = pass{ "dof.gather", shader = "dof_gather.frag",
+                         inputs = { src = image, coc = f == 1 and circles or nil, tiles = tiles }, -- else image.a
                          params = { max_radius = radius, samples = math.max(1, o.samples // f) },
                          defines = { TILE = tile, FOREIGN = f > 1 },
                          out = target{ "dof.gather", format = "rgba16f", scale = 1 / f } }
   if f == 1 then return gathered end
   return pass{ "dof.composite", shader = "dof_composite.frag",
-               inputs = { src = src, coc = coc, foreign = gathered, small_coc = circles },
+               inputs = { src = src, dpt = G.dpt, foreign = gathered, small_coc = circles },
                out = target{ "dof.composite", format = "rgba16f" } }
 end
 

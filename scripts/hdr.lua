@@ -1,7 +1,9 @@
 -- HDR tone mapping with eye adaptation (seed 001 lines 208-291, 1355-1400;
 -- seed 003 "Eye adaptation") over any float image:
 --   1. hdr.reduceN: the log-average luminance, eq 2.1, by 8x8 reduction
---      passes down to 1x1 (hdr_reduce.frag says why not glGenerateMipmap)
+--      passes down to 1x1 (hdr_reduce.frag says why not glGenerateMipmap),
+--      the first reading one pixel of each 2x2 (a quarter of the reads; the
+--      adaptation smooths what a sampled mean varies)
 --   2. hdr.adapt: the adapted luminance moves `rate` of the way to the
 --      average each frame, in a persistent 1x1 target; a pass cannot read
 --      and write one target, so two of them take turns (ping-pong)
@@ -33,6 +35,7 @@ local rules = {
 }
 
 local BLOCK = 8 -- reduction factor a side: 64 reads a texel, log8 levels
+local STEP = 2  -- the first level reads one pixel of each STEP x STEP
 
 local adapted -- the two persistent 1x1 targets, from hdr.create()
 local turn = 0
@@ -48,27 +51,41 @@ end
 hdr.check = options.checker("hdr", hdr.defaults, rules)
 
 -- Records tone mapping of `src` (an output-sized float target) with options
--- o (see hdr.defaults). Returns the display-referred target, or src when off.
-function hdr.render(src, o)
+-- o (see hdr.defaults), adding `glow` (bloom.glow's) to the image as its
+-- first reduction and the tone mapping read it. Returns the display-referred
+-- target, or src when off.
+function hdr.render(src, o, _, glow)
   o = hdr.check(o, 2)
   if not o.enabled then return src end
   if not adapted then error("hdr: call hdr.create() from OnCreate (it declares the adaptation targets)", 2) end
   local w, h = output_size()
+  -- The inputs and params of a pass that adds the glow, where there is one.
+  local function glow_inputs(t)
+    t.bloom = glow and glow.image
+    return t
+  end
+  local function glow_params(t)
+    t.strength = glow and glow.strength
+    return t
+  end
   local level, n = src, 0
   repeat
-    w, h, n = (w + BLOCK - 1) // BLOCK, (h + BLOCK - 1) // BLOCK, n + 1
-    level = pass{ "hdr.reduce" .. n, shader = "hdr_reduce.frag", inputs = { src = level },
-                  params = n == 1 and { delta = o.delta } or nil,
-                  defines = { FIRST = n == 1, BLOCK = BLOCK },
+    local first = n == 0
+    local f = first and BLOCK * STEP or BLOCK
+    w, h, n = (w + f - 1) // f, (h + f - 1) // f, n + 1
+    level = pass{ "hdr.reduce" .. n, shader = "hdr_reduce.frag",
+                  inputs = first and glow_inputs{ src = level } or { src = level },
+                  params = first and glow_params{ delta = o.delta } or nil,
+                  defines = { FIRST = first, BLOCK = BLOCK, STEP = first and STEP or 1, BLOOM = first and glow ~= nil },
                   out = target{ "hdr.reduce" .. n, format = "rg32f", size = { w, h } } }
   until w == 1 and h == 1
   local previous, next = adapted[turn + 1], adapted[2 - turn]
   turn = 1 - turn
   pass{ "hdr.adapt", shader = "hdr_adapt.frag", inputs = { average = level, previous = previous },
         params = { rate = o.rate }, out = next }
-  return pass{ "hdr.tonemap", shader = "hdr_tonemap.frag", inputs = { src = src, adapted = next },
-               params = { key = o.key, white = o.white, exposure = o.exposure },
-               defines = { AUTO_KEY = o.auto_key },
+  return pass{ "hdr.tonemap", shader = "hdr_tonemap.frag", inputs = glow_inputs{ src = src, adapted = next },
+               params = glow_params{ key = o.key, white = o.white, exposure = o.exposure },
+               defines = { AUTO_KEY = o.auto_key, BLOOM = glow ~= nil },
                out = target{ "hdr.tonemap", format = "rgba16f" } }
 end
 

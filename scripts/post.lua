@@ -6,6 +6,8 @@
 -- Each effect is a module as scripts/README.md says (`defaults`, `check`,
 -- `render(src, o, frame)`); an effect whose `enabled` is false records no
 -- pass. Any pipeline can use the chain (post.render) or the modules one by one.
+-- With hdr on, bloom's glow goes to hdr, which adds it as it reads the image:
+-- the same picture without a full-size pass that writes the sum.
 local options = require "options"
 
 local post = {}
@@ -34,9 +36,13 @@ end
 -- "scene" (pre-exposed radiance, as `lit`).
 function post.render(lit, o, frame)
   o = o or {}
-  local img = lit
-  for _, name in ipairs(post.order) do img = modules[name].render(img, o[name], frame) end
-  return img, modules.hdr.check(o.hdr, 2).enabled and "display" or "scene"
+  local tone_mapped = modules.hdr.check(o.hdr, 2).enabled
+  local img, glow = lit, nil
+  for _, name in ipairs(post.order) do
+    if name == "bloom" and tone_mapped then glow = modules.bloom.glow(img, o.bloom)
+    else img = modules[name].render(img, o[name], frame, name == "hdr" and glow or nil) end
+  end
+  return img, tone_mapped and "display" or "scene"
 end
 
 return post

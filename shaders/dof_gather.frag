@@ -2,6 +2,9 @@
 // disc of max_radius pixels (a Vogel spiral, `samples` taps) adds to this
 // pixel p only if its own circle of confusion reaches p:
 //   reach(q) = |coc_q|, but no more than |coc_p| when q lies behind p.
+// The signed circle grows with depth (dof.glsl) and where two differ only in
+// depth both are at the cap, so "behind" is coc_q > coc_p: a tap reads the
+// circle alone, which at half size (FOREIGN) is the image's alpha.
 // So a blurred foreground spreads over a sharp background (its large circle
 // reaches p whatever p's own), while a blurred background cannot bleed onto
 // a sharp foreground, and a sharp foreground (circle ~0) reaches no blurred
@@ -21,16 +24,29 @@
 #include "post.glsl"
 
 in vec2 uv;
-uniform sampler2D src, coc, tiles;
+uniform sampler2D src, tiles;
+#ifndef FOREIGN
+uniform sampler2D coc; // (signed coc, eye depth) at full size; at half size src.a holds the circle
+#endif
 uniform float max_radius = 8.0; // pixels, >= 0
 uniform int samples = 48;       // 1..256
 
 out vec4 dst;
 
+// A texel's light and signed circle of confusion.
+vec4 tap(ivec2 q) {
+#ifdef FOREIGN
+  return texelFetch(src, q, 0);
+#else
+  return vec4(texelFetch(src, q, 0).rgb, texelFetch(coc, q, 0).r);
+#endif
+}
+
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy), last = textureSize(src, 0) - 1;
-  vec3 centre = hdr_clamp(texelFetch(src, p, 0).rgb, HALF_MAX);
-  vec2 cp = texelFetch(coc, p, 0).rg; // signed coc, eye depth
+  vec4 sp = tap(p);
+  vec3 centre = hdr_clamp(sp.rgb, HALF_MAX);
+  float cp = sp.a; // signed coc
   float rmax = max(max_radius, 0.0);
   ivec2 tile = min(p / TILE, textureSize(tiles, 0) - 1);
   float reach_max = texelFetch(tiles, tile, 0).r;
@@ -46,19 +62,19 @@ void main() {
   int all = clamp(samples, 1, 256);
   int n = clamp(int(ceil(float(all) * r * r / (rmax * rmax))), min(all, 8), all);
   float tap_area = PI * r * r / float(n);
-  float w0 = min(1.0, 1.0 / (PI * max(cp.x * cp.x, 0.25)));
+  float w0 = min(1.0, 1.0 / (PI * max(cp * cp, 0.25)));
   vec3 sum = vec3(0.0);
   float wsum = w0;
   for (int i = 0; i < n; i++) {
     ivec2 off = ivec2(round(vogel_disc(i, n) * r));
     ivec2 q = clamp(p + off, ivec2(0), last);
     if (q == p) continue;
-    vec2 cq = texelFetch(coc, q, 0).rg;
-    float reach = abs(cq.x);
-    if (cq.y > cp.y) reach = min(reach, abs(cp.x)); // behind p: no wider than p's own blur
+    vec4 sq = tap(q);
+    float cq = sq.a, reach = abs(cq);
+    if (cq > cp) reach = min(reach, abs(cp)); // behind p: no wider than p's own blur
     // A circle under half a pixel stays in its pixel: a sharp tap gives nothing.
-    float w = saturate(reach - length(vec2(off)) + 0.5) * min(1.0, tap_area / (PI * max(cq.x * cq.x, 0.25)));
-    sum += w * hdr_clamp(texelFetch(src, q, 0).rgb, HALF_MAX);
+    float w = saturate(reach - length(vec2(off)) + 0.5) * min(1.0, tap_area / (PI * max(cq * cq, 0.25)));
+    sum += w * hdr_clamp(sq.rgb, HALF_MAX);
     wsum += w;
   }
 #ifdef FOREIGN

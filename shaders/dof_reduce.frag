@@ -1,30 +1,25 @@
-// Depth of field at reduced resolution, step 1: each texel of the 1/FACTOR
-// image takes the mean colour of the FACTOR x FACTOR pixels under it and the
-// circle of confusion of the nearest of them (scaled to the reduced pixels),
-// so a foreground's blur still spreads and a sharp foreground still shields
-// what lies behind it.
-#include "post.glsl"
+// Depth of field at half size, step 1: each texel of the half-size image
+// takes the mean colour of the 2 x 2 pixels under it and the circle of
+// confusion of the nearest of them (scaled to the reduced pixels), so a
+// foreground's blur still spreads and a sharp foreground still shields what
+// lies behind it. The circle comes from the G-buffer's depth here (dof.glsl):
+// no full-size circle target is written or read. It goes to the image's
+// alpha too, so that each of the gather's taps is one read.
+#include "dof.glsl"
 
-uniform sampler2D src, coc;
+uniform sampler2D src;
 
 layout(location = 0) out vec4 dst;
 layout(location = 1) out vec4 dst_coc;
 
-#ifndef FACTOR
-#define FACTOR 2
-#endif
-
 void main() {
-  ivec2 base = ivec2(gl_FragCoord.xy) * FACTOR, last = textureSize(src, 0) - 1;
+  ivec2 base = ivec2(gl_FragCoord.xy) * 2, last = textureSize(src, 0) - 1;
   vec3 c = vec3(0.0);
-  vec2 nearest = vec2(0.0, 1e30);
-  for (int y = 0; y < FACTOR; y++)
-    for (int x = 0; x < FACTOR; x++) {
-      ivec2 q = min(base + ivec2(x, y), last);
-      c += hdr_clamp(texelFetch(src, q, 0).rgb, HALF_MAX);
-      vec2 cq = texelFetch(coc, q, 0).rg;
-      if (cq.y < nearest.y) nearest = cq;
-    }
-  dst = vec4(hdr_clamp(c / float(FACTOR * FACTOR), HALF_MAX), 1.0);
-  dst_coc = vec4(nearest.x / float(FACTOR), nearest.y, 0.0, 0.0);
+  for (int i = 0; i < 4; i++) c += hdr_clamp(texelFetch(src, min(base + ivec2(i & 1, i >> 1), last), 0).rgb, HALF_MAX);
+  // The block's depths in one gather at its centre (clamped at the border, as the colours are).
+  vec4 d = textureGather(dpt, vec2(base + 1) / vec2(textureSize(dpt, 0)), 0);
+  float nearest = min(min(eye_depth(d.x), eye_depth(d.y)), min(eye_depth(d.z), eye_depth(d.w)));
+  float circle = dof_coc(nearest, dof_focus()) * 0.5;
+  dst = vec4(hdr_clamp(c * 0.25, HALF_MAX), circle);
+  dst_coc = vec4(circle, nearest, 0.0, 0.0);
 }

@@ -1,15 +1,19 @@
 // The log-average luminance (seed 001 eq 2.1), one level of a reduction:
 //   L_avg = exp( (1/N) sum ln(delta + L_w(x, y)) )
 // Each output texel covers a BLOCK x BLOCK square of its source. The first
-// level (FIRST) reads the HDR image and writes, per block, the mean of
-// ln(delta + luminance) and how many pixels it covers; later levels take the
+// level (FIRST) reads the HDR image, one pixel of each STEP x STEP (a meter:
+// the log-average of a regular quarter of the pixels at STEP 2, for a
+// quarter of the reads), and writes per block the mean of
+// ln(delta + luminance) and how many pixels it read; later levels take the
 // count-weighted mean of the level below. Blocks cut by the image's edge
-// count only the pixels they hold, so the result is the exact mean for any
-// size (glGenerateMipmap's box filter drops or blends edge texels of odd
-// sizes). Output: r = mean ln, g = pixel count. The image is pre-exposed
+// count only the pixels they hold, so the result is the exact mean of the
+// pixels read for any size (glGenerateMipmap's box filter drops or blends
+// edge texels of odd sizes). Output: r = mean ln, g = pixel count. The image is pre-exposed
 // (common.glsl's exposed()) and delta is added to it as it is: the mean is of
 // ln(delta + E L_w), hdr_adapt.frag takes ln E away, and an image lit 1e10
-// times more adapts to the same picture.
+// times more adapts to the same picture. With BLOOM the first level reads
+// the image plus `strength` of bloom's blurred bright pass (scripts/hdr.lua:
+// bloom's sum is never written).
 #include "post.glsl"
 
 in vec2 uv;
@@ -17,22 +21,34 @@ uniform sampler2D src;
 #ifdef FIRST
 uniform float delta = 1e-4; // against ln(0) (seed 001: "a small constant")
 #endif
+#ifdef BLOOM
+uniform sampler2D bloom;
+uniform float strength = 1.0;
+#endif
 
 #ifndef BLOCK
 #define BLOCK 8
+#endif
+#ifndef STEP
+#define STEP 1
 #endif
 
 out vec4 dst;
 
 void main() {
-  ivec2 base = ivec2(gl_FragCoord.xy) * BLOCK, size = textureSize(src, 0);
+  ivec2 base = ivec2(gl_FragCoord.xy) * (BLOCK * STEP), size = textureSize(src, 0);
   float sum = 0.0, count = 0.0;
   for (int y = 0; y < BLOCK; y++) {
     for (int x = 0; x < BLOCK; x++) {
-      ivec2 q = base + ivec2(x, y);
+      ivec2 q = base + ivec2(x, y) * STEP;
       if (any(greaterThanEqual(q, size))) continue;
       vec4 t = texelFetch(src, q, 0);
 #ifdef FIRST
+#ifdef BLOOM
+      // The glow's texel under the pixel, not its bilinear enlargement: the
+      // glow is smooth, and a plain fetch costs half a filtered one on llvmpipe.
+      t.rgb = bloom_sum(t.rgb, texelFetch(bloom, q * textureSize(bloom, 0) / size, 0).rgb, strength);
+#endif
       // Up to 1e30 (an fp32 input may hold far more than a half float).
       float l = luminance(hdr_clamp(t.rgb, 1e30));
       sum += log(max(delta, 1e-30) + l);

@@ -5,6 +5,7 @@
 // in [0, 1] (the output stage encodes sRGB). With AUTO_KEY the key follows
 // the average (seed 001 fig 6.17: darker views a lower key): Krawczyk et al.
 // 2005, a = 1.03 - 2 / (2 + log10(L_avg + 1)), in the seed's 0.045..0.9.
+// With BLOOM it adds bloom's blurred bright pass first (hdr_reduce.frag).
 #include "post.glsl"
 
 in vec2 uv;
@@ -13,11 +14,18 @@ uniform sampler2D adapted;     // hdr_adapt.frag (1x1): r = adapted luminance
 uniform float key = 0.18;      // a, 0.045..0.9 typical
 uniform float white = 4.0;     // L_white in scaled units, > 0
 uniform float exposure = 0.0;  // bias in stops
+#ifdef BLOOM
+uniform sampler2D bloom;
+uniform float strength = 1.0;
+#endif
 
 out vec4 dst;
 
 void main() {
   vec3 c = hdr_clamp(texelFetch(src, ivec2(gl_FragCoord.xy), 0).rgb, 1e30);
+#ifdef BLOOM
+  c = bloom_sum(c, texture(bloom, uv).rgb, strength);
+#endif
   float avg = max(texelFetch(adapted, ivec2(0), 0).r, 1e-30);
   avg = isnan(avg) || isinf(avg) ? 1.0 : avg;
   float a = key;

@@ -16,6 +16,14 @@ vec3 hdr_clamp(vec3 c, float hi) {
 }
 vec4 hdr_clamp(vec4 c, float hi) { return vec4(hdr_clamp(c.rgb, hi), c.a); }
 
+// Bloom's sum (bloom_add.frag, and hdr's passes that add it as they read the
+// image): the image and `strength` of the blurred bright pass, each clamped
+// as read and the sum under the half-float limit, so a very bright source
+// cannot overflow to Inf.
+vec3 bloom_sum(vec3 image, vec3 bloom, float strength) {
+  return hdr_clamp(hdr_clamp(image, HALF_MAX) + max(strength, 0.0) * hdr_clamp(bloom, HALF_MAX), HALF_MAX);
+}
+
 // Linear eye depth at a G-buffer texel: dpt holds depth / far, 0 where no
 // geometry was drawn (the background counts as the far plane).
 float eye_depth(float depth01) {

@@ -44,18 +44,23 @@ static const char *image_frag =
     "}\n";
 
 static const char *image_script =
-    "local post = require 'post'\n"
+    "local post, bloom, hdr = require 'post', require 'bloom', require 'hdr'\n"
     "Techniques = { 'image' }\n"
     "Options = post.defaults()\n"
     "Options.image = { pattern = 0, lo = 0.25, mid = 1.0, hi = 4.0, gain = 1.0, fill = 0.0,\n"
-    "                  peak = 0.0, peak_x = -1, peak_y = -1, dim = 0.0, dim_x = -1, dim_y = -1 }\n"
+    "                  peak = 0.0, peak_x = -1, peak_y = -1, dim = 0.0, dim_x = -1, dim_y = -1,\n"
+    "                  separate = false }\n"
     "function OnCreate() post.create() end\n"
     "function OnRender(tech)\n"
     "  local i = tech.image\n"
     "  local img = pass{ 'image', shader = 'test_image.frag', out = target{ 'image', format = 'rgba32f' },\n"
     "    params = { pattern = i.pattern, bands = { i.lo, i.mid, i.hi }, gain = i.gain, fill = i.fill,\n"
     "               peak = i.peak, peak_at = { i.peak_x, i.peak_y }, dim = i.dim, dim_at = { i.dim_x, i.dim_y } } }\n"
-    "  present(post.render(img, tech))\n"
+    "  if i.separate then -- bloom's sum written, then tone mapped: the modules one by one\n"
+    "    present(hdr.render(bloom.render(img, tech.bloom), tech.hdr), 'display')\n"
+    "  else\n"
+    "    present(post.render(img, tech))\n"
+    "  end\n"
     "end\n";
 
 static int setup(void **state) {
@@ -240,6 +245,35 @@ static void bloom_spreads_one_bright_pixel_and_nothing_else(void **state) {
   free(out);
 }
 
+/* In the chain (post.render) hdr adds bloom's glow as it reads the image, so
+ * no pass writes the sum: the picture is that of bloom.add then hdr one by
+ * one, within 0.001 a channel (the written sum's half-float rounding, and the
+ * first reduction reading the glow's texel under a pixel, not its bilinear
+ * enlargement), over bands and a bright peak whose glow spreads. */
+static void bloom_in_the_chain_is_bloom_then_hdr(void **state) {
+  (void)state;
+  const char *fused[] = {"bloom=true", "hdr=true", "bloom.threshold=2", "image.peak=400", "image.peak_x=100",
+                         "image.peak_y=160", NULL};
+  const char *separate[] = {"bloom=true", "hdr=true", "bloom.threshold=2", "image.peak=400", "image.peak_x=100",
+                            "image.peak_y=160", "image.separate=true", NULL};
+  char names[1024];
+  gl_result a = start(image_lua, NULL, fused), b = start(image_lua, NULL, separate);
+  gl_pass_names(&a, names, sizeof names);
+  assert_null(strstr(names, "bloom.add"));
+  gl_pass_names(&b, names, sizeof names);
+  assert_non_null(strstr(names, "bloom.add"));
+  double worst = 0, glow = 0;
+  for (int i = 0; i < W * H * 3; i++) worst = fmax(worst, fabsf(a.rgb[i] - b.rgb[i]));
+  /* The glow is there: beside the peak, the top band (4, over the threshold) is brighter than far from it. */
+  glow = at(a.rgb, 106, 160)[0] - at(a.rgb, 250, 160)[0];
+  print_message("bloom in the chain against bloom then hdr: largest difference %.5f; glow near the peak %.4f\n",
+                worst, glow);
+  assert_true(worst < 0.001);
+  assert_true(glow > 0.01);
+  gl_result_free(&a);
+  gl_result_free(&b);
+}
+
 /* ---- depth of field ---------------------------------------------------- */
 /* Pixel of a world point of the box, the row from the bottom as at() counts. */
 static void project(float x, float y, float z, int *col, int *row) {
@@ -405,17 +439,28 @@ static void motion_blur_follows_the_camera(void **state) {
 static const char *const effects[] = {"motion_blur", "dof", "bloom", "hdr", "radial_blur", "glass", "tiles", "sepia"};
 enum { EFFECTS = sizeof effects / sizeof *effects };
 
+/* Targets that may hold negative values: a signed circle of confusion
+ * (dof.small's alpha too), mean logarithms of luminance. */
+static bool holds_signed(const char *name) {
+  return !strcmp(name, "dof.coc") || !strcmp(name, "dof.small_coc") || !strcmp(name, "dof.small") ||
+         !strncmp(name, "hdr.reduce", 10);
+}
+
 /* Every float target the frame used holds finite values (read before the
- * output stage, which would hide a NaN); colour targets are not negative. */
+ * output stage, which would hide a NaN); colour targets are not negative.
+ * Targets whose passes never overlap share a texture (the graph's aliasing),
+ * which then holds what the last of them wrote: signed if any of them is. */
 static void assert_targets_finite(lm_graph *g, const char *what) {
   float *px = malloc(sizeof(float) * 4 * W * H);
   for (int t = 0; t < lm_graph_target_count(g); t++) {
     lm_graph_target_info ti = lm_graph_target(g, t);
     if (!ti.used || lm_format_is_depth(ti.format) || ti.format == LM_FORMAT_RGBA8 || !ti.texture.id) continue;
     lm_texture_read(ti.texture, ti.width, ti.height, true, px);
-    /* A signed circle of confusion; mean logarithms of luminance. */
-    bool signed_ok = !strcmp(ti.name, "dof.coc") || !strcmp(ti.name, "dof.small_coc") ||
-                     !strncmp(ti.name, "hdr.reduce", 10);
+    bool signed_ok = false;
+    for (int u = 0; u < lm_graph_target_count(g); u++) {
+      lm_graph_target_info tu = lm_graph_target(g, u);
+      signed_ok |= tu.used && tu.texture.id == ti.texture.id && holds_signed(tu.name);
+    }
     for (int i = 0; i < ti.width * ti.height * 4; i++)
       if (!isfinite(px[i]) || (!signed_ok && px[i] < 0))
         fail_msg("%s: target '%s' holds %g at %d", what, ti.name, px[i], i / 4);
@@ -480,7 +525,7 @@ static void degenerate_settings_stay_finite(void **state) {
 static void an_effect_off_records_no_pass(void **state) {
   (void)state;
   static const char *const passes[EFFECTS] = {
-      "motion_blur.tiles4 motion_blur.tiles motion_blur.near motion_blur ", "dof.coc dof.reduce dof.tiles dof.dilate dof.gather dof.composite ", "bloom.bright bloom.blur_x bloom.blur_y bloom.add ",
+      "motion_blur.tiles4 motion_blur.tiles motion_blur.near motion_blur ", "dof.reduce dof.tiles dof.dilate dof.gather dof.composite ", "bloom.bright bloom.blur_x bloom.blur_y bloom.add ",
       "hdr.reduce1 hdr.reduce2 hdr.reduce3 hdr.adapt hdr.tonemap ", "radial_blur ", "glass ", "tiles ", "sepia "};
   char names[1024], want[1024];
   gl_result r = start(pp_lua, "dl", NULL);
@@ -531,6 +576,7 @@ int main(void) {
       cmocka_unit_test(extremes_stay_finite_white_and_black),
       cmocka_unit_test(adaptation_converges_to_the_key_at_its_rate),
       cmocka_unit_test(bloom_spreads_one_bright_pixel_and_nothing_else),
+      cmocka_unit_test(bloom_in_the_chain_is_bloom_then_hdr),
       cmocka_unit_test(depth_of_field_keeps_the_focus_plane_sharp),
       cmocka_unit_test(depth_of_field_orders_foreground_and_background),
       cmocka_unit_test(depth_of_field_at_half_size_follows_the_full_size_one),
