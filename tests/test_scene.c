@@ -200,6 +200,49 @@ static void sky_harmonics_match_the_sky(void **state) {
   assert_non_null(strstr(err.msg, "limn-no-such-sky.exr"));
 }
 
+/* lm_box_outside_frustum (one plane test a side) says what transforming the
+ * box's eight corners says: all of them beyond one clip plane. Boxes from
+ * every side of a perspective and an orthographic view, those whose corners
+ * come within 1e-3 of w of a plane left out (rounding may go either way there). */
+static void boxes_outside_the_frustum_as_their_corners_say(void **state) {
+  (void)state;
+  mat4 proj[2], view, vp;
+  glm_perspective(glm_rad(50), 4.0f / 3, 0.1f, 40, proj[0]);
+  glm_ortho(-6, 6, -4, 4, -10, 30, proj[1]);
+  glm_lookat((vec3){1, 2, 6}, (vec3){0, 0.5f, 0}, (vec3){0, 1, 0}, view);
+  unsigned seed = 7;
+  int checked = 0, outside = 0;
+  for (int v = 0; v < 2; v++) {
+    glm_mat4_mul(proj[v], view, vp);
+    for (int i = 0; i < 4000; i++) {
+      float lo[3], hi[3];
+      for (int k = 0; k < 3; k++) {
+        seed = seed * 1664525u + 1013904223u;
+        float c = ((float)(seed >> 8) / 16777216.0f - 0.5f) * 24;
+        seed = seed * 1664525u + 1013904223u;
+        float e = (float)(seed >> 8) / 16777216.0f * 3;
+        lo[k] = c - e, hi[k] = c + e;
+      }
+      int beyond[6] = {0};
+      bool near = false;
+      for (int c = 0; c < 8; c++) {
+        vec4 p = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2], 1}, q;
+        glm_mat4_mulv(vp, p, q);
+        for (int k = 0; k < 3; k++) {
+          beyond[2 * k] += q[3] + q[k] < 0, beyond[2 * k + 1] += q[3] - q[k] < 0;
+          near |= fabsf(q[3] + q[k]) < 1e-3f || fabsf(q[3] - q[k]) < 1e-3f;
+        }
+      }
+      if (near) continue;
+      bool all = false;
+      for (int k = 0; k < 6; k++) all |= beyond[k] == 8;
+      assert_int_equal(lm_box_outside_frustum((float *)vp, lo, hi), all);
+      checked++, outside += all;
+    }
+  }
+  assert_true(checked > 7000 && outside > 1000 && outside < checked - 1000); /* both answers, often */
+}
+
 /* Scripts set a material's reflectivity per pass like any other parameter. */
 static void reflectivity_is_a_material_parameter(void **state) {
   (void)state;
@@ -220,6 +263,7 @@ int main(void) {
       cmocka_unit_test(positions_rebuild_from_linear_depth),
       cmocka_unit_test(sky_harmonics_match_the_sky),
       cmocka_unit_test(reflectivity_is_a_material_parameter),
+      cmocka_unit_test(boxes_outside_the_frustum_as_their_corners_say),
       cmocka_unit_test(extreme_cameras_stay_finite),
       cmocka_unit_test(children_follow_their_parents),
       cmocka_unit_test(nodes_move_to_a_world_transform),
