@@ -355,25 +355,8 @@ static void bounces_reach_the_ceiling_and_stay_bounded(void **state) {
 static void an_outdoor_corner_sees_less_sky_than_open_ground(void **state) {
   (void)state;
   enum { SW = 96, SH = 72 };
-  lm_scene *s = lm_scene_create("yard");
-  int grey = gl_material(s, "grey", 0.5f, 0.5f, 0.5f);
-  rect(s, grey, 1, 0, 1, -10, 10, -10, 10); /* ground: z, x */
-  rect(s, grey, 0, 0, 1, 0, 4, 0, 8);       /* a wall facing +x: y, z */
-  rect(s, grey, 2, 0, 1, 0, 8, 0, 4);       /* one facing +z: x, y */
-  mat4 view, m, proj, vp;
-  glm_lookat((vec3){0, 0, 0}, (vec3){-0.3f, -1, -0.2f}, (vec3){0, 1, 0}, view);
-  glm_mat4_inv(view, m);
-  int sun = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
-  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 0,
-                                     .casts_shadows = true, .node = sun});
-  glm_lookat((vec3){9, 6, 9}, (vec3){3, 0, 3}, (vec3){0, 1, 0}, view);
-  glm_mat4_inv(view, m);
-  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
-  lm_scene_add_camera(s, &(lm_camera){.name = "yard", .fov_y = glm_rad(60.0f), .znear = 0.01f, .zfar = 100,
-                                      .node = cam});
-  lm_scene_update(s);
-  glm_perspective(glm_rad(60.0f), (float)SW / SH, 0.01f, 100, proj);
-  glm_mat4_mul(proj, view, vp);
+  mat4 vp;
+  lm_scene *s = gl_sunlit_corner(SW, SH, (float *)vp);
   const float corner[3] = {0.7f, 0, 0.7f}, open[3] = {6, 0, 6};
   const char *const techs[] = {"lpv+esm", "lpv+esm", "dl+esm"};
   for (int t = 0; t < 3; t++) {

@@ -547,27 +547,8 @@ static void a_moving_light_caps_the_history_under_a_moving_camera(void **state) 
  * bounce would then add to an open sky). */
 static void an_outdoor_corner_sees_less_sky_than_open_ground(void **state) {
   (void)state;
-  lm_scene *s = lm_scene_create("yard");
-  int grey = gl_material(s, "grey", 0.5f, 0.5f, 0.5f);
-  gl_quad(s, "ground", grey, (const float[4][3]){{-10, 0, 10}, {10, 0, 10}, {10, 0, -10}, {-10, 0, -10}},
-          (const float[3]){0, 1, 0});
-  gl_quad(s, "wall x", grey, (const float[4][3]){{0, 0, 8}, {0, 0, 0}, {0, 4, 0}, {0, 4, 8}}, (const float[3]){1, 0, 0});
-  gl_quad(s, "wall z", grey, (const float[4][3]){{0, 0, 0}, {8, 0, 0}, {8, 4, 0}, {0, 4, 0}}, (const float[3]){0, 0, 1});
-  mat4 view, m;
-  glm_lookat((vec3){0, 0, 0}, (vec3){-0.3f, -1, -0.2f}, (vec3){0, 1, 0}, view);
-  glm_mat4_inv(view, m);
-  int sun = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
-  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 0,
-                                     .casts_shadows = true, .node = sun});
-  glm_lookat((vec3){9, 6, 9}, (vec3){3, 0, 3}, (vec3){0, 1, 0}, view);
-  glm_mat4_inv(view, m);
-  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
-  lm_scene_add_camera(s, &(lm_camera){.name = "yard", .fov_y = glm_rad(60.0f), .znear = 0.01f, .zfar = 100,
-                                      .node = cam});
-  lm_scene_update(s);
-  mat4 proj, vp;
-  glm_perspective(glm_rad(60.0f), 96.0f / 72, 0.01f, 100, proj);
-  glm_mat4_mul(proj, view, vp);
+  mat4 vp;
+  lm_scene *s = gl_sunlit_corner(96, 72, (float *)vp);
   const float points[2][3] = {{0.7f, 0, 0.7f}, {6, 0, 6}}; /* the corner, open ground */
   for (int t = 0; t < 2; t++) {
     const char *const sets[] = {"ambient=0", "sky=true", "sky.zenith=0.5", "sky.horizon=0.5",
