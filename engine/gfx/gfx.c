@@ -138,8 +138,9 @@ void lm_texture_clear(lm_texture tex) {
 
 /* A texture's clear, not a scissored glClear: llvmpipe clears a 512x512
  * rectangle of five targets (r32f, two rgba16f, rgba32f, depth32f) in 3 ms
- * so against 40-50 ms scissored (its clear of a whole 1024x1024 framebuffer
- * took 55 ms; CPU clock around glFinish, a loaded 2-core machine). */
+ * so against 40-50 ms scissored (CPU clock around glFinish, a loaded 2-core
+ * machine). A whole framebuffer's glClear stays faster in a frame: llvmpipe
+ * folds it into the draws that follow. */
 void lm_texture_clear_rect(lm_texture tex, lm_format format, int x, int y, int width, int height,
                            const float value[4]) {
   if (width <= 0 || height <= 0) return;
