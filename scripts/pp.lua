@@ -32,17 +32,14 @@ Options = {
 for name, d in pairs(post.defaults()) do Options[name] = d end
 
 -- Each technique a row (fields: scripts/techniques.lua), its modules' options joining Options: the
--- default first, the seed viewer's modes, then the seeds' GI (docs/gi-combined.md for the combined rows).
+-- seed viewer's modes first, then the seeds' GI (docs/gi-combined.md for the combined rows).
 local technique = techniques.add
--- The default (the first row) is the technique on the error-against-time front that removes the most
--- indirect error (docs/techniques.md#the-default-error-against-time): against POV-Ray (reference set,
--- 256x192) isr+rsm+esm removes 74.5% of dl+esm's indirect error and against Cycles 67.5%, raising every
--- view's Pearson, where isr+esm removes 43.2% / 34.4%; with the camera moving (256x192, four scenes)
--- it costs 2.73x dl+esm's frame against isr+esm's 2.26x, and rsm+esm, lpv+esm and vpl+esm cost as much
--- for less. No GI technique fits 2x dl+esm on llvmpipe; isr+rsm+esm is 1.2x isr+esm's frame for 1.7x
--- the error removed.
-technique{ "isr+rsm+esm", lighting = "isr", shadows = true, offscreen = "rsm", joins = "march", split = true,
-           temporal = "isr" } -- image-space radiosity with reflective shadow maps (docs/gi-combined.md)
+-- The default (the first row) is the technique that removes the most indirect error within 2x dl+esm's
+-- frame at 256x192 with a moving camera (docs/techniques.md#the-default-error-against-time). On a quiet
+-- machine (MOTION=1 tools/gi_time.sh, four rounds) isr+esm costs 1.84x and removes 43.2% of dl+esm's
+-- indirect error against POV-Ray (34.4% against Cycles); isr+rsm+esm removes 74.5% (67.5%) at 3.25x, and
+-- every technique that reads an RSM costs 2.7x or more (its shadow tiles, five targets, drawn as the
+-- camera moves). isr+esm is the only GI technique within the budget.
 technique{ "isr+esm", lighting = "isr", shadows = true, temporal = "isr", key = "F2" } -- image-space radiosity
 technique{ "isr", lighting = "isr", temporal = "isr", key = "F3" }
 technique{ "dl+esm", shadows = true, key = "F4" }
@@ -53,6 +50,8 @@ technique{ "ssao+esm", lighting = "ssao", shadows = true } -- ambient occlusion 
 technique{ "ssao", lighting = "ssao" }
 technique{ "rsm+esm", shadows = true, offscreen = "rsm", temporal = "rsm" } -- reflective shadow maps (seed 004)
 technique{ "vpl+esm", shadows = true, offscreen = "vpl", joins = "lit" } -- indirect, negative point lights (seed 002)
+technique{ "isr+rsm+esm", lighting = "isr", shadows = true, offscreen = "rsm", joins = "march", split = true,
+           temporal = "isr" }
 technique{ "lpv+esm", shadows = true, offscreen = "lpv" } -- light propagation volumes (seed 003)
 technique{ "isr+lpv+esm", lighting = "isr", shadows = true, offscreen = "lpv", split = true, temporal = "isr" }
 
