@@ -411,17 +411,22 @@ static bool apply_set_list(lm_pipeline *p, char *const *sets, int count, lm_erro
   return true;
 }
 
-/* Applies --set and toggled options. */
-static bool apply_sets(viewer *v, lm_pipeline *p, lm_error *err) {
-  return apply_set_list(p, v->args->sets, v->args->set_count, err);
+/* The script with technique `tech` (NULL: the script's first) and the
+ * viewer's options (--set, the job's, toggles), loaded as capture, bench and
+ * graph load theirs; *rc as capture_load_pipeline's. */
+_Static_assert((int)MAX_SETS <= (int)LIMN_MAX_SETS, "the viewer's options fit the shared loader's");
+static lm_pipeline *load_pipeline(viewer *v, const char *tech, int *rc, lm_error *err) {
+  limn_common_args c = {.script = v->script, .tech = tech, .set_count = v->args->set_count};
+  for (int i = 0; i < c.set_count; i++) c.sets[i] = v->args->sets[i];
+  return capture_load_pipeline(&c, rc, err);
 }
 
 /* The A/B wipe's other side: the script again with the --compare technique,
  * the viewer's options, then --compare-set's; NULL with err. */
 static lm_pipeline *load_compare(viewer *v, lm_error *err) {
-  lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = v->script}, err);
-  if (p && (!lm_pipeline_set_technique(p, v->compare_tech, err) || !apply_sets(v, p, err) ||
-            !apply_set_list(p, v->args->compare_sets, v->args->compare_set_count, err))) {
+  int rc;
+  lm_pipeline *p = load_pipeline(v, v->compare_tech, &rc, err);
+  if (p && !apply_set_list(p, v->args->compare_sets, v->args->compare_set_count, err)) {
     lm_pipeline_destroy(p);
     return NULL;
   }
@@ -570,17 +575,20 @@ static void apply_panel(viewer *v) {
 }
 
 /* ---- reloading --------------------------------------------------------- */
-/* Loads the script again and swaps it in when its first frame renders. */
+/* Loads the script again and swaps it in when its first frame renders. The
+ * technique shown stays when the script still has it; when not, the
+ * script's first is taken and said (the shared loader would refuse it). */
 static bool reload_script(viewer *v) {
   lm_error err;
-  lm_pipeline *p = lm_pipeline_load(&(lm_pipeline_desc){.path = v->script}, &err);
+  int rc;
+  lm_pipeline *p = load_pipeline(v, NULL, &rc, &err);
   bool ok = p != NULL;
   if (ok) {
     lm_error ignore;
     const char *tech = lm_pipeline_technique(v->pipeline);
     if (!lm_pipeline_set_technique(p, tech, &ignore))
       say(v, "technique %s is gone from %s: %s", tech, v->script, lm_pipeline_technique(p));
-    ok = apply_sets(v, p, &err) && lm_renderer_swap_pipeline(v->renderer, p, &err);
+    ok = lm_renderer_swap_pipeline(v->renderer, p, &err);
   }
   if (!ok) {
     lm_pipeline_destroy(p);
@@ -922,14 +930,10 @@ static void viewer_free(viewer *v) {
 static int run(viewer *v) {
   view_args *a = v->args;
   lm_error err;
-  v->pipeline = lm_pipeline_load(&(lm_pipeline_desc){.path = v->script}, &err);
-  if (!v->pipeline) {
+  int rc;
+  if (!(v->pipeline = load_pipeline(v, a->common.tech, &rc, &err))) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
-    return 1;
-  }
-  if ((a->common.tech && !lm_pipeline_set_technique(v->pipeline, a->common.tech, &err)) || !apply_sets(v, v->pipeline, &err)) {
-    lm_log(LM_LOG_ERROR, "%s", err.msg);
-    return 2;
+    return rc;
   }
   v->scene = a->job_loaded ? a->job_loaded : lm_scene_load(a->common.scene, &err);
   a->job_loaded = NULL;
