@@ -213,10 +213,7 @@ static int parse_args(int argc, char **argv, bench *b) {
       if (!limn_parse_int(optarg, 0, 10000, &b->warmup)) return usage_error("--warmup wants 0..10000, not '%s'", optarg);
       break;
     case 'k':
-      if (!strcmp(optarg, "auto")) b->clock = LM_CLOCK_AUTO;
-      else if (!strcmp(optarg, "gpu")) b->clock = LM_CLOCK_GPU;
-      else if (!strcmp(optarg, "cpu")) b->clock = LM_CLOCK_CPU;
-      else return usage_error("--clock wants auto, gpu or cpu, not '%s'", optarg);
+      if (!capture_parse_clock(optarg, &b->clock)) return usage_error("--clock wants auto, gpu or cpu, not '%s'", optarg);
       break;
     case 'j': b->json = true; break;
     case 'r': b->trace = true; break;

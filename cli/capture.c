@@ -222,10 +222,7 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       break;
     }
     case 'k':
-      if (!strcmp(optarg, "auto")) a->clock = LM_CLOCK_AUTO;
-      else if (!strcmp(optarg, "gpu")) a->clock = LM_CLOCK_GPU;
-      else if (!strcmp(optarg, "cpu")) a->clock = LM_CLOCK_CPU;
-      else return usage_error("--clock wants auto, gpu or cpu, not '%s'", optarg);
+      if (!capture_parse_clock(optarg, &a->clock)) return usage_error("--clock wants auto, gpu or cpu, not '%s'", optarg);
       break;
     case 'e':
       if (strcmp(optarg, "auto") && strcmp(optarg, "device") && strcmp(optarg, "surfaceless"))

@@ -50,5 +50,7 @@ void capture_resolve(const char *given, char *out, size_t cap);
  * bad technique or option (the user's flags). */
 struct limn_common_args;
 lm_pipeline *capture_load_pipeline(const struct limn_common_args *a, int *rc, lm_error *err);
+/* --clock of capture and bench: auto, gpu or cpu; false when s is none. */
+bool capture_parse_clock(const char *s, lm_clock *out);
 
 #endif
