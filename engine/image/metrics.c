@@ -86,32 +86,29 @@ static void ssim_taps(double taps[2 * LM_SSIM_RADIUS + 1]) {
     taps[t + LM_SSIM_RADIUS] = exp(-(double)(t * t) / (2.0 * LM_SSIM_SIGMA * LM_SSIM_SIGMA));
 }
 
-/* Separable Gaussian blur of a w x h plane, the window cut at the borders
- * and its weights renormalized there (the 2-D window is a product, so its
- * cut is too). */
+/* One pass of the separable Gaussian blur: `lines` lines of n values, value
+ * k of line l at l * across + k * along, the window cut at the line's ends
+ * and its weights renormalized there. */
+static void blur_lines(const double *src, double *dst, int lines, int n, size_t along, size_t across,
+                       const double *taps) {
+  for (int l = 0; l < lines; l++)
+    for (int k = 0; k < n; k++) {
+      double s = 0, wsum = 0;
+      for (int t = -LM_SSIM_RADIUS; t <= LM_SSIM_RADIUS; t++) {
+        int kk = k + t;
+        if (kk < 0 || kk >= n) continue;
+        s += taps[t + LM_SSIM_RADIUS] * src[l * across + kk * along];
+        wsum += taps[t + LM_SSIM_RADIUS];
+      }
+      dst[l * across + k * along] = s / wsum;
+    }
+}
+
+/* Separable Gaussian blur of a w x h plane: rows into tmp, then its columns
+ * (the 2-D window is a product, so its cut at the borders is too). */
 static void blur(const double *src, double *dst, double *tmp, int w, int h, const double *taps) {
-  for (int y = 0; y < h; y++)
-    for (int x = 0; x < w; x++) {
-      double s = 0, wsum = 0;
-      for (int t = -LM_SSIM_RADIUS; t <= LM_SSIM_RADIUS; t++) {
-        int xx = x + t;
-        if (xx < 0 || xx >= w) continue;
-        s += taps[t + LM_SSIM_RADIUS] * src[(size_t)y * w + xx];
-        wsum += taps[t + LM_SSIM_RADIUS];
-      }
-      tmp[(size_t)y * w + x] = s / wsum;
-    }
-  for (int y = 0; y < h; y++)
-    for (int x = 0; x < w; x++) {
-      double s = 0, wsum = 0;
-      for (int t = -LM_SSIM_RADIUS; t <= LM_SSIM_RADIUS; t++) {
-        int yy = y + t;
-        if (yy < 0 || yy >= h) continue;
-        s += taps[t + LM_SSIM_RADIUS] * tmp[(size_t)yy * w + x];
-        wsum += taps[t + LM_SSIM_RADIUS];
-      }
-      dst[(size_t)y * w + x] = s / wsum;
-    }
+  blur_lines(src, tmp, h, w, 1, (size_t)w, taps);
+  blur_lines(tmp, dst, w, h, (size_t)w, 1, taps);
 }
 
 static double ssim(const lm_image *a, const lm_image *b, int nc) {
