@@ -355,6 +355,18 @@ double view_get(const View &v, size_t i, int c) {
   }
 }
 
+// Component c of element i of accessor `index` into *out; fails naming it
+// (`what`, the accessor, `noun` i) when it is non-finite or beyond
+// LM_GLTF_MAX_COORD.
+bool read_coord(Loader &L, const View &v, const char *what, int index, const char *noun, size_t i, int c,
+                float *out) {
+  double x = view_get(v, i, c);
+  if (!std::isfinite(x) || std::fabs(x) > LM_GLTF_MAX_COORD)
+    return fail(L, "%s: accessor %d: %s %zu has a non-finite or huge value (%g)", what, index, noun, i, x);
+  *out = (float)x;
+  return true;
+}
+
 // Copies attribute `name` of the primitive into slots [at, at + ncomp) of the
 // 8-float vertices; false when absent (*present = false) or bad (error set).
 bool read_attribute(Loader &L, const char *where, const tinygltf::Primitive &p, const char *name,
@@ -371,13 +383,8 @@ bool read_attribute(Loader &L, const char *where, const tinygltf::Primitive &p, 
                 v.count, count);
   verts.resize(count * (size_t)stride);
   for (size_t i = 0; i < count; i++)
-    for (int c = 0; c < ncomp; c++) {
-      double x = view_get(v, i, c);
-      if (!std::isfinite(x) || std::fabs(x) > LM_GLTF_MAX_COORD)
-        return fail(L, "%s: accessor %d: element %zu has a non-finite or huge value (%g)", what,
-                    it->second, i, x);
-      verts[i * (size_t)stride + at + c] = (float)x;
-    }
+    for (int c = 0; c < ncomp; c++)
+      if (!read_coord(L, v, what, it->second, "element", i, c, &verts[i * (size_t)stride + at + c])) return false;
   return true;
 }
 
@@ -488,12 +495,8 @@ bool read_target(Loader &L, const char *where, size_t t, const std::string &name
   if (v.count != count)
     return fail(L, "%s: accessor %d has %zu elements, but POSITION has %zu", what, index, v.count, count);
   for (size_t i = 0; i < count; i++)
-    for (int c = 0; c < 3; c++) {
-      double x = view_get(v, i, c);
-      if (!std::isfinite(x) || std::fabs(x) > LM_GLTF_MAX_COORD)
-        return fail(L, "%s: accessor %d: element %zu has a non-finite or huge value (%g)", what, index, i, x);
-      out[i * 3 + c] = (float)x;
-    }
+    for (int c = 0; c < 3; c++)
+      if (!read_coord(L, v, what, index, "element", i, c, &out[i * 3 + c])) return false;
   return true;
 }
 
@@ -1404,12 +1407,8 @@ bool add_skin(Loader &L, int si, int *out) {
       return fail(L, "%s: accessor %d has component type %d, not floats (5126)", what, ai, v.type);
     if (v.count < n) return fail(L, "%s: accessor %d has %zu matrices for %zu joints", what, ai, v.count, n);
     for (size_t j = 0; j < n; j++)
-      for (int k = 0; k < 16; k++) {
-        double x = view_get(v, j, k);
-        if (!std::isfinite(x) || std::fabs(x) > LM_GLTF_MAX_COORD)
-          return fail(L, "%s: accessor %d: matrix %zu has a non-finite or huge value (%g)", what, ai, j, x);
-        bind[j * 16 + k] = (float)x;
-      }
+      for (int k = 0; k < 16; k++)
+        if (!read_coord(L, v, what, ai, "matrix", j, k, &bind[j * 16 + k])) return false;
   }
   lm_skin *k = push(L.s->skins, L.s->skin_count, L.s->skin_cap);
   snprintf(k->name, sizeof k->name, "%s", sk.name.empty() ? where : sk.name.c_str());
