@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene/gltf.h"
+
 char gltf_test_dir[64];
 
 int gltf_test_setup(void **state) {
@@ -121,4 +123,32 @@ size_t mutate_glb(unsigned char *glb, size_t len, size_t json_end) {
     }
   }
   return len;
+}
+
+void gltf_mutation_soak(unsigned char *const *seeds, const size_t *lens, const size_t *json_ends, int count,
+                        int iters, void (*check)(struct lm_scene *s)) {
+  const char *env = getenv("LIMN_GLTF_MUTATIONS");
+  if (env && atoi(env) > 0) iters = atoi(env);
+  size_t most = 0;
+  for (int i = 0; i < count; i++) most = lens[i] > most ? lens[i] : most;
+  unsigned char *mutant = malloc(most); /* mutate_glb only shortens */
+  int loaded = 0;
+  for (int iter = 0; iter < iters; iter++) {
+    int seed = iter % count;
+    memcpy(mutant, seeds[seed], lens[seed]);
+    size_t len = mutate_glb(mutant, lens[seed], json_ends[seed]);
+    lm_error err = {""};
+    const char *path = write_bytes("mutant.glb", mutant, len);
+    lm_scene *s = lm_scene_load_gltf(path, &err);
+    if (s) {
+      check(s);
+      lm_scene_destroy(s);
+      loaded++;
+    } else if (!strstr(err.msg, path)) {
+      fail_msg("iteration %d: message without the path: %s", iter, err.msg);
+    }
+  }
+  free(mutant);
+  print_message("mutations: %d of %d still loaded\n", loaded, iters);
+  assert_true(loaded > 0 && loaded < iters);
 }

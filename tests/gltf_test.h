@@ -33,5 +33,13 @@ size_t make_glb(const char *json, const blob *b, unsigned char *out, size_t cap)
  * the JSON changed (still JSON, other indices and sizes). Returns the new
  * length. Deterministic: failures reproduce. */
 size_t mutate_glb(unsigned char *glb, size_t len, size_t json_end);
+/* Loads `iters` mutants (mutate_glb) of the count seed GLBs, mutant i of
+ * seed i % count, whose JSON ends at json_ends: each loads and passes
+ * `check`, or is refused by a message naming its path. LIMN_GLTF_MUTATIONS=N
+ * runs N instead (a longer soak, as under ASan). Fails unless some mutants
+ * loaded and some did not (the loop explored both sides). */
+struct lm_scene;
+void gltf_mutation_soak(unsigned char *const *seeds, const size_t *lens, const size_t *json_ends, int count,
+                        int iters, void (*check)(struct lm_scene *s));
 
 #endif
