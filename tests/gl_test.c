@@ -253,6 +253,28 @@ void gl_quad(lm_scene *s, const char *name, int material, const float c[4][3], c
   lm_scene_add_node(s, name, -1, (float *)id, lm_scene_add_mesh(s, name, v, 4, idx, 6), material);
 }
 
+int gl_uv_sphere(lm_scene *s, const char *name, float r) {
+  enum { SEG = 32, RINGS = 16 };
+  static float v[(SEG + 1) * (RINGS + 1) * 8];
+  static uint32_t idx[SEG * RINGS * 6];
+  int nv = 0, ni = 0;
+  for (int j = 0; j <= RINGS; j++)
+    for (int i = 0; i <= SEG; i++) {
+      float th = GLM_PIf * (float)j / RINGS, ph = 2 * GLM_PIf * (float)i / SEG;
+      float n[3] = {sinf(th) * cosf(ph), cosf(th), -sinf(th) * sinf(ph)};
+      float *o = v + nv++ * 8;
+      for (int k = 0; k < 3; k++) o[k] = r * n[k], o[3 + k] = n[k];
+      o[6] = (float)i / SEG, o[7] = (float)j / RINGS;
+    }
+  for (int j = 0; j < RINGS; j++)
+    for (int i = 0; i < SEG; i++) {
+      uint32_t a = (uint32_t)(j * (SEG + 1) + i), b = a + SEG + 1;
+      uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
+      memcpy(idx + ni, q, sizeof q), ni += 6;
+    }
+  return lm_scene_add_mesh(s, name, v, nv, idx, ni);
+}
+
 int gl_material(lm_scene *s, const char *name, float r, float g, float b) {
   lm_material m = {.color = {r, g, b}, .rho = 0.5f, .ka = 1, .kd = 1, .shininess = 1};
   snprintf(m.name, sizeof m.name, "%s", name);

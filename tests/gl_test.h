@@ -92,6 +92,9 @@ bool gl_target_finite(gl_result *r, const char *name);
 void gl_quad(lm_scene *s, const char *name, int material, const float c[4][3], const float n[3]);
 int gl_material(lm_scene *s, const char *name, float r, float g, float b);
 void gl_camera_up(lm_scene *s, float y);
+/* A UV sphere of radius r at the origin, 32 segments by 16 rings (position,
+ * normal, uv), as mesh `name`: the mesh's index. */
+int gl_uv_sphere(lm_scene *s, const char *name, float r);
 /* An outdoor corner: open grey ground, two 4-high walls meeting at the
  * origin (facing +x and +z), a sun casting shadows and a camera looking
  * into the corner from (9, 6, 9); view_proj gets the camera's, at aspect

@@ -35,27 +35,8 @@ static lm_scene *metal_sphere_at(float albedo, float shininess, bool behind, mat
   lm_material metal = {.name = "metal", .color = {albedo, albedo, albedo}, .rho = 0.5f, .ka = 1, .kd = 0, .ks = 1,
                        .shininess = shininess};
   int m = lm_scene_add_material(s, &metal);
-  enum { SEG = 32, RINGS = 16 };
-  static float v[(SEG + 1) * (RINGS + 1) * 8];
-  static uint32_t idx[SEG * RINGS * 6];
-  int nv = 0, ni = 0;
-  for (int r = 0; r <= RINGS; r++)
-    for (int k = 0; k <= SEG; k++) {
-      float th = GLM_PIf * (float)r / RINGS, ph = 2 * GLM_PIf * (float)k / SEG;
-      float n[3] = {sinf(th) * cosf(ph), cosf(th), -sinf(th) * sinf(ph)};
-      float *o = v + 8 * nv++;
-      o[0] = 0.5f * n[0], o[1] = 0.5f * n[1], o[2] = 0.5f * n[2], o[3] = n[0], o[4] = n[1], o[5] = n[2];
-      o[6] = (float)k / SEG, o[7] = (float)r / RINGS;
-    }
-  for (int r = 0; r < RINGS; r++)
-    for (int k = 0; k < SEG; k++) {
-      uint32_t a = (uint32_t)(r * (SEG + 1) + k), b = a + SEG + 1;
-      uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
-      memcpy(idx + ni, q, sizeof q);
-      ni += 6;
-    }
   mat4 id = GLM_MAT4_IDENTITY_INIT, view, world;
-  lm_scene_add_node(s, "ball", -1, (float *)id, lm_scene_add_mesh(s, "ball", v, nv, idx, ni), m);
+  lm_scene_add_node(s, "ball", -1, (float *)id, gl_uv_sphere(s, "ball", 0.5f), m);
   int red = gl_material(s, "red", 0.8f, 0.1f, 0.1f);
   if (behind)
     gl_quad(s, "wall", red, (const float[4][3]){{3, -3, -3}, {3, -3, 3}, {3, 3, 3}, {3, 3, -3}},

@@ -313,29 +313,6 @@ static void mutated_scene_files_never_crash(void **state) {
   assert_true(loaded > 0 && loaded < iters);
 }
 
-/* A UV sphere of radius r at the origin (position, normal, uv). */
-static int add_sphere(lm_scene *s, float r) {
-  enum { SEG = 32, RINGS = 16 };
-  static float v[(SEG + 1) * (RINGS + 1) * 8];
-  static uint32_t idx[SEG * RINGS * 6];
-  int nv = 0, ni = 0;
-  for (int j = 0; j <= RINGS; j++)
-    for (int i = 0; i <= SEG; i++) {
-      float th = 3.14159265f * (float)j / RINGS, ph = 2 * 3.14159265f * (float)i / SEG;
-      float n[3] = {sinf(th) * cosf(ph), cosf(th), -sinf(th) * sinf(ph)};
-      float *o = v + nv++ * 8;
-      for (int k = 0; k < 3; k++) o[k] = r * n[k], o[3 + k] = n[k];
-      o[6] = (float)i / SEG, o[7] = (float)j / RINGS;
-    }
-  for (int j = 0; j < RINGS; j++)
-    for (int i = 0; i < SEG; i++) {
-      uint32_t a = (uint32_t)(j * (SEG + 1) + i), b = a + SEG + 1;
-      uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
-      memcpy(idx + ni, q, sizeof q), ni += 6;
-    }
-  return lm_scene_add_mesh(s, "sphere", v, nv, idx, ni);
-}
-
 /* The pbr technique over a grid of spheres, metallic (rows) by roughness
  * (columns), lit from the eye: every value finite, each row's highlight
  * falls as roughness grows while the diffuse part stays, a metal's
@@ -346,7 +323,7 @@ static void pbr_sphere_grid_is_finite_and_monotonic(void **state) {
   enum { GW = 128, GH = 96, ROWS = 3, COLS = 4 };
   static const float metallic[ROWS] = {0, 0.5f, 1}, roughness[COLS] = {0.3f, 0.5f, 0.7f, 1.0f};
   lm_scene *s = lm_scene_create("grid");
-  int sphere = add_sphere(s, 0.42f);
+  int sphere = gl_uv_sphere(s, "sphere", 0.42f);
   float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   for (int r = 0; r < ROWS; r++)
     for (int c = 0; c < COLS; c++) {
@@ -455,7 +432,7 @@ static void alpha_masked_casters_cast_no_shadow(void **state) {
   (void)state;
   enum { W = 96, H = 72 };
   lm_scene *s = lm_scene_create("mask");
-  int sphere = add_sphere(s, 0.5f);
+  int sphere = gl_uv_sphere(s, "sphere", 0.5f);
   static const float floor_v[4 * 8] = {-4, 0, -4, 0, 1, 0, 0, 0, 4, 0, -4, 0, 1, 0, 1, 0,
                                        4, 0, 4,  0, 1, 0, 1, 1, -4, 0, 4, 0, 1, 0, 0, 1};
   static const uint32_t floor_i[6] = {0, 2, 1, 0, 3, 2};
