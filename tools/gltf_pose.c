@@ -8,16 +8,7 @@
 #include <string.h>
 
 #include "scene/gltf.h"
-
-static void print_json_string(const char *s) {
-  putchar('"');
-  for (; *s; s++) {
-    if (*s == '"' || *s == '\\') printf("\\%c", *s);
-    else if ((unsigned char)*s < 0x20) printf("\\u%04x", *s);
-    else putchar(*s);
-  }
-  putchar('"');
-}
+#include "tools.h"
 
 int main(int argc, char **argv) {
   const char *spec = "all";
@@ -60,9 +51,9 @@ int main(int argc, char **argv) {
   for (int c = 0; c < s->camera_count; c++) {
     const lm_camera *cam = &s->cameras[c];
     printf("%s{\"name\": ", c ? ", " : "");
-    print_json_string(cam->name);
+    limn_json_string(cam->name);
     printf(", \"node\": ");
-    print_json_string(s->nodes[cam->node].name);
+    limn_json_string(s->nodes[cam->node].name);
     printf(", \"fov_y\": %.9g, \"aspect\": %.9g, \"znear\": %.9g, \"zfar\": %.9g}", cam->fov_y, cam->aspect,
            cam->znear, cam->zfar);
   }
@@ -71,7 +62,7 @@ int main(int argc, char **argv) {
   printf("],\n \"nodes\": {");
   for (int n = 0; n < s->node_count; n++) {
     printf("%s\n  ", n ? "," : "");
-    print_json_string(s->nodes[n].name);
+    limn_json_string(s->nodes[n].name);
     printf(": [");
     for (int t = 0; t < time_count; t++) {
       lm_scene_set_time(s, anim, times[t]);
