@@ -5,14 +5,9 @@
 set -u
 limn=$1
 root=$2
-tmp=$(mktemp -d /tmp/limn-cli-XXXXXX)
-trap 'rm -rf "$tmp"' EXIT
-passed=0 failed=0
+. "$(dirname "$0")/shell_test.sh"
+scratch cli
 
-check() { # check NAME CONDITION...
-  local name=$1; shift
-  if "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $name"; fi
-}
 run() { # run EXPECTED_RC ARGS... : output in $tmp/out, $tmp/err, rc in $rc
   local want=$1; shift
   "$limn" "$@" >"$tmp/out" 2>"$tmp/err"; rc=$?
@@ -197,5 +192,4 @@ check "read without writer" run 1 capture --script "$tmp/nowriter.lua" --output 
 check "read without writer names pass and line" first_error_has "nowriter.lua:5: pass 'direct' reads target 'gbuffer.clr' that no pass writes before it"
 check "read without writer leaves no file" no_files
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish

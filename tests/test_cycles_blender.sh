@@ -9,11 +9,10 @@
 set -u
 limn=$1
 root=$2
-command -v blender >/dev/null || { echo "blender not installed: skipped (tools/dev.sh installs it)"; exit 77; }
+. "$(dirname "$0")/shell_test.sh"
+needs blender "tools/dev.sh installs it"
 [ -f "$root/cli/cycles_render.py" ] || { echo "no cli/cycles_render.py: skipped"; exit 77; }
-tmp=$(mktemp -d /tmp/limn-blender-XXXXXX)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+scratch blender
 cd "$tmp" || exit 1
 cp "$root/data/scenes/pov_ball.gltf" ball.gltf
 printf '# name eye target fov\nfront 0 1.5 3  0 0.3 0  45\n' > ball.cams

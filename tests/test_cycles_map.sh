@@ -25,13 +25,8 @@ root=$2
 blender=${BLENDER:-blender}
 command -v "$blender" >/dev/null ||
   { echo "test_cycles_map: skipped: no blender (Debian package blender: apt-get install blender)"; exit 77; }
-tmp=$(mktemp -d /tmp/limn-cycles-map-XXXXXX)
-trap 'rm -rf "$tmp"' EXIT
-passed=0 failed=0
-check() { # check NAME CONDITION...
-  local name=$1; shift
-  if "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $name"; fi
-}
+. "$(dirname "$0")/shell_test.sh"
+scratch cycles-map
 cycles() { # cycles SPEC OUT [SPEC OUT ...]: stderr in $tmp/err.txt, status in rc
   "$blender" -b --factory-startup -noaudio --python-exit-code 1 --python "$root/cli/cycles_render.py" -- "$@" \
     >"$tmp/log.txt" 2>"$tmp/err.txt"
@@ -169,5 +164,4 @@ for v in "${bad[@]}"; do check "$v: no image" test ! -e "$tmp/$v.exr"; done
 check "the good view among them is rendered" test -s "$tmp/good.exr"
 check "no temporary file left" test -z "$(find "$tmp" -name '.cycles-*')"
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish

@@ -19,10 +19,9 @@
 set -u
 limn=$1
 root=$2
-command -v python3 >/dev/null || { echo "python3 not installed: skipped (tools/dev.sh installs it)"; exit 77; }
-tmp=$(mktemp -d /tmp/limn-cycles-XXXXXX)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+. "$(dirname "$0")/shell_test.sh"
+needs python3 "tools/dev.sh installs it"
+scratch cycles
 cd "$tmp" || exit 1
 mkdir cache
 export FAKE_BLENDER_LOG=$tmp/calls FAKE_BLENDER_LIMN=$limn FAKE_BLENDER_CACHE=$tmp/cache

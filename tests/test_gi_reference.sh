@@ -9,10 +9,9 @@ set -u
 limn=$1 root=$2 name=$3 tech=$4 ratio=${5#*..} low=0
 case $5 in *..*) low=${5%%..*} ;; esac
 shift 5
-command -v povray >/dev/null || { echo "povray not installed: skipped (tools/dev.sh installs it)"; exit 77; }
-tmp=$(mktemp -d /tmp/limn-gi-XXXXXX)   # POV-Ray's default I/O policy allows writing under /tmp
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+. "$(dirname "$0")/shell_test.sh"
+needs povray "tools/dev.sh installs it"
+scratch gi
 size=64x48 w=64 h=48
 "$limn" export-pov --scene cornell_pov --size $size --output "$tmp/ref.pov" || fail "export-pov"
 (cd "$tmp" && povray -D -V +Iref.pov +Oref.exr +FE +W$w +H$h -A >"$tmp/pov.log" 2>&1) \

@@ -4,10 +4,9 @@
 # flags exit 2 and write nothing.
 set -u
 limn=$1
-tmp=$(mktemp -d /tmp/limn-graph-XXXXXX)
-trap 'rm -rf "$tmp"' EXIT
-command -v python3 >/dev/null || { echo "test_graph_command: needs python3 (Debian python3)"; exit 77; }
-fail() { echo "FAIL: $*"; exit 1; }
+. "$(dirname "$0")/shell_test.sh"
+needs python3 "Debian python3"
+scratch graph
 
 "$limn" graph --help >"$tmp/help" || fail "graph --help exited $?"
 grep -q -- "--output" "$tmp/help" || fail "graph --help names no --output"

@@ -8,15 +8,10 @@
 set -u
 limn=$1
 root=$2
-tmp=$(mktemp -d /tmp/limn-jobs-XXXXXX)
-trap 'rm -rf "$tmp"' EXIT
-passed=0 failed=0
+. "$(dirname "$0")/shell_test.sh"
+scratch jobs
 cd "$tmp"
 
-check() { # check NAME CONDITION...
-  local name=$1; shift
-  if "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $name"; fi
-}
 run() { # run EXPECTED_RC ARGS... : output in out.txt, err.txt
   local want=$1; shift
   "$limn" "$@" >out.txt 2>err.txt; rc=$?
@@ -386,5 +381,4 @@ badseq "too many views" 1 "bad.lua: 360004 views (scenes' cameras x sizes x tech
 badseq "unknown animation" 1 "bad.lua: scenes[1]: animation: scene " "time = 0, animation = 'walk'"
 check "no image from a bad sequence" test ! -e o
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish

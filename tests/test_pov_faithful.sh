@@ -9,10 +9,9 @@
 set -u
 limn=$1
 root=$2
-command -v povray >/dev/null || { echo "povray not installed: skipped (tools/dev.sh installs it)"; exit 77; }
-tmp=$(mktemp -d /tmp/limn-pov-XXXXXX)   # POV-Ray's default I/O policy allows writing under /tmp
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+. "$(dirname "$0")/shell_test.sh"
+needs povray "tools/dev.sh installs it"
+scratch pov
 size=128x96 w=128 h=96
 
 num() { grep -o "\"$1\": [-0-9.e+]*" "$tmp/m.json" | awk '{print $2}'; }

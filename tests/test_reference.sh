@@ -15,13 +15,13 @@
 # - --require-refs and --cached-refs render nothing: the first names the command, the second
 #   leaves out (and names) the views without cached references.
 # Skipped (77) where povray is not installed (tools/dev.sh installs it).
+# Its job file is written out whole, as the other job tests' are, so they read alike.
 set -u
 limn=$1
 root=$2
-command -v povray >/dev/null || { echo "povray not installed: skipped (tools/dev.sh installs it)"; exit 77; }
-tmp=$(mktemp -d /tmp/limn-ref-XXXXXX)   # POV-Ray's default I/O policy allows writing under /tmp
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+. "$(dirname "$0")/shell_test.sh"
+needs povray "tools/dev.sh installs it"
+scratch ref
 cd "$tmp" || exit 1
 cp "$root/data/scenes/pov_ball.gltf" ball.gltf
 printf '# name eye target fov\nfront 0 1.5 3  0 0.3 0  45\n' > ball.cams

@@ -12,10 +12,9 @@
 set -u
 limn=$1
 root=$2
-command -v povray >/dev/null || { echo "povray not installed: skipped (tools/dev.sh installs it)"; exit 77; }
-tmp=$(mktemp -d /tmp/limn-sky-XXXXXX) # POV-Ray's default I/O policy allows writing under /tmp
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+. "$(dirname "$0")/shell_test.sh"
+needs povray "tools/dev.sh installs it"
+scratch sky
 size=128x96 w=128 h=96 scene="$root/tests/sky_yard.gltf"
 sky=0.1,0.15,0.3:0.3,0.32,0.35 # sky.lua's zenith and horizon
 

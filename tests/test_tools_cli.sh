@@ -5,13 +5,8 @@
 set -u
 limn=$1
 root=$2
-tmp=$(mktemp -d /tmp/limn-tools-XXXXXX)
-trap 'rm -rf "$tmp"' EXIT
-passed=0 failed=0
-check() {
-  local name=$1; shift
-  if "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $name"; fi
-}
+. "$(dirname "$0")/shell_test.sh"
+scratch tools
 run() {
   local want=$1; shift
   "$limn" "$@" >"$tmp/out" 2>"$tmp/err"; rc=$?
@@ -243,5 +238,4 @@ check "bench bad fps message" err_has "--fps wants frames a second"
 check "bench time without animation" run 2 bench --time 0:1 --sizes 32x24
 check "bench time without animation message" err_has "--time: scene 'cornell' has no animation"
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish
