@@ -957,6 +957,7 @@ static void print_motion(const bench *b) {
          motion_pass(m) ? "PASS" : "FAIL");
 }
 
+/* print_motion's figures as JSON: the two read alike. */
 static void print_motion_json(const bench *b) {
   const motion *m = &b->motion;
   printf(", \"motion\": {\"width\": %d, \"height\": %d, \"frames\": %d, \"warmup\": %d, \"camera\": ",

@@ -218,7 +218,8 @@ static void json_sequence(lm_buf *b, const report_args *a, const job *j, const j
   lm_buf_append(b, "]}", -1);
 }
 
-/* The rows of write_csv, with the run's settings and sequences, as JSON. */
+/* The rows of write_csv, with the run's settings and sequences, as JSON:
+ * the two loops read alike. */
 static void write_json(lm_buf *b, const report_args *a, const job *j, const job_view *places,
                        const report_row *rows, int n, const report_runs *runs, const char *clock, int frames,
                        int warmup) {

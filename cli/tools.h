@@ -49,8 +49,9 @@ bool limn_parse_camera(const char *s, int *out);
 struct lm_scene;
 int limn_camera_resolve(struct lm_scene *s, int camera, int width, int height);
 /* Each command keeps its own getopt table and loop (its flags as its
- * --help and docs/commands.md list them), so the loops read alike; what the
- * commands share is parsed here and in limn_pov_flag.
+ * --help and docs/commands.md list them) and frees what it made at its end,
+ * so commands read alike; what they share is parsed here and in
+ * limn_pov_flag.
  * The flags capture, view, bench and graph share: --scene, --script, --tech,
  * --set NAME=VALUE (at most LIMN_MAX_SETS), --size WxH, --camera N (or
  * "auto" where camera_auto). Each command lists those it takes in its own

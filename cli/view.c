@@ -906,6 +906,7 @@ static bool watch_dirs(viewer *v, lm_error *err) {
   return true;
 }
 
+/* Everything the viewer made, freed one by one: destroy functions read alike. */
 static void viewer_free(viewer *v) {
   lm_texture_destroy(&v->shown);
   lm_texture_destroy(&v->overlay_tex);

@@ -2,6 +2,7 @@
 -- knee at 1/downsample of the size, a separable Gaussian (blur.frag), and
 -- the sum with the image, before tone mapping. Half floats throughout, each
 -- pass clamping under their largest finite value.
+-- Laid out as scripts/README.md's contract says, so modules read alike.
 local options = require "options"
 
 local bloom = {}

@@ -10,6 +10,7 @@
 -- depth-aware upsampling, so sharp pixels keep their full-size detail
 -- (dof_reduce.frag, which computes the reduced circles from the depth, and
 -- dof_composite.frag).
+-- Laid out as scripts/README.md's contract says, so modules read alike.
 local options = require "options"
 
 local dof = {}

@@ -1,5 +1,6 @@
 -- The image through rippled glass (glass.frag: procedural ripples), the seed
 -- viewer's F8.
+-- A one-pass post effect: they read alike (examples/tint.lua).
 local options = require "options"
 
 local glass = {}

@@ -3,6 +3,7 @@
 -- the screen shows nothing (through the light propagation volumes where the
 -- technique has them). Recorded only for materials = "pbr": Phong frames are
 -- left as they were. docs/gi-combined.md.
+-- Laid out as scripts/README.md's contract says, so modules read alike.
 local gbuffer = require "gbuffer"
 local lpv = require "lpv"
 local options = require "options"

@@ -26,6 +26,7 @@
 --   3. a separable Gaussian blur of the coarse result that skips background
 --      and does not cross depth edges (blur.frag)
 --   4. bilateral upsampling and the composite (isr_light.frag)
+-- Laid out as scripts/README.md's contract says, so modules read alike.
 local gbuffer = require "gbuffer"
 local options = require "options"
 local sky = require "sky"

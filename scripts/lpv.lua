@@ -19,6 +19,7 @@
 --      L = D + k_a L_a albedo A + k k_d albedo E)
 -- The combined technique (isr+lpv+esm) leaves the VPLs the camera sees to
 -- ISR's screen-space march (docs/gi-combined.md).
+-- Laid out as scripts/README.md's contract says, so modules read alike.
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local options = require "options"

@@ -4,7 +4,8 @@
 -- camera's alone (the previous frame's view-projection), with depth-aware
 -- weights (a moving object smears over what lies behind it, not over what
 -- lies in front). A still frame is left as it is, and records no pass after
--- the first. Its checks open as dof.lua's: both read the G-buffer's depth.
+-- the first. Its checks open as dof.lua's, alike: both read the G-buffer's
+-- depth.
 local options = require "options"
 
 local motion_blur = {}

@@ -1,4 +1,5 @@
 -- Radial (zoom) blur towards a centre (radial_blur.frag), the seed viewer's F9.
+-- A one-pass post effect: they read alike (examples/tint.lua).
 local options = require "options"
 
 local radial_blur = {}

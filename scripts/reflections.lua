@@ -6,6 +6,7 @@
 -- with shadows), brings them to full size with the geometry-aware upsampling
 -- of filters.lua and adds them weighted by each pixel's reflectivity
 -- (reflect_apply.frag). One bounce: a mirror seen in a mirror shows unlit.
+-- Laid out as scripts/README.md's contract says, so modules read alike.
 local filters = require "filters"
 local gbuffer = require "gbuffer"
 local options = require "options"

@@ -9,6 +9,7 @@
 -- first march instead (rsm.bind; docs/gi-combined.md): on ISR's grid (no
 -- finer than `coarse` when isr.coarse is auto), with ISR's blur and temporal
 -- reuse, so there `coarse` sets the grid's bound and the samples' density.
+-- Laid out as scripts/README.md's contract says, so modules read alike.
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local options = require "options"

@@ -23,6 +23,7 @@
 -- pass turns its pattern each frame and accumulates (A, bounce), skipping
 -- the pixels that have converged; the blur takes fewer taps where a pixel's
 -- history holds more frames (filters.blur's age).
+-- Laid out as scripts/README.md's contract says, so modules read alike.
 local gbuffer = require "gbuffer"
 local filters = require "filters"
 local options = require "options"

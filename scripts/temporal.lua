@@ -13,6 +13,7 @@
 -- pattern each frame (rsm.rotate, ISR's next rays of its sequence) so the
 -- accumulation averages different samples, or only while the view moves
 -- (the `turn` option; temporal.glsl's temporal_turn).
+-- Laid out as scripts/README.md's contract says, so modules read alike.
 local options = require "options"
 
 local temporal = {}

@@ -1,4 +1,5 @@
 -- The image as square tiles with grout lines (tiles.frag), the seed viewer's F12.
+-- A one-pass post effect: they read alike (examples/tint.lua).
 local options = require "options"
 
 local tiles = {}

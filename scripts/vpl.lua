@@ -17,6 +17,7 @@
 --      that agree)
 --      and that pass lights the pixel too: L = D + k_a L_a albedo + k k_d albedo E
 --      (direct.frag's, with INDIRECT)
+-- Laid out as scripts/README.md's contract says, so modules read alike.
 local gbuffer = require "gbuffer"
 local isr = require "isr"
 local options = require "options"

@@ -2,7 +2,8 @@
  * primitives scene (tests/compressed, README there) load into the same
  * geometry as the original, within their quantization, and render the same
  * image. Corrupt copies are refused in tests/test_compressed.sh. And the
- * loader's memory budget (LIMN_MEMORY_BUDGET). */
+ * loader's memory budget (LIMN_MEMORY_BUDGET).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>

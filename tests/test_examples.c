@@ -1,7 +1,8 @@
 /* The tutorial's pipelines (scripts/examples/, scripts/README.md), each
  * image checked against what its code says, and pp.lua's technique rows:
  * the engine lists them as written, and a bad row is refused naming its
- * line. */
+ * line.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include "gl_test.h"
 
 #include <math.h>

@@ -7,7 +7,8 @@
  * same without pre-exposure (a fixed exposure of 1: what half floats lost
  * before), which must exceed the bound somewhere, or the sweep could not
  * see the loss it guards against. With tone mapping the extremes give the
- * same picture; no pixel is ever NaN or Inf. */
+ * same picture; no pixel is ever NaN or Inf.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

@@ -1,5 +1,6 @@
 /* The extreme-case suite (docs/extremes.md has the table): each case renders
- * and asserts finite output and a sane image. */
+ * and asserts finite output and a sane image.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

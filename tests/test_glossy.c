@@ -4,7 +4,8 @@
  * through the light propagation volumes (glossy.fallback); no composite
  * gives a metal an ambient term; Phong frames are
  * unchanged bit for bit; extremes stay finite; bad options name themselves.
- * Needs a GL context (llvmpipe will do). */
+ * Needs a GL context (llvmpipe will do).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

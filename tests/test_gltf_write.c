@@ -3,7 +3,8 @@
  * a glTF file's metallic-roughness materials and lights, and an animated
  * scene posed at a time. Where glTF cannot hold Limn's values (a Phong
  * material no metallic-roughness one reads back as, a window falloff) a
- * warning names the material or light, and only those differ. No GL. */
+ * warning names the material or light, and only those differ. No GL.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

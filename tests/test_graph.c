@@ -1,4 +1,5 @@
-/* Frame graph validation, culling and texture planning: no GL needed. */
+/* Frame graph validation, culling and texture planning: no GL needed.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

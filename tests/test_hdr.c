@@ -4,7 +4,8 @@
  * a moving camera, no NaN or Inf anywhere in any effect's chain on the
  * Cornell box with dl and isr, and that an effect turned off records no
  * pass. The synthetic images come from a test shader written into a scratch
- * root (the real shaders and scripts linked in). Needs GL (llvmpipe will do). */
+ * root (the real shaders and scripts linked in). Needs GL (llvmpipe will do).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>

@@ -4,7 +4,8 @@
  * built-in Cornell box the seed mode's colour bleeding, ambient occlusion in
  * corners, coarse versus full size; finite results at extreme parameters,
  * option errors, and that the dl technique records no ISR pass. Needs a GL
- * context (llvmpipe will do). */
+ * context (llvmpipe will do).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <cglm/cglm.h>
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>

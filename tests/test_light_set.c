@@ -3,7 +3,8 @@
  * for its kind, render what the general loop renders, for one light and for
  * eight of every kind, falloff and shadow kind, with Phong and with the pbr
  * materials; a light added at run time compiles one new variant, and a scene
- * with more lights than pp.lua's light_variants takes the general loop. */
+ * with more lights than pp.lua's light_variants takes the general loop.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

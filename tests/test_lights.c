@@ -2,7 +2,8 @@
  * that reaches a point of it, checked on the CPU at points just inside each
  * light's range and cone; and the Cornell box lit by many lights whose ranges
  * end on its walls renders as it does with every light evaluated everywhere;
- * spots of unbounded reach are culled by their cones. */
+ * spots of unbounded reach are culled by their cones.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

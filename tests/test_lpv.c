@@ -4,7 +4,8 @@
  * move leaves the volumes where they were; cells follow the box the camera
  * sees (lpv.fit) or a cap; a frame that reads no LPV records
  * none of its passes; any unit gives the same image; extremes stay finite;
- * bad options name themselves. Needs a GL context (llvmpipe will do). */
+ * bad options name themselves. Needs a GL context (llvmpipe will do).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <cglm/cglm.h>
 #include <setjmp.h>

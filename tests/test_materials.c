@@ -1,6 +1,7 @@
 /* Materials on whatever EGL offers: base-colour textures (decoded, sRGB,
  * sampled), per-pass parameter overrides from scripts, reloading, frustum
- * culling, and the messages a bad texture or override gives. */
+ * culling, and the messages a bad texture or override gives.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>

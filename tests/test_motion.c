@@ -5,7 +5,8 @@
  * and leaves a still frame as it is; temporal reuse that reprojects a moving
  * object along its motion and so leaves no ghost behind it; nothing
  * non-finite from extreme motion. On the built-in Cornell box, moved by hand
- * between frames. Needs GL (llvmpipe will do). */
+ * between frames. Needs GL (llvmpipe will do).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>

@@ -3,7 +3,8 @@
  * and skin; and, posed at known times, where the orbiting camera, the door,
  * the bent tube and the light are. The animation parts skip, saying why,
  * while the loader reads no animations or lm_scene_set_time is a stub
- * (tests/test_scenes_gen.sh checks the files' animation data either way). */
+ * (tests/test_scenes_gen.sh checks the files' animation data either way).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>

@@ -1,6 +1,7 @@
 /* POV-Ray export (engine/scene/pov.h): what the SDL says about the camera,
  * lights and materials, and what it refuses or warns about by name. No GL,
- * no POV-Ray (tests/test_pov_faithful.sh renders with it). */
+ * no POV-Ray (tests/test_pov_faithful.sh renders with it).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

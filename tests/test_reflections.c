@@ -2,7 +2,8 @@
  * whatever EGL offers: the mirror of cornell_mirror shows the (red) tall box
  * exactly where the CPU tracer says its reflection lands, follows the box
  * when it moves, and the passes are left out where nothing reflects.
- * (The agreement with POV-Ray is tests/test_pov_faithful.sh.) */
+ * (The agreement with POV-Ray is tests/test_pov_faithful.sh.)
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

@@ -1,7 +1,8 @@
 /* Reloading without a window (what `limn view` does on a save): a new
  * pipeline swapped into a running renderer keeps persistent targets that
  * match by name, format and size rule, a failing one leaves the old one
- * running, and a broken shader rebuild keeps the last good program. */
+ * running, and a broken shader rebuild keeps the last good program.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>

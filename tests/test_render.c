@@ -1,6 +1,7 @@
 /* Rendering on whatever EGL offers (llvmpipe in CI): the Cornell box through
  * scripts/pp.lua, checked for what must be where, against a golden image,
- * and the GL-side errors a script or shader can cause. */
+ * and the GL-side errors a script or shader can cause.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>

@@ -4,7 +4,8 @@
  * POV-Ray's scale; a closed room lit by one spot patch lights its ceiling;
  * a frame that reads no RSM renders none; an outdoor corner sees less sky
  * than open ground; extremes stay finite. Needs a GL
- * context (llvmpipe will do). */
+ * context (llvmpipe will do).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <cglm/cglm.h>
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>

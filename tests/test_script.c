@@ -1,5 +1,6 @@
 /* Pipeline scripts: errors with script:line, options, the sandbox, the
- * instruction budget, and what a script records (no GL needed). */
+ * instruction budget, and what a script records (no GL needed).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>

@@ -1,4 +1,5 @@
-/* #include expansion and compiler-log mapping back to file:line (no GL). */
+/* #include expansion and compiler-log mapping back to file:line (no GL).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>

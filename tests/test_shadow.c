@@ -1,6 +1,7 @@
 /* The shadow manager: plans (no GL), then shadows on the Cornell box and the
  * field, every filter, extreme exponents and depth ranges, cascade
- * stabilization, and that nothing is rendered when nothing casts or reads. */
+ * stabilization, and that nothing is rendered when nothing casts or reads.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

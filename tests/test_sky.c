@@ -2,7 +2,8 @@
  * albedo times the sky's radiance under every technique, the GI techniques
  * occlude it beside an obstacle where `dl` cannot, a sky of intensity 0
  * changes nothing, and bad options are refused by name. POV-Ray agreement:
- * tests/test_sky_pov.sh. */
+ * tests/test_sky_pov.sh.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

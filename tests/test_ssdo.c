@@ -4,7 +4,8 @@
  * bounce's colour, edges the filters must not cross, reduced resolution
  * against full, the two SSDO variants against each other, finite results
  * at extreme parameters, option errors, the two-step variant's pbr light,
- * and that dl records no SSDO or SSAO pass. Needs a GL context (llvmpipe will do). */
+ * and that dl records no SSDO or SSAO pass. Needs a GL context (llvmpipe will do).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>

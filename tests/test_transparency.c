@@ -3,7 +3,8 @@
  * wall is seen through the pane tinted by its transmission, the pane's
  * shadow is lighter than an opaque pane's, a scene without blended
  * materials records no extra pass, bad values are refused by name, and the
- * glTF and POV-Ray exports carry the glass. */
+ * glTF and POV-Ray exports carry the glass.
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>

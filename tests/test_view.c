@@ -2,7 +2,8 @@
  * window's content, keys, live reload of shaders and scripts with errors,
  * resizing to 1x1, the inspector's files and a 1000-edit reload loop counted
  * for leaks. Each case starts the real `limn view` on a scratch engine root
- * (copies of shaders/ and scripts/, so edits never touch the source tree). */
+ * (copies of shaders/ and scripts/, so edits never touch the source tree).
+ * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>

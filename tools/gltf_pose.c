@@ -2,7 +2,8 @@
  * the given times, and its cameras, as JSON (tools/blender_motion_check.sh
  * compares it with what Blender evaluates for the same export).
  *   gltf_pose FILE.glb [--animation NAME|INDEX|all] SECONDS...
- * Matrices are column-major, in the file's (glTF, y-up) space. */
+ * Matrices are column-major, in the file's (glTF, y-up) space. Its JSON is
+ * printed as limn bench --json prints its own, so they read alike. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

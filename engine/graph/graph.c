@@ -24,6 +24,7 @@ const char *lm_pass_kind_name(lm_pass_kind k) {
 
 lm_graph *lm_graph_create(void) { return lm_alloc(sizeof(lm_graph)); }
 
+/* Frees each array the graph owns, one by one: destroy functions read alike. */
 void lm_graph_destroy(lm_graph *g) {
   if (!g) return;
   for (int i = 0; i < g->persistent_count; i++) {

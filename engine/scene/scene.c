@@ -52,6 +52,7 @@ void lm_scene_shift_animation_nodes(lm_scene *s, int from, int by) {
       if (s->skins[k].joints[j] >= from) s->skins[k].joints[j] += by;
 }
 
+/* Frees each array the scene owns, one by one: destroy functions read alike. */
 void lm_scene_destroy(lm_scene *s) {
   if (!s) return;
   for (int i = 0; i < s->mesh_count; i++) {

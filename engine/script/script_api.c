@@ -377,6 +377,8 @@ static void read_inputs(lua_State *L, int idx, pass_builder *b) {
   qsort(b->inputs, (size_t)b->desc.input_count, sizeof *b->inputs, compare_inputs);
 }
 
+/* A pass's params, read and sorted as read_inputs reads its inputs: the two
+ * read alike (their checks and messages differ). */
 static int compare_params(const void *a, const void *b) {
   return strcmp(((const lm_pass_param *)a)->name, ((const lm_pass_param *)b)->name);
 }

@@ -1,6 +1,7 @@
 -- The tutorial's post effect, a module as scripts/README.md says: each
 -- channel of the image times its own gain (shaders/examples/tint.frag).
--- Every one-pass post effect has this shape (glass, radial_blur, sepia, tiles).
+-- Every one-pass post effect has this shape, so they read alike (glass,
+-- radial_blur, sepia, tiles).
 local options = require "options"
 
 local tint = {}
