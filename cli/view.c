@@ -414,8 +414,8 @@ static bool apply_set_list(lm_pipeline *p, char *const *sets, int count, lm_erro
 /* The script with technique `tech` (NULL: the script's first) and the
  * viewer's options (--set, the job's, toggles), loaded as capture, bench and
  * graph load theirs; *rc as capture_load_pipeline's. */
-_Static_assert((int)MAX_SETS <= (int)LIMN_MAX_SETS, "the viewer's options fit the shared loader's");
 static lm_pipeline *load_pipeline(viewer *v, const char *tech, int *rc, lm_error *err) {
+  _Static_assert((int)MAX_SETS <= (int)LIMN_MAX_SETS, "the viewer's options fit the shared loader's");
   limn_common_args c = {.script = v->script, .tech = tech, .set_count = v->args->set_count};
   for (int i = 0; i < c.set_count; i++) c.sets[i] = v->args->sets[i];
   return capture_load_pipeline(&c, rc, err);
