@@ -11,7 +11,8 @@ layout(std140, binding = 0) uniform LimnFrame {
   vec4 time;        // seconds, frame index
   ivec4 counts;     // x: lights
   mat4 prev_view_proj; // last frame's, for reprojection and motion blur
-  vec4 exposure;    // x: the pre-exposure E, y: 1/E, z: E over the last frame's (see exposed())
+  vec4 exposure;    // x: the pre-exposure E, y: 1/E, z: E over the last frame's (see exposed()),
+                    // w: the exposure meter's last key times E (> 0; 1: none metered)
 } frame;
 
 struct Light {

@@ -10,7 +10,8 @@
 // confidence
 //   conf = 1 - saturate(|V_{t-1} - V_t|) / (1 + bias)
 // over values normalized as HDR (v / (1 + v), the seed's "normalize HDR
-// values before the confidence") restarts a pixel whose confidence falls
+// values before the confidence"; v is light over the frame's metered key, so
+// the same at any light level) restarts a pixel whose confidence falls
 // below `confidence` (its light changed), on the frames it has fresh samples.
 // The history is last frame's accumulation: value (rgba, every channel
 // accumulated; the confidence reads rgb) and state (r: view depth, 0 none;
@@ -143,9 +144,12 @@ vec4 temporal_accumulate(vec4 cur, bool found, vec4 h, float n, out float seen) 
   // The same samples as the history's (a still view's kept pattern): nothing to average, and one
   // frame's samples held (so the blur's age stays that of a fresh frame, the one reuse off blurs).
   if (found && (temporal_turning() || gather_turns != 0)) {
-    // Judged on the scene's radiance (frame.exposure.y undoes the pre-exposure), so the exposure the
-    // renderer picks does not change what counts as a change of light.
-    vec3 ha = h.rgb * frame.exposure.y, hb = cur.rgb * frame.exposure.y;
+    // Judged on light relative to the frame's key (frame.exposure.w, pre-exposed as h and cur), so
+    // that a change restarts a pixel alike under starlight and sunlight: on radiance v / (1 + v)
+    // saturates above about 1 (a bright scene never restarted) and is linear below (a dim one
+    // neither), and E alone leaves the key anywhere within its band, where the noise of a few
+    // samples restarts pixels at one level and not at another.
+    vec3 ha = h.rgb / frame.exposure.w, hb = cur.rgb / frame.exposure.w; // w > 0
     vec3 a = ha / (1.0 + ha), b = hb / (1.0 + hb), diff = abs(a - b);
     float conf = 1.0 - saturate(max(diff.r, max(diff.g, diff.b))) / (1.0 + bias);
     if (conf >= confidence) {

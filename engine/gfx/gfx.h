@@ -206,7 +206,8 @@ typedef struct lm_frame_data {
   int32_t counts[4];    /* lights */
   float prev_view_proj[16]; /* the previous frame's (this frame's on the first) */
   float exposure[4];  /* pre-exposure E (lights, sky, ambient, emission arrive times it), 1/E,
-                         E over the last frame's (what a history kept since is rescaled by), 0 */
+                         E over the last frame's (what a history kept since is rescaled by), the
+                         exposure meter's last key times E (1: none) */
 } lm_frame_data;
 typedef struct lm_light_data {
   float position[4];  /* xyz, w = type: 0 point, 1 spot, 2 directional */

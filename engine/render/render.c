@@ -81,6 +81,7 @@ struct lm_renderer {
   lm_readback meter_read; /* the last frame's exposure meter, read for this one's pre-exposure */
   float meter_exposure;   /* the pre-exposure it was metered under (0: none started) */
   struct meter { bool valid; float key, brightest; } meter; /* what it read (read_meter) */
+  float key;              /* the last key metered (radiance; 0: none yet), the histories' scale of light */
   float peak;             /* this frame's light_peak */
   float script_peak; /* the radiance the script's own light reaches (lm_pipeline_light_peak) */
 };
@@ -956,9 +957,14 @@ static bool execute(lm_renderer *r, lm_graph *g, int meter, lm_error *err) {
   if (r->meter_exposure > 0) read_meter(r); /* else a view's first frame read it at once */
   if (r->frame < 2) r->meter.valid = false; /* a view's first frame: the meter saw another */
   float e = fixed_exposure(r) ? r->desc.exposure : frame_exposure(r);
+  if (r->meter.valid) r->key = r->meter.key;
   r->meter.valid = false;
   frame->exposure[0] = e, frame->exposure[1] = 1 / e;
   frame->exposure[2] = r->frame > 1 && r->exposure > 0 ? e / r->exposure : 1;
+  /* The key pre-exposed: a history's confidence judges light relative to it (temporal.glsl), the same
+   * at any light level, where E alone (a power of two, held within a band) leaves the key anywhere in
+   * 2^-8 .. 2^8. None metered (a fixed exposure, a view's first frames): E stands for it. */
+  frame->exposure[3] = r->key > 0 && isfinite(r->key * e) ? fmaxf(r->key * e, 0x1p-24f) : 1;
   r->exposure = e;
   for (int i = 0; i < n; i++)
     for (int c = 0; c < 3; c++) lights[i].color[c] *= e;

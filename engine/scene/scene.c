@@ -476,7 +476,7 @@ void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_f
     out->frustum_u[i] = right[i] * 2 * fx;
     out->frustum_v[i] = up[i] * 2 * fy;
   }
-  out->exposure[0] = out->exposure[1] = out->exposure[2] = 1; /* none: the renderer sets its own */
+  out->exposure[0] = out->exposure[1] = out->exposure[2] = out->exposure[3] = 1; /* none: the renderer's */
   out->clip[0] = c.znear;
   out->clip[1] = c.zfar;
   out->clip[2] = 1.0f / c.zfar;
