@@ -605,7 +605,7 @@ def linear_textures():
             continue
         for node in mat.node_tree.nodes:
             image = getattr(node, "image", None) if node.type == "TEX_IMAGE" else None
-            if image is None or image.is_float or image.colorspace_settings.name != "sRGB":
+            if image is None or image.is_float or image.colorspace_settings.name != "sRGB" or 0 in image.size:
                 continue
             if image.name not in copies:
                 w, h = image.size
