@@ -593,7 +593,36 @@ def default_material(mode):
     return mat
 
 
+def linear_textures():
+    """Colour textures as linear floats. Cycles filters an 8-bit sRGB image
+    in sRGB and decodes after (an edge between texels of 60 and 230 comes out
+    darker than either's light would mix); Limn's GL_SRGB8_ALPHA8 textures
+    decode before filtering, as light mixes. A float copy of the decoded
+    texels filters the same way in both."""
+    copies = {}
+    for mat in bpy.data.materials:
+        if not mat.use_nodes:
+            continue
+        for node in mat.node_tree.nodes:
+            image = getattr(node, "image", None) if node.type == "TEX_IMAGE" else None
+            if image is None or image.is_float or image.colorspace_settings.name != "sRGB" or 0 in image.size:
+                continue
+            if image.name not in copies:
+                w, h = image.size
+                px = numpy.empty(w * h * 4, dtype=numpy.float32)
+                image.pixels.foreach_get(px)  # the stored sRGB values over 255
+                rgb = px.reshape(-1, 4)[:, :3]
+                rgb[:] = numpy.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+                copy = bpy.data.images.new(image.name + "_linear", w, h, alpha=True, float_buffer=True)
+                copy.colorspace_settings.name = "Linear"
+                copy.alpha_mode = image.alpha_mode
+                copy.pixels.foreach_set(px)
+                copies[image.name] = copy
+            node.image = copies[image.name]
+
+
 def map_materials(doc, mode):
+    linear_textures()
     gms = doc.get("materials", [])
     for mat in list(bpy.data.materials):
         m = re.match(r"limn_m(\d+)", mat.name)

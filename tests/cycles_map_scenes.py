@@ -17,6 +17,10 @@
   sky, skyball      a white plane and a white sphere lit by no light (a spot
                     aimed at nothing), for sky.lua's gradient and map; sky.hdr,
                     the map (write_map)
+  checker           the white plane textured with a 4x4 checker of sRGB 60
+                    and 230 (checker.png, each texel a metre: magnified, so
+                    the filter blends neighbouring texels across the view)
+                    under the sun
   spheres           a rough gold metal and a rough red dielectric sphere under
                     a sun, for materials=pbr (one light: Cycles, which picks one
                     light a sample, is then free of noise)
@@ -27,6 +31,7 @@ import math
 import os
 import struct
 import sys
+import zlib
 
 PHOTOMETRIC = 683.0 * math.pi  # glTF cd or lux per engine unit (engine/scene/gltf.h)
 
@@ -98,10 +103,12 @@ class Gltf:
         self.doc["accessors"].append(acc)
         return len(self.doc["accessors"]) - 1
 
-    def mesh(self, positions, normals, indices, material):
+    def mesh(self, positions, normals, indices, material, uvs=None):
         prim = {"attributes": {"POSITION": self.accessor(positions, "VEC3", 3),
                                "NORMAL": self.accessor(normals, "VEC3", 3)},
                 "indices": self.accessor(indices, "SCALAR", 1), "material": material}
+        if uvs:
+            prim["attributes"]["TEXCOORD_0"] = self.accessor(uvs, "VEC2", 2)
         self.doc["meshes"].append({"primitives": [prim]})
         return len(self.doc["meshes"]) - 1
 
@@ -109,6 +116,13 @@ class Gltf:
         self.doc["materials"].append({"name": name, "pbrMetallicRoughness": {
             "baseColorFactor": base + [1.0], "metallicFactor": metallic, "roughnessFactor": roughness}})
         return len(self.doc["materials"]) - 1
+
+    def texture(self, material, png):
+        """PNG bytes as the material's base colour texture (a data URI)."""
+        self.doc.setdefault("images", []).append({"uri": "data:image/png;base64," + base64.b64encode(png).decode()})
+        self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1})
+        self.doc["materials"][material]["pbrMetallicRoughness"]["baseColorTexture"] = {
+            "index": len(self.doc["textures"]) - 1}
 
     def light(self, light, eye, target=None):
         ext = self.doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {"lights": []})
@@ -135,9 +149,20 @@ class Gltf:
             json.dump(self.doc, f)
 
 
-def plane(g, material, half=4.0):
+def plane(g, material, half=4.0, uv=None):
     p = [-half, 0, -half, half, 0, -half, half, 0, half, -half, 0, half]
-    g.node(name="plane", mesh=g.mesh(p, [0, 1, 0] * 4, [0, 2, 1, 0, 3, 2], material))
+    uvs = [0, 0, uv, 0, uv, uv, 0, uv] if uv else None
+    g.node(name="plane", mesh=g.mesh(p, [0, 1, 0] * 4, [0, 2, 1, 0, 3, 2], material, uvs))
+
+
+def checker_png(n=4, dark=60, light=230):
+    """An n x n RGB PNG of alternating sRGB grey texels (zlib: standard library)."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    rows = b"".join(b"\0" + bytes(v for x in range(n) for v in [dark if (x + y) % 2 else light] * 3)
+                    for y in range(n))
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", n, n, 8, 2, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
 
 
 def sphere(g, centre, radius, material, rings=24, segments=48):
@@ -197,6 +222,11 @@ def main(folder, width, height, samples):
         g.light(light, at, aim)
         specs[name] = (g, g.camera(eye, target, 40.0))
         g.camera(eye, [0.0, 6.0, 9.0], 40.0)  # camera 1 sees nothing: Limn's black image
+    g = Gltf()
+    plane(g, g.material("checker", [1.0, 1.0, 1.0], 0.0, 0.0), uv=2.0)
+    g.texture(0, checker_png())
+    g.light(*lights["sun"][:2], lights["sun"][2])
+    specs["checker"] = (g, g.camera(eye, target, 40.0))
     g = Gltf()
     sphere(g, [-0.6, 0.5, 0.0], 0.5, g.material("gold", [1.0, 0.77, 0.34], 1.0, 0.35))
     sphere(g, [0.6, 0.5, 0.0], 0.5, g.material("red", [0.7, 0.1, 0.1], 0.0, 0.6))

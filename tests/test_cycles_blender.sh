@@ -31,4 +31,17 @@ awk -v m="$mean" 'BEGIN { exit !(m > 0) }' || { cat m.json; fail "indirect light
 "$limn" capture --scene ball.gltf --tech dl --size 32x24 --output dl.exr --quiet || fail "capture"
 "$limn" compare dl.exr "$direct" --json >d.json || fail "Limn's image and Cycles' do not compare (size?)"
 cat m.json d.json
+# Stopped mid-view with the real Blender: a render of a million samples, stopped by SIGTERM once Blender
+# says it is sampling, leaves no reference, no partial file and no Blender.
+"$limn" reference --job job.lua "${cy[@]}" --samples 1000000 --refs refs-kill >log 2>&1 &
+pid=$!
+for i in $(seq 600); do grep -qs "Sample " refs-kill/ball/*.log && break; sleep 0.1; done
+grep -qs "Sample " refs-kill/ball/*.log || { kill "$pid"; cat log; fail "the render did not start in 60 s"; }
+kill -TERM "$pid"
+{ wait "$pid"; } 2>/dev/null
+left() { pgrep -f "blender .*$tmp/refs-kill"; }
+for i in $(seq 50); do left >/dev/null || break; sleep 0.1; done
+blender_pid=$(left) && { kill $blender_pid; fail "Blender outlived limn"; }
+[ -z "$(find refs-kill -name "*.exr" -o -name "*tmp*" -o -name ".cycles*")" ] ||
+  fail "a stopped render left files: $(find refs-kill)"
 echo "Cycles end to end passed"
