@@ -145,6 +145,7 @@ typedef struct viewer {
   bool cursor_in;           /* the cursor over the window while inspecting: its texel's value */
   int cursor_px[2];
   float cursor_value[4];
+  int cursor_logged[3];     /* the texel and target the debug log last gave the value of */
   bool mouse_scripted;
   char script_error[2048];  /* the last reload's error ("" when it loaded) */
   char frame_error[2048];   /* the current pipeline's last frame error */

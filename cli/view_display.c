@@ -91,6 +91,11 @@ static void read_probe(viewer *v, int c) {
   if (v->cursor_in) {
     v->cursor_px[0] = (int)(x * v->probe_w / v->width), v->cursor_px[1] = (int)(y * v->probe_h / v->height);
     memcpy(v->cursor_value, px + ((size_t)v->cursor_px[1] * v->probe_w + v->cursor_px[0]) * 4, sizeof v->cursor_value);
+    int now[3] = {v->cursor_px[0], v->cursor_px[1], v->inspect};
+    if (memcmp(now, v->cursor_logged, sizeof now)) /* what the overlay shows, for tests: once a texel */
+      lm_debug("texel %d,%d of the inspected target: %.9g %.9g %.9g %.9g", now[0], now[1], v->cursor_value[0],
+               v->cursor_value[1], v->cursor_value[2], v->cursor_value[3]);
+    memcpy(v->cursor_logged, now, sizeof now);
   }
   free(px);
 }
