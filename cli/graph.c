@@ -3,6 +3,7 @@
  * for docs and reviews; what the viewer's panel shows under "frame graph". */
 #define _GNU_SOURCE
 #include <getopt.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -106,6 +107,30 @@ static int pass_targets(const lm_pass_desc *d, bool inputs, int *out) {
   return n;
 }
 
+/* Does a pass after pass i read what it wrote to target t? */
+static bool read_later(lm_graph *g, int i, int t) {
+  for (int j = i + 1; j < lm_graph_pass_count(g); j++) {
+    const lm_pass_desc *d = lm_graph_pass(g, j).desc;
+    for (int k = 0; k < d->input_count; k++)
+      if (d->inputs[k].target == t && lm_graph_input_writer(g, j, k) == i) return true;
+  }
+  return false;
+}
+
+/* A target as a DOT node (once): what a pass reads of the last frame, or
+ * writes that no later pass reads (the presented frame, a history). */
+static void dot_target(FILE *f, lm_graph *g, int t, bool *seen) {
+  if (seen[t]) return;
+  lm_graph_target_info info = lm_graph_target(g, t);
+  fprintf(f, "  t%d [shape=ellipse, label=\"", t);
+  escaped(f, info.name, true);
+  fprintf(f, "\\n%s %dx%d\"];\n", lm_format_name(info.format), info.width, info.height);
+  seen[t] = true;
+}
+
+/* Passes as boxes, an edge labelled with the target from each output to
+ * each later pass that reads it; targets as ellipses where the frame begins
+ * (read of the last frame) or ends (written, read by no later pass). */
 static void write_dot(FILE *f, lm_graph *g) {
   fprintf(f, "digraph frame {\n  rankdir=LR;\n  node [fontname=\"DejaVu Sans Mono\", fontsize=10];\n");
   int count = lm_graph_target_count(g);
@@ -113,75 +138,143 @@ static void write_dot(FILE *f, lm_graph *g) {
   int ends[LM_MAX_PASS_INPUTS + LM_MAX_COLOR_OUTPUTS + 1];
   for (int i = 0; i < lm_graph_pass_count(g); i++) {
     lm_graph_pass_info p = lm_graph_pass(g, i);
+    const char *grey = p.culled ? " [color=gray70, fontcolor=gray55]" : "";
     fprintf(f, "  p%d [shape=box, label=\"", i);
     escaped(f, p.name, true);
     if (p.culled) fprintf(f, "\\n(culled)\", style=filled, fillcolor=gray92, fontcolor=gray55, color=gray70];\n");
     else fprintf(f, "\\n%.3f ms\", style=filled, fillcolor=lightsteelblue1];\n", p.ms > 0 ? p.ms : 0);
-    for (int side = 0; side < 2; side++) {
-      int n = pass_targets(p.desc, side == 0, ends);
-      for (int k = 0; k < n; k++) {
-        if (ends[k] < 0 || ends[k] >= count) continue;
-        if (!seen[ends[k]]) {
-          lm_graph_target_info t = lm_graph_target(g, ends[k]);
-          fprintf(f, "  t%d [shape=ellipse, label=\"", ends[k]);
-          escaped(f, t.name, true);
-          fprintf(f, "\\n%s %dx%d\"];\n", lm_format_name(t.format), t.width, t.height);
-          seen[ends[k]] = true;
-        }
-        if (side == 0) fprintf(f, "  t%d -> p%d%s;\n", ends[k], i, p.culled ? " [color=gray70]" : "");
-        else fprintf(f, "  p%d -> t%d%s;\n", i, ends[k], p.culled ? " [color=gray70]" : "");
+    int n = pass_targets(p.desc, true, ends);
+    for (int k = 0; k < n; k++) {
+      int w = lm_graph_input_writer(g, i, k);
+      if (w < 0) {
+        dot_target(f, g, ends[k], seen);
+        fprintf(f, "  t%d -> p%d%s;\n", ends[k], i, grey);
+        continue;
       }
+      fprintf(f, "  p%d -> p%d [label=\"", w, i);
+      escaped(f, lm_graph_target(g, ends[k]).name, true);
+      fprintf(f, "\"%s];\n", p.culled || lm_graph_pass(g, w).culled ? ", color=gray70, fontcolor=gray55" : "");
+    }
+    n = pass_targets(p.desc, false, ends);
+    for (int k = 0; k < n; k++) {
+      if (read_later(g, i, ends[k])) continue;
+      dot_target(f, g, ends[k], seen);
+      fprintf(f, "  p%d -> t%d%s;\n", i, ends[k], grey);
     }
   }
   fprintf(f, "}\n");
   free(seen);
 }
 
-/* Passes top to bottom in recording order, each a box: its name and time, a
- * bar of its share of the longest pass, the targets it reads and writes. */
+/* The graph as the viewer's panel draws it: a column for each depth
+ * (lm_graph_pass_depths), each pass a box with its name, its time as a bar
+ * of the longest pass's, the targets it reads down its left edge and those
+ * it writes down its right, and an edge from each output to each later pass
+ * that reads it; culled passes and their edges grey. */
 static void write_svg(FILE *f, lm_graph *g) {
-  enum { WIDTH = 760, ROW = 58, BAR = 300 };
-  int passes = lm_graph_pass_count(g);
+  enum { LINE = 16, PAD = 6, GAP = 48 };
+  const double advance = 7.3; /* DejaVu Sans Mono at 12 px */
+  int n = lm_graph_pass_count(g), columns = 1, ends[LM_MAX_PASS_INPUTS + LM_MAX_COLOR_OUTPUTS + 1];
+  int *depth = lm_alloc(sizeof *depth * (size_t)(n + 1));
+  double *box = lm_alloc(sizeof *box * 4 * (size_t)(n + 1)); /* x, y, width, height of each */
+  lm_graph_pass_depths(g, depth);
+  for (int i = 0; i < n; i++) columns = depth[i] + 1 > columns ? depth[i] + 1 : columns;
+  double *width = calloc((size_t)columns, sizeof *width), *bottom = calloc((size_t)columns, sizeof *bottom);
   double longest = 0;
-  for (int i = 0; i < passes; i++) longest = lm_graph_pass(g, i).ms > longest ? lm_graph_pass(g, i).ms : longest;
-  fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
-             "font-family=\"DejaVu Sans Mono, monospace\" font-size=\"12\">\n",
-          WIDTH, ROW * passes + 8);
-  int ends[LM_MAX_PASS_INPUTS + LM_MAX_COLOR_OUTPUTS + 1];
-  for (int i = 0; i < passes; i++) {
+  for (int i = 0; i < n; i++) {
     lm_graph_pass_info p = lm_graph_pass(g, i);
-    int y = 4 + i * ROW;
-    fprintf(f, "  <g class=\"%s\">\n", p.culled ? "pass culled" : "pass");
-    fprintf(f, "    <rect x=\"4\" y=\"%d\" width=\"%d\" height=\"%d\" rx=\"4\" fill=\"%s\" stroke=\"%s\"/>\n", y,
-            WIDTH - 8, ROW - 6, p.culled ? "#eeeeee" : "#dde8f6", p.culled ? "#bbbbbb" : "#6688aa");
-    fprintf(f, "    <text class=\"name\" x=\"12\" y=\"%d\" fill=\"%s\">", y + 16, p.culled ? "#999999" : "#000000");
+    size_t chars = strlen(p.name) > 12 ? strlen(p.name) : 12; /* at least "1234.567 ms" */
+    int rows = 0;
+    for (int side = 0; side < 2; side++) {
+      int count = pass_targets(p.desc, side == 0, ends);
+      for (int k = 0; k < count; k++) {
+        size_t len = strlen(lm_graph_target(g, ends[k]).name);
+        chars = len > chars ? len : chars;
+      }
+      rows += count;
+    }
+    box[4 * i + 2] = (double)chars * advance + 4 * PAD;
+    box[4 * i + 3] = (2 + rows) * LINE + 2 * PAD;
+    if (box[4 * i + 2] > width[depth[i]]) width[depth[i]] = box[4 * i + 2];
+    if (!p.culled && p.ms > longest) longest = p.ms;
+  }
+  double x = PAD, height = 0;
+  for (int c = 0; c < columns; c++) {
+    for (int i = 0; i < n; i++) {
+      if (depth[i] != c) continue;
+      box[4 * i] = x, box[4 * i + 1] = bottom[c] + PAD;
+      bottom[c] = box[4 * i + 1] + box[4 * i + 3] + LINE;
+    }
+    height = bottom[c] > height ? bottom[c] : height;
+    x += width[c] + GAP;
+  }
+  fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+             "font-family=\"DejaVu Sans Mono, monospace\" font-size=\"12\">\n",
+          x - GAP + PAD, height + PAD);
+  /* Edges first, under the boxes: from the writer's row of the target to the reader's. */
+  for (int i = 0; i < n; i++) {
+    lm_graph_pass_info p = lm_graph_pass(g, i);
+    for (int k = 0; k < p.desc->input_count; k++) {
+      int w = lm_graph_input_writer(g, i, k), t = p.desc->inputs[k].target, row = 0;
+      if (w < 0) continue;
+      lm_graph_pass_info from = lm_graph_pass(g, w);
+      int outs = pass_targets(from.desc, false, ends);
+      while (row < outs - 1 && ends[row] != t) row++;
+      double ax = box[4 * w] + box[4 * w + 2], ay = box[4 * w + 1] + PAD + (2 + from.desc->input_count + row + 0.5) * LINE;
+      double bx = box[4 * i], by = box[4 * i + 1] + PAD + (2 + k + 0.5) * LINE;
+      double bend = fabs(bx - ax) * 0.4 > GAP ? fabs(bx - ax) * 0.4 : GAP;
+      bool grey = p.culled || from.culled;
+      fprintf(f, "  <path class=\"edge%s\" data-from=\"p%d\" data-to=\"p%d\" data-target=\"", grey ? " culled" : "",
+              w, i);
+      escaped(f, lm_graph_target(g, t).name, false);
+      fprintf(f, "\" d=\"M%.1f %.1f C%.1f %.1f %.1f %.1f %.1f %.1f\" fill=\"none\" stroke=\"%s\" stroke-width=\"1.5\">"
+                 "<title>", ax, ay, ax + bend, ay, bx - bend, by, bx, by, grey ? "#cccccc" : "#6688aa");
+      escaped(f, from.name, false);
+      fputs(" -> ", f);
+      escaped(f, p.name, false);
+      fputs(": ", f);
+      escaped(f, lm_graph_target(g, t).name, false);
+      fprintf(f, "</title></path>\n");
+    }
+  }
+  for (int i = 0; i < n; i++) {
+    lm_graph_pass_info p = lm_graph_pass(g, i);
+    double bx = box[4 * i], by = box[4 * i + 1], bw = box[4 * i + 2], bh = box[4 * i + 3];
+    const char *ink = p.culled ? "#999999" : "#000000";
+    fprintf(f, "  <g class=\"%s\" id=\"p%d\">\n", p.culled ? "pass culled" : "pass", i);
+    fprintf(f, "    <rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" rx=\"4\" fill=\"%s\" stroke=\"%s\"/>\n",
+            bx, by, bw, bh, p.culled ? "#eeeeee" : "#dde8f6", p.culled ? "#bbbbbb" : "#6688aa");
+    fprintf(f, "    <text class=\"name\" x=\"%.1f\" y=\"%.1f\" fill=\"%s\">", bx + PAD, by + PAD + 12, ink);
     escaped(f, p.name, false);
     fprintf(f, "</text>\n");
+    double bar_y = by + PAD + LINE;
     if (p.culled) {
-      fprintf(f, "    <text x=\"%d\" y=\"%d\" fill=\"#999999\">culled: nothing it writes reaches the output</text>\n",
-              WIDTH - 8 - BAR, y + 16);
+      fprintf(f, "    <text x=\"%.1f\" y=\"%.1f\" fill=\"%s\">culled</text>\n", bx + PAD, bar_y + 12, ink);
     } else {
       double share = longest > 0 && p.ms > 0 ? p.ms / longest : 0;
-      fprintf(f, "    <rect class=\"time\" x=\"%d\" y=\"%d\" width=\"%.1f\" height=\"10\" fill=\"#e0a020\"/>\n",
-              WIDTH - 8 - BAR, y + 7, share * (BAR - 80));
-      fprintf(f, "    <text x=\"%d\" y=\"%d\" text-anchor=\"end\">%.3f ms</text>\n", WIDTH - 14, y + 16,
-              p.ms > 0 ? p.ms : 0);
+      fprintf(f, "    <rect class=\"time\" x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%d\" fill=\"#e0a020\"/>\n",
+              bx + PAD, bar_y + 2, share * (bw - 2 * PAD), LINE - 4);
+      fprintf(f, "    <text x=\"%.1f\" y=\"%.1f\">%.3f ms</text>\n", bx + PAD + 2, bar_y + 12, p.ms > 0 ? p.ms : 0);
     }
+    int row = 0;
     for (int side = 0; side < 2; side++) {
-      int n = pass_targets(p.desc, side == 0, ends);
-      fprintf(f, "    <text class=\"%s\" x=\"12\" y=\"%d\" fill=\"%s\">%s", side ? "writes" : "reads",
-              y + 32 + 14 * side, p.culled ? "#999999" : "#333333", side ? "out:" : " in:");
-      for (int k = 0; k < n; k++) {
-        if (ends[k] < 0 || ends[k] >= lm_graph_target_count(g)) continue;
-        fputc(' ', f);
+      int count = pass_targets(p.desc, side == 0, ends);
+      for (int k = 0; k < count; k++, row++) {
+        fprintf(f, "    <text class=\"%s\" x=\"%.1f\" y=\"%.1f\" fill=\"%s\"%s>", side ? "write" : "read",
+                side ? bx + bw - PAD : bx + PAD, by + PAD + (2 + row) * LINE + 12, p.culled ? "#999999" : "#333333",
+                side ? " text-anchor=\"end\"" : "");
         escaped(f, lm_graph_target(g, ends[k]).name, false);
+        fprintf(f, "</text>\n");
       }
-      fprintf(f, "</text>\n");
     }
     fprintf(f, "  </g>\n");
   }
   fprintf(f, "</svg>\n");
+  free(depth);
+  free(box);
+  free(width);
+  free(bottom);
 }
 
 int limn_graph(int argc, char **argv) {

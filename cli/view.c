@@ -985,7 +985,8 @@ static int run(viewer *v) {
             v->camera_animated ? "; it moves the camera" : "");
   if (a->reload_test) return reload_test(v, a->reload_test);
 
-  double last = lm_now_ms();
+  double last = lm_now_ms(), last_cpu = lm_cpu_ms();
+  bool drawn_on = false; /* the panel drawn in the last frame */
   for (v->frame = 0; !stop_requested && !lm_window_should_close(v->window); v->frame++) {
     lm_window_poll(v->window);
     char key[64];
@@ -994,13 +995,17 @@ static int run(viewer *v) {
     apply_panel(v);
     for (int i = 0; i < a->key_count; i++)
       if (a->keys[i].frame == v->frame) handle_key(v, a->keys[i].key);
-    double now = lm_now_ms();
+    double now = lm_now_ms(), now_cpu = lm_cpu_ms();
     v->frame_ms = now - last;
-    if (v->frame > 1) { /* the panel's share: frames with it on and off, and its own time */
-      bool on = v->panel && v->panel_on;
-      v->frame_ms_sum[on] += v->frame_ms;
-      v->frames_timed[on]++;
+    /* The panel's share: the last frame's times, with the panel on or off
+     * as it drew, but for the frames its own timing stalls (glFinish, the
+     * display's extra draw: one in PANEL_EVERY), on and off alike. */
+    if (v->frame > 1 && (v->frame - 1) % PANEL_EVERY != 0) {
+      v->frame_ms_sum[drawn_on] += v->frame_ms;
+      v->frame_cpu_sum[drawn_on] += now_cpu - last_cpu;
+      v->frames_timed[drawn_on]++;
     }
+    last_cpu = now_cpu;
     /* Real time, a frame's stall (a shader rebuild) counted at most 0.25 s;
      * scripted runs (tests) 1/60 s a frame. The first frame shows --time. */
     if (!v->paused && v->frame > 0) advance(v, a->key_count ? 1.0 / 60.0 : fmin(now - last, 250.0) * 1e-3);
@@ -1015,6 +1020,7 @@ static int run(viewer *v) {
     render(v, handle_changes(v));
     update_reference(v);
     display(v);
+    drawn_on = v->panel && v->panel_on;
     if (a->exit_after && v->frame + 1 >= a->exit_after) break;
     lm_window_swap(v->window);
   }
@@ -1023,7 +1029,8 @@ static int run(viewer *v) {
   if (v->frames_timed[1] > 0) {
     char cost[200];
     panel_cost(v, cost, sizeof cost);
-    lm_info("%s; %ld frames on, %ld off (glFinish + CLOCK_MONOTONIC)", cost, v->frames_timed[1], v->frames_timed[0]);
+    lm_info("%s; %ld frames on, %ld off (glFinish + CLOCK_MONOTONIC; CPU: CLOCK_PROCESS_CPUTIME_ID)", cost,
+            v->frames_timed[1], v->frames_timed[0]);
   }
   report_time(v, "at exit");
   if (v->live_ok) describe_reference(v, true);
@@ -1043,7 +1050,7 @@ int limn_view(int argc, char **argv) {
   signal(SIGINT, on_signal);
   signal(SIGTERM, on_signal);
   viewer v = {.args = &a, .inspect = -1, .inspect_logged = -1, .channel = 4, .overlay_on = a.overlay, .panel_on = a.panel,
-              .range = {0, 1}, .edits = no_edits(), .place = -1, .split = 0.5f};
+              .range = {0, 1}, .edits = no_edits(), .place = -1, .split = 0.5f, .cursor_logged = {-1, -1, -1}};
   capture_resolve(a.common.script, v.script, sizeof v.script);
   rc = run(&v);
   viewer_free(&v);

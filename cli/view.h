@@ -115,8 +115,9 @@ typedef struct viewer {
   char status[1200];        /* the panel's note: the job last written */
   /* The panel's cost: its own milliseconds in its last timed frames (one in
    * PANEL_EVERY, glFinish on both sides) and the frames' with it on and off,
-   * for the share the overlay prints. */
-  double panel_times[PANEL_TIMES], frame_ms_sum[2];
+   * wall and the process's CPU time, for the share the overlay prints. */
+  double panel_times[2][PANEL_TIMES], frame_ms_sum[2], frame_cpu_sum[2]; /* [0] wall, [1] CPU */
+  double panel_spent[2];    /* a timed frame's so far, wall and CPU */
   long panel_timed, frames_timed[2]; /* [0] panel off, [1] on */
   char panel_cost_text[200]; /* the panel's line of it */
   /* Live error against the reference (view_reference.c) while the camera
@@ -144,6 +145,7 @@ typedef struct viewer {
   bool cursor_in;           /* the cursor over the window while inspecting: its texel's value */
   int cursor_px[2];
   float cursor_value[4];
+  int cursor_logged[3];     /* the texel and target the debug log last gave the value of */
   bool mouse_scripted;
   char script_error[2048];  /* the last reload's error ("" when it loaded) */
   char frame_error[2048];   /* the current pipeline's last frame error */
@@ -171,7 +173,7 @@ bool make_window_textures(viewer *v, lm_error *err);
 bool reference_shown(const viewer *v);
 /* Draws the frame (or the inspected target) and the overlay into the back buffer. */
 void display(viewer *v);
-/* "panel 0.61 ms, 0.9% of the frame (frames 70.2 ms on, 69.8 off)". */
+/* "panel 0.61 ms, 0.9% of the frame; CPU 0.70 ms, 1.7% (frames 70.2 ms on, 69.8 off; CPU 41.0, 40.8)". */
 void panel_cost(const viewer *v, char *out, size_t cap);
 /* The inspected target as EXR and the frame as PNG, into --capture-dir. */
 void write_captures(viewer *v);

@@ -91,6 +91,11 @@ static void read_probe(viewer *v, int c) {
   if (v->cursor_in) {
     v->cursor_px[0] = (int)(x * v->probe_w / v->width), v->cursor_px[1] = (int)(y * v->probe_h / v->height);
     memcpy(v->cursor_value, px + ((size_t)v->cursor_px[1] * v->probe_w + v->cursor_px[0]) * 4, sizeof v->cursor_value);
+    int now[3] = {v->cursor_px[0], v->cursor_px[1], v->inspect};
+    if (memcmp(now, v->cursor_logged, sizeof now)) /* what the overlay shows, for tests: once a texel */
+      lm_debug("texel %d,%d of the inspected target: %.9g %.9g %.9g %.9g", now[0], now[1], v->cursor_value[0],
+               v->cursor_value[1], v->cursor_value[2], v->cursor_value[3]);
+    memcpy(v->cursor_logged, now, sizeof now);
   }
   free(px);
 }
@@ -277,24 +282,68 @@ static int by_value(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-/* The panel's own time is the median of its last frames: on llvmpipe a
- * glFinish now and then waits for the rasterizer threads to be scheduled
- * (milliseconds on a loaded machine), which a mean would count as the panel's. */
-void panel_cost(const viewer *v, char *out, size_t cap) {
-  double on = v->frames_timed[1] ? v->frame_ms_sum[1] / v->frames_timed[1] : 0;
-  double off = v->frames_timed[0] ? v->frame_ms_sum[0] / v->frames_timed[0] : 0;
-  double t[PANEL_TIMES], own = 0;
-  int n = v->panel_timed < PANEL_TIMES ? (int)v->panel_timed : PANEL_TIMES;
-  memcpy(t, v->panel_times, sizeof *t * (size_t)n);
+/* The median of the last n of a ring of PANEL_TIMES figures. */
+static double median(const double *ring, long count) {
+  double t[PANEL_TIMES];
+  int n = count < PANEL_TIMES ? (int)count : PANEL_TIMES;
+  memcpy(t, ring, sizeof *t * (size_t)n);
   qsort(t, (size_t)n, sizeof *t, by_value);
-  if (n) own = t[n / 2];
-  n = snprintf(out, cap, "panel %.2f ms, %.1f%% of the frame", own, on > 0 ? 100.0 * own / on : 0.0);
-  if (off > 0 && n > 0 && (size_t)n < cap)
-    snprintf(out + n, cap - (size_t)n, " (frames %.1f ms on, %.1f off)", on, off);
+  return n ? t[n / 2] : 0;
 }
 
-/* The panel's image; its own time (glFinish on both sides, CLOCK_MONOTONIC) into v->panel_times. */
-static lm_texture draw_panel(viewer *v) {
+/* The panel's own time is the median of its last timed frames: on llvmpipe a
+ * glFinish now and then waits for the rasterizer threads to be scheduled
+ * (milliseconds on a loaded machine), which a mean would count as the
+ * panel's. Its CPU time (the process's: llvmpipe's threads too) is steadier
+ * on a machine others load; the frame's share of each is against the frames
+ * with the panel on. */
+void panel_cost(const viewer *v, char *out, size_t cap) {
+  double on[2] = {0, 0}, off[2] = {0, 0}, own[2];
+  for (int c = 0; c < 2; c++) {
+    const double *on_sum = c ? v->frame_cpu_sum : v->frame_ms_sum;
+    if (v->frames_timed[1]) on[c] = on_sum[1] / v->frames_timed[1];
+    if (v->frames_timed[0]) off[c] = on_sum[0] / v->frames_timed[0];
+    own[c] = median(v->panel_times[c], v->panel_timed);
+  }
+  int n = snprintf(out, cap, "panel %.2f ms, %.1f%% of the frame; CPU %.2f ms, %.1f%%", own[0],
+                   on[0] > 0 ? 100.0 * own[0] / on[0] : 0.0, own[1], on[1] > 0 ? 100.0 * own[1] / on[1] : 0.0);
+  if (off[0] > 0 && n > 0 && (size_t)n < cap)
+    snprintf(out + n, cap - (size_t)n, " (frames %.1f ms on, %.1f off; CPU %.1f, %.1f)", on[0], off[0], on[1], off[1]);
+}
+
+static void set_texture(const lm_program *p, const char *name, lm_texture t) {
+  const lm_uniform *u = lm_program_uniform(p, name);
+  if (u) lm_program_bind_texture(u, t);
+}
+
+/* A timed stretch of the panel's work (glFinish on both sides; wall:
+ * CLOCK_MONOTONIC, CPU: the process's), in frames PANEL_EVERY apart: the
+ * glFinish stalls llvmpipe's pipelining, a cost of the timing the other
+ * frames spare. panel_clock() starts one, panel_lap() adds its time since to
+ * spent[2] (wall, CPU) with the sign given. */
+typedef struct panel_stretch {
+  double start[2];
+} panel_stretch;
+
+static bool panel_timed_frame(const viewer *v) { return v->frame % PANEL_EVERY == 0; }
+
+static panel_stretch panel_clock(const viewer *v) {
+  if (!panel_timed_frame(v)) return (panel_stretch){{0, 0}};
+  lm_finish();
+  return (panel_stretch){{lm_now_ms(), lm_cpu_ms()}};
+}
+
+static void panel_lap(const viewer *v, panel_stretch s, double sign, double spent[2]) {
+  if (!panel_timed_frame(v)) return;
+  lm_finish();
+  spent[0] += sign * (lm_now_ms() - s.start[0]);
+  spent[1] += sign * (lm_cpu_ms() - s.start[1]);
+}
+
+/* The panel laid out (its model built from the viewer's state, its image
+ * drawn again when it changed); its time into v->panel_spent. */
+static panel_image lay_out_panel(viewer *v) {
+  panel_stretch t0 = panel_clock(v);
   if (v->options_stale) {
     free(v->options);
     v->option_count = lm_pipeline_options(v->pipeline, &v->options);
@@ -315,13 +364,9 @@ static lm_texture draw_panel(viewer *v) {
   const lm_option_info *compare_option = NULL; /* the option the A/B sets apart, as that side has it */
   for (int i = 0; i < v->compare_option_count && v->compare_option[0]; i++)
     if (!strcmp(v->compare_options[i].name, v->compare_option)) compare_option = &v->compare_options[i];
-  /* Its own time, one frame in PANEL_EVERY: the glFinish on both sides
-   * stalls llvmpipe's pipelining, a cost of the timing the other frames
-   * spare. The cost line changes once in PANEL_EVERY timed frames (after a
-   * first figure): a line changing every frame would draw the panel's image
-   * every frame. */
-  bool timed = v->frame % PANEL_EVERY == 0;
-  if (timed && (v->panel_timed == 3 || v->panel_timed % PANEL_EVERY == 0))
+  /* The cost line changes once in PANEL_EVERY timed frames (after a first
+   * figure): a line changing every frame would lay the panel out every frame. */
+  if (panel_timed_frame(v) && (v->panel_timed == 3 || v->panel_timed % PANEL_EVERY == 0))
     panel_cost(v, v->panel_cost_text, sizeof v->panel_cost_text);
   /* The frame graph: passes with their targets as indices. */
   lm_graph *g = lm_renderer_graph(v->renderer);
@@ -331,15 +376,20 @@ static lm_texture draw_panel(viewer *v) {
     ends += d->input_count + d->output_count + 1;
   }
   panel_pass *passes = lm_alloc(sizeof *passes * (size_t)(pass_count + 1));
-  int *targets_of = lm_alloc(sizeof *targets_of * (size_t)(ends + 1)), used = 0;
+  int *targets_of = lm_alloc(sizeof *targets_of * (size_t)(2 * ends + 1)), used = 0;
+  int *columns = lm_alloc(sizeof *columns * (size_t)(pass_count + 1));
   const char **target_names = lm_alloc(sizeof *target_names * (size_t)(target_count + 1));
   for (int i = 0; i < target_count; i++) target_names[i] = lm_graph_target(g, i).name;
+  lm_graph_pass_depths(g, columns);
   for (int i = 0; i < pass_count; i++) {
     lm_graph_pass_info info = lm_graph_pass(g, i);
     panel_pass *pp = &passes[i];
-    *pp = (panel_pass){.name = info.name, .culled = info.culled, .ms = info.ms, .inputs = targets_of + used};
+    *pp = (panel_pass){.name = info.name, .culled = info.culled, .ms = info.ms, .inputs = targets_of + used,
+                       .column = columns[i]};
     for (int k = 0; k < info.desc->input_count; k++) targets_of[used++] = info.desc->inputs[k].target;
     pp->input_count = info.desc->input_count;
+    pp->writers = targets_of + used;
+    for (int k = 0; k < info.desc->input_count; k++) targets_of[used++] = lm_graph_input_writer(g, i, k);
     pp->outputs = targets_of + used;
     for (int k = 0; k < info.desc->output_count; k++) targets_of[used++] = info.desc->outputs[k];
     if (info.desc->depth >= 0) targets_of[used++] = info.desc->depth;
@@ -354,17 +404,36 @@ static lm_texture draw_panel(viewer *v) {
                    .compare_technique = compare, .compare_on = v->compare_on, .compare_option = compare_option,
                    .reference = v->args->job ? v->reference_text : NULL, .reference_here = v->place_ready,
                    .error_view = v->error_view};
-  if (timed) lm_finish();
-  double t0 = lm_now_ms();
-  lm_texture image = panel_frame(v->panel, &m, v->width, v->height, &v->edits);
-  if (timed) {
-    lm_finish();
-    v->panel_times[v->panel_timed++ % PANEL_TIMES] = lm_now_ms() - t0;
-  }
+  panel_image image = panel_frame(v->panel, &m, v->width, v->height, &v->edits);
   free(passes);
   free(targets_of);
+  free(columns);
   free(target_names);
+  v->panel_spent[0] = v->panel_spent[1] = 0;
+  panel_lap(v, t0, 1, v->panel_spent);
   return image;
+}
+
+/* The panel's image over the display (the window's framebuffer bound); its
+ * time added to v->panel_spent (which the display's draw over the panel's
+ * column, the pixels the panel spares it, has lessened), the frame's total
+ * into v->panel_times. */
+static void composite_panel(viewer *v, const panel_image *image) {
+  panel_stretch t0 = panel_clock(v);
+  lm_error err;
+  lm_program *p = lm_program_get("fullscreen.vert", "view.frag", "PANEL", &err);
+  const int *r = image->cover;
+  if (image->texture.id && p && r[2] > 0 && r[3] > 0) {
+    lm_program_use(p);
+    set_texture(p, "panel", image->texture);
+    lm_set_scissor(true, r[0], r[1], r[2], r[3]);
+    lm_draw_fullscreen_over();
+    lm_set_scissor(false, 0, 0, 0, 0);
+  }
+  panel_lap(v, t0, 1, v->panel_spent);
+  if (!panel_timed_frame(v)) return;
+  for (int c = 0; c < 2; c++) v->panel_times[c][v->panel_timed % PANEL_TIMES] = v->panel_spent[c];
+  v->panel_timed++;
 }
 
 bool reference_shown(const viewer *v) { return v->error_view != ERROR_VIEW_OFF && v->place_ready; }
@@ -390,34 +459,44 @@ void display(viewer *v) {
     v->inspect_logged = v->inspect;
   }
   draw_overlay(v);
-  lm_texture panel = v->panel && v->panel_on ? draw_panel(v) : (lm_texture){0};
-  lm_program *p = lm_program_get("fullscreen.vert", "view.frag", "", &err);
+  /* The panel first: the display leaves out the column its window covers. */
+  panel_image panel = {.column = v->width};
+  if (v->panel && v->panel_on) panel = lay_out_panel(v);
+  if (!panel.texture.id) panel.column = v->width;
+  /* The wipe: the other side right of the split (the frame only, not a
+   * target): the reference or its heat map while the error view is on,
+   * else the A/B --compare side. view.frag's variant: what this frame shows. */
+  bool reference = reference_shown(v), wipe = (v->compare_on || reference) && mode == 0;
+  bool linear = wipe && reference && v->error_view == ERROR_VIEW_REFERENCE;
+  char defines[64];
+  snprintf(defines, sizeof defines, "MODE=%d%s%s", mode, wipe ? ";WIPE" : "", linear ? ";OTHER_LINEAR" : "");
+  lm_program *p = lm_program_get("fullscreen.vert", "view.frag", defines, &err);
   lm_screen_bind(v->width, v->height);
   if (!p) { /* view.frag itself is broken: show what can be shown */
     set_error(v->shader_error, sizeof v->shader_error, err.msg, "");
-    return;
+  } else {
+    lm_program_use(p);
+    set_texture(p, "src", src);
+    set_texture(p, "overlay", v->overlay_tex);
+    set_texture(p, "other", !reference ? v->compare_shown
+                            : linear   ? v->reference_tex
+                                       : v->heat_tex);
+    float split = v->split * (float)v->width;
+    set_float(p, "split", &split);
+    set_int(p, "channel", v->channel);
+    set_float(p, "exposure", &v->exposure);
+    set_float(p, "range", v->range);
+    lm_set_scissor(true, 0, 0, panel.column, v->height);
+    lm_draw_fullscreen();
+    if (panel.column < v->width && panel_timed_frame(v)) { /* what the panel spares the display, timed */
+      panel_stretch t0 = panel_clock(v);
+      lm_set_scissor(true, panel.column, 0, v->width - panel.column, v->height);
+      lm_draw_fullscreen();
+      panel_lap(v, t0, -1, v->panel_spent);
+    }
+    lm_set_scissor(false, 0, 0, 0, 0);
   }
-  lm_program_use(p);
-  lm_program_bind_texture(lm_program_uniform(p, "src"), src);
-  lm_program_bind_texture(lm_program_uniform(p, "overlay"), v->overlay_tex);
-  lm_program_bind_texture(lm_program_uniform(p, "panel"), panel.id ? panel : v->overlay_tex);
-  set_int(p, "show_panel", panel.id != 0);
-  /* The wipe: the other side right of the split (the frame only, not a
-   * target): the reference or its heat map while the error view is on,
-   * else the A/B --compare side. */
-  bool reference = reference_shown(v);
-  lm_texture other = !reference                             ? (v->compare_on ? v->compare_shown : src)
-                     : v->error_view == ERROR_VIEW_REFERENCE ? v->reference_tex
-                                                             : v->heat_tex;
-  float split = (v->compare_on || reference) && mode == 0 ? v->split * (float)v->width : -1.0f;
-  lm_program_bind_texture(lm_program_uniform(p, "other"), other);
-  set_int(p, "other_linear", reference && v->error_view == ERROR_VIEW_REFERENCE);
-  set_float(p, "split", &split);
-  set_int(p, "mode", mode);
-  set_int(p, "channel", v->channel);
-  set_float(p, "exposure", &v->exposure);
-  set_float(p, "range", v->range);
-  lm_draw_fullscreen();
+  if (v->panel && v->panel_on) composite_panel(v, &panel);
 }
 
 bool screenshot(viewer *v, const char *path) {

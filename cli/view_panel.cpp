@@ -40,6 +40,13 @@ struct lm_panel {
   lm_texture image;
   int image_w, image_h;
   uint64_t drawn;                  // the draw lists' hash in `image`
+  panel_image shown;               // the last frame's
+  // Laid out only while something changes: ImGui's frame (new frame,
+  // layout, draw lists) is most of an idle panel's cost, and with the same
+  // input and model it lays out the same panel.
+  uint64_t input, model;           // the last frame's
+  int quiet;                       // frames in a row with both the same
+  bool graph_open;                 // the frame graph's window was open last frame
 };
 
 // The mouse without the GLFW backend's per-frame queries: its NewFrame asks
@@ -72,7 +79,9 @@ lm_panel *panel_create(lm_window *w, lm_error *err) {
   p->context = ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr; // no imgui.ini in the user's folder
   ImGui::StyleColorsDark();
-  ImGui::GetStyle().Alpha = 0.92f;
+  // Opaque: where its window stands the display composites the panel alone
+  // (llvmpipe's cost is per pixel drawn, 10-16 ns of CPU at 640x480).
+  ImGui::GetStyle().Colors[ImGuiCol_WindowBg].w = 1.0f;
   // The backends chain GLFW's callbacks: the viewer's key queue still gets every key.
   p->window = static_cast<GLFWwindow *>(lm_window_handle(w));
   bool glfw = ImGui_ImplGlfw_InitForOpenGL(p->window, true);
@@ -254,20 +263,9 @@ static bool graph_header(lm_panel *p, const panel_model *m) {
 }
 
 static void graph_window(lm_panel *p, const panel_model *m, panel_edits *e, float left_width, float height) {
-  int n = m->pass_count;
-  // Columns: one right of the last pass that wrote any of its inputs.
-  std::vector<int> column(n, 0), writer(m->target_count, -1);
-  int columns = 1;
-  for (int i = 0; i < n; i++) {
-    const panel_pass &pass = m->passes[i];
-    for (int k = 0; k < pass.input_count; k++) {
-      int t = pass.inputs[k];
-      if (t >= 0 && t < m->target_count && writer[t] >= 0) column[i] = std::max(column[i], column[writer[t]] + 1);
-    }
-    for (int k = 0; k < pass.output_count; k++)
-      if (pass.outputs[k] >= 0 && pass.outputs[k] < m->target_count) writer[pass.outputs[k]] = i;
-    columns = std::max(columns, column[i] + 1);
-  }
+  int n = m->pass_count, columns = 1;
+  std::vector<int> column(n);
+  for (int i = 0; i < n; i++) column[i] = m->passes[i].column, columns = std::max(columns, column[i] + 1);
   const ImGuiStyle &style = ImGui::GetStyle();
   float line = ImGui::GetTextLineHeightWithSpacing(), pad = style.FramePadding.x, gap = 36;
   // Each box's size, each column's width, and the boxes' places within their column.
@@ -306,22 +304,19 @@ static void graph_window(lm_panel *p, const panel_model *m, panel_edits *e, floa
     return ImVec2(origin.x + at[i].x + (input ? 0 : size[i].x), origin.y + at[i].y + (2 + row + 0.5f) * line + pad);
   };
   // Edges first, under the boxes: from the pass that last wrote a target before each reader.
-  std::fill(writer.begin(), writer.end(), -1);
-  std::vector<int> writer_row(m->target_count, 0);
   for (int i = 0; i < n; i++) {
     const panel_pass &pass = m->passes[i];
     for (int k = 0; k < pass.input_count; k++) {
-      int t = pass.inputs[k];
-      if (t < 0 || t >= m->target_count || writer[t] < 0) continue;
-      ImVec2 a = slot(writer[t], writer_row[t], false), b = slot(i, k, true);
+      int w = pass.writers[k];
+      if (w < 0 || w >= n) continue;
+      const panel_pass &from = m->passes[w];
+      int row = 0; // the target's row among the writer's outputs
+      while (row < from.output_count && from.outputs[row] != pass.inputs[k]) row++;
+      ImVec2 a = slot(w, from.input_count + row, false), b = slot(i, k, true);
       float bend = std::fmax(gap, 0.4f * std::fabs(b.x - a.x));
-      bool grey = pass.culled || m->passes[writer[t]].culled;
+      bool grey = pass.culled || from.culled;
       draw->AddBezierCubic(a, ImVec2(a.x + bend, a.y), ImVec2(b.x - bend, b.y), b,
                            ImGui::GetColorU32(grey ? ImGuiCol_TextDisabled : ImGuiCol_PlotLines), 1.5f);
-    }
-    for (int k = 0; k < pass.output_count; k++) {
-      int t = pass.outputs[k];
-      if (t >= 0 && t < m->target_count) writer[t] = i, writer_row[t] = pass.input_count + k;
     }
   }
   ImVec2 clip_lo = ImGui::GetWindowPos(), clip_hi = ImVec2(clip_lo.x + left_width, clip_lo.y + height);
@@ -433,15 +428,65 @@ static uint64_t draw_hash(const ImDrawData *d) {
   return h;
 }
 
-lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height, panel_edits *e) {
+// A string in a hash, NULL apart from "".
+static uint64_t hash_text(const char *s, uint64_t h) { return s ? lm_hash(s, strlen(s) + 1, h) : lm_hash("\1", 1, h); }
+
+template <typename T> static uint64_t hash_value(const T &x, uint64_t h) { return lm_hash(&x, sizeof x, h); }
+
+// What the model shows at this size. The frame graph's times change every
+// frame: they count only while its window is open.
+static uint64_t model_hash(const panel_model *m, int width, int height, bool graph_open) {
+  uint64_t h = hash_value(width, hash_value(height, 14695981039346656037ull));
+  for (int i = 0; i < m->option_count; i++) {
+    const lm_option_info &o = m->options[i];
+    h = hash_text(o.value, hash_text(o.name, h));
+    h = hash_value(o.lo, hash_value(o.hi, hash_value(o.step, hash_value(o.rule, hash_value(o.type, h)))));
+  }
+  for (int i = 0; i < m->technique_count; i++) h = hash_text(m->techniques[i], h);
+  if (m->animated) // a still scene's time runs on unseen
+    h = hash_value(m->time, hash_value(m->time_lo, hash_value(m->time_hi, hash_value(m->paused, h))));
+  h = hash_value(m->technique, hash_value(m->compare_technique, hash_value(m->compare_on, h)));
+  h = hash_value(m->reference_here, hash_value(m->error_view, h));
+  h = hash_text(m->status, hash_text(m->cost, hash_text(m->reference, h)));
+  if (m->compare_option) h = hash_text(m->compare_option->value, hash_text(m->compare_option->name, h));
+  for (int i = 0; graph_open && i < m->pass_count; i++) {
+    const panel_pass &pass = m->passes[i];
+    h = hash_value(pass.ms, hash_value(pass.culled, hash_text(pass.name, h)));
+    h = lm_hash(pass.inputs, sizeof *pass.inputs * static_cast<size_t>(pass.input_count), h);
+    h = lm_hash(pass.outputs, sizeof *pass.outputs * static_cast<size_t>(pass.output_count), h);
+  }
+  for (int i = 0; graph_open && i < m->target_count; i++) h = hash_text(m->targets[i], h);
+  return h;
+}
+
+// The input ImGui sees this frame: the mouse, keys, typed text and the wheel.
+static uint64_t input_hash(const ImGuiIO &io) {
+  uint64_t h = hash_value(io.MousePos, hash_value(io.MouseDown, 14695981039346656037ull));
+  h = hash_value(io.KeysDown, hash_value(io.KeyCtrl, hash_value(io.KeyShift, hash_value(io.KeyAlt, h))));
+  return hash_value(io.MouseWheel, hash_value(io.MouseWheelH, hash_value(io.InputQueueCharacters.Size, h)));
+}
+
+// The rectangle the draw lists' vertices cover, in window pixels from the
+// bottom left (x, y, width, height): all the panel draws.
+static void cover(const ImDrawData *d, int width, int height, int rect[4]) {
+  float lo[2] = {FLT_MAX, FLT_MAX}, hi[2] = {-FLT_MAX, -FLT_MAX};
+  for (int i = 0; i < d->CmdListsCount; i++)
+    for (const ImDrawVert &v : d->CmdLists[i]->VtxBuffer) {
+      lo[0] = std::fmin(lo[0], v.pos.x), lo[1] = std::fmin(lo[1], v.pos.y);
+      hi[0] = std::fmax(hi[0], v.pos.x), hi[1] = std::fmax(hi[1], v.pos.y);
+    }
+  float w = static_cast<float>(width), h = static_cast<float>(height);
+  int x0 = static_cast<int>(std::floor(std::fmin(std::fmax(lo[0], 0.0f), w)));
+  int y0 = static_cast<int>(std::floor(std::fmin(std::fmax(lo[1], 0.0f), h)));
+  int x1 = static_cast<int>(std::ceil(std::fmin(std::fmax(hi[0], 0.0f), w)));
+  int y1 = static_cast<int>(std::ceil(std::fmin(std::fmax(hi[1], 0.0f), h)));
+  rect[0] = x0, rect[1] = height - y1, rect[2] = std::max(0, x1 - x0), rect[3] = std::max(0, y1 - y0);
+}
+
+panel_image panel_frame(lm_panel *p, const panel_model *m, int width, int height, panel_edits *e) {
   *e = panel_edits{};
   e->technique = -1, e->inspect = -1, e->error_view = -1, e->compare_technique = -1, e->compare_pick = -1;
-  ImGui_ImplOpenGL3_NewFrame();
   ImGuiIO &io = ImGui::GetIO();
-  double now = lm_now_ms();
-  io.DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
-  io.DeltaTime = p->last_ms > 0 ? static_cast<float>(std::fmax((now - p->last_ms) * 1e-3, 1e-4)) : 1.0f / 60.0f;
-  p->last_ms = now;
   if (p->scripted) {
     io.MousePos = ImVec2(static_cast<float>(p->mouse[0]), static_cast<float>(p->mouse[1]));
     io.MouseDown[0] = p->mouse_down;
@@ -452,8 +497,20 @@ lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height,
       pressed[i] = false;
     }
   }
+  // Unchanged for a few frames (a click, a hover settle over two or three)
+  // and nothing held or typed into: the last frame's panel stands.
+  enum { SETTLE_FRAMES = 3 };
+  uint64_t input = input_hash(io), model = model_hash(m, width, height, p->graph_open);
+  p->quiet = input == p->input && model == p->model && !ImGui::IsAnyItemActive() ? p->quiet + 1 : 0;
+  p->input = input, p->model = model;
+  if (p->quiet > SETTLE_FRAMES && p->shown.texture.id && p->image_w == width && p->image_h == height) return p->shown;
+  ImGui_ImplOpenGL3_NewFrame();
+  double now = lm_now_ms();
+  io.DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
+  io.DeltaTime = p->last_ms > 0 ? static_cast<float>(std::fmax((now - p->last_ms) * 1e-3, 1e-4)) : 1.0f / 60.0f;
+  p->last_ms = now;
   ImGui::NewFrame();
-  float w = std::fmin(320.0f, 0.45f * static_cast<float>(width));
+  float w = std::floor(std::fmin(320.0f, 0.45f * static_cast<float>(width))); // whole pixels: opaque to its edge
   ImGui::SetNextWindowPos(ImVec2(static_cast<float>(width) - w, 0), ImGuiCond_Always);
   ImGui::SetNextWindowSize(ImVec2(w, static_cast<float>(height)), ImGuiCond_Always);
   ImGui::Begin("limn", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
@@ -488,25 +545,30 @@ lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height,
   ImGui::PopItemWidth();
   ImGui::End();
   if (graph) graph_window(p, m, e, static_cast<float>(width) - w, static_cast<float>(height));
+  p->graph_open = graph;
   ImGui::Render();
   ImDrawData *d = ImGui::GetDrawData();
+  p->shown = panel_image{};
   if (!p->image.id || p->image_w != width || p->image_h != height) {
     lm_texture_destroy(&p->image);
     lm_texture_desc desc = {LM_FORMAT_RGBA8, width, height, false};
     lm_error err;
-    if (!lm_texture_create(&p->image, &desc, "viewer panel", &err)) return p->image;
+    if (!lm_texture_create(&p->image, &desc, "viewer panel", &err)) return p->shown;
     p->image_w = width, p->image_h = height, p->drawn = 0;
   }
   uint64_t h = draw_hash(d);
   if (h != p->drawn) { // premultiplied: ImGui blends alpha as "over" into the cleared image
     lm_attachments att = {{p->image}, 1, {0}, width, height};
     lm_error err;
-    if (!lm_attachments_bind(&att, &err)) return lm_texture{0};
+    if (!lm_attachments_bind(&att, &err)) return p->shown;
     lm_texture_clear(p->image);
     ImGui_ImplOpenGL3_RenderDrawData(d);
     p->drawn = h;
   }
-  return p->image;
+  p->shown.texture = p->image;
+  cover(d, width, height, p->shown.cover);
+  p->shown.column = width - static_cast<int>(w);
+  return p->shown;
 }
 
 void panel_list_widgets(const lm_panel *p, FILE *out) {

@@ -27,6 +27,8 @@ typedef struct panel_pass {
   double ms;                      /* its time last frame, < 0: not run */
   const int *inputs, *outputs;    /* outputs: colour targets, then the depth target */
   int input_count, output_count;
+  const int *writers;             /* each input's writer (a pass index; -1: last frame's), lm_graph_input_writer */
+  int column;                     /* its depth, lm_graph_pass_depths */
 } panel_pass;
 
 /* What the panel shows this frame (borrowed for the call). */
@@ -73,10 +75,17 @@ typedef struct panel_edits {
 
 lm_panel *panel_create(lm_window *w, lm_error *err);
 void panel_destroy(lm_panel *p);
+/* The panel's image and where it goes over the display. */
+typedef struct panel_image {
+  lm_texture texture;  /* RGBA8, premultiplied alpha, the window's size; id 0 on a GL error */
+  int cover[4];        /* what it draws: x, y from the bottom left, width, height */
+  int column;          /* its window covers x >= column at every height, opaque */
+} panel_image;
 /* Lays the panel out along the right edge of a width x height window, fills
- * *edits, and returns the panel's image (RGBA8, premultiplied alpha, drawn
- * again only when it changed) to composite over the frame; id 0 on a GL error. */
-lm_texture panel_frame(lm_panel *p, const panel_model *m, int width, int height, panel_edits *edits);
+ * *edits, and returns its image (drawn again only when it changed). While
+ * neither the input nor the model changes (after a few frames to settle) the
+ * layout is skipped and the last image returned. */
+panel_image panel_frame(lm_panel *p, const panel_model *m, int width, int height, panel_edits *edits);
 /* Scripted mouse input (tests): from this call on the panel sees the cursor
  * at (x, y) window pixels and the left button as `down`, not the real mouse. */
 void panel_set_mouse(lm_panel *p, double x, double y, bool down);

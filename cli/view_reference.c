@@ -159,8 +159,9 @@ void describe_reference(viewer *v, bool log) {
     char share[32] = "n/a";
     if (has_removed) snprintf(share, sizeof share, "%.1f%%", removed);
     snprintf(v->reference_text + n, sizeof v->reference_text - (size_t)n,
-             ": mean error %.5f, Pearson %.4f, indirect error removed %s (%s %.5f, floor %.5f)",
-             v->live.mean_error, v->live.pearson, share, BASELINE, v->base_error, v->floor);
+             ": mean error %.5f, Pearson %.4f, indirect error removed %s of %s's (its error %.5f, floor %.5f;"
+             " limn report --baseline %s)",
+             v->live.mean_error, v->live.pearson, share, BASELINE, v->base_error, v->floor, BASELINE);
   } else if (n > 0 && (size_t)n < sizeof v->reference_text) {
     snprintf(v->reference_text + n, sizeof v->reference_text - (size_t)n, " here (E: the error against it)");
   }

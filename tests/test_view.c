@@ -1242,6 +1242,81 @@ static void panel_graph_button_inspects_target(void **state) {
   assert_true(file_has(log, "inspecting 'gbuffer.clr' rgba8"));
 }
 
+/* The panel's "Write job (J)" button writes one job, as J does: the
+ * technique and the options changed. */
+static void panel_button_writes_job(void **state) {
+  (void)state;
+  char log[512], keys[256], dir[512], job[600], scene[512];
+  double rect[4];
+  log_path(log, "panel_job");
+  snprintf(dir, sizeof dir, "%s/button", root);
+  mkdir(dir, 0755);
+  snprintf(scene, sizeof scene, "%s/data/scenes/cornell.glb", LIMN_SOURCE_ROOT); /* a job names a file */
+  strcpy(keys, "5:widgets");
+  int rc = 0;
+  for (int run = 0; run < 2 && !rc; run++) { /* where the button is, then a click on it */
+    pid_t pid = spawn_view(log, "--panel", "on", "--scene", scene, "--tech", "dl", "--set", "ambient=0.25", "--size",
+                           "384x288", "--exit-after", run ? "12" : "6", "--capture-dir", dir, "--script-keys", keys,
+                           NULL);
+    rc = wait_exit(pid, 30000);
+    if (run) break;
+    find_control(log, "job", rect);
+    keys[0] = '\0';
+    click_keys(keys, sizeof keys, 6, rect);
+  }
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  snprintf(job, sizeof job, "%s/limn-view-0001.lua", dir);
+  assert_true(file_has(job, "\"dl\""));
+  assert_true(file_has(job, "[\"ambient\"] = \"0.25\""));
+  snprintf(job, sizeof job, "%s/limn-view-0002.lua", dir);
+  assert_false(lm_file_exists(job)); /* one click, one job */
+}
+
+/* The inspector gives the raw value of the texel under the cursor: the
+ * depth target's there equals what P writes of it (EXR, raw values), at a
+ * texel (on the short block) whose depth differs from its mirror's across
+ * either axis, so that a flipped cursor would not pass. */
+static void inspector_value_under_cursor(void **state) {
+  (void)state;
+  enum { X = 62, Y = 50, W = 96, H = 72 };
+  char log[512], dir[512], keys[128];
+  log_path(log, "inspect_cursor");
+  snprintf(dir, sizeof dir, "%s/cursor", root);
+  mkdir(dir, 0755);
+  snprintf(keys, sizeof keys, "2:inspect=gbuffer.dpt,3:mouse=%d;%d,4:P", X, Y);
+  pid_t pid = spawn_view(log, "--tech", "dl", "--size", "96x72", "--verbose", "--exit-after", "6", "--capture-dir",
+                         dir, "--script-keys", keys, NULL);
+  int rc = wait_exit(pid, 30000);
+  if (rc) print_log(log);
+  assert_int_equal(rc, 0);
+  char *s = read_text(log), *line = strstr(s, "of the inspected target: "), path[600];
+  if (!line) print_log(log);
+  assert_non_null(line);
+  int at[2];
+  float shown[4];
+  while (line > s && line[-1] != '\n') line--;
+  line = strstr(line, "texel ");
+  assert_int_equal(sscanf(line, "texel %d,%d of the inspected target: %f %f %f %f", &at[0], &at[1], &shown[0],
+                          &shown[1], &shown[2], &shown[3]), 6);
+  free(s);
+  assert_int_equal(at[0], X);
+  assert_int_equal(at[1], Y);
+  snprintf(path, sizeof path, "%s/limn-gbuffer.dpt-0001.exr", dir);
+  lm_image img;
+  lm_error err;
+  assert_true(lm_image_read(path, &img, &err));
+  assert_int_equal(img.width, W);
+#define DEPTH(x, y) img.pixels[((size_t)(y) * img.width + (x)) * img.channels]
+  float raw = DEPTH(X, Y), across_x = DEPTH(W - 1 - X, Y), across_y = DEPTH(X, H - 1 - Y);
+#undef DEPTH
+  fprintf(stderr, "depth under the cursor: shown %.9g, written %.9g (mirrored %.9g, %.9g)\n", shown[0], raw, across_x,
+          across_y);
+  assert_true(fabsf(raw - across_x) > 1e-3f && fabsf(raw - across_y) > 1e-3f);
+  assert_true(fabsf(shown[0] - raw) <= 1e-6f * fabsf(raw));
+  lm_image_free(&img);
+}
+
 /* Mean absolute difference per value over columns x0..x1-1 of the lower half
  * (a message may show at the top). */
 static double band_diff(const lm_image *a, const lm_image *b, int x0, int x1) {
@@ -1519,6 +1594,8 @@ int main(int argc, char **argv) {
       cmocka_unit_test_teardown(inspector_order_and_grey_depth, stop_leftover),
       cmocka_unit_test_teardown(panel_plays_pauses_and_scrubs, stop_leftover),
       cmocka_unit_test_teardown(panel_graph_button_inspects_target, stop_leftover),
+      cmocka_unit_test_teardown(panel_button_writes_job, stop_leftover),
+      cmocka_unit_test_teardown(inspector_value_under_cursor, stop_leftover),
       cmocka_unit_test_teardown(compare_wipe_shows_both_sides, stop_leftover),
       cmocka_unit_test_teardown(reference_error_and_wipe, stop_leftover),
       cmocka_unit_test_teardown(panel_picks_compare_technique, stop_leftover),

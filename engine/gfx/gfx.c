@@ -220,6 +220,14 @@ void lm_draw_fullscreen(void) {
   glDrawArrays(GL_TRIANGLES, 0, 3); /* one triangle covering the viewport */
 }
 
+void lm_draw_fullscreen_over(void) {
+  glEnable(GL_BLEND);
+  glBlendEquation(GL_FUNC_ADD);
+  glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  lm_draw_fullscreen();
+  glDisable(GL_BLEND);
+}
+
 void lm_draw_points(int count) {
   if (count <= 0) return;
   if (!empty_vao) glCreateVertexArrays(1, &empty_vao);

@@ -86,6 +86,9 @@ typedef struct lm_attachments {
 bool lm_attachments_bind(const lm_attachments *att, lm_error *err);
 void lm_clear(int color_count, const float rgba[4], bool clear_depth, float depth);
 void lm_draw_fullscreen(void);
+/* The same over what the outputs hold, the fragment's colour premultiplied by
+ * its alpha (colour + (1 - alpha) * output; blending on for this draw only). */
+void lm_draw_fullscreen_over(void);
 /* Draws `count` points from no vertex data (the vertex shader numbers them by
  * gl_VertexID), each one pixel, added to what the outputs hold (additive
  * blending, on for this draw only). */

@@ -377,6 +377,20 @@ lm_graph_pass_info lm_graph_pass(const lm_graph *g, int i) {
                               t >= 0 ? g->targets[t].height : 0, &p->desc};
 }
 
+int lm_graph_input_writer(const lm_graph *g, int i, int k) {
+  return last_writer(g, g->passes[i].desc.inputs[k].target, i);
+}
+
+void lm_graph_pass_depths(const lm_graph *g, int *depth) {
+  for (int i = 0; i < g->pass_count; i++) { /* writers come before readers: their depths are known */
+    depth[i] = 0;
+    for (int k = 0; k < g->passes[i].desc.input_count; k++) {
+      int w = lm_graph_input_writer(g, i, k);
+      if (w >= 0 && depth[w] + 1 > depth[i]) depth[i] = depth[w] + 1;
+    }
+  }
+}
+
 int lm_graph_target_count(const lm_graph *g) { return g->target_count; }
 
 lm_graph_target_info lm_graph_target(const lm_graph *g, int i) {

@@ -150,6 +150,13 @@ typedef struct lm_graph_pass_info {
 } lm_graph_pass_info;
 int lm_graph_pass_count(const lm_graph *g);
 lm_graph_pass_info lm_graph_pass(const lm_graph *g, int i);
+/* The pass whose output input k of pass i reads: the last before i that
+ * writes its target; -1 when none does (a persistent target's last frame). */
+int lm_graph_input_writer(const lm_graph *g, int i, int k);
+/* Each pass's depth into depth[lm_graph_pass_count]: 0 when it reads no
+ * earlier pass's output, else one more than the deepest whose output it
+ * reads (the column a drawing of the graph puts it in). */
+void lm_graph_pass_depths(const lm_graph *g, int *depth);
 
 typedef struct lm_graph_target_info {
   const char *name;
