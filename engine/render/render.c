@@ -9,7 +9,7 @@
 
 #include "trace/trace.h"
 
-enum { MAX_LIGHTS = 256 };
+enum { MAX_LIGHTS = 256, VIEW_SETS = 2 /* lm_pass_desc.view_set: shadow tiles, RSM views */ };
 
 /* Shadow tiles kept from frame to frame, one cache for each scene pass with
  * views (lm_pass_desc.view_set: the shadow pass, the RSM pass): a copy of
@@ -63,7 +63,7 @@ struct lm_renderer {
   bool sharing;
   lm_trace *trace; /* the scene's BVH, built by the first CPU "trace" pass */
   uint64_t trace_hash; /* geometry_hash when it was built or refitted */
-  tile_cache tiles[2]; /* by lm_pass_desc.view_set */
+  tile_cache tiles[VIEW_SETS];
   uint64_t casters_hash; /* this frame's material_hash (record) */
   float *prev_world; /* each node's world transform in the previous frame (velocities) */
   int prev_world_count, prev_world_cap; /* nodes it holds (another count than the scene's: a first frame) */
@@ -93,7 +93,7 @@ lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
   r->graph = lm_graph_create();
   r->sharing = true;
   r->output_srgb = r->output_linear = -1;
-  for (int i = 0; i < 2; i++) r->tiles[i].execution = -1;
+  for (int i = 0; i < VIEW_SETS; i++) r->tiles[i].execution = -1;
   lm_renderer_resize(r, desc->width, desc->height);
   r->clock = lm_clock_choose(desc->clock);
   return r;
@@ -107,7 +107,7 @@ static void tile_cache_free(tile_cache *c) {
 
 void lm_renderer_destroy(lm_renderer *r) {
   if (!r) return;
-  for (int i = 0; i < 2; i++) tile_cache_free(&r->tiles[i]);
+  for (int i = 0; i < VIEW_SETS; i++) tile_cache_free(&r->tiles[i]);
   lm_graph_destroy(r->graph);
   lm_shadow_plan_free(&r->shadows);
   lm_readback_free(&r->fit_read);
@@ -582,7 +582,8 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
 bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
   if (!lm_scene_upload(scene, err)) return false;
   r->desc.scene = scene;
-  for (int i = 0; i < 2; i++) r->tiles[i].tile_count = 0; /* another scene's textures are not hashed: draw every tile again */
+  for (int i = 0; i < VIEW_SETS; i++) /* another scene's textures are not hashed: draw every tile again */
+    r->tiles[i].tile_count = 0;
   r->frame = 0;
   lm_trace_destroy(r->trace);
   r->trace = NULL;
@@ -951,7 +952,7 @@ static bool execute(lm_renderer *r, lm_graph *g, int meter, lm_error *err) {
   lm_frame_data *frame = &r->camera;
   r->stats = r->shadow_stats = (lm_scene_draw_stats){0};
   r->executions++;
-  for (int i = 0; i < 2; i++) r->tiles[i].in_place = false;
+  for (int i = 0; i < VIEW_SETS; i++) r->tiles[i].in_place = false;
   memcpy(frame->prev_view_proj, r->frame ? r->prev_view_proj : frame->view_proj, sizeof frame->prev_view_proj);
   memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
   /* A first frame (after a cut, or another scene) has no previous transforms: nothing moved. */

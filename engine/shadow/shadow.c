@@ -251,7 +251,7 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
   if (!(zf > zn) || !isfinite(zf)) zn = 0, zf = 2.0f * extent + step;
   glm_ortho(l, r, b, t, zn, zf, proj);
   glm_mat4_mul(proj, view, vp);
-  int size = grow > 0 ? tile_size(plan->tile, plan->rsm_level) : plan->tile;
+  int size = grow > 0 ? plan->rsm_tile : plan->tile;
   if (st->stabilize) {
     /* Texel snapping: move the projection so the world origin falls on a
      * texel corner; a camera moving by less than a texel moves no edge. */
@@ -510,7 +510,7 @@ static void plan_rsm_views(lm_shadow_plan *plan) {
   plan->rsm_height = plan->rsm_tile * (n > 0 ? (n + plan->rsm_columns - 1) / plan->rsm_columns : 1);
   plan->rsm_views = lm_realloc(plan->rsm_views, sizeof *plan->rsm_views * (size_t)(n + 1));
   lm_shadow_view_data *data = lm_alloc(sizeof *data * (size_t)(shadows + n + 1));
-  memcpy(data, plan->view_data, sizeof *data * (size_t)shadows);
+  if (shadows > 0) memcpy(data, plan->view_data, sizeof *data * (size_t)shadows);
   for (int i = 0, k = 0; i < plan->light_count; i++) {
     int32_t *cube = plan->lights[i].cube, first = cube[1];
     cube[1] = shadows + k;
@@ -586,7 +586,7 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
   while (tile_size(plan->tile, plan->rsm_level + 1) >= st->rsm_resolution) plan->rsm_level++;
   lm_light_data *ld = lm_alloc(sizeof *ld * (size_t)(s->light_count + 1));
   lm_scene_light_data(s, ld, s->light_count);
-  int count = 0, *size = lm_alloc(sizeof *size * (size_t)(6 * s->light_count + 1));
+  int count = 0, rsm_count = 0, *size = lm_alloc(sizeof *size * (size_t)(6 * s->light_count + 1));
   for (int i = 0; i < s->light_count; i++) {
     const lm_light *l = &s->lights[i];
     plan->levels[i] = 0;
@@ -602,6 +602,7 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
       views = l->type == LM_LIGHT_SPOT ? 1 : __builtin_popcount((unsigned)plan->lights[i].cube[0]);
     }
     for (int k = 0; k < views; k++) size[count++] = tile_size(plan->tile, plan->levels[i]);
+    if (st->rsm > 0) rsm_count += l->type == LM_LIGHT_DIRECTIONAL ? 1 : views; /* plan_rsm_views */
   }
   free(ld);
   int *cell = lm_alloc(sizeof *cell * (size_t)(3 * count + 1));
@@ -615,6 +616,8 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
   plan->atlas_width = plan->tile * plan->columns;
   plan->atlas_height = plan->tile * plan->rows;
   plan->rsm_tile = tile_size(plan->tile, plan->rsm_level);
+  int rsm_columns = rsm_count > 0 ? (int)ceil(sqrt((double)rsm_count)) : 1; /* as plan_rsm_views lays them */
+  while (plan->rsm_tile > 1 && plan->rsm_tile * rsm_columns > max) plan->rsm_tile /= 2;
   plan_views(plan, s, cam);
   return true;
 }

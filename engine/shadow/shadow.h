@@ -91,8 +91,9 @@ typedef struct lm_shadow_plan {
   int view_count;
   int shadow_views; /* the views shadow lookups read: all of them (the ESM blur's) */
   /* The RSM views (settings.rsm > 0), for the RSM pass: every light's, each
-   * rsm_tile texels a side, in rows of rsm_columns in their own atlas of
-   * rsm_width x rsm_height texels, in the lights' order. */
+   * rsm_tile texels a side (the cell halved rsm_level times, halved again
+   * while the RSM atlas would pass the GL limit), in rows of rsm_columns in
+   * their own atlas of rsm_width x rsm_height texels, in the lights' order. */
   lm_pass_view *rsm_views;
   int rsm_view_count, rsm_tile, rsm_columns, rsm_width, rsm_height;
   /* Block 3: the shadow views' records, then the RSM views' (their rect in the RSM atlas). */
