@@ -821,7 +821,8 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
           anim[at] = round ? fmin(anim[at], a) : a;
           outside[at] = round ? fmin(outside[at], t1 - t0 - in_passes) : t1 - t0 - in_passes;
           lm_scene_draw_stats ds = lm_renderer_shadow_draw_stats(s->r);
-          tiles[at] = lm_renderer_shadows(s->r)->view_count - ds.kept;
+          const lm_shadow_plan *plan = lm_renderer_shadows(s->r); /* shadow tiles and RSM views */
+          tiles[at] = plan->view_count + plan->rsm_view_count - ds.kept;
           scrolled[at] = ds.scrolled;
         }
         if (ok && k == STREAM_MOVING) {

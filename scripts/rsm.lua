@@ -29,8 +29,8 @@ rsm.defaults = {
   radius = 1.0,      -- sampling disc radius in tiles of the RSM, (0, 2]
   reach = 3,         -- a directional light's RSM tile covers the sphere around what is seen,
                      -- its radius times reach, 1..64 (senders off screen; no world unit)
-  resolution = 128,  -- that tile's texels a side, 16..8192 (shadow.resolution halved whole times, the
-                     -- least at or above; spot and point lights' RSMs are their shadow tiles): the
+  resolution = 128,  -- every RSM view's texels a side, 16..8192 (shadow.resolution halved whole times,
+                     -- the least at or above; spot and point lights' views too: docs/shadows.md): the
                      -- gather's cost grows with the texels its samples scatter over, and 128 removed
                      -- as much of dl+esm's indirect error as 512 (docs/gi-combined.md)
   steps = 0,         -- screen-space visibility march a sample, 0..32 (0: none; the seed's

@@ -80,13 +80,14 @@ end
 -- `shadow_atlas`, or nil when no light casts shadows (nothing is recorded).
 -- With the G-buffer G (recorded before), cascades fit the depths it sees
 -- (shadow.depth_range); without, the depths of the meshes in view.
--- With rsm ({ reach =, resolution = }: the checked options of rsm, vpl or lpv), the same pass
--- also writes reflective shadow maps (seed 004; shadow.frag), returned second as
--- { flux =, nrm =, pos =, views =, seen = } (atlas-sized, rsm.frag reads them; views: how many
--- tiles are the lights' RSM views; seen: the depth range G sees, shadow.depth_range, nil
--- without G); a directional light gets one more tile for them, over the sphere around all that
--- is seen, its radius times reach, of `resolution` texels a side (shadow_plan's rsm_resolution).
--- Without, no RSM target or tile exists.
+-- With rsm ({ reach =, resolution = }: the checked options of rsm, vpl or lpv), a second scene
+-- pass, shadow.rsm, writes reflective shadow maps (seed 004; shadow.frag) over the plan's RSM
+-- views alone, into their own atlas (docs/shadows.md "The RSM atlas": every view `resolution`
+-- texels a side, shadow_plan's rsm_resolution); returned second as { flux =, nrm =, pos =,
+-- views =, seen = } (rsm.frag reads them through the views' records; views: how many RSM views;
+-- seen: the depth range G sees, shadow.depth_range, nil without G). A directional light's RSM
+-- view is one tile over the sphere around all that is seen, its radius times reach; a spot or
+-- point light's are its shadow views. Without, no RSM target or view exists.
 -- A scene with blended materials (scene_blended()) gets one more output, shadow.transmit: what
 -- its blended casters let through (rgb) beyond their least depth (a), which shadow.bind adds
 -- to lighting passes (SHADOW_TRANSMIT, shaders/shadow.glsl): lighter, tinted shadows.
@@ -102,24 +103,30 @@ function shadow.render(o, G, rsm)
   local size = { plan.width, plan.height }
   local map = target{ "shadow.map", format = "r32f", size = size }
   local seen = G and shadow.depth_range(G) or nil
-  local R = rsm and { flux = target{ "shadow.rsm_flux", format = "rgba16f", size = size },
-                      nrm = target{ "shadow.rsm_nrm", format = "rgba16f", size = size },
-                      pos = target{ "shadow.rsm_pos", format = "rgba32f", size = size },
-                      views = plan.rsm_views, seen = seen } or nil
-  local out = R and { map, R.flux, R.nrm, R.pos } or { map }
   local transmit = scene_blended() and target{ "shadow.transmit", format = "rgba16f", size = size } or nil
-  out[#out + 1] = transmit
   scene{ "shadow.depth", technique = "shadow", views = plan, fit = seen,
          fit_margin = seen and o.fit == "previous" and o.fit_margin or nil,
-         out = out, clear = { 1, 1, 1, 1 }, transmit = transmit,
-         defines = { RSM = R ~= nil, TRANSMIT = transmit and #out - 1 or nil },
+         out = { map, transmit }, clear = { 1, 1, 1, 1 }, transmit = transmit,
+         defines = { TRANSMIT = transmit and 1 or nil },
          depth = target{ "shadow.zbuffer", format = "depth32f", size = size } }
+  local R
+  if rsm then
+    local rsize = { plan.rsm_width, plan.rsm_height }
+    R = { flux = target{ "shadow.rsm_flux", format = "rgba16f", size = rsize },
+          nrm = target{ "shadow.rsm_nrm", format = "rgba16f", size = rsize },
+          pos = target{ "shadow.rsm_pos", format = "rgba32f", size = rsize },
+          views = plan.rsm_views, seen = seen }
+    -- After shadow.depth: its fit (seen) places the RSM views too.
+    scene{ "shadow.rsm", technique = "shadow", views = plan, rsm = true, fit = seen,
+           out = { R.flux, R.nrm, R.pos }, clear = { 1, 1, 1, 1 }, defines = { RSM = true },
+           depth = target{ "shadow.rsm_zbuffer", format = "depth32f", size = rsize } }
+  end
   filter_of[map], transmit_of[map] = FILTERS[plan.technique], transmit
   if plan.technique ~= "esm" or plan.blur == 0 then return map, R end
   local blurred = map
   for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do
     blurred = pass{ "shadow.blur_" .. axis[1], shader = "esm_blur.frag", inputs = { shadow_atlas = blurred },
-                    params = { direction = axis[2], radius = plan.blur, c = plan.c, views = plan.shadow_views }, -- not the RSM's wide tiles after them
+                    params = { direction = axis[2], radius = plan.blur, c = plan.c, views = plan.shadow_views },
                     out = target{ "shadow.esm_" .. axis[1], format = "r32f", size = size } }
   end
   filter_of[blurred], transmit_of[blurred] = filter_of[map], transmit

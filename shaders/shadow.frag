@@ -1,6 +1,7 @@
 // Stores depth normalized to the light's range (not exp(c d): filtering in
-// log space keeps large c finite, see esm_blur.frag). With RSM, the
-// reflective shadow map of seed 004 (lines 858-904) as well: the sender's
+// log space keeps large c finite, see esm_blur.frag). With RSM (the RSM
+// pass over the RSM views, scripts/shadow.lua), instead the reflective
+// shadow map of seed 004 (lines 858-904): the sender's
 // reflectance k_d albedo (its flux is the light's radiance there times this
 // and the texel's area, rsm.glsl), its world normal turned toward the light
 // and its world position, with the normal again in w (normal_pack: the
@@ -21,12 +22,12 @@ uniform mat3 base_color_xform; // KHR_texture_transform
 in vec3 world_normal;
 uniform vec3 material_color;
 uniform vec4 material_k; // k_a, k_d, k_s, shininess
-layout(location = 1) out vec4 rsm_flux;
-layout(location = 2) out vec4 rsm_nrm;
-layout(location = 3) out vec4 rsm_pos;
-#endif
-
+layout(location = 0) out vec4 rsm_flux;
+layout(location = 1) out vec4 rsm_nrm;
+layout(location = 2) out vec4 rsm_pos;
+#else
 layout(location = 0) out float depth01;
+#endif
 
 #ifdef TRANSMIT
 // The transmittance output (lm_pass_desc.transmit): what a blended caster
@@ -69,10 +70,12 @@ void main() {
 #ifdef ALPHA_MASK
   if (alpha_masked(texel.a)) discard;
 #endif
+#ifndef RSM
   if (pass_depth.w > 0.0) // perspective: distance from the light / range
     depth01 = saturate(length(world_pos - pass_depth.xyz) * pass_depth.w);
   else                    // orthographic: window depth is already linear
     depth01 = saturate(gl_FragCoord.z); // casters before the near plane are clamped onto it
+#endif
 #ifdef TRANSMIT
 #ifdef ALPHA_BLEND
   transmit = vec4(glass_transmittance(texel), depth01);

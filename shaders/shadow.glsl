@@ -29,10 +29,10 @@ struct ShadowView {
   vec4 texel; // a texel's world size (orthographic) or its size per unit of distance; world depth 0..1 spans
 };
 #ifdef LIGHT_BLOCKS
-// Copies in uniform blocks, as common.glsl's lights: at most 6 views a light
-// (engine/scene/scene.h, LM_LIGHT_SET_VIEWS).
+// Copies in uniform blocks, as common.glsl's lights: at most 6 shadow views a
+// light and as many RSM views (engine/scene/scene.h, LM_LIGHT_SET_VIEWS).
 layout(std140, binding = 2) uniform LimnLightSetShadows { ShadowLight shadow_lights[LIGHT_BLOCKS]; };
-layout(std140, binding = 3) uniform LimnLightSetShadowViews { ShadowView shadow_views[LIGHT_BLOCKS * 6]; };
+layout(std140, binding = 3) uniform LimnLightSetShadowViews { ShadowView shadow_views[LIGHT_BLOCKS * 12]; };
 #else
 layout(std430, binding = 2) readonly buffer LimnShadowLights { ShadowLight shadow_lights[]; };
 layout(std430, binding = 3) readonly buffer LimnShadowViews { ShadowView shadow_views[]; };

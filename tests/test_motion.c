@@ -529,7 +529,7 @@ static void shadows_follow_moving_casters(void **state) {
       frame(&c);
       frame(&u);
       lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(c.renderer);
-      int views = lm_renderer_shadows(c.renderer)->view_count;
+      int views = lm_renderer_shadows(c.renderer)->view_count + lm_renderer_shadows(c.renderer)->rsm_view_count;
       double worst = 0;
       for (int i = 0; i < c.width * c.height * 3; i++) worst = fmax(worst, fabs(c.rgb[i] - u.rgb[i]));
       print_message("%s, %s: %d of %d tiles kept, %d drawn over their static layer, %d nodes drawn; worst "

@@ -179,8 +179,8 @@ static void a_closed_room_with_one_lit_patch_lights_its_ceiling(void **state) {
   }
 }
 
-/* RSM targets, the gather and a directional light's wide tile exist only
- * in a frame that reads them; the combined technique gathers the RSM in
+/* RSM targets, their pass, the gather and a directional light's wide tile
+ * (the one RSM view, in the RSM atlas) exist only in a frame that reads them; the combined technique gathers the RSM in
  * ISR's first march, with no pass of the RSM's own. */
 static void a_frame_that_reads_no_rsm_renders_none(void **state) {
   (void)state;
@@ -193,15 +193,17 @@ static void a_frame_that_reads_no_rsm_renders_none(void **state) {
     assert_int_equal(lm_graph_find_target(g, "shadow.rsm_flux") >= 0, reads);
     assert_int_equal(lm_graph_find_target(g, "shadow.rsm_pos") >= 0, reads);
     assert_int_equal(gl_has_pass(&r, "rsm.") || gl_has_pass(&r, "vpl."), reads && t != 3);
-    assert_int_equal(lm_renderer_shadows(r.renderer)->view_count, 3 + reads); /* cascades (+ the wide tile) */
+    assert_int_equal(gl_has_pass(&r, "shadow.rsm"), reads);
+    assert_int_equal(lm_renderer_shadows(r.renderer)->view_count, 3); /* cascades */
+    assert_int_equal(lm_renderer_shadows(r.renderer)->rsm_view_count, reads); /* the wide tile */
     assert_int_equal(gl_culled(&r, ""), 0);
     gl_result_free(&r);
   }
   lm_scene_destroy(s);
 }
 
-/* The shadow pass's RSM targets are kept across frames as its depth is
- * (shadow.cache): a still frame keeps every tile, the RSM's wide tile too,
+/* The RSM pass's targets are kept across frames as the shadow pass's are
+ * (shadow.cache, a cache each): a still frame keeps every tile, the RSM's wide tile too,
  * in place, and gives the image of a renderer that draws them all; after
  * the canopy moves every tile is drawn again (each cleared alone) and the
  * frame is the one a fresh renderer gives. rsm+esm reads them all; vpl+esm
@@ -216,7 +218,7 @@ static void rsm_tiles_are_kept_and_give_the_drawn_image(void **state) {
     gl_result c = gl_render(&(gl_run){.scene = s, .tech = techs[t], .sets = on, .width = W, .height = H, .frames = 2});
     gl_result u = gl_render(&(gl_run){.scene = s, .tech = techs[t], .sets = off, .width = W, .height = H, .frames = 2});
     assert_true(c.ok && u.ok);
-    int views = lm_renderer_shadows(c.renderer)->view_count;
+    int views = lm_renderer_shadows(c.renderer)->view_count + lm_renderer_shadows(c.renderer)->rsm_view_count;
     lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(c.renderer);
     size_t bytes = sizeof(float) * 3 * W * H;
     printf("%s: %d of %d tiles kept, %d in place; %s the image every tile drawn gives\n", techs[t], kept.kept, views,

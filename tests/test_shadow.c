@@ -526,6 +526,62 @@ static void local_tiles_keep_their_size_near_a_boundary(void **state) {
   lm_scene_destroy(s);
 }
 
+/* The RSM views lie in an atlas of their own, after the shadow views in the
+ * records: a sun (its wide tile) and a point light (six faces) give seven
+ * views of rsm_resolution texels in rows of three, each rect inside the atlas
+ * and apart from the others; the point light's faces keep their shadow
+ * views' matrices, with the texel size of their new size; the shadow pass
+ * keeps the shadow views alone. An atlas past the GL limit halves the views. */
+static void rsm_views_lie_in_an_atlas_of_their_own(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  mat4 m;
+  glm_mat4_identity(m);
+  glm_rotate_x(m, glm_rad(-60.0f), m);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 0.2f,
+                                    .casts_shadows = true, .node = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1)});
+  lm_scene_update(s);
+  lm_frame_data cam;
+  lm_scene_frame_data(s, 0, 256, 192, &cam);
+  lm_shadow_settings st;
+  lm_shadow_settings_default(&st);
+  st.rsm = 3, st.rsm_resolution = 128;
+  lm_shadow_plan plan;
+  lm_error err;
+  assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+  printf("a point light and a sun: %d shadow views in %dx%d, %d RSM views in %dx%d\n", plan.view_count,
+         plan.atlas_width, plan.atlas_height, plan.rsm_view_count, plan.rsm_width, plan.rsm_height);
+  assert_int_equal(plan.view_count, 6 + 3);
+  assert_int_equal(plan.shadow_views, plan.view_count);
+  assert_int_equal(plan.rsm_view_count, 7);
+  assert_int_equal(plan.rsm_tile, 128);
+  assert_int_equal(plan.rsm_width, 3 * 128);
+  assert_int_equal(plan.rsm_height, 3 * 128);
+  const lm_shadow_light_data *point = &plan.lights[0], *sun = &plan.lights[1];
+  assert_int_equal(point->cube[1], plan.view_count);
+  assert_int_equal(point->cube[2], 6);
+  assert_int_equal(sun->cube[1], plan.view_count + 6);
+  assert_int_equal(sun->cube[2], 1);
+  for (int v = 0; v < plan.rsm_view_count; v++) {
+    const float *r = plan.view_data[plan.view_count + v].rect;
+    assert_int_equal(plan.rsm_views[v].width, 128);
+    assert_true(r[0] >= 0 && r[1] >= 0 && r[0] + r[2] <= 1.0f + 1e-6f && r[1] + r[3] <= 1.0f + 1e-6f);
+    for (int u = 0; u < v; u++) assert_false(rects_overlap(r, plan.view_data[plan.view_count + u].rect));
+  }
+  for (int f = 0; f < 6; f++) { /* the faces' views, their texels 512 / 128 times wider */
+    const lm_shadow_view_data *shadow = &plan.view_data[point->info[0] + f], *rsm = &plan.view_data[point->cube[1] + f];
+    assert_memory_equal(shadow->view_proj, rsm->view_proj, sizeof rsm->view_proj);
+    assert_float_equal(rsm->texel[0], shadow->texel[0] * (float)plan.views[point->info[0] + f].width / 128.0f, 1e-6f);
+  }
+  lm_shadow_plan_free(&plan);
+  st.resolution = st.rsm_resolution = 8192; /* seven views of 8192 in rows of three pass 16384 texels */
+  assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+  assert_int_equal(plan.rsm_tile, 4096);
+  assert_true(plan.rsm_width <= 16384 && plan.rsm_height <= 16384);
+  lm_shadow_plan_free(&plan);
+  lm_scene_destroy(s);
+}
+
 static void local_tiles_follow_their_screen_coverage(void **state) {
   (void)state;
   lm_scene *s = builtin("cornell");
@@ -873,11 +929,12 @@ static void unchanged_tiles_are_kept_and_changed_ones_drawn(void **state) {
   lm_scene_destroy(s);
 }
 
-/* A tile drawn over part of a cached one of another size (here the sun's RSM
- * tile, 512 then 64 texels a side at the same place) leaves the cached one
- * stale: when its view comes back with the same key, it is drawn again, and
- * the frame is the one an uncached renderer gives. */
-static void a_tile_drawn_over_a_cached_one_of_another_size_is_drawn_again(void **state) {
+/* The RSM views lie in their own atlas with a cache of its own: the sun's
+ * RSM tile at 512, then 64, then 512 texels a side resizes that atlas and
+ * draws its view again (its cache forgets the tiles of another size), while
+ * every shadow tile stays kept; the frame is the one an uncached renderer
+ * gives. */
+static void the_rsm_resolution_redraws_the_rsm_views_alone(void **state) {
   (void)state;
   lm_scene *s = builtin("field");
   static const char *const at512[] = {"rsm.resolution=512", NULL},
@@ -886,15 +943,15 @@ static void a_tile_drawn_over_a_cached_one_of_another_size_is_drawn_again(void *
   assert_true(c.ok);
   assert_true(gl_set(&c, "rsm.resolution=64") && gl_render_again(&c));
   lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(c.renderer);
-  int views = lm_renderer_shadows(c.renderer)->view_count;
+  int views = lm_renderer_shadows(c.renderer)->view_count, rsm_views = lm_renderer_shadows(c.renderer)->rsm_view_count;
   assert_true(gl_set(&c, "rsm.resolution=512") && gl_render_again(&c));
   lm_scene_draw_stats back = lm_renderer_shadow_draw_stats(c.renderer);
   gl_result fresh = gl_render(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = off});
   assert_true(fresh.ok);
   float d = share_different(&c, &fresh);
-  printf("RSM tile 512 -> 64 -> 512: %d of %d tiles kept, then %d; %.3f%% of pixels differ from a fresh frame\n",
-         kept.kept, views, back.kept, 100.0 * d);
-  assert_true(kept.kept == views - 1 && back.kept == views - 1 && d == 0.0f);
+  printf("RSM tile 512 -> 64 -> 512: %d of %d shadow and %d RSM tiles kept, then %d; %.3f%% of pixels differ from "
+         "a fresh frame\n", kept.kept, views, rsm_views, back.kept, 100.0 * d);
+  assert_true(rsm_views == 1 && kept.kept == views && back.kept == views && d == 0.0f);
   gl_result_free(&c);
   gl_result_free(&fresh);
   lm_scene_destroy(s);
@@ -948,7 +1005,8 @@ int main(void) {
       cmocka_unit_test(cascades_scroll_with_a_moving_camera),
       cmocka_unit_test(unchanged_tiles_are_kept_and_changed_ones_drawn),
       cmocka_unit_test(tiles_whose_texture_another_target_shares_are_copied_back),
-      cmocka_unit_test(a_tile_drawn_over_a_cached_one_of_another_size_is_drawn_again),
+      cmocka_unit_test(the_rsm_resolution_redraws_the_rsm_views_alone),
+      cmocka_unit_test(rsm_views_lie_in_an_atlas_of_their_own),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

@@ -91,6 +91,7 @@ typedef struct lm_pass_desc {
   double fetches;     /* texture fetches a pixel, as the script declares (0: not said); for bench */
   const lm_pass_view *views; /* scene passes: draw once per view; none: the camera */
   int view_count;
+  int view_set; /* which list of the shadow plan the views are: 0 its shadow tiles, 1 its RSM views */
   /* Scene passes with views: a target the engine reads on the CPU just before
    * the pass to fit the views again (lm_graph_exec_desc.fit_views), e.g. the
    * depth range the camera saw for shadow cascades. Kept alive and ordered

@@ -9,10 +9,11 @@
 
 #include "trace/trace.h"
 
-enum { MAX_LIGHTS = 256 };
+enum { MAX_LIGHTS = 256, VIEW_SETS = 2 /* lm_pass_desc.view_set: shadow tiles, RSM views */ };
 
-/* Shadow tiles kept from frame to frame: a copy of every output of the
- * shadow pass (and its depth), and per tile drawn the key of what drew it.
+/* Shadow tiles kept from frame to frame, one cache for each scene pass with
+ * views (lm_pass_desc.view_set: the shadow pass, the RSM pass): a copy of
+ * every output of the pass, and per tile drawn the key of what drew it.
  * While casters move, a second copy keeps each drawn tile's static layer
  * (its casters that did not move this frame, and their key): a tile a moving
  * caster touches copies that layer back and draws the moving casters over it
@@ -62,7 +63,7 @@ struct lm_renderer {
   bool sharing;
   lm_trace *trace; /* the scene's BVH, built by the first CPU "trace" pass */
   uint64_t trace_hash; /* geometry_hash when it was built or refitted */
-  tile_cache tiles;
+  tile_cache tiles[VIEW_SETS];
   uint64_t casters_hash; /* this frame's material_hash (record) */
   float *prev_world; /* each node's world transform in the previous frame (velocities) */
   int prev_world_count, prev_world_cap; /* nodes it holds (another count than the scene's: a first frame) */
@@ -93,7 +94,7 @@ lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
   r->graph = lm_graph_create();
   r->sharing = true;
   r->output_srgb = r->output_linear = -1;
-  r->tiles.execution = -1;
+  for (int i = 0; i < VIEW_SETS; i++) r->tiles[i].execution = -1;
   lm_renderer_resize(r, desc->width, desc->height);
   r->clock = lm_clock_choose(desc->clock);
   return r;
@@ -107,7 +108,7 @@ static void tile_cache_free(tile_cache *c) {
 
 void lm_renderer_destroy(lm_renderer *r) {
   if (!r) return;
-  tile_cache_free(&r->tiles);
+  for (int i = 0; i < VIEW_SETS; i++) tile_cache_free(&r->tiles[i]);
   lm_graph_destroy(r->graph);
   lm_shadow_plan_free(&r->shadows);
   lm_readback_free(&r->fit_read);
@@ -145,6 +146,10 @@ static bool fit_views(void *user, const lm_pass_desc *d, lm_texture fit, int w, 
   (void)err;
   lm_renderer *r = user;
   lm_shadow_plan *plan = &r->shadows;
+  if (d->view_set == 1) { /* the RSM views: the shadow pass before it fitted the plan */
+    if (d->view_count == plan->rsm_view_count) memcpy(views, plan->rsm_views, sizeof *views * (size_t)d->view_count);
+    return true;
+  }
   if (d->view_count != plan->view_count || w < 1 || h < 1) return true;
   double t0 = lm_now_ms();
   float far = r->camera.clip[1], seen_far = far;
@@ -195,7 +200,9 @@ static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, int layer, const 
                           .pancake = sp->view && sp->view->depth[3] == 0,
                           .params = params, .param_count = n, .prev_world = r->prev_world,
                           .dynamic = r->dynamic, .layer = layer,
-                          .blend = sp->view ? LM_BLEND_CAST : sp->desc->blend ? LM_BLEND_ONLY : LM_BLEND_SKIP,
+                          /* blended casters: no RSM senders (the shadow pass's transmittance alone) */
+                          .blend = sp->view ? (sp->desc->view_set ? LM_BLEND_SKIP : LM_BLEND_CAST)
+                                            : sp->desc->blend ? LM_BLEND_ONLY : LM_BLEND_SKIP,
                           .eye_view_proj = sp->view ? NULL : r->camera.view_proj,
                           .transmit = sp->view ? sp->desc->transmit : 0, .outputs = sp->desc->output_count};
   if (sp->view && r->shadows.settings.simplify > 0) /* simplified casters where a tile's texels hide them */
@@ -324,7 +331,7 @@ static uint64_t view_layout(const lm_scene_pass *sp, const lm_graph_target_info 
  * executed, the views in the same places). */
 static bool keeps_views(void *user, const lm_scene_pass *sp) {
   lm_renderer *r = user;
-  tile_cache *c = &r->tiles;
+  tile_cache *c = &r->tiles[sp->desc->view_set];
   lm_graph_target_info t[LM_MAX_COLOR_OUTPUTS + 1];
   int nt = r->shadows.settings.cache ? pass_textures(sp, t) : 0;
   bool same = nt > 0 && nt == c->count && c->execution == r->executions - 1 && view_layout(sp, t) == c->layout;
@@ -407,7 +414,7 @@ static bool casters_animated(const lm_scene *s) {
  * then the moving casters over it. */
 static bool draw_layered(lm_renderer *r, const lm_scene_pass *sp, const lm_graph_target_info *t, int nt,
                          struct cached_tile *cached, uint64_t pass, bool in_place, lm_error *err) {
-  tile_cache *c = &r->tiles;
+  tile_cache *c = &r->tiles[sp->desc->view_set];
   if (!tile_cache_layers(c, err)) return false;
   uint64_t key = tile_key(r, sp, true, pass);
   if (cached->layered && cached->static_key == key) {
@@ -489,12 +496,13 @@ static int scroll_tile(lm_renderer *r, const lm_scene_pass *sp, const lm_graph_t
   int keep[4] = {had[0] + kx > need[0] ? had[0] + kx : need[0], had[1] + ky > need[1] ? had[1] + ky : need[1],
                  had[2] + kx < need[2] ? had[2] + kx : need[2], had[3] + ky < need[3] ? had[3] + ky : need[3]};
   if (!(far <= had_far + 1e-5f && far > -1.0f + 1e-6f) || keep[0] >= keep[2] || keep[1] >= keep[3]) return 0;
-  if (!cached->copied) copy_tile(t, r->tiles.tex, nt, cached, true); /* last frame's, where they move from */
+  const lm_texture *copy = r->tiles[sp->desc->view_set].tex;
+  if (!cached->copied) copy_tile(t, copy, nt, cached, true); /* last frame's, where they move from */
   /* The whole tile moved (outside the box too: what lookups never read stays as it was) */
   int x0 = kx > 0 ? kx : 0, y0 = ky > 0 ? ky : 0, x1 = kx < 0 ? w + kx : w, y1 = ky < 0 ? h + ky : h;
   for (int i = 0; i < nt; i++)
-    if (r->tiles.tex[i].id)
-      lm_texture_copy_moved(t[i].texture, v->x + x0, v->y + y0, r->tiles.tex[i], v->x + x0 - kx, v->y + y0 - ky,
+    if (copy[i].id)
+      lm_texture_copy_moved(t[i].texture, v->x + x0, v->y + y0, copy[i], v->x + x0 - kx, v->y + y0 - ky,
                             x1 - x0, y1 - y0);
   if (in_place) { /* the bands the move left hold last frame's texels: cleared, as a pass not in place is */
     clear_texels(sp, t, nt, v->x, v->y, w, y0);
@@ -532,7 +540,7 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   lm_graph_target_info t[LM_MAX_COLOR_OUTPUTS + 1];
   int nt = sp->view && r->shadows.settings.cache ? pass_textures(sp, t) : 0;
   uint64_t key = 0, pass = 0;
-  tile_cache *c = &r->tiles;
+  tile_cache *c = &r->tiles[sp->desc->view_set];
   if (nt > 0) {
     bool in_place = c->in_place;
     if (!tile_cache_fit(c, t, nt, err)) return false;
@@ -575,7 +583,8 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
 bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
   if (!lm_scene_upload(scene, err)) return false;
   r->desc.scene = scene;
-  r->tiles.tile_count = 0; /* another scene's textures are not hashed: draw every tile again */
+  for (int i = 0; i < VIEW_SETS; i++) /* another scene's textures are not hashed: draw every tile again */
+    r->tiles[i].tile_count = 0;
   r->frame = 0;
   lm_trace_destroy(r->trace);
   r->trace = NULL;
@@ -944,7 +953,7 @@ static bool execute(lm_renderer *r, lm_graph *g, int meter, lm_error *err) {
   lm_frame_data *frame = &r->camera;
   r->stats = r->shadow_stats = (lm_scene_draw_stats){0};
   r->executions++;
-  r->tiles.in_place = false;
+  for (int i = 0; i < VIEW_SETS; i++) r->tiles[i].in_place = false;
   memcpy(frame->prev_view_proj, r->frame ? r->prev_view_proj : frame->view_proj, sizeof frame->prev_view_proj);
   memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
   /* A first frame (after a cut, or another scene) has no previous transforms: nothing moved. */

@@ -116,9 +116,9 @@ typedef struct lm_light {
  * reads a storage buffer in a fragment shader lane by lane (a loop that
  * checks and loads each lane's address, even one all lanes share), a uniform
  * block at an index all lanes share once, at others in one gather. At most 6
- * shadow views a light (a cube; 4 cascades and an RSM tile), LM_LIGHT_SET_VIEWS
- * in all. */
-#define LM_LIGHT_SET_VIEWS (LM_LIGHT_SET_MAX * 6)
+ * shadow views a light (a cube; 4 cascades) and as many RSM views after them
+ * (lm_shadow_plan.view_data), LM_LIGHT_SET_VIEWS in all. */
+#define LM_LIGHT_SET_VIEWS (LM_LIGHT_SET_MAX * 12)
 
 /* Distance beyond which a point or spot light adds nothing (the window's or
  * range's radius); INFINITY for directional lights and unbounded falloffs. */

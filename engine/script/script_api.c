@@ -252,16 +252,14 @@ static int l_plan_index(lua_State *L) {
   else if (!strcmp(k, "tile")) lua_pushinteger(L, plan->tile);
   else if (!strcmp(k, "views")) lua_pushinteger(L, plan->view_count);
   else if (!strcmp(k, "shadow_views")) lua_pushinteger(L, plan->shadow_views);
-  else if (!strcmp(k, "rsm_views")) {
-    int n = 0; /* the lights' RSM views (lm_shadow_light_data.cube z) */
-    for (int i = 0; i < plan->light_count; i++) n += plan->lights[i].cube[2];
-    lua_pushinteger(L, n);
-  }
+  else if (!strcmp(k, "rsm_views")) lua_pushinteger(L, plan->rsm_view_count);
+  else if (!strcmp(k, "rsm_width")) lua_pushinteger(L, plan->rsm_width);
+  else if (!strcmp(k, "rsm_height")) lua_pushinteger(L, plan->rsm_height);
   else if (!strcmp(k, "c")) lua_pushnumber(L, plan->settings.c);
   else if (!strcmp(k, "blur")) lua_pushinteger(L, plan->settings.blur);
   else if (!strcmp(k, "technique")) lua_pushstring(L, (const char *[]){"esm", "pcf", "poisson", "hard", "pcss"}[plan->settings.technique]);
-  else return luaL_error(L, "shadow plan has no field '%s' (width, height, tile, views, shadow_views, rsm_views, c, "
-                         "blur, technique)", k);
+  else return luaL_error(L, "shadow plan has no field '%s' (width, height, tile, views, shadow_views, rsm_views, "
+                         "rsm_width, rsm_height, c, blur, technique)", k);
   return 1;
 }
 
@@ -562,8 +560,8 @@ static int l_scene(lua_State *L) {
   int top = lua_gettop(L);
   begin_pass(L, &b, LM_PASS_SCENE, "scene");
   static const char *const fields[] = {"technique", "out", "depth", "clear", "params", "defines",
-                                       "materials", "views", "fit", "fit_margin", "inputs", "blend", "transmit",
-                                       "simplify", NULL};
+                                       "materials", "views", "rsm", "fit", "fit_margin", "inputs", "blend",
+                                       "transmit", "simplify", NULL};
   check_fields(L, 1, b.what, fields);
   b.desc.shader = opt_string(L, 1, "technique", b.what);
   if (!b.desc.shader) b.desc.shader = "std";
@@ -600,11 +598,20 @@ static int l_scene(lua_State *L) {
     b.desc.simplify = (float)px;
   }
   lua_pop(L, 1);
+  lua_getfield(L, 1, "rsm"); /* the plan's RSM views instead of its shadow tiles (lm_pass_desc.view_set) */
+  if (!lua_isnil(L, -1) && !lua_isboolean(L, -1)) return luaL_error(L, "%s: rsm must be true or false", b.what);
+  bool rsm = lua_toboolean(L, -1);
+  lua_pop(L, 1);
   lua_getfield(L, 1, "views");
   if (!lua_isnil(L, -1)) {
     const lm_shadow_plan *plan = to_plan(L, -1, b.what);
-    b.desc.views = plan->views;
-    b.desc.view_count = plan->view_count;
+    b.desc.views = rsm ? plan->rsm_views : plan->views;
+    b.desc.view_count = rsm ? plan->rsm_view_count : plan->view_count;
+    b.desc.view_set = rsm;
+    if (rsm && !b.desc.view_count)
+      return luaL_error(L, "%s: rsm: the shadow plan has no RSM views (shadow_plan{ rsm = ... })", b.what);
+  } else if (rsm) {
+    return luaL_error(L, "%s: rsm is for a pass with views (a shadow plan)", b.what);
   }
   lua_pop(L, 1);
   lua_getfield(L, 1, "transmit"); /* the output blended casters multiply (lm_pass_desc) */

@@ -251,7 +251,7 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
   if (!(zf > zn) || !isfinite(zf)) zn = 0, zf = 2.0f * extent + step;
   glm_ortho(l, r, b, t, zn, zf, proj);
   glm_mat4_mul(proj, view, vp);
-  int size = grow > 0 ? tile_size(plan->tile, plan->rsm_level) : plan->tile;
+  int size = grow > 0 ? plan->rsm_tile : plan->tile;
   if (st->stabilize) {
     /* Texel snapping: move the projection so the world origin falls on a
      * texel corner; a camera moving by less than a texel moves no edge. */
@@ -301,8 +301,8 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_fram
 }
 
 /* The RSM's wide tile of a directional light: what its cascades cover and
- * around it, in one; after every shadow view, so that the ESM blur, which
- * it does not need, stops before it (plan->shadow_views). */
+ * around it, in one; after every shadow view (plan_rsm_views moves it into
+ * the RSM atlas). */
 static void plan_wide_tile(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
                            const lm_light_data *light, lm_shadow_light_data *out) {
   vec3 dir;
@@ -495,6 +495,41 @@ static int pack_tiles(int tile, const int *size, int n, int *cell, int *x, int *
   return cells;
 }
 
+/* The RSM views, out of the views planned (a directional light's wide tile
+ * after the shadow views, a spot or point light's shadow views): each
+ * light's (cube y, z) in turn, rsm_tile texels a side, in rows of the RSM
+ * atlas; their records follow the shadow views' in view_data, where cube y
+ * then points. A perspective view's texel size follows its new size. The
+ * shadow pass keeps the shadow views alone. */
+static void plan_rsm_views(lm_shadow_plan *plan) {
+  int n = 0, shadows = plan->shadow_views;
+  for (int i = 0; i < plan->light_count; i++) n += plan->lights[i].cube[2];
+  plan->rsm_view_count = n;
+  plan->rsm_columns = n > 0 ? (int)ceil(sqrt((double)n)) : 1;
+  plan->rsm_width = plan->rsm_tile * plan->rsm_columns;
+  plan->rsm_height = plan->rsm_tile * (n > 0 ? (n + plan->rsm_columns - 1) / plan->rsm_columns : 1);
+  plan->rsm_views = lm_realloc(plan->rsm_views, sizeof *plan->rsm_views * (size_t)(n + 1));
+  lm_shadow_view_data *data = lm_alloc(sizeof *data * (size_t)(shadows + n + 1));
+  if (shadows > 0) memcpy(data, plan->view_data, sizeof *data * (size_t)shadows);
+  for (int i = 0, k = 0; i < plan->light_count; i++) {
+    int32_t *cube = plan->lights[i].cube, first = cube[1];
+    cube[1] = shadows + k;
+    for (int j = 0; j < cube[2]; j++, k++) {
+      lm_pass_view *w = &plan->rsm_views[k];
+      lm_shadow_view_data *d = &data[shadows + k];
+      *w = plan->views[first + j], *d = plan->view_data[first + j];
+      if (d->depth[3] > 0) d->texel[0] *= (float)w->width / (float)plan->rsm_tile;
+      w->width = w->height = plan->rsm_tile;
+      w->x = k % plan->rsm_columns * plan->rsm_tile, w->y = k / plan->rsm_columns * plan->rsm_tile;
+      d->rect[0] = (float)w->x / (float)plan->rsm_width, d->rect[1] = (float)w->y / (float)plan->rsm_height;
+      d->rect[2] = (float)w->width / (float)plan->rsm_width, d->rect[3] = (float)w->height / (float)plan->rsm_height;
+    }
+  }
+  free(plan->view_data);
+  plan->view_data = data;
+  plan->view_count = shadows;
+}
+
 /* Every light's views for the camera; then the tiles' places in the atlas. */
 static void plan_views(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam) {
   plan->view_count = 0;
@@ -506,7 +541,7 @@ static void plan_views(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
     if (plan->settings.rsm > 0 && s->lights[i].casts_shadows && s->lights[i].type == LM_LIGHT_DIRECTIONAL)
       plan_wide_tile(plan, s, cam, &ld[i], &plan->lights[i]);
   free(ld);
-  int n = plan->view_count, *cell = lm_alloc(sizeof *cell * (size_t)(4 * n + 1)), *x = cell + n, *y = x + n;
+  int n = plan->shadow_views, *cell = lm_alloc(sizeof *cell * (size_t)(4 * n + 1)), *x = cell + n, *y = x + n;
   int *size = y + n;
   for (int v = 0; v < n; v++) size[v] = plan->views[v].width;
   pack_tiles(plan->tile, size, n, cell, x, y);
@@ -521,6 +556,7 @@ static void plan_views(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
     rect[3] = (float)w->height / (float)plan->atlas_height;
   }
   free(cell);
+  plan_rsm_views(plan);
 }
 
 bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
@@ -550,7 +586,7 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
   while (tile_size(plan->tile, plan->rsm_level + 1) >= st->rsm_resolution) plan->rsm_level++;
   lm_light_data *ld = lm_alloc(sizeof *ld * (size_t)(s->light_count + 1));
   lm_scene_light_data(s, ld, s->light_count);
-  int count = 0, *size = lm_alloc(sizeof *size * (size_t)(6 * s->light_count + 1));
+  int count = 0, rsm_count = 0, *size = lm_alloc(sizeof *size * (size_t)(6 * s->light_count + 1));
   for (int i = 0; i < s->light_count; i++) {
     const lm_light *l = &s->lights[i];
     plan->levels[i] = 0;
@@ -566,7 +602,7 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
       views = l->type == LM_LIGHT_SPOT ? 1 : __builtin_popcount((unsigned)plan->lights[i].cube[0]);
     }
     for (int k = 0; k < views; k++) size[count++] = tile_size(plan->tile, plan->levels[i]);
-    if (st->rsm > 0 && l->type == LM_LIGHT_DIRECTIONAL) size[count++] = tile_size(plan->tile, plan->rsm_level);
+    if (st->rsm > 0) rsm_count += l->type == LM_LIGHT_DIRECTIONAL ? 1 : views; /* plan_rsm_views */
   }
   free(ld);
   int *cell = lm_alloc(sizeof *cell * (size_t)(3 * count + 1));
@@ -579,6 +615,9 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
   while (cells && plan->tile > 1 && (plan->tile * plan->columns > max || plan->tile * plan->rows > max)) plan->tile /= 2;
   plan->atlas_width = plan->tile * plan->columns;
   plan->atlas_height = plan->tile * plan->rows;
+  plan->rsm_tile = tile_size(plan->tile, plan->rsm_level);
+  int rsm_columns = rsm_count > 0 ? (int)ceil(sqrt((double)rsm_count)) : 1; /* as plan_rsm_views lays them */
+  while (plan->rsm_tile > 1 && plan->rsm_tile * rsm_columns > max) plan->rsm_tile /= 2;
   plan_views(plan, s, cam);
   return true;
 }
@@ -594,6 +633,7 @@ void lm_shadow_plan_fit(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_
 void lm_shadow_plan_free(lm_shadow_plan *plan) {
   free(plan->levels);
   free(plan->views);
+  free(plan->rsm_views);
   free(plan->view_data);
   free(plan->lights);
   *plan = (lm_shadow_plan){0};
@@ -610,8 +650,8 @@ void lm_shadow_plan_upload(const lm_shadow_plan *plan, int light_count) {
   if (plan && plan->lights) {
     upload(2, plan->lights, sizeof *plan->lights * (size_t)plan->light_count, sizeof *plan->lights,
            LM_LIGHT_SET_MAX);
-    upload(3, plan->view_data, sizeof *plan->view_data * (size_t)plan->view_count, sizeof *plan->view_data,
-           LM_LIGHT_SET_VIEWS);
+    upload(3, plan->view_data, sizeof *plan->view_data * (size_t)(plan->view_count + plan->rsm_view_count),
+           sizeof *plan->view_data, LM_LIGHT_SET_VIEWS);
     return;
   }
   lm_shadow_light_data *none = lm_alloc(sizeof *none * (size_t)(light_count + 1));

@@ -4,8 +4,9 @@
  * cube faces for a point light. The plan becomes one scene pass drawn once
  * per tile, and two storage blocks the lighting shaders read through
  * shaders/shadow.glsl. A frame that plans nothing renders no shadow map.
- * With settings.rsm the same pass also writes reflective shadow maps
- * (scripts/shadow.lua, shaders/rsm.glsl). */
+ * With settings.rsm it also plans the lights' RSM views, drawn by a second
+ * scene pass into their own atlas of reflective shadow maps (scripts/shadow.lua,
+ * shaders/rsm.glsl). */
 #ifndef LIMN_SHADOW_H
 #define LIMN_SHADOW_H
 
@@ -42,12 +43,12 @@ typedef struct lm_shadow_settings {
                     * false: every tile at resolution */
   float simplify;  /* a caster whose simplified copy (lm_scene_mesh.casters) errs by at most this
                     * many texels of a tile draws that copy there (far cascades, small tiles); 0: none */
-  float rsm;       /* > 0: a frame reads reflective shadow maps (seed 004's senders); each
-                    * directional light gets one more tile, over the sphere around all
+  float rsm;       /* > 0: a frame reads reflective shadow maps (seed 004's senders): every light
+                    * gets RSM views, a directional light one tile over the sphere around all
                     * that is seen with its radius times rsm (senders off screen), 0..64 */
-  int rsm_resolution; /* texels a side of that tile (16 .. 8192): the cell's tile halved whole times,
-                       * the least at or above this (the gathers' cost grows with the texels they
-                       * scatter over, not their count) */
+  int rsm_resolution; /* texels a side of every RSM view (16 .. 8192): the cell's tile halved whole
+                       * times, the least at or above this (the gathers' cost grows with the texels
+                       * they scatter over, not their count) */
   /* The last frame's plan's levels (lm_shadow_plan.levels), last_light_count
    * of them, or NULL: with coverage, a local light keeps its last level
    * while that level's tile is within LM_SHADOW_LEVEL_SLACK of the size the
@@ -65,8 +66,9 @@ typedef struct lm_shadow_light_data {
   float splits[4]; /* cascades: camera depth where each ends */
   float params[4]; /* c, bias (texels), blend, Poisson radius */
   int32_t cube[4]; /* x: point lights' cube faces drawn (bit f: face f, +X -X +Y -Y +Z -Z), in order;
-                    * y, z: the light's RSM views (first, count; count 0 without RSM): the
-                    * wide tile of a directional light, else its shadow views */
+                    * y, z: the light's RSM views (first record in block 3, count; count 0 without
+                    * RSM): the wide tile of a directional light, else its shadow views' matrices,
+                    * in the RSM atlas (lm_shadow_plan.rsm_views) */
   float soft[4];   /* PCSS: light size (radians for cascades, world units else), widest penumbra (texels) */
 } lm_shadow_light_data;
 typedef struct lm_shadow_view_data {
@@ -80,15 +82,22 @@ typedef struct lm_shadow_plan {
   lm_shadow_settings settings;
   /* The atlas is a grid of columns x rows cells of tile texels a side (the
    * resolution, halved while the atlas would pass the GL limit). A cascade
-   * or RSM tile fills a cell; a spot or point light's tiles are the cell
+   * fills a cell; a spot or point light's tiles are the cell
    * halved levels[light] times, packed into quadrants of shared cells. */
   int tile, columns, rows, atlas_width, atlas_height;
   int *levels;         /* per scene light */
-  int rsm_level;       /* the halvings of a directional light's RSM tile (settings.rsm_resolution) */
-  lm_pass_view *views; /* for the scene pass, one per tile */
-  lm_shadow_view_data *view_data;
+  int rsm_level;       /* the halvings of the cell that give an RSM view (settings.rsm_resolution) */
+  lm_pass_view *views; /* for the shadow pass, one per tile */
   int view_count;
-  int shadow_views; /* the first views, those shadow lookups read (the RSM's wide tiles follow) */
+  int shadow_views; /* the views shadow lookups read: all of them (the ESM blur's) */
+  /* The RSM views (settings.rsm > 0), for the RSM pass: every light's, each
+   * rsm_tile texels a side (the cell halved rsm_level times, halved again
+   * while the RSM atlas would pass the GL limit), in rows of rsm_columns in
+   * their own atlas of rsm_width x rsm_height texels, in the lights' order. */
+  lm_pass_view *rsm_views;
+  int rsm_view_count, rsm_tile, rsm_columns, rsm_width, rsm_height;
+  /* Block 3: the shadow views' records, then the RSM views' (their rect in the RSM atlas). */
+  lm_shadow_view_data *view_data;
   lm_shadow_light_data *lights; /* one per scene light */
   int light_count;
   float seen[2]; /* camera depths cascades cover: where receivers are seen */
