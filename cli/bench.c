@@ -560,7 +560,8 @@ static double trace_median_ms(const bench *b, const lm_trace *t, const lm_trace_
   return m;
 }
 
-static void trace_figures(bench *b, const lm_scene *s) {
+static void trace_figures(bench *b, lm_scene *s) {
+  lm_scene_restore_geometry(s);
   lm_trace *t = lm_trace_create(s, &b->trace_stats);
   lm_trace_ray *rays = lm_alloc(sizeof *rays * 800 * 450);
   b->trace_rays = mirror_rays(t, s, b->trace_threads, 800, 450, rays);
@@ -742,6 +743,7 @@ static bool stream_open(bench *b, int k, stream *s, lm_error *err) {
   motion *m = &b->motion;
   int rc;
   s->scene = lm_scene_load(b->common.scene, err);
+  if (s->scene) s->scene->gpu_only = true;
   s->pipe = s->scene ? capture_load_pipeline(&b->common, &rc, err) : NULL;
   if (!s->pipe || !lm_scene_upload(s->scene, err)) return false;
   if (k == STREAM_ALONE && !caches_off(s->pipe, m->caches_off, sizeof m->caches_off, err)) return false;
@@ -1194,6 +1196,7 @@ int limn_bench(int argc, char **argv) {
     lm_pipeline_destroy(pipe);
     return 2;
   }
+  scene->gpu_only = true; /* the tracer's figures read the vertices back (trace_figures) */
   motion *m = &b.motion;
   if (m->timed) {
     m->anim = lm_scene_find_animation(scene, m->animation, &err);

@@ -343,6 +343,7 @@ int limn_capture(int argc, char **argv) {
     lm_pipeline_destroy(pipeline);
     return 2;
   }
+  scene->gpu_only = true; /* a technique that traces reads them back (lm_scene_restore_geometry) */
   int animation = LM_ANIM_ALL;
   if (a.animation && (animation = lm_scene_find_animation(scene, a.animation, &err)) < LM_ANIM_NONE) {
     lm_log(LM_LOG_ERROR, "--animation %s: %s", a.animation, err.msg);

@@ -131,6 +131,40 @@ static void a_mirror_shows_the_box_where_the_tracer_says(void **state) {
   lm_scene_destroy(s);
 }
 
+/* A gpu_only scene (as the command line's renderers load one) frees its
+ * meshes' CPU vertices and indices at the upload, and reads them back from
+ * the GPU, exactly, when a technique traces: the reflection is the same. */
+static void a_gpu_only_scene_reads_its_vertices_back(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *s = lm_scene_builtin("cornell_mirror", &err), *kept = lm_scene_builtin("cornell_mirror", &err);
+  assert_non_null(s);
+  assert_non_null(kept);
+  s->gpu_only = true;
+  const char *off[] = {"ambient=0.3", NULL}, *on[] = {"ambient=0.3", "reflections.enabled=true", NULL};
+  gl_result r = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = off, .width = W, .height = H});
+  if (!r.ok) fail_msg("%s", r.err.msg);
+  assert_true(s->mesh_count > 0);
+  for (int i = 0; i < s->mesh_count; i++) assert_null(s->meshes[i].vertices), assert_null(s->meshes[i].indices);
+  gl_result_free(&r);
+  r = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = on, .width = W, .height = H, .check_finite = true});
+  if (!r.ok) fail_msg("%s", r.err.msg);
+  gl_result k = gl_render(&(gl_run){.scene = kept, .tech = "dl", .sets = on, .width = W, .height = H});
+  if (!k.ok) fail_msg("%s", k.err.msg);
+  for (int i = 0; i < s->mesh_count; i++) {
+    const lm_scene_mesh *m = &s->meshes[i], *w = &kept->meshes[i];
+    assert_non_null(m->vertices);
+    assert_memory_equal(m->vertices, w->vertices, sizeof(float) * 8 * (size_t)m->vertex_count);
+    assert_memory_equal(m->indices, w->indices, sizeof(uint32_t) * (size_t)m->index_count);
+  }
+  assert_true(gl_all_finite(&r));
+  assert_memory_equal(r.rgb, k.rgb, sizeof(float) * 3 * W * H);
+  gl_result_free(&k);
+  gl_result_free(&r);
+  lm_scene_destroy(kept);
+  lm_scene_destroy(s);
+}
+
 /* With reflections on but no reflective material, no reflection pass is recorded. */
 static void nothing_reflective_records_no_pass(void **state) {
   (void)state;
@@ -209,6 +243,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(a_mirror_shows_the_box_where_the_tracer_says),
       cmocka_unit_test(nothing_reflective_records_no_pass),
+      cmocka_unit_test(a_gpu_only_scene_reads_its_vertices_back),
       cmocka_unit_test(every_technique_reflects),
       cmocka_unit_test(reflections_hold_at_every_scale),
   };

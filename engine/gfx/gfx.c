@@ -399,6 +399,11 @@ void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const f
   m->index_count = index_count;
 }
 
+void lm_mesh_read(const lm_mesh *m, float *vertices, int vertex_count, uint32_t *indices, int index_count) {
+  glGetNamedBufferSubData(m->vbo, 0, (GLsizeiptr)vertex_count * 8 * sizeof(float), vertices);
+  glGetNamedBufferSubData(m->ibo, 0, (GLsizeiptr)index_count * sizeof(uint32_t), indices);
+}
+
 void lm_mesh_update_vertices(lm_mesh *m, const float *vertices, int vertex_count) {
   glNamedBufferSubData(m->vbo, 0, (GLsizeiptr)vertex_count * 8 * sizeof(float), vertices);
 }

@@ -228,6 +228,9 @@ typedef struct lm_mesh { uint32_t vao, vbo, tbo, ibo, pbo; int index_count; bool
 void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const float *tangents,
                     const uint32_t *indices, int index_count);
 void lm_mesh_destroy(lm_mesh *m);
+/* Reads back the first vertex_count vertices and index_count indices given to lm_mesh_create
+ * (a scene that freed its own copy after the upload and needs it again: lm_scene_restore_geometry). */
+void lm_mesh_read(const lm_mesh *m, float *vertices, int vertex_count, uint32_t *indices, int index_count);
 /* Replaces the interleaved vertices (the same count as created): a deformed mesh's new pose. */
 void lm_mesh_update_vertices(lm_mesh *m, const float *vertices, int vertex_count);
 /* A deformed mesh's positions in the previous frame (xyz a vertex, the same

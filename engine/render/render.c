@@ -678,7 +678,10 @@ static bool run_trace(lm_renderer *r, const lm_cpu_pass *cp, lm_error *err) {
   }
   const lm_scene *s = r->desc.scene;
   uint64_t h = geometry_hash(r);
-  if (!r->trace) r->trace = lm_trace_create(s, NULL);
+  if (!r->trace) {
+    lm_scene_restore_geometry(r->desc.scene); /* a gpu_only scene's */
+    r->trace = lm_trace_create(s, NULL);
+  }
   else if (h != r->trace_hash) lm_trace_update(r->trace, s, NULL); /* nodes moved: refit (or rebuild) */
   r->trace_hash = h;
   int n = ro->width * ro->height, count = 0;

@@ -36,7 +36,9 @@ namespace {
 
 // A file mapped read-only. tinygltf would read the file into memory and copy
 // each buffer out of it again; mapped, its bytes are the page cache's, read
-// where they lie and dropped when the load ends.
+// where they lie and dropped when the load ends (and after each mesh, by
+// release, so that the file's pages and the meshes read from them are not
+// resident together).
 struct Mapping {
   void *addr = MAP_FAILED;
   size_t len = 0;
@@ -47,6 +49,11 @@ struct Mapping {
     if (addr != MAP_FAILED) munmap(addr, len);
   }
   const unsigned char *bytes() const { return addr == MAP_FAILED ? nullptr : (const unsigned char *)addr; }
+  // Drops the pages read so far from this process (they stay in the page
+  // cache: a later read maps them again without reading the disk).
+  void release() const {
+    if (addr != MAP_FAILED) madvise(addr, len, MADV_DONTNEED);
+  }
 };
 
 // Maps regular file `path`; false with "path: why" in err.
@@ -1183,6 +1190,8 @@ bool add_mesh(Loader &L, int ni, int mi, int lm_node) {
       if (id == -1) return false;
       ids.push_back(id);
     }
+    L.src->file.release();
+    for (const auto &bin : L.src->bins) bin->release();
     if (cache.empty()) cache = ids;
   }
   static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};

@@ -316,6 +316,10 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
       return false;
     }
   }
+  for (int i = 0; s->gpu_only && i < s->texture_count; i++) { /* after all: a failed upload keeps them */
+    free(s->textures[i].rgba);
+    s->textures[i].rgba = NULL;
+  }
   double t0 = lm_now_ms();
   long whole = 0, casters = 0, camera = 0;
   int simplified = 0;
@@ -332,6 +336,10 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
     lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, indices ? indices : m->indices, (int)len);
     free(indices);
     m->dirty = false;
+    if (s->gpu_only && !m->rest) {
+      free(m->vertices), free(m->indices);
+      m->vertices = NULL, m->indices = NULL;
+    }
     if (m->caster_levels || m->lod_levels) {
       simplified++, whole += m->index_count / 3;
       casters += m->caster_levels ? m->casters[m->caster_levels - 1].count / 3 : m->index_count / 3;
@@ -343,6 +351,16 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
              "camera's (%.0f ms)", s->name, simplified, whole, casters, camera, lm_now_ms() - t0);
   s->uploaded = true;
   return true;
+}
+
+void lm_scene_restore_geometry(lm_scene *s) {
+  for (int i = 0; s->uploaded && i < s->mesh_count; i++) {
+    lm_scene_mesh *m = &s->meshes[i];
+    if (m->vertices) continue;
+    m->vertices = lm_alloc(sizeof(float) * 8 * (size_t)m->vertex_count);
+    m->indices = lm_alloc(sizeof(uint32_t) * (size_t)m->index_count);
+    lm_mesh_read(&m->gpu, m->vertices, m->vertex_count, m->indices, m->index_count);
+  }
 }
 
 int lm_scene_upload_deformed(lm_scene *s) {

@@ -249,6 +249,13 @@ typedef struct lm_scene {
   double time;           /* the seconds lm_scene_set_time last posed */
   int animation;         /* and its animation (LM_ANIM_NONE before any) */
   bool uploaded;
+  /* Set before lm_scene_upload by an owner that reads no vertex on the CPU
+   * (a renderer's, not an exporter's): the upload frees each undeformed
+   * mesh's vertices and indices once they are on the GPU (vertices NULL),
+   * so that the two copies are never whole together, and the textures'
+   * pixels (rgba NULL); the tracer reads the geometry back
+   * (lm_scene_restore_geometry). */
+  bool gpu_only;
 } lm_scene;
 
 /* The animation `spec` names: its name, its index ("0"), or "all"
@@ -348,6 +355,10 @@ bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err)
 
 /* ---- rendering (needs a GL context) ------------------------------------ */
 bool lm_scene_upload(lm_scene *s, lm_error *err);
+/* Reads back from the GPU the vertices and indices a gpu_only upload freed
+ * (the tracer's, when a technique with traced rays is loaded); needs the GL
+ * context. Nothing to do when none were freed. */
+void lm_scene_restore_geometry(lm_scene *s);
 /* Uploads the vertices of the deformed meshes that lm_scene_set_time changed,
  * with their prev_positions (lm_mesh_set_prev_positions); a mesh that did not
  * change since the last call draws its current positions as the previous
