@@ -32,14 +32,16 @@ Options = {
 for name, d in pairs(post.defaults()) do Options[name] = d end
 
 -- Each technique a row (fields: scripts/techniques.lua), its modules' options joining Options: the
--- seed viewer's modes first, then the seeds' GI (docs/gi-combined.md for the combined rows).
+-- default first, the seed viewer's modes, then the seeds' GI (docs/gi-combined.md for the combined rows).
 local technique = techniques.add
--- The default (the first row) is the technique that removes the most indirect error within 2x dl+esm's
--- frame at 256x192 with a moving camera (docs/techniques.md#the-default-error-against-time). On a quiet
--- machine (MOTION=1 tools/gi_time.sh, four rounds) isr+esm costs 1.84x and removes 43.2% of dl+esm's
--- indirect error against POV-Ray (34.4% against Cycles); isr+rsm+esm removes 74.5% (67.5%) at 3.25x, and
--- every technique that reads an RSM costs 2.7x or more (its shadow tiles, five targets, drawn as the
--- camera moves). isr+esm is the only GI technique within the budget.
+-- The default (the first row) is the technique that removes the most indirect error within about 2x
+-- dl+esm's frame at 256x192 with a moving camera (docs/techniques.md#the-default-error-against-time):
+-- isr+rsm+esm removes 72.9% of dl+esm's indirect error against POV-Ray and 67.2% against Cycles (the
+-- reference set, 160x120) at 1.96-2.10x (three quiet runs of MOTION=1 tools/gi_time.sh), where isr+esm
+-- removes 42.1% / 34.4% at 1.6-1.85x and rsm+esm 61.5% / 54.0% at 1.5x. Its RSM is drawn by a pass of
+-- its own over 128-texel views, so a moving camera no longer pays the RSM at every cascade tile.
+technique{ "isr+rsm+esm", lighting = "isr", shadows = true, offscreen = "rsm", joins = "march", split = true,
+           temporal = "isr" } -- image-space radiosity with reflective shadow maps (docs/gi-combined.md)
 technique{ "isr+esm", lighting = "isr", shadows = true, temporal = "isr", key = "F2" } -- image-space radiosity
 technique{ "isr", lighting = "isr", temporal = "isr", key = "F3" }
 technique{ "dl+esm", shadows = true, key = "F4" }
@@ -50,8 +52,6 @@ technique{ "ssao+esm", lighting = "ssao", shadows = true } -- ambient occlusion 
 technique{ "ssao", lighting = "ssao" }
 technique{ "rsm+esm", shadows = true, offscreen = "rsm", temporal = "rsm" } -- reflective shadow maps (seed 004)
 technique{ "vpl+esm", shadows = true, offscreen = "vpl", joins = "lit" } -- indirect, negative point lights (seed 002)
-technique{ "isr+rsm+esm", lighting = "isr", shadows = true, offscreen = "rsm", joins = "march", split = true,
-           temporal = "isr" }
 technique{ "lpv+esm", shadows = true, offscreen = "lpv" } -- light propagation volumes (seed 003)
 technique{ "isr+lpv+esm", lighting = "isr", shadows = true, offscreen = "lpv", split = true, temporal = "isr" }
 

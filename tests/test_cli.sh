@@ -56,11 +56,11 @@ check "bad set" run 2 capture --set novalue
 check "unknown option" run 2 capture --set nope=1
 check "unknown option lists known" err_has "known: ambient="
 check "unknown technique" run 2 capture --tech nope
-check "unknown technique lists known" err_has "known: isr+esm, isr, dl+esm, dl"
+check "unknown technique lists known" err_has "known: isr+rsm+esm, isr+esm, isr, dl+esm, dl"
 check "unknown scene" run 2 capture --scene nope
 check "bad option value" run 2 capture --set ambient=bright
 check "list options" run 0 capture --list-options
-check "list options shows techniques" out_has "techniques: isr+esm isr dl+esm dl"
+check "list options shows techniques" out_has "techniques: isr+rsm+esm isr+esm isr dl+esm dl"
 rows=$(sed -n 's/^technique{ "\([^"]*\)".*/\1/p' "$root/scripts/pp.lua" | tr '\n' ' ')
 check "list options lists pp.lua's rows, no more" grep -qxF "techniques: ${rows% }" "$tmp/out"
 

@@ -149,12 +149,14 @@ static void rows_are_the_techniques(void **state) {
   }
   assert_int_equal(n, 13);
   assert_int_equal(lm_pipeline_technique_count(p), n);
+  /* The default first, then the seed viewer's F2-F5 modes with their keys; no other row has one. */
+  assert_string_equal(lm_pipeline_technique_name(p, 0), "isr+rsm+esm");
   const char *keys[] = {"F2", "F3", "F4", "F5"}, *techs[] = {"isr+esm", "isr", "dl+esm", "dl"};
   for (int i = 0; i < n; i++) {
     const char *key = lm_pipeline_technique_key(p, i);
-    if (i < 4) {
-      assert_string_equal(lm_pipeline_technique_name(p, i), techs[i]);
-      assert_string_equal(key, keys[i]);
+    if (i >= 1 && i <= 4) {
+      assert_string_equal(lm_pipeline_technique_name(p, i), techs[i - 1]);
+      assert_string_equal(key, keys[i - 1]);
     } else {
       assert_null(key);
     }
