@@ -11,6 +11,10 @@
 #       there (device run with carry .devcheck): NVIDIA's EGL device platform,
 #       then `limn bench --motion --clock gpu` per scene at SIZE (default
 #       1920x1080), base and head taking turns, each pass's GPU time moving.
+#       TECHS (default isr+esm), SCENES and ROUNDS (default 2) choose the runs.
+#   tools/device_bench.sh memory FILE...
+#       there: peak resident memory, time to first frame and GPU memory of
+#       `limn bench` (head, dl+esm and the default, 640x480) per scene file.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=.devcheck
@@ -51,37 +55,57 @@ prepare() {
   echo "device: run with carry [\"$dir\"]: tools/device_bench.sh run"
 }
 
-run() {
-  local size=${1:-1920x1080} out=${OUT:-/tmp}/device_bench
-  mkdir -p "$out"
+use_nvidia() { # glvnd's libraries from .devcheck, the machine's NVIDIA EGL vendor
   export LIMN_ROOT=$PWD LD_LIBRARY_PATH=$PWD/$dir/lib
   local f
   for f in /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json; do
     [ -f "$f" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$f && break
   done
   nvidia-smi -L || true
+}
+
+memory() {
+  use_nvidia
+  local file tech
+  for file in "$@"; do
+    for tech in dl+esm default; do
+      local args=(--scene "$file" --sizes 640x480 --frames 4 --warmup 1)
+      [ "$tech" = default ] || args+=(--tech "$tech")
+      echo "== $file $tech"
+      timeout 150 "$dir/head/limn" bench "${args[@]}" 2>&1 | grep -i -e 'peak' -e 'first frame' -e 'gpu memory' || echo "  failed"
+    done
+  done
+}
+
+run() {
+  local size=${1:-1920x1080} out=${OUT:-/tmp}/device_bench
+  mkdir -p "$out"
+  use_nvidia
   local revs=(head)
   [ -x "$dir/base/limn" ] && revs=(base head)
-  local scene
-  for scene in cornell data/scenes/office.glb data/scenes/garage.glb data/scenes/outdoor.glb; do
-    for round in 1 2; do
+  local scene tech round
+  for scene in ${SCENES:-cornell data/scenes/office.glb data/scenes/garage.glb data/scenes/outdoor.glb}; do
+   for tech in ${TECHS:-isr+esm}; do
+    for round in $(seq "${ROUNDS:-2}"); do
       for rev in "${revs[@]}"; do
-        echo "== $rev round $round: $scene isr+esm $size moving"
+        echo "== $rev round $round: $scene $tech $size moving"
         # Whole tables to $OUT (the device tool brings them back); here the moving column.
-        local log="$out/$(basename "$scene" .glb)-$rev-$round.txt"
+        local log="$out/$(basename "$scene" .glb)-$tech-$rev-$round.txt"
         local root=$PWD
         [ -d "$dir/$rev/root" ] && root=$PWD/$dir/$rev/root
-        LIMN_ROOT=$root timeout 150 "$dir/$rev/limn" bench --motion --clock gpu --scene "$scene" --tech isr+esm --sizes "$size" \
+        LIMN_ROOT=$root timeout 150 "$dir/$rev/limn" bench --motion --clock gpu --scene "$scene" --tech "$tech" --sizes "$size" \
           --frames 24 --warmup 4 >"$log" 2>&1 || echo "  failed: $(tail -1 "$log")"
         awk '/^motion at/ {on=1} on && /pass \(ms\)/ {t=1; next} /shadow tiles drawn/ {t=0}
              t { name=$1; for (i=2; i<=NF-5; i++) name=name " " $i; printf "  %-24s %s\n", name, $(NF-3) }' "$log"
       done
     done
+   done
   done
 }
 
 case "${1:-}" in
   prepare) shift; prepare "$@" ;;
   run) shift; run "$@" ;;
-  *) sed -n '2,13p' "$0" >&2; exit 2 ;;
+  memory) shift; memory "$@" ;;
+  *) sed -n '2,16p' "$0" >&2; exit 2 ;;
 esac
