@@ -537,9 +537,8 @@ void lm_pipeline_destroy(lm_pipeline *p) {
 bool lm_pipeline_created(const lm_pipeline *p) { return p->created; }
 
 void lm_pipeline_set_scene(lm_pipeline *p, const lm_scene *scene, const lm_frame_data *camera,
-                           lm_shadow_plan *shadows, int still, int scene_still) {
+                           lm_shadow_plan *shadows, lm_still_frames still) {
   p->still = still;
-  p->scene_still = scene_still;
   p->scene = scene;
   p->camera = camera;
   p->shadows = shadows;

@@ -869,12 +869,14 @@ static int l_output_size(lua_State *L) {
  * world (pipeline, scene content, lights, camera, output size, shaders);
  * 0 when anything changed since the last frame. still_frames("scene"): the
  * same without the camera and the output size (a light's view, such as an
- * RSM, is the same while it is above 0, whatever the camera does). */
+ * RSM, is the same while it is above 0, whatever the camera does).
+ * still_frames("light"): the same light (the lights' records and the
+ * materials' emission), whatever moves. */
 static int l_still_frames(lua_State *L) {
   lm_pipeline *p = recording(L, "still_frames");
-  static const char *const what[] = {"world", "scene", NULL};
-  bool scene = luaL_checkoption(L, 1, "world", what) == 1;
-  lua_pushinteger(L, p->in_create ? 0 : scene ? p->scene_still : p->still);
+  static const char *const what[] = {"world", "scene", "light", NULL};
+  int k = luaL_checkoption(L, 1, "world", what);
+  lua_pushinteger(L, p->in_create ? 0 : k == 0 ? p->still.world : k == 1 ? p->still.scene : p->still.light);
   return 1;
 }
 
