@@ -147,8 +147,16 @@ function temporal.velocity(vel) velocity = vel end
 -- stays as it is, and a refreshed tile finds no change to see (nothing
 -- changed), so the passes would give the same result again (a pixel whose
 -- noise restarted it since keeps the value it has). o: the user's checked
--- options.
-function temporal.settled(o) return o.enabled and o.skip and quiet >= o.frames end
+-- options. A settled frame shows results pre-exposed as they were made, so
+-- it keeps the last frame's pre-exposure (keep_exposure()): the meter reads
+-- a frame late, and after a change of light it may move the exposure on a
+-- settled frame, under results it would not rescale (a sun 1e4 times
+-- brighter: rsm+esm's settled frames 98 times too bright).
+function temporal.settled(o)
+  local settled = o.enabled and o.skip and quiet >= o.frames
+  if settled then keep_exposure() end
+  return settled
+end
 
 -- Declares the history of `user` at 1 / f of the output for each coarse
 -- factor f of `factors` (a number or a list); from OnCreate. Only the

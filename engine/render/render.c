@@ -87,6 +87,7 @@ struct lm_renderer {
   float key;              /* the last key metered (radiance; 0: none yet), the histories' scale of light */
   float peak;             /* this frame's light_peak */
   float script_peak; /* the radiance the script's own light reaches (lm_pipeline_light_peak) */
+  bool keep_exposure; /* the frame shows results kept under the last one's pre-exposure (keep_exposure()) */
 };
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
@@ -855,6 +856,7 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[3], lm_e
   int presented = -1;
   if (!lm_pipeline_record(p, g, &presented, err)) return false;
   r->script_peak = lm_pipeline_light_peak(p);
+  r->keep_exposure = lm_pipeline_keeps_exposure(p);
   double t1 = lm_cpu_ms();
   if (!add_output_stage(r, g, p, presented, out, err) || !add_meter_stage(r, g, p, presented, &out[2], err) ||
       !lm_graph_compile(g, err))
@@ -984,7 +986,9 @@ static bool execute(lm_renderer *r, lm_graph *g, int meter, lm_error *err) {
   r->peak = light_peak(r->desc.scene, frame, lights, n, r->script_peak);
   if (r->meter_exposure > 0) read_meter(r); /* else a view's first frame read it at once */
   if (r->frame < 2) r->meter.valid = false; /* a view's first frame: the meter saw another */
-  float e = fixed_exposure(r) ? r->desc.exposure : frame_exposure(r);
+  float e = fixed_exposure(r)                     ? r->desc.exposure
+            : r->keep_exposure && r->exposure > 0 ? r->exposure /* results kept under it (a settled frame) */
+                                                  : frame_exposure(r);
   if (r->meter.valid) r->key = r->meter.key;
   r->meter.valid = false;
   frame->exposure[0] = e, frame->exposure[1] = 1 / e;

@@ -91,6 +91,10 @@ bool lm_pipeline_present_display(const lm_pipeline *p);
  * lights (light_peak(), sky_sh{}): the renderer's pre-exposure keeps it
  * within half floats too. */
 float lm_pipeline_light_peak(const lm_pipeline *p);
+/* Did the last frame's script call keep_exposure()? It shows results kept
+ * from an earlier frame (a settled GI result, temporal.lua), pre-exposed as
+ * they were made, so the renderer keeps the last frame's pre-exposure. */
+bool lm_pipeline_keeps_exposure(const lm_pipeline *p);
 /* The target the last frame's script named with meter(t): pre-exposed
  * radiance whose brightness sets the next frame's pre-exposure; -1: none
  * (the renderer meters what it presented, unless display values). */

@@ -880,6 +880,17 @@ static int l_still_frames(lua_State *L) {
   return 1;
 }
 
+/* keep_exposure(): this frame shows results kept from an earlier one (a
+ * settled GI result), pre-exposed as they were made: the renderer keeps the
+ * last frame's pre-exposure, where the meter (a frame late) would change it
+ * under them. The world is as it was, so that exposure still holds it. */
+static int l_keep_exposure(lua_State *L) {
+  lm_pipeline *p = recording(L, "keep_exposure");
+  if (p->in_create) return luaL_error(L, "keep_exposure() is called from OnRender");
+  p->keep_exposure = true;
+  return 0;
+}
+
 /* light_peak(x, ...): radiances the frame's script adds besides the scene's
  * lights (ambient, background), so that the renderer's pre-exposure, which
  * brightens a dim scene before half floats store it, keeps them in range. */
@@ -905,7 +916,7 @@ void lm_script_open_api(lua_State *L) {
   lua_pop(L, 1);
   static const luaL_Reg api[] = {{"target", l_target}, {"scene", l_scene}, {"pass", l_pass},
                                  {"present", l_present}, {"output_size", l_output_size}, {"still_frames", l_still_frames},
-                                 {"light_peak", l_light_peak}, {"meter", l_meter},
+                                 {"light_peak", l_light_peak}, {"meter", l_meter}, {"keep_exposure", l_keep_exposure},
                                  {"shadow_plan", l_shadow_plan}, {"sky_sh", l_sky_sh}, {"cpu", l_cpu},
                                  {"scene_reflective", l_scene_reflective}, {"points", l_points},
                                  {"scene_blended", l_scene_blended},

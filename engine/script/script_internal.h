@@ -32,6 +32,7 @@ struct lm_pipeline {
   int shadow_level_count;
   lm_still_frames still;  /* frames in a row before this one that drew the same world, scene, light */
   float light_peak;       /* the largest radiance the script's own light reaches this frame (light_peak, sky_sh) */
+  bool keep_exposure;     /* keep_exposure(): this frame shows results kept under the last one's pre-exposure */
   char sky_map[1024];     /* the sky map sky_sh{} read last ("" none) and its coefficients */
   float sky_map_sh[LM_SKY_SH];
 };
