@@ -80,8 +80,10 @@ options.declare("temporal", rules) -- serves every module's <module>.temporal (o
 
 local velocity = nil -- this frame's G-buffer velocity target (temporal.velocity), or nil
 local histories = {} -- user -> { view = bool, at = { [coarse factor] = { targets = {a, b}, turn = 0, kept = } } }
-local settings, restart = nil, false -- a copy of the last frame's settings (temporal.begin), and whether they changed
+local settings, restart = nil, false -- a copy of the last frame's settings (temporal.begin), and whether
+                                     -- every history starts again this frame (they, or the light, changed)
 local quiet = 0 -- frames in a row before this one with the same world and settings
+local relighting = 0 -- frames in a row before this one whose light changed (still_frames("light") 0)
 
 -- Do two values hold the same content (tables compared key by key)?
 -- Walked each frame instead of a text key: building and sorting one took
@@ -113,9 +115,22 @@ end
 -- settings wherever the two differ by less than its threshold (a report's
 -- next setting, the viewer's next technique). A pipeline's first frame
 -- keeps them: the viewer's reload keeps the histories on purpose.
+-- So does a step of the light (a light's colour, power, position or cone,
+-- a material's emission: still_frames("light"); the sky, ambient and
+-- background are settings): a running mean would keep the old light as
+-- a share of held / (held + new frames), and a converged pixel keeps it
+-- all (its confidence sees a x4 step of faint bounce light as noise), so
+-- the histories start again where the light changes after standing still,
+-- and again where it stands still after changing for two frames or more
+-- (the history then holds the light of the change's last frames). While it
+-- keeps changing, every history is capped at `moving` frames instead
+-- (world_moved), so that a light in constant motion keeps its reuse.
 function temporal.begin(settings_now)
   restart = settings ~= nil and not same(settings_now, settings)
   if restart or not settings then settings = copy(settings_now) end
+  local relit = still_frames("light") == 0
+  restart = restart or (relit and relighting == 0) or (not relit and relighting >= 2)
+  relighting = relit and relighting + 1 or 0
   quiet = (restart or still_frames() == 0) and 0 or quiet + 1
 end
 
@@ -132,8 +147,16 @@ function temporal.velocity(vel) velocity = vel end
 -- stays as it is, and a refreshed tile finds no change to see (nothing
 -- changed), so the passes would give the same result again (a pixel whose
 -- noise restarted it since keeps the value it has). o: the user's checked
--- options.
-function temporal.settled(o) return o.enabled and o.skip and quiet >= o.frames end
+-- options. A settled frame shows results pre-exposed as they were made, so
+-- it keeps the last frame's pre-exposure (keep_exposure()): the meter reads
+-- a frame late, and after a change of light it may move the exposure on a
+-- settled frame, under results it would not rescale (a sun 1e4 times
+-- brighter: rsm+esm's settled frames 98 times too bright).
+function temporal.settled(o)
+  local settled = o.enabled and o.skip and quiet >= o.frames
+  if settled then keep_exposure() end
+  return settled
+end
 
 -- Declares the history of `user` at 1 / f of the output for each coarse
 -- factor f of `factors` (a number or a list); from OnCreate. Only the

@@ -26,7 +26,7 @@
 uniform sampler2D history, history_state;
 uniform float epsilon = 0.02, frames = 36.0, bias = 0.1, confidence = 0.25;
 uniform int refresh = 32;
-uniform int restart = 0; // 1: the settings changed (temporal.begin), no history is kept
+uniform int restart = 0; // 1: the settings or the light changed (temporal.begin), no history is kept
 uniform float moving = 0.0; // > 0: a view-dependent result's most frames while the view changes
 uniform int world_moved = 0; // 1: the world changed since the last frame (a view-dependent result: the camera
                              // too; another: the scene alone, still_frames("scene"))

@@ -152,7 +152,7 @@ static void camera_view_gives_the_frames_camera(void **state) {
   lm_frame_data f = {.camera_pos = {1, 2, 3, 1}, .clip = {0.1f, 50, 0.02f, 0.5f}, .output_size = {64, 48}};
   const float inv_view[16] = {0, 0, -1, 0, 0, 1, 0, 0, 1, 0, 0, 0, 1, 2, 3, 1};
   memcpy(f.inv_view, inv_view, sizeof inv_view);
-  lm_pipeline_set_scene(p, NULL, &f, NULL, 0, 0);
+  lm_pipeline_set_scene(p, NULL, &f, NULL, (lm_still_frames){0});
   assert_false(frame(p, g, &err));
   assert_non_null(strstr(err.msg, "camera 1 2 3 | -1 -0 -0 | 0 1 0 | 0 0 -1 | 0.1 50 0.5 1.33333"));
   lm_graph_destroy(g);

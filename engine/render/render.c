@@ -77,6 +77,8 @@ struct lm_renderer {
   int still;       /* frames in a row before this one whose world_hash was this one's */
   uint64_t scene;  /* the last frame's scene_hash (the world without the camera) */
   int scene_still; /* the same count for scene_hash */
+  uint64_t light;  /* the last frame's light_hash */
+  int light_still; /* the same count for light_hash */
   long executions; /* frames executed, never reset (tile_cache.execution) */
   float exposure;  /* the last frame's pre-exposure (frame_exposure) */
   lm_readback meter_read; /* the last frame's exposure meter, read for this one's pre-exposure */
@@ -85,6 +87,7 @@ struct lm_renderer {
   float key;              /* the last key metered (radiance; 0: none yet), the histories' scale of light */
   float peak;             /* this frame's light_peak */
   float script_peak; /* the radiance the script's own light reaches (lm_pipeline_light_peak) */
+  bool keep_exposure; /* the frame shows results kept under the last one's pre-exposure (keep_exposure()) */
 };
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
@@ -778,17 +781,28 @@ static bool add_meter_stage(const lm_renderer *r, lm_graph *g, lm_pipeline *p, i
   return true;
 }
 
+/* A hash of the scene's light: its lights' records (colour, power,
+ * position, direction, cones, falloff) and its materials' emission. A
+ * change restarts the GI histories (still_frames("light"), temporal.lua),
+ * where a running mean would keep the old light. */
+static uint64_t light_hash(const lm_scene *s) {
+  lm_light_data lights[MAX_LIGHTS];
+  int n = lm_scene_light_data(s, lights, MAX_LIGHTS);
+  uint64_t h = lm_hash(lights, sizeof *lights * (size_t)n, lm_hash(&n, sizeof n, 0));
+  for (int i = 0; i < s->material_count; i++)
+    h = lm_hash(s->material_pbr[i].emissive, sizeof s->material_pbr[i].emissive, h);
+  return h;
+}
+
 /* A hash of what a frame draws besides its script's settings and the
  * camera: the pipeline, the scene's casters and materials (caster_hash, the
- * nodes' transforms and pose with them), its lights and the shaders'
- * generation. What a light's view (shadow tiles, RSM) sees depends on
- * nothing else. */
-static uint64_t scene_hash(const lm_renderer *r, const lm_pipeline *p) {
-  lm_light_data lights[MAX_LIGHTS];
-  int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
+ * nodes' transforms and pose with them), its light (light_hash) and the
+ * shaders' generation. What a light's view (shadow tiles, RSM) sees depends
+ * on nothing else. */
+static uint64_t scene_hash(const lm_renderer *r, const lm_pipeline *p, uint64_t light) {
   unsigned shaders = lm_programs_generation();
   uint64_t h = lm_hash(&p, sizeof p, caster_hash(r));
-  h = lm_hash(lights, sizeof *lights * (size_t)n, lm_hash(&n, sizeof n, h));
+  h = lm_hash(&light, sizeof light, h);
   return lm_hash(&shaders, sizeof shaders, h);
 }
 
@@ -829,16 +843,20 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[3], lm_e
   }
   r->pose += lm_scene_upload_deformed(r->desc.scene) > 0;
   r->casters_hash = material_hash(s); /* once a frame: the world hash and the tile keys read it */
-  uint64_t scene = scene_hash(r, p), world = world_hash(scene, frame);
+  uint64_t light = light_hash(s), scene = scene_hash(r, p, light), world = world_hash(scene, frame);
   r->still = r->frame > 0 && world == r->world ? r->still + 1 : 0;
   r->scene_still = r->frame > 0 && scene == r->scene ? r->scene_still + 1 : 0;
+  r->light_still = r->frame > 0 && light == r->light ? r->light_still + 1 : 0;
   r->world = world;
   r->scene = scene;
-  lm_pipeline_set_scene(p, r->desc.scene, frame, &r->shadows, r->still, r->scene_still);
+  r->light = light;
+  lm_pipeline_set_scene(p, r->desc.scene, frame, &r->shadows,
+                        (lm_still_frames){.world = r->still, .scene = r->scene_still, .light = r->light_still});
   double t0 = lm_cpu_ms();
   int presented = -1;
   if (!lm_pipeline_record(p, g, &presented, err)) return false;
   r->script_peak = lm_pipeline_light_peak(p);
+  r->keep_exposure = lm_pipeline_keeps_exposure(p);
   double t1 = lm_cpu_ms();
   if (!add_output_stage(r, g, p, presented, out, err) || !add_meter_stage(r, g, p, presented, &out[2], err) ||
       !lm_graph_compile(g, err))
@@ -968,7 +986,9 @@ static bool execute(lm_renderer *r, lm_graph *g, int meter, lm_error *err) {
   r->peak = light_peak(r->desc.scene, frame, lights, n, r->script_peak);
   if (r->meter_exposure > 0) read_meter(r); /* else a view's first frame read it at once */
   if (r->frame < 2) r->meter.valid = false; /* a view's first frame: the meter saw another */
-  float e = fixed_exposure(r) ? r->desc.exposure : frame_exposure(r);
+  float e = fixed_exposure(r)                     ? r->desc.exposure
+            : r->keep_exposure && r->exposure > 0 ? r->exposure /* results kept under it (a settled frame) */
+                                                  : frame_exposure(r);
   if (r->meter.valid) r->key = r->meter.key;
   r->meter.valid = false;
   frame->exposure[0] = e, frame->exposure[1] = 1 / e;

@@ -537,9 +537,8 @@ void lm_pipeline_destroy(lm_pipeline *p) {
 bool lm_pipeline_created(const lm_pipeline *p) { return p->created; }
 
 void lm_pipeline_set_scene(lm_pipeline *p, const lm_scene *scene, const lm_frame_data *camera,
-                           lm_shadow_plan *shadows, int still, int scene_still) {
+                           lm_shadow_plan *shadows, lm_still_frames still) {
   p->still = still;
-  p->scene_still = scene_still;
   p->scene = scene;
   p->camera = camera;
   p->shadows = shadows;
@@ -548,6 +547,7 @@ void lm_pipeline_set_scene(lm_pipeline *p, const lm_scene *scene, const lm_frame
 const char *lm_pipeline_present_where(const lm_pipeline *p) { return p->present_where; }
 bool lm_pipeline_present_display(const lm_pipeline *p) { return p->present_display; }
 float lm_pipeline_light_peak(const lm_pipeline *p) { return p->light_peak; }
+bool lm_pipeline_keeps_exposure(const lm_pipeline *p) { return p->keep_exposure; }
 int lm_pipeline_metered(const lm_pipeline *p) { return p->metered; }
 
 bool lm_pipeline_record(lm_pipeline *p, lm_graph *g, int *presented, lm_error *err) {
@@ -570,6 +570,7 @@ bool lm_pipeline_record(lm_pipeline *p, lm_graph *g, int *presented, lm_error *e
   if (ok) {
     p->frame = ++serial ? serial : ++serial; /* never 0: that marks OnCreate's targets */
     p->light_peak = 0;
+    p->keep_exposure = false;
     lua_getglobal(L, "OnRender");
     lua_rawgeti(L, LUA_REGISTRYINDEX, p->options_ref);
     deep_copy(L, -1);

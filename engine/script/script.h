@@ -61,14 +61,21 @@ typedef struct lm_option_info {
  * lists (tables without names) too; *out is malloc'd. Returns the count. */
 int lm_pipeline_options(lm_pipeline *p, lm_option_info **out);
 
+/* How many frames in a row before this one drew the same world (world:
+ * still_frames(), a script's GI may then keep a converged result), the
+ * same without the camera (scene: still_frames("scene"), a light's view,
+ * such as the RSM, changed only when it is 0), and the same light (light:
+ * still_frames("light"), the lights and emission; a GI history restarts
+ * when it changes, temporal.lua). */
+typedef struct lm_still_frames {
+  int world, scene, light;
+} lm_still_frames;
+
 /* What shadow_plan() plans from: the scene, the camera's frame block, and
  * where the plan goes (owned by the caller, kept until the frame executes);
- * still: how many frames in a row before this one drew the same world
- * (still_frames(): a script's GI may then keep a converged result);
- * scene_still: the same without the camera (still_frames("scene"): a
- * light's view, such as the RSM, changed only when it is 0). */
+ * still: how long its world, scene and light have stayed the same. */
 void lm_pipeline_set_scene(lm_pipeline *p, const lm_scene *scene, const lm_frame_data *camera,
-                           lm_shadow_plan *shadows, int still, int scene_still);
+                           lm_shadow_plan *shadows, lm_still_frames still);
 
 /* Records one frame into g (lm_graph_begin already called): OnCreate the
  * first time, then OnRender(tech). *presented gets the target passed to
@@ -84,6 +91,10 @@ bool lm_pipeline_present_display(const lm_pipeline *p);
  * lights (light_peak(), sky_sh{}): the renderer's pre-exposure keeps it
  * within half floats too. */
 float lm_pipeline_light_peak(const lm_pipeline *p);
+/* Did the last frame's script call keep_exposure()? It shows results kept
+ * from an earlier frame (a settled GI result, temporal.lua), pre-exposed as
+ * they were made, so the renderer keeps the last frame's pre-exposure. */
+bool lm_pipeline_keeps_exposure(const lm_pipeline *p);
 /* The target the last frame's script named with meter(t): pre-exposed
  * radiance whose brightness sets the next frame's pre-exposure; -1: none
  * (the renderer meters what it presented, unless display values). */

@@ -869,13 +869,26 @@ static int l_output_size(lua_State *L) {
  * world (pipeline, scene content, lights, camera, output size, shaders);
  * 0 when anything changed since the last frame. still_frames("scene"): the
  * same without the camera and the output size (a light's view, such as an
- * RSM, is the same while it is above 0, whatever the camera does). */
+ * RSM, is the same while it is above 0, whatever the camera does).
+ * still_frames("light"): the same light (the lights' records and the
+ * materials' emission), whatever moves. */
 static int l_still_frames(lua_State *L) {
   lm_pipeline *p = recording(L, "still_frames");
-  static const char *const what[] = {"world", "scene", NULL};
-  bool scene = luaL_checkoption(L, 1, "world", what) == 1;
-  lua_pushinteger(L, p->in_create ? 0 : scene ? p->scene_still : p->still);
+  static const char *const what[] = {"world", "scene", "light", NULL};
+  int k = luaL_checkoption(L, 1, "world", what);
+  lua_pushinteger(L, p->in_create ? 0 : k == 0 ? p->still.world : k == 1 ? p->still.scene : p->still.light);
   return 1;
+}
+
+/* keep_exposure(): this frame shows results kept from an earlier one (a
+ * settled GI result), pre-exposed as they were made: the renderer keeps the
+ * last frame's pre-exposure, where the meter (a frame late) would change it
+ * under them. The world is as it was, so that exposure still holds it. */
+static int l_keep_exposure(lua_State *L) {
+  lm_pipeline *p = recording(L, "keep_exposure");
+  if (p->in_create) return luaL_error(L, "keep_exposure() is called from OnRender");
+  p->keep_exposure = true;
+  return 0;
 }
 
 /* light_peak(x, ...): radiances the frame's script adds besides the scene's
@@ -903,7 +916,7 @@ void lm_script_open_api(lua_State *L) {
   lua_pop(L, 1);
   static const luaL_Reg api[] = {{"target", l_target}, {"scene", l_scene}, {"pass", l_pass},
                                  {"present", l_present}, {"output_size", l_output_size}, {"still_frames", l_still_frames},
-                                 {"light_peak", l_light_peak}, {"meter", l_meter},
+                                 {"light_peak", l_light_peak}, {"meter", l_meter}, {"keep_exposure", l_keep_exposure},
                                  {"shadow_plan", l_shadow_plan}, {"sky_sh", l_sky_sh}, {"cpu", l_cpu},
                                  {"scene_reflective", l_scene_reflective}, {"points", l_points},
                                  {"scene_blended", l_scene_blended},

@@ -30,9 +30,9 @@ struct lm_pipeline {
   unsigned shadows_frame; /* frame serial of the plan in *shadows */
   int *shadow_levels;     /* the last plan's levels (lm_shadow_settings.last_levels), one a light */
   int shadow_level_count;
-  int still;              /* frames in a row before this one that drew the same world (still_frames) */
-  int scene_still;        /* the same without the camera (still_frames("scene")) */
+  lm_still_frames still;  /* frames in a row before this one that drew the same world, scene, light */
   float light_peak;       /* the largest radiance the script's own light reaches this frame (light_peak, sky_sh) */
+  bool keep_exposure;     /* keep_exposure(): this frame shows results kept under the last one's pre-exposure */
   char sky_map[1024];     /* the sky map sky_sh{} read last ("" none) and its coefficients */
   float sky_map_sh[LM_SKY_SH];
 };

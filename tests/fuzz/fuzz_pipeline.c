@@ -87,7 +87,7 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size) {
   lm_shadow_plan plan = {0};
   lm_frame_data camera;
   lm_scene_frame_data(scene, 0, 64, 48, &camera);
-  lm_pipeline_set_scene(p, scene, &camera, &plan, 0, 0);
+  lm_pipeline_set_scene(p, scene, &camera, &plan, (lm_still_frames){0});
   for (int frame = 0; frame < 2; frame++) {
     lm_graph_begin(g, 64, 48);
     int presented;
