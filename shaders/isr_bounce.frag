@@ -154,7 +154,7 @@ void main() {
   // and 60.8% against POV-Ray, where nothing removes 70.0% and 66.8%); rays that left the scene, nothing.
   ivec2 size = textureSize(clr, 0), q = block_centre(px, STRIDE, size);
   vec3 rho = texelFetch(mat, q, 0).y * texelFetch(clr, q, 0).rgb;
-  vec3 second = (gathered + rays.y * gathered / max(rays.x, 1.0)) / float(n);
+  vec3 second = (gathered + rays.y * gathered / max(float(n) - rays.y, 1.0)) / float(n);
   float known = float(n) - rays.y;
   second += later_bounces(second, rho, known > 0.0 ? saturate(rays.x / known) : 1.0);
   isr = vec4(e.rgb + finite_or_zero(second), e.a);
