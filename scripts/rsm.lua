@@ -43,10 +43,10 @@ rsm.defaults = {
                      -- screen cannot show as meeting ones like those it knows; more, that second
                      -- bounce goes on as a geometric series in each surface's k_d albedo (at most
                      -- 0.9 a bounce: bounded at any count). isr_bounce.frag. On the reference set
-                     -- (160 x 120) 1, 2, 3 remove 72.9%, 67.8%, 54.8% of dl+esm's indirect error
-                     -- against POV-Ray (two bounces) and 67.2%, 69.6%, 69.7% against Cycles (eight):
-                     -- 2 removes the most against Cycles of those that keep 60% against both
-                     -- (docs/gi-combined.md "Bounces the screen cannot see")
+                     -- (160 x 120) 1, 2, 3, 4 remove 72.9%, 71.9%, 67.9%, 64.2% of dl+esm's indirect
+                     -- error against POV-Ray (two bounces) and 67.2%, 68.4%, 71.6%, 72.5% against
+                     -- Cycles (eight): 2 removes the most on the mean of the two (docs/gi-combined.md
+                     -- "Bounces the screen cannot see")
   coarse = 0,        -- coarse factor a side: 1, 2, 3 or 4 (the seed: 2, half resolution); 0 (auto): 4
                      -- from 256 pixels wide, else 3 (isr.gather_factor). At the same samples a pixel
                      -- 3 removed as much error as 2 (24: 63.0% and 62.6%) on 2.25 times fewer pixels,
