@@ -42,7 +42,8 @@ rsm.defaults = {
                      -- (isr.bounces); 2, its second bounce counts the rays that met surfaces the
                      -- screen cannot show as meeting ones like those it knows; more, that second
                      -- bounce goes on as a geometric series in each surface's k_d albedo (at most
-                     -- 0.9 a bounce: bounded at any count). isr_bounce.frag. On the reference set
+                     -- 0.9 a bounce: bounded at any count). isr_bounce.frag, from the senders ISR's
+                     -- march records (isr.reuse, isr.bounces 2 or more). On the reference set
                      -- (160 x 120) 1, 2, 3, 4 remove 72.9%, 71.9%, 67.9%, 64.2% of dl+esm's indirect
                      -- error against POV-Ray (two bounces) and 67.2%, 68.4%, 71.6%, 72.5% against
                      -- Cycles (eight): 2 removes the most on the mean of the two (docs/gi-combined.md

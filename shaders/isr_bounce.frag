@@ -14,9 +14,9 @@
 // the march found converged (hits0 -1) keeps the march's E, its history.
 // UNSEEN (rsm.bounces above 1; the hit value the march gives a ray that met
 // a surface the screen cannot show, isr_march.frag): those rays are taken to
-// meet surroundings like the ones seen, each sending the mean of what the
-// sending rays send, and with `bounces` above 2 the second bounce at p goes
-// on as a geometric series (later_bounces).
+// fare as the rays whose fate the march knows (each brings the mean of what
+// they bring), and with `bounces` above 2 the second bounce at p goes on as
+// a geometric series (later_bounces).
 #include "gbuffer.glsl"
 #ifdef TEMPORAL
 #include "temporal.glsl"
@@ -149,9 +149,10 @@ void main() {
 #if HITS > 5
   rays += count4(texelFetch(hits5, px, 0));
 #endif
-  // The unseen rays send what the sending rays send on average, nothing where none sends (taking p's own
-  // reflected light there removed 68.6% of dl+esm's indirect error against Cycles on the reference set
-  // and 60.8% against POV-Ray, where nothing removes 70.0% and 66.8%); rays that left the scene, nothing.
+  // Each unseen ray brings the mean of what the rays of known fate bring (those that left the scene bring
+  // nothing), so nothing is made up where the march knows no ray's fate. The mean over the sending rays
+  // alone, or p's own reflected first bounce where none sends, took more from POV-Ray's figure than they
+  // gave to Cycles' on the reference set (docs/gi-combined.md).
   ivec2 size = textureSize(clr, 0), q = block_centre(px, STRIDE, size);
   vec3 rho = texelFetch(mat, q, 0).y * texelFetch(clr, q, 0).rgb;
   vec3 second = (gathered + rays.y * gathered / max(float(n) - rays.y, 1.0)) / float(n);
