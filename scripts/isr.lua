@@ -260,6 +260,9 @@ function isr.render(direct, o, frame)
     end
   end
   local steps = seed and seed.bounces or o.bounces
+  -- rsm.bounces above 1: the march marks the rays that met surfaces the screen cannot show with this
+  -- hit value (under 0.5: no sender), the recorded-senders bounce counts them (isr_bounce.frag's UNSEEN)
+  local unseen = hits > 0 and light.rsm and light.rsm.bounces > 1 and 0.25 or nil
   for b = 1, steps do
     local inputs = gbuffer.inputs(C)
     inputs.previous = E
@@ -273,6 +276,7 @@ function isr.render(direct, o, frame)
       local from = { clr = C.clr, mat = C.mat, first = E1, previous = E, z = history and C.z or nil }
       for k = 1, hits do from["hits" .. (k - 1)] = H[k] end
       local defines, params = { HITS = hits, STRIDE = C.stride }, { samples = o.samples }
+      if unseen then defines.UNSEEN, params.bounces = unseen, light.rsm.bounces end
       E = kept and b == steps and o.blur == 0 and kept.value or coarse_target("isr.e" .. b, f)
       local out = { E }
       with_history(from, defines, params, out, b == steps)
@@ -293,6 +297,7 @@ function isr.render(direct, o, frame)
         end
       end
       local defines, params = { BOUNCE = b > 1, Z = b == 1, HITS = H and hits or nil, STRIDE = C.stride }, march_params(o)
+      defines.UNSEEN = H and unseen or nil
       local fetches = 4 + o.samples * (o.steps + (b > 1 and 6 or 5)) -- the march, and the hit's G-buffer and light
       if light.rsm and b == 1 then
         fetches = fetches + light.rsm.bind(inputs, defines, params, f, o.temporal.enabled)

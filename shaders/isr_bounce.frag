@@ -12,6 +12,11 @@
 // TEMPORAL, TEMPORAL_NEXT: as isr_march.frag (temporal reuse; z, the grid's
 // depth the march wrote, places each pixel for the reprojection); a pixel
 // the march found converged (hits0 -1) keeps the march's E, its history.
+// UNSEEN (rsm.bounces above 1; the hit value the march gives a ray that met
+// a surface the screen cannot show, isr_march.frag): those rays are taken to
+// fare as the rays whose fate the march knows (each brings the mean of what
+// they bring), and with `bounces` above 2 the second bounce at p goes on as
+// a geometric series (later_bounces).
 #include "gbuffer.glsl"
 #ifdef TEMPORAL
 #include "temporal.glsl"
@@ -61,6 +66,30 @@ vec3 sent(float hit, int width) {
 
 vec3 sent4(vec4 h, int width) { return sent(h.x, width) + sent(h.y, width) + sent(h.z, width) + sent(h.w, width); }
 
+#ifdef UNSEEN
+uniform int bounces = 2; // rsm.bounces: the series' count
+
+// How many of four rays' hits h send (at least 0.5) and how many met an unseen surface.
+vec2 count4(vec4 h) {
+  return vec2(dot(vec4(greaterThanEqual(h, vec4(0.5))), vec4(1.0)),
+              dot(vec4(lessThan(abs(h - vec4(UNSEEN)), vec4(0.01))), vec4(1.0)));
+}
+
+// Bounces 3 .. `bounces` after a second bounce e2 at a surface of k_d albedo
+// rho: each sends on the share r = rho closed of the last, `closed` the
+// share of p's rays that met a surface. r is at most BOUNCE_MAX, so at any
+// count the sum stays below e2 BOUNCE_MAX / (1 - BOUNCE_MAX): energy bounded.
+const float BOUNCE_MAX = 0.9;
+vec3 later_bounces(vec3 e2, vec3 rho, float closed) {
+  vec3 r = clamp(rho * saturate(closed), 0.0, BOUNCE_MAX), term = vec3(1.0), sum = vec3(0.0);
+  for (int b = 3; b <= min(bounces, 64); b++) {
+    term *= r;
+    sum += term;
+  }
+  return e2 * sum;
+}
+#endif
+
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   vec4 hit0 = texelFetch(hits0, px, 0);
@@ -103,7 +132,36 @@ void main() {
   gathered += sent4(texelFetch(hits5, px, 0), width);
 #endif
   vec4 e = texelFetch(first, px, 0);
+#ifdef UNSEEN
+  vec2 rays = count4(hit0);
+#if HITS > 1
+  rays += count4(texelFetch(hits1, px, 0));
+#endif
+#if HITS > 2
+  rays += count4(texelFetch(hits2, px, 0));
+#endif
+#if HITS > 3
+  rays += count4(texelFetch(hits3, px, 0));
+#endif
+#if HITS > 4
+  rays += count4(texelFetch(hits4, px, 0));
+#endif
+#if HITS > 5
+  rays += count4(texelFetch(hits5, px, 0));
+#endif
+  // Each unseen ray brings the mean of what the rays of known fate bring (those that left the scene bring
+  // nothing), so nothing is made up where the march knows no ray's fate. The mean over the sending rays
+  // alone, or p's own reflected first bounce where none sends, took more from POV-Ray's figure than they
+  // gave to Cycles' on the reference set (docs/gi-combined.md).
+  ivec2 size = textureSize(clr, 0), q = block_centre(px, STRIDE, size);
+  vec3 rho = texelFetch(mat, q, 0).y * texelFetch(clr, q, 0).rgb;
+  vec3 second = (gathered + rays.y * gathered / max(float(n) - rays.y, 1.0)) / float(n);
+  float known = float(n) - rays.y;
+  second += later_bounces(second, rho, known > 0.0 ? saturate(rays.x / known) : 1.0);
+  isr = vec4(e.rgb + finite_or_zero(second), e.a);
+#else
   isr = vec4(e.rgb + gathered / float(n), e.a);
+#endif
 #ifdef TEMPORAL_NEXT
   if (d > 0.0) {
     next = temporal_accumulate(isr, found, h, held, next_state.y);
