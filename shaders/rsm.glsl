@@ -68,7 +68,9 @@ bool rsm_seen(sampler2D dpt, vec3 q) {
 // A light-set variant (LIGHT_SET, lighting.glsl) gathers each light unrolled,
 // for its kind alone: a software rasterizer runs every branch of every
 // sample (each kind's light and falloff, both texel areas) where the kind is
-// read at run time (at 256 x 192 the gather took about a fifth less time).
+// read at run time (isr+rsm+esm moving at 256 x 192: isr.transport, march and
+// gather, 19% less time over tools/gi_time.sh's four scenes, 29% on the
+// Cornell box's point light).
 uniform sampler2D rsm_flux, rsm_pos; // shadow.lua's RSM targets (atlas-sized; the normal in rsm_pos.w)
 uniform int rsm_samples = 24;        // a coarse pixel and light
 uniform float rsm_radius = 1.0;      // the disc's radius, in tiles
