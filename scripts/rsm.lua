@@ -106,15 +106,17 @@ end
 
 -- Binds the RSM's gather (rsm.glsl's rsm_gather, RSM_GATHER) to a pass
 -- over a grid of coarse factor f: the RSM targets R and the atlas
--- `shadows` into inputs and defines, the checked options o into params.
+-- `shadows` into inputs and defines, the checked options o into params,
+-- G's light set (gbuffer.lights: each light gathered for its kind alone).
 -- A pixel takes o.samples at o.coarse, and on another grid as many as keep
 -- the samples per unit of screen area (at least one). temporal: the pass
 -- accumulates, so the pattern turns each frame (o.rotate). exclude_seen:
 -- senders the camera sees are left to the combined technique's march.
 -- Returns the fetches a coarse pixel (the pass's cost estimate).
-function rsm.bind(inputs, defines, params, R, shadows, o, f, temporal_on, exclude_seen)
+function rsm.bind(inputs, defines, params, R, shadows, o, f, temporal_on, exclude_seen, G)
   local samples = math.max(1, math.floor(o.samples * (f / o.coarse) ^ 2 + 0.5))
   shadow.bind(shadows, inputs, defines)
+  gbuffer.lights(G, defines)
   inputs.rsm_flux, inputs.rsm_pos = R.flux, R.pos
   defines.RSM_GATHER, defines.VISIBILITY, defines.EXCLUDE_SEEN = true, o.steps > 0, exclude_seen
   params.rsm_samples, params.rsm_radius, params.rsm_steps = samples, o.radius, o.steps
@@ -122,18 +124,18 @@ function rsm.bind(inputs, defines, params, R, shadows, o, f, temporal_on, exclud
   return samples * (2 + o.steps * 2 + (exclude_seen and 1 or 0))
 end
 
--- Records the gather over the coarse view C (isr.coarse_view, factor f),
--- whose depth it writes, from the RSM targets R (shadow.render's second
+-- Records the gather over the coarse view C (isr.coarse_view, factor f) of
+-- G, whose depth it writes, from the RSM targets R (shadow.render's second
 -- result) and the atlas `shadows`; with access (ssao.occlusion at f), E's a
 -- is the share of open sky (o.sky_occlusion of it). Returns the coarse E and, with temporal
 -- reuse, the history it wrote (temporal.bind).
-function rsm.gather(C, f, R, shadows, o, kept, access)
+function rsm.gather(C, f, R, shadows, o, kept, access, G)
   local inputs, defines, params = gbuffer.inputs(C), { STRIDE = C.stride, Z = true }, {}
   if access then
     inputs.access, defines.ACCESS, params.sky_occlusion = access, true, o.sky_occlusion
   end
   local turning = o.temporal.enabled and (o.temporal.turn == "always" or still_frames() == 0)
-  local fetches = rsm.bind(inputs, defines, params, R, shadows, o, f, turning)
+  local fetches = rsm.bind(inputs, defines, params, R, shadows, o, f, turning, false, G)
   local history = temporal.bind("rsm", inputs, defines, params, o.temporal, f)
   if history and history.fresh then defines.TEMPORAL_CLAMP = true end
   local E = kept and o.blur == 0 and kept.value or target{ "rsm.e", format = "rgba16f", scale = 1 / f }
@@ -167,7 +169,7 @@ function rsm.render(_, o, frame)
   local light = frame.light
   local access = o.sky_occlusion > 0 and (light.sky or light.ambient[1] > 0) and
                  ssao.occlusion(frame.G, ssao.check({ reach = o.sky_reach }, 2), f, "rsm.ao") or nil
-  local E, history = rsm.gather(C, f, frame.R, frame.shadows, o, kept, access)
+  local E, history = rsm.gather(C, f, frame.R, frame.shadows, o, kept, access, frame.G)
   return { C = C, E = isr.blur(E, C, f, o.blur, history and history.state, kept and kept.value, o.temporal.narrow),
            k = o.k }
 end
@@ -186,7 +188,7 @@ function rsm.march(o, frame)
   end
   return { coarse = o.coarse, bounces = o.bounces, bind = function(inputs, defines, params, f, temporal_on)
     params.rsm_k = o.k
-    return rsm.bind(inputs, defines, params, frame.R, frame.shadows, o, f, temporal_on, row.split == true)
+    return rsm.bind(inputs, defines, params, frame.R, frame.shadows, o, f, temporal_on, row.split == true, frame.G)
   end }
 end
 

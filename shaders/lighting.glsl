@@ -179,13 +179,18 @@ vec3 reflect_light(Reflector m, vec3 n, vec3 v, vec3 l, float ndl) {
 #endif
 bool light_set_has(int mask, int i) { return ((mask >> i) & 1) != 0; }
 
+// Light i's kind and falloff as light_arriving_as takes them, from the masks.
+int light_set_type(int i) { return light_set_has(LIGHT_SUNS, i) ? 2 : light_set_has(LIGHT_SPOTS, i) ? 1 : 0; }
+int light_set_falloff(int i) {
+  return light_set_has(LIGHT_FALLOFF_NONE, i) ? 1 : light_set_has(LIGHT_FALLOFF_SQUARE, i) ? 2
+       : light_set_has(LIGHT_FALLOFF_RANGE, i) ? 3 : 0;
+}
+
 // Light i of the set reflected toward v: what reflected_light's loop adds
 // for it, by the same operations (the same value; only the loop's order of
 // summing, light grid first, may differ in the last bits).
 vec3 light_set_reflected(int i, Reflector m, vec3 n, vec3 v, vec3 p) {
-  int type = light_set_has(LIGHT_SUNS, i) ? 2 : light_set_has(LIGHT_SPOTS, i) ? 1 : 0;
-  int falloff = light_set_has(LIGHT_FALLOFF_NONE, i) ? 1 : light_set_has(LIGHT_FALLOFF_SQUARE, i) ? 2
-              : light_set_has(LIGHT_FALLOFF_RANGE, i) ? 3 : 0;
+  int type = light_set_type(i), falloff = light_set_falloff(i);
   // the shadow kind follows the light's (engine/shadow: cascades, spot, cube)
   int shadow = light_set_has(LIGHT_SHADOWED, i) ? (type == 2 ? 1 : type == 1 ? 2 : 3) : 0;
   vec3 l, radiance;

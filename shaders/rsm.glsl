@@ -13,15 +13,17 @@
 // of distance squared times r^2 cos(off-axis angle). Times the light's
 // radiance there (light_incident) and the k_d albedo, it is the sender's
 // radiance times area (POV-Ray's diffuse convention, no 1/pi): cos of the
-// light's incidence cancels with the projection.
-float rsm_texel_area(ShadowView sv, vec2 t, vec3 q, float tile) {
+// light's incidence cancels with the projection. perspective: sv.depth.w > 0
+// (a spot or point light's view; a constant where the light's kind is).
+float rsm_texel_area_as(ShadowView sv, vec2 t, vec3 q, float tile, bool perspective) {
   float area = sv.texel.x * sv.texel.x;
-  if (sv.depth.w > 0.0) {
+  if (perspective) {
     vec2 tn = (t * 2.0 - 1.0) * sv.texel.x * tile * 0.5; // tan of the off-axis angles
     area *= dot(q - sv.depth.xyz, q - sv.depth.xyz) * inversesqrt(1.0 + dot(tn, tn));
   }
   return area;
 }
+float rsm_texel_area(ShadowView sv, vec2 t, vec3 q, float tile) { return rsm_texel_area_as(sv, t, q, tile, sv.depth.w > 0.0); }
 
 // Does the camera see q: on screen and within 2% of the depth buffer's
 // depth (`dpt`, the G-buffer's) there? The combined techniques leave such
@@ -63,6 +65,12 @@ bool rsm_seen(sampler2D dpt, vec3 q) {
 // on p -> q; one behind the depth buffer rejects q.
 // EXCLUDE_SEEN: a sender the camera sees (rsm_seen) is left to the
 // screen-space march of the combined technique.
+// A light-set variant (LIGHT_SET, lighting.glsl) gathers each light unrolled,
+// for its kind alone: a software rasterizer runs every branch of every
+// sample (each kind's light and falloff, both texel areas) where the kind is
+// read at run time (isr+rsm+esm moving at 256 x 192: isr.transport, march and
+// gather, 19% less time over tools/gi_time.sh's four scenes, 29% on the
+// Cornell box's point light).
 uniform sampler2D rsm_flux, rsm_pos; // shadow.lua's RSM targets (atlas-sized; the normal in rsm_pos.w)
 uniform int rsm_samples = 24;        // a coarse pixel and light
 uniform float rsm_radius = 1.0;      // the disc's radius, in tiles
@@ -87,6 +95,65 @@ bool rsm_blocked(vec3 p, vec3 q, sampler2D dpt, sampler2D mat) {
   return false;
 }
 
+// Light i's share of E(p) at the surface s: its RSM views, j the pixel's
+// block of the pattern, turn and shift its frame's turn (rsm_gather); type
+// and falloff light i's kind as light_arriving_as takes them. dpt and mat:
+// the full G-buffer's, for EXCLUDE_SEEN and VISIBILITY.
+vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn, float shift, sampler2D dpt,
+                      sampler2D mat) {
+  vec2 atlas = vec2(textureSize(rsm_pos, 0));
+  ShadowLight sl = shadow_lights[i];
+  Light li = lights[i]; // read once, not in the sample loop (rsm.gather about 8% faster on llvmpipe)
+  int first = sl.cube.y, count = sl.cube.z;
+  int n = count > 0 ? max(rsm_samples / count, 1) : 0;
+  // The block's first angle: j n phi turns (j integer: fract(j fract(n phi)) = fract(j n phi),
+  // without the rounding of the large product).
+  float a0 = 2.0 * PI * fract(float(j) * fract(float(n) * GOLDEN) + turn);
+  uint k0 = uint(j * n);
+  float centred = 0.5 / float(max(n * INTERLEAVE * INTERLEAVE, 1)) + shift; // half the union's radial stratum
+  // Its direction, once a light and not a view: llvmpipe's cos and sin cost about 70 ns a pair
+  // a pixel (a point light's six faces took 2.4 ms of the Cornell box's 8.5 ms gather at 256 x 192).
+  vec2 start = vec2(cos(a0), sin(a0));
+  vec3 e = vec3(0.0);
+  for (int v = first; v < first + count; v++) {
+    vec2 dir = start;
+    ShadowView sv = shadow_views[v];
+    vec4 c = sv.view_proj * vec4(s.p, 1.0);
+    vec2 centre = c.w > 1e-12 ? c.xy / c.w * 0.5 + 0.5 : vec2(0.5);
+    centre = clamp(centre, vec2(0.0), vec2(1.0)); // behind a cube face: its nearest edge
+    float tile = sv.rect.z * atlas.x;
+    // The disc reaches no farther than the tile's farthest corner: beyond it every sample would fall
+    // outside and add nothing, so the pattern keeps its samples where texels are.
+    float reach = min(rsm_radius, length(max(centre, 1.0 - centre)));
+    float texels = 2.0 * PI * reach * reach * tile * tile / float(max(n, 1));
+    for (int k = 0; k < n; k++, dir = vec2(dir.x * TURN.x - dir.y * TURN.y, dir.x * TURN.y + dir.y * TURN.x)) {
+      float xi = fract(radical_inverse(k0 + uint(k), 2u) + centred);
+      vec2 t = centre + xi * reach * dir;
+      if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
+      ivec2 a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
+      vec4 qn = texelFetch(rsm_pos, a, 0); // position, normal (normal_pack)
+      if (qn.w > 0.0) continue; // empty
+      vec3 q = qn.xyz, nq = normal_unpack(qn.w);
+      float area = rsm_texel_area_as(sv, t, q, tile, type != 2);
+      vec3 d = q - s.p;
+      float d2 = dot(d, d);
+      vec3 towards = d * inversesqrt(max(d2, 1e-30));
+      float g = max(dot(s.n, towards), 0.0) * max(dot(nq, -towards), 0.0) / max(d2, area);
+      if (g <= 0.0) continue; // before the flux and the light: coplanar and facing-away senders are common
+#ifdef EXCLUDE_SEEN
+      if (rsm_seen(dpt, q)) continue;
+#endif
+#ifdef VISIBILITY
+      if (rsm_blocked(s.p, q, dpt, mat)) continue;
+#endif
+      vec3 l;
+      vec3 radiance = light_arriving_as(li, type, falloff, q, l);
+      e += texelFetch(rsm_flux, a, 0).rgb * radiance * area * g * texels * xi;
+    }
+  }
+  return e;
+}
+
 // E(p) at the surface s of coarse pixel px; dpt and mat: the full G-buffer's,
 // for EXCLUDE_SEEN and VISIBILITY.
 vec3 rsm_gather(Surface s, ivec2 px, sampler2D dpt, sampler2D mat) {
@@ -95,58 +162,30 @@ vec3 rsm_gather(Surface s, ivec2 px, sampler2D dpt, sampler2D mat) {
   // With temporal reuse the radii move too (by the plastic number's step, unrelated to the angle's), so
   // that the frames a pixel accumulates cover other distances, not only other angles.
   float shift = rsm_rotate > 0.0 ? fract(frame.time.y * PLASTIC) : 0.0;
-  vec2 atlas = vec2(textureSize(rsm_pos, 0));
   vec3 e = vec3(0.0);
+#ifdef LIGHT_SET
+  // As reflected_light unrolls the set: four at a time, the compiler drops those past the count.
+#define RSM_GATHER_AT(i) \
+  if ((i) < LIGHT_SET) e += rsm_gather_light(i, light_set_type(i), light_set_falloff(i), s, j, turn, shift, dpt, mat);
+#define RSM_GATHER_FROM(i) RSM_GATHER_AT(i) RSM_GATHER_AT(i + 1) RSM_GATHER_AT(i + 2) RSM_GATHER_AT(i + 3)
+#if LIGHT_SET > 0
+  RSM_GATHER_FROM(0)
+#endif
+#if LIGHT_SET > 4
+  RSM_GATHER_FROM(4)
+#endif
+#if LIGHT_SET > 8
+  RSM_GATHER_FROM(8)
+#endif
+#if LIGHT_SET > 12
+  RSM_GATHER_FROM(12)
+#endif
+#else
   for (int i = 0; i < frame.counts.x; i++) {
-    ShadowLight sl = shadow_lights[i];
-    Light li = lights[i]; // read once, not in the sample loop (rsm.gather about 8% faster on llvmpipe)
-    int first = sl.cube.y, count = sl.cube.z;
-    int n = count > 0 ? max(rsm_samples / count, 1) : 0;
-    // The block's first angle: j n phi turns (j integer: fract(j fract(n phi)) = fract(j n phi),
-    // without the rounding of the large product).
-    float a0 = 2.0 * PI * fract(float(j) * fract(float(n) * GOLDEN) + turn);
-    uint k0 = uint(j * n);
-    float centred = 0.5 / float(max(n * INTERLEAVE * INTERLEAVE, 1)) + shift; // half the union's radial stratum
-    // Its direction, once a light and not a view: llvmpipe's cos and sin cost about 70 ns a pair
-    // a pixel (a point light's six faces took 2.4 ms of the Cornell box's 8.5 ms gather at 256 x 192).
-    vec2 start = vec2(cos(a0), sin(a0));
-    for (int v = first; v < first + count; v++) {
-      vec2 dir = start;
-      ShadowView sv = shadow_views[v];
-      vec4 c = sv.view_proj * vec4(s.p, 1.0);
-      vec2 centre = c.w > 1e-12 ? c.xy / c.w * 0.5 + 0.5 : vec2(0.5);
-      centre = clamp(centre, vec2(0.0), vec2(1.0)); // behind a cube face: its nearest edge
-      float tile = sv.rect.z * atlas.x;
-      // The disc reaches no farther than the tile's farthest corner: beyond it every sample would fall
-      // outside and add nothing, so the pattern keeps its samples where texels are.
-      float reach = min(rsm_radius, length(max(centre, 1.0 - centre)));
-      float texels = 2.0 * PI * reach * reach * tile * tile / float(max(n, 1));
-      for (int k = 0; k < n; k++, dir = vec2(dir.x * TURN.x - dir.y * TURN.y, dir.x * TURN.y + dir.y * TURN.x)) {
-        float xi = fract(radical_inverse(k0 + uint(k), 2u) + centred);
-        vec2 t = centre + xi * reach * dir;
-        if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
-        ivec2 a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
-        vec4 qn = texelFetch(rsm_pos, a, 0); // position, normal (normal_pack)
-        if (qn.w > 0.0) continue; // empty
-        vec3 q = qn.xyz, nq = normal_unpack(qn.w);
-        float area = rsm_texel_area(sv, t, q, tile);
-        vec3 d = q - s.p;
-        float d2 = dot(d, d);
-        vec3 towards = d * inversesqrt(max(d2, 1e-30));
-        float g = max(dot(s.n, towards), 0.0) * max(dot(nq, -towards), 0.0) / max(d2, area);
-        if (g <= 0.0) continue; // before the flux and the light: coplanar and facing-away senders are common
-#ifdef EXCLUDE_SEEN
-        if (rsm_seen(dpt, q)) continue;
-#endif
-#ifdef VISIBILITY
-        if (rsm_blocked(s.p, q, dpt, mat)) continue;
-#endif
-        vec3 l;
-        vec3 radiance = light_arriving(li, q, l);
-        e += texelFetch(rsm_flux, a, 0).rgb * radiance * area * g * texels * xi;
-      }
-    }
+    Light li = lights[i];
+    e += rsm_gather_light(i, int(li.position.w + 0.5), int(li.params.y + 0.5), s, j, turn, shift, dpt, mat);
   }
+#endif
   return finite_or_zero(e / PI);
 }
 #endif

@@ -2,7 +2,8 @@
  * lighting passes compiled for the scene's lights, each evaluated unrolled
  * for its kind, render what the general loop renders, for one light and for
  * eight of every kind, falloff and shadow kind, with Phong and with the pbr
- * materials; a light added at run time compiles one new variant, and a scene
+ * materials, and so does the RSM's gather of the combined technique (each light
+ * of its RSM views unrolled, shaders/rsm.glsl); a light added at run time compiles one new variant, and a scene
  * with more lights than pp.lua's light_variants takes the general loop.
  * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
@@ -132,6 +133,8 @@ static void variants_render_as_the_general_loop(void **state) {
   assert_true(variant_against_loop(eight, "dl+esm", "materials=pbr", &sum) < 4e-3);
   assert_true(variant_against_loop(eight, "dl", "shadow.technique=esm", &sum) < 4e-3);
   assert_true(sum_eight > 1.3 * sum_one); /* the seven more lights do light the box */
+  /* The RSM gather inside ISR's march (its direct pass checked above), every kind of sender's light. */
+  assert_true(variant_against_loop(eight, "isr+rsm+esm", "rsm.k=4", &sum) < 4e-3);
   lm_scene_destroy(one);
   lm_scene_destroy(eight);
 }
