@@ -43,8 +43,8 @@ shadow.defaults = {
   fit_margin = 0.25,  -- "previous": that range widened by this share each way, 0..10, for what came
                       -- into view since (on still frames too: cascades keep their size when the
                       -- camera starts or stops)
-  simplify = 0.5,     -- a caster whose simplified copy (made at load: meshoptimizer, 1% of the mesh's
-                      -- extent) errs by at most this many texels of a tile draws that copy there:
+  simplify = 0.5,     -- a caster whose simplified copy (made at load: meshoptimizer, 0.0625% to 16% of
+                      -- the mesh's extent) errs by at most this many texels of a tile draws it there:
                       -- far cascades and small tiles draw fewer triangles; 0..64, 0: never
   debug = false,      -- present the shadow atlas instead of the image
 }
