@@ -553,7 +553,14 @@ void lm_mesh_set_prev_positions(lm_mesh *m, const float *positions, int vertex_c
     glVertexArrayAttribFormat(m->vao, 15, 3, GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(m->vao, 15, 3);
   }
-  glNamedBufferSubData(m->pbo, 0, bytes, positions);
+  if (m->float_positions) {
+    glNamedBufferSubData(m->pbo, 0, bytes, positions);
+  } else { /* in the quantized positions' space, which the instance matrices map (lm_mesh_dequantize) */
+    float *local = lm_alloc((size_t)bytes), inv = m->extent > 0 ? 1.0f / m->extent : 0.0f;
+    for (int i = 0; i < 3 * vertex_count; i++) local[i] = (positions[i] - m->origin[i % 3]) * inv;
+    glNamedBufferSubData(m->pbo, 0, bytes, local);
+    free(local);
+  }
   if (!m->prev) glEnableVertexArrayAttrib(m->vao, 15);
   m->prev = true;
 }

@@ -254,7 +254,8 @@ void lm_mesh_read(const lm_mesh *m, float *vertices, int vertex_count, uint32_t 
 /* Multiplies a node's model matrix (column-major) by m's dequantization:
  * out = model * translate(origin) * scale(extent); model itself for float positions. */
 void lm_mesh_dequantize(const lm_mesh *m, const float model[16], float out[16]);
-/* Replaces the interleaved vertices (the same count as created): a deformed mesh's new pose. */
+/* Replaces the interleaved vertices (the same count as created): a deformed mesh's new pose
+ * (one not created `deforms` keeps its quantized box: positions outside it are clamped). */
 void lm_mesh_update_vertices(lm_mesh *m, const float *vertices, int vertex_count);
 /* A deformed mesh's positions in the previous frame (xyz a vertex, the same
  * count as created), attribute 15 (in_prev_position, w 1) for velocities;
