@@ -362,6 +362,14 @@ void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, in
 }
 
 /* ---- meshes ------------------------------------------------------------ */
+/* llvmpipe or softpipe: the "GPU" is this process's CPU and memory. */
+static bool software_rasterizer(void) {
+  static int known = -1;
+  const char *r = known < 0 ? lm_gl_renderer() : NULL;
+  if (r) known = strstr(r, "llvmpipe") || strstr(r, "softpipe");
+  return known > 0;
+}
+
 /* Bytes a vertex for m's formats: position, normal (4), uv. */
 static int position_bytes(const lm_mesh *m) { return m->float_positions ? 12 : 8; }
 static int vertex_stride(const lm_mesh *m) { return position_bytes(m) + 4 + (m->float_uvs ? 8 : 4); }
@@ -594,6 +602,13 @@ void lm_mesh_draw_instances(const lm_mesh *m, int first_index, int index_count, 
    * (0, 0, 0, 0) tells the shader that the mesh has no previous positions. */
   if (!m->prev) glVertexAttrib4f(15, 0, 0, 0, 0);
   glBindVertexArray(m->vao);
+  /* A software rasterizer keeps every triangle it has binned, in this
+   * process, until a flush: a scene of millions of triangles drawn at once
+   * would hold them all (the export in docs/benchmarks.md "Big files": 50
+   * MiB at its first frame). A flush every LM_FLUSH_TRIANGLES bounds that. */
+  static long pending;
+  pending += (long)(index_count / 3) * count;
+  if (pending >= LM_FLUSH_TRIANGLES && software_rasterizer()) glFlush(), pending = 0;
   size_t index_bytes = m->short_indices ? 2 : 4;
   glDrawElementsInstancedBaseInstance(GL_TRIANGLES, index_count, m->short_indices ? GL_UNSIGNED_SHORT : GL_UNSIGNED_INT,
                                       (const void *)((size_t)first_index * index_bytes), count, (GLuint)first);
@@ -604,7 +619,7 @@ lm_clock lm_clock_choose(lm_clock wanted) {
   if (wanted != LM_CLOCK_AUTO) return wanted;
   const char *r = lm_gl_renderer();
   /* llvmpipe's GL_TIME_ELAPSED results were seen to be nonsense. */
-  if (!r || strstr(r, "llvmpipe") || strstr(r, "softpipe") || strstr(r, "SVGA3D")) return LM_CLOCK_CPU;
+  if (!r || software_rasterizer() || strstr(r, "SVGA3D")) return LM_CLOCK_CPU;
   return LM_CLOCK_GPU;
 }
 
