@@ -2,7 +2,8 @@
  * nodes written one by one (the G-buffer, the shadow atlas and the image),
  * and simplified copies (meshoptimizer, lm_scene_mesh.casters and .lods)
  * draw fewer triangles into the shadow tiles and the G-buffer and leave the
- * image within a stated error of the whole meshes'.
+ * image within a stated error of the whole meshes'; the GPU's quantized
+ * vertices (lm_mesh) lie within their stated error of the floats.
  * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
