@@ -350,8 +350,10 @@ void lm_set_caster_layer(int transmit, int count, bool translucent) {
 
 /* ---- frame block ------------------------------------------------------- */
 static GLuint frame_ubo;
+static long flush_pending; /* triangles drawn this frame since the last flush (lm_mesh_draw_instances) */
 
 void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, int light_count) {
+  flush_pending = 0; /* a frame of fewer triangles never flushes */
   if (!frame_ubo) {
     glCreateBuffers(1, &frame_ubo);
     glNamedBufferData(frame_ubo, sizeof *frame, NULL, GL_DYNAMIC_DRAW);
@@ -605,10 +607,9 @@ void lm_mesh_draw_instances(const lm_mesh *m, int first_index, int index_count, 
   /* A software rasterizer keeps every triangle it has binned, in this
    * process, until a flush: a scene of millions of triangles drawn at once
    * would hold them all (the export in docs/benchmarks.md "Big files": 50
-   * MiB at its first frame). A flush every LM_FLUSH_TRIANGLES bounds that. */
-  static long pending;
-  pending += (long)(index_count / 3) * count;
-  if (pending >= LM_FLUSH_TRIANGLES && software_rasterizer()) glFlush(), pending = 0;
+   * MiB at its first frame). A flush every LM_FLUSH_TRIANGLES of a frame bounds that. */
+  flush_pending += (long)(index_count / 3) * count;
+  if (flush_pending >= LM_FLUSH_TRIANGLES && software_rasterizer()) glFlush(), flush_pending = 0;
   size_t index_bytes = m->short_indices ? 2 : 4;
   glDrawElementsInstancedBaseInstance(GL_TRIANGLES, index_count, m->short_indices ? GL_UNSIGNED_SHORT : GL_UNSIGNED_INT,
                                       (const void *)((size_t)first_index * index_bytes), count, (GLuint)first);

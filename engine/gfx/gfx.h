@@ -274,7 +274,8 @@ void lm_instances_upload(const lm_instance *instances, int count);
  * once for each of the uploaded instances first .. first + count - 1: one
  * draw call however many there are. */
 void lm_mesh_draw_instances(const lm_mesh *m, int first_index, int index_count, int first, int count);
-/* On a software rasterizer, draws flush after this many triangles (lm_mesh_draw_instances). */
+/* On a software rasterizer, draws flush after this many triangles of a frame (lm_frame_upload
+ * starts one; lm_mesh_draw_instances counts). */
 #define LM_FLUSH_TRIANGLES 16384
 
 /* ---- timers ------------------------------------------------------------ */
