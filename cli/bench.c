@@ -742,8 +742,7 @@ static bool caches_off(lm_pipeline *p, char *off, size_t cap, lm_error *err) {
 static bool stream_open(bench *b, int k, stream *s, lm_error *err) {
   motion *m = &b->motion;
   int rc;
-  s->scene = lm_scene_load(b->common.scene, err);
-  if (s->scene) s->scene->gpu_only = true;
+  s->scene = lm_scene_load_gpu(b->common.scene, err);
   s->pipe = s->scene ? capture_load_pipeline(&b->common, &rc, err) : NULL;
   if (!s->pipe || !lm_scene_upload(s->scene, err)) return false;
   if (k == STREAM_ALONE && !caches_off(s->pipe, m->caches_off, sizeof m->caches_off, err)) return false;
@@ -1188,28 +1187,29 @@ int limn_bench(int argc, char **argv) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     return prc;
   }
-  double t0 = lm_now_ms();
-  lm_scene *scene = lm_scene_load(b.common.scene, &err);
-  b.load_ms = lm_now_ms() - t0;
-  if (!scene) {
-    lm_log(LM_LOG_ERROR, "%s", err.msg);
+  if (!lm_context_create_headless(&(lm_context_desc){.platform = "auto"}, &err)) {
+    lm_log(LM_LOG_ERROR, "no OpenGL context: %s", err.msg);
     lm_pipeline_destroy(pipe);
-    return 2;
+    return 1;
   }
-  scene->gpu_only = true; /* the tracer's figures read the vertices back (trace_figures) */
+  double t0 = lm_now_ms();
+  /* To the GPU as it is read; the tracer's figures read the vertices back (trace_figures). */
+  lm_scene *scene = lm_scene_load_gpu(b.common.scene, &err);
+  b.load_ms = lm_now_ms() - t0;
   motion *m = &b.motion;
-  if (m->timed) {
+  if (scene && m->timed) {
     m->anim = lm_scene_find_animation(scene, m->animation, &err);
     if (m->anim >= LM_ANIM_ALL && !lm_scene_animated(scene))
       lm_error_set(&err, "--time: scene '%s' has no animation", scene->name), m->anim = -3;
-    if (m->anim < LM_ANIM_ALL) {
-      lm_log(LM_LOG_ERROR, "%s", err.msg);
-      lm_scene_destroy(scene);
-      lm_pipeline_destroy(pipe);
-      return 2;
-    }
+    if (m->anim < LM_ANIM_ALL) lm_scene_destroy(scene), scene = NULL;
   }
-  bool ok = lm_context_create_headless(&(lm_context_desc){.platform = "auto"}, &err);
+  if (!scene) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    lm_pipeline_destroy(pipe);
+    lm_context_destroy();
+    return 2;
+  }
+  bool ok = true;
   lm_clock used = LM_CLOCK_AUTO;
   for (int s = 0; s < b.size_count && ok; s++) ok = run_size(&b, s, SERIES_SIZES, scene, pipe, &used, &err);
   for (int v = 0; v < b.vary_count && ok; v++) {

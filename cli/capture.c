@@ -337,32 +337,29 @@ int limn_capture(int argc, char **argv) {
     return 0;
   }
 
-  lm_scene *scene = lm_scene_load(o->scene, &err);
-  if (!scene) {
-    lm_log(LM_LOG_ERROR, "%s", err.msg);
-    lm_pipeline_destroy(pipeline);
-    return 2;
-  }
-  scene->gpu_only = true; /* a technique that traces reads them back (lm_scene_restore_geometry) */
-  int animation = LM_ANIM_ALL;
-  if (a.animation && (animation = lm_scene_find_animation(scene, a.animation, &err)) < LM_ANIM_NONE) {
-    lm_log(LM_LOG_ERROR, "--animation %s: %s", a.animation, err.msg);
-    lm_scene_destroy(scene);
-    lm_pipeline_destroy(pipeline);
-    return 2;
-  }
-  o->camera = limn_camera_resolve(scene, o->camera, o->width, o->height);
-  if (o->camera > 0 && o->camera >= scene->camera_count) {
-    lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", o->camera, o->scene, scene->camera_count);
-    lm_scene_destroy(scene);
-    lm_pipeline_destroy(pipeline);
-    return 2;
-  }
   if (!lm_context_create_headless(&(lm_context_desc){.platform = a.egl, .debug = a.verbose}, &err)) {
     lm_log(LM_LOG_ERROR, "no OpenGL context: %s", err.msg);
-    lm_scene_destroy(scene);
     lm_pipeline_destroy(pipeline);
     return 1;
+  }
+  /* To the GPU as it is read: a technique that traces reads the vertices back (lm_scene_restore_geometry). */
+  lm_scene *scene = lm_scene_load_gpu(o->scene, &err);
+  int animation = LM_ANIM_ALL;
+  bool bad = true;
+  if (!scene)
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+  else if (a.animation && (animation = lm_scene_find_animation(scene, a.animation, &err)) < LM_ANIM_NONE)
+    lm_log(LM_LOG_ERROR, "--animation %s: %s", a.animation, err.msg);
+  else if ((o->camera = limn_camera_resolve(scene, o->camera, o->width, o->height)) > 0 &&
+           o->camera >= scene->camera_count)
+    lm_log(LM_LOG_ERROR, "--camera %d: scene '%s' has %d camera(s)", o->camera, o->scene, scene->camera_count);
+  else
+    bad = false;
+  if (bad) {
+    lm_scene_destroy(scene);
+    lm_pipeline_destroy(pipeline);
+    lm_context_destroy();
+    return 2;
   }
   bool any_linear = false;
   for (int i = 0; i < a.output_count; i++) {

@@ -9,7 +9,7 @@ layout(location = 2) in vec2 in_uv;
 out vec2 tex_uv;
 #endif
 #ifdef RSM
-layout(location = 1) in vec3 in_normal;
+layout(location = 1) in vec2 in_normal; // octahedral (lm_mesh)
 layout(location = 7) in mat3 instance_normal; // the model matrix's inverse transpose
 out vec3 world_normal;
 #endif
@@ -27,7 +27,7 @@ void main() {
   tex_uv = in_uv;
 #endif
 #ifdef RSM
-  world_normal = instance_normal * in_normal;
+  world_normal = instance_normal * oct_decode(in_normal);
 #endif
   gl_Position = pass_view_proj * world;
 }

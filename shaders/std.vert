@@ -2,9 +2,10 @@
 #include "common.glsl"
 
 layout(location = 0) in vec3 in_position;
-layout(location = 1) in vec3 in_normal;
+layout(location = 1) in vec2 in_normal;   // octahedral (lm_mesh)
 layout(location = 2) in vec2 in_uv;
-layout(location = 3) in mat4 instance_model;  // the node's (lm_instance: one draw, many nodes)
+layout(location = 3) in mat4 instance_model;  // the node's (lm_instance: one draw, many nodes), its
+                                              // mesh's dequantization included (lm_mesh_dequantize)
 layout(location = 7) in mat3 instance_normal; // its inverse transpose
 layout(location = 10) in vec4 in_tangent;     // glTF TANGENT; (0, 0, 0, 1) when the mesh has none
 
@@ -22,7 +23,7 @@ flat out float self_moved;
 
 void main() {
   vec4 world = instance_model * vec4(in_position, 1.0);
-  world_normal = instance_normal * in_normal;
+  world_normal = instance_normal * oct_decode(in_normal);
   world_pos = world.xyz;
   // Tangents follow the surface (the model matrix, not its inverse transpose).
   float handed = dot(in_tangent.xyz, in_tangent.xyz) > 0.0 ? (in_tangent.w < 0.0 ? -1.0 : 1.0) : 0.0;

@@ -3,7 +3,9 @@
  * and simplified copies (meshoptimizer, lm_scene_mesh.casters and .lods)
  * draw fewer triangles into the shadow tiles and the G-buffer and leave the
  * image within a stated error of the whole meshes', for a finely cut sphere,
- * a cone cut as exporters cut it (outdoor.glb's tree crowns) and a terrain.
+ * a cone cut as exporters cut it (outdoor.glb's tree crowns) and a terrain;
+ * the GPU's quantized vertices (lm_mesh) lie within their stated error of the
+ * floats.
  * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -317,6 +319,97 @@ static void simplified_meshes_keep_the_image(void **state) {
   lm_scene_destroy(s);
 }
 
+/* Deterministic numbers in [0, 1) (a linear congruential generator). */
+static float next_unit(uint32_t *seed) {
+  *seed = *seed * 1664525u + 1013904223u;
+  return (float)(*seed >> 8) / 16777216.0f;
+}
+
+/* The GPU's copy of a mesh is quantized (lm_mesh): read back, every position
+ * lies within LM_MESH_POSITION_ERROR of the mesh's extent (a box off the
+ * origin, 30 units wide), every normal within LM_MESH_NORMAL_ERROR radians
+ * (every octant, the axes and the seam of the octahedral map's fold), uvs
+ * in [0, 1] within LM_MESH_UV_ERROR and others exactly (they stay floats),
+ * indices exactly, in 16 bits below 65536 vertices and 32 above; a mesh that
+ * deforms keeps its positions exact. */
+static void quantized_vertices_read_back_within_their_error(void **state) {
+  (void)state;
+  enum { MANY = 70000 };
+  float *v = malloc(sizeof(float) * 8 * MANY), *back = malloc(sizeof(float) * 8 * MANY);
+  uint32_t *ix = malloc(sizeof(uint32_t) * 3 * MANY), *ix_back = malloc(sizeof(uint32_t) * 3 * MANY);
+  static const float axes[8][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1},
+                                   {0.6f, 0.8f, 0}, {-0.6f, 0, -0.8f}};
+  for (int pass = 0; pass < 3; pass++) {
+    int count = pass == 1 ? MANY : 1000;
+    bool tiled = pass == 2, deforms = pass == 2; /* pass 2: uvs beyond [0, 1], float positions */
+    uint32_t seed = 7u + (uint32_t)pass;
+    for (int i = 0; i < count; i++) {
+      float *o = v + 8 * (size_t)i, n[3];
+      for (int c = 0; c < 3; c++) n[c] = 2 * next_unit(&seed) - 1;
+      if (i < 8) memcpy(n, axes[i], sizeof n);
+      float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      if (len < 1e-3f) n[0] = 1, n[1] = n[2] = 0, len = 1;
+      o[0] = 100 + 30 * next_unit(&seed), o[1] = -5 + 10 * next_unit(&seed), o[2] = 2 * next_unit(&seed);
+      for (int c = 0; c < 3; c++) o[3 + c] = n[c] / len;
+      o[6] = next_unit(&seed) * (tiled ? 8 : 1) - (tiled ? 2 : 0), o[7] = i == 9 ? 1.0f : next_unit(&seed);
+    }
+    for (int i = 0; i < 3 * count; i++) ix[i] = (uint32_t)(next_unit(&seed) * (float)count) % (uint32_t)count;
+    ix[0] = (uint32_t)count - 1;
+    lm_mesh m;
+    lm_mesh_create(&m, v, count, NULL, ix, 3 * count, deforms);
+    assert_int_equal(m.short_indices, count <= 65536);
+    assert_int_equal(m.float_uvs, tiled);
+    assert_int_equal(m.float_positions, deforms);
+    lm_mesh_read(&m, back, count, ix_back, 3 * count);
+    lm_mesh_destroy(&m);
+    assert_memory_equal(ix, ix_back, sizeof *ix * 3 * (size_t)count);
+    double position = 0, normal = 0, uv = 0;
+    for (int i = 0; i < count; i++) {
+      const float *a = v + 8 * (size_t)i, *b = back + 8 * (size_t)i;
+      for (int c = 0; c < 3; c++) position = fmax(position, fabs((double)a[c] - b[c]));
+      double cx = (double)a[4] * b[5] - (double)a[5] * b[4], cy = (double)a[5] * b[3] - (double)a[3] * b[5],
+             cz = (double)a[3] * b[4] - (double)a[4] * b[3], dot = (double)a[3] * b[3] + (double)a[4] * b[4] + (double)a[5] * b[5];
+      normal = fmax(normal, atan2(sqrt(cx * cx + cy * cy + cz * cz), dot)); /* the angle, exact when small */
+      for (int c = 6; c < 8; c++) uv = fmax(uv, fabs((double)a[c] - b[c]));
+    }
+    print_message("%d vertices: positions within %.3g (%.3g of the 30-unit extent), normals %.3g rad, uvs %.3g\n",
+                  count, position, position / 30, normal, uv);
+    assert_true(deforms ? position == 0 : position <= LM_MESH_POSITION_ERROR * 30.0);
+    assert_true(normal <= LM_MESH_NORMAL_ERROR);
+    assert_true(tiled ? uv == 0 : uv <= LM_MESH_UV_ERROR);
+  }
+  free(v), free(back), free(ix), free(ix_back);
+}
+
+/* The spheres drawn from quantized positions against the same spheres
+ * drawn from floats (the mesh made to deform, whose positions stay floats;
+ * their normals are quantized alike, within LM_MESH_NORMAL_ERROR, below the
+ * G-buffer's own half-float precision), every mesh whole: the G-buffer's
+ * normals and the image within 0.1% (mean absolute difference over the
+ * mean). */
+static void quantized_positions_keep_the_image(void **state) {
+  (void)state;
+  lm_scene *quantized = spheres_scene(), *floats = spheres_scene();
+  lm_scene_mesh *m = &floats->meshes[1];
+  m->rest = memcpy(malloc(sizeof(float) * 8 * (size_t)m->vertex_count), m->vertices, sizeof(float) * 8 * (size_t)m->vertex_count);
+  const char *sets[] = {"simplify=0", "shadow.simplify=0", "ambient=0.05", NULL};
+  gl_result q = gl_render_ok(&(gl_run){.scene = quantized, .tech = "dl+esm", .sets = sets, .width = 128, .height = 96});
+  gl_result f = gl_render_ok(&(gl_run){.scene = floats, .tech = "dl+esm", .sets = sets, .width = 128, .height = 96});
+  assert_false(quantized->meshes[1].gpu.float_positions);
+  assert_true(floats->meshes[1].gpu.float_positions);
+  double worst, dn = target_diff(&q, &f, "gbuffer.nrm", &worst);
+  int n = q.width * q.height * 3;
+  double mean = 0;
+  for (int i = 0; i < n; i++) mean += f.rgb[i];
+  mean /= n;
+  double d = gl_mean_abs_diff(q.rgb, f.rgb, n) / mean;
+  print_message("quantized positions: gbuffer.nrm %.3g%% of the mean (largest %.3g), image %.3g%% of the mean (%.3g)\n",
+                100 * dn, worst, 100 * d, mean);
+  assert_true(mean > 0.05 && d <= 0.001 && dn <= 0.001);
+  gl_result_free(&q), gl_result_free(&f);
+  lm_scene_destroy(quantized), lm_scene_destroy(floats);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(instanced_nodes_render_as_the_nodes),
@@ -324,6 +417,8 @@ int main(void) {
       cmocka_unit_test(simplified_cone_casters_keep_the_shadows),
       cmocka_unit_test(a_terrain_has_copies_within_a_near_texel),
       cmocka_unit_test(simplified_meshes_keep_the_image),
+      cmocka_unit_test(quantized_vertices_read_back_within_their_error),
+      cmocka_unit_test(quantized_positions_keep_the_image),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

@@ -2,6 +2,8 @@
 #include "gfx/gfx.h"
 
 #include <epoxy/gl.h>
+#include <math.h>
+#include <meshoptimizer.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -348,8 +350,10 @@ void lm_set_caster_layer(int transmit, int count, bool translucent) {
 
 /* ---- frame block ------------------------------------------------------- */
 static GLuint frame_ubo;
+static long flush_pending; /* triangles drawn this frame since the last flush (lm_mesh_draw_instances) */
 
 void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, int light_count) {
+  flush_pending = 0; /* a frame of fewer triangles never flushes */
   if (!frame_ubo) {
     glCreateBuffers(1, &frame_ubo);
     glNamedBufferData(frame_ubo, sizeof *frame, NULL, GL_DYNAMIC_DRAW);
@@ -360,19 +364,107 @@ void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, in
 }
 
 /* ---- meshes ------------------------------------------------------------ */
+/* llvmpipe or softpipe: the "GPU" is this process's CPU and memory. */
+static bool software_rasterizer(void) {
+  static int known = -1;
+  const char *r = known < 0 ? lm_gl_renderer() : NULL;
+  if (r) known = strstr(r, "llvmpipe") || strstr(r, "softpipe");
+  return known > 0;
+}
+
+/* Bytes a vertex for m's formats: position, normal (4), uv. */
+static int position_bytes(const lm_mesh *m) { return m->float_positions ? 12 : 8; }
+static int vertex_stride(const lm_mesh *m) { return position_bytes(m) + 4 + (m->float_uvs ? 8 : 4); }
+
+static uint16_t unorm16(float v) { return (uint16_t)(v > 0 ? (v < 1 ? v * 65535.0f + 0.5f : 65535.0f) : 0.0f); }
+
+/* Vertices first .. first + count - 1 of `vertices` (8 floats each) into
+ * `out` in m's formats; normals through meshoptimizer's octahedral encoder
+ * (its first two snorm16 components are the octahedral x, y that
+ * common.glsl's oct_decode reads). `scratch`: 8 floats a vertex. */
+static void pack_vertices(const lm_mesh *m, const float *vertices, int count, unsigned char *out, float *scratch) {
+  int stride = vertex_stride(m), pos = position_bytes(m);
+  float inv = m->extent > 0 ? 1.0f / m->extent : 0.0f;
+  int16_t *oct = (int16_t *)(scratch + 4 * (size_t)count);
+  for (int i = 0; i < count; i++) {
+    const float *v = vertices + 8 * (size_t)i;
+    float *n = scratch + 4 * (size_t)i;
+    n[0] = v[3], n[1] = v[4], n[2] = v[5], n[3] = 0;
+  }
+  meshopt_encodeFilterOct(oct, (size_t)count, 8, 16, scratch);
+  for (int i = 0; i < count; i++) {
+    const float *v = vertices + 8 * (size_t)i;
+    unsigned char *o = out + (size_t)i * stride;
+    if (m->float_positions) {
+      memcpy(o, v, 12);
+    } else {
+      uint16_t q[4] = {0};
+      for (int c = 0; c < 3; c++) q[c] = unorm16((v[c] - m->origin[c]) * inv);
+      memcpy(o, q, 8);
+    }
+    memcpy(o + pos, oct + 4 * (size_t)i, 4);
+    if (m->float_uvs) {
+      memcpy(o + pos + 4, v + 6, 8);
+    } else {
+      uint16_t uv[2] = {unorm16(v[6]), unorm16(v[7])};
+      memcpy(o + pos + 4, uv, 4);
+    }
+  }
+}
+
+/* Writes vertices (8 floats each) into m's buffer from vertex `first` on, a
+ * block at a time: the packed copy is never whole in memory. */
+static void upload_vertices(const lm_mesh *m, const float *vertices, int count) {
+  enum { BLOCK = 4096 };
+  int stride = vertex_stride(m);
+  unsigned char *packed = lm_alloc((size_t)BLOCK * (size_t)stride);
+  float *scratch = lm_alloc(sizeof(float) * 8 * BLOCK);
+  for (int first = 0; first < count; first += BLOCK) {
+    int n = count - first < BLOCK ? count - first : BLOCK;
+    pack_vertices(m, vertices + 8 * (size_t)first, n, packed, scratch);
+    glNamedBufferSubData(m->vbo, (GLintptr)first * stride, (GLsizeiptr)n * stride, packed);
+  }
+  free(scratch);
+  free(packed);
+}
+
 void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const float *tangents,
-                    const uint32_t *indices, int index_count) {
+                    const uint32_t *indices, int index_count, bool deforms) {
+  *m = (lm_mesh){.float_positions = deforms, .short_indices = vertex_count <= 65536};
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int i = 0; i < vertex_count; i++) {
+    const float *v = vertices + 8 * (size_t)i;
+    for (int c = 0; c < 3; c++) /* fminf, fmaxf: a non-finite coordinate leaves them */
+      if (isfinite(v[c])) lo[c] = fminf(lo[c], v[c]), hi[c] = fmaxf(hi[c], v[c]);
+    m->float_uvs = m->float_uvs || !(v[6] >= 0 && v[6] <= 1 && v[7] >= 0 && v[7] <= 1);
+  }
+  for (int c = 0; c < 3; c++) {
+    m->origin[c] = lo[c] <= hi[c] ? lo[c] : 0;
+    m->extent = fmaxf(m->extent, lo[c] <= hi[c] ? hi[c] - lo[c] : 0);
+  }
+  int stride = vertex_stride(m);
   glCreateVertexArrays(1, &m->vao);
   glCreateBuffers(1, &m->vbo);
   glCreateBuffers(1, &m->ibo);
-  glNamedBufferData(m->vbo, (GLsizeiptr)vertex_count * 8 * sizeof(float), vertices, GL_STATIC_DRAW);
-  glNamedBufferData(m->ibo, (GLsizeiptr)index_count * sizeof(uint32_t), indices, GL_STATIC_DRAW);
-  glVertexArrayVertexBuffer(m->vao, 0, m->vbo, 0, 8 * sizeof(float));
+  glNamedBufferData(m->vbo, (GLsizeiptr)vertex_count * stride, NULL, GL_STATIC_DRAW);
+  upload_vertices(m, vertices, vertex_count);
+  if (m->short_indices) {
+    uint16_t *shorts = lm_alloc(sizeof *shorts * (size_t)(index_count > 0 ? index_count : 1));
+    for (int i = 0; i < index_count; i++) shorts[i] = (uint16_t)indices[i];
+    glNamedBufferData(m->ibo, (GLsizeiptr)index_count * 2, shorts, GL_STATIC_DRAW);
+    free(shorts);
+  } else {
+    glNamedBufferData(m->ibo, (GLsizeiptr)index_count * 4, indices, GL_STATIC_DRAW);
+  }
+  glVertexArrayVertexBuffer(m->vao, 0, m->vbo, 0, stride);
   glVertexArrayElementBuffer(m->vao, m->ibo);
-  static const int sizes[3] = {3, 3, 2}, offsets[3] = {0, 3, 6};
+  int pos = position_bytes(m);
+  glVertexArrayAttribFormat(m->vao, 0, 3, m->float_positions ? GL_FLOAT : GL_UNSIGNED_SHORT,
+                            !m->float_positions, 0);
+  glVertexArrayAttribFormat(m->vao, 1, 2, GL_SHORT, GL_TRUE, (GLuint)pos);
+  glVertexArrayAttribFormat(m->vao, 2, 2, m->float_uvs ? GL_FLOAT : GL_UNSIGNED_SHORT, !m->float_uvs, (GLuint)pos + 4);
   for (int a = 0; a < 3; a++) {
     glEnableVertexArrayAttrib(m->vao, a);
-    glVertexArrayAttribFormat(m->vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a] * sizeof(float));
     glVertexArrayAttribBinding(m->vao, a, 0);
   }
   /* Binding 1: lm_instance, one an instance (its buffer is bound at draw time):
@@ -399,13 +491,62 @@ void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const f
   m->index_count = index_count;
 }
 
+void lm_mesh_dequantize(const lm_mesh *m, const float model[16], float out[16]) {
+  memcpy(out, model, sizeof(float) * 16);
+  if (m->float_positions) return;
+  for (int r = 0; r < 4; r++) {
+    out[12 + r] = model[12 + r] + model[r] * m->origin[0] + model[4 + r] * m->origin[1] + model[8 + r] * m->origin[2];
+    for (int c = 0; c < 3; c++) out[4 * c + r] = model[4 * c + r] * m->extent;
+  }
+}
+
+/* The inverse of meshoptimizer's octahedral encoding (common.glsl's oct_decode). */
+static void oct_decode(const int16_t q[2], float n[3]) {
+  float x = fmaxf(q[0] / 32767.0f, -1.0f), y = fmaxf(q[1] / 32767.0f, -1.0f), z = 1.0f - fabsf(x) - fabsf(y);
+  float t = fmaxf(-z, 0.0f);
+  x += x >= 0 ? -t : t, y += y >= 0 ? -t : t;
+  float len = sqrtf(x * x + y * y + z * z); /* at least 1 / sqrt(3) */
+  n[0] = x / len, n[1] = y / len, n[2] = z / len;
+}
+
 void lm_mesh_read(const lm_mesh *m, float *vertices, int vertex_count, uint32_t *indices, int index_count) {
-  glGetNamedBufferSubData(m->vbo, 0, (GLsizeiptr)vertex_count * 8 * sizeof(float), vertices);
-  glGetNamedBufferSubData(m->ibo, 0, (GLsizeiptr)index_count * sizeof(uint32_t), indices);
+  int stride = vertex_stride(m), pos = position_bytes(m);
+  unsigned char *packed = lm_alloc((size_t)(vertex_count > 0 ? vertex_count : 1) * (size_t)stride);
+  glGetNamedBufferSubData(m->vbo, 0, (GLsizeiptr)vertex_count * stride, packed);
+  for (int i = 0; i < vertex_count; i++) {
+    const unsigned char *o = packed + (size_t)i * stride;
+    float *v = vertices + 8 * (size_t)i;
+    if (m->float_positions) {
+      memcpy(v, o, 12);
+    } else {
+      uint16_t q[3];
+      memcpy(q, o, 6);
+      for (int c = 0; c < 3; c++) v[c] = m->origin[c] + m->extent * (q[c] / 65535.0f);
+    }
+    int16_t oct[2];
+    memcpy(oct, o + pos, 4);
+    oct_decode(oct, v + 3);
+    if (m->float_uvs) {
+      memcpy(v + 6, o + pos + 4, 8);
+    } else {
+      uint16_t uv[2];
+      memcpy(uv, o + pos + 4, 4);
+      v[6] = uv[0] / 65535.0f, v[7] = uv[1] / 65535.0f;
+    }
+  }
+  free(packed);
+  if (!m->short_indices) {
+    glGetNamedBufferSubData(m->ibo, 0, (GLsizeiptr)index_count * 4, indices);
+    return;
+  }
+  uint16_t *shorts = lm_alloc(sizeof *shorts * (size_t)(index_count > 0 ? index_count : 1));
+  glGetNamedBufferSubData(m->ibo, 0, (GLsizeiptr)index_count * 2, shorts);
+  for (int i = 0; i < index_count; i++) indices[i] = shorts[i];
+  free(shorts);
 }
 
 void lm_mesh_update_vertices(lm_mesh *m, const float *vertices, int vertex_count) {
-  glNamedBufferSubData(m->vbo, 0, (GLsizeiptr)vertex_count * 8 * sizeof(float), vertices);
+  upload_vertices(m, vertices, vertex_count);
 }
 
 void lm_mesh_set_prev_positions(lm_mesh *m, const float *positions, int vertex_count) {
@@ -422,7 +563,14 @@ void lm_mesh_set_prev_positions(lm_mesh *m, const float *positions, int vertex_c
     glVertexArrayAttribFormat(m->vao, 15, 3, GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(m->vao, 15, 3);
   }
-  glNamedBufferSubData(m->pbo, 0, bytes, positions);
+  if (m->float_positions) {
+    glNamedBufferSubData(m->pbo, 0, bytes, positions);
+  } else { /* in the quantized positions' space, which the instance matrices map (lm_mesh_dequantize) */
+    float *local = lm_alloc((size_t)bytes), inv = m->extent > 0 ? 1.0f / m->extent : 0.0f;
+    for (int i = 0; i < 3 * vertex_count; i++) local[i] = (positions[i] - m->origin[i % 3]) * inv;
+    glNamedBufferSubData(m->pbo, 0, bytes, local);
+    free(local);
+  }
   if (!m->prev) glEnableVertexArrayAttrib(m->vao, 15);
   m->prev = true;
 }
@@ -456,8 +604,15 @@ void lm_mesh_draw_instances(const lm_mesh *m, int first_index, int index_count, 
    * (0, 0, 0, 0) tells the shader that the mesh has no previous positions. */
   if (!m->prev) glVertexAttrib4f(15, 0, 0, 0, 0);
   glBindVertexArray(m->vao);
-  glDrawElementsInstancedBaseInstance(GL_TRIANGLES, index_count, GL_UNSIGNED_INT,
-                                      (const void *)((size_t)first_index * sizeof(uint32_t)), count, (GLuint)first);
+  /* A software rasterizer keeps every triangle it has binned, in this
+   * process, until a flush: a scene of millions of triangles drawn at once
+   * would hold them all (the export in docs/benchmarks.md "Big files": 50
+   * MiB at its first frame). A flush every LM_FLUSH_TRIANGLES of a frame bounds that. */
+  flush_pending += (long)(index_count / 3) * count;
+  if (flush_pending >= LM_FLUSH_TRIANGLES && software_rasterizer()) glFlush(), flush_pending = 0;
+  size_t index_bytes = m->short_indices ? 2 : 4;
+  glDrawElementsInstancedBaseInstance(GL_TRIANGLES, index_count, m->short_indices ? GL_UNSIGNED_SHORT : GL_UNSIGNED_INT,
+                                      (const void *)((size_t)first_index * index_bytes), count, (GLuint)first);
 }
 
 /* ---- timers ------------------------------------------------------------ */
@@ -465,7 +620,7 @@ lm_clock lm_clock_choose(lm_clock wanted) {
   if (wanted != LM_CLOCK_AUTO) return wanted;
   const char *r = lm_gl_renderer();
   /* llvmpipe's GL_TIME_ELAPSED results were seen to be nonsense. */
-  if (!r || strstr(r, "llvmpipe") || strstr(r, "softpipe") || strstr(r, "SVGA3D")) return LM_CLOCK_CPU;
+  if (!r || software_rasterizer() || strstr(r, "SVGA3D")) return LM_CLOCK_CPU;
   return LM_CLOCK_GPU;
 }
 

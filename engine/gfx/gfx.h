@@ -221,17 +221,41 @@ typedef struct lm_light_data {
 void lm_frame_upload(const lm_frame_data *frame, const lm_light_data *lights, int light_count);
 
 /* ---- meshes ------------------------------------------------------------ */
-typedef struct lm_mesh { uint32_t vao, vbo, tbo, ibo, pbo; int index_count; bool prev; } lm_mesh;
-/* Interleaved position(3) normal(3) uv(2) floats (attributes 0, 1, 2); 32-bit indices.
+/* A mesh's vertices on the GPU, quantized as glTF's KHR_mesh_quantization
+ * allows (with llvmpipe the GPU's copy lives in the process: about half the
+ * floats' memory): positions unorm16 over the mesh's bounding cube,
+ * position = origin + extent * q (the instance matrices apply it:
+ * lm_mesh_dequantize), or floats for a mesh that deforms (its bounds move
+ * each frame); normals octahedral, snorm16 x 2 (attribute 1 is a vec2:
+ * common.glsl's oct_decode); uvs unorm16 when every one lies in [0, 1], else
+ * floats; 16-bit indices below 65536 vertices. */
+typedef struct lm_mesh {
+  uint32_t vao, vbo, tbo, ibo, pbo;
+  int index_count;
+  bool prev;
+  bool float_positions, float_uvs, short_indices;
+  float origin[3], extent; /* quantized positions' box: its lowest corner and side */
+} lm_mesh;
+/* Interleaved position(3) normal(3) uv(2) floats, stored as above (attributes
+ * 0, 1, 2); `deforms`: positions stay floats (lm_mesh_update_vertices).
  * tangents (may be NULL): xyz and handedness w a vertex, attribute 10; without,
  * the attribute reads (0, 0, 0, 1), which shaders take for "none". */
 void lm_mesh_create(lm_mesh *m, const float *vertices, int vertex_count, const float *tangents,
-                    const uint32_t *indices, int index_count);
+                    const uint32_t *indices, int index_count, bool deforms);
 void lm_mesh_destroy(lm_mesh *m);
 /* Reads back the first vertex_count vertices and index_count indices given to lm_mesh_create
- * (a scene that freed its own copy after the upload and needs it again: lm_scene_restore_geometry). */
+ * (a scene that freed its own copy after the upload and needs it again: lm_scene_restore_geometry),
+ * as floats again: the quantized values the GPU draws, each within LM_MESH_POSITION_ERROR times
+ * the extent, LM_MESH_NORMAL_ERROR radians and LM_MESH_UV_ERROR of what was given. */
 void lm_mesh_read(const lm_mesh *m, float *vertices, int vertex_count, uint32_t *indices, int index_count);
-/* Replaces the interleaved vertices (the same count as created): a deformed mesh's new pose. */
+#define LM_MESH_POSITION_ERROR (0.5f / 65535 + 1e-6f) /* rounding, and float arithmetic's */
+#define LM_MESH_NORMAL_ERROR 1e-4f
+#define LM_MESH_UV_ERROR (0.5f / 65535 + 1e-6f)
+/* Multiplies a node's model matrix (column-major) by m's dequantization:
+ * out = model * translate(origin) * scale(extent); model itself for float positions. */
+void lm_mesh_dequantize(const lm_mesh *m, const float model[16], float out[16]);
+/* Replaces the interleaved vertices (the same count as created): a deformed mesh's new pose
+ * (one not created `deforms` keeps its quantized box: positions outside it are clamped). */
 void lm_mesh_update_vertices(lm_mesh *m, const float *vertices, int vertex_count);
 /* A deformed mesh's positions in the previous frame (xyz a vertex, the same
  * count as created), attribute 15 (in_prev_position, w 1) for velocities;
@@ -250,6 +274,9 @@ void lm_instances_upload(const lm_instance *instances, int count);
  * once for each of the uploaded instances first .. first + count - 1: one
  * draw call however many there are. */
 void lm_mesh_draw_instances(const lm_mesh *m, int first_index, int index_count, int first, int count);
+/* On a software rasterizer, draws flush after this many triangles of a frame (lm_frame_upload
+ * starts one; lm_mesh_draw_instances counts). */
+#define LM_FLUSH_TRIANGLES 16384
 
 /* ---- timers ------------------------------------------------------------ */
 typedef enum lm_clock { LM_CLOCK_AUTO, LM_CLOCK_GPU, LM_CLOCK_CPU } lm_clock;

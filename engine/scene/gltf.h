@@ -169,6 +169,12 @@ extern "C" {
  * The scene's world transforms are up to date; nothing is uploaded. */
 lm_scene *lm_scene_load_gltf(const char *path, lm_error *err);
 
+/* lm_scene_load for an owner that reads no vertex on the CPU (a renderer's:
+ * the scene comes gpu_only): a glTF file's textures and meshes, but those
+ * that deform, go to the GPU as they are read and their CPU copies are
+ * freed at once, so that the file's meshes are never whole in memory and on
+ * the GPU together. Needs a current GL context. */
+lm_scene *lm_scene_load_gpu(const char *name, lm_error *err);
 /* True when `name` ends in .gltf or .glb (any case): a file, not a built-in. */
 bool lm_scene_is_gltf_name(const char *name);
 /* A glTF file when lm_scene_is_gltf_name(name), else a built-in scene. */

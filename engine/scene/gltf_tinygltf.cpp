@@ -741,6 +741,7 @@ int load_primitive(Loader &L, int mi, int pi) {
     lm_scene_mesh_set_tangents(L.s, m, tangents.data());
   }
   if (!read_deform(L, where, mesh, p, count, m)) return -1;
+  if (L.s->gpu_only && !L.s->meshes[m].rest) lm_scene_upload_mesh(L.s, m); // lm_scene_load_gpu
   return m;
 }
 
@@ -859,6 +860,9 @@ int texture_for(Loader &L, int material, const char *what, int index, bool linea
   snprintf(label, sizeof label, "%s", img.name.empty() ? name.c_str() : img.name.c_str());
   cached = lm_scene_add_texture(L.s, label, w, h, rgba);
   L.s->textures[cached].linear = linear;
+  lm_error why = {""};
+  if (L.s->gpu_only && !lm_scene_upload_texture(L.s, cached, &why)) // lm_scene_load_gpu
+    return fail(L, "%s: %s", at, why.msg), -1;
   return cached;
 }
 
@@ -1601,8 +1605,15 @@ void scene_bounds(const lm_scene *s, double lo[3], double hi[3]) {
     if (n->mesh < 0) continue;
     const lm_scene_mesh *m = &s->meshes[n->mesh];
     const float *w = n->world;
+    std::vector<float> back; // a mesh already on the GPU (lm_scene_load_gpu): as it is drawn
+    if (!m->vertices) {
+      back.resize((size_t)m->vertex_count * 8);
+      std::vector<uint32_t> indices((size_t)m->index_count);
+      lm_mesh_read(&m->gpu, back.data(), m->vertex_count, indices.data(), m->index_count);
+    }
+    const float *vertices = m->vertices ? m->vertices : back.data();
     for (int v = 0; v < m->vertex_count; v++) {
-      const float *p = m->vertices + v * 8;
+      const float *p = vertices + v * 8;
       for (int k = 0; k < 3; k++) {
         double x = (double)w[k] * p[0] + (double)w[4 + k] * p[1] + (double)w[8 + k] * p[2] + w[12 + k];
         if (!std::isfinite(x)) continue; // a degenerate transform: leave this one out
@@ -1635,6 +1646,7 @@ void look_along(const double eye[3], const double dir[3], float out[16]) {
 }
 
 void add_defaults(lm_scene *s) {
+  if (s->light_count && s->camera_count) return;
   double lo[3], hi[3], c[3], diag = 0;
   scene_bounds(s, lo, hi);
   for (int k = 0; k < 3; k++) c[k] = 0.5 * (lo[k] + hi[k]), diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
@@ -1945,7 +1957,8 @@ bool convert(const char *path, const Source &src, const tinygltf::Model &model, 
 
 } // namespace
 
-extern "C" lm_scene *lm_scene_load_gltf(const char *path, lm_error *err) {
+// lm_scene_load_gltf; gpu_only: lm_scene_load_gpu's.
+static lm_scene *load_gltf(const char *path, bool gpu_only, lm_error *err) {
   lm_scene *s = nullptr;
   try {
     tinygltf::Model model;
@@ -1953,6 +1966,7 @@ extern "C" lm_scene *lm_scene_load_gltf(const char *path, lm_error *err) {
     if (!parse(path, src, &model, err)) return nullptr;
     const char *base = strrchr(path, '/');
     s = lm_scene_create(base ? base + 1 : path);
+    s->gpu_only = gpu_only;
     if (convert(path, src, model, s, err)) return s;
   } catch (const std::exception &e) { // tinygltf throws on some malformed input
     lm_error_set(err, "%s: malformed glTF (%s)", path, e.what());
@@ -1961,6 +1975,15 @@ extern "C" lm_scene *lm_scene_load_gltf(const char *path, lm_error *err) {
   }
   lm_scene_destroy(s);
   return nullptr;
+}
+
+extern "C" lm_scene *lm_scene_load_gltf(const char *path, lm_error *err) { return load_gltf(path, false, err); }
+
+extern "C" lm_scene *lm_scene_load_gpu(const char *name, lm_error *err) {
+  if (lm_scene_is_gltf_name(name)) return load_gltf(name, true, err);
+  lm_scene *s = lm_scene_builtin(name, err);
+  if (s) s->gpu_only = true;
+  return s;
 }
 
 extern "C" bool lm_scene_is_gltf_name(const char *name) {

@@ -56,7 +56,7 @@ void lm_scene_shift_animation_nodes(lm_scene *s, int from, int by) {
 void lm_scene_destroy(lm_scene *s) {
   if (!s) return;
   for (int i = 0; i < s->mesh_count; i++) {
-    if (s->uploaded) lm_mesh_destroy(&s->meshes[i].gpu);
+    lm_mesh_destroy(&s->meshes[i].gpu); /* none made: nothing to do */
     free(s->meshes[i].vertices);
     free(s->meshes[i].tangents);
     free(s->meshes[i].indices);
@@ -65,7 +65,7 @@ void lm_scene_destroy(lm_scene *s) {
   for (int i = 0; i < s->node_count; i++) free(s->nodes[i].weights);
   lm_scene_free_animations(s);
   for (int i = 0; i < s->texture_count; i++) {
-    if (s->uploaded) lm_texture_destroy(&s->textures[i].gpu);
+    lm_texture_destroy(&s->textures[i].gpu);
     free(s->textures[i].rgba);
   }
   free(s->textures);
@@ -328,12 +328,43 @@ static int simplify_levels(const lm_scene_mesh *m, bool positions, uint32_t *ind
   return levels;
 }
 
+bool lm_scene_upload_texture(lm_scene *s, int i, lm_error *err) {
+  lm_scene_texture *t = &s->textures[i];
+  if (t->gpu.id) return true;
+  if (!lm_texture_upload_rgba8(&t->gpu, t->width, t->height, t->rgba, !t->linear, t->name, err)) return false;
+  if (s->gpu_only) free(t->rgba), t->rgba = NULL;
+  return true;
+}
+
+void lm_scene_upload_mesh(lm_scene *s, int i) {
+  lm_scene_mesh *m = &s->meshes[i];
+  if (m->gpu.vao) return;
+  size_t n = (size_t)m->index_count, len = n;
+  uint32_t *indices = NULL;
+  m->caster_levels = m->lod_levels = 0;
+  if (!m->rest && n / 3 >= LM_LOD_MIN_TRIANGLES) { /* a deformed mesh moves its vertices */
+    indices = memcpy(lm_alloc(sizeof *indices * n * 7), m->indices, sizeof *indices * n);
+    m->caster_levels = simplify_levels(m, true, indices, &len, m->casters);
+    m->lod_levels = simplify_levels(m, false, indices, &len, m->lods);
+  }
+  lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, indices ? indices : m->indices, (int)len,
+                 m->rest != NULL);
+  free(indices);
+  m->dirty = false;
+  if (s->gpu_only && !m->rest) {
+    free(m->vertices), free(m->indices);
+    m->vertices = NULL, m->indices = NULL;
+  }
+}
+
 bool lm_scene_upload(lm_scene *s, lm_error *err) {
   if (s->uploaded) return true;
   for (int i = 0; i < s->texture_count; i++) {
     lm_scene_texture *t = &s->textures[i];
+    if (t->gpu.id) continue; /* uploaded as the file was read (lm_scene_load_gpu) */
     if (!lm_texture_upload_rgba8(&t->gpu, t->width, t->height, t->rgba, !t->linear, t->name, err)) {
-      for (int k = 0; k < i; k++) lm_texture_destroy(&s->textures[k].gpu);
+      for (int k = 0; k < i; k++)
+        if (s->textures[k].rgba) lm_texture_destroy(&s->textures[k].gpu);
       lm_error_prefix(err, "scene '%s'", s->name);
       return false;
     }
@@ -347,21 +378,7 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
   int simplified = 0;
   for (int i = 0; i < s->mesh_count; i++) {
     lm_scene_mesh *m = &s->meshes[i];
-    size_t n = (size_t)m->index_count, len = n;
-    uint32_t *indices = NULL;
-    m->caster_levels = m->lod_levels = 0;
-    if (!m->rest && n / 3 >= LM_LOD_MIN_TRIANGLES) { /* a deformed mesh moves its vertices */
-      indices = memcpy(lm_alloc(sizeof *indices * n * 7), m->indices, sizeof *indices * n);
-      m->caster_levels = simplify_levels(m, true, indices, &len, m->casters);
-      m->lod_levels = simplify_levels(m, false, indices, &len, m->lods);
-    }
-    lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, indices ? indices : m->indices, (int)len);
-    free(indices);
-    m->dirty = false;
-    if (s->gpu_only && !m->rest) {
-      free(m->vertices), free(m->indices);
-      m->vertices = NULL, m->indices = NULL;
-    }
+    lm_scene_upload_mesh(s, i);
     if (m->caster_levels || m->lod_levels) {
       simplified++, whole += m->index_count / 3;
       casters += m->caster_levels ? m->casters[m->caster_levels - 1].count / 3 : m->index_count / 3;
@@ -864,16 +881,17 @@ static void bind_material(const lm_scene *s, const lm_program *p, const lm_mater
 }
 
 /* A node's model matrix, normal matrix (the inverse transpose's 3x3) and
- * model matrix in the previous frame (`prev`, NULL: the current one). */
-static void node_instance(const lm_node *n, const float *prev, lm_instance *out) {
+ * model matrix in the previous frame (`prev`, NULL: the current one); the
+ * model matrices take the quantized positions of its mesh (lm_mesh_dequantize). */
+static void node_instance(const lm_node *n, const lm_mesh *mesh, const float *prev, lm_instance *out) {
   mat4 model, inv;
   mat3 normal;
   memcpy(model, n->world, sizeof model);
-  memcpy(out->prev_model, prev ? prev : n->world, sizeof out->prev_model);
+  lm_mesh_dequantize(mesh, prev ? prev : n->world, out->prev_model);
   glm_mat4_inv(model, inv);
   glm_mat4_transpose(inv);
   glm_mat4_pick3(inv, normal);
-  memcpy(out->model, model, sizeof out->model);
+  lm_mesh_dequantize(mesh, n->world, out->model);
   memcpy(out->normal, normal, sizeof out->normal);
 }
 
@@ -913,7 +931,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
   lm_instance *instances = lm_alloc(sizeof *instances * (size_t)(count > 0 ? count : 1));
   for (int i = 0; i < count; i++) {
     int k = nodes[i].node;
-    node_instance(&s->nodes[k], d->prev_world ? d->prev_world + (size_t)k * 16 : NULL, &instances[i]);
+    node_instance(&s->nodes[k], &s->meshes[s->nodes[k].mesh].gpu, d->prev_world ? d->prev_world + (size_t)k * 16 : NULL, &instances[i]);
   }
   lm_instances_upload(instances, count);
   free(instances);

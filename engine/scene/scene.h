@@ -358,6 +358,11 @@ bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err)
 
 /* ---- rendering (needs a GL context) ------------------------------------ */
 bool lm_scene_upload(lm_scene *s, lm_error *err);
+/* Texture i, mesh i (with its simplified copies) to the GPU, as
+ * lm_scene_upload does for every one; a gpu_only scene frees the CPU copy
+ * (a mesh's unless it deforms). One already there: nothing to do. */
+bool lm_scene_upload_texture(lm_scene *s, int i, lm_error *err);
+void lm_scene_upload_mesh(lm_scene *s, int i);
 /* Reads back from the GPU the vertices and indices a gpu_only upload freed
  * (the tracer's, when a technique with traced rays is loaded); needs the GL
  * context. Nothing to do when none were freed. */
