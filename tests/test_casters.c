@@ -389,7 +389,7 @@ static void quantized_vertices_read_back_within_their_error(void **state) {
  * mean). */
 static void quantized_positions_keep_the_image(void **state) {
   (void)state;
-  lm_scene *quantized = spheres_scene(), *floats = spheres_scene();
+  lm_scene *quantized = nine_scene(false), *floats = nine_scene(false);
   lm_scene_mesh *m = &floats->meshes[1];
   m->rest = memcpy(malloc(sizeof(float) * 8 * (size_t)m->vertex_count), m->vertices, sizeof(float) * 8 * (size_t)m->vertex_count);
   const char *sets[] = {"simplify=0", "shadow.simplify=0", "ambient=0.05", NULL};
