@@ -90,6 +90,16 @@ vec3 later_bounces(vec3 e2, vec3 rho, float closed) {
 }
 #endif
 
+// One hit texture's four rays: what they send, into gathered, and (UNSEEN)
+// how many send and how many met an unseen surface, into rays: each
+// texture read once for both.
+void take4(vec4 h, int width, inout vec3 gathered, inout vec2 rays) {
+  gathered += sent4(h, width);
+#ifdef UNSEEN
+  rays += count4(h);
+#endif
+}
+
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   vec4 hit0 = texelFetch(hits0, px, 0);
@@ -115,40 +125,26 @@ void main() {
   bool found = d > 0.0 && temporal_history(uv, d, h, held);
 #endif
   int width = textureSize(clr, 0).x, n = clamp(samples, 1, 4 * HITS);
-  vec3 gathered = sent4(hit0, width);
+  vec3 gathered = vec3(0.0);
+  vec2 rays = vec2(0.0); // UNSEEN: rays that send, rays that met an unseen surface
+  take4(hit0, width, gathered, rays);
 #if HITS > 1
-  gathered += sent4(texelFetch(hits1, px, 0), width);
+  take4(texelFetch(hits1, px, 0), width, gathered, rays);
 #endif
 #if HITS > 2
-  gathered += sent4(texelFetch(hits2, px, 0), width);
+  take4(texelFetch(hits2, px, 0), width, gathered, rays);
 #endif
 #if HITS > 3
-  gathered += sent4(texelFetch(hits3, px, 0), width);
+  take4(texelFetch(hits3, px, 0), width, gathered, rays);
 #endif
 #if HITS > 4
-  gathered += sent4(texelFetch(hits4, px, 0), width);
+  take4(texelFetch(hits4, px, 0), width, gathered, rays);
 #endif
 #if HITS > 5
-  gathered += sent4(texelFetch(hits5, px, 0), width);
+  take4(texelFetch(hits5, px, 0), width, gathered, rays);
 #endif
   vec4 e = texelFetch(first, px, 0);
 #ifdef UNSEEN
-  vec2 rays = count4(hit0);
-#if HITS > 1
-  rays += count4(texelFetch(hits1, px, 0));
-#endif
-#if HITS > 2
-  rays += count4(texelFetch(hits2, px, 0));
-#endif
-#if HITS > 3
-  rays += count4(texelFetch(hits3, px, 0));
-#endif
-#if HITS > 4
-  rays += count4(texelFetch(hits4, px, 0));
-#endif
-#if HITS > 5
-  rays += count4(texelFetch(hits5, px, 0));
-#endif
   // Each unseen ray brings the mean of what the rays of known fate bring (those that left the scene bring
   // nothing), so nothing is made up where the march knows no ray's fate. The mean over the sending rays
   // alone, or p's own reflected first bounce where none sends, took more from POV-Ray's figure than they
