@@ -14,7 +14,8 @@
 #       TECHS (default isr+esm), SCENES and ROUNDS (default 2) choose the runs.
 #   tools/device_bench.sh memory FILE...
 #       there: peak resident memory, time to first frame and GPU memory of
-#       `limn bench` (head, dl+esm and the default, 640x480) per scene file.
+#       `limn bench` (dl+esm and the default, 640x480) per scene file, base
+#       (when prepared) and head taking turns.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=.devcheck
@@ -69,13 +70,20 @@ use_nvidia() { # glvnd's libraries from .devcheck, the machine's NVIDIA EGL vend
 
 memory() {
   use_nvidia
-  local file tech
+  local revs=(head)
+  [ -x "$dir/base/limn" ] && revs=(base head)
+  local file tech rev
   for file in "$@"; do
     for tech in dl+esm default; do
       local args=(--scene "$file" --sizes 640x480 --frames 4 --warmup 1)
       [ "$tech" = default ] || args+=(--tech "$tech")
-      echo "== $file $tech"
-      timeout 150 "$dir/head/limn" bench "${args[@]}" 2>&1 | grep -i -e 'peak' -e 'first frame' -e 'gpu memory' || echo "  failed"
+      for rev in "${revs[@]}"; do
+        echo "== $rev: $file $tech"
+        local root=$PWD
+        [ -d "$dir/$rev/root" ] && root=$PWD/$dir/$rev/root
+        LIMN_ROOT=$root timeout 150 "$dir/$rev/limn" bench "${args[@]}" 2>&1 |
+          grep -i -e 'peak' -e 'first frame' -e 'gpu memory' || echo "  failed"
+      done
     done
   done
 }
