@@ -23,6 +23,7 @@ packages=(
   libmeshoptimizer-dev                   # simplified shadow casters (engine/scene/scene.c)
   libdraco-dev                           # Draco-compressed glTF meshes (engine/scene/gltf_decode.cpp)
   libembree-dev                          # the ray tracer's acceleration structure (engine/trace, Embree 3)
+  libpng-dev libjpeg-dev                 # PNG and JPEG without OpenImageIO (engine/image/image.c)
   blender                                # Cycles references (limn reference --renderer cycles, cli/cycles_render.py)
 )
 

@@ -2,8 +2,8 @@
 # GPU figures of the moving-camera benchmark on a lent GPU machine (the
 # `device` tool), never a test dependency. Two steps:
 #   tools/device_bench.sh prepare [BASE_REV]
-#       here: builds `limn` without image files (LIMN_IMAGE_IO=OFF: OpenImageIO's
-#       libraries are too big to carry) from the working tree into
+#       here: builds `limn` without OpenImageIO (LIMN_IMAGE_IO=OFF: PNG and JPEG only;
+#       its libraries are too big to carry) from the working tree into
 #       .devcheck/head, and from BASE_REV (if given) into .devcheck/base, and
 #       copies the libraries they load into .devcheck/lib (libEGL and libGL
 #       from glvnd, so that the machine's NVIDIA driver is the one loaded).
@@ -33,9 +33,12 @@ prepare() {
     local wt=/tmp/limn-device-base
     git worktree remove --force "$wt" 2>/dev/null || true
     git worktree add -q --detach "$wt" "$1"
-    # A revision older than LIMN_IMAGE_IO: swap its image bridge for the stub.
+    # A revision older than LIMN_IMAGE_IO: swap its image bridge for the libpng stub that
+    # LIMN_IMAGE_IO=OFF built until engine/image/image.c replaced it.
     if ! grep -q LIMN_IMAGE_IO "$wt/CMakeLists.txt"; then
-      cp engine/image/image_png.c "$wt/engine/image/"
+      local gone
+      gone=$(git log -1 --format=%H --diff-filter=D HEAD -- engine/image/image_png.c)
+      git show "$gone^:engine/image/image_png.c" >"$wt/engine/image/image_png.c"
       sed -i -e 's|engine/image/image_oiio.cpp|engine/image/image_png.c|' -e 's|PkgConfig::OIIO|png16|' \
         -e '/pkg_check_modules(OIIO/d' -e '/add_subdirectory(tests)/d' "$wt/CMakeLists.txt"
     fi
