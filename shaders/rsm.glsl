@@ -60,6 +60,13 @@ bool rsm_seen(sampler2D dpt, vec3 q) {
 // geometry-aware blur averages. Each sample still weighs its own density, so
 // one pixel alone is exact too, only noisier. The angle steps by a fixed
 // rotation (no sin or cos a sample); the pattern turns per frame by `rotate`.
+// Each 4 x 4 tile turns the pattern and shifts its radii by its own amounts
+// (the R2 sequence over the tiles' coordinates): with one pattern for every
+// tile, the points of a surface that project onto nearly the same RSM texels
+// (a wall under a high sun) all took the same senders, so a few samples hit
+// or missed a thin sunlit strip for the whole wall at once, a bias and not
+// noise (the reference street at 64 x 48, rsm+esm's mean indirect light at 24
+// samples: 0.044 against 0.078 at 256; with the turns 0.072 and 0.072).
 // 1/d^2 is capped at the texel's own area, so a sender next to p stays finite.
 // VISIBILITY: the seed's screen-space test (lines 930-958): `steps` points
 // on p -> q; one behind the depth buffer rejects q.
@@ -162,6 +169,9 @@ vec3 rsm_gather(Surface s, ivec2 px, sampler2D dpt, sampler2D mat) {
   // With temporal reuse the radii move too (by the plastic number's step, unrelated to the angle's), so
   // that the frames a pixel accumulates cover other distances, not only other angles.
   float shift = rsm_rotate > 0.0 ? fract(frame.time.y * PLASTIC) : 0.0;
+  vec2 tile = vec2(px / INTERLEAVE), r2 = vec2(PLASTIC, PLASTIC * PLASTIC); // the tile's turn and shift
+  turn = fract(turn + dot(tile, r2));
+  shift = fract(shift + dot(tile, r2.yx));
   vec3 e = vec3(0.0);
 #ifdef LIGHT_SET
   // As reflected_light unrolls the set: four at a time, the compiler drops those past the count.

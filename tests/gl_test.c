@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "gl_test.h"
+#include "scene/gltf.h"
 
 static lm_scene *cornell;
 static char scratch[256];
@@ -287,6 +288,20 @@ void gl_camera_up(lm_scene *s, float y) {
   glm_rotate(m, glm_rad(90.0f), (vec3){1, 0, 0}); /* -Z of the node points up */
   int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
   lm_scene_add_camera(s, &(lm_camera){.name = "up", .fov_y = glm_rad(45.0f), .znear = 0.01f, .zfar = 100, .node = cam});
+}
+
+lm_scene *gl_reference_scene(const char *name) {
+  lm_error err;
+  char path[1024];
+  snprintf(path, sizeof path, "%s/../data/scenes/reference/%s.glb", LIMN_TEST_DIR, name);
+  lm_scene *s = lm_scene_load_gltf(path, &err);
+  if (!s) fail_msg("%s", err.msg);
+  snprintf(path, sizeof path, "%s/../data/scenes/reference/%s.cams", LIMN_TEST_DIR, name);
+  int n, first = lm_scene_add_camera_list(s, path, &n, &err);
+  if (first < 0) fail_msg("%s", err.msg);
+  lm_camera c = s->cameras[0];
+  s->cameras[0] = s->cameras[first], s->cameras[first] = c;
+  return s;
 }
 
 lm_scene *gl_sunlit_corner(int width, int height, float view_proj[16]) {

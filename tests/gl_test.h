@@ -92,6 +92,9 @@ bool gl_target_finite(gl_result *r, const char *name);
 void gl_quad(lm_scene *s, const char *name, int material, const float c[4][3], const float n[3]);
 int gl_material(lm_scene *s, const char *name, float r, float g, float b);
 void gl_camera_up(lm_scene *s, float y);
+/* data/scenes/reference/<name>.glb with the first view of its .cams list as
+ * camera 0 (the one a frame renders); fails the test when either cannot be read. */
+lm_scene *gl_reference_scene(const char *name);
 /* A UV sphere of radius r at the origin, 32 segments by 16 rings (position,
  * normal, uv), as mesh `name`: the mesh's index. */
 int gl_uv_sphere(lm_scene *s, const char *name, float r);

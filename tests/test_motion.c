@@ -367,8 +367,10 @@ static double masked_error(const float *a, const float *b, const bool *mask) {
  * are reuse off's, history or not), the combined technique and RSM at
  * their defaults (their RSM turns every frame, so their histories
  * average). Measured, band error with velocity / a frame without reuse / a
- * whole ghost: isr 0.0519 / 0.0494 / 0.269, isr+rsm+esm 0.0542 / 0.0440 /
- * 0.265, rsm+esm 0.0214 / 0.0368 / 0.293. isr+rsm+esm's excess over the
+ * whole ghost: isr 0.0517 / 0.0492 / 0.269, isr+rsm+esm 0.0537 / 0.0463 /
+ * 0.274, rsm+esm 0.0214 / 0.0173 / 0.302 (its fresh frame 0.0368 while
+ * every tile of the RSM gather took one pattern, whose bias reuse averaged
+ * away: now its lag shows as isr+rsm+esm's). isr+rsm+esm's excess over the
  * fresh frame is lag, not a ghost: the box changes the RSM, so every
  * pixel's light changes while it moves, and a history (the band was
  * uncovered over 4 frames; its pixels' histories since, and their
@@ -393,7 +395,7 @@ static void moving_object_leaves_no_ghost(void **state) {
       {"isr+rsm+esm", {"isr.temporal=true", "isr.temporal.moving=1", NULL},
        {"isr.temporal=true", "isr.temporal.moving=1", "isr.temporal.velocity=false", NULL}, 1.2,
        {"isr.temporal.frames=64", "isr.temporal.clamp=0"}},
-      {"rsm+esm", {"rsm.temporal=true", NULL}, {"rsm.temporal=true", "rsm.temporal.velocity=false", NULL}, 0.8,
+      {"rsm+esm", {"rsm.temporal=true", NULL}, {"rsm.temporal=true", "rsm.temporal.velocity=false", NULL}, 1.3,
        {"rsm.temporal.frames=64", "rsm.temporal.clamp=0"}},
   };
   enum { STILL = 10, MOVING = 4 };
