@@ -3,8 +3,9 @@
  * read: a job makes one chain of one mesh from the mesh's own vertices and
  * indices, and the context thread, which alone may call GL, creates a
  * mesh's buffers once both its chains are done, in the order the meshes
- * came (lm_scene_upload_mesh, lm_scene_finish_meshes). A copy depends on its
- * mesh alone, so the buffers are the same whatever the threads' timing. */
+ * came (lm_scene_upload_mesh, lm_scene_finish_meshes), and takes a job
+ * itself where it would wait. A copy depends on its mesh alone, so the
+ * buffers are the same whatever the threads' timing. */
 #include "scene/scene_internal.h"
 
 #include <math.h>
@@ -25,7 +26,6 @@ typedef struct lod_job {
   size_t len;
   lm_mesh_lod lods[LM_LOD_LEVELS]; /* first: within out */
   int levels;
-  double cpu_ms; /* the worker's CPU time on it */
   bool done;
 } lod_job;
 
@@ -40,7 +40,7 @@ typedef struct lm_lod_work {
   int taken;        /* jobs a worker has begun */
   int collected;    /* jobs whose mesh is on the GPU (the first ones) */
   bool quit;
-  double cpu_ms, wait_ms; /* the workers' CPU time, the context thread's waits */
+  double cpu_ms, wait_ms; /* the jobs' CPU time, the context thread's waits */
 } lm_lod_work;
 
 /* Whether meshoptimizer can take one edge of the mesh within the coarsest
@@ -128,22 +128,27 @@ static void simplify_levels(lod_job *j, bool positions) {
   free(from), free(to), free(first), free(distinct);
 }
 
+/* Runs the next job not begun; called and returns with w->lock held. */
+static void run_next(lm_lod_work *w) {
+  int i = w->taken++;
+  lod_job *j = w->jobs[i];
+  pthread_mutex_unlock(&w->lock);
+  double t0 = lm_thread_cpu_ms();
+  simplify_levels(j, i % CHAINS == CASTERS);
+  double ms = lm_thread_cpu_ms() - t0;
+  pthread_mutex_lock(&w->lock);
+  j->done = true;
+  w->cpu_ms += ms;
+  pthread_cond_broadcast(&w->done);
+}
+
 static void *worker(void *arg) {
   lm_lod_work *w = arg;
   pthread_mutex_lock(&w->lock);
   for (;;) {
     while (!w->quit && w->taken == w->job_count) pthread_cond_wait(&w->wake, &w->lock);
     if (w->quit) break; /* the jobs not begun are dropped (lm_scene_drop_meshes) */
-    int i = w->taken++;
-    lod_job *j = w->jobs[i];
-    pthread_mutex_unlock(&w->lock);
-    double t0 = lm_thread_cpu_ms();
-    simplify_levels(j, i % CHAINS == CASTERS);
-    j->cpu_ms = lm_thread_cpu_ms() - t0;
-    pthread_mutex_lock(&w->lock);
-    j->done = true;
-    w->cpu_ms += j->cpu_ms;
-    pthread_cond_broadcast(&w->done);
+    run_next(w);
   }
   pthread_mutex_unlock(&w->lock);
   return NULL;
@@ -183,6 +188,10 @@ static void collect(lm_scene *s, int pending) {
     bool done = true;
     for (int c = 0; c < CHAINS; c++) done = done && jobs[c]->done;
     if (!done && (w->job_count - w->collected) / CHAINS <= pending) break;
+    if (!done && w->taken < w->job_count) { /* a job not begun: made here rather than waited for */
+      run_next(w);
+      continue;
+    }
     if (!done) {
       double t0 = lm_now_ms();
       pthread_cond_wait(&w->done, &w->lock);
@@ -215,15 +224,6 @@ void lm_scene_simplify_mesh(lm_scene *s, int mesh) {
   if (!s->lod_work) s->lod_work = start();
   lm_lod_work *w = s->lod_work;
   const lm_scene_mesh *m = &s->meshes[mesh];
-  if (!w->thread_count) { /* no thread could start: made here */
-    lod_job jobs[CHAINS] = {{.vertices = m->vertices, .indices = m->indices, .vertex_count = (size_t)m->vertex_count,
-                             .index_count = (size_t)m->index_count}};
-    jobs[CAMERA] = jobs[CASTERS];
-    simplify_levels(&jobs[CASTERS], true), simplify_levels(&jobs[CAMERA], false);
-    make_buffers(s, mesh, (lod_job *[CHAINS]){&jobs[CASTERS], &jobs[CAMERA]});
-    free(jobs[CASTERS].out), free(jobs[CAMERA].out);
-    return;
-  }
   pthread_mutex_lock(&w->lock);
   int cap = w->mesh_cap;
   w->jobs = lm_grow(w->jobs, &w->job_cap, w->job_count + CHAINS, sizeof *w->jobs);
@@ -238,7 +238,8 @@ void lm_scene_simplify_mesh(lm_scene *s, int mesh) {
   }
   pthread_cond_broadcast(&w->wake);
   pthread_mutex_unlock(&w->lock);
-  /* Meshes waiting keep their CPU copies: a few a worker keep every worker busy and the memory small. */
+  /* Meshes waiting keep their CPU copies: a few a worker keep every worker busy and the memory small
+   * (none where no thread could start: this thread makes them). */
   collect(s, 2 * w->thread_count);
 }
 
@@ -261,8 +262,8 @@ void lm_scene_finish_meshes(lm_scene *s) {
   if (!s->lod_work) return;
   lm_lod_work *w = s->lod_work;
   collect(s, 0);
-  lm_debug("scene '%s': %d meshes simplified on %d threads: %.0f ms of their CPU time, %.0f ms waited for", s->name,
-           w->job_count / CHAINS, w->thread_count, w->cpu_ms, w->wait_ms);
+  lm_debug("scene '%s': %d meshes simplified on %d threads and this one: %.0f ms of CPU time, %.0f ms waited for",
+           s->name, w->job_count / CHAINS, w->thread_count, w->cpu_ms, w->wait_ms);
   stop(s);
 }
 
