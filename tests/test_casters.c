@@ -5,14 +5,17 @@
  * image within a stated error of the whole meshes', for a finely cut sphere,
  * a cone cut as exporters cut it (outdoor.glb's tree crowns) and a terrain;
  * the GPU's quantized vertices (lm_mesh) lie within their stated error of the
- * floats.
+ * floats; the copies, made on worker threads, are the same on any number.
  * Each test stands alone (it makes and frees its own), so tests read alike. */
+#define _GNU_SOURCE /* sched_setaffinity: one worker thread */
+#include <sched.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
 #include <cglm/cglm.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -319,6 +322,182 @@ static void simplified_meshes_keep_the_image(void **state) {
   lm_scene_destroy(s);
 }
 
+/* The sphere of sphere_mesh flat-shaded, as exporters write one: each
+ * triangle its own three vertices with the triangle's normal, so that every
+ * vertex is a seam. */
+static int flat_sphere_mesh(lm_scene *s, float r, int seg, int rings) {
+  int nt = seg * rings * 2, k = 0;
+  float *v = malloc(sizeof(float) * 8 * 3 * (size_t)nt);
+  uint32_t *ix = malloc(sizeof(uint32_t) * 3 * (size_t)nt);
+  for (int j = 0; j < rings; j++)
+    for (int i = 0; i < seg; i++)
+      for (int half = 0; half < 2; half++) {
+        const int corners[2][3][2] = {{{0, 0}, {1, 0}, {1, 1}}, {{0, 0}, {1, 1}, {0, 1}}};
+        float p[3][3];
+        for (int c = 0; c < 3; c++) {
+          float t = GLM_PIf * (float)(j + corners[half][c][1]) / (float)rings;
+          float a = 2 * GLM_PIf * (float)(i + corners[half][c][0]) / (float)seg;
+          p[c][0] = r * sinf(t) * cosf(a), p[c][1] = r * cosf(t), p[c][2] = r * sinf(t) * sinf(a);
+        }
+        vec3 e1, e2, n;
+        glm_vec3_sub(p[1], p[0], e1), glm_vec3_sub(p[2], p[0], e2), glm_vec3_cross(e1, e2, n);
+        glm_vec3_normalize(n); /* a pole's degenerate triangle: a zero normal, as exporters leave it */
+        for (int c = 0; c < 3; c++, k++) {
+          float *o = v + 8 * (size_t)k;
+          memcpy(o, p[c], sizeof p[c]), memcpy(o + 3, n, sizeof n);
+          o[6] = (float)(i + corners[half][c][0]) / (float)seg, o[7] = (float)(j + corners[half][c][1]) / (float)rings;
+          ix[k] = (uint32_t)k;
+        }
+      }
+  int id = lm_scene_add_mesh(s, "flat sphere", v, 3 * nt, ix, 3 * nt);
+  free(v), free(ix);
+  return id;
+}
+
+/* A mesh's GPU indices (its own, then its copies'), read back. */
+static uint32_t *read_indices(const lm_scene_mesh *m) {
+  float *v = malloc(sizeof(float) * 8 * (size_t)m->vertex_count);
+  uint32_t *ix = malloc(sizeof(uint32_t) * (size_t)m->gpu.index_count);
+  lm_mesh_read(&m->gpu, v, m->vertex_count, ix, m->gpu.index_count);
+  free(v);
+  return ix;
+}
+
+/* Two scenes whose meshes went to the GPU with the same copies: the same
+ * levels (triangles and errors) and the same index buffers. */
+static void assert_same_copies(const lm_scene *a, const lm_scene *b) {
+  assert_int_equal(a->mesh_count, b->mesh_count);
+  for (int i = 0; i < a->mesh_count; i++) {
+    const lm_scene_mesh *ma = &a->meshes[i], *mb = &b->meshes[i];
+    assert_int_equal(ma->caster_levels, mb->caster_levels);
+    assert_int_equal(ma->lod_levels, mb->lod_levels);
+    assert_memory_equal(ma->casters, mb->casters, sizeof ma->casters[0] * (size_t)ma->caster_levels);
+    assert_memory_equal(ma->lods, mb->lods, sizeof ma->lods[0] * (size_t)ma->lod_levels);
+    assert_int_equal(ma->gpu.index_count, mb->gpu.index_count);
+    uint32_t *ia = read_indices(ma), *ib = read_indices(mb);
+    assert_memory_equal(ia, ib, sizeof *ia * (size_t)ma->gpu.index_count);
+    free(ia), free(ib);
+  }
+}
+
+/* Distance from p to the triangle abc: to its plane where p projects inside,
+ * else to the nearest of its edges. */
+static float point_triangle_distance(const float *p, const float *a, const float *b, const float *c) {
+  const float *v[3] = {a, b, c};
+  vec3 e1, e2, n, ap;
+  glm_vec3_sub((float *)b, (float *)a, e1), glm_vec3_sub((float *)c, (float *)a, e2), glm_vec3_cross(e1, e2, n);
+  glm_vec3_sub((float *)p, (float *)a, ap);
+  float area = glm_vec3_norm(n);
+  bool inside = area > 0;
+  for (int i = 0; i < 3 && inside; i++) { /* p on the inner side of each edge's plane through n */
+    vec3 edge, to, side;
+    glm_vec3_sub((float *)v[(i + 1) % 3], (float *)v[i], edge), glm_vec3_sub((float *)p, (float *)v[i], to);
+    glm_vec3_cross(edge, to, side);
+    inside = glm_vec3_dot(side, n) >= 0;
+  }
+  if (inside) return fabsf(glm_vec3_dot(ap, n)) / area;
+  float best = FLT_MAX;
+  for (int i = 0; i < 3; i++) {
+    vec3 edge, to, q;
+    glm_vec3_sub((float *)v[(i + 1) % 3], (float *)v[i], edge), glm_vec3_sub((float *)p, (float *)v[i], to);
+    float len2 = glm_vec3_norm2(edge), t = len2 > 0 ? glm_clamp(glm_vec3_dot(to, edge) / len2, 0, 1) : 0;
+    glm_vec3_scale(edge, t, q);
+    best = fminf(best, glm_vec3_distance(to, q));
+  }
+  return best;
+}
+
+/* How far the mesh lies from a copy: the largest distance of a vertex of the mesh to the copy's surface. */
+static float copy_distance(const lm_scene_mesh *m, const uint32_t *copy, int count) {
+  float worst = 0;
+  for (int i = 0; i < m->vertex_count; i++) {
+    const float *p = m->vertices + 8 * (size_t)i;
+    float best = FLT_MAX;
+    for (int t = 0; t + 2 < count && best > 0; t += 3)
+      best = fminf(best, point_triangle_distance(p, m->vertices + 8 * (size_t)copy[t], m->vertices + 8 * (size_t)copy[t + 1],
+                                                 m->vertices + 8 * (size_t)copy[t + 2]));
+    worst = fmaxf(worst, best);
+  }
+  return worst;
+}
+
+/* Eighteen meshes (spheres and flat-shaded spheres of several cuts, cones,
+ * a bare triangle) uploaded: more than the worker threads keep waiting. */
+static lm_scene *many_meshes(void) {
+  lm_scene *s = lm_scene_create("many");
+  int mat = gl_material(s, "paint", 0.8f, 0.3f, 0.2f);
+  for (int k = 0; k < 6; k++) {
+    place(s, sphere_mesh(s, 0.6f, 12 + 8 * k, 6 + 4 * k), mat, (float)k, 0, 0);
+    place(s, flat_sphere_mesh(s, 0.6f, 12 + 8 * k, 6 + 4 * k), mat, (float)k, 0, 2);
+    place(s, k < 5 ? cone_mesh(s, 0.6f, 1.4f, 16 + 4 * k) : sphere_mesh(s, 0.1f, 2, 2), mat, (float)k, 0, 4);
+  }
+  lm_scene_update(s);
+  return s;
+}
+
+/* Simplified copies are made on worker threads, one a core, while meshes
+ * are read, each mesh's GL buffers once its copies are done: the copies are
+ * the same on one worker as on all (the buffers do not depend on the
+ * threads' timing), each within its budget (check_levels); a flat-shaded
+ * sphere, every vertex a seam, has caster copies (over its positions) and
+ * no camera copy, and the bare mesh none. Loading a file to the GPU as it
+ * is read (lm_scene_load_gpu: meshes wait while their copies are made, the
+ * CPU copies freed after) gives the copies of loading it whole and then
+ * uploading it. */
+static void copies_are_the_same_on_any_number_of_threads(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *all = many_meshes(), *one = many_meshes();
+  assert_true(lm_scene_upload(all, &err));
+  cpu_set_t cores, first;
+  assert_int_equal(sched_getaffinity(0, sizeof cores, &cores), 0);
+  CPU_ZERO(&first);
+  for (int c = 0; c < CPU_SETSIZE; c++)
+    if (CPU_ISSET(c, &cores)) {
+      CPU_SET(c, &first);
+      break;
+    }
+  assert_int_equal(sched_setaffinity(0, sizeof first, &first), 0); /* lm_cpu_count: one worker */
+  assert_int_equal(lm_cpu_count(), 1);
+  bool uploaded = lm_scene_upload(one, &err);
+  assert_int_equal(sched_setaffinity(0, sizeof cores, &cores), 0);
+  assert_true(uploaded);
+  print_message("%d cores\n", lm_cpu_count());
+  assert_same_copies(all, one);
+  double ratio = 0;
+  for (int i = 0; i < all->mesh_count; i++) {
+    const lm_scene_mesh *m = &all->meshes[i];
+    check_levels(m->name, m->casters, m->caster_levels, m->index_count / 3, mesh_extent(m));
+    check_levels(m->name, m->lods, m->lod_levels, m->index_count / 3, mesh_extent(m));
+    uint32_t *ix = read_indices(m);
+    for (int chain = 0; chain < 2; chain++)
+      for (int k = 0; k < (chain ? m->lod_levels : m->caster_levels); k++) {
+        const lm_mesh_lod *l = &(chain ? m->lods : m->casters)[k];
+        float d = copy_distance(m, ix + l->first, l->count);
+        ratio = fmax(ratio, d / l->error);
+        print_message("%s %s level %d: the mesh lies within %.4g of it, its error %.4g\n", m->name,
+                      chain ? "camera" : "casters", k, (double)d, (double)l->error);
+      }
+    free(ix);
+    if (!strcmp(m->name, "flat sphere")) assert_true(m->caster_levels > 0 && m->lod_levels == 0);
+    if (!strcmp(m->name, "sphere")) assert_true(m->index_count / 3 < LM_LOD_MIN_TRIANGLES ? !m->caster_levels && !m->lod_levels
+                                                                                         : m->caster_levels && m->lod_levels);
+  }
+  print_message("the mesh's vertices lie within %.3g times a copy's error of it\n", ratio);
+  assert_true(ratio > 0.5 && ratio <= 2.5);
+  lm_scene_destroy(all), lm_scene_destroy(one);
+
+  char path[1024];
+  snprintf(path, sizeof path, "%s/../data/scenes/big/big_small.glb", LIMN_TEST_DIR);
+  lm_scene *read = lm_scene_load_gpu(path, &err), *whole = lm_scene_load_gltf(path, &err);
+  assert_non_null(read);
+  assert_non_null(whole);
+  assert_true(lm_scene_upload(read, &err) && lm_scene_upload(whole, &err));
+  for (int i = 0; i < read->mesh_count; i++) assert_null(read->meshes[i].vertices);
+  assert_same_copies(read, whole);
+  lm_scene_destroy(read), lm_scene_destroy(whole);
+}
+
 /* Deterministic numbers in [0, 1) (a linear congruential generator). */
 static float next_unit(uint32_t *seed) {
   *seed = *seed * 1664525u + 1013904223u;
@@ -419,6 +598,7 @@ int main(void) {
       cmocka_unit_test(simplified_meshes_keep_the_image),
       cmocka_unit_test(quantized_vertices_read_back_within_their_error),
       cmocka_unit_test(quantized_positions_keep_the_image),
+      cmocka_unit_test(copies_are_the_same_on_any_number_of_threads),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

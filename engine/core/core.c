@@ -52,6 +52,7 @@ static double clock_ms(clockid_t id) {
 }
 double lm_now_ms(void) { return clock_ms(CLOCK_MONOTONIC); }
 double lm_cpu_ms(void) { return clock_ms(CLOCK_PROCESS_CPUTIME_ID); }
+double lm_thread_cpu_ms(void) { return clock_ms(CLOCK_THREAD_CPUTIME_ID); }
 
 int lm_cpu_count(void) {
   /* The affinity mask, not the machine's online count: a Slurm task, a

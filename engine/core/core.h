@@ -37,6 +37,7 @@ void lm_log(lm_log_level level, const char *fmt, ...) __attribute__((format(prin
 /* ---- clocks ------------------------------------------------------------ */
 double lm_now_ms(void);     /* CLOCK_MONOTONIC, milliseconds */
 double lm_cpu_ms(void);     /* this process's CPU time, milliseconds */
+double lm_thread_cpu_ms(void); /* the calling thread's CPU time, milliseconds */
 int lm_cpu_count(void);     /* cores this process may run on (its affinity mask), at least 1 */
 
 /* ---- files ------------------------------------------------------------- */

@@ -2,7 +2,6 @@
 
 #include <cglm/cglm.h>
 #include <float.h>
-#include <meshoptimizer.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -55,6 +54,7 @@ void lm_scene_shift_animation_nodes(lm_scene *s, int from, int by) {
 /* Frees each array the scene owns, one by one: destroy functions read alike. */
 void lm_scene_destroy(lm_scene *s) {
   if (!s) return;
+  lm_scene_drop_meshes(s); /* its threads read the meshes */
   for (int i = 0; i < s->mesh_count; i++) {
     lm_mesh_destroy(&s->meshes[i].gpu); /* none made: nothing to do */
     free(s->meshes[i].vertices);
@@ -275,59 +275,6 @@ bool lm_scene_camera_check(const lm_scene *s, int cam, lm_error *err) {
   return true;
 }
 
-/* Makes up to LM_LOD_LEVELS simplified copies of m, each from the mesh
- * itself (not from the last: the errors of a chain add up, and the finer
- * levels made its coarse ones err more for as many triangles), appended to
- * `indices` (*len of them; room for 7 times the mesh's own: meshopt_simplify
- * writes up to its input's count, and each copy keeps at most 3/4 of the
- * last's, so 5 copies at most 2.3 times), into lods; returns how many. A
- * level whose budget (LM_LOD_ERROR times 4^k of the extent) keeps over 3/4
- * of the last's triangles is left out. Over positions alone (casters), the mesh is
- * first made of its distinct positions (a seam, vertices that differ only in
- * normal or uv, would stop the simplifier there), each copy's indices then
- * naming one vertex at each position; otherwise the seams stay, and so the
- * normals and uvs the camera sees. */
-static int simplify_levels(const lm_scene_mesh *m, bool positions, uint32_t *indices, size_t *len,
-                           lm_mesh_lod lods[LM_LOD_LEVELS]) {
-  size_t n = (size_t)m->index_count, nv = (size_t)m->vertex_count, stride = 8 * sizeof(float);
-  uint32_t *from = lm_alloc(sizeof *from * n), *first = NULL; /* first: a vertex of m at each position */
-  const float *vertices = m->vertices;
-  float *distinct = NULL;
-  if (positions) {
-    /* Not meshopt_generateShadowIndexBuffer alone: meshoptimizer (0.18) still sees the vertices its indices
-     * no longer use beside the ones they do, and keeps every such seam vertex where it is, so a cone cut as
-     * exporters cut it (a tip vertex a side, a ring a side and one for its base) kept all its triangles. */
-    uint32_t *remap = lm_alloc(sizeof *remap * nv);
-    struct meshopt_Stream xyz = {m->vertices, 3 * sizeof(float), stride};
-    size_t unique = meshopt_generateVertexRemapMulti(remap, m->indices, n, nv, &xyz, 1);
-    distinct = lm_alloc(stride * (unique > 0 ? unique : 1));
-    meshopt_remapVertexBuffer(distinct, m->vertices, nv, stride, remap);
-    meshopt_remapIndexBuffer(from, m->indices, n, remap);
-    first = lm_alloc(sizeof *first * (unique > 0 ? unique : 1));
-    for (size_t i = nv; i-- > 0;)
-      if (remap[i] != ~0u) first[remap[i]] = (uint32_t)i;
-    free(remap);
-    vertices = distinct, nv = unique;
-  } else {
-    memcpy(from, m->indices, sizeof *from * n);
-  }
-  float scale = meshopt_simplifyScale(vertices, nv, stride), error = 0, budget = LM_LOD_ERROR;
-  int levels = 0;
-  size_t last = n; /* the last copy's indices */
-  for (int k = 0; k < LM_LOD_LEVELS; k++, budget *= 4) { /* a budget too tight for a level: the next one */
-    uint32_t *to = indices + *len;
-    float step = 0; /* meshoptimizer's error, relative to the extent as its target is */
-    size_t kept = meshopt_simplify(to, from, n, vertices, nv, stride, last / 4, budget, 0, &step);
-    if (kept == 0 || kept > last * 3 / 4 || !(step >= 0)) continue;
-    error = fmaxf(error, step); /* levels err no less than the finer ones (node_lod walks them so) */
-    lods[levels++] = (lm_mesh_lod){(int)*len, (int)kept, error * scale};
-    for (size_t i = 0; first && i < kept; i++) to[i] = first[to[i]];
-    *len += kept, last = kept;
-  }
-  free(from), free(first), free(distinct);
-  return levels;
-}
-
 bool lm_scene_upload_texture(lm_scene *s, int i, lm_error *err) {
   lm_scene_texture *t = &s->textures[i];
   if (t->gpu.id) return true;
@@ -338,19 +285,20 @@ bool lm_scene_upload_texture(lm_scene *s, int i, lm_error *err) {
 
 void lm_scene_upload_mesh(lm_scene *s, int i) {
   lm_scene_mesh *m = &s->meshes[i];
-  if (m->gpu.vao) return;
-  size_t n = (size_t)m->index_count, len = n;
-  uint32_t *indices = NULL;
+  if (m->gpu.vao || m->simplifying) return;
   m->caster_levels = m->lod_levels = 0;
-  if (!m->rest && n / 3 >= LM_LOD_MIN_TRIANGLES) { /* a deformed mesh moves its vertices */
-    indices = memcpy(lm_alloc(sizeof *indices * n * 7), m->indices, sizeof *indices * n);
-    m->caster_levels = simplify_levels(m, true, indices, &len, m->casters);
-    m->lod_levels = simplify_levels(m, false, indices, &len, m->lods);
+  if (!m->rest && m->index_count / 3 >= LM_LOD_MIN_TRIANGLES) { /* a deformed mesh moves its vertices */
+    m->simplifying = true;
+    lm_scene_simplify_mesh(s, i);
+    return;
   }
-  lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, indices ? indices : m->indices, (int)len,
-                 m->rest != NULL);
-  free(indices);
-  m->dirty = false;
+  lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, m->indices, m->index_count, m->rest != NULL);
+  lm_scene_mesh_uploaded(s, i);
+}
+
+void lm_scene_mesh_uploaded(lm_scene *s, int i) {
+  lm_scene_mesh *m = &s->meshes[i];
+  m->dirty = m->simplifying = false;
   if (s->gpu_only && !m->rest) {
     free(m->vertices), free(m->indices);
     m->vertices = NULL, m->indices = NULL;
@@ -376,9 +324,10 @@ bool lm_scene_upload(lm_scene *s, lm_error *err) {
   double t0 = lm_now_ms();
   long whole = 0, casters = 0, camera = 0;
   int simplified = 0;
+  for (int i = 0; i < s->mesh_count; i++) lm_scene_upload_mesh(s, i);
+  lm_scene_finish_meshes(s);
   for (int i = 0; i < s->mesh_count; i++) {
-    lm_scene_mesh *m = &s->meshes[i];
-    lm_scene_upload_mesh(s, i);
+    const lm_scene_mesh *m = &s->meshes[i];
     if (m->caster_levels || m->lod_levels) {
       simplified++, whole += m->index_count / 3;
       casters += m->caster_levels ? m->casters[m->caster_levels - 1].count / 3 : m->index_count / 3;

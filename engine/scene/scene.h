@@ -168,17 +168,19 @@ typedef struct lm_scene_mesh {
                               the skin's joints */
   float *joint_weights;    /* the same layout, normalized to sum 1 a vertex */
   bool dirty;              /* vertices (or prev_positions) changed since the last upload (lm_scene_upload_deformed) */
-  /* Simplified copies made by lm_scene_upload (meshoptimizer), each level
+  /* Simplified copies made at upload (meshoptimizer, on worker threads), each level
    * about a quarter of the last's triangles within LM_LOD_ERROR times 4^level
    * of the mesh's extent, stored after the mesh's own indices in its GPU
    * index buffer: `casters` over positions alone (shadow tiles), `lods` with
    * the seams of normals and uvs kept (the camera's passes). A level's error
-   * (local units, meshoptimizer's measure, summed over the levels it was
-   * made from) bounds how far its surface lies from the mesh's. None (0
+   * (local units, meshoptimizer's measure; a level made from the last, the
+   * sum of the two) bounds how far its surface lies from the mesh's, and is
+   * no less than the finer levels'. None (0
    * levels) for a deformed mesh, one of fewer than LM_LOD_MIN_TRIANGLES, and
    * no level that keeps over 3/4 of the last's triangles. */
   lm_mesh_lod casters[LM_LOD_LEVELS], lods[LM_LOD_LEVELS];
   int caster_levels, lod_levels;
+  bool simplifying; /* its copies are being made: its GL buffers come after (lm_scene_upload waits) */
 } lm_scene_mesh;
 /* The first level's target error, a share of the mesh's extent: 1/16 of 1%, so that a mesh as large as a
  * terrain (160 m, outdoor.glb) has copies within a shadow texel of a near cascade (10 cm), while the
@@ -259,6 +261,7 @@ typedef struct lm_scene {
    * pixels (rgba NULL); the tracer reads the geometry back
    * (lm_scene_restore_geometry). */
   bool gpu_only;
+  struct lm_lod_work *lod_work; /* the threads making simplified copies, while a mesh waits for its own */
 } lm_scene;
 
 /* The animation `spec` names: its name, its index ("0"), or "all"
@@ -360,7 +363,10 @@ bool lm_scene_reload_materials(lm_scene *s, const lm_scene *from, lm_error *err)
 bool lm_scene_upload(lm_scene *s, lm_error *err);
 /* Texture i, mesh i (with its simplified copies) to the GPU, as
  * lm_scene_upload does for every one; a gpu_only scene frees the CPU copy
- * (a mesh's unless it deforms). One already there: nothing to do. */
+ * (a mesh's unless it deforms). One already there: nothing to do. A mesh
+ * with copies to make is queued for worker threads and goes to the GPU
+ * (on this thread) at a later call or at lm_scene_upload, which waits for
+ * every one. */
 bool lm_scene_upload_texture(lm_scene *s, int i, lm_error *err);
 void lm_scene_upload_mesh(lm_scene *s, int i);
 /* Reads back from the GPU the vertices and indices a gpu_only upload freed

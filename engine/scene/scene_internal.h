@@ -21,6 +21,17 @@ void lm_scene_trs_matrix(const float t[3], const float q[4], const float s[3], f
 /* Poses the scene as lm_scene_set_time does, leaving prev_positions, the
  * scene's time and its animation alone: the loader's rest pose. */
 void lm_scene_pose(lm_scene *s, int anim, double seconds);
+/* Simplified copies (engine/scene/lod.c). lm_scene_simplify_mesh queues
+ * mesh i's two chains for the worker threads (started at the first call)
+ * and makes the GL buffers of the meshes done so far, waiting while too
+ * many wait (each keeps its CPU copy); lm_scene_mesh_uploaded then ends
+ * each one's upload. lm_scene_finish_meshes waits for every one and stops
+ * the threads; lm_scene_drop_meshes stops them, leaving what is not done
+ * (a scene destroyed half-read). All on the GL context's thread. */
+void lm_scene_simplify_mesh(lm_scene *s, int i);
+void lm_scene_mesh_uploaded(lm_scene *s, int i);
+void lm_scene_finish_meshes(lm_scene *s);
+void lm_scene_drop_meshes(lm_scene *s);
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,273 @@
+/* Simplified copies of the scene's meshes (lm_scene_mesh.casters, .lods),
+ * made by meshoptimizer on worker threads while the file is still being
+ * read: a job makes one chain of one mesh from the mesh's own vertices and
+ * indices, and the context thread, which alone may call GL, creates a
+ * mesh's buffers once both its chains are done, in the order the meshes
+ * came (lm_scene_upload_mesh, lm_scene_finish_meshes), and takes a job
+ * itself where it would wait. A copy depends on its mesh alone, so the
+ * buffers are the same whatever the threads' timing. */
+#include "scene/scene_internal.h"
+
+#include <math.h>
+#include <meshoptimizer.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { CASTERS, CAMERA, CHAINS };
+#define MAX_THREADS 64
+#define LOD_CHAINED 3 /* the first level made from the last kept copy (simplify_levels) */
+
+typedef struct lod_job {
+  const float *vertices; /* the mesh's own, kept until its buffers are made */
+  const uint32_t *indices;
+  size_t vertex_count, index_count;
+  uint32_t *out; /* the chain's indices, one level after another */
+  size_t len;
+  lm_mesh_lod lods[LM_LOD_LEVELS]; /* first: within out */
+  int levels;
+  bool done;
+} lod_job;
+
+typedef struct lm_lod_work {
+  pthread_mutex_t lock;
+  pthread_cond_t wake, done; /* a job queued (or quit), a job done */
+  pthread_t threads[MAX_THREADS];
+  int thread_count;
+  lod_job **jobs;   /* CHAINS a mesh, in the order the meshes came */
+  int *meshes;      /* the mesh of each CHAINS jobs */
+  int job_count, job_cap, mesh_cap;
+  int taken;        /* jobs a worker has begun */
+  int collected;    /* jobs whose mesh is on the GPU (the first ones) */
+  bool quit;
+  double cpu_ms, wait_ms; /* the jobs' CPU time, the context thread's waits */
+} lm_lod_work;
+
+/* Whether meshoptimizer can take one edge of the mesh within the coarsest
+ * budget. It picks the edges it may collapse by the mesh alone and then
+ * takes those within the budget, so if none goes there, none goes within
+ * any level's budget, and no level can be made. */
+static bool reducible(uint32_t *to, const uint32_t *from, size_t n, const float *vertices, size_t nv, size_t stride) {
+  float coarsest = LM_LOD_ERROR * powf(4, LM_LOD_LEVELS - 1);
+  return meshopt_simplify(to, from, n, vertices, nv, stride, n / 4, coarsest, 0, NULL) < n;
+}
+
+/* Whether no vertex is shared by two triangles: a mesh flat-shaded as exporters write one, every vertex
+ * a seam, of which copies that keep the seams (the camera's) can seldom be made: worth asking first. */
+static bool each_vertex_once(const uint32_t *indices, size_t n, size_t nv) {
+  unsigned char *seen = calloc(nv > 0 ? nv : 1, 1);
+  size_t i = 0;
+  for (; i < n && indices[i] < nv && !seen[indices[i]]; i++) seen[indices[i]] = 1;
+  free(seen);
+  return i == n;
+}
+
+/* Makes up to LM_LOD_LEVELS simplified copies of a mesh into j->out and
+ * j->lods, level k within a budget of LM_LOD_ERROR times 4^k of the extent,
+ * with at most a quarter of the last kept level's triangles as its target.
+ * The fine levels are made from the mesh itself, erring no less than the
+ * finer ones: made from the last, their errors add up, and the coarse ones
+ * erred more for as many triangles, so that nodes drew finer copies. From
+ * LOD_CHAINED on (budgets of 4% and 16%), where a level has few triangles
+ * and a budget four times the last's error or more, a level is made from
+ * the last kept copy with its budget less that copy's error, and errs by
+ * the sum: within its budget still, for a tenth of the work (a 64 x 30
+ * sphere, as the export's: 133 triangles within 4.0% of the extent, where
+ * from the mesh the same 133 are within 3.4%; both lie 5.1% off, measured
+ * from the mesh's vertices). A level that keeps over 3/4 of the last's triangles is
+ * left out. Over positions alone (casters), the mesh is first made of its
+ * distinct positions (a seam, vertices that differ only in normal or uv,
+ * would stop the simplifier there), each copy's indices then naming one
+ * vertex at each position; otherwise the seams stay, and so the normals and
+ * uvs the camera sees. */
+static void simplify_levels(lod_job *j, bool positions) {
+  size_t n = j->index_count, nv = j->vertex_count, stride = 8 * sizeof(float);
+  uint32_t *from = lm_alloc(sizeof *from * n), *to = lm_alloc(sizeof *to * n), *first = NULL;
+  const float *vertices = j->vertices;
+  float *distinct = NULL;
+  if (positions) {
+    /* Not meshopt_generateShadowIndexBuffer alone: meshoptimizer (0.18) still sees the vertices its indices
+     * no longer use beside the ones they do, and keeps every such seam vertex where it is, so a cone cut as
+     * exporters cut it (a tip vertex a side, a ring a side and one for its base) kept all its triangles. */
+    uint32_t *remap = lm_alloc(sizeof *remap * (nv > 0 ? nv : 1));
+    struct meshopt_Stream xyz = {j->vertices, 3 * sizeof(float), stride};
+    size_t unique = meshopt_generateVertexRemapMulti(remap, j->indices, n, nv, &xyz, 1);
+    distinct = lm_alloc(stride * (unique > 0 ? unique : 1));
+    meshopt_remapVertexBuffer(distinct, j->vertices, nv, stride, remap);
+    meshopt_remapIndexBuffer(from, j->indices, n, remap);
+    first = lm_alloc(sizeof *first * (unique > 0 ? unique : 1));
+    for (size_t i = nv; i-- > 0;)
+      if (remap[i] != ~0u) first[remap[i]] = (uint32_t)i;
+    free(remap);
+    vertices = distinct, nv = unique;
+  } else {
+    memcpy(from, j->indices, sizeof *from * n);
+  }
+  /* Each kept level has at most 3/4 of the last's indices: 2.3 times the mesh's in all. */
+  j->out = lm_alloc(sizeof *j->out * (n * 7 / 3 + 1));
+  uint32_t *prev = lm_alloc(sizeof *prev * n); /* the last copy's indices, over `vertices` */
+  float scale = meshopt_simplifyScale(vertices, nv, stride), error = 0, budget = LM_LOD_ERROR;
+  size_t last = n;
+  /* A level that removes nothing, or a flat-shaded mesh's camera chain before it: is any level possible? */
+  bool probed = !positions && each_vertex_once(from, n, nv);
+  int levels = probed && !reducible(to, from, n, vertices, nv, stride) ? 0 : LM_LOD_LEVELS;
+  for (int k = 0; k < levels; k++, budget *= 4) { /* a budget too tight for a level: the next one */
+    float step = 0; /* meshoptimizer's error, relative to the extent (of every vertex) as its target is */
+    bool chained = k >= LOD_CHAINED && last < n;
+    size_t kept = chained ? meshopt_simplify(to, prev, last, vertices, nv, stride, last / 4, budget - error, 0, &step)
+                          : meshopt_simplify(to, from, n, vertices, nv, stride, last / 4, budget, 0, &step);
+    if (kept == n && !probed && !(probed = true, reducible(to, from, n, vertices, nv, stride))) break;
+    if (kept == 0 || kept > last * 3 / 4 || !(step >= 0)) continue;
+    error = chained ? error + step : fmaxf(error, step); /* a chained level: its own error to the last, plus the last's */
+    j->lods[j->levels++] = (lm_mesh_lod){(int)j->len, (int)kept, error * scale};
+    uint32_t *copy = j->out + j->len;
+    for (size_t i = 0; i < kept; i++) copy[i] = first ? first[to[i]] : to[i];
+    memcpy(prev, to, sizeof *prev * kept);
+    j->len += kept, last = kept;
+  }
+  free(prev);
+  free(from), free(to), free(first), free(distinct);
+}
+
+/* Runs the next job not begun; called and returns with w->lock held. */
+static void run_next(lm_lod_work *w) {
+  int i = w->taken++;
+  lod_job *j = w->jobs[i];
+  pthread_mutex_unlock(&w->lock);
+  double t0 = lm_thread_cpu_ms();
+  simplify_levels(j, i % CHAINS == CASTERS);
+  double ms = lm_thread_cpu_ms() - t0;
+  pthread_mutex_lock(&w->lock);
+  j->done = true;
+  w->cpu_ms += ms;
+  pthread_cond_broadcast(&w->done);
+}
+
+static void *worker(void *arg) {
+  lm_lod_work *w = arg;
+  pthread_mutex_lock(&w->lock);
+  for (;;) {
+    while (!w->quit && w->taken == w->job_count) pthread_cond_wait(&w->wake, &w->lock);
+    if (w->quit) break; /* the jobs not begun are dropped (lm_scene_drop_meshes) */
+    run_next(w);
+  }
+  pthread_mutex_unlock(&w->lock);
+  return NULL;
+}
+
+/* The mesh's own indices, then its caster levels, then the camera's, to the GPU. */
+static void make_buffers(lm_scene *s, int mesh, lod_job *const jobs[CHAINS]) {
+  lm_scene_mesh *m = &s->meshes[mesh];
+  size_t n = (size_t)m->index_count, len = n;
+  uint32_t *indices = lm_alloc(sizeof *indices * (n + jobs[CASTERS]->len + jobs[CAMERA]->len));
+  memcpy(indices, m->indices, sizeof *indices * n);
+  lm_mesh_lod *levels[CHAINS] = {m->casters, m->lods};
+  int *counts[CHAINS] = {&m->caster_levels, &m->lod_levels};
+  for (int c = 0; c < CHAINS; c++) {
+    const lod_job *j = jobs[c];
+    memcpy(indices + len, j->out, sizeof *indices * j->len);
+    for (int k = 0; k < j->levels; k++) levels[c][k] = j->lods[k], levels[c][k].first += (int)len;
+    *counts[c] = j->levels, len += j->len;
+  }
+  lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, indices, (int)len, false);
+  free(indices);
+  lm_scene_mesh_uploaded(s, mesh);
+}
+
+static void free_job(lod_job *j) {
+  if (j) free(j->out);
+  free(j);
+}
+
+/* Makes the buffers of the meshes whose copies are done, in order, until
+ * at most `pending` meshes are left waiting (0: all; waits for them). */
+static void collect(lm_scene *s, int pending) {
+  lm_lod_work *w = s->lod_work;
+  pthread_mutex_lock(&w->lock);
+  while (w->collected < w->job_count) {
+    lod_job **jobs = w->jobs + w->collected;
+    bool done = true;
+    for (int c = 0; c < CHAINS; c++) done = done && jobs[c]->done;
+    if (!done && (w->job_count - w->collected) / CHAINS <= pending) break;
+    if (!done && w->taken < w->job_count) { /* a job not begun: made here rather than waited for */
+      run_next(w);
+      continue;
+    }
+    if (!done) {
+      double t0 = lm_now_ms();
+      pthread_cond_wait(&w->done, &w->lock);
+      w->wait_ms += lm_now_ms() - t0;
+      continue;
+    }
+    int mesh = w->meshes[w->collected / CHAINS];
+    lod_job *pair[CHAINS] = {jobs[CASTERS], jobs[CAMERA]};
+    pthread_mutex_unlock(&w->lock); /* the workers go on while GL takes the buffers */
+    make_buffers(s, mesh, pair);
+    pthread_mutex_lock(&w->lock);
+    for (int c = 0; c < CHAINS; c++) free_job(w->jobs[w->collected + c]), w->jobs[w->collected + c] = NULL;
+    w->collected += CHAINS;
+  }
+  pthread_mutex_unlock(&w->lock);
+}
+
+static lm_lod_work *start(void) {
+  lm_lod_work *w = lm_alloc(sizeof *w);
+  pthread_mutex_init(&w->lock, NULL);
+  pthread_cond_init(&w->wake, NULL);
+  pthread_cond_init(&w->done, NULL);
+  int want = lm_cpu_count() < MAX_THREADS ? lm_cpu_count() : MAX_THREADS;
+  for (int i = 0; i < want; i++)
+    if (pthread_create(&w->threads[w->thread_count], NULL, worker, w) == 0) w->thread_count++;
+  return w;
+}
+
+void lm_scene_simplify_mesh(lm_scene *s, int mesh) {
+  if (!s->lod_work) s->lod_work = start();
+  lm_lod_work *w = s->lod_work;
+  const lm_scene_mesh *m = &s->meshes[mesh];
+  pthread_mutex_lock(&w->lock);
+  int cap = w->mesh_cap;
+  w->jobs = lm_grow(w->jobs, &w->job_cap, w->job_count + CHAINS, sizeof *w->jobs);
+  w->meshes = lm_grow(w->meshes, &cap, w->job_count / CHAINS + 1, sizeof *w->meshes);
+  w->mesh_cap = cap;
+  w->meshes[w->job_count / CHAINS] = mesh;
+  for (int c = 0; c < CHAINS; c++) {
+    lod_job *j = lm_alloc(sizeof *j);
+    *j = (lod_job){.vertices = m->vertices, .indices = m->indices, .vertex_count = (size_t)m->vertex_count,
+                   .index_count = (size_t)m->index_count};
+    w->jobs[w->job_count++] = j;
+  }
+  pthread_cond_broadcast(&w->wake);
+  pthread_mutex_unlock(&w->lock);
+  /* Meshes waiting keep their CPU copies: a few a worker keep every worker busy and the memory small
+   * (none where no thread could start: this thread makes them). */
+  collect(s, 2 * w->thread_count);
+}
+
+static void stop(lm_scene *s) {
+  lm_lod_work *w = s->lod_work;
+  pthread_mutex_lock(&w->lock);
+  w->quit = true;
+  pthread_cond_broadcast(&w->wake);
+  pthread_mutex_unlock(&w->lock);
+  for (int i = 0; i < w->thread_count; i++) pthread_join(w->threads[i], NULL);
+  for (int i = w->collected; i < w->job_count; i++) free_job(w->jobs[i]); /* a scene destroyed half-read */
+  pthread_cond_destroy(&w->wake);
+  pthread_cond_destroy(&w->done);
+  pthread_mutex_destroy(&w->lock);
+  free(w->jobs), free(w->meshes), free(w);
+  s->lod_work = NULL;
+}
+
+void lm_scene_finish_meshes(lm_scene *s) {
+  if (!s->lod_work) return;
+  lm_lod_work *w = s->lod_work;
+  collect(s, 0);
+  lm_debug("scene '%s': %d meshes simplified on %d threads and this one: %.0f ms of CPU time, %.0f ms waited for",
+           s->name, w->job_count / CHAINS, w->thread_count, w->cpu_ms, w->wait_ms);
+  stop(s);
+}
+
+void lm_scene_drop_meshes(lm_scene *s) {
+  if (s->lod_work) stop(s);
+}
