@@ -77,16 +77,16 @@ vec2 count4(vec4 h) {
 
 // Bounces 3 .. `bounces` after a second bounce e2 at a surface of k_d albedo
 // rho: each sends on the share r = rho closed of the last, `closed` the
-// share of p's rays that met a surface. r is at most BOUNCE_MAX, so at any
-// count the sum stays below e2 BOUNCE_MAX / (1 - BOUNCE_MAX): energy bounded.
+// share of p's rays that met a surface, so they sum to e2 (r + r^2 + ... +
+// r^m), m = bounces - 2, the geometric series r (1 - r^m) / (1 - r). r is at
+// most BOUNCE_MAX (1 - r >= 0.1), so at any count the sum stays below
+// e2 BOUNCE_MAX / (1 - BOUNCE_MAX): energy bounded.
 const float BOUNCE_MAX = 0.9;
 vec3 later_bounces(vec3 e2, vec3 rho, float closed) {
-  vec3 r = clamp(rho * saturate(closed), 0.0, BOUNCE_MAX), term = vec3(1.0), sum = vec3(0.0);
-  for (int b = 3; b <= min(bounces, 64); b++) {
-    term *= r;
-    sum += term;
-  }
-  return e2 * sum;
+  int m = min(bounces, 64) - 2;
+  if (m <= 0) return vec3(0.0);
+  vec3 r = clamp(rho * saturate(closed), 0.0, BOUNCE_MAX);
+  return e2 * r * (1.0 - pow(r, vec3(float(m)))) / (1.0 - r); // pow: base >= 0, exponent >= 1
 }
 #endif
 

@@ -25,6 +25,12 @@ float light_falloff(int mode, float d, float radius) {
   return saturate(1.0 - (d / radius_safe) * (d / radius_safe));
 }
 
+// Light li's kind (0 point, 1 spot, 2 directional) and falloff (light_falloff's
+// mode) as its record holds them (floats; a constant kind is a light-set
+// variant's light_set_type and light_set_falloff).
+int light_type(Light li) { return int(li.position.w + 0.5); }
+int light_falloff_mode(Light li) { return int(li.params.y + 0.5); }
+
 // Light arriving at p from light li of kind `type` (0 point, 1 spot, 2
 // directional) and falloff `falloff` (light_falloff's mode): direction to the
 // light in *l, radiance returned. Constant kind and falloff (a light-set
@@ -49,7 +55,7 @@ vec3 light_arriving_as(Light li, int type, int falloff, vec3 p, out vec3 l) {
 // Light arriving at p from light li, its kind and falloff read from it. A
 // loop over many points of one light reads li once, outside it.
 vec3 light_arriving(Light li, vec3 p, out vec3 l) {
-  return light_arriving_as(li, int(li.position.w + 0.5), int(li.params.y + 0.5), p, l);
+  return light_arriving_as(li, light_type(li), light_falloff_mode(li), p, l);
 }
 
 // Light arriving at p from light i (light_arriving).
@@ -80,7 +86,7 @@ bool light_on_surface(int i, vec3 p, vec3 n, out vec3 l, out float ndl, out vec3
 #else
   int shadow = 0;
 #endif
-  return light_on_surface_as(i, int(li.position.w + 0.5), int(li.params.y + 0.5), shadow, p, n, l, ndl, radiance);
+  return light_on_surface_as(i, light_type(li), light_falloff_mode(li), shadow, p, n, l, ndl, radiance);
 }
 
 // The lights that may reach p: light_index(r, j) for j < r.count. Every light

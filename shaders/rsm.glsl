@@ -193,7 +193,7 @@ vec3 rsm_gather(Surface s, ivec2 px, sampler2D dpt, sampler2D mat) {
 #else
   for (int i = 0; i < frame.counts.x; i++) {
     Light li = lights[i];
-    e += rsm_gather_light(i, int(li.position.w + 0.5), int(li.params.y + 0.5), s, j, turn, shift, dpt, mat);
+    e += rsm_gather_light(i, light_type(li), light_falloff_mode(li), s, j, turn, shift, dpt, mat);
   }
 #endif
   return finite_or_zero(e / PI);

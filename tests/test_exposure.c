@@ -266,9 +266,12 @@ static void the_exposure_settles_and_holds(void **state) {
  * isr.temporal (isr+rsm+esm), rsm.temporal and ssdo.temporal. A change
  * of the light now starts every history again (temporal.lua), so what may
  * differ is where the noise of a few samples restarts a pixel afterwards,
- * and the clamp. Measured: at most 0.0008 apart for ISR and RSM, 0.0087
- * for SSDO (x4, scale 1 against the other two; 0.0046 before the restart,
- * as much without the key: not the confidence). Before the restart (the
+ * and the clamp. Measured: at most 0.0001 apart, every technique. Before a
+ * view's first frame, drawn again (its exposure guessed from its lights far
+ * off), kept its number (frame.time.y), a renderer so drawn took the next
+ * frame's sampling pattern from then on: 0.0008 apart for ISR and RSM,
+ * 0.0087 for SSDO (x4, scale 1 against the other two; 0.0046 before the
+ * restart, as much without the key: not the confidence). Before the restart (the
  * step kept by the confidence): at most 0.0011 and 0.0046; judged on
  * radiance 0.87 (a sun 1e4 times brighter restarted nothing at scale 1e4,
  * both sides saturating v / (1 + v), nor at 1e-4, both near 0); judged on
@@ -278,7 +281,7 @@ static void the_exposure_settles_and_holds(void **state) {
  * histories of a few frames begun at other frames, not lag:
  * a_change_of_light_is_absorbed_at_once measures that (none). */
 enum { WARM = 6, STEPPED = 5 };
-#define ALIKE 0.01
+#define ALIKE 0.001
 static void a_history_follows_a_light_step_alike_at_any_light_level(void **state) {
   (void)state;
   static const char *const techs[][2] = {{"isr+rsm+esm", "isr.temporal.enabled=true"},
@@ -344,9 +347,7 @@ static void turn_sun(lm_scene *s, float degrees) {
  * sun steps x4 or /4, or turns by TURN degrees a frame for TURNING frames
  * and stops, or steps x1e4 or /1e4 (the exposure jumps); from ABSORBED
  * frames after the step (or the stop) each frame lies within LAG (mean
- * relative difference; EXPOSED where the exposure jumps: ssdo+esm with reuse
- * depends on the pre-exposure by about 1%, 0.011-0.016 from the step's frame
- * on, not lag; ISR and RSM 0) of the same frame of a
+ * relative difference; measured at most 1e-5) of the same frame of a
  * renderer that had the new light all along, with the settled skip on and
  * off (<gi>.temporal.skip), for isr+rsm+esm, rsm+esm and ssdo+esm with
  * reuse on at their defaults. That renderer's sun is nudged by a millionth
@@ -365,10 +366,13 @@ static void turn_sun(lm_scene *s, float degrees) {
  * 0.063, 0.096 (rsm+esm), 0.004; now 0 from the step's (the stop's) frame.
  * A settled frame keeps the pre-exposure (keep_exposure()): after the x1e4
  * step the meter, a frame late, moved it on rsm+esm's first settled frame,
- * under kept results it does not rescale: 97.7 (98 times too bright). */
+ * under kept results it does not rescale: 97.7 (98 times too bright). And
+ * ssdo+esm lay 0.011-0.016 away from the x1e4 step's frame on, not lag: the
+ * reference's first frame was drawn again (its exposure, guessed from its
+ * sun, far off), which gave it the next frame's sampling pattern from then
+ * on; a frame drawn again now keeps its number. */
 enum { ABSORBED = 0, TURNING = 4, MOST = 36 + TURNING + 3 };
 #define LAG 0.002
-#define EXPOSED 0.02
 #define TURN 3.0f
 static void a_change_of_light_is_absorbed_at_once(void **state) {
   (void)state;
@@ -377,22 +381,20 @@ static void a_change_of_light_is_absorbed_at_once(void **state) {
     int frames; /* <gi>.temporal.frames at its default */
   } cases[] = {{"isr+rsm+esm", "isr", "isr.transport", 4}, {"rsm+esm", "rsm", "rsm.gather", 3},
                {"ssdo+esm", "ssdo", "ssdo.physical", 36}};
-  static const struct {
-    double step, bound; /* step 1: the sun turns */
-  } changes[] = {{4, LAG}, {0.25, LAG}, {1, LAG}, {1e4, EXPOSED}, {1e-4, EXPOSED}};
+  static const double steps[] = {4, 0.25, 1 /* the sun turns */, 1e4, 1e-4};
   bool ok = true;
   double worst = 0;
   for (size_t t = 0; t < sizeof cases / sizeof *cases; t++)
-    for (size_t k = 0; k < sizeof changes / sizeof *changes; k++)
+    for (size_t k = 0; k < sizeof steps / sizeof *steps; k++)
       for (int skip = 1; skip >= 0; skip--) {
         char enabled[64], skip_off[64], what[32];
         snprintf(enabled, sizeof enabled, "%s.temporal.enabled=true", cases[t].gi);
         snprintf(skip_off, sizeof skip_off, "%s.temporal.skip=false", cases[t].gi);
         const char *sets[] = {"ambient=0.02", "background=0.05", enabled, skip ? NULL : skip_off, NULL};
-        bool turns = changes[k].step == 1;
+        bool turns = steps[k] == 1;
         if (turns) snprintf(what, sizeof what, "sun turns %gx%d deg", TURN, TURNING);
-        else snprintf(what, sizeof what, "sun x%g", changes[k].step);
-        lm_scene *s = room(SUN_LUX), *lit = room(SUN_LUX * changes[k].step);
+        else snprintf(what, sizeof what, "sun x%g", steps[k]);
+        lm_scene *s = room(SUN_LUX), *lit = room(SUN_LUX * steps[k]);
         if (turns) turn_sun(lit, TURN * TURNING); /* the new light: the sun's last pose */
         /* Steady long enough to settle, changed, and steady again until it settled again and a frame more. */
         int warm = cases[t].frames + 2, changing = turns ? TURNING : 1, after = changing + cases[t].frames + 2;
@@ -413,7 +415,7 @@ static void a_change_of_light_is_absorbed_at_once(void **state) {
           if (!gl_all_finite(&r)) fail_msg("%s, %s, frame %d after: a pixel is NaN, Inf or negative", name, what, f);
           err[f] = relative_difference(&r, 1, &ref);
           int since = f - (turns ? changing : 0); /* frames since the light last changed */
-          if (since >= ABSORBED) worst = fmax(worst, err[f]), ok &= err[f] <= changes[k].bound;
+          if (since >= ABSORBED) worst = fmax(worst, err[f]), ok &= err[f] <= LAG;
           bool gathered = gl_has_pass(&r, cases[t].gather);
           if (skip && since <= 0 && !gathered) fail_msg("%s, %s: frame %d after ran no %s", name, what, f, cases[t].gather);
           if (skip && !gathered && resettled < 0) resettled = since;
@@ -433,8 +435,7 @@ static void a_change_of_light_is_absorbed_at_once(void **state) {
         lm_scene_destroy(lit);
       }
   printf("largest difference from the new light's frames, from frame %d after: %.5f\n", ABSORBED, worst);
-  if (!ok) fail_msg("a change of light was not absorbed within %d frame(s) (a frame more than %g or %g off)", ABSORBED,
-                    LAG, EXPOSED);
+  if (!ok) fail_msg("a change of light was not absorbed within %d frame(s) (a frame more than %g off)", ABSORBED, LAG);
 }
 
 int main(int argc, char **argv) {

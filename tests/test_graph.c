@@ -268,6 +268,45 @@ static void disjoint_lifetimes_share_a_texture(void **state) {
   lm_graph_destroy(g);
 }
 
+/* A scene pass with views (shadow tiles, the RSM's) keeps its tiles in its
+ * textures across frames (render.c's tile cache): its targets get slots of
+ * their own. Here "before" dies before the tiles are drawn and "late" is
+ * first written after the last read of them, all alike: shared, either
+ * would overwrite the tiles (before the fix "late" took their texture). */
+static void tile_targets_share_no_texture(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_graph_begin(g, 64, 48);
+  lm_error err;
+  int before = target(g, "before", LM_FORMAT_RGBA16F, 0.5f), mid = target(g, "mid", LM_FORMAT_RGBA16F, 0.5f);
+  int tiles = target(g, "tiles", LM_FORMAT_RGBA16F, 0.5f), zbuf = target(g, "zbuf", LM_FORMAT_DEPTH32F, 0.5f);
+  int read = target(g, "read", LM_FORMAT_RGBA16F, 0.5f), late = target(g, "late", LM_FORMAT_RGBA16F, 0.5f);
+  int out = target(g, "out", LM_FORMAT_RGBA16F, 1);
+  fs(g, "p_before", -1, before);
+  fs(g, "p_mid", before, mid);
+  lm_pass_view view = {.width = 32, .height = 24};
+  lm_pass_desc d = {.kind = LM_PASS_SCENE, .name = "shadow.rsm", .where = "t.lua:1", .shader = "shadow",
+                    .outputs = &tiles, .output_count = 1, .depth = zbuf, .clear = true, .views = &view,
+                    .view_count = 1};
+  assert_true(lm_graph_add_pass(g, &d, &err) >= 0);
+  lm_pass_input both[] = {{"tiles", tiles}, {"mid", mid}}; /* mid lives past the tiles' pass */
+  lm_pass_desc r = {.kind = LM_PASS_FULLSCREEN, .name = "p_read", .where = "t.lua:2", .shader = "x.frag",
+                    .inputs = both, .input_count = 2, .outputs = &read, .output_count = 1, .depth = -1};
+  assert_true(lm_graph_add_pass(g, &r, &err) >= 0);
+  fs(g, "p_late", read, late);
+  fs(g, "p_out", late, out);
+  lm_graph_mark_output(g, out);
+  assert_true(lm_graph_compile(g, &err));
+  lm_graph_target_info t = lm_graph_target(g, tiles);
+  assert_true(t.alone && lm_graph_target(g, zbuf).alone);
+  int others[] = {before, mid, read, late};
+  for (int i = 0; i < 4; i++) assert_int_not_equal(lm_graph_target(g, others[i]).slot, t.slot);
+  /* The targets around them still share among themselves. */
+  assert_int_equal(lm_graph_target(g, before).slot, lm_graph_target(g, read).slot);
+  assert_int_equal(lm_graph_target(g, mid).slot, lm_graph_target(g, late).slot);
+  lm_graph_destroy(g);
+}
+
 static void persistent_targets_outlive_frames(void **state) {
   (void)state;
   lm_graph *g = lm_graph_create();
@@ -304,6 +343,7 @@ int main(void) {
       cmocka_unit_test(formats_and_sizes_are_checked),
       cmocka_unit_test(scene_passes_without_clear_keep_the_earlier_writer),
       cmocka_unit_test(disjoint_lifetimes_share_a_texture),
+      cmocka_unit_test(tile_targets_share_no_texture),
       cmocka_unit_test(persistent_targets_outlive_frames),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -277,6 +277,69 @@ static void rsm_tiles_are_kept_and_give_the_drawn_image(void **state) {
   }
 }
 
+/* A pipeline of the user's whose transient targets have the RSM targets'
+ * size and format, first written after shadow.rsm (late.a when nothing reads
+ * the RSM's normals any more: before the fix it took their texture): the RSM
+ * targets keep textures of their own, so a still frame keeps every RSM tile
+ * in place (only the tiles' pass wrote them). A late target in the normals'
+ * texture cost Cornell's shadow.rsm 0.01 -> 3.7 ms. */
+static void a_late_target_like_the_rsm_takes_none_of_its_textures(void **state) {
+  (void)state;
+  assert_true(gl_write_file("shaders/test_late.frag",
+                            "#include \"common.glsl\"\nuniform sampler2D src;\nuniform sampler2D other;\nout vec4 o;\n"
+                            "void main() {\n  ivec2 p = ivec2(gl_FragCoord.xy);\n"
+                            "  o = texelFetch(src, min(p, textureSize(src, 0) - 1), 0)"
+                            " + vec4(min(texelFetch(other, ivec2(0), 0).r, 0.0));\n}\n"));
+  lm_scene *s = canopy_scene();
+  int rw = 1, rh = 1; /* the RSM targets' size: from a first run of the script itself */
+  for (int run = 0; run < 2; run++) {
+    char text[1536];
+    snprintf(text, sizeof text,
+             "local gbuffer, shadow, rsm = require 'gbuffer', require 'shadow', require 'rsm'\n"
+             "Techniques = { 'late' }\nOptions = {}\nfunction OnRender()\n"
+             "  local G = gbuffer.render(gbuffer.targets(1, 'std'), 'std')\n"
+             "  local atlas, R = shadow.render({}, G, rsm.check({ reach = 16 }))\n"
+             "  local function late(name, src, other)\n"
+             "    return pass{ name, shader = 'test_late.frag', inputs = { src = src, other = other },\n"
+             "                 out = target{ name, format = 'rgba16f', size = { %d, %d } } }\n  end\n"
+             "  local a = late('late.a', R.flux, atlas)\n  local b = late('late.b', a, R.flux)\n"
+             "  present(pass{ 'late.out', shader = 'test_late.frag', inputs = { src = b, other = G.clr },\n"
+             "                out = target{ 'late.out', format = 'rgba16f' } })\nend\n",
+             rw, rh);
+    assert_true(gl_write_file("late.lua", text));
+    gl_result r = gl_render(&(gl_run){.scene = s, .script = "late.lua", .width = W, .height = H, .frames = 2});
+    if (!r.ok) fail_msg("%s", r.err.msg);
+    lm_graph *g = lm_renderer_graph(r.renderer);
+    int flux = lm_graph_find_target(g, "shadow.rsm_flux");
+    assert_true(flux >= 0);
+    lm_graph_target_info f = lm_graph_target(g, flux);
+    if (run == 0) {
+      rw = f.width, rh = f.height;
+      gl_result_free(&r);
+      continue;
+    }
+    static const char *const rsm_targets[] = {"shadow.rsm_flux", "shadow.rsm_nrm", "shadow.rsm_pos",
+                                              "shadow.rsm_zbuffer"};
+    static const char *const late_targets[] = {"late.a", "late.b"};
+    for (int i = 0; i < 4; i++) {
+      lm_graph_target_info t = lm_graph_target(g, lm_graph_find_target(g, rsm_targets[i]));
+      assert_true(t.used && t.alone);
+      for (int k = 0; k < 2; k++) {
+        lm_graph_target_info l = lm_graph_target(g, lm_graph_find_target(g, late_targets[k]));
+        assert_true(l.width == f.width && l.height == f.height && l.format == LM_FORMAT_RGBA16F);
+        assert_int_not_equal(l.slot, t.slot);
+      }
+    }
+    int views = lm_renderer_shadows(r.renderer)->view_count + lm_renderer_shadows(r.renderer)->rsm_view_count;
+    lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(r.renderer);
+    printf("late targets of the RSM's %dx%d: %d of %d tiles kept, %d in place on a still frame\n", rw, rh, kept.kept,
+           views, kept.in_place);
+    assert_true(views == 4 && kept.kept == views && kept.in_place == views && kept.drawn == 0);
+    gl_result_free(&r);
+  }
+  lm_scene_destroy(s);
+}
+
 /* A light inside geometry (a point light in a closed box the camera looks
  * at from outside), a spot whose cone is nearly closed (a tile seeing next
  * to nothing), one sample, 4096 samples and the visibility march: finite. */
@@ -797,6 +860,7 @@ int main(int argc, char **argv) {
       cmocka_unit_test(a_closed_room_with_one_lit_patch_lights_its_ceiling),
       cmocka_unit_test(a_frame_that_reads_no_rsm_renders_none),
       cmocka_unit_test(rsm_tiles_are_kept_and_give_the_drawn_image),
+      cmocka_unit_test(a_late_target_like_the_rsm_takes_none_of_its_textures),
       cmocka_unit_test(still_frames_with_temporal_reuse_converge),
       cmocka_unit_test(a_moving_light_caps_the_history_under_a_moving_camera),
       cmocka_unit_test(a_light_change_reaches_converged_pixels_at_once),

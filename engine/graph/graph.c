@@ -277,7 +277,19 @@ static void touch(graph_target *t, int pi) {
   t->last = pi;
 }
 
-/* Transient targets whose lifetimes do not overlap share a slot (texture). */
+/* Does a scene pass with views that runs write t? Its tiles are cached in
+ * place across frames (render.c's tile cache, lm_graph_target_info.alone). */
+static bool holds_tiles(const lm_graph *g, int t) {
+  for (int pi = 0; pi < g->pass_count; pi++) {
+    const graph_pass *p = &g->passes[pi];
+    if (!p->culled && p->desc.view_count > 0 && pass_writes(&p->desc, t)) return true;
+  }
+  return false;
+}
+
+/* Transient targets whose lifetimes do not overlap share a slot (texture),
+ * except those that hold tiles: a texture of their own, which no target
+ * before or after them in the frame writes, keeps last frame's tiles. */
 static void plan_slots(lm_graph *g) {
   g->slot_count = 0;
   for (int pi = 0; pi < g->pass_count; pi++) {
@@ -286,16 +298,16 @@ static void plan_slots(lm_graph *g) {
       graph_target *gt = &g->targets[t];
       if (!gt->used || gt->first != pi) continue;
       lm_texture_desc want = {gt->desc.format, gt->width, gt->height, gt->desc.mips};
+      bool own = g->no_sharing || holds_tiles(g, t);
       int found = -1;
-      for (int s = 0; s < g->slot_count && found < 0; s++)
-        if (!g->no_sharing && lm_texture_desc_equal(&g->slots[s].desc, &want) && g->slots[s].free_after < pi)
-          found = s;
+      for (int s = 0; s < g->slot_count && found < 0 && !own; s++)
+        if (lm_texture_desc_equal(&g->slots[s].desc, &want) && g->slots[s].free_after < pi) found = s;
       if (found < 0) {
         graph_slot *s = LM_PUSH(g->slots, g->slot_count, g->slot_cap);
         s->desc = want;
         found = g->slot_count - 1;
       }
-      g->slots[found].free_after = gt->last;
+      g->slots[found].free_after = own ? g->pass_count : gt->last;
       gt->slot = found;
     }
   }

@@ -88,6 +88,13 @@ struct lm_renderer {
   float peak;             /* this frame's light_peak */
   float script_peak; /* the radiance the script's own light reaches (lm_pipeline_light_peak) */
   bool keep_exposure; /* the frame shows results kept under the last one's pre-exposure (keep_exposure()) */
+  /* 1 when the view's first frame was drawn again (lm_renderer_frame): the
+   * frame's number (frame.time.y, which turns the GI passes' sampling
+   * patterns) counts the frames shown, so that a view's frames take the same
+   * samples whether or not its first was drawn again (a guess of the
+   * exposure from its lights that the meter found far off). Last: the
+   * matrices above stay where cglm's aligned loads want them. */
+  int redrawn;
 };
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
@@ -588,7 +595,7 @@ bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
   r->desc.scene = scene;
   for (int i = 0; i < VIEW_SETS; i++) /* another scene's textures are not hashed: draw every tile again */
     r->tiles[i].tile_count = 0;
-  r->frame = 0;
+  r->frame = r->redrawn = 0;
   lm_trace_destroy(r->trace);
   r->trace = NULL;
   return true;
@@ -726,7 +733,7 @@ static bool run_cpu(void *user, const lm_cpu_pass *cp, lm_error *err) {
 void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height) {
   lm_renderer_set_camera(r, camera);
   lm_renderer_resize(r, width, height);
-  r->frame = 0; /* a new view has no previous frame to reproject from */
+  r->frame = r->redrawn = 0; /* a new view has no previous frame to reproject from */
 }
 
 lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r) { return r->stats; }
@@ -979,7 +986,7 @@ static bool execute(lm_renderer *r, lm_graph *g, int meter, lm_error *err) {
   memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
   /* A first frame (after a cut, or another scene) has no previous transforms: nothing moved. */
   if (r->frame == 0 || r->prev_world_count != r->desc.scene->node_count) remember_world(r);
-  frame->time[1] = (float)r->frame++;
+  frame->time[1] = (float)(r->frame++ - r->redrawn);
   lm_light_data lights[MAX_LIGHTS];
   int n = lm_scene_light_data(r->desc.scene, lights, MAX_LIGHTS);
   frame->counts[0] = n;
@@ -1032,8 +1039,10 @@ bool lm_renderer_frame(lm_renderer *r, lm_error *err) {
     /* A view's first frame, exposed by its lights alone, where its meter
      * finds the exposure far off (a bright light that lights nothing in
      * view: frame_exposure), is drawn again as the second frame would be,
-     * so a capture of one frame loses no more to precision than a longer one. */
+     * so a capture of one frame loses no more to precision than a longer one;
+     * it keeps its number (redrawn). */
     if (again || r->frame != 1 || !r->meter.valid || frame_exposure(r) == r->exposure) return true;
+    r->redrawn = 1;
   }
 }
 

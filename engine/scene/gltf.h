@@ -23,8 +23,9 @@
  *   node transform dequantizes). Data that does not decode fails the file
  *   naming the mesh, primitive, accessor and bufferView.
  * - A memory budget: the loader adds up what the scene will hold (vertices
- *   and indices, decoded images with their mip levels, each in memory and
- *   on the GPU) before building it and refuses a file over the budget,
+ *   and indices, decoded images with their mip levels, as the GPU holds
+ *   them and in memory where the scene keeps them) before building it and
+ *   refuses a file over the budget,
  *   naming it: LIMN_MEMORY_BUDGET (MiB) in the environment, else 3/4 of the
  *   machine's physical memory.
  * - Nodes of the file's default scene (scene 0 when it names none; every

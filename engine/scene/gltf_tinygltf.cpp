@@ -1894,26 +1894,61 @@ double memory_budget(const char **from) {
   return 0.75 * (double)sysconf(_SC_PHYS_PAGES) * (double)sysconf(_SC_PAGESIZE);
 }
 
-// What the scene will hold, in bytes, against the budget: every primitive's
-// vertices (32 bytes, 48 with tangents) and indices (4 bytes) once in the
-// scene and once as GPU buffers, the decoded images once in the scene and
-// once on the GPU with their mip levels (4/3). Checked before the images
-// are decoded and again after (their size is known then), before a mesh is
-// made.
+// Do the uvs of primitive p lie in [0, 1], so that the GPU keeps them in
+// 16 bits (lm_mesh_create)? A normalized unsigned accessor's do; a float
+// one's bounds say so where given (glTF asks them only of POSITION). None:
+// zeros.
+bool uvs_in_unit_square(const Loader &L, const tinygltf::Primitive &p) {
+  auto uv = p.attributes.find("TEXCOORD_0");
+  if (uv == p.attributes.end()) return true;
+  if (uv->second < 0 || (size_t)uv->second >= L.m.accessors.size()) return false;
+  const tinygltf::Accessor &a = L.m.accessors[uv->second];
+  if (a.normalized && (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                       a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT))
+    return true;
+  if (a.minValues.size() < 2 || a.maxValues.size() < 2) return false;
+  for (int c = 0; c < 2; c++)
+    if (!(a.minValues[c] >= 0 && a.maxValues[c] <= 1)) return false;
+  return true;
+}
+
+// What the scene will hold, in bytes, against the budget. On the GPU what
+// lm_mesh_create uploads: a vertex 16 bytes (positions and uvs in 16 bits,
+// octahedral normals), floats where a primitive deforms (positions, 4 more)
+// or its uvs leave [0, 1] (4 more), tangents 16 more; indices of 2 bytes
+// below 65536 vertices, else 4, and for a mesh of LM_LOD_MIN_TRIANGLES or
+// more that does not deform its simplified copies (lm_scene_upload_mesh:
+// two chains, each level aiming at a quarter of the last's triangles, about
+// 1/3 of the mesh's indices a chain); the decoded images with their mip
+// levels (4/3). In memory the scene's own copies: tangents, 16 bytes a
+// vertex, always (lm_scene_upload_mesh frees vertices and indices alone);
+// the rest where it keeps them (all but lm_scene_load_gpu's, which frees
+// each mesh that does not deform and each image as it uploads them): 32
+// bytes a vertex (its undeformed copy 32 more where it deforms), 4 an
+// index, 4 a texel. Checked before the images are decoded and again after
+// (their size is known then), before a mesh is made.
 bool within_budget(Loader &L) {
   double geometry = 0, images = 0;
-  for (size_t mi = 0; mi < L.m.meshes.size(); mi++)
+  bool gpu_only = L.s->gpu_only;
+  for (size_t mi = 0; mi < L.m.meshes.size(); mi++) {
+    bool deforms = deformable(L.m.meshes[mi]);
     for (size_t pi = 0; pi < L.m.meshes[mi].primitives.size(); pi++) {
       const tinygltf::Primitive &p = L.m.meshes[mi].primitives[pi];
-      int indices = indices_of(L, (int)mi, (int)pi);
+      int index_accessor = indices_of(L, (int)mi, (int)pi);
       auto pos = p.attributes.find("POSITION");
       auto count = [&](int a) { return a >= 0 && (size_t)a < L.m.accessors.size() ? (double)L.m.accessors[a].count : 0; };
       double vertices = pos == p.attributes.end() ? 0 : count(pos->second);
-      double stride = p.attributes.count("TANGENT") ? 48 : 32;
-      geometry += 2 * (vertices * stride + (indices >= 0 ? count(indices) : vertices) * 4);
+      double indices = index_accessor >= 0 ? count(index_accessor) : vertices;
+      double tangents = p.attributes.count("TANGENT") ? 16 : 0;
+      double gpu_vertex = 16 + (deforms ? 4 : 0) + (uvs_in_unit_square(L, p) ? 0 : 4) + tangents;
+      double copies = !deforms && indices / 3 >= LM_LOD_MIN_TRIANGLES ? 2.0 / 3 : 0;
+      geometry += vertices * (gpu_vertex + tangents /* the scene's */) +
+                  indices * (1 + copies) * (vertices <= 65536 ? 2 : 4);
+      if (!gpu_only || deforms) geometry += vertices * (32 + (deforms ? 32 : 0)) + indices * 4;
     }
+  }
   for (const Pending &d : L.decoded)
-    if (d.rgba) images += (1 + 4.0 / 3) * 4 * (double)d.width * (double)d.height;
+    if (d.rgba) images += (gpu_only ? 4.0 / 3 : 1 + 4.0 / 3) * 4 * (double)d.width * (double)d.height;
   const char *from;
   double budget = memory_budget(&from);
   if (geometry + images <= budget) return true;
