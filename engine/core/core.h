@@ -66,6 +66,12 @@ uint64_t lm_hash(const void *data, size_t len, uint64_t seed);
 #define LM_HASH_SEED 0xcbf29ce484222325ull
 
 /* ---- memory ------------------------------------------------------------ */
+/* Alignment of a field in a header C and C++ both read. */
+#ifdef __cplusplus
+#define LM_ALIGNED(n) alignas(n)
+#else
+#define LM_ALIGNED(n) _Alignas(n)
+#endif
 /* Allocation that cannot fail quietly: aborts with a message when out of memory. */
 void *lm_alloc(size_t size);
 void *lm_realloc(void *p, size_t size);

@@ -199,8 +199,11 @@ int lm_programs_stats(const char *define, double *build_ms);
 const char *lm_shader_dir(void);
 
 /* ---- per-frame engine data (std140 block LimnFrame, binding 0) --------- */
+/* 16-byte aligned wherever it lives: its matrices are read as cglm's mat4,
+ * whose SIMD loads need that. */
 typedef struct lm_frame_data {
-  float view[16], proj[16], view_proj[16], inv_view[16];
+  LM_ALIGNED(16) float view[16];
+  float proj[16], view_proj[16], inv_view[16];
   float camera_pos[4];
   float frustum_o[4], frustum_u[4], frustum_v[4]; /* rays to the far plane */
   float clip[4];        /* near, far, 1/far, tan(fov_y/2) */

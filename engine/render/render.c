@@ -51,6 +51,12 @@ struct lm_renderer {
   lm_clock clock;
   int output_srgb, output_linear;
   int frame;
+  /* 1 when the view's first frame was drawn again (lm_renderer_frame): the
+   * frame's number (frame.time.y, which turns the GI passes' sampling
+   * patterns) counts the frames shown, so that a view's frames take the same
+   * samples whether or not its first was drawn again (a guess of the
+   * exposure from its lights that the meter found far off). */
+  int redrawn;
   float prev_view_proj[16];
   lm_frame_data camera;
   lm_shadow_plan shadows;
@@ -88,13 +94,6 @@ struct lm_renderer {
   float peak;             /* this frame's light_peak */
   float script_peak; /* the radiance the script's own light reaches (lm_pipeline_light_peak) */
   bool keep_exposure; /* the frame shows results kept under the last one's pre-exposure (keep_exposure()) */
-  /* 1 when the view's first frame was drawn again (lm_renderer_frame): the
-   * frame's number (frame.time.y, which turns the GI passes' sampling
-   * patterns) counts the frames shown, so that a view's frames take the same
-   * samples whether or not its first was drawn again (a guess of the
-   * exposure from its lights that the meter found far off). Last: the
-   * matrices above stay where cglm's aligned loads want them. */
-  int redrawn;
 };
 
 lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
