@@ -21,6 +21,11 @@ void lm_scene_trs_matrix(const float t[3], const float q[4], const float s[3], f
 /* Poses the scene as lm_scene_set_time does, leaving prev_positions, the
  * scene's time and its animation alone: the loader's rest pose. */
 void lm_scene_pose(lm_scene *s, int anim, double seconds);
+/* Cuts a static mesh's index ranges (the mesh whole, then its simplified
+ * copies) into spatial chunks (m->chunks; engine/scene/chunks.c), reordering
+ * the triangles of each range in `indices`, the buffer its GPU mesh is made
+ * from. A deformed or small mesh gets none. */
+void lm_scene_mesh_chunk(lm_scene_mesh *m, uint32_t *indices);
 
 #ifdef __cplusplus
 }
