@@ -210,20 +210,11 @@ void lm_scene_update(lm_scene *s) {
 bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]) {
   glm_vec3_fill(min, FLT_MAX);
   glm_vec3_fill(max, -FLT_MAX);
-  for (int i = 0; i < s->node_count; i++) {
-    const lm_node *n = &s->nodes[i];
-    if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
-    const lm_scene_mesh *m = &s->meshes[n->mesh];
-    if (m->bounds[0][0] > m->bounds[1][0]) continue;
-    mat4 w;
-    memcpy(w, n->world, sizeof w);
-    for (int c = 0; c < 8; c++) {
-      vec4 p = {m->bounds[c & 1 ? 1 : 0][0], m->bounds[c & 2 ? 1 : 0][1], m->bounds[c & 4 ? 1 : 0][2], 1}, q;
-      glm_mat4_mulv(w, p, q);
-      if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) continue;
-      glm_vec3_minv(min, q, min);
-      glm_vec3_maxv(max, q, max);
-    }
+  for (int i = 0; i < s->node_count; i++) { /* scripts and shadow plans ask each frame: one product a node */
+    float lo[3], hi[3];
+    if (!lm_scene_node_bounds(s, i, lo, hi)) continue; /* no mesh, or no finite box */
+    glm_vec3_minv(min, lo, min);
+    glm_vec3_maxv(max, hi, max);
   }
   if (min[0] > max[0]) {
     glm_vec3_fill(min, -1);
