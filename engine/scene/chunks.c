@@ -44,7 +44,7 @@ void lm_scene_mesh_chunk(lm_scene_mesh *m, uint32_t *indices) {
   memset(&m->whole_chunks, 0, sizeof m->whole_chunks);
   memset(m->caster_chunks, 0, sizeof m->caster_chunks);
   memset(m->lod_chunks, 0, sizeof m->lod_chunks);
-  if (m->rest || m->index_count / 3 < 2 * LM_CHUNK_TRIANGLES) return; /* a deformed mesh's bounds move */
+  if (m->rest || m->index_count / 3 < LM_CHUNK_MIN_TRIANGLES) return; /* a deformed mesh's bounds move */
   int cap = m->index_count / 3 / LM_CHUNK_TRIANGLES;
   for (int k = 0; k < m->caster_levels; k++) cap += m->casters[k].count / 3 / LM_CHUNK_TRIANGLES;
   for (int k = 0; k < m->lod_levels; k++) cap += m->lods[k].count / 3 / LM_CHUNK_TRIANGLES;
