@@ -5,7 +5,9 @@
  * image within a stated error of the whole meshes', for a finely cut sphere,
  * a cone cut as exporters cut it (outdoor.glb's tree crowns) and a terrain;
  * the GPU's quantized vertices (lm_mesh) lie within their stated error of the
- * floats; the copies, made on worker threads, are the same on any number.
+ * floats; the copies, made on worker threads, are the same on any number;
+ * a large mesh's spatial chunks leave out what a view does not see
+ * and render the image of the mesh drawn whole.
  * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _GNU_SOURCE /* sched_setaffinity: one worker thread */
 #include <sched.h>
@@ -251,25 +253,31 @@ static void simplified_cone_casters_keep_the_shadows(void **state) {
  * first level's budget, LM_LOD_ERROR of its extent: a texel of a near
  * cascade), not only within 1.6 (1%, the first budget before): a tile whose
  * texels are a tenth of a unit or more draws a copy of it. */
+/* A height field of 160 x 160 units cut into n x n quads as mesh "terrain" (its index). */
+static int terrain_mesh(lm_scene *s, int n) {
+  float *v = calloc((size_t)(n + 1) * (n + 1) * 8, sizeof(float));
+  uint32_t *ix = malloc(sizeof(uint32_t) * (size_t)n * n * 6);
+  for (int j = 0, k = 0; j <= n; j++)
+    for (int i = 0; i <= n; i++, k++) {
+      float x = -80 + 160.0f * (float)i / n, z = -80 + 160.0f * (float)j / n, *o = v + 8 * k;
+      o[0] = x, o[1] = 2.5f * sinf(x * 0.08f) * cosf(z * 0.07f), o[2] = z, o[4] = 1; /* normals: up */
+      o[6] = (float)i / n, o[7] = (float)j / n;
+    }
+  for (int j = 0, k = 0; j < n; j++)
+    for (int i = 0; i < n; i++, k += 6) {
+      uint32_t a = (uint32_t)(j * (n + 1) + i), b = a + n + 1, q[6] = {a, b, a + 1, a + 1, b, b + 1};
+      memcpy(ix + k, q, sizeof q);
+    }
+  int mesh = lm_scene_add_mesh(s, "terrain", v, (n + 1) * (n + 1), ix, n * n * 6);
+  free(v), free(ix);
+  return mesh;
+}
+
 static void a_terrain_has_copies_within_a_near_texel(void **state) {
   (void)state;
   enum { N = 64 };
-  float *v = calloc((N + 1) * (N + 1) * 8, sizeof(float));
-  uint32_t *ix = malloc(sizeof(uint32_t) * N * N * 6);
-  for (int j = 0, k = 0; j <= N; j++)
-    for (int i = 0; i <= N; i++, k++) {
-      float x = -80 + 160.0f * (float)i / N, z = -80 + 160.0f * (float)j / N, *o = v + 8 * k;
-      o[0] = x, o[1] = 2.5f * sinf(x * 0.08f) * cosf(z * 0.07f), o[2] = z, o[4] = 1; /* normals: up */
-      o[6] = (float)i / N, o[7] = (float)j / N;
-    }
-  for (int j = 0, k = 0; j < N; j++)
-    for (int i = 0; i < N; i++, k += 6) {
-      uint32_t a = (uint32_t)(j * (N + 1) + i), b = a + N + 1, q[6] = {a, b, a + 1, a + 1, b, b + 1};
-      memcpy(ix + k, q, sizeof q);
-    }
   lm_scene *s = lm_scene_create("terrain");
-  int mesh = lm_scene_add_mesh(s, "terrain", v, (N + 1) * (N + 1), ix, N * N * 6);
-  free(v), free(ix);
+  int mesh = terrain_mesh(s, N);
   place(s, mesh, gl_material(s, "grass", 0.3f, 0.5f, 0.2f), 0, 0, 0);
   lm_scene_update(s);
   lm_error err;
@@ -498,6 +506,79 @@ static void copies_are_the_same_on_any_number_of_threads(void **state) {
   lm_scene_destroy(read), lm_scene_destroy(whole);
 }
 
+/* Three nodes of one terrain (128 x 128 quads: 32768 triangles, 64
+ * chunks) side by side under a sun, seen from a camera low over the middle
+ * one looking along it, so that most of the terrains lies out of view and
+ * out of some cascades: the chunked meshes leave out the chunks outside each
+ * view (chunks_culled, fewer triangles) and render the same image as the
+ * mesh drawn whole from its own triangle order (the reference: its GPU mesh
+ * made again from the mesh's indices, no chunks). The same triangles
+ * rasterize alike in any order and any split into draws, so the bound is 0
+ * in the G-buffer and the image. (The shadow atlas differs where no pixel
+ * reads it: a tile's view reaches beyond its cull volume, where a whole mesh
+ * draws and its chunks outside that volume do not.) Every mesh and caster whole
+ * (simplify=0, shadow.simplify=0): the chunking of the whole ranges alone. */
+static void chunked_meshes_render_as_the_whole_mesh(void **state) {
+  (void)state;
+  lm_scene *sc[2];
+  for (int k = 0; k < 2; k++) {
+    lm_scene *s = sc[k] = lm_scene_create("terrains");
+    int mesh = terrain_mesh(s, 128), grass = gl_material(s, "grass", 0.3f, 0.5f, 0.2f);
+    for (int t = -1; t <= 1; t++) place(s, mesh, grass, 150.0f * (float)t, 0, 0);
+    float w[16];
+    lm_camera_look_at((float[]){3, 4, 2}, (float[]){0, 0, 0}, w); /* the sun shines down along (-3, -4, -2) */
+    for (int c = 0; c < 3; c++) w[12 + c] = 0;
+    int sun = lm_scene_add_node(s, "sun", -1, w, -1, -1);
+    lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 1,
+                                      .casts_shadows = true, .node = sun});
+    lm_camera_look_at((float[]){10, 20, 60}, (float[]){-10, 0, 0}, w);
+    int cam = lm_scene_add_node(s, "camera", -1, w, -1, -1);
+    lm_scene_add_camera(s, &(lm_camera){.name = "view", .fov_y = glm_rad(50.0f), .znear = 0.1f, .zfar = 200, .node = cam});
+    lm_scene_update(s);
+  }
+  lm_scene_mesh *m = &sc[1]->meshes[0];
+  uint32_t *order = memcpy(malloc(sizeof(uint32_t) * (size_t)m->index_count), m->indices,
+                           sizeof(uint32_t) * (size_t)m->index_count);
+  lm_error err;
+  for (int k = 0; k < 2; k++) assert_true(lm_scene_upload(sc[k], &err));
+  const lm_scene_mesh *c = &sc[0]->meshes[0];
+  assert_int_equal(c->whole_chunks.count, 128 * 128 * 2 / LM_CHUNK_TRIANGLES);
+  for (int k = 0, end = 0; k < c->whole_chunks.count; end = c->chunks[k].first + c->chunks[k].count, k++) {
+    assert_int_equal(c->chunks[k].first, end); /* the chunks tile the mesh's range */
+    assert_true(c->chunks[k].count >= 3 * LM_CHUNK_TRIANGLES && c->chunks[k].count < 6 * LM_CHUNK_TRIANGLES);
+    assert_true(k < c->whole_chunks.count - 1 || end + c->chunks[k].count == c->index_count);
+  }
+  lm_mesh_destroy(&m->gpu); /* the reference: the mesh's own order, one range */
+  lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, NULL, order, m->index_count, false);
+  m->whole_chunks.count = m->caster_levels = m->lod_levels = 0;
+  free(order);
+  const char *sets[] = {"simplify=0", "shadow.simplify=0", "ambient=0.05", NULL};
+  gl_result a = gl_render_ok(&(gl_run){.scene = sc[0], .tech = "dl+esm", .sets = sets, .width = 128, .height = 96});
+  gl_result b = gl_render_ok(&(gl_run){.scene = sc[1], .tech = "dl+esm", .sets = sets, .width = 128, .height = 96});
+  lm_scene_draw_stats ca = lm_renderer_draw_stats(a.renderer), cb = lm_renderer_draw_stats(b.renderer);
+  lm_scene_draw_stats ha = lm_renderer_shadow_draw_stats(a.renderer), hb = lm_renderer_shadow_draw_stats(b.renderer);
+  print_message("camera: %ld triangles in %d calls chunked (%d chunks left out), %ld in %d whole; shadow tiles: %ld "
+                "(%d left out) and %ld\n", ca.triangles, ca.calls, ca.chunks_culled, cb.triangles, cb.calls,
+                ha.triangles, ha.chunks_culled, hb.triangles);
+  assert_int_equal(ca.drawn, cb.drawn);
+  assert_int_equal(cb.chunks_culled, 0);
+  assert_true(ca.chunks_culled > 0 && ca.triangles < cb.triangles);
+  assert_true(ha.chunks_culled > 0 && ha.triangles < hb.triangles);
+  static const char *const targets[] = {"gbuffer.clr", "gbuffer.nrm", "gbuffer.dpt"};
+  for (size_t t = 0; t < sizeof targets / sizeof targets[0]; t++) {
+    double worst, d = target_diff(&a, &b, targets[t], &worst);
+    print_message("%-12s mean difference %.2g of the mean, largest %.3g\n", targets[t], d, worst);
+    assert_true(worst == 0);
+  }
+  int n = a.width * a.height * 3;
+  double mean = 0, worst = 0;
+  for (int i = 0; i < n; i++) mean += b.rgb[i], worst = fmax(worst, fabs(a.rgb[i] - b.rgb[i]));
+  print_message("image: largest difference %.3g (mean %.3g)\n", worst, mean / n);
+  assert_true(mean / n > 0.05 && worst == 0);
+  gl_result_free(&a), gl_result_free(&b);
+  lm_scene_destroy(sc[0]), lm_scene_destroy(sc[1]);
+}
+
 /* Deterministic numbers in [0, 1) (a linear congruential generator). */
 static float next_unit(uint32_t *seed) {
   *seed = *seed * 1664525u + 1013904223u;
@@ -595,6 +676,7 @@ int main(void) {
       cmocka_unit_test(simplified_casters_keep_the_shadows),
       cmocka_unit_test(simplified_cone_casters_keep_the_shadows),
       cmocka_unit_test(a_terrain_has_copies_within_a_near_texel),
+      cmocka_unit_test(chunked_meshes_render_as_the_whole_mesh),
       cmocka_unit_test(simplified_meshes_keep_the_image),
       cmocka_unit_test(quantized_vertices_read_back_within_their_error),
       cmocka_unit_test(quantized_positions_keep_the_image),

@@ -169,6 +169,7 @@ static void make_buffers(lm_scene *s, int mesh, lod_job *const jobs[CHAINS]) {
     for (int k = 0; k < j->levels; k++) levels[c][k] = j->lods[k], levels[c][k].first += (int)len;
     *counts[c] = j->levels, len += j->len;
   }
+  lm_scene_mesh_chunk(m, indices);
   lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, indices, (int)len, false);
   free(indices);
   lm_scene_mesh_uploaded(s, mesh);

@@ -60,6 +60,7 @@ void lm_scene_destroy(lm_scene *s) {
     free(s->meshes[i].vertices);
     free(s->meshes[i].tangents);
     free(s->meshes[i].indices);
+    free(s->meshes[i].chunks);
     lm_scene_mesh_free_deform(&s->meshes[i]);
   }
   for (int i = 0; i < s->node_count; i++) free(s->nodes[i].weights);
@@ -209,20 +210,11 @@ void lm_scene_update(lm_scene *s) {
 bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]) {
   glm_vec3_fill(min, FLT_MAX);
   glm_vec3_fill(max, -FLT_MAX);
-  for (int i = 0; i < s->node_count; i++) {
-    const lm_node *n = &s->nodes[i];
-    if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
-    const lm_scene_mesh *m = &s->meshes[n->mesh];
-    if (m->bounds[0][0] > m->bounds[1][0]) continue;
-    mat4 w;
-    memcpy(w, n->world, sizeof w);
-    for (int c = 0; c < 8; c++) {
-      vec4 p = {m->bounds[c & 1 ? 1 : 0][0], m->bounds[c & 2 ? 1 : 0][1], m->bounds[c & 4 ? 1 : 0][2], 1}, q;
-      glm_mat4_mulv(w, p, q);
-      if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) continue;
-      glm_vec3_minv(min, q, min);
-      glm_vec3_maxv(max, q, max);
-    }
+  for (int i = 0; i < s->node_count; i++) { /* scripts and shadow plans ask each frame: one product a node */
+    float lo[3], hi[3];
+    if (!lm_scene_node_bounds(s, i, lo, hi)) continue; /* no mesh, or no finite box */
+    glm_vec3_minv(min, lo, min);
+    glm_vec3_maxv(max, hi, max);
   }
   if (min[0] > max[0]) {
     glm_vec3_fill(min, -1);
@@ -750,10 +742,11 @@ bool lm_scene_node_culled(const lm_scene *s, int node, const float view_proj[16]
 }
 
 /* A visible mesh node, sorted so that nodes of one mesh, material and
- * simplification (lod: 1 + the level of its simplified copy) lie together, translucent casters
+ * simplification (lod: 1 + the level of its simplified copy) lie together, those seen in
+ * part (part: some chunk of what they draw out of view) after the whole ones, translucent casters
  * (into a transmittance output) after the others; blended ones in the
  * forward pass by the camera's depth of their bounds' centre, farthest first. */
-typedef struct drawn_node { int translucent, material, mesh, lod, node; float depth; } drawn_node;
+typedef struct drawn_node { int translucent, material, mesh, lod, part, node; float depth; } drawn_node;
 
 static int back_to_front(const void *pa, const void *pb) {
   const drawn_node *a = pa, *b = pb;
@@ -767,6 +760,7 @@ static int drawn_node_order(const void *pa, const void *pb) {
   if (a->material != b->material) return a->material < b->material ? -1 : 1;
   if (a->mesh != b->mesh) return a->mesh < b->mesh ? -1 : 1;
   if (a->lod != b->lod) return a->lod - b->lod;
+  if (a->part != b->part) return a->part - b->part;
   if (a->depth != b->depth) return a->depth < b->depth ? -1 : 1; /* nearest first: the depth test then
                                                                     spares the shading of what they hide */
   return (a->node > b->node) - (a->node < b->node);
@@ -844,6 +838,43 @@ static void node_instance(const lm_node *n, const lm_mesh *mesh, const float *pr
   memcpy(out->normal, normal, sizeof out->normal);
 }
 
+/* The chunks of the index range a node of mesh m draws at `lod` (1 + a
+ * copy's level; 0: the mesh whole), *count of them (0: none, NULL). */
+static const lm_mesh_chunk *lod_chunks(const lm_scene_draw_desc *d, const lm_scene_mesh *m, int lod, int *count) {
+  lm_chunk_span span = lod ? (d->lod_camera ? m->lod_chunks : m->caster_chunks)[lod - 1] : m->whole_chunks;
+  *count = span.count;
+  return span.count ? m->chunks + span.first : NULL;
+}
+
+/* Does d's cull volume leave out chunk c of node n's mesh? */
+static bool chunk_outside(const lm_scene_draw_desc *d, const lm_node *n, const lm_mesh_chunk *c) {
+  float lo[3], hi[3];
+  world_bounds(n->world, c->bounds, lo, hi);
+  return box_outside(d->view_proj, lo, hi, d->pancake);
+}
+
+/* Draws the chunks of node n's range (instance `instance`) that d's view
+ * keeps, each run of adjacent ones (adjacent in the index buffer) in one
+ * draw; returns the triangles drawn. */
+static long draw_chunks(const lm_scene_draw_desc *d, const lm_node *n, const lm_mesh *gpu, const lm_mesh_chunk *c,
+                        int chunks, int instance, lm_scene_draw_stats *stats) {
+  long triangles = 0;
+  for (int k = 0; k < chunks; k++) {
+    bool out = chunk_outside(d, n, &c[k]);
+    if (!out) { /* the run of kept chunks from k, and whether the one after it is left out */
+      int end = k + 1;
+      while (end < chunks && !(out = chunk_outside(d, n, &c[end]))) end++;
+      int from = c[k].first, count = c[end - 1].first + c[end - 1].count - from;
+      lm_mesh_draw_instances(gpu, from, count, instance, 1);
+      triangles += count / 3;
+      if (stats) stats->calls++;
+      k = end; /* the chunk left out after the run, or past the last */
+    }
+    if (stats && out) stats->chunks_culled++;
+  }
+  return triangles;
+}
+
 bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw_stats *stats, lm_error *err) {
   const lm_program *p = d->program;
   if (lm_program_uniform(p, "model") || lm_program_uniform(p, "normal_matrix")) {
@@ -872,8 +903,10 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     float depth = 0; /* the camera's clip w of the bounds' centre: its view depth */
     for (int k = 0; k < 3 && d->eye_view_proj; k++) depth += d->eye_view_proj[4 * k + 3] * (lo[k] + hi[k]) / 2;
     int translucent = d->blend == LM_BLEND_CAST && d->transmit > 0 && material_blends(s, n->material);
-    nodes[count++] =
-        (drawn_node){translucent, n->material, n->mesh, node_lod(d, n, &s->meshes[n->mesh], lo, hi), i, depth};
+    int lod = node_lod(d, n, &s->meshes[n->mesh], lo, hi), part = 0, chunks;
+    const lm_mesh_chunk *c = lod_chunks(d, &s->meshes[n->mesh], lod, &chunks);
+    for (int k = 0; k < chunks && d->view_proj && !part; k++) part = chunk_outside(d, n, &c[k]);
+    nodes[count++] = (drawn_node){translucent, n->material, n->mesh, lod, part, i, depth};
   }
   bool sorted = d->blend == LM_BLEND_ONLY; /* blending needs the order, one node a draw */
   qsort(nodes, (size_t)count, sizeof *nodes, sorted ? back_to_front : drawn_node_order);
@@ -888,7 +921,8 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
   bool ok = true, translucent = false; /* drawing into the transmittance output */
   for (int first = 0, last; first < count && ok; first = last) {
     for (last = first + 1; !sorted && last < count && nodes[last].material == nodes[first].material &&
-                           nodes[last].mesh == nodes[first].mesh && nodes[last].lod == nodes[first].lod;)
+                           nodes[last].mesh == nodes[first].mesh && nodes[last].lod == nodes[first].lod &&
+                           nodes[last].part == nodes[first].part;)
       last++;
     const lm_node *n = &s->nodes[nodes[first].node];
     const lm_scene_mesh *mesh = &s->meshes[n->mesh];
@@ -914,9 +948,18 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     int lod = nodes[first].lod;
     const lm_mesh_lod *copy = lod ? &(d->lod_camera ? mesh->lods : mesh->casters)[lod - 1] : NULL;
     int index_count = copy ? copy->count : mesh->index_count;
-    lm_mesh_draw_instances(&mesh->gpu, copy ? copy->first : 0, index_count, first, last - first);
+    long triangles = 0;
+    if (nodes[first].part) { /* node by node, the chunks in view */
+      int chunks;
+      const lm_mesh_chunk *c = lod_chunks(d, mesh, lod, &chunks);
+      for (int i = first; i < last; i++) triangles += draw_chunks(d, &s->nodes[nodes[i].node], &mesh->gpu, c, chunks, i, stats);
+    } else {
+      lm_mesh_draw_instances(&mesh->gpu, copy ? copy->first : 0, index_count, first, last - first);
+      triangles = (long)(last - first) * (index_count / 3);
+      if (stats) stats->calls++;
+    }
     if (stats) {
-      stats->calls++, stats->drawn += last - first, stats->triangles += (long)(last - first) * (index_count / 3);
+      stats->drawn += last - first, stats->triangles += triangles;
       stats->simplified += lod ? last - first : 0;
     }
   }

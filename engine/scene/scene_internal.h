@@ -32,6 +32,11 @@ void lm_scene_simplify_mesh(lm_scene *s, int i);
 void lm_scene_mesh_uploaded(lm_scene *s, int i);
 void lm_scene_finish_meshes(lm_scene *s);
 void lm_scene_drop_meshes(lm_scene *s);
+/* Cuts a static mesh's index ranges (the mesh whole, then its simplified
+ * copies) into spatial chunks (m->chunks; engine/scene/chunks.c), reordering
+ * the triangles of each range in `indices`, the buffer its GPU mesh is made
+ * from. A deformed or small mesh gets none. */
+void lm_scene_mesh_chunk(lm_scene_mesh *m, uint32_t *indices);
 
 #ifdef __cplusplus
 }

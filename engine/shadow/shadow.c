@@ -98,12 +98,14 @@ static void caster_depth(const lm_scene *s, mat4 view, float l, float r, float b
   float cmin = FLT_MAX, cmax = -FLT_MAX, lo[3], hi[3];
   for (int i = 0; i < s->node_count; i++) {
     if (!lm_scene_node_bounds(s, i, lo, hi)) continue;
-    vec3 bl = {FLT_MAX, FLT_MAX, FLT_MAX}, bh = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
-    for (int c = 0; c < 8; c++) {
-      vec4 p = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2], 1}, q;
-      glm_mat4_mulv(view, p, q);
-      glm_vec3_minv(bl, q, bl);
-      glm_vec3_maxv(bh, q, bh);
+    /* The light-view box of the box's eight corners: its centre's image
+     * plus the half extents weighed by |view| (one product for eight: this
+     * runs over every node for every tile of every frame). */
+    vec3 bl, bh;
+    for (int row = 0; row < 3; row++) {
+      float c = view[3][row], e = 0;
+      for (int j = 0; j < 3; j++) c += view[j][row] * (lo[j] + hi[j]) / 2, e += fabsf(view[j][row]) * (hi[j] - lo[j]) / 2;
+      bl[row] = c - e, bh[row] = c + e;
     }
     if (bh[0] < l || bl[0] > r || bh[1] < b || bl[1] > t) continue;
     cmin = fminf(cmin, -bh[2]), cmax = fmaxf(cmax, -bl[2]); /* the light looks down -z */
