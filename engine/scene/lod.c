@@ -155,6 +155,16 @@ static void *worker(void *arg) {
   return NULL;
 }
 
+/* The end of a mesh's upload, with copies or without: a GPU-only scene frees its CPU copy. */
+void lm_scene_mesh_uploaded(lm_scene *s, int i) {
+  lm_scene_mesh *m = &s->meshes[i];
+  m->dirty = m->simplifying = false;
+  if (s->gpu_only && !m->rest) {
+    free(m->vertices), free(m->indices);
+    m->vertices = NULL, m->indices = NULL;
+  }
+}
+
 /* The mesh's own indices, then its caster levels, then the camera's, to the GPU. */
 static void make_buffers(lm_scene *s, int mesh, lod_job *const jobs[CHAINS]) {
   lm_scene_mesh *m = &s->meshes[mesh];

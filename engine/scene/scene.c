@@ -288,15 +288,6 @@ void lm_scene_upload_mesh(lm_scene *s, int i) {
   lm_scene_mesh_uploaded(s, i);
 }
 
-void lm_scene_mesh_uploaded(lm_scene *s, int i) {
-  lm_scene_mesh *m = &s->meshes[i];
-  m->dirty = m->simplifying = false;
-  if (s->gpu_only && !m->rest) {
-    free(m->vertices), free(m->indices);
-    m->vertices = NULL, m->indices = NULL;
-  }
-}
-
 bool lm_scene_upload(lm_scene *s, lm_error *err) {
   if (s->uploaded) return true;
   for (int i = 0; i < s->texture_count; i++) {

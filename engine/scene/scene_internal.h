@@ -25,7 +25,8 @@ void lm_scene_pose(lm_scene *s, int anim, double seconds);
  * mesh i's two chains for the worker threads (started at the first call)
  * and makes the GL buffers of the meshes done so far, waiting while too
  * many wait (each keeps its CPU copy); lm_scene_mesh_uploaded then ends
- * each one's upload. lm_scene_finish_meshes waits for every one and stops
+ * each one's upload (a mesh without copies too: scene.c calls it after its
+ * buffers). lm_scene_finish_meshes waits for every one and stops
  * the threads; lm_scene_drop_meshes stops them, leaving what is not done
  * (a scene destroyed half-read). All on the GL context's thread. */
 void lm_scene_simplify_mesh(lm_scene *s, int i);
