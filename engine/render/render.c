@@ -214,9 +214,15 @@ static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, int layer, const 
                                             : sp->desc->blend ? LM_BLEND_ONLY : LM_BLEND_SKIP,
                           .eye_view_proj = sp->view ? NULL : r->camera.view_proj,
                           .transmit = sp->view ? sp->desc->transmit : 0, .outputs = sp->desc->output_count};
-  if (sp->view && r->shadows.settings.simplify > 0) /* simplified casters where a tile's texels hide them */
+  /* Simplified casters where a tile's texels hide them. The RSM views
+   * (view_set 1) store each sender's normal and albedo, which the caster
+   * copies (over positions alone: each corner takes one of its faces'
+   * normal and uv) do not keep, so they draw the camera's copies, whose
+   * seams stay (a box room's floor read as facing a wall made its bounce
+   * light three times too bright). */
+  if (sp->view && r->shadows.settings.simplify > 0)
     d.lod_view_proj = sp->view->view_proj, d.lod_size[0] = sp->view->width, d.lod_size[1] = sp->view->height,
-    d.lod_texels = r->shadows.settings.simplify;
+    d.lod_texels = r->shadows.settings.simplify, d.lod_camera = sp->desc->view_set == 1;
   lm_graph_target_info t[LM_MAX_COLOR_OUTPUTS + 1];
   if (!sp->view && sp->desc->simplify > 0 && pass_textures(sp, t) > 0) /* and where pixels hide them */
     d.lod_view_proj = r->camera.view_proj, d.lod_size[0] = t[0].width, d.lod_size[1] = t[0].height,

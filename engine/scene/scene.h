@@ -483,8 +483,9 @@ typedef struct lm_scene_draw_desc {
    * times the node's largest scale, is at most lod_texels texels of this
    * view (lod_view_proj, lod_size texels wide and high) where the node's
    * bounds come nearest its eye (the light's for a shadow tile: `casters`;
-   * the camera's for camera passes, lod_camera: `lods`). NULL or lod_texels
-   * 0: every mesh whole. */
+   * the camera's for camera passes, lod_camera: `lods`, which keep normals
+   * and uvs, as an RSM view needs too). NULL or lod_texels 0: every mesh
+   * whole. */
   const float *lod_view_proj;
   int lod_size[2];
   float lod_texels;
