@@ -21,40 +21,58 @@
 static const float octa[18] = {1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1};
 static const uint16_t octa_idx[24] = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
 
-typedef enum { TWO_MESHES, ONE_MESH, MORPHED } layout;
+typedef enum { TWO_MESHES, ONE_MESH, MORPHED, SKINNED, COLOURED } layout;
 
 /* Nodes "left" (x = -1.5) and "right" (x = 1.5). TWO_MESHES: each its own
  * mesh ("first", "second"), each with its own accessors; the second's
  * vertex 0 moved by `nudge` in x. ONE_MESH: both name mesh "first". MORPHED:
- * as TWO_MESHES, each mesh with one morph target (no motion, weights 0). */
+ * as TWO_MESHES, each mesh with one morph target (no motion, weights 0);
+ * SKINNED, each bound to joint "bone" (weight 1, at rest); COLOURED, the
+ * first red, the second blue. */
 static const char *write_pair(const char *name, layout how, float nudge) {
   float second[18];
   memcpy(second, octa, sizeof second);
   second[0] += nudge;
   static const float still[18] = {0};
+  static const uint16_t joints[24] = {0};
+  float weights1[24] = {0};
+  for (int v = 0; v < 6; v++) weights1[v * 4] = 1;
+  static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   blob b = {0};
   size_t p0 = blob_add(&b, octa, sizeof octa), i0 = blob_add(&b, octa_idx, sizeof octa_idx);
   size_t p1 = blob_add(&b, second, sizeof second), i1 = blob_add(&b, octa_idx, sizeof octa_idx);
-  size_t t = blob_add(&b, still, sizeof still);
+  size_t t = blob_add(&b, still, sizeof still), j = blob_add(&b, joints, sizeof joints);
+  size_t w = blob_add(&b, weights1, sizeof weights1), ib = blob_add(&b, identity, sizeof identity);
   const char *targets = how == MORPHED ? ",\"targets\":[{\"POSITION\":4}]" : "";
   const char *weights = how == MORPHED ? ",\"weights\":[0]" : "";
+  const char *bound = how == SKINNED ? ",\"JOINTS_0\":5,\"WEIGHTS_0\":6" : "";
+  const char *skin = how == SKINNED ? ",\"skin\":0" : "";
+  const char *red = how == COLOURED ? ",\"material\":0" : "", *blue = how == COLOURED ? ",\"material\":1" : "";
   char json[4096];
   snprintf(json, sizeof json,
-           "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
-           "\"nodes\":[{\"name\":\"left\",\"mesh\":0,\"translation\":[-1.5,0,0]},"
-           "{\"name\":\"right\",\"mesh\":%d,\"translation\":[1.5,0,0]}],"
-           "\"meshes\":[{\"name\":\"first\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1%s}]%s},"
-           "{\"name\":\"second\",\"primitives\":[{\"attributes\":{\"POSITION\":2},\"indices\":3%s}]%s}],"
+           "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1,2]}],"
+           "\"nodes\":[{\"name\":\"left\",\"mesh\":0,\"translation\":[-1.5,0,0]%s},"
+           "{\"name\":\"right\",\"mesh\":%d,\"translation\":[1.5,0,0]%s},{\"name\":\"bone\"}],"
+           "\"skins\":[{\"joints\":[2],\"inverseBindMatrices\":7}],\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,0,0,1]}},"
+           "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,1,1]}}],"
+           "\"meshes\":[{\"name\":\"first\",\"primitives\":[{\"attributes\":{\"POSITION\":0%s},\"indices\":1%s%s}]%s},"
+           "{\"name\":\"second\",\"primitives\":[{\"attributes\":{\"POSITION\":2%s},\"indices\":3%s%s}]%s}],"
            "\"buffers\":[{\"uri\":\"%%s\",\"byteLength\":%%zu}],"
            "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":72},"
            "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":72},"
-           "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":72}],"
+           "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":72},"
+           "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":96},"
+           "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":64}],"
            "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\","
            "\"min\":[-1,-1,-1],\"max\":[1,1,1]},{\"bufferView\":1,\"componentType\":5123,\"count\":24,\"type\":\"SCALAR\"},"
            "{\"bufferView\":2,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\"},"
            "{\"bufferView\":3,\"componentType\":5123,\"count\":24,\"type\":\"SCALAR\"},"
-           "{\"bufferView\":4,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\"}]}",
-           how == ONE_MESH ? 0 : 1, targets, weights, targets, weights, p0, i0, p1, i1, t);
+           "{\"bufferView\":4,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\"},"
+           "{\"bufferView\":5,\"componentType\":5123,\"count\":6,\"type\":\"VEC4\"},"
+           "{\"bufferView\":6,\"componentType\":5126,\"count\":6,\"type\":\"VEC4\"},"
+           "{\"bufferView\":7,\"componentType\":5126,\"count\":1,\"type\":\"MAT4\"}]}",
+           skin, how == ONE_MESH ? 0 : 1, skin, bound, red, targets, weights, bound, blue, targets, weights, p0, i0, p1,
+           i1, t, j, w, ib);
   return write_gltf(name, json, &b);
 }
 
@@ -113,13 +131,29 @@ static void meshes_a_vertex_apart_stay_two(void **state) {
   }
 }
 
-/* Morphed meshes (each node's own pose) are never shared, identical or not. */
+/* Morphed and skinned meshes (each node's own pose) are never shared, identical or not. */
 static void deforming_meshes_are_never_shared(void **state) {
   (void)state;
   lm_scene *s = load(write_pair("morphed.gltf", MORPHED, 0), false);
   assert_int_equal(s->mesh_count, 2);
   assert_int_not_equal(s->nodes[0].mesh, s->nodes[1].mesh);
   assert_int_equal(s->meshes[s->nodes[1].mesh].target_count, 1);
+  lm_scene_destroy(s);
+  s = load(write_pair("skinned.gltf", SKINNED, 0), false);
+  assert_int_equal(s->mesh_count, 2);
+  assert_int_not_equal(s->nodes[0].mesh, s->nodes[1].mesh);
+  assert_int_equal(s->meshes[s->nodes[1].mesh].influence_sets, 1);
+  lm_scene_destroy(s);
+}
+
+/* Identical geometry under two materials: one mesh, each node its own material. */
+static void shared_meshes_keep_each_nodes_material(void **state) {
+  (void)state;
+  lm_scene *s = load(write_pair("coloured.gltf", COLOURED, 0), false);
+  assert_int_equal(s->mesh_count, 1);
+  const float *left = s->materials[s->nodes[0].material].color, *right = s->materials[s->nodes[1].material].color;
+  assert_true(left[0] > 0.9f && left[2] < 0.1f);
+  assert_true(right[2] > 0.9f && right[0] < 0.1f);
   lm_scene_destroy(s);
 }
 
@@ -132,6 +166,7 @@ int main(void) {
       cmocka_unit_test(shared_meshes_render_as_one_mesh),
       cmocka_unit_test(meshes_a_vertex_apart_stay_two),
       cmocka_unit_test(deforming_meshes_are_never_shared),
+      cmocka_unit_test(shared_meshes_keep_each_nodes_material),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }
