@@ -37,6 +37,10 @@
  *   primitive holds it itself; a node whose mesh has several gets one child
  *   node per primitive ("<node>.<i>", identity transform), so that each node
  *   keeps one material. Nodes sharing a mesh share its lm meshes.
+ *   A primitive that does not deform whose decoded geometry (vertices,
+ *   tangents, indices) is byte-identical to one already read shares that
+ *   one's lm mesh and name, as if the nodes named one mesh (exporters write
+ *   each duplicated object as a mesh of its own).
  * - EXT_mesh_gpu_instancing: a node's TRANSLATION, ROTATION, SCALE accessors
  *   (the same count; floats, or normalized integers) place one child node
  *   "<node>[i]" a copy, holding the mesh as above, under the node's own

@@ -27,7 +27,9 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <thread>
+#include <unordered_map>
 #include <vector>
 
 namespace {
@@ -146,6 +148,9 @@ struct Loader {
   std::map<int, Decoded> draco;        // [accessor] -> the current primitive's Draco-decoded elements
   std::vector<Pending> decoded;        // [image] -> decoded by decode_images
   std::vector<std::string> warned_glass; // glass extension fields not read, each warned about once
+  // [geometry_hash] -> an lm mesh of a primitive that does not deform and the [mesh, primitive] it came from
+  std::unordered_multimap<size_t, std::pair<int, std::pair<int, int>>> loaded;
+  int shared = 0;                        // primitives given an identical one's lm mesh
 };
 
 // Every failure goes through here: "path: what".
@@ -675,17 +680,23 @@ int indices_of(const Loader &L, int mi, int pi) {
   return d != L.src->draco_indices.end() ? d->second : L.m.meshes[mi].primitives[pi].indices;
 }
 
-// lm mesh of primitive pi of mesh mi; -2 when skipped, -1 on error.
-int load_primitive(Loader &L, int mi, int pi) {
+// A primitive's decoded geometry, as its lm mesh will hold it.
+struct Geometry {
+  std::vector<float> verts;    // position(3) normal(3) uv(2)
+  std::vector<float> tangents; // empty: none
+  std::vector<uint32_t> idx;   // a triangle list
+  bool operator==(const Geometry &o) const { return verts == o.verts && tangents == o.tangents && idx == o.idx; }
+};
+
+// Decodes primitive pi of mesh mi into g: 1, 0 when skipped (points and
+// lines), -1 on error.
+int decode_primitive(Loader &L, int mi, int pi, Geometry &g) {
   const tinygltf::Mesh &mesh = L.m.meshes[mi];
   const tinygltf::Primitive &p = mesh.primitives[pi];
   char where[64];
   snprintf(where, sizeof where, "mesh %d primitive %d", mi, pi);
   int mode = p.mode == -1 ? TINYGLTF_MODE_TRIANGLES : p.mode;
-  if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP) {
-    if (!L.skipped++) L.first_skipped = std::string(where) + " (mode " + std::to_string(mode) + ")";
-    return -2;
-  }
+  if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP) return 0;
   if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
       mode != TINYGLTF_MODE_TRIANGLE_FAN)
     return fail(L, "%s: mode %d is not a glTF primitive mode (0 to 6)", where, mode), -1;
@@ -700,17 +711,16 @@ int load_primitive(Loader &L, int mi, int pi) {
   View v; // POSITION's count first: every other attribute must match it
   if (!accessor_view(L, what, pos->second, 3, &v)) return -1;
   size_t count = v.count;
-  std::vector<float> verts;
-  bool present, has_normals;
-  std::vector<float> tangents;
-  bool has_tangents;
-  if (!read_attribute(L, where, p, "POSITION", 3, 0, 8, verts, count, &present) ||
-      !read_attribute(L, where, p, "NORMAL", 3, 3, 8, verts, count, &has_normals) ||
-      !read_attribute(L, where, p, "TEXCOORD_0", 2, 6, 8, verts, count, &present) ||
-      !read_attribute(L, where, p, "TANGENT", 4, 0, 4, tangents, count, &has_tangents))
+  bool present, has_normals, has_tangents;
+  if (!read_attribute(L, where, p, "POSITION", 3, 0, 8, g.verts, count, &present) ||
+      !read_attribute(L, where, p, "NORMAL", 3, 3, 8, g.verts, count, &has_normals) ||
+      !read_attribute(L, where, p, "TEXCOORD_0", 2, 6, 8, g.verts, count, &present) ||
+      !read_attribute(L, where, p, "TANGENT", 4, 0, 4, g.tangents, count, &has_tangents))
     return -1;
+  if (!has_tangents || count == 0) g.tangents.clear();
+  else normalize_tangents(g.tangents);
 
-  std::vector<uint32_t> idx;
+  std::vector<uint32_t> &idx = g.idx;
   if (indices >= 0) {
     if (!read_indices(L, where, indices, count, idx)) return -1;
   } else {
@@ -727,20 +737,78 @@ int load_primitive(Loader &L, int mi, int pi) {
                   indices >= 0 ? "indices" : "vertices"), -1;
     idx = triangle_list(mode, idx);
   }
-  if (has_normals) normalize_normals(verts);
-  else compute_normals(verts, idx);
+  if (has_normals) normalize_normals(g.verts);
+  else compute_normals(g.verts, idx);
+  return 1;
+}
+
+// A hash of everything that decides a primitive's lm mesh (what its GPU
+// buffers hold), with the standard library's hash of bytes.
+size_t geometry_hash(const Geometry &g) {
+  auto bytes = [](const void *p, size_t n) { return std::hash<std::string_view>{}({(const char *)p, n}); };
+  size_t h = bytes(g.verts.data(), g.verts.size() * sizeof(float));
+  h = h * 31 + bytes(g.tangents.data(), g.tangents.size() * sizeof(float));
+  return h * 31 + bytes(g.idx.data(), g.idx.size() * sizeof(uint32_t));
+}
+
+// True when lm mesh `m`, loaded from primitive `from` ([mesh, primitive]),
+// holds geometry g byte for byte: compared with the mesh's arrays while it
+// has them, else with the primitive decoded again (a GPU-only scene frees
+// them once uploaded), so that a hash collision never merges two meshes.
+bool same_geometry(Loader &L, int m, std::pair<int, int> from, const Geometry &g) {
+  const lm_scene_mesh &mesh = L.s->meshes[m];
+  if (mesh.vertices) {
+    size_t n = (size_t)mesh.vertex_count;
+    return n * 8 == g.verts.size() && (size_t)mesh.index_count == g.idx.size() &&
+           !memcmp(mesh.vertices, g.verts.data(), n * 8 * sizeof(float)) &&
+           !memcmp(mesh.indices, g.idx.data(), g.idx.size() * sizeof(uint32_t)) &&
+           (mesh.tangents ? g.tangents.size() == n * 4 && !memcmp(mesh.tangents, g.tangents.data(), n * 4 * sizeof(float))
+                          : g.tangents.empty());
+  }
+  Geometry again;
+  return decode_primitive(L, from.first, from.second, again) == 1 && again == g;
+}
+
+// lm mesh of primitive pi of mesh mi; -2 when skipped, -1 on error. A
+// primitive of a mesh that does not deform whose geometry is byte-identical
+// to one already loaded (as exporters write duplicated objects: a mesh each)
+// gets that one's lm mesh, name included, so that its nodes are drawn as
+// instances of it, with one set of simplified copies and GPU buffers.
+int load_primitive(Loader &L, int mi, int pi) {
+  const tinygltf::Mesh &mesh = L.m.meshes[mi];
+  Geometry g;
+  int decoded = decode_primitive(L, mi, pi, g);
+  if (decoded == 0) {
+    int mode = mesh.primitives[pi].mode;
+    if (!L.skipped++)
+      L.first_skipped = "mesh " + std::to_string(mi) + " primitive " + std::to_string(pi) + " (mode " +
+                        std::to_string(mode) + ")";
+    return -2;
+  }
+  if (decoded < 0) return -1;
+  bool deforms = deformable(mesh);
+  size_t hash = deforms ? 0 : geometry_hash(g);
+  if (!deforms) {
+    auto [first, last] = L.loaded.equal_range(hash);
+    for (auto it = first; it != last; ++it)
+      if (same_geometry(L, it->second.first, it->second.second, g)) {
+        L.shared++;
+        return it->second.first;
+      }
+  }
 
   char base[LM_NAME_MAX], name[LM_NAME_MAX];
   if (mesh.name.empty()) snprintf(base, sizeof base, "mesh%d", mi);
   else snprintf(base, sizeof base, "%s", mesh.name.c_str());
   if (mesh.primitives.size() == 1) snprintf(name, sizeof name, "%s", base);
   else snprintf(name, sizeof name, "%s.%d", base, pi);
-  int m = lm_scene_add_mesh(L.s, name, verts.data(), (int)count, idx.data(), (int)idx.size());
-  if (has_tangents && count > 0) {
-    normalize_tangents(tangents);
-    lm_scene_mesh_set_tangents(L.s, m, tangents.data());
-  }
-  if (!read_deform(L, where, mesh, p, count, m)) return -1;
+  size_t count = g.verts.size() / 8;
+  int m = lm_scene_add_mesh(L.s, name, g.verts.data(), (int)count, g.idx.data(), (int)g.idx.size());
+  if (!g.tangents.empty()) lm_scene_mesh_set_tangents(L.s, m, g.tangents.data());
+  char where[64];
+  snprintf(where, sizeof where, "mesh %d primitive %d", mi, pi);
+  if (!read_deform(L, where, mesh, mesh.primitives[pi], count, m)) return -1;
+  if (!deforms) L.loaded.insert({hash, {m, {mi, pi}}});
   if (L.s->gpu_only && !L.s->meshes[m].rest) lm_scene_upload_mesh(L.s, m); // lm_scene_load_gpu
   return m;
 }
@@ -1959,7 +2027,7 @@ bool within_budget(Loader &L) {
 
 // Fills `s` from the parsed model; false (message in L.err) on bad input.
 bool convert(const char *path, const Source &src, const tinygltf::Model &model, lm_scene *s, lm_error *err) {
-  Loader L{path, model, s, err, {}, {}, {}, {}, 0, {}, {}, 0, 0, 0, {}, {}, {}, &src, {}, {}, {}, {}};
+  Loader L{path, model, s, err, {}, {}, {}, {}, 0, {}, {}, 0, 0, 0, {}, {}, {}, &src, {}, {}, {}, {}, {}, 0};
   L.views.resize(model.bufferViews.size());
   if (!within_budget(L)) return false; // the geometry, before an image is decoded
   decode_images(L);
@@ -1983,6 +2051,8 @@ bool convert(const char *path, const Source &src, const tinygltf::Model &model, 
   if (L.mended_weights)
     lm_warn("%s: the skin weights of %d vert%s did not sum to 1 and were normalized (the first: %s)", path,
             L.mended_weights, L.mended_weights > 1 ? "ices" : "ex", L.first_weights.c_str());
+  if (L.shared)
+    lm_debug("%s: %d meshes identical to another, shared (each keeps the first one's name)", path, L.shared);
   lm_scene_update(s);
   if (!check_world(L)) return false;
   lm_scene_pose(s, LM_ANIM_NONE, 0); // morph weights and skins at rest
