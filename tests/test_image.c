@@ -95,7 +95,9 @@ static void png_rgba_as_stored(void **state) {
   free(png), free(rgba), lm_image_free(&img);
 }
 
-/* 16 bits: lm_image_read divides by 65535, the texture rounds to 8 bits. */
+/* 16 bits: lm_image_read divides by 65535, the texture rounds to 8 bits.
+ * (Reads alike png_rgba_as_stored: each case builds its own PNG and checks
+ * both decoders' values, so a failure names the format.) */
 static void png_16_bit(void **state) {
   (void)state;
   const uint16_t v[] = {50000, 1000, 65535};
