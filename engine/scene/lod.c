@@ -16,7 +16,6 @@
 
 enum { CASTERS, CAMERA, CHAINS };
 #define MAX_THREADS 64
-#define LOD_CHAINED 3 /* the first level made from the last kept copy (simplify_levels) */
 
 typedef struct lod_job {
   const float *vertices; /* the mesh's own, kept until its buffers are made */
@@ -65,17 +64,14 @@ static bool each_vertex_once(const uint32_t *indices, size_t n, size_t nv) {
 /* Makes up to LM_LOD_LEVELS simplified copies of a mesh into j->out and
  * j->lods, level k within a budget of LM_LOD_ERROR times 4^k of the extent,
  * with at most a quarter of the last kept level's triangles as its target.
- * The fine levels are made from the mesh itself, erring no less than the
- * finer ones: made from the last, their errors add up, and the coarse ones
- * erred more for as many triangles, so that nodes drew finer copies. From
- * LOD_CHAINED on (budgets of 4% and 16%), where a level has few triangles
- * and a budget four times the last's error or more, a level is made from
- * the last kept copy with its budget less that copy's error, and errs by
- * the sum: within its budget still, for a tenth of the work (a 64 x 30
- * sphere, as the export's: 133 triangles within 4.0% of the extent, where
- * from the mesh the same 133 are within 3.4%; both lie 5.1% off, measured
- * from the mesh's vertices). A level that keeps over 3/4 of the last's triangles is
- * left out. Over positions alone (casters), the mesh is first made of its
+ * Every level is made from the mesh itself, erring no less than the finer
+ * ones: not from the last copy, whose errors add up, so that its coarse
+ * levels recorded more error for as many triangles and nodes drew finer
+ * copies (the 64 x 30 sphere of the big scene: 138 triangles recorded at
+ * 3.8% of the extent, 34 at 14.1%, against 132 at 3.2% and 33 at 11.3% from
+ * the mesh; its moving frames' shadow tiles drew 1.23-1.41x the triangles,
+ * for a tenth of two levels' work at load). A level that keeps over 3/4 of
+ * the last's triangles is left out. Over positions alone (casters), the mesh is first made of its
  * distinct positions (a seam, vertices that differ only in normal or uv,
  * would stop the simplifier there), each copy's indices then naming one
  * vertex at each position; otherwise the seams stay, and so the normals and
@@ -105,7 +101,6 @@ static void simplify_levels(lod_job *j, bool positions) {
   }
   /* Each kept level has at most 3/4 of the last's indices: 2.3 times the mesh's in all. */
   j->out = lm_alloc(sizeof *j->out * (n * 7 / 3 + 1));
-  uint32_t *prev = lm_alloc(sizeof *prev * n); /* the last copy's indices, over `vertices` */
   float scale = meshopt_simplifyScale(vertices, nv, stride), error = 0, budget = LM_LOD_ERROR;
   size_t last = n;
   /* A level that removes nothing, or a flat-shaded mesh's camera chain before it: is any level possible? */
@@ -113,19 +108,15 @@ static void simplify_levels(lod_job *j, bool positions) {
   int levels = probed && !reducible(to, from, n, vertices, nv, stride) ? 0 : LM_LOD_LEVELS;
   for (int k = 0; k < levels; k++, budget *= 4) { /* a budget too tight for a level: the next one */
     float step = 0; /* meshoptimizer's error, relative to the extent (of every vertex) as its target is */
-    bool chained = k >= LOD_CHAINED && last < n;
-    size_t kept = chained ? meshopt_simplify(to, prev, last, vertices, nv, stride, last / 4, budget - error, 0, &step)
-                          : meshopt_simplify(to, from, n, vertices, nv, stride, last / 4, budget, 0, &step);
+    size_t kept = meshopt_simplify(to, from, n, vertices, nv, stride, last / 4, budget, 0, &step);
     if (kept == n && !probed && !(probed = true, reducible(to, from, n, vertices, nv, stride))) break;
     if (kept == 0 || kept > last * 3 / 4 || !(step >= 0)) continue;
-    error = chained ? error + step : fmaxf(error, step); /* a chained level: its own error to the last, plus the last's */
+    error = fmaxf(error, step); /* levels err no less than the finer ones (node_lod walks them so) */
     j->lods[j->levels++] = (lm_mesh_lod){(int)j->len, (int)kept, error * scale};
     uint32_t *copy = j->out + j->len;
     for (size_t i = 0; i < kept; i++) copy[i] = first ? first[to[i]] : to[i];
-    memcpy(prev, to, sizeof *prev * kept);
     j->len += kept, last = kept;
   }
-  free(prev);
   free(from), free(to), free(first), free(distinct);
 }
 

@@ -221,6 +221,10 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
   glm_vec3_muladds(dir, -(behind + extent), eye);
   mat4 view, proj, vp;
   glm_lookat(eye, center, up, view);
+  /* The eye plane's depth as snapped, not as the eye's dot product gives it back: that cancels terms
+   * as large as the scene and moved a tile's depth row by float noise (2e-7 in clip z, outdoor.glb)
+   * from frame to frame, so a cascade that only moved across the light could not scroll. */
+  view[3][2] = floorf(along / step) * step - extent;
   if (st->stabilize) {
     /* A sphere around the slice does not change as the camera turns
      * (seed 003); rounding its radius keeps float noise from resizing it. */
@@ -273,11 +277,18 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
 }
 
 /* Cascades cover the depths where receivers are seen (plan->seen), snapped
- * outwards to a relative grid so that a small camera move keeps them. */
-static void cascade_range(const lm_shadow_plan *plan, float *n, float *reach) {
+ * outwards to a relative grid so that a small camera move keeps them, or
+ * the last frame's depths while they hold these and reach not much past
+ * them (lm_shadow_settings.last_range); kept in plan->range. */
+static void cascade_range(lm_shadow_plan *plan, float *n, float *reach) {
   *n = round_relative(plan->seen[0], false), *reach = round_relative(plan->seen[1], true);
   if (plan->settings.distance > 0) *reach = fminf(plan->settings.distance, *reach);
   if (!(*reach > *n)) *reach = *n * 1.001f;
+  const float *last = plan->settings.last_range;
+  if (last[0] > 0 && last[0] <= *n && last[0] * LM_SHADOW_RANGE_SLACK >= *n && last[1] >= *reach &&
+      last[1] <= *reach * LM_SHADOW_RANGE_SLACK)
+    *n = last[0], *reach = last[1];
+  plan->range[0] = *n, plan->range[1] = *reach;
 }
 
 static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,

@@ -56,8 +56,14 @@ typedef struct lm_shadow_settings {
    * (redraws) its tiles nor moves every other tile in the atlas. */
   const int *last_levels;
   int last_light_count;
+  /* The last frame's plan's cascade depths (lm_shadow_plan.range), 0 0: none: kept while they
+   * hold the depths seen now and reach no more than LM_SHADOW_RANGE_SLACK times past them, so
+   * that a moving camera's cascades keep their size and scroll (engine/render) instead of
+   * being drawn whole each time the depths seen cross a step of their grid. */
+  float last_range[2];
 } lm_shadow_settings;
 #define LM_SHADOW_LEVEL_SLACK 1.25f
+#define LM_SHADOW_RANGE_SLACK 1.25f
 void lm_shadow_settings_default(lm_shadow_settings *s);
 
 /* std430 layouts mirrored by shaders/shadow.glsl. */
@@ -101,6 +107,7 @@ typedef struct lm_shadow_plan {
   lm_shadow_light_data *lights; /* one per scene light */
   int light_count;
   float seen[2]; /* camera depths cascades cover: where receivers are seen */
+  float range[2]; /* the camera depths the cascades span: seen, snapped (or the last frame's) */
 } lm_shadow_plan;
 
 /* Plans the tiles for `camera` (a frame block from lm_scene_frame_data).
