@@ -49,7 +49,8 @@ static const char bench_usage[] =
     "set again before each frame (no previous frame; textures stay allocated, as\n"
     "in the sequence: lm_renderer_set_view). Prints per pass the\n"
     "three medians, moving / still and moving / alone, the shadow tiles drawn a\n"
-    "frame, each frame's times (wall and the process's CPU time, every thread's)\n"
+    "frame, the triangles and draw calls of the camera's passes and the shadow\n"
+    "tiles' triangles, each frame's times (wall and the process's CPU time, every thread's)\n"
     "with the passes that cost most more than alone, and the target: each frame\n"
     "of a sequence within 1.2x of the same frame alone: PASS when the ratio of\n"
     "the frame medians and every frame's ratio are within it, a frame judged on\n"
@@ -122,6 +123,10 @@ typedef struct bench_pass {
   int width, height;        /* its output at the largest size */
 } bench_pass;
 
+enum { DRAW_TRIANGLES, DRAW_CALLS, DRAW_SHADOW_TRIANGLES, DRAW_FIGURES };
+static const char *const draw_names[DRAW_FIGURES] = {"camera triangles", "camera draw calls", "shadow triangles"};
+static const char *const draw_keys[DRAW_FIGURES] = {"camera_triangles", "camera_draw_calls", "shadow_triangles"};
+
 typedef struct motion {
   bool on, orbit_given, timed;
   double step, radius, elevation; /* the orbit: degrees a frame, scene units (0: the framing camera's), degrees */
@@ -137,6 +142,9 @@ typedef struct motion {
   double frame_ms[STREAMS], animate_ms[STREAMS], tiles[STREAMS], scrolled[STREAMS]; /* medians; tiles: shadow tiles
                                                                       drawn, scrolled: of them, cascades scrolled */
   double *tiles_drawn;   /* per timed frame and renderer: the shadow tiles drawn */
+  /* per timed frame and renderer, then their medians: the camera passes' triangles and draw calls, the
+   * shadow tiles' triangles (lm_scene_draw_stats: where the rasterizer's work goes) */
+  double *draws, draw_median[STREAMS][DRAW_FIGURES];
   double outside_ms[STREAMS]; /* median of the frame's wall time less its passes' (record, compile, uploads) */
   double ratio_worst;    /* the largest moving / alone of one frame */
   double cpu_ratio, cpu_worst; /* median and largest over frames of moving / alone in process CPU time */
@@ -784,6 +792,7 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
   m->compile_ms = m->compiles + STREAMS * n;
   memset(m->compiles, 0, sizeof(double) * STREAMS * 2 * (size_t)n);
   m->by_pass = lm_alloc(sizeof(double) * STREAMS * MAX_PASSES * (size_t)n);
+  m->draws = lm_alloc(sizeof(double) * STREAMS * DRAW_FIGURES * (size_t)n);
   double *pass_ms = lm_alloc(sizeof(double) * STREAMS * MAX_PASSES * (size_t)cap);
   int pass_n[STREAMS][MAX_PASSES] = {{0}};
   m->eye = lm_alloc(sizeof *m->eye * (size_t)n);
@@ -825,6 +834,10 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
           const lm_shadow_plan *plan = lm_renderer_shadows(s->r); /* shadow tiles and RSM views */
           tiles[at] = plan->view_count + plan->rsm_view_count - ds.kept;
           scrolled[at] = ds.scrolled;
+          lm_scene_draw_stats cs = lm_renderer_draw_stats(s->r);
+          double *dr = m->draws + at * DRAW_FIGURES; /* the same each round: the same frames */
+          dr[DRAW_TRIANGLES] = (double)cs.triangles, dr[DRAW_CALLS] = cs.calls;
+          dr[DRAW_SHADOW_TRIANGLES] = (double)ds.triangles;
         }
         if (ok && k == STREAM_MOVING) {
           const float *eye = s->scene->nodes[s->node].world + 12;
@@ -858,6 +871,10 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
       m->animate_ms[k] = median(anim + k * n, n);
       m->scrolled[k] = median(scrolled + k * n, n);
       m->outside_ms[k] = median(outside + k * n, n);
+      for (int d = 0; d < DRAW_FIGURES; d++) {
+        for (int f = 0; f < n; f++) sorted[f] = m->draws[((size_t)k * n + f) * DRAW_FIGURES + d];
+        m->draw_median[k][d] = median(sorted, n);
+      }
       for (int i = 0; i < b->pass_count; i++)
         if (pass_n[k][i])
           b->passes[i].motion_ms[k] = median(pass_ms + ((size_t)k * MAX_PASSES + i) * cap, pass_n[k][i]);
@@ -947,6 +964,9 @@ static void print_motion(const bench *b) {
   }
   printf("  %-24s %10.0f %10.0f %10.0f\n", "shadow tiles drawn", m->tiles[0], m->tiles[1], m->tiles[2]);
   printf("  %-24s %10.0f %10.0f %10.0f\n", "  of them scrolled", m->scrolled[0], m->scrolled[1], m->scrolled[2]);
+  for (int d = 0; d < DRAW_FIGURES; d++)
+    printf("  %-24s %10.0f %10.0f %10.0f\n", draw_names[d], m->draw_median[0][d], m->draw_median[1][d],
+           m->draw_median[2][d]);
   printf("  (-: the pass did not run there; outside the passes: the frame's wall time less its passes'\n"
          "  times, with the pass clock cpu: Lua, graph compilation, uploads)\n");
   printf("  the moving camera moved in %d of %d frames\n", m->moved, m->frames);
@@ -983,6 +1003,7 @@ static void print_motion_json(const bench *b) {
     printf(", \"%s\": {\"frame_ms\": %.6g, \"outside_passes_ms\": %.6g, \"shadow_tiles_drawn\": %.6g, \"shadow_tiles_scrolled\": %.6g",
            stream_names[k], m->frame_ms[k], m->outside_ms[k], m->tiles[k], m->scrolled[k]);
     if (m->timed && k != STREAM_STILL) printf(", \"animate_ms\": %.6g", m->animate_ms[k]);
+    for (int d = 0; d < DRAW_FIGURES; d++) printf(", \"%s\": %.6g", draw_keys[d], m->draw_median[k][d]);
     printf("}");
   }
   printf(", \"passes\": [");
@@ -1237,6 +1258,7 @@ int limn_bench(int argc, char **argv) {
   free(m->eye);
   free(m->wall);
   free(m->by_pass);
+  free(m->draws);
   lm_programs_clear();
   lm_scene_destroy(scene);
   lm_context_destroy();

@@ -154,6 +154,11 @@ if tiles["still"] != 0 or tiles["alone"] <= 0 or (tiles["moving"] == 0) != (want
 scrolled = {k: m[k]["shadow_tiles_scrolled"] for k in ("still", "moving", "alone")}
 if scrolled["still"] != 0 or scrolled["alone"] != 0 or not 0 <= scrolled["moving"] <= tiles["moving"]:
     bad.append(f"shadow tiles scrolled {scrolled} of {tiles}")  # alone draws whole; scrolled ones count as drawn
+# The draws' figures: the same camera triangles moving and alone (the same views), shadow triangles where tiles are drawn.
+draws = {k: (m[k]["camera_triangles"], m[k]["camera_draw_calls"], m[k]["shadow_triangles"]) for k in ("still", "moving", "alone")}
+if not all(t > 0 and c > 0 for t, c, _ in draws.values()) or draws["moving"][0] != draws["alone"][0] \
+        or draws["still"][2] != 0 or draws["alone"][2] <= 0:
+    bad.append(f"draws (camera triangles, calls, shadow triangles) {draws}")
 if "shadow.cache=false" not in m["alone_options"].split() or "isr.temporal.enabled=false" not in m["alone_options"].split():
     bad.append(f"alone options {m['alone_options']}")
 r, t = m["target"]["moving_over_alone"], m["target"]

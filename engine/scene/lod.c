@@ -61,6 +61,38 @@ static bool each_vertex_once(const uint32_t *indices, size_t n, size_t nv) {
   return i == n;
 }
 
+/* A camera copy made over positions alone shades with a vertex of the mesh at each corner of its faces:
+ * one whose normal lies within acos(LOD_NORMAL_COS), 60 degrees, of its face's (corners_by_normal). */
+#define LOD_NORMAL_COS 0.5f
+
+/* Writes the corners of a copy's faces (to: its indices over the distinct positions, kept of them) into
+ * copy, each the vertex at its position (members[start[p] .. start[p + 1])) whose normal lies nearest the
+ * face's (as its winding gives it): where the mesh splits a position by normal (a cone's tip, a
+ * flat-shaded box), the face keeps its own. False when a corner has none within LOD_NORMAL_COS of its
+ * face (a face turned over, or across an edge of the mesh): no copy to shade with. */
+static bool corners_by_normal(const float *mesh, const float *positions, const uint32_t *to, size_t kept,
+                              const uint32_t *start, const uint32_t *members, uint32_t *copy) {
+  for (size_t t = 0; t + 2 < kept; t += 3) {
+    const float *a = positions + (size_t)to[t] * 8, *b = positions + (size_t)to[t + 1] * 8,
+                *c = positions + (size_t)to[t + 2] * 8;
+    float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    float f[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    float len = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    if (!(len > 0)) continue; /* no area: it draws nothing */
+    for (int k = 0; k < 3; k++) {
+      uint32_t p = to[t + k];
+      float most = -INFINITY;
+      for (uint32_t i = start[p]; i < start[p + 1]; i++) {
+        const float *n = mesh + (size_t)members[i] * 8 + 3;
+        float d = (n[0] * f[0] + n[1] * f[1] + n[2] * f[2]) / len;
+        if (d > most) most = d, copy[t + k] = members[i];
+      }
+      if (!(most >= LOD_NORMAL_COS)) return false;
+    }
+  }
+  return true;
+}
+
 /* Makes up to LM_LOD_LEVELS simplified copies of a mesh into j->out and
  * j->lods, level k within a budget of LM_LOD_ERROR times 4^k of the extent,
  * with at most a quarter of the last kept level's triangles as its target.
@@ -75,10 +107,14 @@ static bool each_vertex_once(const uint32_t *indices, size_t n, size_t nv) {
  * distinct positions (a seam, vertices that differ only in normal or uv,
  * would stop the simplifier there), each copy's indices then naming one
  * vertex at each position; otherwise the seams stay, and so the normals and
- * uvs the camera sees. */
-static void simplify_levels(lod_job *j, bool positions) {
+ * uvs the camera sees. by_normal (over positions): each corner of a copy's
+ * face takes the vertex at its position whose normal is nearest the face's,
+ * a level without one near enough left out (corners_by_normal): the
+ * camera's chain where its seams stop the simplifier. */
+static void simplify_levels(lod_job *j, bool positions, bool by_normal) {
   size_t n = j->index_count, nv = j->vertex_count, stride = 8 * sizeof(float);
   uint32_t *from = lm_alloc(sizeof *from * n), *to = lm_alloc(sizeof *to * n), *first = NULL;
+  uint32_t *start = NULL, *members = NULL; /* by_normal: the vertices at each distinct position */
   const float *vertices = j->vertices;
   float *distinct = NULL;
   if (positions) {
@@ -94,6 +130,18 @@ static void simplify_levels(lod_job *j, bool positions) {
     first = lm_alloc(sizeof *first * (unique > 0 ? unique : 1));
     for (size_t i = nv; i-- > 0;)
       if (remap[i] != ~0u) first[remap[i]] = (uint32_t)i;
+    if (by_normal) {
+      start = lm_alloc(sizeof *start * (unique + 1)), members = lm_alloc(sizeof *members * (nv > 0 ? nv : 1));
+      memset(start, 0, sizeof *start * (unique + 1));
+      for (size_t i = 0; i < nv; i++)
+        if (remap[i] != ~0u) start[remap[i] + 1]++;
+      for (size_t p = 0; p < unique; p++) start[p + 1] += start[p];
+      uint32_t *fill = lm_alloc(sizeof *fill * (unique > 0 ? unique : 1));
+      memcpy(fill, start, sizeof *fill * unique);
+      for (size_t i = 0; i < nv; i++)
+        if (remap[i] != ~0u) members[fill[remap[i]]++] = (uint32_t)i;
+      free(fill);
+    }
     free(remap);
     vertices = distinct, nv = unique;
   } else {
@@ -111,13 +159,14 @@ static void simplify_levels(lod_job *j, bool positions) {
     size_t kept = meshopt_simplify(to, from, n, vertices, nv, stride, last / 4, budget, 0, &step);
     if (kept == n && !probed && !(probed = true, reducible(to, from, n, vertices, nv, stride))) break;
     if (kept == 0 || kept > last * 3 / 4 || !(step >= 0)) continue;
-    error = fmaxf(error, step); /* levels err no less than the finer ones (node_lod walks them so) */
-    j->lods[j->levels++] = (lm_mesh_lod){(int)j->len, (int)kept, error * scale};
     uint32_t *copy = j->out + j->len;
     for (size_t i = 0; i < kept; i++) copy[i] = first ? first[to[i]] : to[i];
+    if (by_normal && !corners_by_normal(j->vertices, vertices, to, kept, start, members, copy)) continue;
+    error = fmaxf(error, step); /* levels err no less than the finer ones (node_lod walks them so) */
+    j->lods[j->levels++] = (lm_mesh_lod){(int)j->len, (int)kept, error * scale};
     j->len += kept, last = kept;
   }
-  free(from), free(to), free(first), free(distinct);
+  free(from), free(to), free(first), free(distinct), free(start), free(members);
 }
 
 /* Runs the next job not begun; called and returns with w->lock held. */
@@ -126,7 +175,13 @@ static void run_next(lm_lod_work *w) {
   lod_job *j = w->jobs[i];
   pthread_mutex_unlock(&w->lock);
   double t0 = lm_thread_cpu_ms();
-  simplify_levels(j, i % CHAINS == CASTERS);
+  bool casters = i % CHAINS == CASTERS;
+  simplify_levels(j, casters, false);
+  if (!casters && j->levels == 0) { /* seams that leave no copy (a cone's tip a side): over positions */
+    free(j->out);
+    j->out = NULL, j->len = 0;
+    simplify_levels(j, true, true);
+  }
   double ms = lm_thread_cpu_ms() - t0;
   pthread_mutex_lock(&w->lock);
   j->done = true;

@@ -736,8 +736,10 @@ bool lm_scene_node_culled(const lm_scene *s, int node, const float view_proj[16]
  * simplification (lod: 1 + the level of its simplified copy) lie together, those seen in
  * part (part: some chunk of what they draw out of view) after the whole ones, translucent casters
  * (into a transmittance output) after the others; blended ones in the
- * forward pass by the camera's depth of their bounds' centre, farthest first. */
-typedef struct drawn_node { int translucent, material, mesh, lod, part, node; float depth; } drawn_node;
+ * forward pass by the camera's depth of their bounds' centre, farthest first.
+ * outside: where a node seen in part has its chunks' frustum tests (one byte a
+ * chunk, 1: left out), so that each chunk is tested once a draw. */
+typedef struct drawn_node { int translucent, material, mesh, lod, part, node; float depth; int outside; } drawn_node;
 
 static int back_to_front(const void *pa, const void *pb) {
   const drawn_node *a = pa, *b = pb;
@@ -844,24 +846,24 @@ static bool chunk_outside(const lm_scene_draw_desc *d, const lm_node *n, const l
   return box_outside(d->view_proj, lo, hi, d->pancake);
 }
 
-/* Draws the chunks of node n's range (instance `instance`) that d's view
- * keeps, each run of adjacent ones (adjacent in the index buffer) in one
- * draw; returns the triangles drawn. */
-static long draw_chunks(const lm_scene_draw_desc *d, const lm_node *n, const lm_mesh *gpu, const lm_mesh_chunk *c,
-                        int chunks, int instance, lm_scene_draw_stats *stats) {
+/* Draws the chunks of a node's range (instance `instance`) that its view
+ * keeps (outside[k]: chunk k left out), each run of adjacent ones (adjacent
+ * in the index buffer) in one draw; returns the triangles drawn. */
+static long draw_chunks(const lm_mesh *gpu, const lm_mesh_chunk *c, int chunks, const unsigned char *outside,
+                        int instance, lm_scene_draw_stats *stats) {
   long triangles = 0;
   for (int k = 0; k < chunks; k++) {
-    bool out = chunk_outside(d, n, &c[k]);
-    if (!out) { /* the run of kept chunks from k, and whether the one after it is left out */
-      int end = k + 1;
-      while (end < chunks && !(out = chunk_outside(d, n, &c[end]))) end++;
-      int from = c[k].first, count = c[end - 1].first + c[end - 1].count - from;
-      lm_mesh_draw_instances(gpu, from, count, instance, 1);
-      triangles += count / 3;
-      if (stats) stats->calls++;
-      k = end; /* the chunk left out after the run, or past the last */
+    if (outside[k]) {
+      if (stats) stats->chunks_culled++;
+      continue;
     }
-    if (stats && out) stats->chunks_culled++;
+    int end = k + 1; /* the run of kept chunks from k */
+    while (end < chunks && !outside[end]) end++;
+    int from = c[k].first, count = c[end - 1].first + c[end - 1].count - from;
+    lm_mesh_draw_instances(gpu, from, count, instance, 1);
+    triangles += count / 3;
+    if (stats) stats->calls++;
+    k = end - 1;
   }
   return triangles;
 }
@@ -880,6 +882,8 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
    * material: a scene of many copies costs a few draw calls, not one a copy. */
   drawn_node *nodes = lm_alloc(sizeof *nodes * (size_t)(s->node_count > 0 ? s->node_count : 1));
   int count = 0;
+  unsigned char *outside = NULL; /* the chunk tests of the nodes seen in part (drawn_node.outside) */
+  int outside_len = 0, outside_cap = 0;
   for (int i = 0; i < s->node_count; i++) {
     const lm_node *n = &s->nodes[i];
     if (n->mesh < 0 || n->mesh >= s->mesh_count) continue;
@@ -896,8 +900,15 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     int translucent = d->blend == LM_BLEND_CAST && d->transmit > 0 && material_blends(s, n->material);
     int lod = node_lod(d, n, &s->meshes[n->mesh], lo, hi), part = 0, chunks;
     const lm_mesh_chunk *c = lod_chunks(d, &s->meshes[n->mesh], lod, &chunks);
-    for (int k = 0; k < chunks && d->view_proj && !part; k++) part = chunk_outside(d, n, &c[k]);
-    nodes[count++] = (drawn_node){translucent, n->material, n->mesh, lod, part, i, depth};
+    if (d->view_proj && chunks) { /* kept only when some chunk is left out: a node seen whole is one draw */
+      outside = lm_grow(outside, &outside_cap, outside_len + chunks, 1);
+      for (int k = 0; k < chunks; k++) {
+        outside[outside_len + k] = chunk_outside(d, n, &c[k]);
+        part |= outside[outside_len + k];
+      }
+    }
+    nodes[count++] = (drawn_node){translucent, n->material, n->mesh, lod, part, i, depth, outside_len};
+    if (part) outside_len += chunks;
   }
   bool sorted = d->blend == LM_BLEND_ONLY; /* blending needs the order, one node a draw */
   qsort(nodes, (size_t)count, sizeof *nodes, sorted ? back_to_front : drawn_node_order);
@@ -943,7 +954,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     if (nodes[first].part) { /* node by node, the chunks in view */
       int chunks;
       const lm_mesh_chunk *c = lod_chunks(d, mesh, lod, &chunks);
-      for (int i = first; i < last; i++) triangles += draw_chunks(d, &s->nodes[nodes[i].node], &mesh->gpu, c, chunks, i, stats);
+      for (int i = first; i < last; i++) triangles += draw_chunks(&mesh->gpu, c, chunks, outside + nodes[i].outside, i, stats);
     } else {
       lm_mesh_draw_instances(&mesh->gpu, copy ? copy->first : 0, index_count, first, last - first);
       triangles = (long)(last - first) * (index_count / 3);
@@ -956,5 +967,6 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
   }
   if (translucent) lm_set_caster_layer(-1, d->outputs, false);
   free(nodes);
+  free(outside);
   return ok;
 }
