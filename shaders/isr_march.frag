@@ -335,7 +335,7 @@ void main() {
   }
   isr = vec4(gathered / float(n), open / float(n));
 #ifdef RSM_GATHER
-  isr.rgb += max(rsm_k, 0.0) * rsm_gather(s, px, dpt, mat);
+  isr.rgb += max(rsm_k, 0.0) * rsm_gather(s, px, dpt);
 #endif
 #ifdef FIRST
   isr.rgb += texelFetch(first_step, px, 0).rgb;

@@ -347,6 +347,7 @@ static void extremes_stay_finite(void **state) {
   (void)state;
   static const char *const cases[][4] = {
       {"rsm.samples=1", NULL}, {"rsm.samples=4096", "rsm.coarse=4", NULL}, {"rsm.steps=32", NULL},
+      {"rsm.steps=32", "rsm.thickness=16", NULL}, {"rsm.steps=1", "rsm.thickness=0", NULL},
       {"rsm.radius=2", "rsm.reach=64", NULL}, {"rsm.coarse=1", "rsm.blur=0", NULL},
   };
   static const char *const vpl_cases[][4] = {
@@ -754,6 +755,8 @@ static void bad_options_name_themselves(void **state) {
       {"rsm+esm", "rsm.samples=0", "rsm.samples"},    {"rsm+esm", "rsm.samples=4097", "rsm.samples"},
       {"rsm+esm", "rsm.radius=0", "rsm.radius"},      {"rsm+esm", "rsm.reach=0.5", "rsm.reach"},
       {"isr+rsm+esm", "rsm.steps=33", "rsm.steps"},   {"rsm+esm", "rsm.coarse=5", "rsm.coarse"},
+      {"isr+rsm+esm", "rsm.steps=-2", "rsm.steps"},   {"isr+rsm+esm", "rsm.thickness=-0.1", "rsm.thickness"},
+      {"rsm+esm", "rsm.thickness=17", "rsm.thickness"},
       {"vpl+esm", "vpl.lights=-1", "vpl.lights"},     {"vpl+esm", "vpl.negative=4097", "vpl.negative"},
       {"vpl+esm", "vpl.threshold=3", "vpl.threshold"}, {"vpl+esm", "vpl.focus=0", "vpl.focus"},
       {"vpl+esm", "vpl.recompute=some", "vpl.recompute"},
