@@ -104,6 +104,41 @@ bool rsm_blocked(vec3 p, vec3 q, sampler2D dpt) {
   return false;
 }
 
+// Is x in the shadow of every light whose RSM views hold it, by those views
+// (and of one at least): the sender its texel holds lies nearer the light
+// than x (by 2% of the light's distance for a spot or point light, 1% of the
+// depth range for a directional one)? Over an empty texel x is lit; a light
+// whose views do not hold x has no say (a light that lights nothing in view
+// changes nothing: test_exposure). The combined technique's march asks it of
+// the point above p near the scene box's top (isr_march.frag's UNSEEN): under
+// a roof the upward rays the screen lost met a ceiling, in the open the sky.
+bool rsm_shadowed(vec3 x) {
+  vec2 atlas = vec2(textureSize(rsm_pos, 0));
+  bool any_view = false;
+  for (int i = 0; i < frame.counts.x; i++) {
+    ShadowLight sl = shadow_lights[i];
+    int first = sl.cube.y, count = sl.cube.z;
+    bool shadowed = false, inside = false;
+    for (int v = first; v < first + count && !inside; v++) {
+      ShadowView sv = shadow_views[v];
+      vec4 c = sv.view_proj * vec4(x, 1.0);
+      if (c.w <= 1e-12) continue;
+      vec3 ndc = c.xyz / c.w;
+      vec2 t = ndc.xy * 0.5 + 0.5;
+      if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
+      inside = true;
+      vec4 qn = texelFetch(rsm_pos, ivec2((sv.rect.xy + t * sv.rect.zw) * atlas), 0);
+      if (qn.w > 0.0) continue; // empty: nothing between x and the light
+      vec4 cq = sv.view_proj * vec4(qn.xyz, 1.0);
+      shadowed = sv.depth.w > 0.0 ? distance(x, sv.depth.xyz) > 1.02 * distance(qn.xyz, sv.depth.xyz)
+                                  : ndc.z > cq.z / max(cq.w, 1e-12) + 0.02; // ndc z spans 2
+    }
+    if (inside && !shadowed) return false;
+    any_view = any_view || inside;
+  }
+  return any_view;
+}
+
 // Light i's share of E(p) at the surface s: its RSM views, j the pixel's
 // block of the pattern, turn and shift its frame's turn (rsm_gather); type
 // and falloff light i's kind as light_arriving_as takes them. dpt:

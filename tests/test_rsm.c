@@ -464,7 +464,7 @@ static void a_light_change_reaches_converged_pixels_at_once(void **state) {
  * what is still seen, the disocclusion test drops what was not. Measured
  * (bound): rsm+esm 0.36% (0.7%; 0.52% at rsm.temporal.narrow = 1/4, 0.87%
  * there at rsm.temporal.epsilon = 1, which keeps the ghost), isr+rsm+esm
- * with isr.temporal 0.36% (0.6%), isr+esm
+ * with isr.temporal 0.36% (0.8%, below), isr+esm
  * 0.67% (1.5%): ISR's light at a point depends on what the screen shows,
  * and a reprojected pixel holds the old view's estimate, which the new
  * frames replace as they accumulate, the history capped at
@@ -475,7 +475,10 @@ static void a_light_change_reaches_converged_pixels_at_once(void **state) {
  * frames, as measured (the defaults' 3 and 4 leave the still render's own
  * noise: rsm+esm 0.74%). isr+rsm+esm's second bounce over the rays the
  * screen cannot follow (rsm.bounces 2) depends on what the view shows, so a
- * history carries some of the view before the move: 0.52% (0.37% at 1). */
+ * history carries some of the view before the move: 0.52% (0.37% at 1);
+ * 0.72% (bound 0.8%) since the upward rays under a roof count too (the room
+ * behind the panel lies in the panel's shadow: under a roof), 1.08% when
+ * every upward ray counted. */
 static void a_camera_move_leaves_no_ghost_edge(void **state) {
   (void)state;
   static const struct {
@@ -485,7 +488,7 @@ static void a_camera_move_leaves_no_ghost_edge(void **state) {
       {"rsm+esm", {"ambient=0", "rsm.samples=64", "rsm.temporal.enabled=true", "rsm.temporal.frames=36", NULL}, 0.007},
       {"isr+rsm+esm",
        {"ambient=0", "rsm.samples=64", "isr.samples=16", "isr.temporal.enabled=true", "isr.temporal.frames=36", NULL},
-       0.006},
+       0.008},
       {"isr+esm", {"ambient=0", "isr.samples=16", "isr.temporal.enabled=true", "isr.temporal.frames=36", NULL}, 0.015},
   };
   lm_scene *s = closed_room(LM_LIGHT_POINT);
