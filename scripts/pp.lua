@@ -43,6 +43,8 @@ local technique = techniques.add
 -- Since rsm.bounces 2 (a second bounce over the rays the screen cannot follow) 71.9% / 68.4%: more
 -- against Cycles' eight bounces, less against POV-Ray's two (docs/gi-combined.md). Since the RSM
 -- gather's pattern turns per 4 x 4 tile (rsm.glsl: one pattern for all biased its mean) 74.6% / 69.3%.
+-- Since its unseen senders' visibility (rsm.thickness) and upward rays under a roof counted as unseen
+-- 75.7% / 70.2%, Pearson raised in every view against both (docs/gi-combined.md).
 technique{ "isr+rsm+esm", lighting = "isr", shadows = true, offscreen = "rsm", joins = "march", split = true,
            temporal = "isr" } -- image-space radiosity with reflective shadow maps (docs/gi-combined.md)
 technique{ "isr+esm", lighting = "isr", shadows = true, temporal = "isr", key = "F2" } -- image-space radiosity

@@ -33,8 +33,17 @@ rsm.defaults = {
                      -- the least at or above; spot and point lights' views too: docs/shadows.md): the
                      -- gather's cost grows with the texels its samples scatter over, and 128 removed
                      -- as much of dl+esm's indirect error as 512 (docs/gi-combined.md)
-  steps = 0,         -- screen-space visibility march a sample, 0..32 (0: none; the seed's
-                     -- test, which about halves its frame rate)
+  steps = -1,        -- screen-space visibility march a sample, 0..32 (0: none; the seed's test): a
+                     -- sender is dropped where a point of the segment to it lies behind the depth
+                     -- buffer, within `thickness`. -1 (auto): 1 where the camera's senders are left to
+                     -- the march (isr+rsm+esm, which tests only the senders it does not see; without
+                     -- it the Cornell box's boxes lit what lies behind them, and the default's Pearson
+                     -- fell there against POV-Ray: docs/gi-combined.md), 0 in rsm+esm's own gather
+                     -- (which would test every sender, and its temporal reuse lagged twice as far
+                     -- behind its fresh frame in test_motion's uncovered band)
+  thickness = 0.15,  -- how far behind the depth buffer such a point blocks, a share of the depth there,
+                     -- 0..16 (0: anywhere behind, the seed's test, which also dropped senders that
+                     -- lie behind a near surface but not behind anything in the scene)
   rotate = 10,       -- pattern turn a frame in degrees with temporal reuse, 0..180 (the seed: 10;
                      -- its radii shift too); without, the pattern stays (a still camera, a still image)
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
@@ -82,7 +91,8 @@ local rules = {
   radius = options.positive(2),
   reach = options.number(1, 64),
   resolution = options.whole(16, 8192),
-  steps = options.whole(0, 32),
+  steps = options.whole(-1, 32),
+  thickness = options.number(0, 16),
   rotate = options.number(0, 180),
   k = options.number(0, 16),
   bounces = options.whole(1, 64),
@@ -118,10 +128,12 @@ function rsm.bind(inputs, defines, params, R, shadows, o, f, temporal_on, exclud
   shadow.bind(shadows, inputs, defines)
   gbuffer.lights(G, defines)
   inputs.rsm_flux, inputs.rsm_pos = R.flux, R.pos
-  defines.RSM_GATHER, defines.VISIBILITY, defines.EXCLUDE_SEEN = true, o.steps > 0, exclude_seen
-  params.rsm_samples, params.rsm_radius, params.rsm_steps = samples, o.radius, o.steps
+  local steps = o.steps >= 0 and o.steps or exclude_seen and 1 or 0 -- auto (rsm.defaults.steps)
+  defines.RSM_GATHER, defines.VISIBILITY, defines.EXCLUDE_SEEN = true, steps > 0, exclude_seen
+  params.rsm_samples, params.rsm_radius, params.rsm_steps = samples, o.radius, steps
+  params.rsm_thickness = o.thickness
   params.rsm_rotate = temporal_on and o.rotate / 360 or 0
-  return samples * (2 + o.steps * 2 + (exclude_seen and 1 or 0))
+  return samples * (2 + steps * 2 + (exclude_seen and 1 or 0))
 end
 
 -- Records the gather over the coarse view C (isr.coarse_view, factor f) of

@@ -58,11 +58,12 @@
 // and stayed in the scene's box (box_exit) met one the screen cannot show
 // (off screen, behind the first depth layer): its hit is UNSEEN (the value,
 // under 0.5), which isr_bounce.frag counts. A ray that left the box stays 0
-// (open), and so does one that points up: outdoors such rays meet the sky
-// (on the reference set's blocks, counted as unseen, they took the ground's
+// (open), and so does one that points up, unless p lies under a roof (with
+// RSM_GATHER: rsm_shadowed above it): outdoors such rays meet the sky (on
+// the reference set's blocks, counted as unseen, they took the ground's
 // light: 71.9% / 68.4% of dl+esm's indirect error removed against POV-Ray /
 // Cycles at rsm.bounces 2 with them open, 67.8% / 69.6% counted, 72.9% /
-// 67.2% at 1), and indoors a ceiling's rays all point down.
+// 67.2% at 1), and indoors they meet the ceiling.
 // TEMPORAL (isr.temporal, temporal.glsl): each frame the rays are the next
 // 16 n points of the sequence, and a pixel whose history has converged is
 // not marched: its E is that history (every bounce's sum), which a later
@@ -262,6 +263,16 @@ void main() {
   first += temporal_turn() * 16 * n; // this frame's points (below 2^28: no overflow)
 #endif
   vec4 a = frame.view_proj * vec4(s.p, 1.0);
+#ifdef UNSEEN
+#ifdef RSM_GATHER
+  // Under a roof: the point straight above p, near the scene box's top, lies in the lights' shadow
+  // (halfway up put the blocks' shaded ground under the blocks' shadow; docs/gi-combined.md).
+  const vec3 UP = vec3(0.0, 1.0, 0.0);
+  bool roofed = rsm_shadowed(s.p + 0.9 * box_exit(s.p, UP) * UP);
+#else
+  const bool roofed = false;
+#endif
+#endif
   vec3 gathered = vec3(0.0);
   float open = 0.0;
   for (int i = 0; i < n; i++) {
@@ -330,12 +341,12 @@ void main() {
     }
     if (!seen) open += 1.0;
 #ifdef UNSEEN
-    if (!seen && i < 4 * HITS && w.y <= 0.0 && box_exit(s.p, w) > t_end) record_hit(i, float(UNSEEN));
+    if (!seen && i < 4 * HITS && (w.y <= 0.0 || roofed) && box_exit(s.p, w) > t_end) record_hit(i, float(UNSEEN));
 #endif
   }
   isr = vec4(gathered / float(n), open / float(n));
 #ifdef RSM_GATHER
-  isr.rgb += max(rsm_k, 0.0) * rsm_gather(s, px, dpt, mat);
+  isr.rgb += max(rsm_k, 0.0) * rsm_gather(s, px, dpt);
 #endif
 #ifdef FIRST
   isr.rgb += texelFetch(first_step, px, 0).rgb;

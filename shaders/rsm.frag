@@ -82,7 +82,7 @@ void main() {
   }
 #endif
 
-  vec3 v = rsm_gather(s, px, dpt, mat);
+  vec3 v = rsm_gather(s, px, dpt);
 #ifdef TEMPORAL
   next = temporal_accumulate(vec4(v, 1.0), found, h, held, next_state.y);
   v = next.rgb;

@@ -83,13 +83,14 @@ uniform int rsm_samples = 24;        // a coarse pixel and light
 uniform float rsm_radius = 1.0;      // the disc's radius, in tiles
 uniform float rsm_rotate = 0.0;      // turn of the pattern a frame, in turns (seed 004: 10 degrees)
 uniform int rsm_steps = 0;           // VISIBILITY's march
+uniform float rsm_thickness = 0.0;   // VISIBILITY: how far behind the depth buffer blocks, a share of its depth (0: any)
 
 const int INTERLEAVE = 4;                          // tile side of the interleaved pattern
 const float GOLDEN = 0.61803398874989;             // the angle's step, in turns
 const vec2 TURN = vec2(-0.73736887807832, -0.67549029426152); // cos, sin of 2 pi GOLDEN
 const float PLASTIC = 0.75487766624669;            // 1 / the plastic number
 
-bool rsm_blocked(vec3 p, vec3 q, sampler2D dpt, sampler2D mat) {
+bool rsm_blocked(vec3 p, vec3 q, sampler2D dpt) {
   for (int j = 1; j <= rsm_steps; j++) {
     vec3 x = mix(p, q, float(j) / float(rsm_steps + 1));
     vec4 c = frame.view_proj * vec4(x, 1.0);
@@ -97,17 +98,52 @@ bool rsm_blocked(vec3 p, vec3 q, sampler2D dpt, sampler2D mat) {
     vec2 s = c.xy / c.w * 0.5 + 0.5;
     if (any(lessThan(s, vec2(0.0))) || any(greaterThan(s, vec2(1.0)))) continue;
     float z = c.w * frame.clip.z, zb = texture(dpt, s).r; // a perspective's clip w is the view depth
-    if (texture(mat, s).a >= 0.5 && z > zb * 1.02) return true;
+    bool within = rsm_thickness <= 0.0 || z < zb * (1.0 + rsm_thickness);
+    if (zb > 0.0 && z > zb * 1.02 && within) return true; // 0: nothing drawn there
   }
   return false;
 }
 
+// Is x in the shadow of every light whose RSM views hold it, by those views
+// (and of one at least): the sender its texel holds lies nearer the light
+// than x (by 2% of the light's distance for a spot or point light, 1% of the
+// depth range for a directional one)? Over an empty texel x is lit; a light
+// whose views do not hold x has no say (a light that lights nothing in view
+// changes nothing: test_exposure). The combined technique's march asks it of
+// the point above p near the scene box's top (isr_march.frag's UNSEEN): under
+// a roof the upward rays the screen lost met a ceiling, in the open the sky.
+bool rsm_shadowed(vec3 x) {
+  vec2 atlas = vec2(textureSize(rsm_pos, 0));
+  bool any_view = false;
+  for (int i = 0; i < frame.counts.x; i++) {
+    ShadowLight sl = shadow_lights[i];
+    int first = sl.cube.y, count = sl.cube.z;
+    bool shadowed = false, inside = false;
+    for (int v = first; v < first + count && !inside; v++) {
+      ShadowView sv = shadow_views[v];
+      vec4 c = sv.view_proj * vec4(x, 1.0);
+      if (c.w <= 1e-12) continue;
+      vec3 ndc = c.xyz / c.w;
+      vec2 t = ndc.xy * 0.5 + 0.5;
+      if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
+      inside = true;
+      vec4 qn = texelFetch(rsm_pos, ivec2((sv.rect.xy + t * sv.rect.zw) * atlas), 0);
+      if (qn.w > 0.0) continue; // empty: nothing between x and the light
+      vec4 cq = sv.view_proj * vec4(qn.xyz, 1.0);
+      shadowed = sv.depth.w > 0.0 ? distance(x, sv.depth.xyz) > 1.02 * distance(qn.xyz, sv.depth.xyz)
+                                  : ndc.z > cq.z / max(cq.w, 1e-12) + 0.02; // ndc z spans 2
+    }
+    if (inside && !shadowed) return false;
+    any_view = any_view || inside;
+  }
+  return any_view;
+}
+
 // Light i's share of E(p) at the surface s: its RSM views, j the pixel's
 // block of the pattern, turn and shift its frame's turn (rsm_gather); type
-// and falloff light i's kind as light_arriving_as takes them. dpt and mat:
-// the full G-buffer's, for EXCLUDE_SEEN and VISIBILITY.
-vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn, float shift, sampler2D dpt,
-                      sampler2D mat) {
+// and falloff light i's kind as light_arriving_as takes them. dpt:
+// the full G-buffer's depth, for EXCLUDE_SEEN and VISIBILITY.
+vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn, float shift, sampler2D dpt) {
   vec2 atlas = vec2(textureSize(rsm_pos, 0));
   ShadowLight sl = shadow_lights[i];
   Light li = lights[i]; // read once, not in the sample loop (rsm.gather about 8% faster on llvmpipe)
@@ -151,7 +187,7 @@ vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn
       if (rsm_seen(dpt, q)) continue;
 #endif
 #ifdef VISIBILITY
-      if (rsm_blocked(s.p, q, dpt, mat)) continue;
+      if (rsm_blocked(s.p, q, dpt)) continue;
 #endif
       vec3 l;
       vec3 radiance = light_arriving_as(li, type, falloff, q, l);
@@ -161,9 +197,9 @@ vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn
   return e;
 }
 
-// E(p) at the surface s of coarse pixel px; dpt and mat: the full G-buffer's,
+// E(p) at the surface s of coarse pixel px; dpt: the full G-buffer's depth,
 // for EXCLUDE_SEEN and VISIBILITY.
-vec3 rsm_gather(Surface s, ivec2 px, sampler2D dpt, sampler2D mat) {
+vec3 rsm_gather(Surface s, ivec2 px, sampler2D dpt) {
   int j = interleave_index(px, INTERLEAVE);
   float turn = fract(frame.time.y * rsm_rotate);
   // With temporal reuse the radii move too (by the plastic number's step, unrelated to the angle's), so
@@ -176,7 +212,7 @@ vec3 rsm_gather(Surface s, ivec2 px, sampler2D dpt, sampler2D mat) {
 #ifdef LIGHT_SET
   // As reflected_light unrolls the set: four at a time, the compiler drops those past the count.
 #define RSM_GATHER_AT(i) \
-  if ((i) < LIGHT_SET) e += rsm_gather_light(i, light_set_type(i), light_set_falloff(i), s, j, turn, shift, dpt, mat);
+  if ((i) < LIGHT_SET) e += rsm_gather_light(i, light_set_type(i), light_set_falloff(i), s, j, turn, shift, dpt);
 #define RSM_GATHER_FROM(i) RSM_GATHER_AT(i) RSM_GATHER_AT(i + 1) RSM_GATHER_AT(i + 2) RSM_GATHER_AT(i + 3)
 #if LIGHT_SET > 0
   RSM_GATHER_FROM(0)
@@ -193,7 +229,7 @@ vec3 rsm_gather(Surface s, ivec2 px, sampler2D dpt, sampler2D mat) {
 #else
   for (int i = 0; i < frame.counts.x; i++) {
     Light li = lights[i];
-    e += rsm_gather_light(i, light_type(li), light_falloff_mode(li), s, j, turn, shift, dpt, mat);
+    e += rsm_gather_light(i, light_type(li), light_falloff_mode(li), s, j, turn, shift, dpt);
   }
 #endif
   return finite_or_zero(e / PI);

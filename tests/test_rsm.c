@@ -347,6 +347,7 @@ static void extremes_stay_finite(void **state) {
   (void)state;
   static const char *const cases[][4] = {
       {"rsm.samples=1", NULL}, {"rsm.samples=4096", "rsm.coarse=4", NULL}, {"rsm.steps=32", NULL},
+      {"rsm.steps=32", "rsm.thickness=16", NULL}, {"rsm.steps=1", "rsm.thickness=0", NULL},
       {"rsm.radius=2", "rsm.reach=64", NULL}, {"rsm.coarse=1", "rsm.blur=0", NULL},
   };
   static const char *const vpl_cases[][4] = {
@@ -463,7 +464,7 @@ static void a_light_change_reaches_converged_pixels_at_once(void **state) {
  * what is still seen, the disocclusion test drops what was not. Measured
  * (bound): rsm+esm 0.36% (0.7%; 0.52% at rsm.temporal.narrow = 1/4, 0.87%
  * there at rsm.temporal.epsilon = 1, which keeps the ghost), isr+rsm+esm
- * with isr.temporal 0.36% (0.6%), isr+esm
+ * with isr.temporal 0.36% (0.8%, below), isr+esm
  * 0.67% (1.5%): ISR's light at a point depends on what the screen shows,
  * and a reprojected pixel holds the old view's estimate, which the new
  * frames replace as they accumulate, the history capped at
@@ -474,7 +475,10 @@ static void a_light_change_reaches_converged_pixels_at_once(void **state) {
  * frames, as measured (the defaults' 3 and 4 leave the still render's own
  * noise: rsm+esm 0.74%). isr+rsm+esm's second bounce over the rays the
  * screen cannot follow (rsm.bounces 2) depends on what the view shows, so a
- * history carries some of the view before the move: 0.52% (0.37% at 1). */
+ * history carries some of the view before the move: 0.52% (0.37% at 1);
+ * 0.72% (bound 0.8%) since the upward rays under a roof count too (the room
+ * behind the panel lies in the panel's shadow: under a roof), 1.08% when
+ * every upward ray counted. */
 static void a_camera_move_leaves_no_ghost_edge(void **state) {
   (void)state;
   static const struct {
@@ -484,7 +488,7 @@ static void a_camera_move_leaves_no_ghost_edge(void **state) {
       {"rsm+esm", {"ambient=0", "rsm.samples=64", "rsm.temporal.enabled=true", "rsm.temporal.frames=36", NULL}, 0.007},
       {"isr+rsm+esm",
        {"ambient=0", "rsm.samples=64", "isr.samples=16", "isr.temporal.enabled=true", "isr.temporal.frames=36", NULL},
-       0.006},
+       0.008},
       {"isr+esm", {"ambient=0", "isr.samples=16", "isr.temporal.enabled=true", "isr.temporal.frames=36", NULL}, 0.015},
   };
   lm_scene *s = closed_room(LM_LIGHT_POINT);
@@ -754,6 +758,8 @@ static void bad_options_name_themselves(void **state) {
       {"rsm+esm", "rsm.samples=0", "rsm.samples"},    {"rsm+esm", "rsm.samples=4097", "rsm.samples"},
       {"rsm+esm", "rsm.radius=0", "rsm.radius"},      {"rsm+esm", "rsm.reach=0.5", "rsm.reach"},
       {"isr+rsm+esm", "rsm.steps=33", "rsm.steps"},   {"rsm+esm", "rsm.coarse=5", "rsm.coarse"},
+      {"isr+rsm+esm", "rsm.steps=-2", "rsm.steps"},   {"isr+rsm+esm", "rsm.thickness=-0.1", "rsm.thickness"},
+      {"rsm+esm", "rsm.thickness=17", "rsm.thickness"},
       {"vpl+esm", "vpl.lights=-1", "vpl.lights"},     {"vpl+esm", "vpl.negative=4097", "vpl.negative"},
       {"vpl+esm", "vpl.threshold=3", "vpl.threshold"}, {"vpl+esm", "vpl.focus=0", "vpl.focus"},
       {"vpl+esm", "vpl.recompute=some", "vpl.recompute"},
