@@ -37,6 +37,17 @@ layout(std140, binding = 3) uniform LimnLightSetShadowViews { ShadowView shadow_
 layout(std430, binding = 2) readonly buffer LimnShadowLights { ShadowLight shadow_lights[]; };
 layout(std430, binding = 3) readonly buffer LimnShadowViews { ShadowView shadow_views[]; };
 #endif
+#ifdef LIGHT_SET
+// A light-set variant's copy of each light's shadow views at fixed places
+// (engine/render/render.c, upload_shadows): light i's view j at
+// SHADOW_SLOTS i + j, j its cube face (+X -X +Y -Y +Z -Z), its cascade, or 0
+// for a spot. The light's index is a constant there, so what all its views
+// share is read at constant offsets, which llvmpipe reads once for all
+// lanes; an offset that varies by pixel (the records' own order: the cube's
+// drawn faces counted) it reads lane by lane, value by value.
+#define SHADOW_SLOTS 6
+layout(std140, binding = 5) uniform LimnLightSetShadowSlots { ShadowView shadow_slots[LIGHT_BLOCKS * SHADOW_SLOTS]; };
+#endif
 
 uniform sampler2D shadow_atlas;
 
@@ -47,6 +58,21 @@ const vec2 POISSON[16] = vec2[](
   vec2(-0.242, 0.997), vec2(-0.814, 0.914), vec2(0.200, 0.786), vec2(0.144, -0.141));
 
 float shadow_texel(ivec2 t, ivec2 lo, ivec2 hi) { return texelFetch(shadow_atlas, clamp(t, lo, hi), 0).r; }
+
+// The 2 x 2 texels from t, each clamped into the tile [lo, hi] as
+// shadow_texel does, in the order (0, 0), (1, 0), (0, 1), (1, 1): one gather
+// of a block inside the tile (a tile is at least 2 texels a side), whose
+// columns or rows stand for both where t lies on or past an edge. One read
+// instead of four (llvmpipe: a gather costs about one fetch).
+vec4 shadow_texels(ivec2 t, ivec2 lo, ivec2 hi) {
+  ivec2 b = clamp(t, lo, hi - 1);
+  vec4 z = textureGather(shadow_atlas, (vec2(b) + 1.0) / vec2(textureSize(shadow_atlas, 0)), 0).wzxy;
+  if (t.x < lo.x) z.yw = z.xz;
+  if (t.x >= hi.x) z.xz = z.yw;
+  if (t.y < lo.y) z.zw = z.xy;
+  if (t.y >= hi.y) z.xy = z.zw;
+  return z;
+}
 
 // A texel's world size, where a point at stored depth r is, in stored depth
 // (the tile's 0..1): the unit of the bias and of ESM's c, so both mean the
@@ -92,17 +118,15 @@ float pcss_lookup(ShadowLight s, ShadowView sv, vec2 texel, float r, float bias,
     ivec2 b = ivec2(floor(t));
     vec2 f = t - vec2(b);
     float rb = r - bias * (1.0 + (length(o) + 1.0) * tan_tilt);
-    vec4 v = step(vec4(rb), vec4(shadow_texel(b, lo, hi), shadow_texel(b + ivec2(1, 0), lo, hi),
-                                 shadow_texel(b + ivec2(0, 1), lo, hi), shadow_texel(b + ivec2(1, 1), lo, hi)));
+    vec4 v = step(vec4(rb), shadow_texels(b, lo, hi));
     lit += mix(mix(v.x, v.y, f.x), mix(v.z, v.w, f.x), f.y);
   }
   return lit / 16.0;
 }
 
-// Visibility in [0, 1] of p from view v.
-float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
-  ShadowView sv = shadow_views[v];
-  vec4 ls = sv.view_proj * vec4(p, 1.0);
+// Visibility in [0, 1] of p from view sv of light s, p at ls in its clip
+// space (shadow_view_of).
+float shadow_view_lookup(ShadowView sv, vec4 ls, ShadowLight s, vec3 p, float ndl) {
   if (ls.w <= 1e-12) return 1.0;
   vec3 ndc = ls.xyz / ls.w;
   vec2 tuv = ndc.xy * 0.5 + 0.5;
@@ -128,8 +152,7 @@ float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
     // the depth difference is clamped at 0 and scaled by n.l, then exp(-k d)
     // with k = c per texel of depth (a scale-free c; leaks within a texel).
     float k = s.params.x / texel_depth, scale = saturate(ndl);
-    vec4 z = vec4(shadow_texel(base, lo, hi), shadow_texel(base + ivec2(1, 0), lo, hi),
-                  shadow_texel(base + ivec2(0, 1), lo, hi), shadow_texel(base + ivec2(1, 1), lo, hi));
+    vec4 z = shadow_texels(base, lo, hi);
     vec4 vis = exp(-k * max(vec4(r) - z - bias, 0.0) * scale);
     return mix(mix(vis.x, vis.y, f.x), mix(vis.z, vis.w, f.x), f.y);
   }
@@ -148,19 +171,30 @@ float shadow_view_lookup(int v, ShadowLight s, vec3 p, float ndl) {
   return r - bias <= shadow_texel(ivec2(floor(texel + 0.5)), lo, hi) ? 1.0 : 0.0;
 }
 
-// The view of light s (shadow of kind `kind`, ShadowLight.info.z) that p
-// reads, -1 for none, and for cascades the next one's weight *t: one view
-// whatever the kind (a software rasterizer runs every kind's branch).
-int shadow_view_at(ShadowLight s, int kind, vec3 p, out float t) {
-  int first = s.info.x, count = s.info.y;
+// Where point light `light` (record s) is: its cube's centre.
+vec3 shadow_cube_centre(int light, ShadowLight s) {
+#ifdef LIGHT_SET
+  return shadow_slots[light * SHADOW_SLOTS].depth.xyz;
+#else
+  return shadow_views[s.info.x].depth.xyz;
+#endif
+}
+
+// Which view of light `light` (record s, shadow of kind `kind`,
+// ShadowLight.info.z) p reads, as the light numbers them: the cube face of a
+// point light, the cascade, 0 for a spot (shadow_view_of finds it); -1 for
+// none, and for cascades the next one's weight *t. One view whatever the kind
+// (a software rasterizer runs every kind's branch).
+int shadow_view_at(int light, ShadowLight s, int kind, vec3 p, out float t) {
+  int count = s.info.y;
   t = 0.0;
   if (count <= 0) return -1;
   if (kind == 3) { // point light: the cube face of the major axis
-    vec3 d = p - shadow_views[first].depth.xyz;
+    vec3 d = p - shadow_cube_centre(light, s);
     vec3 a = abs(d);
     int face = a.x >= a.y && a.x >= a.z ? (d.x >= 0.0 ? 0 : 1) : a.y >= a.z ? (d.y >= 0.0 ? 2 : 3) : (d.z >= 0.0 ? 4 : 5);
     if ((s.cube.x & (1 << face)) == 0) return -1; // no visible pixel was to sample it
-    return first + bitCount(s.cube.x & ((1 << face) - 1));
+    return face;
   }
   if (kind == 1) { // cascades: by camera depth, blended over the last `blend` share of each
     float z = -(frame.view * vec4(p, 1.0)).z;
@@ -170,9 +204,41 @@ int shadow_view_at(ShadowLight s, int kind, vec3 p, out float t) {
     float start = k > 0 ? s.splits[k - 1] : frame.clip.x;
     float band = (s.splits[k] - start) * s.params.z;
     if (k < count - 1 && band > 0.0 && z > s.splits[k] - band) t = saturate((z - (s.splits[k] - band)) / band);
-    return first + k;
+    return k;
   }
-  return first;
+  return 0;
+}
+
+// View j of light `light` (shadow_view_at's numbering), p at *clip in its
+// clip space. The records hold a light's views in order, a cube's drawn
+// faces alone. A light-set variant reads the light's fixed places instead:
+// a cube face's own values (its matrix's rows x, y, w and its tile's place:
+// 11) at the face's place, the rest (centre, range, texel and tile size,
+// shared by the faces) at the first place's constant offset; the whole
+// record read at a pixel's own index made much of the lookup's cost on
+// llvmpipe (Cornell box, dl+esm, 128x96, 4 frames, callgrind: the shadow's
+// share of the JIT'd code 10.4 -> 6.5 million instructions with this and
+// shadow_texels' one gather).
+ShadowView shadow_view_of(int light, ShadowLight s, int kind, int j, vec3 p, out vec4 clip) {
+#ifdef LIGHT_SET
+  int at = light * SHADOW_SLOTS;
+  if (kind == 3) {
+    ShadowView sv = shadow_slots[at], face = shadow_slots[at + j];
+    // Rows x, y and w of the face's matrix on p - centre (its translation
+    // moves the centre to 0); z only serves orthographic views.
+    vec3 d = p - sv.depth.xyz;
+    mat4 m = face.view_proj;
+    clip = vec4(dot(vec3(m[0][0], m[1][0], m[2][0]), d), dot(vec3(m[0][1], m[1][1], m[2][1]), d), 0.0,
+                dot(vec3(m[0][3], m[1][3], m[2][3]), d));
+    sv.rect.xy = face.rect.xy;
+    return sv;
+  }
+  ShadowView sv = shadow_slots[at + j];
+#else
+  ShadowView sv = shadow_views[s.info.x + (kind == 3 ? bitCount(s.cube.x & ((1 << j) - 1)) : j)];
+#endif
+  clip = sv.view_proj * vec4(p, 1.0);
+  return sv;
 }
 
 // Shadow factor of light `light` at p, whose shadow is of kind `kind`
@@ -181,15 +247,18 @@ int shadow_view_at(ShadowLight s, int kind, vec3 p, out float t) {
 float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
   ShadowLight s = shadow_lights[light];
   float t;
-  int v = shadow_view_at(s, kind, p, t);
+  int v = shadow_view_at(light, s, kind, p, t);
   if (v < 0) return 1.0;
   float ndl = dot(n, l), vis = 1.0;
   // Both lookups in a loop that tests at its end, not the second in an if: a
   // software rasterizer leaves such a loop once no pixel of its group goes on,
   // but runs both sides of every if.
   int j = 0;
-  do vis = mix(vis, shadow_view_lookup(v + j, s, p, ndl), j == 0 ? 1.0 : t);
-  while (++j < (t > 0.0 ? 2 : 1));
+  do {
+    vec4 clip;
+    ShadowView sv = shadow_view_of(light, s, kind, v + j, p, clip);
+    vis = mix(vis, shadow_view_lookup(sv, clip, s, p, ndl), j == 0 ? 1.0 : t);
+  } while (++j < (t > 0.0 ? 2 : 1));
   return vis;
 }
 
@@ -207,10 +276,10 @@ uniform sampler2D shadow_transmit;
 vec3 shadow_transmittance_as(int light, int kind, vec3 p) {
   ShadowLight s = shadow_lights[light];
   float t;
-  int v = shadow_view_at(s, kind, p, t);
+  int v = shadow_view_at(light, s, kind, p, t);
   if (v < 0) return vec3(1.0);
-  ShadowView sv = shadow_views[v];
-  vec4 ls = sv.view_proj * vec4(p, 1.0);
+  vec4 ls;
+  ShadowView sv = shadow_view_of(light, s, kind, v, p, ls);
   if (ls.w <= 1e-12) return vec3(1.0);
   vec3 ndc = ls.xyz / ls.w;
   vec2 tuv = ndc.xy * 0.5 + 0.5;
