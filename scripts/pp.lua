@@ -19,7 +19,7 @@ Options = {
   materials = "phong",     -- "phong" (the std technique) or "pbr" (glTF metallic-roughness, GGX)
   light_variants = 12,     -- up to this many lights (0..16) lighting passes unroll them; more, 0: grid loop
   light_cull = true,       -- yet more than one light and one the grid culls (cone, range): the grid's loop
-  simplify = 0.1,          -- a mesh node draws its simplified copy (made at load) that errs by at most this
+  simplify = 0.25,         -- a mesh node draws its simplified copy (made at load) that errs by at most this
                            -- many pixels where it comes nearest the camera; 0..64, 0: every mesh whole
   shadow = options.copy(shadow.defaults),
   sky = options.copy(sky.defaults),                -- off by default

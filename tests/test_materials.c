@@ -120,7 +120,8 @@ static void culling_drops_what_the_camera_cannot_see(void **state) {
   assert_true(over->ok && ground->ok);
   printf("outdoor overview: %d drawn, %d culled, %ld triangles; ground view: %d drawn, %d culled\n",
          over->stats.drawn, over->stats.culled, over->stats.triangles, ground->stats.drawn, ground->stats.culled);
-  assert_true(over->stats.triangles >= 200000);
+  /* most of the forest in view (4201 mesh nodes): drawn, though far trees draw simplified copies */
+  assert_true(over->stats.drawn >= 3000 && over->stats.drawn > 3 * over->stats.culled);
   assert_true(ground->stats.culled > ground->stats.drawn); /* most of the forest is behind or beside */
   free(over), free(ground);
   lm_scene_destroy(s);

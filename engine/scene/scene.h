@@ -192,7 +192,9 @@ typedef struct lm_scene_mesh {
    * about a quarter of the last's triangles within LM_LOD_ERROR times 4^level
    * of the mesh's extent, stored after the mesh's own indices in its GPU
    * index buffer: `casters` over positions alone (shadow tiles), `lods` with
-   * the seams of normals and uvs kept (the camera's passes). A level's error
+   * the seams of normals and uvs kept (the camera's passes; where the seams
+   * leave no copy, over positions with each corner's vertex chosen by its
+   * normal: engine/scene/lod.c corners_by_normal). A level's error
    * (local units, meshoptimizer's measure; a level made from the last, the
    * sum of the two) bounds how far its surface lies from the mesh's, and is
    * no less than the finer levels'. None (0
