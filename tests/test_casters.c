@@ -439,9 +439,12 @@ static float copy_distance(const lm_scene_mesh *m, const uint32_t *copy, int cou
  * the first vertex at each position, a tip corner would take another side's
  * normal, a corner of the base the sides'). With `simplify` at 1 pixel the
  * nine cones (a tenth of a unit a pixel) draw copies: fewer triangles, and
- * the G-buffer's normals and the image within 2% (mean absolute difference
- * over the mean) of every mesh whole; the outdoor scene's tree crowns are
- * such cones. */
+ * the G-buffer's normals within 2% and the image within 5% (mean absolute
+ * difference over the mean) of every mesh whole; the outdoor scene's tree
+ * crowns are such cones. Measured: 104 triangles of 362, normals 1.55%,
+ * image 4.38% (the nodes take the 8-triangle level, whose error made from the
+ * mesh is 5.7% of its extent: made from the last copy it recorded more and
+ * they took the 18-triangle one, 164 triangles, image 1.08%). */
 static void cones_have_camera_copies_that_keep_their_normals(void **state) {
   (void)state;
   lm_scene *s = nine_scene(true);
@@ -480,7 +483,7 @@ static void cones_have_camera_copies_that_keep_their_normals(void **state) {
   double d = gl_mean_abs_diff(whole.rgb, simple.rgb, n) / mean;
   print_message("gbuffer.nrm: mean difference %.3g%% of the mean (largest %.3g); image %.3g%% of the mean (%.3g)\n",
                 100 * dn, worst, 100 * d, mean);
-  assert_true(mean > 0.05 && d <= 0.02 && dn <= 0.02);
+  assert_true(mean > 0.05 && d <= 0.05 && dn <= 0.02);
   gl_result_free(&whole), gl_result_free(&simple);
   lm_scene_destroy(s);
 }

@@ -195,9 +195,10 @@ typedef struct lm_scene_mesh {
    * the seams of normals and uvs kept (the camera's passes; where the seams
    * leave no copy, over positions with each corner's vertex chosen by its
    * normal: engine/scene/lod.c corners_by_normal). A level's error
-   * (local units, meshoptimizer's measure; a level made from the last, the
-   * sum of the two) bounds how far its surface lies from the mesh's, and is
-   * no less than the finer levels'. None (0
+   * (local units, meshoptimizer's measure, every level made from the mesh)
+   * says how far its surface lies from the mesh's (the mesh's vertices lie
+   * within 3.5 times it: test_casters), and is no less than the finer
+   * levels'. None (0
    * levels) for a deformed mesh, one of fewer than LM_LOD_MIN_TRIANGLES, and
    * no level that keeps over 3/4 of the last's triangles. */
   lm_mesh_lod casters[LM_LOD_LEVELS], lods[LM_LOD_LEVELS];
