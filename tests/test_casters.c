@@ -53,6 +53,15 @@ static double target_diff(gl_result *a, gl_result *b, const char *name, double *
   return mean > 0 ? diff / mean : diff;
 }
 
+/* Mean |a - ref| over the images of both runs, against ref's mean (in *mean). */
+static double image_diff(const gl_result *a, const gl_result *ref, double *mean) {
+  int n = ref->width * ref->height * 3;
+  *mean = 0;
+  for (int i = 0; i < n; i++) *mean += ref->rgb[i];
+  *mean /= n;
+  return gl_mean_abs_diff(a->rgb, ref->rgb, n) / *mean;
+}
+
 /* big_small: 64 spheres as 64 nodes of four meshes; big_small_instanced: the
  * same spheres as four nodes carrying EXT_mesh_gpu_instancing. The loader
  * makes each instance a child node, so both draw the spheres in one call a
@@ -86,11 +95,7 @@ static void instanced_nodes_render_as_the_nodes(void **state) {
     print_message("%-12s mean difference %.2g of the mean, largest %.3g\n", targets[t], d, worst);
     assert_true(d <= 1e-4);
   }
-  int n = a.width * a.height * 3;
-  double mean = 0;
-  for (int i = 0; i < n; i++) mean += b.rgb[i];
-  mean /= n;
-  double d = gl_mean_abs_diff(a.rgb, b.rgb, n) / mean;
+  double mean, d = image_diff(&a, &b, &mean);
   print_message("image        mean difference %.2g of the mean\n", d);
   assert_true(mean > 0.05 && d <= 1e-4);
   gl_result_free(&a), gl_result_free(&b);
@@ -223,11 +228,8 @@ static void casters_keep_the_shadows(bool cones, double bound) {
   assert_int_equal(sw.simplified, 0);
   assert_int_equal(sw.drawn, ss.drawn);
   assert_true(ss.simplified > 0 && ss.triangles < sw.triangles);
-  int n = whole.width * whole.height * 3;
-  double mean = 0, worst = 0;
-  for (int i = 0; i < n; i++) mean += whole.rgb[i], worst = fmax(worst, fabs(whole.rgb[i] - simple.rgb[i]));
-  mean /= n;
-  double d = gl_mean_abs_diff(whole.rgb, simple.rgb, n) / mean;
+  double mean, worst = 0, d = image_diff(&simple, &whole, &mean);
+  for (int i = 0; i < whole.width * whole.height * 3; i++) worst = fmax(worst, fabs(whole.rgb[i] - simple.rgb[i]));
   print_message("image: mean difference %.3g%% of the mean (%.3g), largest %.3g\n", 100 * d, mean, worst);
   assert_true(mean > 0.05 && d <= bound);
   gl_result_free(&whole), gl_result_free(&simple);
@@ -320,11 +322,7 @@ static void simplified_meshes_keep_the_image(void **state) {
   assert_true(ss.simplified == 9 && ss.triangles < sw.triangles);
   double worst, dn = target_diff(&simple, &whole, "gbuffer.nrm", &worst);
   print_message("gbuffer.nrm: mean difference %.3g%% of the mean, largest %.3g\n", 100 * dn, worst);
-  int n = whole.width * whole.height * 3;
-  double mean = 0;
-  for (int i = 0; i < n; i++) mean += whole.rgb[i];
-  mean /= n;
-  double d = gl_mean_abs_diff(whole.rgb, simple.rgb, n) / mean;
+  double mean, d = image_diff(&simple, &whole, &mean);
   print_message("image: mean difference %.3g%% of the mean (%.3g)\n", 100 * d, mean);
   assert_true(mean > 0.05 && d <= 0.005);
   assert_true(dn <= 0.005);
@@ -476,11 +474,7 @@ static void cones_have_camera_copies_that_keep_their_normals(void **state) {
                 ss.simplified, ss.drawn);
   assert_true(sw.simplified == 0 && ss.simplified == 9 && ss.triangles < sw.triangles);
   double worst, dn = target_diff(&simple, &whole, "gbuffer.nrm", &worst);
-  int n = whole.width * whole.height * 3;
-  double mean = 0;
-  for (int i = 0; i < n; i++) mean += whole.rgb[i];
-  mean /= n;
-  double d = gl_mean_abs_diff(whole.rgb, simple.rgb, n) / mean;
+  double mean, d = image_diff(&simple, &whole, &mean);
   print_message("gbuffer.nrm: mean difference %.3g%% of the mean (largest %.3g); image %.3g%% of the mean (%.3g)\n",
                 100 * dn, worst, 100 * d, mean);
   assert_true(mean > 0.05 && d <= 0.05 && dn <= 0.02);
@@ -721,11 +715,7 @@ static void quantized_positions_keep_the_image(void **state) {
   assert_false(quantized->meshes[1].gpu.float_positions);
   assert_true(floats->meshes[1].gpu.float_positions);
   double worst, dn = target_diff(&q, &f, "gbuffer.nrm", &worst);
-  int n = q.width * q.height * 3;
-  double mean = 0;
-  for (int i = 0; i < n; i++) mean += f.rgb[i];
-  mean /= n;
-  double d = gl_mean_abs_diff(q.rgb, f.rgb, n) / mean;
+  double mean, d = image_diff(&q, &f, &mean);
   print_message("quantized positions: gbuffer.nrm %.3g%% of the mean (largest %.3g), image %.3g%% of the mean (%.3g)\n",
                 100 * dn, worst, 100 * d, mean);
   assert_true(mean > 0.05 && d <= 0.001 && dn <= 0.001);
