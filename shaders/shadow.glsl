@@ -39,7 +39,7 @@ layout(std430, binding = 3) readonly buffer LimnShadowViews { ShadowView shadow_
 #endif
 #ifdef LIGHT_SET
 // A light-set variant's copy of each light's shadow views at fixed places
-// (engine/render/render.c, upload_shadows): light i's view j at
+// (engine/shadow/shadow.c, upload_slots): light i's view j at
 // SHADOW_SLOTS i + j, j its cube face (+X -X +Y -Y +Z -Z), its cascade, or 0
 // for a spot. The light's index is a constant there, so what all its views
 // share is read at constant offsets, which llvmpipe reads once for all

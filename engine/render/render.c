@@ -143,33 +143,6 @@ void lm_renderer_overhead(const lm_renderer *r, double *record_ms, double *compi
 double lm_renderer_fit_ms(const lm_renderer *r) { return r->fit_ms; }
 const lm_shadow_plan *lm_renderer_shadows(const lm_renderer *r) { return &r->shadows; }
 
-/* The shadow plan's records (lm_shadow_plan_upload) and, for light-set
- * variants, each light's shadow views again at fixed places (shadow.glsl's
- * shadow_slots, SHADOW_SLOTS the same): light i's view j at SHADOW_SLOTS i + j,
- * j its cube face (+X -X +Y -Y +Z -Z), its cascade or 0 for a spot. A
- * variant's light index is a constant, so what a light's views share is read
- * at a constant offset (once for all lanes on llvmpipe), not at the offset a
- * pixel's cube face gives in the records' order (lane by lane). A cube's
- * faces not drawn hold its first view (their centre; never sampled). */
-enum { SHADOW_SLOTS = 6 };
-static void upload_shadows(const lm_shadow_plan *plan, int light_count) {
-  lm_shadow_plan_upload(plan, light_count);
-  lm_shadow_view_data slots[LM_LIGHT_SET_MAX * SHADOW_SLOTS];
-  memset(slots, 0, sizeof slots);
-  int lights = plan ? plan->light_count < LM_LIGHT_SET_MAX ? plan->light_count : LM_LIGHT_SET_MAX : 0;
-  for (int i = 0; i < lights; i++) {
-    const int32_t *info = plan->lights[i].info;
-    unsigned faces = (unsigned)plan->lights[i].cube[0];
-    bool cube = info[2] == 3; /* shadow.glsl's kinds: 3 point */
-    for (int j = 0; j < SHADOW_SLOTS; j++) {
-      int v = cube ? info[0] + (faces >> j & 1 ? __builtin_popcount(faces & ((1u << j) - 1)) : 0)
-                   : j < info[1] ? info[0] + j : -1;
-      if (info[1] > 0 && v >= 0 && v < plan->view_count) slots[i * SHADOW_SLOTS + j] = plan->view_data[v];
-    }
-  }
-  lm_uniform_upload(5, slots, sizeof slots, sizeof slots);
-}
-
 /* The shadow pass fits its views to the camera depths the G-buffer holds
  * (the script's reduction: min in r, max in g, as depth / far). Reading this
  * frame's waits for the passes before it (timed: lm_renderer_fit_ms); with
@@ -204,7 +177,7 @@ static bool fit_views(void *user, const lm_pass_desc *d, lm_texture fit, int w, 
   }
   lm_shadow_plan_fit(plan, r->desc.scene, &r->camera, zmin, zmax);
   for (int v = 0; v < plan->view_count; v++) views[v] = plan->views[v];
-  upload_shadows(plan, plan->light_count);
+  lm_shadow_plan_upload(plan, plan->light_count);
   r->fit_ms += lm_now_ms() - t0;
   return true;
 }
@@ -1045,7 +1018,7 @@ static bool execute(lm_renderer *r, lm_graph *g, int meter, lm_error *err) {
   lm_uniform_upload(1, lights, sizeof *lights * (size_t)n, sizeof *lights * LM_LIGHT_SET_MAX);
   lm_light_grid_build(&r->light_grid, frame, lights, n, !r->desc.no_light_culling);
   lm_storage_upload(4, r->light_grid.data, r->light_grid.count * sizeof *r->light_grid.data);
-  upload_shadows(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
+  lm_shadow_plan_upload(r->shadows.view_count > 0 ? &r->shadows : NULL, n);
   r->fit_ms = 0;
   lm_graph_exec_desc x = {.clock = r->clock, .draw_scene = draw_scene, .fit_views = fit_views,
                           .keeps_views = keeps_views, .run_cpu = run_cpu,

@@ -659,7 +659,34 @@ static void upload(int binding, const void *data, size_t bytes, size_t record, i
   lm_uniform_upload(binding, data, bytes, record * (size_t)records);
 }
 
+/* For light-set variants, each light's shadow views again at fixed places
+ * (uniform block 5, shadow.glsl's shadow_slots, SHADOW_SLOTS the same): light
+ * i's view j at SHADOW_SLOTS i + j, j its cube face (+X -X +Y -Y +Z -Z), its
+ * cascade or 0 for a spot. A variant's light index is a constant, so what a
+ * light's views share is read at a constant offset (once for all lanes on
+ * llvmpipe), not at the offset a pixel's cube face gives in the records'
+ * order (lane by lane). A cube's faces not drawn hold its first view (their
+ * centre; never sampled); no plan: zeros. */
+enum { SHADOW_SLOTS = 6 };
+static void upload_slots(const lm_shadow_plan *plan) {
+  lm_shadow_view_data slots[LM_LIGHT_SET_MAX * SHADOW_SLOTS];
+  memset(slots, 0, sizeof slots);
+  int lights = plan ? plan->light_count < LM_LIGHT_SET_MAX ? plan->light_count : LM_LIGHT_SET_MAX : 0;
+  for (int i = 0; i < lights; i++) {
+    const int32_t *info = plan->lights[i].info;
+    unsigned faces = (unsigned)plan->lights[i].cube[0];
+    bool cube = info[2] == KIND_POINT;
+    for (int j = 0; j < SHADOW_SLOTS; j++) {
+      int v = cube ? info[0] + (faces >> j & 1 ? __builtin_popcount(faces & ((1u << j) - 1)) : 0)
+                   : j < info[1] ? info[0] + j : -1;
+      if (info[1] > 0 && v >= 0 && v < plan->view_count) slots[i * SHADOW_SLOTS + j] = plan->view_data[v];
+    }
+  }
+  lm_uniform_upload(5, slots, sizeof slots, sizeof slots);
+}
+
 void lm_shadow_plan_upload(const lm_shadow_plan *plan, int light_count) {
+  upload_slots(plan && plan->lights ? plan : NULL);
   if (plan && plan->lights) {
     upload(2, plan->lights, sizeof *plan->lights * (size_t)plan->light_count, sizeof *plan->lights,
            LM_LIGHT_SET_MAX);

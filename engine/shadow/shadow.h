@@ -121,7 +121,8 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
 void lm_shadow_plan_fit(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *camera, float zmin,
                         float zmax);
 void lm_shadow_plan_free(lm_shadow_plan *plan);
-/* Storage blocks 2 (per light) and 3 (per tile); a NULL plan marks every light unshadowed. */
+/* Storage blocks 2 (per light) and 3 (per tile), and uniform block 5 (each light's views at fixed
+ * places, for light-set variants); a NULL plan marks every light unshadowed. */
 void lm_shadow_plan_upload(const lm_shadow_plan *plan, int light_count);
 
 #endif
