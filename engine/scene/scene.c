@@ -658,13 +658,13 @@ bool lm_box_outside_frustum(const float view_proj[16], const float lo[3], const 
 }
 
 /* World bounds of a mesh under a node's transform (the box of the moved box). */
-static void world_bounds(const float w[16], const float b[2][3], float lo[3], float hi[3]) {
+void lm_box_transform(const float m[16], const float lo[3], const float hi[3], float out_lo[3], float out_hi[3]) {
   for (int r = 0; r < 3; r++) {
-    lo[r] = hi[r] = w[12 + r];
+    out_lo[r] = out_hi[r] = m[12 + r];
     for (int k = 0; k < 3; k++) {
-      float a = w[4 * k + r] * b[0][k], c = w[4 * k + r] * b[1][k];
-      lo[r] += a < c ? a : c;
-      hi[r] += a < c ? c : a;
+      float a = m[4 * k + r] * lo[k], c = m[4 * k + r] * hi[k];
+      out_lo[r] += a < c ? a : c;
+      out_hi[r] += a < c ? c : a;
     }
   }
 }
@@ -723,7 +723,7 @@ bool lm_scene_node_bounds(const lm_scene *s, int node, float lo[3], float hi[3])
   if (n->mesh < 0 || n->mesh >= s->mesh_count) return false;
   const lm_scene_mesh *m = &s->meshes[n->mesh];
   if (!(m->bounds[0][0] <= m->bounds[1][0])) return false;
-  world_bounds(n->world, m->bounds, lo, hi);
+  lm_box_transform(n->world, m->bounds[0], m->bounds[1], lo, hi);
   return isfinite(lo[0] + lo[1] + lo[2] + hi[0] + hi[1] + hi[2]);
 }
 
@@ -842,7 +842,7 @@ static const lm_mesh_chunk *lod_chunks(const lm_scene_draw_desc *d, const lm_sce
 /* Does d's cull volume leave out chunk c of node n's mesh? */
 static bool chunk_outside(const lm_scene_draw_desc *d, const lm_node *n, const lm_mesh_chunk *c) {
   float lo[3], hi[3];
-  world_bounds(n->world, c->bounds, lo, hi);
+  lm_box_transform(n->world, c->bounds[0], c->bounds[1], lo, hi);
   return box_outside(d->view_proj, lo, hi, d->pancake);
 }
 
@@ -890,7 +890,8 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     if (d->dynamic && d->layer && d->dynamic[i] != (d->layer == 2)) continue;
     if (material_blends(s, n->material) ? d->blend == LM_BLEND_SKIP : d->blend == LM_BLEND_ONLY) continue;
     float lo[3] = {0}, hi[3] = {0};
-    if (d->view_proj || d->lod_view_proj || d->eye_view_proj) world_bounds(n->world, s->meshes[n->mesh].bounds, lo, hi);
+    const float(*b)[3] = s->meshes[n->mesh].bounds;
+    if (d->view_proj || d->lod_view_proj || d->eye_view_proj) lm_box_transform(n->world, b[0], b[1], lo, hi);
     if (d->view_proj && box_outside(d->view_proj, lo, hi, d->pancake)) {
       if (stats) stats->culled++;
       continue;

@@ -340,6 +340,10 @@ void lm_scene_update(lm_scene *s);
 /* Moves a node (a camera the viewer flies) so its world transform becomes
  * `world`: its local transform is set against its parent's, then updated. */
 void lm_scene_node_set_world(lm_scene *s, int node, const float world[16]);
+/* The axis-aligned box holding the box lo..hi moved by the affine transform m
+ * (column-major), one product a row rather than eight corners; out_lo and
+ * out_hi must not be lo or hi. */
+void lm_box_transform(const float m[16], const float lo[3], const float hi[3], float out_lo[3], float out_hi[3]);
 /* World-space box of one mesh node; false for a node without a mesh, empty or not finite bounds. */
 bool lm_scene_node_bounds(const lm_scene *s, int node, float lo[3], float hi[3]);
 /* World-space box around every mesh node; false (and a unit box) when empty. */

@@ -98,15 +98,8 @@ static void caster_depth(const lm_scene *s, mat4 view, float l, float r, float b
   float cmin = FLT_MAX, cmax = -FLT_MAX, lo[3], hi[3];
   for (int i = 0; i < s->node_count; i++) {
     if (!lm_scene_node_bounds(s, i, lo, hi)) continue;
-    /* The light-view box of the box's eight corners: its centre's image
-     * plus the half extents weighed by |view| (one product for eight: this
-     * runs over every node for every tile of every frame). */
-    vec3 bl, bh;
-    for (int row = 0; row < 3; row++) {
-      float c = view[3][row], e = 0;
-      for (int j = 0; j < 3; j++) c += view[j][row] * (lo[j] + hi[j]) / 2, e += fabsf(view[j][row]) * (hi[j] - lo[j]) / 2;
-      bl[row] = c - e, bh[row] = c + e;
-    }
+    float bl[3], bh[3]; /* the box in the light's view (this runs over every node for every tile of every frame) */
+    lm_box_transform((const float *)view, lo, hi, bl, bh);
     if (bh[0] < l || bl[0] > r || bh[1] < b || bl[1] > t) continue;
     cmin = fminf(cmin, -bh[2]), cmax = fmaxf(cmax, -bl[2]); /* the light looks down -z */
   }
