@@ -125,7 +125,9 @@ static void script_text(const farm_args *a, const char *cwd, const char *self, c
     lm_buf_printf(b, "\"$limn\" reference --job %s --shard auto/%d --refs ", job.data, a->shards);
     quote(b, a->refs);
     if (a->povray) lm_buf_append(b, " --povray ", -1), quote(b, a->povray);
-    lm_buf_printf(b, "%s || rc=1\n", pov.data ? pov.data : "");
+    /* A task cancelled while it renders references (SIGTERM: the reference step dies of it, 128 + 15) stops
+     * there: Slurm may signal the shell after it has started the images, which then were written. */
+    lm_buf_printf(b, "%s || { s=$?; [ \"$s\" -gt 128 ] && exit \"$s\"; rc=1; }\n", pov.data ? pov.data : "");
   }
   lm_buf_printf(b, "\"$limn\" capture --job %s --shard auto/%d%s || rc=1\n", job.data, a->shards,
                 sets.data ? sets.data : "");
