@@ -8,7 +8,8 @@
  * floats; the copies, made on worker threads, are the same on any number;
  * a large mesh's spatial chunks leave out what a view does not see
  * and render the image of the mesh drawn whole; the RSM's views keep their
- * senders' normals.
+ * senders' normals; copies whose corners mix a uv seam's sides are drawn by
+ * no textured material.
  * Each test stands alone (it makes and frees its own), so tests read alike. */
 #define _GNU_SOURCE /* sched_setaffinity: one worker thread */
 #include <sched.h>
@@ -484,6 +485,86 @@ static void cones_have_camera_copies_that_keep_their_normals(void **state) {
 
 /* Eighteen meshes (spheres and flat-shaded spheres of several cuts, cones,
  * a bare triangle) uploaded: more than the worker threads keep waiting. */
+/* A flat mesh of n x n quads in the plane y = h over [-2, 2]^2, each quad with
+ * its own four vertices and uvs 0..1 (a tiled floor as exporters write one):
+ * a uv seam at every inner position, none of normals. */
+static int tiles_mesh(lm_scene *s, int n, float h) {
+  float *v = calloc((size_t)n * n * 4 * 8, sizeof(float));
+  uint32_t *ix = malloc(sizeof(uint32_t) * (size_t)n * n * 6);
+  for (int q = 0; q < n * n; q++)
+    for (int c = 0; c < 4; c++) {
+      int u = c == 1 || c == 2, w = c >= 2;
+      float *o = v + 8 * (4 * q + c);
+      o[0] = -2 + 4.0f * (float)(q % n + u) / (float)n, o[1] = h, o[2] = -2 + 4.0f * (float)(q / n + w) / (float)n;
+      o[4] = 1, o[6] = (float)u, o[7] = (float)w;
+      uint32_t b = (uint32_t)(4 * q), t[6] = {b, b + 2, b + 1, b, b + 3, b + 2};
+      if (c == 0) memcpy(ix + 6 * q, t, sizeof t);
+    }
+  int id = lm_scene_add_mesh(s, "tiles", v, n * n * 4, ix, n * n * 6);
+  free(v), free(ix);
+  return id;
+}
+
+/* Copies over positions take one side's uv at a uv seam: a flat tiled mesh
+ * (tiles_mesh) loses nothing to the simplifier but its seams, so its copies
+ * are two triangles whose corners carry the corner tiles' uvs, the whole mesh
+ * one tile. Drawn with a texture (a disc on each tile, cut out by its alpha
+ * as a mask), it draws no such copy, in the camera's passes nor in the shadow
+ * tiles (a caster whose texture's alpha cuts its shadow): the image is the
+ * one with every mesh whole, to the bit; the same mesh untextured beside it
+ * still draws its copies. */
+static void textured_copies_keep_their_uvs(void **state) {
+  (void)state;
+  lm_scene *s = lm_scene_create("tiles");
+  int floor = gl_material(s, "floor", 0.7f, 0.7f, 0.7f), plain = gl_material(s, "plain", 0.3f, 0.5f, 0.8f);
+  gl_quad(s, "floor", floor, (const float[4][3]){{-8, 0, 8}, {8, 0, 8}, {8, 0, -8}, {-8, 0, -8}}, (const float[3]){0, 1, 0});
+  enum { T = 16 };
+  unsigned char *rgba = malloc(T * T * 4);
+  for (int y = 0; y < T; y++)
+    for (int x = 0; x < T; x++) {
+      float dx = ((float)x + 0.5f) / T - 0.5f, dy = ((float)y + 0.5f) / T - 0.5f;
+      bool disc = dx * dx + dy * dy < 0.3f * 0.3f;
+      unsigned char *o = rgba + 4 * (y * T + x);
+      o[0] = disc ? 230 : 40, o[1] = 60, o[2] = disc ? 40 : 200, o[3] = disc ? 255 : 0;
+    }
+  int tex = lm_scene_add_texture(s, "discs", T, T, rgba);
+  int cut = gl_material(s, "discs", 1, 1, 1);
+  s->materials[cut].base_color_texture = tex + 1;
+  s->material_pbr[cut] = (lm_material_pbr){.set = true, .alpha = 1, .alpha_mode = LM_ALPHA_MASK, .alpha_cutoff = 0.5f,
+                                           .roughness = 1, .normal_scale = 1, .occlusion_strength = 1};
+  int mesh = tiles_mesh(s, 8, 1.0f);
+  place(s, mesh, cut, -2.2f, 0, 0);
+  place(s, mesh, plain, 2.2f, 0, 0);
+  float w[16];
+  lm_camera_look_at((float[]){1, 4, 1}, (float[]){0, 0, 0}, w); /* the sun shines along (-1, -4, -1) */
+  for (int c = 0; c < 3; c++) w[12 + c] = 0;
+  int sun = lm_scene_add_node(s, "sun", -1, w, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 1,
+                                    .casts_shadows = true, .node = sun});
+  lm_camera_look_at((float[]){0, 9, 5}, (float[]){0, 0, 0}, w);
+  int cam = lm_scene_add_node(s, "camera", -1, w, -1, -1);
+  lm_scene_add_camera(s, &(lm_camera){.name = "view", .fov_y = glm_rad(50.0f), .znear = 0.1f, .zfar = 40, .node = cam});
+  lm_scene_update(s);
+  const char *whole_sets[] = {"shadow.resolution=128", "shadow.simplify=0", "simplify=0", "ambient=0.05", NULL};
+  const char *simple_sets[] = {"shadow.resolution=128", "ambient=0.05", NULL};
+  gl_result whole = gl_render_ok(&(gl_run){.scene = s, .tech = "dl+esm", .sets = whole_sets, .width = 128, .height = 96});
+  gl_result simple = gl_render_ok(&(gl_run){.scene = s, .tech = "dl+esm", .sets = simple_sets, .width = 128, .height = 96});
+  const lm_scene_mesh *m = &s->meshes[mesh];
+  lm_scene_draw_stats cam_stats = lm_renderer_draw_stats(simple.renderer);
+  lm_scene_draw_stats tile_stats = lm_renderer_shadow_draw_stats(simple.renderer);
+  double mean, d = image_diff(&simple, &whole, &mean);
+  print_message("tiles: %d camera and %d caster levels (uvs mixed: %d, %d), the coarsest %d triangles; nodes simplified: "
+                "camera %d of %d, shadow tiles %d of %d; image: mean difference %.3g%% of the mean (%.3g)\n",
+                m->lod_levels, m->caster_levels, m->lods_mix_uvs, m->casters_mix_uvs,
+                m->lod_levels ? m->lods[m->lod_levels - 1].count / 3 : 0, cam_stats.simplified, cam_stats.drawn,
+                tile_stats.simplified, tile_stats.drawn, 100 * d, mean);
+  assert_true(m->lod_levels > 0 && m->caster_levels > 0 && m->lods_mix_uvs && m->casters_mix_uvs);
+  assert_true(cam_stats.simplified > 0 && tile_stats.simplified > 0); /* the untextured node */
+  assert_true(mean > 0.05 && d == 0);
+  gl_result_free(&whole), gl_result_free(&simple);
+  lm_scene_destroy(s);
+}
+
 static lm_scene *many_meshes(void) {
   lm_scene *s = lm_scene_create("many");
   int mat = gl_material(s, "paint", 0.8f, 0.3f, 0.2f);
@@ -773,6 +854,7 @@ int main(void) {
       cmocka_unit_test(copies_are_the_same_on_any_number_of_threads),
       cmocka_unit_test(rsm_views_keep_their_senders_normals),
       cmocka_unit_test(cones_have_camera_copies_that_keep_their_normals),
+      cmocka_unit_test(textured_copies_keep_their_uvs),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

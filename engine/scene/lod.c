@@ -25,6 +25,7 @@ typedef struct lod_job {
   size_t len;
   lm_mesh_lod lods[LM_LOD_LEVELS]; /* first: within out */
   int levels;
+  bool mixes_uvs; /* made over positions where vertices at one position differ in uv */
   bool done;
 } lod_job;
 
@@ -130,6 +131,11 @@ static void simplify_levels(lod_job *j, bool positions, bool by_normal) {
     first = lm_alloc(sizeof *first * (unique > 0 ? unique : 1));
     for (size_t i = nv; i-- > 0;)
       if (remap[i] != ~0u) first[remap[i]] = (uint32_t)i;
+    for (size_t i = 0; i < nv && !j->mixes_uvs; i++) { /* a uv seam: a copy's corner takes one side's uv */
+      if (remap[i] == ~0u) continue;
+      const float *uv = j->vertices + i * 8 + 6, *other = j->vertices + (size_t)first[remap[i]] * 8 + 6;
+      j->mixes_uvs = uv[0] != other[0] || uv[1] != other[1];
+    }
     if (by_normal) {
       start = lm_alloc(sizeof *start * (unique + 1)), members = lm_alloc(sizeof *members * (nv > 0 ? nv : 1));
       memset(start, 0, sizeof *start * (unique + 1));
@@ -219,6 +225,7 @@ static void make_buffers(lm_scene *s, int mesh, lod_job *const jobs[CHAINS]) {
   memcpy(indices, m->indices, sizeof *indices * n);
   lm_mesh_lod *levels[CHAINS] = {m->casters, m->lods};
   int *counts[CHAINS] = {&m->caster_levels, &m->lod_levels};
+  m->casters_mix_uvs = jobs[CASTERS]->mixes_uvs, m->lods_mix_uvs = jobs[CAMERA]->mixes_uvs;
   for (int c = 0; c < CHAINS; c++) {
     const lod_job *j = jobs[c];
     memcpy(indices + len, j->out, sizeof *indices * j->len);

@@ -759,6 +759,31 @@ static int drawn_node_order(const void *pa, const void *pb) {
   return (a->node > b->node) - (a->node < b->node);
 }
 
+/* The chain of simplified copies a node draws from. */
+typedef enum copy_chain { COPIES_NONE, COPIES_CASTERS, COPIES_CAMERA } copy_chain;
+
+/* Does `material` read uvs in d's pass: a texture in a camera pass or an RSM
+ * view, a texture whose alpha cuts (a mask or a blend) in a shadow tile? */
+static bool reads_uvs(const lm_scene *s, const lm_scene_draw_desc *d, int material) {
+  if (material < 0 || material >= s->material_count) return false;
+  const lm_material *m = &s->materials[material];
+  const lm_material_pbr *p = &s->material_pbr[material];
+  if (!d->lod_camera) return p->set && p->alpha_mode != LM_ALPHA_OPAQUE && slot_texture(s, m, p, LM_TEX_BASE_COLOR) >= 0;
+  for (int slot = 0; slot < LM_TEX_SLOTS; slot++)
+    if (slot_texture(s, m, p, slot) >= 0) return true;
+  return false;
+}
+
+/* The camera's copies (`lods`, which keep normals and uvs) in camera passes
+ * and RSM views, the casters' (over positions alone) in shadow tiles; where
+ * the material reads uvs, only copies whose uvs are the mesh's (a caster cut
+ * by its texture's alpha draws the camera's), else none. */
+static copy_chain node_copies(const lm_scene *s, const lm_scene_draw_desc *d, const lm_scene_mesh *m, int material) {
+  bool uvs = reads_uvs(s, d, material);
+  if (!d->lod_camera && !(uvs && m->casters_mix_uvs)) return COPIES_CASTERS;
+  return uvs && m->lods_mix_uvs ? COPIES_NONE : COPIES_CAMERA;
+}
+
 /* The simplified copy node n (world bounds lo..hi) draws in d's view: 1 +
  * the coarsest level whose error times the node's largest axis scale is at
  * most d->lod_texels of the view's finer texel (pixel) where the bounds come
@@ -766,9 +791,9 @@ static int drawn_node_order(const void *pa, const void *pb) {
  * lod_view_proj, w its clip w there (1 for an orthographic tile; in a
  * perspective view texels grow with distance, and a node reaching behind
  * the eye is drawn whole); 0: the mesh whole. */
-static int node_lod(const lm_scene_draw_desc *d, const lm_node *n, const lm_scene_mesh *m, const float lo[3],
-                    const float hi[3]) {
-  int levels = d->lod_camera ? m->lod_levels : m->caster_levels;
+static int node_lod(const lm_scene_draw_desc *d, const lm_node *n, const lm_scene_mesh *m, copy_chain chain,
+                    const float lo[3], const float hi[3]) {
+  int levels = chain == COPIES_CAMERA ? m->lod_levels : chain == COPIES_CASTERS ? m->caster_levels : 0;
   if (!d->lod_view_proj || !(d->lod_texels > 0) || levels <= 0) return 0;
   const float *v = d->lod_view_proj, *w = n->world;
   float scale = 0, w_near = v[15], radius = 0;
@@ -783,7 +808,7 @@ static int node_lod(const lm_scene_draw_desc *d, const lm_node *n, const lm_scen
   if (!(w_near > 0) || !(rows > 0)) return 0;
   float texel = 2 * w_near / rows, allowed = d->lod_texels * texel;
   if (!isfinite(allowed)) return 0;
-  const lm_mesh_lod *lods = d->lod_camera ? m->lods : m->casters;
+  const lm_mesh_lod *lods = chain == COPIES_CAMERA ? m->lods : m->casters;
   int level = 0;
   while (level < levels && lods[level].error * scale <= allowed) level++;
   return level;
@@ -833,8 +858,8 @@ static void node_instance(const lm_node *n, const lm_mesh *mesh, const float *pr
 
 /* The chunks of the index range a node of mesh m draws at `lod` (1 + a
  * copy's level; 0: the mesh whole), *count of them (0: none, NULL). */
-static const lm_mesh_chunk *lod_chunks(const lm_scene_draw_desc *d, const lm_scene_mesh *m, int lod, int *count) {
-  lm_chunk_span span = lod ? (d->lod_camera ? m->lod_chunks : m->caster_chunks)[lod - 1] : m->whole_chunks;
+static const lm_mesh_chunk *lod_chunks(const lm_scene_mesh *m, copy_chain chain, int lod, int *count) {
+  lm_chunk_span span = lod ? (chain == COPIES_CAMERA ? m->lod_chunks : m->caster_chunks)[lod - 1] : m->whole_chunks;
   *count = span.count;
   return span.count ? m->chunks + span.first : NULL;
 }
@@ -899,8 +924,9 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     float depth = 0; /* the camera's clip w of the bounds' centre: its view depth */
     for (int k = 0; k < 3 && d->eye_view_proj; k++) depth += d->eye_view_proj[4 * k + 3] * (lo[k] + hi[k]) / 2;
     int translucent = d->blend == LM_BLEND_CAST && d->transmit > 0 && material_blends(s, n->material);
-    int lod = node_lod(d, n, &s->meshes[n->mesh], lo, hi), part = 0, chunks;
-    const lm_mesh_chunk *c = lod_chunks(d, &s->meshes[n->mesh], lod, &chunks);
+    copy_chain chain = node_copies(s, d, &s->meshes[n->mesh], n->material);
+    int lod = node_lod(d, n, &s->meshes[n->mesh], chain, lo, hi), part = 0, chunks;
+    const lm_mesh_chunk *c = lod_chunks(&s->meshes[n->mesh], chain, lod, &chunks);
     if (d->view_proj && chunks) { /* kept only when some chunk is left out: a node seen whole is one draw */
       outside = lm_grow(outside, &outside_cap, outside_len + chunks, 1);
       for (int k = 0; k < chunks; k++) {
@@ -949,12 +975,13 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     }
     bind_material(s, p, &m, &mp, defines);
     int lod = nodes[first].lod;
-    const lm_mesh_lod *copy = lod ? &(d->lod_camera ? mesh->lods : mesh->casters)[lod - 1] : NULL;
+    copy_chain chain = node_copies(s, d, mesh, n->material); /* alike for the group: one material and mesh */
+    const lm_mesh_lod *copy = lod ? &(chain == COPIES_CAMERA ? mesh->lods : mesh->casters)[lod - 1] : NULL;
     int index_count = copy ? copy->count : mesh->index_count;
     long triangles = 0;
     if (nodes[first].part) { /* node by node, the chunks in view */
       int chunks;
-      const lm_mesh_chunk *c = lod_chunks(d, mesh, lod, &chunks);
+      const lm_mesh_chunk *c = lod_chunks(mesh, chain, lod, &chunks);
       for (int i = first; i < last; i++) triangles += draw_chunks(&mesh->gpu, c, chunks, outside + nodes[i].outside, i, stats);
     } else {
       lm_mesh_draw_instances(&mesh->gpu, copy ? copy->first : 0, index_count, first, last - first);

@@ -203,6 +203,9 @@ typedef struct lm_scene_mesh {
    * no level that keeps over 3/4 of the last's triangles. */
   lm_mesh_lod casters[LM_LOD_LEVELS], lods[LM_LOD_LEVELS];
   int caster_levels, lod_levels;
+  /* Copies made over positions where the mesh has uv seams: each corner took
+   * one side's uv, so a textured material (an alpha-cut caster) cannot draw them. */
+  bool casters_mix_uvs, lods_mix_uvs;
   bool simplifying; /* its copies are being made: its GL buffers come after (lm_scene_upload waits) */
   /* Spatial chunks made by lm_scene_upload (none for a deformed mesh: its
    * bounds move): the whole mesh's, then each copy's (a count of 0: drawn whole). */
@@ -491,8 +494,9 @@ typedef struct lm_scene_draw_desc {
    * view (lod_view_proj, lod_size texels wide and high) where the node's
    * bounds come nearest its eye (the light's for a shadow tile: `casters`;
    * the camera's for camera passes, lod_camera: `lods`, which keep normals
-   * and uvs, as an RSM view needs too). NULL or lod_texels 0: every mesh
-   * whole. */
+   * and uvs, as an RSM view needs too; a textured material never draws copies
+   * whose uvs are mixed, nor does a caster whose texture's alpha cuts its
+   * shadow). NULL or lod_texels 0: every mesh whole. */
   const float *lod_view_proj;
   int lod_size[2];
   float lod_texels;
