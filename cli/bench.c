@@ -85,6 +85,10 @@ static const char bench_usage[] =
     "                      degrees a frame, at the distance and 20 degrees above\n"
     "                      as the framing camera), or with --time and a scene\n"
     "                      whose camera the animation moves, that camera\n"
+    "  --walk STEP         the path is a walk instead (implies --motion): the\n"
+    "                      scene's camera (the framing camera where it has none)\n"
+    "                      flies forward, STEP of the scene's bounding-box diagonal\n"
+    "                      a frame (0.0075: the viewer's W, --script-keys hold=W)\n"
     "  --orbit STEP[,RADIUS[,ELEVATION]]  that orbit (implies --motion): degrees a\n"
     "                      frame (0..360), radius in scene units (0: the framing\n"
     "                      camera's), elevation in degrees (-89..89); with --time,\n"
@@ -130,11 +134,12 @@ static const char *const draw_keys[DRAW_FIGURES] = {"camera_triangles", "camera_
 typedef struct motion {
   bool on, orbit_given, timed;
   double step, radius, elevation; /* the orbit: degrees a frame, scene units (0: the framing camera's), degrees */
+  double walk;                    /* --walk: the share of the scene's diagonal a frame (0: no walk) */
   double start, stop, fps;        /* --time and --fps */
   const char *animation;          /* --animation */
   int frames;                     /* timed frames: --frames, or those of --time */
   /* what the run used and measured */
-  bool orbit;            /* the path is the orbit, else the scene's camera moved by the animation */
+  bool orbit;            /* the path is the orbit, else the scene's camera (walking, or moved by the animation) */
   char camera[LM_NAME_MAX];
   char caches_off[512];  /* the alone pipeline's options turned off */
   int anim;              /* lm_scene_find_animation's index */
@@ -204,7 +209,7 @@ static int parse_args(int argc, char **argv, bench *b) {
       {"motion", no_argument, 0, 'M'},      {"orbit", required_argument, 0, 'O'},
       {"time", required_argument, 0, 'I'},  {"fps", required_argument, 0, 'F'},
       {"animation", required_argument, 0, 'A'}, {"rounds", required_argument, 0, 'U'},
-      {0, 0, 0, 0}};
+      {"walk", required_argument, 0, 'W'},  {0, 0, 0, 0}};
   motion *m = &b->motion;
   *m = (motion){.step = 2, .elevation = 20, .fps = 24, .animation = "all", .rounds = 1};
   bool fps_given = false, animation_given = false;
@@ -278,6 +283,11 @@ static int parse_args(int argc, char **argv, bench *b) {
       m->on = m->orbit_given = true;
       break;
     }
+    case 'W':
+      if (!limn_parse_double(optarg, &m->walk) || !(m->walk > 0 && m->walk <= 1))
+        return usage_error("--walk wants a share of the scene's diagonal a frame in (0, 1], not '%s'", optarg);
+      m->on = true;
+      break;
     case 'I':
       if (!strchr(optarg, ':') || !limn_parse_time(optarg, &m->start, &m->stop) || m->stop < m->start)
         return usage_error("--time wants START:STOP in seconds, STOP >= START, not '%s'", optarg);
@@ -299,13 +309,14 @@ static int parse_args(int argc, char **argv, bench *b) {
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
+  if (m->walk > 0 && m->orbit_given) return usage_error("%s", "--walk and --orbit are two paths: give one");
   if ((fps_given || animation_given) && !m->timed)
     return usage_error("%s plays an animation: it needs --time START:STOP", fps_given ? "--fps" : "--animation");
   if (m->timed) {
     double frames = floor((m->stop - m->start) * m->fps + 1e-9) + 1;
     if (frames > 10000) return usage_error("%s: more than 10000 frames", "--time at --fps");
     m->frames = (int)frames;
-  } else if (m->on && !(m->step > 0)) {
+  } else if (m->on && !(m->step > 0) && !(m->walk > 0)) {
     return usage_error("%s", "--orbit with a step of 0 and no --time: nothing moves");
   }
   if (!m->timed) m->frames = b->frames;
@@ -691,6 +702,7 @@ typedef struct stream {
   lm_pipeline *pipe;
   lm_renderer *r;    /* one for the run (alone's view is set again before each frame) */
   int camera, node; /* the camera rendered through and its node */
+  float start[16];  /* --walk: the camera node's world where the walk starts */
 } stream;
 
 /* Does animation `anim` move node `node` or a node above it? */
@@ -710,7 +722,17 @@ static bool node_animated(const lm_scene *s, int anim, int node) {
  * (the renderer uploads the deformed vertices at the frame's start). Returns the milliseconds that
  * lm_scene_set_time took (0 without --time). */
 static double pose(const motion *m, stream *s, int f) {
-  if (m->orbit) {
+  if (m->walk > 0) { /* forward: along the camera's -Z, as the viewer's W */
+    float lo[3], hi[3], w[16], z[3];
+    lm_scene_bounds(s->scene, lo, hi);
+    float diagonal = sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                           (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    memcpy(w, s->start, sizeof w);
+    memcpy(z, w + 8, sizeof z);
+    float length = sqrtf(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]); /* the node may scale */
+    for (int i = 0; i < 3 && length > 0; i++) w[12 + i] -= (float)(m->walk * f) * diagonal * z[i] / length;
+    lm_scene_node_set_world(s->scene, s->node, w);
+  } else if (m->orbit) {
     double az = m->step * f * M_PI / 180, el = m->elevation * M_PI / 180;
     float eye[3] = {m->centre[0] + (float)(m->radius * cos(el) * sin(az)), m->centre[1] + (float)(m->radius * sin(el)),
                     m->centre[2] + (float)(m->radius * cos(el) * cos(az))}, w[16];
@@ -765,9 +787,12 @@ static bool stream_open(bench *b, int k, stream *s, lm_error *err) {
     for (int i = 0; i < 3; i++) m->centre[i] = 0.5f * (lo[i] + hi[i]), d += (eye[i] - m->centre[i]) * (eye[i] - m->centre[i]);
     if (!(m->radius > 0)) m->radius = sqrt(d);
   } else {
-    s->camera = 0;
-    s->node = s->scene->cameras[0].node;
+    s->camera = s->scene->camera_count > 0 ? 0 : lm_scene_add_framing_camera(s->scene, "bench.walk",
+                                                                               (float)b->sizes[b->largest][0] /
+                                                                               (float)b->sizes[b->largest][1]);
+    s->node = s->scene->cameras[s->camera].node;
   }
+  memcpy(s->start, s->scene->nodes[s->node].world, sizeof s->start);
   snprintf(m->camera, sizeof m->camera, "%s", s->scene->cameras[s->camera].name);
   s->r = lm_renderer_create(&(lm_renderer_desc){.scene = s->scene, .pipeline = s->pipe, .camera = s->camera,
                                                 .width = b->sizes[b->largest][0],
@@ -784,7 +809,8 @@ static double ratio_of(double a, double c) { return a >= 0 && c > 0 ? a / c : -1
 static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
   motion *m = &b->motion;
   const lm_camera *cams = first->cameras;
-  m->orbit = !m->timed || m->orbit_given || first->camera_count == 0 || !node_animated(first, m->anim, cams[0].node);
+  m->orbit = m->walk <= 0 && (!m->timed || m->orbit_given || first->camera_count == 0 ||
+                               !node_animated(first, m->anim, cams[0].node));
   int n = m->frames, cap = n * m->rounds;
   double *wall = lm_alloc(sizeof(double) * STREAMS * 8 * (size_t)n), *anim = wall + STREAMS * n,
          *tiles = anim + STREAMS * n, *outside = tiles + STREAMS * n, *scrolled = outside + STREAMS * n;
@@ -944,6 +970,9 @@ static void print_motion(const bench *b) {
   if (m->orbit)
     printf("  camera: an orbit around (%.4g, %.4g, %.4g), radius %.4g, elevation %.4g degrees, %.4g degrees a frame\n",
            m->centre[0], m->centre[1], m->centre[2], m->radius, m->elevation, m->step);
+  else if (m->walk > 0)
+    printf("  camera: the scene's camera '%s' walking forward, %.4g of the scene's diagonal a frame\n", m->camera,
+           m->walk);
   else
     printf("  camera: the scene's camera '%s', moved by the animation\n", m->camera);
   if (m->timed)
@@ -990,6 +1019,7 @@ static void print_motion_json(const bench *b) {
   else {
     printf("{\"scene\": ");
     limn_json_string(m->camera);
+    if (m->walk > 0) printf(", \"walk\": %.6g", m->walk);
     printf("}");
   }
   if (m->timed) {

@@ -274,6 +274,58 @@ static void cascades_keep_their_depths_as_the_camera_moves(void **state) {
   lm_scene_destroy(s);
 }
 
+/* A camera walking along the light (a forward walk under a low sun): each
+ * tile's eye plane steps with it (a step is 1/16 of the tile's extent), and a
+ * depth row made from the plane alone moved with it, so the tile was drawn
+ * whole at each step instead of scrolled (engine/render scrolls a tile whose
+ * matrix moved across the light alone). The rows are kept while they hold
+ * what the tiles need (lm_shadow_settings.last_depths); made anew, they reach
+ * past it either way, so that the next steps keep them. 24 moves of 0.25 m,
+ * with and without the last rows: the times each cascade's matrix changed
+ * other than across the light. */
+static void cascade_rows_stay_as_the_camera_moves_along_the_light(void **state) {
+  (void)state;
+  lm_scene *s = builtin("field");
+  int node = s->cameras[0].node;
+  mat4 w0;
+  memcpy(w0, s->nodes[node].world, sizeof w0);
+  lm_light_data sun;
+  lm_scene_light_data(s, &sun, 1);
+  vec3 along;
+  glm_vec3_normalize_to(sun.direction, along);
+  int changed[2][3] = {{0}};
+  for (int keep = 0; keep < 2; keep++) {
+    lm_shadow_settings st;
+    lm_shadow_settings_default(&st);
+    lm_shadow_plan last = {0}, plan;
+    lm_error err;
+    mat4 w;
+    memcpy(w, w0, sizeof w);
+    for (int move = 0; move <= 24; move++) {
+      lm_scene_node_set_world(s, node, (float *)w);
+      lm_frame_data cam;
+      lm_scene_frame_data(s, 0, 256, 192, &cam);
+      assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+      lm_shadow_plan_fit(&plan, s, &cam, 4.0f, 90.0f);
+      assert_int_equal(plan.view_count, 3);
+      if (move > 0) {
+        for (int v = 0; v < 3; v++) changed[keep][v] += !moved_alone(last.views[v].view_proj, plan.views[v].view_proj);
+        lm_shadow_plan_free(&last);
+      }
+      last = plan;
+      memcpy(st.last_range, last.range, sizeof st.last_range);
+      st.last_depths = keep ? (const float(*)[2])last.depths : NULL, st.last_light_count = s->light_count;
+      glm_vec3_muladds(along, 0.25f, w[3]);
+    }
+    lm_shadow_plan_free(&last);
+  }
+  printf("24 moves of 0.25 m along the light: cascades' matrices changed %d, %d, %d times (%d, %d, %d without the "
+         "last rows)\n", changed[1][0], changed[1][1], changed[1][2], changed[0][0], changed[0][1], changed[0][2]);
+  assert_true(changed[0][0] >= 6); /* the eye plane stepped */
+  assert_true(changed[1][0] <= 3 && changed[1][1] <= 2 && changed[1][2] <= 2);
+  lm_scene_destroy(s);
+}
+
 /* Cascades fit the camera depths the G-buffer holds (the depth-range
  * reduction read back before the shadow pass), here 0.1 .. 150 m of camera
  * range of which the field shows about 4 .. 96 m. */
@@ -1078,6 +1130,7 @@ int main(void) {
       cmocka_unit_test(extreme_exponents_stay_finite_and_on_the_right_side),
       cmocka_unit_test(the_sun_casts_cascaded_shadows_at_any_depth_range),
       cmocka_unit_test(cascades_keep_their_depths_as_the_camera_moves),
+      cmocka_unit_test(cascade_rows_stay_as_the_camera_moves_along_the_light),
       cmocka_unit_test(cascades_fit_the_depths_the_frame_sees),
       cmocka_unit_test(cascades_fit_the_last_frames_depths_widened),
       cmocka_unit_test(stabilized_cascades_do_not_shimmer),

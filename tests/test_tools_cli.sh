@@ -180,6 +180,9 @@ check "bench motion figures, tiles kept" motion_json 0
 check "bench motion field" run 0 bench --scene field --tech dl+esm --sizes 48x32 --frames 3 --warmup 1 --orbit 5,0,30 --json
 check "bench motion field figures, cascades drawn" motion_json some
 check "bench motion orbit stated" out_has '"orbit": {"centre": [0, 1, 0], "radius": '
+check "bench motion walk" run 0 bench --scene field --tech dl+esm --sizes 48x32 --frames 3 --warmup 1 --walk 0.01 --json
+check "bench motion walk figures, cascades drawn" motion_json some
+check "bench motion walk stated" out_has '"walk": 0.01}'
 check "bench motion rounds" run 0 bench --tech dl+esm --sizes 32x24 --frames 2 --warmup 1 --rounds 2 --json
 check "bench motion rounds figures" motion_json 0
 check "bench motion table" run 0 bench --tech dl+esm --sizes 32x24 --frames 2 --warmup 1 --motion
@@ -230,6 +233,10 @@ PY
 check "gltf_pose turntable" pose_turntable
 check "bench bad orbit" run 2 bench --orbit 400
 check "bench bad orbit message" err_has "--orbit wants STEP[,RADIUS[,ELEVATION]]"
+check "bench bad walk" run 2 bench --walk 0
+check "bench bad walk message" err_has "--walk wants a share of the scene's diagonal a frame in (0, 1]"
+check "bench walk and orbit" run 2 bench --walk 0.01 --orbit 5
+check "bench walk and orbit message" err_has "--walk and --orbit are two paths: give one"
 check "bench still orbit" run 2 bench --orbit 0
 check "bench still orbit message" err_has "--orbit with a step of 0 and no --time: nothing moves"
 check "bench bad time" run 2 bench --time 2:1

@@ -835,9 +835,15 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[3], lm_e
   lm_graph_begin(g, r->desc.width, r->desc.height);
   lm_frame_data *frame = &r->camera;
   lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, frame);
-  float range[2] = {r->shadows.range[0], r->shadows.range[1]}; /* for the next plan: lm_shadow_settings.last_range */
+  /* For the next plan: lm_shadow_settings.last_range and last_depths, none for a new view (frame 0). */
+  float range[2] = {r->shadows.range[0], r->shadows.range[1]}, (*depths)[2] = r->shadows.depths;
+  r->shadows.depths = NULL;
   lm_shadow_plan_free(&r->shadows);
-  memcpy(r->shadows.range, range, sizeof range);
+  if (r->frame > 0) {
+    memcpy(r->shadows.range, range, sizeof range);
+    r->shadows.depths = depths;
+  } else
+    free(depths);
   /* Deformed meshes' new poses, before anything hashes or draws them (the
    * renderer alone calls lm_scene_upload_deformed: it clears their marks). */
   const lm_scene *s = r->desc.scene;

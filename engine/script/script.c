@@ -531,6 +531,7 @@ void lm_pipeline_destroy(lm_pipeline *p) {
   if (!p) return;
   if (p->L) lua_close(p->L);
   free(p->shadow_levels);
+  free(p->shadow_depths);
   free(p);
 }
 

@@ -217,6 +217,9 @@ static int l_shadow_plan(lua_State *L) {
   st.rsm_resolution = (int)opt_number(L, 1, "rsm_resolution", (float)st.rsm_resolution, 16, 8192, what);
   st.last_levels = p->shadow_levels, st.last_light_count = p->shadow_level_count;
   memcpy(st.last_range, p->shadows->range, sizeof st.last_range); /* as the last frame's fit left them */
+  free(p->shadow_depths); /* the last frame's rows, kept for this plan (lm_shadow_settings.last_depths) */
+  p->shadow_depths = p->shadows->depths, p->shadows->depths = NULL;
+  st.last_depths = (const float(*)[2])p->shadow_depths;
   lm_shadow_plan_free(p->shadows);
   lm_error err;
   if (!lm_shadow_plan_make(p->shadows, p->scene, p->camera, &st, &err)) return luaL_error(L, "shadow_plan: %s", err.msg);

@@ -180,9 +180,10 @@ static void cascade_cull(const lm_frame_data *cam, mat4 view, float zr, float z1
   }
   float pad = texel * reach;
   l = fmaxf(l - pad, tile[0]), r = fminf(r + pad, tile[1]), b = fmaxf(b - pad, tile[2]), t = fminf(t + pad, tile[3]);
-  /* The far end snapped out to the tile's depth steps: a camera moving a
-   * little keeps it, so that the tile can scroll (engine/render). */
-  far = fminf(tile[4] + ceilf((far + pad - tile[4]) / step) * step, tile[5]);
+  /* The far end snapped out to four of the tile's depth steps: a camera
+   * moving a little keeps it, so that the tile can scroll (engine/render;
+   * one step flipped it every few frames of a forward walk). */
+  far = fminf(tile[4] + ceilf((far + pad - tile[4]) / (4.0f * step)) * 4.0f * step, tile[5]);
   if (!(l < r && b < t && far > tile[4])) l = tile[0], r = tile[1], b = tile[2], t = tile[3], far = tile[5];
   mat4 proj;
   glm_ortho(l, r, b, t, tile[4], far, proj);
@@ -192,11 +193,27 @@ static void cascade_cull(const lm_frame_data *cam, mat4 view, float zr, float z1
 /* A tile of the cell's `tile` texels halved `level` times (never empty). */
 static int tile_size(int tile, int level) { return tile >> level > 0 ? tile >> level : 1; }
 
+/* A cascade's depth row: zn .. zf in depths from its eye plane `eye` (along
+ * the light), row[0..1] the last frame's as depths along the light (0 0:
+ * none) and then this frame's. The eye plane steps with the camera's moves
+ * along the light, and with it a row made from it: last frame's row is kept
+ * while it holds zn .. zf and spans at most LM_SHADOW_RANGE_SLACK times
+ * them; a row made anew reaches as far past them either way as that allows,
+ * in whole steps, so that the next eye steps keep it. */
+static void cascade_row(float eye, float step, float row[2], float *zn, float *zf) {
+  double n = (double)eye + *zn, f = (double)eye + *zf, span = f - n;
+  if (!(row[1] > row[0] && row[0] <= n && row[1] >= f && row[1] - row[0] <= span * LM_SHADOW_RANGE_SLACK)) {
+    double pad = row[1] > row[0] ? floor((LM_SHADOW_RANGE_SLACK - 1.0) * span / 2.0 / step) * step : 0;
+    row[0] = (float)(n - pad), row[1] = (float)(f + pad);
+  }
+  *zn = (float)((double)row[0] - eye), *zf = (float)((double)row[1] - eye);
+}
+
 /* One orthographic tile along dir over the camera's slice z0 .. z1: a
  * cascade (grow 0; its receivers from camera depth zr), or the RSM's wide
  * tile over the slice's bounding sphere with its radius times grow. */
 static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam, vec3 dir,
-                           float z0, float z1, float zr, const float bounds[2][3], float grow) {
+                           float z0, float z1, float zr, const float bounds[2][3], float grow, float *row) {
   const lm_shadow_settings *st = &plan->settings;
   vec3 corners[8], center = {0, 0, 0};
   slice_corners(cam, z0, z1, corners);
@@ -248,6 +265,7 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
     zn = fmaxf(floorf(zn / step) * step, 0.0f), zf = fminf(ceilf(zf / step) * step, 2.0f * extent + step);
   }
   if (!(zf > zn) || !isfinite(zf)) zn = 0, zf = 2.0f * extent + step;
+  if (row) cascade_row(view[3][2], step, row, &zn, &zf);
   glm_ortho(l, r, b, t, zn, zf, proj);
   glm_mat4_mul(proj, view, vp);
   int size = grow > 0 ? plan->rsm_tile : plan->tile;
@@ -281,6 +299,15 @@ static void cascade_range(lm_shadow_plan *plan, float *n, float *reach) {
   if (last[0] > 0 && last[0] <= *n && last[0] * LM_SHADOW_RANGE_SLACK >= *n && last[1] >= *reach &&
       last[1] <= *reach * LM_SHADOW_RANGE_SLACK)
     *n = last[0], *reach = last[1];
+  else if (last[0] > 0) {
+    /* A camera in motion plans them anew with room either way (half the slack's ratio), so that
+     * the next frames, which see a little nearer or farther, keep them (a forward walk's nearest
+     * depth falls a little each frame: planned to the grid alone, it asked again every few). */
+    float half = sqrtf(LM_SHADOW_RANGE_SLACK);
+    *n = round_relative(plan->seen[0] / half, false), *reach = round_relative(plan->seen[1] * half, true);
+    if (plan->settings.distance > 0) *reach = fminf(plan->settings.distance, *reach);
+    if (!(*reach > *n)) *reach = *n * 1.001f;
+  }
   plan->range[0] = *n, plan->range[1] = *reach;
 }
 
@@ -302,7 +329,10 @@ static void plan_cascades(lm_shadow_plan *plan, const lm_scene *s, const lm_fram
     /* shadow.glsl blends the last `blend` share of cascade k - 1 into this one. */
     float zr = k > 0 ? z0 - (z0 - split_depth(n, reach, k - 1, st->cascades, st->lambda)) * st->blend : z0;
     out->splits[k] = z1;
-    add_slice_view(plan, s, cam, dir, z0, z1, zr, (const float(*)[3])bounds, 0.0f);
+    int slot = (int)(out - plan->lights) * LM_SHADOW_MAX_CASCADES + k;
+    float *row = plan->depths[slot];
+    memcpy(row, plan->last_depths ? plan->last_depths[slot] : (float[2]){0, 0}, sizeof(float[2]));
+    add_slice_view(plan, s, cam, dir, z0, z1, zr, (const float(*)[3])bounds, 0.0f, row);
   }
 }
 
@@ -316,7 +346,7 @@ static void plan_wide_tile(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
   float n, reach;
   cascade_range(plan, &n, &reach);
   out->cube[1] = plan->view_count, out->cube[2] = 1;
-  add_slice_view(plan, s, cam, dir, n, reach, n, NULL, plan->settings.rsm);
+  add_slice_view(plan, s, cam, dir, n, reach, n, NULL, plan->settings.rsm, NULL);
 }
 
 /* Range of a point or spot light: where its light ends (lm_light_reach: the
@@ -569,7 +599,7 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
                          const lm_shadow_settings *settings, lm_error *err) {
   *plan = (lm_shadow_plan){.settings = *settings};
   const lm_shadow_settings *st = settings;
-  if (st->resolution < 16 || st->resolution > 8192 || st->cascades < 1 || st->cascades > 4 ||
+  if (st->resolution < 16 || st->resolution > 8192 || st->cascades < 1 || st->cascades > LM_SHADOW_MAX_CASCADES ||
       !(st->c > 0 && st->c <= 10000) || st->blur < 0 || st->blur > 32 || !(st->lambda >= 0 && st->lambda <= 1) ||
       !(st->bias >= 0 && st->bias <= 64) || !(st->distance >= 0) || !(st->blend >= 0 && st->blend <= 1) ||
       !(st->radius >= 0 && st->radius <= 32) || !(st->rsm >= 0 && st->rsm <= 64) ||
@@ -581,6 +611,13 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
   }
   plan->light_count = s->light_count;
   plan->lights = lm_alloc(sizeof *plan->lights * (size_t)(s->light_count + 1));
+  size_t rows = sizeof *plan->depths * LM_SHADOW_MAX_CASCADES * (size_t)(s->light_count + 1);
+  plan->depths = lm_alloc(rows);
+  if (st->last_depths && st->last_light_count == s->light_count) {
+    plan->last_depths = lm_alloc(rows);
+    memcpy(plan->last_depths, st->last_depths, sizeof *plan->depths * LM_SHADOW_MAX_CASCADES * (size_t)s->light_count);
+  }
+  plan->settings.last_depths = NULL; /* the caller's: plan->last_depths holds them */
   visible_depth(s, cam, plan->seen);
   /* Each light's tiles and their sizes (a point light's faces chosen now,
    * for the whole frame), then a near-square grid of cells that holds them,
@@ -642,6 +679,8 @@ void lm_shadow_plan_free(lm_shadow_plan *plan) {
   free(plan->rsm_views);
   free(plan->view_data);
   free(plan->lights);
+  free(plan->depths);
+  free(plan->last_depths);
   *plan = (lm_shadow_plan){0};
 }
 

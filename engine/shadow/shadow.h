@@ -61,9 +61,15 @@ typedef struct lm_shadow_settings {
    * that a moving camera's cascades keep their size and scroll (engine/render) instead of
    * being drawn whole each time the depths seen cross a step of their grid. */
   float last_range[2];
+  /* The last frame's plan's cascade depth rows (lm_shadow_plan.depths), last_light_count *
+   * LM_SHADOW_MAX_CASCADES of them, or NULL: a cascade keeps its row while it holds the depths its
+   * tile needs and spans at most LM_SHADOW_RANGE_SLACK times them, so that a camera moving along
+   * the light, whose tiles' eye plane steps, scrolls them instead of drawing them whole. */
+  const float (*last_depths)[2];
 } lm_shadow_settings;
 #define LM_SHADOW_LEVEL_SLACK 1.25f
 #define LM_SHADOW_RANGE_SLACK 1.25f
+#define LM_SHADOW_MAX_CASCADES 4
 void lm_shadow_settings_default(lm_shadow_settings *s);
 
 /* std430 layouts mirrored by shaders/shadow.glsl. */
@@ -108,6 +114,10 @@ typedef struct lm_shadow_plan {
   int light_count;
   float seen[2]; /* camera depths cascades cover: where receivers are seen */
   float range[2]; /* the camera depths the cascades span: seen, snapped (or the last frame's) */
+  /* Per light and cascade (light * LM_SHADOW_MAX_CASCADES + cascade): the depths along the light
+   * (world units, dot(p, direction)) that its tile's 0..1 spans; 0 0 where none. last_depths:
+   * settings.last_depths as the plan was made (a fit reads them again). */
+  float (*depths)[2], (*last_depths)[2];
 } lm_shadow_plan;
 
 /* Plans the tiles for `camera` (a frame block from lm_scene_frame_data).
