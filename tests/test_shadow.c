@@ -203,23 +203,6 @@ static void the_sun_casts_cascaded_shadows_at_any_depth_range(void **state) {
   lm_scene_destroy(s);
 }
 
-/* Does every entry of b but the xy translation (12, 13) lie within 1e-6 of
- * its row's largest entry of a's: a tile that moved across the light alone? */
-static bool moved_alone(const float *a, const float *b) {
-  for (int row = 0; row < 4; row++) {
-    float scale = 0;
-    for (int col = 0; col < 4; col++) scale = fmaxf(scale, fabsf(a[col * 4 + row]));
-    for (int col = 0; col < 4; col++) {
-      int i = col * 4 + row;
-      if (i != 12 && i != 13 && !(fabsf(a[i] - b[i]) <= 1e-6f * scale)) {
-        printf("entry %d: %.9g against %.9g\n", i, (double)a[i], (double)b[i]);
-        return false;
-      }
-    }
-  }
-  return true;
-}
-
 /* A camera that moves a little across the light and sees a little less: the cascades keep the
  * last frame's depths (lm_shadow_settings.last_range), so their tiles keep
  * their size, and each tile's matrix is the last one's moved across the light
@@ -261,7 +244,7 @@ static void cascades_keep_their_depths_as_the_camera_moves(void **state) {
   assert_true(a.range[0] == b.range[0] && a.range[1] == b.range[1]);
   assert_int_equal(a.view_count, 3);
   assert_int_equal(b.view_count, 3);
-  for (int v = 0; v < 3; v++) assert_true(moved_alone(a.views[v].view_proj, b.views[v].view_proj));
+  for (int v = 0; v < 3; v++) assert_true(lm_shadow_view_moved_across(a.views[v].view_proj, b.views[v].view_proj));
   lm_shadow_plan_free(&b);
   static const float seen[2][2] = {{4.3f, 120.0f}, {4.3f, 60.0f}}; /* farther; under 1/1.25 as far */
   for (int k = 0; k < 2; k++) {
@@ -309,7 +292,8 @@ static void cascade_rows_stay_as_the_camera_moves_along_the_light(void **state) 
       lm_shadow_plan_fit(&plan, s, &cam, 4.0f, 90.0f);
       assert_int_equal(plan.view_count, 3);
       if (move > 0) {
-        for (int v = 0; v < 3; v++) changed[keep][v] += !moved_alone(last.views[v].view_proj, plan.views[v].view_proj);
+        for (int v = 0; v < 3; v++)
+          changed[keep][v] += !lm_shadow_view_moved_across(last.views[v].view_proj, plan.views[v].view_proj);
         lm_shadow_plan_free(&last);
       }
       last = plan;

@@ -470,20 +470,6 @@ static void cull_texels(const float *view_proj, const float *cull, int w, int h,
   *far = hi[2];
 }
 
-/* Same within float noise: a view's matrix made again from a moved eye
- * (rotation rows and depth), the xy translation left out (m[12], m[13]). */
-static bool same_but_moved(const float *a, const float *b) {
-  for (int row = 0; row < 4; row++) {
-    float scale = 0;
-    for (int col = 0; col < 4; col++) scale = fmaxf(scale, fabsf(a[col * 4 + row]));
-    for (int col = 0; col < 4; col++) {
-      int i = col * 4 + row;
-      if (i != 12 && i != 13 && !(fabsf(a[i] - b[i]) <= 1e-6f * scale)) return false;
-    }
-  }
-  return true;
-}
-
 /* Scrolls a cascade's tile: when its view only moved across the light by
  * whole texels since last frame (a moving camera: texel snapping keeps the
  * texel grid, the snapped eye plane and depth range the depth mapping) and
@@ -497,7 +483,7 @@ static int scroll_tile(lm_renderer *r, const lm_scene_pass *sp, const lm_graph_t
   const lm_pass_view *v = sp->view;
   int w = v->width, h = v->height;
   if (!cached->drawn || !(in_place || cached->copied) || cached->at != r->executions - 1 || cached->pass != pass ||
-      v->depth[3] != 0 || !same_but_moved(cached->view_proj, v->view_proj))
+      v->depth[3] != 0 || !lm_shadow_view_moved_across(cached->view_proj, v->view_proj))
     return 0;
   float sx = (v->view_proj[12] - cached->view_proj[12]) * 0.5f * (float)w;
   float sy = (v->view_proj[13] - cached->view_proj[13]) * 0.5f * (float)h;

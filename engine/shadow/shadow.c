@@ -673,6 +673,18 @@ void lm_shadow_plan_fit(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_
   plan_views(plan, s, cam);
 }
 
+bool lm_shadow_view_moved_across(const float a[16], const float b[16]) {
+  for (int row = 0; row < 4; row++) {
+    float scale = 0;
+    for (int col = 0; col < 4; col++) scale = fmaxf(scale, fabsf(a[col * 4 + row]));
+    for (int col = 0; col < 4; col++) {
+      int i = col * 4 + row;
+      if (i != 12 && i != 13 && !(fabsf(a[i] - b[i]) <= 1e-6f * scale)) return false;
+    }
+  }
+  return true;
+}
+
 void lm_shadow_plan_free(lm_shadow_plan *plan) {
   free(plan->levels);
   free(plan->views);

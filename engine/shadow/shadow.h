@@ -131,6 +131,11 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
 void lm_shadow_plan_fit(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *camera, float zmin,
                         float zmax);
 void lm_shadow_plan_free(lm_shadow_plan *plan);
+/* True when view matrix b is a within float noise (rotation rows and depth
+ * row, made again from a moved eye) but for its xy translation (m[12],
+ * m[13]): a cascade that only moved across the light, which its tile can
+ * scroll to. */
+bool lm_shadow_view_moved_across(const float a[16], const float b[16]);
 /* Storage blocks 2 (per light) and 3 (per tile), and uniform block 5 (each light's views at fixed
  * places, for light-set variants); a NULL plan marks every light unshadowed. */
 void lm_shadow_plan_upload(const lm_shadow_plan *plan, int light_count);
