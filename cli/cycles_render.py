@@ -41,7 +41,13 @@ import tempfile
 import warnings
 
 import bpy
-import numpy
+
+try:
+    import numpy  # Blender's glTF importer needs it too; Debian's blender does not depend on it
+except ImportError:
+    print("limn cycles: Blender's Python has no numpy: install Debian's python3-numpy "
+          "(apt-get install python3-numpy)", file=sys.stderr)
+    sys.exit(1)
 
 PREFIX = "limn cycles"
 VIEW = "?"

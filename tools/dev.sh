@@ -25,6 +25,7 @@ packages=(
   libembree-dev                          # the ray tracer's acceleration structure (engine/trace, Embree 3)
   libpng-dev libjpeg-dev                 # PNG and JPEG without OpenImageIO (engine/image/image.c)
   blender                                # Cycles references (limn reference --renderer cycles, cli/cycles_render.py)
+  python3-numpy                          # Blender's glTF importer and exporter (blender does not depend on it)
 )
 
 deps() {

@@ -8,6 +8,8 @@
 #   FRAMES     timed frames per image, after one warm-up (default 3)
 #   JOB        the job (default data/jobs/reference.lua)
 #   REFS       the references' folder (default out/reference)
+#   MOVING_SIZE  the size of the moving-camera times the time targets judge (default 256x192;
+#              MOVING_ROUNDS rounds of tools/gi_time.sh, default 2)
 # POV-Ray's references (radiosity and direct-only) are rendered once and cached
 # under REFS; `limn report` writes report.md/.csv/.json/.svg to OUT. The Cycles
 # column needs Cycles' references cached there (8 bounces, 0 bounces for the
@@ -19,7 +21,7 @@ LIMN=${BUILD_DIR:-build}/limn
 [ -x "$LIMN" ] || { echo "fidelity: no $LIMN (build first: tools/dev.sh build)" >&2; exit 2; }
 # shellcheck source=tools/techniques.sh
 . tools/techniques.sh
-limn_gi_report --targets --cycles --refs "${REFS:-out/reference}" "${OUT:-out/fidelity}" \
+limn_gi_report --targets --cycles --moving "${MOVING_SIZE:-256x192}" --refs "${REFS:-out/reference}" "${OUT:-out/fidelity}" \
   "${JOB:-data/jobs/reference.lua}" "${FRAMES:-3}" \
   "$LIMN_BASELINE=$LIMN_BASELINE" "seed ISR=$(limn_seed_isr_spec)" "ssdo+esm=ssdo+esm" "ssao+esm=ssao+esm" \
   "default=$(limn_default_spec)" "rsm+esm=rsm+esm" "vpl+esm=vpl+esm:vpl.lights=100;vpl.negative=50" \
