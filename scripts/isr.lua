@@ -276,7 +276,9 @@ function isr.render(direct, o, frame)
       local from = { clr = C.clr, mat = C.mat, first = E1, previous = E, z = history and C.z or nil }
       for k = 1, hits do from["hits" .. (k - 1)] = H[k] end
       local defines, params = { HITS = hits, STRIDE = C.stride }, { samples = o.samples }
-      if unseen then defines.UNSEEN, params.bounces = unseen, light.rsm.bounces end
+      if unseen then
+        defines.UNSEEN, defines.LAST, params.bounces, params.steps = unseen, b == steps, light.rsm.bounces, steps
+      end
       E = kept and b == steps and o.blur == 0 and kept.value or coarse_target("isr.e" .. b, f)
       local out = { E }
       with_history(from, defines, params, out, b == steps)

@@ -49,10 +49,12 @@ rsm.defaults = {
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
   bounces = 2,       -- the combined technique's bounces, 1..64: 1, ISR's screen-space bounces alone
                      -- (isr.bounces); 2, its second bounce counts the rays that met surfaces the
-                     -- screen cannot show as meeting ones like those it knows; more, that second
-                     -- bounce goes on as a geometric series in each surface's k_d albedo (at most
-                     -- 0.9 a bounce: bounded at any count). isr_bounce.frag, from the senders ISR's
-                     -- march records (isr.reuse, isr.bounces 2 or more). On the reference set
+                     -- screen cannot show as meeting ones like those it knows (and so do ISR's
+                     -- later steps, isr.bounces 3 or 4, each a bounce more); beyond isr.bounces,
+                     -- the last step's newest bounce goes on as a geometric series in its senders'
+                     -- k_d albedo (at most 0.9 a bounce: bounded at any count). isr_bounce.frag,
+                     -- from the senders ISR's march records (isr.reuse, isr.bounces 2 or more).
+                     -- On the reference set
                      -- (160 x 120) 1, 2, 3, 4 remove 72.9%, 71.9%, 67.9%, 64.2% of dl+esm's indirect
                      -- error against POV-Ray (two bounces) and 67.2%, 68.4%, 71.6%, 72.5% against
                      -- Cycles (eight): 2 removes the most on the mean of the two (docs/gi-combined.md

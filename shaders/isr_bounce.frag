@@ -15,8 +15,10 @@
 // UNSEEN (rsm.bounces above 1; the hit value the march gives a ray that met
 // a surface the screen cannot show, isr_march.frag): those rays are taken to
 // fare as the rays whose fate the march knows (each brings the mean of what
-// they bring), and with `bounces` above 2 the second bounce at p goes on as
-// a geometric series (later_bounces).
+// they bring), and with `bounces` above the screen's steps (`steps`,
+// isr.bounces) the last step's newest bounce at p goes on as a geometric
+// series (later_bounces), in the last step alone (LAST): each step adds one
+// bounce, so a series in every step would count the later bounces twice.
 #include "gbuffer.glsl"
 #ifdef TEMPORAL
 #include "temporal.glsl"
@@ -55,19 +57,21 @@ layout(location = NEXT) out vec4 next;
 layout(location = NEXT + 1) out vec2 next_state; // view depth (0 none), frames seen
 #endif
 
-// What a ray whose recorded hit is `hit` sends of the last step's light (nothing for 0).
-vec3 sent(float hit, int width) {
-  if (hit < 0.5) return vec3(0.0);
+// What a ray whose recorded hit is `hit` sends of the last step's light
+// (nothing for 0), into gathered, and its sender's k_d albedo into albedo.
+void send(float hit, int width, inout vec3 gathered, inout vec3 albedo) {
+  if (hit < 0.5) return;
   int k = int(hit - 0.5);
   ivec2 q = ivec2(k % width, k / width);
   vec3 e = texelFetch(previous, min(q / STRIDE, textureSize(previous, 0) - 1), 0).rgb;
-  return texelFetch(mat, q, 0).y * texelFetch(clr, q, 0).rgb * e;
+  vec3 rho = texelFetch(mat, q, 0).y * texelFetch(clr, q, 0).rgb;
+  gathered += rho * e;
+  albedo += rho;
 }
 
-vec3 sent4(vec4 h, int width) { return sent(h.x, width) + sent(h.y, width) + sent(h.z, width) + sent(h.w, width); }
-
 #ifdef UNSEEN
-uniform int bounces = 2; // rsm.bounces: the series' count
+uniform int bounces = 2; // rsm.bounces: the series runs from bounce steps + 1 to this one
+uniform int steps = 2;   // isr.bounces: the bounces the screen's steps carry (the march's and these passes')
 
 // How many of four rays' hits h send (at least 0.5) and how many met an unseen surface.
 vec2 count4(vec4 h) {
@@ -75,26 +79,30 @@ vec2 count4(vec4 h) {
               dot(vec4(lessThan(abs(h - vec4(UNSEEN)), vec4(0.01))), vec4(1.0)));
 }
 
-// Bounces 3 .. `bounces` after a second bounce e2 at a surface of k_d albedo
-// rho: each sends on the share r = rho closed of the last, `closed` the
-// share of p's rays that met a surface, so they sum to e2 (r + r^2 + ... +
-// r^m), m = bounces - 2, the geometric series r (1 - r^m) / (1 - r). r is at
-// most BOUNCE_MAX (1 - r >= 0.1), so at any count the sum stays below
-// e2 BOUNCE_MAX / (1 - BOUNCE_MAX): energy bounded.
+// Bounces steps + 1 .. `bounces` after the newest bounce e2 the steps
+// carry: each sends on the share r of the last, r the mean k_d albedo of
+// the senders p's rays met times the share of its rays that met one (the
+// light that arrives at p next has bounced off them, not off p), so they sum
+// to e2 (r + r^2 + ... + r^m), m = bounces - steps, the geometric series
+// r (1 - r^m) / (1 - r). r is at most BOUNCE_MAX (1 - r >= 0.1), so at any
+// count the sum stays below e2 BOUNCE_MAX / (1 - BOUNCE_MAX): energy bounded.
 const float BOUNCE_MAX = 0.9;
-vec3 later_bounces(vec3 e2, vec3 rho, float closed) {
-  int m = min(bounces, 64) - 2;
+vec3 later_bounces(vec3 e2, vec3 r) {
+  int m = min(bounces, 64) - clamp(steps, 2, 64);
   if (m <= 0) return vec3(0.0);
-  vec3 r = clamp(rho * saturate(closed), 0.0, BOUNCE_MAX);
+  r = clamp(r, 0.0, BOUNCE_MAX);
   return e2 * r * (1.0 - pow(r, vec3(float(m)))) / (1.0 - r); // pow: base >= 0, exponent >= 1
 }
 #endif
 
-// One hit texture's four rays: what they send, into gathered, and (UNSEEN)
-// how many send and how many met an unseen surface, into rays: each
-// texture read once for both.
-void take4(vec4 h, int width, inout vec3 gathered, inout vec2 rays) {
-  gathered += sent4(h, width);
+// One hit texture's four rays: what they send, into gathered, their
+// senders' albedo, into albedo, and (UNSEEN) how many send and how many met
+// an unseen surface, into rays: each texture read once for all.
+void take4(vec4 h, int width, inout vec3 gathered, inout vec3 albedo, inout vec2 rays) {
+  send(h.x, width, gathered, albedo);
+  send(h.y, width, gathered, albedo);
+  send(h.z, width, gathered, albedo);
+  send(h.w, width, gathered, albedo);
 #ifdef UNSEEN
   rays += count4(h);
 #endif
@@ -125,23 +133,23 @@ void main() {
   bool found = d > 0.0 && temporal_history(uv, d, h, held);
 #endif
   int width = textureSize(clr, 0).x, n = clamp(samples, 1, 4 * HITS);
-  vec3 gathered = vec3(0.0);
+  vec3 gathered = vec3(0.0), albedo = vec3(0.0);
   vec2 rays = vec2(0.0); // UNSEEN: rays that send, rays that met an unseen surface
-  take4(hit0, width, gathered, rays);
+  take4(hit0, width, gathered, albedo, rays);
 #if HITS > 1
-  take4(texelFetch(hits1, px, 0), width, gathered, rays);
+  take4(texelFetch(hits1, px, 0), width, gathered, albedo, rays);
 #endif
 #if HITS > 2
-  take4(texelFetch(hits2, px, 0), width, gathered, rays);
+  take4(texelFetch(hits2, px, 0), width, gathered, albedo, rays);
 #endif
 #if HITS > 3
-  take4(texelFetch(hits3, px, 0), width, gathered, rays);
+  take4(texelFetch(hits3, px, 0), width, gathered, albedo, rays);
 #endif
 #if HITS > 4
-  take4(texelFetch(hits4, px, 0), width, gathered, rays);
+  take4(texelFetch(hits4, px, 0), width, gathered, albedo, rays);
 #endif
 #if HITS > 5
-  take4(texelFetch(hits5, px, 0), width, gathered, rays);
+  take4(texelFetch(hits5, px, 0), width, gathered, albedo, rays);
 #endif
   vec4 e = texelFetch(first, px, 0);
 #ifdef UNSEEN
@@ -149,11 +157,14 @@ void main() {
   // nothing), so nothing is made up where the march knows no ray's fate. The mean over the sending rays
   // alone, or p's own reflected first bounce where none sends, took more from POV-Ray's figure than they
   // gave to Cycles' on the reference set (docs/gi-combined.md).
-  ivec2 size = textureSize(clr, 0), q = block_centre(px, STRIDE, size);
-  vec3 rho = texelFetch(mat, q, 0).y * texelFetch(clr, q, 0).rgb;
   vec3 second = (gathered + rays.y * gathered / max(float(n) - rays.y, 1.0)) / float(n);
+#ifdef LAST
+  // The newest bounce at p: this step's bounces beyond the first less the last step's (its E less the
+  // first's), no less than 0 (the rays' noise); at the second step the second bounce itself.
+  vec3 newest = max(second - (texelFetch(previous, px, 0).rgb - e.rgb), vec3(0.0));
   float known = float(n) - rays.y;
-  second += later_bounces(second, rho, known > 0.0 ? saturate(rays.x / known) : 1.0);
+  second += later_bounces(newest, known > 0.0 ? albedo / known : vec3(0.0));
+#endif
   isr = vec4(e.rgb + finite_or_zero(second), e.a);
 #else
   isr = vec4(e.rgb + gathered / float(n), e.a);

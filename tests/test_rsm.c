@@ -752,6 +752,46 @@ static void more_bounces_light_a_ceiling_more_and_stay_bounded(void **state) {
   }
 }
 
+/* isr.bounces above 2 in the combined technique: each screen step adds one
+ * bounce (isr_bounce.frag again over the recorded senders) and the series of
+ * rsm.bounces carries on from the last step's newest bounce, in the last
+ * step alone. In the white room (albedo 0.8) the ceiling's light grows with
+ * the screen's steps (2, 3, 4 bounces, no series), and 64 bounces come to
+ * nearly the same light whichever of the steps or the series carries bounces
+ * 3 and 4 (0.0211, 0.0181, 0.0201 at 2, 3, 4 steps: within 20%; a series in
+ * every step, as before, counted them again: 0.0747 and 0.324, 15 times the
+ * light at 4 steps), under the albedo's bound over rsm.bounces 1. */
+static void screen_steps_and_the_series_count_each_bounce_once(void **state) {
+  (void)state;
+  lm_scene *s = window_room(0.8f);
+  float one = 0, steps_alone[3], all[3]; /* rsm.bounces 1 (no unseen rays counted), then the others */
+  for (int k = -1; k < 6; k++) {
+    char a[32], b[32];
+    int isr = k < 0 ? 2 : 2 + k % 3, bounces = k < 0 ? 1 : k < 3 ? isr : 64;
+    snprintf(a, sizeof a, "isr.bounces=%d", isr);
+    snprintf(b, sizeof b, "rsm.bounces=%d", bounces);
+    const char *const sets[] = {"ambient=0", a, b, NULL};
+    gl_result r = render_ok(s, "isr+rsm+esm", sets);
+    float rgb[3];
+    gl_region(&r, W / 4, H / 4, 3 * W / 4, 3 * H / 4, rgb);
+    float c = gl_luminance(rgb);
+    assert_true(isfinite(c));
+    if (k < 0) one = c;
+    else if (k < 3) steps_alone[k] = c;
+    else all[k - 3] = c;
+    gl_result_free(&r);
+  }
+  print_message("ceiling: one bounce %.5f; 2, 3, 4 screen steps %.5f %.5f %.5f; with 64 bounces %.5f %.5f %.5f\n", one,
+                steps_alone[0], steps_alone[1], steps_alone[2], all[0], all[1], all[2]);
+  assert_true(steps_alone[0] > one && steps_alone[1] > steps_alone[0] && steps_alone[2] > steps_alone[1]);
+  for (int k = 0; k < 3; k++) {
+    assert_true(all[k] >= steps_alone[k]);
+    assert_true(all[k] <= 1.001f * one / (1 - 0.8f));
+    assert_true(fabsf(all[k] - all[0]) <= 0.2f * all[0]);
+  }
+  lm_scene_destroy(s);
+}
+
 static void bad_options_name_themselves(void **state) {
   (void)state;
   static const gl_bad_option cases[] = {
@@ -875,6 +915,7 @@ int main(int argc, char **argv) {
       cmocka_unit_test(a_moving_camera_keeps_screen_space_light_current),
       cmocka_unit_test(an_outdoor_corner_sees_less_sky_than_open_ground),
       cmocka_unit_test(more_bounces_light_a_ceiling_more_and_stay_bounded),
+      cmocka_unit_test(screen_steps_and_the_series_count_each_bounce_once),
       cmocka_unit_test(extremes_stay_finite),
       cmocka_unit_test(bad_options_name_themselves),
   };
