@@ -65,8 +65,9 @@ void main() {
   float w0 = min(1.0, 1.0 / (PI * max(cp * cp, 0.25)));
   vec3 sum = vec3(0.0);
   float wsum = w0;
-  for (int i = 0; i < n; i++) {
-    ivec2 off = ivec2(round(vogel_disc(i, n) * r));
+  vec2 dir = vec2(1.0, 0.0); // point i's direction (post.glsl's vogel_next)
+  for (int i = 0; i < n; i++, dir = vogel_next(dir)) {
+    ivec2 off = ivec2(round(vogel_point(i, n, dir) * r));
     ivec2 q = clamp(p + off, ivec2(0), last);
     if (q == p) continue;
     vec4 sq = tap(q);
