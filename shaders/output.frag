@@ -20,11 +20,7 @@ vec3 srgb_encode(vec3 c) {
 }
 
 void main() {
-  // What the script presents is output-sized as a rule: its texel under the
-  // pixel, one read where a filtered one takes four on a software rasterizer.
-  ivec2 size = textureSize(src, 0);
-  vec3 c = finite_or_zero(size == ivec2(frame.output_size.xy) ? texelFetch(src, ivec2(gl_FragCoord.xy), 0).rgb
-                                                               : texture(src, uv).rgb);
+  vec3 c = finite_or_zero(texture(src, uv).rgb);
 #ifndef DISPLAY
   c = min(c * frame.exposure.y, vec3(3e38));
 #endif
