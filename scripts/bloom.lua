@@ -35,19 +35,14 @@ bloom.check = options.checker("bloom", bloom.defaults, rules)
 -- Records bloom's bright pass and blur over `src` (output-sized). Returns the
 -- glow to add, { image = the blurred target, strength = o.strength }, or nil
 -- when off. hdr.render adds it as it reads the image (post.lua), so the sum
--- is never written at full size. With dof's layer (dof.layer; downsample 2
--- or 4) the bright pass reads the layer's half-size image laid over by its
--- gather instead of src.
-function bloom.glow(src, o, layer)
+-- is never written at full size.
+function bloom.glow(src, o)
   o = bloom.check(o, 2)
   if not o.enabled then return nil end
   local f = o.downsample
-  if layer and f < 2 then error("bloom.glow: dof's layer is half size, bloom.downsample 2 or 4 reads it", 2) end
   local function small(name) return target{ name, format = "rgba16f", scale = 1 / f } end
-  local b = pass{ "bloom.bright", shader = "bloom_bright.frag",
-                  inputs = { src = layer and layer.image or src, foreign = layer and layer.foreign },
-                  params = { threshold = o.threshold, knee = o.knee },
-                  defines = { FACTOR = layer and f // 2 or f, DOF_LAYER = layer ~= nil },
+  local b = pass{ "bloom.bright", shader = "bloom_bright.frag", inputs = { src = src },
+                  params = { threshold = o.threshold, knee = o.knee }, defines = { FACTOR = f },
                   out = small("bloom.bright") }
   if o.radius > 0 then
     for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do

@@ -9,8 +9,7 @@
 -- light it moves between pixels comes back to full size, through ISR's
 -- depth-aware upsampling, so sharp pixels keep their full-size detail
 -- (dof_reduce.frag, which computes the reduced circles from the depth, and
--- dof_composite.frag; with hdr on, hdr's passes lay it over the image as
--- they read it instead: dof.layer, post.lua).
+-- dof_composite.frag).
 -- Laid out as scripts/README.md's contract says, so modules read alike.
 local options = require "options"
 
@@ -48,9 +47,13 @@ local rules = {
 
 dof.check = options.checker("dof", dof.defaults, rules)
 
--- The passes up to the gather: at downsample 1 the blurred image, else the
--- layer dof.layer returns.
-local function gather(src, o, G)
+-- Records depth of field over `src` (output-sized) with the frame's G-buffer (frame.G).
+-- Returns the blurred image, or src when off.
+function dof.render(src, o, frame)
+  o = dof.check(o, 2)
+  local G = frame and frame.G
+  if not o.enabled then return src end
+  if not (G and G.dpt) then error("dof: needs the G-buffer's depth (frame.G.dpt)", 2) end
   local params = o.mode == "lens"
     and { focus = o.focus, max_radius = o.max_radius, focal_length = o.focal_length, f_number = o.f_number,
           sensor = o.sensor }
@@ -81,35 +84,8 @@ local function gather(src, o, G)
                          defines = { TILE = tile, FOREIGN = f > 1 },
                          out = target{ "dof.gather", format = "rgba16f", scale = 1 / f } }
   if f == 1 then return gathered end
-  return { src = src, image = image, foreign = gathered, coc = circles, dpt = G.dpt }
-end
-
--- Records depth of field over `src` (output-sized) with the frame's G-buffer
--- (frame.G) up to its reduced-resolution result, the layer laid over src
--- (dof_layer.glsl): { src =, image = the reduced image, foreign = the gather,
--- coc = the reduced circles, dpt = the G-buffer's depth }. nil when off, and
--- at downsample 1 (its gather is the whole image; the caller renders it).
--- hdr.render takes the layer and lays it over the image as it reads it
--- (post.lua), so the blurred image is never written at full size.
-function dof.layer(src, o, frame)
-  o = dof.check(o, 2)
-  if not o.enabled or o.downsample == 1 then return nil end
-  local G = frame and frame.G
-  if not (G and G.dpt) then error("dof: needs the G-buffer's depth (frame.G.dpt)", 2) end
-  return gather(src, o, G)
-end
-
--- Records depth of field over `src` (output-sized) with the frame's G-buffer (frame.G).
--- Returns the blurred image, or src when off.
-function dof.render(src, o, frame)
-  o = dof.check(o, 2)
-  local G = frame and frame.G
-  if not o.enabled then return src end
-  if not (G and G.dpt) then error("dof: needs the G-buffer's depth (frame.G.dpt)", 2) end
-  local layer = gather(src, o, G)
-  if o.downsample == 1 then return layer end
   return pass{ "dof.composite", shader = "dof_composite.frag",
-               inputs = { src = src, dpt = G.dpt, foreign = layer.foreign, small_coc = layer.coc },
+               inputs = { src = src, dpt = G.dpt, foreign = gathered, small_coc = circles },
                out = target{ "dof.composite", format = "rgba16f" } }
 end
 

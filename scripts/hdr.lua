@@ -52,10 +52,9 @@ hdr.check = options.checker("hdr", hdr.defaults, rules)
 
 -- Records tone mapping of `src` (an output-sized float target) with options
 -- o (see hdr.defaults), adding `glow` (bloom.glow's) to the image as its
--- first reduction and the tone mapping read it, and before that laying
--- `layer` (dof.layer's) over it (dof_layer.glsl). Returns the
--- display-referred target, or src when off.
-function hdr.render(src, o, _, glow, layer)
+-- first reduction and the tone mapping read it. Returns the display-referred
+-- target, or src when off.
+function hdr.render(src, o, _, glow)
   o = hdr.check(o, 2)
   if not o.enabled then return src end
   if not adapted then error("hdr: call hdr.create() from OnCreate (it declares the adaptation targets)", 2) end
@@ -63,7 +62,6 @@ function hdr.render(src, o, _, glow, layer)
   -- The inputs and params of a pass that adds the glow, where there is one.
   local function glow_inputs(t)
     t.bloom = glow and glow.image
-    if layer then t.foreign, t.dpt, t.small_coc = layer.foreign, layer.dpt, layer.coc end
     return t
   end
   local function glow_params(t)
@@ -78,8 +76,7 @@ function hdr.render(src, o, _, glow, layer)
     level = pass{ "hdr.reduce" .. n, shader = "hdr_reduce.frag",
                   inputs = first and glow_inputs{ src = level } or { src = level },
                   params = first and glow_params{ delta = o.delta } or nil,
-                  defines = { FIRST = first, BLOCK = BLOCK, STEP = first and STEP or 1, BLOOM = first and glow ~= nil,
-                              DOF_LAYER = first and layer ~= nil },
+                  defines = { FIRST = first, BLOCK = BLOCK, STEP = first and STEP or 1, BLOOM = first and glow ~= nil },
                   out = target{ "hdr.reduce" .. n, format = "rg32f", size = { w, h } } }
   until w == 1 and h == 1
   local previous, next = adapted[turn + 1], adapted[2 - turn]
@@ -88,7 +85,7 @@ function hdr.render(src, o, _, glow, layer)
         params = { rate = o.rate }, out = next }
   return pass{ "hdr.tonemap", shader = "hdr_tonemap.frag", inputs = glow_inputs{ src = src, adapted = next },
                params = glow_params{ key = o.key, white = o.white, exposure = o.exposure },
-               defines = { AUTO_KEY = o.auto_key, BLOOM = glow ~= nil, DOF_LAYER = layer ~= nil },
+               defines = { AUTO_KEY = o.auto_key, BLOOM = glow ~= nil },
                out = target{ "hdr.tonemap", format = "rgba16f" } }
 end
 

@@ -7,11 +7,7 @@
 -- `render(src, o, frame)`); an effect whose `enabled` is false records no
 -- pass. Any pipeline can use the chain (post.render) or the modules one by one.
 -- With hdr on, bloom's glow goes to hdr, which adds it as it reads the image:
--- the same picture without a full-size pass that writes the sum. So with
--- depth of field at half size: hdr lays its layer (dof.layer) over the image
--- as it tone maps it, and bloom's bright pass and hdr's meter read its
--- half-size image laid over by the gather, where the separate composite
--- wrote the blurred image at full size for them to read (dof_layer.glsl).
+-- the same picture without a full-size pass that writes the sum.
 local options = require "options"
 
 local post = {}
@@ -41,17 +37,10 @@ end
 function post.render(lit, o, frame)
   o = o or {}
   local tone_mapped = modules.hdr.check(o.hdr, 2).enabled
-  -- bloom's bright pass reads dof's half-size image at bloom.downsample 2 or 4, not at 1
-  local b = modules.bloom.check(o.bloom, 2)
-  local layered = tone_mapped and (not b.enabled or b.downsample > 1)
-  local img, glow, layer = lit, nil, nil
+  local img, glow = lit, nil
   for _, name in ipairs(post.order) do
-    if name == "dof" and layered then
-      layer = modules.dof.layer(img, o.dof, frame)
-      if not layer then img = modules.dof.render(img, o.dof, frame) end
-    elseif name == "bloom" and tone_mapped then glow = modules.bloom.glow(img, o.bloom, layer)
-    elseif name == "hdr" then img = modules.hdr.render(img, o.hdr, frame, glow, layer)
-    else img = modules[name].render(img, o[name], frame) end
+    if name == "bloom" and tone_mapped then glow = modules.bloom.glow(img, o.bloom)
+    else img = modules[name].render(img, o[name], frame, name == "hdr" and glow or nil) end
   end
   return img, tone_mapped and "display" or "scene"
 end

@@ -1,14 +1,8 @@
 // Bloom's bright pass (seed 001, lines 1355-1400): at a lower resolution,
 // keep what exceeds `threshold`, with a soft knee of width `knee` so that the
 // cut does not show as an edge. Each output texel averages the FACTOR x FACTOR
-// source texels under it, so no bright pixel falls between the taps. With
-// DOF_LAYER the source is depth of field's reduced image, laid over by its
-// gather as read (dof_layer.glsl; FACTOR is then relative to that size).
+// source texels under it, so no bright pixel falls between the taps.
 #include "post.glsl"
-#ifdef DOF_LAYER
-#define DOF_REDUCED_ONLY
-#include "dof_layer.glsl"
-#endif
 
 in vec2 uv;
 uniform sampler2D src;
@@ -25,14 +19,8 @@ void main() {
   ivec2 base = ivec2(gl_FragCoord.xy) * FACTOR, last = textureSize(src, 0) - 1;
   vec3 c = vec3(0.0);
   for (int y = 0; y < FACTOR; y++)
-    for (int x = 0; x < FACTOR; x++) {
-      ivec2 q = min(base + ivec2(x, y), last);
-#ifdef DOF_LAYER
-      c += dof_over_reduced(texelFetch(src, q, 0).rgb, q);
-#else
-      c += hdr_clamp(texelFetch(src, q, 0).rgb, HALF_MAX);
-#endif
-    }
+    for (int x = 0; x < FACTOR; x++)
+      c += hdr_clamp(texelFetch(src, min(base + ivec2(x, y), last), 0).rgb, HALF_MAX);
   c /= float(FACTOR * FACTOR);
   // Quadratic soft knee: the kept fraction rises smoothly from
   // threshold - knee to threshold + knee, then follows brightness - threshold.

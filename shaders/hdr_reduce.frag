@@ -13,18 +13,8 @@
 // ln(delta + E L_w), hdr_adapt.frag takes ln E away, and an image lit 1e10
 // times more adapts to the same picture. With BLOOM the first level reads
 // the image plus `strength` of bloom's blurred bright pass (scripts/hdr.lua:
-// bloom's sum is never written). With DOF_LAYER the first level lays depth
-// of field's reduced result over each pixel it reads (dof_layer.glsl), as
-// the tone mapping does: the log-average of what is shown. (Cheaper reads,
-// the reduced image's texels laid over by their gather, or the gather's
-// texel over each pixel, moved the exposure: the Cornell box with hdr and
-// dof 0.0018 and 0.0020 off a channel on average, this 0.00005. A
-// log-average weighs its darkest pixels most, and the blur moves light into
-// them.)
+// bloom's sum is never written).
 #include "post.glsl"
-#if defined(DOF_LAYER) && defined(FIRST)
-#include "dof_layer.glsl"
-#endif
 
 in vec2 uv;
 uniform sampler2D src;
@@ -54,9 +44,6 @@ void main() {
       if (any(greaterThanEqual(q, size))) continue;
       vec4 t = texelFetch(src, q, 0);
 #ifdef FIRST
-#ifdef DOF_LAYER
-      t.rgb = dof_over(t.rgb, q, size);
-#endif
 #ifdef BLOOM
       // The glow's texel under the pixel, not its bilinear enlargement: the
       // glow is smooth, and a plain fetch costs half a filtered one on llvmpipe.

@@ -5,13 +5,8 @@
 // in [0, 1] (the output stage encodes sRGB). With AUTO_KEY the key follows
 // the average (seed 001 fig 6.17: darker views a lower key): Krawczyk et al.
 // 2005, a = 1.03 - 2 / (2 + log10(L_avg + 1)), in the seed's 0.045..0.9.
-// With BLOOM it adds bloom's blurred bright pass first (hdr_reduce.frag);
-// before that, with DOF_LAYER, it lays depth of field's reduced result over
-// the image (dof_layer.glsl), which no pass of its own writes at full size.
+// With BLOOM it adds bloom's blurred bright pass first (hdr_reduce.frag).
 #include "post.glsl"
-#ifdef DOF_LAYER
-#include "dof_layer.glsl"
-#endif
 
 in vec2 uv;
 uniform sampler2D src;
@@ -27,11 +22,7 @@ uniform float strength = 1.0;
 out vec4 dst;
 
 void main() {
-  ivec2 p = ivec2(gl_FragCoord.xy);
-  vec3 c = hdr_clamp(texelFetch(src, p, 0).rgb, 1e30);
-#ifdef DOF_LAYER
-  c = dof_over(c, p, textureSize(src, 0));
-#endif
+  vec3 c = hdr_clamp(texelFetch(src, ivec2(gl_FragCoord.xy), 0).rgb, 1e30);
 #ifdef BLOOM
   c = bloom_sum(c, texture(bloom, uv).rgb, strength);
 #endif
