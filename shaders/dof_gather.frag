@@ -33,12 +33,14 @@ uniform int samples = 48;       // 1..256
 
 out vec4 dst;
 
-// A texel's light and signed circle of confusion.
+// A texel's light and signed circle of confusion. The half-size image
+// (FOREIGN) is written clamped (dof_reduce.frag): read as it is; the
+// full-size one is any lit image, clamped as read.
 vec4 tap(ivec2 q) {
 #ifdef FOREIGN
   return texelFetch(src, q, 0);
 #else
-  return vec4(texelFetch(src, q, 0).rgb, texelFetch(coc, q, 0).r);
+  return vec4(hdr_clamp(texelFetch(src, q, 0).rgb, HALF_MAX), texelFetch(coc, q, 0).r);
 #endif
 }
 
@@ -65,8 +67,9 @@ void main() {
   float w0 = min(1.0, 1.0 / (PI * max(cp * cp, 0.25)));
   vec3 sum = vec3(0.0);
   float wsum = w0;
-  for (int i = 0; i < n; i++) {
-    ivec2 off = ivec2(round(vogel_disc(i, n) * r));
+  vec2 dir = vec2(1.0, 0.0); // point i's direction (post.glsl's vogel_next)
+  for (int i = 0; i < n; i++, dir = vogel_next(dir)) {
+    ivec2 off = ivec2(round(vogel_point(i, n, dir) * r));
     ivec2 q = clamp(p + off, ivec2(0), last);
     if (q == p) continue;
     vec4 sq = tap(q);
@@ -74,7 +77,7 @@ void main() {
     if (cq > cp) reach = min(reach, abs(cp)); // behind p: no wider than p's own blur
     // A circle under half a pixel stays in its pixel: a sharp tap gives nothing.
     float w = saturate(reach - length(vec2(off)) + 0.5) * min(1.0, tap_area / (PI * max(cq * cq, 0.25)));
-    sum += w * hdr_clamp(sq.rgb, HALF_MAX);
+    sum += w * sq.rgb;
     wsum += w;
   }
 #ifdef FOREIGN

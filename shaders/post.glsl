@@ -30,10 +30,15 @@ float eye_depth(float depth01) {
   return dpt_view_depth(depth01 > 0.0 ? min(depth01, 1.0) : 1.0);
 }
 
-// The i-th of n points of a golden-angle (Vogel) spiral filling the unit disc.
-vec2 vogel_disc(int i, int n) {
-  float r = sqrt((float(i) + 0.5) / float(max(n, 1)));
-  float a = float(i) * 2.39996323; // the golden angle
-  return r * vec2(cos(a), sin(a));
+// A golden-angle (Vogel) spiral of n points filling the unit disc: point i
+// at radius sqrt((i + 0.5) / n) in direction i times the golden angle. A loop
+// over the points turns the direction by that angle each step (vogel_next)
+// rather than take a sine and a cosine a point: on llvmpipe each costs a
+// polynomial a lane. In float the turned direction drifts under 1e-5 over
+// 256 steps (6.9e-6), 0.0002 pixels at dof's largest radius (32).
+const vec2 GOLDEN_TURN = vec2(-0.73736887808, 0.67549029426); // cos, sin of 2.39996323, the golden angle
+vec2 vogel_next(vec2 d) {
+  return vec2(d.x * GOLDEN_TURN.x - d.y * GOLDEN_TURN.y, d.x * GOLDEN_TURN.y + d.y * GOLDEN_TURN.x);
 }
+vec2 vogel_point(int i, int n, vec2 d) { return sqrt((float(i) + 0.5) / float(max(n, 1))) * d; }
 #endif
