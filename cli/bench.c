@@ -703,6 +703,7 @@ typedef struct stream {
   lm_renderer *r;    /* one for the run (alone's view is set again before each frame) */
   int camera, node; /* the camera rendered through and its node */
   float start[16];  /* --walk: the camera node's world where the walk starts */
+  float diagonal;   /* --walk: the scene's bounding-box diagonal there (a frame's step is a share of it) */
 } stream;
 
 /* Does animation `anim` move node `node` or a node above it? */
@@ -723,14 +724,11 @@ static bool node_animated(const lm_scene *s, int anim, int node) {
  * lm_scene_set_time took (0 without --time). */
 static double pose(const motion *m, stream *s, int f) {
   if (m->walk > 0) { /* forward: along the camera's -Z, as the viewer's W */
-    float lo[3], hi[3], w[16], z[3];
-    lm_scene_bounds(s->scene, lo, hi);
-    float diagonal = sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                           (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    float w[16], z[3];
     memcpy(w, s->start, sizeof w);
     memcpy(z, w + 8, sizeof z);
     float length = sqrtf(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]); /* the node may scale */
-    for (int i = 0; i < 3 && length > 0; i++) w[12 + i] -= (float)(m->walk * f) * diagonal * z[i] / length;
+    for (int i = 0; i < 3 && length > 0; i++) w[12 + i] -= (float)(m->walk * f) * s->diagonal * z[i] / length;
     lm_scene_node_set_world(s->scene, s->node, w);
   } else if (m->orbit) {
     double az = m->step * f * M_PI / 180, el = m->elevation * M_PI / 180;
@@ -793,6 +791,12 @@ static bool stream_open(bench *b, int k, stream *s, lm_error *err) {
     s->node = s->scene->cameras[s->camera].node;
   }
   memcpy(s->start, s->scene->nodes[s->node].world, sizeof s->start);
+  if (m->walk > 0) { /* once: lm_scene_bounds visits every node, which pose() would do each frame */
+    float lo[3], hi[3];
+    lm_scene_bounds(s->scene, lo, hi);
+    s->diagonal = sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  }
   snprintf(m->camera, sizeof m->camera, "%s", s->scene->cameras[s->camera].name);
   s->r = lm_renderer_create(&(lm_renderer_desc){.scene = s->scene, .pipeline = s->pipe, .camera = s->camera,
                                                 .width = b->sizes[b->largest][0],
