@@ -44,6 +44,10 @@ rsm.defaults = {
   thickness = 0.15,  -- how far behind the depth buffer such a point blocks, a share of the depth there,
                      -- 0..16 (0: anywhere behind, the seed's test, which also dropped senders that
                      -- lie behind a near surface but not behind anything in the scene)
+  ray_steps = 0,     -- the combined technique: points at which an upward ray the screen lost is tested
+                     -- against the lights' RSM views on its way out of the scene's box, 0..32 (0: none,
+                     -- such a ray is open unless p lies under a roof); one that crosses a surface they
+                     -- hold met a surface off screen (rsm.bounces above 1 carry light over it)
   rotate = 10,       -- pattern turn a frame in degrees with temporal reuse, 0..180 (the seed: 10;
                      -- its radii shift too); without, the pattern stays (a still camera, a still image)
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
@@ -95,6 +99,7 @@ local rules = {
   resolution = options.whole(16, 8192),
   steps = options.whole(-1, 32),
   thickness = options.number(0, 16),
+  ray_steps = options.whole(0, 32),
   rotate = options.number(0, 180),
   k = options.number(0, 16),
   bounces = options.whole(1, 64),
@@ -134,6 +139,7 @@ function rsm.bind(inputs, defines, params, R, shadows, o, f, temporal_on, exclud
   defines.RSM_GATHER, defines.VISIBILITY, defines.EXCLUDE_SEEN = true, steps > 0, exclude_seen
   params.rsm_samples, params.rsm_radius, params.rsm_steps = samples, o.radius, steps
   params.rsm_thickness = o.thickness
+  defines.RAY_STEPS = exclude_seen and o.ray_steps > 0 and o.ray_steps or nil
   params.rsm_rotate = temporal_on and o.rotate / 360 or 0
   return samples * (2 + steps * 2 + (exclude_seen and 1 or 0))
 end

@@ -341,7 +341,15 @@ void main() {
     }
     if (!seen) open += 1.0;
 #ifdef UNSEEN
-    if (!seen && i < 4 * HITS && (w.y <= 0.0 || roofed) && box_exit(s.p, w) > t_end) record_hit(i, float(UNSEEN));
+    float t_box = box_exit(s.p, w);
+#ifdef RAY_STEPS
+    // An upward ray in the open meets a surface off screen where the lights' RSM views hold one on its
+    // way out of the scene's box (rsm.ray_steps; a street's facades, docs/gi-combined.md).
+    bool closed = w.y <= 0.0 || roofed || (!seen && t_box > t_end && rsm_meets(s.p, w, t_end, t_box));
+#else
+    bool closed = w.y <= 0.0 || roofed;
+#endif
+    if (!seen && i < 4 * HITS && closed && t_box > t_end) record_hit(i, float(UNSEEN));
 #endif
   }
   isr = vec4(gathered / float(n), open / float(n));

@@ -139,6 +139,43 @@ bool rsm_shadowed(vec3 x) {
   return any_view;
 }
 
+#ifdef RAY_STEPS
+// Does the ray p + t w meet, between t0 and t1, a surface some light's RSM
+// views hold? RAY_STEPS points, each tested as the march tests the depth
+// buffer: behind the sender its texel holds (farther from the light) and
+// within the step's length of it (the ray crossed that surface in this
+// step, give or take its texel's side; a point far behind its texel's
+// sender lies in the shadow's air, not in a wall). The combined technique's march asks it of the stretch a ray
+// the screen lost runs inside the scene's box (isr_march.frag's UNSEEN):
+// what the light sees there stands for the surfaces off screen.
+bool rsm_meets(vec3 p, vec3 w, float t0, float t1) {
+  vec2 atlas = vec2(textureSize(rsm_pos, 0));
+  float dt = (t1 - t0) / float(RAY_STEPS);
+  for (int j = 0; j < RAY_STEPS; j++) {
+    vec3 x = p + (t0 + (float(j) + 0.5) * dt) * w;
+    for (int i = 0; i < frame.counts.x; i++) {
+      ShadowLight sl = shadow_lights[i];
+      for (int v = sl.cube.y; v < sl.cube.y + sl.cube.z; v++) {
+        ShadowView sv = shadow_views[v];
+        vec4 c = sv.view_proj * vec4(x, 1.0);
+        if (c.w <= 1e-12) continue;
+        vec3 ndc = c.xyz / c.w;
+        vec2 t = ndc.xy * 0.5 + 0.5;
+        if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
+        vec4 qn = texelFetch(rsm_pos, ivec2((sv.rect.xy + t * sv.rect.zw) * atlas), 0);
+        if (qn.w > 0.0) continue; // empty
+        vec4 cq = sv.view_proj * vec4(qn.xyz, 1.0);
+        bool behind = sv.depth.w > 0.0 ? distance(x, sv.depth.xyz) > distance(qn.xyz, sv.depth.xyz)
+                                       : ndc.z > cq.z / max(cq.w, 1e-12);
+        float side = sqrt(max(rsm_texel_area(sv, t, qn.xyz, sv.rect.z * atlas.x), 0.0)); // the texel's footprint
+        if (behind && distance(x, qn.xyz) <= dt + side) return true;
+      }
+    }
+  }
+  return false;
+}
+#endif
+
 // Light i's share of E(p) at the surface s: its RSM views, j the pixel's
 // block of the pattern, turn and shift its frame's turn (rsm_gather); type
 // and falloff light i's kind as light_arriving_as takes them. dpt:

@@ -342,13 +342,15 @@ static void a_late_target_like_the_rsm_takes_none_of_its_textures(void **state) 
 
 /* A light inside geometry (a point light in a closed box the camera looks
  * at from outside), a spot whose cone is nearly closed (a tile seeing next
- * to nothing), one sample, 4096 samples and the visibility march: finite. */
+ * to nothing), one sample, 4096 samples, the visibility march and the
+ * off-screen rays' RSM test at its most steps: finite. */
 static void extremes_stay_finite(void **state) {
   (void)state;
   static const char *const cases[][4] = {
       {"rsm.samples=1", NULL}, {"rsm.samples=4096", "rsm.coarse=4", NULL}, {"rsm.steps=32", NULL},
       {"rsm.steps=32", "rsm.thickness=16", NULL}, {"rsm.steps=1", "rsm.thickness=0", NULL},
       {"rsm.radius=2", "rsm.reach=64", NULL}, {"rsm.coarse=1", "rsm.blur=0", NULL},
+      {"rsm.ray_steps=32", "rsm.bounces=64", "isr.bounces=4"},
   };
   static const char *const vpl_cases[][4] = {
       {"vpl.lights=0", NULL}, {"vpl.lights=4096", "vpl.negative=4096", "vpl.coarse=4", NULL},
@@ -800,6 +802,7 @@ static void bad_options_name_themselves(void **state) {
       {"isr+rsm+esm", "rsm.steps=33", "rsm.steps"},   {"rsm+esm", "rsm.coarse=5", "rsm.coarse"},
       {"isr+rsm+esm", "rsm.steps=-2", "rsm.steps"},   {"isr+rsm+esm", "rsm.thickness=-0.1", "rsm.thickness"},
       {"rsm+esm", "rsm.thickness=17", "rsm.thickness"},
+      {"isr+rsm+esm", "rsm.ray_steps=33", "rsm.ray_steps"}, {"isr+rsm+esm", "rsm.ray_steps=-1", "rsm.ray_steps"},
       {"vpl+esm", "vpl.lights=-1", "vpl.lights"},     {"vpl+esm", "vpl.negative=4097", "vpl.negative"},
       {"vpl+esm", "vpl.threshold=3", "vpl.threshold"}, {"vpl+esm", "vpl.focus=0", "vpl.focus"},
       {"vpl+esm", "vpl.recompute=some", "vpl.recompute"},
