@@ -64,6 +64,10 @@
 // light: 71.9% / 68.4% of dl+esm's indirect error removed against POV-Ray /
 // Cycles at rsm.bounces 2 with them open, 67.8% / 69.6% counted, 72.9% /
 // 67.2% at 1), and indoors they meet the ceiling.
+// RAY_STEPS (rsm.ray_steps): an upward ray is also tested at that many points
+// between where it leaves the view and where it leaves the box against the
+// lights' RSM views (rsm.glsl's rsm_meets); one that crosses a surface they
+// hold met it off screen (the street's facades; docs/gi-combined.md).
 // TEMPORAL (isr.temporal, temporal.glsl): each frame the rays are the next
 // 16 n points of the sequence, and a pixel whose history has converged is
 // not marched: its E is that history (every bounce's sum), which a later
