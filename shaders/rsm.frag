@@ -6,7 +6,7 @@
 // light's radiance there, light_incident: what the direct pass gives it,
 // with cos cancelled by the area) times the texel's area seen from the light
 // A_q (orthographic: a texel's world size squared; perspective: its size per
-// unit distance squared times r^2 cos(off-axis angle)), and w_q the texels a
+// unit distance squared times r^2 cos^3(off-axis angle)), and w_q the texels a
 // sample stands for. The composite (isr_light.frag) multiplies by k_d albedo.
 //
 // The sampling and its options: rsm_gather (rsm.glsl's RSM_GATHER).

@@ -37,7 +37,7 @@
 // a directional light has none of: points uniform over the tile stand for
 // the same thing, each weighing its share of the tile's area (seen from the
 // light: orthographic T^2 texel areas / N; perspective its texel's area
-// r^2 cos(a) tan-step^2 times T^2 / N). A light at q sends
+// r^2 cos^3(a) tan-step^2 times T^2 / N). A light at q sends
 //   E(p) += (1/pi) Phi max(0, n_p.t) max(0, n_q.-t) / max(|q - p|^2, A)
 // (seed 002's gather, t = (q - p)/|q - p|), A the area the light stands
 // for: its own size caps 1/d^2. Output of GATHER: E+ (rgb), S_neg (rgb) and
