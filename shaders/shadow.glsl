@@ -215,12 +215,16 @@ int shadow_view_at(int light, ShadowLight s, int kind, vec3 p, out float t) {
   }
   if (kind == 1) { // cascades: by camera depth, blended over the last `blend` share of each
     float z = -(frame.view * vec4(p, 1.0)).z;
-    int k = 0;
-    while (k < count - 1 && z > s.splits[k]) k++;
+    // The cascade: how many of the first count - 1 splits z lies beyond
+    // (they increase), its ends picked by selects; no loop, which llvmpipe
+    // runs until its last lane stops (callgrind: 0.6% of direct's code).
+    bvec4 beyond = greaterThan(vec4(z), s.splits);
+    int k = int(dot(vec4(beyond), vec4(lessThan(ivec4(0, 1, 2, 3), ivec4(count - 1)))));
     if (z > s.splits[count - 1]) return -1; // beyond the shadowed distance
-    float start = k > 0 ? s.splits[k - 1] : frame.clip.x;
-    float band = (s.splits[k] - start) * s.params.z;
-    if (k < count - 1 && band > 0.0 && z > s.splits[k] - band) t = saturate((z - (s.splits[k] - band)) / band);
+    float end = k == 0 ? s.splits.x : k == 1 ? s.splits.y : k == 2 ? s.splits.z : s.splits.w;
+    float start = k == 0 ? frame.clip.x : k == 1 ? s.splits.x : k == 2 ? s.splits.y : s.splits.z;
+    float band = (end - start) * s.params.z;
+    if (k < count - 1 && band > 0.0 && z > end - band) t = saturate((z - (end - band)) / band);
     return k;
   }
   return 0;
