@@ -77,17 +77,26 @@ vec4 shadow_texels(ivec2 t, ivec2 lo, ivec2 hi) {
 // A texel's world size, where a point at stored depth r is, in stored depth
 // (the tile's 0..1): the unit of the bias and of ESM's c, so both mean the
 // same in any scene unit, tile size and depth range.
-float shadow_texel_depth(ShadowView sv, float r) {
-  return max(sv.depth.w > 0.0 ? sv.texel.x * r : sv.texel.x / max(sv.texel.y, 1e-30), 1e-30);
+// perspective: sv's projection (sv.depth.w > 0; shadow_perspective).
+float shadow_texel_depth_as(ShadowView sv, float r, bool perspective) {
+  return max(perspective ? sv.texel.x * r : sv.texel.x / max(sv.texel.y, 1e-30), 1e-30);
 }
+float shadow_texel_depth(ShadowView sv, float r) { return shadow_texel_depth_as(sv, r, sv.depth.w > 0.0); }
+
+// Whether the views of a light whose shadow is of kind `kind`
+// (ShadowLight.info.z) are perspective (spot, point: sv.depth.w = 1 / range
+// > 0) or orthographic (cascades: 0), as engine/shadow/shadow.c makes them:
+// a constant kind (a light-set variant) compiles one projection's code, not
+// both under a mask.
+bool shadow_perspective(int kind) { return kind != 1; }
 
 // PCSS penumbra width in texels for a blocker at normalized depth zb over a
 // receiver at r (similar triangles, as ratios: no world unit). Orthographic:
 // the world depth between them times the light's angular size, over the
 // texel's world size. Perspective: the light's size times (d - db) / (d db),
 // an angle, over the texel's angle (its size per unit of distance).
-float pcss_penumbra(ShadowView sv, float size, float r, float zb) {
-  if (sv.depth.w > 0.0) {
+float pcss_penumbra(ShadowView sv, bool perspective, float size, float r, float zb) {
+  if (perspective) {
     float d = r / sv.depth.w, db = max(zb, 1e-6) / sv.depth.w;
     return size * max(d - db, 0.0) / max(d * db * sv.texel.x, 1e-30);
   }
@@ -100,10 +109,10 @@ float pcss_penumbra(ShadowView sv, float size, float r, float zb) {
 // fixed offsets from the point's own texel position, so the result follows
 // the stabilized map (whole-texel moves only). The bias grows with each
 // tap's distance along a tilted receiver.
-float pcss_lookup(ShadowLight s, ShadowView sv, vec2 texel, float r, float bias, float tan_tilt, ivec2 lo,
-                  ivec2 hi) {
+float pcss_lookup(ShadowLight s, ShadowView sv, bool perspective, vec2 texel, float r, float bias, float tan_tilt,
+                  ivec2 lo, ivec2 hi) {
   float size = s.soft.x, widest = s.soft.y;
-  float search = clamp(0.5 * pcss_penumbra(sv, size, r, sv.depth.w > 0.0 ? 0.1 * r : 0.0), 1.0, widest);
+  float search = clamp(0.5 * pcss_penumbra(sv, perspective, size, r, perspective ? 0.1 * r : 0.0), 1.0, widest);
   float sum = 0.0, n = 0.0;
   for (int i = 0; i < 16; i++) {
     vec2 o = POISSON[i] * search;
@@ -111,7 +120,7 @@ float pcss_lookup(ShadowLight s, ShadowView sv, vec2 texel, float r, float bias,
     if (r - bias * (1.0 + length(o) * tan_tilt) > z) { sum += z; n += 1.0; }
   }
   if (n == 0.0) return 1.0;
-  float radius = clamp(0.5 * pcss_penumbra(sv, size, r, sum / n), 1.0, widest);
+  float radius = clamp(0.5 * pcss_penumbra(sv, perspective, size, r, sum / n), 1.0, widest);
   float lit = 0.0;
   for (int i = 0; i < 16; i++) {
     vec2 o = POISSON[i] * radius, t = texel + o;
@@ -125,27 +134,29 @@ float pcss_lookup(ShadowLight s, ShadowView sv, vec2 texel, float r, float bias,
 }
 
 // Visibility in [0, 1] of p from view sv of light s, p at ls in its clip
-// space (shadow_view_of).
-float shadow_view_lookup(ShadowView sv, vec4 ls, ShadowLight s, vec3 p, float ndl) {
+// space (shadow_view_of), sv perspective or not (shadow_perspective), the
+// surface's n.l and the tilt shadow_tilt gives for it.
+float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s, vec3 p, float ndl,
+                         float tan_tilt) {
   if (ls.w <= 1e-12) return 1.0;
-  vec3 ndc = ls.xyz / ls.w;
+  // An orthographic view's w is 1 (its matrix's last row 0 0 0 1): no division.
+  vec3 ndc = perspective ? ls.xyz / ls.w : ls.xyz;
   vec2 tuv = ndc.xy * 0.5 + 0.5;
   if (any(lessThan(tuv, vec2(0.0))) || any(greaterThan(tuv, vec2(1.0)))) return 1.0; // outside: lit
-  float r = sv.depth.w > 0.0 ? length(p - sv.depth.xyz) * sv.depth.w : ndc.z * 0.5 + 0.5;
+  float r = perspective ? length(p - sv.depth.xyz) * sv.depth.w : ndc.z * 0.5 + 0.5;
   if (r >= 1.0) return 1.0;
   vec2 size = vec2(textureSize(shadow_atlas, 0));
   ivec2 lo = ivec2(sv.rect.xy * size + 0.5), hi = ivec2((sv.rect.xy + sv.rect.zw) * size + 0.5) - 1;
   vec2 texel = (sv.rect.xy + tuv * sv.rect.zw) * size - 0.5;
   ivec2 base = ivec2(floor(texel));
   vec2 f = texel - vec2(base);
-  float texel_depth = shadow_texel_depth(sv, r);
+  float texel_depth = shadow_texel_depth_as(sv, r, perspective);
   float bias = s.params.y * texel_depth;
   int technique = SHADOW_FILTER_OF(s);
   // Filters reach `spread` texels away, where a tilted receiver is deeper:
   // scale the bias by the tilt (tan of the light's angle, capped).
   float spread = technique == 0 ? 1.0 : technique == 1 ? 1.5 : technique == 2 ? s.params.w : 0.0;
-  float c = saturate(ndl), tan_tilt = min(sqrt(max(1.0 - c * c, 0.0)) / max(c, 0.1), 10.0);
-  if (technique == 4) return pcss_lookup(s, sv, texel, r, bias, tan_tilt, lo, hi);
+  if (technique == 4) return pcss_lookup(s, sv, perspective, texel, r, bias, tan_tilt, lo, hi);
   bias *= 1.0 + spread * tan_tilt;
   if (technique == 0) {
     // ESM with the seed's 4-tap bilinear combination (seed 000, Listing 8):
@@ -169,6 +180,12 @@ float shadow_view_lookup(ShadowView sv, vec4 ls, ShadowLight s, vec3 p, float nd
     return lit / 16.0;
   }
   return r - bias <= shadow_texel(ivec2(floor(texel + 0.5)), lo, hi) ? 1.0 : 0.0;
+}
+
+// The tan of the angle between a surface and the light by its n.l, capped.
+float shadow_tilt(float ndl) {
+  float c = saturate(ndl);
+  return min(sqrt(max(1.0 - c * c, 0.0)) / max(c, 0.1), 10.0);
 }
 
 // Where point light `light` (record s) is: its cube's centre.
@@ -198,12 +215,16 @@ int shadow_view_at(int light, ShadowLight s, int kind, vec3 p, out float t) {
   }
   if (kind == 1) { // cascades: by camera depth, blended over the last `blend` share of each
     float z = -(frame.view * vec4(p, 1.0)).z;
-    int k = 0;
-    while (k < count - 1 && z > s.splits[k]) k++;
+    // The cascade: how many of the first count - 1 splits z lies beyond
+    // (they increase), its ends picked by selects; no loop, which llvmpipe
+    // runs until its last lane stops (callgrind: 0.6% of direct's code).
+    bvec4 beyond = greaterThan(vec4(z), s.splits);
+    int k = int(dot(vec4(beyond), vec4(lessThan(ivec4(0, 1, 2, 3), ivec4(count - 1)))));
     if (z > s.splits[count - 1]) return -1; // beyond the shadowed distance
-    float start = k > 0 ? s.splits[k - 1] : frame.clip.x;
-    float band = (s.splits[k] - start) * s.params.z;
-    if (k < count - 1 && band > 0.0 && z > s.splits[k] - band) t = saturate((z - (s.splits[k] - band)) / band);
+    float end = k == 0 ? s.splits.x : k == 1 ? s.splits.y : k == 2 ? s.splits.z : s.splits.w;
+    float start = k == 0 ? frame.clip.x : k == 1 ? s.splits.x : k == 2 ? s.splits.y : s.splits.z;
+    float band = (end - start) * s.params.z;
+    if (k < count - 1 && band > 0.0 && z > end - band) t = saturate((z - (end - band)) / band);
     return k;
   }
   return 0;
@@ -249,7 +270,7 @@ float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
   float t;
   int v = shadow_view_at(light, s, kind, p, t);
   if (v < 0) return 1.0;
-  float ndl = dot(n, l), vis = 1.0;
+  float ndl = dot(n, l), tan_tilt = shadow_tilt(ndl), vis = 1.0; // the same for both lookups
   // Both lookups in a loop that tests at its end, not the second in an if: a
   // software rasterizer leaves such a loop once no pixel of its group goes on,
   // but runs both sides of every if.
@@ -257,7 +278,8 @@ float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
   do {
     vec4 clip;
     ShadowView sv = shadow_view_of(light, s, kind, v + j, p, clip);
-    vis = mix(vis, shadow_view_lookup(sv, clip, s, p, ndl), j == 0 ? 1.0 : t);
+    float lit = shadow_view_lookup(sv, shadow_perspective(kind), clip, s, p, ndl, tan_tilt);
+    vis = mix(vis, lit, j == 0 ? 1.0 : t);
   } while (++j < (t > 0.0 ? 2 : 1));
   return vis;
 }
@@ -284,13 +306,14 @@ vec3 shadow_transmittance_as(int light, int kind, vec3 p) {
   vec3 ndc = ls.xyz / ls.w;
   vec2 tuv = ndc.xy * 0.5 + 0.5;
   if (any(lessThan(tuv, vec2(0.0))) || any(greaterThan(tuv, vec2(1.0)))) return vec3(1.0);
-  float r = sv.depth.w > 0.0 ? length(p - sv.depth.xyz) * sv.depth.w : ndc.z * 0.5 + 0.5;
+  bool perspective = shadow_perspective(kind);
+  float r = perspective ? length(p - sv.depth.xyz) * sv.depth.w : ndc.z * 0.5 + 0.5;
   vec2 size = vec2(textureSize(shadow_transmit, 0));
   ivec2 lo = ivec2(sv.rect.xy * size + 0.5), hi = ivec2((sv.rect.xy + sv.rect.zw) * size + 0.5) - 1;
   vec2 texel = (sv.rect.xy + tuv * sv.rect.zw) * size - 0.5;
   ivec2 base = ivec2(floor(texel));
   vec2 f = texel - vec2(base);
-  float bias = s.params.y * shadow_texel_depth(sv, r);
+  float bias = s.params.y * shadow_texel_depth_as(sv, r, perspective);
   vec3 c[4];
   for (int k = 0; k < 4; k++) {
     vec4 tr = texelFetch(shadow_transmit, clamp(base + ivec2(k & 1, k >> 1), lo, hi), 0);
