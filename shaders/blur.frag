@@ -35,15 +35,13 @@ uniform float narrow = 0.25; // the reach shrinks as n^-narrow (temporal.narrow)
 
 out vec4 dst;
 
-// The tap at q's weight beside the Gaussian's; d: its depth (DEPTH), which
-// the centre's plane expects at `expected`.
-float weight_at(ivec2 q, float d, float z, float expected) {
+float weight_at(ivec2 q, float z, float expected) {
   float w = 1.0;
 #ifdef MASK
   w *= step(0.5, texelFetch(mask, q, 0).a);
 #endif
 #ifdef DEPTH
-  float dz = (d - expected) / (max(z, 1e-12) * DEPTH_TOLERANCE);
+  float d = texelFetch(depth, q, 0).r, dz = (d - expected) / (max(z, 1e-12) * DEPTH_TOLERANCE);
   w *= exp(-dz * dz);
 #ifndef MASK
   w *= d > 0.0 ? 1.0 : 0.0;
@@ -51,25 +49,6 @@ float weight_at(ivec2 q, float d, float z, float expected) {
 #endif
   return w;
 }
-
-// Tap i of the Gaussian (i != 0, depth d), added to sum and its weight to wsum.
-void add_tap(ivec2 p, int i, float d, ivec2 last, float z, float slope, float inv2s2, inout vec4 sum,
-             inout float wsum) {
-  ivec2 q = clamp(p + axis * i, ivec2(0), last);
-  float w = exp(-float(i * i) * inv2s2) * weight_at(q, d, z, z + float(i) * slope);
-  sum += w * texelFetch(src, q, 0);
-  wsum += w;
-}
-
-#ifdef DEPTH
-// The depths of taps i and i + 1 in one gather at the corner they share
-// (clamped at the border, as the taps are): a gather costs about a fetch.
-vec2 depth_pair(ivec2 p, int i) {
-  vec2 corner = vec2(p + axis * (i + 1) + (ivec2(1) - axis)) / vec2(textureSize(depth, 0));
-  vec4 g = textureGather(depth, corner, 0); // w: (i0, j0), z: (i1, j0), x: (i0, j1)
-  return vec2(g.w, axis.x == 1 ? g.z : g.x);
-}
-#endif
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy), last = textureSize(src, 0) - 1;
@@ -90,37 +69,24 @@ void main() {
   }
   float z = 0.0, slope = 0.0;
 #ifdef DEPTH
-  vec2 below = depth_pair(p, -1), above = depth_pair(p, 1); // taps -1, 0 and 1, 2
-  z = below.y;
-  float ahead = above.x - z, behind = z - below.x;
+  z = texelFetch(depth, p, 0).r;
+  float ahead = texelFetch(depth, clamp(p + axis, ivec2(0), last), 0).r - z;
+  float behind = z - texelFetch(depth, clamp(p - axis, ivec2(0), last), 0).r;
   slope = abs(ahead) < abs(behind) ? ahead : behind;
 #endif
-  float wsum = weight_at(p, z, z, z); // the centre's tap, fetched once
+  float wsum = weight_at(p, z, z); // the centre's tap, fetched once
   if (wsum == 0.0) {
     dst = centre;
     return;
   }
   float sigma = 0.5 * reach, inv2s2 = 0.5 / (sigma * sigma);
   vec4 sum = wsum * centre;
-  // Two loops around the centre: a `continue` at i = 0 would still cost a
-  // tap's reads, which a software rasterizer makes under a mask. With DEPTH
-  // the taps go in pairs, one gather of depths each.
-#ifdef DEPTH
-  for (int i = -taps; i < 0; i += 2) {
-    vec2 d = depth_pair(p, i);
-    add_tap(p, i, d.x, last, z, slope, inv2s2, sum, wsum);
-    if (i + 1 < 0) add_tap(p, i + 1, d.y, last, z, slope, inv2s2, sum, wsum);
+  for (int i = -taps; i <= taps; i++) {
+    if (i == 0) continue;
+    ivec2 q = clamp(p + axis * i, ivec2(0), last);
+    float w = exp(-float(i * i) * inv2s2) * weight_at(q, z, z + float(i) * slope);
+    sum += w * texelFetch(src, q, 0);
+    wsum += w;
   }
-  add_tap(p, 1, above.x, last, z, slope, inv2s2, sum, wsum);
-  if (taps >= 2) add_tap(p, 2, above.y, last, z, slope, inv2s2, sum, wsum);
-  for (int i = 3; i <= taps; i += 2) {
-    vec2 d = depth_pair(p, i);
-    add_tap(p, i, d.x, last, z, slope, inv2s2, sum, wsum);
-    if (i + 1 <= taps) add_tap(p, i + 1, d.y, last, z, slope, inv2s2, sum, wsum);
-  }
-#else
-  for (int i = -taps; i < 0; i++) add_tap(p, i, 0.0, last, z, slope, inv2s2, sum, wsum);
-  for (int i = 1; i <= taps; i++) add_tap(p, i, 0.0, last, z, slope, inv2s2, sum, wsum);
-#endif
   dst = wsum > 0.0 ? sum / wsum : centre; // the centre tap has weight 1
 }
