@@ -108,6 +108,20 @@ bool rsm_blocked(vec3 p, vec3 q, sampler2D dpt) {
   return false;
 }
 
+// Where x falls in RSM view sv (atlas: the RSM atlas' size): false outside
+// the view or behind its eye; else its normalized device coordinates, its
+// tile coordinates t (0..1) and the texel there (rsm_pos: the sender's
+// position, w > 0 where the texel is empty).
+bool rsm_view_texel(ShadowView sv, vec3 x, vec2 atlas, out vec3 ndc, out vec2 t, out vec4 qn) {
+  vec4 c = sv.view_proj * vec4(x, 1.0);
+  ndc = c.xyz / max(c.w, 1e-12);
+  t = ndc.xy * 0.5 + 0.5;
+  qn = vec4(0.0, 0.0, 0.0, 1.0);
+  if (c.w <= 1e-12 || any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) return false;
+  qn = texelFetch(rsm_pos, ivec2((sv.rect.xy + t * sv.rect.zw) * atlas), 0);
+  return true;
+}
+
 // Is x in the shadow of every light whose RSM views hold it, by those views
 // (and of one at least): the sender its texel holds lies nearer the light
 // than x (by 2% of the light's distance for a spot or point light, 1% of the
@@ -125,13 +139,11 @@ bool rsm_shadowed(vec3 x) {
     bool shadowed = false, inside = false;
     for (int v = first; v < first + count && !inside; v++) {
       ShadowView sv = shadow_views[v];
-      vec4 c = sv.view_proj * vec4(x, 1.0);
-      if (c.w <= 1e-12) continue;
-      vec3 ndc = c.xyz / c.w;
-      vec2 t = ndc.xy * 0.5 + 0.5;
-      if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
+      vec3 ndc;
+      vec2 t;
+      vec4 qn;
+      if (!rsm_view_texel(sv, x, atlas, ndc, t, qn)) continue;
       inside = true;
-      vec4 qn = texelFetch(rsm_pos, ivec2((sv.rect.xy + t * sv.rect.zw) * atlas), 0);
       if (qn.w > 0.0) continue; // empty: nothing between x and the light
       vec4 cq = sv.view_proj * vec4(qn.xyz, 1.0);
       shadowed = sv.depth.w > 0.0 ? distance(x, sv.depth.xyz) > 1.02 * distance(qn.xyz, sv.depth.xyz)
@@ -161,13 +173,10 @@ bool rsm_meets(vec3 p, vec3 w, float t0, float t1) {
       ShadowLight sl = shadow_lights[i];
       for (int v = sl.cube.y; v < sl.cube.y + sl.cube.z; v++) {
         ShadowView sv = shadow_views[v];
-        vec4 c = sv.view_proj * vec4(x, 1.0);
-        if (c.w <= 1e-12) continue;
-        vec3 ndc = c.xyz / c.w;
-        vec2 t = ndc.xy * 0.5 + 0.5;
-        if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
-        vec4 qn = texelFetch(rsm_pos, ivec2((sv.rect.xy + t * sv.rect.zw) * atlas), 0);
-        if (qn.w > 0.0) continue; // empty
+        vec3 ndc;
+        vec2 t;
+        vec4 qn;
+        if (!rsm_view_texel(sv, x, atlas, ndc, t, qn) || qn.w > 0.0) continue; // outside, or empty
         vec4 cq = sv.view_proj * vec4(qn.xyz, 1.0);
         bool behind = sv.depth.w > 0.0 ? distance(x, sv.depth.xyz) > distance(qn.xyz, sv.depth.xyz)
                                        : ndc.z > cq.z / max(cq.w, 1e-12);
