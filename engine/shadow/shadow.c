@@ -495,13 +495,6 @@ static void plan_light(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
     if (faces & 1 << f) plan_perspective(plan, tile, pos, cube_faces[f], GLM_PI_2f, range);
 }
 
-/* The least power of two at or above n (n > 0; 0 stays 0). */
-static int power_of_two_up(int n) {
-  int p = 1;
-  while (n > 0 && p < n) p *= 2;
-  return n > 0 ? p : 0;
-}
-
 /* Places n tiles of size[v] texels a side in cells of `tile` texels: largest first, each in a free square of its size, else in the
  * smallest larger one split into quadrants (the three it does not take stay
  * free), else in a new cell. Sizes are the cell halved whole times, so the
@@ -661,12 +654,6 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
   free(size);
   plan->columns = cells ? (int)ceil(sqrt((double)cells)) : 0;
   plan->rows = cells ? (cells + plan->columns - 1) / plan->columns : 0;
-  /* Sides of a power of two: llvmpipe compiles every shader that samples the
-   * atlas anew for a texture whose side changes from a power of two to
-   * another size or back (its sampler code is keyed on it), a 1.3 s stall in
-   * office's walk when its cells went from 4 x 4 to 4 x 3; such a grid costs
-   * spare cells instead (37 tiles of 512: 4096 x 4096 against 3584 x 3072). */
-  plan->columns = power_of_two_up(plan->columns), plan->rows = power_of_two_up(plan->rows);
   int max = 16384;
   while (cells && plan->tile > 1 && (plan->tile * plan->columns > max || plan->tile * plan->rows > max)) plan->tile /= 2;
   plan->atlas_width = plan->tile * plan->columns;
