@@ -161,6 +161,17 @@ typedef struct motion {
   int moved;             /* timed frames whose camera is not the previous one's */
 } motion;
 
+/* What the scene's meshes share and the copies made of them at load
+ * (issue 33: instanced draws, simplified casters and camera copies). */
+typedef struct mesh_figures {
+  int meshes, nodes;           /* meshes, and the mesh nodes drawing them */
+  int shared, shared_nodes;    /* meshes drawn by two nodes or more, and those nodes (instanced draws) */
+  int casters, lods;           /* meshes with simplified copies for shadow tiles, for the camera */
+  long triangles;              /* of every mesh once */
+  long caster_triangles, lod_triangles; /* of those meshes' coarsest copies, and of the meshes themselves */
+  long caster_full, lod_full;
+} mesh_figures;
+
 typedef struct bench {
   int sizes[MAX_SIZES][2], size_count, frames, warmup;
   limn_common_args common; /* --scene, --script, --tech, --set (--sizes is bench's own) */
@@ -191,6 +202,7 @@ typedef struct bench {
    * most GPU memory the driver reported in use (MiB; -1: it reports none). */
   double start_ms, load_ms, first_frame_ms, gpu_mib;
   long first_frame_rss_kib;
+  mesh_figures meshes;
 } bench;
 
 static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("bench", fmt, arg); }
@@ -623,6 +635,38 @@ static bool cpu_pass_ms(const bench *b, int s, double *ms) {
   return any;
 }
 
+static mesh_figures count_meshes(const lm_scene *s) {
+  mesh_figures f = {.meshes = s->mesh_count};
+  int *users = lm_alloc(sizeof *users * (size_t)(s->mesh_count + 1));
+  memset(users, 0, sizeof *users * (size_t)(s->mesh_count + 1));
+  for (int i = 0; i < s->node_count; i++)
+    if (s->nodes[i].mesh >= 0 && s->nodes[i].mesh < s->mesh_count) users[s->nodes[i].mesh]++, f.nodes++;
+  for (int m = 0; m < s->mesh_count; m++) {
+    const lm_scene_mesh *mesh = &s->meshes[m];
+    long tris = mesh->index_count / 3;
+    f.triangles += tris;
+    if (users[m] > 1) f.shared++, f.shared_nodes += users[m];
+    if (mesh->caster_levels > 0)
+      f.casters++, f.caster_full += tris, f.caster_triangles += mesh->casters[mesh->caster_levels - 1].count / 3;
+    if (mesh->lod_levels > 0)
+      f.lods++, f.lod_full += tris, f.lod_triangles += mesh->lods[mesh->lod_levels - 1].count / 3;
+  }
+  free(users);
+  return f;
+}
+
+static double share(long part, long whole) { return whole > 0 ? 100.0 * (double)part / (double)whole : 0; }
+
+static void print_meshes(const mesh_figures *f) {
+  printf("meshes: %d (%ld triangles) for %d mesh nodes; %d drawn by several nodes (%d nodes: one instanced draw a "
+         "run of one mesh and material)\n", f->meshes, f->triangles, f->nodes, f->shared, f->shared_nodes);
+  printf("  simplified copies (meshoptimizer, made at load; level k errs by at most %.4g%% x 4^k of its mesh's "
+         "extent): for shadow tiles of %d of the meshes (the coarsest %.1f%% of their triangles), for the camera of %d "
+         "(%.1f%%)\n",
+         100.0 * LM_LOD_ERROR, f->casters, share(f->caster_triangles, f->caster_full), f->lods,
+         share(f->lod_triangles, f->lod_full));
+}
+
 static void print_tables(const bench *b, lm_clock clock) {
   printf("peak memory: %.1f MiB resident (getrusage ru_maxrss, the whole run; with llvmpipe GPU memory is in it)\n",
          (double)peak_rss_kib() / 1024);
@@ -631,6 +675,7 @@ static void print_tables(const bench *b, lm_clock clock) {
          (double)b->first_frame_rss_kib / 1024);
   if (b->gpu_mib >= 0) printf("GPU memory: %.1f MiB in use at most (the driver's GL_NVX_gpu_memory_info, whole GPU)\n", b->gpu_mib);
   else printf("GPU memory: not reported by this driver (llvmpipe's textures and buffers are in the resident memory)\n");
+  print_meshes(&b->meshes);
   printf("frame (wall clock, glFinish before and after) and compositor overhead (CPU: Lua + graph compile);\n"
          "passes: clock %s; medians of %d frames after %d warm-up\n", lm_clock_name(clock), b->frames, b->warmup);
   printf("  %-12s %10s %12s %12s %9s\n", "size", "pixels", "frame ms", "overhead ms", "overhead");
@@ -1075,6 +1120,11 @@ static void print_json(const bench *b, lm_clock clock) {
   printf(", \"peak_rss_kib\": %ld, \"first_frame_ms\": %.6g, \"load_ms\": %.6g, \"first_frame_rss_kib\": %ld",
          peak_rss_kib(), b->first_frame_ms, b->load_ms, b->first_frame_rss_kib);
   if (b->gpu_mib >= 0) printf(", \"gpu_memory_mib\": %.6g", b->gpu_mib);
+  const mesh_figures *mf = &b->meshes;
+  printf(", \"meshes\": {\"count\": %d, \"triangles\": %ld, \"nodes\": %d, \"shared\": %d, \"shared_nodes\": %d, "
+         "\"caster_copies\": %d, \"caster_coarsest_share\": %.6g, \"camera_copies\": %d, \"camera_coarsest_share\": %.6g}",
+         mf->meshes, mf->triangles, mf->nodes, mf->shared, mf->shared_nodes, mf->casters,
+         share(mf->caster_triangles, mf->caster_full) / 100, mf->lods, share(mf->lod_triangles, mf->lod_full) / 100);
   printf(", \"frames\": %d, \"warmup\": %d, \"sizes\": [", b->frames, b->warmup);
   for (int s = 0; s < b->size_count; s++) {
     printf("%s{\"width\": %d, \"height\": %d, \"frame_ms\": %.6g, \"overhead_ms\": %.6g", s ? ", " : "",
@@ -1277,6 +1327,7 @@ int limn_bench(int argc, char **argv) {
     ok = run_size(&b, v, SERIES_LIGHTS, scene, pipe, &used, &err) &&
          run_size(&b, v, SERIES_LIGHTS_ALL, scene, pipe, &used, &err);
   }
+  if (ok) b.meshes = count_meshes(scene); /* after a frame: the copies are made by then (lm_scene_upload) */
   if (ok && m->on) ok = run_motion(&b, scene, &err);
   if (ok) ok = calibrate(&b, scene, &err);
   if (ok && b.trace) trace_figures(&b, scene);

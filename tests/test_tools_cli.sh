@@ -102,8 +102,14 @@ check "bench peak memory" out_has '"peak_rss_kib": '
 # The scene is read before the first frame ends, and the peak memory by then is within the run's.
 check "bench time to first frame" python3 -c 'import json, sys; d = json.load(open(sys.argv[1]))
 sys.exit(not (0 <= d["load_ms"] < d["first_frame_ms"] and 0 < d["first_frame_rss_kib"] <= d["peak_rss_kib"]))' "$tmp/out"
+# The built-in Cornell box: six meshes for seven nodes, its two boxes one mesh drawn instanced; none large
+# enough for simplified copies (LM_LOD_MIN_TRIANGLES).
+check "bench meshes" python3 -c 'import json, sys; m = json.load(open(sys.argv[1]))["meshes"]
+sys.exit(not (m["count"] == 6 and m["nodes"] == 7 and m["shared"] == 1 and m["shared_nodes"] == 2
+              and m["caster_copies"] == 0 and m["camera_copies"] == 0))' "$tmp/out"
 check "bench table" run 0 bench --sizes 32x24,64x48 --frames 1 --warmup 0
 check "bench table names the fit" out_has "fit: a ms + b ns/pixel"
+check "bench table names the meshes" out_has "meshes: 6 (22 triangles) for 7 mesh nodes; 1 drawn by several nodes"
 check "bench cpu pass" run 0 bench --scene cornell_mirror --tech dl --set reflections=true --sizes 32x24 --frames 1 --warmup 0
 check "bench cpu pass ratio" out_has "CPU passes at 32x24: "
 check "bench bad set" run 2 bench --set reflections
