@@ -19,6 +19,14 @@
 // isr.bounces) the last step's newest bounce at p goes on as a geometric
 // series (later_bounces), in the last step alone (LAST): each step adds one
 // bounce, so a series in every step would count the later bounces twice.
+// TRACE (rsm.trace): the unseen rays are every ray the march lost, and one
+// of them was traced (isr_trace.frag: `traced`, the light its hit sends on,
+// k_d albedo E1 there; `traced_albedo`, that k_d albedo): each brings that
+// light, grown from the second bounce to this step's as the light of the
+// pixel's senders grew (their light of the last step over their first:
+// 1 at the second step), and the series' ratio counts the hit's albedo for
+// them. Where the screen shows no sender (the Cornell box's tall box, its
+// face toward the open side) the second bounce is the traced one.
 #include "gbuffer.glsl"
 #ifdef TEMPORAL
 #include "temporal.glsl"
@@ -50,6 +58,10 @@ uniform sampler2D hits4;
 uniform sampler2D hits5;
 #endif
 uniform int samples = 4;
+#ifdef TRACE
+uniform sampler2D traced, traced_albedo; // isr_trace.frag's outputs, the output's size
+vec3 gathered_first = vec3(0.0); // what the sending rays' senders sent of the first step's E
+#endif
 
 layout(location = 0) out vec4 isr;
 #ifdef TEMPORAL_NEXT
@@ -67,6 +79,9 @@ void send(float hit, int width, inout vec3 gathered, inout vec3 albedo) {
   vec3 rho = texelFetch(mat, q, 0).y * texelFetch(clr, q, 0).rgb;
   gathered += rho * e;
   albedo += rho;
+#ifdef TRACE
+  gathered_first += rho * texelFetch(first, min(q / STRIDE, textureSize(first, 0) - 1), 0).rgb;
+#endif
 }
 
 #ifdef UNSEEN
@@ -157,13 +172,23 @@ void main() {
   // nothing), so nothing is made up where the march knows no ray's fate. The mean over the sending rays
   // alone, or p's own reflected first bounce where none sends, took more from POV-Ray's figure than they
   // gave to Cycles' on the reference set (docs/gi-combined.md).
+#ifdef TRACE
+  // The senders' light grew from the first step's by this factor (at most the series' bound: 10).
+  vec3 grown = mix(vec3(1.0), gathered / max(gathered_first, vec3(1e-30)), greaterThan(gathered_first, vec3(1e-20)));
+  vec3 second = (gathered + rays.y * texelFetch(traced, px, 0).rgb * clamp(grown, 1.0, 10.0)) / float(n);
+#else
   vec3 second = (gathered + rays.y * gathered / max(float(n) - rays.y, 1.0)) / float(n);
+#endif
 #ifdef LAST
   // The newest bounce at p: this step's bounces beyond the first less the last step's (its E less the
   // first's), no less than 0 (the rays' noise); at the second step the second bounce itself.
   vec3 newest = max(second - (texelFetch(previous, px, 0).rgb - e.rgb), vec3(0.0));
+#ifdef TRACE
+  second += later_bounces(newest, (albedo + rays.y * texelFetch(traced_albedo, px, 0).rgb) / float(n));
+#else
   float known = float(n) - rays.y;
   second += later_bounces(newest, known > 0.0 ? albedo / known : vec3(0.0));
+#endif
 #endif
   isr = vec4(e.rgb + finite_or_zero(second), e.a);
 #else
