@@ -22,11 +22,12 @@
 // TRACE (rsm.trace): the unseen rays are every ray the march lost, and one
 // of them was traced (isr_trace.frag: `traced`, the light its hit sends on,
 // k_d albedo E1 there; `traced_albedo`, that k_d albedo): each brings that
-// light, grown from the second bounce to this step's as the light of the
-// pixel's senders grew (their light of the last step over their first:
-// 1 at the second step), and the series' ratio counts the hit's albedo for
-// them. Where the screen shows no sender (the Cornell box's tall box, its
-// face toward the open side) the second bounce is the traced one.
+// light, the hit's second bounce, at every step (its later bounces are not
+// known: grown as the pixel's senders' light grew over the steps, the
+// room's views overshot against both references, docs/gi-combined.md), and
+// the series' ratio counts the hit's albedo for them. Where the screen shows
+// no sender (the Cornell box's tall box, its face toward the open side) the
+// second bounce is the traced one.
 #include "gbuffer.glsl"
 #ifdef TEMPORAL
 #include "temporal.glsl"
@@ -60,7 +61,6 @@ uniform sampler2D hits5;
 uniform int samples = 4;
 #ifdef TRACE
 uniform sampler2D traced, traced_albedo; // isr_trace.frag's outputs, the output's size
-vec3 gathered_first = vec3(0.0); // what the sending rays' senders sent of the first step's E
 #endif
 
 layout(location = 0) out vec4 isr;
@@ -79,9 +79,6 @@ void send(float hit, int width, inout vec3 gathered, inout vec3 albedo) {
   vec3 rho = texelFetch(mat, q, 0).y * texelFetch(clr, q, 0).rgb;
   gathered += rho * e;
   albedo += rho;
-#ifdef TRACE
-  gathered_first += rho * texelFetch(first, min(q / STRIDE, textureSize(first, 0) - 1), 0).rgb;
-#endif
 }
 
 #ifdef UNSEEN
@@ -173,9 +170,7 @@ void main() {
   // alone, or p's own reflected first bounce where none sends, took more from POV-Ray's figure than they
   // gave to Cycles' on the reference set (docs/gi-combined.md).
 #ifdef TRACE
-  // The senders' light grew from the first step's by this factor (at most the series' bound: 10).
-  vec3 grown = mix(vec3(1.0), gathered / max(gathered_first, vec3(1e-30)), greaterThan(gathered_first, vec3(1e-20)));
-  vec3 second = (gathered + rays.y * texelFetch(traced, px, 0).rgb * clamp(grown, 1.0, 10.0)) / float(n);
+  vec3 second = (gathered + rays.y * texelFetch(traced, px, 0).rgb) / float(n);
 #else
   vec3 second = (gathered + rays.y * gathered / max(float(n) - rays.y, 1.0)) / float(n);
 #endif
