@@ -283,7 +283,7 @@ function isr.render(direct, o, frame)
       if unseen then
         defines.UNSEEN, defines.LAST, params.bounces, params.steps = unseen, b == steps, light.rsm.bounces, steps
       end
-      if traced then from.traced, from.traced_albedo, defines.TRACE = traced[1], traced[2], true end
+      if traced then from.traced, from.traced_albedo, defines.TRACE, params.step = traced[1], traced[2], true, b end
       E = kept and b == steps and o.blur == 0 and kept.value or coarse_target("isr.e" .. b, f)
       local out = { E }
       with_history(from, defines, params, out, b == steps)

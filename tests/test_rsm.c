@@ -798,8 +798,9 @@ static void more_bounces_light_a_ceiling_more_and_stay_bounded(void **state) {
  * of the rays the screen followed, here none: the second bounce adds
  * nothing. Traced, they bring the light the walls, floor and ceiling they
  * meet send on (their first bounce off the patch): the wall gains by more
- * than a tenth at two bounces, grows with bounces and stays within the
- * albedo's bound over one bounce (64 bounces: finite). With rsm.trace 0 the
+ * than a tenth at two bounces, grows with bounces (and with four screen
+ * steps, at each of which the traced light grows as the series does) and
+ * stays within the albedo's bound over one bounce. With rsm.trace 0 the
  * frame has no ray target. */
 static void traced_rays_bring_a_second_bounce_where_the_screen_shows_no_sender(void **state) {
   (void)state;
@@ -809,14 +810,16 @@ static void traced_rays_bring_a_second_bounce_where_the_screen_shows_no_sender(v
   glm_rotate(m, glm_rad(90.0f), (vec3){0, 1, 0}); /* -Z of the node: -x */
   memcpy(s->nodes[s->cameras[0].node].local, m, sizeof m);
   lm_scene_update(s);
-  static const char *const cases[][4] = {
-      {"rsm.bounces=1", "rsm.trace=0"}, {"rsm.bounces=2", "rsm.trace=0"}, {"rsm.bounces=2", "rsm.trace=1"},
-      {"rsm.bounces=8", "rsm.trace=1"}, {"rsm.bounces=64", "rsm.trace=1"},
+  static const char *const cases[][3] = {
+      {"rsm.bounces=1", "rsm.trace=0", "isr.bounces=2"}, {"rsm.bounces=2", "rsm.trace=0", "isr.bounces=2"},
+      {"rsm.bounces=2", "rsm.trace=1", "isr.bounces=2"}, {"rsm.bounces=8", "rsm.trace=1", "isr.bounces=2"},
+      {"rsm.bounces=64", "rsm.trace=1", "isr.bounces=2"}, {"rsm.bounces=4", "rsm.trace=1", "isr.bounces=4"},
+      {"rsm.bounces=64", "rsm.trace=1", "isr.bounces=4"},
   };
   enum { N = sizeof cases / sizeof *cases };
   float c[N];
   for (int k = 0; k < N; k++) {
-    const char *const sets[] = {"ambient=0", cases[k][0], cases[k][1], NULL};
+    const char *const sets[] = {"ambient=0", cases[k][0], cases[k][1], cases[k][2], NULL};
     gl_result r = render_ok(s, "isr+rsm+esm", sets);
     assert_true(gl_all_finite(&r));
     float rgb[3];
@@ -826,12 +829,14 @@ static void traced_rays_bring_a_second_bounce_where_the_screen_shows_no_sender(v
     assert_true((lm_graph_find_target(lm_renderer_graph(r.renderer), "isr.rays_o") >= 0) == traced);
     gl_result_free(&r);
   }
-  print_message("the wall: 1 bounce %.5f, 2 %.5f, traced 2 %.5f, 8 %.5f, 64 %.5f\n", c[0], c[1], c[2], c[3], c[4]);
+  print_message("the wall: 1 bounce %.5f, 2 %.5f, traced 2 %.5f, 8 %.5f, 64 %.5f; 4 screen steps, 4 %.5f, 64 %.5f\n",
+                c[0], c[1], c[2], c[3], c[4], c[5], c[6]);
   assert_true(c[0] > 1e-3f);
   assert_true(c[1] < 1.02f * c[0]); /* nothing on screen sends: no second bounce without tracing */
   assert_true(c[2] > 1.1f * c[1]);
-  assert_true(c[3] >= c[2] && c[4] >= c[3]);
-  assert_true(c[4] <= 1.001f * c[0] / (1 - 0.8f));
+  assert_true(c[3] >= c[2] && c[4] >= c[3] && c[5] >= c[2] && c[6] >= c[5]);
+  assert_true(c[4] <= 1.001f * c[0] / (1 - 0.8f) && c[6] <= 1.001f * c[0] / (1 - 0.8f));
+  assert_true(fabsf(c[6] - c[4]) < 0.05f * c[4]); /* 64 bounces alike whether steps or the series carry 3, 4 */
   lm_scene_destroy(s);
 }
 
