@@ -322,7 +322,8 @@ function isr.render(direct, o, frame)
       with_history(inputs, defines, params, out, b == steps)
       if rays and b == 1 and #out > 8 then
         error(string.format("rsm.trace: the march would write %d targets, at most 8 (its rays take two): lower "
-                            .. "isr.samples (%d) or turn isr.temporal off", #out, o.samples), 2)
+                            .. "isr.samples (%d)%s", #out, o.samples,
+                            o.temporal.enabled and " or turn isr.temporal off" or ""), 2)
       end
       pass{ name, shader = "isr_march.frag", inputs = inputs, params = params, defines = defines, out = out,
             fetches = fetches }

@@ -906,6 +906,13 @@ static void bad_options_name_themselves(void **state) {
       {"isr+rsm+esm", "isr.mode=seed", "isr+rsm+esm needs isr.mode \"physical\""},
   };
   gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
+  /* The traced rays' two outputs beside 24 rays' hits: more than the march may write, named. */
+  const char *const sets[] = {"rsm.trace=1", "isr.samples=24", NULL};
+  gl_result r = gl_render(&(gl_run){.tech = "isr+rsm+esm", .sets = sets});
+  assert_false(r.ok);
+  assert_non_null(strstr(r.err.msg, "pp.lua:"));
+  assert_non_null(strstr(r.err.msg, "rsm.trace: the march would write 10 targets"));
+  gl_result_free(&r);
 }
 
 /* Gives the closed room's floor (its first quad) a material of its own, the
