@@ -263,6 +263,10 @@ function isr.render(direct, o, frame)
   -- rsm.bounces above 1: the march marks the rays that met surfaces the screen cannot show with this
   -- hit value (under 0.5: no sender), the recorded-senders bounce counts them (isr_bounce.frag's UNSEEN)
   local unseen = hits > 0 and light.rsm and light.rsm.bounces > 1 and 0.25 or nil
+  -- rsm.trace: the march also writes one ray a pixel the screen lost, the CPU traces it, a pass lights
+  -- its hit (isr.trace_light), and the recorded-senders bounce sends that light on for the lost rays
+  local trace = unseen and light.rsm.trace > 0
+  local rays, traced
   for b = 1, steps do
     local inputs = gbuffer.inputs(C)
     inputs.previous = E
@@ -279,6 +283,7 @@ function isr.render(direct, o, frame)
       if unseen then
         defines.UNSEEN, defines.LAST, params.bounces, params.steps = unseen, b == steps, light.rsm.bounces, steps
       end
+      if traced then from.traced, from.traced_albedo, defines.TRACE, params.step = traced[1], traced[2], true, b end
       E = kept and b == steps and o.blur == 0 and kept.value or coarse_target("isr.e" .. b, f)
       local out = { E }
       with_history(from, defines, params, out, b == steps)
@@ -300,6 +305,13 @@ function isr.render(direct, o, frame)
       end
       local defines, params = { BOUNCE = b > 1, Z = b == 1, HITS = H and hits or nil, STRIDE = C.stride }, march_params(o)
       defines.UNSEEN = H and unseen or nil
+      if b == 1 and trace then
+        rays = { target{ "isr.rays_o", format = "rgba32f", scale = 1 / f },
+                 target{ "isr.rays_d", format = "rgba32f", scale = 1 / f } }
+        defines.TRACE = #out -- the location after the hits
+        out[#out + 1] = rays[1]
+        out[#out + 1] = rays[2]
+      end
       local fetches = 4 + o.samples * (o.steps + (b > 1 and 6 or 5)) -- the march, and the hit's G-buffer and light
       if light.rsm and b == 1 then
         fetches = fetches + light.rsm.bind(inputs, defines, params, f, o.temporal.enabled)
@@ -308,13 +320,38 @@ function isr.render(direct, o, frame)
         inputs.first_step, inputs.sender, defines.FIRST = first, nil, true
       end
       with_history(inputs, defines, params, out, b == steps)
+      if rays and b == 1 and #out > 8 then
+        error(string.format("rsm.trace: the march would write %d targets, at most 8 (its rays take two): lower "
+                            .. "isr.samples (%d)%s", #out, o.samples,
+                            o.temporal.enabled and " or turn isr.temporal off" or ""), 2)
+      end
       pass{ name, shader = "isr_march.frag", inputs = inputs, params = params, defines = defines, out = out,
             fetches = fetches }
+      if rays then traced = isr.trace(rays, G, f, light.rsm) end
     end
   end
   E = temporal.clamp("isr", history, E)
   E = isr.blur(E, C, f, o.blur, history and history.state, kept and kept.value, o.temporal.narrow)
   return isr.composite(G, direct, C, E, params, seed ~= nil, light.sky)
+end
+
+-- Traces the rays the first march lost (rsm.trace; rays = { origins, directions },
+-- isr_march.frag's TRACE) on the CPU (the engine's "trace", engine/trace) and
+-- lights each hit with its first bounce, the RSM's gather over every sender
+-- (light.rsm.bind_all; isr_trace.frag). Returns { light, albedo }: what each
+-- hit sends on and its k_d albedo, coarse targets of factor f.
+function isr.trace(rays, G, f, rsm)
+  local function coarse(name, format) return target{ name, format = format, scale = 1 / f } end
+  local H = { clr = coarse("isr.hit_clr", "rgba8"), nrm = coarse("isr.hit_nrm", "rgba16f"),
+              pos = coarse("isr.hit_pos", "rgba32f"), mat = coarse("isr.hit_mat", "rgba8") }
+  cpu{ "isr.trace", fn = "trace", inputs = { rays_o = rays[1], rays_d = rays[2] }, out = { H.clr, H.nrm, H.pos, H.mat } }
+  local inputs, defines, params = { hit_clr = H.clr, hit_nrm = H.nrm, hit_pos = H.pos, hit_mat = H.mat,
+                                    rays_o = rays[1], dpt = G.dpt }, {}, {}
+  local fetches = rsm.bind_all(inputs, defines, params, f)
+  local out = { coarse_target("isr.traced", f), coarse_target("isr.traced_albedo", f) }
+  pass{ "isr.trace_light", shader = "isr_trace.frag", inputs = inputs, defines = defines, params = params,
+        out = out, fetches = 5 + fetches }
+  return out
 end
 
 -- A separable Gaussian blur of the coarse result E over the coarse

@@ -48,6 +48,11 @@ rsm.defaults = {
                      -- against the lights' RSM views on its way out of the scene's box, 0..32 (0: none,
                      -- such a ray is open unless p lies under a roof); one that crosses a surface they
                      -- hold met a surface off screen (rsm.bounces above 1 carry light over it)
+  trace = 0,         -- the combined technique, rsm.bounces above 1: rays a coarse pixel traced on the CPU
+                     -- (engine/trace), 0..1 (0: none). One of the rays the screen lost (not seen, inside the
+                     -- scene's box) is traced, its hit lit by its first bounce (the RSM's gather, every
+                     -- sender), and the pixel's rays the screen lost bring that light as their second
+                     -- bounce instead of the mean of the rays it followed (isr_bounce.frag's TRACE)
   rotate = 10,       -- pattern turn a frame in degrees with temporal reuse, 0..180 (the seed: 10;
                      -- its radii shift too); without, the pattern stays (a still camera, a still image)
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
@@ -100,6 +105,7 @@ local rules = {
   steps = options.whole(-1, 32),
   thickness = options.number(0, 16),
   ray_steps = options.whole(0, 32),
+  trace = options.whole(0, 1),
   rotate = options.number(0, 180),
   k = options.number(0, 16),
   bounces = options.whole(1, 64),
@@ -197,8 +203,10 @@ end
 -- The gather as the first march of the frame's lighting takes it (isr.render's
 -- light.rsm; pp.lua's joins = "march"), with options o: { coarse = the RSM's
 -- coarse factor, bind = function(inputs, defines, params, f, temporal_on) that
--- binds it (rsm.bind) and returns its fetches }. With split, the senders the
--- camera sees are the march's. Its temporal reuse is the march's.
+-- binds it (rsm.bind) and returns its fetches, bind_all = the same without temporal
+-- reuse for the gather at the traced hits (rsm.trace: every sender, no visibility test),
+-- bounces, trace }. With split, the senders the camera sees are the march's. Its
+-- temporal reuse is the march's.
 function rsm.march(o, frame)
   o = rsm.check(o, 2)
   local row = frame.technique
@@ -206,10 +214,20 @@ function rsm.march(o, frame)
     error(string.format("%s takes temporal reuse from %s.temporal (one pass gathers both); rsm.temporal is for "
                         .. "rsm's own gather", row[1], row.lighting), 2)
   end
-  return { coarse = o.coarse, bounces = o.bounces, bind = function(inputs, defines, params, f, temporal_on)
-    params.rsm_k = o.k
-    return rsm.bind(inputs, defines, params, frame.R, frame.shadows, o, f, temporal_on, row.split == true, frame.G)
-  end }
+  -- The traced hits lie off screen: every sender counts, and no screen-space visibility.
+  local all = {}
+  for k, v in pairs(o) do all[k] = v end
+  all.steps = 0
+  return { coarse = o.coarse, bounces = o.bounces, trace = o.trace,
+           bind = function(inputs, defines, params, f, temporal_on)
+             params.rsm_k = o.k
+             return rsm.bind(inputs, defines, params, frame.R, frame.shadows, o, f, temporal_on, row.split == true,
+                             frame.G)
+           end,
+           bind_all = function(inputs, defines, params, f)
+             params.rsm_k = o.k
+             return rsm.bind(inputs, defines, params, frame.R, frame.shadows, all, f, false, false, frame.G)
+           end }
 end
 
 return rsm

@@ -19,6 +19,18 @@
 // isr.bounces) the last step's newest bounce at p goes on as a geometric
 // series (later_bounces), in the last step alone (LAST): each step adds one
 // bounce, so a series in every step would count the later bounces twice.
+// TRACE (rsm.trace): the unseen rays are every ray the march lost, and one
+// of them was traced (isr_trace.frag: `traced`, the light its hit sends on,
+// k_d albedo E1 there; `traced_albedo`, that k_d albedo). The series' ratio
+// r counts the hit's albedo for them, and each brings that light grown as
+// the series grows, L (1 + r + ... + r^(step - 2)): the hit's second bounce
+// at the second step, and at the later screen steps the bounces the series
+// would have carried, so that 64 bounces come to the same light whichever
+// of the steps or the series carries bounces 3 and 4 (test_rsm; kept at the
+// second bounce, a face whose rays all leave the screen got no bounce past
+// the second at isr.bounces 4). Where the screen shows no sender (the
+// Cornell box's tall box, its face toward the open side) the second bounce
+// is the traced one.
 #include "gbuffer.glsl"
 #ifdef TEMPORAL
 #include "temporal.glsl"
@@ -50,6 +62,10 @@ uniform sampler2D hits4;
 uniform sampler2D hits5;
 #endif
 uniform int samples = 4;
+#ifdef TRACE
+uniform sampler2D traced, traced_albedo; // isr_trace.frag's outputs, the output's size
+uniform int step = 2;                    // this step (isr.bounces counts them; 1: the march)
+#endif
 
 layout(location = 0) out vec4 isr;
 #ifdef TEMPORAL_NEXT
@@ -157,13 +173,25 @@ void main() {
   // nothing), so nothing is made up where the march knows no ray's fate. The mean over the sending rays
   // alone, or p's own reflected first bounce where none sends, took more from POV-Ray's figure than they
   // gave to Cycles' on the reference set (docs/gi-combined.md).
+#ifdef TRACE
+  // The hit's light after this step's bounces: its second bounce grown as the series grows, 1 + r + ... +
+  // r^(step - 2), r the series' ratio below (1 at the second step; at most 10: bounded)
+  vec3 r_hit = clamp((albedo + rays.y * texelFetch(traced_albedo, px, 0).rgb) / float(n), 0.0, BOUNCE_MAX);
+  vec3 grown = (1.0 - pow(r_hit, vec3(float(max(step, 2) - 1)))) / (1.0 - r_hit); // pow: base >= 0, exponent >= 1
+  vec3 second = (gathered + rays.y * texelFetch(traced, px, 0).rgb * grown) / float(n);
+#else
   vec3 second = (gathered + rays.y * gathered / max(float(n) - rays.y, 1.0)) / float(n);
+#endif
 #ifdef LAST
   // The newest bounce at p: this step's bounces beyond the first less the last step's (its E less the
   // first's), no less than 0 (the rays' noise); at the second step the second bounce itself.
   vec3 newest = max(second - (texelFetch(previous, px, 0).rgb - e.rgb), vec3(0.0));
+#ifdef TRACE
+  second += later_bounces(newest, r_hit);
+#else
   float known = float(n) - rays.y;
   second += later_bounces(newest, known > 0.0 ? albedo / known : vec3(0.0));
+#endif
 #endif
   isr = vec4(e.rgb + finite_or_zero(second), e.a);
 #else

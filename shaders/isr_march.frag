@@ -68,6 +68,14 @@
 // between where it leaves the view and where it leaves the box against the
 // lights' RSM views (rsm.glsl's rsm_meets); one that crosses a surface they
 // hold met it off screen (the street's facades; docs/gi-combined.md).
+// TRACE (rsm.trace; with UNSEEN): every ray the screen lost (not seen, and
+// inside the scene's box where it leaves the view) is UNSEEN, whatever its
+// direction (the tracer, not a guess, says what it meets), and one of them,
+// chosen uniformly (a reservoir over a hash of the pixel and ray), goes to
+// outputs TRACE (origin a little off p along its normal, w 1) and TRACE + 1
+// (direction, w 0: unlimited) for the CPU's "trace" (engine/trace); both 0
+// where none was lost, which the tracer skips. isr_trace.frag lights the
+// hit, isr_bounce.frag sends its light on for the pixel's unseen rays.
 // TEMPORAL (isr.temporal, temporal.glsl): each frame the rays are the next
 // 16 n points of the sequence, and a pixel whose history has converged is
 // not marched: its E is that history (every bounce's sum), which a later
@@ -120,6 +128,19 @@ layout(location = 1) out float z;
 #ifdef TEMPORAL_NEXT
 layout(location = NEXT) out vec4 next;
 layout(location = NEXT + 1) out vec2 next_state; // view depth (0 none), frames seen
+#endif
+#ifdef TRACE
+layout(location = TRACE) out vec4 ray_o;
+layout(location = TRACE + 1) out vec4 ray_d;
+
+// A hash of a pixel and a ray index to [0, 1): the choice among the lost rays.
+float trace_hash(ivec2 px, int i) {
+  uint h = uint(px.x) * 1973u + uint(px.y) * 9277u + uint(i) * 26699u;
+  h = (h ^ (h >> 16u)) * 0x7feb352du;
+  h = (h ^ (h >> 15u)) * 0x846ca68bu;
+  h ^= h >> 16u;
+  return float(h >> 8u) / 16777216.0;
+}
 #endif
 #ifdef HITS
 layout(location = 2) out vec4 hits0;
@@ -230,6 +251,11 @@ void main() {
   hits5 = vec4(0.0);
 #endif
 #endif
+#ifdef TRACE
+  ray_o = vec4(0.0); // no ray: the tracer skips it
+  ray_d = vec4(0.0);
+  float lost = 0.0; // the rays the screen lost so far (the reservoir's count)
+#endif
 #ifdef TEMPORAL_CLAMP
   temporal_fresh = vec4(0.0, 0.0, 0.0, -1.0);
 #endif
@@ -267,7 +293,7 @@ void main() {
   first += temporal_turn() * 16 * n; // this frame's points (below 2^28: no overflow)
 #endif
   vec4 a = frame.view_proj * vec4(s.p, 1.0);
-#ifdef UNSEEN
+#if defined(UNSEEN) && !defined(TRACE)
 #ifdef RSM_GATHER
   // Under a roof: the point straight above p, near the scene box's top, lies in the lights' shadow
   // (halfway up put the blocks' shaded ground under the blocks' shadow; docs/gi-combined.md).
@@ -346,14 +372,26 @@ void main() {
     if (!seen) open += 1.0;
 #ifdef UNSEEN
     float t_box = box_exit(s.p, w);
-#ifdef RAY_STEPS
+#if defined(TRACE)
+    const bool closed = true; // the tracer says what it meets
+#elif defined(RAY_STEPS)
     // An upward ray in the open meets a surface off screen where the lights' RSM views hold one on its
     // way out of the scene's box (rsm.ray_steps; a street's facades, docs/gi-combined.md).
     bool closed = w.y <= 0.0 || roofed || (!seen && t_box > t_end && rsm_meets(s.p, w, t_end, t_box));
 #else
     bool closed = w.y <= 0.0 || roofed;
 #endif
-    if (!seen && i < 4 * HITS && closed && t_box > t_end) record_hit(i, float(UNSEEN));
+    if (!seen && i < 4 * HITS && closed && t_box > t_end) {
+      record_hit(i, float(UNSEEN));
+#ifdef TRACE
+      lost += 1.0;
+      if (trace_hash(px, i) * lost < 1.0) { // kept with chance 1 / lost: each lost ray alike
+        // Off p by a share of its distance to the eye, as the reflection rays (reflect_rays.frag).
+        ray_o = vec4(s.p + s.n * (1e-4 * distance(s.p, frame.camera_pos.xyz)), 1.0);
+        ray_d = vec4(w, 0.0);
+      }
+#endif
+    }
 #endif
   }
   isr = vec4(gathered / float(n), open / float(n));

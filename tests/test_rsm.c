@@ -383,7 +383,8 @@ static void extremes_stay_finite(void **state) {
       {"rsm.samples=1", NULL}, {"rsm.samples=4096", "rsm.coarse=4", NULL}, {"rsm.steps=32", NULL},
       {"rsm.steps=32", "rsm.thickness=16", NULL}, {"rsm.steps=1", "rsm.thickness=0", NULL},
       {"rsm.radius=2", "rsm.reach=64", NULL}, {"rsm.coarse=1", "rsm.blur=0", NULL},
-      {"rsm.ray_steps=32", "rsm.bounces=64", "isr.bounces=4"},
+      {"rsm.ray_steps=32", "rsm.bounces=64", "isr.bounces=4"}, {"rsm.trace=1", "rsm.bounces=64", "isr.bounces=4"},
+      {"rsm.trace=1", "isr.samples=16", "rsm.samples=1"},
   };
   static const char *const vpl_cases[][4] = {
       {"vpl.lights=0", NULL}, {"vpl.lights=4096", "vpl.negative=4096", "vpl.coarse=4", NULL},
@@ -789,6 +790,56 @@ static void more_bounces_light_a_ceiling_more_and_stay_bounded(void **state) {
   }
 }
 
+/* rsm.trace (the Cornell box's tall box, its face toward the open side): a
+ * face the screen shows alone, lit only by bounce light, whose rays all meet
+ * surfaces the screen does not show. The white room's wall opposite the
+ * window (x = -1) fills the view; the sun lights a patch of the floor, which
+ * the screen does not show either. Without tracing, its rays bring the mean
+ * of the rays the screen followed, here none: the second bounce adds
+ * nothing. Traced, they bring the light the walls, floor and ceiling they
+ * meet send on (their first bounce off the patch): the wall gains by more
+ * than a tenth at two bounces, grows with bounces (and with four screen
+ * steps, at each of which the traced light grows as the series does) and
+ * stays within the albedo's bound over one bounce. With rsm.trace 0 the
+ * frame has no ray target. */
+static void traced_rays_bring_a_second_bounce_where_the_screen_shows_no_sender(void **state) {
+  (void)state;
+  lm_scene *s = window_room(0.8f);
+  mat4 m;
+  glm_translate_make(m, (vec3){-0.3f, 0, 0});
+  glm_rotate(m, glm_rad(90.0f), (vec3){0, 1, 0}); /* -Z of the node: -x */
+  memcpy(s->nodes[s->cameras[0].node].local, m, sizeof m);
+  lm_scene_update(s);
+  static const char *const cases[][3] = {
+      {"rsm.bounces=1", "rsm.trace=0", "isr.bounces=2"}, {"rsm.bounces=2", "rsm.trace=0", "isr.bounces=2"},
+      {"rsm.bounces=2", "rsm.trace=1", "isr.bounces=2"}, {"rsm.bounces=8", "rsm.trace=1", "isr.bounces=2"},
+      {"rsm.bounces=64", "rsm.trace=1", "isr.bounces=2"}, {"rsm.bounces=4", "rsm.trace=1", "isr.bounces=4"},
+      {"rsm.bounces=64", "rsm.trace=1", "isr.bounces=4"},
+  };
+  enum { N = sizeof cases / sizeof *cases };
+  float c[N];
+  for (int k = 0; k < N; k++) {
+    const char *const sets[] = {"ambient=0", cases[k][0], cases[k][1], cases[k][2], NULL};
+    gl_result r = render_ok(s, "isr+rsm+esm", sets);
+    assert_true(gl_all_finite(&r));
+    float rgb[3];
+    gl_region(&r, W / 4, H / 4, 3 * W / 4, 3 * H / 4, rgb);
+    c[k] = gl_luminance(rgb);
+    bool traced = cases[k][1][10] == '1';
+    assert_true((lm_graph_find_target(lm_renderer_graph(r.renderer), "isr.rays_o") >= 0) == traced);
+    gl_result_free(&r);
+  }
+  print_message("the wall: 1 bounce %.5f, 2 %.5f, traced 2 %.5f, 8 %.5f, 64 %.5f; 4 screen steps, 4 %.5f, 64 %.5f\n",
+                c[0], c[1], c[2], c[3], c[4], c[5], c[6]);
+  assert_true(c[0] > 1e-3f);
+  assert_true(c[1] < 1.02f * c[0]); /* nothing on screen sends: no second bounce without tracing */
+  assert_true(c[2] > 1.1f * c[1]);
+  assert_true(c[3] >= c[2] && c[4] >= c[3] && c[5] >= c[2] && c[6] >= c[5]);
+  assert_true(c[4] <= 1.001f * c[0] / (1 - 0.8f) && c[6] <= 1.001f * c[0] / (1 - 0.8f));
+  assert_true(fabsf(c[6] - c[4]) < 0.05f * c[4]); /* 64 bounces alike whether steps or the series carry 3, 4 */
+  lm_scene_destroy(s);
+}
+
 /* isr.bounces above 2 in the combined technique: each screen step adds one
  * bounce (isr_bounce.frag again over the recorded senders) and the series of
  * rsm.bounces carries on from the last step's newest bounce, in the last
@@ -838,6 +889,7 @@ static void bad_options_name_themselves(void **state) {
       {"isr+rsm+esm", "rsm.steps=-2", "rsm.steps"},   {"isr+rsm+esm", "rsm.thickness=-0.1", "rsm.thickness"},
       {"rsm+esm", "rsm.thickness=17", "rsm.thickness"},
       {"isr+rsm+esm", "rsm.ray_steps=33", "rsm.ray_steps"}, {"isr+rsm+esm", "rsm.ray_steps=-1", "rsm.ray_steps"},
+      {"isr+rsm+esm", "rsm.trace=2", "rsm.trace"}, {"isr+rsm+esm", "rsm.trace=-1", "rsm.trace"},
       {"vpl+esm", "vpl.lights=-1", "vpl.lights"},     {"vpl+esm", "vpl.negative=4097", "vpl.negative"},
       {"vpl+esm", "vpl.threshold=3", "vpl.threshold"}, {"vpl+esm", "vpl.focus=0", "vpl.focus"},
       {"vpl+esm", "vpl.recompute=some", "vpl.recompute"},
@@ -854,6 +906,13 @@ static void bad_options_name_themselves(void **state) {
       {"isr+rsm+esm", "isr.mode=seed", "isr+rsm+esm needs isr.mode \"physical\""},
   };
   gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
+  /* The traced rays' two outputs beside 24 rays' hits: more than the march may write, named. */
+  const char *const sets[] = {"rsm.trace=1", "isr.samples=24", NULL};
+  gl_result r = gl_render(&(gl_run){.tech = "isr+rsm+esm", .sets = sets});
+  assert_false(r.ok);
+  assert_non_null(strstr(r.err.msg, "pp.lua:"));
+  assert_non_null(strstr(r.err.msg, "rsm.trace: the march would write 10 targets"));
+  gl_result_free(&r);
 }
 
 /* Gives the closed room's floor (its first quad) a material of its own, the
@@ -955,6 +1014,7 @@ int main(int argc, char **argv) {
       cmocka_unit_test(an_outdoor_corner_sees_less_sky_than_open_ground),
       cmocka_unit_test(more_bounces_light_a_ceiling_more_and_stay_bounded),
       cmocka_unit_test(screen_steps_and_the_series_count_each_bounce_once),
+      cmocka_unit_test(traced_rays_bring_a_second_bounce_where_the_screen_shows_no_sender),
       cmocka_unit_test(extremes_stay_finite),
       cmocka_unit_test(bad_options_name_themselves),
   };

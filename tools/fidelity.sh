@@ -29,4 +29,5 @@ limn_gi_report --targets --cycles --moving "${MOVING_SIZE:-256x192}" --refs "${R
   "isr+lpv=isr+lpv+esm" "lpv 2 bounces=lpv+esm:lpv.bounces=2" "isr+lpv 2 b.=isr+lpv+esm:lpv.bounces=2" \
   "combined 8 b.=isr+rsm+esm:isr.bounces=4;rsm.bounces=8" \
   "8 b. 8 rays=isr+rsm+esm:isr.bounces=4;rsm.bounces=8;isr.samples=8" \
-  "8 b. 8 r. RSM rays=isr+rsm+esm:isr.bounces=4;rsm.bounces=8;isr.samples=8;rsm.ray_steps=2"
+  "8 b. 8 r. RSM rays=isr+rsm+esm:isr.bounces=4;rsm.bounces=8;isr.samples=8;rsm.ray_steps=2" \
+  "default traced=isr+rsm+esm:rsm.trace=1" "8 b. 8 r. traced=isr+rsm+esm:isr.bounces=4;rsm.bounces=8;isr.samples=8;rsm.trace=1"
