@@ -591,6 +591,27 @@ static void check_packing(const lm_shadow_plan *plan) {
   }
 }
 
+/* Tiles of mixed sizes in the box: its light's reach cut to 1.6, a sun's cascades and five small
+ * point lights far off (at 256x192 from the box's camera: 37 tiles in 1024x1024 texels). */
+static void add_mixed_lights(lm_scene *s) {
+  s->lights[0].falloff = LM_FALLOFF_WINDOW;
+  s->lights[0].radius = 1.6f;
+  mat4 m;
+  glm_mat4_identity(m);
+  glm_rotate_x(m, glm_rad(-60.0f), m);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 0.2f,
+                                    .casts_shadows = true, .node = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1)});
+  for (int i = 0; i < 5; i++) {
+    glm_translate_make(m, (vec3){-0.8f + 0.4f * (float)i, 0.5f + 0.2f * (float)i, -0.5f});
+    char name[16];
+    snprintf(name, sizeof name, "lamp%d", i);
+    lm_scene_add_light(s, &(lm_light){.type = LM_LIGHT_POINT, .color = {1, 1, 1}, .power = 0.05f,
+                                      .radius = 0.05f + 0.1f * (float)i, .falloff = LM_FALLOFF_WINDOW,
+                                      .casts_shadows = true, .node = lm_scene_add_node(s, name, -1, (float *)m, -1, -1)});
+  }
+  lm_scene_update(s);
+}
+
 /* The box's camera moved inside it, at (0, 1, 0.2), turned `yaw` degrees from -Z and looking a
  * little down: the light's reach holds it (every face at 512 texels), and it sees these of the
  * light's cube faces: yaw 0: +X -X -Y -Z; 10: +X -Y -Z; 190: -Y alone; 200: -X -Y +Z. */
@@ -634,7 +655,8 @@ static int places_kept(const lm_shadow_plan *a, const lm_shadow_plan *b) {
  * appears takes a free square and the other tiles keep their places in an atlas of the same
  * size; one that goes leaves the others where they were; a still camera's plan is the last one;
  * a grid the tiles do not fit grows; a grid stays while a fresh packing needs more than half its
- * cells, and shrinks when it needs no more. */
+ * cells, and shrinks when it needs no more; tiles that fit the grid but not its free squares are
+ * packed afresh in it. */
 static void tiles_keep_their_places_as_faces_come_and_go(void **state) {
   (void)state;
   lm_scene *s = builtin("cornell");
@@ -678,6 +700,37 @@ static void tiles_keep_their_places_as_faces_come_and_go(void **state) {
   assert_true(d.columns == 2 && d.rows == 2);
   lm_shadow_plan_free(&c);
   lm_shadow_plan_free(&d);
+  lm_scene_destroy(s);
+
+  /* Small tiles that lay one in each cell last frame leave no cell free for a cascade: the tiles
+   * are packed afresh in the same grid (as a plan without a last layout packs them). */
+  s = builtin("cornell");
+  add_mixed_lights(s);
+  lm_frame_data cam;
+  lm_scene_frame_data(s, 0, 256, 192, &cam);
+  lm_shadow_settings st;
+  lm_shadow_settings_default(&st);
+  lm_error err;
+  assert_true(lm_shadow_plan_make(&a, s, &cam, &st, &err));
+  int cells = a.columns * a.rows, spread = 0;
+  lm_shadow_place scattered[16];
+  for (int v = 0; v < a.layout.count && spread < cells && spread < 16; v++)
+    if (a.layout.places[v].size < a.tile) {
+      scattered[spread] = a.layout.places[v];
+      scattered[spread].x = spread % a.columns * a.tile, scattered[spread].y = spread / a.columns * a.tile;
+      spread++;
+    }
+  assert_int_equal(spread, cells);
+  lm_shadow_layout last = {scattered, spread, a.columns, a.rows, a.tile};
+  st.last_layout = &last;
+  assert_true(lm_shadow_plan_make(&b, s, &cam, &st, &err));
+  printf("%d tiles in %d cells, small ones scattered over every cell: %d in %dx%d cells, as packed afresh: %s\n",
+         a.view_count, cells, b.view_count, b.columns, b.rows,
+         places_kept(&a, &b) == a.view_count ? "yes" : "no");
+  assert_true(b.columns == a.columns && b.rows == a.rows && places_kept(&a, &b) == a.view_count);
+  check_packing(&b);
+  lm_shadow_plan_free(&a);
+  lm_shadow_plan_free(&b);
   lm_scene_destroy(s);
 }
 
@@ -814,21 +867,7 @@ static void local_tiles_follow_their_screen_coverage(void **state) {
   lm_shadow_plan_free(&plan);
 
   /* Mixed sizes: the sun's cascades, the box's light and small lights far off. */
-  s->lights[0].radius = 1.6f;
-  mat4 m;
-  glm_mat4_identity(m);
-  glm_rotate_x(m, glm_rad(-60.0f), m);
-  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 0.2f,
-                                    .casts_shadows = true, .node = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1)});
-  for (int i = 0; i < 5; i++) {
-    glm_translate_make(m, (vec3){-0.8f + 0.4f * (float)i, 0.5f + 0.2f * (float)i, -0.5f});
-    char name[16];
-    snprintf(name, sizeof name, "lamp%d", i);
-    lm_scene_add_light(s, &(lm_light){.type = LM_LIGHT_POINT, .color = {1, 1, 1}, .power = 0.05f,
-                                      .radius = 0.05f + 0.1f * (float)i, .falloff = LM_FALLOFF_WINDOW,
-                                      .casts_shadows = true, .node = lm_scene_add_node(s, name, -1, (float *)m, -1, -1)});
-  }
-  lm_scene_update(s);
+  add_mixed_lights(s);
   assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
   check_packing(&plan);
   int area = plan.atlas_width * plan.atlas_height;
