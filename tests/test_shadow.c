@@ -591,6 +591,149 @@ static void check_packing(const lm_shadow_plan *plan) {
   }
 }
 
+/* Tiles of mixed sizes in the box: its light's reach cut to 1.6, a sun's cascades and five small
+ * point lights far off (at 256x192 from the box's camera: 37 tiles in 1024x1024 texels). */
+static void add_mixed_lights(lm_scene *s) {
+  s->lights[0].falloff = LM_FALLOFF_WINDOW;
+  s->lights[0].radius = 1.6f;
+  mat4 m;
+  glm_mat4_identity(m);
+  glm_rotate_x(m, glm_rad(-60.0f), m);
+  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 0.2f,
+                                    .casts_shadows = true, .node = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1)});
+  for (int i = 0; i < 5; i++) {
+    glm_translate_make(m, (vec3){-0.8f + 0.4f * (float)i, 0.5f + 0.2f * (float)i, -0.5f});
+    char name[16];
+    snprintf(name, sizeof name, "lamp%d", i);
+    lm_scene_add_light(s, &(lm_light){.type = LM_LIGHT_POINT, .color = {1, 1, 1}, .power = 0.05f,
+                                      .radius = 0.05f + 0.1f * (float)i, .falloff = LM_FALLOFF_WINDOW,
+                                      .casts_shadows = true, .node = lm_scene_add_node(s, name, -1, (float *)m, -1, -1)});
+  }
+  lm_scene_update(s);
+}
+
+/* The box's camera moved inside it, at (0, 1, 0.2), turned `yaw` degrees from -Z and looking a
+ * little down: the light's reach holds it (every face at 512 texels), and it sees these of the
+ * light's cube faces: yaw 0: +X -X -Y -Z; 10: +X -Y -Z; 190: -Y alone; 200: -X -Y +Z. */
+static void look_from_inside(lm_scene *s, float yaw) {
+  mat4 view, world;
+  float a = glm_rad(yaw);
+  glm_lookat((vec3){0.0f, 1.0f, 0.2f}, (vec3){sinf(a), 0.7f, 0.2f - cosf(a)}, (vec3){0, 1, 0}, view);
+  glm_mat4_inv(view, world);
+  lm_scene_node_set_world(s, s->cameras[0].node, (float *)world);
+}
+
+static void plan_from_inside(lm_scene *s, float yaw, const lm_shadow_layout *last, lm_shadow_plan *plan) {
+  look_from_inside(s, yaw);
+  lm_frame_data cam;
+  lm_scene_frame_data(s, 0, 256, 192, &cam);
+  lm_shadow_settings st;
+  lm_shadow_settings_default(&st);
+  st.last_layout = last;
+  lm_error err;
+  assert_true(lm_shadow_plan_make(plan, s, &cam, &st, &err));
+  check_packing(plan);
+  assert_int_equal(plan->layout.count, plan->view_count);
+  for (int v = 0; v < plan->view_count; v++) {
+    assert_int_equal(plan->views[v].x, plan->layout.places[v].x);
+    assert_int_equal(plan->views[v].y, plan->layout.places[v].y);
+  }
+}
+
+/* How many of plan a's tiles lie in plan b at the same place (same light, view and size). */
+static int places_kept(const lm_shadow_plan *a, const lm_shadow_plan *b) {
+  int kept = 0;
+  for (int u = 0; u < a->layout.count; u++)
+    for (int v = 0; v < b->layout.count; v++) {
+      const lm_shadow_place *p = &a->layout.places[u], *q = &b->layout.places[v];
+      kept += p->light == q->light && p->view == q->view && p->size == q->size && p->x == q->x && p->y == q->y;
+    }
+  return kept;
+}
+
+/* A plan made with the last frame's layout (lm_shadow_settings.last_layout): a cube face that
+ * appears takes a free square and the other tiles keep their places in an atlas of the same
+ * size; one that goes leaves the others where they were; a still camera's plan is the last one;
+ * a grid the tiles do not fit grows; a grid stays while a fresh packing needs more than half its
+ * cells, and shrinks when it needs no more; tiles that fit the grid but not its free squares are
+ * packed afresh in it. */
+static void tiles_keep_their_places_as_faces_come_and_go(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  lm_shadow_plan a, b, c, d;
+  plan_from_inside(s, 10.0f, NULL, &a);
+  plan_from_inside(s, 0.0f, &a.layout, &b);
+  printf("a face appears: %d tiles in %dx%d, then %d in %dx%d, %d of them in their places\n", a.view_count,
+         a.atlas_width, a.atlas_height, b.view_count, b.atlas_width, b.atlas_height, places_kept(&a, &b));
+  assert_int_equal(a.lights[0].cube[0], 1 << 0 | 1 << 3 | 1 << 5);
+  assert_int_equal(b.lights[0].cube[0], 1 << 0 | 1 << 1 | 1 << 3 | 1 << 5);
+  assert_int_equal(places_kept(&a, &b), 3);
+  assert_true(b.atlas_width == a.atlas_width && b.atlas_height == a.atlas_height);
+  plan_from_inside(s, 0.0f, &b.layout, &c); /* still */
+  assert_int_equal(places_kept(&b, &c), 4);
+  assert_memory_equal(b.layout.places, c.layout.places, sizeof *b.layout.places * (size_t)b.layout.count);
+  lm_shadow_plan_free(&c);
+  plan_from_inside(s, 10.0f, &b.layout, &c); /* the face goes again */
+  assert_int_equal(places_kept(&b, &c), 3);
+  assert_true(c.atlas_width == b.atlas_width && c.atlas_height == b.atlas_height);
+  lm_shadow_plan_free(&a);
+  lm_shadow_plan_free(&b);
+  lm_shadow_plan_free(&c);
+
+  /* One face in a 1 x 1 grid, then three: it grows. */
+  plan_from_inside(s, 190.0f, NULL, &a);
+  plan_from_inside(s, 200.0f, &a.layout, &b);
+  printf("one face in %dx%d texels, then %d in %dx%d\n", a.atlas_width, a.atlas_height, b.view_count, b.atlas_width,
+         b.atlas_height);
+  assert_true(a.view_count == 1 && a.columns == 1 && a.rows == 1);
+  assert_true(b.view_count == 3 && b.columns * b.rows >= 3);
+  lm_shadow_plan_free(&a);
+  lm_shadow_plan_free(&b);
+
+  /* Four faces (a fresh grid of 2 x 2) after a grid of 3 x 2 cells keep it; after 3 x 3 they would
+   * fill no more than half of it: 2 x 2. */
+  lm_shadow_layout wide = {.columns = 3, .rows = 2, .tile = 512}, wider = {.columns = 3, .rows = 3, .tile = 512};
+  plan_from_inside(s, 0.0f, &wide, &c);
+  plan_from_inside(s, 0.0f, &wider, &d);
+  printf("four faces after 3x2 cells: %dx%d; after 3x3: %dx%d\n", c.columns, c.rows, d.columns, d.rows);
+  assert_true(c.columns == 3 && c.rows == 2 && c.atlas_width == 1536 && c.atlas_height == 1024);
+  assert_true(d.columns == 2 && d.rows == 2);
+  lm_shadow_plan_free(&c);
+  lm_shadow_plan_free(&d);
+  lm_scene_destroy(s);
+
+  /* Small tiles that lay one in each cell last frame leave no cell free for a cascade: the tiles
+   * are packed afresh in the same grid (as a plan without a last layout packs them). */
+  s = builtin("cornell");
+  add_mixed_lights(s);
+  lm_frame_data cam;
+  lm_scene_frame_data(s, 0, 256, 192, &cam);
+  lm_shadow_settings st;
+  lm_shadow_settings_default(&st);
+  lm_error err;
+  assert_true(lm_shadow_plan_make(&a, s, &cam, &st, &err));
+  int cells = a.columns * a.rows, spread = 0;
+  lm_shadow_place scattered[16];
+  for (int v = 0; v < a.layout.count && spread < cells && spread < 16; v++)
+    if (a.layout.places[v].size < a.tile) {
+      scattered[spread] = a.layout.places[v];
+      scattered[spread].x = spread % a.columns * a.tile, scattered[spread].y = spread / a.columns * a.tile;
+      spread++;
+    }
+  assert_int_equal(spread, cells);
+  lm_shadow_layout last = {scattered, spread, a.columns, a.rows, a.tile};
+  st.last_layout = &last;
+  assert_true(lm_shadow_plan_make(&b, s, &cam, &st, &err));
+  printf("%d tiles in %d cells, small ones scattered over every cell: %d in %dx%d cells, as packed afresh: %s\n",
+         a.view_count, cells, b.view_count, b.columns, b.rows,
+         places_kept(&a, &b) == a.view_count ? "yes" : "no");
+  assert_true(b.columns == a.columns && b.rows == a.rows && places_kept(&a, &b) == a.view_count);
+  check_packing(&b);
+  lm_shadow_plan_free(&a);
+  lm_shadow_plan_free(&b);
+  lm_scene_destroy(s);
+}
+
 /* A light's tile size at output height h (width 4h/3), made with the last
  * plan's levels `last` (NULL: none); its levels into `levels` when given. */
 static int face_size(lm_scene *s, int h, const int *last, int *levels) {
@@ -724,21 +867,7 @@ static void local_tiles_follow_their_screen_coverage(void **state) {
   lm_shadow_plan_free(&plan);
 
   /* Mixed sizes: the sun's cascades, the box's light and small lights far off. */
-  s->lights[0].radius = 1.6f;
-  mat4 m;
-  glm_mat4_identity(m);
-  glm_rotate_x(m, glm_rad(-60.0f), m);
-  lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 0.2f,
-                                    .casts_shadows = true, .node = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1)});
-  for (int i = 0; i < 5; i++) {
-    glm_translate_make(m, (vec3){-0.8f + 0.4f * (float)i, 0.5f + 0.2f * (float)i, -0.5f});
-    char name[16];
-    snprintf(name, sizeof name, "lamp%d", i);
-    lm_scene_add_light(s, &(lm_light){.type = LM_LIGHT_POINT, .color = {1, 1, 1}, .power = 0.05f,
-                                      .radius = 0.05f + 0.1f * (float)i, .falloff = LM_FALLOFF_WINDOW,
-                                      .casts_shadows = true, .node = lm_scene_add_node(s, name, -1, (float *)m, -1, -1)});
-  }
-  lm_scene_update(s);
+  add_mixed_lights(s);
   assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
   check_packing(&plan);
   int area = plan.atlas_width * plan.atlas_height;
@@ -1036,6 +1165,45 @@ static void unchanged_tiles_are_kept_and_changed_ones_drawn(void **state) {
   lm_scene_destroy(s);
 }
 
+/* A cube face that appears as the camera turns takes a free square of the atlas: the other
+ * tiles keep their places, so the shadow pass keeps them in its outputs (neither cleared nor
+ * copied) and draws the new face alone; when it goes again, every tile left is kept. Each frame is
+ * the one an uncached renderer gives, whose fresh packing puts the tiles elsewhere (the lit image
+ * compared, not the atlas). */
+static void a_face_that_appears_draws_its_tile_alone(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  static const char *const off[] = {"shadow.cache=false", NULL};
+  look_from_inside(s, 10.0f);
+  gl_result c = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .frames = 2});
+  assert_true(c.ok);
+  float turns[2] = {0.0f, 10.0f};
+  int faces[2] = {4, 3};
+  for (int k = 0; k < 2; k++) {
+    look_from_inside(s, turns[k]);
+    assert_true(gl_render_again(&c));
+    gl_result fresh = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = off});
+    assert_true(fresh.ok);
+    const lm_shadow_plan *plan = lm_renderer_shadows(c.renderer), *packed = lm_renderer_shadows(fresh.renderer);
+    lm_scene_draw_stats kept = lm_renderer_shadow_draw_stats(c.renderer);
+    int moved = 0;
+    for (int v = 0; v < plan->view_count && v < packed->view_count; v++)
+      moved += plan->views[v].x != packed->views[v].x || plan->views[v].y != packed->views[v].y;
+    float d = share_different(&c, &fresh);
+    printf("turned to %.0f degrees: %d tiles, %d kept (%d in place); %d placed elsewhere than a fresh packing; "
+           "%.3f%% of pixels differ from an uncached frame\n", turns[k], plan->view_count, kept.kept, kept.in_place,
+           moved, 100.0 * d);
+    assert_int_equal(plan->view_count, faces[k]);
+    assert_int_equal(kept.kept, 3);
+    assert_int_equal(kept.in_place, 3);
+    assert_true(d == 0.0f);
+    if (k == 0) assert_true(moved > 0);
+    gl_result_free(&fresh);
+  }
+  gl_result_free(&c);
+  lm_scene_destroy(s);
+}
+
 /* The RSM views lie in their own atlas with a cache of its own: the sun's
  * RSM tile at 512, then 64, then 512 texels a side resizes that atlas and
  * draws its view again (its cache forgets the tiles of another size), while
@@ -1122,6 +1290,7 @@ int main(void) {
       cmocka_unit_test(cube_faces_no_pixel_samples_are_not_drawn),
       cmocka_unit_test(local_tiles_follow_their_screen_coverage),
       cmocka_unit_test(local_tiles_keep_their_size_near_a_boundary),
+      cmocka_unit_test(tiles_keep_their_places_as_faces_come_and_go),
       cmocka_unit_test(nothing_casts_or_nothing_reads_means_no_shadow_pass),
       cmocka_unit_test(the_atlas_can_be_viewed),
       cmocka_unit_test(esm_keeps_the_rooms_sun_patch_and_does_not_leak),
@@ -1129,6 +1298,7 @@ int main(void) {
       cmocka_unit_test(cascades_draw_the_casters_of_their_slice),
       cmocka_unit_test(cascades_scroll_with_a_moving_camera),
       cmocka_unit_test(unchanged_tiles_are_kept_and_changed_ones_drawn),
+      cmocka_unit_test(a_face_that_appears_draws_its_tile_alone),
       cmocka_unit_test(tiles_keep_their_texture_or_are_copied_back),
       cmocka_unit_test(the_rsm_resolution_redraws_the_rsm_views_alone),
       cmocka_unit_test(rsm_views_lie_in_an_atlas_of_their_own),

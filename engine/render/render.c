@@ -21,9 +21,9 @@ enum { MAX_LIGHTS = 256, VIEW_SETS = 2 /* lm_pass_desc.view_set: shadow tiles, R
  * A view whose key matches the tile in its place copies the texels back
  * instead of drawing (lm_shadow_settings.cache). When the pass's outputs
  * are the very textures it left last frame, which nothing else wrote since
- * (lm_graph_target_info.alone), and the tiles lie where they lay, the texels
- * are still there: the pass clears nothing, a kept tile costs nothing, and a
- * drawn one is cleared alone (keeps_views). */
+ * (lm_graph_target_info.alone), the texels of the tiles it drew or kept
+ * then are still there: the pass clears nothing, such a tile kept in its
+ * place costs nothing, and a drawn one is cleared alone (keeps_views). */
 typedef struct tile_cache {
   lm_texture tex[LM_MAX_COLOR_OUTPUTS + 1];
   lm_format format[LM_MAX_COLOR_OUTPUTS + 1];
@@ -41,8 +41,7 @@ typedef struct tile_cache {
   int tile_count, tile_cap;
   uint32_t left[LM_MAX_COLOR_OUTPUTS + 1]; /* the textures the pass left, 0 where another may write */
   long execution;  /* lm_renderer.executions when it left them */
-  uint64_t layout; /* the views' places then (view_layout) */
-  bool in_place;   /* this frame's pass: they hold the tiles still */
+  bool in_place;   /* this frame's pass: they hold the tiles it processed last frame still */
 } tile_cache;
 
 struct lm_renderer {
@@ -330,26 +329,18 @@ static struct cached_tile *tile_at(tile_cache *c, const lm_pass_view *v) {
   return t;
 }
 
-/* Where a pass's views lie in its outputs, and the outputs' size. */
-static uint64_t view_layout(const lm_scene_pass *sp, const lm_graph_target_info *t) {
-  uint64_t h = lm_hash(&t[0].width, sizeof t[0].width, lm_hash(&t[0].height, sizeof t[0].height, 0));
-  for (int v = 0; v < sp->desc->view_count; v++) {
-    const lm_pass_view *w = &sp->desc->views[v];
-    int place[4] = {w->x, w->y, w->width, w->height};
-    h = lm_hash(place, sizeof place, h);
-  }
-  return h;
-}
-
 /* lm_graph_exec_desc.keeps_views: the shadow pass's outputs still hold last
  * frame's tiles (its textures, which only it writes, in the last frame
- * executed, the views in the same places). */
+ * executed, of the same size). Views may lie elsewhere (lm_shadow_layout: a
+ * cube face that appears takes a free square): a tile processed last frame
+ * is still where it lay (draw_scene), and one drawn is cleared alone. */
 static bool keeps_views(void *user, const lm_scene_pass *sp) {
   lm_renderer *r = user;
   tile_cache *c = &r->tiles[sp->desc->view_set];
   lm_graph_target_info t[LM_MAX_COLOR_OUTPUTS + 1];
   int nt = r->shadows.settings.cache ? pass_textures(sp, t) : 0;
-  bool same = nt > 0 && nt == c->count && c->execution == r->executions - 1 && view_layout(sp, t) == c->layout;
+  bool same = nt > 0 && nt == c->count && c->execution == r->executions - 1 && t[0].width == c->width &&
+              t[0].height == c->height;
   for (int i = 0; i < nt && same; i++) same = t[i].alone && t[i].texture.id == c->left[i];
   c->in_place = same;
   return same;
@@ -552,11 +543,13 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
     /* What the pass leaves for the next frame (whether or not it was in place). */
     for (int i = 0; i < nt; i++) c->left[i] = t[i].alone ? t[i].texture.id : 0;
     c->execution = r->executions;
-    c->layout = view_layout(sp, t);
-    if (cached->drawn && cached->key == key && (in_place || cached->copied)) {
-      if (!in_place) copy_tile(t, c->tex, nt, cached, false);
+    /* Its texels are in the outputs when it was processed last frame (another tile drawn over
+     * them since would have marked it not drawn: tile_cache_drawn). */
+    bool held = in_place && cached->at == r->executions - 1;
+    if (cached->drawn && cached->key == key && (held || cached->copied)) {
+      if (!held) copy_tile(t, c->tex, nt, cached, false);
       r->shadow_stats.kept++;
-      r->shadow_stats.in_place += in_place;
+      r->shadow_stats.in_place += held;
       cached->at = r->executions;
       return true;
     }
@@ -821,10 +814,13 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[3], lm_e
   lm_graph_begin(g, r->desc.width, r->desc.height);
   lm_frame_data *frame = &r->camera;
   lm_scene_frame_data(r->desc.scene, r->desc.camera, r->desc.width, r->desc.height, frame);
-  /* For the next plan: lm_shadow_settings.last_range and last_depths, none for a new view (frame 0). */
+  /* For the next plan: lm_shadow_settings.last_range and last_depths, none for a new view (frame 0),
+   * and last_layout, kept across views as the tile cache is. */
   float range[2] = {r->shadows.range[0], r->shadows.range[1]}, (*depths)[2] = r->shadows.depths;
-  r->shadows.depths = NULL;
+  lm_shadow_layout layout = r->shadows.layout;
+  r->shadows.depths = NULL, r->shadows.layout = (lm_shadow_layout){0};
   lm_shadow_plan_free(&r->shadows);
+  r->shadows.layout = layout;
   if (r->frame > 0) {
     memcpy(r->shadows.range, range, sizeof range);
     r->shadows.depths = depths;

@@ -220,9 +220,14 @@ static int l_shadow_plan(lua_State *L) {
   free(p->shadow_depths); /* the last frame's rows, kept for this plan (lm_shadow_settings.last_depths) */
   p->shadow_depths = p->shadows->depths, p->shadows->depths = NULL;
   st.last_depths = (const float(*)[2])p->shadow_depths;
+  lm_shadow_layout layout = p->shadows->layout; /* where the last plan's tiles lay (last_layout) */
+  p->shadows->layout = (lm_shadow_layout){0};
+  st.last_layout = &layout;
   lm_shadow_plan_free(p->shadows);
   lm_error err;
-  if (!lm_shadow_plan_make(p->shadows, p->scene, p->camera, &st, &err)) return luaL_error(L, "shadow_plan: %s", err.msg);
+  bool made = lm_shadow_plan_make(p->shadows, p->scene, p->camera, &st, &err);
+  free(layout.places);
+  if (!made) return luaL_error(L, "shadow_plan: %s", err.msg);
   int n = p->shadows->light_count; /* the levels, kept for the next plan (lm_shadow_settings.last_levels) */
   p->shadow_levels = lm_realloc(p->shadow_levels, sizeof *p->shadow_levels * (size_t)(n + 1));
   memcpy(p->shadow_levels, p->shadows->levels, sizeof *p->shadow_levels * (size_t)n);

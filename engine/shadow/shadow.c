@@ -531,6 +531,98 @@ static int pack_tiles(int tile, const int *size, int n, int *cell, int *x, int *
   return cells;
 }
 
+/* Into best (x, y, size; size 0: none yet): the smallest square of at least `need` texels within
+ * square x, y, s that none of the n tiles at p (where placed[v]) overlaps, if smaller than best's.
+ * Tiles lie on multiples of their size in a cell (pack_tiles' quadrants), so a tile that overlaps
+ * a square no smaller than it lies inside it: its other quadrants may still be free. */
+static void free_square(const lm_shadow_place *p, const bool *placed, int n, int x, int y, int s, int need,
+                        int best[3]) {
+  if (s < need || best[2] == need) return; /* none fits, or none can be smaller */
+  bool partly = false;
+  for (int v = 0; v < n; v++) {
+    if (!placed[v] || p[v].x >= x + s || x >= p[v].x + p[v].size || p[v].y >= y + s || y >= p[v].y + p[v].size)
+      continue;
+    if (p[v].size >= s) return; /* it covers the square */
+    partly = true;
+  }
+  if (!partly) {
+    if (best[2] == 0 || s < best[2]) best[0] = x, best[1] = y, best[2] = s;
+    return;
+  }
+  int h = s / 2;
+  if (h < need) return;
+  free_square(p, placed, n, x, y, h, need, best);
+  free_square(p, placed, n, x + h, y, h, need, best);
+  free_square(p, placed, n, x, y + h, h, need, best);
+  free_square(p, placed, n, x + h, y + h, h, need, best);
+}
+
+/* Places the n tiles p in the last frame's grid: a tile of the same light, view and size keeps its
+ * place; the others, largest first, take the smallest free square that holds them (pack_tiles'
+ * best fit). False when one finds none. */
+static bool keep_places(const lm_shadow_plan *plan, const lm_shadow_layout *last, lm_shadow_place *p, int n) {
+  int width = plan->tile * plan->columns, height = plan->tile * plan->rows, left = 0;
+  int *order = lm_alloc(sizeof *order * (size_t)(n + 1));
+  bool *placed = lm_alloc(sizeof *placed * (size_t)(n + 1)), ok = true;
+  for (int v = 0; v < n; v++) {
+    placed[v] = false;
+    for (int u = 0; u < last->count && !placed[v]; u++) {
+      const lm_shadow_place *q = &last->places[u];
+      if (q->light == p[v].light && q->view == p[v].view && q->size == p[v].size && q->x + q->size <= width &&
+          q->y + q->size <= height)
+        p[v].x = q->x, p[v].y = q->y, placed[v] = true;
+    }
+    if (placed[v]) continue;
+    int k = left++; /* insertion sort, largest first, views in order among equals */
+    for (; k > 0 && p[order[k - 1]].size < p[v].size; k--) order[k] = order[k - 1];
+    order[k] = v;
+  }
+  for (int i = 0; i < left && ok; i++) {
+    int v = order[i], best[3] = {0, 0, 0};
+    for (int c = 0; c < plan->columns * plan->rows; c++)
+      free_square(p, placed, n, c % plan->columns * plan->tile, c / plan->columns * plan->tile, plan->tile, p[v].size,
+                  best);
+    ok = best[2] > 0;
+    p[v].x = best[0], p[v].y = best[1], placed[v] = ok;
+  }
+  free(order);
+  free(placed);
+  return ok;
+}
+
+enum { MAX_ATLAS = 16384 }; /* texels a side: the GL limit assumed */
+
+/* The atlas' grid and the n tiles' places in it (p: light, view and the size at plan->tile;
+ * plan->layout takes p). The last frame's grid stays while a fresh packing needs its cells but
+ * more than half of them (a fresh grid always holds that: hysteresis for a camera walking to and
+ * fro); its tiles keep their places (keep_places), or all are packed afresh in it when free
+ * squares are too scattered. Otherwise a near-square grid of the fresh packing's cells, its
+ * cells halved while the atlas would pass the GL limit. */
+static void plan_layout(lm_shadow_plan *plan, const lm_shadow_layout *last, lm_shadow_place *p, int n) {
+  int *size = lm_alloc(sizeof *size * (size_t)(4 * n + 1)), *cell = size + n, *x = cell + n, *y = x + n;
+  for (int v = 0; v < n; v++) size[v] = p[v].size;
+  int cells = pack_tiles(plan->tile, size, n, cell, x, y), grid = last ? last->columns * last->rows : 0;
+  bool keep = n > 0 && last && last->tile == plan->tile && cells <= grid && 2 * cells > grid;
+  if (keep) {
+    plan->columns = last->columns, plan->rows = last->rows;
+  } else {
+    plan->columns = cells ? (int)ceil(sqrt((double)cells)) : 0;
+    plan->rows = cells ? (cells + plan->columns - 1) / plan->columns : 0;
+    int tile = plan->tile;
+    while (cells && plan->tile > 1 && (plan->tile * plan->columns > MAX_ATLAS || plan->tile * plan->rows > MAX_ATLAS))
+      plan->tile /= 2;
+    if (plan->tile != tile) { /* the same packing, in halved cells */
+      for (int v = 0; v < n; v++) size[v] = p[v].size = tile_size(plan->tile, plan->levels[p[v].light]);
+      pack_tiles(plan->tile, size, n, cell, x, y);
+    }
+  }
+  if (!keep || !keep_places(plan, last, p, n))
+    for (int v = 0; v < n; v++)
+      p[v].x = cell[v] % plan->columns * plan->tile + x[v], p[v].y = cell[v] / plan->columns * plan->tile + y[v];
+  free(size);
+  plan->layout = (lm_shadow_layout){p, n, plan->columns, plan->rows, plan->tile};
+}
+
 /* The RSM views, out of the views planned (a directional light's wide tile
  * after the shadow views, a spot or point light's shadow views): each
  * light's (cube y, z) in turn, rsm_tile texels a side, in rows of the RSM
@@ -577,27 +669,22 @@ static void plan_views(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
     if (plan->settings.rsm > 0 && s->lights[i].casts_shadows && s->lights[i].type == LM_LIGHT_DIRECTIONAL)
       plan_wide_tile(plan, s, cam, &ld[i], &plan->lights[i]);
   free(ld);
-  int n = plan->shadow_views, *cell = lm_alloc(sizeof *cell * (size_t)(4 * n + 1)), *x = cell + n, *y = x + n;
-  int *size = y + n;
-  for (int v = 0; v < n; v++) size[v] = plan->views[v].width;
-  pack_tiles(plan->tile, size, n, cell, x, y);
-  for (int v = 0; v < n; v++) {
+  for (int v = 0; v < plan->shadow_views && v < plan->layout.count; v++) {
     lm_pass_view *w = &plan->views[v];
-    w->x = cell[v] % plan->columns * plan->tile + x[v];
-    w->y = cell[v] / plan->columns * plan->tile + y[v];
+    w->x = plan->layout.places[v].x, w->y = plan->layout.places[v].y;
     float *rect = plan->view_data[v].rect;
     rect[0] = (float)w->x / (float)plan->atlas_width;
     rect[1] = (float)w->y / (float)plan->atlas_height;
     rect[2] = (float)w->width / (float)plan->atlas_width;
     rect[3] = (float)w->height / (float)plan->atlas_height;
   }
-  free(cell);
   plan_rsm_views(plan);
 }
 
 bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,
                          const lm_shadow_settings *settings, lm_error *err) {
   *plan = (lm_shadow_plan){.settings = *settings};
+  plan->settings.last_layout = NULL; /* the caller's, read while the plan is made */
   const lm_shadow_settings *st = settings;
   if (st->resolution < 16 || st->resolution > 8192 || st->cascades < 1 || st->cascades > LM_SHADOW_MAX_CASCADES ||
       !(st->c > 0 && st->c <= 10000) || st->blur < 0 || st->blur > 32 || !(st->lambda >= 0 && st->lambda <= 1) ||
@@ -629,12 +716,13 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
   while (tile_size(plan->tile, plan->rsm_level + 1) >= st->rsm_resolution) plan->rsm_level++;
   lm_light_data *ld = lm_alloc(sizeof *ld * (size_t)(s->light_count + 1));
   lm_scene_light_data(s, ld, s->light_count);
-  int count = 0, rsm_count = 0, *size = lm_alloc(sizeof *size * (size_t)(6 * s->light_count + 1));
+  int count = 0, rsm_count = 0;
+  lm_shadow_place *places = lm_alloc(sizeof *places * (size_t)(6 * s->light_count + 1));
   for (int i = 0; i < s->light_count; i++) {
     const lm_light *l = &s->lights[i];
     plan->levels[i] = 0;
     if (!l->casts_shadows) continue;
-    int views = st->cascades;
+    int views = st->cascades, mask = (1 << views) - 1; /* the views by cascade, cube face or 0 (spot) */
     if (l->type != LM_LIGHT_DIRECTIONAL) {
       vec3 pos = {ld[i].position[0], ld[i].position[1], ld[i].position[2]};
       float range = light_range(s, l, pos);
@@ -642,25 +730,21 @@ bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame
       plan->levels[i] = coverage_level(plan, cam, pos, range, l->type == LM_LIGHT_POINT, last);
       /* An RSM needs every face: a sender off screen lights what is seen. */
       if (l->type == LM_LIGHT_POINT) plan->lights[i].cube[0] = st->rsm > 0 ? 63 : cube_faces_seen(plan, s, cam, pos, range);
-      views = l->type == LM_LIGHT_SPOT ? 1 : __builtin_popcount((unsigned)plan->lights[i].cube[0]);
+      mask = l->type == LM_LIGHT_SPOT ? 1 : plan->lights[i].cube[0];
+      views = __builtin_popcount((unsigned)mask);
     }
-    for (int k = 0; k < views; k++) size[count++] = tile_size(plan->tile, plan->levels[i]);
+    for (int k = 0; k < 6; k++) /* in plan_light's order */
+      if (mask >> k & 1)
+        places[count++] = (lm_shadow_place){.light = i, .view = k, .size = tile_size(plan->tile, plan->levels[i])};
     if (st->rsm > 0) rsm_count += l->type == LM_LIGHT_DIRECTIONAL ? 1 : views; /* plan_rsm_views */
   }
   free(ld);
-  int *cell = lm_alloc(sizeof *cell * (size_t)(3 * count + 1));
-  int cells = pack_tiles(plan->tile, size, count, cell, cell + count, cell + 2 * count);
-  free(cell);
-  free(size);
-  plan->columns = cells ? (int)ceil(sqrt((double)cells)) : 0;
-  plan->rows = cells ? (cells + plan->columns - 1) / plan->columns : 0;
-  int max = 16384;
-  while (cells && plan->tile > 1 && (plan->tile * plan->columns > max || plan->tile * plan->rows > max)) plan->tile /= 2;
+  plan_layout(plan, st->last_layout, places, count);
   plan->atlas_width = plan->tile * plan->columns;
   plan->atlas_height = plan->tile * plan->rows;
   plan->rsm_tile = tile_size(plan->tile, plan->rsm_level);
   int rsm_columns = rsm_count > 0 ? (int)ceil(sqrt((double)rsm_count)) : 1; /* as plan_rsm_views lays them */
-  while (plan->rsm_tile > 1 && plan->rsm_tile * rsm_columns > max) plan->rsm_tile /= 2;
+  while (plan->rsm_tile > 1 && plan->rsm_tile * rsm_columns > MAX_ATLAS) plan->rsm_tile /= 2;
   plan_views(plan, s, cam);
   return true;
 }
@@ -687,6 +771,7 @@ bool lm_shadow_view_moved_across(const float a[16], const float b[16]) {
 
 void lm_shadow_plan_free(lm_shadow_plan *plan) {
   free(plan->levels);
+  free(plan->layout.places);
   free(plan->views);
   free(plan->rsm_views);
   free(plan->view_data);

@@ -23,6 +23,18 @@ typedef enum lm_shadow_technique {
 /* "esm", "pcf", "poisson", "hard", "pcss"; -1 when unknown. */
 int lm_shadow_technique_parse(const char *name);
 
+/* A shadow tile's place in the atlas, kept for the next frame's plan (lm_shadow_layout). */
+typedef struct lm_shadow_place {
+  int light, view; /* the scene light, and its cascade, cube face (+X -X +Y -Y +Z -Z) or 0 for a spot */
+  int size, x, y;  /* texels a side, and its corner in the atlas */
+} lm_shadow_place;
+/* Where a plan's tiles lie: one place a shadow view, in the views' order, in a grid of columns x
+ * rows cells of tile texels. */
+typedef struct lm_shadow_layout {
+  lm_shadow_place *places;
+  int count, columns, rows, tile;
+} lm_shadow_layout;
+
 typedef struct lm_shadow_settings {
   lm_shadow_technique technique;
   int resolution;  /* tile size in texels (16 .. 8192) */
@@ -66,6 +78,13 @@ typedef struct lm_shadow_settings {
    * tile needs and spans at most LM_SHADOW_RANGE_SLACK times them, so that a camera moving along
    * the light, whose tiles' eye plane steps, scrolls them instead of drawing them whole. */
   const float (*last_depths)[2];
+  /* The last frame's plan's layout (lm_shadow_plan.layout), or NULL: its grid stays while the
+   * tiles fit in it and a fresh packing would fill more than half its cells, so that the atlas'
+   * sides (and the shaders that sample it, which llvmpipe compiles again when they change) stay
+   * as a camera walks to and fro; in it, a tile of the same light, view and size keeps its place
+   * and the others take free squares, so that the tile cache (engine/render), keyed by place,
+   * keeps them when a cube face appears or a light's tiles resize. */
+  const lm_shadow_layout *last_layout;
 } lm_shadow_settings;
 #define LM_SHADOW_LEVEL_SLACK 1.25f
 #define LM_SHADOW_RANGE_SLACK 1.25f
@@ -93,10 +112,12 @@ typedef struct lm_shadow_view_data {
 typedef struct lm_shadow_plan {
   lm_shadow_settings settings;
   /* The atlas is a grid of columns x rows cells of tile texels a side (the
-   * resolution, halved while the atlas would pass the GL limit). A cascade
+   * resolution, halved while the atlas would pass the GL limit; the last
+   * frame's grid while it suits: lm_shadow_settings.last_layout). A cascade
    * fills a cell; a spot or point light's tiles are the cell
    * halved levels[light] times, packed into quadrants of shared cells. */
   int tile, columns, rows, atlas_width, atlas_height;
+  lm_shadow_layout layout; /* the shadow views' places (the views hold them too) */
   int *levels;         /* per scene light */
   int rsm_level;       /* the halvings of the cell that give an RSM view (settings.rsm_resolution) */
   lm_pass_view *views; /* for the shadow pass, one per tile */
