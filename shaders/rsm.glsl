@@ -94,6 +94,9 @@ const float GOLDEN = 0.61803398874989;             // the angle's step, in turns
 const vec2 TURN = vec2(-0.73736887807832, -0.67549029426152); // cos, sin of 2 pi GOLDEN
 const float PLASTIC = 0.75487766624669;            // 1 / the plastic number
 
+// The pattern's direction one sample on: turned by 2 pi GOLDEN.
+vec2 rsm_turn(vec2 dir) { return vec2(dir.x * TURN.x - dir.y * TURN.y, dir.x * TURN.y + dir.y * TURN.x); }
+
 bool rsm_blocked(vec3 p, vec3 q, sampler2D dpt) {
   for (int j = 1; j <= rsm_steps; j++) {
     vec3 x = mix(p, q, float(j) / float(rsm_steps + 1));
@@ -219,20 +222,30 @@ vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn
     // outside and add nothing, so the pattern keeps its samples where texels are.
     float reach = min(rsm_radius, length(max(centre, 1.0 - centre)));
     float texels = 2.0 * PI * reach * reach * tile * tile / float(max(n, 1));
-    for (int k = 0; k < n; k++, dir = vec2(dir.x * TURN.x - dir.y * TURN.y, dir.x * TURN.y + dir.y * TURN.x)) {
-      float xi = fract(radical_inverse(k0 + uint(k), 2u) + centred);
-      vec2 t = centre + xi * reach * dir;
-      if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
-      ivec2 a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
-      vec4 qn = texelFetch(rsm_pos, a, 0); // position, normal (normal_pack)
-      if (qn.w > 0.0) continue; // empty
-      vec3 q = qn.xyz, nq = normal_unpack(qn.w);
-      float area = rsm_texel_area_as(sv, t, q, tile, type != 2);
-      vec3 d = q - s.p;
-      float d2 = dot(d, d);
-      vec3 towards = d * inversesqrt(max(d2, 1e-30));
-      float g = max(dot(s.n, towards), 0.0) * max(dot(nq, -towards), 0.0) / max(d2, area);
-      if (g <= 0.0) continue; // before the flux and the light: coplanar and facing-away senders are common
+    for (int k = 0; k < n; k++, dir = rsm_turn(dir)) {
+      // The samples up to the next sender that the geometry term lets through, in a loop of their own:
+      // llvmpipe runs an if's body for every pixel of its group, so the tests below inside this loop cost
+      // as much at every sample, while few pass it (about 1 in 100 on the reference set's framing views).
+      float xi = 0.0, area = 0.0, g = 0.0;
+      ivec2 a = ivec2(0);
+      vec3 q = vec3(0.0);
+      for (; k < n; k++, dir = rsm_turn(dir)) {
+        xi = fract(radical_inverse(k0 + uint(k), 2u) + centred);
+        vec2 t = centre + xi * reach * dir;
+        if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
+        a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
+        vec4 qn = texelFetch(rsm_pos, a, 0); // position, normal (normal_pack)
+        if (qn.w > 0.0) continue; // empty
+        q = qn.xyz;
+        vec3 nq = normal_unpack(qn.w);
+        area = rsm_texel_area_as(sv, t, q, tile, type != 2);
+        vec3 d = q - s.p;
+        float d2 = dot(d, d);
+        vec3 towards = d * inversesqrt(max(d2, 1e-30));
+        g = max(dot(s.n, towards), 0.0) * max(dot(nq, -towards), 0.0) / max(d2, area);
+        if (g > 0.0) break; // coplanar and facing-away senders are common
+      }
+      if (k >= n) break;
 #ifdef EXCLUDE_SEEN
       if (rsm_seen(dpt, q)) continue;
 #endif
