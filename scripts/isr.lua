@@ -283,7 +283,10 @@ function isr.render(direct, o, frame)
       if unseen then
         defines.UNSEEN, defines.LAST, params.bounces, params.steps = unseen, b == steps, light.rsm.bounces, steps
       end
-      if traced then from.traced, from.traced_albedo, defines.TRACE, params.step = traced[1], traced[2], true, b end
+      if traced then
+        from.traced, from.traced_albedo, defines.TRACE, params.step = traced[1], traced[2], true, b
+        defines.TRACE_BLOCK = traced.block > 1 and traced.block or nil
+      end
       E = kept and b == steps and o.blur == 0 and kept.value or coarse_target("isr.e" .. b, f)
       local out = { E }
       with_history(from, defines, params, out, b == steps)
@@ -327,7 +330,7 @@ function isr.render(direct, o, frame)
       end
       pass{ name, shader = "isr_march.frag", inputs = inputs, params = params, defines = defines, out = out,
             fetches = fetches }
-      if rays then traced = isr.trace(rays, G, f, light.rsm) end
+      if rays then traced = isr.trace(rays, G, f, light.rsm, history ~= nil) end
     end
   end
   E = temporal.clamp("isr", history, E)
@@ -338,19 +341,31 @@ end
 -- Traces the rays the first march lost (rsm.trace; rays = { origins, directions },
 -- isr_march.frag's TRACE) on the CPU (the engine's "trace", engine/trace) and
 -- lights each hit with its first bounce, the RSM's gather over every sender
--- (light.rsm.bind_all; isr_trace.frag). Returns { light, albedo }: what each
--- hit sends on and its k_d albedo, coarse targets of factor f.
-function isr.trace(rays, G, f, rsm)
-  local function coarse(name, format) return target{ name, format = format, scale = 1 / f } end
+-- (light.rsm.bind_all; isr_trace.frag). Under one ray a coarse pixel, one ray
+-- a block of pixels (rsm.trace 1/4: 2 x 2, 1/16: 4 x 4), which the engine
+-- chooses among the block's lost rays (turning each frame where `turn`:
+-- temporal reuse averages the choices): the tracer, the write-back and the
+-- light take a target that much smaller. Returns { light, albedo, block = the
+-- block's side }: what each hit sends on and its k_d albedo.
+function isr.trace(rays, G, f, rsm, turn)
+  local block = math.floor(1 / math.sqrt(rsm.trace) + 0.5) -- rsm.trace > 0 (checked: 1, 1/4 or 1/16)
+  local w, h = output_size()
+  local function blocks(n) return math.ceil(math.max(math.floor(n * (1 / f)), 1) / block) end -- as the engine sizes
+  local size = block > 1 and { blocks(w), blocks(h) } or nil
+  local function coarse(name, format)
+    return target{ name, format = format, scale = not size and 1 / f or nil, size = size }
+  end
   local H = { clr = coarse("isr.hit_clr", "rgba8"), nrm = coarse("isr.hit_nrm", "rgba16f"),
               pos = coarse("isr.hit_pos", "rgba32f"), mat = coarse("isr.hit_mat", "rgba8") }
-  cpu{ "isr.trace", fn = "trace", inputs = { rays_o = rays[1], rays_d = rays[2] }, out = { H.clr, H.nrm, H.pos, H.mat } }
+  cpu{ "isr.trace", fn = "trace", inputs = { rays_o = rays[1], rays_d = rays[2] }, out = { H.clr, H.nrm, H.pos, H.mat },
+       params = block > 1 and { block = block, turn = turn and 1 or 0 } or nil }
   local inputs, defines, params = { hit_clr = H.clr, hit_nrm = H.nrm, hit_pos = H.pos, hit_mat = H.mat,
-                                    rays_o = rays[1], dpt = G.dpt }, {}, {}
+                                    rays_o = not size and rays[1] or nil, dpt = G.dpt }, { BLOCK = size ~= nil }, {}
   local fetches = rsm.bind_all(inputs, defines, params, f)
-  local out = { coarse_target("isr.traced", f), coarse_target("isr.traced_albedo", f) }
+  local out = { coarse("isr.traced", "rgba16f"), coarse("isr.traced_albedo", "rgba16f") }
   pass{ "isr.trace_light", shader = "isr_trace.frag", inputs = inputs, defines = defines, params = params,
         out = out, fetches = 5 + fetches }
+  out.block = block
   return out
 end
 

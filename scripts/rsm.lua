@@ -49,10 +49,12 @@ rsm.defaults = {
                      -- such a ray is open unless p lies under a roof); one that crosses a surface they
                      -- hold met a surface off screen (rsm.bounces above 1 carry light over it)
   trace = 0,         -- the combined technique, rsm.bounces above 1: rays a coarse pixel traced on the CPU
-                     -- (engine/trace), 0..1 (0: none). One of the rays the screen lost (not seen, inside the
-                     -- scene's box) is traced, its hit lit by its first bounce (the RSM's gather, every
-                     -- sender), and the pixel's rays the screen lost bring that light as their second
-                     -- bounce instead of the mean of the rays it followed (isr_bounce.frag's TRACE)
+                     -- (engine/trace), 0, 1/16, 1/4 or 1 (0: none). One of the rays the screen lost (not
+                     -- seen, inside the scene's box) is traced, its hit lit by its first bounce (the RSM's
+                     -- gather, every sender), and the pixel's rays the screen lost bring that light as
+                     -- their second bounce instead of the mean of the rays it followed (isr_bounce.frag's
+                     -- TRACE); under 1, one ray for a block of 2 x 2 or 4 x 4 pixels, chosen among all
+                     -- the block's lost rays, whose light they all take
   rotate = 10,       -- pattern turn a frame in degrees with temporal reuse, 0..180 (the seed: 10;
                      -- its radii shift too); without, the pattern stays (a still camera, a still image)
   k = 1.0,           -- indirect light factor, 0..16 (1: physical)
@@ -105,7 +107,7 @@ local rules = {
   steps = options.whole(-1, 32),
   thickness = options.number(0, 16),
   ray_steps = options.whole(0, 32),
-  trace = options.whole(0, 1),
+  trace = options.one_of(0, 1 / 16, 1 / 4, 1),
   rotate = options.number(0, 180),
   k = options.number(0, 16),
   bounces = options.whole(1, 64),

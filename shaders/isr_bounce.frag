@@ -63,8 +63,15 @@ uniform sampler2D hits5;
 #endif
 uniform int samples = 4;
 #ifdef TRACE
-uniform sampler2D traced, traced_albedo; // isr_trace.frag's outputs, the output's size
+uniform sampler2D traced, traced_albedo; // isr_trace.frag's outputs, the output's size (or its blocks')
 uniform int step = 2;                    // this step (isr.bounces counts them; 1: the march)
+#endif
+#ifdef TRACE_BLOCK
+// One ray traced for a block of TRACE_BLOCK x TRACE_BLOCK pixels (rsm.trace under 1): its light stands
+// for every lost ray of the block's pixels.
+ivec2 traced_texel(ivec2 px) { return min(px / TRACE_BLOCK, textureSize(traced, 0) - 1); }
+#else
+ivec2 traced_texel(ivec2 px) { return px; }
 #endif
 
 layout(location = 0) out vec4 isr;
@@ -176,9 +183,9 @@ void main() {
 #ifdef TRACE
   // The hit's light after this step's bounces: its second bounce grown as the series grows, 1 + r + ... +
   // r^(step - 2), r the series' ratio below (1 at the second step; at most 10: bounded)
-  vec3 r_hit = clamp((albedo + rays.y * texelFetch(traced_albedo, px, 0).rgb) / float(n), 0.0, BOUNCE_MAX);
+  vec3 r_hit = clamp((albedo + rays.y * texelFetch(traced_albedo, traced_texel(px), 0).rgb) / float(n), 0.0, BOUNCE_MAX);
   vec3 grown = (1.0 - pow(r_hit, vec3(float(max(step, 2) - 1)))) / (1.0 - r_hit); // pow: base >= 0, exponent >= 1
-  vec3 second = (gathered + rays.y * texelFetch(traced, px, 0).rgb * grown) / float(n);
+  vec3 second = (gathered + rays.y * texelFetch(traced, traced_texel(px), 0).rgb * grown) / float(n);
 #else
   vec3 second = (gathered + rays.y * gathered / max(float(n) - rays.y, 1.0)) / float(n);
 #endif

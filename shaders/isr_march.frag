@@ -72,7 +72,7 @@
 // inside the scene's box where it leaves the view) is UNSEEN, whatever its
 // direction (the tracer, not a guess, says what it meets), and one of them,
 // chosen uniformly (a reservoir over a hash of the pixel and ray), goes to
-// outputs TRACE (origin a little off p along its normal, w 1) and TRACE + 1
+// outputs TRACE (origin a little off p along its normal, w the count of lost rays) and TRACE + 1
 // (direction, w 0: unlimited) for the CPU's "trace" (engine/trace); both 0
 // where none was lost, which the tracer skips. isr_trace.frag lights the
 // hit, isr_bounce.frag sends its light on for the pixel's unseen rays.
@@ -394,6 +394,9 @@ void main() {
     }
 #endif
   }
+#ifdef TRACE
+  if (lost > 0.0) ray_o.w = lost; // the reservoir's weight where one ray stands for a block's (rsm.trace under 1)
+#endif
   isr = vec4(gathered / float(n), open / float(n));
 #ifdef RSM_GATHER
   isr.rgb += max(rsm_k, 0.0) * rsm_gather(s, px, dpt);

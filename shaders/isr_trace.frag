@@ -10,11 +10,15 @@
 // through the march's accessibility, as for a ray the march saw leave.
 // Outputs: light (rgb: the radiance sent toward p; a: 1 where a ray was
 // traced) and albedo (rgb: the hit's k_d albedo, 0 for a miss), which
-// isr_bounce.frag's later bounces (the series' ratio) take.
+// isr_bounce.frag's later bounces (the series' ratio) take. BLOCK (rsm.trace
+// under 1): a texel per block of pixels, whose ray the engine chose.
 #include "gbuffer.glsl"
 #include "rsm.glsl"
 
-uniform sampler2D hit_clr, hit_nrm, hit_pos, hit_mat, rays_o; // the trace's hit record (std.frag's layout)
+uniform sampler2D hit_clr, hit_nrm, hit_pos, hit_mat; // the trace's hit record (std.frag's layout)
+#ifndef BLOCK
+uniform sampler2D rays_o; // the march's rays (w 0: none)
+#endif
 uniform sampler2D dpt; // the G-buffer's depth (rsm_gather's argument; unused without EXCLUDE_SEEN, VISIBILITY)
 uniform float rsm_k = 1.0; // the RSM light's factor (rsm.k)
 
@@ -25,7 +29,12 @@ void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   light = vec4(0.0);
   albedo = vec4(0.0);
+#ifdef BLOCK
+  // A block of pixels' one ray (rsm.trace under 1): the engine marks a traced one, hit or miss, in w
+  if (texelFetch(hit_pos, px, 0).w < 0.5) return;
+#else
   if (texelFetch(rays_o, px, 0).w < 0.5) return; // nothing lost: nothing traced
+#endif
   light.a = 1.0;
   vec4 m = texelFetch(hit_mat, px, 0);
   if (m.a < 0.5) return; // a miss

@@ -656,18 +656,54 @@ static const lm_cpu_image *cpu_input(const lm_cpu_pass *cp, const char *name) {
   return NULL;
 }
 
+/* A whole number param of a CPU pass, or `fallback` where it has none. */
+static int cpu_param_int(const lm_cpu_pass *cp, const char *name, int fallback) {
+  for (int i = 0; i < cp->desc->param_count; i++) {
+    const lm_pass_param *p = &cp->desc->params[i];
+    if (!strcmp(p->name, name) && p->kind == LM_PARAM_NUMBER && p->count == 1 && isfinite(p->v[0]))
+      return (int)p->v[0];
+  }
+  return fallback;
+}
+
+/* With params.block = b > 1, one ray for each b x b block of rays_o's pixels
+ * (rsm.trace under 1): chosen among the block's rays with chance in
+ * proportion to rays_o's w (the lost rays each stands for: every lost ray
+ * alike), by a hash of the pixel and `frame` (params.turn 1, with temporal
+ * reuse: the choice turns each frame; 0: a still camera keeps its image).
+ * Writes into pixel[] the index of each block's ray, -1 for none. */
+static void choose_in_blocks(const lm_cpu_image *ro, int b, int ow, int oh, unsigned frame, int *pixel) {
+  float *total = lm_alloc(sizeof *total * (size_t)ow * oh);
+  for (int i = 0; i < ow * oh; i++) pixel[i] = -1;
+  for (int y = 0; y < ro->height; y++)
+    for (int x = 0; x < ro->width; x++) {
+      float w = ro->rgba[((size_t)y * ro->width + x) * 4 + 3];
+      int bx = x / b, by = y / b, k = by * ow + bx;
+      if (!(w > 0.5f) || bx >= ow || by >= oh) continue;
+      total[k] += w;
+      unsigned key[3] = {(unsigned)x, (unsigned)y, frame};
+      double u = (double)(lm_hash(key, sizeof key, 0x7ace) >> 11) / 9007199254740992.0; /* [0, 1) */
+      if (u * total[k] < w) pixel[k] = y * ro->width + x; /* kept with chance w / total so far */
+    }
+  free(total);
+}
+
 /* The CPU step of ray-traced reflections (seed 003 section 6.2): rays from
  * rays_o (origin, w > 0.5: a ray) and rays_d (direction, w: the longest
  * distance, 0 for none), traced on every core; out: a G-buffer of the hits
  * as std.frag lays it out (albedo and rho; normal and shininess; position
  * and 1; k_a, k_d, k_s and coverage), zero for a miss. The materials are the
- * scene's own: a pass's material overrides do not reach the hits. */
+ * scene's own: a pass's material overrides do not reach the hits. With
+ * params.block (choose_in_blocks) the outputs hold a texel a block, and a
+ * traced miss has position w 1 too. */
 static bool run_trace(lm_renderer *r, const lm_cpu_pass *cp, lm_error *err) {
   const lm_cpu_image *ro = cpu_input(cp, "rays_o"), *rd = cpu_input(cp, "rays_d");
-  if (!ro || !rd || cp->output_count != 4 || rd->width != ro->width || rd->height != ro->height ||
-      cp->outputs[0].width != ro->width || cp->outputs[0].height != ro->height) {
-    lm_error_set(err, "function 'trace' takes inputs rays_o and rays_d and 4 outputs of their size "
-                      "(hit colour, normal, position, material)");
+  int b = cpu_param_int(cp, "block", 1);
+  bool sized = ro && cp->output_count == 4 && b >= 1 && b <= 16 &&
+               cp->outputs[0].width == (ro->width + b - 1) / b && cp->outputs[0].height == (ro->height + b - 1) / b;
+  if (!ro || !rd || !sized || rd->width != ro->width || rd->height != ro->height) {
+    lm_error_set(err, "function 'trace' takes inputs rays_o and rays_d and 4 outputs of their size, or of their "
+                      "size / params.block (1..16) rounded up (hit colour, normal, position, material)");
     return false;
   }
   const lm_scene *s = r->desc.scene;
@@ -678,14 +714,19 @@ static bool run_trace(lm_renderer *r, const lm_cpu_pass *cp, lm_error *err) {
   }
   else if (h != r->trace_hash) lm_trace_update(r->trace, s, NULL); /* nodes moved: refit (or rebuild) */
   r->trace_hash = h;
-  int n = ro->width * ro->height, count = 0;
+  int ow = cp->outputs[0].width, n = ow * cp->outputs[0].height, count = 0;
   lm_trace_ray *rays = lm_alloc(sizeof *rays * (size_t)n);
-  int *pixel = lm_alloc(sizeof *pixel * (size_t)n);
+  int *pixel = lm_alloc(sizeof *pixel * (size_t)n); /* the output texel of each ray */
+  int *chosen = b > 1 ? lm_alloc(sizeof *chosen * (size_t)n) : NULL;
+  if (chosen) choose_in_blocks(ro, b, ow, cp->outputs[0].height, cpu_param_int(cp, "turn", 0) ? (unsigned)r->frame : 0u, chosen);
   for (int i = 0; i < n; i++) {
-    const float *o = ro->rgba + (size_t)i * 4, *d = rd->rgba + (size_t)i * 4;
+    int from = chosen ? chosen[i] : i;
+    if (from < 0) continue;
+    const float *o = ro->rgba + (size_t)from * 4, *d = rd->rgba + (size_t)from * 4;
     if (!(o[3] > 0.5f)) continue;
     rays[count] = (lm_trace_ray){{o[0], o[1], o[2]}, 0, {d[0], d[1], d[2]}, d[3] > 0 ? d[3] : INFINITY};
     pixel[count++] = i;
+    if (chosen) cp->outputs[2].rgba[(size_t)i * 4 + 3] = 1; /* traced, hit or miss */
   }
   lm_trace_hit *hits = lm_alloc(sizeof *hits * (size_t)(count ? count : 1));
   lm_trace_rays(r->trace, rays, hits, count, 0);
@@ -704,7 +745,7 @@ static bool run_trace(lm_renderer *r, const lm_cpu_pass *cp, lm_error *err) {
     pos[3] = 1;
     mat[0] = m->ka, mat[1] = m->kd, mat[2] = m->ks, mat[3] = 1;
   }
-  free(rays), free(pixel), free(hits);
+  free(rays), free(pixel), free(hits), free(chosen);
   return true;
 }
 
