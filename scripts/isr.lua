@@ -263,8 +263,8 @@ function isr.render(direct, o, frame)
   -- rsm.bounces above 1: the march marks the rays that met surfaces the screen cannot show with this
   -- hit value (under 0.5: no sender), the recorded-senders bounce counts them (isr_bounce.frag's UNSEEN)
   local unseen = hits > 0 and light.rsm and light.rsm.bounces > 1 and 0.25 or nil
-  -- rsm.trace: the march also writes one ray a pixel the screen lost, the CPU traces it, a pass lights
-  -- its hit (isr.trace_light), and the recorded-senders bounce sends that light on for the lost rays
+  -- rsm.trace: the march also writes one ray a pixel the screen lost, the CPU traces it (or one a block's), a
+  -- pass lights its hit (isr.trace_light), and the recorded-senders bounce sends that light on for the lost rays
   local trace = unseen and light.rsm.trace > 0
   local rays, traced
   for b = 1, steps do

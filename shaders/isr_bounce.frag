@@ -183,9 +183,10 @@ void main() {
 #ifdef TRACE
   // The hit's light after this step's bounces: its second bounce grown as the series grows, 1 + r + ... +
   // r^(step - 2), r the series' ratio below (1 at the second step; at most 10: bounded)
-  vec3 r_hit = clamp((albedo + rays.y * texelFetch(traced_albedo, traced_texel(px), 0).rgb) / float(n), 0.0, BOUNCE_MAX);
+  ivec2 tp = traced_texel(px);
+  vec3 r_hit = clamp((albedo + rays.y * texelFetch(traced_albedo, tp, 0).rgb) / float(n), 0.0, BOUNCE_MAX);
   vec3 grown = (1.0 - pow(r_hit, vec3(float(max(step, 2) - 1)))) / (1.0 - r_hit); // pow: base >= 0, exponent >= 1
-  vec3 second = (gathered + rays.y * texelFetch(traced, traced_texel(px), 0).rgb * grown) / float(n);
+  vec3 second = (gathered + rays.y * texelFetch(traced, tp, 0).rgb * grown) / float(n);
 #else
   vec3 second = (gathered + rays.y * gathered / max(float(n) - rays.y, 1.0)) / float(n);
 #endif

@@ -718,7 +718,10 @@ static bool run_trace(lm_renderer *r, const lm_cpu_pass *cp, lm_error *err) {
   lm_trace_ray *rays = lm_alloc(sizeof *rays * (size_t)n);
   int *pixel = lm_alloc(sizeof *pixel * (size_t)n); /* the output texel of each ray */
   int *chosen = b > 1 ? lm_alloc(sizeof *chosen * (size_t)n) : NULL;
-  if (chosen) choose_in_blocks(ro, b, ow, cp->outputs[0].height, cpu_param_int(cp, "turn", 0) ? (unsigned)r->frame : 0u, chosen);
+  if (chosen) {
+    unsigned frame = cpu_param_int(cp, "turn", 0) ? (unsigned)r->frame : 0u;
+    choose_in_blocks(ro, b, ow, cp->outputs[0].height, frame, chosen);
+  }
   for (int i = 0; i < n; i++) {
     int from = chosen ? chosen[i] : i;
     if (from < 0) continue;
