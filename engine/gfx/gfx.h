@@ -350,7 +350,7 @@ bool lm_window_should_close(const lm_window *w);
 void lm_window_poll(lm_window *w);
 void lm_window_swap(lm_window *w);
 /* The framebuffer's size in pixels: 0x0 while the window is minimized. */
-void lm_window_size(const lm_window *w, int *width, int *height);
+void lm_window_size(lm_window *w, int *width, int *height);
 void lm_window_resize(lm_window *w, int width, int height);
 /* The next key pressed since the last call (its name); false when none. */
 bool lm_window_next_key(lm_window *w, char *name, size_t cap);
