@@ -458,6 +458,20 @@ static void composite_panel(viewer *v, const panel_image *image) {
   v->panel_timed++;
 }
 
+/* The display's columns x .. x + w - 1: src copied to the window, or drawn
+ * by the program in use. */
+static void draw_columns(viewer *v, bool copy, lm_texture src, int x, int w) {
+  lm_error err;
+  if (copy && !lm_screen_blit(src, x, 0, w, v->height, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    copy = false;
+  }
+  if (copy) return;
+  lm_set_scissor(true, x, 0, w, v->height);
+  lm_draw_fullscreen();
+  lm_set_scissor(false, 0, 0, 0, 0);
+}
+
 bool reference_shown(const viewer *v) { return v->error_view != ERROR_VIEW_OFF && v->place_ready; }
 
 void display(viewer *v) {
@@ -509,15 +523,15 @@ void display(viewer *v) {
     set_int(p, "channel", v->channel);
     set_float(p, "exposure", &v->exposure);
     set_float(p, "range", v->range);
-    lm_set_scissor(true, 0, 0, panel.column, v->height);
-    lm_draw_fullscreen();
+    /* The frame as it is (no target, wipe or text over it) is copied, not
+     * drawn: llvmpipe's blit spares the shader, ~1.4 ms of CPU a frame at 640x480. */
+    bool copy = mode == 0 && !wipe && !v->overlay_drawn.len;
+    draw_columns(v, copy, src, 0, panel.column);
     if (panel.column < v->width && panel_timed_frame(v)) { /* what the panel spares the display, timed */
       panel_stretch t0 = panel_clock(v);
-      lm_set_scissor(true, panel.column, 0, v->width - panel.column, v->height);
-      lm_draw_fullscreen();
+      draw_columns(v, copy, src, panel.column, v->width - panel.column);
       panel_lap(v, t0, -1, v->panel_spent);
     }
-    lm_set_scissor(false, 0, 0, 0, 0);
   }
   if (v->panel && v->panel_on) composite_panel(v, &panel);
 }
