@@ -913,6 +913,8 @@ static void viewer_free(viewer *v) {
   lm_texture_destroy(&v->probe);
   lm_texture_destroy(&v->compare_shown);
   free(v->overlay);
+  lm_buf_free(&v->overlay_lines);
+  lm_buf_free(&v->overlay_drawn);
   free(v->options);
   free(v->compare_options);
   reference_free(v);

@@ -76,6 +76,8 @@ typedef struct viewer {
   lm_texture shown;         /* the last good frame: shown while a frame fails */
   lm_texture overlay_tex;   /* text, rgba8 */
   uint8_t *overlay;
+  lm_buf overlay_lines;     /* this frame's (view_display.c's draw_text) */
+  lm_buf overlay_drawn;     /* those overlay_tex holds: none, nothing to blend */
   lm_texture probe;         /* the inspected target's raw values, rgba32f */
   int probe_w, probe_h;
   int camera;

@@ -9,7 +9,7 @@
 // program of the frame's path alone). MODE: 0 the frame, 1 a target, 2 a
 // target in false colour, 3 black, 4 a one-channel or depth target, grey
 // over its range; WIPE: the other side right of the split (OTHER_LINEAR:
-// it holds linear radiance).
+// it holds linear radiance); OVERLAY: text to blend over it (none, no fetch).
 #include "common.glsl"
 
 #ifndef MODE
@@ -80,7 +80,11 @@ void main() {
   }
   if (abs(gl_FragCoord.x - split) < 1.0) c = vec3(1.0); // the line to drag
 #endif
+#if defined(OVERLAY)
   vec4 o = at_pixel(overlay);
   color = vec4(c * (1.0 - o.a) + o.rgb, 1.0);
+#else
+  color = vec4(c, 1.0);
+#endif
 #endif
 }

@@ -218,13 +218,16 @@ static int teardown(void **state) {
 static void log_path(char *out, const char *name) { snprintf(out, 512, "%s/%s.log", root, name); }
 static void shot_path(char *out, const char *name) { snprintf(out, 512, "%s/%s", root, name); }
 
-/* The window shows the box; the overlay draws text over its top only. */
+/* The window shows the box; the overlay draws text over its top only, and
+ * turned off (F1) leaves none behind (its image is redrawn only when its
+ * lines change). */
 static void window_shows_the_box(void **state) {
   (void)state;
-  char log[512], plain[512], text[512];
+  char log[512], plain[512], text[512], off[512];
   log_path(log, "plain");
   shot_path(plain, "plain.png");
   shot_path(text, "overlay.png");
+  shot_path(off, "overlay_off.png");
   pid_t pid = spawn_view(log, "--tech", "dl", "--size", "256x192", "--overlay", "off", "--exit-after", "5",
                          "--screenshot", plain, NULL);
   int rc = wait_exit(pid, 20000);
@@ -232,24 +235,32 @@ static void window_shows_the_box(void **state) {
   assert_int_equal(rc, 0);
   pid = spawn_view(log, "--tech", "dl", "--size", "256x192", "--exit-after", "5", "--screenshot", text, NULL);
   assert_int_equal(wait_exit(pid, 20000), 0);
-  lm_image a, b;
+  pid = spawn_view(log, "--tech", "dl", "--size", "256x192", "--exit-after", "5", "--script-keys", "2:F1",
+                   "--screenshot", off, NULL);
+  assert_int_equal(wait_exit(pid, 20000), 0);
+  lm_image a, b, c;
   load("plain.png", &a);
   load("overlay.png", &b);
+  load("overlay_off.png", &c);
   assert_int_equal(a.width, 256);
   assert_int_equal(a.height, 192);
   assert_walls(&a);
   /* Text and its dark band change the top rows; the floor is left alone. */
-  double top_a[3], top_b[3], low_a[3], low_b[3];
+  double top_a[3], top_b[3], top_c[3], low_a[3], low_b[3];
   box_mean(&a, 0, 0, 1, 0.1, top_a);
   box_mean(&b, 0, 0, 1, 0.1, top_b);
+  box_mean(&c, 0, 0, 1, 0.1, top_c);
   box_mean(&a, 0.3, 0.95, 0.7, 1, low_a);
   box_mean(&b, 0.3, 0.95, 0.7, 1, low_b);
-  double dtop = 0, dlow = 0;
-  for (int c = 0; c < 3; c++) dtop += fabs(top_a[c] - top_b[c]), dlow += fabs(low_a[c] - low_b[c]);
+  double dtop = 0, dlow = 0, doff = 0;
+  for (int k = 0; k < 3; k++)
+    dtop += fabs(top_a[k] - top_b[k]), dlow += fabs(low_a[k] - low_b[k]), doff += fabs(top_a[k] - top_c[k]);
   assert_true(dtop > 0.05);
   assert_true(dlow < 0.01);
+  assert_true(doff < 0.01);
   lm_image_free(&a);
   lm_image_free(&b);
+  lm_image_free(&c);
 }
 
 /* A scratch pipeline: the isr technique adds 0.25 to the ambient light,

@@ -165,7 +165,8 @@ static bool same_attachments(const lm_attachments *a, const lm_attachments *b) {
   return true;
 }
 
-bool lm_attachments_bind(const lm_attachments *att, lm_error *err) {
+/* The cached framebuffer of these attachments (made on first use); 0 when incomplete. */
+static GLuint framebuffer_for(const lm_attachments *att, lm_error *err) {
   fbo_entry *e = NULL;
   for (int i = 0; i < fbo_count && !e; i++)
     if (same_attachments(&fbos[i].att, att)) e = &fbos[i];
@@ -183,13 +184,19 @@ bool lm_attachments_bind(const lm_attachments *att, lm_error *err) {
     if (status != GL_FRAMEBUFFER_COMPLETE) {
       glDeleteFramebuffers(1, &fbo);
       lm_error_set(err, "framebuffer incomplete (0x%x)", status);
-      return false;
+      return 0;
     }
     e = LM_PUSH(fbos, fbo_count, fbo_cap);
     e->att = *att;
     e->fbo = fbo;
   }
-  glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
+  return e->fbo;
+}
+
+bool lm_attachments_bind(const lm_attachments *att, lm_error *err) {
+  GLuint fbo = framebuffer_for(att, err);
+  if (!fbo) return false;
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, att->width, att->height);
   return true;
 }
@@ -760,6 +767,17 @@ void lm_texture_copy_moved(lm_texture dst, int dx, int dy, lm_texture src, int s
 void lm_screen_bind(int width, int height) {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glViewport(0, 0, width, height);
+}
+
+bool lm_screen_blit(lm_texture src, int x, int y, int width, int height, lm_error *err) {
+  lm_attachments att = {.color = {src}, .color_count = 1};
+  GLuint fbo = framebuffer_for(&att, err);
+  if (!fbo) return false;
+  glDisable(GL_SCISSOR_TEST); /* it would clip the blit */
+  glBlitNamedFramebuffer(fbo, 0, x, y, x + width, y + height, x, y, x + width, y + height, GL_COLOR_BUFFER_BIT,
+                         GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  return true;
 }
 
 void lm_screen_read(int width, int height, uint8_t *rgb) {

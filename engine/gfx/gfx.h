@@ -329,6 +329,11 @@ void lm_texture_copy_rect(lm_texture dst, lm_texture src, int x, int y, int widt
 void lm_texture_copy_moved(lm_texture dst, int dx, int dy, lm_texture src, int sx, int sy, int width, int height);
 /* Binds the window's (default) framebuffer and sets the viewport. */
 void lm_screen_bind(int width, int height);
+/* Copies the rectangle (x, y: from the bottom left) of src, a texture of the
+ * window's size, to the same place in the window's back buffer, no shader (on
+ * llvmpipe a copy of the pixels); the scissor test ends off and the window's
+ * framebuffer bound. */
+bool lm_screen_blit(lm_texture src, int x, int y, int width, int height, lm_error *err);
 /* The default framebuffer's back buffer as RGB bytes, top row first. */
 void lm_screen_read(int width, int height, uint8_t *rgb);
 
@@ -350,7 +355,7 @@ bool lm_window_should_close(const lm_window *w);
 void lm_window_poll(lm_window *w);
 void lm_window_swap(lm_window *w);
 /* The framebuffer's size in pixels: 0x0 while the window is minimized. */
-void lm_window_size(const lm_window *w, int *width, int *height);
+void lm_window_size(lm_window *w, int *width, int *height);
 void lm_window_resize(lm_window *w, int width, int height);
 /* The next key pressed since the last call (its name); false when none. */
 bool lm_window_next_key(lm_window *w, char *name, size_t cap);

@@ -16,6 +16,12 @@ struct lm_window {
   int head, count;
   double last_x, last_y;
   bool dragging;
+  /* The cursor and the framebuffer's size as GLFW's events last told them:
+   * asking would be a round trip to the X server every frame (XQueryPointer,
+   * XGetWindowAttributes), each a wait for its process on a loaded machine. */
+  double cursor_x, cursor_y;
+  int width, height;
+  bool size_asked; /* a resize of ours is on its way: ask the server once */
 };
 
 static const struct {
@@ -59,6 +65,21 @@ static void on_key(GLFWwindow *glfw, int key, int scancode, int action, int mods
   w->queue[(w->head + w->count++) % KEY_QUEUE] = key;
 }
 
+static void on_cursor(GLFWwindow *glfw, double x, double y) {
+  lm_window *w = glfwGetWindowUserPointer(glfw);
+  w->cursor_x = x, w->cursor_y = y;
+}
+
+static void on_cursor_enter(GLFWwindow *glfw, int entered) {
+  lm_window *w = glfwGetWindowUserPointer(glfw);
+  if (!entered && !w->dragging) w->cursor_x = w->cursor_y = -1; /* outside (a drag still reports motion) */
+}
+
+static void on_framebuffer_size(GLFWwindow *glfw, int width, int height) {
+  lm_window *w = glfwGetWindowUserPointer(glfw);
+  w->width = width, w->height = height;
+}
+
 static char glfw_message[512];
 static void on_error(int code, const char *message) {
   snprintf(glfw_message, sizeof glfw_message, "GLFW error 0x%x: %s", code, message);
@@ -92,6 +113,12 @@ lm_window *lm_window_create(const char *title, int width, int height, lm_error *
   w->glfw = glfw;
   glfwSetWindowUserPointer(glfw, w);
   glfwSetKeyCallback(glfw, on_key);
+  /* Set before the panel's library chains its own in front of them. */
+  glfwSetCursorPosCallback(glfw, on_cursor);
+  glfwSetCursorEnterCallback(glfw, on_cursor_enter);
+  glfwSetFramebufferSizeCallback(glfw, on_framebuffer_size);
+  glfwGetCursorPos(glfw, &w->cursor_x, &w->cursor_y);
+  glfwGetFramebufferSize(glfw, &w->width, &w->height);
   return w;
 }
 
@@ -109,10 +136,15 @@ void lm_window_destroy(lm_window *w) {
 bool lm_window_should_close(const lm_window *w) { return glfwWindowShouldClose(w->glfw); }
 void lm_window_poll(lm_window *w) { (void)w, glfwPollEvents(); }
 void lm_window_swap(lm_window *w) { glfwSwapBuffers(w->glfw); }
-void lm_window_size(const lm_window *w, int *width, int *height) {
-  glfwGetFramebufferSize(w->glfw, width, height);
+void lm_window_size(lm_window *w, int *width, int *height) {
+  if (w->size_asked) glfwGetFramebufferSize(w->glfw, &w->width, &w->height); /* after our resize request */
+  w->size_asked = false;
+  *width = w->width, *height = w->height;
 }
-void lm_window_resize(lm_window *w, int width, int height) { glfwSetWindowSize(w->glfw, width, height); }
+void lm_window_resize(lm_window *w, int width, int height) {
+  glfwSetWindowSize(w->glfw, width, height);
+  w->size_asked = true;
+}
 
 bool lm_window_next_key(lm_window *w, char *name, size_t cap) {
   while (w->count > 0) {
@@ -130,8 +162,7 @@ bool lm_window_key_down(const lm_window *w, const char *name) {
 }
 
 void lm_window_mouse_drag(lm_window *w, double *dx, double *dy) {
-  double x, y;
-  glfwGetCursorPos(w->glfw, &x, &y);
+  double x = w->cursor_x, y = w->cursor_y;
   bool down = glfwGetMouseButton(w->glfw, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
   *dx = down && w->dragging ? x - w->last_x : 0;
   *dy = down && w->dragging ? y - w->last_y : 0;
@@ -139,5 +170,5 @@ void lm_window_mouse_drag(lm_window *w, double *dx, double *dy) {
   w->last_x = x, w->last_y = y;
 }
 
-void lm_window_cursor(const lm_window *w, double *x, double *y) { glfwGetCursorPos(w->glfw, x, y); }
+void lm_window_cursor(const lm_window *w, double *x, double *y) { *x = w->cursor_x, *y = w->cursor_y; }
 void *lm_window_handle(lm_window *w) { return w->glfw; }
