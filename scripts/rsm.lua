@@ -216,10 +216,6 @@ function rsm.march(o, frame)
     error(string.format("%s takes temporal reuse from %s.temporal (one pass gathers both); rsm.temporal is for "
                         .. "rsm's own gather", row[1], row.lighting), 2)
   end
-  -- The traced hits lie off screen: every sender counts, and no screen-space visibility.
-  local all = {}
-  for k, v in pairs(o) do all[k] = v end
-  all.steps = 0
   return { coarse = o.coarse, bounces = o.bounces, trace = o.trace,
            bind = function(inputs, defines, params, f, temporal_on)
              params.rsm_k = o.k
@@ -227,6 +223,10 @@ function rsm.march(o, frame)
                              frame.G)
            end,
            bind_all = function(inputs, defines, params, f)
+             -- The traced hits lie off screen: every sender counts, and no screen-space visibility.
+             local all = {}
+             for k, v in pairs(o) do all[k] = v end
+             all.steps = 0
              params.rsm_k = o.k
              return rsm.bind(inputs, defines, params, frame.R, frame.shadows, all, f, false, false, frame.G)
            end }
