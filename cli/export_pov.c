@@ -58,8 +58,6 @@ typedef struct export_args {
 
 static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("export-pov", fmt, arg); }
 
-enum { SKY_FLAG = 0x100 }; /* beyond any one-letter flag */
-
 /* "r,g,b" or one grey number, each finite in 0 .. 1e6. */
 static bool parse_colour(const char *s, float out[3]) {
   double v[3];
@@ -76,8 +74,7 @@ static bool parse_colour(const char *s, float out[3]) {
   return true;
 }
 
-/* --sky ZENITH:HORIZON[:INTENSITY], as scripts/sky.lua's options. */
-static bool parse_sky(const char *s, lm_sky *sky) {
+bool limn_parse_sky(const char *s, lm_sky *sky) {
   char buf[512];
   snprintf(buf, sizeof buf, "%s", s);
   char *save = NULL, *z = strtok_r(buf, ":", &save), *h = strtok_r(NULL, ":", &save);
@@ -96,7 +93,7 @@ const struct option limn_pov_options[] = {
     {"pretrace-end", required_argument, 0, 'E'},   {"recursion-limit", required_argument, 0, 'l'},
     {"brightness", required_argument, 0, 'b'},     {"shadows", required_argument, 0, 'w'},
     {"approximate", no_argument, 0, 'a'},          {"materials", required_argument, 0, 'M'},
-    {"sky", required_argument, 0, SKY_FLAG},
+    {"sky", required_argument, 0, LIMN_POV_SKY_FLAG},
     {0, 0, 0, 0}};
 _Static_assert(sizeof limn_pov_options / sizeof *limn_pov_options == LIMN_POV_OPTION_COUNT,
                "LIMN_POV_OPTION_COUNT (tools.h) counts limn_pov_options");
@@ -137,8 +134,8 @@ int limn_pov_flag(const char *cmd, int c, const char *arg, lm_pov_desc *d) {
     if (!strcmp(arg, "pbr") || !strcmp(arg, "phong")) d->pbr_materials = !strcmp(arg, "pbr");
     else bad = "--materials wants phong or pbr, not '%s'";
     break;
-  case SKY_FLAG:
-    d->has_sky = parse_sky(arg, &d->sky);
+  case LIMN_POV_SKY_FLAG:
+    d->has_sky = limn_parse_sky(arg, &d->sky);
     if (!d->has_sky) bad = "--sky wants ZENITH:HORIZON[:INTENSITY], colours r,g,b or one grey number, not '%s'";
     break;
   default: return 1;

@@ -221,7 +221,6 @@ int limn_farm(int argc, char **argv) {
   static const char *const named[6] = {"partition", "time", "mem", "cpus-per-task", "gres", "account"};
   reference_args ref; /* the flags checked here, passed on as given */
   reference_defaults(&ref);
-  lm_pov_desc *pov = &ref.pov;
   struct option opts[18 + LIMN_POV_OPTION_COUNT - 1 + REFERENCE_OPTION_COUNT] = {
       {"job", required_argument, 0, 'J'},       {"shards", required_argument, 0, 'K'},
       {"partition", required_argument, 0, '0'}, {"time", required_argument, 0, '1'},
@@ -239,8 +238,7 @@ int limn_farm(int argc, char **argv) {
   int c, rc = -1;
   char name[256];
   while (rc < 0 && (c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
-    int taken = limn_pov_flag("farm slurm", c, optarg, pov);
-    if (taken == 1) taken = reference_flag("farm slurm", c, optarg, &ref);
+    int taken = reference_flag("farm slurm", c, optarg, &ref);
     if (taken == 2) rc = 2;
     if (taken == 0 && a.pov_count == 64) rc = usage_error("%s", "at most 64 export-pov and renderer flags");
     if (taken == 0 && rc < 0) { /* kept as given, for reference and merge */
@@ -284,7 +282,7 @@ int limn_farm(int argc, char **argv) {
     }
   }
   if (rc >= 0) return rc;
-  const char *bad = pov->radiosity ? lm_pov_radiosity_check(&pov->rad) : NULL;
+  const char *bad = ref.pov.radiosity ? lm_pov_radiosity_check(&ref.pov.rad) : NULL;
   if (bad) return usage_error("radiosity setting out of range: %s", bad);
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
   if (!a.job || !a.shards) return usage_error("%s", "--job FILE and --shards N are required");

@@ -16,6 +16,8 @@
  *     animation = "walk",                         -- name or index (default all)
  *     renderer = "cycles",                        -- the references' (limn reference, report):
  *                                                 -- "pov" (default) or "cycles"
+ *     references = { sky = "0.1,0.15,0.3:0.3,0.32,0.35:1", materials = "pbr", approximate = true },
+ *                                                 -- as --sky, --materials, --approximate (which win)
  *     path = { { t = 0, eye = { 0, 1, 5 }, target = { 0, 1, 0 }, fov = 45 }, ... },
  *                                                 -- or "file.cams" / { cameras = "file.cams",
  *                                                 -- times = {...} }; or instead
@@ -441,6 +443,48 @@ static bool read_turntable(lua_State *L, job *j, lm_error *err) {
   return ok;
 }
 
+/* references = { sky = "Z:H[:I]", materials = "pbr" | "phong", approximate = true }: the
+ * references' settings kept with the views they judge, so that a sky-lit job is never compared
+ * with sky-less references because a flag was left off a command line. */
+static bool read_references(lua_State *L, job *j, lm_error *err) {
+  job_references *r = &j->references;
+  *r = (job_references){.pbr_materials = -1, .approximate = -1};
+  lua_getfield(L, -1, "references");
+  bool ok = true;
+  if (lua_istable(L, -1)) {
+    lua_pushnil(L);
+    while (ok && lua_next(L, -2)) {
+      const char *key = lua_type(L, -2) == LUA_TSTRING ? lua_tostring(L, -2) : "?";
+      const char *value = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : NULL;
+      if (!strcmp(key, "sky")) {
+        ok = value && limn_parse_sky(value, &r->sky);
+        r->has_sky = ok;
+        if (!ok) lm_error_set(err, "%s: references.sky: \"ZENITH:HORIZON[:INTENSITY]\" (colours r,g,b or one grey "
+                              "number in 0 .. 1e6), not %s", j->path, value ? value : luaL_typename(L, -1));
+      } else if (!strcmp(key, "materials")) {
+        ok = value && (!strcmp(value, "pbr") || !strcmp(value, "phong"));
+        r->pbr_materials = ok && !strcmp(value, "pbr");
+        if (!ok) lm_error_set(err, "%s: references.materials: \"phong\" or \"pbr\", not %s", j->path,
+                              value ? value : luaL_typename(L, -1));
+      } else if (!strcmp(key, "approximate")) {
+        ok = lua_isboolean(L, -1);
+        r->approximate = lua_toboolean(L, -1);
+        if (!ok) lm_error_set(err, "%s: references.approximate: true or false, not a %s", j->path, luaL_typename(L, -1));
+      } else {
+        lm_error_set(err, "%s: references: unknown field '%s' (known: sky, materials, approximate)", j->path, key);
+        ok = false;
+      }
+      lua_pop(L, ok ? 1 : 2);
+    }
+  } else if (!lua_isnil(L, -1)) {
+    lm_error_set(err, "%s: references: a table { sky = \"Z:H[:I]\", materials = \"pbr\", approximate = true }, "
+                 "not a %s", j->path, luaL_typename(L, -1));
+    ok = false;
+  }
+  lua_pop(L, 1);
+  return ok;
+}
+
 static int compare_sets(const void *a, const void *b) { return strcmp(a, b); }
 
 bool job_read(job *j, const char *path, lm_error *err) {
@@ -474,7 +518,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
   }
   static const char *const known[] = {"script", "scenes", "techniques", "sizes", "set", "frames", "output",
                                       "manifest", "time", "animation", "path", "turntable", "events",
-                                      "renderer", NULL};
+                                      "renderer", "references", NULL};
   lua_pushnil(L);
   while (ok && lua_next(L, -2)) {
     lua_pop(L, 1);
@@ -482,7 +526,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
     for (const char *const *k = known; *k && lua_type(L, -1) == LUA_TSTRING; k++) found |= !strcmp(*k, lua_tostring(L, -1));
     if (!found) {
       lm_error_set(err, "%s: unknown field '%s' (known: script, scenes, techniques, sizes, set, frames, output, "
-                   "manifest, time, animation, path, turntable, events, renderer)", path, lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : luaL_typename(L, -1));
+                   "manifest, time, animation, path, turntable, events, renderer, references)", path, lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : luaL_typename(L, -1));
       ok = false;
       lua_pop(L, 1);
     }
@@ -496,7 +540,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
        read_list(L, -1, "techniques", path, &j->technique_count, err, each_technique, j) &&
        read_list(L, -1, "sizes", path, &j->size_count, err, each_size, j) && read_sets(L, j, err) &&
        read_list(L, -1, "events", path, &j->event_count, err, each_event, j) && read_time(L, j, err) &&
-       read_path(L, j, err) && read_turntable(L, j, err);
+       read_path(L, j, err) && read_turntable(L, j, err) && read_references(L, j, err);
   if (ok) { /* a name, or an index as a number */
     lua_getfield(L, -1, "animation");
     if (lua_isinteger(L, -1)) lua_pushfstring(L, "%d", (int)lua_tointeger(L, -1)), lua_setfield(L, -3, "animation");

@@ -6,6 +6,7 @@
 
 #include "camera_path.h"
 #include "capture_render.h"
+#include "scene/sky.h"
 
 #define MAX_LIST 64
 #define MAX_PATH_KEYS 256
@@ -24,9 +25,19 @@ typedef struct job_scene {
   float orbit;        /* a turntable's distance from the centre */
 } job_scene;
 
+/* The job's `references` table (limn reference, report, manifest merge): the command line's
+ * --sky, --materials and --approximate win over it when given. */
+typedef struct job_references {
+  bool has_sky;
+  lm_sky sky;
+  int pbr_materials; /* 1 pbr, 0 phong, -1 not given */
+  int approximate;   /* 1 or 0, -1 not given */
+} job_references;
+
 typedef struct job {
   char path[1024], dir[1024], script[1024], output[1024], manifest[1024];
   char renderer[16]; /* the references' renderer: "pov", "cycles" or "" (not given; cli/reference.h) */
+  job_references references;
   job_scene scenes[MAX_LIST];
   int scene_count;
   char techniques[MAX_LIST][64];

@@ -233,8 +233,7 @@ int limn_manifest(int argc, char **argv) {
   optind = 1;
   int c;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
-    int pov = limn_pov_flag("manifest merge", c, optarg, &a.ref.pov);
-    if (pov == 1) pov = reference_flag("manifest merge", c, optarg, &a.ref);
+    int pov = reference_flag("manifest merge", c, optarg, &a.ref);
     if (pov == 2) return 2;
     if (pov == 0) continue;
     switch (c) {

@@ -100,6 +100,16 @@ static bool parse_renderer(const char *s, reference_renderer *out) {
 }
 
 int reference_flag(const char *cmd, int c, const char *arg, reference_args *a) {
+  int pov = limn_pov_flag(cmd, c, arg, &a->pov);
+  if (pov != 1) {
+    for (const struct option *o = limn_pov_options; pov == 0 && o->name; o++) {
+      if (o->val != c) continue;
+      a->sky_given |= !strcmp(o->name, "sky");
+      a->materials_given |= !strcmp(o->name, "materials");
+      a->approximate_given |= !strcmp(o->name, "approximate");
+    }
+    return pov;
+  }
   reference_cycles *y = &a->cycles;
   const char *bad = NULL;
   switch (c) {
@@ -117,8 +127,26 @@ int reference_flag(const char *cmd, int c, const char *arg, reference_args *a) {
   return bad ? limn_usage_error(cmd, bad, arg) : 0;
 }
 
+/* The job sets sky.enabled to true: its views are lit by the sky. */
+static bool job_has_sky(const job *j) {
+  bool on = false;
+  for (int i = 0; i < j->set_count; i++)
+    if (!strcmp(j->set_names[i], "sky.enabled")) on = !strcmp(j->set_values[i], "true") || !strcmp(j->set_values[i], "1");
+  return on;
+}
+
 bool reference_prepare(reference_args *a, const job *j, lm_error *err) {
   if (!a->renderer_given && j->renderer[0]) parse_renderer(j->renderer, &a->renderer); /* job_read checked it */
+  const job_references *r = &j->references;
+  if (!a->sky_given && r->has_sky) a->pov.has_sky = true, a->pov.sky = r->sky;
+  if (!a->materials_given && r->pbr_materials >= 0) a->pov.pbr_materials = r->pbr_materials;
+  if (!a->approximate_given && r->approximate >= 0) a->pov.strict = !r->approximate;
+  if (job_has_sky(j) && !a->pov.has_sky) {
+    lm_error_set(err, "%s: its views are lit by the sky (set sky.enabled) but the references would have none: "
+                 "give the job references = { sky = \"ZENITH:HORIZON[:INTENSITY]\" } (scripts/sky.lua's "
+                 "sky.zenith, sky.horizon, sky.intensity) or --sky", j->path);
+    return false;
+  }
   if (a->renderer == REFERENCE_POV) return true;
   /* What only POV-Ray has: refused rather than ignored, so no one compares with a reference they did not ask for. */
   if (!a->pov.radiosity) {
@@ -603,8 +631,7 @@ int limn_reference(int argc, char **argv) {
   optind = 1;
   int c;
   while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
-    int pov = limn_pov_flag("reference", c, optarg, &a.pov);
-    if (pov == 1) pov = reference_flag("reference", c, optarg, &a);
+    int pov = reference_flag("reference", c, optarg, &a);
     if (pov == 2) return 2;
     if (pov == 0) continue;
     switch (c) {

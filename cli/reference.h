@@ -44,6 +44,7 @@ typedef struct reference_args {
   const char *refs;   /* folder of the references (default out/reference) */
   reference_renderer renderer;
   bool renderer_given; /* --renderer on the command line: it wins over the job's `renderer` */
+  bool sky_given, materials_given, approximate_given; /* and these over the job's `references` */
   const char *povray; /* POV-Ray's program (default povray) */
   lm_pov_desc pov;    /* POV-Ray's export settings (camera and size are the view's); Cycles takes
                          its materials and sky */
@@ -61,10 +62,11 @@ void reference_describe(const reference_args *a, char *out, size_t cap);
 
 /* The flags that choose and set the renderer (--renderer, --samples,
  * --bounces, --seed, --blender, --cycles-script), shared by reference,
- * report, manifest merge and farm as export-pov's are: reference_options
- * ends with a zero entry (REFERENCE_OPTION_COUNT entries in all);
- * reference_flag returns 0 when it took getopt's c, 1 when c is not one of
- * them, 2 after printing a usage error for `limn CMD`. */
+ * report, manifest merge and farm: reference_options ends with a zero entry
+ * (REFERENCE_OPTION_COUNT entries in all). reference_flag takes these and
+ * export-pov's (limn_pov_options, into a->pov, noting which were given):
+ * 0 when it took getopt's c, 1 when c is neither, 2 after printing a usage
+ * error for `limn CMD`. */
 extern const struct option reference_options[];
 #define REFERENCE_OPTION_COUNT 7
 #define REFERENCE_OPTIONS_HELP                                                                           \
@@ -77,8 +79,10 @@ extern const struct option reference_options[];
   "  --cycles-script FILE Cycles: the script Blender runs (default cli/cycles_render.py)\n"
 int reference_flag(const char *cmd, int c, const char *arg, reference_args *a);
 
-/* Before any view, once a run: takes the job's `renderer` unless one was
- * given, checks the settings fit the renderer, and for Cycles reads
+/* Before any view, once a run: takes the job's `renderer` and `references`
+ * unless the command line gave them, refuses a job whose views are lit by
+ * the sky (set sky.enabled) against references without one, checks the
+ * settings fit the renderer, and for Cycles reads
  * Blender's version and the script. False with a message naming the
  * program and the Debian package that installs it when it cannot run. */
 bool reference_prepare(reference_args *a, const job *j, lm_error *err);

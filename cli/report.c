@@ -1081,8 +1081,7 @@ int limn_report(int argc, char **argv) {
   optind = 1;
   int c, rc = 0, sweeps = 0;
   while (!rc && (c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
-    int pov = limn_pov_flag("report", c, optarg, &a.ref.pov);
-    if (pov == 1) pov = reference_flag("report", c, optarg, &a.ref);
+    int pov = reference_flag("report", c, optarg, &a.ref);
     if (pov == 2) rc = 2;
     if (pov != 1) continue;
     switch (c) {

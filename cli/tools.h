@@ -79,8 +79,13 @@ void limn_json_append(lm_buf *b, const char *s); /* the same, appended to b */
 struct lm_pov_desc;
 extern const struct option limn_pov_options[];
 #define LIMN_POV_OPTION_COUNT 12
+enum { LIMN_POV_SKY_FLAG = 0x100 }; /* --sky's getopt value, beyond any one-letter flag */
 void limn_pov_defaults(struct lm_pov_desc *d);
 int limn_pov_flag(const char *cmd, int c, const char *arg, struct lm_pov_desc *d);
+/* --sky's ZENITH:HORIZON[:INTENSITY] (colours r,g,b or one grey number, each in
+ * 0 .. 1e6), as scripts/sky.lua's options; also a job's references.sky. */
+struct lm_sky;
+bool limn_parse_sky(const char *s, struct lm_sky *sky);
 /* Writes the file under a temporary name and renames it: whole or not at all. */
 typedef struct lm_error lm_error;
 bool limn_write_whole(const char *path, const char *data, size_t len, lm_error *err);

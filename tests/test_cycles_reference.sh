@@ -12,7 +12,8 @@
 #   one killed by SIGKILL takes its render with it, and the next run removes
 #   its partial file;
 # - a missing Blender names the Debian package and the install command;
-# - --shard splits the views; the job's renderer field selects Cycles;
+# - --shard splits the views; the job's renderer field selects Cycles, its
+#   references table sets the sky (a sky-lit job without one is refused);
 # - limn report against Cycles: every row says so, and the direct-only
 #   floor is the same render with 0 bounces; limn farm passes the flags on;
 # - an animated scene at a time is given to Blender posed, one file a frame.
@@ -212,6 +213,21 @@ sed 's/sizes = /renderer = "cycles", sizes = /' job.lua > field.lua
 sed 's/sizes = /renderer = "mitsuba", sizes = /' job.lua > badfield.lua
 "$limn" reference --job badfield.lua "${cy[@]:2}" >log 2>&1
 [ $? = 2 ] && grep -q 'field.lua: renderer: "pov" or "cycles", not "mitsuba"' log || { cat log; fail "a bad renderer field"; }
+# The job's references table: its sky finds the reference --sky made; a bad one is refused by name; a
+# sky-lit job (sky.enabled) without a reference sky is refused rather than judged against a sky-less one.
+sed 's/sizes = /references = { sky = "1,1,1:0.5" }, sizes = /' job.lua > refsky.lua
+"$limn" reference --job refsky.lua "${cy[@]}" >log 2>&1 && grep -q "0 rendered, 1 cached" log \
+  || { cat log; fail "the job's references.sky did not find the reference --sky 1,1,1:0.5 made"; }
+sed 's/sizes = /references = { sky = "0.1,0.2" }, sizes = /' job.lua > badsky.lua
+"$limn" reference --job badsky.lua "${cy[@]}" >log 2>&1
+[ $? = 2 ] && grep -q 'badsky.lua: references.sky: "ZENITH:HORIZON' log || { cat log; fail "a bad references.sky"; }
+sed 's/ambient = 0/ambient = 0, ["sky.enabled"] = true/' job.lua > skylit.lua
+"$limn" reference --job skylit.lua "${cy[@]}" >log 2>&1
+[ $? = 1 ] && grep -q "skylit.lua: its views are lit by the sky" log || { cat log; fail "a sky-lit job without a reference sky"; }
+"$limn" report --job skylit.lua "${cy[@]}" --out rep-sky --sweep dl --frames 1 --warmup 0 >log 2>&1
+[ $? != 0 ] && grep -q "references would have none" log && [ ! -e rep-sky ] || { cat log; fail "report on a sky-lit job without a reference sky"; }
+"$limn" reference --job skylit.lua "${cy[@]}" --sky 1,1,1:0.5 >log 2>&1 && grep -q "0 rendered, 1 cached" log \
+  || { cat log; fail "--sky did not serve a sky-lit job"; }
 "$limn" reference --job job.lua --renderer mitsuba >log 2>&1
 [ $? = 2 ] && grep -q "renderer wants pov or cycles" log || { cat log; fail "a bad --renderer"; }
 # What only POV-Ray has is refused for Cycles.

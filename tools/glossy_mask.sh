@@ -25,10 +25,10 @@ cams=${SCENE%.glb}.cams
 mkdir -p "$OUT"
 cat > "$OUT/job.lua" <<LUA
 return { scenes = { "$PWD/$SCENE" }, techniques = { "dl+esm" }, sizes = { "$SIZE" },
-         set = { ambient = 0, materials = "pbr", ["sky.enabled"] = true }, output = "$PWD/$OUT/job/{camera}.png" }
+         set = { ambient = 0, materials = "pbr", ["sky.enabled"] = true }, output = "$PWD/$OUT/job/{camera}.png",
+         references = { sky = "$SKY", materials = "pbr" } }
 LUA
-"$LIMN" reference --job "$OUT/job.lua" --refs "$REFS" --renderer cycles --samples "$SAMPLES" --materials pbr \
-  --sky "$SKY" --quiet
+"$LIMN" reference --job "$OUT/job.lua" --refs "$REFS" --renderer cycles --samples "$SAMPLES" --quiet
 settings=("dl+esm" "dl+esm:glossy.enabled=true" "lpv+esm" "lpv+esm:glossy.enabled=true"
           "lpv+esm:glossy.enabled=true,glossy.fallback=sky" "isr+lpv+esm:glossy.enabled=true")
 printf "%-10s" view; for s in "${settings[@]}"; do printf " | %s" "$s"; done; echo

@@ -2,12 +2,13 @@
 -- sky.lua's default sky and a low sun behind its back building, with a
 -- mirror-like steel sphere, a brushed steel bench and a copper door. Written
 -- after the GI defaults were chosen and never tuned against
--- (docs/gi-combined.md). The references take the same sky (`--sky`, export-pov's
--- ZENITH:HORIZON[:INTENSITY]); POV-Ray draws the metals as its closest finish
--- (--approximate), Cycles as glTF defines them with --materials pbr:
---   build/limn reference --job data/jobs/holdout-yard.lua --sky 0.1,0.15,0.3:0.3,0.32,0.35:1 --approximate
---   build/limn report --job data/jobs/holdout-yard.lua --baseline dl+esm --sweep isr+esm ... (the same flags)
--- and with --renderer cycles --samples 512 against Cycles. POV-Ray gathers
+-- (docs/gi-combined.md). The references take the same sky (`references.sky`,
+-- sky.lua's defaults as export-pov's ZENITH:HORIZON[:INTENSITY]); POV-Ray draws
+-- the metals as its closest finish (approximate), Cycles as glTF defines them
+-- with --materials pbr:
+--   build/limn reference --job data/jobs/holdout-yard.lua
+--   build/limn report --job data/jobs/holdout-yard.lua --baseline dl+esm --sweep isr+esm ...
+-- and with --renderer cycles --samples 512 --materials pbr against Cycles. POV-Ray gathers
 -- the sky only through radiosity, so its direct-only floor (--radiosity off)
 -- lacks the sky's light: against POV-Ray the report's gain over dl+esm is the
 -- figure, against Cycles (whose floor keeps the sky's direct light) the share
@@ -17,5 +18,6 @@ return {
   techniques = { "dl+esm" },
   sizes = { "96x72" },
   set = { ambient = 0, ["sky.enabled"] = true },
+  references = { sky = "0.1,0.15,0.3:0.3,0.32,0.35:1", approximate = true },
   output = "out/holdout/{scene}/{camera}_{technique}.png",
 }
