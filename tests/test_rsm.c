@@ -375,7 +375,7 @@ static void a_late_target_like_the_rsm_takes_none_of_its_textures(void **state) 
 
 /* A light inside geometry (a point light in a closed box the camera looks
  * at from outside), a spot whose cone is nearly closed (a tile seeing next
- * to nothing), one sample, 4096 samples, the visibility march and the
+ * to nothing), one sample, 4096 samples (at the traced hits too), the visibility march and the
  * off-screen rays' RSM test at its most steps: finite. */
 static void extremes_stay_finite(void **state) {
   (void)state;
@@ -384,7 +384,8 @@ static void extremes_stay_finite(void **state) {
       {"rsm.steps=32", "rsm.thickness=16", NULL}, {"rsm.steps=1", "rsm.thickness=0", NULL},
       {"rsm.radius=2", "rsm.reach=64", NULL}, {"rsm.coarse=1", "rsm.blur=0", NULL},
       {"rsm.ray_steps=32", "rsm.bounces=64", "isr.bounces=4"}, {"rsm.trace=1", "rsm.bounces=64", "isr.bounces=4"},
-      {"rsm.trace=1", "isr.samples=16", "rsm.samples=1"},
+      {"rsm.trace=1", "isr.samples=16", "rsm.samples=1"}, {"rsm.trace=1", "rsm.trace_samples=1", NULL},
+      {"rsm.trace=1", "rsm.trace_samples=4096", "rsm.bounces=64"},
       {"rsm.trace=0.0625", "rsm.bounces=64", "isr.bounces=4"},
   };
   static const char *const vpl_cases[][4] = {
@@ -939,6 +940,8 @@ static void bad_options_name_themselves(void **state) {
       {"isr+rsm+esm", "rsm.ray_steps=33", "rsm.ray_steps"}, {"isr+rsm+esm", "rsm.ray_steps=-1", "rsm.ray_steps"},
       {"isr+rsm+esm", "rsm.trace=2", "rsm.trace"}, {"isr+rsm+esm", "rsm.trace=-1", "rsm.trace"},
       {"isr+rsm+esm", "rsm.trace=0.5", "rsm.trace"},
+      {"isr+rsm+esm", "rsm.trace_samples=-1", "rsm.trace_samples"},
+      {"isr+rsm+esm", "rsm.trace_samples=4097", "rsm.trace_samples"},
       {"vpl+esm", "vpl.lights=-1", "vpl.lights"},     {"vpl+esm", "vpl.negative=4097", "vpl.negative"},
       {"vpl+esm", "vpl.threshold=3", "vpl.threshold"}, {"vpl+esm", "vpl.focus=0", "vpl.focus"},
       {"vpl+esm", "vpl.recompute=some", "vpl.recompute"},
