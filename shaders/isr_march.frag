@@ -69,7 +69,10 @@
 // lights' RSM views (rsm.glsl's rsm_meets); one that crosses a surface they
 // hold met it off screen (the street's facades; docs/gi-combined.md).
 // TRACE (rsm.trace; with UNSEEN): every ray the screen lost (not seen, and
-// inside the scene's box where it leaves the view) is UNSEEN, whatever its
+// inside the scene's box where it leaves the view, or passed behind a surface
+// on its way: what it met there the screen cannot say; the Cornell box's rays
+// behind its boxes, counted as leaving the scene, left its views at 0.77 of
+// Cycles' indirect light) is UNSEEN, whatever its
 // direction (the tracer, not a guess, says what it meets), and one of them,
 // chosen uniformly (a reservoir over a hash of the pixel and ray), goes to
 // outputs TRACE (origin a little off p along its normal, w the count of lost rays) and TRACE + 1
@@ -311,6 +314,9 @@ void main() {
     vec4 b = frame.view_proj * vec4(w, 0.0);
     float t_end = exit_distance(a, b, s.p, w);
     bool seen = false;
+#ifdef TRACE
+    bool hidden = false; // the ray passed behind a surface it did not meet: what it met there is unknown
+#endif
     float t_prev = 0.0, t = 0.0, ahead = -1.0;
     ivec2 q = px;
     // The march goes on to the next sample behind the depth buffer in a loop
@@ -365,6 +371,9 @@ void main() {
         }
         break;
       }
+#ifdef TRACE
+      hidden = true;
+#endif
       t_prev = t;
       ahead = -1.0;
       j++;
@@ -381,7 +390,12 @@ void main() {
 #else
     bool closed = w.y <= 0.0 || roofed;
 #endif
-    if (!seen && i < 4 * HITS && closed && t_box > t_end) {
+#ifdef TRACE
+    bool lost_ray = t_box > t_end || hidden;
+#else
+    bool lost_ray = t_box > t_end;
+#endif
+    if (!seen && i < 4 * HITS && closed && lost_ray) {
       record_hit(i, float(UNSEEN));
 #ifdef TRACE
       lost += 1.0;

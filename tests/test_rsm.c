@@ -375,7 +375,7 @@ static void a_late_target_like_the_rsm_takes_none_of_its_textures(void **state) 
 
 /* A light inside geometry (a point light in a closed box the camera looks
  * at from outside), a spot whose cone is nearly closed (a tile seeing next
- * to nothing), one sample, 4096 samples, the visibility march and the
+ * to nothing), one sample, 4096 samples (at the traced hits too), the visibility march and the
  * off-screen rays' RSM test at its most steps: finite. */
 static void extremes_stay_finite(void **state) {
   (void)state;
@@ -384,7 +384,8 @@ static void extremes_stay_finite(void **state) {
       {"rsm.steps=32", "rsm.thickness=16", NULL}, {"rsm.steps=1", "rsm.thickness=0", NULL},
       {"rsm.radius=2", "rsm.reach=64", NULL}, {"rsm.coarse=1", "rsm.blur=0", NULL},
       {"rsm.ray_steps=32", "rsm.bounces=64", "isr.bounces=4"}, {"rsm.trace=1", "rsm.bounces=64", "isr.bounces=4"},
-      {"rsm.trace=1", "isr.samples=16", "rsm.samples=1"},
+      {"rsm.trace=1", "isr.samples=16", "rsm.samples=1"}, {"rsm.trace=1", "rsm.trace_samples=1", NULL},
+      {"rsm.trace=1", "rsm.trace_samples=4096", "rsm.bounces=64"},
       {"rsm.trace=0.0625", "rsm.bounces=64", "isr.bounces=4"},
   };
   static const char *const vpl_cases[][4] = {
@@ -850,6 +851,44 @@ static void traced_rays_bring_a_second_bounce_where_the_screen_shows_no_sender(v
   lm_scene_destroy(s);
 }
 
+/* rsm.trace: a ray that passes behind a surface the screen shows and is not
+ * seen again met something the screen cannot say (the Cornell box's rays
+ * behind its boxes), though it leaves the view only where it leaves the
+ * scene's box. The white room seen from near its front wall (z = 0.9, level,
+ * towards -z) with a white panel at z = 0.5 that hides the left half of the
+ * view: the back wall beside the panel sends rays to the left, behind it,
+ * onto the left wall and the floor (lit by the sunlit patch's first bounce)
+ * where the scene's box ends. Traced, they bring what they meet: the wall
+ * takes 1.58 times its light without tracing; counted as leaving the scene,
+ * as before, 1.38 times (the rays that leave the view alone). */
+static void rays_behind_a_surface_are_traced(void **state) {
+  (void)state;
+  lm_scene *s = window_room(0.8f);
+  gl_quad(s, "panel", gl_material(s, "white", 0.8f, 0.8f, 0.8f),
+          (const float[4][3]){{-1, -1, 0.5f}, {-0.02f, -1, 0.5f}, {-0.02f, 1, 0.5f}, {-1, 1, 0.5f}},
+          (const float[3]){0, 0, 1});
+  mat4 m;
+  glm_translate_make(m, (vec3){0, 0, 0.9f}); /* the node's -Z: -z, level */
+  memcpy(s->nodes[s->cameras[0].node].local, m, sizeof m);
+  lm_scene_update(s);
+  static const char *const cases[] = {"rsm.trace=0", "rsm.trace=1"};
+  float c[2];
+  for (int k = 0; k < 2; k++) {
+    const char *const sets[] = {"ambient=0", "rsm.bounces=2", cases[k], "isr.samples=8", NULL};
+    gl_result r = render_ok(s, "isr+rsm+esm", sets);
+    assert_true(gl_all_finite(&r));
+    float rgb[3];
+    gl_region(&r, 5 * W / 8, 3 * H / 8, 3 * W / 4, 5 * H / 8, rgb);
+    c[k] = gl_luminance(rgb);
+    gl_result_free(&r);
+  }
+  print_message("the back wall beside the panel: %.5f, traced %.5f\n", c[0], c[1]);
+  assert_true(c[0] > 1e-3f);
+  assert_true(c[1] > 1.5f * c[0]);
+  assert_true(c[1] <= 1.001f * c[0] / (1 - 0.8f));
+  lm_scene_destroy(s);
+}
+
 /* isr.bounces above 2 in the combined technique: each screen step adds one
  * bounce (isr_bounce.frag again over the recorded senders) and the series of
  * rsm.bounces carries on from the last step's newest bounce, in the last
@@ -901,6 +940,8 @@ static void bad_options_name_themselves(void **state) {
       {"isr+rsm+esm", "rsm.ray_steps=33", "rsm.ray_steps"}, {"isr+rsm+esm", "rsm.ray_steps=-1", "rsm.ray_steps"},
       {"isr+rsm+esm", "rsm.trace=2", "rsm.trace"}, {"isr+rsm+esm", "rsm.trace=-1", "rsm.trace"},
       {"isr+rsm+esm", "rsm.trace=0.5", "rsm.trace"},
+      {"isr+rsm+esm", "rsm.trace_samples=-1", "rsm.trace_samples"},
+      {"isr+rsm+esm", "rsm.trace_samples=4097", "rsm.trace_samples"},
       {"vpl+esm", "vpl.lights=-1", "vpl.lights"},     {"vpl+esm", "vpl.negative=4097", "vpl.negative"},
       {"vpl+esm", "vpl.threshold=3", "vpl.threshold"}, {"vpl+esm", "vpl.focus=0", "vpl.focus"},
       {"vpl+esm", "vpl.recompute=some", "vpl.recompute"},
@@ -1026,6 +1067,7 @@ int main(int argc, char **argv) {
       cmocka_unit_test(more_bounces_light_a_ceiling_more_and_stay_bounded),
       cmocka_unit_test(screen_steps_and_the_series_count_each_bounce_once),
       cmocka_unit_test(traced_rays_bring_a_second_bounce_where_the_screen_shows_no_sender),
+      cmocka_unit_test(rays_behind_a_surface_are_traced),
       cmocka_unit_test(extremes_stay_finite),
       cmocka_unit_test(bad_options_name_themselves),
   };
