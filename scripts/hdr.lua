@@ -6,9 +6,10 @@
 --      adaptation smooths what a sampled mean varies)
 --   2. hdr.adapt: the adapted luminance moves `rate` of the way to the
 --      average each frame, in a persistent 1x1 target; a pass cannot read
---      and write one target, so two of them take turns (ping-pong)
---   3. hdr.tonemap: key, exposure bias, Reinhard with white (eq 2.2-2.4);
---      linear display values in [0, 1] (the output stage encodes sRGB)
+--      and write one target, so two of them take turns (ping-pong); with it
+--      the scale key * 2^exposure / adapted (eq 2.2), once a frame
+--   3. hdr.tonemap: that scale, Reinhard with white (eq 2.3-2.4); linear
+--      display values in [0, 1] (the output stage encodes sRGB)
 -- A pipeline calls hdr.create() from OnCreate and hdr.render() from OnRender.
 local options = require "options"
 
@@ -82,10 +83,10 @@ function hdr.render(src, o, _, glow)
   local previous, next = adapted[turn + 1], adapted[2 - turn]
   turn = 1 - turn
   pass{ "hdr.adapt", shader = "hdr_adapt.frag", inputs = { average = level, previous = previous },
-        params = { rate = o.rate }, out = next }
+        params = { rate = o.rate, key = o.key, exposure = o.exposure }, defines = { AUTO_KEY = o.auto_key },
+        out = next }
   return pass{ "hdr.tonemap", shader = "hdr_tonemap.frag", inputs = glow_inputs{ src = src, adapted = next },
-               params = glow_params{ key = o.key, white = o.white, exposure = o.exposure },
-               defines = { AUTO_KEY = o.auto_key, BLOOM = glow ~= nil },
+               params = glow_params{ white = o.white }, defines = { BLOOM = glow ~= nil },
                out = target{ "hdr.tonemap", format = "rgba16f" } }
 end
 

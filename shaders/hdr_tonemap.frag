@@ -2,18 +2,15 @@
 // adapted log-average luminance, times 2^exposure, and map with a white point:
 //   L = 2^exposure * a / L_avg * L_w,   L_d = L (1 + L / L_white^2) / (1 + L)
 // Colour keeps its hue: rgb * L_d / L_w. The result is linear display values
-// in [0, 1] (the output stage encodes sRGB). With AUTO_KEY the key follows
-// the average (seed 001 fig 6.17: darker views a lower key): Krawczyk et al.
-// 2005, a = 1.03 - 2 / (2 + log10(L_avg + 1)), in the seed's 0.045..0.9.
-// With BLOOM it adds bloom's blurred bright pass first (hdr_reduce.frag).
+// in [0, 1] (the output stage encodes sRGB). 2^exposure * a / L_avg comes
+// from hdr_adapt.frag (its alpha), with AUTO_KEY's key. With BLOOM it adds
+// bloom's blurred bright pass first (hdr_reduce.frag).
 #include "post.glsl"
 
 in vec2 uv;
 uniform sampler2D src;
-uniform sampler2D adapted;     // hdr_adapt.frag (1x1): r = adapted luminance
-uniform float key = 0.18;      // a, 0.045..0.9 typical
+uniform sampler2D adapted;     // hdr_adapt.frag (1x1): a = 2^exposure * key / adapted luminance
 uniform float white = 4.0;     // L_white in scaled units, > 0
-uniform float exposure = 0.0;  // bias in stops
 #ifdef BLOOM
 uniform sampler2D bloom;
 uniform float strength = 1.0;
@@ -26,16 +23,11 @@ void main() {
 #ifdef BLOOM
   c = bloom_sum(c, texture(bloom, uv).rgb, strength);
 #endif
-  float avg = max(texelFetch(adapted, ivec2(0), 0).r, 1e-30);
-  avg = isnan(avg) || isinf(avg) ? 1.0 : avg;
-  float a = key;
-#ifdef AUTO_KEY
-  a = clamp(1.03 - 2.0 / (2.0 + log(avg + 1.0) / log(10.0)), 0.045, 0.9);
-#endif
-  float lw = luminance(c); // pre-exposed (exposed()); avg is radiance
-  // In this order no intermediate overflows: a / avg <= 1e30 * 0.9, and
-  // lw in radiance is clamped, so L is finite up to ~1e38 and is then capped.
-  float l = min(exp2(clamp(exposure, -40.0, 40.0)) * (a / avg) * min(lw * frame.exposure.y, 1e30), 1e30);
+  float scale = texelFetch(adapted, ivec2(0), 0).a;
+  float lw = luminance(c); // pre-exposed (exposed()); the adapted luminance is radiance
+  // lw in radiance is clamped and scale <= 0.9e30 (hdr_adapt.frag), so L is
+  // finite up to ~1e38 and is then capped.
+  float l = min(scale * min(lw * frame.exposure.y, 1e30), 1e30);
   float w = max(white, 1e-3);
   float ld = l / (1.0 + l) * (1.0 + min(l / (w * w), 1e30));
   // rgb * ld / lw; where lw is ~0 the colour is ~0 too.

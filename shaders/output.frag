@@ -13,12 +13,6 @@ layout(location = 0) out vec4 out_srgb;
 layout(location = 1) out vec4 out_linear;
 #endif
 
-vec3 srgb_encode(vec3 c) {
-  c = saturate(c);
-  vec3 lo = c * 12.92, hi = 1.055 * pow(max(c, vec3(1e-8)), vec3(1.0 / 2.4)) - 0.055;
-  return mix(lo, hi, step(vec3(0.0031308), c));
-}
-
 void main() {
   vec3 c = finite_or_zero(texture(src, uv).rgb);
 #ifndef DISPLAY

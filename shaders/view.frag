@@ -28,12 +28,6 @@ uniform vec2 range = vec2(0.0, 1.0);   // false colour and grey: min and max sho
 
 out vec4 color;
 
-vec3 srgb_encode(vec3 c) {
-  c = saturate(c);
-  vec3 lo = c * 12.92, hi = 1.055 * pow(max(c, vec3(1e-8)), vec3(1.0 / 2.4)) - 0.055;
-  return mix(lo, hi, step(vec3(0.0031308), c));
-}
-
 // Blue (low) through cyan, green, yellow to red (high).
 vec3 false_colour(float t) {
   t = saturate(t);
