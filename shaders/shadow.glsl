@@ -26,7 +26,8 @@ struct ShadowView {
   mat4 view_proj;
   vec4 rect;  // tile in atlas uv: offset, size
   vec4 depth; // light position, 1 / range (0: orthographic)
-  vec4 texel; // a texel's world size (orthographic) or its size per unit of distance; world depth 0..1 spans
+  vec4 texel; // a texel's world size (orthographic) or its size per unit of distance; world depth 0..1 spans;
+              // perspective: the projection's x and y scale
 };
 #ifdef LIGHT_BLOCKS
 // Copies in uniform blocks, as common.glsl's lights: at most 6 shadow views a
@@ -233,25 +234,30 @@ int shadow_view_at(int light, ShadowLight s, int kind, vec3 p, out float t) {
 // View j of light `light` (shadow_view_at's numbering), p at *clip in its
 // clip space. The records hold a light's views in order, a cube's drawn
 // faces alone. A light-set variant reads the light's fixed places instead:
-// a cube face's own values (its matrix's rows x, y, w and its tile's place:
-// 11) at the face's place, the rest (centre, range, texel and tile size,
-// shared by the faces) at the first place's constant offset; the whole
-// record read at a pixel's own index made much of the lookup's cost on
-// llvmpipe (Cornell box, dl+esm, 128x96, 4 frames, callgrind: the shadow's
-// share of the JIT'd code 10.4 -> 6.5 million instructions with this and
-// shadow_texels' one gather).
+// what a cube's faces share (centre, range, texel and tile size, the
+// projection's scale) at the first place's constant offset, and at the
+// face's place only its tile's corner; the whole record read at a pixel's
+// own index made much of the lookup's cost on llvmpipe (Cornell box,
+// dl+esm, 128x96, 4 frames, callgrind: the shadow's share of the JIT'd code
+// 10.4 -> 6.5 million instructions with this and shadow_texels' one gather),
+// which reads a place that varies by pixel lane by lane.
 ShadowView shadow_view_of(int light, ShadowLight s, int kind, int j, vec3 p, out vec4 clip) {
 #ifdef LIGHT_SET
   int at = light * SHADOW_SLOTS;
   if (kind == 3) {
-    ShadowView sv = shadow_slots[at], face = shadow_slots[at + j];
-    // Rows x, y and w of the face's matrix on p - centre (its translation
-    // moves the centre to 0); z only serves orthographic views.
+    ShadowView sv = shadow_slots[at];
+    // The face's clip x, y and w from p - centre (its translation moves the
+    // centre to 0): each of those rows of its matrix is a signed axis times
+    // the scale (perspective_view_proj in engine/shadow/shadow.c: glm_lookat
+    // toward the face with up_for's up; x: +z -z -z +z -x +x, y: y or, for
+    // the +Y and -Y faces, x), so that no row is read at the face's place
+    // (office, isr+esm, 640x480, moving: `direct` 3% faster; docs/benchmarks.md).
     vec3 d = p - sv.depth.xyz;
-    mat4 m = face.view_proj;
-    clip = vec4(dot(vec3(m[0][0], m[1][0], m[2][0]), d), dot(vec3(m[0][1], m[1][1], m[2][1]), d), 0.0,
-                dot(vec3(m[0][3], m[1][3], m[2][3]), d));
-    sv.rect.xy = face.rect.xy;
+    float x = j == 0 || j == 3 ? d.z : j == 4 ? -d.x : j == 5 ? d.x : -d.z;
+    float y = j == 2 || j == 3 ? d.x : d.y;
+    float w = j < 2 ? d.x : j < 4 ? d.y : d.z;
+    clip = vec4(sv.texel.z * x, sv.texel.z * y, 0.0, (j & 1) == 0 ? w : -w);
+    sv.rect.xy = shadow_slots[at + j].rect.xy;
     return sv;
   }
   ShadowView sv = shadow_slots[at + j];
@@ -259,6 +265,9 @@ ShadowView shadow_view_of(int light, ShadowLight s, int kind, int j, vec3 p, out
   ShadowView sv = shadow_views[s.info.x + (kind == 3 ? bitCount(s.cube.x & ((1 << j) - 1)) : j)];
 #endif
   clip = sv.view_proj * vec4(p, 1.0);
+  // An orthographic view's w is 1 (its matrix's last row 0 0 0 1): that row
+  // not read, lane by lane where the cascade varies by pixel.
+  if (!shadow_perspective(kind)) clip.w = 1.0;
   return sv;
 }
 

@@ -364,7 +364,9 @@ static float light_range(const lm_scene *s, const lm_light *l, const vec3 pos) {
   return fminf(range * 1.01f, reach);
 }
 
-static void perspective_view_proj(const vec3 pos, const vec3 dir, float fov, float range, mat4 vp) {
+/* The view-projection of a square perspective view; its projection's x and
+ * y scale (1 / tan(fov / 2)) in *scale. */
+static float perspective_view_proj(const vec3 pos, const vec3 dir, float fov, float range, mat4 vp) {
   vec3 up, target;
   up_for(dir, up);
   glm_vec3_add((float *)pos, (float *)dir, target);
@@ -372,15 +374,17 @@ static void perspective_view_proj(const vec3 pos, const vec3 dir, float fov, flo
   glm_lookat((float *)pos, target, up, view);
   glm_perspective(fov, 1.0f, range * 1e-4f, range, proj);
   glm_mat4_mul(proj, view, vp);
+  return proj[0][0];
 }
 
 static void plan_perspective(lm_shadow_plan *plan, int size, const vec3 pos, const vec3 dir, float fov,
                              float range) {
   mat4 vp;
-  perspective_view_proj(pos, dir, fov, range, vp);
-  /* A texel's world size per unit of distance, and the world depth 0..1 spans. */
+  float scale = perspective_view_proj(pos, dir, fov, range, vp);
+  /* A texel's world size per unit of distance, the world depth 0..1 spans, and the projection's scale
+   * (shadow.glsl projects a cube face by its axes with it). */
   add_view(plan, size, vp, (float[4]){pos[0], pos[1], pos[2], 1.0f / range},
-           (float[4]){2.0f * tanf(fov * 0.5f) / (float)size, range, 0, 0}, NULL);
+           (float[4]){2.0f * tanf(fov * 0.5f) / (float)size, range, scale, 0}, NULL);
 }
 
 /* Point light: cube faces +X -X +Y -Y +Z -Z (shadow.glsl picks by major axis). */
