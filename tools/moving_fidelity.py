@@ -2,12 +2,14 @@
 """Error against Cycles on the frame of a moving camera (temporal reuse judged as it runs).
 
     tools/moving_fidelity.py [--spec TECH[:NAME=VALUE;...]] ... [--speed M] [--refs DIR] [--out DIR]
+                             [--size WxH] [--scene PATH ...]
 
 `limn report` judges a still view: a history that settles on a still camera (or a
 pattern that turns only while the view moves, isr.temporal's default) says
 nothing of a moving one, and Cycles' references exist for the still poses
-alone. So each view of the reference set whose Cycles references are cached
-(8 bounces at 1024 samples and 0 bounces, seed 0, 160x120) becomes a sequence
+alone. So each view of the reference set (or of --scene's) whose Cycles
+references are cached (8 bounces at 1024 samples and 0 bounces, seed 0, at
+--size, default 160x120) becomes a sequence
 job: the camera trucks sideways through the view's pose at SPEED metres a
 second (keys at t = 0, 1, 2, 24 fps; `limn capture`'s path, every cache and
 history carried from frame to frame), and the frame at t = 1, the reference's
@@ -28,7 +30,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENES = ("reference/room.glb", "reference/street.glb", "reference/blocks.glb", "cornell.glb")
 
 
-def references(refs, size):
+def references(refs, size, scenes):
     """view name -> (scene, camera, 8-bounce reference, direct-only reference)."""
     found = {}
     for meta in sorted(glob.glob(os.path.join(refs, "*", "*_%s-cycles-*.json" % size))):
@@ -38,7 +40,7 @@ def references(refs, size):
         scene = os.path.join(ROOT, scene[scene.rfind("data/scenes/"):]) if "data/scenes/" in scene else scene
         if m["samples"] != 1024 or m["seed"] != 0 or m["materials"] != "phong" or m["sky"]:
             continue
-        if not scene.endswith(SCENES):
+        if not scene.endswith(scenes):
             continue
         name = m["view"].split()[0]
         entry = found.setdefault(name, [scene, m["camera"], None, None])
@@ -91,12 +93,14 @@ def main():
     p.add_argument("--speed", type=float, default=0.5, help="metres a second, 24 frames a second (default 0.5)")
     p.add_argument("--refs", default=os.path.join(ROOT, "out", "reference"))
     p.add_argument("--out", default=os.path.join(ROOT, "out", "moving_fidelity"))
+    p.add_argument("--size", default="160x120", help="the references' size (default 160x120)")
+    p.add_argument("--scene", action="append", help="a scene path ending (repeatable; default the reference set's)")
     p.add_argument("--build", default=os.path.join(ROOT, os.environ.get("BUILD_DIR", "build")))
     a = p.parse_args()
     limn = os.path.join(a.build, "limn")
     if not os.access(limn, os.X_OK):
         sys.exit("moving_fidelity: no %s (build first: tools/dev.sh build)" % limn)
-    views = references(a.refs, "160x120")
+    views = references(a.refs, a.size, tuple(a.scene or SCENES))
     if not views:
         sys.exit("moving_fidelity: no cached Cycles references (8 and 0 bounces) under %s" % a.refs)
     specs = ["dl+esm"] + (a.spec or ["isr+rsm+esm"])
@@ -109,9 +113,9 @@ def main():
             os.makedirs(folder, exist_ok=True)
             job = os.path.join(folder, "job.lua")
             with open(job, "w") as f:
-                f.write('return {\n  scenes = { "%s" },\n  techniques = { "%s" },\n  sizes = { "160x120" },\n'
+                f.write('return {\n  scenes = { "%s" },\n  techniques = { "%s" },\n  sizes = { "%s" },\n'
                         '  set = { %s },\n  time = { 0, 1, 24 },\n  path = { %s },\n'
-                        '  output = "%s/{frame}.exr",\n}\n' % (scene, tech, sets, path_keys(camera, a.speed), folder))
+                        '  output = "%s/{frame}.exr",\n}\n' % (scene, tech, a.size, sets, path_keys(camera, a.speed), folder))
             subprocess.run([limn, "capture", "--job", job, "--force"], check=True, stdout=subprocess.DEVNULL,
                            stderr=subprocess.DEVNULL)
             image = os.path.join(folder, "0024.exr")
