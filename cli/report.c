@@ -910,28 +910,24 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
         char out[1400], base_out[1400], view[512];
         image_path(a, j, v, s, sequence, out, sizeof out);
         image_path(a, j, v, 0, sequence, base_out, sizeof base_out);
-        /* A still place: the warm-up, then the timed frames, as always. A
-         * sequence: its first frame after the warm-up in one call (no reset
-         * between them), then each next frame on from it. */
+        /* The warm-up, then the timed frames (a still place's) or the first
+         * frame (a sequence's, each next frame on from it), in one call: a
+         * second would set the view again and drop the histories the warm-up
+         * built, so a still place's temporal reuse would start cold. */
         const char *outs[1] = {out};
-        capture_view warm = {.camera = v->camera, .width = w, .height = h, .frames = sequence ? 0 : a->warmup,
-                             .quiet = true};
         capture_view cv = {.camera = v->camera, .width = w, .height = h, .frames = sequence ? 1 : a->frames,
-                           .warmup = sequence ? a->warmup : 0, .outputs = outs, .output_count = 1, .quiet = true};
-        capture_result scratch = {0};
+                           .warmup = a->warmup, .outputs = outs, .output_count = 1, .quiet = true};
         lm_image ref = {0}, img = {0}, base = {0}, floor_ref = {0};
         bool ok = lm_image_read(refs[p], &ref, &err);
         if (ok && sc->scene != current) ok = lm_renderer_set_scene(r, sc->scene, &err), current = sc->scene;
         if (ok) job_pose(j, v); /* its time, and the camera a path or turntable moves */
         if (first_frame)
           ok = ok && set_setting(pipeline, &base_options, &a->settings[s], &err) && job_make_parent(out, &err) &&
-               (warm.frames == 0 || capture_render_write(r, &warm, &scratch, &err)) &&
                capture_render_write(r, &cv, &row->res, &err);
         else ok = ok && capture_render_write(r, &(capture_view){.camera = v->camera, .width = w, .height = h,
                                                                 .frames = 1, .outputs = outs, .output_count = 1,
                                                                 .quiet = true, .continues = true},
                                              &row->res, &err);
-        capture_result_free(&scratch);
         if (ok) ok = lm_image_read(out, &img, &err) && lm_metrics_check(&img, out, &ref, refs[p], &err);
         if (ok) lm_metrics_compute(&img, &ref, &row->m);
         if (ok && s == 0) {

@@ -11,7 +11,8 @@
 #   and the Markdown summary, with consistent numbers; it renders (once) the
 #   direct-only reference of the view, whose error against the baseline is
 #   the floor of the share of indirect error removed;
-# - each setting starts from the job's options, inheriting none from the one before.
+# - each setting starts from the job's options, inheriting none from the one before; a still place's
+#   warm-up carries into its timed frames.
 # - --require-refs and --cached-refs render nothing: the first names the command, the second
 #   leaves out (and names) the views without cached references.
 # Skipped (77) where povray is not installed (tools/dev.sh installs it).
@@ -228,6 +229,20 @@ sed -e 's/sizes = /techniques = { "isr" }, sizes = /' -e 's|out/{camera}_{techni
 grep -q '"mean_error": 0[,}]' c2.json || { cat c2.json; fail "isr after isr.mode=seed is not isr's default"; }
 "$limn" compare rep4/images/ball_front_48x36_1.exr isr/front.exr --json >c1.json || fail "compare setting 1"
 grep -q '"mean_error": 0[,}]' c1.json && fail "isr.mode=seed rendered the default"
+
+# A still place's warm-up carries into its timed frames: with a pattern that turns every frame, the report's
+# image after 4 warm-up frames is a capture's fifth frame (and not its first, which it was when the report
+# set the view again between them).
+turn=(isr.temporal.enabled=true isr.temporal.turn=always)
+"$limn" report --job job.lua "${fast[@]}" --out rep7 --frames 1 --warmup 4 --sweep "isr:${turn[0]};${turn[1]}" >log14 2>&1 \
+  || { cat log14; fail "report with a warm-up"; }
+for n in 5 1; do
+  sed "s/sizes = /frames = $n, sizes = /" isr.lua >isr$n.lua
+  "$limn" capture --job isr$n.lua --set "${turn[0]}" --set "${turn[1]}" --force >/dev/null 2>&1 || fail "capture of $n frames"
+  "$limn" compare rep7/images/ball_front_48x36_1.exr isr/front.exr --json >c$n.json || fail "compare with $n frames"
+done
+grep -q '"mean_error": 0[,}]' c5.json || { cat c5.json; fail "the report's warm-up did not carry into its timed frame"; }
+grep -q '"mean_error": 0[,}]' c1.json && fail "the warm-up changed nothing (the check above proves nothing)"
 
 # 4. --require-refs names the command when a reference is missing
 "$limn" report --job job.lua "${fast[@]}" --refs refs-none --require-refs --out rep2 --sweep dl >log7 2>&1
