@@ -24,6 +24,7 @@
 
 #include "reference.h"
 #include "tools.h"
+#include "script/script.h"
 
 static const char reference_usage[] =
     "usage: limn reference --job FILE [--refs DIR] [--force] [--jobs N] [--shard I/N|auto[/N]]\n"
@@ -127,11 +128,11 @@ int reference_flag(const char *cmd, int c, const char *arg, reference_args *a) {
   return bad ? limn_usage_error(cmd, bad, arg) : 0;
 }
 
-/* The job sets sky.enabled to true: its views are lit by the sky. */
+/* The job turns sky.enabled on (its last word on it, read as the pipeline reads it): its views are lit by the sky. */
 static bool job_has_sky(const job *j) {
-  bool on = false;
+  bool on = false, v;
   for (int i = 0; i < j->set_count; i++)
-    if (!strcmp(j->set_names[i], "sky.enabled")) on = !strcmp(j->set_values[i], "true") || !strcmp(j->set_values[i], "1");
+    if (!strcmp(j->set_names[i], "sky.enabled") && lm_option_bool(j->set_values[i], &v)) on = v;
   return on;
 }
 

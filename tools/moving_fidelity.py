@@ -83,8 +83,8 @@ def lua_set(spec):
 
 
 def mean_error(limn, a, b):
-    out = subprocess.run([limn, "compare", a, b], capture_output=True, text=True, check=True).stdout
-    return float(next(l for l in out.splitlines() if "mean error" in l).split()[-1])
+    out = subprocess.run([limn, "compare", a, b, "--json"], capture_output=True, text=True, check=True).stdout
+    return float(json.loads(out)["mean_error"])
 
 
 def main():

@@ -324,7 +324,7 @@ bool lm_pipeline_get_option(const lm_pipeline *p, const char *name, char *value,
   return false;
 }
 
-static bool parse_bool(const char *v, bool *out) {
+bool lm_option_bool(const char *v, bool *out) {
   static const char *yes[] = {"true", "1", "on", "yes"}, *no[] = {"false", "0", "off", "no"};
   for (int i = 0; i < 4; i++) {
     if (!strcmp(v, yes[i])) return *out = true, true;
@@ -363,7 +363,7 @@ bool lm_pipeline_set_option(lm_pipeline *p, const char *name, const char *value,
     lua_pop(L, 1);
     if (type == LUA_TBOOLEAN) {
       bool b;
-      if (!parse_bool(value, &b)) {
+      if (!lm_option_bool(value, &b)) {
         lm_error_set(err, "option %s: '%s' is not a boolean (true/false)", name, value);
         lua_settop(L, top);
         return false;

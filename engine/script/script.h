@@ -34,6 +34,9 @@ const char *lm_pipeline_technique(const lm_pipeline *p);
  * the value parsed by the default's type. Unknown names are an error that
  * lists the known ones. */
 bool lm_pipeline_set_option(lm_pipeline *p, const char *name, const char *value, lm_error *err);
+/* A boolean option's text as lm_pipeline_set_option reads it: true, 1, on,
+ * yes or false, 0, off, no; false when it is none of them. */
+bool lm_option_bool(const char *v, bool *out);
 /* The current value of an option by dotted name, as text ("true", "0.5",
  * "table" for a table of options); false when the script declares none. */
 bool lm_pipeline_get_option(const lm_pipeline *p, const char *name, char *value, size_t cap);
