@@ -9,7 +9,9 @@
 --      and write one target, so two of them take turns (ping-pong); with it
 --      the scale key * 2^exposure / adapted (eq 2.2), once a frame
 --   3. hdr.tonemap: that scale, Reinhard with white (eq 2.3-2.4); linear
---      display values in [0, 1] (the output stage encodes sRGB)
+--      display values in [0, 1] (the output stage encodes sRGB); where the
+--      frame presents its image, the output stage runs in this pass
+--      (fold_output: a full-size image not written and read again)
 -- A pipeline calls hdr.create() from OnCreate and hdr.render() from OnRender.
 local options = require "options"
 
@@ -87,7 +89,7 @@ function hdr.render(src, o, _, glow)
         out = next }
   return pass{ "hdr.tonemap", shader = "hdr_tonemap.frag", inputs = glow_inputs{ src = src, adapted = next },
                params = glow_params{ white = o.white }, defines = { BLOOM = glow ~= nil },
-               out = target{ "hdr.tonemap", format = "rgba16f" } }
+               out = target{ "hdr.tonemap", format = "rgba16f" }, fold_output = true }
 end
 
 return hdr
