@@ -248,9 +248,8 @@ static void bloom_spreads_one_bright_pixel_and_nothing_else(void **state) {
 
 /* In the chain (post.render) hdr adds bloom's glow as it reads the image, so
  * no pass writes the sum: the picture is that of bloom.add then hdr one by
- * one, within 0.001 a channel (the written sum's half-float rounding, and the
- * first reduction reading the glow's texel under a pixel, not its bilinear
- * enlargement), over bands and a bright peak whose glow spreads. */
+ * one, within 0.0005 a channel (the written sum's half-float rounding), over
+ * bands and a bright peak whose glow spreads. */
 static void bloom_in_the_chain_is_bloom_then_hdr(void **state) {
   (void)state;
   const char *fused[] = {"bloom=true", "hdr=true", "bloom.threshold=2", "image.peak=400", "image.peak_x=100",
@@ -269,7 +268,7 @@ static void bloom_in_the_chain_is_bloom_then_hdr(void **state) {
   glow = at(a.rgb, 106, 160)[0] - at(a.rgb, 250, 160)[0];
   print_message("bloom in the chain against bloom then hdr: largest difference %.5f; glow near the peak %.4f\n",
                 worst, glow);
-  assert_true(worst < 0.001);
+  assert_true(worst < 0.0005);
   assert_true(glow > 0.01);
   gl_result_free(&a);
   gl_result_free(&b);
@@ -528,7 +527,7 @@ static void an_effect_off_records_no_pass(void **state) {
   (void)state;
   static const char *const passes[EFFECTS] = {
       "motion_blur.tiles4 motion_blur.tiles motion_blur.near motion_blur ", "dof.reduce dof.tiles dof.dilate dof.gather dof.composite ", "bloom.bright bloom.blur_x bloom.blur_y bloom.add ",
-      "hdr.reduce1 hdr.reduce2 hdr.reduce3 hdr.adapt hdr.tonemap ", "radial_blur ", "glass ", "tiles ", "sepia "};
+      "hdr.reduce1 hdr.reduce2 hdr.adapt hdr.tonemap ", "radial_blur ", "glass ", "tiles ", "sepia "};
   char names[1024], want[1024];
   gl_result r = start(pp_lua, "dl", NULL);
   gl_pass_names(&r, names, sizeof names);
