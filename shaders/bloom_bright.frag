@@ -16,12 +16,19 @@ uniform float knee = 0.5;      // soft transition width, >= 0
 out vec4 dst;
 
 void main() {
-  ivec2 base = ivec2(gl_FragCoord.xy) * FACTOR, last = textureSize(src, 0) - 1;
+  ivec2 base = ivec2(gl_FragCoord.xy) * FACTOR;
+#if FACTOR == 1
+  vec3 c = hdr_clamp(texelFetch(src, base, 0).rgb, HALF_MAX);
+#else
+  // Each 2 x 2 of the source texels in one filtered read at its centre (the
+  // bilinear weights there are a quarter each; clamped at the border): a
+  // quarter of the reads of one fetch a texel.
+  vec2 size = vec2(textureSize(src, 0));
   vec3 c = vec3(0.0);
-  for (int y = 0; y < FACTOR; y++)
-    for (int x = 0; x < FACTOR; x++)
-      c += hdr_clamp(texelFetch(src, min(base + ivec2(x, y), last), 0).rgb, HALF_MAX);
-  c /= float(FACTOR * FACTOR);
+  for (int y = 0; y < FACTOR; y += 2)
+    for (int x = 0; x < FACTOR; x += 2) c += texture(src, vec2(base + ivec2(x, y) + 1) / size).rgb;
+  c = hdr_clamp(c / float(FACTOR * FACTOR / 4), HALF_MAX);
+#endif
   // Quadratic soft knee: the kept fraction rises smoothly from
   // threshold - knee to threshold + knee, then follows brightness - threshold.
   float t = max(threshold, 0.0), k = max(knee, 0.0);

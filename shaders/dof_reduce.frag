@@ -13,13 +13,15 @@ layout(location = 0) out vec4 dst;
 layout(location = 1) out vec4 dst_coc;
 
 void main() {
-  ivec2 base = ivec2(gl_FragCoord.xy) * 2, last = textureSize(src, 0) - 1;
-  vec3 c = vec3(0.0);
-  for (int i = 0; i < 4; i++) c += hdr_clamp(texelFetch(src, min(base + ivec2(i & 1, i >> 1), last), 0).rgb, HALF_MAX);
+  ivec2 base = ivec2(gl_FragCoord.xy) * 2;
+  // The block's mean colour in one filtered read at its centre (the bilinear
+  // weights there are a quarter each; clamped at the border), clamped once:
+  // dof.reduce 10.3 -> 6.8 ms against four fetches (512x384, moving, load 9-10).
+  vec3 c = hdr_clamp(texture(src, vec2(base + 1) / vec2(textureSize(src, 0))).rgb, HALF_MAX);
   // The block's depths in one gather at its centre (clamped at the border, as the colours are).
   vec4 d = textureGather(dpt, vec2(base + 1) / vec2(textureSize(dpt, 0)), 0);
   float nearest = min(min(eye_depth(d.x), eye_depth(d.y)), min(eye_depth(d.z), eye_depth(d.w)));
   float circle = dof_coc(nearest, dof_focus()) * 0.5;
-  dst = vec4(hdr_clamp(c * 0.25, HALF_MAX), circle);
+  dst = vec4(c, circle);
   dst_coc = vec4(circle, nearest, 0.0, 0.0);
 }

@@ -2,8 +2,8 @@
 //   L_avg = exp( (1/N) sum ln(delta + L_w(x, y)) )
 // Each output texel covers a BLOCK x BLOCK square of its source. The first
 // level (FIRST) reads the HDR image, one pixel of each STEP x STEP (a meter:
-// the log-average of a regular quarter of the pixels at STEP 2, for a
-// quarter of the reads), and writes per block the mean of
+// the log-average of a regular sixteenth of the pixels at STEP 4, for a
+// sixteenth of the reads), and writes per block the mean of
 // ln(delta + luminance) and how many pixels it read; later levels take the
 // count-weighted mean of the level below. Blocks cut by the image's edge
 // count only the pixels they hold, so the result is the exact mean of the
@@ -45,9 +45,10 @@ void main() {
       vec4 t = texelFetch(src, q, 0);
 #ifdef FIRST
 #ifdef BLOOM
-      // The glow's texel under the pixel, not its bilinear enlargement: the
-      // glow is smooth, and a plain fetch costs half a filtered one on llvmpipe.
-      t.rgb = bloom_sum(t.rgb, texelFetch(bloom, q * textureSize(bloom, 0) / size, 0).rgb, strength);
+      // The glow as tone mapping adds it (its bilinear enlargement): at one
+      // pixel of 16 the filtered read costs little, and a texel under the
+      // pixel moved the meter by 0.001 from the written sum's.
+      t.rgb = bloom_sum(t.rgb, texture(bloom, (vec2(q) + 0.5) / vec2(size)).rgb, strength);
 #endif
       // Up to 1e30 (an fp32 input may hold far more than a half float).
       float l = luminance(hdr_clamp(t.rgb, 1e30));

@@ -4,8 +4,11 @@
 // Colour keeps its hue: rgb * L_d / L_w. The result is linear display values
 // in [0, 1] (the output stage encodes sRGB). 2^exposure * a / L_avg comes
 // from hdr_adapt.frag (its alpha), with AUTO_KEY's key. With BLOOM it adds
-// bloom's blurred bright pass first (hdr_reduce.frag).
+// bloom's blurred bright pass first (hdr_reduce.frag). With OUTPUT_STAGE
+// (scripts/hdr.lua's fold_output) it is the frame's output stage too: the
+// mapped image goes to output.glsl's outputs, not written and read again.
 #include "post.glsl"
+#include "output.glsl"
 
 in vec2 uv;
 uniform sampler2D src;
@@ -16,7 +19,9 @@ uniform sampler2D bloom;
 uniform float strength = 1.0;
 #endif
 
+#ifndef OUTPUT_STAGE
 out vec4 dst;
+#endif
 
 void main() {
   vec3 c = hdr_clamp(texelFetch(src, ivec2(gl_FragCoord.xy), 0).rgb, 1e30);
@@ -32,5 +37,9 @@ void main() {
   float ld = l / (1.0 + l) * (1.0 + min(l / (w * w), 1e30));
   // rgb * ld / lw; where lw is ~0 the colour is ~0 too.
   vec3 mapped = lw > 1e-30 ? c * (min(ld, 1e4) / lw) : vec3(0.0);
+#ifdef OUTPUT_STAGE
+  output_write(saturate(mapped));
+#else
   dst = vec4(saturate(mapped), 1.0);
+#endif
 }

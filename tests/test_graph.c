@@ -28,6 +28,42 @@ static int fs(lm_graph *g, const char *name, int in, int out) {
   return p;
 }
 
+/* The output stage folds into the last pass only where that pass allows it, writes the image alone,
+ * and the image is output-sized and transient and read by nobody; else nothing changes. */
+static void output_stage_folds_only_into_a_pass_that_allows_it(void **state) {
+  (void)state;
+  lm_graph *g = lm_graph_create();
+  lm_error err;
+  for (int c = 0; c < 5; c++) {
+    lm_graph_begin(g, 64, 32);
+    int lit = target(g, "lit", LM_FORMAT_RGBA16F, 1);
+    int img = target(g, "img", LM_FORMAT_RGBA16F, c == 1 ? 0.5f : 1); /* 1: not output-sized */
+    int srgb = target(g, "output.srgb", LM_FORMAT_RGBA8, 1);
+    fs(g, "lit", -1, lit);
+    lm_pass_input in[2] = {{"src", lit}, {"self", img}};
+    lm_pass_desc d = {.kind = LM_PASS_FULLSCREEN, .name = "tonemap", .where = "test.lua:2", .shader = "x.frag",
+                      .defines = "BLOOM", .inputs = in, .input_count = c == 3 ? 2 : 1, .outputs = &img,
+                      .output_count = 1, .depth = -1, .fold_output = c != 2}; /* 2: not allowed */
+    int tonemap = lm_graph_add_pass(g, &d, &err);
+    if (c == 4) fs(g, "after", lit, target(g, "other", LM_FORMAT_RGBA8, 1)); /* 4: not the last pass */
+    int folded = lm_graph_fold_output(g, img, &srgb, 1, "OUTPUT_STAGE;DISPLAY");
+    lm_graph_pass_info p = lm_graph_pass(g, tonemap);
+    if (c == 0) {
+      assert_int_equal(folded, tonemap);
+      assert_int_equal(p.desc->output_count, 1), assert_int_equal(p.desc->outputs[0], srgb);
+      assert_string_equal(p.desc->defines, "BLOOM;OUTPUT_STAGE;DISPLAY");
+      lm_graph_mark_output(g, srgb);
+      assert_true(lm_graph_compile(g, &err)); /* img has no writer now, and nothing reads it */
+      assert_false(lm_graph_target(g, img).used);
+    } else {
+      assert_int_equal(folded, -1);
+      assert_int_equal(p.desc->outputs[0], img);
+      assert_string_equal(p.desc->defines, "BLOOM");
+    }
+  }
+  lm_graph_destroy(g);
+}
+
 static void target_sizes_follow_output_and_never_vanish(void **state) {
   (void)state;
   int w, h;
@@ -334,6 +370,7 @@ static void persistent_targets_outlive_frames(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(target_sizes_follow_output_and_never_vanish),
+      cmocka_unit_test(output_stage_folds_only_into_a_pass_that_allows_it),
       cmocka_unit_test(bad_targets_are_refused),
       cmocka_unit_test(unread_passes_are_left_out),
       cmocka_unit_test(cpu_passes_follow_their_edges),

@@ -201,7 +201,7 @@ static void script_errors_name_the_field(void **state) {
     const char *body, *expect;
   } cases[] = {
       {"pass{ 'p', shader = 'x.frag', inptus = {}, out = target{ 't', format = 'rgba8' } }",
-       "bad.lua:3: pass 'p': unknown field 'inptus' (known: shader, inputs, params, out, defines, fetches)"},
+       "bad.lua:3: pass 'p': unknown field 'inptus' (known: shader, inputs, params, out, defines, fetches, fold_output)"},
       {"target{ 't', format = 'rgb9' }", "bad.lua:3: target 't': unknown format 'rgb9'"},
       {"target{ 't', format = 'rgba8', scale = -1 }", "bad.lua:3: target 't': scale must be"},
       {"pass{ shader = 'x.frag' }", "bad.lua:3: pass: give the pass a name first"},

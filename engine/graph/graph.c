@@ -3,6 +3,7 @@
 #include "graph/graph_internal.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -185,6 +186,31 @@ int lm_graph_add_pass(lm_graph *g, const lm_pass_desc *d, lm_error *err) {
 
 void lm_graph_mark_output(lm_graph *g, int target) {
   if (target >= 0 && target < g->target_count) *LM_PUSH(g->outputs, g->output_count, g->output_cap) = target;
+}
+
+int lm_graph_fold_output(lm_graph *g, int target, const int *outputs, int output_count, const char *defines) {
+  if (target < 0 || target >= g->target_count || g->pass_count == 0 || output_count > LM_MAX_COLOR_OUTPUTS)
+    return -1;
+  const lm_target_desc *t = &g->targets[target].desc;
+  bool output_sized = (t->scale == 0 || t->scale == 1) && !(t->width > 0 && t->height > 0);
+  if (!output_sized || t->persistent || t->mips) return -1;
+  for (int i = 0; i < g->output_count; i++)
+    if (g->outputs[i] == target) return -1;
+  graph_pass *p = &g->passes[g->pass_count - 1]; /* the last recorded: nothing after it reads its image */
+  lm_pass_desc *d = &p->desc;
+  if (d->kind != LM_PASS_FULLSCREEN || !d->fold_output || d->output_count != 1 || d->outputs[0] != target ||
+      d->depth >= 0)
+    return -1;
+  for (int i = 0; i < d->input_count; i++)
+    if (d->inputs[i].target == target) return -1;
+  int *out = lm_arena_alloc(&g->arena, sizeof *out * (size_t)output_count);
+  memcpy(out, outputs, sizeof *out * (size_t)output_count);
+  d->outputs = out, d->output_count = output_count;
+  size_t n = strlen(d->defines) + strlen(defines) + 2;
+  char *joined = lm_arena_alloc(&g->arena, n);
+  snprintf(joined, n, "%s%s%s", d->defines, d->defines[0] && defines[0] ? ";" : "", defines);
+  d->defines = joined;
+  return g->pass_count - 1;
 }
 
 static bool pass_writes(const lm_pass_desc *d, int t) {

@@ -120,6 +120,9 @@ typedef struct lm_pass_desc {
    * pixels of the pass's outputs where the node comes nearest the camera;
    * 0: every mesh whole. */
   float simplify;
+  /* Full-screen passes: the engine's output stage may run in this pass
+   * (lm_graph_fold_output; its shader then writes through output.glsl). */
+  bool fold_output;
 } lm_pass_desc;
 
 lm_graph *lm_graph_create(void);
@@ -134,6 +137,14 @@ int lm_graph_add_target(lm_graph *g, const lm_target_desc *d, lm_error *err);
 int lm_graph_add_pass(lm_graph *g, const lm_pass_desc *d, lm_error *err);
 /* Marks a target as a result of the frame: what reaches it is kept. */
 void lm_graph_mark_output(lm_graph *g, int target);
+/* Folds a last stage into the pass that writes `target`, so that the image
+ * is not written and read again at full size: when the last pass writing
+ * `target` is a full-screen pass that allows it (lm_pass_desc.fold_output),
+ * writes `target` alone, and no pass reads `target` or is recorded after it,
+ * and `target` is transient and output-sized, that pass writes `outputs`
+ * instead with `defines` added to its own. Returns the pass, or -1 when
+ * nothing changed (the caller adds its stage as a pass of its own). */
+int lm_graph_fold_output(lm_graph *g, int target, const int *outputs, int output_count, const char *defines);
 
 /* ---- compiling (no GL) ------------------------------------------------- */
 /* Validates (reads with no writer, feedback loops, formats, sizes), culls

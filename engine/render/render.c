@@ -767,7 +767,21 @@ void lm_renderer_set_view(lm_renderer *r, int camera, int width, int height) {
 lm_scene_draw_stats lm_renderer_draw_stats(const lm_renderer *r) { return r->stats; }
 lm_scene_draw_stats lm_renderer_shadow_draw_stats(const lm_renderer *r) { return r->shadow_stats; }
 
-/* The engine's last pass: sanitize and encode what the script presented.
+enum { METER_SIDE = 16, METER_SAMPLES = 8 }; /* exposure_meter.frag's SIDE and SAMPLES */
+
+/* lm_renderer_desc.exposure fixes the pre-exposure: no meter. */
+static bool fixed_exposure(const lm_renderer *r) { return r->desc.exposure > 0 && isfinite(r->desc.exposure); }
+
+/* The target the exposure meter reads: the one the script metered
+ * (meter(t)), or else what it presented when that is radiance; -1: none
+ * (display values alone, or a fixed exposure). */
+static int meter_source(const lm_renderer *r, const lm_pipeline *p, int presented) {
+  if (fixed_exposure(r)) return -1;
+  return lm_pipeline_metered(p) >= 0 ? lm_pipeline_metered(p) : lm_pipeline_present_display(p) ? -1 : presented;
+}
+
+/* The engine's last stage: sanitize and encode what the script presented, in
+ * the pass that wrote it where that pass allows it (fold_output), else a pass.
  * out[0], out[1] get the sRGB and linear outputs (-1: none). */
 static bool add_output_stage(lm_renderer *r, lm_graph *g, lm_pipeline *p, int presented, int out[2],
                              lm_error *err) {
@@ -779,29 +793,36 @@ static bool add_output_stage(lm_renderer *r, lm_graph *g, lm_pipeline *p, int pr
   if (out[0] < 0 || (r->desc.linear_output && out[1] < 0)) return false;
   lm_pass_input input = {"src", presented};
   static const char *const defines[2][2] = {{"", "DISPLAY"}, {"LINEAR_OUTPUT", "LINEAR_OUTPUT;DISPLAY"}};
+  const char *mode = defines[r->desc.linear_output][lm_pipeline_present_display(p)];
+  int count = r->desc.linear_output ? 2 : 1;
+  /* In the pass that wrote the image where it allows it (hdr.tonemap): a full-size image fewer written
+   * and read. Not where the meter reads that image, nor where the viewer inspects every target. */
+  char folded[64];
+  snprintf(folded, sizeof folded, "OUTPUT_STAGE%s%s", mode[0] ? ";" : "", mode);
+  if (meter_source(r, p, presented) != presented && r->sharing &&
+      lm_graph_fold_output(g, presented, out, count, folded) >= 0)
+  {
+    lm_graph_mark_output(g, out[0]);
+    lm_graph_mark_output(g, out[1]);
+    return true;
+  }
   lm_pass_desc d = {.kind = LM_PASS_FULLSCREEN, .name = "output", .where = lm_pipeline_present_where(p),
-                    .shader = "output.frag", .defines = defines[r->desc.linear_output][lm_pipeline_present_display(p)],
-                    .inputs = &input, .input_count = 1, .outputs = out,
-                    .output_count = r->desc.linear_output ? 2 : 1, .depth = -1};
+                    .shader = "output.frag", .defines = mode, .inputs = &input, .input_count = 1, .outputs = out,
+                    .output_count = count, .depth = -1};
   if (lm_graph_add_pass(g, &d, err) < 0) return false;
   lm_graph_mark_output(g, out[0]);
   if (out[1] >= 0) lm_graph_mark_output(g, out[1]);
   return true;
 }
 
-enum { METER_SIDE = 16, METER_SAMPLES = 8 }; /* exposure_meter.frag's SIDE and SAMPLES */
-
-/* lm_renderer_desc.exposure fixes the pre-exposure: no meter. */
-static bool fixed_exposure(const lm_renderer *r) { return r->desc.exposure > 0 && isfinite(r->desc.exposure); }
-
 /* The exposure meter (shaders/exposure_meter.frag) over the image the script
  * metered (meter(t)), or else what it presented when that is radiance;
  * *meter gets its target (-1: none, display values alone). */
 static bool add_meter_stage(const lm_renderer *r, lm_graph *g, lm_pipeline *p, int presented, int *meter,
                             lm_error *err) {
-  int src = lm_pipeline_metered(p) >= 0 ? lm_pipeline_metered(p) : lm_pipeline_present_display(p) ? -1 : presented;
+  int src = meter_source(r, p, presented);
   *meter = -1;
-  if (src < 0 || fixed_exposure(r)) return true;
+  if (src < 0) return true;
   *meter = lm_graph_add_target(g, &(lm_target_desc){.name = "exposure.meter", .format = LM_FORMAT_RGBA32F,
                                                     .width = METER_SIDE, .height = METER_SIDE}, err);
   if (*meter < 0) return false;

@@ -672,15 +672,21 @@ static lm_pipeline *begin_output_pass(lua_State *L, pass_builder *b, lm_pass_kin
   return p;
 }
 
-/* pass{ "name", shader = "x.frag", inputs = {...}, params = {...}, out = T | {...}, defines = {...} }
- * returns its first output, so passes chain. */
+/* pass{ "name", shader = "x.frag", inputs = {...}, params = {...}, out = T | {...}, defines = {...},
+ * fold_output = B } returns its first output, so passes chain. fold_output: the engine's output
+ * stage may run in this pass when it presents its image (lm_pass_desc.fold_output). */
 static int l_pass(lua_State *L) {
-  static const char *const fields[] = {"shader", "inputs", "params", "out", "defines", "fetches", NULL};
+  static const char *const fields[] = {"shader", "inputs", "params", "out", "defines", "fetches", "fold_output",
+                                       NULL};
   pass_builder b;
   int top = lua_gettop(L);
   lm_pipeline *p = begin_output_pass(L, &b, LM_PASS_FULLSCREEN, "pass", fields, "shader", "a file in shaders/");
   read_defines(L, 1, &b);
   b.desc.fetches = opt_number(L, 1, "fetches", 0, 0, 1e6f, b.what);
+  lua_getfield(L, 1, "fold_output");
+  if (!lua_isnil(L, -1) && !lua_isboolean(L, -1)) luaL_error(L, "%s: fold_output must be true or false", b.what);
+  b.desc.fold_output = lua_toboolean(L, -1);
+  lua_pop(L, 1);
   return add_pass_returning_output(L, p, &b, top);
 }
 
