@@ -35,19 +35,22 @@ uniform float narrow = 0.25; // the reach shrinks as n^-narrow (temporal.narrow)
 
 out vec4 dst;
 
-float weight_at(ivec2 q, float z, float expected) {
-  float w = 1.0;
+// The weight of tap q, whose spatial Gaussian is exp(-spatial): both
+// Gaussians in one exp (llvmpipe's exp is a polynomial a lane), the centre's
+// 1 / (z tolerance) taken once a pixel (inv_tol), not once a tap.
+float weight_at(ivec2 q, float inv_tol, float expected, float spatial) {
+  float w = 1.0, x = spatial;
 #ifdef MASK
   w *= step(0.5, texelFetch(mask, q, 0).a);
 #endif
 #ifdef DEPTH
-  float d = texelFetch(depth, q, 0).r, dz = (d - expected) / (max(z, 1e-12) * DEPTH_TOLERANCE);
-  w *= exp(-dz * dz);
+  float d = texelFetch(depth, q, 0).r, dz = (d - expected) * inv_tol;
+  x += dz * dz;
 #ifndef MASK
   w *= d > 0.0 ? 1.0 : 0.0;
 #endif
 #endif
-  return w;
+  return w * exp(-x);
 }
 
 void main() {
@@ -67,14 +70,15 @@ void main() {
     dst = centre;
     return;
   }
-  float z = 0.0, slope = 0.0;
+  float z = 0.0, slope = 0.0, inv_tol = 0.0;
 #ifdef DEPTH
   z = texelFetch(depth, p, 0).r;
+  inv_tol = 1.0 / (max(z, 1e-12) * DEPTH_TOLERANCE);
   float ahead = texelFetch(depth, clamp(p + axis, ivec2(0), last), 0).r - z;
   float behind = z - texelFetch(depth, clamp(p - axis, ivec2(0), last), 0).r;
   slope = abs(ahead) < abs(behind) ? ahead : behind;
 #endif
-  float wsum = weight_at(p, z, z); // the centre's tap, fetched once
+  float wsum = weight_at(p, inv_tol, z, 0.0); // the centre's tap, fetched once
   if (wsum == 0.0) {
     dst = centre;
     return;
@@ -84,7 +88,7 @@ void main() {
   for (int i = -taps; i <= taps; i++) {
     if (i == 0) continue;
     ivec2 q = clamp(p + axis * i, ivec2(0), last);
-    float w = exp(-float(i * i) * inv2s2) * weight_at(q, z, z + float(i) * slope);
+    float w = weight_at(q, inv_tol, z + float(i) * slope, float(i * i) * inv2s2);
     sum += w * texelFetch(src, q, 0);
     wsum += w;
   }
