@@ -2,6 +2,8 @@
 // depth is z0 + log(sum w_i exp(k (z_i - z0))) / k with z0 the largest tap, so
 // no exponent exceeds 0 and k can be large. k is the lookup's (shadow.glsl):
 // c per texel of depth, from the tile's view. Taps stay inside their tile.
+// Over depths (the map negates faces the light sees from behind, shadow.frag):
+// the result keeps its own texel's sign.
 #include "shadow.glsl"
 
 in vec2 uv;
@@ -34,11 +36,11 @@ void main() {
   float inv_two_sigma2 = 1.0 / (2.0 * max(float(r) * 0.5, 0.5) * max(float(r) * 0.5, 0.5));
   // One pass of a running log-sum-exp: z0 is the largest depth so far and
   // sum is scaled to it, so no exponent is ever positive.
-  float z0 = texelFetch(shadow_atlas, p, 0).r, sum = 0.0, norm = 0.0;
+  float own = texelFetch(shadow_atlas, p, 0).r, z0 = abs(own), sum = 0.0, norm = 0.0;
   float k = max(c, 1e-3) / shadow_texel_depth(shadow_views[view], z0);
   for (int i = -r; i <= r; i++) {
     float w = exp(-float(i * i) * inv_two_sigma2);
-    float z = shadow_texel(p + ivec2(direction) * i, lo, hi);
+    float z = abs(shadow_texel(p + ivec2(direction) * i, lo, hi));
     if (z > z0) {
       sum *= exp(k * (z0 - z));
       z0 = z;
@@ -47,5 +49,6 @@ void main() {
     norm += w;
   }
   // sum holds at least the largest tap's own weight, so the log is finite.
-  blurred = z0 + log(max(sum / norm, 1e-30)) / k;
+  float d = z0 + log(max(sum / norm, 1e-30)) / k;
+  blurred = own >= 0.0 ? d : -max(d, 1e-30);
 }

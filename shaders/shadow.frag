@@ -1,5 +1,6 @@
 // Stores depth normalized to the light's range (not exp(c d): filtering in
-// log space keeps large c finite, see esm_blur.frag). With RSM (the RSM
+// log space keeps large c finite, see esm_blur.frag), negated on faces the
+// light sees from behind. With RSM (the RSM
 // pass over the RSM views, scripts/shadow.lua), instead the reflective
 // shadow map of seed 004 (lines 858-904): the sender's
 // reflectance k_d albedo (its flux is the light's radiance there times this
@@ -71,14 +72,20 @@ void main() {
   if (alpha_masked(texel.a)) discard;
 #endif
 #ifndef RSM
-  if (pass_depth.w > 0.0) // perspective: distance from the light / range
-    depth01 = saturate(length(world_pos - pass_depth.xyz) * pass_depth.w);
-  else                    // orthographic: window depth is already linear
-    depth01 = saturate(gl_FragCoord.z); // casters before the near plane are clamped onto it
+  // Perspective: distance from the light / range. Orthographic: window depth,
+  // already linear (casters before the near plane are clamped onto it).
+  float d = pass_depth.w > 0.0 ? saturate(length(world_pos - pass_depth.xyz) * pass_depth.w) : saturate(gl_FragCoord.z);
+  // A face the light sees from behind is stored negated (its least magnitude
+  // a normal float, so that a depth of 0 keeps its sign): such a face is dark
+  // in its own light, so no lit receiver is that surface and lookups compare
+  // against it without the bias meant for a receiver's own surface, which
+  // lit the floor and walls beyond the back of a thin wall or ceiling up to
+  // two texels from the seam (shadow.glsl: shadow_lit).
+  depth01 = gl_FrontFacing ? d : -max(d, 1e-30);
 #endif
 #ifdef TRANSMIT
 #ifdef ALPHA_BLEND
-  transmit = vec4(glass_transmittance(texel), depth01);
+  transmit = vec4(glass_transmittance(texel), d);
 #else
   transmit = vec4(1.0); // masked off: opaque casters leave it
 #endif

@@ -60,6 +60,19 @@ const vec2 POISSON[16] = vec2[](
 
 float shadow_texel(ivec2 t, ivec2 lo, ivec2 hi) { return texelFetch(shadow_atlas, clamp(t, lo, hi), 0).r; }
 
+// Whether a receiver at depth r is lit against map texel z (shadow.frag:
+// the depth, negated where the light saw a face from behind) with a bias:
+// `bias` against a face toward the light, which may be the receiver's own
+// surface, none against a back face, which a lit receiver never is. That
+// bias grows with the tilt (up to 2.5 texels on the room's floor) and
+// exceeded the depth between a receiver and the back of a thin wall or
+// ceiling within two texels of where they meet: a lit line along the seam
+// (docs/shadows.md). A lit face beside lit ground keeps it (the ground's
+// texels nearer the light by a texel's tilt).
+bool shadow_lit(float r, float bias, float z) { return z >= 0.0 ? r - bias <= z : r <= -z; }
+// The same for 4 texels, 1 where lit.
+vec4 shadow_lit4(float r, float bias, vec4 z) { return step(vec4(r) - bias * step(0.0, z), abs(z)); }
+
 // The 2 x 2 texels from t, each clamped into the tile [lo, hi] as
 // shadow_texel does, in the order (0, 0), (1, 0), (0, 1), (1, 1): one gather
 // of a block inside the tile (a tile is at least 2 texels a side), whose
@@ -118,7 +131,7 @@ float pcss_lookup(ShadowLight s, ShadowView sv, bool perspective, vec2 texel, fl
   for (int i = 0; i < 16; i++) {
     vec2 o = POISSON[i] * search;
     float z = shadow_texel(ivec2(floor(texel + 0.5 + o)), lo, hi);
-    if (r - bias * (1.0 + length(o) * tan_tilt) > z) { sum += z; n += 1.0; }
+    if (!shadow_lit(r, bias * (1.0 + length(o) * tan_tilt), z)) { sum += abs(z); n += 1.0; }
   }
   if (n == 0.0) return 1.0;
   float radius = clamp(0.5 * pcss_penumbra(sv, perspective, size, r, sum / n), 1.0, widest);
@@ -127,15 +140,21 @@ float pcss_lookup(ShadowLight s, ShadowView sv, bool perspective, vec2 texel, fl
     vec2 o = POISSON[i] * radius, t = texel + o;
     ivec2 b = ivec2(floor(t));
     vec2 f = t - vec2(b);
-    float rb = r - bias * (1.0 + (length(o) + 1.0) * tan_tilt);
-    vec4 v = step(vec4(rb), shadow_texels(b, lo, hi));
+    vec4 v = shadow_lit4(r, bias * (1.0 + (length(o) + 1.0) * tan_tilt), shadow_texels(b, lo, hi));
     lit += mix(mix(v.x, v.y, f.x), mix(v.z, v.w, f.x), f.y);
   }
   return lit / 16.0;
 }
 
+// How far filter `technique` of light s reads from the lookup's texel, in
+// texels, where a tilted receiver is nearer the light (the hard compare
+// reads its own).
+float shadow_spread(ShadowLight s, int technique) {
+  return technique == 0 ? 1.0 : technique == 1 ? 1.5 : technique == 2 ? s.params.w : 0.0;
+}
+
 // Visibility in [0, 1] of p from view sv of light s, p at ls in its clip
-// space (shadow_view_of), sv perspective or not (shadow_perspective), the
+// space (shadow_clip), sv perspective or not (shadow_perspective), the
 // surface's n.l and the tilt shadow_tilt gives for it.
 float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s, vec3 p, float ndl,
                          float tan_tilt) {
@@ -154,33 +173,34 @@ float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s
   float texel_depth = shadow_texel_depth_as(sv, r, perspective);
   float bias = s.params.y * texel_depth;
   int technique = SHADOW_FILTER_OF(s);
-  // Filters reach `spread` texels away, where a tilted receiver is deeper:
-  // scale the bias by the tilt (tan of the light's angle, capped).
-  float spread = technique == 0 ? 1.0 : technique == 1 ? 1.5 : technique == 2 ? s.params.w : 0.0;
   if (technique == 4) return pcss_lookup(s, sv, perspective, texel, r, bias, tan_tilt, lo, hi);
-  bias *= 1.0 + spread * tan_tilt;
+  // Filters reach `spread` texels away, where a tilted receiver is deeper:
+  // scale the bias by the tilt (tan of the light's angle, capped). Only
+  // against faces toward the light (shadow_lit).
+  bias *= 1.0 + shadow_spread(s, technique) * tan_tilt;
   if (technique == 0) {
     // ESM with the seed's 4-tap bilinear combination (seed 000, Listing 8):
     // the depth difference is clamped at 0 and scaled by n.l, then exp(-k d)
-    // with k = c per texel of depth (a scale-free c; leaks within a texel).
+    // with k = c per texel of depth (a scale-free c; leaks within a texel);
+    // no bias against a back face (shadow_lit).
     float k = s.params.x / texel_depth, scale = saturate(ndl);
     vec4 z = shadow_texels(base, lo, hi);
-    vec4 vis = exp(-k * max(vec4(r) - z - bias, 0.0) * scale);
+    vec4 vis = exp(-k * max(vec4(r) - abs(z) - bias * step(0.0, z), 0.0) * scale);
     return mix(mix(vis.x, vis.y, f.x), mix(vis.z, vis.w, f.x), f.y);
   }
   if (technique == 1) { // PCF 3x3
     float lit = 0.0;
     for (int y = -1; y <= 1; y++)
-      for (int x = -1; x <= 1; x++) lit += r - bias <= shadow_texel(base + ivec2(x, y), lo, hi) ? 1.0 : 0.0;
+      for (int x = -1; x <= 1; x++) lit += shadow_lit(r, bias, shadow_texel(base + ivec2(x, y), lo, hi)) ? 1.0 : 0.0;
     return lit / 9.0;
   }
   if (technique == 2) { // Poisson disc
     float lit = 0.0;
     for (int i = 0; i < 16; i++)
-      lit += r - bias <= shadow_texel(ivec2(floor(texel + 0.5 + POISSON[i] * s.params.w)), lo, hi) ? 1.0 : 0.0;
+      lit += shadow_lit(r, bias, shadow_texel(ivec2(floor(texel + 0.5 + POISSON[i] * s.params.w)), lo, hi)) ? 1.0 : 0.0;
     return lit / 16.0;
   }
-  return r - bias <= shadow_texel(ivec2(floor(texel + 0.5)), lo, hi) ? 1.0 : 0.0;
+  return shadow_lit(r, bias, shadow_texel(ivec2(floor(texel + 0.5)), lo, hi)) ? 1.0 : 0.0;
 }
 
 // The tan of the angle between a surface and the light by its n.l, capped.
@@ -231,21 +251,35 @@ int shadow_view_at(int light, ShadowLight s, int kind, vec3 p, out float t) {
   return 0;
 }
 
-// View j of light `light` (shadow_view_at's numbering), p at *clip in its
-// clip space. The records hold a light's views in order, a cube's drawn
-// faces alone. A light-set variant reads the light's fixed places instead:
-// what a cube's faces share (centre, range, texel and tile size, the
-// projection's scale) at the first place's constant offset, and at the
-// face's place only its tile's corner; the whole record read at a pixel's
-// own index made much of the lookup's cost on llvmpipe (Cornell box,
-// dl+esm, 128x96, 4 frames, callgrind: the shadow's share of the JIT'd code
-// 10.4 -> 6.5 million instructions with this and shadow_texels' one gather),
-// which reads a place that varies by pixel lane by lane.
-ShadowView shadow_view_of(int light, ShadowLight s, int kind, int j, vec3 p, out vec4 clip) {
+// View j of light `light` (shadow_view_at's numbering). The records hold a
+// light's views in order, a cube's drawn faces alone. A light-set variant
+// reads the light's fixed places instead: what a cube's faces share (centre,
+// range, texel and tile size, the projection's scale) at the first place's
+// constant offset, and at the face's place only its tile's corner; the whole
+// record read at a pixel's own index made much of the lookup's cost on
+// llvmpipe (Cornell box, dl+esm, 128x96, 4 frames, callgrind: the shadow's
+// share of the JIT'd code 10.4 -> 6.5 million instructions with this and
+// shadow_texels' one gather), which reads a place that varies by pixel lane
+// by lane.
+ShadowView shadow_view_of(int light, ShadowLight s, int kind, int j) {
 #ifdef LIGHT_SET
   int at = light * SHADOW_SLOTS;
   if (kind == 3) {
     ShadowView sv = shadow_slots[at];
+    sv.rect.xy = shadow_slots[at + j].rect.xy;
+    return sv;
+  }
+  return shadow_slots[at + j];
+#else
+  return shadow_views[s.info.x + (kind == 3 ? bitCount(s.cube.x & ((1 << j) - 1)) : j)];
+#endif
+}
+
+// p in the clip space of view j (sv, shadow_view_of) of a light whose shadow
+// is of kind `kind`.
+vec4 shadow_clip(ShadowView sv, int kind, int j, vec3 p) {
+#ifdef LIGHT_SET
+  if (kind == 3) {
     // The face's clip x, y and w from p - centre (its translation moves the
     // centre to 0): each of those rows of its matrix is a signed axis times
     // the scale (perspective_view_proj in engine/shadow/shadow.c: glm_lookat
@@ -256,19 +290,28 @@ ShadowView shadow_view_of(int light, ShadowLight s, int kind, int j, vec3 p, out
     float x = j == 0 || j == 3 ? d.z : j == 4 ? -d.x : j == 5 ? d.x : -d.z;
     float y = j == 2 || j == 3 ? d.x : d.y;
     float w = j < 2 ? d.x : j < 4 ? d.y : d.z;
-    clip = vec4(sv.texel.z * x, sv.texel.z * y, 0.0, (j & 1) == 0 ? w : -w);
-    sv.rect.xy = shadow_slots[at + j].rect.xy;
-    return sv;
+    return vec4(sv.texel.z * x, sv.texel.z * y, 0.0, (j & 1) == 0 ? w : -w);
   }
-  ShadowView sv = shadow_slots[at + j];
-#else
-  ShadowView sv = shadow_views[s.info.x + (kind == 3 ? bitCount(s.cube.x & ((1 << j) - 1)) : j)];
 #endif
-  clip = sv.view_proj * vec4(p, 1.0);
+  vec4 clip = sv.view_proj * vec4(p, 1.0);
   // An orthographic view's w is 1 (its matrix's last row 0 0 0 1): that row
   // not read, lane by lane where the cascade varies by pixel.
   if (!shadow_perspective(kind)) clip.w = 1.0;
-  return sv;
+  return clip;
+}
+
+// Whether the 2 x 2 texels around ls (clip position in orthographic view
+// sv) hold a face the light sees from behind (negated: shadow.frag) within
+// `reach` texels of depth nearer the light than ls: one it touches.
+bool shadow_back_face_near(ShadowView sv, vec4 ls, float reach) {
+  vec2 size = vec2(textureSize(shadow_atlas, 0));
+  ivec2 lo = ivec2(sv.rect.xy * size + 0.5), hi = ivec2((sv.rect.xy + sv.rect.zw) * size + 0.5) - 1;
+  vec2 texel = (sv.rect.xy + (ls.xy * 0.5 + 0.5) * sv.rect.zw) * size - 0.5;
+  vec4 z = shadow_texels(ivec2(floor(texel)), lo, hi);
+  float r = ls.z * 0.5 + 0.5;
+  // Back faces' depths are negated: r + z is r less their depth.
+  vec4 touching = step(vec4(r) + z, vec4(reach * shadow_texel_depth_as(sv, r, false)));
+  return dot(step(z, vec4(-1e-31)), touching) > 0.0; // stored back faces are -1e-30 or less
 }
 
 // Shadow factor of light `light` at p, whose shadow is of kind `kind`
@@ -280,14 +323,35 @@ float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
   int v = shadow_view_at(light, s, kind, p, t);
   if (v < 0) return 1.0;
   float ndl = dot(n, l), tan_tilt = shadow_tilt(ndl), vis = 1.0; // the same for both lookups
+  // Where a cascade's texels at p hold a face the light sees from behind
+  // (a thin wall, a ceiling) that p touches, the lookup is at a point `bias`
+  // times the filter's spread of texels along the normal (shadow_spread),
+  // toward the light where the surface faces it: within a texel of where
+  // such a wall meets what it shades (the floor under the window wall, the
+  // walls under the ceiling) the taps read texels past the wall's edge,
+  // where the light passes beside it, and lit a line along the seam; moved,
+  // they fall inside the wall's texels. Elsewhere the lookup stays at p: the
+  // offset moves shadow edges toward their casters by as much (at a low sun,
+  // a texel times the tilt along the ground), which raised the blocks' and a
+  // street view's direct-only error against POV-Ray by 10-28% (offset
+  // everywhere, or wherever a back face was near). Spot and point lights
+  // take no offset: an offset point leaves its cube face near an edge.
+  bool perspective = shadow_perspective(kind);
+  int technique = SHADOW_FILTER_OF(s);
+  float offset = perspective || technique == 4 ? 0.0 : s.params.y * max(shadow_spread(s, technique), 1.0);
   // Both lookups in a loop that tests at its end, not the second in an if: a
   // software rasterizer leaves such a loop once no pixel of its group goes on,
   // but runs both sides of every if.
   int j = 0;
   do {
-    vec4 clip;
-    ShadowView sv = shadow_view_of(light, s, kind, v + j, p, clip);
-    float lit = shadow_view_lookup(sv, shadow_perspective(kind), clip, s, p, ndl, tan_tilt);
+    ShadowView sv = shadow_view_of(light, s, kind, v + j);
+    vec3 q = p;
+    vec4 clip = shadow_clip(sv, kind, v + j, p);
+    if (offset > 0.0 && shadow_back_face_near(sv, clip, 4.0 * (1.0 + tan_tilt))) {
+      q += n * (offset * sv.texel.x); // an orthographic view's texel.x: a texel's world size
+      clip = shadow_clip(sv, kind, v + j, q);
+    }
+    float lit = shadow_view_lookup(sv, perspective, clip, s, q, ndl, tan_tilt);
     vis = mix(vis, lit, j == 0 ? 1.0 : t);
   } while (++j < (t > 0.0 ? 2 : 1));
   return vis;
@@ -309,8 +373,8 @@ vec3 shadow_transmittance_as(int light, int kind, vec3 p) {
   float t;
   int v = shadow_view_at(light, s, kind, p, t);
   if (v < 0) return vec3(1.0);
-  vec4 ls;
-  ShadowView sv = shadow_view_of(light, s, kind, v, p, ls);
+  ShadowView sv = shadow_view_of(light, s, kind, v);
+  vec4 ls = shadow_clip(sv, kind, v, p);
   if (ls.w <= 1e-12) return vec3(1.0);
   vec3 ndc = ls.xyz / ls.w;
   vec2 tuv = ndc.xy * 0.5 + 0.5;

@@ -6,6 +6,6 @@ uniform sampler2D atlas;
 out vec4 color;
 
 void main() {
-  float d = texture(atlas, uv).r;
+  float d = abs(texture(atlas, uv).r); // negated on faces the light sees from behind (shadow.frag)
   color = vec4(vec3(saturate(d)), 1.0);
 }
