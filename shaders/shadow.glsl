@@ -60,19 +60,20 @@ const vec2 POISSON[16] = vec2[](
 
 float shadow_texel(ivec2 t, ivec2 lo, ivec2 hi) { return texelFetch(shadow_atlas, clamp(t, lo, hi), 0).r; }
 
-// The 2 x 2 texels from t, each clamped into the tile [lo, hi] as
-// shadow_texel does, in the order (0, 0), (1, 0), (0, 1), (1, 1): one gather
-// of a block inside the tile (a tile is at least 2 texels a side), whose
-// columns or rows stand for both where t lies on or past an edge. One read
-// instead of four (llvmpipe: a gather costs about one fetch).
-vec4 shadow_texels(ivec2 t, ivec2 lo, ivec2 hi) {
-  ivec2 b = clamp(t, lo, hi - 1);
-  vec4 z = textureGather(shadow_atlas, (vec2(b) + 1.0) / vec2(textureSize(shadow_atlas, 0)), 0).wzxy;
-  if (t.x < lo.x) z.yw = z.xz;
-  if (t.x >= hi.x) z.xz = z.yw;
-  if (t.y < lo.y) z.zw = z.xy;
-  if (t.y >= hi.y) z.xy = z.zw;
-  return z;
+// The 2 x 2 texels around atlas position `texel` (texel centres at whole
+// numbers) within the tile [lo, hi], in the order (0, 0), (1, 0), (0, 1),
+// (1, 1), and in *f the bilinear weights between them. A position on the
+// tile's outer half texel is moved onto its edge texels' centres, where the
+// weights give the value that clamping each texel into the tile gives, by
+// one clamp of the position rather than four selects of texels. One gather
+// of a block inside the tile (a tile is at least 2 texels a side), at its
+// corner, where the reciprocal's rounding cannot pick another block
+// (llvmpipe: a gather costs about one fetch; a division, several products).
+vec4 shadow_texels(vec2 texel, ivec2 lo, ivec2 hi, out vec2 f) {
+  vec2 t = clamp(texel, vec2(lo), vec2(hi));
+  vec2 b = min(floor(t), vec2(hi - 1));
+  f = t - b;
+  return textureGather(shadow_atlas, (b + 1.0) * (1.0 / vec2(textureSize(shadow_atlas, 0))), 0).wzxy;
 }
 
 // A texel's world size, where a point at stored depth r is, in stored depth
@@ -124,11 +125,9 @@ float pcss_lookup(ShadowLight s, ShadowView sv, bool perspective, vec2 texel, fl
   float radius = clamp(0.5 * pcss_penumbra(sv, perspective, size, r, sum / n), 1.0, widest);
   float lit = 0.0;
   for (int i = 0; i < 16; i++) {
-    vec2 o = POISSON[i] * radius, t = texel + o;
-    ivec2 b = ivec2(floor(t));
-    vec2 f = t - vec2(b);
+    vec2 o = POISSON[i] * radius, f;
     float rb = r - bias * (1.0 + (length(o) + 1.0) * tan_tilt);
-    vec4 v = step(vec4(rb), shadow_texels(b, lo, hi));
+    vec4 v = step(vec4(rb), shadow_texels(texel + o, lo, hi, f));
     lit += mix(mix(v.x, v.y, f.x), mix(v.z, v.w, f.x), f.y);
   }
   return lit / 16.0;
@@ -163,10 +162,14 @@ float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s
     // ESM with the seed's 4-tap bilinear combination (seed 000, Listing 8):
     // the depth difference is clamped at 0 and scaled by n.l, then exp(-k d)
     // with k = c per texel of depth (a scale-free c; leaks within a texel).
-    float k = s.params.x / texel_depth, scale = saturate(ndl);
-    vec4 z = shadow_texels(base, lo, hi);
-    vec4 vis = exp(-k * max(vec4(r) - z - bias, 0.0) * scale);
-    return mix(mix(vis.x, vis.y, f.x), mix(vis.z, vis.w, f.x), f.y);
+    // Taken as exp2 of the difference times one factor a pixel, -k n.l
+    // log2(e) (finite: c <= 10000, texel_depth >= 1e-30), so that each tap
+    // costs one product, not three.
+    float m = -1.44269504 * s.params.x / texel_depth * saturate(ndl);
+    vec2 w;
+    vec4 z = shadow_texels(texel, lo, hi, w);
+    vec4 vis = exp2(max(vec4(r - bias) - z, 0.0) * m);
+    return mix(mix(vis.x, vis.y, w.x), mix(vis.z, vis.w, w.x), w.y);
   }
   if (technique == 1) { // PCF 3x3
     float lit = 0.0;
