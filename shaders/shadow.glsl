@@ -149,7 +149,6 @@ float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s
   ivec2 lo = ivec2(sv.rect.xy * size + 0.5), hi = ivec2((sv.rect.xy + sv.rect.zw) * size + 0.5) - 1;
   vec2 texel = (sv.rect.xy + tuv * sv.rect.zw) * size - 0.5;
   ivec2 base = ivec2(floor(texel));
-  vec2 f = texel - vec2(base);
   float texel_depth = shadow_texel_depth_as(sv, r, perspective);
   float bias = s.params.y * texel_depth;
   int technique = SHADOW_FILTER_OF(s);
@@ -166,10 +165,10 @@ float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s
     // log2(e) (finite: c <= 10000, texel_depth >= 1e-30), so that each tap
     // costs one product, not three.
     float m = -1.44269504 * s.params.x / texel_depth * saturate(ndl);
-    vec2 w;
-    vec4 z = shadow_texels(texel, lo, hi, w);
+    vec2 f;
+    vec4 z = shadow_texels(texel, lo, hi, f);
     vec4 vis = exp2(max(vec4(r - bias) - z, 0.0) * m);
-    return mix(mix(vis.x, vis.y, w.x), mix(vis.z, vis.w, w.x), w.y);
+    return mix(mix(vis.x, vis.y, f.x), mix(vis.z, vis.w, f.x), f.y);
   }
   if (technique == 1) { // PCF 3x3
     float lit = 0.0;
