@@ -73,19 +73,20 @@ bool shadow_lit(float r, float bias, float z) { return z >= 0.0 ? r - bias <= z 
 // The same for 4 texels, 1 where lit.
 vec4 shadow_lit4(float r, float bias, vec4 z) { return step(vec4(r) - bias * step(0.0, z), abs(z)); }
 
-// The 2 x 2 texels from t, each clamped into the tile [lo, hi] as
-// shadow_texel does, in the order (0, 0), (1, 0), (0, 1), (1, 1): one gather
-// of a block inside the tile (a tile is at least 2 texels a side), whose
-// columns or rows stand for both where t lies on or past an edge. One read
-// instead of four (llvmpipe: a gather costs about one fetch).
-vec4 shadow_texels(ivec2 t, ivec2 lo, ivec2 hi) {
-  ivec2 b = clamp(t, lo, hi - 1);
-  vec4 z = textureGather(shadow_atlas, (vec2(b) + 1.0) / vec2(textureSize(shadow_atlas, 0)), 0).wzxy;
-  if (t.x < lo.x) z.yw = z.xz;
-  if (t.x >= hi.x) z.xz = z.yw;
-  if (t.y < lo.y) z.zw = z.xy;
-  if (t.y >= hi.y) z.xy = z.zw;
-  return z;
+// The 2 x 2 texels around atlas position `texel` (texel centres at whole
+// numbers) within the tile [lo, hi], in the order (0, 0), (1, 0), (0, 1),
+// (1, 1), and in *f the bilinear weights between them. A position on the
+// tile's outer half texel is moved onto its edge texels' centres, where the
+// weights give the value that clamping each texel into the tile gives, by
+// one clamp of the position rather than four selects of texels. One gather
+// of a block inside the tile (a tile is at least 2 texels a side), at its
+// corner, where the reciprocal's rounding cannot pick another block
+// (llvmpipe: a gather costs about one fetch; a division, several products).
+vec4 shadow_texels(vec2 texel, ivec2 lo, ivec2 hi, out vec2 f) {
+  vec2 t = clamp(texel, vec2(lo), vec2(hi));
+  vec2 b = min(floor(t), vec2(hi - 1));
+  f = t - b;
+  return textureGather(shadow_atlas, (b + 1.0) * (1.0 / vec2(textureSize(shadow_atlas, 0))), 0).wzxy;
 }
 
 // A texel's world size, where a point at stored depth r is, in stored depth
@@ -137,10 +138,8 @@ float pcss_lookup(ShadowLight s, ShadowView sv, bool perspective, vec2 texel, fl
   float radius = clamp(0.5 * pcss_penumbra(sv, perspective, size, r, sum / n), 1.0, widest);
   float lit = 0.0;
   for (int i = 0; i < 16; i++) {
-    vec2 o = POISSON[i] * radius, t = texel + o;
-    ivec2 b = ivec2(floor(t));
-    vec2 f = t - vec2(b);
-    vec4 v = shadow_lit4(r, bias * (1.0 + (length(o) + 1.0) * tan_tilt), shadow_texels(b, lo, hi));
+    vec2 o = POISSON[i] * radius, f;
+    vec4 v = shadow_lit4(r, bias * (1.0 + (length(o) + 1.0) * tan_tilt), shadow_texels(texel + o, lo, hi, f));
     lit += mix(mix(v.x, v.y, f.x), mix(v.z, v.w, f.x), f.y);
   }
   return lit / 16.0;
@@ -169,7 +168,6 @@ float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s
   ivec2 lo = ivec2(sv.rect.xy * size + 0.5), hi = ivec2((sv.rect.xy + sv.rect.zw) * size + 0.5) - 1;
   vec2 texel = (sv.rect.xy + tuv * sv.rect.zw) * size - 0.5;
   ivec2 base = ivec2(floor(texel));
-  vec2 f = texel - vec2(base);
   float texel_depth = shadow_texel_depth_as(sv, r, perspective);
   float bias = s.params.y * texel_depth;
   int technique = SHADOW_FILTER_OF(s);
@@ -182,10 +180,13 @@ float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s
     // ESM with the seed's 4-tap bilinear combination (seed 000, Listing 8):
     // the depth difference is clamped at 0 and scaled by n.l, then exp(-k d)
     // with k = c per texel of depth (a scale-free c; leaks within a texel);
-    // no bias against a back face (shadow_lit).
-    float k = s.params.x / texel_depth, scale = saturate(ndl);
-    vec4 z = shadow_texels(base, lo, hi);
-    vec4 vis = exp(-k * max(vec4(r) - abs(z) - bias * step(0.0, z), 0.0) * scale);
+    // no bias against a back face (shadow_lit). Taken as exp2 of the
+    // difference times one factor a pixel, -k n.l log2(e) (finite: c <=
+    // 10000, texel_depth >= 1e-30), so that each tap costs one product.
+    float m = -1.44269504 * s.params.x / texel_depth * saturate(ndl);
+    vec2 f;
+    vec4 z = shadow_texels(texel, lo, hi, f);
+    vec4 vis = exp2(max(vec4(r) - abs(z) - bias * step(0.0, z), 0.0) * m);
     return mix(mix(vis.x, vis.y, f.x), mix(vis.z, vis.w, f.x), f.y);
   }
   if (technique == 1) { // PCF 3x3
@@ -307,7 +308,8 @@ bool shadow_back_face_near(ShadowView sv, vec4 ls, float reach) {
   vec2 size = vec2(textureSize(shadow_atlas, 0));
   ivec2 lo = ivec2(sv.rect.xy * size + 0.5), hi = ivec2((sv.rect.xy + sv.rect.zw) * size + 0.5) - 1;
   vec2 texel = (sv.rect.xy + (ls.xy * 0.5 + 0.5) * sv.rect.zw) * size - 0.5;
-  vec4 z = shadow_texels(ivec2(floor(texel)), lo, hi);
+  vec2 f;
+  vec4 z = shadow_texels(texel, lo, hi, f);
   float r = ls.z * 0.5 + 0.5;
   // Back faces' depths are negated: r + z is r less their depth.
   vec4 touching = step(vec4(r) + z, vec4(reach * shadow_texel_depth_as(sv, r, false)));
