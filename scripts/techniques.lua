@@ -93,13 +93,18 @@ function techniques.settings(tech, list)
 end
 
 -- Does the frame of `row` with options `tech` read the G-buffer's velocity
--- (motion blur while things move, or the row's temporal reuse)? A frame
--- that does not declares none.
+-- (motion blur while things move, or the row's temporal reuse while the
+-- scene changes)? A frame that does not declares none. Temporal reuse reads
+-- it only for surfaces that moved on their own (a = 2, temporal.glsl); in a
+-- frame whose scene is the last one's (still_frames("scene") > 0: no node or
+-- mesh moved) there are none, and every pixel reprojects through the camera
+-- alone, to the bit as with the target, which costs the G-buffer pass a
+-- full-size output (isr+rsm+esm's moving frame at 256 x 192: docs/gi-combined.md).
 function techniques.reads_velocity(tech, row)
   local function on(t) return type(t) == "table" and t.enabled == true end
   local gi = row.temporal and tech[row.temporal]
   return (on(tech.motion_blur) and still_frames() == 0) or
-         (gi ~= nil and on(gi.temporal) and gi.temporal.velocity ~= false)
+         (gi ~= nil and on(gi.temporal) and gi.temporal.velocity ~= false and still_frames("scene") == 0)
 end
 
 return techniques
