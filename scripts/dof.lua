@@ -73,13 +73,19 @@ function dof.render(src, o, frame)
   -- The largest circle reaching each 8 x 8 tile: the gather spreads its taps
   -- over that radius, as many as keep the density of `samples` over max_radius.
   local tile, radius = 8, o.max_radius / f
+  -- The smallest too: where every circle near a tile is large, the reduced
+  -- gather reads its taps from the image at half its size again, a quarter
+  -- as many (dof_quarter.frag).
   local tiles = pass{ "dof.tiles", shader = "dof_tiles.frag", inputs = { src = circles }, defines = { TILE = tile },
-                      out = target{ "dof.tiles", format = "r16f", scale = 1 / (tile * f) } }
+                      out = target{ "dof.tiles", format = "rg16f", scale = 1 / (tile * f) } }
   tiles = pass{ "dof.dilate", shader = "dof_tiles.frag", inputs = { src = tiles },
                 params = { max_radius = radius }, defines = { TILE = tile, DILATE = true },
-                out = target{ "dof.dilate", format = "r16f", scale = 1 / (tile * f) } }
+                out = target{ "dof.dilate", format = "rg16f", scale = 1 / (tile * f) } }
+  local quarter = f > 1 and pass{ "dof.quarter", shader = "dof_quarter.frag", inputs = { src = image },
+                                  out = target{ "dof.quarter", format = "rgba16f", scale = 1 / (2 * f) } } or nil
   local gathered = pass{ "dof.gather", shader = "dof_gather.frag",
-                         inputs = { src = image, coc = f == 1 and circles or nil, tiles = tiles }, -- else image.a
+                         inputs = { src = image, coc = f == 1 and circles or nil, tiles = tiles, -- else image.a
+                                    quarter = quarter },
                          params = { max_radius = radius, samples = math.max(1, o.samples // f) },
                          defines = { TILE = tile, FOREIGN = f > 1 },
                          out = target{ "dof.gather", format = "rgba16f", scale = 1 / f } }

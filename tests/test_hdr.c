@@ -440,11 +440,14 @@ static const char *const effects[] = {"motion_blur", "dof", "bloom", "hdr", "rad
 enum { EFFECTS = sizeof effects / sizeof *effects };
 
 /* Targets that may hold negative values: a signed circle of confusion
- * (dof.small's alpha too), mean logarithms of luminance, the G-buffer's
- * normals and velocities. */
+ * (dof.small's and dof.quarter's alpha too, and the tiles' least),
+ * mean logarithms of luminance, the G-buffer's normals and velocities. */
 static bool holds_signed(const char *name) {
-  return !strcmp(name, "dof.coc") || !strcmp(name, "dof.small_coc") || !strcmp(name, "dof.small") ||
-         !strncmp(name, "hdr.reduce", 10) || !strcmp(name, "gbuffer.nrm") || !strcmp(name, "gbuffer.vel");
+  static const char *const names[] = {"dof.coc",    "dof.small_coc", "dof.small",  "dof.quarter",
+                                      "dof.tiles",  "dof.dilate",    "gbuffer.nrm", "gbuffer.vel"};
+  for (size_t i = 0; i < sizeof names / sizeof *names; i++)
+    if (!strcmp(name, names[i])) return true;
+  return !strncmp(name, "hdr.reduce", 10);
 }
 
 /* Every float target the frame used holds finite values (read before the
@@ -526,7 +529,7 @@ static void degenerate_settings_stay_finite(void **state) {
 static void an_effect_off_records_no_pass(void **state) {
   (void)state;
   static const char *const passes[EFFECTS] = {
-      "motion_blur.tiles4 motion_blur.tiles motion_blur.near motion_blur ", "dof.reduce dof.tiles dof.dilate dof.gather dof.composite ", "bloom.bright bloom.blur_x bloom.blur_y bloom.add ",
+      "motion_blur.tiles4 motion_blur.tiles motion_blur.near motion_blur ", "dof.reduce dof.tiles dof.dilate dof.quarter dof.gather dof.composite ", "bloom.bright bloom.blur_x bloom.blur_y bloom.add ",
       "hdr.reduce1 hdr.reduce2 hdr.adapt hdr.tonemap ", "radial_blur ", "glass ", "tiles ", "sepia "};
   char names[1024], want[1024];
   gl_result r = start(pp_lua, "dl", NULL);
