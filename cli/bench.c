@@ -77,7 +77,8 @@ static const char bench_usage[] =
     "                      against N\n"
     "  --light-reach F     those lights' range, a fraction of the scene's\n"
     "                      bounding-box diagonal (default 0.08)\n"
-    "  --clock auto|gpu|cpu\n"
+    "  --clock auto|gpu|cpu|process   how passes are timed (capture's; process:\n"
+    "                      every thread's CPU time, steadier on a loaded machine)\n"
     "  --trace             also measure the ray tracer (see above)\n"
     "  --trace-threads N   its threads (default 2)\n"
     "  --motion            the moving frame (see above); the path is an orbit\n"
@@ -238,7 +239,7 @@ static int parse_args(int argc, char **argv, bench *b) {
       if (!limn_parse_int(optarg, 0, 10000, &b->warmup)) return usage_error("--warmup wants 0..10000, not '%s'", optarg);
       break;
     case 'k':
-      if (!capture_parse_clock(optarg, &b->clock)) return usage_error("--clock wants auto, gpu or cpu, not '%s'", optarg);
+      if (!capture_parse_clock(optarg, &b->clock)) return usage_error("--clock wants auto, gpu, cpu or process, not '%s'", optarg);
       break;
     case 'j': b->json = true; break;
     case 'r': b->trace = true; break;

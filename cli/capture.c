@@ -48,8 +48,11 @@ static const char capture_usage[] =
     "  --time START:STOP    a sequence: frames at START + k / fps up to STOP\n"
     "  --fps N              frames a second of a sequence\n"
     "  --animation NAME|INDEX|all   the animation posed (default all)\n"
-    "  --clock auto|gpu|cpu how passes are timed (default auto: GL timer queries,\n"
-    "                       or glFinish + a CPU clock on software renderers)\n"
+    "  --clock auto|gpu|cpu|process   how passes are timed (default auto: GL timer\n"
+    "                       queries, or glFinish + CLOCK_MONOTONIC on software\n"
+    "                       renderers; process: glFinish + the process's CPU time,\n"
+    "                       every thread's: on llvmpipe the rendering's work, which\n"
+    "                       a loaded machine disturbs less than the wall clock)\n"
     "  --egl auto|device|surfaceless   EGL platform (default auto)\n"
     "  --check-nan          debug: fail at the first pass that writes a NaN or Inf,\n"
     "                       naming the pass, target and pixel (slow)\n"
@@ -222,7 +225,7 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       break;
     }
     case 'k':
-      if (!capture_parse_clock(optarg, &a->clock)) return usage_error("--clock wants auto, gpu or cpu, not '%s'", optarg);
+      if (!capture_parse_clock(optarg, &a->clock)) return usage_error("--clock wants auto, gpu, cpu or process, not '%s'", optarg);
       break;
     case 'e':
       if (strcmp(optarg, "auto") && strcmp(optarg, "device") && strcmp(optarg, "surfaceless"))

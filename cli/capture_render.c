@@ -148,8 +148,9 @@ lm_pipeline *capture_load_pipeline(const limn_common_args *a, int *rc, lm_error 
 }
 
 bool capture_parse_clock(const char *s, lm_clock *out) {
-  static const char *const names[] = {[LM_CLOCK_AUTO] = "auto", [LM_CLOCK_GPU] = "gpu", [LM_CLOCK_CPU] = "cpu"};
-  for (int i = 0; i < 3; i++)
+  static const char *const names[] = {[LM_CLOCK_AUTO] = "auto", [LM_CLOCK_GPU] = "gpu", [LM_CLOCK_CPU] = "cpu",
+                                      [LM_CLOCK_PROCESS] = "process"};
+  for (int i = 0; i < (int)(sizeof names / sizeof *names); i++)
     if (!strcmp(s, names[i])) {
       *out = (lm_clock)i;
       return true;

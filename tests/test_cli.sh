@@ -75,6 +75,12 @@ check "times name the clock" out_has "clock: "
 check "times list the gbuffer pass" out_has "gbuffer"
 check "times list the direct pass" out_has "direct"
 check "times are medians of 2" out_has "median of 2 frames"
+check "the process clock" run 0 capture --scene cornell --tech dl --size 64x48 --frames 2 --clock process
+check "the process clock is named" out_has "clock: process (glFinish + CLOCK_PROCESS_CPUTIME_ID"
+check "the process clock counts the direct pass's work" \
+  awk '$1 == "direct" { found = 1; if ($3 + 0 <= 0) exit 1 } END { exit !found }' "$tmp/out"
+check "a bad clock" run 2 capture --clock sundial
+check "a bad clock names the choices" err_has "auto, gpu, cpu or process, not 'sundial'"
 rm -f "$tmp/img/"*
 
 # time: a still at --time SECONDS, a sequence at --time START:STOP --fps N, one file a frame

@@ -632,7 +632,9 @@ lm_clock lm_clock_choose(lm_clock wanted) {
 }
 
 const char *lm_clock_name(lm_clock c) {
-  return c == LM_CLOCK_GPU ? "gpu (GL_TIME_ELAPSED queries)" : "cpu (glFinish + CLOCK_MONOTONIC)";
+  return c == LM_CLOCK_GPU       ? "gpu (GL_TIME_ELAPSED queries)"
+         : c == LM_CLOCK_PROCESS ? "process (glFinish + CLOCK_PROCESS_CPUTIME_ID, every thread's)"
+                                 : "cpu (glFinish + CLOCK_MONOTONIC)";
 }
 
 void lm_timer_begin(lm_timer *t, lm_clock clock) {
@@ -643,7 +645,7 @@ void lm_timer_begin(lm_timer *t, lm_clock clock) {
     glBeginQuery(GL_TIME_ELAPSED, t->query);
   } else {
     glFinish();
-    t->start_ms = lm_now_ms();
+    t->start_ms = clock == LM_CLOCK_PROCESS ? lm_cpu_ms() : lm_now_ms();
   }
 }
 
@@ -652,7 +654,7 @@ void lm_timer_end(lm_timer *t) {
     glEndQuery(GL_TIME_ELAPSED);
   } else {
     glFinish();
-    t->ms = lm_now_ms() - t->start_ms;
+    t->ms = (t->clock == LM_CLOCK_PROCESS ? lm_cpu_ms() : lm_now_ms()) - t->start_ms;
   }
 }
 

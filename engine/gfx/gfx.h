@@ -282,7 +282,11 @@ void lm_mesh_draw_instances(const lm_mesh *m, int first_index, int index_count, 
 #define LM_FLUSH_TRIANGLES 16384
 
 /* ---- timers ------------------------------------------------------------ */
-typedef enum lm_clock { LM_CLOCK_AUTO, LM_CLOCK_GPU, LM_CLOCK_CPU } lm_clock;
+/* LM_CLOCK_PROCESS: glFinish plus the process's CPU time (every thread's),
+ * asked for alone: on a software rasterizer the rendering is this process's
+ * threads' work, which other processes on a loaded machine disturb far less
+ * than they do the wall clock; a GPU's work it does not count. */
+typedef enum lm_clock { LM_CLOCK_AUTO, LM_CLOCK_GPU, LM_CLOCK_CPU, LM_CLOCK_PROCESS } lm_clock;
 /* GPU queries unless the renderer is a software one whose queries are not
  * trustworthy (llvmpipe, softpipe): then glFinish plus CLOCK_MONOTONIC. */
 lm_clock lm_clock_choose(lm_clock wanted);

@@ -231,7 +231,8 @@ typedef struct lm_graph_exec_desc {
   bool (*keeps_views)(void *user, const lm_scene_pass *sp);
   /* Runs a CPU pass (desc->shader names the function); false with a message
    * stops the frame. NULL: a CPU pass is an error naming it. Its time, with
-   * the read-back and upload, is the pass's time (wall clock). */
+   * the read-back and upload, is the pass's time (wall clock; the process's
+   * CPU time with LM_CLOCK_PROCESS). */
   bool (*run_cpu)(void *user, const lm_cpu_pass *cp, lm_error *err);
   /* Uniforms the scene sets on each draw (not bindable from a script). */
   bool (*scene_owns_uniform)(const char *name);

@@ -261,7 +261,7 @@ static bool run_cpu_pass(lm_graph *g, const lm_pass_desc *d, lm_timer *timer, co
     return false;
   }
   lm_cpu_image in[LM_MAX_PASS_INPUTS], out[LM_MAX_COLOR_OUTPUTS];
-  lm_timer_begin(timer, LM_CLOCK_CPU);
+  lm_timer_begin(timer, x->clock == LM_CLOCK_PROCESS ? LM_CLOCK_PROCESS : LM_CLOCK_CPU);
   for (int i = 0; i < d->input_count; i++) {
     const graph_target *t = &g->targets[d->inputs[i].target];
     in[i] = (lm_cpu_image){d->inputs[i].name, t->width, t->height,
