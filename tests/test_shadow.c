@@ -928,6 +928,17 @@ static void the_atlas_can_be_viewed(void **state) {
   lm_scene_destroy(s);
 }
 
+/* data/scenes/reference/<name>.glb with the cameras it holds (not its .cams
+ * list: gl_reference_scene's); fails the test when it cannot be read. */
+static lm_scene *load_reference_scene(const char *name) {
+  char path[1200];
+  snprintf(path, sizeof path, "%s/data/scenes/reference/%s.glb", LIMN_SOURCE_ROOT, name);
+  lm_error err;
+  lm_scene *s = lm_scene_load(path, &err);
+  if (!s) fail_msg("%s", err.msg);
+  return s;
+}
+
 
 /* The reference room (data/scenes/reference/room.glb) is lit only by a sun
  * through a window: POV-Ray and hard shadows light a patch on the floor and
@@ -938,11 +949,7 @@ static void the_atlas_can_be_viewed(void **state) {
  * grew with the tilt and lit their joints). */
 static void esm_keeps_the_rooms_sun_patch_and_does_not_leak(void **state) {
   (void)state;
-  char path[1200];
-  snprintf(path, sizeof path, "%s/data/scenes/reference/room.glb", LIMN_SOURCE_ROOT);
-  lm_error err;
-  lm_scene *s = lm_scene_load(path, &err);
-  if (!s) fail_msg("%s", err.msg);
+  lm_scene *s = load_reference_scene("room");
   static const char *const esm[] = {"ambient=0", NULL}, *const hard[] = {"ambient=0", "shadow.technique=hard", NULL};
   gl_result e = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = esm, .width = 96, .height = 72});
   gl_result h = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = hard, .width = 96, .height = 72});
@@ -981,11 +988,7 @@ static void esm_keeps_the_rooms_sun_patch_and_does_not_leak(void **state) {
  * (shadow.glsl) ESM's contact is left, under a texel (10-23% measured). */
 static void seams_where_thin_walls_meet_stay_dark(void **state) {
   (void)state;
-  char path[1200];
-  snprintf(path, sizeof path, "%s/data/scenes/reference/room.glb", LIMN_SOURCE_ROOT);
-  lm_error err;
-  lm_scene *s = lm_scene_load(path, &err);
-  if (!s) fail_msg("%s", err.msg);
+  lm_scene *s = load_reference_scene("room");
   static const char *const sets[] = {"ambient=0", NULL};
   enum { W = 160, H = 120 };
   gl_result r = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = sets, .width = W, .height = H});
@@ -1042,11 +1045,7 @@ static void seams_where_lit_faces_meet_stay_lit(void **state) {
   static const char *const sets[] = {"ambient=0", NULL};
   int seams = 0;
   {
-    char path[1200];
-    snprintf(path, sizeof path, "%s/data/scenes/reference/blocks.glb", LIMN_SOURCE_ROOT);
-    lm_error err;
-    lm_scene *s = lm_scene_load(path, &err);
-    if (!s) fail_msg("%s", err.msg);
+    lm_scene *s = load_reference_scene("blocks");
     gl_result plain = gl_render(&(gl_run){.scene = s, .tech = "dl", .sets = sets, .width = W, .height = H});
     gl_result r = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = sets, .width = W, .height = H});
     assert_true(plain.ok && r.ok);
