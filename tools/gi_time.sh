@@ -20,11 +20,16 @@
 #              histories carried; no settled skip, no shadow tile kept whole), the median of FRAMES
 #              after WARMUP. A still capture keeps its shadow tiles and, with temporal reuse on,
 #              skips the GI passes once settled: cheaper than any frame of a moving camera.
+#   CLOCK      with MOTION=1, process: the moving frames' process CPU time (every thread's: on
+#              llvmpipe the rendering's work, steadier than the wall clock on a loaded machine,
+#              though not the frame's latency); default wall
 set -euo pipefail
 cd "$(dirname "$0")/.."
 LIMN=${BUILD_DIR:-build}/limn
 [ -x "$LIMN" ] || { echo "gi_time: no $LIMN (build first: tools/dev.sh build)" >&2; exit 2; }
-SIZE=${SIZE:-256x192} FRAMES=${FRAMES:-5} WARMUP=${WARMUP:-1} ROUNDS=${ROUNDS:-3}
+SIZE=${SIZE:-256x192} FRAMES=${FRAMES:-5} WARMUP=${WARMUP:-1} ROUNDS=${ROUNDS:-3} CLOCK=${CLOCK:-wall}
+case "$CLOCK" in wall | process) ;; *) echo "gi_time: CLOCK wants wall or process, not '$CLOCK'" >&2; exit 2 ;; esac
+[ "$CLOCK" = wall ] || [ "${MOTION:-0}" = 1 ] || { echo "gi_time: CLOCK=process needs MOTION=1" >&2; exit 2; }
 read -r -a techs <<< "${TECHS:-dl+esm rsm+esm vpl+esm isr+rsm+esm isr+esm lpv+esm isr+lpv+esm}"
 read -r -a scenes <<< "${SCENES:-data/scenes/reference/room.glb data/scenes/reference/street.glb \
 data/scenes/reference/blocks.glb data/scenes/cornell.glb}"
@@ -41,7 +46,9 @@ for scene in "${scenes[@]}"; do
     if [ "${MOTION:-0}" = 1 ]; then
       ms=$("$LIMN" bench --motion --scene "$scene" "${args[@]}" --sizes "$SIZE" --warmup "$WARMUP" --frames "$FRAMES" \
              --set ambient=0 --json 2>/dev/null |
-           python3 -c 'import json, sys; print(json.load(sys.stdin)["motion"]["moving"]["frame_ms"])')
+           python3 -c 'import json, statistics, sys
+m = json.load(sys.stdin)["motion"]
+print(m["moving"]["frame_ms"] if sys.argv[1] == "wall" else statistics.median(m["per_frame"]["moving_cpu_ms"]))' "$CLOCK")
     else
       ms=$("$LIMN" capture --scene "$scene" "${args[@]}" --size "$SIZE" --warmup "$WARMUP" --frames "$FRAMES" \
              --set ambient=0 --output /tmp/gi_time_$$.png 2>&1 | awk '$1 == "total" { print $2 }')
@@ -58,7 +65,7 @@ median() { tr ' ' '\n' | sed '/^$/d' | sort -g | awk '{ v[NR] = $1 } END { print
 base=$(median <<< "${rounds[${techs[0]}]}")
 echo "frame time$([ "${MOTION:-0}" = 1 ] && echo " with a moving camera (limn bench --motion's moving frame)"):" \
      "median of $FRAMES frames after $WARMUP untimed, median of $ROUNDS rounds;" \
-     "clock: glFinish + CLOCK_MONOTONIC on llvmpipe"
+     "clock: glFinish + $([ "$CLOCK" = wall ] && echo "CLOCK_MONOTONIC" || echo "the process's CPU time (CLOCK_PROCESS_CPUTIME_ID)") on llvmpipe"
 printf "%-40s %10s %8s  %s\n" "technique ($SIZE, ${#scenes[@]} scenes)" "ms/frame" "time x" "rounds (ms)"
 for spec in "${techs[@]}"; do
   awk -v m="$(median <<< "${rounds[$spec]}")" -v b="$base" -v t="$spec" -v r="${rounds[$spec]}" \
