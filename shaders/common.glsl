@@ -117,17 +117,22 @@ float normal_pack(vec3 n) {
   uvec2 q = uvec2(round(clamp(o * 0.5 + 0.5, 0.0, 1.0) * 4095.0));
   return -1.0 - float(q.x * 4096u + q.y);
 }
-// The unit vector at octahedral coordinates o (-1..1 each): a mesh's normals
-// (vertex attribute 1, lm_mesh) and normal_pack's.
-vec3 oct_decode(vec2 o) {
+// oct_decode: the unit vector at octahedral coordinates o (-1..1 each): a
+// mesh's normals (vertex attribute 1, lm_mesh) and normal_pack's;
+// oct_direction: the same direction before normalizing (|x| + |y| + |z| = 1,
+// never zero): enough for the sign of a dot product.
+vec3 oct_direction(vec2 o) {
   vec3 n = vec3(o, 1.0 - abs(o.x) - abs(o.y));
   if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
-  return safe_normalize(n, vec3(0.0, 0.0, 1.0));
+  return n;
 }
-vec3 normal_unpack(float w) {
+vec3 oct_decode(vec2 o) { return safe_normalize(oct_direction(o), vec3(0.0, 0.0, 1.0)); }
+// normal_unpack_direction: normal_unpack before normalizing (oct_direction's).
+vec3 normal_unpack_direction(float w) {
   uint c = uint(clamp(-1.0 - w, 0.0, 16777215.0));
-  return oct_decode(vec2(uvec2(c >> 12, c & 4095u)) / 4095.0 * 2.0 - 1.0);
+  return oct_direction(vec2(uvec2(c >> 12, c & 4095u)) / 4095.0 * 2.0 - 1.0);
 }
+vec3 normal_unpack(float w) { return safe_normalize(normal_unpack_direction(w), vec3(0.0, 0.0, 1.0)); }
 
 // Replaces NaN and Inf by zero, negatives by zero.
 vec3 finite_or_zero(vec3 c) {

@@ -191,18 +191,13 @@ void record_hit(int i, float h) {
 // Tightens t so that the constraint g0 + g1 t >= 0 holds on [0, t].
 float limit(float g0, float g1, float t) { return g1 < 0.0 ? min(t, max(g0, 0.0) / -g1) : t; }
 
-// How far the ray a + t b (clip space; p + t w in the world) stays in the
-// view frustum and in the scene's box, t >= 0. Past the box nothing is met,
-// and a ray that only the far plane stops would spread its steps that far:
-// the image would depend on where the far plane lies (test_scale).
-float exit_distance(vec4 a, vec4 b, vec3 p, vec3 w) {
+// How far the ray p + t w stays in the scene's box, t >= 0. Past the box
+// nothing is met, and a ray that only the far plane stops would spread its
+// steps that far: the image would depend on where the far plane lies
+// (test_scale). UNSEEN: where it bounds exit_distance, the ray left the
+// scene and meets nothing anywhere.
+float box_exit(vec3 p, vec3 w) {
   float t = 4.0 * frame.clip.y; // a bound for rays the planes do not stop
-  t = limit(a.w - a.x, b.w - b.x, t);
-  t = limit(a.w + a.x, b.w + b.x, t);
-  t = limit(a.w - a.y, b.w - b.y, t);
-  t = limit(a.w + a.y, b.w + b.y, t);
-  t = limit(a.w - frame.clip.x, b.w, t);
-  t = limit(frame.clip.y - a.w, -b.w, t);
   for (int k = 0; k < 3; k++) {
     t = limit(p[k] - scene_lo[k], w[k], t);
     t = limit(scene_hi[k] - p[k], -w[k], t);
@@ -210,18 +205,17 @@ float exit_distance(vec4 a, vec4 b, vec3 p, vec3 w) {
   return t;
 }
 
-#ifdef UNSEEN
-// How far the ray p + t w stays in the scene's box alone: where that bounds
-// exit_distance, the ray left the scene and meets nothing anywhere.
-float box_exit(vec3 p, vec3 w) {
-  float t = 4.0 * frame.clip.y; // as exit_distance's
-  for (int k = 0; k < 3; k++) {
-    t = limit(p[k] - scene_lo[k], w[k], t);
-    t = limit(scene_hi[k] - p[k], -w[k], t);
-  }
-  return t;
+// How far the ray a + t b (clip space) stays in the view frustum, within
+// t_box (box_exit: the ray's own, computed once for both).
+float exit_distance(vec4 a, vec4 b, float t_box) {
+  float t = t_box;
+  t = limit(a.w - a.x, b.w - b.x, t);
+  t = limit(a.w + a.x, b.w + b.x, t);
+  t = limit(a.w - a.y, b.w - b.y, t);
+  t = limit(a.w + a.y, b.w + b.y, t);
+  t = limit(a.w - frame.clip.x, b.w, t);
+  return limit(frame.clip.y - a.w, -b.w, t);
 }
-#endif
 
 // The texel a clip-space point falls on, and that texel's view depth (0: background).
 float buffer_depth(vec4 c, ivec2 size, out ivec2 q) {
@@ -312,7 +306,7 @@ void main() {
     vec3 u = r3_sample(first + i, vec3(0.0)); // no turn: every tile the same
     vec3 w = basis * hemisphere_cosine(u.xy);
     vec4 b = frame.view_proj * vec4(w, 0.0);
-    float t_end = exit_distance(a, b, s.p, w);
+    float t_box = box_exit(s.p, w), t_end = exit_distance(a, b, t_box);
     bool seen = false;
 #ifdef TRACE
     bool hidden = false; // the ray passed behind a surface it did not meet: what it met there is unknown
@@ -380,7 +374,6 @@ void main() {
     }
     if (!seen) open += 1.0;
 #ifdef UNSEEN
-    float t_box = box_exit(s.p, w);
 #if defined(TRACE)
     const bool closed = true; // the tracer says what it meets
 #elif defined(RAY_STEPS)

@@ -226,26 +226,31 @@ vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn
       // The samples up to the next sender that the geometry term lets through, in a loop of their own:
       // llvmpipe runs an if's body for every pixel of its group, so the tests below inside this loop cost
       // as much at every sample, while few pass it (about 1 in 100 on the reference set's framing views).
-      float xi = 0.0, area = 0.0, g = 0.0;
+      // Only the cosines' signs decide there, of vectors not normalized: the normal's length, the distance,
+      // the texel's area and the division wait for the few that pass.
+      float xi = 0.0;
+      vec2 t = vec2(0.0);
       ivec2 a = ivec2(0);
-      vec3 q = vec3(0.0);
+      vec3 q = vec3(0.0), nq = vec3(0.0);
       for (; k < n; k++, dir = rsm_turn(dir)) {
         xi = fract(radical_inverse(k0 + uint(k), 2u) + centred);
-        vec2 t = centre + xi * reach * dir;
+        t = centre + xi * reach * dir;
         if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
         a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
         vec4 qn = texelFetch(rsm_pos, a, 0); // position, normal (normal_pack)
         if (qn.w > 0.0) continue; // empty
         q = qn.xyz;
-        vec3 nq = normal_unpack(qn.w);
-        area = rsm_texel_area_as(sv, t, q, tile, type != 2);
+        nq = normal_unpack_direction(qn.w);
         vec3 d = q - s.p;
-        float d2 = dot(d, d);
-        vec3 towards = d * inversesqrt(max(d2, 1e-30));
-        g = max(dot(s.n, towards), 0.0) * max(dot(nq, -towards), 0.0) / max(d2, area);
-        if (g > 0.0) break; // coplanar and facing-away senders are common
+        if (dot(s.n, d) > 0.0 && dot(nq, d) < 0.0) break; // coplanar and facing-away senders are common
       }
       if (k >= n) break;
+      nq = safe_normalize(nq, vec3(0.0, 0.0, 1.0)); // normal_unpack's
+      vec3 d = q - s.p;
+      float d2 = dot(d, d);
+      vec3 towards = d * inversesqrt(max(d2, 1e-30));
+      float area = rsm_texel_area_as(sv, t, q, tile, type != 2);
+      float g = max(dot(s.n, towards), 0.0) * max(dot(nq, -towards), 0.0) / max(d2, area);
 #ifdef EXCLUDE_SEEN
       if (rsm_seen(dpt, q)) continue;
 #endif
