@@ -76,6 +76,8 @@ bool rsm_seen(sampler2D dpt, vec3 q) {
 // on p -> q; one behind the depth buffer rejects q.
 // EXCLUDE_SEEN: a sender the camera sees (rsm_seen) is left to the
 // screen-space march of the combined technique.
+// RSM_INSIDE: every sample falls inside its view's tile (the traced hits'
+// gather, rsm.trace: rsm_gather_light says how), none wasted off its edges.
 // A light-set variant (LIGHT_SET, lighting.glsl) gathers each light unrolled,
 // for its kind alone: a software rasterizer runs every branch of every
 // sample (each kind's light and falloff, both texel areas) where the kind is
@@ -215,26 +217,44 @@ vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn
     vec2 dir = start;
     ShadowView sv = shadow_views[v];
     vec4 c = sv.view_proj * vec4(s.p, 1.0);
-    vec2 centre = c.w > 1e-12 ? c.xy / c.w * 0.5 + 0.5 : vec2(0.5);
-    centre = clamp(centre, vec2(0.0), vec2(1.0)); // behind a cube face: its nearest edge
+    vec2 projected = c.w > 1e-12 ? c.xy / c.w * 0.5 + 0.5 : vec2(0.5);
+    vec2 centre = clamp(projected, vec2(0.0), vec2(1.0)); // behind a cube face: its nearest edge
     float tile = sv.rect.z * atlas.x;
     // The disc reaches no farther than the tile's farthest corner: beyond it every sample would fall
     // outside and add nothing, so the pattern keeps its samples where texels are.
     float reach = min(rsm_radius, length(max(centre, 1.0 - centre)));
     float texels = 2.0 * PI * reach * reach * tile * tile / float(max(n, 1));
+#ifdef RSM_INSIDE
+    // Every sample inside the tile (the traced hits' gather, where samples are dearest): a direction that
+    // leaves the tile from a centre on its edge (corner) folds back across it, the disc being symmetric
+    // about the edge (the density inside doubles: each weighs half); and each direction's radius ends at
+    // the tile's edge, L <= reach, xi L from the centre (density 1 / (2 pi L^2 xi) a unit area: each weighs
+    // (L / reach)^2 of the disc's sample).
+    vec2 fold = vec2(notEqual(projected, centre)), inward = 1.0 - 2.0 * centre;
+    texels *= exp2(-(fold.x + fold.y)) / max(reach * reach, 1e-30);
+#endif
     for (int k = 0; k < n; k++, dir = rsm_turn(dir)) {
       // The samples up to the next sender that the geometry term lets through, in a loop of their own:
       // llvmpipe runs an if's body for every pixel of its group, so the tests below inside this loop cost
       // as much at every sample, while few pass it (about 1 in 100 on the reference set's framing views).
       // Only the cosines' signs decide there, of vectors not normalized: the normal's length, the distance,
       // the texel's area and the division wait for the few that pass.
-      float xi = 0.0;
+      float xi = 0.0, weight = 0.0;
       vec2 t = vec2(0.0);
       ivec2 a = ivec2(0);
       vec3 q = vec3(0.0), nq = vec3(0.0);
       for (; k < n; k++, dir = rsm_turn(dir)) {
         xi = fract(radical_inverse(k0 + uint(k), 2u) + centred);
+#ifdef RSM_INSIDE
+        vec2 w = mix(dir, abs(dir) * inward, fold);
+        vec2 room = mix(centre, 1.0 - centre, step(0.0, w)) / max(abs(w), vec2(1e-6)); // to the edge, each axis
+        float along = min(reach, min(room.x, room.y));
+        t = centre + xi * along * w;
+        weight = along * along * xi; // the sample's weight over texels (reach^2 divided out above)
+#else
         t = centre + xi * reach * dir;
+        weight = xi;
+#endif
         if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
         a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
         vec4 qn = texelFetch(rsm_pos, a, 0); // position, normal (normal_pack)
@@ -259,7 +279,7 @@ vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn
 #endif
       vec3 l;
       vec3 radiance = light_arriving_as(li, type, falloff, q, l);
-      e += texelFetch(rsm_flux, a, 0).rgb * radiance * area * g * texels * xi;
+      e += texelFetch(rsm_flux, a, 0).rgb * radiance * area * g * texels * weight;
     }
   }
   return e;

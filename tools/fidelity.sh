@@ -35,4 +35,4 @@ limn_gi_report --targets --cycles --moving "${MOVING_SIZE:-256x192}" --refs "${R
   "default traced=isr+rsm+esm:rsm.trace=1" "8 b. 8 r. traced=isr+rsm+esm:isr.bounces=4;rsm.bounces=8;isr.samples=8;rsm.trace=1" \
   "5 b. traced reach 2=isr+rsm+esm:isr.bounces=4;rsm.bounces=5;isr.samples=8;rsm.trace=1;rsm.reach=2" \
   "5 b. traced 96 hits=isr+rsm+esm:isr.bounces=4;rsm.bounces=5;isr.samples=8;rsm.trace=1;rsm.reach=2;rsm.trace_samples=96" \
-  "6 rays temporal=isr+rsm+esm:isr.bounces=4;rsm.bounces=5;isr.samples=6;rsm.trace=1;rsm.reach=2;rsm.trace_samples=96;isr.temporal.enabled=true"
+  "6 rays temporal=isr+rsm+esm:isr.bounces=4;rsm.bounces=5;isr.samples=6;rsm.trace=1;rsm.reach=2;rsm.trace_samples=64;isr.temporal.enabled=true"
