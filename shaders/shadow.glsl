@@ -152,11 +152,38 @@ float shadow_spread(ShadowLight s, int technique) {
   return technique == 0 ? 1.0 : technique == 1 ? 1.5 : technique == 2 ? s.params.w : 0.0;
 }
 
+// Whether the 2 x 2 texels z (shadow_texels) hold a face the light sees from
+// behind (negated: shadow.frag) within `reach` of depth nearer the light
+// than r: one a receiver at r touches.
+bool shadow_touches_back_face(vec4 z, float r, float reach) {
+  // Back faces' depths are negated: r + z is r less their depth.
+  vec4 touching = step(vec4(r) + z, vec4(reach));
+  return dot(step(z, vec4(-1e-31)), touching) > 0.0; // stored back faces are -1e-30 or less
+}
+
+// Whether the 2 x 2 texels around ls (clip position in orthographic view
+// sv) hold a face the light sees from behind (negated: shadow.frag) within
+// `reach` texels of depth nearer the light than ls: one it touches.
+bool shadow_back_face_near(ShadowView sv, vec4 ls, float reach) {
+  vec2 size = vec2(textureSize(shadow_atlas, 0));
+  ivec2 lo = ivec2(sv.rect.xy * size + 0.5), hi = ivec2((sv.rect.xy + sv.rect.zw) * size + 0.5) - 1;
+  vec2 texel = (sv.rect.xy + (ls.xy * 0.5 + 0.5) * sv.rect.zw) * size - 0.5;
+  vec2 f;
+  vec4 z = shadow_texels(texel, lo, hi, f);
+  float r = ls.z * 0.5 + 0.5;
+  return shadow_touches_back_face(z, r, reach * shadow_texel_depth_as(sv, r, false));
+}
+
 // Visibility in [0, 1] of p from view sv of light s, p at ls in its clip
 // space (shadow_clip), sv perspective or not (shadow_perspective), the
 // surface's n.l and the tilt shadow_tilt gives for it.
+// With reach > 0 (cascades: orthographic), *touching says whether the
+// texels at p hold a face the light sees from behind within reach texels of
+// depth nearer the light (shadow_touches_back_face); ESM tells it from its
+// own taps, the other filters by one gather more.
 float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s, vec3 p, float ndl,
-                         float tan_tilt) {
+                         float tan_tilt, float reach, out bool touching) {
+  touching = false;
   if (ls.w <= 1e-12) return 1.0;
   // An orthographic view's w is 1 (its matrix's last row 0 0 0 1): no division.
   vec3 ndc = perspective ? ls.xyz / ls.w : ls.xyz;
@@ -176,6 +203,7 @@ float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s
   // scale the bias by the tilt (tan of the light's angle, capped). Only
   // against faces toward the light (shadow_lit).
   bias *= 1.0 + shadow_spread(s, technique) * tan_tilt;
+  if (technique != 0) touching = reach > 0.0 && shadow_back_face_near(sv, ls, reach);
   if (technique == 0) {
     // ESM with the seed's 4-tap bilinear combination (seed 000, Listing 8):
     // the depth difference is clamped at 0 and scaled by n.l, then exp(-k d)
@@ -187,6 +215,7 @@ float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s
     vec2 f;
     vec4 z = shadow_texels(texel, lo, hi, f);
     vec4 vis = exp2(max(vec4(r) - abs(z) - bias * step(0.0, z), 0.0) * m);
+    touching = reach > 0.0 && shadow_touches_back_face(z, r, reach * texel_depth);
     return mix(mix(vis.x, vis.y, f.x), mix(vis.z, vis.w, f.x), f.y);
   }
   if (technique == 1) { // PCF 3x3
@@ -301,21 +330,6 @@ vec4 shadow_clip(ShadowView sv, int kind, int j, vec3 p) {
   return clip;
 }
 
-// Whether the 2 x 2 texels around ls (clip position in orthographic view
-// sv) hold a face the light sees from behind (negated: shadow.frag) within
-// `reach` texels of depth nearer the light than ls: one it touches.
-bool shadow_back_face_near(ShadowView sv, vec4 ls, float reach) {
-  vec2 size = vec2(textureSize(shadow_atlas, 0));
-  ivec2 lo = ivec2(sv.rect.xy * size + 0.5), hi = ivec2((sv.rect.xy + sv.rect.zw) * size + 0.5) - 1;
-  vec2 texel = (sv.rect.xy + (ls.xy * 0.5 + 0.5) * sv.rect.zw) * size - 0.5;
-  vec2 f;
-  vec4 z = shadow_texels(texel, lo, hi, f);
-  float r = ls.z * 0.5 + 0.5;
-  // Back faces' depths are negated: r + z is r less their depth.
-  vec4 touching = step(vec4(r) + z, vec4(reach * shadow_texel_depth_as(sv, r, false)));
-  return dot(step(z, vec4(-1e-31)), touching) > 0.0; // stored back faces are -1e-30 or less
-}
-
 // Shadow factor of light `light` at p, whose shadow is of kind `kind`
 // (ShadowLight.info.z): a constant kind (a light-set variant, lighting.glsl)
 // compiles that kind's lookup alone.
@@ -341,21 +355,23 @@ float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
   bool perspective = shadow_perspective(kind);
   int technique = SHADOW_FILTER_OF(s);
   float offset = perspective || technique == 4 ? 0.0 : s.params.y * max(shadow_spread(s, technique), 1.0);
-  // Both lookups in a loop that tests at its end, not the second in an if: a
-  // software rasterizer leaves such a loop once no pixel of its group goes on,
-  // but runs both sides of every if.
+  // Every lookup in one loop that tests at its end, not the blend's second
+  // view or the offset lookup in an if: a software rasterizer leaves such a
+  // loop once no pixel of its group goes on, but runs both sides of every if.
+  // The first lookup at p tells from its own taps whether p touches a back
+  // face; only then does the next step look again at the offset point.
+  float reach = offset > 0.0 ? 4.0 * (1.0 + tan_tilt) : 0.0;
   int j = 0;
+  bool offset_now = false;
   do {
     ShadowView sv = shadow_view_of(light, s, kind, v + j);
-    vec3 q = p;
-    vec4 clip = shadow_clip(sv, kind, v + j, p);
-    if (offset > 0.0 && shadow_back_face_near(sv, clip, 4.0 * (1.0 + tan_tilt))) {
-      q += n * (offset * sv.texel.x); // an orthographic view's texel.x: a texel's world size
-      clip = shadow_clip(sv, kind, v + j, q);
-    }
-    float lit = shadow_view_lookup(sv, perspective, clip, s, q, ndl, tan_tilt);
-    vis = mix(vis, lit, j == 0 ? 1.0 : t);
-  } while (++j < (t > 0.0 ? 2 : 1));
+    vec3 q = offset_now ? p + n * (offset * sv.texel.x) : p; // an orthographic view's texel.x: a texel's world size
+    bool touching;
+    float lit = shadow_view_lookup(sv, perspective, shadow_clip(sv, kind, v + j, q), s, q, ndl, tan_tilt,
+                                   offset_now ? 0.0 : reach, touching);
+    offset_now = touching;
+    if (!touching) vis = mix(vis, lit, j == 0 ? 1.0 : t), j++;
+  } while (j < (t > 0.0 ? 2 : 1));
   return vis;
 }
 
