@@ -792,6 +792,18 @@ static void more_bounces_light_a_ceiling_more_and_stay_bounded(void **state) {
   }
 }
 
+/* window_room(0.8) with its camera turned to the wall opposite the window
+ * (-x), the lit floor off screen. */
+static lm_scene *window_room_facing_the_far_wall(void) {
+  lm_scene *s = window_room(0.8f);
+  mat4 m;
+  glm_translate_make(m, (vec3){-0.3f, 0, 0});
+  glm_rotate(m, glm_rad(90.0f), (vec3){0, 1, 0}); /* -Z of the node: -x */
+  memcpy(s->nodes[s->cameras[0].node].local, m, sizeof m);
+  lm_scene_update(s);
+  return s;
+}
+
 /* rsm.trace (the Cornell box's tall box, its face toward the open side): a
  * face the screen shows alone, lit only by bounce light, whose rays all meet
  * surfaces the screen does not show. The white room's wall opposite the
@@ -807,12 +819,7 @@ static void more_bounces_light_a_ceiling_more_and_stay_bounded(void **state) {
  * rsm.trace 0 the frame has no ray target. */
 static void traced_rays_bring_a_second_bounce_where_the_screen_shows_no_sender(void **state) {
   (void)state;
-  lm_scene *s = window_room(0.8f);
-  mat4 m;
-  glm_translate_make(m, (vec3){-0.3f, 0, 0});
-  glm_rotate(m, glm_rad(90.0f), (vec3){0, 1, 0}); /* -Z of the node: -x */
-  memcpy(s->nodes[s->cameras[0].node].local, m, sizeof m);
-  lm_scene_update(s);
+  lm_scene *s = window_room_facing_the_far_wall();
   static const char *const cases[][4] = {
       {"rsm.bounces=1", "rsm.trace=0", "isr.bounces=2"}, {"rsm.bounces=2", "rsm.trace=0", "isr.bounces=2"},
       {"rsm.bounces=2", "rsm.trace=1", "isr.bounces=2"}, {"rsm.bounces=8", "rsm.trace=1", "isr.bounces=2"},
@@ -939,12 +946,7 @@ static void traced_hits_gather_every_sample_inside_the_rsm_tiles(void **state) {
   double ratio, spread = traced_spread(gl_cornell(), "rsm.trace_samples=6", &ratio);
   print_message("the Cornell box: spread at 6 samples %.3f, mean %.4f of 1024's\n", spread, ratio);
   assert_true(fabs(ratio - 1) < 0.03 && spread < 0.037);
-  lm_scene *s = window_room(0.8f);
-  mat4 m;
-  glm_translate_make(m, (vec3){-0.3f, 0, 0});
-  glm_rotate(m, glm_rad(90.0f), (vec3){0, 1, 0}); /* -Z of the node: -x */
-  memcpy(s->nodes[s->cameras[0].node].local, m, sizeof m);
-  lm_scene_update(s);
+  lm_scene *s = window_room_facing_the_far_wall();
   spread = traced_spread(s, "rsm.trace_samples=16", &ratio);
   print_message("the white room: spread at 16 samples %.3f, mean %.4f of 1024's\n", spread, ratio);
   assert_true(fabs(ratio - 1) < 0.03 && spread < 0.285);
