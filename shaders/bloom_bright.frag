@@ -20,13 +20,10 @@ void main() {
 #if FACTOR == 1
   vec3 c = hdr_clamp(texelFetch(src, base, 0).rgb, HALF_MAX);
 #else
-  // Each 2 x 2 of the source texels in one filtered read at its centre (the
-  // bilinear weights there are a quarter each; clamped at the border): a
-  // quarter of the reads of one fetch a texel.
-  vec2 size = vec2(textureSize(src, 0));
+  // Each 2 x 2 of the source texels in one filtered read (block_mean).
   vec3 c = vec3(0.0);
   for (int y = 0; y < FACTOR; y += 2)
-    for (int x = 0; x < FACTOR; x += 2) c += texture(src, vec2(base + ivec2(x, y) + 1) / size).rgb;
+    for (int x = 0; x < FACTOR; x += 2) c += block_mean(src, base + ivec2(x, y)).rgb;
   c = hdr_clamp(c / float(FACTOR * FACTOR / 4), HALF_MAX);
 #endif
   // Quadratic soft knee: the kept fraction rises smoothly from

@@ -12,7 +12,7 @@ uniform sampler2D src; // dof.small: clamped colour, signed circle
 out vec4 dst;
 
 void main() {
-  vec2 centre = vec2(ivec2(gl_FragCoord.xy) * 2 + 1) / vec2(textureSize(src, 0));
-  vec4 circles = textureGather(src, centre, 3);
-  dst = vec4(texture(src, centre).rgb, min(min(circles.x, circles.y), min(circles.z, circles.w)));
+  ivec2 corner = ivec2(gl_FragCoord.xy) * 2;
+  vec4 circles = textureGather(src, vec2(corner + 1) / vec2(textureSize(src, 0)), 3);
+  dst = vec4(block_mean(src, corner).rgb, min(min(circles.x, circles.y), min(circles.z, circles.w)));
 }

@@ -14,10 +14,9 @@ layout(location = 1) out vec4 dst_coc;
 
 void main() {
   ivec2 base = ivec2(gl_FragCoord.xy) * 2;
-  // The block's mean colour in one filtered read at its centre (the bilinear
-  // weights there are a quarter each; clamped at the border), clamped once:
+  // The block's mean colour in one filtered read (block_mean), clamped once:
   // dof.reduce 10.3 -> 6.8 ms against four fetches (512x384, moving, load 9-10).
-  vec3 c = hdr_clamp(texture(src, vec2(base + 1) / vec2(textureSize(src, 0))).rgb, HALF_MAX);
+  vec3 c = hdr_clamp(block_mean(src, base).rgb, HALF_MAX);
   // The block's depths in one gather at its centre (clamped at the border, as the colours are).
   vec4 d = textureGather(dpt, vec2(base + 1) / vec2(textureSize(dpt, 0)), 0);
   float nearest = min(min(eye_depth(d.x), eye_depth(d.y)), min(eye_depth(d.z), eye_depth(d.w)));

@@ -16,6 +16,12 @@ vec3 hdr_clamp(vec3 c, float hi) {
 }
 vec4 hdr_clamp(vec4 c, float hi) { return vec4(hdr_clamp(c.rgb, hi), c.a); }
 
+// The mean of the 2 x 2 texels of s whose lowest corner is `corner`: one
+// filtered read at their shared corner, where the bilinear weights are a
+// quarter each (clamped at the border as texel clamps are): a quarter of the
+// reads of four fetches (the reductions of dof and bloom).
+vec4 block_mean(sampler2D s, ivec2 corner) { return texture(s, vec2(corner + 1) / vec2(textureSize(s, 0))); }
+
 // Bloom's sum (bloom_add.frag, and hdr's passes that add it as they read the
 // image): the image and `strength` of the blurred bright pass, each clamped
 // as read and the sum under the half-float limit, so a very bright source
