@@ -113,6 +113,7 @@ gl_result gl_render(const gl_run *run) {
                                                       .exposure = run->exposure,
                                                       .no_culling = run->no_culling}, &r.err);
   if (!r.renderer) return r;
+  if (run->keep_targets) lm_renderer_set_sharing(r.renderer, false);
   r.rgb = malloc(sizeof(float) * 3 * (size_t)r.width * (size_t)r.height);
   r.srgb = malloc(3 * (size_t)r.width * (size_t)r.height);
   r.ok = true;
@@ -221,12 +222,40 @@ static bool finite_not_negative(const float *v, size_t n) {
 
 bool gl_all_finite(const gl_result *r) { return finite_not_negative(r->rgb, (size_t)r->width * r->height * 3); }
 
+/* Whether pass i (run, not culled) writes target `id`. */
+static bool pass_writes(lm_graph *g, int i, int id) {
+  lm_graph_pass_info p = lm_graph_pass(g, i);
+  if (p.culled) return false;
+  for (int k = 0; k < p.desc->output_count; k++)
+    if (p.desc->outputs[k] == id) return true;
+  return p.desc->depth == id;
+}
+
+/* The target sharing `id`'s texture that a pass wrote after `id`'s last
+ * writer (what a read after the frame would hold instead), or NULL. */
+static const char *overwritten_by(lm_graph *g, int id) {
+  int slot = lm_graph_target(g, id).slot, last = -1;
+  if (slot < 0) return NULL;
+  for (int i = 0; i < lm_graph_pass_count(g); i++)
+    if (pass_writes(g, i, id)) last = i;
+  for (int i = last + 1; i < lm_graph_pass_count(g); i++)
+    for (int t = 0; t < lm_graph_target_count(g); t++)
+      if (t != id && lm_graph_target(g, t).slot == slot && pass_writes(g, i, t)) return lm_graph_target(g, t).name;
+  return NULL;
+}
+
 float *gl_read_target(gl_result *r, const char *name, int *width, int *height) {
   lm_graph *g = lm_renderer_graph(r->renderer);
   int id = lm_graph_find_target(g, name);
   if (id < 0) return NULL;
   lm_graph_target_info t = lm_graph_target(g, id);
   if (!t.used || !t.texture.id) return NULL; /* an unused target's slot holds another's texels */
+  const char *other = overwritten_by(g, id);
+  if (other) { /* a test would judge another target's texels */
+    fprintf(stderr, "gl_read_target: %s shares its texture with %s, written after it: render with sharing off\n", name,
+            other);
+    return NULL;
+  }
   float *px = malloc(sizeof(float) * 4 * (size_t)t.width * (size_t)t.height);
   lm_texture_read(t.texture, t.width, t.height, true, px);
   *width = t.width;

@@ -18,6 +18,7 @@ typedef struct gl_run {
   bool no_light_culling;    /* every pixel evaluates every light */
   bool no_culling;          /* every node drawn in every view (lm_renderer_desc.no_culling) */
   float exposure;           /* a fixed pre-exposure (lm_renderer_desc.exposure); 0: the scene's */
+  bool keep_targets;        /* sharing off: every target readable after the frame (gl_read_target) */
 } gl_run;
 
 typedef struct gl_result {
@@ -79,7 +80,8 @@ float gl_luminance(const float rgb[3]);
 /* Every value finite and not negative. */
 bool gl_all_finite(const gl_result *r);
 /* A used target of the last frame as RGBA floats, rows top first (caller
- * frees); NULL when the frame has none of that name. */
+ * frees); NULL when the frame has none of that name, or when a target that
+ * shares its texture was written after it (render with sharing off). */
 float *gl_read_target(gl_result *r, const char *name, int *width, int *height);
 /* Does that target hold only finite values that are not negative? (It is
  * read before the output stage, which would hide a NaN.) */

@@ -78,8 +78,10 @@ static void instanced_nodes_render_as_the_nodes(void **state) {
   for (int i = 0; i < instanced->node_count; i++) spheres += instanced->nodes[i].parent >= 0 && instanced->nodes[i].mesh >= 0;
   assert_int_equal(spheres, 64);
   const char *sets[] = {"shadow.simplify=0", "simplify=0", NULL}; /* the instancing alone */
-  gl_result a = gl_render_ok(&(gl_run){.scene = instanced, .tech = "dl+esm", .sets = sets, .width = 128, .height = 96});
-  gl_result b = gl_render_ok(&(gl_run){.scene = nodes, .tech = "dl+esm", .sets = sets, .width = 128, .height = 96});
+  gl_result a = gl_render_ok(&(gl_run){.scene = instanced, .tech = "dl+esm", .sets = sets, .width = 128, .height = 96,
+                                       .keep_targets = true});
+  gl_result b = gl_render_ok(&(gl_run){.scene = nodes, .tech = "dl+esm", .sets = sets, .width = 128, .height = 96,
+                                       .keep_targets = true});
   lm_scene_draw_stats sa = lm_renderer_draw_stats(a.renderer), sb = lm_renderer_draw_stats(b.renderer);
   lm_scene_draw_stats ha = lm_renderer_shadow_draw_stats(a.renderer), hb = lm_renderer_shadow_draw_stats(b.renderer);
   print_message("camera: %d nodes in %d calls (instanced) and %d in %d; shadow tiles: %d in %d and %d in %d\n",
@@ -691,8 +693,10 @@ static void chunked_meshes_render_as_the_whole_mesh(void **state) {
   m->whole_chunks.count = m->caster_levels = m->lod_levels = 0;
   free(order);
   const char *sets[] = {"simplify=0", "shadow.simplify=0", "ambient=0.05", NULL};
-  gl_result a = gl_render_ok(&(gl_run){.scene = sc[0], .tech = "dl+esm", .sets = sets, .width = 128, .height = 96});
-  gl_result b = gl_render_ok(&(gl_run){.scene = sc[1], .tech = "dl+esm", .sets = sets, .width = 128, .height = 96});
+  gl_result a = gl_render_ok(&(gl_run){.scene = sc[0], .tech = "dl+esm", .sets = sets, .width = 128, .height = 96,
+                                       .keep_targets = true});
+  gl_result b = gl_render_ok(&(gl_run){.scene = sc[1], .tech = "dl+esm", .sets = sets, .width = 128, .height = 96,
+                                       .keep_targets = true});
   lm_scene_draw_stats ca = lm_renderer_draw_stats(a.renderer), cb = lm_renderer_draw_stats(b.renderer);
   lm_scene_draw_stats ha = lm_renderer_shadow_draw_stats(a.renderer), hb = lm_renderer_shadow_draw_stats(b.renderer);
   print_message("camera: %ld triangles in %d calls chunked (%d chunks left out), %ld in %d whole; shadow tiles: %ld "

@@ -423,7 +423,8 @@ static void cells_follow_the_box_the_camera_sees(void **state) {
               {"lpv.max_cell=0.1", NULL, 3 * 32 * 32, 22}};
   for (int t = 0; t < 3; t++) {
     const char *const sets[] = {"ambient=0", fits[t].extent ? fits[t].extent : "ambient=0", fits[t].set, NULL};
-    gl_result r = render_ok(s, "lpv+esm", sets, HW, HH);
+    gl_result r = gl_render_ok(&(gl_run){.scene = s, .tech = "lpv+esm", .sets = sets, .width = HW, .height = HH,
+                                         .keep_targets = true});
     int w, h;
     float *v = gl_read_target(&r, "lpv.inject_r", &w, &h);
     assert_non_null(v);
@@ -522,7 +523,8 @@ static void extremes_stay_finite(void **state) {
   };
   lm_scene *s = corner_scene(LM_LIGHT_DIRECTIONAL);
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
-    gl_result r = render_ok(s, "lpv+esm", cases[i], 48, 36);
+    gl_result r = gl_render_ok(&(gl_run){.scene = s, .tech = "lpv+esm", .sets = cases[i], .width = 48, .height = 36,
+                                         .keep_targets = true});
     if (gl_has_pass(&r, "lpv.lookup") && !gl_target_finite(&r, "lpv.e")) fail_msg("case %zu: lpv.e", i);
     if (!gl_all_finite(&r)) fail_msg("case %zu: the image", i);
     gl_result_free(&r);

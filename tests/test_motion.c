@@ -24,7 +24,7 @@
 enum { W = 256, H = 192 };
 
 static gl_result start(const char *tech, const char *const *sets, int width, int height) {
-  gl_result r = gl_render(&(gl_run){.tech = tech, .sets = sets, .width = width, .height = height});
+  gl_result r = gl_render(&(gl_run){.tech = tech, .sets = sets, .width = width, .height = height, .keep_targets = true});
   if (!r.ok) fail_msg("%s", r.err.msg);
   return r;
 }
