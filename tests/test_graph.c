@@ -79,6 +79,19 @@ static void target_sizes_follow_output_and_never_vanish(void **state) {
   assert_int_equal(w, 512), assert_int_equal(h, 64);
   lm_target_size(&(lm_target_desc){.scale = 1.0f / 3.0f}, 100, 7, &w, &h);
   assert_int_equal(w, 33), assert_int_equal(h, 2);
+  /* The output stage reads an output-sized image texel by texel (lm_graph_target_output_sized). */
+  lm_graph *g = lm_graph_create();
+  lm_graph_begin(g, 64, 48);
+  lm_error err;
+  int one = target(g, "one", LM_FORMAT_RGBA16F, 1), half = target(g, "half", LM_FORMAT_RGBA16F, 0.5f),
+      same = lm_graph_add_target(g, &(lm_target_desc){.name = "same", .format = LM_FORMAT_RGBA8, .width = 64,
+                                                       .height = 48}, &err),
+      other = lm_graph_add_target(g, &(lm_target_desc){.name = "other", .format = LM_FORMAT_RGBA8, .width = 64,
+                                                        .height = 47}, &err);
+  assert_true(lm_graph_target_output_sized(g, one) && lm_graph_target_output_sized(g, same));
+  assert_false(lm_graph_target_output_sized(g, half) || lm_graph_target_output_sized(g, other));
+  assert_false(lm_graph_target_output_sized(g, -1));
+  lm_graph_destroy(g);
 }
 
 static void bad_targets_are_refused(void **state) {

@@ -60,6 +60,13 @@ void lm_graph_output_size(const lm_graph *g, int *width, int *height) {
   *height = g->height;
 }
 
+bool lm_graph_target_output_sized(const lm_graph *g, int target) {
+  if (target < 0 || target >= g->target_count) return false;
+  int w, h;
+  lm_target_size(&g->targets[target].desc, g->width, g->height, &w, &h);
+  return w == g->width && h == g->height;
+}
+
 int lm_graph_find_target(const lm_graph *g, const char *name) {
   for (int i = 0; i < g->target_count; i++)
     if (!strcmp(g->targets[i].desc.name, name)) return i;

@@ -133,6 +133,8 @@ void lm_graph_begin(lm_graph *g, int width, int height);
 void lm_graph_output_size(const lm_graph *g, int *width, int *height);
 /* Returns the target's handle, or -1 with a message. */
 int lm_graph_add_target(lm_graph *g, const lm_target_desc *d, lm_error *err);
+/* Whether the target has the output's size this frame (scaled by 1, or absolute and equal). */
+bool lm_graph_target_output_sized(const lm_graph *g, int target);
 /* Copies the description. Returns the pass index, or -1 with a message. */
 int lm_graph_add_pass(lm_graph *g, const lm_pass_desc *d, lm_error *err);
 /* Marks a target as a result of the frame: what reaches it is kept. */

@@ -806,8 +806,13 @@ static bool add_output_stage(lm_renderer *r, lm_graph *g, lm_pipeline *p, int pr
     lm_graph_mark_output(g, out[1]);
     return true;
   }
+  /* A pass of its own reads an output-sized image by its texels (OUTPUT_SIZED): the same values, and a
+   * filtered read costs llvmpipe four fetches (office at 640x480: 8.0 -> 6.5 ms). */
+  char alone[64];
+  bool sized = lm_graph_target_output_sized(g, presented);
+  snprintf(alone, sizeof alone, "%s%s%s", mode, mode[0] && sized ? ";" : "", sized ? "OUTPUT_SIZED" : "");
   lm_pass_desc d = {.kind = LM_PASS_FULLSCREEN, .name = "output", .where = lm_pipeline_present_where(p),
-                    .shader = "output.frag", .defines = mode, .inputs = &input, .input_count = 1, .outputs = out,
+                    .shader = "output.frag", .defines = alone, .inputs = &input, .input_count = 1, .outputs = out,
                     .output_count = count, .depth = -1};
   if (lm_graph_add_pass(g, &d, err) < 0) return false;
   lm_graph_mark_output(g, out[0]);
