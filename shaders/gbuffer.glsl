@@ -51,11 +51,6 @@ Surface gbuffer_decode(vec4 c, vec4 nn, float d, vec4 m, vec2 uv) {
   return s;
 }
 
-// Filtered read at uv (exact at texel centres).
-Surface gbuffer_read(sampler2D clr, sampler2D nrm, sampler2D dpt, sampler2D mat, vec2 uv) {
-  return gbuffer_decode(texture(clr, uv), texture(nrm, uv), texture(dpt, uv).r, texture(mat, uv), uv);
-}
-
 // Unfiltered read of texel q (blending depths across an edge would invent points).
 Surface gbuffer_fetch(sampler2D clr, sampler2D nrm, sampler2D dpt, sampler2D mat, ivec2 q) {
   vec2 uv = (vec2(q) + 0.5) / vec2(textureSize(dpt, 0));
