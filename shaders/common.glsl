@@ -63,8 +63,6 @@ vec3 safe_normalize(vec3 v, vec3 fallback) {
   return len2 > 1e-24 ? v * inversesqrt(len2) : fallback;
 }
 
-float safe_div(float a, float b) { return a / (abs(b) > 1e-20 ? b : (b < 0.0 ? -1e-20 : 1e-20)); }
-
 // Seed 000 eq 17.
 float luminance(vec3 c) { return dot(c, vec3(0.27, 0.67, 0.06)); }
 

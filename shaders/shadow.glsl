@@ -375,10 +375,6 @@ float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
   return vis;
 }
 
-float shadow_factor(int light, vec3 p, vec3 n, vec3 l) {
-  return shadow_factor_as(light, shadow_lights[light].info.z, p, n, l);
-}
-
 #ifdef SHADOW_TRANSMIT
 // What blended casters let through to p from light `light` (pass input
 // shadow_transmit, the shadow pass's transmittance output: rgb, the least
