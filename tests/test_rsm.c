@@ -907,6 +907,11 @@ static double traced_spread(lm_scene *s, const char *few, double *mean_ratio) {
   const char *const a_sets[] = {"ambient=0", "rsm.bounces=2", "rsm.trace=1", few, NULL},
                     *const b_sets[] = {"ambient=0", "rsm.bounces=2", "rsm.trace=1", "rsm.trace_samples=1024", NULL};
   gl_result a = render_ok(s, "isr+rsm+esm", a_sets), b = render_ok(s, "isr+rsm+esm", b_sets);
+  /* isr.traced's texel after the frame: its texture must be its own (another target's writes once read
+   * as the traced light's) */
+  lm_renderer_set_sharing(a.renderer, false);
+  lm_renderer_set_sharing(b.renderer, false);
+  assert_true(gl_render_again(&a) && gl_render_again(&b));
   int wa, ha, wb, hb;
   float *ta = gl_read_target(&a, "isr.traced", &wa, &ha), *tb = gl_read_target(&b, "isr.traced", &wb, &hb);
   assert_non_null(ta);
@@ -935,21 +940,22 @@ static double traced_spread(lm_scene *s, const char *few, double *mean_ratio) {
 /* The traced hits' gather (isr.trace_light) keeps every RSM sample inside its
  * view's tile (rsm.glsl's RSM_INSIDE): a direction's radius ends at the
  * tile's edge, and a cube face beside the hit folds the directions that leave
- * it back across its edge. The same light (each sample weighs its density:
- * the mean within 3% of 1024 samples') for less noise. The Cornell box's
- * point light at 6 samples (one a face): spread 0.031 (0.043 with the disc's
- * samples that fell outside left out); the white room's sun through its
- * window, the camera facing the wall opposite (the lit floor off screen), at
- * 16: 0.275 (0.293). */
+ * it back across its edge, each sample weighing its density: the same light
+ * as 1024 samples give, within the few samples' noise. The Cornell box's
+ * point light at 6 samples (one a face): spread 0.695, mean 1.097 of 1024's
+ * (0.255 and 0.985 at 24); the white room's sun through its window, the
+ * camera facing the wall opposite (the lit floor off screen), at 16: 1.696,
+ * 0.980. (The figures once given here, 0.031 and 0.275 within 3%, were read
+ * from the texture isr.traced shares with a later target after the frame.) */
 static void traced_hits_gather_every_sample_inside_the_rsm_tiles(void **state) {
   (void)state;
   double ratio, spread = traced_spread(gl_cornell(), "rsm.trace_samples=6", &ratio);
   print_message("the Cornell box: spread at 6 samples %.3f, mean %.4f of 1024's\n", spread, ratio);
-  assert_true(fabs(ratio - 1) < 0.03 && spread < 0.037);
+  assert_true(fabs(ratio - 1) < 0.15 && spread < 0.8);
   lm_scene *s = window_room_facing_the_far_wall();
   spread = traced_spread(s, "rsm.trace_samples=16", &ratio);
   print_message("the white room: spread at 16 samples %.3f, mean %.4f of 1024's\n", spread, ratio);
-  assert_true(fabs(ratio - 1) < 0.03 && spread < 0.285);
+  assert_true(fabs(ratio - 1) < 0.05 && spread < 1.9);
   lm_scene_destroy(s);
 }
 
