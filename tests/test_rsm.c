@@ -768,11 +768,11 @@ static lm_scene *roof_off_screen(float view_proj[16]) {
  * roof leaves (0.03); traced, the hits say it (0.68: one traced ray a pixel, within 0.1). */
 static void a_roof_the_view_does_not_show_hides_its_sky(void **state) {
   (void)state;
-  float vp[16];
-  lm_scene *s = roof_off_screen(vp);
+  mat4 vp; /* aligned as cglm wants */
+  lm_scene *s = roof_off_screen((float *)vp);
   int col, row;
   static const float roof[4][3] = {{-2.5f, 3, -3}, {2.5f, 3, -3}, {2.5f, 3, 1}, {-2.5f, 3, 1}};
-  for (int k = 0; k < 4; k++) assert_false(on_screen(vp, W, H, roof[k], 0, &col, &row));
+  for (int k = 0; k < 4; k++) assert_false(on_screen((float *)vp, W, H, roof[k], 0, &col, &row));
   static const char *const cases[] = {"rsm.trace=0", "rsm.trace=1"};
   for (int t = 0; t < 2; t++) {
     const char *const sets[] = {"ambient=0", "sky=true", "sky.zenith=0.5", "sky.horizon=0.5", cases[t], NULL};
@@ -781,7 +781,7 @@ static void a_roof_the_view_does_not_show_hides_its_sky(void **state) {
     static const float points[2][3] = {{0, 0, -1}, {0, 0, -7}}; /* under the roof, open ground */
     float c[2][3];
     for (int k = 0; k < 2; k++) {
-      assert_true(on_screen(vp, W, H, points[k], 24, &col, &row));
+      assert_true(on_screen((float *)vp, W, H, points[k], 24, &col, &row));
       gl_region(&r, col - 24, row - 2, col + 24, row + 2, c[k]); /* 1.3 m wide under the roof */
     }
     float under = gl_luminance(c[0]), open = gl_luminance(c[1]), ratio = under / fmaxf(open, 1e-6f);
