@@ -8,7 +8,8 @@
 // with first the first march's E (the senders' own light, kept in 32-bit
 // floats so that the sum is the march's), previous the last step's E (at the
 // coarse texel over q, the G-buffer being STRIDE times finer); A, the share
-// of open rays, is first's.
+// of open rays, is first's (TRACE: less the lost rays where the traced one met
+// a surface).
 // TEMPORAL, TEMPORAL_NEXT: as isr_march.frag (temporal reuse; z, the grid's
 // depth the march wrote, places each pixel for the reprojection); a pixel
 // the march found converged (hits0 -1) keeps the march's E, its history.
@@ -187,6 +188,9 @@ void main() {
   vec3 r_hit = clamp((albedo + rays.y * texelFetch(traced_albedo, tp, 0).rgb) / float(n), 0.0, BOUNCE_MAX);
   vec3 grown = (1.0 - pow(r_hit, vec3(float(max(step, 2) - 1)))) / (1.0 - r_hit); // pow: base >= 0, exponent >= 1
   vec3 second = (gathered + rays.y * texelFetch(traced, tp, 0).rgb * grown) / float(n);
+  // The march counted the lost rays open (the sky's share A); where the traced one met a surface they met
+  // one, whose light they bring: not the sky's too.
+  e.a = max(e.a - rays.y / float(max(samples, 1)) * texelFetch(traced_albedo, tp, 0).a, 0.0);
 #else
   vec3 second = (gathered + rays.y * gathered / max(float(n) - rays.y, 1.0)) / float(n);
 #endif

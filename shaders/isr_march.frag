@@ -44,7 +44,9 @@
 // sky: the ambient term, occluded by the returned accessibility.
 //
 // Output: rgb = E, a = A, the share of rays (cosine-weighted) that meet no
-// surface. Background texels: (0, 0, 0, 1). With Z, also z: p's depth / far,
+// surface: the sky's (a ray UNSEEN counts below met one off screen, whose
+// light it brings; the yard's portico took the sky through its roof as well:
+// docs/gi-combined.md). Background texels: (0, 0, 0, 1). With Z, also z: p's depth / far,
 // 0 where nothing is drawn (the view's depth that the blur and composite
 // read, isr.coarse_view).
 // With HITS (1..6, the first bounce of several), also the sending hit of each
@@ -78,7 +80,8 @@
 // outputs TRACE (origin a little off p along its normal, w the count of lost rays) and TRACE + 1
 // (direction, w 0: unlimited) for the CPU's "trace" (engine/trace); both 0
 // where none was lost, which the tracer skips. isr_trace.frag lights the
-// hit, isr_bounce.frag sends its light on for the pixel's unseen rays.
+// hit, isr_bounce.frag sends its light on for the pixel's unseen rays and,
+// where it met a surface, takes them from A (here they count open).
 // TEMPORAL (isr.temporal, temporal.glsl): each frame the rays are the next
 // 16 n points of the sequence, and a pixel whose history has converged is
 // not marched: its E is that history (every bounce's sum), which a later
@@ -372,7 +375,7 @@ void main() {
       ahead = -1.0;
       j++;
     }
-    if (!seen) open += 1.0;
+    bool sky = !seen; // a ray that meets no surface sees the sky: the ambient term's, through A
 #ifdef UNSEEN
 #if defined(TRACE)
     const bool closed = true; // the tracer says what it meets
@@ -390,6 +393,9 @@ void main() {
 #endif
     if (!seen && i < 4 * HITS && closed && lost_ray) {
       record_hit(i, float(UNSEEN));
+#ifndef TRACE
+      sky = false; // it brings the light of the surface it met, not the sky's (with TRACE the tracer says)
+#endif
 #ifdef TRACE
       lost += 1.0;
       if (trace_hash(px, i) * lost < 1.0) { // kept with chance 1 / lost: each lost ray alike
@@ -400,6 +406,7 @@ void main() {
 #endif
     }
 #endif
+    if (sky) open += 1.0;
   }
 #ifdef TRACE
   if (lost > 0.0) ray_o.w = lost; // the reservoir's weight where one ray stands for a block's (rsm.trace under 1)

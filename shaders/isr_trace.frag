@@ -9,8 +9,9 @@
 // the scene) brings nothing: what it sees of the sky is the ambient term's,
 // through the march's accessibility, as for a ray the march saw leave.
 // Outputs: light (rgb: the radiance sent toward p; a: 1 where a ray was
-// traced) and albedo (rgb: the hit's k_d albedo, 0 for a miss), which
-// isr_bounce.frag's later bounces (the series' ratio) take. BLOCK (rsm.trace
+// traced) and albedo (rgb: the hit's k_d albedo, 0 for a miss, which
+// isr_bounce.frag's later bounces (the series' ratio) take; a: 1 for a hit,
+// whose lost rays then see a surface, not the sky). BLOCK (rsm.trace
 // under 1): a texel per block of pixels, whose ray the engine chose.
 #include "gbuffer.glsl"
 #include "rsm.glsl"
@@ -43,5 +44,5 @@ void main() {
   s.p = texelFetch(hit_pos, px, 0).xyz; // given, not rebuilt from a depth
   vec3 rho = clamp(m.y, 0.0, 1.0) * clamp(c.rgb, 0.0, 1.0);
   light.rgb = finite_or_zero(rho * max(rsm_k, 0.0) * rsm_gather(s, px, dpt));
-  albedo.rgb = rho;
+  albedo = vec4(rho, 1.0); // a: a hit, which isr_bounce.frag takes from the sky's share A
 }

@@ -266,7 +266,14 @@ static void the_exposure_settles_and_holds(void **state) {
  * isr.temporal (isr+rsm+esm), rsm.temporal and ssdo.temporal. A change
  * of the light now starts every history again (temporal.lua), so what may
  * differ is where the noise of a few samples restarts a pixel afterwards,
- * and the clamp. Measured: at most 0.0001 apart, every technique. Before a
+ * and the clamp. Measured: at most 0.0001 apart, every technique, but
+ * isr+rsm+esm's x4 at scale 1, 0.0015 from the third frame after the step
+ * since the sky's share A (the ambient term's) leaves out the rays taken to
+ * meet a surface off screen (the room's roofed pixels): the image, so the
+ * metered key, changed, and the keys at scale 1 and 1e-4, one image's
+ * median in half floats pre-exposed by other powers of two, differ by their
+ * rounding (0.0359802 against 0.0360049 of the light before the step),
+ * which moves the confidence's cut on a few pixels. Before a
  * view's first frame, drawn again (its exposure guessed from its lights far
  * off), kept its number (frame.time.y), a renderer so drawn took the next
  * frame's sampling pattern from then on: 0.0008 apart for ISR and RSM,
@@ -281,7 +288,7 @@ static void the_exposure_settles_and_holds(void **state) {
  * histories of a few frames begun at other frames, not lag:
  * a_change_of_light_is_absorbed_at_once measures that (none). */
 enum { WARM = 6, STEPPED = 5 };
-#define ALIKE 0.001
+#define ALIKE 0.002
 static void a_history_follows_a_light_step_alike_at_any_light_level(void **state) {
   (void)state;
   static const char *const techs[][2] = {{"isr+rsm+esm", "isr.temporal.enabled=true"},
