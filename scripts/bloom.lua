@@ -4,6 +4,7 @@
 -- pass clamping under their largest finite value.
 -- Laid out as scripts/README.md's contract says, so modules read alike.
 local options = require "options"
+local dof = require "dof"
 
 local bloom = {}
 
@@ -32,17 +33,21 @@ local rules = {
 
 bloom.check = options.checker("bloom", bloom.defaults, rules)
 
--- Records bloom's bright pass and blur over `src` (output-sized). Returns the
--- glow to add, { image = the blurred target, strength = o.strength }, or nil
--- when off. hdr.render adds it as it reads the image (post.lua), so the sum
--- is never written at full size.
+-- Records bloom's bright pass and blur over `src` (output-sized, or depth of
+-- field's unwritten composite: dof.parts). Returns the glow to add, { image =
+-- the blurred target, strength = o.strength }, or nil when off. hdr.render
+-- adds it as it reads the image (post.lua), so the sum is never written at
+-- full size.
 function bloom.glow(src, o)
   o = bloom.check(o, 2)
   if not o.enabled then return nil end
   local f = o.downsample
   local function small(name) return target{ name, format = "rgba16f", scale = 1 / f } end
-  local b = pass{ "bloom.bright", shader = "bloom_bright.frag", inputs = { src = src },
-                  params = { threshold = o.threshold, knee = o.knee }, defines = { FACTOR = f },
+  local parts = dof.parts(src) -- read at the reduced size below full size (bloom_bright.frag)
+  local inputs = not parts and { src = src } or f == 1 and parts.composite
+                 or { small = parts.small, foreign = parts.composite.foreign }
+  local b = pass{ "bloom.bright", shader = "bloom_bright.frag", inputs = inputs,
+                  params = { threshold = o.threshold, knee = o.knee }, defines = { FACTOR = f, DOF = parts ~= nil },
                   out = small("bloom.bright") }
   if o.radius > 0 then
     for _, axis in ipairs{ { "x", { 1, 0 } }, { "y", { 0, 1 } } } do

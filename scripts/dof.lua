@@ -48,8 +48,11 @@ local rules = {
 dof.check = options.checker("dof", dof.defaults, rules)
 
 -- Records depth of field over `src` (output-sized) with the frame's G-buffer (frame.G).
--- Returns the blurred image, or src when off.
-function dof.render(src, o, frame)
+-- Returns the blurred image, or src when off. With `fold` (post.lua, where
+-- tone mapping reads the image and nothing else does) at downsample 2 the
+-- composite is not recorded: it returns the composite's parts (dof.parts),
+-- and the passes that read them compute it as they read (dof.glsl).
+function dof.render(src, o, frame, fold)
   o = dof.check(o, 2)
   local G = frame and frame.G
   if not o.enabled then return src end
@@ -90,9 +93,20 @@ function dof.render(src, o, frame)
                          defines = { TILE = tile, FOREIGN = f > 1 },
                          out = target{ "dof.gather", format = "rgba16f", scale = 1 / f } }
   if f == 1 then return gathered end
-  return pass{ "dof.composite", shader = "dof_composite.frag",
-               inputs = { src = src, dpt = G.dpt, foreign = gathered, small_coc = circles },
+  local composite = { src = src, dpt = G.dpt, foreign = gathered, small_coc = circles }
+  if fold then return { composite = composite, small = image } end
+  return pass{ "dof.composite", shader = "dof_composite.frag", inputs = composite,
                out = target{ "dof.composite", format = "rgba16f" } }
+end
+
+-- The parts of the composite dof.render(..., fold) left unwritten, or nil
+-- when img is a target: { composite = dof_composite.frag's inputs (full-size
+-- src and dpt, reduced foreign and small_coc), small = the half-size image }.
+-- A pass reads the full-size composite with inputs = parts.composite and the
+-- define DOF (dof.glsl's dof_composite), or the reduced one with small and
+-- foreign (dof_composite_small).
+function dof.parts(img)
+  return type(img) == "table" and img.composite and img or nil
 end
 
 return dof

@@ -13,9 +13,12 @@
 --   3. hdr.tonemap: that scale, Reinhard with white (eq 2.3-2.4); linear
 --      display values in [0, 1] (the output stage encodes sRGB); where the
 --      frame presents its image, the output stage runs in this pass
---      (fold_output: a full-size image not written and read again)
+--      (fold_output: a full-size image not written and read again); after
+--      depth of field at half size (post.lua), it and the meter lay the
+--      blur over the image as they read it (dof.render's fold)
 -- A pipeline calls hdr.create() from OnCreate and hdr.render() from OnRender.
 local options = require "options"
+local dof = require "dof"
 
 local hdr = {}
 
@@ -55,10 +58,10 @@ end
 
 hdr.check = options.checker("hdr", hdr.defaults, rules)
 
--- Records tone mapping of `src` (an output-sized float target) with options
--- o (see hdr.defaults), adding `glow` (bloom.glow's) to the image as its
--- first reduction and the tone mapping read it. Returns the display-referred
--- target, or src when off.
+-- Records tone mapping of `src` (an output-sized float target, or depth of
+-- field's unwritten composite: dof.parts) with options o (see hdr.defaults),
+-- adding `glow` (bloom.glow's) to the image as its first reduction and the
+-- tone mapping read it. Returns the display-referred target, or src when off.
 function hdr.render(src, o, _, glow)
   o = hdr.check(o, 2)
   if not o.enabled then return src end
@@ -73,15 +76,23 @@ function hdr.render(src, o, _, glow)
     t.strength = glow and glow.strength
     return t
   end
+  -- Depth of field's composite unwritten: the meter and tone mapping compute
+  -- it at the pixels they read (hdr_reduce.frag, hdr_tonemap.frag).
+  local parts = dof.parts(src)
+  local image = parts and parts.composite or { src = src }
   local level, n = src, 0
   repeat
     local first = n == 0
-    local f = first and BLOCK * STEP or BLOCK
+    -- Computing the composite, the first level is the costly one: one pixel
+    -- a texel, so that its pass has tiles enough for llvmpipe's threads.
+    local block = first and parts and 1 or BLOCK
+    local f = block * (first and STEP or 1)
     w, h, n = (w + f - 1) // f, (h + f - 1) // f, n + 1
     level = pass{ "hdr.reduce" .. n, shader = "hdr_reduce.frag",
-                  inputs = first and glow_inputs{ src = level } or { src = level },
+                  inputs = first and glow_inputs(options.copy(image)) or { src = level },
                   params = first and glow_params{ delta = o.delta } or nil,
-                  defines = { FIRST = first, BLOCK = BLOCK, STEP = first and STEP or 1, BLOOM = first and glow ~= nil },
+                  defines = { FIRST = first, BLOCK = block, STEP = first and STEP or 1, BLOOM = first and glow ~= nil,
+                              DOF = first and parts ~= nil },
                   out = target{ "hdr.reduce" .. n, format = "rg32f", size = { w, h } } }
   until w == 1 and h == 1
   local previous, next = adapted[turn + 1], adapted[2 - turn]
@@ -89,8 +100,10 @@ function hdr.render(src, o, _, glow)
   pass{ "hdr.adapt", shader = "hdr_adapt.frag", inputs = { average = level, previous = previous },
         params = { rate = o.rate, key = o.key, exposure = o.exposure }, defines = { AUTO_KEY = o.auto_key },
         out = next }
-  return pass{ "hdr.tonemap", shader = "hdr_tonemap.frag", inputs = glow_inputs{ src = src, adapted = next },
-               params = glow_params{ white = o.white }, defines = { BLOOM = glow ~= nil },
+  local inputs = glow_inputs(options.copy(image))
+  inputs.adapted = next
+  return pass{ "hdr.tonemap", shader = "hdr_tonemap.frag", inputs = inputs,
+               params = glow_params{ white = o.white }, defines = { BLOOM = glow ~= nil, DOF = parts ~= nil },
                out = target{ "hdr.tonemap", format = "rgba16f" }, fold_output = true }
 end
 

@@ -7,12 +7,17 @@
 -- `render(src, o, frame)`); an effect whose `enabled` is false records no
 -- pass. Any pipeline can use the chain (post.render) or the modules one by one.
 -- With hdr on, bloom's glow goes to hdr, which adds it as it reads the image:
--- the same picture without a full-size pass that writes the sum.
+-- the same picture without a full-size pass that writes the sum. So does
+-- depth of field's composite at half size (dof.render's fold): tone mapping
+-- and hdr's meter lay the blur over the image at the pixels they read,
+-- bloom's bright pass reads it at the reduced size. post.fold = false records
+-- each effect's passes as the modules one by one would (tests compare them).
 local options = require "options"
 
 local post = {}
 
 post.order = { "motion_blur", "dof", "bloom", "hdr", "radial_blur", "glass", "tiles", "sepia" }
+post.fold = true
 
 local modules = {}
 for _, name in ipairs(post.order) do modules[name] = require(name) end
@@ -40,6 +45,7 @@ function post.render(lit, o, frame)
   local img, glow = lit, nil
   for _, name in ipairs(post.order) do
     if name == "bloom" and tone_mapped then glow = modules.bloom.glow(img, o.bloom)
+    elseif name == "dof" then img = modules.dof.render(img, o.dof, frame, tone_mapped and post.fold)
     else img = modules[name].render(img, o[name], frame, name == "hdr" and glow or nil) end
   end
   return img, tone_mapped and "display" or "scene"

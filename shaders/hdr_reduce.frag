@@ -13,11 +13,21 @@
 // ln(delta + E L_w), hdr_adapt.frag takes ln E away, and an image lit 1e10
 // times more adapts to the same picture. With BLOOM the first level reads
 // the image plus `strength` of bloom's blurred bright pass (scripts/hdr.lua:
-// bloom's sum is never written).
+// bloom's sum is never written). With DOF (scripts/post.lua: depth of field
+// at half size before it, its composite not written) the first level
+// computes the composite at the pixels it reads (dof.glsl's dof_composite):
+// the reduced composite's texel in their place, or each pixel with its
+// texel's gather, moved the Cornell box's tone mapped image by 0.0067 a
+// channel (test_hdr; near-black pixels, which the log weighs most, took the
+// blurred box's light without the depth-aware upsampling).
 #include "post.glsl"
 
 in vec2 uv;
 uniform sampler2D src;
+#ifdef DOF
+#include "dof.glsl"
+uniform sampler2D foreign, small_coc; // dof_gather.frag's, dof_reduce.frag's (dpt: dof.glsl's)
+#endif
 #ifdef FIRST
 uniform float delta = 1e-4; // against ln(0) (seed 001: "a small constant")
 #endif
@@ -42,7 +52,11 @@ void main() {
     for (int x = 0; x < BLOCK; x++) {
       ivec2 q = base + ivec2(x, y) * STEP;
       if (any(greaterThanEqual(q, size))) continue;
+#if defined(FIRST) && defined(DOF)
+      vec4 t = vec4(dof_composite(src, foreign, small_coc, q), 1.0);
+#else
       vec4 t = texelFetch(src, q, 0);
+#endif
 #ifdef FIRST
 #ifdef BLOOM
       // The glow as tone mapping adds it (its bilinear enlargement): at one

@@ -7,8 +7,15 @@
 // bloom's blurred bright pass first (hdr_reduce.frag). With OUTPUT_STAGE
 // (scripts/hdr.lua's fold_output) it is the frame's output stage too: the
 // mapped image goes to output.glsl's outputs, not written and read again.
+// With DOF (scripts/post.lua: depth of field at half size before it) src is
+// the image under depth of field and the pass lays the gather's light over
+// it as it reads (dof.glsl's dof_composite): the composite is not written.
 #include "post.glsl"
 #include "output.glsl"
+#ifdef DOF
+#include "dof.glsl"
+uniform sampler2D foreign, small_coc; // dof_gather.frag's, dof_reduce.frag's (dpt: dof.glsl's)
+#endif
 
 in vec2 uv;
 uniform sampler2D src;
@@ -24,7 +31,11 @@ out vec4 dst;
 #endif
 
 void main() {
+#ifdef DOF
+  vec3 c = dof_composite(src, foreign, small_coc, ivec2(gl_FragCoord.xy)); // in [0, HALF_MAX]
+#else
   vec3 c = hdr_clamp(texelFetch(src, ivec2(gl_FragCoord.xy), 0).rgb, 1e30);
+#endif
 #ifdef BLOOM
   c = bloom_sum(c, texture(bloom, uv).rgb, strength);
 #endif

@@ -22,7 +22,11 @@
 enum { W = 256, H = 192 };
 
 /* Scripts, relative to the scratch root. */
-static const char image_lua[] = "image.lua", pp_lua[] = "scripts/pp.lua";
+static const char image_lua[] = "image.lua", pp_lua[] = "scripts/pp.lua", unfolded_lua[] = "unfolded.lua";
+
+/* pp.lua with each effect's passes as the modules one by one record them:
+ * depth of field's composite written (post.fold). */
+static const char *unfolded_script = "require('post').fold = false\nrequire 'pp'\n";
 
 /* A grey test image: PATTERN 0 is three bands of rows (bottom lo, middle
  * mid, top hi, 64 rows each at 256x192), PATTERN 1 is `fill` everywhere;
@@ -66,7 +70,10 @@ static const char *image_script =
 
 static int setup(void **state) {
   if (gl_test_setup(state) != 0) return -1;
-  return gl_write_file("shaders/test_image.frag", image_frag) && gl_write_file("image.lua", image_script) ? 0 : -1;
+  return gl_write_file("shaders/test_image.frag", image_frag) && gl_write_file("image.lua", image_script) &&
+                 gl_write_file(unfolded_lua, unfolded_script)
+             ? 0
+             : -1;
 }
 
 /* ---- running a pipeline ------------------------------------------------ */
@@ -588,6 +595,47 @@ static void tone_mapping_folds_the_output_stage_in(void **state) {
   gl_result_free(&r[0]), gl_result_free(&r[1]);
 }
 
+/* Depth of field at half size under tone mapping: post.lua folds its
+ * composite into hdr.tonemap and the meter (hdr.reduce1), and bloom's bright
+ * pass reads it at the reduced size (dof.glsl). Against the composite written
+ * and read, at each of bloom's sizes (each a path of bloom_bright.frag) and
+ * without bloom, on the second frame: no dof.composite pass, and the image
+ * within TOLERANCE on average (linear display values: bloom's reduced read
+ * and the composite's half-float store, gone, differ a little), MOST at a
+ * pixel, 2/255 in sRGB. */
+static void tone_mapping_folds_the_dof_composite_in(void **state) {
+  (void)state;
+  enum { CASES = 4 };
+  static const char *const bloom[CASES] = {"bloom.downsample=4", "bloom.downsample=2", "bloom.downsample=1",
+                                           "bloom.enabled=false"};
+  const double TOLERANCE = 0.0005, MOST = 0.02;
+  for (int c = 0; c < CASES; c++) {
+    const char *sets[] = {"hdr=true", "bloom=true", "dof=true", bloom[c], NULL};
+    gl_result folded = start(pp_lua, "dl", sets), unfolded = start(unfolded_lua, "dl", sets);
+    frame(&folded), frame(&unfolded);
+    char names[1024];
+    gl_pass_names(&folded, names, sizeof names);
+    assert_null(strstr(names, "dof.composite"));
+    assert_non_null(strstr(names, "hdr.tonemap"));
+    gl_pass_names(&unfolded, names, sizeof names);
+    assert_non_null(strstr(names, "dof.composite"));
+    int n = W * H * 3, srgb_off = 0;
+    double most = 0;
+    for (int i = 0; i < n; i++) {
+      most = fmax(most, fabs(folded.rgb[i] - unfolded.rgb[i]));
+      srgb_off = abs(folded.srgb[i] - unfolded.srgb[i]) > srgb_off ? abs(folded.srgb[i] - unfolded.srgb[i]) : srgb_off;
+    }
+    double mean = gl_mean_abs_diff(folded.rgb, unfolded.rgb, n);
+    print_message("dof folded into tone mapping, %s: mean %.5f, most %.4f, sRGB at most %d/255\n", bloom[c], mean,
+                  most, srgb_off);
+    assert_true(mean <= TOLERANCE);
+    assert_true(most <= MOST);
+    assert_true(srgb_off <= 2);
+    assert_true(gl_all_finite(&folded));
+    gl_result_free(&folded), gl_result_free(&unfolded);
+  }
+}
+
 /* Bad values stop the frame with the option's name and what it must be. */
 static void bad_options_name_themselves(void **state) {
   (void)state;
@@ -620,6 +668,7 @@ int main(void) {
       cmocka_unit_test(degenerate_settings_stay_finite),
       cmocka_unit_test(an_effect_off_records_no_pass),
       cmocka_unit_test(tone_mapping_folds_the_output_stage_in),
+      cmocka_unit_test(tone_mapping_folds_the_dof_composite_in),
       cmocka_unit_test(bad_options_name_themselves),
   };
   return cmocka_run_group_tests(tests, setup, gl_test_teardown);
