@@ -54,7 +54,12 @@ local rules = { technique = options.one_of("esm", "pcf", "poisson", "hard", "pcs
                 fit = options.one_of("current", "previous"), fit_margin = options.number(0, 10) }
 shadow.check = options.checker("shadow", shadow.defaults, rules)
 
-local BLOCK = 8
+-- The depth range's reduction (shadow.depth_range): the first level reads
+-- FIRST_BLOCK x FIRST_BLOCK pixels a texel, so that its output spans several
+-- of llvmpipe's 64 x 64 tiles, which its threads share (at 8 x 8 a 512x384
+-- frame's first level was one tile: one thread read the whole G-buffer);
+-- later levels BLOCK x BLOCK.
+local FIRST_BLOCK, BLOCK = 4, 16
 
 -- Each atlas's filter as shaders/shadow.glsl numbers them (SHADOW_FILTER:
 -- lm_shadow_technique), kept for shadow.bind; weak keys: atlases are per frame.
@@ -63,14 +68,15 @@ local filter_of = setmetatable({}, { __mode = "k" })
 local transmit_of = setmetatable({}, { __mode = "k" }) -- atlas -> its blended casters' transmittance
 
 -- The least and greatest camera depth the G-buffer G sees (depth / far in r
--- and g of a 1x1 target), by BLOCK x BLOCK min/max reduction passes.
+-- and g of a 1x1 target), by min/max reduction passes.
 function shadow.depth_range(G)
   local w, h = output_size()
   local level, n = G.dpt, 0
   repeat
-    w, h, n = (w + BLOCK - 1) // BLOCK, (h + BLOCK - 1) // BLOCK, n + 1
+    local block = n == 0 and FIRST_BLOCK or BLOCK
+    w, h, n = (w + block - 1) // block, (h + block - 1) // block, n + 1
     level = pass{ "shadow.range" .. n, shader = "depth_range.frag", inputs = { src = level },
-                  defines = { FIRST = n == 1, BLOCK = BLOCK },
+                  defines = { FIRST = n == 1, BLOCK = block },
                   out = target{ "shadow.range" .. n, format = "rg32f", size = { w, h } } }
   until w == 1 and h == 1
   return level
