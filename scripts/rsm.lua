@@ -48,8 +48,9 @@ rsm.defaults = {
                      -- hold, 0..64 (0: none): one inside a solid (behind a surface the light sees and
                      -- before the face where that solid ends, the pass shadow.rsm_back) drops the
                      -- sender, off screen too. 16 took the yard's first bounce from 1.12-1.59 times
-                     -- Cycles' to 1.01-1.34 (senders behind its buildings), but cost the reference
-                     -- set 4x the default's frame and 1.1 points against Cycles: off by default
+                     -- Cycles' to 1.01-1.34 (senders behind its buildings), but the default's gather
+                     -- pass took 1.5-2.7x as long and it lost 1.1 points against Cycles on the
+                     -- reference set: off by default
                      -- (docs/gi-combined.md "Senders behind solids", issue 32)
   ray_steps = 0,     -- the combined technique: points at which an upward ray the screen lost is tested
                      -- against the lights' RSM views on its way out of the scene's box, 0..32 (0: none,
