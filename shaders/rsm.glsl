@@ -74,6 +74,10 @@ bool rsm_seen(sampler2D dpt, vec3 q) {
 // 1/d^2 is capped at the texel's own area, so a sender next to p stays finite.
 // VISIBILITY: the seed's screen-space test (lines 930-958): `steps` points
 // on p -> q; one behind the depth buffer rejects q.
+// SOLIDS: `solid_steps` points on p -> q; one inside a solid the light's
+// views hold rejects q (rsm_inside_solid): off screen too, where VISIBILITY
+// sees nothing. Without it, outdoors, the senders behind the buildings lit
+// the walls and ceilings facing them (issue 32, docs/gi-combined.md).
 // EXCLUDE_SEEN: a sender the camera sees (rsm_seen) is left to the
 // screen-space march of the combined technique.
 // RSM_INSIDE: every sample falls inside its view's tile (the traced hits'
@@ -90,6 +94,10 @@ uniform float rsm_radius = 1.0;      // the disc's radius, in tiles
 uniform float rsm_rotate = 0.0;      // turn of the pattern a frame, in turns (seed 004: 10 degrees)
 uniform int rsm_steps = 0;           // VISIBILITY's march
 uniform float rsm_thickness = 0.0;   // VISIBILITY: how far behind the depth buffer blocks, a share of its depth (0: any)
+#ifdef SOLIDS
+uniform sampler2D rsm_back;          // where the first solid on the light's way ends (shadow.frag's RSM_BACK)
+uniform int rsm_solid_steps = 0;
+#endif
 
 const int INTERLEAVE = 4;                          // tile side of the interleaved pattern
 const float GOLDEN = 0.61803398874989;             // the angle's step, in turns
@@ -194,6 +202,38 @@ bool rsm_meets(vec3 p, vec3 w, float t0, float t1) {
 }
 #endif
 
+#ifdef SOLIDS
+// Does a point of p -> q (rsm_solid_steps of them, ends excluded) lie inside a solid that the views
+// first .. first + count of one light hold: behind the surface its texel's sender lies on (its plane,
+// the normal toward the light) and before the face where that solid ends (rsm_back: its plane, the
+// normal away from the light)? Planes, not depths: a point beside a slanted surface reads a sender up to
+// half a texel off, whose depth differs by that times the slope (at 0.25 of a texel's side as a depth
+// bias, the yard's court view lost 17% of its first bounce). A solid thinner than the points'
+// spacing can fall between them; a surface no back face closes (an open mesh) blocks nothing.
+bool rsm_inside_solid(int first, int count, vec3 p, vec3 q, vec2 atlas) {
+  for (int j = 1; j <= rsm_solid_steps; j++) {
+    vec3 x = mix(p, q, float(j) / float(rsm_solid_steps + 1));
+    for (int v = first; v < first + count; v++) {
+      ShadowView sv = shadow_views[v];
+      vec3 ndc;
+      vec2 t;
+      vec4 front;
+      if (!rsm_view_texel(sv, x, atlas, ndc, t, front)) continue;
+      if (front.w > 0.0) break; // the light sees nothing there: no solid
+      vec4 back = texelFetch(rsm_back, ivec2((sv.rect.xy + t * sv.rect.zw) * atlas), 0);
+      if (back.w > 0.0) break; // no face closes it
+      // A margin of a thousandth of the distance keeps p's and q's own surfaces out.
+      float margin = 1e-3 * distance(p, q);
+      if (dot(normal_unpack_direction(front.w), x - front.xyz) < -margin &&
+          dot(normal_unpack_direction(back.w), x - back.xyz) < -margin)
+        return true;
+      break;
+    }
+  }
+  return false;
+}
+#endif
+
 // Light i's share of E(p) at the surface s: its RSM views, j the pixel's
 // block of the pattern, turn and shift its frame's turn (rsm_gather); type
 // and falloff light i's kind as light_arriving_as takes them. dpt:
@@ -276,6 +316,9 @@ vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn
 #endif
 #ifdef VISIBILITY
       if (rsm_blocked(s.p, q, dpt)) continue;
+#endif
+#ifdef SOLIDS
+      if (rsm_inside_solid(first, count, s.p, q, atlas)) continue;
 #endif
       vec3 l;
       vec3 radiance = light_arriving_as(li, type, falloff, q, l);

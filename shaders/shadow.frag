@@ -8,10 +8,19 @@
 // and its world position, with the normal again in w (normal_pack: the
 // gather reads both in one fetch). The pass clears every target to 1: a
 // normal of length above 1, or a w above 0, marks an empty texel.
+// With RSM_BACK (the pass shadow.rsm_back, rsm.solid_steps), the faces the
+// light sees from behind alone, the nearest kept: where the first solid on
+// the light's way through the texel ends, its position and its face's normal
+// pointing away from the light (normal_pack, in w; the gather's
+// rsm_inside_solid). The face's own normal (from the position's
+// derivatives), not the mesh's: smooth normals lean off the face.
 #include "common.glsl"
 
 in vec3 world_pos;
 uniform vec4 pass_depth;
+#ifdef RSM_BACK
+uniform mat4 pass_view_proj;
+#endif
 #if defined(RSM) || defined(ALPHA_MASK) || defined(ALPHA_BLEND)
 in vec2 tex_uv;
 #ifdef BASE_COLOR_TEXTURE
@@ -26,6 +35,8 @@ uniform vec4 material_k; // k_a, k_d, k_s, shininess
 layout(location = 0) out vec4 rsm_flux;
 layout(location = 1) out vec4 rsm_nrm;
 layout(location = 2) out vec4 rsm_pos;
+#elif defined(RSM_BACK)
+layout(location = 0) out vec4 rsm_back;
 #else
 layout(location = 0) out float depth01;
 #endif
@@ -71,7 +82,15 @@ void main() {
 #ifdef ALPHA_MASK
   if (alpha_masked(texel.a)) discard;
 #endif
-#ifndef RSM
+#ifdef RSM_BACK
+  if (gl_FrontFacing) discard;
+  // Away from the light: from its position (perspective), or along the clip depth's gradient in world
+  // space (orthographic: the view-projection's third row).
+  vec3 away = pass_depth.w > 0.0 ? world_pos - pass_depth.xyz
+                                 : vec3(pass_view_proj[0][2], pass_view_proj[1][2], pass_view_proj[2][2]);
+  vec3 face = safe_normalize(cross(dFdx(world_pos), dFdy(world_pos)), away);
+  rsm_back = vec4(world_pos, normal_pack(dot(face, away) < 0.0 ? -face : face));
+#elif !defined(RSM)
   // Perspective: distance from the light / range. Orthographic: window depth,
   // already linear (casters before the near plane are clamped onto it).
   float d = pass_depth.w > 0.0 ? saturate(length(world_pos - pass_depth.xyz) * pass_depth.w) : saturate(gl_FragCoord.z);

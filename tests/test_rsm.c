@@ -59,10 +59,11 @@ static gl_result render_ok(lm_scene *s, const char *tech, const char *const *set
 /* The canopy's centre receives k_d albedo (1/pi) int L cos cos / d^2 dA
  * over the lit floor (L = floor_l times the light arriving: POV-Ray's
  * diffuse 1 under a sun of 1, or the lamp's 2 / (4 + r^2)^1.5 at r from
- * the point under it); cos = h / d at height h = 1. */
-static double canopy_expected(double albedo, double floor_l, bool lamp) {
+ * the point under it); cos = h / d at height h = 1. beyond: the floor counted lies outside the square of
+ * that half side (0: the canopy's shadow's). */
+static double canopy_integral(double albedo, double floor_l, bool lamp, double beyond) {
   const int n = 800;
-  double sum = 0, da = (2.0 * F / n) * (2.0 * F / n), shadow = lamp ? 1 : 2;
+  double sum = 0, da = (2.0 * F / n) * (2.0 * F / n), shadow = beyond > 0 ? beyond : lamp ? 1 : 2;
   for (int i = 0; i < n; i++)
     for (int j = 0; j < n; j++) {
       double x = -F + (i + 0.5) * 2.0 * F / n, z = -F + (j + 0.5) * 2.0 * F / n;
@@ -71,6 +72,9 @@ static double canopy_expected(double albedo, double floor_l, bool lamp) {
       sum += da / (d2 * d2) * (lamp ? 2.0 / pow(4.0 + r2, 1.5) : 1.0);
     }
   return albedo * floor_l * sum / GLM_PI;
+}
+static double canopy_expected(double albedo, double floor_l, bool lamp) {
+  return canopy_integral(albedo, floor_l, lamp, 0);
 }
 
 /* The sun cannot reach the canopy's underside and the camera sees nothing
@@ -129,6 +133,55 @@ static void a_point_lights_floor_bleeds_onto_a_ceiling_as_the_integral_says(void
   assert_true(fabs(c[0] - red) < 0.05 * red);
   gl_result_free(&rsm);
   gl_result_free(&both);
+  lm_scene_destroy(s);
+}
+
+/* A closed box from lo to hi: six quads, each wound counter-clockwise seen from outside (a solid the
+ * RSM's back faces close, rsm.solid_steps). */
+static void closed_box(lm_scene *s, const char *name, int material, const float lo[3], const float hi[3]) {
+  for (int a = 0; a < 3; a++)
+    for (int side = 0; side < 2; side++) {
+      int u = (a + 1) % 3, v = (a + 2) % 3; /* e_u x e_v = e_a */
+      float c[4][3], n[3] = {0, 0, 0}, uv[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+      n[a] = side ? 1.0f : -1.0f;
+      for (int k = 0; k < 4; k++) {
+        int j = side ? k : 3 - k; /* the other face turns the other way */
+        c[k][a] = side ? hi[a] : lo[a];
+        c[k][u] = uv[j][0] > 0 ? hi[u] : lo[u];
+        c[k][v] = uv[j][1] > 0 ? hi[v] : lo[v];
+      }
+      gl_quad(s, name, material, (const float(*)[3])c, n);
+    }
+}
+
+/* The canopy under its sun with a closed wall 0.6 thick and as high as the canopy round it (from 2 to
+ * 2.6 out, grey): every path from the underside to the sunlit floor runs through the wall, whose top
+ * is level with the canopy and whose sides the sun grazes, so the underside gets no first bounce but
+ * the shadowed floor's (none). The camera sees the underside alone: only rsm.solid_steps can tell.
+ * Without it (the default) the underside takes the light of the floor beyond the wall through it, as
+ * the integral over that floor says (within 10%); with 16 points, under 10% of that (measured 0). */
+static void a_solid_between_hides_the_senders_behind_it(void **state) {
+  (void)state;
+  static const char *const sets[] = {"ambient=0", "rsm.reach=16", "rsm.solid_steps=16", NULL};
+  static const char *const off[] = {"ambient=0", "rsm.reach=16", NULL}; /* the default: 0 */
+  lm_scene *s = canopy_scene();
+  int grey = gl_material(s, "wall", 0.8f, 0.8f, 0.8f);
+  const float in = 2.0f, out = 2.6f;
+  closed_box(s, "east", grey, (const float[3]){in, 0, -out}, (const float[3]){out, 1, out});
+  closed_box(s, "west", grey, (const float[3]){-out, 0, -out}, (const float[3]){-in, 1, out});
+  closed_box(s, "north", grey, (const float[3]){-in, 0, -out}, (const float[3]){in, 1, -in});
+  closed_box(s, "south", grey, (const float[3]){-in, 0, in}, (const float[3]){in, 1, out});
+  lm_scene_update(s);
+  gl_result walled = render_ok(s, "rsm+esm", sets), through = render_ok(s, "rsm+esm", off);
+  float a[3], b[3];
+  gl_region(&walled, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, a);
+  gl_region(&through, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, b);
+  double beyond = canopy_integral(0.8, 0.8, false, out);
+  print_message("walled canopy: %.4f red (through the wall %.4f; the floor beyond it %.4f)\n", a[0], b[0], beyond);
+  assert_true(fabs(b[0] - beyond) < 0.1 * beyond);
+  assert_true(a[0] < 0.1 * beyond);
+  gl_result_free(&walled);
+  gl_result_free(&through);
   lm_scene_destroy(s);
 }
 
@@ -1083,7 +1136,8 @@ static void bad_options_name_themselves(void **state) {
       {"isr+rsm+esm", "rsm.steps=33", "rsm.steps"},   {"rsm+esm", "rsm.coarse=5", "rsm.coarse"},
       {"isr+rsm+esm", "rsm.steps=-2", "rsm.steps"},   {"isr+rsm+esm", "rsm.thickness=-0.1", "rsm.thickness"},
       {"rsm+esm", "rsm.thickness=17", "rsm.thickness"},
-      {"isr+rsm+esm", "rsm.ray_steps=33", "rsm.ray_steps"}, {"isr+rsm+esm", "rsm.ray_steps=-1", "rsm.ray_steps"},
+      {"isr+rsm+esm", "rsm.ray_steps=33", "rsm.ray_steps"}, {"rsm+esm", "rsm.solid_steps=65", "rsm.solid_steps"},
+      {"isr+rsm+esm", "rsm.solid_steps=-1", "rsm.solid_steps"}, {"isr+rsm+esm", "rsm.ray_steps=-1", "rsm.ray_steps"},
       {"isr+rsm+esm", "rsm.trace=2", "rsm.trace"}, {"isr+rsm+esm", "rsm.trace=-1", "rsm.trace"},
       {"isr+rsm+esm", "rsm.trace=0.5", "rsm.trace"},
       {"isr+rsm+esm", "rsm.trace_samples=-1", "rsm.trace_samples"},
@@ -1196,6 +1250,7 @@ int main(int argc, char **argv) {
   if (argc > 1) cmocka_set_test_filter(argv[1]); /* one test by name (a pattern) */
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(sunlit_floor_bleeds_onto_a_ceiling_the_sun_cannot_reach),
+      cmocka_unit_test(a_solid_between_hides_the_senders_behind_it),
       cmocka_unit_test(a_point_lights_floor_bleeds_onto_a_ceiling_as_the_integral_says),
       cmocka_unit_test(the_gathered_light_does_not_depend_on_the_sample_count),
       cmocka_unit_test(a_changed_technique_starts_the_history_again),

@@ -9,10 +9,10 @@
 
 #include "trace/trace.h"
 
-enum { MAX_LIGHTS = 256, VIEW_SETS = 2 /* lm_pass_desc.view_set: shadow tiles, RSM views */ };
+enum { MAX_LIGHTS = 256, VIEW_PASSES = 4 /* scene passes with views: shadow.depth, shadow.rsm, shadow.rsm_back */ };
 
 /* Shadow tiles kept from frame to frame, one cache for each scene pass with
- * views (lm_pass_desc.view_set: the shadow pass, the RSM pass): a copy of
+ * views (tile_cache_of: the shadow pass, the RSM passes): a copy of
  * every output of the pass, and per tile drawn the key of what drew it.
  * While casters move, a second copy keeps each drawn tile's static layer
  * (its casters that did not move this frame, and their key): a tile a moving
@@ -41,6 +41,7 @@ typedef struct tile_cache {
   int tile_count, tile_cap;
   uint32_t left[LM_MAX_COLOR_OUTPUTS + 1]; /* the textures the pass left, 0 where another may write */
   long execution;  /* lm_renderer.executions when it left them */
+  uint64_t owner;  /* lm_hash of its pass's name (0: free) */
   bool in_place;   /* this frame's pass: they hold the tiles it processed last frame still */
 } tile_cache;
 
@@ -68,7 +69,7 @@ struct lm_renderer {
   bool sharing;
   lm_trace *trace; /* the scene's BVH, built by the first CPU "trace" pass */
   uint64_t trace_hash; /* geometry_hash when it was built or refitted */
-  tile_cache tiles[VIEW_SETS];
+  tile_cache tiles[VIEW_PASSES];
   uint64_t casters_hash; /* this frame's material_hash (record) */
   float *prev_world; /* each node's world transform in the previous frame (velocities) */
   int prev_world_count, prev_world_cap; /* nodes it holds (another count than the scene's: a first frame) */
@@ -102,7 +103,7 @@ lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
   r->graph = lm_graph_create();
   r->sharing = true;
   r->output_srgb = r->output_linear = -1;
-  for (int i = 0; i < VIEW_SETS; i++) r->tiles[i].execution = -1;
+  for (int i = 0; i < VIEW_PASSES; i++) r->tiles[i].execution = -1;
   lm_renderer_resize(r, desc->width, desc->height);
   r->clock = lm_clock_choose(desc->clock);
   return r;
@@ -111,12 +112,13 @@ lm_renderer *lm_renderer_create(const lm_renderer_desc *desc, lm_error *err) {
 static void tile_cache_free(tile_cache *c) {
   for (int i = 0; i < c->count; i++) lm_texture_destroy(&c->tex[i]), lm_texture_destroy(&c->layer[i]);
   free(c->tiles);
-  *c = (tile_cache){.execution = -1};
+  uint64_t owner = c->owner; /* still its pass's */
+  *c = (tile_cache){.execution = -1, .owner = owner};
 }
 
 void lm_renderer_destroy(lm_renderer *r) {
   if (!r) return;
-  for (int i = 0; i < VIEW_SETS; i++) tile_cache_free(&r->tiles[i]);
+  for (int i = 0; i < VIEW_PASSES; i++) tile_cache_free(&r->tiles[i]);
   lm_graph_destroy(r->graph);
   lm_shadow_plan_free(&r->shadows);
   lm_readback_free(&r->fit_read);
@@ -293,6 +295,25 @@ static uint64_t tile_key(const lm_renderer *r, const lm_scene_pass *sp, bool sta
   return lm_hash(v->cull, sizeof v->cull, h);
 }
 
+/* Scene pass sp's cache, by its name: two passes over the same views (the
+ * RSM's and its back faces') each keep their own tiles, where one cache for
+ * both made each forget the other's every frame. Past VIEW_PASSES passes
+ * the last cache is shared: tiles drawn again, never wrong ones (the key
+ * holds the pass). */
+static tile_cache *tile_cache_of(lm_renderer *r, const lm_scene_pass *sp) {
+  const char *name = sp->desc->name ? sp->desc->name : "";
+  uint64_t h = lm_hash(name, strlen(name), 1) | 1; /* never 0, the free mark */
+  for (int i = 0; i < VIEW_PASSES; i++) {
+    tile_cache *c = &r->tiles[i];
+    if (c->owner == h) return c;
+    if (c->owner == 0) {
+      c->owner = h;
+      return c;
+    }
+  }
+  return &r->tiles[VIEW_PASSES - 1];
+}
+
 /* Makes the cache hold textures like the pass's (forgetting every tile when
  * they change); false when a texture cannot be made. */
 static bool tile_cache_fit(tile_cache *c, const lm_graph_target_info *t, int n, lm_error *err) {
@@ -336,7 +357,7 @@ static struct cached_tile *tile_at(tile_cache *c, const lm_pass_view *v) {
  * is still where it lay (draw_scene), and one drawn is cleared alone. */
 static bool keeps_views(void *user, const lm_scene_pass *sp) {
   lm_renderer *r = user;
-  tile_cache *c = &r->tiles[sp->desc->view_set];
+  tile_cache *c = tile_cache_of(r, sp);
   lm_graph_target_info t[LM_MAX_COLOR_OUTPUTS + 1];
   int nt = r->shadows.settings.cache ? pass_textures(sp, t) : 0;
   bool same = nt > 0 && nt == c->count && c->execution == r->executions - 1 && t[0].width == c->width &&
@@ -420,7 +441,7 @@ static bool casters_animated(const lm_scene *s) {
  * then the moving casters over it. */
 static bool draw_layered(lm_renderer *r, const lm_scene_pass *sp, const lm_graph_target_info *t, int nt,
                          struct cached_tile *cached, uint64_t pass, bool in_place, lm_error *err) {
-  tile_cache *c = &r->tiles[sp->desc->view_set];
+  tile_cache *c = tile_cache_of(r, sp);
   if (!tile_cache_layers(c, err)) return false;
   uint64_t key = tile_key(r, sp, true, pass);
   if (cached->layered && cached->static_key == key) {
@@ -488,7 +509,7 @@ static int scroll_tile(lm_renderer *r, const lm_scene_pass *sp, const lm_graph_t
   int keep[4] = {had[0] + kx > need[0] ? had[0] + kx : need[0], had[1] + ky > need[1] ? had[1] + ky : need[1],
                  had[2] + kx < need[2] ? had[2] + kx : need[2], had[3] + ky < need[3] ? had[3] + ky : need[3]};
   if (!(far <= had_far + 1e-5f && far > -1.0f + 1e-6f) || keep[0] >= keep[2] || keep[1] >= keep[3]) return 0;
-  const lm_texture *copy = r->tiles[sp->desc->view_set].tex;
+  const lm_texture *copy = tile_cache_of(r, sp)->tex;
   if (!cached->copied) copy_tile(t, copy, nt, cached, true); /* last frame's, where they move from */
   /* The whole tile moved (outside the box too: what lookups never read stays as it was) */
   int x0 = kx > 0 ? kx : 0, y0 = ky > 0 ? ky : 0, x1 = kx < 0 ? w + kx : w, y1 = ky < 0 ? h + ky : h;
@@ -532,7 +553,7 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
   lm_graph_target_info t[LM_MAX_COLOR_OUTPUTS + 1];
   int nt = sp->view && r->shadows.settings.cache ? pass_textures(sp, t) : 0;
   uint64_t key = 0, pass = 0;
-  tile_cache *c = &r->tiles[sp->desc->view_set];
+  tile_cache *c = tile_cache_of(r, sp);
   if (nt > 0) {
     bool in_place = c->in_place;
     if (!tile_cache_fit(c, t, nt, err)) return false;
@@ -577,7 +598,7 @@ static bool draw_scene(void *user, const lm_scene_pass *sp, lm_error *err) {
 bool lm_renderer_set_scene(lm_renderer *r, lm_scene *scene, lm_error *err) {
   if (!lm_scene_upload(scene, err)) return false;
   r->desc.scene = scene;
-  for (int i = 0; i < VIEW_SETS; i++) /* another scene's textures are not hashed: draw every tile again */
+  for (int i = 0; i < VIEW_PASSES; i++) /* another scene's textures are not hashed: draw every tile again */
     r->tiles[i].tile_count = 0;
   r->frame = r->redrawn = 0;
   lm_trace_destroy(r->trace);
@@ -1046,7 +1067,7 @@ static bool execute(lm_renderer *r, lm_graph *g, int meter, lm_error *err) {
   lm_frame_data *frame = &r->camera;
   r->stats = r->shadow_stats = (lm_scene_draw_stats){0};
   r->executions++;
-  for (int i = 0; i < VIEW_SETS; i++) r->tiles[i].in_place = false;
+  for (int i = 0; i < VIEW_PASSES; i++) r->tiles[i].in_place = false;
   memcpy(frame->prev_view_proj, r->frame ? r->prev_view_proj : frame->view_proj, sizeof frame->prev_view_proj);
   memcpy(r->prev_view_proj, frame->view_proj, sizeof r->prev_view_proj);
   /* A first frame (after a cut, or another scene) has no previous transforms: nothing moved. */
