@@ -204,6 +204,10 @@ bad "unknown option" 2 "bad.lua: set.nosuch: " \
   "return { scenes = { '$scenes/cornell.glb' }, set = { nosuch = 1 }, output = 'o/{camera}.png' }"
 bad "unknown field" 2 "bad.lua: unknown field 'outputs'" \
   "return { scenes = { '$scenes/cornell.glb' }, outputs = 'o/{camera}.png' }"
+bad "misspelt scene field" 2 "bad.lua: scenes[1]: unknown field 'camera' (known: scene, cameras)" \
+  "return { scenes = { { scene = '$scenes/cornell.glb', camera = 'x.cams' } }, output = 'o/{camera}.png' }"
+bad "named entry in a list" 2 "bad.lua: sizes: unknown field 'big' (known: none: a list of 1)" \
+  "return { scenes = { '$scenes/cornell.glb' }, sizes = { '8x8', big = '16x16' }, output = 'o/{camera}.png' }"
 bad "bad size" 2 "bad.lua: sizes[1]: want \"WxH\"" \
   "return { scenes = { '$scenes/cornell.glb' }, sizes = { '0x3' }, output = 'o/{camera}.png' }"
 bad "unknown placeholder" 1 "bad.lua: output: unknown placeholder '{cam}'" \
@@ -367,6 +371,18 @@ badseq "path fov" 2 "bad.lua: path[1].fov: 200 degrees is outside (0.1, 179)" \
   "time = { 0, 1, 4 }, path = { { t = 0, eye = { 0, 1, 3 }, target = { 0, 1, 0 }, fov = 200 } }"
 badseq "path eye at target" 2 "bad.lua: path[1]: the eye is at the target" \
   "time = { 0, 1, 4 }, path = { { t = 0, eye = { 0, 1, 0 }, target = { 0, 1, 0 } } }"
+badseq "misspelt path key field" 2 "bad.lua: path[2]: unknown field 'fvo' (known: t, eye, target, fov)" \
+  "time = { 0, 1, 4 }, path = { $k0, { t = 1, eye = { 1, 1, 3 }, target = { 0, 1, 0 }, fvo = 30 } }"
+badseq "path eye far out" 2 "bad.lua: path[1].eye[2]: 1e+30 is not within +-1e9" \
+  "time = { 0, 1, 4 }, path = { { t = 0, eye = { 0, 1e30, 3 }, target = { 0, 1, 0 } } }"
+badseq "misspelt time field" 2 "bad.lua: time: unknown field 'fsp' (known: start, stop, fps, or 3 in a list)" \
+  "time = { start = 0, stop = 1, fsp = 8 }"
+badseq "time of four numbers" 2 "bad.lua: time: unknown field '4' (known: start, stop, fps, or 3 in a list)" \
+  "time = { 0, 1, 4, 8 }"
+badseq "misspelt path list field" 2 "bad.lua: path: unknown field 'time' (known: cameras, times)" \
+  "time = { 0, 1, 4 }, path = { cameras = '$tmp/keys.cams', time = { 0, 1 } }"
+badseq "misspelt turntable field" 2 "bad.lua: turntable: unknown field 'turn' (known: turns, elevation, distance)" \
+  "time = { 0, 1, 4 }, turntable = { turn = 2 }"
 badseq "path list times" 2 "bad.lua: path.times: a list of 2 times (one for each view of $tmp/keys.cams)" \
   "time = { 0, 1, 4 }, path = { cameras = '$tmp/keys.cams', times = { 0 } }"
 badseq "path list missing" 2 "bad.lua: path: " "time = { 0, 1, 4 }, path = '$tmp/nosuch.cams'"
