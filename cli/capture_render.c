@@ -64,13 +64,17 @@ static void collect_times(lm_graph *g, pass_samples **times, int *count, int fra
   }
 }
 
+/* A frame's outputs are written all or none: when one fails, those written
+ * before it are removed, so that no failed frame is left half there (its
+ * PNG without its EXR) to pass for a rendered one. */
 static bool write_outputs(lm_renderer *r, int width, int height, const char *const *outputs, int count,
                           bool quiet, lm_error *err) {
   size_t px = (size_t)width * height;
   unsigned char *srgb = NULL;
   float *linear = NULL;
   bool ok = true;
-  for (int i = 0; i < count && ok; i++) {
+  int written = 0;
+  for (int i = 0; i < count && ok; i++, written += ok) {
     bool want_linear = false;
     capture_known_extension(outputs[i], &want_linear);
     if (want_linear && !linear) {
@@ -85,6 +89,7 @@ static bool write_outputs(lm_renderer *r, int width, int height, const char *con
                           want_linear ? (void *)linear : (void *)srgb, err);
     if (ok && !quiet) lm_info("wrote %s", outputs[i]);
   }
+  for (int i = 0; i < written && !ok; i++) remove(outputs[i]);
   free(srgb);
   free(linear);
   return ok;

@@ -111,6 +111,15 @@ check "fps without a range message" err_has "--fps goes with --time START:STOP"
 check "unknown animation" run 2 capture --size 16x12 --animation walk --output "$tmp/img/s.png"
 check "unknown animation message" first_error_has "--animation walk: scene 'cornell' has no animation 'walk'"
 check "bad time values leave no file" no_files
+# A sequence whose frame 2 fails (its EXR cannot take its name): frames 0 and 1 whole, and nothing of frame 2,
+# not its PNG written before the EXR failed; the failed frame named.
+mkdir "$tmp/img/f0002.exr"
+check "a failing frame" run 1 capture --size 16x12 --tech dl --time 0:1 --fps 4 --quiet \
+  --output "$tmp/img/f{frame}.png" --output "$tmp/img/f{frame}.exr"
+check "a failing frame named" first_error_has "frame 2 at 0.500 s: $tmp/img/f0002.exr"
+check "the frames before it, whole, and nothing of it" \
+  test "$(ls "$tmp/img" | tr '\n' ' ')" = "f0000.exr f0000.png f0001.exr f0001.png f0002.exr "
+rm -rf "$tmp/img/"*
 # video: raw RGB frames piped to the ffmpeg program (a stand-in here that keeps its arguments and
 # input; the real program is not needed to check what limn hands it)
 mkdir -p "$tmp/bin"
