@@ -1057,7 +1057,8 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   m.header = NULL;
   m.run++;
 
-  int rc = 0;
+  int rc = 0, mine = 0; /* views in this shard */
+  for (int i = 0; i < view_count; i++) mine += job_shard_of(j, i, view_count, a->shards) == a->shard;
   bool any_linear;
   capture_known_extension(j->output, &any_linear);
   if (!job_make_parent(manifest_path, &err) ||
@@ -1091,8 +1092,10 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     limn_json_append(&h, lm_gl_version());
     lm_buf_append(&h, ",\n  \"platform\": ", -1);
     limn_json_append(&h, lm_context_platform());
-    lm_buf_printf(&h, ",\n  \"clock\": \"%s\",\n  \"shard\": \"%d/%d\",\n  \"run\": %d,\n  \"options\": [",
-                  lm_clock_name(lm_renderer_clock(r)), a->shard, a->shards, m.run);
+    /* "views": the images this manifest is to list; fewer in "images" when a run failed, was killed or
+     * goes on, so that a sequence cut short never reads as whole. */
+    lm_buf_printf(&h, ",\n  \"clock\": \"%s\",\n  \"shard\": \"%d/%d\",\n  \"views\": %d,\n  \"run\": %d,\n"
+                  "  \"options\": [", lm_clock_name(lm_renderer_clock(r)), a->shard, a->shards, mine, m.run);
     for (int i = 0; i < j->set_count + a->set_count; i++) {
       char set[400];
       if (i < j->set_count) snprintf(set, sizeof set, "%s=%s", j->set_names[i], j->set_values[i]);
@@ -1109,8 +1112,7 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
    * kill would, at a point a timed kill cannot hit reliably. */
   const char *kill_env = getenv("LIMN_JOB_KILL_AFTER");
   int kill_after = kill_env ? atoi(kill_env) : 0;
-  int mine = 0, done = 0, rendered = 0, skipped = 0;
-  for (int i = 0; i < view_count; i++) mine += job_shard_of(j, i, view_count, a->shards) == a->shard;
+  int done = 0, rendered = 0, skipped = 0;
   if (!rc && !a->quiet)
     printf("job %s: %d view%s (%d in shard %d/%d); %s; %s\n", j->path, view_count, view_count == 1 ? "" : "s",
            mine, a->shard, a->shards, lm_gl_renderer(), manifest_path);
