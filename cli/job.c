@@ -455,6 +455,32 @@ static bool read_path(lua_State *L, job *j, lm_error *err) {
   return ok;
 }
 
+/* Keys apart, a path's eye can still fly through the point it looks at
+ * between them (eye and target crossing), where the view has no direction:
+ * each frame's eye must stay off its target by a millionth of the keys'
+ * largest eye-to-target distance. */
+static bool path_frames_check(const job *j, lm_error *err) {
+  double reach = 0;
+  for (int i = 0; i < j->key_count; i++) {
+    double d2 = 0;
+    for (int c = 0; c < 3; c++) d2 += ((double)j->keys[i].target[c] - j->keys[i].eye[c]) * ((double)j->keys[i].target[c] - j->keys[i].eye[c]);
+    reach = fmax(reach, sqrt(d2));
+  }
+  for (int f = 0; f < j->frame_count && j->key_count > 1; f++) {
+    double t = j->fps > 0 ? j->time_start + f / j->fps : j->time_start, d2 = 0; /* as job_views times it */
+    float eye[3], target[3], fov;
+    camera_path_eval(j->keys, j->key_count, t, eye, target, &fov);
+    for (int c = 0; c < 3; c++) d2 += ((double)target[c] - eye[c]) * ((double)target[c] - eye[c]);
+    if (sqrt(d2) > 1e-6 * reach) continue;
+    int i = 0;
+    while (i < j->key_count - 2 && t >= j->keys[i + 1].t) i++;
+    lm_error_set(err, "%s: path: frame %d at %.3f s: the eye reaches the target between path[%d] and path[%d] "
+                 "(the path flies through the point it looks at: no view direction there)", j->path, f, t, i + 1, i + 2);
+    return false;
+  }
+  return true;
+}
+
 /* turntable = { turns = 1, elevation = 20, distance = "auto" | number }. */
 static bool read_turntable(lua_State *L, job *j, lm_error *err) {
   lua_getfield(L, -1, "turntable");
@@ -624,6 +650,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
                  j->turntable ? "turntable" : "path");
     return false;
   }
+  if (j->key_count && !path_frames_check(j, err)) return false;
   if (j->frame_count > 1 && !strstr(j->output, "{frame}")) {
     lm_error_set(err, "%s: output: a sequence of %d frames needs {frame} in the pattern (\"%s\")", path,
                  j->frame_count, j->output);

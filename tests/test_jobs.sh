@@ -397,6 +397,8 @@ badseq "misspelt path list field" 2 "bad.lua: path: unknown field 'time' (known:
   "time = { 0, 1, 4 }, path = { cameras = '$tmp/keys.cams', time = { 0, 1 } }"
 badseq "misspelt turntable field" 2 "bad.lua: turntable: unknown field 'turn' (known: turns, elevation, distance)" \
   "time = { 0, 1, 4 }, turntable = { turn = 2 }"
+badseq "path through its target" 2 "bad.lua: path: frame 2 at 0.500 s: the eye reaches the target between path[1] and path[2]" \
+  "time = { 0, 1, 4 }, path = { $k0, { t = 1, eye = { 0, 1, -3 }, target = { 0, 1, 0 } } }"
 badseq "path list times" 2 "bad.lua: path.times: a list of 2 times (one for each view of $tmp/keys.cams)" \
   "time = { 0, 1, 4 }, path = { cameras = '$tmp/keys.cams', times = { 0 } }"
 badseq "path list missing" 2 "bad.lua: path: " "time = { 0, 1, 4 }, path = '$tmp/nosuch.cams'"
