@@ -102,6 +102,11 @@ bool capture_render_write(lm_renderer *r, const capture_view *v, capture_result 
   if (!v->continues) lm_renderer_set_view(r, v->camera, v->width, v->height);
   bool ok = true;
   for (int f = 0; f < v->warmup + v->frames && ok; f++) {
+    if (v->stop && *v->stop) {
+      lm_error_set(err, "stopped by signal %d", (int)*v->stop);
+      ok = false;
+      break;
+    }
     ok = lm_renderer_frame(r, err);
     if (ok && f >= v->warmup) collect_times(lm_renderer_graph(r), &samples, &n, v->frames);
   }
