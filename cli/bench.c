@@ -289,9 +289,9 @@ static int parse_args(int argc, char **argv, bench *b) {
       double v[3] = {m->step, 0, m->elevation};
       bool ok = n >= 1 && n <= 3;
       for (int i = 0; i < n && ok; i++) ok = limn_parse_double(parts[i], &v[i]);
-      if (!ok || v[0] < 0 || v[0] > 360 || v[1] < 0 || v[2] < -89 || v[2] > 89)
-        return usage_error("--orbit wants STEP[,RADIUS[,ELEVATION]]: degrees a frame 0..360, a radius >= 0, "
-                           "an elevation -89..89, not '%s'", optarg);
+      if (!ok || v[0] < 0 || v[0] > 360 || v[1] < 0 || v[1] >= 1e9 || v[2] < -89 || v[2] > 89)
+        return usage_error("--orbit wants STEP[,RADIUS[,ELEVATION]]: degrees a frame 0..360, a radius in [0, 1e9) "
+                           "(a job's turntable distance's bound), an elevation -89..89, not '%s'", optarg);
       m->step = v[0], m->radius = v[1], m->elevation = v[2];
       m->on = m->orbit_given = true;
       break;

@@ -182,6 +182,13 @@ static bool video_close(video *v, bool ok, lm_error *err) {
   return ok;
 }
 
+/* SIGINT or SIGTERM while frames render: the run stops before the next
+ * rendered frame (a frame being written is finished and renamed into place),
+ * removes a video's temporary file and dies of the signal, as without the
+ * handler, leaving no temporary file behind. A second signal kills at once. */
+static volatile sig_atomic_t stop_signal;
+static void on_stop(int sig) { stop_signal = sig; }
+
 /* Returns 0 to go on, else the exit code. */
 static int parse_args(int argc, char **argv, capture_args *a) {
   *a = (capture_args){.common = {.scene = "cornell", .width = 256, .height = 192, .camera_auto = true},
@@ -389,9 +396,17 @@ int limn_capture(int argc, char **argv) {
   unsigned char *rgb = a.video_count ? lm_alloc((size_t)o->width * o->height * 3) : NULL;
   int opened = 0;
   if (a.video_count) signal(SIGPIPE, SIG_IGN); /* a failed ffmpeg is an error from write, not a kill */
+  struct sigaction stop = {.sa_handler = on_stop, .sa_flags = SA_RESTART | SA_RESETHAND}, old_int, old_term;
+  sigemptyset(&stop.sa_mask);
+  stop_signal = 0;
+  sigaction(SIGINT, NULL, &old_int);
+  sigaction(SIGTERM, NULL, &old_term);
+  if (old_int.sa_handler != SIG_IGN) sigaction(SIGINT, &stop, NULL); /* ignored (a background job's): kept so */
+  if (old_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &stop, NULL);
   for (int i = 0; i < a.video_count && ok; i++)
     if ((ok = video_open(&videos[i], a.videos[i], o->width, o->height, a.fps, &err))) opened++;
-  for (int k = 0; k < a.frame_count && ok; k++) {
+  int written = 0; /* frames */
+  for (int k = 0; k < a.frame_count && ok && !stop_signal; k++) {
     double t = a.frame_count > 1 ? a.time_start + k / a.fps : a.time_start;
     if (a.time_flag || a.animation) {
       if (k == 0) /* the previous pose (velocities): the frame before's, a still's own */
@@ -404,12 +419,18 @@ int limn_capture(int argc, char **argv) {
     }
     capture_view v = {.camera = o->camera, .width = o->width, .height = o->height, .frames = a.frames,
                       .warmup = k ? 0 : a.warmup, .outputs = outputs, .output_count = a.output_count,
-                      .quiet = a.quiet, .continues = k > 0};
+                      .quiet = a.quiet, .continues = k > 0, .stop = &stop_signal};
     capture_result_free(&res);
     ok = capture_render_write(r, &v, &res, &err);
     if (ok && a.video_count) ok = lm_renderer_read(r, false, rgb, &err);
     for (int i = 0; i < a.video_count && ok; i++) ok = video_write(&videos[i], rgb, (size_t)o->width * o->height * 3, &err);
     if (!ok && a.frame_count > 1) lm_error_prefix(&err, "frame %d at %.3f s", k, t);
+    written += ok;
+  }
+  if (stop_signal) {
+    lm_error_set(&err, "stopped by signal %d after %d of %d frames (those written whole; no partial file left)",
+                 (int)stop_signal, written, a.frame_count);
+    ok = false;
   }
   for (int i = 0; i < opened; i++) {
     lm_error e;
@@ -427,5 +448,8 @@ int limn_capture(int argc, char **argv) {
   lm_scene_destroy(scene);
   lm_context_destroy();
   lm_pipeline_destroy(pipeline);
+  sigaction(SIGINT, &old_int, NULL);
+  sigaction(SIGTERM, &old_term, NULL);
+  if (stop_signal) raise(stop_signal);
   return ok ? 0 : 1;
 }

@@ -64,13 +64,17 @@ static void collect_times(lm_graph *g, pass_samples **times, int *count, int fra
   }
 }
 
+/* A frame's outputs are written all or none: when one fails, those written
+ * before it are removed, so that no failed frame is left half there (its
+ * PNG without its EXR) to pass for a rendered one. */
 static bool write_outputs(lm_renderer *r, int width, int height, const char *const *outputs, int count,
                           bool quiet, lm_error *err) {
   size_t px = (size_t)width * height;
   unsigned char *srgb = NULL;
   float *linear = NULL;
   bool ok = true;
-  for (int i = 0; i < count && ok; i++) {
+  int written = 0;
+  for (int i = 0; i < count && ok; i++, written += ok) {
     bool want_linear = false;
     capture_known_extension(outputs[i], &want_linear);
     if (want_linear && !linear) {
@@ -85,6 +89,7 @@ static bool write_outputs(lm_renderer *r, int width, int height, const char *con
                           want_linear ? (void *)linear : (void *)srgb, err);
     if (ok && !quiet) lm_info("wrote %s", outputs[i]);
   }
+  for (int i = 0; i < written && !ok; i++) remove(outputs[i]);
   free(srgb);
   free(linear);
   return ok;
@@ -97,6 +102,11 @@ bool capture_render_write(lm_renderer *r, const capture_view *v, capture_result 
   if (!v->continues) lm_renderer_set_view(r, v->camera, v->width, v->height);
   bool ok = true;
   for (int f = 0; f < v->warmup + v->frames && ok; f++) {
+    if (v->stop && *v->stop) {
+      lm_error_set(err, "stopped by signal %d", (int)*v->stop);
+      ok = false;
+      break;
+    }
     ok = lm_renderer_frame(r, err);
     if (ok && f >= v->warmup) collect_times(lm_renderer_graph(r), &samples, &n, v->frames);
   }

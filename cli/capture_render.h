@@ -5,6 +5,8 @@
 #ifndef LIMN_CAPTURE_RENDER_H
 #define LIMN_CAPTURE_RENDER_H
 
+#include <signal.h>
+
 #include "render/render.h"
 
 typedef struct capture_view {
@@ -16,6 +18,9 @@ typedef struct capture_view {
   /* The next frame of a sequence through the same camera and size: the
    * renderer keeps its temporal histories (no lm_renderer_set_view). */
   bool continues;
+  /* A signal's flag (NULL: none): set, the frames stop before the next one
+   * and nothing is written. */
+  const volatile sig_atomic_t *stop;
 } capture_view;
 
 /* How outputs name a sequence's frame and time ({frame}, {time}). */

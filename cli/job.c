@@ -83,6 +83,33 @@ static bool field_string(lua_State *L, int t, const char *key, char *out, size_t
 }
 
 
+/* Refuses a key of the table at the top of the stack that is neither in
+ * `known` (NULL-ended) nor an index 1 .. max_index: a misspelt field
+ * ("fvo") is an error naming it, not a default taken in silence. */
+static bool known_fields(lua_State *L, const char *const *known, int max_index, const char *what, lm_error *err) {
+  bool ok = true;
+  lua_pushnil(L);
+  while (ok && lua_next(L, -2)) {
+    lua_pop(L, 1);
+    bool found = lua_isinteger(L, -1) && lua_tointeger(L, -1) >= 1 && lua_tointeger(L, -1) <= max_index;
+    for (const char *const *k = known; *k && !found && lua_type(L, -1) == LUA_TSTRING; k++)
+      found = !strcmp(*k, lua_tostring(L, -1));
+    if (found) continue;
+    lm_buf names = {0};
+    for (const char *const *k = known; *k; k++) lm_buf_printf(&names, "%s%s", k == known ? "" : ", ", *k);
+    if (max_index > 0 && known[0]) lm_buf_printf(&names, ", or %d in a list", max_index);
+    else if (!known[0]) lm_buf_printf(&names, "none: a list of %d", max_index);
+    lua_pushvalue(L, -1); /* tostring on a copy */
+    const char *key = lua_type(L, -1) == LUA_TSTRING || lua_type(L, -1) == LUA_TNUMBER ? lua_tostring(L, -1)
+                                                                                    : luaL_typename(L, -1);
+    lm_error_set(err, "%s: unknown field '%s' (known: %s)", what, key, names.data);
+    lm_buf_free(&names);
+    lua_pop(L, 2); /* the copy and lua_next's key */
+    ok = false;
+  }
+  return ok;
+}
+
 /* Reads the list at key: each element through `each` (index from 1). */
 static bool read_list(lua_State *L, int t, const char *key, const char *path, int *count, lm_error *err,
                       bool (*each)(lua_State *L, job *j, int i, lm_error *err), job *j) {
@@ -93,9 +120,14 @@ static bool read_list(lua_State *L, int t, const char *key, const char *path, in
     *count = ok;
   } else if (lua_istable(L, -1)) {
     int n = (int)lua_rawlen(L, -1);
+    static const char *const none[] = {NULL};
+    char what[1100];
+    snprintf(what, sizeof what, "%s: %s", path, key);
     if (n > MAX_LIST) {
       lm_error_set(err, "%s: %s: at most %d entries", path, key, MAX_LIST);
       ok = false;
+    } else {
+      ok = known_fields(L, none, n, what, err);
     }
     for (int i = 1; i <= n && ok; i++) {
       lua_rawgeti(L, -1, i);
@@ -119,7 +151,8 @@ static bool each_scene(lua_State *L, job *j, int i, lm_error *err) {
   } else if (lua_istable(L, -1)) {
     char what[64];
     snprintf(what, sizeof what, "%s: scenes[%d]", j->path, i);
-    if (!field_string(L, -1, "scene", given, sizeof given, what, err) ||
+    static const char *const known[] = {"scene", "cameras", NULL};
+    if (!known_fields(L, known, 0, what, err) || !field_string(L, -1, "scene", given, sizeof given, what, err) ||
         !field_string(L, -1, "cameras", cams, sizeof cams, what, err))
       return false;
   } else {
@@ -255,8 +288,10 @@ static bool read_time(lua_State *L, job *j, lm_error *err) {
     return ok;
   }
   if (type == LUA_TTABLE) {
-    static const char *const names[3] = {"start", "stop", "fps"};
+    static const char *const names[4] = {"start", "stop", "fps", NULL};
     double v[3] = {NAN, NAN, NAN};
+    snprintf(what, sizeof what, "%s: time", j->path);
+    ok = known_fields(L, names, 3, what, err);
     for (int i = 0; i < 3 && ok; i++) {
       snprintf(what, sizeof what, "%s: time.%s", j->path, names[i]);
       ok = field_number(L, -1, NULL, i + 1, &v[i], what, err) && field_number(L, -1, names[i], 0, &v[i], what, err);
@@ -287,18 +322,22 @@ static bool read_time(lua_State *L, job *j, lm_error *err) {
   return ok;
 }
 
-/* path[i]'s eye or target: three finite numbers. */
+/* path[i]'s eye or target: three numbers within 1e9 (a camera further out
+ * has no depth range floats can hold with the scene's). */
 static bool read_point(lua_State *L, const char *key, float out[3], const char *what, lm_error *err) {
   lua_getfield(L, -1, key);
   bool ok = lua_istable(L, -1) && lua_rawlen(L, -1) == 3;
+  if (!ok) lm_error_set(err, "%s.%s: needs 3 numbers", what, key);
   for (int k = 0; k < 3 && ok; k++) {
     lua_rawgeti(L, -1, k + 1);
-    ok = lua_type(L, -1) == LUA_TNUMBER && isfinite(lua_tonumber(L, -1)) && fabs(lua_tonumber(L, -1)) < 1e9;
-    out[k] = (float)lua_tonumber(L, -1);
+    double v = lua_tonumber(L, -1);
+    if (lua_type(L, -1) != LUA_TNUMBER) lm_error_set(err, "%s.%s: needs 3 numbers, not a %s", what, key,
+                                                      luaL_typename(L, -1)), ok = false;
+    else if (!(fabs(v) < 1e9)) lm_error_set(err, "%s.%s[%d]: %g is not within +-1e9", what, key, k + 1, v), ok = false;
+    out[k] = (float)v;
     lua_pop(L, 1);
   }
   lua_pop(L, 1);
-  if (!ok) lm_error_set(err, "%s.%s: needs 3 numbers", what, key);
   return ok;
 }
 
@@ -357,6 +396,8 @@ static bool read_key(lua_State *L, job *j, int i, lm_error *err) {
     lm_error_set(err, "%s: a key { t = SECONDS, eye = {x,y,z}, target = {x,y,z}, fov = DEGREES }, not a %s", what,
                  luaL_typename(L, -1));
   double t = NAN, fov = i > 1 ? j->keys[i - 2].fov : 45; /* fov: the previous key's */
+  static const char *const known[] = {"t", "eye", "target", "fov", NULL};
+  ok = ok && known_fields(L, known, 0, what, err);
   snprintf(field, sizeof field, "%s.t", what);
   ok = ok && field_number(L, -1, "t", 0, &t, field, err);
   snprintf(field, sizeof field, "%s.fov", what);
@@ -382,12 +423,17 @@ static bool read_path(lua_State *L, job *j, lm_error *err) {
     if (lua_type(L, -1) == LUA_TSTRING) snprintf(given, sizeof given, "%s", lua_tostring(L, -1));
     lua_pop(L, 1);
     int n = (int)lua_rawlen(L, -1);
+    static const char *const list_fields[] = {"cameras", "times", NULL}, *const none[] = {NULL};
+    char what[1100];
+    snprintf(what, sizeof what, "%s: path", j->path);
     if (given[0]) {
-      ok = read_path_list(L, j, given, err);
+      ok = known_fields(L, list_fields, 0, what, err) && read_path_list(L, j, given, err);
     } else if (n < 1 || n > MAX_PATH_KEYS) {
       lm_error_set(err, "%s: path: 1 to %d keys { t = SECONDS, eye = {x,y,z}, target = {x,y,z}, fov = DEGREES }, "
                    "or { cameras = FILE, times = {...} }", j->path, MAX_PATH_KEYS);
       ok = false;
+    } else {
+      ok = known_fields(L, none, n, what, err);
     }
     for (int i = 1; i <= n && ok && !given[0]; i++) ok = read_key(L, j, i, err);
     if (ok && !given[0]) j->key_count = n;
@@ -409,6 +455,32 @@ static bool read_path(lua_State *L, job *j, lm_error *err) {
   return ok;
 }
 
+/* Keys apart, a path's eye can still fly through the point it looks at
+ * between them (eye and target crossing), where the view has no direction:
+ * each frame's eye must stay off its target by a millionth of the keys'
+ * largest eye-to-target distance. */
+static bool path_frames_check(const job *j, lm_error *err) {
+  double reach = 0;
+  for (int i = 0; i < j->key_count; i++) {
+    double d2 = 0;
+    for (int c = 0; c < 3; c++) d2 += ((double)j->keys[i].target[c] - j->keys[i].eye[c]) * ((double)j->keys[i].target[c] - j->keys[i].eye[c]);
+    reach = fmax(reach, sqrt(d2));
+  }
+  for (int f = 0; f < j->frame_count && j->key_count > 1; f++) {
+    double t = j->fps > 0 ? j->time_start + f / j->fps : j->time_start, d2 = 0; /* as job_views times it */
+    float eye[3], target[3], fov;
+    camera_path_eval(j->keys, j->key_count, t, eye, target, &fov);
+    for (int c = 0; c < 3; c++) d2 += ((double)target[c] - eye[c]) * ((double)target[c] - eye[c]);
+    if (sqrt(d2) > 1e-6 * reach) continue;
+    int i = 0;
+    while (i < j->key_count - 2 && t >= j->keys[i + 1].t) i++;
+    lm_error_set(err, "%s: path: frame %d at %.3f s: the eye reaches the target between path[%d] and path[%d] "
+                 "(the path flies through the point it looks at: no view direction there)", j->path, f, t, i + 1, i + 2);
+    return false;
+  }
+  return true;
+}
+
 /* turntable = { turns = 1, elevation = 20, distance = "auto" | number }. */
 static bool read_turntable(lua_State *L, job *j, lm_error *err) {
   lua_getfield(L, -1, "turntable");
@@ -417,8 +489,11 @@ static bool read_turntable(lua_State *L, job *j, lm_error *err) {
   if (lua_istable(L, -1)) {
     char what[1100];
     j->turntable = true;
+    static const char *const known[] = {"turns", "elevation", "distance", NULL};
+    snprintf(what, sizeof what, "%s: turntable", j->path);
+    ok = known_fields(L, known, 0, what, err);
     snprintf(what, sizeof what, "%s: turntable.turns", j->path);
-    ok = field_number(L, -1, "turns", 0, &j->turns, what, err);
+    ok = ok && field_number(L, -1, "turns", 0, &j->turns, what, err);
     snprintf(what, sizeof what, "%s: turntable.elevation", j->path);
     ok = ok && field_number(L, -1, "elevation", 0, &j->elevation, what, err);
     if (ok && !(fabs(j->elevation) < 89)) {
@@ -519,18 +594,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
   static const char *const known[] = {"script", "scenes", "techniques", "sizes", "set", "frames", "output",
                                       "manifest", "time", "animation", "path", "turntable", "events",
                                       "renderer", "references", NULL};
-  lua_pushnil(L);
-  while (ok && lua_next(L, -2)) {
-    lua_pop(L, 1);
-    bool found = false;
-    for (const char *const *k = known; *k && lua_type(L, -1) == LUA_TSTRING; k++) found |= !strcmp(*k, lua_tostring(L, -1));
-    if (!found) {
-      lm_error_set(err, "%s: unknown field '%s' (known: script, scenes, techniques, sizes, set, frames, output, "
-                   "manifest, time, animation, path, turntable, events, renderer, references)", path, lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : luaL_typename(L, -1));
-      ok = false;
-      lua_pop(L, 1);
-    }
-  }
+  ok = known_fields(L, known, 0, path, err);
   char script[1024] = "scripts/pp.lua", manifest[1024] = "";
   ok = ok && field_string(L, -1, "script", script, sizeof script, path, err) &&
        field_string(L, -1, "output", j->output, sizeof j->output, path, err) &&
@@ -586,6 +650,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
                  j->turntable ? "turntable" : "path");
     return false;
   }
+  if (j->key_count && !path_frames_check(j, err)) return false;
   if (j->frame_count > 1 && !strstr(j->output, "{frame}")) {
     lm_error_set(err, "%s: output: a sequence of %d frames needs {frame} in the pattern (\"%s\")", path,
                  j->frame_count, j->output);
@@ -1019,7 +1084,8 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   m.header = NULL;
   m.run++;
 
-  int rc = 0;
+  int rc = 0, mine = 0; /* views in this shard */
+  for (int i = 0; i < view_count; i++) mine += job_shard_of(j, i, view_count, a->shards) == a->shard;
   bool any_linear;
   capture_known_extension(j->output, &any_linear);
   if (!job_make_parent(manifest_path, &err) ||
@@ -1053,8 +1119,10 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     limn_json_append(&h, lm_gl_version());
     lm_buf_append(&h, ",\n  \"platform\": ", -1);
     limn_json_append(&h, lm_context_platform());
-    lm_buf_printf(&h, ",\n  \"clock\": \"%s\",\n  \"shard\": \"%d/%d\",\n  \"run\": %d,\n  \"options\": [",
-                  lm_clock_name(lm_renderer_clock(r)), a->shard, a->shards, m.run);
+    /* "views": the images this manifest is to list; fewer in "images" when a run failed, was killed or
+     * goes on, so that a sequence cut short never reads as whole. */
+    lm_buf_printf(&h, ",\n  \"clock\": \"%s\",\n  \"shard\": \"%d/%d\",\n  \"views\": %d,\n  \"run\": %d,\n"
+                  "  \"options\": [", lm_clock_name(lm_renderer_clock(r)), a->shard, a->shards, mine, m.run);
     for (int i = 0; i < j->set_count + a->set_count; i++) {
       char set[400];
       if (i < j->set_count) snprintf(set, sizeof set, "%s=%s", j->set_names[i], j->set_values[i]);
@@ -1071,8 +1139,7 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
    * kill would, at a point a timed kill cannot hit reliably. */
   const char *kill_env = getenv("LIMN_JOB_KILL_AFTER");
   int kill_after = kill_env ? atoi(kill_env) : 0;
-  int mine = 0, done = 0, rendered = 0, skipped = 0;
-  for (int i = 0; i < view_count; i++) mine += job_shard_of(j, i, view_count, a->shards) == a->shard;
+  int done = 0, rendered = 0, skipped = 0;
   if (!rc && !a->quiet)
     printf("job %s: %d view%s (%d in shard %d/%d); %s; %s\n", j->path, view_count, view_count == 1 ? "" : "s",
            mine, a->shard, a->shards, lm_gl_renderer(), manifest_path);

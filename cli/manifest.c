@@ -59,13 +59,14 @@ static void describe(const job *j, const job_view *v, int index, bool technique,
            j->sizes[v->size][1]);
 }
 
-/* The first shard's header for the whole job: "shards" for its "shard", no "run". */
-static char *merged_header(const char *header, int shards) {
+/* The first shard's header for the whole job: "shards" for its "shard", the job's "views", no "run". */
+static char *merged_header(const char *header, int shards, int views) {
   lm_buf b = {0};
   for (const char *line = header; *line;) {
     const char *nl = strchr(line, '\n');
     size_t len = nl ? (size_t)(nl - line + 1) : strlen(line);
     if (!strncmp(line, "  \"shard\": ", 11)) lm_buf_printf(&b, "  \"shards\": %d,\n", shards);
+    else if (!strncmp(line, "  \"views\": ", 11)) lm_buf_printf(&b, "  \"views\": %d,\n", views);
     else if (strncmp(line, "  \"run\": ", 9)) lm_buf_append(&b, line, (long)len);
     line += len;
   }
@@ -191,7 +192,7 @@ static int merge(const merge_args *a, job *j) {
            list.data ? list.data : "-");
     lm_buf_free(&list);
   } else {
-    job_manifest out = {.header = merged_header(m[first].header, a->shards), .entries = entries};
+    job_manifest out = {.header = merged_header(m[first].header, a->shards, n), .entries = entries};
     const char *output = a->output ? a->output : j->manifest;
     if (!job_make_parent(output, &err) || !job_manifest_write(output, &out, n, &err)) {
       lm_log(LM_LOG_ERROR, "%s", err.msg);

@@ -32,7 +32,13 @@ void set_error(char *slot, size_t cap, const char *msg, const char *cleared) {
   snprintf(slot, cap, "%s", msg);
 }
 
-long view_frame(const viewer *v) { return (long)floor(v->time * v->args->fps + 1e-6); }
+/* Held within +-1e15: a time as far out as 1e30 s (--time, time=, a job's
+ * time; it poses the animation's end) has a frame number past a long's range,
+ * whose conversion is undefined (it read -9223372036854775808). */
+long view_frame(const viewer *v) {
+  double f = floor(v->time * v->args->fps + 1e-6);
+  return (long)fmax(-1e15, fmin(f, 1e15));
+}
 
 const char *view_animation_name(const viewer *v) {
   return v->anim >= 0 && v->anim < v->scene->animation_count ? v->scene->animations[v->anim].name : "all";

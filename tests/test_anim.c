@@ -515,6 +515,38 @@ static void animated_camera_moves_the_view(void **state) {
   lm_scene_destroy(s);
 }
 
+/* A camera keyed to scale 0 at 1 s loads (its first pose is whole) and
+ * renders at 0.5 s; posed at 1 s it is refused naming camera and node, as
+ * the loader refuses such a camera at rest (it rendered an empty frame). */
+static void a_camera_scaled_to_zero_is_refused_at_that_pose(void **state) {
+  (void)state;
+  doc d = {0};
+  const float times[2] = {0, 1}, shrink[6] = {1, 1, 1, 0, 0, 0};
+  floats(&d, tri, 3, "VEC3");
+  int t = floats(&d, times, 2, "SCALAR"), v = floats(&d, shrink, 2, "VEC3");
+  char body[1024];
+  snprintf(body, sizeof body,
+           "\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
+           "\"nodes\":[{\"name\":\"cam\",\"camera\":0,\"translation\":[0,0,5]},{\"name\":\"tri\",\"mesh\":0}],"
+           "\"cameras\":[{\"name\":\"eye\",\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.1,\"zfar\":100}}],"
+           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+           "\"animations\":[{\"name\":\"shrink\",\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"scale\"}}],"
+           "\"samplers\":[{\"input\":%d,\"output\":%d}]}]",
+           t, v);
+  lm_scene *s = load(write_doc("shrink.gltf", &d, body));
+  lm_error err = {0};
+  assert_true(lm_scene_camera_check(s, 0, &err));
+  lm_scene_set_time(s, 0, 0.5);
+  assert_true(lm_scene_camera_check(s, 0, &err));
+  lm_scene_set_time(s, 0, 1);
+  assert_false(lm_scene_camera_check(s, 0, &err));
+  if (!strstr(err.msg, "camera 'eye' (0) on node 'cam'") || !strstr(err.msg, "zero scale"))
+    fail_msg("'%s' names no camera, node or cause", err.msg);
+  lm_scene_set_time(s, 0, 0.5); /* and back */
+  assert_true(lm_scene_camera_check(s, 0, &err));
+  lm_scene_destroy(s);
+}
+
 /* ---- bad data ----------------------------------------------------------- */
 
 /* Animation "walk": channel 0 a good one on node "box", channel 1 the case
@@ -728,6 +760,7 @@ int main(void) {
       cmocka_unit_test(skinned_grid_poses_where_its_joints_say),
       cmocka_unit_test(a_root_added_above_keeps_channels_and_joints),
       cmocka_unit_test(animated_camera_moves_the_view),
+      cmocka_unit_test(a_camera_scaled_to_zero_is_refused_at_that_pose),
       cmocka_unit_test(bad_animation_data_is_refused_by_name),
       cmocka_unit_test(bad_skins_are_refused_by_name),
       cmocka_unit_test(vast_keys_never_pose_non_finite_values),

@@ -111,6 +111,15 @@ check "fps without a range message" err_has "--fps goes with --time START:STOP"
 check "unknown animation" run 2 capture --size 16x12 --animation walk --output "$tmp/img/s.png"
 check "unknown animation message" first_error_has "--animation walk: scene 'cornell' has no animation 'walk'"
 check "bad time values leave no file" no_files
+# A sequence whose frame 2 fails (its EXR cannot take its name): frames 0 and 1 whole, and nothing of frame 2,
+# not its PNG written before the EXR failed; the failed frame named.
+mkdir "$tmp/img/f0002.exr"
+check "a failing frame" run 1 capture --size 16x12 --tech dl --time 0:1 --fps 4 --quiet \
+  --output "$tmp/img/f{frame}.png" --output "$tmp/img/f{frame}.exr"
+check "a failing frame named" first_error_has "frame 2 at 0.500 s: $tmp/img/f0002.exr"
+check "the frames before it, whole, and nothing of it" \
+  test "$(ls "$tmp/img" | tr '\n' ' ')" = "f0000.exr f0000.png f0001.exr f0001.png f0002.exr "
+rm -rf "$tmp/img/"*
 # video: raw RGB frames piped to the ffmpeg program (a stand-in here that keeps its arguments and
 # input; the real program is not needed to check what limn hands it)
 mkdir -p "$tmp/bin"
@@ -138,6 +147,19 @@ check "video without ffmpeg: a clear error" err_has "--output $tmp/img/v.mp4: vi
 check "video without ffmpeg: no file" no_files
 check "video of a still" run 2 capture --time 1 --output "$tmp/img/v.mp4"
 check "video of a still message" err_has "a video is of a sequence"
+# SIGTERM part-way through a sequence (a stop, a job scheduler's time limit): the frame in hand is finished,
+# then the run dies of the signal, leaving whole frames and no video, not even its temporary file.
+PATH="$tmp/bin:$PATH" "$limn" capture --size 32x24 --tech dl --time 0:100 --fps 4 --quiet \
+  --output "$tmp/img/f{frame}.png" --output "$tmp/img/v.mp4" 2>"$tmp/err" & pid=$!
+for i in $(seq 600); do [ -e "$tmp/img/f0001.png" ] && break; sleep 0.1; done
+kill -TERM "$pid"
+wait "$pid"; rc=$?
+check "stopped: dies of SIGTERM" test "$rc" = 143
+check "stopped: said so" err_has "stopped by signal 15 after"
+check "stopped: no video and no temporary file" test -z "$(ls "$tmp/img" | grep -v '^f[0-9]*\.png$')"
+whole_pngs() { local f; for f in "$@"; do tail -c 12 "$f" | grep -q IEND || { echo "  $f is cut short"; return 1; }; done; }
+check "stopped: the frames written whole" whole_pngs "$tmp/img/"f*.png
+rm -f "$tmp/img/"*
 
 # effects: `--set bloom=true` turns on bloom.enabled; dotted names set parameters
 check "effects capture" run 0 capture --scene cornell --script scripts/pp.lua --tech dl --size 64x48 \

@@ -204,6 +204,10 @@ bad "unknown option" 2 "bad.lua: set.nosuch: " \
   "return { scenes = { '$scenes/cornell.glb' }, set = { nosuch = 1 }, output = 'o/{camera}.png' }"
 bad "unknown field" 2 "bad.lua: unknown field 'outputs'" \
   "return { scenes = { '$scenes/cornell.glb' }, outputs = 'o/{camera}.png' }"
+bad "misspelt scene field" 2 "bad.lua: scenes[1]: unknown field 'camera' (known: scene, cameras)" \
+  "return { scenes = { { scene = '$scenes/cornell.glb', camera = 'x.cams' } }, output = 'o/{camera}.png' }"
+bad "named entry in a list" 2 "bad.lua: sizes: unknown field 'big' (known: none: a list of 1)" \
+  "return { scenes = { '$scenes/cornell.glb' }, sizes = { '8x8', big = '16x16' }, output = 'o/{camera}.png' }"
 bad "bad size" 2 "bad.lua: sizes[1]: want \"WxH\"" \
   "return { scenes = { '$scenes/cornell.glb' }, sizes = { '0x3' }, output = 'o/{camera}.png' }"
 bad "unknown placeholder" 1 "bad.lua: output: unknown placeholder '{cam}'" \
@@ -248,7 +252,8 @@ error_below() {
   local m; m=$(mean_error "$1" "$2")
   awk -v m="$m" -v x="$3" 'BEGIN { exit !(m < x) }' || { echo "  $1 vs $2: mean error $m, not below $3"; return 1; }
 }
-frames_of() { ls "$@" 2>/dev/null | grep -o '[0-9]\{4\}\.png' | tr '\n' ' '; }
+frames_of() { ls "$@" 2>/dev/null | frames_of_list; }
+frames_of_list() { grep -o '[0-9]\{4\}\.png' | tr '\n' ' '; }
 printf 'front 0 1 3.4  0 1 0  45\n' > one.cams
 cat > seq.lua <<LUA
 return {
@@ -271,9 +276,20 @@ rm -rf seq
 (LIMN_JOB_KILL_AFTER=2 "$limn" capture --job seq.lua >/dev/null 2>&1) 2>/dev/null
 check "sequence killed by SIGKILL" test $? -eq 137
 check "2 frames before the kill" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png "
+check "the killed sequence's manifest: 2 images of its 5 views" \
+  test "$(grep -c '"views": 5,' seq/manifest.json) $(entries seq/manifest.json)" = "1 2"
 check "rerun the killed sequence" run 0 capture --job seq.lua
 check "the rerun renders only the 3 missing frames" out_has "3 rendered, 2 skipped"
 check "all 5 frames after the rerun" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png 0002.png 0003.png 0004.png "
+check "the rerun's manifest: 5 images of 5 views" test "$(grep -c '"views": 5,' seq/manifest.json) $(entries seq/manifest.json)" = "1 5"
+rm -rf seq
+# A frame that fails (frame 3's name is taken by a folder): the job stops there naming it, exit 1; the
+# frames before it whole and in the manifest, which says they are 3 of the sequence's 5.
+mkdir -p seq/front-0003.png
+check "a failing frame" run 1 capture --job seq.lua
+check "a failing frame named" err_has "seq.lua: view 3 (cornell, camera 'front', dl, 48x36, frame 3 at 0.750 s): "
+check "the frames before it only" test "$(find seq -type f -name 'front-*' | sort | frames_of_list)" = "0000.png 0001.png 0002.png "
+check "its manifest: 3 images of 5 views" test "$(grep -c '"views": 5,' seq/manifest.json) $(entries seq/manifest.json)" = "1 3"
 rm -rf seq
 check "sequence shard 0/2" run 0 capture --job seq.lua --shard 0/2
 check "shard 0/2 renders frames 0-2 (a contiguous run)" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png 0002.png "
@@ -282,6 +298,8 @@ check "shard 1/2 renders the 2 others" out_has "2 rendered, 0 skipped"
 check "shards 0/2 and 1/2 cover every frame once" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png 0002.png 0003.png 0004.png "
 check "sequence shards merge" run 0 manifest merge --job seq.lua --shards 2
 check "sequence merge: each frame once" out_has "seq.lua: 5 views from 2 shards, each rendered once"
+check "shard manifests count their own views, the merged one the job's" \
+  test "$(grep -h '"views": ' seq/manifest.shard-0-of-2.json seq/manifest.shard-1-of-2.json seq/manifest.json | tr -d ' \n')" = '"views":3,"views":2,"views":5,'
 rm -rf seq
 check "farm a sequence" run 0 farm slurm --job seq.lua --shards 2 --dir seqfarm
 : > seqtasks.txt
@@ -367,6 +385,20 @@ badseq "path fov" 2 "bad.lua: path[1].fov: 200 degrees is outside (0.1, 179)" \
   "time = { 0, 1, 4 }, path = { { t = 0, eye = { 0, 1, 3 }, target = { 0, 1, 0 }, fov = 200 } }"
 badseq "path eye at target" 2 "bad.lua: path[1]: the eye is at the target" \
   "time = { 0, 1, 4 }, path = { { t = 0, eye = { 0, 1, 0 }, target = { 0, 1, 0 } } }"
+badseq "misspelt path key field" 2 "bad.lua: path[2]: unknown field 'fvo' (known: t, eye, target, fov)" \
+  "time = { 0, 1, 4 }, path = { $k0, { t = 1, eye = { 1, 1, 3 }, target = { 0, 1, 0 }, fvo = 30 } }"
+badseq "path eye far out" 2 "bad.lua: path[1].eye[2]: 1e+30 is not within +-1e9" \
+  "time = { 0, 1, 4 }, path = { { t = 0, eye = { 0, 1e30, 3 }, target = { 0, 1, 0 } } }"
+badseq "misspelt time field" 2 "bad.lua: time: unknown field 'fsp' (known: start, stop, fps, or 3 in a list)" \
+  "time = { start = 0, stop = 1, fsp = 8 }"
+badseq "time of four numbers" 2 "bad.lua: time: unknown field '4' (known: start, stop, fps, or 3 in a list)" \
+  "time = { 0, 1, 4, 8 }"
+badseq "misspelt path list field" 2 "bad.lua: path: unknown field 'time' (known: cameras, times)" \
+  "time = { 0, 1, 4 }, path = { cameras = '$tmp/keys.cams', time = { 0, 1 } }"
+badseq "misspelt turntable field" 2 "bad.lua: turntable: unknown field 'turn' (known: turns, elevation, distance)" \
+  "time = { 0, 1, 4 }, turntable = { turn = 2 }"
+badseq "path through its target" 2 "bad.lua: path: frame 2 at 0.500 s: the eye reaches the target between path[1] and path[2]" \
+  "time = { 0, 1, 4 }, path = { $k0, { t = 1, eye = { 0, 1, -3 }, target = { 0, 1, 0 } } }"
 badseq "path list times" 2 "bad.lua: path.times: a list of 2 times (one for each view of $tmp/keys.cams)" \
   "time = { 0, 1, 4 }, path = { cameras = '$tmp/keys.cams', times = { 0 } }"
 badseq "path list missing" 2 "bad.lua: path: " "time = { 0, 1, 4 }, path = '$tmp/nosuch.cams'"

@@ -239,6 +239,8 @@ PY
 check "gltf_pose turntable" pose_turntable
 check "bench bad orbit" run 2 bench --orbit 400
 check "bench bad orbit message" err_has "--orbit wants STEP[,RADIUS[,ELEVATION]]"
+check "bench orbit far out" run 2 bench --orbit 2,1e30
+check "bench orbit far out message" err_has "a radius in [0, 1e9)"
 check "bench bad walk" run 2 bench --walk 0
 check "bench bad walk message" err_has "--walk wants a share of the scene's diagonal a frame in (0, 1]"
 check "bench walk and orbit" run 2 bench --walk 0.01 --orbit 5

@@ -127,7 +127,7 @@ static void sample(const lm_anim_channel *c, double t, float *out) {
     const float *m0 = a + w, *m1 = b - w;
     double u2 = u * u, u3 = u2 * u;
     double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
-    double q[4];
+    double q[4] = {0}; /* w is 4 where it is read; gcc 12 under -fsanitize cannot tell (-Werror) */
     for (int i = 0; i < w; i++) {
       double v = h00 * a[i] + h10 * dt * m0[i] + h01 * b[i] + h11 * dt * m1[i];
       if (rotation) q[i] = v;

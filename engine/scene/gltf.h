@@ -32,7 +32,8 @@
  *   root node when it has no scenes), parents before children. A node's
  *   local transform is its matrix, or T * R * S. Every world transform must
  *   stay within LM_GLTF_MAX_COORD, and a camera's must be invertible (no
- *   zero scale), or the file is refused.
+ *   zero scale), or the file is refused (a pose an animation gives it,
+ *   lm_scene_camera_check refuses when a frame renders it).
  * - Each mesh primitive becomes its own lm mesh: a node whose mesh has one
  *   primitive holds it itself; a node whose mesh has several gets one child
  *   node per primitive ("<node>.<i>", identity transform), so that each node

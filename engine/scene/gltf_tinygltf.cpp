@@ -1442,11 +1442,7 @@ bool check_world(Loader &L) {
                     "translations too large", ni, (double)w[k], (double)LM_GLTF_MAX_COORD);
   }
   for (int ci = 0; ci < L.s->camera_count; ci++) {
-    const float *w = L.s->nodes[L.s->cameras[ci].node].world;
-    double det = (double)w[0] * ((double)w[5] * w[10] - (double)w[9] * w[6]) -
-                 (double)w[4] * ((double)w[1] * w[10] - (double)w[9] * w[2]) +
-                 (double)w[8] * ((double)w[1] * w[6] - (double)w[5] * w[2]);
-    if (!(std::fabs(det) > 1e-24))
+    if (!lm_scene_camera_invertible(L.s, ci))
       return fail(L, "camera '%s' on node '%s': its world transform has (near) zero scale and "
                   "cannot be inverted into a view", L.s->cameras[ci].name,
                   L.s->nodes[L.s->cameras[ci].node].name);

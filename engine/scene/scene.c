@@ -255,6 +255,15 @@ int lm_scene_add_framing_camera(lm_scene *s, const char *name, float aspect) {
   return lm_scene_add_camera(s, &cam);
 }
 
+bool lm_scene_camera_invertible(const lm_scene *s, int cam) {
+  if (cam < 0 || cam >= s->camera_count || s->cameras[cam].node < 0) return true;
+  const float *w = s->nodes[s->cameras[cam].node].world;
+  double det = (double)w[0] * ((double)w[5] * w[10] - (double)w[9] * w[6]) -
+               (double)w[4] * ((double)w[1] * w[10] - (double)w[9] * w[2]) +
+               (double)w[8] * ((double)w[1] * w[6] - (double)w[5] * w[2]);
+  return fabs(det) > 1e-24;
+}
+
 bool lm_scene_camera_check(const lm_scene *s, int cam, lm_error *err) {
   if (cam < 0 || cam >= s->camera_count) return true;
   const lm_camera *c = &s->cameras[cam];
@@ -262,6 +271,12 @@ bool lm_scene_camera_check(const lm_scene *s, int cam, lm_error *err) {
     lm_error_set(err, "camera '%s' (%d) is orthographic (xmag %g, ymag %g): the passes rebuild positions "
                  "from depth along rays from one eye and cannot take it; give the view a perspective camera "
                  "(or --camera auto)", c->name, cam, (double)c->ortho[0], (double)c->ortho[1]);
+    return false;
+  }
+  if (!lm_scene_camera_invertible(s, cam)) { /* the view, its inverse, would be inf or NaN: an empty frame */
+    lm_error_set(err, "camera '%s' (%d) on node '%s': posed with (near) zero scale (an animation scales it or a "
+                 "node above it to zero), its world transform cannot be inverted into a view", c->name, cam,
+                 s->nodes[c->node].name);
     return false;
   }
   return true;

@@ -359,10 +359,16 @@ bool lm_scene_bounds(const lm_scene *s, float min[3], float max[3]);
  * camera's index. World transforms are updated. */
 int lm_scene_add_framing_camera(lm_scene *s, const char *name, float aspect);
 /* False, with a message naming the camera, when the passes cannot render
- * through camera `cam` (an orthographic one: every pass rebuilds positions
- * from depth along rays from one eye, common.glsl's position_from_depth). An
- * index with no camera is the engine's default one, which they can. */
+ * through camera `cam` as posed: an orthographic one (every pass rebuilds
+ * positions from depth along rays from one eye, common.glsl's
+ * position_from_depth), or one whose world transform an animation scales to
+ * zero (no view inverts it). An index with no camera is the engine's default
+ * one, which they can. */
 bool lm_scene_camera_check(const lm_scene *s, int cam, lm_error *err);
+/* Whether camera cam's world transform inverts into a view (no zero scale):
+ * the loader refuses a file whose camera does not, lm_scene_camera_check a
+ * pose in which it does not. */
+bool lm_scene_camera_invertible(const lm_scene *s, int cam);
 
 /* Reads a camera list (engine/scene/camlist.c: one view per line, "name
  * eye_x eye_y eye_z target_x target_y target_z fov_y_degrees [near far]",
