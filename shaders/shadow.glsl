@@ -355,24 +355,23 @@ float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
   float reach = offset > 0.0 ? 4.0 * (1.0 + tan_tilt) : 0.0;
   int j = 0;
   bool offset_now = false;
+  vec3 q = p;
   do {
     int w = v + j;
-    ShadowView sv = shadow_view_of(light, s, kind, w);
-    vec3 q = p;
-    if (offset_now) {
-      // A texel's world size: an orthographic view's texel.x; a perspective
-      // one's is its size per unit of distance.
-      q = p + n * (offset * sv.texel.x * (perspective ? length(p - sv.depth.xyz) : 1.0));
-      if (kind == 3) {
-        float unused;
-        int face = shadow_view_at(light, s, kind, q, unused);
-        if (face < 0) q = p; // a face no pixel reads: the lookup at p again
-        else if (face != w) w = face, sv = shadow_view_of(light, s, kind, w);
-      }
+    if (kind == 3 && offset_now) {
+      float unused;
+      int face = shadow_view_at(light, s, kind, q, unused);
+      if (face < 0) q = p; // a face no pixel reads: the lookup at p again
+      else w = face;
     }
+    ShadowView sv = shadow_view_of(light, s, kind, w);
     bool touching;
     float lit = shadow_view_lookup(sv, perspective, shadow_clip(sv, kind, w, q), s, q, ndl, tan_tilt,
                                    offset_now ? 0.0 : reach, touching);
+    // The next step's point: the offset by a texel's world size, an
+    // orthographic view's texel.x, a perspective one's (the same for a cube's
+    // faces) its size per unit of distance times p's.
+    q = touching ? p + n * (offset * sv.texel.x * (perspective ? length(p - sv.depth.xyz) : 1.0)) : p;
     offset_now = touching;
     if (!touching) vis = mix(vis, lit, j == 0 ? 1.0 : t), j++;
   } while (j < (t > 0.0 ? 2 : 1));
