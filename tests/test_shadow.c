@@ -1196,16 +1196,15 @@ static const char *const light_kind[] = {"point light", "spot", "sun"};
  * (cube faces), a spot (a perspective tile) and a sun (cascades), with ESM
  * and PCSS: where the lookup touches a face the light sees from behind it
  * looks again one offset along the normal (shadow.glsl), the offset a
- * texel's world size where the receiver is. Seam pixels in shadow lit at
- * 160x120, before and after (ESM: point light 19 -> 8 of 265, spot 32 -> 18
- * of 250, sun 17 -> 17, which had the offset; PCSS: 56 -> 16, 89 -> 30,
- * 91 -> 30) are ESM's and the filters' contact within a texel; no lit seam
- * pixel darkened. */
+ * texel's world size where the receiver is. The ground's seam pixels in
+ * shadow lit at 160x120, before and after: ESM, point light 2 -> 0 of 135,
+ * spot 9 -> 2 of 127, sun 0 -> 0 (it had the offset); PCSS 17 -> 2, 35 -> 5,
+ * 35 -> 4: the filters' contact within a texel. No lit seam pixel darkened. */
 static void seams_of_thin_walls_stay_dark_under_every_light(void **state) {
   (void)state;
   static const char *const esm[] = {"ambient=0", NULL}, *const pcss[] = {"ambient=0", "shadow.technique=pcss", NULL};
   const char *const *filters[] = {esm, pcss};
-  static const float bound[] = {0.1f, 0.15f}; /* the share of the seam in shadow lit */
+  static const float bound[] = {0.05f, 0.1f}; /* the share of the seam in shadow lit */
   int failed = 0;
   for (int type = 0; type < 3; type++) {
     lm_scene *s = thin_wall_scene((lm_light_type)type, false);
@@ -1214,7 +1213,7 @@ static void seams_of_thin_walls_stay_dark_under_every_light(void **state) {
       thin_wall_seams(s, filters[f], at, NULL);
       printf("%s, %s: %d of %d seam pixels in shadow lit; %d of %d lit ones darkened\n", light_kind[type],
              f ? "pcss" : "esm", at[0].lit, at[0].seam, at[1].darkened, at[1].seam);
-      failed += at[0].seam < 200 || at[1].seam < 50 || at[0].lit > bound[f] * at[0].seam || at[1].darkened > 0;
+      failed += at[0].seam < 100 || at[1].seam < 50 || at[0].lit > bound[f] * at[0].seam || at[1].darkened > 0;
     }
     lm_scene_destroy(s);
   }
