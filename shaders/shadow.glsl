@@ -147,9 +147,10 @@ float pcss_lookup(ShadowLight s, ShadowView sv, bool perspective, vec2 texel, fl
 
 // How far filter `technique` of light s reads from the lookup's texel, in
 // texels, where a tilted receiver is nearer the light (the hard compare
-// reads its own).
+// reads its own; PCSS at contact its least radius, a texel: more lit the
+// thin-wall test's seams under a spot).
 float shadow_spread(ShadowLight s, int technique) {
-  return technique == 0 ? 1.0 : technique == 1 ? 1.5 : technique == 2 ? s.params.w : 0.0;
+  return technique == 0 ? 1.0 : technique == 1 ? 1.5 : technique == 2 ? s.params.w : technique == 4 ? 1.0 : 0.0;
 }
 
 // Whether the 2 x 2 texels z (shadow_texels) hold a face the light sees from
@@ -161,26 +162,13 @@ bool shadow_touches_back_face(vec4 z, float r, float reach) {
   return dot(step(z, vec4(-1e-31)), touching) > 0.0; // stored back faces are -1e-30 or less
 }
 
-// Whether the 2 x 2 texels around ls (clip position in orthographic view
-// sv) hold a face the light sees from behind (negated: shadow.frag) within
-// `reach` texels of depth nearer the light than ls: one it touches.
-bool shadow_back_face_near(ShadowView sv, vec4 ls, float reach) {
-  vec2 size = vec2(textureSize(shadow_atlas, 0));
-  ivec2 lo = ivec2(sv.rect.xy * size + 0.5), hi = ivec2((sv.rect.xy + sv.rect.zw) * size + 0.5) - 1;
-  vec2 texel = (sv.rect.xy + (ls.xy * 0.5 + 0.5) * sv.rect.zw) * size - 0.5;
-  vec2 f;
-  vec4 z = shadow_texels(texel, lo, hi, f);
-  float r = ls.z * 0.5 + 0.5;
-  return shadow_touches_back_face(z, r, reach * shadow_texel_depth_as(sv, r, false));
-}
-
 // Visibility in [0, 1] of p from view sv of light s, p at ls in its clip
 // space (shadow_clip), sv perspective or not (shadow_perspective), the
 // surface's n.l and the tilt shadow_tilt gives for it.
-// With reach > 0 (cascades: orthographic), *touching says whether the
-// texels at p hold a face the light sees from behind within reach texels of
-// depth nearer the light (shadow_touches_back_face); ESM tells it from its
-// own taps, the other filters by one gather more.
+// With reach > 0, *touching says whether the texels at p hold a face the
+// light sees from behind within reach texels of depth nearer the light
+// (shadow_touches_back_face); ESM tells it from its own taps, the other
+// filters by one gather more.
 float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s, vec3 p, float ndl,
                          float tan_tilt, float reach, out bool touching) {
   touching = false;
@@ -198,12 +186,15 @@ float shadow_view_lookup(ShadowView sv, bool perspective, vec4 ls, ShadowLight s
   float texel_depth = shadow_texel_depth_as(sv, r, perspective);
   float bias = s.params.y * texel_depth;
   int technique = SHADOW_FILTER_OF(s);
+  if (technique != 0 && reach > 0.0) {
+    vec2 f;
+    touching = shadow_touches_back_face(shadow_texels(texel, lo, hi, f), r, reach * texel_depth);
+  }
   if (technique == 4) return pcss_lookup(s, sv, perspective, texel, r, bias, tan_tilt, lo, hi);
   // Filters reach `spread` texels away, where a tilted receiver is deeper:
   // scale the bias by the tilt (tan of the light's angle, capped). Only
   // against faces toward the light (shadow_lit).
   bias *= 1.0 + shadow_spread(s, technique) * tan_tilt;
-  if (technique != 0) touching = reach > 0.0 && shadow_back_face_near(sv, ls, reach);
   if (technique == 0) {
     // ESM with the seed's 4-tap bilinear combination (seed 000, Listing 8):
     // the depth difference is clamped at 0 and scaled by n.l, then exp(-k d)
@@ -339,22 +330,23 @@ float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
   int v = shadow_view_at(light, s, kind, p, t);
   if (v < 0) return 1.0;
   float ndl = dot(n, l), tan_tilt = shadow_tilt(ndl), vis = 1.0; // the same for both lookups
-  // Where a cascade's texels at p hold a face the light sees from behind
-  // (a thin wall, a ceiling) that p touches, the lookup is at a point `bias`
-  // times the filter's spread of texels along the normal (shadow_spread),
-  // toward the light where the surface faces it: within a texel of where
-  // such a wall meets what it shades (the floor under the window wall, the
-  // walls under the ceiling) the taps read texels past the wall's edge,
-  // where the light passes beside it, and lit a line along the seam; moved,
-  // they fall inside the wall's texels. Elsewhere the lookup stays at p: the
-  // offset moves shadow edges toward their casters by as much (at a low sun,
-  // a texel times the tilt along the ground), which raised the blocks' and a
+  // Where the texels at p hold a face the light sees from behind (a thin
+  // wall, a ceiling) that p touches, the lookup is at a point `bias` times
+  // the filter's spread of texels along the normal (shadow_spread), toward
+  // the light where the surface faces it: within a texel of where such a
+  // wall meets what it shades (the floor under the window wall, the walls
+  // under the ceiling) the taps read texels past the wall's edge, where the
+  // light passes beside it, and lit a line along the seam; moved, they fall
+  // inside the wall's texels. Elsewhere the lookup stays at p: the offset
+  // moves shadow edges toward their casters by as much (at a low sun, a
+  // texel times the tilt along the ground), which raised the blocks' and a
   // street view's direct-only error against POV-Ray by 10-28% (offset
-  // everywhere, or wherever a back face was near). Spot and point lights
-  // take no offset: an offset point leaves its cube face near an edge.
+  // everywhere, or wherever a back face was near). A spot's or point light's
+  // texel grows with the distance from the light; a point light's offset
+  // point is looked up in its own cube face (near an edge, another).
   bool perspective = shadow_perspective(kind);
   int technique = SHADOW_FILTER_OF(s);
-  float offset = perspective || technique == 4 ? 0.0 : s.params.y * max(shadow_spread(s, technique), 1.0);
+  float offset = s.params.y * max(shadow_spread(s, technique), 1.0);
   // Every lookup in one loop that tests at its end, not the blend's second
   // view or the offset lookup in an if: a software rasterizer leaves such a
   // loop once no pixel of its group goes on, but runs both sides of every if.
@@ -363,12 +355,23 @@ float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
   float reach = offset > 0.0 ? 4.0 * (1.0 + tan_tilt) : 0.0;
   int j = 0;
   bool offset_now = false;
+  vec3 q = p;
   do {
-    ShadowView sv = shadow_view_of(light, s, kind, v + j);
-    vec3 q = offset_now ? p + n * (offset * sv.texel.x) : p; // an orthographic view's texel.x: a texel's world size
+    int w = v + j;
+    if (kind == 3 && offset_now) {
+      float unused;
+      int face = shadow_view_at(light, s, kind, q, unused);
+      if (face < 0) q = p; // a face no pixel reads: the lookup at p again
+      else w = face;
+    }
+    ShadowView sv = shadow_view_of(light, s, kind, w);
     bool touching;
-    float lit = shadow_view_lookup(sv, perspective, shadow_clip(sv, kind, v + j, q), s, q, ndl, tan_tilt,
+    float lit = shadow_view_lookup(sv, perspective, shadow_clip(sv, kind, w, q), s, q, ndl, tan_tilt,
                                    offset_now ? 0.0 : reach, touching);
+    // The next step's point: the offset by a texel's world size, an
+    // orthographic view's texel.x, a perspective one's (the same for a cube's
+    // faces) its size per unit of distance times p's.
+    q = touching ? p + n * (offset * sv.texel.x * (perspective ? length(p - sv.depth.xyz) : 1.0)) : p;
     offset_now = touching;
     if (!touching) vis = mix(vis, lit, j == 0 ? 1.0 : t), j++;
   } while (j < (t > 0.0 ? 2 : 1));

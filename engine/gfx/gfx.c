@@ -327,6 +327,8 @@ void lm_set_scene_state(bool on, bool shadow_caster) {
   }
 }
 
+void lm_set_front_face_clockwise(bool clockwise) { glFrontFace(clockwise ? GL_CW : GL_CCW); }
+
 void lm_set_blend_state(bool on) {
   if (on) {
     glEnable(GL_BLEND);

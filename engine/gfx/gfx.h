@@ -107,6 +107,9 @@ void lm_uniform_upload(int binding, const void *data, size_t bytes, size_t block
  * draw both faces (a light inside a closed mesh sees its back faces) and
  * clamp depth (casters before the near plane count). */
 void lm_set_scene_state(bool on, bool shadow_caster);
+/* Which winding faces front in the draws that follow: clockwise for a mirrored node (its world
+ * matrix's determinant negative), counter-clockwise (GL's default) else. */
+void lm_set_front_face_clockwise(bool clockwise);
 /* A blended scene pass (lm_pass_desc.blend): the output becomes the
  * fragment's first colour plus its second (index 1) times the output, per
  * channel; depth tested, not written. Off: no blending, depth written. */

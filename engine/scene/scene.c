@@ -749,12 +749,14 @@ bool lm_scene_node_culled(const lm_scene *s, int node, const float view_proj[16]
 
 /* A visible mesh node, sorted so that nodes of one mesh, material and
  * simplification (lod: 1 + the level of its simplified copy) lie together, those seen in
- * part (part: some chunk of what they draw out of view) after the whole ones, translucent casters
+ * part (part: some chunk of what they draw out of view) after the whole ones, mirrored ones
+ * (a world matrix of negative determinant: their front faces wind clockwise) after the others,
+ * translucent casters
  * (into a transmittance output) after the others; blended ones in the
  * forward pass by the camera's depth of their bounds' centre, farthest first.
  * outside: where a node seen in part has its chunks' frustum tests (one byte a
  * chunk, 1: left out), so that each chunk is tested once a draw. */
-typedef struct drawn_node { int translucent, material, mesh, lod, part, node; float depth; int outside; } drawn_node;
+typedef struct drawn_node { int translucent, material, mesh, lod, part, mirrored, node; float depth; int outside; } drawn_node;
 
 static int back_to_front(const void *pa, const void *pb) {
   const drawn_node *a = pa, *b = pb;
@@ -769,6 +771,7 @@ static int drawn_node_order(const void *pa, const void *pb) {
   if (a->mesh != b->mesh) return a->mesh < b->mesh ? -1 : 1;
   if (a->lod != b->lod) return a->lod - b->lod;
   if (a->part != b->part) return a->part - b->part;
+  if (a->mirrored != b->mirrored) return a->mirrored - b->mirrored;
   if (a->depth != b->depth) return a->depth < b->depth ? -1 : 1; /* nearest first: the depth test then
                                                                     spares the shading of what they hide */
   return (a->node > b->node) - (a->node < b->node);
@@ -949,7 +952,10 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
         part |= outside[outside_len + k];
       }
     }
-    nodes[count++] = (drawn_node){translucent, n->material, n->mesh, lod, part, i, depth, outside_len};
+    const float *w = n->world; /* its 3 x 3 part's determinant (world: not aligned for cglm's) */
+    int mirrored = w[0] * (w[5] * w[10] - w[9] * w[6]) - w[4] * (w[1] * w[10] - w[9] * w[2]) +
+                       w[8] * (w[1] * w[6] - w[5] * w[2]) < 0;
+    nodes[count++] = (drawn_node){translucent, n->material, n->mesh, lod, part, mirrored, i, depth, outside_len};
     if (part) outside_len += chunks;
   }
   bool sorted = d->blend == LM_BLEND_ONLY; /* blending needs the order, one node a draw */
@@ -966,7 +972,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
   for (int first = 0, last; first < count && ok; first = last) {
     for (last = first + 1; !sorted && last < count && nodes[last].material == nodes[first].material &&
                            nodes[last].mesh == nodes[first].mesh && nodes[last].lod == nodes[first].lod &&
-                           nodes[last].part == nodes[first].part;)
+                           nodes[last].part == nodes[first].part && nodes[last].mirrored == nodes[first].mirrored;)
       last++;
     const lm_node *n = &s->nodes[nodes[first].node];
     const lm_scene_mesh *mesh = &s->meshes[n->mesh];
@@ -989,6 +995,10 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
       snprintf(bound, sizeof bound, "%s", defines);
     }
     bind_material(s, p, &m, &mp, defines);
+    /* A mirrored node's triangles wind the other way (glTF: its front faces are clockwise):
+     * culled, and gl_FrontFacing (the shadow pass's back-face sign, two-sided normals), as its
+     * normals (the inverse transpose) say. */
+    lm_set_front_face_clockwise(nodes[first].mirrored);
     int lod = nodes[first].lod;
     copy_chain chain = node_copies(s, d, mesh, n->material); /* alike for the group: one material and mesh */
     const lm_mesh_lod *copy = lod ? &(chain == COPIES_CAMERA ? mesh->lods : mesh->casters)[lod - 1] : NULL;
@@ -1009,6 +1019,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
     }
   }
   if (translucent) lm_set_caster_layer(-1, d->outputs, false);
+  lm_set_front_face_clockwise(false);
   free(nodes);
   free(outside);
   return ok;

@@ -108,11 +108,11 @@ static void caster_depth(const lm_scene *s, mat4 view, float l, float r, float b
 }
 
 /* How far from a receiver's texel a lookup reads, in texels: the filter's
- * reach, the ESM blur's, one for texel snapping and, but for PCSS, the normal
- * offset of the lookup (bias times the filter's spread, at least 1: shadow.glsl). */
+ * reach, the ESM blur's, one for texel snapping and the normal offset of the
+ * lookup (bias times the filter's spread, at least 1; PCSS's a texel: shadow.glsl). */
 static float filter_reach(const lm_shadow_settings *st) {
   float r = st->technique == LM_SHADOW_PCSS ? st->penumbra : st->technique == LM_SHADOW_POISSON ? st->radius : 1.5f;
-  float offset = st->technique == LM_SHADOW_PCSS ? 0.0f : st->bias * fmaxf(r, 1.0f);
+  float offset = st->bias * (st->technique == LM_SHADOW_PCSS ? 1.0f : fmaxf(r, 1.0f));
   return r + (float)st->blur + 1.0f + offset;
 }
 
