@@ -1030,6 +1030,18 @@ static void seams_where_thin_walls_meet_stay_dark(void **state) {
   lm_scene_destroy(s);
 }
 
+/* Renders camera cam of plain (no shadows) and r (shadowed) again at w x h
+ * and returns r's G-buffer normals (the caller frees). */
+static float *render_both_at(gl_result *plain, gl_result *r, int cam, int w, int h) {
+  lm_renderer_set_view(plain->renderer, cam, w, h);
+  lm_renderer_set_view(r->renderer, cam, w, h);
+  assert_true(gl_render_again(plain) && gl_render_again(r) && gl_all_finite(r));
+  int nw, nh;
+  float *nrm = gl_read_target(r, "gbuffer.nrm", &nw, &nh);
+  assert_true(nrm && nw == w && nh == h);
+  return nrm;
+}
+
 /* Where a lit face stands on lit ground (the reference blocks' sunlit sides,
  * no other block's shadow on those seams), the seam stays lit: the bias
  * against a face the light sees from the front is kept. Seam pixels are
@@ -1050,12 +1062,7 @@ static void seams_where_lit_faces_meet_stay_lit(void **state) {
     gl_result r = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = sets, .width = W, .height = H});
     assert_true(plain.ok && r.ok);
     for (int cam = 0; cam < s->camera_count; cam++) {
-      lm_renderer_set_view(plain.renderer, cam, W, H);
-      lm_renderer_set_view(r.renderer, cam, W, H);
-      assert_true(gl_render_again(&plain) && gl_render_again(&r) && gl_all_finite(&r));
-      int w, h;
-      float *nrm = gl_read_target(&r, "gbuffer.nrm", &w, &h);
-      assert_true(nrm && w == W && h == H);
+      float *nrm = render_both_at(&plain, &r, cam, W, H);
       float brightest = 0;
       for (int i = 0; i < W * H; i++) brightest = fmaxf(brightest, gl_luminance(plain.rgb + (size_t)i * 3));
       int seam = 0, dark = 0;
@@ -1156,12 +1163,7 @@ static void thin_wall_seams(lm_scene *s, const char *const *sets, seam_count at[
   gl_result r = gl_render(&(gl_run){.scene = s, .tech = "dl+esm", .sets = sets, .width = W, .height = H});
   assert_true(plain.ok && r.ok);
   for (int cam = 0; cam < 2; cam++) {
-    lm_renderer_set_view(plain.renderer, cam, W, H);
-    lm_renderer_set_view(r.renderer, cam, W, H);
-    assert_true(gl_render_again(&plain) && gl_render_again(&r) && gl_all_finite(&r));
-    int w, h;
-    float *nrm = gl_read_target(&r, "gbuffer.nrm", &w, &h);
-    assert_true(nrm && w == W && h == H);
+    float *nrm = render_both_at(&plain, &r, cam, W, H);
     seam_count c = {0, 0, 0};
     for (int y = 0; y < H; y++)
       for (int x = 0; x < W; x++) {
