@@ -459,19 +459,21 @@ static bool read_path(lua_State *L, job *j, lm_error *err) {
  * between them (eye and target crossing), where the view has no direction:
  * each frame's eye must stay off its target by a millionth of the keys'
  * largest eye-to-target distance. */
+/* A view's eye-to-target distance, in doubles. */
+static double eye_to_target(const float eye[3], const float target[3]) {
+  double d2 = 0;
+  for (int c = 0; c < 3; c++) d2 += ((double)target[c] - eye[c]) * ((double)target[c] - eye[c]);
+  return sqrt(d2);
+}
+
 static bool path_frames_check(const job *j, lm_error *err) {
   double reach = 0;
-  for (int i = 0; i < j->key_count; i++) {
-    double d2 = 0;
-    for (int c = 0; c < 3; c++) d2 += ((double)j->keys[i].target[c] - j->keys[i].eye[c]) * ((double)j->keys[i].target[c] - j->keys[i].eye[c]);
-    reach = fmax(reach, sqrt(d2));
-  }
+  for (int i = 0; i < j->key_count; i++) reach = fmax(reach, eye_to_target(j->keys[i].eye, j->keys[i].target));
   for (int f = 0; f < j->frame_count && j->key_count > 1; f++) {
-    double t = j->fps > 0 ? j->time_start + f / j->fps : j->time_start, d2 = 0; /* as job_views times it */
+    double t = j->fps > 0 ? j->time_start + f / j->fps : j->time_start; /* as job_views times it */
     float eye[3], target[3], fov;
     camera_path_eval(j->keys, j->key_count, t, eye, target, &fov);
-    for (int c = 0; c < 3; c++) d2 += ((double)target[c] - eye[c]) * ((double)target[c] - eye[c]);
-    if (sqrt(d2) > 1e-6 * reach) continue;
+    if (eye_to_target(eye, target) > 1e-6 * reach) continue;
     int i = 0;
     while (i < j->key_count - 2 && t >= j->keys[i + 1].t) i++;
     lm_error_set(err, "%s: path: frame %d at %.3f s: the eye reaches the target between path[%d] and path[%d] "

@@ -211,6 +211,7 @@ bool rsm_meets(vec3 p, vec3 w, float t0, float t1) {
 // bias, the yard's court view lost 17% of its first bounce). A solid thinner than the points'
 // spacing can fall between them; a surface no back face closes (an open mesh) blocks nothing.
 bool rsm_inside_solid(int first, int count, vec3 p, vec3 q, vec2 atlas) {
+  float margin = 1e-3 * distance(p, q); // keeps p's and q's own surfaces out
   for (int j = 1; j <= rsm_solid_steps; j++) {
     vec3 x = mix(p, q, float(j) / float(rsm_solid_steps + 1));
     for (int v = first; v < first + count; v++) {
@@ -222,8 +223,6 @@ bool rsm_inside_solid(int first, int count, vec3 p, vec3 q, vec2 atlas) {
       if (front.w > 0.0) break; // the light sees nothing there: no solid
       vec4 back = texelFetch(rsm_back, ivec2((sv.rect.xy + t * sv.rect.zw) * atlas), 0);
       if (back.w > 0.0) break; // no face closes it
-      // A margin of a thousandth of the distance keeps p's and q's own surfaces out.
-      float margin = 1e-3 * distance(p, q);
       if (dot(normal_unpack_direction(front.w), x - front.xyz) < -margin &&
           dot(normal_unpack_direction(back.w), x - back.xyz) < -margin)
         return true;

@@ -255,13 +255,17 @@ int lm_scene_add_framing_camera(lm_scene *s, const char *name, float aspect) {
   return lm_scene_add_camera(s, &cam);
 }
 
+/* The determinant of a world transform's 3 x 3 part (column-major; the
+ * nodes' world arrays are not aligned for cglm's mat3). */
+static double world_det3(const float w[16]) {
+  return (double)w[0] * ((double)w[5] * w[10] - (double)w[9] * w[6]) -
+         (double)w[4] * ((double)w[1] * w[10] - (double)w[9] * w[2]) +
+         (double)w[8] * ((double)w[1] * w[6] - (double)w[5] * w[2]);
+}
+
 bool lm_scene_camera_invertible(const lm_scene *s, int cam) {
   if (cam < 0 || cam >= s->camera_count || s->cameras[cam].node < 0) return true;
-  const float *w = s->nodes[s->cameras[cam].node].world;
-  double det = (double)w[0] * ((double)w[5] * w[10] - (double)w[9] * w[6]) -
-               (double)w[4] * ((double)w[1] * w[10] - (double)w[9] * w[2]) +
-               (double)w[8] * ((double)w[1] * w[6] - (double)w[5] * w[2]);
-  return fabs(det) > 1e-24;
+  return fabs(world_det3(s->nodes[s->cameras[cam].node].world)) > 1e-24;
 }
 
 bool lm_scene_camera_check(const lm_scene *s, int cam, lm_error *err) {
@@ -952,9 +956,7 @@ bool lm_scene_draw(const lm_scene *s, const lm_scene_draw_desc *d, lm_scene_draw
         part |= outside[outside_len + k];
       }
     }
-    const float *w = n->world; /* its 3 x 3 part's determinant (world: not aligned for cglm's) */
-    int mirrored = w[0] * (w[5] * w[10] - w[9] * w[6]) - w[4] * (w[1] * w[10] - w[9] * w[2]) +
-                       w[8] * (w[1] * w[6] - w[5] * w[2]) < 0;
+    int mirrored = world_det3(n->world) < 0;
     nodes[count++] = (drawn_node){translucent, n->material, n->mesh, lod, part, mirrored, i, depth, outside_len};
     if (part) outside_len += chunks;
   }
