@@ -340,22 +340,29 @@ lm_scene *gl_sunlit_corner(int width, int height, float view_proj[16]) {
           (const float[3]){0, 1, 0});
   gl_quad(s, "wall x", grey, (const float[4][3]){{0, 0, 8}, {0, 0, 0}, {0, 4, 0}, {0, 4, 8}}, (const float[3]){1, 0, 0});
   gl_quad(s, "wall z", grey, (const float[4][3]){{0, 0, 0}, {8, 0, 0}, {8, 4, 0}, {0, 4, 0}}, (const float[3]){0, 0, 1});
-  mat4 view, m, proj, vp;
+  mat4 view, m;
   glm_lookat((vec3){0, 0, 0}, (vec3){-0.3f, -1, -0.2f}, (vec3){0, 1, 0}, view);
   glm_mat4_inv(view, m);
   int sun = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
   lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 0,
                                      .casts_shadows = true, .node = sun});
-  glm_lookat((vec3){9, 6, 9}, (vec3){3, 0, 3}, (vec3){0, 1, 0}, view);
+  gl_look_camera(s, "yard", (const float[3]){9, 6, 9}, (const float[3]){3, 0, 3}, 60, width, height, view_proj);
+  return s;
+}
+
+void gl_look_camera(lm_scene *s, const char *name, const float eye[3], const float target[3], float fov_y, int width,
+                    int height, float view_proj[16]) {
+  mat4 view, m, proj, vp;
+  glm_lookat((float *)eye, (float *)target, (vec3){0, 1, 0}, view);
   glm_mat4_inv(view, m);
   int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
-  lm_scene_add_camera(s, &(lm_camera){.name = "yard", .fov_y = glm_rad(60.0f), .znear = 0.01f, .zfar = 100,
-                                      .node = cam});
+  lm_camera c = {.fov_y = glm_rad(fov_y), .znear = 0.01f, .zfar = 100, .node = cam};
+  snprintf(c.name, sizeof c.name, "%s", name);
+  lm_scene_add_camera(s, &c);
   lm_scene_update(s);
-  glm_perspective(glm_rad(60.0f), (float)width / (float)height, 0.01f, 100, proj);
+  glm_perspective(glm_rad(fov_y), (float)width / (float)height, 0.01f, 100, proj);
   glm_mat4_mul(proj, view, vp);
   memcpy(view_proj, vp, sizeof vp);
-  return s;
 }
 
 void gl_rescale(lm_scene *s, float unit) {

@@ -100,6 +100,11 @@ lm_scene *gl_reference_scene(const char *name);
 /* A UV sphere of radius r at the origin, 32 segments by 16 rings (position,
  * normal, uv), as mesh `name`: the mesh's index. */
 int gl_uv_sphere(lm_scene *s, const char *name, float r);
+/* Adds camera `name` at eye looking at target (up +y), fov_y in degrees,
+ * near 0.01, far 100; view_proj gets its view-projection at aspect
+ * width / height. */
+void gl_look_camera(lm_scene *s, const char *name, const float eye[3], const float target[3], float fov_y, int width,
+                    int height, float view_proj[16]);
 /* An outdoor corner: open grey ground, two 4-high walls meeting at the
  * origin (facing +x and +z), a sun casting shadows and a camera looking
  * into the corner from (9, 6, 9); view_proj gets the camera's, at aspect

@@ -489,22 +489,30 @@ static void a_root_added_above_keeps_channels_and_joints(void **state) {
 
 /* ---- cameras ------------------------------------------------------------ */
 
-static void animated_camera_moves_the_view(void **state) {
-  (void)state;
+/* A file <name>.gltf of a camera "eye" on node 0 "cam" at (0, 0, 5) and a
+ * triangle, animation `name` keying the camera node's `path` (translation,
+ * scale) from values[0..2] at 0 s to values[3..5] at 1 s; loaded. */
+static lm_scene *keyed_camera(const char *name, const char *path, const float values[6]) {
   doc d = {0};
-  const float times[2] = {0, 1}, dolly[6] = {0, 0, 5, 0, 0, 10};
+  const float times[2] = {0, 1};
   floats(&d, tri, 3, "VEC3");
-  int t = floats(&d, times, 2, "SCALAR"), v = floats(&d, dolly, 2, "VEC3");
-  char body[1024];
+  int t = floats(&d, times, 2, "SCALAR"), v = floats(&d, values, 2, "VEC3");
+  char body[1024], file[64];
   snprintf(body, sizeof body,
            "\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
            "\"nodes\":[{\"name\":\"cam\",\"camera\":0,\"translation\":[0,0,5]},{\"name\":\"tri\",\"mesh\":0}],"
-           "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.1,\"zfar\":100}}],"
+           "\"cameras\":[{\"name\":\"eye\",\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.1,\"zfar\":100}}],"
            "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
-           "\"animations\":[{\"name\":\"dolly\",\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}],"
+           "\"animations\":[{\"name\":\"%s\",\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"%s\"}}],"
            "\"samplers\":[{\"input\":%d,\"output\":%d}]}]",
-           t, v);
-  lm_scene *s = load(write_doc("dolly.gltf", &d, body));
+           name, path, t, v);
+  snprintf(file, sizeof file, "%s.gltf", name);
+  return load(write_doc(file, &d, body));
+}
+
+static void animated_camera_moves_the_view(void **state) {
+  (void)state;
+  lm_scene *s = keyed_camera("dolly", "translation", (const float[6]){0, 0, 5, 0, 0, 10});
   lm_frame_data f;
   lm_scene_frame_data(s, 0, 64, 48, &f);
   assert_vec3(f.camera_pos, 0, 0, 5, 1e-5f);
@@ -520,20 +528,7 @@ static void animated_camera_moves_the_view(void **state) {
  * the loader refuses such a camera at rest (it rendered an empty frame). */
 static void a_camera_scaled_to_zero_is_refused_at_that_pose(void **state) {
   (void)state;
-  doc d = {0};
-  const float times[2] = {0, 1}, shrink[6] = {1, 1, 1, 0, 0, 0};
-  floats(&d, tri, 3, "VEC3");
-  int t = floats(&d, times, 2, "SCALAR"), v = floats(&d, shrink, 2, "VEC3");
-  char body[1024];
-  snprintf(body, sizeof body,
-           "\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
-           "\"nodes\":[{\"name\":\"cam\",\"camera\":0,\"translation\":[0,0,5]},{\"name\":\"tri\",\"mesh\":0}],"
-           "\"cameras\":[{\"name\":\"eye\",\"type\":\"perspective\",\"perspective\":{\"yfov\":0.8,\"znear\":0.1,\"zfar\":100}}],"
-           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
-           "\"animations\":[{\"name\":\"shrink\",\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"scale\"}}],"
-           "\"samplers\":[{\"input\":%d,\"output\":%d}]}]",
-           t, v);
-  lm_scene *s = load(write_doc("shrink.gltf", &d, body));
+  lm_scene *s = keyed_camera("shrink", "scale", (const float[6]){1, 1, 1, 0, 0, 0});
   lm_error err = {0};
   assert_true(lm_scene_camera_check(s, 0, &err));
   lm_scene_set_time(s, 0, 0.5);

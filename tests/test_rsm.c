@@ -793,20 +793,12 @@ static lm_scene *roof_off_screen(float view_proj[16]) {
           (const float[3]){0, -1, 0});
   gl_quad(s, "roof top", grey, (const float[4][3]){{-2.5f, 4, 1}, {2.5f, 4, 1}, {2.5f, 4, -3}, {-2.5f, 4, -3}},
           (const float[3]){0, 1, 0});
-  mat4 m, view, proj, vp;
+  mat4 m;
   glm_rotate_make(m, glm_rad(-90.0f), (vec3){1, 0, 0}); /* -Z of the node points down */
   int light = lm_scene_add_node(s, "sun", -1, (float *)m, -1, -1);
   lm_scene_add_light(s, &(lm_light){.name = "sun", .type = LM_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .power = 0,
                                      .casts_shadows = true, .node = light});
-  glm_lookat((vec3){0, 1, 2.5f}, (vec3){0, 0, -3}, (vec3){0, 1, 0}, view);
-  glm_mat4_inv(view, m);
-  int cam = lm_scene_add_node(s, "camera", -1, (float *)m, -1, -1);
-  lm_scene_add_camera(s, &(lm_camera){.name = "roof", .fov_y = glm_rad(50.0f), .znear = 0.01f, .zfar = 100,
-                                      .node = cam});
-  lm_scene_update(s);
-  glm_perspective(glm_rad(50.0f), (float)W / (float)H, 0.01f, 100, proj);
-  glm_mat4_mul(proj, view, vp);
-  memcpy(view_proj, vp, sizeof vp);
+  gl_look_camera(s, "roof", (const float[3]){0, 1, 2.5f}, (const float[3]){0, 0, -3}, 50, W, H, view_proj);
   return s;
 }
 
