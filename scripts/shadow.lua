@@ -91,8 +91,9 @@ end
 -- views alone, into their own atlas (docs/shadows.md "The RSM atlas": every view `resolution`
 -- texels a side, shadow_plan's rsm_resolution); returned second as { flux =, nrm =, pos =,
 -- views =, seen = } (rsm.frag reads them through the views' records; views: how many RSM views;
--- seen: the depth range G sees, shadow.depth_range, nil without G), and with rsm.solid_steps above 0
--- back = shadow.rsm_back, where the first solid on the light's way ends. A directional light's RSM
+-- seen: the depth range G sees, shadow.depth_range, nil without G), and with rsm.solid_steps or
+-- rsm.solid_cell above 0 back = shadow.rsm_back, where the first solid on the light's way ends, with
+-- rsm.solid_cell solid = shadow.rsm_solid, the solid grid (rsm_solid.frag). A directional light's RSM
 -- view is one tile over the sphere around all that is seen, its radius times reach; a spot or
 -- point light's are its shadow views. Without, no RSM target or view exists.
 -- A scene with blended materials (scene_blended()) gets one more output, shadow.transmit: what
@@ -127,13 +128,21 @@ function shadow.render(o, G, rsm)
     scene{ "shadow.rsm", technique = "shadow", views = plan, rsm = true, fit = seen,
            out = { R.flux, R.nrm, R.pos }, clear = { 1, 1, 1, 1 }, defines = { RSM = true },
            depth = target{ "shadow.rsm_zbuffer", format = "depth32f", size = rsize } }
-    if (rsm.solid_steps or 0) > 0 then
+    local cell = rsm.solid_cell or 0
+    if (rsm.solid_steps or 0) > 0 or cell > 0 then
       -- The surfaces the light sees last of the first solid on its way: where a solid ends (shadow.frag's
-      -- RSM_BACK), which the gather's rsm_inside_solid reads.
+      -- RSM_BACK), which the gather's rsm_inside_solid reads, and the solid grid is made of.
       R.back = target{ "shadow.rsm_back", format = "rgba32f", size = rsize }
       scene{ "shadow.rsm_back", technique = "shadow", views = plan, rsm = true, fit = seen,
              out = { R.back }, clear = { 1, 1, 1, 1 }, defines = { RSM_BACK = true },
              depth = target{ "shadow.rsm_back_zbuffer", format = "depth32f", size = rsize } }
+    end
+    if cell > 0 then
+      -- Whole cells a tile where its side (shadow.resolution halved) is a multiple of the cell: a power of two.
+      R.solid = pass{ "shadow.rsm_solid", shader = "rsm_solid.frag", inputs = { rsm_pos = R.pos, rsm_back = R.back },
+                      params = { cell = cell },
+                      out = target{ "shadow.rsm_solid", format = "rg32f",
+                                    size = { math.max(1, rsize[1] // cell), math.max(1, rsize[2] // cell) } } }
     end
   end
   filter_of[map], transmit_of[map] = FILTERS[plan.technique], transmit

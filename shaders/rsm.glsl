@@ -98,6 +98,9 @@ uniform float rsm_thickness = 0.0;   // VISIBILITY: how far behind the depth buf
 uniform sampler2D rsm_back;          // where the first solid on the light's way ends (shadow.frag's RSM_BACK)
 uniform int rsm_solid_steps = 0;
 #endif
+#ifdef SOLID_GRID
+uniform sampler2D rsm_solid;         // the RSM views' solid grid (rsm_solid.frag): a cell's inside depths
+#endif
 
 const int INTERLEAVE = 4;                          // tile side of the interleaved pattern
 const float GOLDEN = 0.61803398874989;             // the angle's step, in turns
@@ -233,6 +236,60 @@ bool rsm_inside_solid(int first, int count, vec3 p, vec3 q, vec2 atlas) {
 }
 #endif
 
+#ifdef SOLID_GRID
+// Does p -> q pass inside a solid of the solid grid (rsm_solid.frag) of one of the views first ..
+// first + count of a light? A projection maps the segment to a segment in each view's tile coordinates
+// and window depth alike (a line stays a line; both ends before the light's eye), so it is marched over
+// the cells it crosses (a grid walk: one fetch a cell), the depths it spans over each compared with the
+// cell's inside depths. Its ends (a thousandth of it each) are left out: p's and q's own surfaces. The
+// walk is exact for the grid; a solid narrower than a cell, or a cell half over its edge, blocks nothing.
+bool rsm_solid_between(int first, int count, vec3 p, vec3 q) {
+  vec2 cells = vec2(textureSize(rsm_solid, 0));
+  for (int v = first; v < first + count; v++) {
+    ShadowView sv = shadow_views[v];
+    vec4 cp = sv.view_proj * vec4(p, 1.0), cq = sv.view_proj * vec4(q, 1.0);
+    if (cp.w <= 1e-12 || cq.w <= 1e-12) continue; // crosses the light's eye plane: another face's
+    vec3 a = cp.xyz / cp.w * 0.5 + 0.5, d = cq.xyz / cq.w * 0.5 + 0.5 - a; // tile coordinates, depth
+    float s0 = 1e-3, s1 = 1.0 - 1e-3;
+    for (int k = 0; k < 2; k++) { // the part inside the tile
+      if (abs(d[k]) < 1e-12) {
+        if (a[k] < 0.0 || a[k] >= 1.0) s1 = -1.0;
+      } else {
+        float e0 = -a[k] / d[k], e1 = (1.0 - a[k]) / d[k];
+        s0 = max(s0, min(e0, e1));
+        s1 = min(s1, max(e0, e1));
+      }
+    }
+    if (s0 >= s1) continue;
+    float n = floor(sv.rect.z * cells.x + 0.5); // the tile's cells a side
+    vec2 u = a.xy * n, du = d.xy * n, origin = floor(sv.rect.xy * cells + 0.5);
+    ivec2 c = ivec2(clamp(floor(u + s0 * du), vec2(0.0), vec2(n - 1.0)));
+    ivec2 go = ivec2(sign(du));
+    vec2 per = 1.0 / max(abs(du), vec2(1e-12)); // s a cell, each axis
+    vec2 next = mix((vec2(c) - u) / min(du, vec2(-1e-12)), (vec2(c + 1) - u) / max(du, vec2(1e-12)),
+                    greaterThan(du, vec2(0.0)));
+    next = mix(next, vec2(2.0), lessThan(abs(du), vec2(1e-12)));
+    float s = s0, margin = 1e-3 * abs(d.z);
+    for (int i = 0; i < int(2.0 * n) + 2 && s < s1; i++) {
+      float e = min(min(next.x, next.y), s1);
+      vec2 inside = texelFetch(rsm_solid, min(ivec2(origin) + c, ivec2(cells) - 1), 0).xy;
+      float z0 = a.z + s * d.z, z1 = a.z + e * d.z;
+      if (max(z0, z1) > inside.x + margin && min(z0, z1) < inside.y - margin) return true;
+      s = e;
+      if (next.x < next.y) {
+        c.x += go.x;
+        next.x += per.x;
+      } else {
+        c.y += go.y;
+        next.y += per.y;
+      }
+      if (any(lessThan(c, ivec2(0))) || any(greaterThanEqual(c, ivec2(n)))) break;
+    }
+  }
+  return false;
+}
+#endif
+
 // Light i's share of E(p) at the surface s: its RSM views, j the pixel's
 // block of the pattern, turn and shift its frame's turn (rsm_gather); type
 // and falloff light i's kind as light_arriving_as takes them. dpt:
@@ -318,6 +375,9 @@ vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn
 #endif
 #ifdef SOLIDS
       if (rsm_inside_solid(first, count, s.p, q, atlas)) continue;
+#endif
+#ifdef SOLID_GRID
+      if (rsm_solid_between(first, count, s.p, q)) continue;
 #endif
       vec3 l;
       vec3 radiance = light_arriving_as(li, type, falloff, q, l);

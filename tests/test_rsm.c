@@ -157,13 +157,15 @@ static void closed_box(lm_scene *s, const char *name, int material, const float 
 /* The canopy under its sun with a closed wall 0.6 thick and as high as the canopy round it (from 2 to
  * 2.6 out, grey): every path from the underside to the sunlit floor runs through the wall, whose top
  * is level with the canopy and whose sides the sun grazes, so the underside gets no first bounce but
- * the shadowed floor's (none). The camera sees the underside alone: only rsm.solid_steps can tell.
- * Without it (the default) the underside takes the light of the floor beyond the wall through it, as
- * the integral over that floor says (within 10%); with 16 points, under 10% of that (measured 0). */
+ * the shadowed floor's (none). The camera sees the underside alone: only rsm.solid_steps or the solid
+ * grid (rsm.solid_cell) can tell. Without them (the default) the underside takes the light of the floor
+ * beyond the wall through it, as the integral over that floor says (within 10%); with 16 points, or
+ * the grid walked in cells of 2 x 2 texels, under 10% of that (measured 0). */
 static void a_solid_between_hides_the_senders_behind_it(void **state) {
   (void)state;
   static const char *const sets[] = {"ambient=0", "rsm.reach=16", "rsm.solid_steps=16", NULL};
   static const char *const off[] = {"ambient=0", "rsm.reach=16", NULL}; /* the default: 0 */
+  static const char *const grid[] = {"ambient=0", "rsm.reach=16", "rsm.solid_cell=2", NULL};
   lm_scene *s = canopy_scene();
   int grey = gl_material(s, "wall", 0.8f, 0.8f, 0.8f);
   const float in = 2.0f, out = 2.6f;
@@ -172,16 +174,21 @@ static void a_solid_between_hides_the_senders_behind_it(void **state) {
   closed_box(s, "north", grey, (const float[3]){-in, 0, -out}, (const float[3]){in, 1, -in});
   closed_box(s, "south", grey, (const float[3]){-in, 0, in}, (const float[3]){in, 1, out});
   lm_scene_update(s);
-  gl_result walled = render_ok(s, "rsm+esm", sets), through = render_ok(s, "rsm+esm", off);
-  float a[3], b[3];
+  gl_result walled = render_ok(s, "rsm+esm", sets), through = render_ok(s, "rsm+esm", off),
+            gridded = render_ok(s, "rsm+esm", grid);
+  float a[3], b[3], c[3];
   gl_region(&walled, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, a);
   gl_region(&through, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, b);
+  gl_region(&gridded, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, c);
   double beyond = canopy_integral(0.8, 0.8, false, out);
-  print_message("walled canopy: %.4f red (through the wall %.4f; the floor beyond it %.4f)\n", a[0], b[0], beyond);
+  print_message("walled canopy: %.4f red (solid grid %.4f; through the wall %.4f; the floor beyond it %.4f)\n", a[0],
+                c[0], b[0], beyond);
   assert_true(fabs(b[0] - beyond) < 0.1 * beyond);
   assert_true(a[0] < 0.1 * beyond);
+  assert_true(c[0] < 0.1 * beyond);
   gl_result_free(&walled);
   gl_result_free(&through);
+  gl_result_free(&gridded);
   lm_scene_destroy(s);
 }
 
@@ -1130,6 +1137,7 @@ static void bad_options_name_themselves(void **state) {
       {"rsm+esm", "rsm.thickness=17", "rsm.thickness"},
       {"isr+rsm+esm", "rsm.ray_steps=33", "rsm.ray_steps"}, {"rsm+esm", "rsm.solid_steps=65", "rsm.solid_steps"},
       {"isr+rsm+esm", "rsm.solid_steps=-1", "rsm.solid_steps"}, {"isr+rsm+esm", "rsm.ray_steps=-1", "rsm.ray_steps"},
+      {"rsm+esm", "rsm.solid_cell=3", "rsm.solid_cell"},
       {"isr+rsm+esm", "rsm.trace=2", "rsm.trace"}, {"isr+rsm+esm", "rsm.trace=-1", "rsm.trace"},
       {"isr+rsm+esm", "rsm.trace=0.5", "rsm.trace"},
       {"isr+rsm+esm", "rsm.trace_samples=-1", "rsm.trace_samples"},

@@ -23,6 +23,7 @@ LIMN=${BUILD_DIR:-build}/limn
 . tools/techniques.sh
 # `6 rays temporal` (the best setting: docs/gi-combined.md): with isr.temporal a still report's history
 # averages the RSM's turning pattern only; tools/moving_fidelity.py judges it on a moving camera's frame.
+# `6 rays temporal grid`: the same with the solid grid (rsm.solid_cell, docs/gi-combined.md), a candidate.
 limn_gi_report --targets --cycles --moving "${MOVING_SIZE:-256x192}" --refs "${REFS:-out/reference}" "${OUT:-out/fidelity}" \
   "${JOB:-data/jobs/reference.lua}" "${FRAMES:-3}" \
   "$LIMN_BASELINE=$LIMN_BASELINE" "seed ISR=$(limn_seed_isr_spec)" "ssdo+esm=ssdo+esm" "ssao+esm=ssao+esm" \
@@ -35,4 +36,5 @@ limn_gi_report --targets --cycles --moving "${MOVING_SIZE:-256x192}" --refs "${R
   "default traced=isr+rsm+esm:rsm.trace=1" "8 b. 8 r. traced=isr+rsm+esm:isr.bounces=4;rsm.bounces=8;isr.samples=8;rsm.trace=1" \
   "5 b. traced reach 2=isr+rsm+esm:isr.bounces=4;rsm.bounces=5;isr.samples=8;rsm.trace=1;rsm.reach=2" \
   "5 b. traced 96 hits=isr+rsm+esm:isr.bounces=4;rsm.bounces=5;isr.samples=8;rsm.trace=1;rsm.reach=2;rsm.trace_samples=96" \
-  "6 rays temporal=isr+rsm+esm:isr.bounces=4;rsm.bounces=5;isr.samples=6;rsm.trace=1;rsm.reach=2;rsm.trace_samples=64;isr.temporal.enabled=true"
+  "6 rays temporal=isr+rsm+esm:isr.bounces=4;rsm.bounces=5;isr.samples=6;rsm.trace=1;rsm.reach=2;rsm.trace_samples=64;isr.temporal.enabled=true" \
+  "6 rays temporal grid=isr+rsm+esm:isr.bounces=4;rsm.bounces=5;isr.samples=6;rsm.trace=1;rsm.reach=2;rsm.trace_samples=64;isr.temporal.enabled=true;rsm.solid_cell=8"
