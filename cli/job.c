@@ -1073,9 +1073,9 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   lm_error err;
   job_view *views;
   int view_count;
-  if (!job_views(j, true, &views, &view_count, &err)) {
+  if (!job_views(j, true, &views, &view_count, &err)) { /* a bad scene, list, animation or output: usage */
     lm_log(LM_LOG_ERROR, "%s", err.msg);
-    return 1;
+    return 2;
   }
 
   char manifest_path[1100];

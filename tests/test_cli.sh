@@ -110,6 +110,9 @@ check "fps without a range" run 2 capture --time 1 --fps 4 --output "$tmp/img/s.
 check "fps without a range message" err_has "--fps goes with --time START:STOP"
 check "unknown animation" run 2 capture --size 16x12 --animation walk --output "$tmp/img/s.png"
 check "unknown animation message" first_error_has "--animation walk: scene 'cornell' has no animation 'walk'"
+# An index is digits alone: " 0" was taken as animation 0.
+check "an index with a space" run 2 capture --scene "$root/data/scenes/door.glb" --size 16x12 --animation " 0" --output "$tmp/img/s.png"
+check "an index with a space: what was given and what exists" first_error_has "scene 'door.glb' has no animation ' 0' (it has 0 'open'; or 'all')"
 check "bad time values leave no file" no_files
 # A sequence whose frame 2 fails (its EXR cannot take its name): frames 0 and 1 whole, and nothing of frame 2,
 # not its PNG written before the EXR failed; the failed frame named.

@@ -188,13 +188,14 @@ check "all images now" count_is "$(ls out/outdoor/*.png | wc -l)" 16
 check "no temporary files left" count_is "$(ls out/outdoor | grep -c tmp)" 0
 check "images are whole after the rerun" whole_pngs out/outdoor/*.png
 
-# Bad input: the job file and the entry, or the camera list and its line.
+# Bad input: the job file and the entry, or the camera list and its line; exit 2 (bad usage) as on
+# the command line.
 bad() { # bad NAME RC MESSAGE JOB_BODY
   printf '%s\n' "$4" > bad.lua
   check "$1" run "$2" capture --job bad.lua
   check "$1: message" err_has "$3"
 }
-bad "unknown scene file" 1 "bad.lua: scenes[2]: $tmp/nosuch.glb" \
+bad "unknown scene file" 2 "bad.lua: scenes[2]: $tmp/nosuch.glb" \
   "return { scenes = { '$scenes/cornell.glb', '$tmp/nosuch.glb' }, output = 'o/{camera}.png' }"
 bad "scene that is not glTF" 2 "bad.lua: scenes[1]: 'cornell' is not a .gltf or .glb file" \
   "return { scenes = { 'cornell' }, output = 'o/{camera}.png' }"
@@ -210,9 +211,9 @@ bad "named entry in a list" 2 "bad.lua: sizes: unknown field 'big' (known: none:
   "return { scenes = { '$scenes/cornell.glb' }, sizes = { '8x8', big = '16x16' }, output = 'o/{camera}.png' }"
 bad "bad size" 2 "bad.lua: sizes[1]: want \"WxH\"" \
   "return { scenes = { '$scenes/cornell.glb' }, sizes = { '0x3' }, output = 'o/{camera}.png' }"
-bad "unknown placeholder" 1 "bad.lua: output: unknown placeholder '{cam}'" \
+bad "unknown placeholder" 2 "bad.lua: output: unknown placeholder '{cam}'" \
   "return { scenes = { '$scenes/cornell.glb' }, output = 'o/{cam}.png' }"
-bad "outputs that collide" 1 "bad.lua: output: views 0 and 1 both write o/x.png" \
+bad "outputs that collide" 2 "bad.lua: output: views 0 and 1 both write o/x.png" \
   "return { scenes = { '$scenes/cornell.glb' }, output = 'o/x.png' }"
 bad "no scenes" 2 "bad.lua: scenes: the job names no scene" "return { output = 'o/{camera}.png' }"
 bad "syntax error" 2 "bad.lua:2:" "return {
@@ -224,20 +225,20 @@ check "missing job file" run 2 capture --job nosuch.lua
 check "missing job file message" err_has "nosuch.lua"
 
 printf 'front 0 1 3.4  0 1 0  45\nside 0 1 x  0 1 0  45\n' > bad.cams
-bad "camera list: a number that does not parse" 1 "bad.cams:2: view 'side': eye_z 'x' is not a finite number" \
+bad "camera list: a number that does not parse" 2 "bad.cams:2: view 'side': eye_z 'x' is not a finite number" \
   "return { scenes = { { scene = '$scenes/cornell.glb', cameras = '$tmp/bad.cams' } }, output = 'o/{camera}.png' }"
 check "camera list message names the job entry" err_has "bad.lua: scenes[1]: "
 printf '# views\n\nfront 0 1 3.4  0 1 0\n' > bad.cams
-check "camera list: too few fields" run 1 capture --job bad.lua
+check "camera list: too few fields" run 2 capture --job bad.lua
 check "too few fields message" err_has "bad.cams:3: 7 fields"
 printf 'front 0 1 3.4  0 1 3.4  45\n' > bad.cams
-check "camera list: eye at the target" run 1 capture --job bad.lua
+check "camera list: eye at the target" run 2 capture --job bad.lua
 check "eye at the target message" err_has "bad.cams:1: view 'front': the eye is at the target"
 printf 'front 0 1 3.4  0 1 0  200\n' > bad.cams
-check "camera list: fov" run 1 capture --job bad.lua
+check "camera list: fov" run 2 capture --job bad.lua
 check "fov message" err_has "bad.cams:1: view 'front': fov_y_degrees 200 is outside"
 printf '# nothing\n' > bad.cams
-check "camera list: empty" run 1 capture --job bad.lua
+check "camera list: empty" run 2 capture --job bad.lua
 check "empty message" err_has "bad.cams: no views"
 check "no image from a failed job" test ! -e o
 
@@ -408,9 +409,11 @@ badseq "turntable elevation" 2 "bad.lua: turntable.elevation: 95 degrees; want o
   "time = { 0, 1, 4 }, turntable = { elevation = 95 }"
 badseq "turntable distance" 2 "bad.lua: turntable.distance: -1; want \"auto\" or a distance in (0, 1e9)" \
   "time = { 0, 1, 4 }, turntable = { distance = -1 }"
-badseq "too many views" 1 "bad.lua: 360004 views (scenes' cameras x sizes x techniques x frames); at most 200000" \
+badseq "too many views" 2 "bad.lua: 360004 views (scenes' cameras x sizes x techniques x frames); at most 200000" \
   "time = { 0, 3000, 30 }"
-badseq "unknown animation" 1 "bad.lua: scenes[1]: animation: scene " "time = 0, animation = 'walk'"
+badseq "unknown animation" 2 "bad.lua: scenes[1]: animation: scene " "time = 0, animation = 'walk'"
+bad "an animation index with a space" 2 "bad.lua: scenes[1]: animation: scene 'door.glb' has no animation ' 0' (it has 0 'open'; or 'all')" \
+  "return { scenes = { '$scenes/door.glb' }, time = 0, animation = ' 0', output = 'o/{camera}.png' }"
 check "no image from a bad sequence" test ! -e o
 
 finish
