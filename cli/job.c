@@ -476,8 +476,10 @@ static bool path_frames_check(const job *j, lm_error *err) {
     if (eye_to_target(eye, target) > 1e-6 * reach) continue;
     int i = 0;
     while (i < j->key_count - 2 && t >= j->keys[i + 1].t) i++;
-    lm_error_set(err, "%s: path: frame %d at %.3f s: the eye reaches the target between path[%d] and path[%d] "
-                 "(the path flies through the point it looks at: no view direction there)", j->path, f, t, i + 1, i + 2);
+    char seconds[LIMN_TIME_TEXT];
+    lm_error_set(err, "%s: path: frame %d at %s s: the eye reaches the target between path[%d] and path[%d] "
+                 "(the path flies through the point it looks at: no view direction there)", j->path, f,
+                 limn_time_text(t, 3, seconds), i + 1, i + 2);
     return false;
   }
   return true;
@@ -691,6 +693,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
 static bool expand(const job *j, const job_view *v, int index, char *out, size_t cap, lm_error *err) {
   const job_scene *s = &j->scenes[v->scene];
   lm_buf b = {0};
+  char seconds[LIMN_TIME_TEXT];
   bool ok = true;
   for (const char *p = j->output; *p && ok; p++) {
     if (*p != '{') {
@@ -708,7 +711,7 @@ static bool expand(const job *j, const job_view *v, int index, char *out, size_t
     else if (!strcmp(key, "width")) lm_buf_printf(&b, "%d", j->sizes[v->size][0]);
     else if (!strcmp(key, "height")) lm_buf_printf(&b, "%d", j->sizes[v->size][1]);
     else if (!strcmp(key, "frame")) lm_buf_printf(&b, CAPTURE_FRAME_FORMAT, v->frame);
-    else if (!strcmp(key, "time")) lm_buf_printf(&b, CAPTURE_TIME_FORMAT, v->time);
+    else if (!strcmp(key, "time")) lm_buf_append(&b, limn_time_text(v->time, 3, seconds), -1);
     else {
       lm_error_set(err, "%s: output: unknown placeholder '{%s}' (known: {scene} {camera} {view} {technique} "
                    "{size} {width} {height} {frame} {time})", j->path, key);
@@ -1187,7 +1190,8 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     if (!ok) {
       if (tty && !a->quiet) printf("\n");
       char frame[64] = "";
-      if (j->timed) snprintf(frame, sizeof frame, ", frame %d at %.3f s", v->frame, v->time);
+      char seconds[LIMN_TIME_TEXT];
+      if (j->timed) snprintf(frame, sizeof frame, ", frame %d at %s s", v->frame, limn_time_text(v->time, 3, seconds));
       lm_log(LM_LOG_ERROR, "%s: view %d (%s, camera '%s', %s, %dx%d%s): %s", j->path, i, s->name,
              s->scene->cameras[v->camera].name, j->techniques[v->technique], j->sizes[v->size][0],
              j->sizes[v->size][1], frame, err.msg);

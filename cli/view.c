@@ -318,8 +318,9 @@ static void move_camera(viewer *v, double dt_ms) {
 /* ---- time ------------------------------------------------------------- */
 /* One line a test can parse: "time 1.250000 s, frame 30, animation 'all', paused (why)". */
 static void report_time(const viewer *v, const char *why) {
-  lm_info("time %.6f s, frame %ld, animation '%s'%s (%s)", v->time, view_frame(v), view_animation_name(v),
-          v->paused ? ", paused" : "", why);
+  char time[LIMN_TIME_TEXT];
+  lm_info("time %s s, frame %ld, animation '%s'%s (%s)", limn_time_text(v->time, 6, time), view_frame(v),
+          view_animation_name(v), v->paused ? ", paused" : "", why);
 }
 
 /* Is the node, or one of its ancestors, moved by a channel of the viewer's animation? */

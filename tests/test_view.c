@@ -767,16 +767,19 @@ static void time_pauses_steps_and_scrubs(void **state) {
   assert_time(&t[2], "at exit", 0.9 + 14.0 / 60 + frame, 28, false);
 }
 
-/* Times as far out as 1e30 s (--time, time=) pose the animation's ends and
- * count a frame number held at +-1e15, with the overlay on (it shows it);
- * the number was a conversion past a long's range, undefined. */
+/* Times as far out as 1e300 s (--time, time=) pose the animation's ends and
+ * count a frame number held at +-1e15, with the overlay and the panel on
+ * (they show it: the panel's slider keeps its knob within the keys). The
+ * number was a conversion past a long's range, undefined, and the time was
+ * printed with its 300 digits (now %g-like: limn_time_text). */
 static void a_time_far_out_has_a_frame_number(void **state) {
   (void)state;
   char log[512], shot[512];
   log_path(log, "time_far");
   shot_path(shot, "time_far.png");
-  pid_t pid = spawn_view(log, "--scene", SCENE("moving_light"), "--tech", "dl", "--size", "48x36", "--time", "1e30",
-                         "--exit-after", "4", "--script-keys", "1:Space,2:time=-1e30", "--screenshot", shot, NULL);
+  pid_t pid = spawn_view(log, "--scene", SCENE("moving_light"), "--tech", "dl", "--size", "96x72", "--time", "1e300",
+                         "--panel", "on", "--exit-after", "4", "--script-keys", "1:Space,2:time=-1e300", "--screenshot",
+                         shot, NULL);
   int rc = wait_exit(pid, 30000);
   if (rc) print_log(log);
   assert_int_equal(rc, 0);
@@ -784,9 +787,11 @@ static void a_time_far_out_has_a_frame_number(void **state) {
   int n = time_lines(log, t, 4);
   if (n != 3) print_log(log);
   assert_int_equal(n, 3);
-  assert_time(&t[0], "Space", 1e30, 1000000000000000L, true);
-  assert_time(&t[1], "scrubbed", -1e30, -1000000000000000L, true);
-  assert_time(&t[2], "at exit", -1e30, -1000000000000000L, true);
+  assert_time(&t[0], "Space", 1e300, 1000000000000000L, true);
+  assert_time(&t[1], "scrubbed", -1e300, -1000000000000000L, true);
+  assert_time(&t[2], "at exit", -1e300, -1000000000000000L, true);
+  assert_true(file_has(log, "limn: time 1e+300 s, frame "));
+  assert_true(file_has(log, "limn: time -1e+300 s, frame "));
 }
 
 /* A script and a scene file saved while paused at 1.25 s: the time and the
