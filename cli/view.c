@@ -43,7 +43,7 @@ static const char view_usage[] =
     "  --animation NAME|INDEX|all  the glTF animation to play (default all)\n"
     "  --time SECONDS       time to start at (default: the animation's first key)\n"
     "  --fps N              frames a second of Left/Right steps and of the frame\n"
-    "                       number on the overlay (default 24)\n"
+    "                       number on the overlay (default 24; a sequence job's)\n"
     "  --overlay on|off     show the overlay at start (default on; F1/Tab toggles)\n"
     "  --panel on|off       show the panel of options at start (default on; M toggles)\n"
     "  --compare TECH       A/B: the frame also through technique TECH, shown right\n"
@@ -178,7 +178,8 @@ static int parse_args(int argc, char **argv, view_args *a) {
       a->time_given = true;
       break;
     case 'F':
-      if (!limn_parse_int(optarg, 1, 1000, &a->fps)) return usage_error("--fps wants 1..1000, not '%s'", optarg);
+      if (!limn_parse_int(optarg, 1, 1000, &n)) return usage_error("--fps wants 1..1000, not '%s'", optarg);
+      a->fps = n, a->fps_given = true;
       break;
     case 'n':
       if (!limn_parse_int(optarg, 1, 1 << 30, &n)) return usage_error("--exit-after wants a frame count, not '%s'", optarg);

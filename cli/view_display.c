@@ -36,7 +36,7 @@ void set_error(char *slot, size_t cap, const char *msg, const char *cleared) {
  * time; it poses the animation's end) has a frame number past a long's range,
  * whose conversion is undefined (it read -9223372036854775808). */
 long view_frame(const viewer *v) {
-  double f = floor(v->time * v->args->fps + 1e-6);
+  double f = floor((v->time - v->args->frame_zero) * v->args->fps + 1e-6);
   return (long)fmax(-1e15, fmin(f, 1e15));
 }
 
