@@ -445,7 +445,9 @@ static bool read_path(lua_State *L, job *j, lm_error *err) {
   for (int i = 0; i < j->key_count && ok; i++) {
     const camera_key *k = &j->keys[i];
     float d[3] = {k->target[0] - k->eye[0], k->target[1] - k->eye[1], k->target[2] - k->eye[2]};
-    if (i > 0 && !(k->t > k[-1].t))
+    if (!(fabs(k->t) < 1e9)) /* the curve divides by key intervals: 1e308 - -1e308 overflows */
+      lm_error_set(err, "%s: path[%d].t: %g s is not within +-1e9", j->path, i + 1, k->t), ok = false;
+    else if (i > 0 && !(k->t > k[-1].t))
       lm_error_set(err, "%s: path[%d].t: %g is not after path[%d].t (%g)", j->path, i + 1, k->t, i, k[-1].t), ok = false;
     else if (!(k->fov > 0.1f && k->fov < 179))
       lm_error_set(err, "%s: path[%d].fov: %g degrees is outside (0.1, 179)", j->path, i + 1, k->fov), ok = false;
@@ -652,6 +654,13 @@ bool job_read(job *j, const char *path, lm_error *err) {
   if ((j->key_count || j->turntable) && !j->timed) {
     lm_error_set(err, "%s: %s: needs time = { start, stop, fps } (or time = SECONDS)", path,
                  j->turntable ? "turntable" : "path");
+    return false;
+  }
+  const camera_key *first = &j->keys[0], *last = &j->keys[j->key_count > 0 ? j->key_count - 1 : 0];
+  if (j->key_count > 1 && (last->t < j->time_start || first->t > j->time_stop)) { /* keys in frames, not seconds? */
+    lm_error_set(err, "%s: path: its keys' times %g .. %g s are all outside the job's time %g .. %g s (the camera "
+                 "would hold path[%d] throughout)", path, first->t, last->t, j->time_start, j->time_stop,
+                 last->t < j->time_start ? j->key_count : 1);
     return false;
   }
   if (j->key_count && !path_frames_check(j, err)) return false;

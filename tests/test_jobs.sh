@@ -382,6 +382,8 @@ badseq "path times not increasing" 2 "bad.lua: path[2].t: 0 is not after path[1]
   "time = { 0, 1, 4 }, path = { $k0, $k0 }"
 badseq "path key without t" 2 "bad.lua: path[1].t: missing" \
   "time = { 0, 1, 4 }, path = { { eye = { 0, 1, 3 }, target = { 0, 1, 0 } } }"
+badseq "path key time far out" 2 "bad.lua: path[1].t: -1e+308 s is not within +-1e9" \
+  "time = { 0, 1, 4 }, path = { { t = -1e308, eye = { 0, 1, 3 }, target = { 0, 1, 0 } }, { t = 1e308, eye = { 1, 1, 3 }, target = { 0, 1, 0 } } }"
 badseq "path fov" 2 "bad.lua: path[1].fov: 200 degrees is outside (0.1, 179)" \
   "time = { 0, 1, 4 }, path = { { t = 0, eye = { 0, 1, 3 }, target = { 0, 1, 0 }, fov = 200 } }"
 badseq "path eye at target" 2 "bad.lua: path[1]: the eye is at the target" \
@@ -402,6 +404,10 @@ badseq "path through its target" 2 "bad.lua: path: frame 2 at 0.500 s: the eye r
   "time = { 0, 1, 4 }, path = { $k0, { t = 1, eye = { 0, 1, -3 }, target = { 0, 1, 0 } } }"
 badseq "path list times" 2 "bad.lua: path.times: a list of 2 times (one for each view of $tmp/keys.cams)" \
   "time = { 0, 1, 4 }, path = { cameras = '$tmp/keys.cams', times = { 0 } }"
+badseq "path keys all after the time" 2 "bad.lua: path: its keys' times 24 .. 48 s are all outside the job's time 0 .. 1 s (the camera would hold path[1] throughout)" \
+  "time = { 0, 1, 4 }, path = { { t = 24, eye = { 0, 1, 3 }, target = { 0, 1, 0 } }, { t = 48, eye = { 1, 1, 3 }, target = { 0, 1, 0 } } }"
+badseq "path keys all before the time" 2 "bad.lua: path: its keys' times 0 .. 0.5 s are all outside the job's time 1 .. 2 s (the camera would hold path[2] throughout)" \
+  "time = { 1, 2, 4 }, path = { $k0, { t = 0.5, eye = { 1, 1, 3 }, target = { 0, 1, 0 } } }"
 badseq "path list missing" 2 "bad.lua: path: " "time = { 0, 1, 4 }, path = '$tmp/nosuch.cams'"
 badseq "path and turntable" 2 "bad.lua: path and turntable: one camera motion at a time" \
   "time = { 0, 1, 4 }, path = { $k0 }, turntable = {}"
