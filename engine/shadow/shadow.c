@@ -285,8 +285,10 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
   mat4 cull;
   if (grow <= 0)
     cascade_cull(cam, view, zr, z1, bounds, texel, filter_reach(st), step, (float[6]){l, r, b, t, zn, zf}, cull);
-  /* A texel's world size and the world depth the tile's 0..1 spans. */
-  add_view(plan, size, vp, (float[4]){0, 0, 0, 0}, (float[4]){texel, zf - zn, 0, 0}, grow <= 0 ? cull : NULL);
+  /* A texel's world width, the world depth the tile's 0..1 spans, and its world height: unstabilized,
+   * the tile is a rectangle, and an RSM texel's area is width times height (rsm.glsl). */
+  add_view(plan, size, vp, (float[4]){0, 0, 0, 0}, (float[4]){texel, zf - zn, (t - b) / (float)size, 0},
+           grow <= 0 ? cull : NULL);
 }
 
 /* Cascades cover the depths where receivers are seen (plan->seen), snapped
