@@ -225,9 +225,12 @@ check "missing job file" run 2 capture --job nosuch.lua
 check "missing job file message" err_has "nosuch.lua"
 
 printf 'front 0 1 3.4  0 1 0  45\nside 0 1 x  0 1 0  45\n' > bad.cams
-bad "camera list: a number that does not parse" 2 "bad.cams:2: view 'side': eye_z 'x' is not a finite number" \
+bad "camera list: a number that does not parse" 2 "bad.cams:2: view 'side': eye_z 'x' is not a number within +-1e9" \
   "return { scenes = { { scene = '$scenes/cornell.glb', cameras = '$tmp/bad.cams' } }, output = 'o/{camera}.png' }"
 check "camera list message names the job entry" err_has "bad.lua: scenes[1]: "
+printf 'front 1e30 1 3.4  0 1 0  45\n' > bad.cams
+check "camera list: a number far out" run 2 capture --job bad.lua
+check "a number far out: named as out of range, not as not finite" err_has "bad.cams:1: view 'front': eye_x '1e30' is not a number within +-1e9"
 printf '# views\n\nfront 0 1 3.4  0 1 0\n' > bad.cams
 check "camera list: too few fields" run 2 capture --job bad.lua
 check "too few fields message" err_has "bad.cams:3: 7 fields"
