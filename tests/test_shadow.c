@@ -843,7 +843,9 @@ static void ortho_extent(const float vp[16], float *width, float *height) {
  * the light's view, here wider than high: the views carry a texel's world
  * width and height apart (texel x and z), and rsm.glsl's orthographic texel
  * area is their product (it was the width squared: the senders' light off
- * by the ratio of the sides). Stabilized, a tile is a square and the two agree. */
+ * by the ratio of the sides). Stabilized, a tile is a square and the two
+ * agree. Either way the RSM's wide tile grows with shadow.rsm (unstabilized,
+ * it kept the slice's rectangle: no senders off screen). */
 static void unstabilized_tiles_have_a_texel_width_and_height(void **state) {
   (void)state;
   lm_scene *s = builtin("field");
@@ -851,11 +853,21 @@ static void unstabilized_tiles_have_a_texel_width_and_height(void **state) {
   lm_scene_frame_data(s, 0, 512, 128, &cam); /* a wide view: its slices' rectangles are not squares */
   lm_shadow_settings st;
   lm_shadow_settings_default(&st);
-  st.rsm = 1, st.rsm_resolution = 128;
+  st.rsm_resolution = 128;
   for (int stabilize = 0; stabilize < 2; stabilize++) {
     st.stabilize = stabilize;
     lm_shadow_plan plan;
     lm_error err;
+    float wide[2]; /* the RSM tile's width at rsm 1 and 2 */
+    for (int k = 0; k < 2; k++) {
+      st.rsm = (float)(k + 1);
+      assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+      float height;
+      ortho_extent(plan.view_data[plan.view_count].view_proj, &wide[k], &height);
+      lm_shadow_plan_free(&plan);
+    }
+    printf("stabilize %d: the RSM tile %.4g wide at shadow.rsm=1, %.4g at 2\n", stabilize, wide[0], wide[1]);
+    assert_true(wide[1] > 1.85f * wide[0] && wide[1] < 2.15f * wide[0]);
     assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
     assert_int_equal(plan.rsm_view_count, 1); /* the sun's wide tile */
     for (int v = 0; v < plan.view_count + plan.rsm_view_count; v++) {

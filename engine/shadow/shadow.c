@@ -248,6 +248,10 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
       glm_mat4_mulv(view, p, q);
       l = fminf(l, q[0]), r = fmaxf(r, q[0]), b = fminf(b, q[1]), t = fmaxf(t, q[1]);
     }
+    /* The RSM's tile grows about its centre as the sphere's radius does (senders off screen). */
+    float g = fmaxf(grow, 1.0f), cx = 0.5f * (l + r), cy = 0.5f * (b + t), hx = 0.5f * (r - l) * g,
+          hy = 0.5f * (t - b) * g;
+    l = cx - hx, r = cx + hx, b = cy - hy, t = cy + hy;
   }
   /* Depth spans the slice's sphere (whatever `behind` is), narrowed to the
    * meshes inside the tile and snapped to steps, so ESM's c acts on a short
