@@ -353,6 +353,13 @@ int limn_capture(int argc, char **argv) {
     lm_pipeline_destroy(pipeline);
     return 1;
   }
+  if (o->width > lm_texture_max_size() || o->height > lm_texture_max_size()) { /* the flag, not a target, named */
+    lm_log(LM_LOG_ERROR, "--size %dx%d: this GL's textures are at most %d a side", o->width, o->height,
+           lm_texture_max_size());
+    lm_pipeline_destroy(pipeline);
+    lm_context_destroy();
+    return 2;
+  }
   /* To the GPU as it is read: a technique that traces reads the vertices back (lm_scene_restore_geometry). */
   lm_scene *scene = lm_scene_load_gpu(o->scene, &err);
   int animation = LM_ANIM_ALL;

@@ -1102,8 +1102,17 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   for (int i = 0; i < view_count; i++) mine += job_shard_of(j, i, view_count, a->shards) == a->shard;
   bool any_linear;
   capture_known_extension(j->output, &any_linear);
-  if (!job_make_parent(manifest_path, &err) ||
-      !lm_context_create_headless(&(lm_context_desc){.platform = a->egl, .debug = a->verbose}, &err)) {
+  if (!lm_context_create_headless(&(lm_context_desc){.platform = a->egl, .debug = a->verbose}, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    rc = 1;
+  }
+  for (int i = 0; i < j->size_count && !rc; i++) /* the entry named, not the first target that fails */
+    if (j->sizes[i][0] > lm_texture_max_size() || j->sizes[i][1] > lm_texture_max_size()) {
+      lm_log(LM_LOG_ERROR, "%s: sizes[%d]: %dx%d; this GL's textures are at most %d a side", j->path, i + 1,
+             j->sizes[i][0], j->sizes[i][1], lm_texture_max_size());
+      rc = 2;
+    }
+  if (!rc && !job_make_parent(manifest_path, &err)) { /* after the checks: a refused job leaves no folder */
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     rc = 1;
   }

@@ -33,6 +33,8 @@ check "unknown flag" run 2 capture --bogus
 check "unknown flag message" err_has "unknown flag '--bogus'"
 check "bad size" run 2 capture --size 0x5
 check "bad size message" err_has "--size wants WxH"
+check "a size past the GL's largest texture" run 2 capture --size 65536x8 --output "$tmp/img/big.png"
+check "a size past the GL's largest texture: the flag named" first_error_has "--size 65536x8: this GL's textures are at most "
 check "missing value" run 2 capture --size
 # A glTF file that requires an extension the engine lacks: refused by name, before its data is read.
 sed 's/"extensionsUsed": \[/"extensionsRequired": ["EXT_mesh_features"], "extensionsUsed": [/' \

@@ -209,6 +209,8 @@ bad "misspelt scene field" 2 "bad.lua: scenes[1]: unknown field 'camera' (known:
   "return { scenes = { { scene = '$scenes/cornell.glb', camera = 'x.cams' } }, output = 'o/{camera}.png' }"
 bad "named entry in a list" 2 "bad.lua: sizes: unknown field 'big' (known: none: a list of 1)" \
   "return { scenes = { '$scenes/cornell.glb' }, sizes = { '8x8', big = '16x16' }, output = 'o/{camera}.png' }"
+bad "size past the GL's largest texture" 2 "bad.lua: sizes[2]: 8x65536; this GL's textures are at most " \
+  "return { scenes = { '$scenes/cornell.glb' }, sizes = { '8x8', '8x65536' }, output = 'o/{camera}-{size}.png' }"
 bad "bad size" 2 "bad.lua: sizes[1]: want \"WxH\"" \
   "return { scenes = { '$scenes/cornell.glb' }, sizes = { '0x3' }, output = 'o/{camera}.png' }"
 bad "unknown placeholder" 2 "bad.lua: output: unknown placeholder '{cam}'" \
