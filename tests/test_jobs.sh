@@ -297,6 +297,24 @@ check "a failing frame named" err_has "seq.lua: view 3 (cornell, camera 'front',
 check "the frames before it only" test "$(find seq -type f -name 'front-*' | sort | frames_of_list)" = "0000.png 0001.png 0002.png "
 check "its manifest: 3 images of 5 views" test "$(grep -c '"views": 5,' seq/manifest.json) $(entries seq/manifest.json)" = "1 3"
 rm -rf seq
+# A script that fails on frame 5 (its sixth OnRender): the job stops there naming the view and script:line,
+# exit 1; frames 0-4 whole and in the manifest, 5 of the sequence's 9.
+cat > late.lua <<'LUA'
+local gbuffer = require "gbuffer"
+Techniques = { "gbuffer" }
+local calls = 0
+function OnRender(tech)
+  calls = calls + 1
+  if calls == 6 then error("frame 5 fails") end
+  present(gbuffer.render(gbuffer.targets()).clr)
+end
+LUA
+sed -e 's|time = .*|time = { 0, 2, 4 }, script = "late.lua",|' -e 's|techniques = { "dl" }|techniques = { "gbuffer" }|' seq.lua > lateseq.lua
+check "a script failing on frame 5" run 1 capture --job lateseq.lua
+check "a script failing on frame 5: named" err_has "lateseq.lua: view 5 (cornell, camera 'front', gbuffer, 48x36, frame 5 at 1.250 s): ./late.lua:6: frame 5 fails"
+check "the frames before it only" test "$(find seq -type f -name 'front-*' | sort | frames_of_list)" = "0000.png 0001.png 0002.png 0003.png 0004.png "
+check "its manifest: 5 images of 9 views" test "$(grep -c '"views": 9,' seq/manifest.json) $(entries seq/manifest.json)" = "1 5"
+rm -rf seq
 check "sequence shard 0/2" run 0 capture --job seq.lua --shard 0/2
 check "shard 0/2 renders frames 0-2 (a contiguous run)" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png 0002.png "
 check "sequence shard 1/2" run 0 capture --job seq.lua --shard 1/2
