@@ -921,6 +921,19 @@ static int compare_outputs(const void *a, const void *b) {
   return c ? c : (x > y) - (x < y); /* ties in view order */
 }
 
+/* The placeholder that would tell views x and y apart: the first field in
+ * which they differ, {view} where that field's names are equal (a scene
+ * listed twice, two cameras of one name). */
+static const char *telling_apart(const job *j, const job_view *x, const job_view *y) {
+  const job_scene *a = &j->scenes[x->scene], *b = &j->scenes[y->scene];
+  if (x->scene != y->scene) return strcmp(a->name, b->name) ? "{scene}" : "{view}";
+  if (x->camera != y->camera)
+    return strcmp(a->scene->cameras[x->camera].name, a->scene->cameras[y->camera].name) ? "{camera}" : "{view}";
+  if (x->technique != y->technique) return "{technique}";
+  if (x->size != y->size) return "{size}";
+  return "{frame}";
+}
+
 /* False, naming two views, when two views write one file (sorted: a long
  * sequence's views are many). */
 static bool unique_outputs(const job *j, const job_view *views, int n, lm_error *err) {
@@ -930,8 +943,9 @@ static bool unique_outputs(const job *j, const job_view *views, int n, lm_error 
   bool ok = true;
   for (int i = 1; i < n && ok; i++)
     if (!strcmp(sorted[i - 1]->output, sorted[i]->output)) {
-      lm_error_set(err, "%s: output: views %d and %d both write %s (add {camera}, {technique} or {size} to the "
-                   "pattern)", j->path, (int)(sorted[i - 1] - views), (int)(sorted[i] - views), sorted[i]->output);
+      lm_error_set(err, "%s: output: views %d and %d both write %s (add %s to the pattern)", j->path,
+                   (int)(sorted[i - 1] - views), (int)(sorted[i] - views), sorted[i]->output,
+                   telling_apart(j, sorted[i - 1], sorted[i]));
       ok = false;
     }
   free(sorted);

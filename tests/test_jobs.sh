@@ -215,8 +215,10 @@ bad "bad size" 2 "bad.lua: sizes[1]: want \"WxH\"" \
   "return { scenes = { '$scenes/cornell.glb' }, sizes = { '0x3' }, output = 'o/{camera}.png' }"
 bad "unknown placeholder" 2 "bad.lua: output: unknown placeholder '{cam}'" \
   "return { scenes = { '$scenes/cornell.glb' }, output = 'o/{cam}.png' }"
-bad "outputs that collide" 2 "bad.lua: output: views 0 and 1 both write o/x.png" \
+bad "outputs that collide" 2 "bad.lua: output: views 0 and 1 both write o/x.png (add {camera} to the pattern)" \
   "return { scenes = { '$scenes/cornell.glb' }, output = 'o/x.png' }"
+bad "a scene listed twice" 2 "bad.lua: output: views 3 and 7 both write o/cornell-boxes.png (add {view} to the pattern)" \
+  "return { scenes = { '$scenes/cornell.glb', '$scenes/cornell.glb' }, output = 'o/{scene}-{camera}.png' }"
 bad "no scenes" 2 "bad.lua: scenes: the job names no scene" "return { output = 'o/{camera}.png' }"
 bad "syntax error" 2 "bad.lua:2:" "return {
   scenes = { 'a.glb' } output = 'x.png' }"
