@@ -33,6 +33,12 @@ bool limn_parse_double(const char *s, double *out) {
   return true;
 }
 
+const char *limn_time_text(double seconds, int places, char out[LIMN_TIME_TEXT]) {
+  if (fabs(seconds) < 1e6) snprintf(out, LIMN_TIME_TEXT, "%.*f", places, seconds);
+  else snprintf(out, LIMN_TIME_TEXT, "%.*g", places + 1, seconds);
+  return out;
+}
+
 bool limn_parse_time(const char *s, double *start, double *stop) {
   const char *colon = strchr(s, ':');
   char first[64];

@@ -297,9 +297,10 @@ static int parse_args(int argc, char **argv, capture_args *a) {
 /* The output name of a sequence's frame: {frame} and {time} filled. */
 static void frame_name(const char *pattern, int frame, double time, char *out, size_t cap) {
   lm_buf b = {0};
+  char seconds[LIMN_TIME_TEXT];
   for (const char *p = pattern; *p; p++) {
     if (!strncmp(p, "{frame}", 7)) lm_buf_printf(&b, CAPTURE_FRAME_FORMAT, frame), p += 6;
-    else if (!strncmp(p, "{time}", 6)) lm_buf_printf(&b, CAPTURE_TIME_FORMAT, time), p += 5;
+    else if (!strncmp(p, "{time}", 6)) lm_buf_append(&b, limn_time_text(time, 3, seconds), -1), p += 5;
     else lm_buf_append(&b, p, 1);
   }
   snprintf(out, cap, "%s", b.data ? b.data : "");
@@ -351,6 +352,13 @@ int limn_capture(int argc, char **argv) {
     lm_log(LM_LOG_ERROR, "no OpenGL context: %s", err.msg);
     lm_pipeline_destroy(pipeline);
     return 1;
+  }
+  if (o->width > lm_texture_max_size() || o->height > lm_texture_max_size()) { /* the flag, not a target, named */
+    lm_log(LM_LOG_ERROR, "--size %dx%d: this GL's textures are at most %d a side", o->width, o->height,
+           lm_texture_max_size());
+    lm_pipeline_destroy(pipeline);
+    lm_context_destroy();
+    return 2;
   }
   /* To the GPU as it is read: a technique that traces reads the vertices back (lm_scene_restore_geometry). */
   lm_scene *scene = lm_scene_load_gpu(o->scene, &err);
@@ -406,6 +414,7 @@ int limn_capture(int argc, char **argv) {
   for (int i = 0; i < a.video_count && ok; i++)
     if ((ok = video_open(&videos[i], a.videos[i], o->width, o->height, a.fps, &err))) opened++;
   int written = 0; /* frames */
+  char seconds[LIMN_TIME_TEXT], stop_text[LIMN_TIME_TEXT];
   for (int k = 0; k < a.frame_count && ok && !stop_signal; k++) {
     double t = a.frame_count > 1 ? a.time_start + k / a.fps : a.time_start;
     if (a.time_flag || a.animation) {
@@ -424,7 +433,7 @@ int limn_capture(int argc, char **argv) {
     ok = capture_render_write(r, &v, &res, &err);
     if (ok && a.video_count) ok = lm_renderer_read(r, false, rgb, &err);
     for (int i = 0; i < a.video_count && ok; i++) ok = video_write(&videos[i], rgb, (size_t)o->width * o->height * 3, &err);
-    if (!ok && a.frame_count > 1) lm_error_prefix(&err, "frame %d at %.3f s", k, t);
+    if (!ok && a.frame_count > 1) lm_error_prefix(&err, "frame %d at %s s", k, limn_time_text(t, 3, seconds));
     written += ok;
   }
   if (stop_signal) {
@@ -438,8 +447,9 @@ int limn_capture(int argc, char **argv) {
     else if (ok && !a.quiet) lm_info("wrote %s", videos[i].path);
   }
   free(rgb);
-  if (ok && !a.quiet && a.frame_count > 1) printf("%d frames, %.3f s to %.3f s at %g fps (times: the last frame's)\n",
-                                                  a.frame_count, a.time_start, a.time_stop, a.fps);
+  if (ok && !a.quiet && a.frame_count > 1)
+    printf("%d frames, %s s to %s s at %g fps (times: the last frame's)\n", a.frame_count,
+           limn_time_text(a.time_start, 3, seconds), limn_time_text(a.time_stop, 3, stop_text), a.fps);
   if (ok && !a.quiet) print_times(&res, a.frames, a.warmup, lm_renderer_clock(r));
   if (!ok) lm_log(LM_LOG_ERROR, "%s", err.msg);
   capture_result_free(&res);

@@ -23,9 +23,8 @@ typedef struct capture_view {
   const volatile sig_atomic_t *stop;
 } capture_view;
 
-/* How outputs name a sequence's frame and time ({frame}, {time}). */
+/* How outputs name a sequence's frame ({frame}; {time} is limn_time_text's, 3 places). */
 #define CAPTURE_FRAME_FORMAT "%04d"
-#define CAPTURE_TIME_FORMAT "%.3f"
 
 typedef struct capture_pass_time {
   const char *name, *kind;

@@ -445,7 +445,9 @@ static bool read_path(lua_State *L, job *j, lm_error *err) {
   for (int i = 0; i < j->key_count && ok; i++) {
     const camera_key *k = &j->keys[i];
     float d[3] = {k->target[0] - k->eye[0], k->target[1] - k->eye[1], k->target[2] - k->eye[2]};
-    if (i > 0 && !(k->t > k[-1].t))
+    if (!(fabs(k->t) < 1e9)) /* the curve divides by key intervals: 1e308 - -1e308 overflows */
+      lm_error_set(err, "%s: path[%d].t: %g s is not within +-1e9", j->path, i + 1, k->t), ok = false;
+    else if (i > 0 && !(k->t > k[-1].t))
       lm_error_set(err, "%s: path[%d].t: %g is not after path[%d].t (%g)", j->path, i + 1, k->t, i, k[-1].t), ok = false;
     else if (!(k->fov > 0.1f && k->fov < 179))
       lm_error_set(err, "%s: path[%d].fov: %g degrees is outside (0.1, 179)", j->path, i + 1, k->fov), ok = false;
@@ -476,8 +478,10 @@ static bool path_frames_check(const job *j, lm_error *err) {
     if (eye_to_target(eye, target) > 1e-6 * reach) continue;
     int i = 0;
     while (i < j->key_count - 2 && t >= j->keys[i + 1].t) i++;
-    lm_error_set(err, "%s: path: frame %d at %.3f s: the eye reaches the target between path[%d] and path[%d] "
-                 "(the path flies through the point it looks at: no view direction there)", j->path, f, t, i + 1, i + 2);
+    char seconds[LIMN_TIME_TEXT];
+    lm_error_set(err, "%s: path: frame %d at %s s: the eye reaches the target between path[%d] and path[%d] "
+                 "(the path flies through the point it looks at: no view direction there)", j->path, f,
+                 limn_time_text(t, 3, seconds), i + 1, i + 2);
     return false;
   }
   return true;
@@ -652,6 +656,13 @@ bool job_read(job *j, const char *path, lm_error *err) {
                  j->turntable ? "turntable" : "path");
     return false;
   }
+  const camera_key *first = &j->keys[0], *last = &j->keys[j->key_count > 0 ? j->key_count - 1 : 0];
+  if (j->key_count > 1 && (last->t < j->time_start || first->t > j->time_stop)) { /* keys in frames, not seconds? */
+    lm_error_set(err, "%s: path: its keys' times %g .. %g s are all outside the job's time %g .. %g s (the camera "
+                 "would hold path[%d] throughout)", path, first->t, last->t, j->time_start, j->time_stop,
+                 last->t < j->time_start ? j->key_count : 1);
+    return false;
+  }
   if (j->key_count && !path_frames_check(j, err)) return false;
   if (j->frame_count > 1 && !strstr(j->output, "{frame}")) {
     lm_error_set(err, "%s: output: a sequence of %d frames needs {frame} in the pattern (\"%s\")", path,
@@ -691,6 +702,7 @@ bool job_read(job *j, const char *path, lm_error *err) {
 static bool expand(const job *j, const job_view *v, int index, char *out, size_t cap, lm_error *err) {
   const job_scene *s = &j->scenes[v->scene];
   lm_buf b = {0};
+  char seconds[LIMN_TIME_TEXT];
   bool ok = true;
   for (const char *p = j->output; *p && ok; p++) {
     if (*p != '{') {
@@ -708,7 +720,7 @@ static bool expand(const job *j, const job_view *v, int index, char *out, size_t
     else if (!strcmp(key, "width")) lm_buf_printf(&b, "%d", j->sizes[v->size][0]);
     else if (!strcmp(key, "height")) lm_buf_printf(&b, "%d", j->sizes[v->size][1]);
     else if (!strcmp(key, "frame")) lm_buf_printf(&b, CAPTURE_FRAME_FORMAT, v->frame);
-    else if (!strcmp(key, "time")) lm_buf_printf(&b, CAPTURE_TIME_FORMAT, v->time);
+    else if (!strcmp(key, "time")) lm_buf_append(&b, limn_time_text(v->time, 3, seconds), -1);
     else {
       lm_error_set(err, "%s: output: unknown placeholder '{%s}' (known: {scene} {camera} {view} {technique} "
                    "{size} {width} {height} {frame} {time})", j->path, key);
@@ -909,6 +921,19 @@ static int compare_outputs(const void *a, const void *b) {
   return c ? c : (x > y) - (x < y); /* ties in view order */
 }
 
+/* The placeholder that would tell views x and y apart: the first field in
+ * which they differ, {view} where that field's names are equal (a scene
+ * listed twice, two cameras of one name). */
+static const char *telling_apart(const job *j, const job_view *x, const job_view *y) {
+  const job_scene *a = &j->scenes[x->scene], *b = &j->scenes[y->scene];
+  if (x->scene != y->scene) return strcmp(a->name, b->name) ? "{scene}" : "{view}";
+  if (x->camera != y->camera)
+    return strcmp(a->scene->cameras[x->camera].name, a->scene->cameras[y->camera].name) ? "{camera}" : "{view}";
+  if (x->technique != y->technique) return "{technique}";
+  if (x->size != y->size) return "{size}";
+  return "{frame}";
+}
+
 /* False, naming two views, when two views write one file (sorted: a long
  * sequence's views are many). */
 static bool unique_outputs(const job *j, const job_view *views, int n, lm_error *err) {
@@ -918,8 +943,9 @@ static bool unique_outputs(const job *j, const job_view *views, int n, lm_error 
   bool ok = true;
   for (int i = 1; i < n && ok; i++)
     if (!strcmp(sorted[i - 1]->output, sorted[i]->output)) {
-      lm_error_set(err, "%s: output: views %d and %d both write %s (add {camera}, {technique} or {size} to the "
-                   "pattern)", j->path, (int)(sorted[i - 1] - views), (int)(sorted[i] - views), sorted[i]->output);
+      lm_error_set(err, "%s: output: views %d and %d both write %s (add %s to the pattern)", j->path,
+                   (int)(sorted[i - 1] - views), (int)(sorted[i] - views), sorted[i]->output,
+                   telling_apart(j, sorted[i - 1], sorted[i]));
       ok = false;
     }
   free(sorted);
@@ -1073,9 +1099,9 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   lm_error err;
   job_view *views;
   int view_count;
-  if (!job_views(j, true, &views, &view_count, &err)) {
+  if (!job_views(j, true, &views, &view_count, &err)) { /* a bad scene, list, animation or output: usage */
     lm_log(LM_LOG_ERROR, "%s", err.msg);
-    return 1;
+    return 2;
   }
 
   char manifest_path[1100];
@@ -1090,8 +1116,17 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
   for (int i = 0; i < view_count; i++) mine += job_shard_of(j, i, view_count, a->shards) == a->shard;
   bool any_linear;
   capture_known_extension(j->output, &any_linear);
-  if (!job_make_parent(manifest_path, &err) ||
-      !lm_context_create_headless(&(lm_context_desc){.platform = a->egl, .debug = a->verbose}, &err)) {
+  if (!lm_context_create_headless(&(lm_context_desc){.platform = a->egl, .debug = a->verbose}, &err)) {
+    lm_log(LM_LOG_ERROR, "%s", err.msg);
+    rc = 1;
+  }
+  for (int i = 0; i < j->size_count && !rc; i++) /* the entry named, not the first target that fails */
+    if (j->sizes[i][0] > lm_texture_max_size() || j->sizes[i][1] > lm_texture_max_size()) {
+      lm_log(LM_LOG_ERROR, "%s: sizes[%d]: %dx%d; this GL's textures are at most %d a side", j->path, i + 1,
+             j->sizes[i][0], j->sizes[i][1], lm_texture_max_size());
+      rc = 2;
+    }
+  if (!rc && !job_make_parent(manifest_path, &err)) { /* after the checks: a refused job leaves no folder */
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     rc = 1;
   }
@@ -1187,7 +1222,8 @@ static int run(const capture_job_args *a, job *j, lm_pipeline *pipeline) {
     if (!ok) {
       if (tty && !a->quiet) printf("\n");
       char frame[64] = "";
-      if (j->timed) snprintf(frame, sizeof frame, ", frame %d at %.3f s", v->frame, v->time);
+      char seconds[LIMN_TIME_TEXT];
+      if (j->timed) snprintf(frame, sizeof frame, ", frame %d at %s s", v->frame, limn_time_text(v->time, 3, seconds));
       lm_log(LM_LOG_ERROR, "%s: view %d (%s, camera '%s', %s, %dx%d%s): %s", j->path, i, s->name,
              s->scene->cameras[v->camera].name, j->techniques[v->technique], j->sizes[v->size][0],
              j->sizes[v->size][1], frame, err.msg);

@@ -272,7 +272,8 @@ bool reference_export(const reference_args *a, const job *j, const job_view *v, 
   /* A sequence's frames: each its own file, the frame in its name and hash. */
   char frame[64] = "";
   if (j->timed) {
-    snprintf(frame, sizeof frame, "-" CAPTURE_FRAME_FORMAT "-" CAPTURE_TIME_FORMAT, v->frame, v->time);
+    char seconds[LIMN_TIME_TEXT];
+    snprintf(frame, sizeof frame, "-" CAPTURE_FRAME_FORMAT "-%s", v->frame, limn_time_text(v->time, 3, seconds));
     h = lm_hash(frame, strlen(frame), h);
   }
   char scene[LM_NAME_MAX], camera[LM_NAME_MAX];
@@ -375,7 +376,8 @@ static void view_error(const job *j, const job_view *places, int place, bool new
   va_end(ap);
   if (newline) printf("\n");
   char frame[64] = "";
-  if (j->timed) snprintf(frame, sizeof frame, ", frame %d at %.3f s", v->frame, v->time);
+  char seconds[LIMN_TIME_TEXT];
+  if (j->timed) snprintf(frame, sizeof frame, ", frame %d at %s s", v->frame, limn_time_text(v->time, 3, seconds));
   lm_log(LM_LOG_ERROR, "%s: view %d (%s, camera '%s', %dx%d%s): %s", j->path, place, s->name,
          s->scene->cameras[v->camera].name, j->sizes[v->size][0], j->sizes[v->size][1], frame, what);
 }

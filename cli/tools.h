@@ -30,6 +30,11 @@ bool limn_parse_double(const char *s, double *out); /* finite */
 /* --time: SECONDS (start = stop) or START:STOP, finite; the order is the caller's to check. */
 bool limn_parse_time(const char *s, double *start, double *stop);
 bool limn_parse_size(const char *s, int *w, int *h); /* WxH, each 1..65536 */
+/* A time in seconds as messages, the viewer and file names ({time}) print it:
+ * `places` decimals (1.250), but %g from 1e6 s on, where fixed decimals
+ * would print a 300-digit number for 1e300. Returns out. */
+#define LIMN_TIME_TEXT 32
+const char *limn_time_text(double seconds, int places, char out[LIMN_TIME_TEXT]);
 bool limn_parse_on_off(const char *s, bool *out);
 /* A command of one subcommand (limn farm slurm, limn manifest merge): -1
  * when argv[1] is `sub`; else the exit status, 0 after printing `usage` for

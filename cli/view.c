@@ -43,7 +43,7 @@ static const char view_usage[] =
     "  --animation NAME|INDEX|all  the glTF animation to play (default all)\n"
     "  --time SECONDS       time to start at (default: the animation's first key)\n"
     "  --fps N              frames a second of Left/Right steps and of the frame\n"
-    "                       number on the overlay (default 24)\n"
+    "                       number on the overlay (default 24; a sequence job's)\n"
     "  --overlay on|off     show the overlay at start (default on; F1/Tab toggles)\n"
     "  --panel on|off       show the panel of options at start (default on; M toggles)\n"
     "  --compare TECH       A/B: the frame also through technique TECH, shown right\n"
@@ -178,7 +178,8 @@ static int parse_args(int argc, char **argv, view_args *a) {
       a->time_given = true;
       break;
     case 'F':
-      if (!limn_parse_int(optarg, 1, 1000, &a->fps)) return usage_error("--fps wants 1..1000, not '%s'", optarg);
+      if (!limn_parse_int(optarg, 1, 1000, &n)) return usage_error("--fps wants 1..1000, not '%s'", optarg);
+      a->fps = n, a->fps_given = true;
       break;
     case 'n':
       if (!limn_parse_int(optarg, 1, 1 << 30, &n)) return usage_error("--exit-after wants a frame count, not '%s'", optarg);
@@ -318,8 +319,9 @@ static void move_camera(viewer *v, double dt_ms) {
 /* ---- time ------------------------------------------------------------- */
 /* One line a test can parse: "time 1.250000 s, frame 30, animation 'all', paused (why)". */
 static void report_time(const viewer *v, const char *why) {
-  lm_info("time %.6f s, frame %ld, animation '%s'%s (%s)", v->time, view_frame(v), view_animation_name(v),
-          v->paused ? ", paused" : "", why);
+  char time[LIMN_TIME_TEXT];
+  lm_info("time %s s, frame %ld, animation '%s'%s (%s)", limn_time_text(v->time, 6, time), view_frame(v),
+          view_animation_name(v), v->paused ? ", paused" : "", why);
 }
 
 /* Is the node, or one of its ancestors, moved by a channel of the viewer's animation? */

@@ -38,7 +38,10 @@ typedef struct view_args {
   const char *animation; /* NAME, INDEX or "all" */
   double time;           /* --time; with time_given */
   bool time_given;
-  int fps;               /* frames a second: what Left/Right step and the overlay counts */
+  double fps;            /* frames a second: what Left/Right step and the overlay counts (--fps, or a
+                          * sequence job's time.fps) */
+  bool fps_given;
+  double frame_zero;     /* the time of frame 0: a sequence job's time.start, so that frames count as its */
   long exit_after, reload_test;
   bool overlay, panel, quiet, verbose;
   const char *job;       /* --job: start at view `job_view` of this capture job */
@@ -167,7 +170,7 @@ void say(viewer *v, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* An error shows once on stderr when it appears and once (as `cleared`) when it goes. */
 void set_error(char *slot, size_t cap, const char *msg, const char *cleared);
 
-/* The frame number at the viewer's time (--fps frames a second) and its animation's name. */
+/* The frame number at the viewer's time (fps frames a second from frame_zero) and its animation's name. */
 long view_frame(const viewer *v);
 const char *view_animation_name(const viewer *v);
 bool make_window_textures(viewer *v, lm_error *err);

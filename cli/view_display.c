@@ -36,7 +36,7 @@ void set_error(char *slot, size_t cap, const char *msg, const char *cleared) {
  * time; it poses the animation's end) has a frame number past a long's range,
  * whose conversion is undefined (it read -9223372036854775808). */
 long view_frame(const viewer *v) {
-  double f = floor(v->time * v->args->fps + 1e-6);
+  double f = floor((v->time - v->args->frame_zero) * v->args->fps + 1e-6);
   return (long)fmax(-1e15, fmin(f, 1e15));
 }
 
@@ -217,9 +217,10 @@ static void draw_overlay(viewer *v) {
     add_line(v, white, "A/B: left %s | right %s%s (B toggles; drag the line)", lm_pipeline_technique(v->pipeline),
               lm_pipeline_technique(v->compare_pipeline), v->args->compare_set_count ? " with its own options" : "");
   if (v->overlay_on && v->args->job && v->reference_text[0]) add_line(v, white, "%s", v->reference_text);
+  char time[LIMN_TIME_TEXT];
   if (v->overlay_on && lm_scene_animated(v->scene))
-    add_line(v, white, "time %.3f s | frame %ld | animation %s (%.3g..%.3g s)%s", v->time, view_frame(v),
-              view_animation_name(v), v->anim_range[0], v->anim_range[1], v->paused ? " | paused" : "");
+    add_line(v, white, "time %s s | frame %ld | animation %s (%.3g..%.3g s)%s", limn_time_text(v->time, 3, time),
+             view_frame(v), view_animation_name(v), v->anim_range[0], v->anim_range[1], v->paused ? " | paused" : "");
   if (v->overlay_on && v->inspect >= 0 && v->inspect < lm_graph_target_count(g)) {
     lm_graph_target_info t = lm_graph_target(g, v->inspect);
     int *order = lm_alloc(sizeof *order * (size_t)lm_graph_target_count(g));
@@ -423,9 +424,11 @@ static panel_image lay_out_panel(viewer *v) {
     if (info.desc->depth >= 0) targets_of[used++] = info.desc->depth;
     pp->output_count = (int)(targets_of + used - pp->outputs);
   }
+  char time_text[LIMN_TIME_TEXT];
   panel_model m = {.options = v->options, .option_count = v->option_count, .techniques = names,
                    .technique_count = count, .technique = current, .animated = lm_scene_animated(v->scene),
                    .time = v->time, .time_lo = v->anim_range[0], .time_hi = v->anim_range[1],
+                   .time_text = limn_time_text(v->time, 3, time_text),
                    .paused = v->paused, .status = v->status[0] ? v->status : NULL,
                    .cost = v->frames_timed[1] ? v->panel_cost_text : NULL, .passes = passes,
                    .pass_count = pass_count, .targets = target_names, .target_count = target_count,

@@ -174,6 +174,10 @@ bool load_view_job(view_args *a) {
   if (ok && a->job_view >= count) {
     lm_error_set(&err, "--view %d: job %s has %d view(s), 0..%d", a->job_view, a->job, count, count - 1);
     ok = false;
+  } else if (ok && a->fps_given && j->fps > 0 && a->fps != j->fps) { /* two frame rates: one of them is a mistake */
+    lm_error_set(&err, "--fps %g: the job's time.fps is %g (leave --fps out: the job's counts the frames)", a->fps,
+                 j->fps);
+    ok = false;
   }
   if (ok) {
     const job_view *jv = &views[a->job_view];
@@ -189,6 +193,7 @@ bool load_view_job(view_args *a) {
     a->common.width = j->sizes[jv->size][0], a->common.height = j->sizes[jv->size][1];
     a->common.camera = jv->camera;
     if (j->timed) a->time = jv->time, a->time_given = true;
+    if (j->fps > 0) a->fps = j->fps, a->frame_zero = j->time_start; /* its frames numbered as the job's */
     if (j->animation[0]) snprintf(a->job_animation, sizeof a->job_animation, "%s", j->animation), a->animation = a->job_animation;
     /* The job's options first: --set flags given with --job come after and win. */
     int given = a->set_count;

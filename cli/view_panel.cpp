@@ -523,9 +523,11 @@ panel_image panel_frame(lm_panel *p, const panel_model *m, int width, int height
   if (m->animated && ImGui::CollapsingHeader("time", ImGuiTreeNodeFlags_DefaultOpen)) {
     if (ImGui::Button(m->paused ? "Play (Space)" : "Pause (Space)")) e->play = true;
     p->controls.push_back(last_item("play", "button", "time"));
-    float t = static_cast<float>(m->time);
+    /* The knob within the keys (a time of 1e300 is past a float's range); the text says the time itself. */
     float lo = static_cast<float>(m->time_lo), hi = static_cast<float>(std::fmax(m->time_hi, m->time_lo + 1e-3));
-    if (ImGui::SliderFloat("time##scrub", &t, lo, hi, "%.3f s")) e->scrub = true, e->scrub_time = t;
+    float t = static_cast<float>(std::fmin(std::fmax(m->time, lo), hi));
+    std::string shown = std::string(m->time_text) + " s";
+    if (ImGui::SliderFloat("time##scrub", &t, lo, hi, shown.c_str())) e->scrub = true, e->scrub_time = t;
     p->controls.push_back(last_item("time", "slider", "time"));
   }
   p->techniques.assign(m->technique_count, widget{});

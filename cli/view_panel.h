@@ -39,6 +39,7 @@ typedef struct panel_model {
   int technique_count, technique; /* the current one's index */
   bool animated;                  /* the time controls show */
   double time, time_lo, time_hi;  /* seconds: now and the animation's keys' range */
+  const char *time_text;          /* the time as the overlay prints it (limn_time_text) */
   bool paused;
   const char *status;             /* a line under the buttons ("wrote out/view.lua"), or NULL */
   const char *cost;               /* the panel's share of the frame, or NULL */

@@ -9,7 +9,8 @@
 
 // The area of the texel at tile coordinates t (0..1) of view sv (a tile of
 // `tile` texels a side) whose sender lies at q, as the light sees it:
-// orthographic, a texel's world size squared; perspective, its solid angle
+// orthographic, a texel's world width times height (a tile not stabilized
+// is a rectangle); perspective, its solid angle
 // (its size per unit of distance squared times cos^3 of the off-axis angle:
 // the image plane lies 1 / cos away and is tilted by the angle) times r^2.
 // cos alone counted a cube face's senders 1.5 times on average (the Cornell
@@ -19,7 +20,7 @@
 // light's incidence cancels with the projection. perspective: sv.depth.w > 0
 // (a spot or point light's view; a constant where the light's kind is).
 float rsm_texel_area_as(ShadowView sv, vec2 t, vec3 q, float tile, bool perspective) {
-  float area = sv.texel.x * sv.texel.x;
+  float area = sv.texel.x * (perspective ? sv.texel.x : sv.texel.z);
   if (perspective) {
     vec2 tn = (t * 2.0 - 1.0) * sv.texel.x * tile * 0.5; // tan of the off-axis angles
     float cos_off = inversesqrt(1.0 + dot(tn, tn));

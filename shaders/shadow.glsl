@@ -26,8 +26,8 @@ struct ShadowView {
   mat4 view_proj;
   vec4 rect;  // tile in atlas uv: offset, size
   vec4 depth; // light position, 1 / range (0: orthographic)
-  vec4 texel; // a texel's world size (orthographic) or its size per unit of distance; world depth 0..1 spans;
-              // perspective: the projection's x and y scale
+  vec4 texel; // a texel's world width (orthographic) or its size per unit of distance; world depth 0..1 spans;
+              // orthographic: a texel's world height; perspective: the projection's x and y scale
 };
 #ifdef LIGHT_BLOCKS
 // Copies in uniform blocks, as common.glsl's lights: at most 6 shadow views a

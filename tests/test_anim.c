@@ -183,6 +183,14 @@ static void animations_are_found_by_name_index_or_all(void **state) {
   assert_non_null(strstr(err.msg, "'walk'"));
   assert_non_null(strstr(err.msg, "0 'interp'"));
   assert_non_null(strstr(err.msg, "1 'animation 1'"));
+  /* An index is digits alone: " 1" and "+1" were taken as animation 1 (strtol skips spaces and signs). */
+  const char *near_misses[] = {" 1", "1 ", "+1", "interp ", " all"};
+  for (size_t i = 0; i < sizeof near_misses / sizeof *near_misses; i++) {
+    if (lm_scene_find_animation(s, near_misses[i], &err) != -3) fail_msg("'%s' was taken", near_misses[i]);
+    char quoted[32];
+    snprintf(quoted, sizeof quoted, "no animation '%s'", near_misses[i]);
+    assert_non_null(strstr(err.msg, quoted));
+  }
   assert_true(lm_scene_animated(s));
   lm_scene_destroy(s);
 }

@@ -33,6 +33,8 @@ check "unknown flag" run 2 capture --bogus
 check "unknown flag message" err_has "unknown flag '--bogus'"
 check "bad size" run 2 capture --size 0x5
 check "bad size message" err_has "--size wants WxH"
+check "a size past the GL's largest texture" run 2 capture --size 65536x8 --output "$tmp/img/big.png"
+check "a size past the GL's largest texture: the flag named" first_error_has "--size 65536x8: this GL's textures are at most "
 check "missing value" run 2 capture --size
 # A glTF file that requires an extension the engine lacks: refused by name, before its data is read.
 sed 's/"extensionsUsed": \[/"extensionsRequired": ["EXT_mesh_features"], "extensionsUsed": [/' \
@@ -110,6 +112,9 @@ check "fps without a range" run 2 capture --time 1 --fps 4 --output "$tmp/img/s.
 check "fps without a range message" err_has "--fps goes with --time START:STOP"
 check "unknown animation" run 2 capture --size 16x12 --animation walk --output "$tmp/img/s.png"
 check "unknown animation message" first_error_has "--animation walk: scene 'cornell' has no animation 'walk'"
+# An index is digits alone: " 0" was taken as animation 0.
+check "an index with a space" run 2 capture --scene "$root/data/scenes/door.glb" --size 16x12 --animation " 0" --output "$tmp/img/s.png"
+check "an index with a space: what was given and what exists" first_error_has "scene 'door.glb' has no animation ' 0' (it has 0 'open'; or 'all')"
 check "bad time values leave no file" no_files
 # A sequence whose frame 2 fails (its EXR cannot take its name): frames 0 and 1 whole, and nothing of frame 2,
 # not its PNG written before the EXR failed; the failed frame named.
@@ -194,6 +199,25 @@ check "runtime error" run 1 capture --script "$tmp/runtime.lua" --output "$tmp/i
 check "runtime error names line" first_error_has "runtime.lua:4: attempt to index a nil value"
 check "runtime error has a traceback" err_has "stack traceback"
 check "runtime error leaves no file" no_files
+
+# A script that fails on frame 5 of a sequence: exit 1 naming script:line and the frame; frames 0-4 whole,
+# nothing of frame 5.
+cat >"$tmp/late.lua" <<'LUA'
+local gbuffer = require "gbuffer"
+Techniques = { "gbuffer" }
+local calls = 0
+function OnRender(tech)
+  calls = calls + 1
+  if calls == 6 then error("frame 5 fails") end
+  present(gbuffer.render(gbuffer.targets()).clr)
+end
+LUA
+check "a script failing on frame 5" run 1 capture --script "$tmp/late.lua" --size 16x12 --time 0:2 --fps 4 --quiet \
+  --output "$tmp/img/l{frame}.png" --output "$tmp/img/l{frame}.exr"
+check "frame 5's error names the frame and script:line" first_error_has "frame 5 at 1.250 s: $tmp/late.lua:6: frame 5 fails"
+check "frames 0-4, nothing of frame 5" test "$(ls "$tmp/img" | tr '\n' ' ')" = \
+  "l0000.exr l0000.png l0001.exr l0001.png l0002.exr l0002.png l0003.exr l0003.png l0004.exr l0004.png "
+rm -f "$tmp/img/"*
 
 cat >"$tmp/shader.lua" <<'LUA'
 Techniques = { "dl" }

@@ -188,13 +188,14 @@ check "all images now" count_is "$(ls out/outdoor/*.png | wc -l)" 16
 check "no temporary files left" count_is "$(ls out/outdoor | grep -c tmp)" 0
 check "images are whole after the rerun" whole_pngs out/outdoor/*.png
 
-# Bad input: the job file and the entry, or the camera list and its line.
+# Bad input: the job file and the entry, or the camera list and its line; exit 2 (bad usage) as on
+# the command line.
 bad() { # bad NAME RC MESSAGE JOB_BODY
   printf '%s\n' "$4" > bad.lua
   check "$1" run "$2" capture --job bad.lua
   check "$1: message" err_has "$3"
 }
-bad "unknown scene file" 1 "bad.lua: scenes[2]: $tmp/nosuch.glb" \
+bad "unknown scene file" 2 "bad.lua: scenes[2]: $tmp/nosuch.glb" \
   "return { scenes = { '$scenes/cornell.glb', '$tmp/nosuch.glb' }, output = 'o/{camera}.png' }"
 bad "scene that is not glTF" 2 "bad.lua: scenes[1]: 'cornell' is not a .gltf or .glb file" \
   "return { scenes = { 'cornell' }, output = 'o/{camera}.png' }"
@@ -208,12 +209,16 @@ bad "misspelt scene field" 2 "bad.lua: scenes[1]: unknown field 'camera' (known:
   "return { scenes = { { scene = '$scenes/cornell.glb', camera = 'x.cams' } }, output = 'o/{camera}.png' }"
 bad "named entry in a list" 2 "bad.lua: sizes: unknown field 'big' (known: none: a list of 1)" \
   "return { scenes = { '$scenes/cornell.glb' }, sizes = { '8x8', big = '16x16' }, output = 'o/{camera}.png' }"
+bad "size past the GL's largest texture" 2 "bad.lua: sizes[2]: 8x65536; this GL's textures are at most " \
+  "return { scenes = { '$scenes/cornell.glb' }, sizes = { '8x8', '8x65536' }, output = 'o/{camera}-{size}.png' }"
 bad "bad size" 2 "bad.lua: sizes[1]: want \"WxH\"" \
   "return { scenes = { '$scenes/cornell.glb' }, sizes = { '0x3' }, output = 'o/{camera}.png' }"
-bad "unknown placeholder" 1 "bad.lua: output: unknown placeholder '{cam}'" \
+bad "unknown placeholder" 2 "bad.lua: output: unknown placeholder '{cam}'" \
   "return { scenes = { '$scenes/cornell.glb' }, output = 'o/{cam}.png' }"
-bad "outputs that collide" 1 "bad.lua: output: views 0 and 1 both write o/x.png" \
+bad "outputs that collide" 2 "bad.lua: output: views 0 and 1 both write o/x.png (add {camera} to the pattern)" \
   "return { scenes = { '$scenes/cornell.glb' }, output = 'o/x.png' }"
+bad "a scene listed twice" 2 "bad.lua: output: views 3 and 7 both write o/cornell-boxes.png (add {view} to the pattern)" \
+  "return { scenes = { '$scenes/cornell.glb', '$scenes/cornell.glb' }, output = 'o/{scene}-{camera}.png' }"
 bad "no scenes" 2 "bad.lua: scenes: the job names no scene" "return { output = 'o/{camera}.png' }"
 bad "syntax error" 2 "bad.lua:2:" "return {
   scenes = { 'a.glb' } output = 'x.png' }"
@@ -224,20 +229,23 @@ check "missing job file" run 2 capture --job nosuch.lua
 check "missing job file message" err_has "nosuch.lua"
 
 printf 'front 0 1 3.4  0 1 0  45\nside 0 1 x  0 1 0  45\n' > bad.cams
-bad "camera list: a number that does not parse" 1 "bad.cams:2: view 'side': eye_z 'x' is not a finite number" \
+bad "camera list: a number that does not parse" 2 "bad.cams:2: view 'side': eye_z 'x' is not a number within +-1e9" \
   "return { scenes = { { scene = '$scenes/cornell.glb', cameras = '$tmp/bad.cams' } }, output = 'o/{camera}.png' }"
 check "camera list message names the job entry" err_has "bad.lua: scenes[1]: "
+printf 'front 1e30 1 3.4  0 1 0  45\n' > bad.cams
+check "camera list: a number far out" run 2 capture --job bad.lua
+check "a number far out: named as out of range, not as not finite" err_has "bad.cams:1: view 'front': eye_x '1e30' is not a number within +-1e9"
 printf '# views\n\nfront 0 1 3.4  0 1 0\n' > bad.cams
-check "camera list: too few fields" run 1 capture --job bad.lua
+check "camera list: too few fields" run 2 capture --job bad.lua
 check "too few fields message" err_has "bad.cams:3: 7 fields"
 printf 'front 0 1 3.4  0 1 3.4  45\n' > bad.cams
-check "camera list: eye at the target" run 1 capture --job bad.lua
+check "camera list: eye at the target" run 2 capture --job bad.lua
 check "eye at the target message" err_has "bad.cams:1: view 'front': the eye is at the target"
 printf 'front 0 1 3.4  0 1 0  200\n' > bad.cams
-check "camera list: fov" run 1 capture --job bad.lua
+check "camera list: fov" run 2 capture --job bad.lua
 check "fov message" err_has "bad.cams:1: view 'front': fov_y_degrees 200 is outside"
 printf '# nothing\n' > bad.cams
-check "camera list: empty" run 1 capture --job bad.lua
+check "camera list: empty" run 2 capture --job bad.lua
 check "empty message" err_has "bad.cams: no views"
 check "no image from a failed job" test ! -e o
 
@@ -290,6 +298,24 @@ check "a failing frame" run 1 capture --job seq.lua
 check "a failing frame named" err_has "seq.lua: view 3 (cornell, camera 'front', dl, 48x36, frame 3 at 0.750 s): "
 check "the frames before it only" test "$(find seq -type f -name 'front-*' | sort | frames_of_list)" = "0000.png 0001.png 0002.png "
 check "its manifest: 3 images of 5 views" test "$(grep -c '"views": 5,' seq/manifest.json) $(entries seq/manifest.json)" = "1 3"
+rm -rf seq
+# A script that fails on frame 5 (its sixth OnRender): the job stops there naming the view and script:line,
+# exit 1; frames 0-4 whole and in the manifest, 5 of the sequence's 9.
+cat > late.lua <<'LUA'
+local gbuffer = require "gbuffer"
+Techniques = { "gbuffer" }
+local calls = 0
+function OnRender(tech)
+  calls = calls + 1
+  if calls == 6 then error("frame 5 fails") end
+  present(gbuffer.render(gbuffer.targets()).clr)
+end
+LUA
+sed -e 's|time = .*|time = { 0, 2, 4 }, script = "late.lua",|' -e 's|techniques = { "dl" }|techniques = { "gbuffer" }|' seq.lua > lateseq.lua
+check "a script failing on frame 5" run 1 capture --job lateseq.lua
+check "a script failing on frame 5: named" err_has "lateseq.lua: view 5 (cornell, camera 'front', gbuffer, 48x36, frame 5 at 1.250 s): ./late.lua:6: frame 5 fails"
+check "the frames before it only" test "$(find seq -type f -name 'front-*' | sort | frames_of_list)" = "0000.png 0001.png 0002.png 0003.png 0004.png "
+check "its manifest: 5 images of 9 views" test "$(grep -c '"views": 9,' seq/manifest.json) $(entries seq/manifest.json)" = "1 5"
 rm -rf seq
 check "sequence shard 0/2" run 0 capture --job seq.lua --shard 0/2
 check "shard 0/2 renders frames 0-2 (a contiguous run)" test "$(frames_of seq/front-*.png)" = "0000.png 0001.png 0002.png "
@@ -381,6 +407,8 @@ badseq "path times not increasing" 2 "bad.lua: path[2].t: 0 is not after path[1]
   "time = { 0, 1, 4 }, path = { $k0, $k0 }"
 badseq "path key without t" 2 "bad.lua: path[1].t: missing" \
   "time = { 0, 1, 4 }, path = { { eye = { 0, 1, 3 }, target = { 0, 1, 0 } } }"
+badseq "path key time far out" 2 "bad.lua: path[1].t: -1e+308 s is not within +-1e9" \
+  "time = { 0, 1, 4 }, path = { { t = -1e308, eye = { 0, 1, 3 }, target = { 0, 1, 0 } }, { t = 1e308, eye = { 1, 1, 3 }, target = { 0, 1, 0 } } }"
 badseq "path fov" 2 "bad.lua: path[1].fov: 200 degrees is outside (0.1, 179)" \
   "time = { 0, 1, 4 }, path = { { t = 0, eye = { 0, 1, 3 }, target = { 0, 1, 0 }, fov = 200 } }"
 badseq "path eye at target" 2 "bad.lua: path[1]: the eye is at the target" \
@@ -401,6 +429,10 @@ badseq "path through its target" 2 "bad.lua: path: frame 2 at 0.500 s: the eye r
   "time = { 0, 1, 4 }, path = { $k0, { t = 1, eye = { 0, 1, -3 }, target = { 0, 1, 0 } } }"
 badseq "path list times" 2 "bad.lua: path.times: a list of 2 times (one for each view of $tmp/keys.cams)" \
   "time = { 0, 1, 4 }, path = { cameras = '$tmp/keys.cams', times = { 0 } }"
+badseq "path keys all after the time" 2 "bad.lua: path: its keys' times 24 .. 48 s are all outside the job's time 0 .. 1 s (the camera would hold path[1] throughout)" \
+  "time = { 0, 1, 4 }, path = { { t = 24, eye = { 0, 1, 3 }, target = { 0, 1, 0 } }, { t = 48, eye = { 1, 1, 3 }, target = { 0, 1, 0 } } }"
+badseq "path keys all before the time" 2 "bad.lua: path: its keys' times 0 .. 0.5 s are all outside the job's time 1 .. 2 s (the camera would hold path[2] throughout)" \
+  "time = { 1, 2, 4 }, path = { $k0, { t = 0.5, eye = { 1, 1, 3 }, target = { 0, 1, 0 } } }"
 badseq "path list missing" 2 "bad.lua: path: " "time = { 0, 1, 4 }, path = '$tmp/nosuch.cams'"
 badseq "path and turntable" 2 "bad.lua: path and turntable: one camera motion at a time" \
   "time = { 0, 1, 4 }, path = { $k0 }, turntable = {}"
@@ -408,9 +440,11 @@ badseq "turntable elevation" 2 "bad.lua: turntable.elevation: 95 degrees; want o
   "time = { 0, 1, 4 }, turntable = { elevation = 95 }"
 badseq "turntable distance" 2 "bad.lua: turntable.distance: -1; want \"auto\" or a distance in (0, 1e9)" \
   "time = { 0, 1, 4 }, turntable = { distance = -1 }"
-badseq "too many views" 1 "bad.lua: 360004 views (scenes' cameras x sizes x techniques x frames); at most 200000" \
+badseq "too many views" 2 "bad.lua: 360004 views (scenes' cameras x sizes x techniques x frames); at most 200000" \
   "time = { 0, 3000, 30 }"
-badseq "unknown animation" 1 "bad.lua: scenes[1]: animation: scene " "time = 0, animation = 'walk'"
+badseq "unknown animation" 2 "bad.lua: scenes[1]: animation: scene " "time = 0, animation = 'walk'"
+bad "an animation index with a space" 2 "bad.lua: scenes[1]: animation: scene 'door.glb' has no animation ' 0' (it has 0 'open'; or 'all')" \
+  "return { scenes = { '$scenes/door.glb' }, time = 0, animation = ' 0', output = 'o/{camera}.png' }"
 check "no image from a bad sequence" test ! -e o
 
 finish

@@ -3,7 +3,8 @@
  * exporter would) renders within a stated tolerance of the scale-1 image, and
  * so does a camera with near 1e-5 and far 1e6. At 96x72: the field under a
  * sun (cascades), the Cornell box under a spot light, and the office (glTF,
- * a sunlit room, a camera-list view). */
+ * a sunlit room, a camera-list view). A camera under a mirrored node sees
+ * the same image as its unmirrored twin. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -186,6 +187,37 @@ static void depth_of_field_defaults_hold_at_every_scale(void **state) {
   }
 }
 
+/* A camera under a mirrored node (scale -1 along x) at the eye, direction
+ * and up of camera 0, its own x axis mirrored so that its world transform
+ * is camera 0's with x negated: it sees camera 0's image, not the mirror
+ * image (which the view had, its triangles wound the other way). */
+static void a_camera_under_a_mirror_sees_the_scene_unmirrored(void **state) {
+  (void)state;
+  lm_scene *s = scaled("cornell", 1.0f);
+  gl_result ref = render(s, "dl", 1.0f);
+  const float mirror[16] = {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  float local[16];
+  memcpy(local, s->nodes[s->cameras[0].node].world, sizeof local);
+  for (int k = 0; k < 3; k++) local[k] = -local[k];              /* its x axis mirrored ... */
+  for (int c = 0; c < 4; c++) local[c * 4] = -local[c * 4];      /* ... under the mirror: world = mirror x local */
+  int parent = lm_scene_add_node(s, "mirror", -1, mirror, -1, -1);
+  lm_camera cam = s->cameras[0];
+  cam.node = lm_scene_add_node(s, "mirrored camera", parent, local, -1, -1);
+  s->cameras[0] = cam;
+  lm_scene_update(s);
+  const float *w = s->nodes[cam.node].world;
+  double det = (double)w[0] * (w[5] * w[10] - w[9] * w[6]) - w[4] * (w[1] * w[10] - w[9] * w[2]) +
+               w[8] * (w[1] * w[6] - w[5] * w[2]);
+  assert_true(det < -0.99); /* the test's premise */
+  gl_result r = render(s, "dl", 1.0f);
+  double d = relative_difference(&ref, &r);
+  printf("a camera under a mirror: relative mean difference %.6f from the plain camera's image\n", d);
+  if (!(d < 1e-4)) fail_msg("the mirrored camera's image differs by %g", d);
+  gl_result_free(&r);
+  gl_result_free(&ref);
+  lm_scene_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(depth_is_exact_at_a_near_far_ratio_of_1e11),
@@ -193,6 +225,7 @@ int main(void) {
       cmocka_unit_test(a_spot_in_the_box_at_every_scale),
       cmocka_unit_test(the_office_at_every_scale),
       cmocka_unit_test(depth_of_field_defaults_hold_at_every_scale),
+      cmocka_unit_test(a_camera_under_a_mirror_sees_the_scene_unmirrored),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

@@ -832,6 +832,61 @@ static void rsm_views_lie_in_an_atlas_of_their_own(void **state) {
   lm_scene_destroy(s);
 }
 
+/* An orthographic tile's world width and height from its matrix: its rows x
+ * and y are the view's axes times 2 / (r - l) and 2 / (t - b). */
+static void ortho_extent(const float vp[16], float *width, float *height) {
+  *width = 2.0f / sqrtf(vp[0] * vp[0] + vp[4] * vp[4] + vp[8] * vp[8]);
+  *height = 2.0f / sqrtf(vp[1] * vp[1] + vp[5] * vp[5] + vp[9] * vp[9]);
+}
+
+/* shadow.stabilize=false fits each tile to the rectangle around its slice in
+ * the light's view, here wider than high: the views carry a texel's world
+ * width and height apart (texel x and z), and rsm.glsl's orthographic texel
+ * area is their product (it was the width squared: the senders' light off
+ * by the ratio of the sides). Stabilized, a tile is a square and the two
+ * agree. Either way the RSM's wide tile grows with shadow.rsm (unstabilized,
+ * it kept the slice's rectangle: no senders off screen). */
+static void unstabilized_tiles_have_a_texel_width_and_height(void **state) {
+  (void)state;
+  lm_scene *s = builtin("field");
+  lm_frame_data cam;
+  lm_scene_frame_data(s, 0, 512, 128, &cam); /* a wide view: its slices' rectangles are not squares */
+  lm_shadow_settings st;
+  lm_shadow_settings_default(&st);
+  st.rsm_resolution = 128;
+  for (int stabilize = 0; stabilize < 2; stabilize++) {
+    st.stabilize = stabilize;
+    lm_shadow_plan plan;
+    lm_error err;
+    float wide[2]; /* the RSM tile's width at rsm 1 and 2 */
+    for (int k = 0; k < 2; k++) {
+      st.rsm = (float)(k + 1);
+      assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+      float height;
+      ortho_extent(plan.view_data[plan.view_count].view_proj, &wide[k], &height);
+      lm_shadow_plan_free(&plan);
+    }
+    printf("stabilize %d: the RSM tile %.4g wide at shadow.rsm=1, %.4g at 2\n", stabilize, wide[0], wide[1]);
+    assert_true(wide[1] > 1.85f * wide[0] && wide[1] < 2.15f * wide[0]);
+    assert_true(lm_shadow_plan_make(&plan, s, &cam, &st, &err));
+    assert_int_equal(plan.rsm_view_count, 1); /* the sun's wide tile */
+    for (int v = 0; v < plan.view_count + plan.rsm_view_count; v++) {
+      const lm_shadow_view_data *d = &plan.view_data[v];
+      int size = v < plan.view_count ? plan.views[v].width : plan.rsm_tile;
+      float width, height;
+      ortho_extent(d->view_proj, &width, &height);
+      printf("stabilize %d, view %d: %.4g x %.4g world units, texel %.4g x %.4g\n", stabilize, v, width, height,
+             d->texel[0], d->texel[2]);
+      assert_float_equal(d->texel[0], width / (float)size, 1e-4f * d->texel[0]);
+      assert_float_equal(d->texel[2], height / (float)size, 1e-4f * d->texel[2]);
+      if (stabilize) assert_true(d->texel[2] == d->texel[0]);
+      else if (v == plan.view_count) assert_true(fabsf(width - height) > 0.1f * width); /* the test's premise */
+    }
+    lm_shadow_plan_free(&plan);
+  }
+  lm_scene_destroy(s);
+}
+
 static void local_tiles_follow_their_screen_coverage(void **state) {
   (void)state;
   lm_scene *s = builtin("cornell");
@@ -1595,6 +1650,7 @@ int main(int argc, char **argv) {
       cmocka_unit_test(tiles_keep_their_texture_or_are_copied_back),
       cmocka_unit_test(the_rsm_resolution_redraws_the_rsm_views_alone),
       cmocka_unit_test(rsm_views_lie_in_an_atlas_of_their_own),
+      cmocka_unit_test(unstabilized_tiles_have_a_texel_width_and_height),
   };
   if (argc > 1) cmocka_set_test_filter(argv[1]); /* one test by name (a pattern) */
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);

@@ -767,16 +767,19 @@ static void time_pauses_steps_and_scrubs(void **state) {
   assert_time(&t[2], "at exit", 0.9 + 14.0 / 60 + frame, 28, false);
 }
 
-/* Times as far out as 1e30 s (--time, time=) pose the animation's ends and
- * count a frame number held at +-1e15, with the overlay on (it shows it);
- * the number was a conversion past a long's range, undefined. */
+/* Times as far out as 1e300 s (--time, time=) pose the animation's ends and
+ * count a frame number held at +-1e15, with the overlay and the panel on
+ * (they show it: the panel's slider keeps its knob within the keys). The
+ * number was a conversion past a long's range, undefined, and the time was
+ * printed with its 300 digits (now %g-like: limn_time_text). */
 static void a_time_far_out_has_a_frame_number(void **state) {
   (void)state;
   char log[512], shot[512];
   log_path(log, "time_far");
   shot_path(shot, "time_far.png");
-  pid_t pid = spawn_view(log, "--scene", SCENE("moving_light"), "--tech", "dl", "--size", "48x36", "--time", "1e30",
-                         "--exit-after", "4", "--script-keys", "1:Space,2:time=-1e30", "--screenshot", shot, NULL);
+  pid_t pid = spawn_view(log, "--scene", SCENE("moving_light"), "--tech", "dl", "--size", "96x72", "--time", "1e300",
+                         "--panel", "on", "--exit-after", "4", "--script-keys", "1:Space,2:time=-1e300", "--screenshot",
+                         shot, NULL);
   int rc = wait_exit(pid, 30000);
   if (rc) print_log(log);
   assert_int_equal(rc, 0);
@@ -784,9 +787,46 @@ static void a_time_far_out_has_a_frame_number(void **state) {
   int n = time_lines(log, t, 4);
   if (n != 3) print_log(log);
   assert_int_equal(n, 3);
-  assert_time(&t[0], "Space", 1e30, 1000000000000000L, true);
-  assert_time(&t[1], "scrubbed", -1e30, -1000000000000000L, true);
-  assert_time(&t[2], "at exit", -1e30, -1000000000000000L, true);
+  assert_time(&t[0], "Space", 1e300, 1000000000000000L, true);
+  assert_time(&t[1], "scrubbed", -1e300, -1000000000000000L, true);
+  assert_time(&t[2], "at exit", -1e300, -1000000000000000L, true);
+  assert_true(file_has(log, "limn: time 1e+300 s, frame "));
+  assert_true(file_has(log, "limn: time -1e+300 s, frame "));
+}
+
+/* A sequence job's view (time = { 1, 2, 10 }: frame 3 at 1.3 s) counts the
+ * job's frames: frame 3, not the viewer's default 24 fps from 0 (frame 31);
+ * a --fps of another rate is refused naming both, the same one taken. */
+static void a_sequence_job_counts_its_own_frames(void **state) {
+  (void)state;
+  char log[512], job[1200];
+  log_path(log, "job_fps");
+  snprintf(job, sizeof job,
+           "return { scenes = { \"%s\" }, sizes = { \"48x36\" }, techniques = { \"dl\" },\n"
+           "  time = { 1, 2, 10 }, output = \"seq/{camera}-{frame}.png\" }\n", SCENE("moving_light"));
+  write_file("fps_job.lua", job);
+  path_in_root(job, sizeof job, "fps_job.lua");
+  for (int fps = 0; fps < 3; fps++) { /* without --fps, with the job's, with another */
+    const char *rate = fps == 1 ? "10" : "24";
+    pid_t pid = fps ? spawn_view(log, "--job", job, "--view", "3", "--fps", rate, "--exit-after", "2",
+                                 "--script-keys", "1:Space", NULL)
+                    : spawn_view(log, "--job", job, "--view", "3", "--exit-after", "2", "--script-keys", "1:Space",
+                                 NULL);
+    int rc = wait_exit(pid, 30000);
+    if (rc != (fps == 2 ? 2 : 0)) print_log(log);
+    if (fps == 2) {
+      assert_int_equal(rc, 2);
+      assert_true(file_has(log, "--fps 24: the job's time.fps is 10"));
+      continue;
+    }
+    assert_int_equal(rc, 0);
+    time_line t[4];
+    int n = time_lines(log, t, 4);
+    if (n != 2) print_log(log);
+    assert_int_equal(n, 2);
+    assert_time(&t[0], "Space", 1.3, 3, true);
+    assert_time(&t[1], "at exit", 1.3, 3, true);
+  }
 }
 
 /* A script and a scene file saved while paused at 1.25 s: the time and the
@@ -1620,6 +1660,7 @@ int main(int argc, char **argv) {
       cmocka_unit_test_teardown(camera_moves_and_turns, stop_leftover),
       cmocka_unit_test_teardown(time_pauses_steps_and_scrubs, stop_leftover),
       cmocka_unit_test_teardown(a_time_far_out_has_a_frame_number, stop_leftover),
+      cmocka_unit_test_teardown(a_sequence_job_counts_its_own_frames, stop_leftover),
       cmocka_unit_test_teardown(time_survives_reload, stop_leftover),
       cmocka_unit_test_teardown(animation_moves_light_and_camera, stop_leftover),
       cmocka_unit_test_teardown(reload_loop_leaks_nothing, stop_leftover),

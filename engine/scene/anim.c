@@ -19,9 +19,10 @@ int lm_scene_find_animation(const lm_scene *s, const char *spec, lm_error *err) 
   if (!strcmp(spec, "all")) return LM_ANIM_ALL;
   for (int a = 0; a < s->animation_count; a++)
     if (!strcmp(s->animations[a].name, spec)) return a;
-  char *end;
-  long i = strtol(spec, &end, 10);
-  if (*spec && !*end && i >= 0 && i < s->animation_count) return (int)i;
+  /* An index is digits only: strtol would take " 0" or "+0" as animation 0. */
+  size_t digits = strspn(spec, "0123456789");
+  long i = digits && !spec[digits] && digits < 10 ? strtol(spec, NULL, 10) : -1;
+  if (i >= 0 && i < s->animation_count) return (int)i;
   char list[512] = "";
   for (int a = 0; a < s->animation_count && strlen(list) < sizeof list - LM_NAME_MAX - 8; a++)
     snprintf(list + strlen(list), sizeof list - strlen(list), "%s%d '%s'", a ? ", " : "", a, s->animations[a].name);

@@ -96,7 +96,7 @@ int lm_scene_add_camera_list(lm_scene *s, const char *path, int *count, lm_error
       char *end;
       double x = strtod(tok[i], &end);
       if (end == tok[i] || *end || !isfinite(x) || fabs(x) > 1e9) {
-        lm_error_set(err, "%s:%d: view '%s': %s '%s' is not a finite number", path, line_no, tok[0],
+        lm_error_set(err, "%s:%d: view '%s': %s '%s' is not a number within +-1e9", path, line_no, tok[0],
                      field[i - 1], tok[i]);
         ok = false;
       }

@@ -439,10 +439,14 @@ void lm_scene_frame_data(const lm_scene *s, int cam, int width, int height, lm_f
   mat4 world = GLM_MAT4_IDENTITY_INIT, view, proj, vp, inv_view;
   if (c.node >= 0) memcpy(world, s->nodes[c.node].world, sizeof world);
   /* A camera under a scaled node (a scene exported in another unit) keeps a
-   * rigid view; near and far are in its node's units, so they scale with it. */
-  float scale = cbrtf(fabsf(glm_mat4_det(world)));
-  if (isfinite(scale) && scale > 0 && fabsf(scale - 1.0f) > 1e-6f) {
+   * rigid view; near and far are in its node's units, so they scale with it.
+   * Under a mirrored node (negative determinant) it keeps its eye, direction
+   * and up and sees the scene unmirrored, its x axis y cross z again: a
+   * mirrored view would flip the image and turn every triangle's winding. */
+  float det = glm_mat4_det(world), scale = cbrtf(fabsf(det));
+  if (isfinite(scale) && scale > 0 && (fabsf(scale - 1.0f) > 1e-6f || det < 0)) {
     for (int k = 0; k < 3; k++) glm_vec3_normalize(world[k]);
+    if (det < 0) glm_vec3_cross(world[1], world[2], world[0]);
     c.znear *= scale, c.zfar *= scale;
   }
   /* Keep the projection invertible whatever a scene file says; any unit and

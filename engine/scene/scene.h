@@ -295,8 +295,8 @@ typedef struct lm_scene {
   struct lm_lod_work *lod_work; /* the threads making simplified copies, while a mesh waits for its own */
 } lm_scene;
 
-/* The animation `spec` names: its name, its index ("0"), or "all"
- * (LM_ANIM_ALL). -3 with a message listing the scene's animations. */
+/* The animation `spec` names exactly: its name, its index (digits only: "0"),
+ * or "all" (LM_ANIM_ALL). -3 with a message listing the scene's animations. */
 int lm_scene_find_animation(const lm_scene *s, const char *spec, lm_error *err);
 /* First and last key time of animation `anim` (LM_ANIM_ALL: over all); 0, 0 when none. */
 void lm_scene_animation_range(const lm_scene *s, int anim, float *start, float *end);

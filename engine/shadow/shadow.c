@@ -248,6 +248,10 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
       glm_mat4_mulv(view, p, q);
       l = fminf(l, q[0]), r = fmaxf(r, q[0]), b = fminf(b, q[1]), t = fmaxf(t, q[1]);
     }
+    /* The RSM's tile grows about its centre as the sphere's radius does (senders off screen). */
+    float g = fmaxf(grow, 1.0f), cx = 0.5f * (l + r), cy = 0.5f * (b + t), hx = 0.5f * (r - l) * g,
+          hy = 0.5f * (t - b) * g;
+    l = cx - hx, r = cx + hx, b = cy - hy, t = cy + hy;
   }
   /* Depth spans the slice's sphere (whatever `behind` is), narrowed to the
    * meshes inside the tile and snapped to steps, so ESM's c acts on a short
@@ -285,8 +289,10 @@ static void add_slice_view(lm_shadow_plan *plan, const lm_scene *s, const lm_fra
   mat4 cull;
   if (grow <= 0)
     cascade_cull(cam, view, zr, z1, bounds, texel, filter_reach(st), step, (float[6]){l, r, b, t, zn, zf}, cull);
-  /* A texel's world size and the world depth the tile's 0..1 spans. */
-  add_view(plan, size, vp, (float[4]){0, 0, 0, 0}, (float[4]){texel, zf - zn, 0, 0}, grow <= 0 ? cull : NULL);
+  /* A texel's world width, the world depth the tile's 0..1 spans, and its world height: unstabilized,
+   * the tile is a rectangle, and an RSM texel's area is width times height (rsm.glsl). */
+  add_view(plan, size, vp, (float[4]){0, 0, 0, 0}, (float[4]){texel, zf - zn, (t - b) / (float)size, 0},
+           grow <= 0 ? cull : NULL);
 }
 
 /* Cascades cover the depths where receivers are seen (plan->seen), snapped

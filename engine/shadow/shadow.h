@@ -106,8 +106,8 @@ typedef struct lm_shadow_view_data {
   float view_proj[16];
   float rect[4];  /* the tile in atlas uv: offset xy, size zw */
   float depth[4]; /* light position xyz, 1 / range (0: orthographic) */
-  float texel[4]; /* a texel's world size (orthographic) or its size per unit of distance; the world depth 0..1 spans;
-                   * perspective: the projection's x and y scale */
+  float texel[4]; /* a texel's world width (orthographic) or its size per unit of distance; the world depth 0..1 spans;
+                   * orthographic: a texel's world height; perspective: the projection's x and y scale */
 } lm_shadow_view_data;
 
 typedef struct lm_shadow_plan {
