@@ -845,10 +845,12 @@ typedef struct drawn_mesh {
   int index_count;
   int *shell;     /* per vertex: its shell (vertices welded by position, joined by triangles) */
   int shells;
-  bool closed;    /* every range closed and consistently wound */
+  bool closed;    /* the mesh's and its caster copies' ranges closed and consistently wound */
   bool deforms;   /* a deformed mesh's pose (read again each time) */
-  lm_mesh_lod ranges[1 + 2 * LM_LOD_LEVELS]; /* the mesh's own indices, then its copies' */
-  int range_count;
+  /* The mesh's own indices, then its caster copies' (what an opaque node draws in a tile: closed_ranges
+   * of them), then the camera's (a caster cut by its texture's alpha may draw them: lm_scene_draw). */
+  lm_mesh_lod ranges[1 + 2 * LM_LOD_LEVELS];
+  int range_count, closed_ranges;
 } drawn_mesh;
 
 typedef struct weld_key { int32_t p[3]; int i; } weld_key;
@@ -891,6 +893,7 @@ static void drawn_mesh_read(const lm_scene_mesh *m, drawn_mesh *d) {
   int n = m->index_count;
   d->ranges[d->range_count++] = (lm_mesh_lod){.first = 0, .count = m->index_count};
   for (int k = 0; k < m->caster_levels; k++) d->ranges[d->range_count++] = m->casters[k];
+  d->closed_ranges = d->range_count;
   for (int k = 0; k < m->lod_levels; k++) d->ranges[d->range_count++] = m->lods[k];
   for (int k = 0; k < d->range_count; k++) n = n > d->ranges[k].first + d->ranges[k].count ? n : d->ranges[k].first + d->ranges[k].count;
   d->index_count = n;
@@ -937,7 +940,7 @@ static void drawn_mesh_read(const lm_scene_mesh *m, drawn_mesh *d) {
   bool valid = true;
   for (int t = 0; t < n; t++) valid = valid && d->indices[t] < (uint32_t)nv;
   d->closed = valid && n >= 3;
-  for (int k = 0; k < d->range_count && d->closed; k++)
+  for (int k = 0; k < d->closed_ranges && d->closed; k++)
     d->closed = range_closed(d->indices, d->ranges[k].first, d->ranges[k].count, weld);
   /* Shells: welded vertices joined by the triangles of every range (a copy's triangles join what the mesh's do). */
   for (int i = 0; i < nv; i++) parent[i] = weld[i];
@@ -999,7 +1002,7 @@ static bool node_front_lit(const drawn_mesh *d, const float m[16], const lm_ligh
    * Each range on its own: a node draws one of them in a tile. */
   double *wind = lm_alloc(sizeof *wind * 2 * (size_t)(d->shells + 1)), *volume = wind + d->shells + 1;
   bool front = true;
-  for (int r = 0; r < d->range_count && front; r++) {
+  for (int r = 0; r < d->closed_ranges && front; r++) {
     memset(wind, 0, sizeof *wind * 2 * (size_t)(d->shells + 1));
     for (int t = d->ranges[r].first; t + 2 < d->ranges[r].first + d->ranges[r].count; t += 3) {
       double p[3][3], len[3];
