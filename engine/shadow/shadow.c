@@ -983,7 +983,10 @@ static bool node_front_lit(const drawn_mesh *d, const float m[16], const lm_ligh
     if (!isfinite(local[c])) return false;
   double L[3] = {local[0], local[1], local[2]};
   bool behind = false; /* a triangle faces away from the light, or edge on (either way, rounded) */
-  for (int t = 0; t + 2 < d->index_count && !behind; t += 3) {
+  /* An opaque node draws its mesh or a caster copy; one cut by its texture's alpha may draw a camera copy. */
+  const lm_mesh_lod *last = &d->ranges[(solid ? d->closed_ranges : d->range_count) - 1];
+  int end = last->first + last->count;
+  for (int t = 0; t + 2 < end && !behind; t += 3) {
     const float *a = d->vertices + 8 * (size_t)d->indices[t], *b = d->vertices + 8 * (size_t)d->indices[t + 1],
                 *c = d->vertices + 8 * (size_t)d->indices[t + 2];
     double u[3], v[3], n[3], w[3];
