@@ -847,6 +847,7 @@ typedef struct drawn_mesh {
   int shells;
   bool closed;    /* the mesh's and its caster copies' ranges closed and consistently wound */
   bool deforms;   /* a deformed mesh's pose (read again each time) */
+  bool valid;     /* every index names a vertex (else no face is taken to face any light) */
   /* The mesh's own indices, then its caster copies' (what an opaque node draws in a tile: closed_ranges
    * of them), then the camera's (a caster cut by its texture's alpha may draw them: lm_scene_draw). */
   lm_mesh_lod ranges[1 + 2 * LM_LOD_LEVELS];
@@ -906,7 +907,9 @@ static void drawn_mesh_read(const lm_scene_mesh *m, drawn_mesh *d) {
     memcpy(d->indices, m->indices, sizeof(uint32_t) * (size_t)m->index_count);
   }
   d->deforms = m->rest != NULL;
-  if (d->deforms) return; /* its pose this time: its triangles alone, not taken for closed */
+  d->valid = true;
+  for (int t = 0; t < n; t++) d->valid = d->valid && d->indices[t] < (uint32_t)m->vertex_count;
+  if (d->deforms || !d->valid) return; /* a pose (this time's): its triangles alone, not taken for closed */
   /* Weld by position, each vertex to its first twin: positions rounded to
    * 1/65536 of the extent (the GPU's 16 bits: lm_mesh), where a seam's or
    * a pole's copies made by sines of 0 and 2 pi meet. Whole fractions of
@@ -937,14 +940,12 @@ static void drawn_mesh_read(const lm_scene_mesh *m, drawn_mesh *d) {
     if (i == 0) first = keys[i].i;
     weld[keys[i].i] = first;
   }
-  bool valid = true;
-  for (int t = 0; t < n; t++) valid = valid && d->indices[t] < (uint32_t)nv;
-  d->closed = valid && n >= 3;
+  d->closed = n >= 3;
   for (int k = 0; k < d->closed_ranges && d->closed; k++)
     d->closed = range_closed(d->indices, d->ranges[k].first, d->ranges[k].count, weld);
   /* Shells: welded vertices joined by the triangles of every range (a copy's triangles join what the mesh's do). */
   for (int i = 0; i < nv; i++) parent[i] = weld[i];
-  for (int t = 0; valid && t + 2 < n; t += 3)
+  for (int t = 0; t + 2 < n; t += 3)
     for (int k = 1; k < 3; k++) {
       int a = shell_root(parent, weld[d->indices[t]]), b = shell_root(parent, weld[d->indices[t + k]]);
       if (a != b) parent[a < b ? b : a] = a < b ? a : b;
@@ -956,7 +957,6 @@ static void drawn_mesh_read(const lm_scene_mesh *m, drawn_mesh *d) {
     if (d->shell[r] < 0) d->shell[r] = d->shells++;
     d->shell[i] = d->shell[r];
   }
-  d->closed = d->closed && valid;
   free(keys), free(weld), free(parent);
 }
 
@@ -980,7 +980,7 @@ static bool node_front_lit(const drawn_mesh *d, const float m[16], const lm_ligh
   vec4 local;
   glm_mat4_mulv(inv, at, local); /* the light's place, or the way toward it (w 0), in the node's space */
   for (int c = 0; c < 4; c++)
-    if (!isfinite(local[c])) return false;
+    if (!isfinite(local[c]) || !d->valid) return false;
   double L[3] = {local[0], local[1], local[2]};
   bool behind = false; /* a triangle faces away from the light, or edge on (either way, rounded) */
   /* An opaque node draws its mesh or a caster copy; one cut by its texture's alpha may draw a camera copy. */
