@@ -19,6 +19,8 @@ Options = {
   materials = "phong",     -- "phong" (the std technique) or "pbr" (glTF metallic-roughness, GGX)
   light_variants = 12,     -- up to this many lights (0..16) lighting passes unroll them; more, 0: grid loop
   light_cull = true,       -- yet more than one light and one the grid culls (cone, range): the grid's loop
+  front_lit = true,        -- unrolled lights whose shadow tiles hold no face seen from behind skip the shadow
+                           -- lookup's second step at a normal offset (the same image; false: every light keeps it)
   simplify = 0.25,         -- a mesh node draws its simplified copy (made at load) that errs by at most this
                            -- many pixels where it comes nearest the camera; 0..64, 0: every mesh whole
   shadow = options.copy(shadow.defaults),
@@ -68,8 +70,9 @@ local function frame(tech, row)
   if not materials then error('materials must be "phong" or "pbr" (got "' .. tostring(tech.materials) .. '")') end
   local G = gbuffer.render(gbuffer.targets(1, materials, techniques.reads_velocity(tech, row)), materials, nil,
                            tech.simplify)
-  G.lights = light_set(tech.light_variants, tech.light_cull) -- the light set's defines (gbuffer.defines); nil:
-                                                             -- the general loop over storage buffers
+  G.lights = light_set(tech.light_variants, tech.light_cull, tech.front_lit) -- the light set's defines
+                                                                             -- (gbuffer.defines); nil: the
+                                                                             -- general loop over storage buffers
   temporal.velocity(G.vel)
   local o = S and S.check(tech[row.offscreen]) -- shadows after the G-buffer: cascades fit what it sees
   local F = { G = G, technique = row, light = { ambient = grey(tech.ambient), background = grey(tech.background) } }
@@ -98,7 +101,8 @@ local function frame(tech, row)
 end
 
 local rules = { ambient = options.number(0, 1e6), background = options.number(0, 1e6),
-                light_variants = options.whole(0, 16), light_cull = options.boolean, simplify = options.number(0, 64),
+                light_variants = options.whole(0, 16), light_cull = options.boolean, front_lit = options.boolean,
+                simplify = options.number(0, 64),
                 materials = options.one_of("phong", "pbr") }
 options.declare("", rules) -- the viewer's panel shows each option by its rule
 
@@ -108,7 +112,7 @@ function OnCreate()
 end
 
 function OnRender(tech)
-  options.fields(tech, rules, { "ambient", "background", "light_variants", "light_cull" }, 2)
+  options.fields(tech, rules, { "ambient", "background", "light_variants", "light_cull", "front_lit" }, 2)
   -- What the GI histories depend on (temporal.lua): a change starts them again.
   temporal.begin(techniques.settings(tech, { tech.name, tech.ambient, tech.background, tech.materials,
                                              tech.shadow, tech.sky }))

@@ -65,15 +65,16 @@ vec3 light_incident(int i, vec3 p, out vec3 l) { return light_arriving(lights[i]
 // shadow kind `shadow` (ShadowLight.info.z, 0: none), on a surface at p
 // facing n: false when it arrives from behind or gives nothing there (beyond
 // its range or cone: no shadow lookup); else its direction l, n.l and its
-// radiance (shadowed with SHADOWS). Constant kinds (a light-set variant,
-// LIGHT_SET) compile one kind's code.
-bool light_on_surface_as(int i, int type, int falloff, int shadow, vec3 p, vec3 n, out vec3 l, out float ndl,
-                         out vec3 radiance) {
+// radiance (shadowed with SHADOWS; back_faces false where its shadow tiles
+// hold no face it sees from behind: shadow_factor_as). Constant kinds (a
+// light-set variant, LIGHT_SET) compile one kind's code.
+bool light_on_surface_as(int i, int type, int falloff, int shadow, bool back_faces, vec3 p, vec3 n, out vec3 l,
+                         out float ndl, out vec3 radiance) {
   radiance = light_arriving_as(lights[i], type, falloff, p, l);
   ndl = dot(n, l);
   if (ndl <= 0.0 || max(radiance.r, max(radiance.g, radiance.b)) <= 0.0) return false;
 #ifdef SHADOWS
-  if (shadow != 0) radiance *= shadow_light_as(i, shadow, p, n, l);
+  if (shadow != 0) radiance *= shadow_light_as(i, shadow, back_faces, p, n, l);
 #endif
   return true;
 }
@@ -86,7 +87,7 @@ bool light_on_surface(int i, vec3 p, vec3 n, out vec3 l, out float ndl, out vec3
 #else
   int shadow = 0;
 #endif
-  return light_on_surface_as(i, light_type(li), light_falloff_mode(li), shadow, p, n, l, ndl, radiance);
+  return light_on_surface_as(i, light_type(li), light_falloff_mode(li), shadow, true, p, n, l, ndl, radiance);
 }
 
 // The lights that may reach p: light_index(r, j) for j < r.count. Every light
@@ -183,6 +184,9 @@ vec3 reflect_light(Reflector m, vec3 n, vec3 v, vec3 l, float ndl) {
 #ifndef LIGHT_FALLOFF_RANGE
 #define LIGHT_FALLOFF_RANGE 0
 #endif
+#ifndef LIGHT_FRONT_LIT
+#define LIGHT_FRONT_LIT 0 // shadow tiles that hold no face the light sees from behind (lm_shadow_front_lit)
+#endif
 bool light_set_has(int mask, int i) { return ((mask >> i) & 1) != 0; }
 
 // Light i's kind and falloff as light_arriving_as takes them, from the masks.
@@ -201,7 +205,8 @@ vec3 light_set_reflected(int i, Reflector m, vec3 n, vec3 v, vec3 p) {
   int shadow = light_set_has(LIGHT_SHADOWED, i) ? (type == 2 ? 1 : type == 1 ? 2 : 3) : 0;
   vec3 l, radiance;
   float ndl;
-  if (!light_on_surface_as(i, type, falloff, shadow, p, n, l, ndl, radiance)) return vec3(0.0);
+  if (!light_on_surface_as(i, type, falloff, shadow, !light_set_has(LIGHT_FRONT_LIT, i), p, n, l, ndl, radiance))
+    return vec3(0.0);
   return radiance * reflect_light(m, n, v, l, ndl);
 }
 #endif

@@ -323,8 +323,12 @@ vec4 shadow_clip(ShadowView sv, int kind, int j, vec3 p) {
 
 // Shadow factor of light `light` at p, whose shadow is of kind `kind`
 // (ShadowLight.info.z): a constant kind (a light-set variant, lighting.glsl)
-// compiles that kind's lookup alone.
-float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
+// compiles that kind's lookup alone. back_faces false: the light's tiles
+// hold no face it sees from behind (engine/shadow, lm_shadow_front_lit), so
+// no lookup touches one and the offset step below is never taken; a
+// constant false (a light-set variant's LIGHT_FRONT_LIT) compiles it out,
+// which a software rasterizer would run under a mask (Cornell box's lamp).
+float shadow_factor_as(int light, int kind, bool back_faces, vec3 p, vec3 n, vec3 l) {
   ShadowLight s = shadow_lights[light];
   float t;
   int v = shadow_view_at(light, s, kind, p, t);
@@ -352,7 +356,7 @@ float shadow_factor_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
   // loop once no pixel of its group goes on, but runs both sides of every if.
   // The first lookup at p tells from its own taps whether p touches a back
   // face; only then does the next step look again at the offset point.
-  float reach = offset > 0.0 ? 4.0 * (1.0 + tan_tilt) : 0.0;
+  float reach = back_faces && offset > 0.0 ? 4.0 * (1.0 + tan_tilt) : 0.0;
   int j = 0;
   bool offset_now = false;
   vec3 q = p;
@@ -415,8 +419,8 @@ vec3 shadow_transmittance_as(int light, int kind, vec3 p) {
 
 // The light of light `light` that reaches p, as a factor: the shadow factor,
 // tinted by the blended casters' transmittance where SHADOW_TRANSMIT is.
-vec3 shadow_light_as(int light, int kind, vec3 p, vec3 n, vec3 l) {
-  float vis = shadow_factor_as(light, kind, p, n, l);
+vec3 shadow_light_as(int light, int kind, bool back_faces, vec3 p, vec3 n, vec3 l) {
+  float vis = shadow_factor_as(light, kind, back_faces, p, n, l);
 #ifdef SHADOW_TRANSMIT
   return vis * shadow_transmittance_as(light, kind, p);
 #else

@@ -4,7 +4,8 @@
  * eight of every kind, falloff and shadow kind, with Phong and with the pbr
  * materials, and so does the RSM's gather of the combined technique (each light
  * of its RSM views unrolled, shaders/rsm.glsl); a light added at run time compiles one new variant, and a scene
- * with more lights than pp.lua's light_variants takes the general loop.
+ * with more lights than pp.lua's light_variants takes the general loop; a light whose shadow tiles hold no
+ * back face compiles out the offset step and renders the same image.
  * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -15,6 +16,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "gl_test.h"
 
@@ -179,11 +181,41 @@ static void adding_a_light_compiles_a_new_variant(void **state) {
   lm_scene_destroy(s);
 }
 
+/* Where a light's shadow tiles hold no face it sees from behind
+ * (lm_shadow_front_lit: the Cornell box's lamp), its variant compiles out the
+ * shadow lookup's offset step (LIGHT_FRONT_LIT) and renders the image of the
+ * variant that keeps it (front_lit=false) to the bit, with ESM and PCF. */
+static void front_lit_lights_render_as_with_the_offset_step(void **state) {
+  (void)state;
+  lm_error err;
+  lm_scene *s = lm_scene_builtin("cornell", &err);
+  assert_non_null(s);
+  static const char *const filters[] = {"shadow.technique=esm", "shadow.technique=pcf"};
+  lm_programs_clear(); /* none cached from the tests before */
+  for (int f = 0; f < 2; f++) {
+    const char *on[] = {"light_variants=16", filters[f], NULL};
+    const char *off[] = {"light_variants=16", filters[f], "front_lit=false", NULL};
+    double ms;
+    int before = lm_programs_stats("LIGHT_FRONT_LIT", &ms);
+    gl_result a = gl_render_ok(&(gl_run){.scene = s, .tech = "dl+esm", .sets = on, .width = W, .height = H});
+    assert_true(lm_programs_stats("LIGHT_FRONT_LIT", &ms) > before);
+    gl_result b = gl_render_ok(&(gl_run){.scene = s, .tech = "dl+esm", .sets = off, .width = W, .height = H});
+    int differ = 0;
+    for (int i = 0; i < 3 * W * H; i++) differ += memcmp(&a.rgb[i], &b.rgb[i], sizeof *a.rgb) != 0;
+    printf("%s: without the offset step against with it: %d of %d values differ\n", filters[f], differ, 3 * W * H);
+    assert_int_equal(differ, 0);
+    gl_result_free(&a);
+    gl_result_free(&b);
+  }
+  lm_scene_destroy(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(variants_render_as_the_general_loop),
       cmocka_unit_test(lights_the_grid_culls_keep_its_loop),
       cmocka_unit_test(adding_a_light_compiles_a_new_variant),
+      cmocka_unit_test(front_lit_lights_render_as_with_the_offset_step),
   };
   return cmocka_run_group_tests(tests, gl_test_setup, gl_test_teardown);
 }

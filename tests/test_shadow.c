@@ -1311,6 +1311,75 @@ static void mirrored_nodes_shade_as_their_twins(void **state) {
   }
 }
 
+/* The sphere of radius 0.5 around (0, 1, 0) over the ground, lit by a
+ * point light at `light`: `scale` -1 mirrors its node (its faces still point
+ * outward: its front faces wind clockwise), `mode` its material's alpha. */
+static unsigned sphere_front_lit(const float light[3], float scale, lm_alpha_mode mode) {
+  lm_scene *s = lm_scene_create("sphere");
+  int grey = gl_material(s, "grey", 0.5f, 0.5f, 0.5f);
+  gl_quad(s, "ground", grey, (const float[4][3]){{-8, 0, 8}, {8, 0, 8}, {8, 0, -8}, {-8, 0, -8}},
+          (const float[3]){0, 1, 0});
+  int ball = gl_material(s, "ball", 0.5f, 0.5f, 0.5f);
+  s->material_pbr[ball].alpha_mode = mode;
+  mat4 m;
+  glm_translate_make(m, (vec3){0, 1, 0});
+  glm_scale(m, (vec3){scale, 1, 1});
+  lm_scene_add_node(s, "ball", -1, (float *)m, gl_uv_sphere(s, "ball", 0.5f), ball);
+  glm_translate_make(m, (vec3){light[0], light[1], light[2]});
+  int node = lm_scene_add_node(s, "light", -1, (float *)m, -1, -1);
+  lm_scene_add_light(s, &(lm_light){.name = "light", .type = LM_LIGHT_POINT, .color = {1, 1, 1}, .power = 1,
+                                     .falloff = LM_FALLOFF_NONE, .casts_shadows = true, .node = node});
+  lm_scene_update(s);
+  lm_shadow_casters *c = NULL;
+  unsigned lit = lm_shadow_front_lit(s, &c);
+  lm_shadow_casters_free(c);
+  lm_scene_destroy(s);
+  return lit;
+}
+
+/* lm_shadow_front_lit: which lights' tiles hold no face they see from
+ * behind, whose lookups light_set() lets skip the offset step (LIGHT_FRONT_LIT).
+ * The Cornell box's lamp: its walls face it, its boxes are closed and it is
+ * outside them; the thin walls' point light, spot and sun see the wall from
+ * behind, mirrored or not (the seams above then keep their offset). A closed
+ * sphere (welded at its seam, its poles' triangles of no area) under a light
+ * outside it: yes, mirrored too; with the light inside it, or its material
+ * alpha-masked (holes show its inside): no. Read back from the GPU (the
+ * renderer's GPU-only scene) the box gives the same. */
+static void lights_whose_tiles_hold_no_back_face(void **state) {
+  (void)state;
+  lm_scene *s = builtin("cornell");
+  lm_shadow_casters *c = NULL;
+  assert_int_equal(lm_shadow_front_lit(s, &c), 1);
+  assert_int_equal(lm_shadow_front_lit(s, &c), 1); /* from what it kept */
+  lm_shadow_casters_free(c);
+  lm_scene_destroy(s);
+  for (int type = 0; type < 3; type++)
+    for (int mirrored = 0; mirrored < 2; mirrored++) {
+      s = thin_wall_scene((lm_light_type)type, mirrored);
+      c = NULL;
+      if (lm_shadow_front_lit(s, &c) != 0) fail_msg("%s%s: taken as front lit", light_kind[type], mirrored ? ", mirrored" : "");
+      lm_shadow_casters_free(c);
+      lm_scene_destroy(s);
+    }
+  static const float outside[3] = {1.5f, 2.5f, 0.5f}, inside[3] = {0.1f, 1.1f, 0};
+  assert_int_equal(sphere_front_lit(outside, 1, LM_ALPHA_OPAQUE), 1);
+  assert_int_equal(sphere_front_lit(outside, -1, LM_ALPHA_OPAQUE), 1);
+  assert_int_equal(sphere_front_lit(inside, 1, LM_ALPHA_OPAQUE), 0);
+  assert_int_equal(sphere_front_lit(inside, -1, LM_ALPHA_OPAQUE), 0);
+  assert_int_equal(sphere_front_lit(outside, 1, LM_ALPHA_MASK), 0);
+  s = builtin("cornell");
+  s->gpu_only = true;
+  lm_error err;
+  assert_true(lm_scene_upload(s, &err));
+  assert_null(s->meshes[0].vertices);
+  c = NULL;
+  assert_int_equal(lm_shadow_front_lit(s, &c), 1);
+  lm_shadow_casters_free(c);
+  lm_scene_destroy(s);
+}
+
+
 /* Direct light under shadows, whose SHADOW_FILTER define the options pick:
  * `filter` -1 keeps shadow.bind's (the plan's filter alone compiled), -2
  * drops it (every filter compiled, each light's info.w picks), 0..4 forces
@@ -1642,6 +1711,7 @@ int main(int argc, char **argv) {
       cmocka_unit_test(seams_where_lit_faces_meet_stay_lit),
       cmocka_unit_test(seams_of_thin_walls_stay_dark_under_every_light),
       cmocka_unit_test(mirrored_nodes_shade_as_their_twins),
+      cmocka_unit_test(lights_whose_tiles_hold_no_back_face),
       cmocka_unit_test(a_filter_variant_compiles_its_filter_alone),
       cmocka_unit_test(cascades_draw_the_casters_of_their_slice),
       cmocka_unit_test(cascades_scroll_with_a_moving_camera),

@@ -85,6 +85,12 @@ struct lm_renderer {
   int scene_still; /* the same count for scene_hash */
   uint64_t light;  /* the last frame's light_hash */
   int light_still; /* the same count for light_hash */
+  /* lm_shadow_front_lit's mask (light_set()'s LIGHT_FRONT_LIT), found again when a caster or light
+   * changed (front_key: caster_hash with light_hash), from the meshes it read once (front_casters). */
+  unsigned front_lit;
+  uint64_t front_key;
+  bool front_known;
+  lm_shadow_casters *front_casters;
   long executions; /* frames executed, never reset (tile_cache.execution) */
   float exposure;  /* the last frame's pre-exposure (frame_exposure) */
   lm_readback meter_read; /* the last frame's exposure meter, read for this one's pre-exposure */
@@ -121,6 +127,7 @@ void lm_renderer_destroy(lm_renderer *r) {
   for (int i = 0; i < VIEW_PASSES; i++) tile_cache_free(&r->tiles[i]);
   lm_graph_destroy(r->graph);
   lm_shadow_plan_free(&r->shadows);
+  lm_shadow_casters_free(r->front_casters);
   lm_readback_free(&r->fit_read);
   lm_readback_free(&r->meter_read);
   lm_light_grid_free(&r->light_grid);
@@ -945,6 +952,15 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[3], lm_e
   r->light = light;
   lm_pipeline_set_scene(p, r->desc.scene, frame, &r->shadows,
                         (lm_still_frames){.world = r->still, .scene = r->scene_still, .light = r->light_still});
+  uint64_t front = lm_hash(&light, sizeof light, caster_hash(r));
+  if (!r->front_known || front != r->front_key) {
+    double t = lm_now_ms();
+    r->front_lit = lm_shadow_front_lit(s, &r->front_casters);
+    lm_debug("lights whose shadow tiles hold no back face: 0x%x of %d (%.1f ms)", r->front_lit, s->light_count,
+             lm_now_ms() - t);
+  }
+  r->front_key = front, r->front_known = true;
+  lm_pipeline_set_front_lit(p, r->front_lit);
   double t0 = lm_cpu_ms();
   int presented = -1;
   if (!lm_pipeline_record(p, g, &presented, err)) return false;

@@ -545,6 +545,8 @@ void lm_pipeline_set_scene(lm_pipeline *p, const lm_scene *scene, const lm_frame
   p->shadows = shadows;
 }
 
+void lm_pipeline_set_front_lit(lm_pipeline *p, unsigned lights) { p->front_lit = lights; }
+
 const char *lm_pipeline_present_where(const lm_pipeline *p) { return p->present_where; }
 bool lm_pipeline_present_display(const lm_pipeline *p) { return p->present_display; }
 float lm_pipeline_light_peak(const lm_pipeline *p) { return p->light_peak; }

@@ -79,6 +79,9 @@ typedef struct lm_still_frames {
  * still: how long its world, scene and light have stayed the same. */
 void lm_pipeline_set_scene(lm_pipeline *p, const lm_scene *scene, const lm_frame_data *camera,
                            lm_shadow_plan *shadows, lm_still_frames still);
+/* The lights whose shadow tiles hold no back face (lm_shadow_front_lit's
+ * mask), which light_set() passes on as LIGHT_FRONT_LIT; 0 until set. */
+void lm_pipeline_set_front_lit(lm_pipeline *p, unsigned lights);
 
 /* Records one frame into g (lm_graph_begin already called): OnCreate the
  * first time, then OnRender(tech). *presented gets the target passed to

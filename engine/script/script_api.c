@@ -790,13 +790,15 @@ static int l_scene_reflective(lua_State *L) {
   return 1;
 }
 
-/* light_set(max[, cull]): the scene's lights as a lighting pass's defines, which
+/* light_set(max[, cull[, front_lit]]): the scene's lights as a lighting pass's defines, which
  * shaders/lighting.glsl reads to evaluate each light unrolled, its kind,
  * falloff and shadow fixed, instead of the general loop: { LIGHT_SET = count,
  * LIGHT_BLOCKS (the records of the uniform blocks it reads: common.glsl),
  * LIGHT_SPOTS, LIGHT_SUNS (directional), LIGHT_SHADOWED (casts shadows),
- * LIGHT_FALLOFF_NONE, LIGHT_FALLOFF_SQUARE, LIGHT_FALLOFF_RANGE = masks,
- * bit i for light i } (zero masks left out: one variant, one cache key). nil
+ * LIGHT_FALLOFF_NONE, LIGHT_FALLOFF_SQUARE, LIGHT_FALLOFF_RANGE, and with
+ * front_lit true LIGHT_FRONT_LIT (shadow tiles that hold no back face:
+ * lm_shadow_front_lit; no offset lookup) = masks, bit i for light i } (zero
+ * masks left out: one variant, one cache key). nil
  * when the scene has more than max lights (0 .. LM_LIGHT_SET_MAX): the
  * general loop, with light culling, reading storage blocks. With cull true,
  * { LIGHT_BLOCKS } alone when the scene has more than one light and the grid
@@ -809,7 +811,7 @@ static int l_light_set(lua_State *L) {
   lua_Integer max = luaL_checkinteger(L, 1);
   if (max < 0 || max > LM_LIGHT_SET_MAX)
     return luaL_error(L, "light_set: max must be an integer in 0 .. %d (got %d)", LM_LIGHT_SET_MAX, (int)max);
-  bool cull = lua_toboolean(L, 2);
+  bool cull = lua_toboolean(L, 2), front_lit = lua_toboolean(L, 3);
   int n = p->scene ? p->scene->light_count : 0, cullable = 0;
   for (int i = 0; cull && i < n; i++) {
     const lm_light *l = &p->scene->lights[i];
@@ -836,8 +838,8 @@ static int l_light_set(lua_State *L) {
   const struct { const char *name; unsigned mask; } masks[] = {
       {"LIGHT_SPOTS", spots}, {"LIGHT_SUNS", suns}, {"LIGHT_SHADOWED", shadowed},
       {"LIGHT_FALLOFF_NONE", falloff[LM_FALLOFF_NONE]}, {"LIGHT_FALLOFF_SQUARE", falloff[LM_FALLOFF_INVERSE_SQUARE]},
-      {"LIGHT_FALLOFF_RANGE", falloff[LM_FALLOFF_RANGE]}};
-  lua_createtable(L, 0, 8);
+      {"LIGHT_FALLOFF_RANGE", falloff[LM_FALLOFF_RANGE]}, {"LIGHT_FRONT_LIT", front_lit ? p->front_lit & shadowed : 0}};
+  lua_createtable(L, 0, 9);
   lua_pushinteger(L, n);
   lua_setfield(L, -2, "LIGHT_SET");
   lua_pushinteger(L, LM_LIGHT_SET_MAX); /* the uniform blocks' records (common.glsl) */

@@ -31,6 +31,7 @@ struct lm_pipeline {
   int *shadow_levels;     /* the last plan's levels (lm_shadow_settings.last_levels), one a light */
   int shadow_level_count;
   float (*shadow_depths)[2]; /* the last plan's cascade rows (lm_shadow_settings.last_depths), taken from it */
+  unsigned front_lit;     /* lm_pipeline_set_front_lit */
   lm_still_frames still;  /* frames in a row before this one that drew the same world, scene, light */
   float light_peak;       /* the largest radiance the script's own light reaches this frame (light_peak, sky_sh) */
   bool keep_exposure;     /* keep_exposure(): this frame shows results kept under the last one's pre-exposure */

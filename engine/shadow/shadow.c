@@ -840,3 +840,251 @@ void lm_shadow_plan_upload(const lm_shadow_plan *plan, int light_count) {
   upload(3, NULL, 0, sizeof(lm_shadow_view_data), LM_LIGHT_SET_VIEWS);
   free(none);
 }
+
+/* ---- lights whose tiles hold no back face (lm_shadow_front_lit) -------- */
+
+/* A mesh as its draws give it: positions (8 floats a vertex, xyz first) and
+ * every index its draws read, its own then its copies' (lm_mesh_lod ranges). */
+typedef struct drawn_mesh {
+  float *vertices;
+  uint32_t *indices;
+  int index_count;
+  int *shell;     /* per vertex: its shell (vertices welded by position, joined by triangles) */
+  int shells;
+  bool closed;    /* the mesh's and its caster copies' ranges closed and consistently wound */
+  bool deforms;   /* a deformed mesh's pose (read again each time) */
+  bool valid;     /* every index names a vertex (else no face is taken to face any light) */
+  /* The mesh's own indices, then its caster copies' (what an opaque node draws in a tile: closed_ranges
+   * of them), then the camera's (a caster cut by its texture's alpha may draw them: lm_scene_draw). */
+  lm_mesh_lod ranges[1 + 2 * LM_LOD_LEVELS];
+  int range_count, closed_ranges;
+} drawn_mesh;
+
+typedef struct weld_key { int32_t p[3]; int i; } weld_key;
+static int weld_cmp(const void *a, const void *b) {
+  const weld_key *x = a, *y = b;
+  int c = memcmp(x->p, y->p, sizeof x->p);
+  return c ? c : (x->i > y->i) - (x->i < y->i);
+}
+static int u64_cmp(const void *a, const void *b) {
+  uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+  return (x > y) - (x < y);
+}
+static int shell_root(int *parent, int v) {
+  while (parent[v] != v) v = parent[v] = parent[parent[v]];
+  return v;
+}
+
+/* Whether indices [first, first + count) close (each directed edge between
+ * welded vertices matched by its reverse: no border, one winding). */
+static bool range_closed(const uint32_t *indices, int first, int count, const int *weld) {
+  int n = count / 3 * 3, m = 0;
+  uint64_t *edges = lm_alloc(sizeof *edges * (size_t)(n + 1)), *reversed = lm_alloc(sizeof *reversed * (size_t)(n + 1));
+  for (int t = first; t < first + n; t += 3) {
+    int v[3] = {weld[indices[t]], weld[indices[t + 1]], weld[indices[t + 2]]};
+    if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) continue; /* no area: rasterizes nothing */
+    for (int k = 0; k < 3; k++, m++) {
+      uint64_t a = (uint32_t)v[k], b = (uint32_t)v[(k + 1) % 3];
+      edges[m] = a << 32 | b, reversed[m] = b << 32 | a;
+    }
+  }
+  qsort(edges, (size_t)m, sizeof *edges, u64_cmp);
+  qsort(reversed, (size_t)m, sizeof *reversed, u64_cmp);
+  bool closed = !memcmp(edges, reversed, sizeof *edges * (size_t)m);
+  free(edges), free(reversed);
+  return closed;
+}
+
+static void drawn_mesh_read(const lm_scene_mesh *m, drawn_mesh *d) {
+  *d = (drawn_mesh){0};
+  int n = m->index_count;
+  d->ranges[d->range_count++] = (lm_mesh_lod){.first = 0, .count = m->index_count};
+  for (int k = 0; k < m->caster_levels; k++) d->ranges[d->range_count++] = m->casters[k];
+  d->closed_ranges = d->range_count;
+  for (int k = 0; k < m->lod_levels; k++) d->ranges[d->range_count++] = m->lods[k];
+  for (int k = 0; k < d->range_count; k++) n = n > d->ranges[k].first + d->ranges[k].count ? n : d->ranges[k].first + d->ranges[k].count;
+  d->index_count = n;
+  d->vertices = lm_alloc(sizeof(float) * 8 * (size_t)(m->vertex_count + 1));
+  d->indices = lm_alloc(sizeof(uint32_t) * (size_t)(n + 1));
+  if (m->gpu.vao && !m->rest) /* what the GPU draws, copies included */
+    lm_mesh_read(&m->gpu, d->vertices, m->vertex_count, d->indices, n);
+  else {
+    memcpy(d->vertices, m->vertices, sizeof(float) * 8 * (size_t)m->vertex_count);
+    memcpy(d->indices, m->indices, sizeof(uint32_t) * (size_t)m->index_count);
+  }
+  d->deforms = m->rest != NULL;
+  d->valid = true;
+  for (int t = 0; t < n; t++) d->valid = d->valid && d->indices[t] < (uint32_t)m->vertex_count;
+  if (d->deforms || !d->valid) return; /* a pose (this time's): its triangles alone, not taken for closed */
+  /* Weld by position, each vertex to its first twin: positions rounded to
+   * 1/65536 of the extent (the GPU's 16 bits: lm_mesh), where a seam's or
+   * a pole's copies made by sines of 0 and 2 pi meet. Whole fractions of
+   * the extent (its middle: 0 in a mesh about the origin) lie at the middle
+   * of a step, not at a rounding edge; a copy rounded to the next step is
+   * left apart (an open edge: not closed). */
+  int nv = m->vertex_count;
+  weld_key *keys = lm_alloc(sizeof *keys * (size_t)(nv + 1));
+  int *weld = lm_alloc(sizeof *weld * (size_t)(nv + 1)), *parent = lm_alloc(sizeof *parent * (size_t)(nv + 1));
+  float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX}, extent = 0.0f;
+  for (int i = 0; i < nv; i++)
+    for (int c = 0; c < 3; c++) {
+      float x = d->vertices[8 * (size_t)i + c];
+      if (isfinite(x)) lo[c] = fminf(lo[c], x), hi[c] = fmaxf(hi[c], x);
+    }
+  for (int c = 0; c < 3; c++) extent = fmaxf(extent, hi[c] - lo[c]);
+  float step = extent > 0.0f && isfinite(extent) ? extent / 65536.0f : 1.0f;
+  for (int i = 0; i < nv; i++) {
+    for (int c = 0; c < 3; c++) {
+      float q = floorf((d->vertices[8 * (size_t)i + c] - lo[c]) / step + 0.5f);
+      keys[i].p[c] = isfinite(q) && fabsf(q) < 1e9f ? (int32_t)q : INT32_MIN;
+    }
+    keys[i].i = i;
+  }
+  qsort(keys, (size_t)nv, sizeof *keys, weld_cmp);
+  for (int i = 0, first = 0; i < nv; i++) {
+    if (i > 0 && memcmp(keys[i].p, keys[i - 1].p, sizeof keys[i].p)) first = keys[i].i;
+    if (i == 0) first = keys[i].i;
+    weld[keys[i].i] = first;
+  }
+  d->closed = n >= 3;
+  for (int k = 0; k < d->closed_ranges && d->closed; k++)
+    d->closed = range_closed(d->indices, d->ranges[k].first, d->ranges[k].count, weld);
+  /* Shells: welded vertices joined by the triangles of every range (a copy's triangles join what the mesh's do). */
+  for (int i = 0; i < nv; i++) parent[i] = weld[i];
+  for (int t = 0; t + 2 < n; t += 3)
+    for (int k = 1; k < 3; k++) {
+      int a = shell_root(parent, weld[d->indices[t]]), b = shell_root(parent, weld[d->indices[t + k]]);
+      if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+    }
+  d->shell = lm_alloc(sizeof *d->shell * (size_t)(nv + 1));
+  for (int i = 0; i < nv; i++) d->shell[i] = -1;
+  for (int i = 0; i < nv; i++) {
+    int r = shell_root(parent, i);
+    if (d->shell[r] < 0) d->shell[r] = d->shells++;
+    d->shell[i] = d->shell[r];
+  }
+  free(keys), free(weld), free(parent);
+}
+
+static void drawn_mesh_free(drawn_mesh *d) {
+  free(d->vertices), free(d->indices), free(d->shell);
+}
+
+/* Whether every face of mesh d, drawn by a node whose world matrix is m,
+ * that light `l` (lm_light_data) sees nearest faces it. In the node's own
+ * space: an affine map keeps which side of a plane the light is on (times
+ * its determinant's sign, which a mirrored node's clockwise front faces
+ * undo: engine/scene, lm_set_front_face_clockwise) and the order along a
+ * ray. `solid`: the node's material is opaque (a mask's holes open it). */
+static bool node_front_lit(const drawn_mesh *d, const float m[16], const lm_light_data *l, bool solid) {
+  mat4 world, inv; /* aligned copies: cglm's vector loads */
+  memcpy(world, m, sizeof world);
+  glm_mat4_inv(world, inv);
+  bool sun = l->position[3] == 2.0f;
+  vec4 at = {l->position[0], l->position[1], l->position[2], 1.0f};
+  if (sun) glm_vec4_copy((vec4){-l->direction[0], -l->direction[1], -l->direction[2], 0.0f}, at);
+  vec4 local;
+  glm_mat4_mulv(inv, at, local); /* the light's place, or the way toward it (w 0), in the node's space */
+  for (int c = 0; c < 4; c++)
+    if (!isfinite(local[c]) || !d->valid) return false;
+  double L[3] = {local[0], local[1], local[2]};
+  bool behind = false; /* a triangle faces away from the light, or edge on (either way, rounded) */
+  /* An opaque node draws its mesh or a caster copy; one cut by its texture's alpha may draw a camera copy. */
+  const lm_mesh_lod *last = &d->ranges[(solid ? d->closed_ranges : d->range_count) - 1];
+  int end = last->first + last->count;
+  for (int t = 0; t + 2 < end && !behind; t += 3) {
+    const float *a = d->vertices + 8 * (size_t)d->indices[t], *b = d->vertices + 8 * (size_t)d->indices[t + 1],
+                *c = d->vertices + 8 * (size_t)d->indices[t + 2];
+    double u[3], v[3], n[3], w[3];
+    for (int k = 0; k < 3; k++) u[k] = b[k] - a[k], v[k] = c[k] - a[k], w[k] = sun ? L[k] : L[k] - a[k];
+    n[0] = u[1] * v[2] - u[2] * v[1], n[1] = u[2] * v[0] - u[0] * v[2], n[2] = u[0] * v[1] - u[1] * v[0];
+    double nn = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), ww = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    if (nn == 0.0) continue; /* no area */
+    behind = n[0] * w[0] + n[1] * w[1] + n[2] * w[2] <= 1e-4 * nn * ww;
+  }
+  if (!behind) return true;
+  if (!solid || !d->closed) return false;
+  /* Closed: the nearest face along a ray from the light enters a shell
+   * where the light lies at the shell's least winding number, outside one
+   * whose faces point outward (0), inside one whose faces point inward (-1);
+   * a sun, at infinity, outside all: each shell's faces must point outward.
+   * Each range on its own: a node draws one of them in a tile. */
+  double *wind = lm_alloc(sizeof *wind * 2 * (size_t)(d->shells + 1)), *volume = wind + d->shells + 1;
+  bool front = true;
+  for (int r = 0; r < d->closed_ranges && front; r++) {
+    memset(wind, 0, sizeof *wind * 2 * (size_t)(d->shells + 1));
+    for (int t = d->ranges[r].first; t + 2 < d->ranges[r].first + d->ranges[r].count; t += 3) {
+      double p[3][3], len[3];
+      for (int j = 0; j < 3; j++) {
+        const float *q = d->vertices + 8 * (size_t)d->indices[t + j];
+        for (int k = 0; k < 3; k++) p[j][k] = q[k] - (sun ? 0.0 : L[k]);
+        len[j] = sqrt(p[j][0] * p[j][0] + p[j][1] * p[j][1] + p[j][2] * p[j][2]);
+      }
+      /* Six times the signed volume of the tetrahedron the triangle spans
+       * with the light (summed: the shell's, with the sun at the origin),
+       * and the triangle's solid angle from the light (Van Oosterom and
+       * Strackee): positive where the light is behind it. */
+      double triple = p[0][0] * (p[1][1] * p[2][2] - p[1][2] * p[2][1]) +
+                      p[0][1] * (p[1][2] * p[2][0] - p[1][0] * p[2][2]) +
+                      p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0]);
+      double dot01 = p[0][0] * p[1][0] + p[0][1] * p[1][1] + p[0][2] * p[1][2];
+      double dot02 = p[0][0] * p[2][0] + p[0][1] * p[2][1] + p[0][2] * p[2][2];
+      double dot12 = p[1][0] * p[2][0] + p[1][1] * p[2][1] + p[1][2] * p[2][2];
+      double den = len[0] * len[1] * len[2] + dot01 * len[2] + dot02 * len[1] + dot12 * len[0];
+      int shell = d->shell[d->indices[t]];
+      volume[shell] += triple;
+      wind[shell] += sun ? 0.0 : 2.0 * atan2(triple, den);
+    }
+    for (int k = 0; k < d->shells && front; k++) {
+      if (volume[k] == 0.0 && wind[k] == 0.0) continue; /* none of this range's triangles */
+      double least = volume[k] > 0.0 ? 0.0 : -1.0, w = wind[k] / (4.0 * GLM_PI);
+      front = volume[k] != 0.0 && (sun ? volume[k] > 0.0 : fabs(w - least) < 0.25);
+    }
+  }
+  free(wind);
+  return front;
+}
+
+struct lm_shadow_casters {
+  drawn_mesh *meshes; /* per scene mesh, read when first needed (vertices NULL before) */
+  int count;
+};
+
+void lm_shadow_casters_free(lm_shadow_casters *c) {
+  for (int i = 0; c && i < c->count; i++) drawn_mesh_free(&c->meshes[i]);
+  if (c) free(c->meshes);
+  free(c);
+}
+
+unsigned lm_shadow_front_lit(const lm_scene *s, lm_shadow_casters **casters) {
+  lm_light_data ld[LM_LIGHT_SET_MAX];
+  int n = lm_scene_light_data(s, ld, LM_LIGHT_SET_MAX);
+  unsigned lit = 0;
+  for (int i = 0; i < n && s->light_count <= LM_LIGHT_SET_MAX; i++) lit |= (unsigned)s->lights[i].casts_shadows << i;
+  lm_shadow_casters *c = *casters;
+  if (lit && (!c || c->count != s->mesh_count)) {
+    lm_shadow_casters_free(c);
+    c = *casters = lm_alloc(sizeof *c);
+    c->count = s->mesh_count;
+    c->meshes = lm_alloc(sizeof *c->meshes * (size_t)(c->count + 1));
+    memset(c->meshes, 0, sizeof *c->meshes * (size_t)(c->count + 1));
+  }
+  for (int mi = 0; mi < s->mesh_count && lit; mi++) {
+    bool drawn = false;
+    for (int i = 0; i < s->node_count && !drawn; i++) drawn = s->nodes[i].mesh == mi;
+    if (!drawn || s->meshes[mi].vertex_count <= 0) continue;
+    drawn_mesh *d = &c->meshes[mi];
+    if (d->deforms) drawn_mesh_free(d), d->vertices = NULL;
+    if (!d->vertices) drawn_mesh_read(&s->meshes[mi], d);
+    for (int i = 0; i < s->node_count && lit; i++) {
+      const lm_node *node = &s->nodes[i];
+      if (node->mesh != mi) continue;
+      int mat = node->material;
+      bool solid = mat < 0 || mat >= s->material_count || !s->material_pbr ||
+                   s->material_pbr[mat].alpha_mode == LM_ALPHA_OPAQUE;
+      for (int k = 0; k < n; k++)
+        if (lit >> k & 1 && !node_front_lit(d, node->world, &ld[k], solid)) lit &= ~(1u << k);
+    }
+  }
+  return lit;
+}

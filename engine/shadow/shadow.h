@@ -158,6 +158,23 @@ void lm_shadow_plan_free(lm_shadow_plan *plan);
  * m[13]): a cascade that only moved across the light, which its tile can
  * scroll to. */
 bool lm_shadow_view_moved_across(const float a[16], const float b[16]);
+/* The lights whose shadow tiles can hold no face they see from behind
+ * nearest (bit i: light i, of the first LM_LIGHT_SET_MAX, that casts):
+ * those need no second lookup at a normal offset (shaders/shadow.glsl,
+ * shadow_factor_as), which a light-set variant then compiles out
+ * (light_set(), LIGHT_FRONT_LIT). Each caster, as its draws give it (its
+ * own triangles and its simplified copies'), either faces the light with
+ * every triangle, or is opaque and closed (every edge shared by two
+ * triangles of opposite windings) with the light outside each of its
+ * shells (inside one whose faces point inward, as a room's): then the
+ * nearest face along any ray from the light enters a solid, a face toward
+ * the light. Shells are taken not to pass through themselves. Reads a
+ * GPU-only scene's meshes back (lm_mesh_read) into *casters (NULL the
+ * first time), which keeps them for the next call (a deformed mesh's pose
+ * is read each time). */
+typedef struct lm_shadow_casters lm_shadow_casters;
+unsigned lm_shadow_front_lit(const lm_scene *s, lm_shadow_casters **casters);
+void lm_shadow_casters_free(lm_shadow_casters *c);
 /* Storage blocks 2 (per light) and 3 (per tile), and uniform block 5 (each light's views at fixed
  * places, for light-set variants); a NULL plan marks every light unshadowed. */
 void lm_shadow_plan_upload(const lm_shadow_plan *plan, int light_count);
