@@ -240,7 +240,7 @@ function isr.render(direct, o, frame)
   local kept = not seed and o.temporal.enabled and temporal.kept("isr", f) or nil
   if kept then
     C.z = kept.z
-    if temporal.settled(o.temporal) then return isr.composite(G, direct, C, kept.value, params, false, light.sky) end
+    if temporal.settled(o.temporal) then return isr.composite(G, direct, C, f, kept.value, params, false, light.sky) end
   end
   local E, E1, H, first
   local hits = seed and 0 or hit_targets(o)
@@ -335,7 +335,7 @@ function isr.render(direct, o, frame)
   end
   E = temporal.clamp("isr", history, E)
   E = isr.blur(E, C, f, o.blur, history and history.state, kept and kept.value, o.temporal.narrow)
-  return isr.composite(G, direct, C, E, params, seed ~= nil, light.sky)
+  return isr.composite(G, direct, C, f, E, params, seed ~= nil, light.sky)
 end
 
 -- Traces the rays the first march lost (rsm.trace; rays = { origins, directions },
@@ -399,12 +399,18 @@ function isr.bind_coarse(inputs, defines, C, E)
   defines.Z_MASK = C.z ~= nil
 end
 
--- Bilateral upsampling of the coarse E (rgb E, a A) and the composite with
--- the direct light (isr_light.frag), to the target "lit"; skylight (from
--- sky.light, may be nil) joins the ambient term.
-function isr.composite(G, direct, C, E, params, seed, skylight)
+-- Bilateral upsampling of the coarse E (rgb E, a A) at factor f and the
+-- composite with the direct light (isr_light.frag), to the target "lit";
+-- skylight (from sky.light, may be nil) joins the ambient term. Where f is
+-- a multiple of 4 that divides the output, every 2 x 2 pixel quad lies
+-- between the same four coarse texels, and its pixels share their reads
+-- (coarse.glsl's QUAD_SHARED: about a sixth of isr.light's time, the same
+-- images bit for bit; docs/benchmarks.md).
+function isr.composite(G, direct, C, f, E, params, seed, skylight)
   local inputs, defines = { clr = G.clr, nrm = G.nrm, dpt = G.dpt, mat = G.mat, direct = direct }, { SEED = seed }
   isr.bind_coarse(inputs, defines, C, E)
+  local w, h = output_size()
+  defines.QUAD_SHARED = f % 4 == 0 and w % f == 0 and h % f == 0
   sky.bind(skylight, params, defines)
   return pass{ "isr.light", shader = "isr_light.frag", inputs = inputs, defines = defines, params = params,
                out = target{ "lit", format = "rgba16f" } }

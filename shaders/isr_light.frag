@@ -29,11 +29,11 @@ out vec4 lit;
 
 void main() {
   Surface s = gbuffer_fetch(clr, nrm, dpt, mat, ivec2(gl_FragCoord.xy)); // unfiltered: a pass at the G-buffer's size
+  vec4 e = coarse_upsample(uv, s.depth01); // before any branch: QUAD_SHARED's derivatives need every pixel
   if (!s.covered) {
     lit = vec4(background_seen(background, uv), 1.0);
     return;
   }
-  vec4 e = coarse_upsample(uv, s.depth01);
   // the ambient term as the direct pass's (ambient_light): k_d albedo, which a pbr metal lacks
   vec3 d = texelFetch(direct, ivec2(gl_FragCoord.xy), 0).rgb, sky = ambient_light(s, ambient);
 #ifdef SEED

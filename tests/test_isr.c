@@ -475,6 +475,99 @@ static void dl_records_no_isr_pass(void **state) {
   gl_result_free(&isr);
 }
 
+/* coarse.glsl's QUAD_SHARED (the composite's upsampling where the coarse
+ * factor is a multiple of 4 that divides the output): each pixel of a 2 x 2
+ * quad reads one of the four coarse texels and takes the others from its
+ * neighbours, against every pixel reading all four (and gathering the
+ * depths and coverage). Test shaders (in the scratch root) fill a coarse E
+ * of values over 2^-6 .. 2^6, depths with holes (0: nothing drawn) and
+ * edges, a coverage, and full-size depths; then the upsampling runs with
+ * and without QUAD_SHARED, with the coverage from the depth (Z_MASK) and
+ * from coarse_mat. */
+static const char coarse_fill_frag[] =
+    "layout(location = 0) out vec4 e;\n"
+    "layout(location = 1) out float z;\n"
+    "layout(location = 2) out vec4 m;\n"
+    "float hash(ivec2 p, int k) { return fract(float(p.x * (37 + 14 * k) + p.y * (101 + 22 * k)) / 997.0); }\n"
+    "void main() {\n"
+    "  ivec2 p = ivec2(gl_FragCoord.xy);\n"
+    "  e = exp2(12.0 * vec4(hash(p, 0), hash(p, 1), hash(p, 2), hash(p, 3)) - 6.0);\n"
+    "  z = hash(p, 4) < 0.1 ? 0.0 : 0.05 + 0.9 * hash(p, 5) * hash(p, 5);\n"
+    "  m = vec4(0.0, 0.0, 0.0, hash(p, 6));\n"
+    "}\n";
+static const char full_depth_frag[] =
+    "out float z;\n"
+    "void main() { z = 0.05 + 0.9 * fract(float(int(gl_FragCoord.x) * 13 + int(gl_FragCoord.y) * 7) / 251.0); }\n";
+static const char upsample_frag[] =
+    "#include \"coarse.glsl\"\n"
+    "in vec2 uv;\n"
+    "uniform sampler2D z;\n"
+    "out vec4 o;\n"
+    "void main() { o = coarse_upsample(uv, texelFetch(z, ivec2(gl_FragCoord.xy), 0).r); }\n";
+static const char upsampled_frag[] = /* reads the four results, so that none is culled */
+    "uniform sampler2D a, b, c, d;\n"
+    "out vec4 o;\n"
+    "void main() {\n"
+    "  ivec2 p = ivec2(gl_FragCoord.xy);\n"
+    "  o = texelFetch(a, p, 0) + texelFetch(b, p, 0) + texelFetch(c, p, 0) + texelFetch(d, p, 0);\n"
+    "}\n";
+static const char upsample_lua[] =
+    "Techniques = { 'upsample' }\n"
+    "Options = {}\n"
+    "function OnRender()\n"
+    "  local e, z, m = target{ 'e', format = 'rgba16f', scale = 1 / 4 }, target{ 'cz', format = 'r32f', scale = 1 / 4 },\n"
+    "                  target{ 'm', format = 'rgba8', scale = 1 / 4 }\n"
+    "  pass{ 'fill', shader = 'test_coarse_fill.frag', out = { e, z, m } }\n"
+    "  local full = pass{ 'depth', shader = 'test_full_depth.frag', out = target{ 'z', format = 'r32f' } }\n"
+    "  local up = {}\n"
+    "  for _, mask in ipairs({ true, false }) do\n"
+    "    for _, shared in ipairs({ true, false }) do\n"
+    "      local name = (shared and 'shared' or 'own') .. (mask and '_z' or '_mat')\n"
+    "      up[#up + 1] = pass{ name, shader = 'test_upsample.frag', defines = { QUAD_SHARED = shared, Z_MASK = mask },\n"
+    "                          inputs = { coarse = e, coarse_dpt = z, coarse_mat = not mask and m or nil, z = full },\n"
+    "                          out = target{ name, format = 'rgba32f' } }\n"
+    "    end\n"
+    "  end\n"
+    "  present(pass{ 'read', shader = 'test_upsampled.frag', inputs = { a = up[1], b = up[2], c = up[3], d = up[4] },\n"
+    "                out = target{ 'read', format = 'rgba32f' } }, 'display')\n"
+    "end\n";
+
+static void a_quad_shares_its_coarse_reads_as_each_pixel_reads_them(void **state) {
+  (void)state;
+  assert_true(gl_write_file("shaders/test_coarse_fill.frag", coarse_fill_frag));
+  assert_true(gl_write_file("shaders/test_full_depth.frag", full_depth_frag));
+  assert_true(gl_write_file("shaders/test_upsample.frag", upsample_frag));
+  assert_true(gl_write_file("shaders/test_upsampled.frag", upsampled_frag));
+  assert_true(gl_write_file("upsample.lua", upsample_lua));
+  gl_result r = gl_render(&(gl_run){.script = "upsample.lua", .width = W, .height = H, .keep_targets = true});
+  if (!r.ok) fail_msg("%s", r.err.msg);
+  static const char *const pairs[][2] = {{"shared_z", "own_z"}, {"shared_mat", "own_mat"}};
+  for (int k = 0; k < 2; k++) {
+    int w = 0, h = 0, w2 = 0, h2 = 0;
+    float *a = gl_read_target(&r, pairs[k][0], &w, &h), *b = gl_read_target(&r, pairs[k][1], &w2, &h2);
+    assert_non_null(a);
+    assert_non_null(b);
+    assert_true(w == W && h == H && w2 == W && h2 == H);
+    double worst = 0, lo = 1e30, hi = 0;
+    int exact = 0;
+    for (int i = 0; i < W * H * 4; i++) {
+      exact += a[i] == b[i];
+      worst = fmax(worst, fabs(a[i] - b[i]) / fmax(fabs(b[i]), 1e-30));
+      lo = fmin(lo, b[i]), hi = fmax(hi, b[i]);
+    }
+    printf("%s against %s: %d of %d values the same bit for bit, the largest relative difference %g; "
+           "values %g .. %g\n", pairs[k][0], pairs[k][1], exact, W * H * 4, worst, lo, hi);
+    /* Where two depths' difference is not exact, a float's rounding, which the depth weight's 1 / EPS_Z
+     * raises 100 times: under a fifth of a half float's step (2^-11) */
+    assert_true(worst <= 1e-4);
+    assert_true(exact >= W * H * 4 * 9 / 10); /* most differences are exact */
+    assert_true(lo < 0.1 && hi > 10);         /* the coarse values were read: they span 2^-6 .. 2^6 */
+    free(a);
+    free(b);
+  }
+  gl_result_free(&r);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(a_uniformly_lit_ceiling_gives_albedo_times_radiance),
@@ -482,6 +575,7 @@ int main(void) {
       cmocka_unit_test(indirect_light_bleeds_wall_colour),
       cmocka_unit_test(occlusion_darkens_inside_corners),
       cmocka_unit_test(coarse_and_full_size_agree),
+      cmocka_unit_test(a_quad_shares_its_coarse_reads_as_each_pixel_reads_them),
       cmocka_unit_test(extreme_parameters_stay_finite),
       cmocka_unit_test(bad_options_name_themselves),
       cmocka_unit_test(an_open_floor_keeps_its_direct_light),
