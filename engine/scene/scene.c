@@ -802,12 +802,10 @@ static int nearest_run_first(const void *pa, const void *pb) {
 
 /* Puts a camera pass's draws in the order of their nearest node, keeping
  * each draw's nodes together: the depth test (before the fragment shader
- * where it neither discards nor writes depth) then spares the shading of
+ * where that writes no depth, llvmpipe's too) then spares the shading of
  * most of what they hide, one draw behind another as within a draw. Drawn by
- * material instead, the G-buffer shaded 1.76-1.84 fragments a covered pixel
- * on outdoor at 640x480, 1.36 on the big scene, 1.21-1.32 in the office and
- * 1.19 in the garage; in this order 1.15-1.18, 1.01-1.03, 1.07 and 1.02-1.03
- * (docs/benchmarks.md). */
+ * material instead, outdoor's G-buffer shaded 1.76-1.84 fragments a covered
+ * pixel, in this order 1.15-1.18 (docs/benchmarks.md). */
 static void order_draws_nearest_first(drawn_node *nodes, int count) {
   node_run *runs = lm_alloc(sizeof *runs * (size_t)(count > 0 ? count : 1));
   int run_count = 0;
