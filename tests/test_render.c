@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
+#include <epoxy/gl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -366,6 +367,52 @@ static void copies_of_a_mesh_draw_in_one_call_and_look_the_same(void **state) {
   gl_result_free(&r);
 }
 
+/* The fragments a frame's passes shade (GL_SAMPLES_PASSED) with the scene:
+ * a ceiling of material "near" 2 above a camera looking up, and with
+ * `hidden` another of material "far" 3 behind it, which sorts first. */
+static GLuint64 fragments_under_a_ceiling(bool hidden) {
+  lm_scene *s = lm_scene_create("ceiling");
+  const float F = 20, down[3] = {0, -1, 0};
+  if (hidden) {
+    int far = gl_material(s, "far", 1, 0, 0);
+    gl_quad(s, "far", far, (const float[4][3]){{-F, 5, -F}, {F, 5, -F}, {F, 5, F}, {-F, 5, F}}, down);
+  }
+  int near = gl_material(s, "near", 0, 1, 0);
+  gl_quad(s, "near", near, (const float[4][3]){{-F, 2, -F}, {F, 2, -F}, {F, 2, F}, {-F, 2, F}}, down);
+  gl_camera_up(s, 0);
+  lm_scene_update(s);
+  assert_true(gl_write_file("gbuffer_only.lua", "local gbuffer = require 'gbuffer'\nTechniques = { 'g' }\n"
+                                                "function OnRender()\n  present(gbuffer.render(gbuffer.targets()).clr)\n"
+                                                "end\n"));
+  GLuint query;
+  glGenQueries(1, &query);
+  glBeginQuery(GL_SAMPLES_PASSED, query);
+  gl_result r = gl_render(&(gl_run){.scene = s, .script = "gbuffer_only.lua", .width = W, .height = H});
+  glEndQuery(GL_SAMPLES_PASSED);
+  GLuint64 fragments = 0;
+  glGetQueryObjectui64v(query, GL_QUERY_RESULT, &fragments);
+  glDeleteQueries(1, &query);
+  assert_true(r.ok);
+  float green[3];
+  gl_region(&r, 0, 0, W - 1, H - 1, green);
+  assert_true(green[1] > 0 && green[0] <= 1e-3f * green[1]); /* the near ceiling, nothing of the far one */
+  gl_result_free(&r);
+  lm_scene_destroy(s);
+  return fragments;
+}
+
+/* The camera's draws go nearest first (lm_scene_draw), not by material: a
+ * node hidden whole behind another costs the G-buffer no fragment shaded,
+ * though its material sorts first (drawn by material, it cost a screenful). */
+static void hidden_draws_shade_no_fragment(void **state) {
+  (void)state;
+  GLuint64 alone = fragments_under_a_ceiling(false), with_hidden = fragments_under_a_ceiling(true);
+  printf("fragments shaded: %llu with the near ceiling alone, %llu with one hidden behind it\n",
+         (unsigned long long)alone, (unsigned long long)with_hidden);
+  assert_true(alone >= (GLuint64)W * H);
+  assert_true(with_hidden == alone);
+}
+
 /* A points pass scatters: 1000 points, point i on texel i % 4 of a 4 x 2
  * target's top row, each adding (1, i, 0, 0), sum exactly what each texel
  * gets; the target starts from zero every frame, so a second frame gives
@@ -463,6 +510,7 @@ int main(void) {
       cmocka_unit_test(cornell_box_has_light_and_colour_where_it_must),
       cmocka_unit_test(cornell_box_matches_the_golden_image),
       cmocka_unit_test(copies_of_a_mesh_draw_in_one_call_and_look_the_same),
+      cmocka_unit_test(hidden_draws_shade_no_fragment),
       cmocka_unit_test(shader_errors_name_the_original_file_and_line),
       cmocka_unit_test(wrong_uniforms_and_inputs_name_the_pass_and_parameter),
       cmocka_unit_test(no_nan_or_inf_leaves_the_output_stage),
