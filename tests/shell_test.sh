@@ -6,6 +6,8 @@
 #   scratch NAME             a fresh folder /tmp/limn-NAME-XXXXXX in $tmp, removed on exit
 #                            (under /tmp: POV-Ray's default I/O policy allows writing there)
 #   fail MESSAGE             stops the test, failed
+#   late_script FILE         writes a pipeline script whose sixth OnRender (frame 5 of a
+#                            capture) fails: what a half-done sequence leaves
 passed=0 failed=0
 check() {
   local name=$1; shift
@@ -23,3 +25,15 @@ scratch() {
   trap 'rm -rf "$tmp"' EXIT
 }
 fail() { echo "FAIL: $*"; exit 1; }
+late_script() {
+  cat >"$1" <<'LUA'
+local gbuffer = require "gbuffer"
+Techniques = { "gbuffer" }
+local calls = 0
+function OnRender(tech)
+  calls = calls + 1
+  if calls == 6 then error("frame 5 fails") end
+  present(gbuffer.render(gbuffer.targets()).clr)
+end
+LUA
+}

@@ -202,16 +202,7 @@ check "runtime error leaves no file" no_files
 
 # A script that fails on frame 5 of a sequence: exit 1 naming script:line and the frame; frames 0-4 whole,
 # nothing of frame 5.
-cat >"$tmp/late.lua" <<'LUA'
-local gbuffer = require "gbuffer"
-Techniques = { "gbuffer" }
-local calls = 0
-function OnRender(tech)
-  calls = calls + 1
-  if calls == 6 then error("frame 5 fails") end
-  present(gbuffer.render(gbuffer.targets()).clr)
-end
-LUA
+late_script "$tmp/late.lua"
 check "a script failing on frame 5" run 1 capture --script "$tmp/late.lua" --size 16x12 --time 0:2 --fps 4 --quiet \
   --output "$tmp/img/l{frame}.png" --output "$tmp/img/l{frame}.exr"
 check "frame 5's error names the frame and script:line" first_error_has "frame 5 at 1.250 s: $tmp/late.lua:6: frame 5 fails"

@@ -301,16 +301,7 @@ check "its manifest: 3 images of 5 views" test "$(grep -c '"views": 5,' seq/mani
 rm -rf seq
 # A script that fails on frame 5 (its sixth OnRender): the job stops there naming the view and script:line,
 # exit 1; frames 0-4 whole and in the manifest, 5 of the sequence's 9.
-cat > late.lua <<'LUA'
-local gbuffer = require "gbuffer"
-Techniques = { "gbuffer" }
-local calls = 0
-function OnRender(tech)
-  calls = calls + 1
-  if calls == 6 then error("frame 5 fails") end
-  present(gbuffer.render(gbuffer.targets()).clr)
-end
-LUA
+late_script late.lua
 sed -e 's|time = .*|time = { 0, 2, 4 }, script = "late.lua",|' -e 's|techniques = { "dl" }|techniques = { "gbuffer" }|' seq.lua > lateseq.lua
 check "a script failing on frame 5" run 1 capture --job lateseq.lua
 check "a script failing on frame 5: named" err_has "lateseq.lua: view 5 (cornell, camera 'front', gbuffer, 48x36, frame 5 at 1.250 s): ./late.lua:6: frame 5 fails"
