@@ -8,6 +8,7 @@
  * buffers are the same whatever the threads' timing. */
 #include "scene/scene_internal.h"
 
+#include <float.h>
 #include <math.h>
 #include <meshoptimizer.h>
 #include <pthread.h>
@@ -26,6 +27,7 @@ typedef struct lod_job {
   lm_mesh_lod lods[LM_LOD_LEVELS]; /* first: within out */
   int levels;
   bool mixes_uvs; /* made over positions where vertices at one position differ in uv */
+  float *welded;  /* made over positions: the vertices welded (lm_welded_vertices), the casters' kept for the buffers */
   bool done;
 } lod_job;
 
@@ -94,6 +96,98 @@ static bool corners_by_normal(const float *mesh, const float *positions, const u
   return true;
 }
 
+static int u64_cmp(const void *a, const void *b) {
+  uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+  return (x > y) - (x < y);
+}
+
+bool lm_indices_closed(const uint32_t *indices, int count, const int *weld) {
+  int n = count > 0 ? count / 3 * 3 : 0, m = 0;
+  uint64_t *edges = lm_alloc(sizeof *edges * (size_t)(n + 1)), *reversed = lm_alloc(sizeof *reversed * (size_t)(n + 1));
+  for (int t = 0; t < n; t += 3) {
+    uint32_t v[3];
+    for (int k = 0; k < 3; k++) v[k] = weld ? (uint32_t)weld[indices[t + k]] : indices[t + k];
+    if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) continue; /* no area: rasterizes nothing */
+    for (int k = 0; k < 3; k++, m++) {
+      uint64_t a = v[k], b = v[(k + 1) % 3];
+      edges[m] = a << 32 | b, reversed[m] = b << 32 | a;
+    }
+  }
+  qsort(edges, (size_t)m, sizeof *edges, u64_cmp);
+  qsort(reversed, (size_t)m, sizeof *reversed, u64_cmp);
+  bool closed = !memcmp(edges, reversed, sizeof *edges * (size_t)m);
+  free(edges), free(reversed);
+  return closed;
+}
+
+typedef struct face_key { uint32_t v[3]; } face_key;
+static int face_cmp(const void *a, const void *b) { return memcmp(a, b, sizeof(face_key)); }
+static face_key face_of(uint32_t a, uint32_t b, uint32_t c) { /* its least corner first, winding kept */
+  return a < b && a < c ? (face_key){{a, b, c}} : b < c ? (face_key){{b, c, a}} : (face_key){{c, a, b}};
+}
+
+/* Whether some triangle's reverse is among the `count` indices too: a sheet drawn from both sides (a thin
+ * box collapsed flat), closed but without volume, whose one side each light sees from behind. */
+static bool has_sheet(const uint32_t *indices, size_t count) {
+  size_t n = count / 3;
+  face_key *faces = lm_alloc(sizeof *faces * (n + 1));
+  for (size_t t = 0; t < n; t++) faces[t] = face_of(indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]);
+  qsort(faces, n, sizeof *faces, face_cmp);
+  bool sheet = false;
+  for (size_t t = 0; t < n && !sheet; t++) {
+    face_key r = face_of(faces[t].v[0], faces[t].v[2], faces[t].v[1]);
+    sheet = bsearch(&r, faces, n, sizeof *faces, face_cmp) != NULL;
+  }
+  free(faces);
+  return sheet;
+}
+
+typedef struct weld_key { int32_t p[3]; int i; } weld_key;
+static int weld_cmp(const void *a, const void *b) {
+  const weld_key *x = a, *y = b;
+  int c = memcmp(x->p, y->p, sizeof x->p);
+  return c ? c : (x->i > y->i) - (x->i < y->i);
+}
+
+/* Positions rounded to 1/65536 of the extent: whole fractions of the extent (its middle: 0 in a mesh
+ * about the origin) lie at the middle of a step, not at a rounding edge; a copy rounded to the next step
+ * is left apart (an open edge, for lm_indices_closed). */
+void lm_weld_positions(const float *vertices, int count, int *weld) {
+  int nv = count > 0 ? count : 0;
+  weld_key *keys = lm_alloc(sizeof *keys * (size_t)(nv + 1));
+  float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX}, extent = 0.0f;
+  for (int i = 0; i < nv; i++)
+    for (int c = 0; c < 3; c++) {
+      float x = vertices[8 * (size_t)i + c];
+      if (isfinite(x)) lo[c] = fminf(lo[c], x), hi[c] = fmaxf(hi[c], x);
+    }
+  for (int c = 0; c < 3; c++) extent = fmaxf(extent, hi[c] - lo[c]);
+  float step = extent > 0.0f && isfinite(extent) ? extent / 65536.0f : 1.0f;
+  for (int i = 0; i < nv; i++) {
+    for (int c = 0; c < 3; c++) {
+      float q = floorf((vertices[8 * (size_t)i + c] - lo[c]) / step + 0.5f);
+      keys[i].p[c] = isfinite(q) && fabsf(q) < 1e9f ? (int32_t)q : INT32_MIN;
+    }
+    keys[i].i = i;
+  }
+  qsort(keys, (size_t)nv, sizeof *keys, weld_cmp);
+  for (int i = 0, first = 0; i < nv; i++) {
+    if (i == 0 || memcmp(keys[i].p, keys[i - 1].p, sizeof keys[i].p)) first = keys[i].i;
+    weld[keys[i].i] = first;
+  }
+  free(keys);
+}
+
+float *lm_welded_vertices(const float *vertices, int count) {
+  int nv = count > 0 ? count : 0, *weld = lm_alloc(sizeof *weld * (size_t)(nv + 1));
+  float *out = lm_alloc(sizeof *out * 8 * (size_t)(nv + 1));
+  memcpy(out, vertices, sizeof *out * 8 * (size_t)nv);
+  lm_weld_positions(vertices, nv, weld);
+  for (int i = 0; i < nv; i++) memcpy(out + 8 * (size_t)i, vertices + 8 * (size_t)weld[i], sizeof *out * 3);
+  free(weld);
+  return out;
+}
+
 /* Makes up to LM_LOD_LEVELS simplified copies of a mesh into j->out and
  * j->lods, level k within a budget of LM_LOD_ERROR times 4^k of the extent,
  * with at most a quarter of the last kept level's triangles as its target.
@@ -123,10 +217,11 @@ static void simplify_levels(lod_job *j, bool positions, bool by_normal) {
      * no longer use beside the ones they do, and keeps every such seam vertex where it is, so a cone cut as
      * exporters cut it (a tip vertex a side, a ring a side and one for its base) kept all its triangles. */
     uint32_t *remap = lm_alloc(sizeof *remap * (nv > 0 ? nv : 1));
-    struct meshopt_Stream xyz = {j->vertices, 3 * sizeof(float), stride};
+    if (!j->welded) j->welded = lm_welded_vertices(j->vertices, (int)nv);
+    struct meshopt_Stream xyz = {j->welded, 3 * sizeof(float), stride};
     size_t unique = meshopt_generateVertexRemapMulti(remap, j->indices, n, nv, &xyz, 1);
     distinct = lm_alloc(stride * (unique > 0 ? unique : 1));
-    meshopt_remapVertexBuffer(distinct, j->vertices, nv, stride, remap);
+    meshopt_remapVertexBuffer(distinct, j->welded, nv, stride, remap);
     meshopt_remapIndexBuffer(from, j->indices, n, remap);
     first = lm_alloc(sizeof *first * (unique > 0 ? unique : 1));
     for (size_t i = nv; i-- > 0;)
@@ -159,6 +254,10 @@ static void simplify_levels(lod_job *j, bool positions, bool by_normal) {
   size_t last = n;
   /* A level that removes nothing, or a flat-shaded mesh's camera chain before it: is any level possible? */
   bool probed = !positions && each_vertex_once(from, n, nv);
+  /* A closed mesh's caster copies stay closed: a shadow tile whose casters are closed solids holds no face
+   * seen from behind (lm_shadow_front_lit), and meshoptimizer may open a thin box (a desk's leg) into
+   * sheets, or flatten it into one drawn from both sides; such a level is left out, the next budget tried. */
+  bool closed = positions && lm_indices_closed(from, (int)n, NULL);
   int levels = probed && !reducible(to, from, n, vertices, nv, stride) ? 0 : LM_LOD_LEVELS;
   for (int k = 0; k < levels; k++, budget *= 4) { /* a budget too tight for a level: the next one */
     float step = 0; /* meshoptimizer's error, relative to the extent (of every vertex) as its target is */
@@ -168,6 +267,7 @@ static void simplify_levels(lod_job *j, bool positions, bool by_normal) {
     uint32_t *copy = j->out + j->len;
     for (size_t i = 0; i < kept; i++) copy[i] = first ? first[to[i]] : to[i];
     if (by_normal && !corners_by_normal(j->vertices, vertices, to, kept, start, members, copy)) continue;
+    if (closed && (!lm_indices_closed(to, (int)kept, NULL) || has_sheet(to, kept))) continue;
     error = fmaxf(error, step); /* levels err no less than the finer ones (node_lod walks them so) */
     j->lods[j->levels++] = (lm_mesh_lod){(int)j->len, (int)kept, error * scale};
     j->len += kept, last = kept;
@@ -233,13 +333,13 @@ static void make_buffers(lm_scene *s, int mesh, lod_job *const jobs[CHAINS]) {
     *counts[c] = j->levels, len += j->len;
   }
   lm_scene_mesh_chunk(m, indices);
-  lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, indices, (int)len, false);
+  lm_mesh_create(&m->gpu, jobs[CASTERS]->welded, m->vertex_count, m->tangents, indices, (int)len, false);
   free(indices);
   lm_scene_mesh_uploaded(s, mesh);
 }
 
 static void free_job(lod_job *j) {
-  if (j) free(j->out);
+  if (j) free(j->out), free(j->welded);
   free(j);
 }
 

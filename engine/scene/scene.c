@@ -303,7 +303,10 @@ void lm_scene_upload_mesh(lm_scene *s, int i) {
     lm_scene_simplify_mesh(s, i);
     return;
   }
-  lm_mesh_create(&m->gpu, m->vertices, m->vertex_count, m->tangents, m->indices, m->index_count, m->rest != NULL);
+  float *welded = m->rest ? NULL : lm_welded_vertices(m->vertices, m->vertex_count);
+  lm_mesh_create(&m->gpu, welded ? welded : m->vertices, m->vertex_count, m->tangents, m->indices, m->index_count,
+                 m->rest != NULL);
+  free(welded);
   lm_scene_mesh_uploaded(s, i);
 }
 

@@ -219,6 +219,15 @@ typedef struct lm_scene_mesh {
 #define LM_LOD_ERROR 0.000625f
 #define LM_LOD_MIN_TRIANGLES 32 /* meshes below this are always drawn whole (a tree's trunk, 40, is not) */
 
+/* Whether `count` indices close: each directed edge between welded vertices (weld[i]: the vertex i is
+ * welded to; NULL: each its own) met by its reverse, so no border and one winding. Triangles with two
+ * corners welded together draw nothing and are passed over. */
+bool lm_indices_closed(const uint32_t *indices, int count, const int *weld);
+/* Welds `count` vertices (8 floats each, xyz first) by position: weld[i] is the first vertex whose
+ * position rounds to i's at 1/65536 of the extent (the GPU's 16 bits: lm_mesh), so that copies of a
+ * corner a few ulps apart (a flat-shaded box's faces, a sphere's seam) meet. */
+void lm_weld_positions(const float *vertices, int count, int *weld);
+
 typedef struct lm_node {
   char name[LM_NAME_MAX];
   int parent;            /* -1: root */

@@ -31,6 +31,12 @@ void lm_scene_pose(lm_scene *s, int anim, double seconds);
  * (a scene destroyed half-read). All on the GL context's thread. */
 void lm_scene_simplify_mesh(lm_scene *s, int i);
 void lm_scene_mesh_uploaded(lm_scene *s, int i);
+/* A copy of `count` vertices (8 floats each) with each moved onto its first twin by position
+ * (lm_weld_positions): corners a few ulps apart (a flat-shaded box's faces as exporters write them) could
+ * quantize a step apart on the GPU (lm_mesh), a crack through which a shadow tile sees a face from behind,
+ * and would be borders to the simplifier, which opened such boxes. What a static mesh's buffers and
+ * caster copies are made of; its CPU vertices stay as read (loaders compare them: a shared mesh). */
+float *lm_welded_vertices(const float *vertices, int count);
 void lm_scene_finish_meshes(lm_scene *s);
 void lm_scene_drop_meshes(lm_scene *s);
 /* Cuts a static mesh's index ranges (the mesh whole, then its simplified

@@ -860,39 +860,9 @@ typedef struct drawn_mesh {
   int range_count, closed_ranges;
 } drawn_mesh;
 
-typedef struct weld_key { int32_t p[3]; int i; } weld_key;
-static int weld_cmp(const void *a, const void *b) {
-  const weld_key *x = a, *y = b;
-  int c = memcmp(x->p, y->p, sizeof x->p);
-  return c ? c : (x->i > y->i) - (x->i < y->i);
-}
-static int u64_cmp(const void *a, const void *b) {
-  uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-  return (x > y) - (x < y);
-}
 static int shell_root(int *parent, int v) {
   while (parent[v] != v) v = parent[v] = parent[parent[v]];
   return v;
-}
-
-/* Whether indices [first, first + count) close (each directed edge between
- * welded vertices matched by its reverse: no border, one winding). */
-static bool range_closed(const uint32_t *indices, int first, int count, const int *weld) {
-  int n = count / 3 * 3, m = 0;
-  uint64_t *edges = lm_alloc(sizeof *edges * (size_t)(n + 1)), *reversed = lm_alloc(sizeof *reversed * (size_t)(n + 1));
-  for (int t = first; t < first + n; t += 3) {
-    int v[3] = {weld[indices[t]], weld[indices[t + 1]], weld[indices[t + 2]]};
-    if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) continue; /* no area: rasterizes nothing */
-    for (int k = 0; k < 3; k++, m++) {
-      uint64_t a = (uint32_t)v[k], b = (uint32_t)v[(k + 1) % 3];
-      edges[m] = a << 32 | b, reversed[m] = b << 32 | a;
-    }
-  }
-  qsort(edges, (size_t)m, sizeof *edges, u64_cmp);
-  qsort(reversed, (size_t)m, sizeof *reversed, u64_cmp);
-  bool closed = !memcmp(edges, reversed, sizeof *edges * (size_t)m);
-  free(edges), free(reversed);
-  return closed;
 }
 
 static void drawn_mesh_read(const lm_scene_mesh *m, drawn_mesh *d) {
@@ -916,39 +886,12 @@ static void drawn_mesh_read(const lm_scene_mesh *m, drawn_mesh *d) {
   d->valid = true;
   for (int t = 0; t < n; t++) d->valid = d->valid && d->indices[t] < (uint32_t)m->vertex_count;
   if (d->deforms || !d->valid) return; /* a pose (this time's): its triangles alone, not taken for closed */
-  /* Weld by position, each vertex to its first twin: positions rounded to
-   * 1/65536 of the extent (the GPU's 16 bits: lm_mesh), where a seam's or
-   * a pole's copies made by sines of 0 and 2 pi meet. Whole fractions of
-   * the extent (its middle: 0 in a mesh about the origin) lie at the middle
-   * of a step, not at a rounding edge; a copy rounded to the next step is
-   * left apart (an open edge: not closed). */
   int nv = m->vertex_count;
-  weld_key *keys = lm_alloc(sizeof *keys * (size_t)(nv + 1));
   int *weld = lm_alloc(sizeof *weld * (size_t)(nv + 1)), *parent = lm_alloc(sizeof *parent * (size_t)(nv + 1));
-  float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX}, extent = 0.0f;
-  for (int i = 0; i < nv; i++)
-    for (int c = 0; c < 3; c++) {
-      float x = d->vertices[8 * (size_t)i + c];
-      if (isfinite(x)) lo[c] = fminf(lo[c], x), hi[c] = fmaxf(hi[c], x);
-    }
-  for (int c = 0; c < 3; c++) extent = fmaxf(extent, hi[c] - lo[c]);
-  float step = extent > 0.0f && isfinite(extent) ? extent / 65536.0f : 1.0f;
-  for (int i = 0; i < nv; i++) {
-    for (int c = 0; c < 3; c++) {
-      float q = floorf((d->vertices[8 * (size_t)i + c] - lo[c]) / step + 0.5f);
-      keys[i].p[c] = isfinite(q) && fabsf(q) < 1e9f ? (int32_t)q : INT32_MIN;
-    }
-    keys[i].i = i;
-  }
-  qsort(keys, (size_t)nv, sizeof *keys, weld_cmp);
-  for (int i = 0, first = 0; i < nv; i++) {
-    if (i > 0 && memcmp(keys[i].p, keys[i - 1].p, sizeof keys[i].p)) first = keys[i].i;
-    if (i == 0) first = keys[i].i;
-    weld[keys[i].i] = first;
-  }
+  lm_weld_positions(d->vertices, nv, weld);
   d->closed = n >= 3;
   for (int k = 0; k < d->closed_ranges && d->closed; k++)
-    d->closed = range_closed(d->indices, d->ranges[k].first, d->ranges[k].count, weld);
+    d->closed = lm_indices_closed(d->indices + d->ranges[k].first, d->ranges[k].count, weld);
   /* Shells: welded vertices joined by the triangles of every range (a copy's triangles join what the mesh's do). */
   for (int i = 0; i < nv; i++) parent[i] = weld[i];
   for (int t = 0; t + 2 < n; t += 3)
@@ -963,7 +906,7 @@ static void drawn_mesh_read(const lm_scene_mesh *m, drawn_mesh *d) {
     if (d->shell[r] < 0) d->shell[r] = d->shells++;
     d->shell[i] = d->shell[r];
   }
-  free(keys), free(weld), free(parent);
+  free(weld), free(parent);
 }
 
 static void drawn_mesh_free(drawn_mesh *d) {
