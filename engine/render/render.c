@@ -888,9 +888,9 @@ static uint64_t light_hash(const lm_scene *s) {
  * nodes' transforms and pose with them), its light (light_hash) and the
  * shaders' generation. What a light's view (shadow tiles, RSM) sees depends
  * on nothing else. */
-static uint64_t scene_hash(const lm_renderer *r, const lm_pipeline *p, uint64_t light) {
+static uint64_t scene_hash(const lm_pipeline *p, uint64_t casters, uint64_t light) {
   unsigned shaders = lm_programs_generation();
-  uint64_t h = lm_hash(&p, sizeof p, caster_hash(r));
+  uint64_t h = lm_hash(&p, sizeof p, casters);
   h = lm_hash(&light, sizeof light, h);
   return lm_hash(&shaders, sizeof shaders, h);
 }
@@ -943,7 +943,8 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[3], lm_e
   }
   r->pose += lm_scene_upload_deformed(r->desc.scene) > 0;
   r->casters_hash = material_hash(s); /* once a frame: the world hash and the tile keys read it */
-  uint64_t light = light_hash(s), scene = scene_hash(r, p, light), world = world_hash(scene, frame);
+  uint64_t casters = caster_hash(r), light = light_hash(s);
+  uint64_t scene = scene_hash(p, casters, light), world = world_hash(scene, frame);
   r->still = r->frame > 0 && world == r->world ? r->still + 1 : 0;
   r->scene_still = r->frame > 0 && scene == r->scene ? r->scene_still + 1 : 0;
   r->light_still = r->frame > 0 && light == r->light ? r->light_still + 1 : 0;
@@ -952,7 +953,7 @@ static bool record(lm_renderer *r, lm_graph *g, lm_pipeline *p, int out[3], lm_e
   r->light = light;
   lm_pipeline_set_scene(p, r->desc.scene, frame, &r->shadows,
                         (lm_still_frames){.world = r->still, .scene = r->scene_still, .light = r->light_still});
-  uint64_t front = lm_hash(&light, sizeof light, caster_hash(r));
+  uint64_t front = lm_hash(&light, sizeof light, casters);
   if (!r->front_known || front != r->front_key) {
     double t = lm_now_ms();
     r->front_lit = lm_shadow_front_lit(s, &r->front_casters);
