@@ -8,6 +8,9 @@
 #   fail MESSAGE             stops the test, failed
 #   late_script FILE         writes a pipeline script whose sixth OnRender (frame 5 of a
 #                            capture) fails: what a half-done sequence leaves
+#   wait_until SECONDS CMD...  runs CMD every 0.1 s until it succeeds or SECONDS of wall time pass;
+#                            fails when the time passes first (a deadline, not a count of tries:
+#                            a loaded machine's slow tries do not shorten it)
 passed=0 failed=0
 check() {
   local name=$1; shift
@@ -36,4 +39,11 @@ function OnRender(tech)
   present(gbuffer.render(gbuffer.targets()).clr)
 end
 LUA
+}
+wait_until() {
+  local end=$((SECONDS + $1)); shift
+  until "$@"; do
+    [ "$SECONDS" -ge "$end" ] && return 1
+    sleep 0.1
+  done
 }

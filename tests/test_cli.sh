@@ -156,7 +156,7 @@ check "video of a still message" err_has "a video is of a sequence"
 # then the run dies of the signal, leaving whole frames and no video, not even its temporary file.
 PATH="$tmp/bin:$PATH" "$limn" capture --size 32x24 --tech dl --time 0:100 --fps 4 --quiet \
   --output "$tmp/img/f{frame}.png" --output "$tmp/img/v.mp4" 2>"$tmp/err" & pid=$!
-for i in $(seq 600); do [ -e "$tmp/img/f0001.png" ] && break; sleep 0.1; done
+wait_until 60 test -e "$tmp/img/f0001.png"
 kill -TERM "$pid"
 wait "$pid"; rc=$?
 check "stopped: dies of SIGTERM" test "$rc" = 143

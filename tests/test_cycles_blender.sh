@@ -35,12 +35,13 @@ cat m.json d.json
 # says it is sampling, leaves no reference, no partial file and no Blender.
 "$limn" reference --job job.lua "${cy[@]}" --samples 1000000 --refs refs-kill >log 2>&1 &
 pid=$!
-for i in $(seq 600); do grep -qs "Sample " refs-kill/ball/*.log && break; sleep 0.1; done
-grep -qs "Sample " refs-kill/ball/*.log || { kill "$pid"; cat log; fail "the render did not start in 60 s"; }
+sampling() { grep -qs "Sample " refs-kill/ball/*.log; }
+wait_until 60 sampling || { kill "$pid"; cat log; fail "the render did not start in 60 s"; }
 kill -TERM "$pid"
 { wait "$pid"; } 2>/dev/null
 left() { pgrep -f "blender .*$tmp/refs-kill"; }
-for i in $(seq 50); do left >/dev/null || break; sleep 0.1; done
+gone() { ! left >/dev/null; }
+wait_until 5 gone
 blender_pid=$(left) && { kill $blender_pid; fail "Blender outlived limn"; }
 [ -z "$(find refs-kill -name "*.exr" -o -name "*tmp*" -o -name ".cycles*")" ] ||
   fail "a stopped render left files: $(find refs-kill)"

@@ -117,17 +117,19 @@ find refs-fail -name "*.exr" | grep -q . && fail "a failed render left an image:
 
 # 5. Stopped mid-view: SIGTERM leaves no file and no Blender; SIGKILL takes the render with it and the
 # next run clears what it left.
+rendering() { [ -n "$(ls -A "$1"/ball/*.tmp-*/.cycles-render.exr 2>/dev/null)" ]; } # REFS: a view's render begun
+gone() { ! kill -0 "$1" 2>/dev/null; }
 stop_mid_view() { # signal
   rm -f calls
   FAKE_BLENDER_SLEEP=30 "$limn" reference --job job.lua "${cy[@]}" --refs refs-kill >log 2>&1 &
-  local pid=$! i
-  for i in $(seq 100); do [ -n "$(ls -A refs-kill/ball/*.tmp-*/.cycles-render.exr 2>/dev/null)" ] && break; sleep 0.1; done
+  local pid=$!
+  wait_until 10 rendering refs-kill
   [ -s calls ] && [ -n "$(ls -A refs-kill/ball/*.tmp-*/)" ] || fail "the render did not start"
   fake=$(pgrep -f "fake_blender.sh .*refs-kill" | head -1)
   [ -n "$fake" ] || fail "no Blender running"
   kill -"$1" "$pid"
   { wait "$pid"; } 2>/dev/null
-  for i in $(seq 50); do kill -0 "$fake" 2>/dev/null || break; sleep 0.1; done
+  wait_until 5 gone "$fake"
   kill -0 "$fake" 2>/dev/null && { kill "$fake"; fail "Blender outlived a limn stopped by SIG$1"; }
   ls refs-kill/ball/*.exr 2>/dev/null | grep -v '\.tmp-' && fail "SIG$1 left a reference"
   return 0
@@ -171,7 +173,7 @@ rm -f calls
 rm -f calls
 FAKE_BLENDER_SLEEP="30:ball/side 32x24" "$limn" reference --job four.lua "${cy[@]}" --refs refs-stop >log 2>&1 &
 pid=$!
-for i in $(seq 100); do [ -n "$(ls -A refs-stop/ball/*.tmp-*/.cycles-render.exr 2>/dev/null)" ] && break; sleep 0.1; done
+wait_until 10 rendering refs-stop
 ls refs-stop/ball/front_32x24-cycles-*.exr >/dev/null 2>&1 || { kill $pid; fail "the first view is not in place before the second ends"; }
 kill -TERM $pid
 { wait $pid; } 2>/dev/null

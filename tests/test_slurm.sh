@@ -20,18 +20,21 @@ for p in munged slurmctld slurmd sbatch squeue sinfo scancel scontrol povray; do
 done
 [ "$(id -u)" = 0 ] || { echo "not root: skipped (the one-node cluster runs slurmd as root)"; exit 77; }
 
+. "$(dirname "$0")/shell_test.sh" # wait_until; fail is this test's own (below: it shows the daemons' logs)
 tmp=$(mktemp -d /tmp/limn-slurm-XXXXXX) # POV-Ray writes only under /tmp and the current folder
 pids=()
+queue_empty() { [ -z "$(squeue -h 2>/dev/null)" ]; }
+gone() { ! kill -0 "$1" 2>/dev/null; }
 stop() {
   rm -f "$tmp/hold"
   if [ -n "${SLURM_CONF:-}" ] && [ ${#pids[@]} -eq 3 ]; then
     scancel --quiet --partition=limn 2>/dev/null
-    for _ in $(seq 50); do [ -z "$(squeue -h 2>/dev/null)" ] && break; sleep 0.1; done
+    wait_until 5 queue_empty
   fi
   local p
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
   for p in "${pids[@]}"; do
-    for _ in $(seq 50); do kill -0 "$p" 2>/dev/null || break; sleep 0.1; done
+    wait_until 5 gone "$p"
     kill -9 "$p" 2>/dev/null
     wait "$p" 2>/dev/null
   done
@@ -95,18 +98,17 @@ ReturnToService=2
 NodeName=$host NodeAddr=127.0.0.1 CPUs=3 RealMemory=1000 State=UNKNOWN
 PartitionName=limn Nodes=$host Default=YES MaxTime=INFINITE State=UP
 CONF
-for _ in $(seq 50); do [ -S "$tmp/munge/socket" ] && break; sleep 0.1; done
-[ -S "$tmp/munge/socket" ] || fail "munged did not start"
+wait_until 30 test -S "$tmp/munge/socket" || fail "munged did not start in 30 s"
 slurmctld -D -f "$SLURM_CONF" > "$tmp/log/slurmctld.out.log" 2>&1 &
 pids+=($!)
 slurmd -D -N "$host" -f "$SLURM_CONF" > "$tmp/log/slurmd.out.log" 2>&1 &
 pids+=($!)
-for _ in $(seq 100); do sinfo -h -o %T 2>/dev/null | grep -q idle && break; sleep 0.1; done
-sinfo -h -o %T 2>/dev/null | grep -q idle || fail "the node did not come up: $(sinfo 2>&1)"
+node_idle() { sinfo -h -o %T 2>/dev/null | grep -q idle; }
+wait_until 60 node_idle || fail "the node did not come up in 60 s: $(sinfo 2>&1)"
 echo "cluster up: slurmctld on port $ctld_port, slurmd on $slurmd_port"
 
 wait_jobs() { # until the queue is empty (at most 90 s)
-  for _ in $(seq 900); do [ -z "$(squeue -h)" ] && return 0; sleep 0.1; done
+  wait_until 90 queue_empty && return 0
   squeue
   fail "jobs still queued after 90 s"
 }
@@ -180,11 +182,9 @@ touch "$tmp/hold"
 bash $script > submit2.txt 2>&1 || { cat submit2.txt; fail "submitting again"; }
 read -r array2 merge2 < <(sed -n 's/.*as job \([0-9]*\), the merge as job \([0-9]*\).*/\1 \2/p' submit2.txt)
 # Task 1 renders references 1 (left) and 4 (side; held), then its images.
-for _ in $(seq 600); do [ -e "$tmp/held" ] && break; sleep 0.1; done
-[ -e "$tmp/held" ] || fail "task 1 never reached its 'side' reference"
+wait_until 60 test -e "$tmp/held" || fail "task 1 never reached its 'side' reference"
 left_done() { ls refs/ball 2>/dev/null | grep -qE '^left_32x24-[0-9a-f]{16}\.exr$'; } # not its temporary file
-for _ in $(seq 600); do left_done && break; sleep 0.1; done
-left_done || fail "task 1 did not render its 'left' reference"
+wait_until 60 left_done || fail "task 1 did not render its 'left' reference"
 echo "step 2: cancelling task 1 while it renders its 'side' reference"
 scancel "${array2}_1" || fail "scancel"
 rm -f "$tmp/hold"
