@@ -46,6 +46,8 @@ isr.defaults = {
   bounces = 2,       -- transport steps, 1..4 (POV-Ray's recursion_limit 2: two bounces)
   reuse = true,      -- later bounces sum over the senders the first march met (the same rays meet
                      -- the same senders every bounce); false: march again every bounce
+  sky_bounce = false, -- physical, bounces above 1 with reuse: the senders send their sky light (ambient
+                     -- term) too, from the second step on (isr_bounce.frag's SKY_BOUNCE)
   coarse = 0,        -- coarse factor a side: 1, 2, 3 or 4; 0 (auto): 3 below 256 pixels wide, 2,
                      -- and 4 where the coarse grid is still at least 128 texels wide (from 512
                      -- pixels wide), a grid as fine relative to the view as 256 pixels wide at 2
@@ -100,6 +102,7 @@ local rules = {
   k = options.number(0, 16),
   bounces = options.whole(1, 4),
   reuse = options.boolean,
+  sky_bounce = options.boolean,
   coarse = options.one_of(0, 1, 2, 3, 4),
   blur = options.whole(0, 32),
   view = options.one_of("lit", "indirect", "ao"),
@@ -244,6 +247,10 @@ function isr.render(direct, o, frame)
   end
   local E, E1, H, first
   local hits = seed and 0 or hit_targets(o)
+  if o.sky_bounce and hits == 0 then
+    error("isr.sky_bounce needs isr.mode \"physical\", isr.bounces above 1, isr.reuse and at most 24 isr.samples "
+          .. "(the senders the first march records)", 2)
+  end
   -- Temporal reuse: every step reads the history (all skip the same converged pixels), the last
   -- accumulates and writes the next one after its other outputs (NEXT).
   local T, history = { inputs = {}, defines = {}, params = {} }, nil
@@ -283,6 +290,10 @@ function isr.render(direct, o, frame)
       if unseen then
         defines.UNSEEN, defines.LAST, params.bounces, params.steps = unseen, b == steps, light.rsm.bounces, steps
       end
+      if o.sky_bounce then
+        from.nrm, defines.SKY_BOUNCE, params.ambient = C.nrm, true, light.ambient
+        sky.bind(light.sky, params, defines)
+      end
       if traced then
         from.traced, from.traced_albedo, defines.TRACE, params.step = traced[1], traced[2], true, b
         defines.TRACE_BLOCK = traced.block > 1 and traced.block or nil
@@ -291,7 +302,7 @@ function isr.render(direct, o, frame)
       local out = { E }
       with_history(from, defines, params, out, b == steps)
       pass{ name, shader = "isr_bounce.frag", inputs = from, params = params, defines = defines, out = out,
-            fetches = 2 + hits + 3 * o.samples } -- first, the hits, and three fetches a sending ray
+            fetches = 2 + hits + (o.sky_bounce and 4 or 3) * o.samples } -- first, the hits, 3 or 4 a sending ray
     else
       inputs.sender = C.direct
       -- The later bounces add to the first E (isr_bounce.frag), or march from it: 32-bit floats in

@@ -10,6 +10,14 @@
 // coarse texel over q, the G-buffer being STRIDE times finer); A, the share
 // of open rays, is first's (TRACE: less the lost rays where the traced one met
 // a surface).
+// SKY_BOUNCE (isr.sky_bounce): each sender also sends its sky light, its
+// ambient term (k_a L_a albedo, the sky's with SKY) times its own A, which
+// the direct light the march sent holds none of: the sky's first bounce,
+// a step late since A is known once the march is done; at most the sky's
+// irradiance times an albedo, so bounded as the senders' light is. UNSEEN
+// rays bring none of it: what they meet (a roof's underside, ground off
+// screen) the march cannot say the sky lights, and their mean of the seen
+// senders' overshot Cycles' sky light on the held-out yard's portico.
 // TEMPORAL, TEMPORAL_NEXT: as isr_march.frag (temporal reuse; z, the grid's
 // depth the march wrote, places each pixel for the reprojection); a pixel
 // the march found converged (hits0 -1) keeps the march's E, its history.
@@ -63,6 +71,11 @@ uniform sampler2D hits4;
 uniform sampler2D hits5;
 #endif
 uniform int samples = 4;
+#ifdef SKY_BOUNCE
+uniform sampler2D nrm;           // the G-buffer's normals
+uniform vec3 ambient = vec3(0.0);
+#endif
+vec3 sky_sent = vec3(0.0); // SKY_BOUNCE: the senders' sky light, summed over the rays
 #ifdef TRACE
 uniform sampler2D traced, traced_albedo; // isr_trace.frag's outputs, the output's size (or its blocks')
 uniform int step = 2;                    // this step (isr.bounces counts them; 1: the march)
@@ -87,10 +100,15 @@ void send(float hit, int width, inout vec3 gathered, inout vec3 albedo) {
   if (hit < 0.5) return;
   int k = int(hit - 0.5);
   ivec2 q = ivec2(k % width, k / width);
-  vec3 e = texelFetch(previous, min(q / STRIDE, textureSize(previous, 0) - 1), 0).rgb;
-  vec3 rho = texelFetch(mat, q, 0).y * texelFetch(clr, q, 0).rgb;
-  gathered += rho * e;
+  vec4 e = texelFetch(previous, min(q / STRIDE, textureSize(previous, 0) - 1), 0);
+  vec4 c = texelFetch(clr, q, 0), m = texelFetch(mat, q, 0);
+  vec3 rho = m.y * c.rgb;
+  gathered += rho * e.rgb;
   albedo += rho;
+#ifdef SKY_BOUNCE
+  Surface s = gbuffer_decode(c, texelFetch(nrm, q, 0), 0.0, m, vec2(0.5)); // its position is not read
+  sky_sent += ambient_light(s, ambient) * saturate(e.a);
+#endif
 }
 
 #ifdef UNSEEN
@@ -187,12 +205,12 @@ void main() {
   ivec2 tp = traced_texel(px);
   vec3 r_hit = clamp((albedo + rays.y * texelFetch(traced_albedo, tp, 0).rgb) / float(n), 0.0, BOUNCE_MAX);
   vec3 grown = (1.0 - pow(r_hit, vec3(float(max(step, 2) - 1)))) / (1.0 - r_hit); // pow: base >= 0, exponent >= 1
-  vec3 second = (gathered + rays.y * texelFetch(traced, tp, 0).rgb * grown) / float(n);
+  vec3 second = (gathered + rays.y * texelFetch(traced, tp, 0).rgb * grown + sky_sent) / float(n);
   // The march counted the lost rays open (the sky's share A); where the traced one met a surface they met
   // one, whose light they bring: not the sky's too.
   e.a = max(e.a - rays.y / float(max(samples, 1)) * texelFetch(traced_albedo, tp, 0).a, 0.0);
 #else
-  vec3 second = (gathered + rays.y * gathered / max(float(n) - rays.y, 1.0)) / float(n);
+  vec3 second = (gathered + rays.y * gathered / max(float(n) - rays.y, 1.0) + sky_sent) / float(n);
 #endif
 #ifdef LAST
   // The newest bounce at p: this step's bounces beyond the first less the last step's (its E less the
@@ -207,7 +225,7 @@ void main() {
 #endif
   isr = vec4(e.rgb + finite_or_zero(second), e.a);
 #else
-  isr = vec4(e.rgb + gathered / float(n), e.a);
+  isr = vec4(e.rgb + (gathered + sky_sent) / float(n), e.a);
 #endif
 #ifdef TEMPORAL_NEXT
   if (d > 0.0) {

@@ -69,6 +69,7 @@ static void assert_triangle(const lm_scene *s) {
   assert_float_equal(mat->color[1], 0.25, 1e-6);
   assert_float_equal(mat->color[2], 1.0, 1e-6);
   assert_float_equal(mat->kd, 1.0, 1e-6);        /* not metallic */
+  assert_float_equal(mat->ka, 1.0, 1e-6);        /* ambient as the diffuse part */
   assert_float_equal(mat->ks, 0.04, 1e-6);       /* dielectric F0 */
   assert_float_equal(mat->shininess, 30.0, 1e-3); /* 2 / 0.5^4 - 2 */
   assert_float_equal(mat->rho, 1.0, 1e-6);
@@ -345,6 +346,7 @@ static void pbr_materials_come_over(void **state) {
   assert_true(p->set);
   assert_float_equal(p->metallic, 0.75, 1e-6), assert_float_equal(p->roughness, 0.4, 1e-6);
   assert_float_equal(m->kd, 0.25, 1e-6); /* the std technique's view of it stays */
+  assert_float_equal(m->ka, 0.25, 1e-6); /* a part-metal reflects the sky by its diffuse part too */
   assert_float_equal(p->alpha, 0.6, 1e-6);
   assert_int_equal(p->alpha_mode, LM_ALPHA_MASK);
   assert_float_equal(p->alpha_cutoff, 0.3, 1e-6);
@@ -430,8 +432,10 @@ static void two_primitives_become_two_meshes_and_children(void **state) {
   assert_float_equal(metal->ks, 0.8, 1e-6);  /* F0 from the base color */
   assert_float_equal(metal->shininess, 1.0, 0); /* roughness 1 */
   assert_float_equal(metal->rho, 0.0, 1e-6);
+  assert_float_equal(metal->ka, 0.0, 1e-6);  /* the sky and ambient light reflect as light does: no diffuse part */
   assert_float_equal(plastic->color[0], 1.0, 0); /* default base color */
   assert_float_equal(plastic->kd, 1.0, 1e-6);
+  assert_float_equal(plastic->ka, 1.0, 1e-6);
   const float *v = s->meshes[0].vertices + 2 * 8;
   assert_float_equal(v[5], 1.0, 1e-6); /* the file's normal, normalized */
   assert_float_equal(v[6], 1.0, 0), assert_float_equal(v[7], 1.0, 0);

@@ -5,8 +5,10 @@
  * does not depend on its sample count;
  * a closed room lit by one spot patch lights its ceiling;
  * a frame that reads no RSM renders none; an outdoor corner sees less sky
- * than open ground, and ground under a roof the view does not show no more
- * than the roof leaves; extremes stay finite. Needs a GL
+ * than open ground (more where its walls send their sky light on,
+ * isr.sky_bounce, which without a sky changes nothing), and ground under a
+ * roof the view does not show no more than the roof leaves; extremes stay
+ * finite. Needs a GL
  * context (llvmpipe will do).
  * Each test stands alone (it makes and frees its own), so tests read alike. */
 #include <cglm/cglm.h>
@@ -495,6 +497,14 @@ static void extremes_stay_finite(void **state) {
     gl_result r = render_ok(room, "rsm+esm", sky_cases[i]);
     gl_result_free(&r);
   }
+  /* The senders' sky light sent on (isr.sky_bounce) under a sky of 1e6, through 64 bounces and traced. */
+  static const char *const sky_bounce_cases[][6] = {
+      {"isr.sky_bounce=true", "sky=true", "sky.intensity=1e6", "rsm.bounces=64", "isr.bounces=4", NULL},
+      {"isr.sky_bounce=true", "ambient=1e6", "rsm.trace=1", "rsm.bounces=64", NULL}};
+  for (size_t i = 0; i < sizeof sky_bounce_cases / sizeof *sky_bounce_cases; i++) {
+    gl_result r = render_ok(room, "isr+rsm+esm", sky_bounce_cases[i]);
+    gl_result_free(&r);
+  }
   lm_scene_destroy(room);
   lm_scene *closed = closed_room(LM_LIGHT_SPOT);
   closed->lights[0].outer_cone = closed->lights[0].inner_cone = 1e-6f;
@@ -784,14 +794,18 @@ static bool on_screen(const float *view_proj, int width, int height, const float
  * sky than open ground at (6, 0, 6) (0.348 of the sky against 1): with
  * rsm.sky_occlusion at its default rsm+esm darkens the corner below the open
  * ground (0.709), with 0 it cannot (the bounce would then add to an open
- * sky); the default (isr+rsm+esm: ISR's march, the walls on screen) 0.495. */
+ * sky); the default (isr+rsm+esm: ISR's march, the walls on screen) 0.495.
+ * With isr.sky_bounce the walls send their own sky light on: the corner is
+ * brighter than the default's, and still darker than open ground. */
 static void an_outdoor_corner_sees_less_sky_than_open_ground(void **state) {
   (void)state;
   mat4 vp;
   lm_scene *s = gl_sunlit_corner(96, 72, (float *)vp);
   const float points[2][3] = {{0.7f, 0, 0.7f}, {6, 0, 6}}; /* the corner, open ground */
-  static const char *const cases[][2] = {{"rsm+esm", NULL}, {"rsm+esm", "rsm.sky_occlusion=0"}, {"isr+rsm+esm", NULL}};
-  for (int t = 0; t < 3; t++) {
+  static const char *const cases[][2] = {{"rsm+esm", NULL}, {"rsm+esm", "rsm.sky_occlusion=0"}, {"isr+rsm+esm", NULL},
+                                         {"isr+rsm+esm", "isr.sky_bounce=true"}};
+  float corner[4];
+  for (int t = 0; t < 4; t++) {
     const char *const sets[] = {"ambient=0", "sky=true", "sky.zenith=0.5", "sky.horizon=0.5", cases[t][1], NULL};
     gl_result r = gl_render_ok(&(gl_run){.scene = s, .tech = cases[t][0], .sets = sets, .width = 96, .height = 72});
     float c[2][3];
@@ -807,9 +821,24 @@ static void an_outdoor_corner_sees_less_sky_than_open_ground(void **state) {
     assert_true(gl_all_finite(&r));
     if (t != 1) assert_true(ratio < 0.85f);
     else assert_true(fabsf(ratio - 1) < 0.02f && fabsf(gl_luminance(b) - 0.25f) < 0.03f);
+    corner[t] = gl_luminance(a);
     gl_result_free(&r);
   }
+  assert_true(corner[3] > corner[2] + 0.005f);
   lm_scene_destroy(s);
+}
+
+/* Without a sky and at ambient 0 (the reference set, the loft) the senders have no sky light to send:
+ * isr.sky_bounce leaves the frame bit for bit. */
+static void no_sky_no_sky_bounce(void **state) {
+  (void)state;
+  lm_scene *room = closed_room(LM_LIGHT_POINT);
+  const char *const off[] = {"ambient=0", NULL}, *const on[] = {"ambient=0", "isr.sky_bounce=true", NULL};
+  gl_result a = render_ok(room, "isr+rsm+esm", off), b = render_ok(room, "isr+rsm+esm", on);
+  assert_memory_equal(a.rgb, b.rgb, sizeof(float) * 3 * W * H);
+  gl_result_free(&a);
+  gl_result_free(&b);
+  lm_scene_destroy(room);
 }
 
 /* Grey ground (0.5) over [-10, 10]^2 and a roof over x -2.5..2.5, z -3..1, a slab 3 to 4 up (its
@@ -1183,6 +1212,11 @@ static void bad_options_name_themselves(void **state) {
       {"isr+rsm+esm", "isr.mode=seed", "isr+rsm+esm needs isr.mode \"physical\""},
   };
   gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
+  /* isr.sky_bounce sends through the senders the first march records: none at one bounce. */
+  const char *const one_bounce[] = {"isr.bounces=1", "isr.sky_bounce=true", NULL};
+  gl_result b = gl_render(&(gl_run){.tech = "isr+esm", .sets = one_bounce});
+  if (b.ok || !strstr(b.err.msg, "isr.sky_bounce needs") || !strstr(b.err.msg, "pp.lua:")) fail_msg("%s", b.err.msg);
+  gl_result_free(&b);
   /* The traced rays' two outputs beside 24 rays' hits: more than the march may write, named. */
   const char *const sets[] = {"rsm.trace=1", "isr.samples=24", NULL};
   gl_result r = gl_render(&(gl_run){.tech = "isr+rsm+esm", .sets = sets});
@@ -1292,6 +1326,7 @@ int main(int argc, char **argv) {
       cmocka_unit_test(a_moving_camera_keeps_screen_space_light_current),
       cmocka_unit_test(an_outdoor_corner_sees_less_sky_than_open_ground),
       cmocka_unit_test(a_roof_the_view_does_not_show_hides_its_sky),
+      cmocka_unit_test(no_sky_no_sky_bounce),
       cmocka_unit_test(more_bounces_light_a_ceiling_more_and_stay_bounded),
       cmocka_unit_test(screen_steps_and_the_series_count_each_bounce_once),
       cmocka_unit_test(traced_rays_bring_a_second_bounce_where_the_screen_shows_no_sender),

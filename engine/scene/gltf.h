@@ -93,7 +93,9 @@
  *                 dielectrics, the base color's for metals)
  *     shininess = 2 / roughness^4 - 2, clamped to [1, 1024] (the Blinn-Phong
  *                 exponent whose lobe matches GGX of alpha = roughness^2)
- *     ka        = 1; rho = max(color) * kd   (what diffuse bounce returns)
+ *     ka        = kd; rho = max(color) * kd  (ka: the ambient term and the
+ *                 sky reflect as the diffuse part does, so a metal takes
+ *                 none of them, as in the pbr technique and both references)
  *     reflectivity = extras.reflectivity, a number in [0, 1] (absent: 0).
  *                 Mirror reflection is the artist's choice, not derived
  *                 from metallic/roughness: a rough metal is no mirror, and
@@ -175,6 +177,10 @@ extern "C" {
  * The scene's world transforms are up to date; nothing is uploaded. */
 lm_scene *lm_scene_load_gltf(const char *path, lm_error *err);
 
+/* The Phong material the loader derives from glTF's metallic-roughness
+ * values (above; color clamped, metallic and roughness in [0, 1]). */
+lm_material lm_gltf_phong(const float color[3], float metallic, float roughness);
+
 /* lm_scene_load for an owner that reads no vertex on the CPU (a renderer's:
  * the scene comes gpu_only): a glTF file's textures and meshes, but those
  * that deform, go to the GPU as they are read and their CPU copies are
@@ -199,7 +205,7 @@ lm_scene *lm_scene_load(const char *name, lm_error *err);
  *   mapping (metallic 1 - kd, roughness from the exponent); Limn's Phong
  *   values always in extras.limn {color, ka, kd, ks, shininess, rho} and
  *   reflectivity in extras.reflectivity. A Phong material the loader would
- *   not read back (ks other than mix(0.04, max(color), metallic), ka not 1)
+ *   not read back (ks other than mix(0.04, max(color), metallic), ka not kd)
  *   warns, naming it. Textures as PNG files beside the file, named
  *   texture-<hash of the texels>.png; KHR_texture_transform is not written.
  * - lights as KHR_lights_punctual in glTF's units: intensity = power /

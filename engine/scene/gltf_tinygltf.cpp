@@ -1048,19 +1048,12 @@ int material_for(Loader &L, const char *where, int index) {
                 "occlusionTexture.strength finite ones", index), -1;
   lm_material m = {};
   snprintf(m.name, sizeof m.name, "%s", gm.name.empty() ? "material" : gm.name.c_str());
-  float maxc = 0;
-  for (int c = 0; c < 3; c++) {
-    m.color[c] = clamp01(pbr.baseColorFactor[c]);
-    maxc = std::fmax(maxc, m.color[c]);
-  }
+  float color[3];
+  for (int c = 0; c < 3; c++) color[c] = clamp01(pbr.baseColorFactor[c]);
   float metal = clamp01(pbr.metallicFactor), rough = clamp01(pbr.roughnessFactor);
-  m.ka = 1.0f;
-  m.kd = 1.0f - metal;
-  m.ks = 0.04f + (maxc - 0.04f) * metal;
-  double r4 = (double)rough * rough * rough * rough;
-  double shin = r4 > 0 ? 2.0 / r4 - 2.0 : 1024.0;
-  m.shininess = (float)(shin < 1 ? 1 : shin > 1024 ? 1024 : shin);
-  m.rho = maxc * m.kd;
+  lm_material phong = lm_gltf_phong(color, metal, rough);
+  memcpy(phong.name, m.name, sizeof m.name);
+  m = phong;
 
   // The metallic-roughness model as glTF gives it, for the pbr technique.
   lm_material_pbr p = {};
@@ -2079,6 +2072,22 @@ static lm_scene *load_gltf(const char *path, bool gpu_only, lm_error *err) {
 }
 
 extern "C" lm_scene *lm_scene_load_gltf(const char *path, lm_error *err) { return load_gltf(path, false, err); }
+
+extern "C" lm_material lm_gltf_phong(const float color[3], float metallic, float roughness) {
+  lm_material m = {};
+  float maxc = 0;
+  for (int c = 0; c < 3; c++) m.color[c] = color[c], maxc = std::fmax(maxc, color[c]);
+  m.kd = 1.0f - metallic;
+  // Light from everywhere (the ambient term, the sky) is reflected as light from one direction is: by the
+  // diffuse part (the Phong lobe's share of it, 2 ks / (n + 2), is left out as for dielectrics).
+  m.ka = m.kd;
+  m.ks = 0.04f + (maxc - 0.04f) * metallic;
+  double r4 = (double)roughness * roughness * roughness * roughness;
+  double shin = r4 > 0 ? 2.0 / r4 - 2.0 : 1024.0;
+  m.shininess = (float)(shin < 1 ? 1 : shin > 1024 ? 1024 : shin);
+  m.rho = maxc * m.kd;
+  return m;
+}
 
 extern "C" lm_scene *lm_scene_load_gpu(const char *name, lm_error *err) {
   if (lm_scene_is_gltf_name(name)) return load_gltf(name, true, err);

@@ -119,18 +119,6 @@ int add_texture(Writer &W, int t, const std::string &dir, std::vector<int> &done
   return done[t] = (int)W.m.textures.size() - 1;
 }
 
-// The Phong values the loader derives from glTF's metallic-roughness (gltf.h), to tell whether they come back.
-lm_material phong_of(const float color[3], float metallic, float roughness) {
-  lm_material p = {};
-  float maxc = std::fmax(color[0], std::fmax(color[1], color[2]));
-  p.ka = 1, p.kd = 1 - metallic, p.ks = 0.04f + (maxc - 0.04f) * metallic;
-  double r4 = (double)roughness * roughness * roughness * roughness;
-  double shin = r4 > 0 ? 2.0 / r4 - 2.0 : 1024.0;
-  p.shininess = (float)(shin < 1 ? 1 : shin > 1024 ? 1024 : shin);
-  p.rho = maxc * p.kd;
-  return p;
-}
-
 bool near(float a, float b) { return std::fabs(a - b) <= 1e-3f * std::fmax(1.0f, std::fabs(b)); }
 
 // Extension `name` on the material, and in the file's extensionsUsed (once).
@@ -195,7 +183,7 @@ bool add_material(Writer &W, int i, const std::string &dir, std::vector<int> &te
   extras["limn"] = tinygltf::Value(limn);
   if (lm.reflectivity > 0) extras["reflectivity"] = tinygltf::Value((double)lm.reflectivity);
   g.extras = tinygltf::Value(extras);
-  lm_material back = phong_of(lm.color, p.metallic, p.roughness);
+  lm_material back = lm_gltf_phong(lm.color, p.metallic, p.roughness);
   if (!near(back.ka, lm.ka) || !near(back.kd, lm.kd) || !near(back.ks, lm.ks) || !near(back.rho, lm.rho) ||
       !near(back.shininess, lm.shininess))
     warn(W, "material '%s': Phong ka %g kd %g ks %g shininess %g rho %g is no glTF metallic-roughness material "
