@@ -162,12 +162,14 @@ static void closed_box(lm_scene *s, const char *name, int material, const float 
  * the shadowed floor's (none). The camera sees the underside alone: only rsm.solid_steps or the solid
  * grid (rsm.solid_cell) can tell. Without them (the default) the underside takes the light of the floor
  * beyond the wall through it, as the integral over that floor says (within 10%); with 16 points, or
- * the grid walked in cells of 2 x 2 texels, under 10% of that (measured 0). */
+ * the grid walked in cells of 2 x 2 texels, under 10% of that (measured 0); and with 16 points on the
+ * first 2 senders a pixel alone (rsm.solid_senders), the rest taking their unblocked share, too. */
 static void a_solid_between_hides_the_senders_behind_it(void **state) {
   (void)state;
   static const char *const sets[] = {"ambient=0", "rsm.reach=16", "rsm.solid_steps=16", NULL};
   static const char *const off[] = {"ambient=0", "rsm.reach=16", NULL}; /* the default: 0 */
   static const char *const grid[] = {"ambient=0", "rsm.reach=16", "rsm.solid_cell=2", NULL};
+  static const char *const few[] = {"ambient=0", "rsm.reach=16", "rsm.solid_steps=16", "rsm.solid_senders=2", NULL};
   lm_scene *s = canopy_scene();
   int grey = gl_material(s, "wall", 0.8f, 0.8f, 0.8f);
   const float in = 2.0f, out = 2.6f;
@@ -177,45 +179,56 @@ static void a_solid_between_hides_the_senders_behind_it(void **state) {
   closed_box(s, "south", grey, (const float[3]){-in, 0, in}, (const float[3]){in, 1, out});
   lm_scene_update(s);
   gl_result walled = render_ok(s, "rsm+esm", sets), through = render_ok(s, "rsm+esm", off),
-            gridded = render_ok(s, "rsm+esm", grid);
-  float a[3], b[3], c[3];
+            gridded = render_ok(s, "rsm+esm", grid), sampled = render_ok(s, "rsm+esm", few);
+  float a[3], b[3], c[3], d[3];
   gl_region(&walled, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, a);
   gl_region(&through, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, b);
   gl_region(&gridded, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, c);
+  gl_region(&sampled, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, d);
   double beyond = canopy_integral(0.8, 0.8, false, out);
-  print_message("walled canopy: %.4f red (solid grid %.4f; through the wall %.4f; the floor beyond it %.4f)\n", a[0],
-                c[0], b[0], beyond);
+  print_message("walled canopy: %.4f red (solid grid %.4f; 2 senders tested %.4f; through the wall %.4f; the floor "
+                "beyond it %.4f)\n", a[0], c[0], d[0], b[0], beyond);
   assert_true(fabs(b[0] - beyond) < 0.1 * beyond);
   assert_true(a[0] < 0.1 * beyond);
   assert_true(c[0] < 0.1 * beyond);
+  assert_true(d[0] < 0.1 * beyond);
   gl_result_free(&walled);
   gl_result_free(&through);
   gl_result_free(&gridded);
+  gl_result_free(&sampled);
   lm_scene_destroy(s);
 }
 
 /* The grid never blocks a sender on its own solid: the canopy's floor laid on a closed slab (0.5 deep),
  * so every sunlit sender's texel is inside a solid from the floor down, and each segment ends on that
  * solid's front. A cell's inside depths lie behind all its fronts (rsm_solid.frag) and the walk leaves
- * the segment's ends out: the underside keeps the slab-less floor's light (within 2%; measured equal). */
+ * the segment's ends out: the underside keeps the slab-less floor's light (within 2%; measured equal). So
+ * does the grid tested on the first 2 senders a pixel alone (rsm.solid_senders): the share it gives the
+ * others is that of the tested senders' light that no solid blocked, all of it here. */
 static void the_solid_grid_keeps_senders_on_their_own_solid(void **state) {
   (void)state;
   static const char *const grid[] = {"ambient=0", "rsm.reach=16", "rsm.solid_cell=2", NULL};
   static const char *const off[] = {"ambient=0", "rsm.reach=16", NULL};
+  static const char *const few[] = {"ambient=0", "rsm.reach=16", "rsm.solid_cell=2", "rsm.solid_senders=2", NULL};
   lm_scene *s = canopy_scene();
   int grey = gl_material(s, "slab", 0.8f, 0.8f, 0.8f);
   closed_box(s, "slab", grey, (const float[3]){-F, -0.5f, -F}, (const float[3]){F, -0.01f, F});
   lm_scene_update(s);
-  gl_result on = render_ok(s, "rsm+esm", grid), plain = render_ok(s, "rsm+esm", off);
-  float a[3], b[3];
+  gl_result on = render_ok(s, "rsm+esm", grid), plain = render_ok(s, "rsm+esm", off),
+            sampled = render_ok(s, "rsm+esm", few);
+  float a[3], b[3], c[3];
   gl_region(&on, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, a);
   gl_region(&plain, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, b);
+  gl_region(&sampled, W / 2 - 6, H / 2 - 6, W / 2 + 6, H / 2 + 6, c);
   double red = canopy_expected(0.8, 0.8, false);
-  print_message("canopy over a slab: %.4f red with the solid grid, %.4f without (expected %.4f)\n", a[0], b[0], red);
+  print_message("canopy over a slab: %.4f red with the solid grid (%.4f on 2 senders), %.4f without (expected %.4f)\n",
+                a[0], c[0], b[0], red);
   assert_true(fabs(b[0] - red) < 0.1 * red);
   assert_true(fabsf(a[0] - b[0]) < 0.02f * b[0]);
+  assert_true(fabsf(c[0] - b[0]) < 0.02f * b[0]);
   gl_result_free(&on);
   gl_result_free(&plain);
+  gl_result_free(&sampled);
   lm_scene_destroy(s);
 }
 
@@ -1191,7 +1204,7 @@ static void bad_options_name_themselves(void **state) {
       {"rsm+esm", "rsm.thickness=17", "rsm.thickness"},
       {"isr+rsm+esm", "rsm.ray_steps=33", "rsm.ray_steps"}, {"rsm+esm", "rsm.solid_steps=65", "rsm.solid_steps"},
       {"isr+rsm+esm", "rsm.solid_steps=-1", "rsm.solid_steps"}, {"isr+rsm+esm", "rsm.ray_steps=-1", "rsm.ray_steps"},
-      {"rsm+esm", "rsm.solid_cell=3", "rsm.solid_cell"},
+      {"rsm+esm", "rsm.solid_cell=3", "rsm.solid_cell"}, {"rsm+esm", "rsm.solid_senders=-1", "rsm.solid_senders"},
       {"isr+rsm+esm", "rsm.trace=2", "rsm.trace"}, {"isr+rsm+esm", "rsm.trace=-1", "rsm.trace"},
       {"isr+rsm+esm", "rsm.trace=0.5", "rsm.trace"},
       {"isr+rsm+esm", "rsm.trace_samples=-1", "rsm.trace_samples"},
