@@ -516,13 +516,19 @@ static void write_md(lm_buf *b, const report_args *a, const job *j, const job_vi
                 frames, frames == 1 ? "" : "s", warmup, warmup == 1 ? "" : "s", clock, name, a->against, a->baseline,
                 name, a->direct_flags + 1);
   if (floor >= 0) lm_buf_printf(b, "Direct-only floor, mean over the views: %.5f.\n\n", floor);
-  if (a->has_noise) { /* the baseline's rows: one a view */
+  if (a->has_noise) { /* the baseline's rows: one a view; a view without its second seed (-1) is left out */
     double noise = 0, base = 0;
+    int measured = 0;
     for (int i = 0; i < n; i++)
-      if (rows[i].setting == 0) noise += rows[i].noise, base += rows[i].m.mean_error;
+      if (rows[i].setting == 0 && rows[i].noise >= 0) noise += rows[i].noise, base += rows[i].m.mean_error, measured++;
     lm_buf_printf(b, "Reference noise (the mean error between the references at seeds %d and %d), mean over the "
-                  "views: %.5f, %.1f%% of the baseline's mean error against the reference.\n\n", a->ref.cycles.seed,
-                  a->second.cycles.seed, place_count ? noise / place_count : 0, base > 0 ? 100 * noise / base : 0);
+                  "views", a->ref.cycles.seed, a->second.cycles.seed);
+    if (!measured)
+      lm_buf_append(b, ": n/a (no view's second seed is cached).\n\n", -1);
+    else
+      lm_buf_printf(b, "%s: %.5f, %.1f%% of the baseline's mean error against the reference.\n\n",
+                    measured < place_count ? " whose second seed is cached" : "", noise / measured,
+                    base > 0 ? 100 * noise / base : 0);
   }
   lm_buf_append(b, "| setting | mean error | ms | mean gain % | median gain % | indirect error removed % | views "
                    "improved | views Pearson rose | pixels closer | Pearson baseline -> setting | Pareto |\n"

@@ -252,6 +252,15 @@ PY
 awk -F, 'NR > 1 && $19 != 0 { bad = 1 } END { exit bad }' rep/report.csv || fail "the reference's noise is not 0"
 grep -q "^Reference noise (the mean error between the references at seeds 0 and 1), mean over the views: 0.00000," \
   rep/report.md || fail "the summary does not give the reference's noise"
+# With the next seed's reference gone and none rendered (--cached-refs), the noise is n/a, not a number.
+rm -rf refs-noseed && cp -r refs refs-noseed
+for f in refs-noseed/ball/*-cycles-*.json; do
+  python3 -c 'import json, sys; sys.exit(json.load(open(sys.argv[1]))["seed"] != 1)' "$f" && rm "${f%.json}.exr"
+done
+"$limn" report --job job.lua "${cy[@]}" --refs refs-noseed --cached-refs --out rep-noseed --sweep dl --frames 1 \
+  --warmup 0 >log 2>&1 || { cat log; fail "report without the next seed's reference"; }
+grep -q "^Reference noise (.*), mean over the views: n/a (no view's second seed is cached)" rep-noseed/report.md \
+  || { grep Reference rep-noseed/report.md; fail "a missing second seed's noise is not n/a"; }
 awk -F, 'NR == 1 { ok = $18 == "reference" } NR > 1 && $18 != "\"Cycles\"" { ok = 0 } END { exit !ok }' rep/report.csv \
   || { cat rep/report.csv; fail "the CSV does not name Cycles on each row"; }
 grep -q '"reference": "Cycles"' rep/report.json || fail "the JSON does not name Cycles"
