@@ -110,6 +110,10 @@ void lm_set_scene_state(bool on, bool shadow_caster);
 /* Which winding faces front in the draws that follow: clockwise for a mirrored node (its world
  * matrix's determinant negative), counter-clockwise (GL's default) else. */
 void lm_set_front_face_clockwise(bool clockwise);
+/* Back faces culled (true) or drawn in the scene draws that follow: a shadow tile of a light that sees
+ * no face from behind (lm_shadow_front_lit) draws its front faces alone, so that no texel where a closed
+ * caster's front and back faces meet at its outline stores the back face by a tie of depth. */
+void lm_set_cull_back_faces(bool on);
 /* A blended scene pass (lm_pass_desc.blend): the output becomes the
  * fragment's first colour plus its second (index 1) times the output, per
  * channel; depth tested, not written. Off: no blending, depth written. */
