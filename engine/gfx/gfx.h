@@ -104,7 +104,8 @@ void lm_storage_upload(int binding, const void *data, size_t bytes);
 void lm_uniform_upload(int binding, const void *data, size_t bytes, size_t block);
 /* Depth test and back-face culling for scene passes; off for full-screen
  * ones. Camera views test reversed depth (near 1, far 0). Shadow casters
- * draw both faces (a light inside a closed mesh sees its back faces) and
+ * draw both faces (a light inside a closed mesh sees its back faces; a
+ * front-lit light's tiles then cull them: lm_set_cull_back_faces) and
  * clamp depth (casters before the near plane count). */
 void lm_set_scene_state(bool on, bool shadow_caster);
 /* Which winding faces front in the draws that follow: clockwise for a mirrored node (its world
