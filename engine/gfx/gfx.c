@@ -315,12 +315,7 @@ void lm_set_scene_state(bool on, bool shadow_caster) {
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(shadow_caster ? GL_LESS : GL_GREATER);
     glDepthMask(GL_TRUE);
-    if (shadow_caster) {
-      glDisable(GL_CULL_FACE);
-    } else {
-      glEnable(GL_CULL_FACE);
-      glCullFace(GL_BACK);
-    }
+    lm_set_cull_back_faces(!shadow_caster);
   } else {
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
@@ -328,6 +323,15 @@ void lm_set_scene_state(bool on, bool shadow_caster) {
 }
 
 void lm_set_front_face_clockwise(bool clockwise) { glFrontFace(clockwise ? GL_CW : GL_CCW); }
+
+void lm_set_cull_back_faces(bool on) {
+  if (on) {
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+  } else {
+    glDisable(GL_CULL_FACE);
+  }
+}
 
 void lm_set_blend_state(bool on) {
   if (on) {

@@ -104,12 +104,17 @@ void lm_storage_upload(int binding, const void *data, size_t bytes);
 void lm_uniform_upload(int binding, const void *data, size_t bytes, size_t block);
 /* Depth test and back-face culling for scene passes; off for full-screen
  * ones. Camera views test reversed depth (near 1, far 0). Shadow casters
- * draw both faces (a light inside a closed mesh sees its back faces) and
+ * draw both faces (a light inside a closed mesh sees its back faces; a
+ * front-lit light's tiles then cull them: lm_set_cull_back_faces) and
  * clamp depth (casters before the near plane count). */
 void lm_set_scene_state(bool on, bool shadow_caster);
 /* Which winding faces front in the draws that follow: clockwise for a mirrored node (its world
  * matrix's determinant negative), counter-clockwise (GL's default) else. */
 void lm_set_front_face_clockwise(bool clockwise);
+/* Back faces culled (true) or drawn in the scene draws that follow: a shadow tile of a light that sees
+ * no face from behind (lm_shadow_front_lit) draws its front faces alone, so that no texel where a closed
+ * caster's front and back faces meet at its outline stores the back face by a tie of depth. */
+void lm_set_cull_back_faces(bool on);
 /* A blended scene pass (lm_pass_desc.blend): the output becomes the
  * fragment's first colour plus its second (index 1) times the output, per
  * channel; depth tested, not written. Off: no blending, depth written. */

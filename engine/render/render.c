@@ -196,6 +196,20 @@ static const lm_program *scene_variant(void *ctx, const char *defines, lm_error 
   return lm_scene_pass_variant(ctx, defines, err);
 }
 
+/* Whether scene pass sp draws a shadow tile (not an RSM view) of a light whose tiles hold no face it
+ * sees from behind (lm_shadow_front_lit): the nearest face along each of its rays faces it, so the
+ * tile draws front faces alone. Drawn, a closed caster's back face met its front face at the caster's
+ * outline with the same depth and took a texel or two by the tie (the office's desks' corners, 198
+ * texels in office's and garage's lamps' tiles), stored negated there: a lookup touched it, and the
+ * variant without the offset step (LIGHT_FRONT_LIT) differed from the one with it. */
+static bool tile_front_faces_alone(const lm_renderer *r, const lm_scene_pass *sp) {
+  if (!sp->view || sp->desc->view_set != 0) return false;
+  ptrdiff_t v = sp->view - sp->desc->views;
+  if (v < 0 || v >= r->shadows.layout.count) return false;
+  int light = r->shadows.layout.places[v].light;
+  return light >= 0 && light < 32 && (r->front_lit >> light & 1);
+}
+
 /* Draws the scene for a scene pass: the camera's, or one shadow tile's
  * (layer: lm_scene_draw_desc's, 0 all its casters; cull: the clip volume
  * outside which nodes are left out, NULL: the view's). */
@@ -235,7 +249,11 @@ static bool draw_pass(lm_renderer *r, const lm_scene_pass *sp, int layer, const 
   if (!sp->view && sp->desc->simplify > 0 && pass_textures(sp, t) > 0) /* and where pixels hide them */
     d.lod_view_proj = r->camera.view_proj, d.lod_size[0] = t[0].width, d.lod_size[1] = t[0].height,
     d.lod_texels = sp->desc->simplify, d.lod_camera = true;
-  return lm_scene_draw(r->desc.scene, &d, sp->view ? &r->shadow_stats : &r->stats, err);
+  bool front_alone = tile_front_faces_alone(r, sp);
+  if (front_alone) lm_set_cull_back_faces(true);
+  bool ok = lm_scene_draw(r->desc.scene, &d, sp->view ? &r->shadow_stats : &r->stats, err);
+  if (front_alone) lm_set_cull_back_faces(false);
+  return ok;
 }
 
 /* The textures a scene pass draws: its colour outputs, then its depth target
@@ -270,8 +288,8 @@ static uint64_t tile_casters(const lm_renderer *r, const lm_pass_view *v, bool s
 
 /* What a shadow tile's texels follow from besides its view's matrices and
  * casters (tile_key): its place and depth mapping, the pass (technique's
- * program, defines, clear colour, material overrides) and the scene's
- * materials (casters_hash). */
+ * program, defines, clear colour, material overrides), the scene's
+ * materials (casters_hash) and whether it draws front faces alone. */
 static uint64_t pass_key(const lm_renderer *r, const lm_scene_pass *sp) {
   const lm_pass_view *v = sp->view;
   const lm_pass_desc *d = sp->desc;
@@ -283,6 +301,8 @@ static uint64_t pass_key(const lm_renderer *r, const lm_scene_pass *sp) {
   h = lm_hash(d->defines, strlen(d->defines), h);
   h = lm_hash(d->clear_color, sizeof d->clear_color, h);
   h = lm_hash(&r->shadows.settings.simplify, sizeof r->shadows.settings.simplify, h);
+  bool front_alone = tile_front_faces_alone(r, sp);
+  h = lm_hash(&front_alone, sizeof front_alone, h);
   for (int i = 0; i < d->material_param_count; i++) {
     const lm_pass_material_param *q = &d->material_params[i];
     h = lm_hash(q->material, strlen(q->material), h);
