@@ -684,7 +684,7 @@ static void copies_are_the_same_on_any_number_of_threads(void **state) {
   lm_scene_destroy(read), lm_scene_destroy(whole);
 }
 
-/* Three nodes of one terrain (128 x 128 quads: 32768 triangles, 64
+/* Three nodes of one terrain (128 x 128 quads: 32768 triangles, 256
  * chunks) side by side under a sun, seen from a camera low over the middle
  * one looking along it, so that most of the terrains lies out of view and
  * out of some cascades: the chunked meshes leave out the chunks outside each

@@ -154,8 +154,12 @@ typedef struct lm_mesh_lod {
  * keeps or leaves whole (the big scene's spheres, 3840 triangles), and their
  * instances stay one draw. On outdoor.glb's terrain (64800 triangles) seen
  * from its `ground` view, chunks of 2048 / 1024 / 512 leave out 16% / 20% /
- * 23% of the camera's triangles and 30% / 37% / 42% of the shadow tiles'. */
-#define LM_CHUNK_TRIANGLES 512
+ * 23% of the camera's triangles and 30% / 37% / 42% of the shadow tiles'.
+ * Small chunks pay most in a moving camera's scrolled cascade strips, a few
+ * texels wide across a tile: walking on outdoor (`limn bench --motion --walk
+ * 0.0075`, 640x480) they drew 61.2k / 47.5k / 40.8k shadow triangles a frame
+ * with chunks of 512 / 256 / 128 (docs/benchmarks.md). */
+#define LM_CHUNK_TRIANGLES 128
 #define LM_CHUNK_MIN_TRIANGLES 8192
 typedef struct lm_mesh_chunk {
   int first, count;   /* its indices in the mesh's GPU index buffer */
