@@ -1092,7 +1092,7 @@ static float *render_both_at(gl_result *plain, gl_result *r, int cam, int w, int
   lm_renderer_set_view(r->renderer, cam, w, h);
   assert_true(gl_render_again(plain) && gl_render_again(r) && gl_all_finite(r));
   int nw, nh;
-  float *nrm = gl_read_target(r, "gbuffer.nrm", &nw, &nh);
+  float *nrm = gl_read_normals(r, "gbuffer.nrm", &nw, &nh);
   assert_true(nrm && nw == w && nh == h);
   return nrm;
 }
