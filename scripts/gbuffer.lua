@@ -11,7 +11,7 @@ function gbuffer.targets(scale, technique, velocity)
   scale = scale or 1
   local G = {
     clr = target{ "gbuffer.clr", format = "rgba8", scale = scale },      -- albedo, rho
-    nrm = target{ "gbuffer.nrm", format = "rgba16f", scale = scale },    -- world normal, shininess
+    nrm = target{ "gbuffer.nrm", format = "rgba8", scale = scale },      -- world normal, shininess (gbuffer_normal_encode)
     dpt = target{ "gbuffer.dpt", format = "r32f", scale = scale },       -- linear depth / far
     mat = target{ "gbuffer.mat", format = "rgba8", scale = scale },      -- k_a, k_d, k_s, coverage
     depth = target{ "gbuffer.depth", format = "depth32f", scale = scale },

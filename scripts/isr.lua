@@ -121,7 +121,7 @@ function isr.coarse_gbuffer(G, direct, f)
   end
   local C = {
     clr = target{ "isr.clr", format = "rgba8", scale = 1 / f },
-    nrm = target{ "isr.nrm", format = "rgba16f", scale = 1 / f },
+    nrm = target{ "isr.nrm", format = "rgba8", scale = 1 / f },
     dpt = target{ "isr.dpt", format = "r32f", scale = 1 / f },
     mat = target{ "isr.mat", format = "rgba8", scale = 1 / f },
     direct = target{ "isr.direct", format = "rgba16f", scale = 1 / f },

@@ -104,15 +104,21 @@ vec3 position_from_depth(vec2 uv, float depth01) {
   return frame.camera_pos.xyz + ray * depth01;
 }
 
+// The octahedral coordinates (-1..1 each) of direction n (any length; zero
+// gives +z): oct_decode's inverse.
+vec2 oct_encode(vec3 n) {
+  vec2 o = n.xy / max(abs(n.x) + abs(n.y) + abs(n.z), 1e-30);
+  if (n.z < 0.0) o = (1.0 - abs(o.yx)) * vec2(o.x >= 0.0 ? 1.0 : -1.0, o.y >= 0.0 ? 1.0 : -1.0);
+  return o;
+}
+
 // A unit normal as one float, held exactly: octahedral coordinates of 12
 // bits each make an integer below 2^24, which a float holds exactly, stored
 // as -1 - that integer so that a value above 0 can mean "none" (the RSM's
 // position target carries its texel's normal in w this way: one fetch for
 // both). normal_unpack(normal_pack(n)) is within 0.05 degrees of n.
 float normal_pack(vec3 n) {
-  vec2 o = n.xy / max(abs(n.x) + abs(n.y) + abs(n.z), 1e-30);
-  if (n.z < 0.0) o = (1.0 - abs(o.yx)) * vec2(o.x >= 0.0 ? 1.0 : -1.0, o.y >= 0.0 ? 1.0 : -1.0);
-  uvec2 q = uvec2(round(clamp(o * 0.5 + 0.5, 0.0, 1.0) * 4095.0));
+  uvec2 q = uvec2(round(clamp(oct_encode(n) * 0.5 + 0.5, 0.0, 1.0) * 4095.0));
   return -1.0 - float(q.x * 4096u + q.y);
 }
 // oct_decode: the unit vector at octahedral coordinates o (-1..1 each): a
@@ -131,6 +137,28 @@ vec3 normal_unpack_direction(float w) {
   return oct_direction(vec2(uvec2(c >> 12, c & 4095u)) / 4095.0 * 2.0 - 1.0);
 }
 vec3 normal_unpack(float w) { return safe_normalize(normal_unpack_direction(w), vec3(0.0, 0.0, 1.0)); }
+
+// The G-buffer's normal target (gbuffer.nrm and ISR's coarse copy, rgba8:
+// std.frag and pbr.frag write it, gbuffer_normal_decode reads it): 4 bytes
+// a pixel where half floats took 8, which llvmpipe writes and reads in less
+// time (docs/benchmarks.md). rgb: the octahedral coordinates of the unit
+// normal at 12 bits each, 2048 + 2047 o, so that o = 0 and +-1 are exact (an
+// axis-aligned normal, +-z included, comes back bit for bit; any other
+// within 0.07 degrees, where half floats kept 0.021); a: log2(1 + shininess)
+// in 16ths, exact at 0 and 1, within 2.2% of 1 + shininess elsewhere, up to
+// 62700. A texel of zeros (nothing drawn) decodes as (0, 1, 0), shininess 0.
+vec4 gbuffer_normal_encode(vec3 n, float shininess) {
+  uvec2 q = uvec2(round(clamp(oct_encode(n), -1.0, 1.0) * 2047.0) + 2048.0); // 1 .. 4095
+  uvec3 b = uvec3(q.x >> 4, ((q.x & 15u) << 4) | (q.y >> 8), q.y & 255u);
+  float a = round(clamp(log2(1.0 + max(shininess, 0.0)) * 16.0, 0.0, 255.0));
+  return vec4(vec3(b), a) / 255.0;
+}
+vec4 gbuffer_normal_decode(vec4 t) {
+  uvec4 b = uvec4(round(clamp(t, 0.0, 1.0) * 255.0));
+  uvec2 q = uvec2((b.x << 4) | (b.y >> 4), ((b.y & 15u) << 8) | b.z);
+  vec3 n = q.x == 0u ? vec3(0.0, 1.0, 0.0) : oct_decode((vec2(q) - 2048.0) / 2047.0);
+  return vec4(n, exp2(float(b.w) / 16.0) - 1.0);
+}
 
 // Replaces NaN and Inf by zero, negatives by zero.
 vec3 finite_or_zero(vec3 c) {

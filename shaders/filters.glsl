@@ -20,7 +20,7 @@ Geometry geometry_at(sampler2D nrm, sampler2D dpt, sampler2D mat, ivec2 q, int f
   ivec2 size = textureSize(dpt, 0);
   ivec2 g = block_centre(q, factor, size);
   Geometry o;
-  o.n = safe_normalize(texelFetch(nrm, g, 0).xyz, vec3(0.0, 1.0, 0.0));
+  o.n = gbuffer_normal_decode(texelFetch(nrm, g, 0)).xyz;
   o.z = max(texelFetch(dpt, g, 0).r, 0.0);
   o.p = position_from_depth((vec2(g) + 0.5) / vec2(size), o.z);
   o.covered = texelFetch(mat, g, 0).a >= 0.5;

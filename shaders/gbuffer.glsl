@@ -18,8 +18,8 @@ float pbr_roughness(float shininess) { return sqrt(sqrt(2.0 / (max(shininess, 0.
 struct Surface {
   vec3 albedo;     // clr.rgb
   float rho;       // clr.a: reflectance, the seed's "radiation mask"
-  vec3 n;          // nrm.xyz, unit even where the buffer holds zero
-  float shininess; // nrm.w
+  vec3 n;          // nrm (gbuffer_normal_decode), unit even where the buffer holds zero
+  float shininess; // nrm's too
   float depth01;   // dpt: linear depth / far
   vec3 k;          // mat.xyz: k_a, k_d, k_s
   bool covered;    // mat.a >= 0.5: geometry, not background
@@ -54,7 +54,7 @@ Surface gbuffer_decode(vec4 c, vec4 nn, float d, vec4 m, vec2 uv) {
 // Unfiltered read of texel q (blending depths across an edge would invent points).
 Surface gbuffer_fetch(sampler2D clr, sampler2D nrm, sampler2D dpt, sampler2D mat, ivec2 q) {
   vec2 uv = (vec2(q) + 0.5) / vec2(textureSize(dpt, 0));
-  return gbuffer_decode(texelFetch(clr, q, 0), texelFetch(nrm, q, 0), texelFetch(dpt, q, 0).r,
+  return gbuffer_decode(texelFetch(clr, q, 0), gbuffer_normal_decode(texelFetch(nrm, q, 0)), texelFetch(dpt, q, 0).r,
                         texelFetch(mat, q, 0), uv);
 }
 

@@ -34,7 +34,7 @@ void main() {
     return;
   }
 #ifdef SKY
-  vec4 n = texelFetch(nrm, p, 0);
+  vec4 n = gbuffer_normal_decode(texelFetch(nrm, p, 0));
 #else
   vec4 n = vec4(0.0, 1.0, 0.0, 0.0); // no sky: the ambient term is the same every way
 #endif

@@ -29,7 +29,7 @@ void main() {
       vec4 m = texelFetch(mat, q, 0);
       float w = step(0.5, m.a);
       c += w * texelFetch(clr, q, 0);
-      n += w * texelFetch(nrm, q, 0);
+      n += w * gbuffer_normal_decode(texelFetch(nrm, q, 0));
       l += w * texelFetch(direct, q, 0);
       d += w * texelFetch(dpt, q, 0).r;
       k += w * m.xyz;
@@ -37,7 +37,7 @@ void main() {
     }
   float inv = covered > 0.0 ? 1.0 / covered : 0.0;
   out_clr = c * inv;
-  out_nrm = vec4(safe_normalize(n.xyz, vec3(0.0, 1.0, 0.0)), n.w * inv);
+  out_nrm = gbuffer_normal_encode(safe_normalize(n.xyz, vec3(0.0, 1.0, 0.0)), n.w * inv);
   out_dpt = d * inv;
   out_mat = vec4(k * inv, covered / float(FACTOR * FACTOR));
   out_direct = l * inv;

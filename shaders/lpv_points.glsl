@@ -77,7 +77,7 @@ bool surfel(int k, int c, out ivec2 px, out vec3 p, out vec3 n, out float area) 
   if (texelFetch(mat, px, 0).a < 0.5) return false; // background
   float z = texelFetch(dpt, px, 0).r;
   p = position_from_depth(uv, z);
-  n = safe_normalize(texelFetch(nrm, px, 0).xyz, vec3(0.0, 1.0, 0.0));
+  n = gbuffer_normal_decode(texelFetch(nrm, px, 0)).xyz;
   float foot = 2.0 * dpt_view_depth(z) * frame.clip.w / float(size.y); // a pixel's world size
   vec3 v = safe_normalize(frame.camera_pos.xyz - p, n);
   area = foot * foot * step.x * step.y / max(abs(dot(n, v)), MIN_COS);

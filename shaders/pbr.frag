@@ -102,7 +102,7 @@ void main() {
   vec3 albedo = saturate(base.rgb);
   vec3 f0 = mix(vec3(0.04), albedo, metallic);
   out_clr = vec4(albedo, max(max(albedo.r, albedo.g), albedo.b) * (1.0 - metallic));
-  out_nrm = vec4(n, pbr_shininess(roughness));
+  out_nrm = gbuffer_normal_encode(n, pbr_shininess(roughness));
   out_dpt = max(view_depth, 0.0) * frame.clip.z;
   out_mat = vec4(saturate(occlusion), 1.0 - metallic, max(max(f0.r, f0.g), f0.b),
                  mat_alpha_encode(material_reflectivity, true));

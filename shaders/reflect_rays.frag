@@ -20,7 +20,7 @@ void main() {
   ray_o = vec4(0.0);
   ray_d = vec4(0.0);
   if (r <= 0.0) return;
-  vec3 n = safe_normalize(texelFetch(nrm, g, 0).xyz, vec3(0.0, 1.0, 0.0));
+  vec3 n = gbuffer_normal_decode(texelFetch(nrm, g, 0)).xyz;
   vec3 p = position_from_depth((vec2(g) + 0.5) / vec2(size), max(texelFetch(dpt, g, 0).r, 0.0));
   vec3 to_p = p - frame.camera_pos.xyz;
   float dist = length(to_p);

@@ -36,7 +36,7 @@ void main() {
     return;
   }
   float far = frame.clip.y, z = max(texelFetch(dpt, g, 0).r, 0.0) * far;
-  vec3 nw = safe_normalize(texelFetch(nrm, g, 0).xyz, vec3(0.0, 1.0, 0.0));
+  vec3 nw = gbuffer_normal_decode(texelFetch(nrm, g, 0)).xyz;
   vec3 n = safe_normalize(mat3(frame.view) * nw, vec3(0.0, 0.0, 1.0));
   float rel = max(reach, 0.0) * z; // scale-free default: a fraction of the depth
   float rad = radius > 0.0 ? radius : rel, tol = tolerance > 0.0 ? tolerance : rel;

@@ -168,7 +168,7 @@ void main() {
         q = min(ivec2(quv * vec2(gsize)), gsize - 1);
         float zq = texelFetch(dpt, q, 0).r * far, zs = clip.w; // view depth of S: w of a perspective projection
         if (texelFetch(mat, q, 0).a >= 0.5 && zs > zq * (1.0 + 1e-4) && zs - zq < rmax) {
-          vec3 nq = safe_normalize(texelFetch(nrm, q, 0).xyz, vec3(0.0, 1.0, 0.0));
+          vec3 nq = gbuffer_normal_decode(texelFetch(nrm, q, 0)).xyz;
           vec3 pq = position_from_depth((vec2(q) + 0.5) / vec2(gsize), zq / far);
           occluded = dot(nq, sp - pq) < 0.0;
         }

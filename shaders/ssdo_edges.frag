@@ -16,7 +16,7 @@ out float count;
 void main() {
   ivec2 size = textureSize(dpt, 0), centre = ivec2(gl_FragCoord.xy) * 16 + 8;
   ivec2 c = clamp(centre, ivec2(0), size - 1);
-  vec3 n0 = safe_normalize(texelFetch(nrm, c, 0).xyz, vec3(0.0, 1.0, 0.0));
+  vec3 n0 = gbuffer_normal_decode(texelFetch(nrm, c, 0)).xyz;
   float z0 = texelFetch(dpt, c, 0).r;
   vec3 p0 = position_from_depth((vec2(c) + 0.5) / vec2(size), z0);
   bool cov0 = texelFetch(mat, c, 0).a >= 0.5;
@@ -30,7 +30,7 @@ void main() {
         continue;
       }
       if (!cov) continue;
-      vec3 n = safe_normalize(texelFetch(nrm, q, 0).xyz, vec3(0.0, 1.0, 0.0));
+      vec3 n = gbuffer_normal_decode(texelFetch(nrm, q, 0)).xyz;
       vec3 p = position_from_depth((vec2(q) + 0.5) / vec2(size), texelFetch(dpt, q, 0).r);
       float dz = abs(dot(n0, p - p0)) / max(z0 * frame.clip.y, 1e-12);
       edge = max(edge, max((1.0 - dot(n, n0)) / normal_edge, dz / depth_edge));

@@ -1,5 +1,5 @@
 // G-buffer as seed 000 (lines 1229-1259), plus the Phong factors:
-//   clr = albedo, rho     nrm = world normal, shininess
+//   clr = albedo, rho     nrm = world normal, shininess (rgba8: gbuffer_normal_encode)
 //   dpt = linear depth / far    mat = k_a, k_d, k_s, coverage and reflectivity
 //   (mat_alpha_encode: >= 0.5 = geometry)
 #include "common.glsl"
@@ -36,7 +36,7 @@ void main() {
 #endif
   vec3 albedo = base.rgb;
   out_clr = vec4(saturate(albedo), saturate(material_rho));
-  out_nrm = vec4(n, max(material_k.w, 0.0));
+  out_nrm = gbuffer_normal_encode(n, material_k.w);
   out_dpt = dpt_encode(view_depth);
   out_mat = vec4(saturate(material_k.xyz), mat_alpha_encode(material_reflectivity, false));
   write_velocity();

@@ -262,7 +262,7 @@ void main() {
   for (int i = 0; i < 4; i++) {
     ivec2 o = ivec2(i & 1, i >> 1), q = clamp(base + o, ivec2(0), csize - 1);
     float zc = texelFetch(cdpt, q, 0).r;
-    vec3 nc = texelFetch(nrm, block_centre(q, STRIDE, textureSize(nrm, 0)), 0).xyz;
+    vec3 nc = gbuffer_normal_decode(texelFetch(nrm, block_centre(q, STRIDE, textureSize(nrm, 0)), 0)).xyz;
     bool agree = abs(zc - s.depth01) <= threshold * max(s.depth01, 1e-12) && dot(nc, s.n) >= 1.0 - threshold;
     all_agree = all_agree && agree;
     vec2 w = mix(1.0 - f, f, vec2(o));

@@ -263,6 +263,26 @@ float *gl_read_target(gl_result *r, const char *name, int *width, int *height) {
   return px;
 }
 
+float *gl_read_normals(gl_result *r, const char *name, int *width, int *height) {
+  float *px = gl_read_target(r, name, width, height);
+  for (size_t i = 0; px && i < (size_t)*width * *height; i++) {
+    float *t = px + i * 4;
+    unsigned b[4];
+    for (int k = 0; k < 4; k++) b[k] = (unsigned)lroundf(fminf(fmaxf(t[k], 0.0f), 1.0f) * 255.0f);
+    unsigned qx = b[0] << 4 | b[1] >> 4, qy = (b[1] & 15u) << 8 | b[2];
+    float n[3] = {0, 1, 0};
+    if (qx) { /* octahedral coordinates (2048 + 2047 o): common.glsl's oct_decode */
+      float ox = (qx - 2048.0f) / 2047.0f, oy = (qy - 2048.0f) / 2047.0f;
+      n[0] = ox, n[1] = oy, n[2] = 1.0f - fabsf(ox) - fabsf(oy);
+      if (n[2] < 0) n[0] = (1.0f - fabsf(oy)) * (ox >= 0 ? 1.0f : -1.0f), n[1] = (1.0f - fabsf(ox)) * (oy >= 0 ? 1.0f : -1.0f);
+      float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]); /* >= 1 / sqrt(3) */
+      for (int k = 0; k < 3; k++) n[k] /= len;
+    }
+    t[0] = n[0], t[1] = n[1], t[2] = n[2], t[3] = exp2f(b[3] / 16.0f) - 1.0f;
+  }
+  return px;
+}
+
 bool gl_target_finite(gl_result *r, const char *name) {
   int w, h;
   float *px = gl_read_target(r, name, &w, &h);

@@ -83,6 +83,10 @@ bool gl_all_finite(const gl_result *r);
  * frees); NULL when the frame has none of that name, or when a target that
  * shares its texture was written after it (render with sharing off). */
 float *gl_read_target(gl_result *r, const char *name, int *width, int *height);
+/* gl_read_target of a G-buffer normal target (gbuffer.nrm: rgba8 as
+ * common.glsl's gbuffer_normal_encode writes it), each texel decoded as
+ * gbuffer_normal_decode does: (unit normal, shininess). */
+float *gl_read_normals(gl_result *r, const char *name, int *width, int *height);
 /* Does that target hold only finite values that are not negative? (It is
  * read before the output stage, which would hide a NaN.) */
 bool gl_target_finite(gl_result *r, const char *name);

@@ -133,7 +133,7 @@ static void scripts_override_materials_by_name(void **state) {
   const char *fmt =
       "Techniques = { 'dl' }\n"
       "function OnRender(tech)\n"
-      "  local G = { clr = target{ 'c', format = 'rgba8' }, nrm = target{ 'n', format = 'rgba16f' },\n"
+      "  local G = { clr = target{ 'c', format = 'rgba8' }, nrm = target{ 'n', format = 'rgba8' },\n"
       "              dpt = target{ 'd', format = 'r32f' }, mat = target{ 'm', format = 'rgba8' },\n"
       "              depth = target{ 'z', format = 'depth32f' } }\n"
       "  scene{ 'gbuffer', out = { G.clr, G.nrm, G.dpt, G.mat }, depth = G.depth, materials = %s }\n"

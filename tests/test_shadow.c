@@ -1053,7 +1053,7 @@ static void seams_where_thin_walls_meet_stay_dark(void **state) {
     lm_renderer_set_view(r.renderer, cam, W, H);
     assert_true(gl_render_again(&r) && gl_all_finite(&r));
     int w, h;
-    float *nrm = gl_read_target(&r, "gbuffer.nrm", &w, &h);
+    float *nrm = gl_read_normals(&r, "gbuffer.nrm", &w, &h);
     assert_true(nrm && w == W && h == H);
     float brightest = 0;
     for (int i = 0; i < W * H; i++) brightest = fmaxf(brightest, gl_luminance(r.rgb + (size_t)i * 3));
@@ -1092,7 +1092,7 @@ static float *render_both_at(gl_result *plain, gl_result *r, int cam, int w, int
   lm_renderer_set_view(r->renderer, cam, w, h);
   assert_true(gl_render_again(plain) && gl_render_again(r) && gl_all_finite(r));
   int nw, nh;
-  float *nrm = gl_read_target(r, "gbuffer.nrm", &nw, &nh);
+  float *nrm = gl_read_normals(r, "gbuffer.nrm", &nw, &nh);
   assert_true(nrm && nw == w && nh == h);
   return nrm;
 }

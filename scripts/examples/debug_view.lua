@@ -17,6 +17,6 @@ function OnRender(tech)
   options.fields(tech, rules, { "show", "scale", "offset" })
   local G = gbuffer.render(gbuffer.targets())
   present(pass{ "show", shader = "examples/show.frag", inputs = { src = G[tech.show] },
-                params = { scale = tech.scale, offset = tech.offset },
+                params = { scale = tech.scale, offset = tech.offset }, defines = { NORMAL = tech.show == "nrm" },
                 out = target{ "show", format = "rgba32f" } }, "display") -- not light: no exposure
 end
