@@ -12,7 +12,8 @@
 #   direct-only reference of the view, whose error against the baseline is
 #   the floor of the share of indirect error removed;
 # - each setting starts from the job's options, inheriting none from the one before; a still place's
-#   warm-up carries into its timed frames.
+#   warm-up carries into its timed frames; a sweep that fails half-way leaves no report (the last run's
+#   is removed with it: its images are being overwritten).
 # - --require-refs and --cached-refs render nothing: the first names the command, the second
 #   leaves out (and names) the views without cached references.
 # Skipped (77) where povray is not installed (tools/dev.sh installs it).
@@ -218,6 +219,16 @@ low=$(grep -o 'text-anchor="end">[-0-9.e+]*<' rep/report.svg | head -1 | tr -dc 
 awk -v l="$low" 'BEGIN { exit !(l > 0) }' || fail "the error axis starts at $low, not at the data"
 # The images are there to look at.
 [ "$(ls rep/images/*.exr | wc -l)" = 3 ] || fail "not three images"
+
+# A sweep whose second setting fails as it renders (isr.sky_bounce with one bounce): exit 1 naming the
+# setting and what it lacks; the report of the run before in the same --out is gone, since this run's
+# images (setting 1's already rendered) no longer match it.
+"$limn" report --job job.lua "${fast[@]}" --out rep --frames 1 --warmup 0 \
+  --sweep "isr:isr.bounces=2,1;isr.sky_bounce=true" >log15 2>&1
+[ $? = 1 ] || { cat log15; fail "a sweep whose setting fails did not exit 1"; }
+grep -q "isr bounces=1 sky_bounce=true: .*isr.bounces above 1 (it is 1)" log15 \
+  || { cat log15; fail "the failing setting and the option it lacks are not named"; }
+for f in report.csv report.json report.svg report.md; do [ -e rep/$f ] && fail "a failed report left rep/$f"; done
 
 # Every setting starts from the job's options: "isr" after "isr:isr.mode=seed" renders the default
 # mode, not the seed's it would inherit.
