@@ -247,7 +247,7 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       break;
     case 'F':
       if (!limn_parse_double(optarg, &a->fps) || !(a->fps > 0) || a->fps > 1e6)
-        return usage_error("--fps wants frames a second above 0, not '%s'", optarg);
+        return usage_error("--fps wants frames a second in (0, 1e6], not '%s'", optarg);
       break;
     case 'A': a->animation = optarg; break;
     case 'j': a->job = optarg; break;

@@ -103,7 +103,7 @@ check "sequence without {frame} names the flag" err_has "--output '$tmp/img/s.pn
 check "sequence without --fps" run 2 capture --time 0:1 --output "$tmp/img/s{frame}.png"
 check "sequence without --fps message" err_has "--time 0:1: a sequence needs --fps N"
 check "negative fps" run 2 capture --time 0:1 --fps -4 --output "$tmp/img/s{frame}.png"
-check "negative fps message" err_has "--fps wants frames a second above 0, not '-4'"
+check "negative fps message" err_has "--fps wants frames a second in (0, 1e6], not '-4'"
 check "stop before start" run 2 capture --time 2:1 --fps 4 --output "$tmp/img/s{frame}.png"
 check "stop before start message" err_has "--time START:STOP wants STOP >= START, not '2:1'"
 check "NaN time" run 2 capture --time nan --output "$tmp/img/s.png"
