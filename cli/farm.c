@@ -166,10 +166,11 @@ static bool slurm_time(const char *t) {
   return !*s;
 }
 
-/* sbatch's --mem: a whole number of megabytes, or with a unit K, M, G or T. */
+/* sbatch's --mem: a whole number of megabytes, or with a unit K, M, G or T (sbatch reads the unit's
+ * letter alone: 8GB is 8G). */
 static bool slurm_mem(const char *m) {
   const char *s = m;
-  return digits(&s) && (!*s || (strchr("KMGTkmgt", *s) && !s[1]));
+  return digits(&s) && (!*s || (strchr("KMGTkmgt", *s) && (!s[1] || ((s[1] | 32) == 'b' && !s[2]))));
 }
 
 static int farm(const farm_args *a) {

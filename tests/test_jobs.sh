@@ -153,7 +153,7 @@ for t in 1h 1:2:3:4 2- -5; do
   check "farm: --time $t refused" run 2 farm slurm --job job.lua --shards 2 --dir badfarm --time "$t"
   check "farm: --time $t named" err_has "--time wants sbatch's MINUTES, MINUTES:SECONDS, HOURS:MINUTES:SECONDS or DAYS-HOURS[:MINUTES[:SECONDS]], not '$t'"
 done
-for m in lots 1.5G 8GB; do
+for m in lots 1.5G 8GiB; do
   check "farm: --mem $m refused" run 2 farm slurm --job job.lua --shards 2 --dir badfarm --mem "$m"
   check "farm: --mem $m named" err_has "--mem wants sbatch's megabytes, or a number with K, M, G or T (8G), not '$m'"
 done
