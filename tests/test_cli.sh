@@ -100,6 +100,11 @@ check "still at a time named" test -s "$tmp/img/t1.500.png"
 rm -f "$tmp/img/"*
 check "sequence without {frame}" run 2 capture --time 0:1 --fps 4 --output "$tmp/img/s.png"
 check "sequence without {frame} names the flag" err_has "--output '$tmp/img/s.png': a sequence of 5 frames (--time 0:1 --fps 4) needs {frame} in the name"
+check "a misspelt placeholder" run 2 capture --time 0:1 --fps 4 --output "$tmp/img/s{frame}_{tiem}.png"
+check "a misspelt placeholder named" err_has "--output '$tmp/img/s{frame}_{tiem}.png': unknown placeholder '{tiem}' (capture fills {frame} and {time})"
+check "an output given twice" run 2 capture --output "$tmp/img/s.png" --output "$tmp/img/s.png"
+check "an output given twice named" err_has "--output '$tmp/img/s.png' is given twice"
+check "nothing of a refused command line" no_files
 check "sequence without --fps" run 2 capture --time 0:1 --output "$tmp/img/s{frame}.png"
 check "sequence without --fps message" err_has "--time 0:1: a sequence needs --fps N"
 check "negative fps" run 2 capture --time 0:1 --fps -4 --output "$tmp/img/s{frame}.png"
