@@ -854,7 +854,7 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
   base_take(&base_options, pipeline, a->settings, a->setting_count);
   for (int s = 0; s < a->setting_count; s++)
     if (!set_setting(pipeline, &base_options, &a->settings[s], &err)) {
-      lm_log(LM_LOG_ERROR, "--sweep %s: %s", a->settings[s].label, err.msg);
+      lm_log(LM_LOG_ERROR, "%s %s: %s", s ? "--sweep" : "--baseline", a->settings[s].label, err.msg);
       base_free(&base_options);
       free(runs.first);
       free(runs.settled);

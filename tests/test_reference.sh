@@ -255,6 +255,11 @@ done
 grep -q '"mean_error": 0[,}]' c5.json || { cat c5.json; fail "the report's warm-up did not carry into its timed frame"; }
 grep -q '"mean_error": 0[,}]' c1.json && fail "the warm-up changed nothing (the check above proves nothing)"
 
+# A baseline the script lacks is named as --baseline (it was named as a --sweep), exit 2, before any reference.
+"$limn" report --job job.lua "${fast[@]}" --out rep8 --baseline nope --sweep dl >log16 2>&1
+[ $? = 2 ] || { cat log16; fail "an unknown baseline did not exit 2"; }
+grep -q "limn: error: --baseline nope: unknown technique 'nope'" log16 || { cat log16; fail "the baseline is not named"; }
+
 # 4. --require-refs names the command when a reference is missing
 "$limn" report --job job.lua "${fast[@]}" --refs refs-none --require-refs --out rep2 --sweep dl >log7 2>&1
 [ $? = 1 ] || { cat log7; fail "--require-refs without references did not fail"; }
