@@ -455,6 +455,9 @@ static bool run_size(bench *b, int si, int series, lm_scene *scene, lm_pipeline 
     lm_finish(); /* nothing of the last frame left in flight */
     double t0 = lm_now_ms();
     ok = lm_renderer_frame(r, err);
+    if (!ok) /* which frame, as capture names it: a script may fail on a later one */
+      lm_error_prefix(err, "%dx%d, frame %d (%d warm-up, %d timed)", b->sizes[size][0], b->sizes[size][1], f,
+                      b->warmup, b->frames);
     lm_finish();
     double t1 = lm_now_ms();
     if (ok && !b->first_frame_ms) b->first_frame_ms = t1 - b->start_ms, b->first_frame_rss_kib = peak_rss_kib();
@@ -891,6 +894,12 @@ static bool run_motion(bench *b, const lm_scene *first, lm_error *err) {
         int built = lm_programs_stats(NULL, &built_ms);
         double a = k == STREAM_STILL ? 0 : pose(m, s, f);
         ok = lm_renderer_frame(s->r, err);
+        if (!ok) { /* which renderer and frame: a script may fail on a later one */
+          char when[64] = "", t[LIMN_TIME_TEXT];
+          if (m->timed) snprintf(when, sizeof when, " at %s s", limn_time_text(m->start + f / m->fps, 3, t));
+          lm_error_prefix(err, "--motion, the %s renderer's frame %d%s (round %d)", stream_names[k], f, when,
+                          round + 1);
+        }
         lm_finish();
         double t1 = lm_now_ms(), c1 = lm_cpu_ms(), built_after_ms;
         int built_after = lm_programs_stats(NULL, &built_after_ms);

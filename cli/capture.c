@@ -95,6 +95,21 @@ typedef struct capture_args {
 
 static int usage_error(const char *fmt, const char *arg) { return limn_usage_error("capture", fmt, arg); }
 
+/* A {word} in an output name that capture does not fill ({frame}, {time}; a job's outputs know more):
+ * false when there is none, else the message naming it in msg. */
+static bool unknown_placeholder(const char *name, char *msg, size_t cap) {
+  for (const char *p = strchr(name, '{'); p; p = strchr(p + 1, '{')) {
+    const char *close = strchr(p, '}');
+    if (!close) return false;
+    if (strncmp(p, "{frame}", 7) && strncmp(p, "{time}", 6)) {
+      snprintf(msg, cap, "--output '%s': unknown placeholder '%.*s' (capture fills {frame} and {time})", name,
+               (int)(close - p + 1), p);
+      return true;
+    }
+  }
+  return false;
+}
+
 static bool is_video(const char *path) {
   const char *dot = strrchr(path, '.');
   return dot && !strchr(dot, '/') && (!strcasecmp(dot, ".mp4") || !strcasecmp(dot, ".webm"));
@@ -224,6 +239,12 @@ static int parse_args(int argc, char **argv, capture_args *a) {
     case 'o': {
       bool linear;
       if (a->output_count + a->video_count == 16) return usage_error("%s", "at most 16 --output flags");
+      char bad[1100];
+      if (unknown_placeholder(optarg, bad, sizeof bad)) /* it would be written as it stands */
+        return usage_error("%s", bad);
+      for (int i = 0; i < a->output_count + a->video_count; i++)
+        if (!strcmp(i < a->output_count ? a->outputs[i] : a->videos[i - a->output_count], optarg))
+          return usage_error("--output '%s' is given twice", optarg);
       if (is_video(optarg)) a->videos[a->video_count++] = optarg;
       else if (!capture_known_extension(optarg, &linear))
         return usage_error("--output '%s': use a .png, .exr, .jpg, .tif or .hdr file (or .mp4, .webm for a "
@@ -247,7 +268,7 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       break;
     case 'F':
       if (!limn_parse_double(optarg, &a->fps) || !(a->fps > 0) || a->fps > 1e6)
-        return usage_error("--fps wants frames a second above 0, not '%s'", optarg);
+        return usage_error("--fps wants frames a second in (0, 1e6], not '%s'", optarg);
       break;
     case 'A': a->animation = optarg; break;
     case 'j': a->job = optarg; break;

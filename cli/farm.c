@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -144,6 +145,34 @@ static bool one_line(const char *s) {
   return true;
 }
 
+/* n digits (1..9) from *s on, advancing it; false without one. */
+static bool digits(const char **s) {
+  size_t n = strspn(*s, "0123456789");
+  *s += n;
+  return n > 0 && n < 10;
+}
+
+/* sbatch's --time: minutes, minutes:seconds, hours:minutes:seconds, days-hours, days-hours:minutes,
+ * days-hours:minutes:seconds, or unlimited / infinite. Checked here, where the job is, rather than
+ * refused by sbatch on the cluster. */
+static bool slurm_time(const char *t) {
+  if (!strcasecmp(t, "unlimited") || !strcasecmp(t, "infinite")) return true;
+  const char *s = t;
+  if (!digits(&s)) return false;
+  bool days = *s == '-';
+  if (days && (s++, !digits(&s))) return false;
+  for (int fields = 1; *s == ':' && fields < 3; fields++) /* the hours or minutes, then up to two more */
+    if (s++, !digits(&s)) return false;
+  return !*s;
+}
+
+/* sbatch's --mem: a whole number of megabytes, or with a unit K, M, G or T (sbatch reads the unit's
+ * letter alone: 8GB is 8G). */
+static bool slurm_mem(const char *m) {
+  const char *s = m;
+  return digits(&s) && (!*s || (strchr("KMGTkmgt", *s) && (!s[1] || ((s[1] | 32) == 'b' && !s[2]))));
+}
+
 static int farm(const farm_args *a) {
   job *j = lm_alloc(sizeof *j);
   lm_error err;
@@ -257,7 +286,23 @@ int limn_farm(int argc, char **argv) {
     case 'K':
       if (!limn_parse_int(optarg, 1, 1 << 20, &a.shards)) rc = usage_error("--shards wants N >= 1, not '%s'", optarg);
       break;
-    case '0': case '1': case '2': case '3': case '4': case '5':
+    case '1':
+      if (!slurm_time(optarg))
+        rc = usage_error("--time wants sbatch's MINUTES, MINUTES:SECONDS, HOURS:MINUTES:SECONDS or "
+                         "DAYS-HOURS[:MINUTES[:SECONDS]], not '%s'", optarg);
+      else snprintf(sbatch_flags[1], sizeof sbatch_flags[0], "--time=%s", optarg);
+      break;
+    case '2':
+      if (!slurm_mem(optarg))
+        rc = usage_error("--mem wants sbatch's megabytes, or a number with K, M, G or T (8G), not '%s'", optarg);
+      else snprintf(sbatch_flags[2], sizeof sbatch_flags[0], "--mem=%s", optarg);
+      break;
+    case '3':
+      if (!limn_parse_int(optarg, 1, 1 << 20, &(int){0}))
+        rc = usage_error("--cpus-per-task wants N >= 1, not '%s'", optarg);
+      else snprintf(sbatch_flags[3], sizeof sbatch_flags[0], "--cpus-per-task=%s", optarg);
+      break;
+    case '0': case '4': case '5':
       snprintf(sbatch_flags[c - '0'], sizeof sbatch_flags[0], "--%s=%s", named[c - '0'], optarg);
       break;
     case 'B':

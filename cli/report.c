@@ -601,6 +601,19 @@ static bool write_file(const report_args *a, const char *name, lm_buf *b, lm_err
   return ok;
 }
 
+static const char *const report_files[] = {"report.csv", "report.json", "report.svg", "report.md"};
+
+/* A report of an earlier run in --out goes before this one renders: its
+ * images are overwritten setting by setting, so a run that fails half-way
+ * would leave a report that no longer describes the images beside it. */
+static void remove_reports(const report_args *a) {
+  for (size_t i = 0; i < sizeof report_files / sizeof *report_files; i++) {
+    char path[1100];
+    snprintf(path, sizeof path, "%s/%s", a->out, report_files[i]);
+    remove(path);
+  }
+}
+
 /* The value each swept option has before any setting (the script's default
  * with the job's `set`), so that every setting starts from the same options
  * and none inherits the one before it. */
@@ -847,7 +860,7 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
   base_take(&base_options, pipeline, a->settings, a->setting_count);
   for (int s = 0; s < a->setting_count; s++)
     if (!set_setting(pipeline, &base_options, &a->settings[s], &err)) {
-      lm_log(LM_LOG_ERROR, "--sweep %s: %s", a->settings[s].label, err.msg);
+      lm_log(LM_LOG_ERROR, "%s %s: %s", s ? "--sweep" : "--baseline", a->settings[s].label, err.msg);
       base_free(&base_options);
       free(runs.first);
       free(runs.settled);
@@ -869,6 +882,7 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
     return rc;
   }
 
+  remove_reports(a);
   if (!lm_context_create_headless(&(lm_context_desc){0}, &err)) {
     lm_log(LM_LOG_ERROR, "%s", err.msg);
     free(refs);
@@ -1035,13 +1049,13 @@ static int run(report_args *a, job *j, lm_pipeline *pipeline) {
     write_svg(&svg, a, err_mean, ms_mean, front, floor, clock, curve, curve_frames);
     write_md(&md, a, j, places, place_count, rows, n, &runs, err_mean, ms_mean, front, floor, clock, a->frames,
              a->warmup);
-    bool ok = write_file(a, "report.csv", &csv, &err) && write_file(a, "report.json", &json, &err) &&
-              write_file(a, "report.svg", &svg, &err) && write_file(a, "report.md", &md, &err);
+    bool ok = write_file(a, report_files[0], &csv, &err) && write_file(a, report_files[1], &json, &err) &&
+              write_file(a, report_files[2], &svg, &err) && write_file(a, report_files[3], &md, &err);
     lm_buf_free(&csv);
     lm_buf_free(&json);
     lm_buf_free(&svg);
     lm_buf_free(&md);
-    if (!ok) lm_log(LM_LOG_ERROR, "%s", err.msg), rc = 1;
+    if (!ok) lm_log(LM_LOG_ERROR, "%s", err.msg), remove_reports(a), rc = 1; /* all four or none */
     free(err_mean);
     free(front);
   }

@@ -26,6 +26,13 @@ static int split(char *s, char sep, char **parts, int max) {
   }
 }
 
+static bool same_setting(const report_setting *a, const report_setting *b) {
+  if (strcmp(a->technique, b->technique) || a->option_count != b->option_count) return false;
+  for (int i = 0; i < a->option_count; i++)
+    if (strcmp(a->names[i], b->names[i]) || strcmp(a->values[i], b->values[i])) return false;
+  return true;
+}
+
 bool report_sweep_parse(const char *spec, report_setting *list, int *count, lm_error *err) {
   char buf[2048];
   if (strlen(spec) >= sizeof buf) {
@@ -85,6 +92,7 @@ bool report_sweep_parse(const char *spec, report_setting *list, int *count, lm_e
     return false;
   }
   /* Every combination, the last option varying fastest. */
+  int first = *count;
   for (long c = 0; c < total; c++) {
     report_setting *s = &list[(*count)++];
     *s = base;
@@ -104,6 +112,14 @@ bool report_sweep_parse(const char *spec, report_setting *list, int *count, lm_e
       len += snprintf(s->label + len, sizeof s->label - (size_t)len, " %s=%s", name, s->values[i]);
     }
   }
+  /* A setting given twice (isr.samples=8,8, or a --sweep repeated) would be two rows of one image. */
+  for (int k = first; k < *count; k++)
+    for (int e = 0; e < k; e++)
+      if (same_setting(&list[e], &list[k])) {
+        lm_error_set(err, "--sweep '%s': setting '%s' is there twice (settings %d and %d)", spec, list[k].label, e, k);
+        *count = first;
+        return false;
+      }
   return true;
 }
 

@@ -178,8 +178,9 @@ static int parse_args(int argc, char **argv, view_args *a) {
       a->time_given = true;
       break;
     case 'F':
-      if (!limn_parse_int(optarg, 1, 1000, &n)) return usage_error("--fps wants 1..1000, not '%s'", optarg);
-      a->fps = n, a->fps_given = true;
+      if (!limn_parse_double(optarg, &a->fps) || !(a->fps > 0) || a->fps > 1000)
+        return usage_error("--fps wants frames a second in (0, 1000], not '%s'", optarg);
+      a->fps_given = true;
       break;
     case 'n':
       if (!limn_parse_int(optarg, 1, 1 << 30, &n)) return usage_error("--exit-after wants a frame count, not '%s'", optarg);

@@ -175,11 +175,17 @@ end
 -- How many targets of four rays' hits the first march records for the later
 -- bounces (isr_march.frag's HITS): none for one bounce, or when they would
 -- not fit in the 6 colour outputs beside E and z or an index of the
--- G-buffer's texels in a float.
+-- G-buffer's texels in a float. With none, the second result says why (for
+-- the options that need them).
 local function hit_targets(o)
   local w, h = output_size()
   local n = (o.samples + 3) // 4
-  if not o.reuse or o.bounces < 2 or n > 6 or (w + 1) * (h + 1) >= 1 << 24 then return 0 end
+  if not o.reuse then return 0, "isr.reuse (it is false)" end
+  if o.bounces < 2 then return 0, ("isr.bounces above 1 (it is %d)"):format(o.bounces) end
+  if n > 6 then return 0, ("at most 24 isr.samples (it is %d)"):format(o.samples) end
+  if (w + 1) * (h + 1) >= 1 << 24 then
+    return 0, ("an output whose (width + 1)(height + 1) is under 2^24 (it is %dx%d)"):format(w, h)
+  end
   return n
 end
 
@@ -246,10 +252,10 @@ function isr.render(direct, o, frame)
     if temporal.settled(o.temporal) then return isr.composite(G, direct, C, f, kept.value, params, false, light.sky) end
   end
   local E, E1, H, first
-  local hits = seed and 0 or hit_targets(o)
+  local hits, no_hits = 0, "isr.mode \"physical\" (it is \"seed\")"
+  if not seed then hits, no_hits = hit_targets(o) end
   if o.sky_bounce and hits == 0 then
-    error("isr.sky_bounce needs isr.mode \"physical\", isr.bounces above 1, isr.reuse and at most 24 isr.samples "
-          .. "(the senders the first march records)", 2)
+    error("isr.sky_bounce needs the senders the first march records: " .. no_hits, 2)
   end
   -- Temporal reuse: every step reads the history (all skip the same converged pixels), the last
   -- accumulates and writes the next one after its other outputs (NEXT).

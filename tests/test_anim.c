@@ -191,6 +191,12 @@ static void animations_are_found_by_name_index_or_all(void **state) {
     snprintf(quoted, sizeof quoted, "no animation '%s'", near_misses[i]);
     assert_non_null(strstr(err.msg, quoted));
   }
+  /* A name two animations share picks neither (exporters write "Take 001" twice): refused with their
+   * indices, which still pick each. */
+  snprintf(s->animations[1].name, sizeof s->animations[1].name, "interp");
+  assert_int_equal(lm_scene_find_animation(s, "interp", &err), -3);
+  assert_non_null(strstr(err.msg, "several animations named 'interp' (0, 1): give its index"));
+  assert_int_equal(lm_scene_find_animation(s, "1", &err), 1);
   assert_true(lm_scene_animated(s));
   lm_scene_destroy(s);
 }

@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 #include <math.h>
+#include <string.h>
 
 #include "camera_path.h"
 #include "scene/scene.h"
@@ -129,6 +130,21 @@ static void look_at(void **state) {
   lm_camera_look_at(eye, eye, w);
   for (int i = 0; i < 16; i++) assert_true(isfinite(w[i]));
   assert_true(fabsf(w[10] - 1) < 1e-6f);
+  /* Tilting towards the vertical from any heading, down and up, the right axis holds still (level,
+   * turning with the heading alone): it flipped at 87.4 degrees from the -z side. */
+  for (int heading = 0; heading < 360; heading += 15)
+    for (int sign = -1; sign <= 1; sign += 2) {
+      float last[3] = {0};
+      for (int tilt = 8000; tilt < 9000; tilt++) { /* 80 to 89.99 degrees, in hundredths */
+        double el = tilt / 100.0 * 3.14159265358979 / 180, az = heading * 3.14159265358979 / 180;
+        const float from[3] = {(float)(cos(el) * sin(az)), (float)(-sign * sin(el)), (float)(cos(el) * cos(az))};
+        lm_camera_look_at(from, (const float[3]){0, 0, 0}, w);
+        if (tilt > 8000 && !(w[0] * last[0] + w[1] * last[1] + w[2] * last[2] > 0.9999f))
+          fail_msg("heading %d, %s at %.2f degrees: the right axis turned", heading, sign < 0 ? "down" : "up",
+                   tilt / 100.0);
+        memcpy(last, w, sizeof last);
+      }
+    }
 }
 
 int main(void) {

@@ -705,6 +705,26 @@ static void malformed_files_name_the_element(void **state) {
          "\"mesh\":0,\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
          "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"point\",\"extras\":{\"size\":-1}}]}},\"extras\":[0",
          "light 0: extras.size must be a finite number >= 0");
+  /* A light's intensity, range and colour each named with its value; negative colour and intensity times
+   * colour past 1e30 (Inf in the lit target) refused with it. */
+  static const struct {
+    const char *file, *light, *want;
+  } lights[] = {
+      {"light_huge.gltf", "\"intensity\":1e30", "light 0 ('lamp'): intensity 1e+30 is not a number in [0, 1e30)"},
+      {"light_range.gltf", "\"range\":-1", "light 0 ('lamp'): range -1 is not a number in [0, 1e30)"},
+      {"light_neg.gltf", "\"color\":[-1,2,0]", "light 0 ('lamp'): color (-1, 2, 0) has a negative component"},
+      {"light_over.gltf", "\"intensity\":1e29,\"color\":[1e30,1,1]",
+       "light 0 ('lamp'): intensity 1e+29 times color 1e+30 is past 1e30"},
+  };
+  for (size_t i = 0; i < sizeof lights / sizeof *lights; i++) {
+    char to[512];
+    snprintf(to, sizeof to,
+             "\"mesh\":0,\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
+             "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"name\":\"lamp\",\"type\":\"point\",%s}]}},"
+             "\"extras\":[0",
+             lights[i].light);
+    EXPECT(lights[i].file, "\"mesh\":0}", to, lights[i].want);
+  }
   EXPECT("color.gltf", "[0.5,0.25,1,1]", "[0.5,0.25]", "baseColorFactor");
   EXPECT("metal.gltf", "\"metallicFactor\":0", "\"metallicFactor\":1e999", "");
   EXPECT("reflect.gltf", "\"materials\":[{", "\"materials\":[{\"extras\":{\"reflectivity\":1.5},",

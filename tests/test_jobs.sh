@@ -148,6 +148,19 @@ check "farm: --shards required" run 2 farm slurm --job job.lua
 check "farm: a bad name" run 2 farm slurm --job job.lua --shards 2 --name 'a b'
 check "farm: a value on two lines" run 2 farm slurm --job job.lua --shards 2 --partition "$(printf 'a\nb')"
 check "farm: only slurm" run 2 farm pbs --job job.lua --shards 2
+# sbatch's --time, --mem and --cpus-per-task checked here, not by sbatch on the cluster at submit time
+for t in 1h 1:2:3:4 2- -5; do
+  check "farm: --time $t refused" run 2 farm slurm --job job.lua --shards 2 --dir badfarm --time "$t"
+  check "farm: --time $t named" err_has "--time wants sbatch's MINUTES, MINUTES:SECONDS, HOURS:MINUTES:SECONDS or DAYS-HOURS[:MINUTES[:SECONDS]], not '$t'"
+done
+for m in lots 1.5G 8GiB; do
+  check "farm: --mem $m refused" run 2 farm slurm --job job.lua --shards 2 --dir badfarm --mem "$m"
+  check "farm: --mem $m named" err_has "--mem wants sbatch's megabytes, or a number with K, M, G or T (8G), not '$m'"
+done
+check "farm: --cpus-per-task 0 refused" run 2 farm slurm --job job.lua --shards 2 --dir badfarm --cpus-per-task 0
+check "farm: nothing written for bad sbatch values" test ! -e badfarm/limn-job.sbatch
+check "farm: sbatch's other time forms" run 0 farm slurm --job job.lua --shards 2 --dir timefarm --time 2-12:30 --mem 8000
+check "farm: days-hours:minutes passed on" grep -qxF -- "#SBATCH --time=2-12:30" timefarm/limn-job.sbatch
 check "bad shard" run 2 capture --job job.lua --shard 3/3
 check "bad shard message" err_has "--shard wants I/N"
 check "--force needs --job" run 2 capture --force

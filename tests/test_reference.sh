@@ -12,7 +12,8 @@
 #   direct-only reference of the view, whose error against the baseline is
 #   the floor of the share of indirect error removed;
 # - each setting starts from the job's options, inheriting none from the one before; a still place's
-#   warm-up carries into its timed frames.
+#   warm-up carries into its timed frames; a sweep that fails half-way leaves no report (the last run's
+#   is removed with it: its images are being overwritten).
 # - --require-refs and --cached-refs render nothing: the first names the command, the second
 #   leaves out (and names) the views without cached references.
 # Skipped (77) where povray is not installed (tools/dev.sh installs it).
@@ -219,6 +220,16 @@ awk -v l="$low" 'BEGIN { exit !(l > 0) }' || fail "the error axis starts at $low
 # The images are there to look at.
 [ "$(ls rep/images/*.exr | wc -l)" = 3 ] || fail "not three images"
 
+# A sweep whose second setting fails as it renders (isr.sky_bounce with one bounce): exit 1 naming the
+# setting and what it lacks; the report of the run before in the same --out is gone, since this run's
+# images (setting 1's already rendered) no longer match it.
+"$limn" report --job job.lua "${fast[@]}" --out rep --frames 1 --warmup 0 \
+  --sweep "isr:isr.bounces=2,1;isr.sky_bounce=true" >log15 2>&1
+[ $? = 1 ] || { cat log15; fail "a sweep whose setting fails did not exit 1"; }
+grep -q "isr bounces=1 sky_bounce=true: .*isr.bounces above 1 (it is 1)" log15 \
+  || { cat log15; fail "the failing setting and the option it lacks are not named"; }
+for f in report.csv report.json report.svg report.md; do [ -e rep/$f ] && fail "a failed report left rep/$f"; done
+
 # Every setting starts from the job's options: "isr" after "isr:isr.mode=seed" renders the default
 # mode, not the seed's it would inherit.
 "$limn" report --job job.lua "${fast[@]}" --out rep4 --frames 1 --warmup 0 \
@@ -243,6 +254,11 @@ for n in 5 1; do
 done
 grep -q '"mean_error": 0[,}]' c5.json || { cat c5.json; fail "the report's warm-up did not carry into its timed frame"; }
 grep -q '"mean_error": 0[,}]' c1.json && fail "the warm-up changed nothing (the check above proves nothing)"
+
+# A baseline the script lacks is named as --baseline (it was named as a --sweep), exit 2, before any reference.
+"$limn" report --job job.lua "${fast[@]}" --out rep8 --baseline nope --sweep dl >log16 2>&1
+[ $? = 2 ] || { cat log16; fail "an unknown baseline did not exit 2"; }
+grep -q "limn: error: --baseline nope: unknown technique 'nope'" log16 || { cat log16; fail "the baseline is not named"; }
 
 # 4. --require-refs names the command when a reference is missing
 "$limn" report --job job.lua "${fast[@]}" --refs refs-none --require-refs --out rep2 --sweep dl >log7 2>&1

@@ -128,6 +128,14 @@ static void sweep_syntax(void **state) {
                                   list, &n, &err));
   assert_non_null(strstr(err.msg, "more than"));
   assert_int_equal(n, 9);
+  /* A setting given twice, within a sweep or by a second one, is refused naming it. */
+  assert_false(report_sweep_parse("isr:isr.samples=4,8,8", list, &n, &err));
+  assert_non_null(
+      strstr(err.msg, "--sweep 'isr:isr.samples=4,8,8': setting 'isr samples=8' is there twice (settings 10 and 11)"));
+  assert_int_equal(n, 9);
+  assert_false(report_sweep_parse("ssao:ssao.radius=0.2", list, &n, &err));
+  assert_non_null(strstr(err.msg, "setting 'ssao radius=0.2' is there twice (settings 8 and 9)"));
+  assert_int_equal(n, 9);
 }
 
 /* Views as a job lists them: camera 0 in frames 0 1 2, camera 1 in frames

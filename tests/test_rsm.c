@@ -1225,11 +1225,19 @@ static void bad_options_name_themselves(void **state) {
       {"isr+rsm+esm", "isr.mode=seed", "isr+rsm+esm needs isr.mode \"physical\""},
   };
   gl_assert_bad_options(cases, sizeof cases / sizeof *cases, "pp.lua:");
-  /* isr.sky_bounce sends through the senders the first march records: none at one bounce. */
-  const char *const one_bounce[] = {"isr.bounces=1", "isr.sky_bounce=true", NULL};
-  gl_result b = gl_render(&(gl_run){.tech = "isr+esm", .sets = one_bounce});
-  if (b.ok || !strstr(b.err.msg, "isr.sky_bounce needs") || !strstr(b.err.msg, "pp.lua:")) fail_msg("%s", b.err.msg);
-  gl_result_free(&b);
+  /* isr.sky_bounce sends through the senders the first march records: none at one bounce, without
+   * reuse or past 24 rays; the error names the option that stops it and its value. */
+  static const char *const no_senders[][4] = {
+      {"isr.bounces=1", "isr.sky_bounce=true", NULL, "isr.bounces above 1 (it is 1)"},
+      {"isr.reuse=false", "isr.sky_bounce=true", NULL, "isr.reuse (it is false)"},
+      {"isr.samples=32", "isr.sky_bounce=true", NULL, "at most 24 isr.samples (it is 32)"}};
+  for (size_t i = 0; i < sizeof no_senders / sizeof *no_senders; i++) {
+    gl_result b = gl_render(&(gl_run){.tech = "isr+esm", .sets = no_senders[i]});
+    if (b.ok || !strstr(b.err.msg, "isr.sky_bounce needs the senders the first march records: ") ||
+        !strstr(b.err.msg, no_senders[i][3]) || !strstr(b.err.msg, "pp.lua:"))
+      fail_msg("%s: %s", no_senders[i][0], b.err.msg);
+    gl_result_free(&b);
+  }
   /* The traced rays' two outputs beside 24 rays' hits: more than the march may write, named. */
   const char *const sets[] = {"rsm.trace=1", "isr.samples=24", NULL};
   gl_result r = gl_render(&(gl_run){.tech = "isr+rsm+esm", .sets = sets});

@@ -196,6 +196,14 @@ check "bench motion table columns" out_has "still     moving      alone  moving/
 check "bench motion table moved" out_has "the moving camera moved in 2 of 2 frames"
 check "bench motion table per frame" out_has "frame   moving    alone  ratio  cpu mov cpu alone  ratio built   tiles"
 check "bench motion table target" grep -qE "^target: a frame of a sequence within 1.2x .*: (PASS|FAIL)$" "$tmp/out"
+# A script failing on its sixth frame: exit 1 naming the size or the motion renderer and frame, as capture does.
+late_script "$tmp/late.lua"
+check "bench late script" run 1 bench --script "$tmp/late.lua" --sizes 32x24 --frames 10 --warmup 2
+check "bench late script names the frame" err_has "limn: error: 32x24, frame 5 (2 warm-up, 10 timed): $tmp/late.lua:6: frame 5 fails"
+check "bench motion late script" run 1 bench --script "$tmp/late.lua" --sizes 32x24 --frames 1 --warmup 0 \
+  --scene "$root/data/scenes/door.glb" --time 0:1
+check "bench motion late script names the renderer, frame and time" \
+  err_has "--motion, the alone renderer's frame 5 at 0.208 s (round 1): $tmp/late.lua:6: frame 5 fails"
 # bench --time on scenes that move: the skinned tube bends under a still camera (its sun's tiles are
 # drawn again each moving frame, none when still), the turntable's animated camera is followed.
 motion_animated() {  # $1: "tube" or "turntable"

@@ -552,7 +552,8 @@ static void command_line_errors(void **state) {
       {{"--scene", "nope"}, "nope", 2},
       {{"--animation", "nope"}, "has no animation 'nope'", 2},
       {{"--time", "soon"}, "--time wants seconds", 2},
-      {{"--fps", "0"}, "--fps wants 1..1000", 2},
+      {{"--fps", "0"}, "--fps wants frames a second in (0, 1000]", 2},
+      {{"--fps", "1001"}, "--fps wants frames a second in (0, 1000]", 2},
       {{"--script-keys", "4:time=later"}, "--script-keys wants FRAME:KEY", 2},
       {{"--panel", "maybe"}, "--panel wants on or off", 2},
       {{"--view", "2"}, "--view N needs --job FILE", 2},
@@ -794,20 +795,21 @@ static void a_time_far_out_has_a_frame_number(void **state) {
   assert_true(file_has(log, "limn: time -1e+300 s, frame "));
 }
 
-/* A sequence job's view (time = { 1, 2, 10 }: frame 3 at 1.3 s) counts the
- * job's frames: frame 3, not the viewer's default 24 fps from 0 (frame 31);
- * a --fps of another rate is refused naming both, the same one taken. */
+/* A sequence job's view (time = { 1, 2, 12.5 }: frame 3 at 1.24 s) counts the
+ * job's frames: frame 3, not the viewer's default 24 fps from 0 (frame 29);
+ * a --fps of another rate is refused naming both, the same one taken (a
+ * rate of 12.5, as capture takes it: --fps wanted a whole number). */
 static void a_sequence_job_counts_its_own_frames(void **state) {
   (void)state;
   char log[512], job[1200];
   log_path(log, "job_fps");
   snprintf(job, sizeof job,
            "return { scenes = { \"%s\" }, sizes = { \"48x36\" }, techniques = { \"dl\" },\n"
-           "  time = { 1, 2, 10 }, output = \"seq/{camera}-{frame}.png\" }\n", SCENE("moving_light"));
+           "  time = { 1, 2, 12.5 }, output = \"seq/{camera}-{frame}.png\" }\n", SCENE("moving_light"));
   write_file("fps_job.lua", job);
   path_in_root(job, sizeof job, "fps_job.lua");
   for (int fps = 0; fps < 3; fps++) { /* without --fps, with the job's, with another */
-    const char *rate = fps == 1 ? "10" : "24";
+    const char *rate = fps == 1 ? "12.5" : "24";
     pid_t pid = fps ? spawn_view(log, "--job", job, "--view", "3", "--fps", rate, "--exit-after", "2",
                                  "--script-keys", "1:Space", NULL)
                     : spawn_view(log, "--job", job, "--view", "3", "--exit-after", "2", "--script-keys", "1:Space",
@@ -816,7 +818,7 @@ static void a_sequence_job_counts_its_own_frames(void **state) {
     if (rc != (fps == 2 ? 2 : 0)) print_log(log);
     if (fps == 2) {
       assert_int_equal(rc, 2);
-      assert_true(file_has(log, "--fps 24: the job's time.fps is 10"));
+      assert_true(file_has(log, "--fps 24: the job's time.fps is 12.5"));
       continue;
     }
     assert_int_equal(rc, 0);
@@ -824,8 +826,8 @@ static void a_sequence_job_counts_its_own_frames(void **state) {
     int n = time_lines(log, t, 4);
     if (n != 2) print_log(log);
     assert_int_equal(n, 2);
-    assert_time(&t[0], "Space", 1.3, 3, true);
-    assert_time(&t[1], "at exit", 1.3, 3, true);
+    assert_time(&t[0], "Space", 1.24, 3, true);
+    assert_time(&t[1], "at exit", 1.24, 3, true);
   }
 }
 

@@ -17,8 +17,20 @@ bool lm_scene_animated(const lm_scene *s) { return s->animation_count > 0; }
 
 int lm_scene_find_animation(const lm_scene *s, const char *spec, lm_error *err) {
   if (!strcmp(spec, "all")) return LM_ANIM_ALL;
+  int found = -1, shared = 0;
+  char indices[128] = ""; /* of a name several animations share: it picks none of them */
   for (int a = 0; a < s->animation_count; a++)
-    if (!strcmp(s->animations[a].name, spec)) return a;
+    if (!strcmp(s->animations[a].name, spec)) {
+      if (found < 0) found = a;
+      size_t n = strlen(indices);
+      if (shared++ < 8) snprintf(indices + n, sizeof indices - n, "%s%d", a > found ? ", " : "", a);
+    }
+  if (shared > 1) {
+    lm_error_set(err, "scene '%s' has several animations named '%s' (%s%s): give its index", s->name, spec, indices,
+                 shared > 8 ? ", ..." : "");
+    return -3;
+  }
+  if (found >= 0) return found;
   /* An index is digits only: strtol would take " 0" or "+0" as animation 0. */
   size_t digits = strspn(spec, "0123456789");
   long i = digits && !spec[digits] && digits < 10 ? strtol(spec, NULL, 10) : -1;

@@ -42,7 +42,11 @@ void lm_camera_look_at(const float eye[3], const float target[3], float world[16
   glm_vec3_sub((float *)target, (float *)eye, f);
   if (!(glm_vec3_norm(f) > 0)) glm_vec3_copy((vec3){0, 0, -1}, f);
   glm_vec3_normalize(f);
-  if (fabsf(f[1]) > 0.999f) up[1] = 0, up[2] = -1; /* straight down or up: any other up */
+  /* The world's up while the view has any level part: its right is then level and turns with its
+   * heading, up to the vertical (switching up at |f.y| 0.999 rolled a view from the -z side 180
+   * degrees, a path or orbit near the vertical flipping between two frames). Straight down or up:
+   * -z or +z, the limit of a view from the +z side. */
+  if (!(f[0] * f[0] + f[2] * f[2] > 1e-12f)) up[1] = 0, up[2] = f[1] < 0 ? -1 : 1;
   glm_vec3_crossn(f, up, r);
   glm_vec3_cross(r, f, u);
   float m[16] = {r[0], r[1], r[2], 0, u[0], u[1], u[2], 0, -f[0], -f[1], -f[2], 0, eye[0], eye[1], eye[2], 1};

@@ -1199,10 +1199,22 @@ bool add_light(Loader &L, int ni, int li, int node) {
   else if (gl.type == "spot") l.type = LM_LIGHT_SPOT;
   else if (gl.type == "directional") l.type = LM_LIGHT_DIRECTIONAL;
   else return fail(L, "light %d: type '%s' is none of point, spot, directional", li, gl.type.c_str());
+  char what[LM_NAME_MAX + 32]; // "light 2" or "light 2 ('lamp')"
+  snprintf(what, sizeof what, gl.name.empty() ? "light %d" : "light %d ('%s')", li, gl.name.c_str());
   if ((!gl.color.empty() && gl.color.size() != 3) || !finite_all(gl.color))
-    return fail(L, "light %d: color needs 3 finite numbers", li);
-  if (!(gl.intensity >= 0 && gl.intensity < 1e30) || !(gl.range >= 0 && gl.range < 1e30))
-    return fail(L, "light %d: intensity and range must be finite and not negative", li);
+    return fail(L, "%s: color needs 3 finite numbers", what);
+  double peak = gl.color.empty() ? 1.0 : std::max({gl.color[0], gl.color[1], gl.color[2]});
+  if (!gl.color.empty() && std::min({gl.color[0], gl.color[1], gl.color[2]}) < 0)
+    return fail(L, "%s: color (%g, %g, %g) has a negative component (light is never negative)", what,
+                gl.color[0], gl.color[1], gl.color[2]);
+  if (!(gl.intensity >= 0 && gl.intensity < 1e30))
+    return fail(L, "%s: intensity %g is not a number in [0, 1e30)", what, gl.intensity);
+  if (!(gl.range >= 0 && gl.range < 1e30))
+    return fail(L, "%s: range %g is not a number in [0, 1e30)", what, gl.range);
+  // The light a pass computes is intensity times colour, in floats: bounded as the intensity is.
+  if (!(gl.intensity * peak < 1e30))
+    return fail(L, "%s: intensity %g times color %g is past 1e30 (a pass's light would overflow)", what,
+                gl.intensity, peak);
   double inner = gl.spot.innerConeAngle, outer = gl.spot.outerConeAngle;
   if (l.type == LM_LIGHT_SPOT && !(inner >= 0 && inner < outer && outer <= M_PI / 2))
     return fail(L, "light %d: spot cone angles need 0 <= inner < outer <= pi/2; got %g, %g", li,
