@@ -57,8 +57,10 @@ bool rsm_seen(sampler2D dpt, vec3 q) {
 // distance" (line 917) made exact for this pattern. The disc is drawn inside
 // the view's bounds (the part of the tile the scene's box covers: no sender
 // lies outside), R at most the distance to their farthest corner, each
-// direction's radius cut at their edge (rsm_gather_light says how): no sample
-// is wasted where no texel can hold a sender; one on an empty texel adds nothing.
+// direction's radius cut at their edge for a directional light's view
+// (rsm_gather_light says how): no sample is wasted where no texel can hold a
+// sender; one on an empty texel adds nothing.
+// RSM_INSIDE: every view's samples cut so (the traced hits' gather, rsm.trace).
 // Interleaved sampling: the pattern is one sequence, xi_1 = Phi_2(k) (van der
 // Corput) and xi_2 = k phi (golden ratio, mod 1), of which pixel j of a 4 x 4
 // tile (Bayer order, halton.glsl) takes the block k = j n .. j n + n - 1: each
@@ -336,14 +338,23 @@ vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn
     // The disc reaches no farther than the bounds' farthest corner: beyond it every sample would fall
     // outside and add nothing.
     float reach = min(rsm_radius, length(max(centre - lo, hi - centre)));
-    // Every sample inside the bounds: a direction that leaves them from a centre on their edge (corner: a
-    // cube face behind p) folds back across it, the disc being symmetric about the edge (the density
-    // inside doubles: each weighs half); and each direction's radius ends at the bounds' edge, L <= reach,
-    // xi L from the centre (density 1 / (2 pi L^2 xi) a unit area: each weighs (L / reach)^2 of the disc's
-    // sample). On the loft, the first bounce's error against Cycles' fell by 9-31% a view at the same
-    // samples (docs/gi-combined.md "The RSM's samples where the senders are").
+    // cut: every sample inside the bounds. A direction that leaves them from a centre on their edge
+    // (corner: a cube face beside p) folds back across it, the disc being symmetric about the edge (the
+    // density inside doubles: each weighs half); and each direction's radius ends at the bounds' edge,
+    // L <= reach, xi L from the centre (density 1 / (2 pi L^2 xi) a unit area: each weighs (L / reach)^2
+    // of the disc's sample). Else the disc's samples outside the bounds are dropped. A directional
+    // light's views cut (its tile reaches past the scene: on the loft the first bounce's error against
+    // Cycles' fell by 9-34% a view at the same samples, docs/gi-combined.md "The RSM's samples where the
+    // senders are"); a spot or point light's keep the disc (cut, a spot's history lagged a dimmed floor
+    // twice as far in test_rsm's a_clamped_history_follows_a_light_step); RSM_INSIDE (the traced hits'
+    // gather, where samples are dearest) cuts every view.
+#ifdef RSM_INSIDE
+    const bool cut = true;
+#else
+    bool cut = type == 2; // a constant in a light-set variant
+#endif
     float texels = 2.0 * PI * tile * tile / float(max(n, 1));
-    vec2 fold = vec2(notEqual(projected, centre));
+    vec2 fold = cut ? vec2(notEqual(projected, centre)) : vec2(0.0);
     vec2 inward = mix(vec2(-1.0), vec2(1.0), lessThan(centre - lo, hi - centre));
     texels *= exp2(-(fold.x + fold.y));
     for (int k = 0; k < n; k++, dir = rsm_turn(dir)) {
@@ -360,10 +371,10 @@ vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn
         xi = fract(radical_inverse(k0 + uint(k), 2u) + centred);
         vec2 w = mix(dir, abs(dir) * inward, fold);
         vec2 room = mix(centre - lo, hi - centre, step(0.0, w)) / max(abs(w), vec2(1e-6)); // to the edge, each axis
-        float along = min(reach, min(room.x, room.y));
+        float along = cut ? min(reach, min(room.x, room.y)) : reach;
         t = centre + xi * along * w;
         weight = along * along * xi; // the sample's weight over texels
-        if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue; // rounding at the edge
+        if (any(lessThan(t, lo)) || any(greaterThan(t, hi)) || any(greaterThanEqual(t, vec2(1.0)))) continue;
         a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
         vec4 qn = texelFetch(rsm_pos, a, 0); // position, normal (normal_pack)
         if (qn.w > 0.0) continue; // empty
