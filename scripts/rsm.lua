@@ -265,7 +265,7 @@ function rsm.march(o, frame)
              all.steps = 0
              if o.trace_samples > 0 then all.samples = o.trace_samples end
              params.rsm_k = o.k
-             defines.RSM_INSIDE = true -- every sample inside its view's tile (rsm.glsl): samples are dearest here
+             defines.RSM_INSIDE = true -- every sample inside its view's bounds (rsm.glsl): samples are dearest here
              return rsm.bind(inputs, defines, params, frame.R, frame.shadows, all, f, false, false, frame.G)
            end }
 end

@@ -54,9 +54,13 @@ bool rsm_seen(sampler2D dpt, vec3 q) {
 // centre where senders are nearest; its density per texel falls as
 // 1 / (2 pi R^2 xi_1), so each sample weighs 2 pi R^2 xi_1 T^2 / N texels
 // (T the tile's side): the seed's "samples weighed by their squared
-// distance" (line 917) made exact for this pattern. Samples outside the tile
-// or on an empty texel add nothing; so R is at most the distance to the
-// tile's farthest corner, where the disc covers the whole tile already.
+// distance" (line 917) made exact for this pattern. The disc is drawn inside
+// the view's bounds (the part of the tile the scene's box covers: no sender
+// lies outside), R at most the distance to their farthest corner, each
+// direction's radius cut at their edge for a directional light's view
+// (rsm_gather_light says how): no sample is wasted where no texel can hold a
+// sender; one on an empty texel adds nothing.
+// RSM_INSIDE: every view's samples cut so (the traced hits' gather, rsm.trace).
 // Interleaved sampling: the pattern is one sequence, xi_1 = Phi_2(k) (van der
 // Corput) and xi_2 = k phi (golden ratio, mod 1), of which pixel j of a 4 x 4
 // tile (Bayer order, halton.glsl) takes the block k = j n .. j n + n - 1: each
@@ -86,8 +90,6 @@ bool rsm_seen(sampler2D dpt, vec3 q) {
 // (on the yard 2 senders of 16 points blocked as much as every sender's).
 // EXCLUDE_SEEN: a sender the camera sees (rsm_seen) is left to the
 // screen-space march of the combined technique.
-// RSM_INSIDE: every sample falls inside its view's tile (the traced hits'
-// gather, rsm.trace: rsm_gather_light says how), none wasted off its edges.
 // A light-set variant (LIGHT_SET, lighting.glsl) gathers each light unrolled,
 // for its kind alone: a software rasterizer runs every branch of every
 // sample (each kind's light and falloff, both texel areas) where the kind is
@@ -327,21 +329,35 @@ vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn
     ShadowView sv = shadow_views[v];
     vec4 c = sv.view_proj * vec4(s.p, 1.0);
     vec2 projected = c.w > 1e-12 ? c.xy / c.w * 0.5 + 0.5 : vec2(0.5);
-    vec2 centre = clamp(projected, vec2(0.0), vec2(1.0)); // behind a cube face: its nearest edge
+    // The samples go where senders can be: the part of the tile the scene's box covers (sv.bounds; a
+    // directional light's tile reaches rsm.reach times past what is seen, and where no ground surrounds
+    // the scene most of it is empty: the loft's sun, its sunlit senders two small patches).
+    vec2 lo = sv.bounds.xy, hi = sv.bounds.zw;
+    vec2 centre = clamp(projected, lo, hi); // behind a cube face: its nearest edge
     float tile = sv.rect.z * atlas.x;
-    // The disc reaches no farther than the tile's farthest corner: beyond it every sample would fall
-    // outside and add nothing, so the pattern keeps its samples where texels are.
-    float reach = min(rsm_radius, length(max(centre, 1.0 - centre)));
-    float texels = 2.0 * PI * reach * reach * tile * tile / float(max(n, 1));
+    // The disc reaches no farther than the bounds' farthest corner: beyond it every sample would fall
+    // outside and add nothing.
+    float reach = min(rsm_radius, length(max(centre - lo, hi - centre)));
+    // cut: every sample inside the bounds. A direction that leaves them from a centre on their edge
+    // (corner: a cube face beside p) folds back across it, the disc being symmetric about the edge (the
+    // density inside doubles: each weighs half); and each direction's radius ends at the bounds' edge,
+    // L <= reach, xi L from the centre (density 1 / (2 pi L^2 xi) a unit area: each weighs (L / reach)^2
+    // of the disc's sample). Else the disc's samples outside the bounds are dropped. A directional
+    // light's views cut (its tile reaches past the scene: on the loft the first bounce's error against
+    // Cycles' fell by 9-34% a view at the same samples, docs/gi-combined.md "The RSM's samples where the
+    // senders are"); a spot or point light's keep the disc (cut, a spot-lit ceiling's clamped history
+    // stood 25% off a dimmed floor's light 6 frames on, against 8.4%: test_rsm's
+    // a_clamped_history_follows_a_light_step); RSM_INSIDE (the traced hits' gather, where samples are
+    // dearest) cuts every view.
 #ifdef RSM_INSIDE
-    // Every sample inside the tile (the traced hits' gather, where samples are dearest): a direction that
-    // leaves the tile from a centre on its edge (corner) folds back across it, the disc being symmetric
-    // about the edge (the density inside doubles: each weighs half); and each direction's radius ends at
-    // the tile's edge, L <= reach, xi L from the centre (density 1 / (2 pi L^2 xi) a unit area: each weighs
-    // (L / reach)^2 of the disc's sample).
-    vec2 fold = vec2(notEqual(projected, centre)), inward = 1.0 - 2.0 * centre;
-    texels *= exp2(-(fold.x + fold.y)) / max(reach * reach, 1e-30);
+    const bool cut = true;
+#else
+    bool cut = type == 2; // a constant in a light-set variant
 #endif
+    float texels = 2.0 * PI * tile * tile / float(max(n, 1));
+    vec2 fold = cut ? vec2(notEqual(projected, centre)) : vec2(0.0);
+    vec2 inward = mix(vec2(-1.0), vec2(1.0), lessThan(centre - lo, hi - centre));
+    texels *= exp2(-(fold.x + fold.y));
     for (int k = 0; k < n; k++, dir = rsm_turn(dir)) {
       // The samples up to the next sender that the geometry term lets through, in a loop of their own:
       // llvmpipe runs an if's body for every pixel of its group, so the tests below inside this loop cost
@@ -354,17 +370,12 @@ vec3 rsm_gather_light(int i, int type, int falloff, Surface s, int j, float turn
       vec3 q = vec3(0.0), nq = vec3(0.0);
       for (; k < n; k++, dir = rsm_turn(dir)) {
         xi = fract(radical_inverse(k0 + uint(k), 2u) + centred);
-#ifdef RSM_INSIDE
         vec2 w = mix(dir, abs(dir) * inward, fold);
-        vec2 room = mix(centre, 1.0 - centre, step(0.0, w)) / max(abs(w), vec2(1e-6)); // to the edge, each axis
-        float along = min(reach, min(room.x, room.y));
+        vec2 room = mix(centre - lo, hi - centre, step(0.0, w)) / max(abs(w), vec2(1e-6)); // to the edge, each axis
+        float along = cut ? min(reach, min(room.x, room.y)) : reach;
         t = centre + xi * along * w;
-        weight = along * along * xi; // the sample's weight over texels (reach^2 divided out above)
-#else
-        t = centre + xi * reach * dir;
-        weight = xi;
-#endif
-        if (any(lessThan(t, vec2(0.0))) || any(greaterThanEqual(t, vec2(1.0)))) continue;
+        weight = along * along * xi; // the sample's weight over texels
+        if (any(lessThan(t, lo)) || any(greaterThan(t, hi)) || any(greaterThanEqual(t, vec2(1.0)))) continue;
         a = ivec2((sv.rect.xy + t * sv.rect.zw) * atlas);
         vec4 qn = texelFetch(rsm_pos, a, 0); // position, normal (normal_pack)
         if (qn.w > 0.0) continue; // empty

@@ -28,6 +28,7 @@ struct ShadowView {
   vec4 depth; // light position, 1 / range (0: orthographic)
   vec4 texel; // a texel's world width (orthographic) or its size per unit of distance; world depth 0..1 spans;
               // orthographic: a texel's world height; perspective: the projection's x and y scale
+  vec4 bounds; // RSM views: the tile coordinates the scene's box covers, min xy, max xy (no sender outside)
 };
 #ifdef LIGHT_BLOCKS
 // Copies in uniform blocks, as common.glsl's lights: at most 6 shadow views a

@@ -113,6 +113,45 @@ static void sunlit_floor_bleeds_onto_a_ceiling_the_sun_cannot_reach(void **state
   lm_scene_destroy(s);
 }
 
+/* The canopy's luminance under rsm+esm (no blur) over the region X0.. Y0.. of RW x RH pixels, with `sets`. */
+enum { X0 = W / 2 - 30, Y0 = H / 2 - 20, RW = 61, RH = 41 };
+static void canopy_luminance(lm_scene *s, const char *const *sets, double *out) {
+  gl_result r = render_ok(s, "rsm+esm", sets);
+  for (int i = 0; i < RW * RH; i++) out[i] = gl_luminance(r.rgb + 3 * ((Y0 + i / RW) * W + X0 + i % RW));
+  gl_result_free(&r);
+}
+
+/* The gather draws its samples inside the part of a light's tile that the scene's box covers
+ * (lm_shadow_view_data.bounds), where every sender lies: a directional light's tile reaches rsm.reach
+ * times past what the camera sees, and with no ground around the scene most of it is empty (the held-out
+ * loft). On the canopy at the default 24 samples, the error over the pixels against 1024 samples (mean
+ * |l - l_1024| / mean l_1024, no blur) is no larger with the tile 64 times as wide as what is seen (512
+ * texels: the same texel as 128 at 16, the floor 1/16 of the tile's area as much) than at 16 (measured
+ * 0.055 and 0.055), the means within 3% (measured 0.25%); with the disc over the whole tile it was 0.330
+ * at 64 (0.097 at 16, the disc's samples beyond the bounds left out). */
+static void the_samples_stay_where_the_scene_is_whatever_the_reach(void **state) {
+  (void)state;
+  lm_scene *s = canopy_scene();
+  static double ref[RW * RH], near[RW * RH], far[RW * RH];
+  static const char *const ref_sets[] = {"ambient=0", "rsm.blur=0", "rsm.reach=16", "rsm.samples=1024", NULL},
+                           *const near_sets[] = {"ambient=0", "rsm.blur=0", "rsm.reach=16", NULL},
+                           *const far_sets[] = {"ambient=0", "rsm.blur=0", "rsm.reach=64", "rsm.resolution=512", NULL};
+  canopy_luminance(s, ref_sets, ref);
+  canopy_luminance(s, near_sets, near);
+  canopy_luminance(s, far_sets, far);
+  double sum = 0, sum_near = 0, sum_far = 0, err_near = 0, err_far = 0;
+  for (int i = 0; i < RW * RH; i++) {
+    sum += ref[i], sum_near += near[i], sum_far += far[i];
+    err_near += fabs(near[i] - ref[i]), err_far += fabs(far[i] - ref[i]);
+  }
+  assert_true(sum > 0);
+  print_message("canopy at 24 samples: error over pixels %.3f at reach 16, %.3f at 64; means %.4f %.4f of 1024's\n",
+                err_near / sum, err_far / sum, sum_near / sum, sum_far / sum);
+  assert_true(err_far < 1.2 * err_near + 0.005 && err_far < 0.12 * sum);
+  assert_true(fabs(sum_far / sum - 1) < 0.03 && fabs(sum_near / sum - 1) < 0.03);
+  lm_scene_destroy(s);
+}
+
 /* The same under a point light: a cube face's texel covers the solid angle
  * of its size per unit distance squared times cos^3 of its angle off the
  * face's axis (rsm_texel_area). With cos alone the canopy took 1.47 times
@@ -234,15 +273,18 @@ static void the_solid_grid_keeps_senders_on_their_own_solid(void **state) {
 
 /* The gather's samples buy less noise, not more light: the mean of rsm+esm's
  * indirect light over the reference street's first view (64 x 48) at 24
- * samples a pixel lies within 5% of that at 256. Under its high sun every
+ * samples a pixel lies within 7% of that at 1024. Under its high sun every
  * point of a wall projects onto nearly the same RSM texels, so one pattern
  * for every tile took the same senders all along the wall: 0.049 at 24
- * against 0.088 at 256 (rsm.glsl's turn and shift per tile: 0.081, 0.080). */
+ * against 0.088 at 256 (rsm.glsl's turn and shift per tile: 0.081, 0.080).
+ * 256 samples were not the converged light (the disc over the whole tile: 24
+ * and 256 samples 8% below 1024's; the sun's samples cut to the scene's
+ * bounds: 24 5.1% below, 256 within 0.7%), so 1024 is the measure. */
 static void the_gathered_light_does_not_depend_on_the_sample_count(void **state) {
   (void)state;
   lm_scene *s = gl_reference_scene("street");
   static const char *const direct_sets[] = {"ambient=0", NULL}, *const few[] = {"ambient=0", "rsm.samples=24", NULL},
-                           *const many[] = {"ambient=0", "rsm.samples=256", NULL};
+                           *const many[] = {"ambient=0", "rsm.samples=1024", NULL};
   enum { SW = 64, SH = 48 };
   gl_result d = gl_render_ok(&(gl_run){.scene = s, .tech = "dl+esm", .sets = direct_sets, .width = SW, .height = SH}),
             a = gl_render_ok(&(gl_run){.scene = s, .tech = "rsm+esm", .sets = few, .width = SW, .height = SH}),
@@ -252,9 +294,9 @@ static void the_gathered_light_does_not_depend_on_the_sample_count(void **state)
   gl_region(&a, 0, 0, SW - 1, SH - 1, ra);
   gl_region(&b, 0, 0, SW - 1, SH - 1, rb);
   float ia = gl_luminance(ra) - gl_luminance(rd), ib = gl_luminance(rb) - gl_luminance(rd);
-  print_message("street: indirect light at 24 samples %.5f, at 256 %.5f\n", ia, ib);
+  print_message("street: indirect light at 24 samples %.5f, at 1024 %.5f\n", ia, ib);
   assert_true(ib > 0.01f);
-  assert_true(fabsf(ia - ib) < 0.05f * ib);
+  assert_true(fabsf(ia - ib) < 0.07f * ib);
   gl_result_free(&d);
   gl_result_free(&a);
   gl_result_free(&b);
@@ -1134,14 +1176,15 @@ static double traced_spread(lm_scene *s, const char *few, double *mean_ratio) {
 }
 
 /* The traced hits' gather (isr.trace_light) keeps every RSM sample inside its
- * view's tile (rsm.glsl's RSM_INSIDE): a direction's radius ends at the
+ * view's bounds (rsm.glsl's rsm_gather_light, as every gather since): a direction's radius ends at the
  * tile's edge, and a cube face beside the hit folds the directions that leave
  * it back across its edge. The same light (each sample weighs its density)
  * for less noise: at 64 samples (the best setting's), against 1024, the
  * Cornell box's point light spreads 0.184 with the mean at 1.016 (0.234 and
  * 1.013 with the disc's samples that fall outside left out), the white
  * room's sun through its window, the camera facing the wall opposite (the lit
- * floor off screen), 1.026 at 0.959 (1.214, 0.977). */
+ * floor off screen), 1.026 at 0.959 (1.214, 0.977); with the tile cut to the scene's bounds, 0.641 at
+ * 0.971. */
 static void traced_hits_gather_every_sample_inside_the_rsm_tiles(void **state) {
   (void)state;
   double ratio, spread = traced_spread(gl_cornell(), "rsm.trace_samples=64", &ratio);
@@ -1330,6 +1373,7 @@ int main(int argc, char **argv) {
   if (argc > 1) cmocka_set_test_filter(argv[1]); /* one test by name (a pattern) */
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(sunlit_floor_bleeds_onto_a_ceiling_the_sun_cannot_reach),
+      cmocka_unit_test(the_samples_stay_where_the_scene_is_whatever_the_reach),
       cmocka_unit_test(a_solid_between_hides_the_senders_behind_it),
       cmocka_unit_test(the_solid_grid_keeps_senders_on_their_own_solid),
       cmocka_unit_test(a_point_lights_floor_bleeds_onto_a_ceiling_as_the_integral_says),

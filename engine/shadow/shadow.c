@@ -41,6 +41,7 @@ static int add_view(lm_shadow_plan *plan, int size, mat4 view_proj, const float 
   memcpy(plan->view_data[i].view_proj, view_proj, 64);
   memcpy(plan->view_data[i].depth, depth, 16);
   memcpy(plan->view_data[i].texel, texel, 16);
+  memcpy(plan->view_data[i].bounds, (float[4]){0, 0, 1, 1}, 16);
   memcpy(plan->views[i].view_proj, view_proj, 64);
   memcpy(plan->views[i].depth, depth, 16);
   memcpy(plan->views[i].cull, cull ? cull : view_proj, 64);
@@ -635,13 +636,35 @@ static void plan_layout(lm_shadow_plan *plan, const lm_shadow_layout *last, lm_s
   plan->layout = (lm_shadow_layout){p, n, plan->columns, plan->rows, plan->tile};
 }
 
+/* Where the box lo .. hi projects in view_proj's tile coordinates (0..1, clamped): min xy, max xy;
+ * the whole tile where a corner lies at or behind the eye plane (a perspective view inside the box). */
+static void tile_bounds(const float view_proj[16], const float lo[3], const float hi[3], float out[4]) {
+  float b[4] = {1, 1, 0, 0};
+  for (int c = 0; c < 8; c++) {
+    vec4 p = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2], 1}, q;
+    glm_mat4_mulv((vec4 *)view_proj, p, q);
+    if (!(q[3] > 1e-12f)) {
+      memcpy(out, (float[4]){0, 0, 1, 1}, 16);
+      return;
+    }
+    for (int k = 0; k < 2; k++) {
+      float t = glm_clamp(q[k] / q[3] * 0.5f + 0.5f, 0.0f, 1.0f);
+      b[k] = fminf(b[k], t), b[k + 2] = fmaxf(b[k + 2], t);
+    }
+  }
+  memcpy(out, b, 16);
+}
+
 /* The RSM views, out of the views planned (a directional light's wide tile
  * after the shadow views, a spot or point light's shadow views): each
  * light's (cube y, z) in turn, rsm_tile texels a side, in rows of the RSM
  * atlas; their records follow the shadow views' in view_data, where cube y
- * then points. A perspective view's texel size follows its new size. The
+ * then points. A perspective view's texel size follows its new size, and
+ * each view's bounds are where the scene's box (s) projects into it. The
  * shadow pass keeps the shadow views alone. */
-static void plan_rsm_views(lm_shadow_plan *plan) {
+static void plan_rsm_views(lm_shadow_plan *plan, const lm_scene *s) {
+  float lo[3], hi[3];
+  bool bounded = lm_scene_bounds(s, lo, hi);
   int n = 0, shadows = plan->shadow_views;
   for (int i = 0; i < plan->light_count; i++) n += plan->lights[i].cube[2];
   plan->rsm_view_count = n;
@@ -663,6 +686,11 @@ static void plan_rsm_views(lm_shadow_plan *plan) {
       w->x = k % plan->rsm_columns * plan->rsm_tile, w->y = k / plan->rsm_columns * plan->rsm_tile;
       d->rect[0] = (float)w->x / (float)plan->rsm_width, d->rect[1] = (float)w->y / (float)plan->rsm_height;
       d->rect[2] = (float)w->width / (float)plan->rsm_width, d->rect[3] = (float)w->height / (float)plan->rsm_height;
+      if (bounded) { /* a texel more each side: the texels the box's edges cross are whole senders */
+        tile_bounds(d->view_proj, lo, hi, d->bounds);
+        for (int e = 0; e < 4; e++)
+          d->bounds[e] = glm_clamp(d->bounds[e] + (e < 2 ? -1.0f : 1.0f) / (float)plan->rsm_tile, 0.0f, 1.0f);
+      }
     }
   }
   free(plan->view_data);
@@ -690,7 +718,7 @@ static void plan_views(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_d
     rect[2] = (float)w->width / (float)plan->atlas_width;
     rect[3] = (float)w->height / (float)plan->atlas_height;
   }
-  plan_rsm_views(plan);
+  plan_rsm_views(plan, s);
 }
 
 bool lm_shadow_plan_make(lm_shadow_plan *plan, const lm_scene *s, const lm_frame_data *cam,

@@ -108,6 +108,9 @@ typedef struct lm_shadow_view_data {
   float depth[4]; /* light position xyz, 1 / range (0: orthographic) */
   float texel[4]; /* a texel's world width (orthographic) or its size per unit of distance; the world depth 0..1 spans;
                    * orthographic: a texel's world height; perspective: the projection's x and y scale */
+  float bounds[4]; /* RSM views: the tile coordinates (0..1) the scene's box projects to, min xy, max xy
+                    * (0 0 1 1 where it reaches behind the eye); no texel outside holds a sender, so the
+                    * RSM's gather draws its samples within (shaders/rsm.glsl) */
 } lm_shadow_view_data;
 
 typedef struct lm_shadow_plan {
