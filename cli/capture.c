@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -108,6 +109,23 @@ static bool unknown_placeholder(const char *name, char *msg, size_t cap) {
     }
   }
   return false;
+}
+
+/* An output whose folder is no writable folder: false when it is one (or holds a placeholder, a
+ * frame's own), else the message in msg. Capture makes no folder (a job does), so without this a
+ * sequence rendered its first frame before its first write failed. */
+static bool unwritable_folder(const char *name, char *msg, size_t cap) {
+  char dir[1100];
+  lm_dirname(name, dir, sizeof dir);
+  if (strchr(dir, '{')) return false;
+  struct stat st;
+  if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
+    snprintf(msg, cap, "--output '%s': no folder '%s' (capture makes none)", name, dir);
+  else if (access(dir, W_OK) != 0)
+    snprintf(msg, cap, "--output '%s': folder '%s' is not writable", name, dir);
+  else
+    return false;
+  return true;
 }
 
 static bool is_video(const char *path) {
@@ -240,7 +258,8 @@ static int parse_args(int argc, char **argv, capture_args *a) {
       bool linear;
       if (a->output_count + a->video_count == 16) return usage_error("%s", "at most 16 --output flags");
       char bad[1100];
-      if (unknown_placeholder(optarg, bad, sizeof bad)) /* it would be written as it stands */
+      if (unknown_placeholder(optarg, bad, sizeof bad) /* it would be written as it stands */
+          || unwritable_folder(optarg, bad, sizeof bad))
         return usage_error("%s", bad);
       for (int i = 0; i < a->output_count + a->video_count; i++)
         if (!strcmp(i < a->output_count ? a->outputs[i] : a->videos[i - a->output_count], optarg))

@@ -1,5 +1,6 @@
 /* limn capture --job FILE: many views of many scenes through one GL context
- * and one pipeline. The job file is Lua data (evaluated with no libraries):
+ * and one pipeline. The job file is Lua data (evaluated with no library but
+ * math's pure functions: math.pi, math.huge, math.floor...; not random):
  *
  *   return {
  *     script = "scripts/pp.lua",                  -- default scripts/pp.lua
@@ -38,6 +39,7 @@
 #include <glob.h>
 #include <signal.h>
 #include <lauxlib.h>
+#include <lualib.h>
 #include <lua.h>
 #include <limits.h>
 #include <math.h>
@@ -582,7 +584,13 @@ bool job_read(job *j, const char *path, lm_error *err) {
   bool ok = luaL_loadbufferx(L, text, len, chunk, "t") == LUA_OK;
   free(text);
   if (ok) {
-    lua_newtable(L); /* an empty environment: data, no functions */
+    /* The environment: data and math's functions alone (no I/O, os or require); math.random and
+     * randomseed left out, so that a job's views follow from its text (its hash keys its outputs). */
+    lua_newtable(L);
+    luaL_requiref(L, LUA_MATHLIBNAME, luaopen_math, 0);
+    lua_pushnil(L), lua_setfield(L, -2, "random");
+    lua_pushnil(L), lua_setfield(L, -2, "randomseed");
+    lua_setfield(L, -2, LUA_MATHLIBNAME);
     lua_setupvalue(L, -2, 1);
     lua_sethook(L, hook_budget, LUA_MASKCOUNT, 1000000);
     ok = lua_pcall(L, 0, 1, 0) == LUA_OK;

@@ -104,6 +104,8 @@ check "a misspelt placeholder" run 2 capture --time 0:1 --fps 4 --output "$tmp/i
 check "a misspelt placeholder named" err_has "--output '$tmp/img/s{frame}_{tiem}.png': unknown placeholder '{tiem}' (capture fills {frame} and {time})"
 check "an output given twice" run 2 capture --output "$tmp/img/s.png" --output "$tmp/img/s.png"
 check "an output given twice named" err_has "--output '$tmp/img/s.png' is given twice"
+check "an output into no folder" run 2 capture --time 0:100 --fps 4 --output "$tmp/nosuch/s{frame}.png"
+check "an output into no folder named, before a frame" err_has "--output '$tmp/nosuch/s{frame}.png': no folder '$tmp/nosuch' (capture makes none)"
 check "nothing of a refused command line" no_files
 check "sequence without --fps" run 2 capture --time 0:1 --output "$tmp/img/s{frame}.png"
 check "sequence without --fps message" err_has "--time 0:1: a sequence needs --fps N"

@@ -238,6 +238,10 @@ bad "syntax error" 2 "bad.lua:2:" "return {
 bad "not a table" 2 "bad.lua: the job file must return a table" "return 42"
 bad "runs forever" 2 "the job file runs too long" "while true do end"
 bad "no functions in a job" 2 "bad.lua:1:" "return { scenes = io.open('x') }"
+# math's functions are there (the error is the next field's, after math.floor ran), math.random is not.
+bad "math in a job" 2 "bad.lua: scenes[1]: 'cornell3' is not a .gltf or .glb file" \
+  "return { scenes = { 'cornell' .. math.floor(math.pi) }, output = 'o/{camera}.png' }"
+bad "no math.random in a job" 2 "bad.lua:1:" "return { scenes = { 'a' .. math.random() } }"
 check "missing job file" run 2 capture --job nosuch.lua
 check "missing job file message" err_has "nosuch.lua"
 
