@@ -106,7 +106,7 @@ void send(float hit, int width, inout vec3 gathered, inout vec3 albedo) {
   gathered += rho * e.rgb;
   albedo += rho;
 #ifdef SKY_BOUNCE
-  Surface s = gbuffer_decode(c, texelFetch(nrm, q, 0), 0.0, m, vec2(0.5)); // its position is not read
+  Surface s = gbuffer_decode(c, gbuffer_normal_decode(texelFetch(nrm, q, 0)), 0.0, m, vec2(0.5)); // its position is not read
   sky_sent += ambient_light(s, ambient) * saturate(e.a);
 #endif
 }
